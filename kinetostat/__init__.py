@@ -1,0 +1,18 @@
+"""kinetostat: kinetostatic analysis of planar linkages by the graphical-analytic method.
+
+    >>> import kinetostat
+    >>> mech = kinetostat.load("models/ice_crank_slider.toml")
+    >>> res = kinetostat.analyze(mech, phi_deg=[30.0])
+    >>> mech.structure.formula
+    'I(0,1) <- II(2,3)'
+"""
+from .analysis import Analysis, InertiaLoad, analyze
+from .errors import AssemblyError, ModelError, SingularPositionWarning, StructureError
+from .kinematics import COND_MAX, COND_WARN
+from .model import Mechanism, from_dict, load, loads
+from .structure import AssurGroup, Structure
+
+__all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
+           "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
+           "SingularPositionWarning", "COND_WARN", "COND_MAX"]
+__version__ = "0.1.0"

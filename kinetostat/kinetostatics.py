@@ -1,0 +1,208 @@
+"""Reactions group by group (seed 000 sec. 6), the initial link (sec. 7), Zhukovsky's lever
+(sec. 8) and friction losses (seed 003), in closed form for all crank angles at once.
+
+Groups are taken from the last attached to the first. In each, the known loads on its two
+links (applied, inertia, and the reactions carried back from groups already solved) are
+balanced by the reactions of its three pairs; the reactions on the outer links are then
+carried to those links with the sign reversed, as the texts do.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+
+from .planar import cross, decompose, rot90
+
+if TYPE_CHECKING:
+    from .kinematics import Kinematics
+    from .model import Mechanism, Pair
+    from .structure import AssurGroup
+
+__all__ = ["Forces", "forces", "lever_moment", "friction_power"]
+
+
+@dataclass(frozen=True)
+class Forces:
+    """Reactions and balancing loads at N crank angles."""
+    R: np.ndarray         # (N, n_pairs, 2) force of pair.links[0] on pair.links[1], N, world
+    x: np.ndarray         # (N, n_pairs) P pairs: line of the normal force at slider point + x d, m (NaN for R)
+    M_bal: np.ndarray     # (N,) moment the drive applies to the crank about +z, N m
+    F_bal: np.ndarray     # (N, 2) machine: balancing force at the pitch point, N (zeros for an engine)
+
+
+class _Statics:
+    """Known wrenches per link about its local origin, updated as groups are solved."""
+
+    def __init__(self, mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray):
+        self.mech, self.kin = mech, kin
+        self.F, self.M = F.copy(), M.copy()
+        N = len(kin.phi)
+        self.R = np.zeros((N, len(mech.pairs), 2))
+        self.x = np.full((N, len(mech.pairs)), np.nan)
+
+    def at(self, k: int, name: str) -> np.ndarray:
+        return self.kin.point(k, self.mech.links[k].points[name])[0]
+
+    def moment(self, k: int, X: np.ndarray) -> np.ndarray:
+        """Moment about X of the known loads on link k."""
+        return self.M[:, k] + cross(self.kin.origin[:, k] - X, self.F[:, k])
+
+    def apply(self, k: int, f: np.ndarray, X: np.ndarray, m: np.ndarray | float = 0.0) -> None:
+        """Add force f through X (and couple m) to the known loads of link k."""
+        self.F[:, k] += f
+        self.M[:, k] += cross(X - self.kin.origin[:, k], f) + m
+
+    def normal(self, p: "Pair") -> np.ndarray:
+        """World unit normal n = rot90(d) of P pair p's guide."""
+        th = self.kin.theta[:, p.links[0]]
+        c, s = np.cos(th), np.sin(th)
+        d = np.stack([c * p.direction[0] - s * p.direction[1], s * p.direction[0] + c * p.direction[1]], -1)
+        return rot90(d)
+
+    def revolute(self, p: "Pair", giver: int, R: np.ndarray) -> None:
+        self.R[:, p.index] = R if giver == p.links[0] else -R
+
+    def prismatic(self, p: "Pair", giver: int, f: np.ndarray, m: np.ndarray, X0: np.ndarray) -> None:
+        """Record the normal force f of `giver` whose moment about X0 is m; its line is located
+        along the guide from the slider point: (S + x d - X0) x f = m."""
+        self.revolute(p, giver, f)
+        n = self.normal(p)
+        N = np.sum(f * n, axis=-1)
+        S = self.at(p.links[1], p.point)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self.x[:, p.index] = np.where(N != 0, m / N - cross(S - X0, n), np.nan)
+
+
+def _rrr(st: _Statics, g: "AssurGroup") -> None:
+    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
+    P, B, Q = st.at(j, pj.point), st.at(j, pin.point), st.at(k, pk.point)
+    lj, lk = np.linalg.norm(B - P, axis=-1), np.linalg.norm(B - Q, axis=-1)
+    uj, uk = (B - P) / lj[:, None], (B - Q) / lk[:, None]
+    # tangential parts from the moments of each link about B, normal parts from the polygon
+    tj, tk = st.moment(j, B) / lj, st.moment(k, B) / lk
+    nj, nk = tj[:, None] * rot90(uj), tk[:, None] * rot90(uk)
+    aj, ak, _ = decompose(-(st.F[:, j] + st.F[:, k] + nj + nk), uj, uk)
+    R_aj, R_ck = aj[:, None] * uj + nj, ak[:, None] * uk + nk
+    st.revolute(pj, a, R_aj)
+    st.revolute(pin, k, -(st.F[:, j] + R_aj))
+    st.revolute(pk, c, R_ck)
+    st.apply(a, -R_aj, P)
+    st.apply(c, -R_ck, Q)
+
+
+def _rrp(st: _Statics, g: "AssurGroup") -> None:
+    (pj, pin, pk), (j, k), (a, b) = g.pairs, g.links, g.known
+    P, B = st.at(j, pj.point), st.at(j, pin.point)
+    lj = np.linalg.norm(B - P, axis=-1)
+    uj, n = (B - P) / lj[:, None], st.normal(pk)
+    tj = st.moment(j, B) / lj
+    nj = tj[:, None] * rot90(uj)
+    aj, N, _ = decompose(-(st.F[:, j] + st.F[:, k] + nj), uj, n)
+    R_aj, f_bk = aj[:, None] * uj + nj, N[:, None] * n
+    mB = st.moment(k, B)
+    st.revolute(pj, a, R_aj)
+    st.revolute(pin, k, -(st.F[:, j] + R_aj))
+    st.prismatic(pk, b, f_bk, -mB, B)
+    st.apply(a, -R_aj, P)
+    st.apply(b, -f_bk, B, mB)
+
+
+def _rpr(st: _Statics, g: "AssurGroup") -> None:
+    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known   # j slides on k's guide
+    P, Q, n = st.at(j, pj.point), st.at(k, pk.point), st.normal(pin)
+    mP = st.moment(j, P)
+    # moment of the whole group about Q fixes the normal force of the slotted link on the block
+    N = (mP + st.moment(k, Q)) / cross(P - Q, n)
+    f_kj = N[:, None] * n
+    R_aj, R_ck = -st.F[:, j] - f_kj, f_kj - st.F[:, k]
+    st.revolute(pj, a, R_aj)
+    st.prismatic(pin, k, f_kj, -mP, P)
+    st.revolute(pk, c, R_ck)
+    st.apply(a, -R_aj, P)
+    st.apply(c, -R_ck, Q)
+
+
+def _prp(st: _Statics, g: "AssurGroup") -> None:
+    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
+    B, na, nc = st.at(j, pin.point), st.normal(pj), st.normal(pk)
+    Na, Nc, _ = decompose(-(st.F[:, j] + st.F[:, k]), na, nc)
+    f_aj, f_ck = Na[:, None] * na, Nc[:, None] * nc
+    mj, mk = st.moment(j, B), st.moment(k, B)
+    st.prismatic(pj, a, f_aj, -mj, B)
+    st.revolute(pin, k, -(st.F[:, j] + f_aj))
+    st.prismatic(pk, c, f_ck, -mk, B)
+    st.apply(a, -f_aj, B, mj)
+    st.apply(c, -f_ck, B, mk)
+
+
+def _rpp(st: _Statics, g: "AssurGroup") -> None:
+    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
+    P, n_in, nc = st.at(j, pj.point), st.normal(pin), st.normal(pk)
+    # link k: F_k - f_kj + f_ck = 0 with both forces normal to their guides
+    N1, Nc, _ = decompose(st.F[:, k], n_in, -nc)
+    f_kj, f_ck = N1[:, None] * n_in, Nc[:, None] * nc
+    mj, mk = st.moment(j, P), st.moment(k, P)
+    R_aj = -st.F[:, j] - f_kj
+    st.revolute(pj, a, R_aj)
+    st.prismatic(pin, k, f_kj, -mj, P)
+    st.prismatic(pk, c, f_ck, -(mj + mk), P)
+    st.apply(a, -R_aj, P)
+    st.apply(c, -f_ck, P, mj + mk)
+
+
+_GROUP_SOLVERS: dict[str, Callable[[_Statics, "AssurGroup"], None]] = {
+    "RRR": _rrr, "RRP": _rrp, "RPR": _rpr, "PRP": _prp, "RPP": _rpp}
+
+
+def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -> Forces:
+    """Reactions in every pair and the balancing load, from the known wrenches F, M per link
+    (applied + inertia, about each link's local origin)."""
+    st = _Statics(mech, kin, F, M)
+    for g in reversed(mech.structure.groups):
+        _GROUP_SOLVERS[g.kind](st, g)
+    dr = mech.drive
+    O = st.at(1, dr.pivot)
+    M_bal = -st.moment(1, O)
+    F_bal = np.zeros_like(O)
+    if dr.kind == "machine":
+        gear = dr.gear
+        e = np.asarray(gear.centre_direction)
+        alpha = np.radians(gear.alpha_w_deg)
+        # the pinion pushes on the wheel's tooth at the pitch point along the line of action
+        # that turns the crank the way M_bal must: moment (r_w e) x F = sign(M) |F| r_b
+        s = np.sign(M_bal)[:, None]
+        F_bal = (np.abs(M_bal) / gear.r_b)[:, None] * (s * np.cos(alpha) * rot90(e) - np.sin(alpha) * e)
+    st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
+    return Forces(st.R, st.x, M_bal, F_bal)
+
+
+def lever_moment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """Zhukovsky's rigid lever: the balancing moment from the velocity plan alone.
+
+    Every applied and inertia load moved to its like point of the plan turned by 90 deg has a
+    moment about the pole proportional to its power F . v (M omega for a couple); the lever's
+    equilibrium is the vanishing of the total, so M_bal omega_1 = -sum(F . v + M omega).
+    Reactions do no work and never enter: this route is independent of the group-by-group one.
+    """
+    power = np.sum(F * kin.v_origin, axis=-1) + M * kin.omega
+    return -power[:, 1:].sum(axis=1) / kin.omega[:, 1]
+
+
+def friction_power(mech: "Mechanism", kin: "Kinematics", R: np.ndarray) -> np.ndarray:
+    """Power lost in every pair (seed 003), W, (N, n_pairs): R f r |w_i - w_j| in a revolute
+    pair, R f |v_rel| in a prismatic one, from the frictionless reactions. Zeros without friction."""
+    out = np.zeros(R.shape[:2])
+    fr = mech.friction
+    if fr is None:
+        return out
+    mag = np.linalg.norm(R, axis=-1)
+    for p in mech.pairs:
+        if p.kind == "R":
+            r = p.radius if p.radius is not None else fr.radius
+            i, j = p.links
+            out[:, p.index] = mag[:, p.index] * fr.f * r * np.abs(kin.omega[:, i] - kin.omega[:, j])
+        else:
+            out[:, p.index] = mag[:, p.index] * fr.f * np.abs(kin.v_slide[:, p.index])
+    return out

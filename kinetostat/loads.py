@@ -1,0 +1,116 @@
+"""Applied loads (seed 000 sec. 2-4): gravity, external forces and moments, springs, inertia.
+
+Every load is reduced to a wrench per link: force F (N, world) and moment M (N m, about +z)
+about the link's local origin, stacked as F (N, L, 2), M (N, L).
+"""
+from __future__ import annotations
+
+import warnings
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .planar import cross
+
+if TYPE_CHECKING:
+    from .kinematics import Kinematics
+    from .model import Load, Mechanism
+
+__all__ = ["applied_wrenches", "inertia_loads", "load_magnitude"]
+
+
+def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
+    F[:, k] += f
+    M[:, k] += cross(X - kin.origin[:, k], f)
+
+
+def inertia_loads(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
+    """Main vector F_i = -m a_S (N, L, 2) at the centre of mass and main moment M_i = -I_S eps (N, L)."""
+    N, L = kin.theta.shape
+    F, M = np.zeros((N, L, 2)), np.zeros((N, L))
+    for link in mech.links[1:]:
+        if link.mass:
+            _, _, aS = kin.point(link.id, link.points[link.com])
+            F[:, link.id] = -link.mass * aS
+        M[:, link.id] = -link.I_S * kin.eps[:, link.id]
+    return F, M
+
+
+def applied_wrenches(mech: "Mechanism", kin: "Kinematics", with_inertia: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """All known loads on each link as a wrench about its local origin: F (N, L, 2), M (N, L)."""
+    N, L = kin.theta.shape
+    F, M = np.zeros((N, L, 2)), np.zeros((N, L))
+    G = np.array([0.0, -mech.g])
+    for link in mech.links[1:]:
+        if link.mass:
+            S, _, _ = kin.point(link.id, link.points[link.com])
+            _add_force(F, M, kin, link.id, np.broadcast_to(link.mass * G, (N, 2)), S)
+    if with_inertia:
+        Fi, Mi = inertia_loads(mech, kin)
+        for link in mech.links[1:]:
+            if link.mass:
+                S, _, _ = kin.point(link.id, link.points[link.com])
+                _add_force(F, M, kin, link.id, Fi[:, link.id], S)
+        M += Mi
+    for ld in mech.loads:
+        mag = load_magnitude(mech, kin, ld)
+        if ld.kind == "moment":
+            if ld.direction == "against_omega":
+                mag = -np.sign(kin.omega[:, ld.link]) * np.abs(mag)
+            M[:, ld.link] += mag
+            continue
+        X, V, _ = kin.point(ld.link, mech.links[ld.link].points[ld.point])
+        if ld.direction == "against_velocity":
+            speed = np.linalg.norm(V, axis=-1, keepdims=True)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                e = np.where(speed > 0, -V / speed, 0.0)    # no velocity, no direction: no force
+        else:
+            e = np.broadcast_to(np.asarray(ld.direction), (N, 2))
+        _add_force(F, M, kin, ld.link, mag[:, None] * e, X)
+    for sp in mech.springs:
+        A, _, _ = kin.point(sp.a[0], mech.links[sp.a[0]].points[sp.a[1]])
+        B, _, _ = kin.point(sp.b[0], mech.links[sp.b[0]].points[sp.b[1]])
+        length = np.linalg.norm(B - A, axis=-1, keepdims=True)
+        f_on_b = -sp.stiffness * (length - sp.free_length) * (B - A) / length
+        if sp.b[0]:
+            _add_force(F, M, kin, sp.b[0], f_on_b, B)
+        if sp.a[0]:
+            _add_force(F, M, kin, sp.a[0], -f_on_b, A)
+    return F, M
+
+
+def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarray:
+    """Magnitude of load `ld` at every angle: N for a force, N m for a moment."""
+    N = len(kin.phi)
+    if ld.table is None:
+        return np.full(N, ld.value)
+    t = ld.table
+    if t.argument == "phi":
+        return t.scale * np.interp(np.degrees(kin.phi) % 360.0, t.x, t.value, period=360.0)
+    p = mech.links[ld.link].points[ld.point]
+    axis = np.asarray(t.axis if t.axis is not None else ld.direction)
+    X, V, _ = kin.point(ld.link, p)
+    lo, hi = _stroke(mech, ld.link, p, axis)
+    s = X @ axis
+    travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
+    forward = (-(V @ axis) if t.origin == "max" else V @ axis) >= 0
+    fwd = np.interp(travel, t.x, t.value)
+    ret = fwd if t.value_return is None else np.interp(travel, t.x, t.value_return)
+    return t.scale * np.where(forward, fwd, ret)
+
+
+def _stroke(mech: "Mechanism", k: int, p, axis: np.ndarray, samples: int = 7200) -> tuple[float, float]:
+    """Extreme projections of a point's path on `axis` over a full cycle, m (dense sampling,
+    refined by a parabola through the extreme sample and its neighbours)."""
+    from .kinematics import kinematics
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        phi = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
+        s = kinematics(mech, phi).point(k, p)[0] @ axis
+    out = []
+    for sign in (-1.0, 1.0):
+        i = int(np.argmax(sign * s))
+        a, b, c = s[i - 1], s[i], s[(i + 1) % samples]
+        den = a - 2 * b + c
+        out.append(b - 0.125 * (c - a) ** 2 / den if den else b)
+    return out[0], out[1]

@@ -1,0 +1,658 @@
+"""The mechanism model: built once from a TOML file (or a dict), validated, never mutated.
+
+Field meanings and units are those of `models/FORMAT.md`. All coordinates in metres, masses in
+kg, moments of inertia in kg m^2, angles in radians unless the name says `_deg`.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, Literal, Mapping
+
+from .errors import ModelError, StructureError
+
+__all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Mechanism",
+           "load", "loads", "from_dict"]
+
+Vec = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid link. `points`: name -> local coordinates (m); link 0 (frame): world coordinates."""
+    id: int
+    name: str
+    points: Mapping[str, Vec]
+    mass: float = 0.0          # kg
+    I_S: float = 0.0           # kg m^2, about the centre of mass
+    com: str | None = None     # name of the centre-of-mass point
+
+
+@dataclass(frozen=True)
+class Pair:
+    """A lower kinematic pair. For P: `links` = (guide link, slider link), `point` on the slider."""
+    index: int
+    kind: Literal["R", "P"]
+    links: tuple[int, int]
+    point: str                        # R: the shared point; P: slider point on the guide line
+    guide: str | None = None          # P: a point of the guide link on the guide line
+    direction: Vec | None = None      # P: unit guide direction, guide link's local frame
+    radius: float | None = None       # journal radius for friction, m
+
+    @property
+    def label(self) -> str:
+        return f"{self.kind}({self.links[0]},{self.links[1]})"
+
+    @property
+    def alpha(self) -> float:
+        """Angle of the slider's frame relative to the guide link's frame (P pairs), rad."""
+        return math.atan2(self.direction[1], self.direction[0])
+
+
+@dataclass(frozen=True)
+class Table:
+    """A piecewise-linear load diagram; the force or moment is `scale * value`."""
+    argument: Literal["phi", "travel"]
+    x: tuple[float, ...]                    # deg (phi, periodic) or fraction of stroke (travel)
+    value: tuple[float, ...]                # forward stroke (or all angles for phi)
+    value_return: tuple[float, ...] | None  # travel only: return stroke (None: as forward)
+    scale: float = 1.0
+    axis: Vec | None = None                 # travel only: world axis of the stroke
+    origin: Literal["max", "min"] = "max"   # travel only: extreme the travel is measured from
+
+
+@dataclass(frozen=True)
+class Load:
+    """An external force at a point (`kind='force'`) or a moment on a link (`kind='moment'`)."""
+    name: str
+    kind: Literal["force", "moment"]
+    link: int
+    point: str | None
+    direction: Vec | Literal["against_velocity", "against_omega"] | None
+    value: float | None
+    table: Table | None
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A linear spring between point a of one link and point b of another (N/m, m)."""
+    name: str
+    a: tuple[int, str]
+    b: tuple[int, str]
+    stiffness: float
+    free_length: float
+
+
+@dataclass(frozen=True)
+class Gear:
+    """The last gear pair of a working machine's drive (seed 000, sec. 7.1); lengths in m."""
+    module: float
+    z_pinion: int
+    z_wheel: int
+    correction: Literal["none", "equal", "unequal"]
+    alpha_w_deg: float
+    y: float
+    centre_direction: Vec   # unit, from the crank axis to the pinion axis
+
+    @property
+    def r_w(self) -> float:
+        """Pitch (rolling) radius of the wheel on the crank shaft, m."""
+        r = self.module * self.z_wheel / 2
+        if self.correction == "unequal":
+            return r * (1 + 2 * self.y / (self.z_pinion + self.z_wheel))
+        return r
+
+    @property
+    def r_b(self) -> float:
+        """Arm of the balancing force about the crank axis (base-circle radius), m."""
+        return self.r_w * math.cos(math.radians(self.alpha_w_deg))
+
+
+@dataclass(frozen=True)
+class Drive:
+    """The initial link I(0,1): crank angle reference, sense, speed."""
+    link: int
+    pivot: str
+    point: str
+    reference: Vec              # unit world direction of phi = 0
+    sense: int                  # +1 ccw, -1 cw
+    omega: float                # rad/s, > 0, in `sense`
+    eps: float                  # rad/s^2, in `sense`
+    kind: Literal["engine", "machine"]
+    gear: Gear | None = None
+
+
+@dataclass(frozen=True)
+class Friction:
+    f: float                   # reduced friction coefficient
+    radius: float | None       # default journal radius, m
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """A planar one-degree-of-freedom linkage. Build with `kinetostat.load`; never mutated."""
+    name: str
+    source: str
+    assumptions: tuple[str, ...]
+    g: float
+    links: tuple[Link, ...]           # index = link id, links[0] is the frame
+    pairs: tuple[Pair, ...]
+    branches: Mapping[frozenset, int]
+    loads: tuple[Load, ...]
+    springs: tuple[Spring, ...]
+    drive: Drive
+    friction: Friction | None
+    path: str | None = None
+    _structure: Any = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self):
+        from .structure import analyse_structure
+        object.__setattr__(self, "_structure", analyse_structure(self))
+
+    @property
+    def structure(self):
+        """Structural analysis: mobility, Assur groups, structure formula."""
+        return self._structure
+
+    @property
+    def n_links(self) -> int:
+        """Number of links including the frame."""
+        return len(self.links)
+
+    def point_owner(self, name: str) -> int:
+        """Id of the first link that carries point `name`."""
+        for link in self.links:
+            if name in link.points:
+                return link.id
+        raise KeyError(f"unknown point {name!r}. Valid names: {sorted(self.point_names)}")
+
+    @property
+    def point_names(self) -> list[str]:
+        seen: dict[str, None] = {}
+        for link in self.links:
+            seen.update(dict.fromkeys(link.points))
+        return list(seen)
+
+    def pair_between(self, i: int, j: int) -> Pair:
+        for p in self.pairs:
+            if set(p.links) == {i, j}:
+                return p
+        raise KeyError(f"no kinematic pair between links {i} and {j}. "
+                       f"Pairs: {[p.label for p in self.pairs]}")
+
+    @property
+    def size(self) -> float:
+        """Characteristic length: the largest distance between two points of one link, m."""
+        best = 0.0
+        for link in self.links[1:]:
+            pts = list(link.points.values())
+            for a in pts:
+                for b in pts:
+                    best = max(best, math.dist(a, b))
+        return best or 1.0
+
+
+# ----------------------------------------------------------------------------- loading
+
+def load(path: str | Path) -> Mechanism:
+    """Read and validate a model file (TOML). Raises `ModelError` listing every problem."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ModelError([f"cannot read file: {exc.strerror}"], source=str(path)) from None
+    return loads(text, source=str(path))
+
+
+def loads(text: str, source: str = "<string>") -> Mechanism:
+    """Parse a model from TOML text."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
+    return from_dict(data, source=source)
+
+
+def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
+    """Build a Mechanism from the parsed structure of a model file."""
+    return _Reader(data, source).mechanism()
+
+
+_TOP_KEYS = {"mechanism", "drive", "frame", "link", "pair", "group", "load", "spring", "friction"}
+
+
+def _finite(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+class _Reader:
+    """Reads the raw TOML structure, collecting every problem instead of stopping at the first."""
+
+    def __init__(self, data: Mapping[str, Any], source: str):
+        self.data, self.source, self.problems = data, source, []
+
+    def err(self, msg: str) -> None:
+        self.problems.append(msg)
+
+    # -- typed getters: each returns None after recording a problem
+    def number(self, tab: Mapping, key: str, where: str, *, default: Any = "required",
+               minimum: float | None = None, positive: bool = False) -> float | None:
+        if key not in tab:
+            if default == "required":
+                self.err(f"{where}.{key}: missing (a number is required)")
+                return None
+            return default
+        x = tab[key]
+        if not _finite(x):
+            self.err(f"{where}.{key}: expected a finite number, got {x!r}")
+            return None
+        if positive and x <= 0:
+            self.err(f"{where}.{key}: must be > 0, got {x!r}")
+            return None
+        if minimum is not None and x < minimum:
+            self.err(f"{where}.{key}: must be >= {minimum}, got {x!r}")
+            return None
+        return float(x)
+
+    def vec(self, x: Any, where: str, *, unit: bool = False) -> Vec | None:
+        if not (isinstance(x, list) and len(x) == 2 and all(_finite(c) for c in x)):
+            self.err(f"{where}: expected [x, y] with two finite numbers, got {x!r}")
+            return None
+        if unit:
+            n = math.hypot(*x)
+            if n == 0:
+                self.err(f"{where}: direction must not be zero")
+                return None
+            return (x[0] / n, x[1] / n)
+        return (float(x[0]), float(x[1]))
+
+    def string(self, tab: Mapping, key: str, where: str, *, choices: tuple[str, ...] | None = None,
+               default: Any = "required") -> str | None:
+        if key not in tab:
+            if default == "required":
+                self.err(f"{where}.{key}: missing (a string is required)")
+                return None
+            return default
+        x = tab[key]
+        if not isinstance(x, str):
+            self.err(f"{where}.{key}: expected a string, got {x!r}")
+            return None
+        if choices and x not in choices:
+            self.err(f"{where}.{key}: invalid value {x!r}. Valid values: {list(choices)}")
+            return None
+        return x
+
+    def integer(self, tab: Mapping, key: str, where: str) -> int | None:
+        x = tab.get(key)
+        if not isinstance(x, int) or isinstance(x, bool):
+            self.err(f"{where}.{key}: expected an integer, got {x!r}" if key in tab
+                     else f"{where}.{key}: missing (an integer is required)")
+            return None
+        return x
+
+    def table_list(self, key: str) -> list:
+        x = self.data.get(key, [])
+        if not isinstance(x, list) or not all(isinstance(t, dict) for t in x):
+            self.err(f"{key}: expected an array of tables ([[{key}]])")
+            return []
+        return x
+
+    def unknown_keys(self, tab: Mapping, allowed: set[str], where: str) -> None:
+        for k in tab:
+            if k not in allowed:
+                self.err(f"{where}.{k}: unknown field. Valid fields: {sorted(allowed)}")
+
+    # -- sections
+    def mechanism(self) -> Mechanism:
+        d = self.data
+        self.unknown_keys(d, _TOP_KEYS, "<top level>")
+        head = d.get("mechanism", {})
+        if not isinstance(head, dict):
+            self.err("mechanism: expected a table")
+            head = {}
+        self.unknown_keys(head, {"name", "source", "assumptions", "g"}, "mechanism")
+        name = self.string(head, "name", "mechanism", default="unnamed")
+        source = self.string(head, "source", "mechanism", default="")
+        assumptions = head.get("assumptions", [])
+        if not (isinstance(assumptions, list) and all(isinstance(a, str) for a in assumptions)):
+            self.err("mechanism.assumptions: expected a list of strings")
+            assumptions = []
+        g = self.number(head, "g", "mechanism", minimum=0.0)
+
+        links = self.links(g)
+        pairs = self.pairs(links)
+        drive = self.drive(links, pairs)
+        branches = self.groups(links)
+        loads_ = self.loads(links)
+        springs = self.springs(links)
+        friction = self.friction()
+        if self.problems:
+            raise ModelError(self.problems, source=self.source)
+        try:
+            return Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
+                             links=tuple(links), pairs=tuple(pairs),
+                             branches=MappingProxyType(branches), loads=tuple(loads_),
+                             springs=tuple(springs), drive=drive, friction=friction,
+                             path=self.source)
+        except StructureError as exc:
+            raise StructureError(f"{self.source}: {exc}") from None
+
+    def points(self, raw: Any, where: str) -> dict[str, Vec]:
+        if not isinstance(raw, dict) or not raw:
+            self.err(f"{where}: expected a table of named points {{A = [x, y], ...}}")
+            return {}
+        out = {}
+        for name, xy in raw.items():
+            v = self.vec(xy, f"{where}.{name}")
+            if v is not None:
+                out[name] = v
+        return out
+
+    def links(self, g: float | None) -> list[Link]:
+        frame_raw = self.data.get("frame")
+        frame = Link(0, "frame", MappingProxyType(self.points(frame_raw, "frame")))
+        raw = self.table_list("link")
+        by_id: dict[int, Link] = {}
+        allowed = {"id", "name", "points", "mass", "weight", "I_S", "com"}
+        for n, t in enumerate(raw):
+            where = f"link[{n}]"
+            self.unknown_keys(t, allowed, where)
+            lid = self.integer(t, "id", where)
+            if lid is not None:
+                where = f"link[{n}] (id {lid})"
+                if lid <= 0:
+                    self.err(f"{where}.id: moving links are numbered from 1 (0 is the frame)")
+                elif lid in by_id:
+                    self.err(f"{where}.id: duplicate link id {lid}")
+            pts = self.points(t.get("points"), f"{where}.points")
+            if "mass" in t and "weight" in t:
+                self.err(f"{where}: give mass or weight, not both")
+            if "weight" in t:
+                w = self.number(t, "weight", where, minimum=0.0)
+                mass = None if (w is None or not g) else w / g
+                if w is not None and not g:
+                    self.err(f"{where}.weight: a weight needs mechanism.g > 0 to give a mass")
+            else:
+                mass = self.number(t, "mass", where, default=0.0, minimum=0.0)
+            I_S = self.number(t, "I_S", where, default=0.0, minimum=0.0)
+            com = self.string(t, "com", where, default=None)
+            if com is not None and pts and com not in pts:
+                self.err(f"{where}.com: unknown point {com!r}. Valid names: {sorted(pts)}")
+            if mass and com is None:
+                self.err(f"{where}.com: missing (a link with mass needs its centre-of-mass point)")
+            if len(pts) >= 2 and max(math.dist(a, b) for a in pts.values() for b in pts.values()) == 0:
+                self.err(f"{where}.points: all points coincide (zero-length link)")
+            if lid is not None and lid > 0 and lid not in by_id:
+                by_id[lid] = Link(lid, self.string(t, "name", where, default=f"link {lid}"),
+                                  MappingProxyType(pts), mass or 0.0, I_S or 0.0, com)
+        ids = sorted(by_id)
+        if ids != list(range(1, len(ids) + 1)):
+            self.err(f"link: ids must be 1..n without gaps, got {ids}")
+            return [frame]
+        return [frame] + [by_id[i] for i in ids]
+
+    def link_ok(self, links: list[Link], lid: Any, where: str) -> bool:
+        if not isinstance(lid, int) or isinstance(lid, bool) or not 0 <= lid < len(links):
+            self.err(f"{where}: unknown link {lid!r}. Valid links: {list(range(len(links)))}")
+            return False
+        return True
+
+    def point_ok(self, links: list[Link], lid: int, name: Any, where: str) -> bool:
+        if not isinstance(name, str) or name not in links[lid].points:
+            self.err(f"{where}: link {lid} has no point {name!r}. "
+                     f"Valid names: {sorted(links[lid].points)}")
+            return False
+        return True
+
+    def pairs(self, links: list[Link]) -> list[Pair]:
+        out = []
+        for n, t in enumerate(self.table_list("pair")):
+            where = f"pair[{n}]"
+            kind = self.string(t, "kind", where, choices=("R", "P"))
+            self.unknown_keys(t, {"kind", "links", "point", "radius"} | (
+                {"guide", "direction"} if kind == "P" else set()), where)
+            lk = t.get("links")
+            if not (isinstance(lk, list) and len(lk) == 2):
+                self.err(f"{where}.links: expected two link ids [i, j], got {lk!r}")
+                continue
+            if not all(self.link_ok(links, x, f"{where}.links") for x in lk):
+                continue
+            if lk[0] == lk[1]:
+                self.err(f"{where}.links: a pair joins two different links, got {lk}")
+                continue
+            radius = self.number(t, "radius", where, default=None, positive=True)
+            if kind == "R":
+                pt = t.get("point")
+                if all(self.point_ok(links, x, pt, f"{where}.point") for x in lk):
+                    out.append(Pair(len(out), "R", tuple(lk), pt, radius=radius))
+            elif kind == "P":
+                ok = self.point_ok(links, lk[1], t.get("point"), f"{where}.point")
+                ok &= self.point_ok(links, lk[0], t.get("guide"), f"{where}.guide")
+                d = self.vec(t.get("direction"), f"{where}.direction", unit=True)
+                if ok and d is not None:
+                    out.append(Pair(len(out), "P", tuple(lk), t["point"], t["guide"], d, radius))
+        seen: dict[frozenset, int] = {}
+        for p in out:
+            key = frozenset(p.links)
+            if key in seen:
+                self.err(f"pair[{p.index}]: links {sorted(key)} are already joined by pair[{seen[key]}]")
+            seen[key] = p.index
+        # a point name on two links must be the revolute pair that joins them
+        owners: dict[str, list[int]] = {}
+        for link in links:
+            for name in link.points:
+                owners.setdefault(name, []).append(link.id)
+        joined = {(frozenset(p.links), p.point) for p in out if p.kind == "R"}
+        for name, ids in owners.items():
+            for a in ids:
+                for b in ids:
+                    if a < b and (frozenset((a, b)), name) not in joined and not _chain(joined, name, a, b):
+                        self.err(f"point {name!r} is on links {a} and {b}, which share no revolute pair "
+                                 f"at {name!r}: rename one of them")
+        return out
+
+    def drive(self, links: list[Link], pairs: list[Pair]) -> Drive | None:
+        t = self.data.get("drive")
+        if not isinstance(t, dict):
+            self.err("drive: missing table [drive]")
+            return None
+        w = "drive"
+        self.unknown_keys(t, {"link", "pivot", "point", "reference", "sense", "rpm", "omega",
+                              "eps", "kind", "gear"}, w)
+        link = t.get("link", 1)
+        if link != 1:
+            self.err(f"drive.link: the crank must be link 1, got {link!r}")
+        pivot, point = t.get("pivot"), t.get("point")
+        if len(links) > 1:
+            self.point_ok(links, 1, pivot, "drive.pivot")
+            self.point_ok(links, 1, point, "drive.point")
+            if not any(p.kind == "R" and set(p.links) == {0, 1} and p.point == pivot for p in pairs):
+                self.err(f"drive.pivot: the crank needs a revolute pair with the frame at {pivot!r}")
+        ref = self.vec(t.get("reference"), "drive.reference", unit=True)
+        sense = self.string(t, "sense", w, choices=("ccw", "cw"))
+        if ("rpm" in t) == ("omega" in t):
+            self.err("drive: give exactly one of rpm or omega")
+            omega = None
+        elif "rpm" in t:
+            rpm = self.number(t, "rpm", w, positive=True)
+            omega = None if rpm is None else rpm * math.pi / 30
+        else:
+            omega = self.number(t, "omega", w, positive=True)
+        eps = self.number(t, "eps", w, default=0.0)
+        kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")
+        gear = None
+        if kind == "machine":
+            gear = self.gear(t.get("gear"))
+        elif "gear" in t:
+            self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
+        if None in (ref, sense, omega, eps) or (kind == "machine" and gear is None):
+            return None
+        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear)
+
+    def gear(self, t: Any) -> Gear | None:
+        w = "drive.gear"
+        if not isinstance(t, dict):
+            self.err(f"{w}: a working machine needs the table [drive.gear] (module, z_pinion, z_wheel, ...)")
+            return None
+        self.unknown_keys(t, {"module", "z_pinion", "z_wheel", "correction", "alpha_w_deg", "y",
+                              "centre_direction"}, w)
+        module = self.number(t, "module", w, positive=True)
+        z1, z2 = self.integer(t, "z_pinion", w), self.integer(t, "z_wheel", w)
+        for key, z in (("z_pinion", z1), ("z_wheel", z2)):
+            if z is not None and z < 5:
+                self.err(f"{w}.{key}: a gear needs at least 5 teeth, got {z}")
+        corr = self.string(t, "correction", w, choices=("none", "equal", "unequal"), default="none")
+        if corr == "unequal" and "alpha_w_deg" not in t:
+            self.err(f"{w}.alpha_w_deg: required for an unequal correction (25-26 deg typically)")
+        alpha = self.number(t, "alpha_w_deg", w, default=20.0, positive=True)
+        if alpha is not None and alpha >= 45:
+            self.err(f"{w}.alpha_w_deg: pressure angle must be below 45 deg, got {alpha}")
+        y = self.number(t, "y", w, default=0.0)
+        cd = self.vec(t.get("centre_direction"), f"{w}.centre_direction", unit=True)
+        if None in (module, z1, z2, corr, alpha, y, cd):
+            return None
+        return Gear(module, z1, z2, corr, alpha, y, cd)
+
+    def groups(self, links: list[Link]) -> dict[frozenset, int]:
+        out = {}
+        for n, t in enumerate(self.table_list("group")):
+            where = f"group[{n}]"
+            self.unknown_keys(t, {"links", "branch"}, where)
+            lk = t.get("links")
+            if not (isinstance(lk, list) and len(lk) == 2
+                    and all(self.link_ok(links, x, f"{where}.links") for x in lk)):
+                if not isinstance(lk, list) or len(lk) != 2:
+                    self.err(f"{where}.links: expected two link ids, got {lk!r}")
+                continue
+            b = t.get("branch")
+            if b not in (1, -1) or isinstance(b, bool):
+                self.err(f"{where}.branch: expected +1 or -1, got {b!r}")
+                continue
+            out[frozenset(lk)] = b
+        return out
+
+    def loads(self, links: list[Link]) -> list[Load]:
+        out = []
+        for n, t in enumerate(self.table_list("load")):
+            where = f"load[{n}]"
+            kind = self.string(t, "kind", where, choices=("force", "moment"), default="force")
+            self.unknown_keys(t, {"name", "kind", "link", "point", "direction", "value", "table"}, where)
+            name = self.string(t, "name", where, default=f"load {n}")
+            lid = t.get("link")
+            if not self.link_ok(links, lid, f"{where}.link"):
+                continue
+            if lid == 0:
+                self.err(f"{where}.link: loads on the frame do not enter the analysis")
+                continue
+            point, direction = None, None
+            if kind == "force":
+                if not self.point_ok(links, lid, t.get("point"), f"{where}.point"):
+                    continue
+                point = t["point"]
+                raw = t.get("direction")
+                direction = ("against_velocity" if raw == "against_velocity"
+                             else self.vec(raw, f"{where}.direction", unit=True))
+            else:
+                raw = t.get("direction")
+                if raw not in (None, "against_omega"):
+                    self.err(f"{where}.direction: a moment takes no direction or 'against_omega', got {raw!r}")
+                direction = raw
+            if ("value" in t) == ("table" in t):
+                self.err(f"{where}: give exactly one of value or table")
+                continue
+            value = self.number(t, "value", where) if "value" in t else None
+            table = self.table(t["table"], f"{where}.table") if "table" in t else None
+            if kind == "force" and direction is None:
+                continue
+            if value is not None or table is not None:
+                out.append(Load(name, kind, lid, point, direction, value, table))
+        return out
+
+    def table(self, t: Any, where: str) -> Table | None:
+        if not isinstance(t, dict):
+            self.err(f"{where}: expected a table")
+            return None
+        self.unknown_keys(t, {"phi_deg", "travel", "value", "value_return", "scale", "axis", "origin"}, where)
+        if ("phi_deg" in t) == ("travel" in t):
+            self.err(f"{where}: give exactly one argument, phi_deg or travel")
+            return None
+        arg = "phi" if "phi_deg" in t else "travel"
+        xs = self.series(t.get("phi_deg" if arg == "phi" else "travel"), f"{where}.{'phi_deg' if arg == 'phi' else 'travel'}")
+        vs = self.series(t.get("value"), f"{where}.value")
+        vr = self.series(t["value_return"], f"{where}.value_return") if "value_return" in t else None
+        scale = self.number(t, "scale", where, default=1.0)
+        if xs is None or vs is None or scale is None:
+            return None
+        if any(b <= a for a, b in zip(xs, xs[1:])):
+            self.err(f"{where}: the argument must increase strictly")
+        for nm, v in (("value", vs), ("value_return", vr)):
+            if v is not None and len(v) != len(xs):
+                self.err(f"{where}.{nm}: {len(v)} values for {len(xs)} arguments")
+        if arg == "phi" and (xs[0] < 0 or xs[-1] > 360):
+            self.err(f"{where}.phi_deg: angles must lie in [0, 360]")
+        if arg == "travel" and (xs[0] < 0 or xs[-1] > 1):
+            self.err(f"{where}.travel: fractions of stroke must lie in [0, 1]")
+        if arg == "phi" and ("value_return" in t or "axis" in t or "origin" in t):
+            self.err(f"{where}: value_return, axis and origin belong to a travel table")
+        axis = self.vec(t["axis"], f"{where}.axis", unit=True) if "axis" in t else None
+        origin = self.string(t, "origin", where, choices=("max", "min"), default="max")
+        return Table(arg, xs, vs, vr, scale, axis, origin)
+
+    def series(self, x: Any, where: str) -> tuple[float, ...] | None:
+        if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) for v in x)):
+            self.err(f"{where}: expected a list of at least two finite numbers")
+            return None
+        return tuple(float(v) for v in x)
+
+    def springs(self, links: list[Link]) -> list[Spring]:
+        out = []
+        for n, t in enumerate(self.table_list("spring")):
+            where = f"spring[{n}]"
+            self.unknown_keys(t, {"name", "a", "b", "stiffness", "free_length"}, where)
+            ends = []
+            for e in ("a", "b"):
+                end = t.get(e)
+                if not isinstance(end, dict):
+                    self.err(f"{where}.{e}: expected {{ link = i, point = 'P' }}")
+                    continue
+                if self.link_ok(links, end.get("link"), f"{where}.{e}.link") and \
+                        self.point_ok(links, end["link"], end.get("point"), f"{where}.{e}.point"):
+                    ends.append((end["link"], end["point"]))
+            k = self.number(t, "stiffness", where, minimum=0.0)
+            l0 = self.number(t, "free_length", where, minimum=0.0)
+            if len(ends) == 2 and k is not None and l0 is not None:
+                out.append(Spring(self.string(t, "name", where, default=f"spring {n}"), ends[0], ends[1], k, l0))
+        return out
+
+    def friction(self) -> Friction | None:
+        t = self.data.get("friction")
+        if t is None:
+            return None
+        if not isinstance(t, dict):
+            self.err("friction: expected a table")
+            return None
+        self.unknown_keys(t, {"f", "radius"}, "friction")
+        f = self.number(t, "f", "friction", minimum=0.0)
+        r = self.number(t, "radius", "friction", default=None, positive=True)
+        return None if f is None else Friction(f, r)
+
+
+def _chain(joined: set, name: str, a: int, b: int) -> bool:
+    """True if links a and b are connected through revolute pairs all at point `name`
+    (a multiple joint: three links on one pin)."""
+    adj: dict[int, set[int]] = {}
+    for key, pt in joined:
+        if pt == name:
+            i, j = tuple(key)
+            adj.setdefault(i, set()).add(j)
+            adj.setdefault(j, set()).add(i)
+    seen, todo = {a}, [a]
+    while todo:
+        for nb in adj.get(todo.pop(), ()):
+            if nb not in seen:
+                seen.add(nb)
+                todo.append(nb)
+    return b in seen

@@ -1,0 +1,131 @@
+"""Structural analysis (seed 000 sec. 5, seed 002 sec. 1.2.1): mobility by Chebyshev and the
+decomposition into the initial mechanism I(0,1) and class-II Assur groups."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from .errors import StructureError
+
+if TYPE_CHECKING:
+    from .model import Mechanism, Pair
+
+__all__ = ["AssurGroup", "Structure", "analyse_structure", "GROUP_KINDS"]
+
+# The five kinds of class-II groups, numbered as the texts number them ("вид").
+GROUP_KINDS = {"RRR": 1, "RRP": 2, "RPR": 3, "PRP": 4, "RPP": 5}
+
+
+@dataclass(frozen=True)
+class AssurGroup:
+    """A class-II, order-2 Assur group (dyad) of links j, k.
+
+    `pairs` = (outer pair of j, inner pair j-k, outer pair of k); `kind` reads their kinds in
+    that order. For RPR, j is the slider of the inner prismatic pair and k carries the guide.
+    `known` = (link that j's outer pair joins, link that k's outer pair joins).
+    """
+    kind: str
+    links: tuple[int, int]
+    pairs: tuple["Pair", "Pair", "Pair"]
+    known: tuple[int, int]
+    branch: int
+
+    @property
+    def label(self) -> str:
+        return f"II({self.links[0]},{self.links[1]})" if self.links[0] < self.links[1] \
+            else f"II({self.links[1]},{self.links[0]})"
+
+
+@dataclass(frozen=True)
+class Structure:
+    """Mobility W = 3n - 2 p5 - p4 and the order in which groups are attached."""
+    n: int
+    p5: int
+    p4: int
+    groups: tuple[AssurGroup, ...]
+
+    @property
+    def W(self) -> int:
+        return 3 * self.n - 2 * self.p5 - self.p4
+
+    @property
+    def formula(self) -> str:
+        """The structure formula as the texts write it, e.g. I(0,1) <- II(2,3) <- II(4,5)."""
+        return " <- ".join(["I(0,1)"] + [g.label for g in self.groups])
+
+    @property
+    def mechanism_class(self) -> int:
+        return 2 if self.groups else 1
+
+    @property
+    def order(self) -> int:
+        return 2 if self.groups else 1
+
+    def __str__(self) -> str:
+        kinds = ", ".join(f"{g.label} {g.kind} (kind {GROUP_KINDS[g.kind]})" for g in self.groups)
+        return (f"W = 3*{self.n} - 2*{self.p5} - {self.p4} = {self.W}; {self.formula}; "
+                f"class {self.mechanism_class}, order {self.order}; groups: {kinds or 'none'}")
+
+
+def analyse_structure(mech: "Mechanism") -> Structure:
+    """Mobility and Assur-group decomposition; raises StructureError for what is unsupported."""
+    n = mech.n_links - 1
+    s = Structure(n, len(mech.pairs), 0, ())
+    if s.W != 1:
+        raise StructureError(f"mobility W = 3*{n} - 2*{s.p5} - 0 = {s.W}; kinetostat analyses "
+                             f"mechanisms with one degree of freedom (W = 1) driven at the crank")
+    crank_frame = [p for p in mech.pairs if set(p.links) == {0, 1}]
+    if len(crank_frame) != 1 or crank_frame[0].kind != "R":
+        raise StructureError("the crank (link 1) must be joined to the frame by exactly one revolute pair")
+
+    known = {0, 1}
+    groups: list[AssurGroup] = []
+    remaining = set(range(2, mech.n_links))
+    while remaining:
+        group = _next_group(mech, known, remaining)
+        if group is None:
+            raise StructureError(
+                f"links {sorted(remaining)} do not split into class-II Assur groups (dyads); "
+                f"a class-III or higher group (e.g. a triad) is not supported by kinetostat")
+        groups.append(group)
+        known |= set(group.links)
+        remaining -= set(group.links)
+    unused = set(mech.branches) - {frozenset(g.links) for g in groups}
+    if unused:
+        raise StructureError(f"group: branch given for {[sorted(u) for u in unused]}, "
+                             f"which is not an Assur group of this mechanism "
+                             f"(groups: {[g.label for g in groups]})")
+    return Structure(n, len(mech.pairs), 0, tuple(groups))
+
+
+def _next_group(mech: "Mechanism", known: set[int], remaining: set[int]) -> AssurGroup | None:
+    for j in sorted(remaining):
+        for k in sorted(remaining):
+            if j >= k:
+                continue
+            inner = [p for p in mech.pairs if set(p.links) == {j, k}]
+            out_j = [p for p in mech.pairs if j in p.links and (set(p.links) - {j}) <= known]
+            out_k = [p for p in mech.pairs if k in p.links and (set(p.links) - {k}) <= known]
+            if len(inner) == 1 and len(out_j) == 1 and len(out_k) == 1:
+                return _orient(mech, j, k, out_j[0], inner[0], out_k[0])
+    return None
+
+
+def _orient(mech: "Mechanism", j: int, k: int, pj: "Pair", pin: "Pair", pk: "Pair") -> AssurGroup:
+    kind = pj.kind + pin.kind + pk.kind
+    if kind not in GROUP_KINDS or (kind == "RPR" and pin.links[1] != j):
+        j, k, pj, pk = k, j, pk, pj
+        kind = kind[::-1]
+    if kind not in GROUP_KINDS:
+        raise StructureError(f"group II({min(j, k)},{max(j, k)}) of kind {kind} is not supported "
+                             f"(kinds: {list(GROUP_KINDS)})")
+    other = lambda p, x: (set(p.links) - {x}).pop()
+    key = frozenset((j, k))
+    if kind in ("RRR", "RRP", "RPR"):
+        if key not in mech.branches:
+            raise StructureError(f"group II({min(j, k)},{max(j, k)}) ({kind}): assembly branch missing; "
+                                 f"add [[group]] links = [{min(j, k)}, {max(j, k)}], branch = 1 or -1")
+        branch = mech.branches[key]
+    else:
+        branch = 1
+    return AssurGroup(kind, (j, k), (pj, pin, pk), (other(pj, j), other(pk, k)), branch)
