@@ -1,0 +1,1 @@
+"""Cross-validation of kinetostat against Pinocchio, MuJoCo and pymunk (see compare.py)."""
