@@ -33,7 +33,7 @@ class AssemblyError(ValueError):
 
     def __init__(self, group: str, phi_deg: np.ndarray, why: str):
         self.group = group
-        self.phi_deg = np.asarray(phi_deg, dtype=float)
+        self.phi_deg = np.round(np.asarray(phi_deg, dtype=float), 9)   # undo rad->deg rounding
         super().__init__(f"group {group} cannot be assembled ({why}) at phi = {_angle_list(self.phi_deg)}")
 
 

@@ -329,6 +329,11 @@ class _Reader:
         loads_ = self.loads(links)
         springs = self.springs(links)
         friction = self.friction()
+        if friction is not None and friction.radius is None:
+            for p in pairs:
+                if p.kind == "R" and p.radius is None:
+                    self.err(f"pair[{p.index}].radius: missing; friction losses need the journal radius "
+                             f"of every revolute pair (or a default friction.radius)")
         if self.problems:
             raise ModelError(self.problems, source=self.source)
         try:

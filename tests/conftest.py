@@ -1,0 +1,81 @@
+"""Shared fixtures: the bundled models and a base model text for mutation tests."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import kinetostat
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = sorted((ROOT / "models").glob("*.toml"))
+
+
+@pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])
+def model_path(request) -> Path:
+    return request.param
+
+
+@pytest.fixture
+def mech(model_path):
+    return kinetostat.load(model_path)
+
+
+# A small four-bar written only here: frame O=(0,0), C=(0.3,0); crank 0.1, coupler 0.35, rocker 0.3.
+FOUR_BAR = """
+[mechanism]
+name = "test four-bar"
+g = 9.81
+[drive]
+pivot = "O"
+point = "A"
+reference = [1.0, 0.0]
+sense = "ccw"
+rpm = 300.0
+kind = "engine"
+[frame]
+O = [0.0, 0.0]
+C = [0.3, 0.0]
+[[link]]
+id = 1
+points = { O = [0.0, 0.0], A = [0.1, 0.0], S1 = [0.03, 0.01] }
+mass = 0.8
+I_S = 0.001
+com = "S1"
+[[link]]
+id = 2
+points = { A = [0.0, 0.0], B = [0.35, 0.0], S2 = [0.15, 0.02] }
+mass = 1.5
+I_S = 0.016
+com = "S2"
+[[link]]
+id = 3
+points = { C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.12, -0.01] }
+mass = 1.2
+I_S = 0.009
+com = "S3"
+[[pair]]
+kind = "R"
+links = [0, 1]
+point = "O"
+[[pair]]
+kind = "R"
+links = [1, 2]
+point = "A"
+[[pair]]
+kind = "R"
+links = [2, 3]
+point = "B"
+[[pair]]
+kind = "R"
+links = [0, 3]
+point = "C"
+[[group]]
+links = [2, 3]
+branch = 1
+[[load]]
+name = "resisting moment"
+kind = "moment"
+link = 3
+value = -4.0
+"""

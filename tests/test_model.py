@@ -1,0 +1,132 @@
+"""Model files: loading, immutability, and one clear error per fault (asserted by message)."""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat import AssemblyError, ModelError, StructureError
+
+from conftest import FOUR_BAR
+
+
+def test_every_bundled_model_loads_and_runs(mech):
+    res = kinetostat.analyze(mech, steps=72)
+    assert res.to_frame().shape[0] == 72
+    assert np.isfinite(res.balancing_moment).all()
+
+
+def test_mechanism_is_immutable():
+    mech = kinetostat.loads(FOUR_BAR)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        mech.g = 10.0
+    with pytest.raises(TypeError):
+        mech.links[2].points["A"] = (1.0, 1.0)
+
+
+def _problems(text: str) -> list[str]:
+    with pytest.raises(ModelError) as exc:
+        kinetostat.loads(text, source="bad.toml")
+    assert str(exc.value).startswith("bad.toml:")
+    return exc.value.problems
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ('links = [2, 3]\npoint = "B"', 'links = [2, 7]\npoint = "B"',
+     "pair[2].links: unknown link 7. Valid links: [0, 1, 2, 3]"),
+    ("mass = 1.5", "mass = -1.5", "link[1] (id 2).mass: must be >= 0.0, got -1.5"),
+    ('points = { C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.12, -0.01] }',
+     'points = { C = [0.0, 0.0], B = [0.0, 0.0], S3 = [0.0, 0.0] }',
+     "link[2] (id 3).points: all points coincide (zero-length link)"),
+    ("I_S = 0.016", 'I_S = "heavy"', "link[1] (id 2).I_S: expected a finite number, got 'heavy'"),
+    ('sense = "ccw"', 'sense = "left"', "drive.sense: invalid value 'left'. Valid values: ['ccw', 'cw']"),
+    ("rpm = 300.0", "rpm = nan", "drive.rpm: expected a finite number, got nan"),
+    ('com = "S2"', 'com = "S9"', "link[1] (id 2).com: unknown point 'S9'. Valid names: ['A', 'B', 'S2']"),
+    ('link = 3\nvalue = -4.0', 'link = 5\nvalue = -4.0', "load[0].link: unknown link 5. Valid links: [0, 1, 2, 3]"),
+    ("branch = 1", "branch = 2", "group[0].branch: expected +1 or -1, got 2"),
+    ("[[group]]", "colour = 'red'\n[[group]]", "pair[3].colour: unknown field. Valid fields: ['kind', 'links', 'point', 'radius']"),
+])
+def test_each_fault_is_named(old, new, message):
+    assert old in FOUR_BAR
+    problems = _problems(FOUR_BAR.replace(old, new, 1))
+    assert any(p.startswith(message) for p in problems), problems
+
+
+def test_all_problems_are_reported_at_once():
+    text = FOUR_BAR.replace("mass = 1.5", "mass = -1.5").replace("I_S = 0.009", "I_S = -1.0")
+    problems = _problems(text.replace('sense = "ccw"', 'sense = "up"'))
+    assert len(problems) == 3, problems
+
+
+def test_pair_on_missing_point():
+    problems = _problems(FOUR_BAR.replace('links = [0, 3]\npoint = "C"', 'links = [0, 3]\npoint = "D"'))
+    assert "pair[3].point: link 0 has no point 'D'. Valid names: ['C', 'O']" in problems
+
+
+def test_toml_syntax_error():
+    problems = _problems(FOUR_BAR.replace("g = 9.81", "g = = 9.81"))
+    assert problems[0].startswith("TOML syntax error: ")
+    assert "line" in problems[0]
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ModelError, match="cannot read file"):
+        kinetostat.load(tmp_path / "none.toml")
+
+
+def test_linkage_that_cannot_be_assembled_names_the_angles():
+    # coupler 0.35 - rocker 0.12 = 0.23 > |AC| = sqrt((0.3 - 0.1 cos)^2 + (0.1 sin)^2) near phi = 0
+    mech = kinetostat.loads(FOUR_BAR.replace("B = [0.3, 0.0], S3", "B = [0.12, 0.0], S3"))
+    with pytest.raises(AssemblyError) as exc:
+        kinetostat.analyze(mech, phi_deg=[0.0, 30.0, 60.0, 180.0, 330.0])
+    assert exc.value.group == "II(2,3)"
+    assert list(exc.value.phi_deg) == [0.0, 30.0, 330.0]
+    assert str(exc.value) == ("group II(2,3) cannot be assembled (|AC| outside [|l2 - l3|, l2 + l3]) "
+                              "at phi = [0, 30, 330] deg")
+
+
+def test_class_three_group_is_refused():
+    # W = 1, but links 2..5 form a class-III group: ternary link 3 (B, D, E) with three dyad legs
+    text = """
+[mechanism]
+g = 9.81
+[drive]
+pivot = "O"
+point = "A"
+reference = [1.0, 0.0]
+sense = "ccw"
+rpm = 60.0
+[frame]
+O = [0.0, 0.0]
+F = [0.5, 0.3]
+G = [0.5, -0.3]
+[[link]]
+id = 1
+points = { O = [0.0, 0.0], A = [0.1, 0.0] }
+[[link]]
+id = 2
+points = { A = [0.0, 0.0], B = [0.3, 0.0] }
+[[link]]
+id = 3
+points = { B = [0.0, 0.0], D = [0.1, 0.1], E = [0.1, -0.1] }
+[[link]]
+id = 4
+points = { D = [0.0, 0.0], F = [0.2, 0.0] }
+[[link]]
+id = 5
+points = { E = [0.0, 0.0], G = [0.2, 0.0] }
+""" + "".join(f'[[pair]]\nkind = "R"\nlinks = [{i}, {j}]\npoint = "{p}"\n'
+              for i, j, p in [(0, 1, "O"), (1, 2, "A"), (2, 3, "B"), (3, 4, "D"), (4, 0, "F"),
+                              (3, 5, "E"), (5, 0, "G")])
+    with pytest.raises(StructureError, match=r"links \[2, 3, 4, 5\] do not split into class-II Assur groups"
+                                             r"(.*)class-III"):
+        kinetostat.loads(text)
+
+
+def test_wrong_mobility_is_refused():
+    text = FOUR_BAR.replace('[[pair]]\nkind = "R"\nlinks = [0, 3]\npoint = "C"\n', "")
+    text = text.replace("C = [0.3, 0.0]", "C0 = [0.3, 0.0]")
+    with pytest.raises(StructureError, match=r"mobility W = 3\*3 - 2\*3 - 0 = 3"):
+        kinetostat.loads(text)
