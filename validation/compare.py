@@ -1,0 +1,161 @@
+"""The accuracy gate: the solver against every engine route over a full cycle.
+
+`compare(mech, engines=..., steps=...)` builds one scene, runs every requested route, and
+returns a `Comparison`: per route and quantity (driving moment, each pair's reaction) the max
+absolute error, the max error relative to the cycle's peak, the RMS (relative to the peak),
+and pass/fail against the route's tolerance in `TOLERANCES`. An engine that is not installed
+is reported as skipped, never passed.
+"""
+from __future__ import annotations
+
+import importlib
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from kinetostat import Analysis, Mechanism, analyze
+
+from .scene import EngineResult, Scene, build_scene
+
+__all__ = ["ROUTES", "TOLERANCES", "Tolerance", "Row", "Comparison", "compare", "errors"]
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """Peak-relative tolerance of one route, with the reason for its value."""
+    peak_relative: float
+    reason: str
+
+
+#: Every route's tolerance, in one place. Peak-relative: max over the cycle of
+#: |engine - solver| divided by max over the cycle of |solver|, per quantity.
+TOLERANCES: dict[str, Tolerance] = {
+    "pinocchio": Tolerance(1e-9, "constrained inverse dynamics at the solver's exact state: the same "
+                                 "equations in another formulation, so rounding only (measured ~1e-13)"),
+    "mujoco": Tolerance(1e-9, "MuJoCo's mass matrix, bias forces and equality Jacobian at the exact "
+                              "state, solved for torque and constraint forces: rounding only"),
+    "mujoco-sim": Tolerance(2e-3, "MuJoCo's own forward simulation driven at the crank: its equality "
+                                  "constraints stay soft (impedance < 1) and the drive is servoed, so "
+                                  "the reactions carry the constraint compliance and time-step error"),
+    "pymunk": Tolerance(3e-2, "pymunk's iterative impulse solver at 1440 steps per revolution: O(dt) "
+                              "error and incomplete convergence on heavy/light mass ratios; public "
+                              "API gives impulse magnitudes only, so magnitudes are compared"),
+}
+
+
+def _route(module: str, func: str, **kw) -> Callable[[Scene], EngineResult]:
+    def run(scene: Scene) -> EngineResult:
+        mod = importlib.import_module(f"validation.{module}")
+        return getattr(mod, func)(scene, **kw)
+    return run
+
+
+#: route name -> (engine package to import, runner)
+ROUTES: dict[str, tuple[str, Callable[[Scene], EngineResult]]] = {
+    "pinocchio": ("pinocchio", _route("engine_pinocchio", "solve")),
+    "mujoco": ("mujoco", _route("engine_mujoco", "solve")),
+    "mujoco-sim": ("mujoco", _route("engine_mujoco", "simulate")),
+    "pymunk": ("pymunk", _route("engine_pymunk", "simulate")),
+}
+
+
+@dataclass(frozen=True)
+class Row:
+    """One route x quantity of a comparison."""
+    route: str
+    quantity: str          # "M_drive" or "R(i,j)" (force of i on j)
+    max_abs: float         # N m or N
+    peak_relative: float   # max |engine - solver| / max |solver|
+    rms_relative: float    # RMS of |engine - solver| / max |solver|
+    peak: float            # max |solver| over the cycle
+    tolerance: float
+    n_compared: int        # angles compared (NaN angles of the engine are left out, and counted)
+    n_skipped: int
+
+    @property
+    def passed(self) -> bool:
+        return bool(self.peak_relative <= self.tolerance) and self.n_compared > 0
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """The gate's answer for one mechanism."""
+    mech: Mechanism
+    res: Analysis
+    rows: tuple[Row, ...]
+    results: dict[str, EngineResult]
+    skipped: dict[str, str] = field(default_factory=dict)   # route -> reason
+    solver_seconds: float = 0.0
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.rows)
+
+    def to_frame(self):
+        import pandas as pd
+        cols = ["route", "quantity", "max_abs", "peak_relative", "rms_relative", "peak", "tolerance",
+                "n_compared", "n_skipped"]
+        df = pd.DataFrame([[getattr(r, c) for c in cols] for r in self.rows], columns=cols)
+        df["passed"] = [r.passed for r in self.rows]
+        return df
+
+
+def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> list[Row]:
+    """Error rows of one engine result against the solver's answer."""
+    m = res.mech
+    pairs = {f"R({p.links[0]},{p.links[1]})": (res.forces.R[:, p.index], er.R[:, p.index]) for p in m.pairs}
+    items = [("M_drive", (res.balancing_moment[:, None], er.M_drive[:, None]))] + list(pairs.items())
+    rows = []
+    for name, (ref, got) in items:
+        if er.magnitudes_only:
+            ref = np.linalg.norm(ref, axis=-1, keepdims=True)
+            got = np.linalg.norm(got, axis=-1, keepdims=True)
+        ok = np.isfinite(got).all(axis=-1) & np.isfinite(ref).all(axis=-1)
+        err = np.linalg.norm(got[ok] - ref[ok], axis=-1)
+        peak = float(np.max(np.linalg.norm(ref[ok], axis=-1))) if ok.any() else 0.0
+        scale = peak if peak > 0 else 1.0
+        rows.append(Row(route, name, float(err.max()) if ok.any() else np.nan,
+                        float(err.max() / scale) if ok.any() else np.nan,
+                        float(np.sqrt(np.mean(err**2)) / scale) if ok.any() else np.nan,
+                        peak, tolerance, int(ok.sum()), int((~ok).sum())))
+    return rows
+
+
+def available(route: str) -> str | None:
+    """None if the route's engine imports, else the reason it is skipped."""
+    package = ROUTES[route][0]
+    try:
+        importlib.import_module(package)
+    except ImportError as exc:
+        return f"{package} not installed ({exc})"
+    return None
+
+
+def compare(mech: Mechanism, engines=tuple(ROUTES), steps: int = 360, res: Analysis | None = None,
+            tolerances: dict[str, Tolerance] | None = None) -> Comparison:
+    """Cross-validate `mech` (or a given solver result `res` of it) against engine routes.
+
+    `engines`: route names from ROUTES. `res`: the solver's answer to check (default: analyze);
+    passing a deliberately wrong one shows that the gate can fail.
+    """
+    unknown = [e for e in engines if e not in ROUTES]
+    if unknown:
+        raise ValueError(f"unknown engine route(s) {unknown}. Valid names: {list(ROUTES)}")
+    tol = TOLERANCES if tolerances is None else tolerances
+    t0 = time.perf_counter()
+    if res is None:
+        res = analyze(mech, steps=steps)
+    solver_seconds = time.perf_counter() - t0
+    scene = build_scene(mech, res=res)
+    rows, results, skipped = [], {}, {}
+    for route in engines:
+        why = available(route)
+        if why:
+            skipped[route] = why
+            continue
+        er = ROUTES[route][1](scene)
+        results[route] = er
+        rows += errors(res, er, tol[route].peak_relative, route)
+    return Comparison(mech, res, tuple(rows), results, skipped, solver_seconds)
