@@ -90,7 +90,10 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarr
     p = mech.links[ld.link].points[ld.point]
     axis = np.asarray(t.axis if t.axis is not None else ld.direction)
     X, V, _ = kin.point(ld.link, p)
-    lo, hi = _stroke(mech, ld.link, p, axis)
+    key = ("stroke", ld.link, tuple(p), tuple(axis))
+    if key not in mech._derived:
+        mech._derived[key] = _stroke(mech, ld.link, p, axis)
+    lo, hi = mech._derived[key]
     s = X @ axis
     travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
     forward = (-(V @ axis) if t.origin == "max" else V @ axis) >= 0
@@ -99,18 +102,27 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarr
     return t.scale * np.where(forward, fwd, ret)
 
 
-def _stroke(mech: "Mechanism", k: int, p, axis: np.ndarray, samples: int = 7200) -> tuple[float, float]:
-    """Extreme projections of a point's path on `axis` over a full cycle, m (dense sampling,
-    refined by a parabola through the extreme sample and its neighbours)."""
+def _stroke(mech: "Mechanism", k: int, p, axis: np.ndarray) -> tuple[float, float]:
+    """Extreme projections of a point's path on `axis` over a full cycle, m: the dead centres,
+    where ds/dphi = 0, found by Newton's method from a coarse scan with the exact plans."""
     from .kinematics import kinematics
+    w, e = mech.drive.omega, mech.drive.eps
+
+    def state(phi):
+        kin = kinematics(mech, phi)
+        X, V, A = kin.point(k, p)
+        d1 = (V @ axis) / w                       # ds/dphi
+        return X @ axis, d1, (A @ axis - d1 * e) / w**2
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        phi = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
-        s = kinematics(mech, phi).point(k, p)[0] @ axis
-    out = []
-    for sign in (-1.0, 1.0):
-        i = int(np.argmax(sign * s))
-        a, b, c = s[i - 1], s[i], s[(i + 1) % samples]
-        den = a - 2 * b + c
-        out.append(b - 0.125 * (c - a) ** 2 / den if den else b)
-    return out[0], out[1]
+        phi = np.linspace(0.0, 2 * np.pi, 72, endpoint=False)
+        s, d1, _ = state(phi)
+        turn = np.flatnonzero(np.sign(d1) != np.sign(np.roll(d1, -1)))
+        x = phi[turn] + np.pi / 72
+        for _ in range(5):
+            _, d1x, d2x = state(x)
+            x = x - np.where(d2x != 0, d1x / d2x, 0.0)
+        sx = state(x)[0] if len(x) else np.empty(0)
+    values = np.concatenate([s, sx])
+    return float(np.nanmin(values)), float(np.nanmax(values))

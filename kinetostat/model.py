@@ -147,6 +147,8 @@ class Mechanism:
     friction: Friction | None
     path: str | None = None
     _structure: Any = field(default=None, repr=False, compare=False)
+    # memo of quantities derived from the (immutable) data, e.g. the strokes of travel tables
+    _derived: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self):
         from .structure import analyse_structure
