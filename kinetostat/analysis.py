@@ -8,7 +8,8 @@ import numpy as np
 
 from .kinematics import COND_MAX, Kinematics, kinematics
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from .loads import applied_wrenches, inertia_loads
+from .loads import applied_wrenches, com_positions, inertia_loads
+from .planar import cross
 from .model import Mechanism
 
 __all__ = ["Analysis", "InertiaLoad", "analyze"]
@@ -201,9 +202,11 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     if phi_deg.ndim != 1 or not np.all(np.isfinite(phi_deg)):
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     kin = kinematics(mech, np.radians(phi_deg))
-    F_app, M_app = applied_wrenches(mech, kin, with_inertia=False)
-    F_i, M_i = inertia_loads(mech, kin)
-    F_all, M_all = applied_wrenches(mech, kin, with_inertia=True)
+    S, aS = com_positions(mech, kin)
+    F_app, M_app = applied_wrenches(mech, kin, S)
+    F_i, M_i = inertia_loads(mech, kin, aS)
+    F_all = F_app + F_i
+    M_all = M_app + M_i + cross(S - kin.origin, F_i)
     frc = forces(mech, kin, F_all, M_all)
     lever = lever_moment(mech, kin, F_all, M_all)
     return Analysis(mech, kin, F_app, M_app, F_i, M_i, frc, lever, friction_power(mech, kin, frc.R))

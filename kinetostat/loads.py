@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Load, Mechanism
 
-__all__ = ["applied_wrenches", "inertia_loads", "load_magnitude"]
+__all__ = ["applied_wrenches", "com_positions", "inertia_loads", "load_magnitude"]
 
 
 def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
@@ -24,34 +24,30 @@ def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) ->
     M[:, k] += cross(X - kin.origin[:, k], f)
 
 
-def inertia_loads(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
+def com_positions(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
+    """Positions (N, L, 2) and accelerations (N, L, 2) of the centres of mass (link origin if massless)."""
+    S, aS = kin.origin.copy(), kin.a_origin.copy()
+    for link in mech.links[1:]:
+        if link.com:
+            S[:, link.id], _, aS[:, link.id] = kin.point(link.id, link.points[link.com])
+    return S, aS
+
+
+def inertia_loads(mech: "Mechanism", kin: "Kinematics", aS: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Main vector F_i = -m a_S (N, L, 2) at the centre of mass and main moment M_i = -I_S eps (N, L)."""
-    N, L = kin.theta.shape
-    F, M = np.zeros((N, L, 2)), np.zeros((N, L))
-    for link in mech.links[1:]:
-        if link.mass:
-            _, _, aS = kin.point(link.id, link.points[link.com])
-            F[:, link.id] = -link.mass * aS
-        M[:, link.id] = -link.I_S * kin.eps[:, link.id]
-    return F, M
+    mass = np.array([link.mass for link in mech.links])
+    I_S = np.array([link.I_S for link in mech.links])
+    return -mass[None, :, None] * aS, -I_S[None, :] * kin.eps
 
 
-def applied_wrenches(mech: "Mechanism", kin: "Kinematics", with_inertia: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """All known loads on each link as a wrench about its local origin: F (N, L, 2), M (N, L)."""
+def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """All applied loads (gravity, external forces and moments, springs; no inertia) on each link
+    as a wrench about its local origin: F (N, L, 2), M (N, L). S: centres of mass (N, L, 2)."""
     N, L = kin.theta.shape
-    F, M = np.zeros((N, L, 2)), np.zeros((N, L))
-    G = np.array([0.0, -mech.g])
-    for link in mech.links[1:]:
-        if link.mass:
-            S, _, _ = kin.point(link.id, link.points[link.com])
-            _add_force(F, M, kin, link.id, np.broadcast_to(link.mass * G, (N, 2)), S)
-    if with_inertia:
-        Fi, Mi = inertia_loads(mech, kin)
-        for link in mech.links[1:]:
-            if link.mass:
-                S, _, _ = kin.point(link.id, link.points[link.com])
-                _add_force(F, M, kin, link.id, Fi[:, link.id], S)
-        M += Mi
+    mass = np.array([link.mass for link in mech.links])
+    F = np.zeros((N, L, 2))
+    F[:, :, 1] = -mech.g * mass
+    M = cross(S - kin.origin, F)
     for ld in mech.loads:
         mag = load_magnitude(mech, kin, ld)
         if ld.kind == "moment":
