@@ -17,10 +17,10 @@ from .planar import cross, decompose, rot90
 
 if TYPE_CHECKING:
     from .kinematics import Kinematics
-    from .model import Mechanism, Pair
+    from .model import Gear, Mechanism, Pair
     from .structure import AssurGroup
 
-__all__ = ["Forces", "forces", "lever_moment", "friction_power"]
+__all__ = ["Forces", "forces", "gear_force", "lever_moment", "friction_power"]
 
 
 @dataclass(frozen=True)
@@ -165,17 +165,20 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
     dr = mech.drive
     O = st.at(1, dr.pivot)
     M_bal = -st.moment(1, O)
-    F_bal = np.zeros_like(O)
-    if dr.kind == "machine":
-        gear = dr.gear
-        e = np.asarray(gear.centre_direction)
-        alpha = np.radians(gear.alpha_w_deg)
-        # the pinion pushes on the wheel's tooth at the pitch point along the line of action
-        # that turns the crank the way M_bal must: moment (r_w e) x F = sign(M) |F| r_b
-        s = np.sign(M_bal)[:, None]
-        F_bal = (np.abs(M_bal) / gear.r_b)[:, None] * (s * np.cos(alpha) * rot90(e) - np.sin(alpha) * e)
+    F_bal = gear_force(dr.gear, M_bal) if dr.kind == "machine" else np.zeros_like(O)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
     return Forces(st.R, st.x, M_bal, F_bal)
+
+
+def gear_force(gear: "Gear", M: np.ndarray) -> np.ndarray:
+    """Force (N, 2) of the pinion on the crank's gear at the pitch point O + r_w e that applies
+    the moment M (N,) about the crank axis (seed 000 sec. 7.1): it pushes on the tooth along the
+    line of action at alpha_w to the tangent, the one that turns the crank the way M must:
+    (r_w e) x F = sign(M) |F| r_b = M."""
+    e = np.asarray(gear.centre_direction)
+    alpha = np.radians(gear.alpha_w_deg)
+    s = np.sign(M)[:, None]
+    return (np.abs(M) / gear.r_b)[:, None] * (s * np.cos(alpha) * rot90(e) - np.sin(alpha) * e)
 
 
 def lever_moment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -> np.ndarray:

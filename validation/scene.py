@@ -11,6 +11,11 @@ Joint coordinates (q = 0 is the placement below, not an assembled configuration)
   parent's anchor + q * axis (axis in the parent frame). q is the slider point's travel
   along the guide direction from the guide point, whichever of the two links is the parent.
 Child frame origin in the parent frame: a_p + q*axis - R(rel_angle [+ q]) a_c.
+
+The drive: an engine's crank is driven by a pure moment about its pivot. A working machine's
+crank (`mech.drive.kind == "machine"`) is driven by the pinion's force on its gear at the pitch
+point, `kinetostat.kinetostatics.gear_force(mech.drive.gear, M)`: same driving moment M, but the
+frame's reaction on the crank carries that force too, so adapters must apply it to compare R(0,1).
 """
 from __future__ import annotations
 
