@@ -58,8 +58,10 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tup
         X, V, _ = kin.point(ld.link, mech.links[ld.link].points[ld.point])
         if ld.direction == "against_velocity":
             speed = np.linalg.norm(V, axis=-1, keepdims=True)
+            # at a dead centre the direction is undefined: no force where the speed is rounding
+            moving = speed > 1e-9 * mech.size * mech.drive.omega
             with np.errstate(invalid="ignore", divide="ignore"):
-                e = np.where(speed > 0, -V / speed, 0.0)    # no velocity, no direction: no force
+                e = np.where(moving, -V / speed, 0.0)
         else:
             e = np.broadcast_to(np.asarray(ld.direction), (N, 2))
         _add_force(F, M, kin, ld.link, mag[:, None] * e, X)

@@ -5,7 +5,9 @@ loop-closing pairs cut, inertias at the centres of mass, and the exact joint tra
 the solver for the prescribed crank motion.
 
 Joint coordinates (q = 0 is the placement below, not an assembled configuration):
-- revolute joint: child angle = parent angle + rel_angle + q; the anchor points
+- revolute joint: child angle = parent angle + rel_angle + q, q wrapped to [-pi, pi) and 0 at
+  phi = 0 in every scene of the mechanism (so scenes at different angles share one engine
+  model); the anchor points
   `anchor_parent` (parent frame) and `anchor_child` (child frame) coincide.
 - prismatic joint: child angle = parent angle + rel_angle; the child's anchor sits at the
   parent's anchor + q * axis (axis in the parent frame). q is the slider point's travel
@@ -101,7 +103,7 @@ class Scene:
 def build_scene(mech: Mechanism, phi_deg=None, steps: int = 360, res: Analysis | None = None) -> Scene:
     """The scene of `mech` with its exact motion at `phi_deg` (or `steps` angles over a cycle)."""
     res = res if res is not None else analyze(mech, phi_deg=phi_deg, steps=steps)
-    ref = analyze(mech, phi_deg=[0.0])          # placement of the revolute joints' zero
+    ref = analyze(mech, phi_deg=[0.0])   # revolute joints' zero: the assembly at phi = 0, for every scene
     parent = {0: None}
     order, joints, used = [], [], set()
     frontier = [0]
