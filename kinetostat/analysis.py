@@ -9,7 +9,7 @@ import numpy as np
 from .kinematics import COND_MAX, Kinematics, kinematics
 from .kinetostatics import Forces, forces, friction_power, lever_moment
 from .loads import applied_wrenches, com_positions, inertia_loads
-from .planar import cross
+from .planar import as_xy, cross_z
 from .model import Mechanism
 
 __all__ = ["Analysis", "InertiaLoad", "analyze"]
@@ -36,7 +36,7 @@ class Analysis:
     kin: Kinematics
     F_applied: np.ndarray   # (N, L, 2) applied loads without inertia, per link, N
     M_applied: np.ndarray   # (N, L) their moment about each link's local origin, N m
-    F_i: np.ndarray         # (N, L, 2) inertia main vectors, N
+    F_i: np.ndarray         # (N, L, 2) inertia main vectors (at the centres of mass), N
     M_i: np.ndarray         # (N, L) inertia main moments, N m
     forces: Forces
     lever_moment: np.ndarray      # (N,) balancing moment by Zhukovsky's lever, N m
@@ -206,7 +206,8 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     F_app, M_app = applied_wrenches(mech, kin, S)
     F_i, M_i = inertia_loads(mech, kin, aS)
     F_all = F_app + F_i
-    M_all = M_app + M_i + cross(S - kin.origin, F_i)
+    M_all = M_app + M_i + cross_z(S - kin.origin_z, F_i)
     frc = forces(mech, kin, F_all, M_all)
     lever = lever_moment(mech, kin, F_all, M_all)
-    return Analysis(mech, kin, F_app, M_app, F_i, M_i, frc, lever, friction_power(mech, kin, frc.R))
+    return Analysis(mech, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
+                    friction_power(mech, kin, frc.R))

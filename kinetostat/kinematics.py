@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from .errors import AssemblyError, SingularPositionWarning, singular_message
-from .planar import cross, decompose, rot90, rotate
+from .planar import as_xy, condition, cross_z, decompose, dot_z
 
 if TYPE_CHECKING:
     from .model import Mechanism, Pair
@@ -34,13 +34,16 @@ COND_MAX = 1e8
 class Kinematics:
     """Motion of every link at N crank angles; arrays lead with the angle axis.
 
-    Link k's local point p is at `origin[:, k] + rotate(p, theta[:, k])` (m, world frame).
+    Positions, velocities and accelerations of the link frames are complex (x + iy) inside the
+    solver; `origin`, `v_origin`, `a_origin` and `point` give the public (..., 2) real views.
+    Link k's local point p is at origin_z[:, k] + p rot[:, k] (m, world frame).
     """
     phi: np.ndarray        # (N,) crank angle from drive.reference in drive.sense, rad
     theta: np.ndarray      # (N, L) link angles, rad, about +z
-    origin: np.ndarray     # (N, L, 2) position of each link's local origin, m
-    v_origin: np.ndarray   # (N, L, 2) its velocity, m/s
-    a_origin: np.ndarray   # (N, L, 2) its acceleration, m/s^2
+    rot: np.ndarray        # (N, L) complex e^{i theta}
+    origin_z: np.ndarray   # (N, L) complex position of each link's local origin, m
+    v_z: np.ndarray        # (N, L) complex velocity of the local origin, m/s
+    a_z: np.ndarray        # (N, L) complex acceleration of the local origin, m/s^2
     omega: np.ndarray      # (N, L) angular velocity about +z, rad/s
     eps: np.ndarray        # (N, L) angular acceleration about +z, rad/s^2
     v_slide: np.ndarray    # (N, n_pairs) velocity of slider relative to guide along the guide, m/s (0 for R)
@@ -48,12 +51,30 @@ class Kinematics:
     cond: np.ndarray       # (N, n_groups) condition number of each group's plan
     singular: np.ndarray   # (N,) bool: some group's cond > COND_MAX (velocities etc. are NaN)
 
-    def point(self, k: int, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    @property
+    def origin(self) -> np.ndarray:
+        """(N, L, 2) position of each link's local origin, m."""
+        return as_xy(self.origin_z)
+
+    @property
+    def v_origin(self) -> np.ndarray:
+        """(N, L, 2) velocity of each link's local origin, m/s."""
+        return as_xy(self.v_z)
+
+    @property
+    def a_origin(self) -> np.ndarray:
+        """(N, L, 2) acceleration of each link's local origin, m/s^2."""
+        return as_xy(self.a_z)
+
+    def point_z(self, k: int, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Complex position, velocity, acceleration (each (N,)) of local point p of link k."""
+        r = complex(p[0], p[1]) * self.rot[:, k]
+        w, e = self.omega[:, k], self.eps[:, k]
+        return self.origin_z[:, k] + r, self.v_z[:, k] + 1j * w * r, self.a_z[:, k] + (1j * e - w**2) * r
+
+    def point(self, k: int, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration (each (N, 2)) of local point p of link k."""
-        r = rotate(np.asarray(p, float), self.theta[:, k])
-        w, e = self.omega[:, k, None], self.eps[:, k, None]
-        return (self.origin[:, k] + r, self.v_origin[:, k] + w * rot90(r),
-                self.a_origin[:, k] - w**2 * r + e * rot90(r))
+        return tuple(as_xy(z) for z in self.point_z(k, p))
 
 
 class _Plan:
@@ -63,39 +84,41 @@ class _Plan:
         N, L = len(phi), mech.n_links
         self.mech, self.phi = mech, phi
         self.th, self.w, self.e = np.zeros((N, L)), np.zeros((N, L)), np.zeros((N, L))
-        self.O, self.V, self.A = np.zeros((N, L, 2)), np.zeros((N, L, 2)), np.zeros((N, L, 2))
+        self.rot = np.ones((N, L), complex)
+        self.O, self.V, self.A = (np.zeros((N, L), complex) for _ in range(3))
         self.vs, self.as_ = np.zeros((N, len(mech.pairs))), np.zeros((N, len(mech.pairs)))
         self.L = mech.size
 
-    def local(self, k: int, name: str) -> np.ndarray:
-        return np.asarray(self.mech.links[k].points[name], float)
+    def local(self, k: int, name: str) -> complex:
+        x, y = self.mech.links[k].points[name]
+        return complex(x, y)
 
     def point(self, k: int, name: str):
-        r = rotate(self.local(k, name), self.th[:, k])
-        w, e = self.w[:, k, None], self.e[:, k, None]
-        return self.O[:, k] + r, self.V[:, k] + w * rot90(r), self.A[:, k] - w**2 * r + e * rot90(r)
+        r = self.local(k, name) * self.rot[:, k]
+        w, e = self.w[:, k], self.e[:, k]
+        return self.O[:, k] + r, self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
 
     def at(self, k: int, X: np.ndarray):
         """Velocity and acceleration of the point of link k that is at world position X."""
         r = X - self.O[:, k]
-        w, e = self.w[:, k, None], self.e[:, k, None]
-        return self.V[:, k] + w * rot90(r), self.A[:, k] - w**2 * r + e * rot90(r)
+        w, e = self.w[:, k], self.e[:, k]
+        return self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
 
     def set_link(self, k: int, th, X, x_local, w, V, e, A) -> None:
         """Fix link k from its angle and the world state of one of its points."""
-        r = rotate(np.asarray(x_local, float), th)
-        self.th[:, k], self.w[:, k], self.e[:, k] = th, w, e
+        rot = np.exp(1j * th)
+        r = x_local * rot
+        self.th[:, k], self.rot[:, k], self.w[:, k], self.e[:, k] = th, rot, w, e
         self.O[:, k] = X - r
-        self.V[:, k] = V - w[:, None] * rot90(r)
-        self.A[:, k] = A + w[:, None] ** 2 * r - e[:, None] * rot90(r)
+        self.V[:, k] = V - 1j * w * r
+        self.A[:, k] = A - (1j * e - w**2) * r
 
     def length(self, k: int, a: str, b: str) -> float:
-        return float(np.linalg.norm(self.local(k, a) - self.local(k, b)))
+        return abs(self.local(k, a) - self.local(k, b))
 
     def angle_from(self, k: int, a: str, b: str, A: np.ndarray, B: np.ndarray) -> np.ndarray:
         """Angle of link k whose points a, b are at world A, B."""
-        d = self.local(k, b) - self.local(k, a)
-        return np.arctan2(B[:, 1] - A[:, 1], B[:, 0] - A[:, 0]) - np.arctan2(d[1], d[0])
+        return np.angle(B - A) - np.angle(self.local(k, b) - self.local(k, a))
 
     # --- prismatic pair geometry: the guide line is fixed in both links (equal rotation)
     def turned(self, p: "Pair", k: int, th_other: np.ndarray) -> np.ndarray:
@@ -105,14 +128,14 @@ class _Plan:
     def guide(self, p: "Pair", k: int, th_k: np.ndarray) -> np.ndarray:
         """World unit direction d of pair p's guide, given the angle of its link k."""
         th_guide = th_k if k == p.links[0] else th_k - p.alpha
-        return rotate(np.asarray(p.direction), th_guide)
+        return complex(*p.direction) * np.exp(1j * th_guide)
 
     def offset(self, p: "Pair", k: int, name: str) -> float:
         """Signed distance c = (X - G) x d of point `name` of link k from the guide line."""
         x = self.local(k, name)
         if k == p.links[0]:
-            return float(cross(x - self.local(k, p.guide), np.asarray(p.direction)))
-        return float(-(x - self.local(k, p.point))[1])
+            return float(cross_z(x - self.local(k, p.guide), complex(*p.direction)))
+        return float(-(x - self.local(k, p.point)).imag)
 
     @staticmethod
     def anchor(p: "Pair", k: int) -> str:
@@ -137,20 +160,20 @@ def _rrr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     P, VP, AP = pl.point(a, pj.point)
     Q, VQ, AQ = pl.point(c, pk.point)
     lj, lk = pl.length(j, pj.point, pin.point), pl.length(k, pk.point, pin.point)
-    d = np.linalg.norm(Q - P, axis=-1)
-    u = (Q - P) / d[:, None]
+    d = np.abs(Q - P)
+    u = (Q - P) / d
     along = (lj**2 - lk**2 + d**2) / (2 * d)
     h = pl.reachable(g, lj**2 - along**2, lj**2, f"|{pj.point}{pk.point}| outside [|l{j} - l{k}|, l{j} + l{k}]")
-    B = P + along[:, None] * u + g.branch * h[:, None] * rot90(u)
+    B = P + u * (along + 1j * g.branch * h)
+    PB, QB = B - P, B - Q
     # v_B = v_P + w_j x PB = v_Q + w_k x QB ;  a_B = a_P - w_j^2 PB + e_j x PB = ...
-    wj, wk, cond = decompose(VQ - VP, rot90(B - P), -rot90(B - Q), pl.L, pl.L)
-    VB = VP + wj[:, None] * rot90(B - P)
-    ej, ek, _ = decompose(AQ - wk[:, None] ** 2 * (B - Q) - AP + wj[:, None] ** 2 * (B - P),
-                          rot90(B - P), -rot90(B - Q), pl.L, pl.L)
-    AB = AP - wj[:, None] ** 2 * (B - P) + ej[:, None] * rot90(B - P)
+    wj, wk = decompose(VQ - VP, 1j * PB, -1j * QB)
+    VB = VP + 1j * wj * PB
+    ej, ek = decompose(AQ - wk**2 * QB - AP + wj**2 * PB, 1j * PB, -1j * QB)
+    AB = AP + (1j * ej - wj**2) * PB
     pl.set_link(j, pl.angle_from(j, pj.point, pin.point, P, B), B, pl.local(j, pin.point), wj, VB, ej, AB)
     pl.set_link(k, pl.angle_from(k, pk.point, pin.point, Q, B), B, pl.local(k, pin.point), wk, VB, ek, AB)
-    return cond
+    return condition(PB, QB, pl.L, pl.L)
 
 
 def _rrp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
@@ -160,23 +183,23 @@ def _rrp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     d = pl.guide(pk, k, th_k)
     K, _, _ = pl.point(b, pl.anchor(pk, b))
     lj, cB = pl.length(j, pj.point, pin.point), pl.offset(pk, k, pin.point)
-    w = K - cB * rot90(d) - P                        # B = K + t d - cB n lies on a circle about P
-    wd = np.sum(w * d, axis=-1)
-    root = pl.reachable(g, wd**2 - np.sum(w * w, axis=-1) + lj**2, lj**2,
+    w = K - cB * 1j * d - P                        # B = K + t d - cB n lies on a circle about P
+    wd = dot_z(w, d)
+    root = pl.reachable(g, wd**2 - np.abs(w) ** 2 + lj**2, lj**2,
                         f"the guide line is farther than l{j} from {pj.point}")
-    B = K + (-wd + g.branch * root)[:, None] * d - cB * rot90(d)
+    B = K + (-wd + g.branch * root - 1j * cB) * d
+    PB = B - P
     wb, eb = pl.w[:, b], pl.e[:, b]
     VBb, ABb = pl.at(b, B)
     # v_B = v_P + w_j x PB = v_B(b) + v_r d ; a_B = ... = a_B(b) + 2 w_b x v_r d + a_r d
-    wj, vr, cond = decompose(VBb - VP, rot90(B - P), -d, pl.L, 1.0)
-    VB = VP + wj[:, None] * rot90(B - P)
-    ej, ar, _ = decompose(ABb + 2 * (wb * vr)[:, None] * rot90(d) - AP + wj[:, None] ** 2 * (B - P),
-                          rot90(B - P), -d, pl.L, 1.0)
-    AB = AP - wj[:, None] ** 2 * (B - P) + ej[:, None] * rot90(B - P)
+    wj, vr = decompose(VBb - VP, 1j * PB, -d)
+    VB = VP + 1j * wj * PB
+    ej, ar = decompose(ABb + 2j * wb * vr * d - AP + wj**2 * PB, 1j * PB, -d)
+    AB = AP + (1j * ej - wj**2) * PB
     pl.set_link(j, pl.angle_from(j, pj.point, pin.point, P, B), B, pl.local(j, pin.point), wj, VB, ej, AB)
     pl.set_link(k, th_k, B, pl.local(k, pin.point), wb, VB, eb, AB)
     pl.slide(pk, k, vr, ar)
-    return cond
+    return condition(1j * PB, d, pl.L, 1.0)
 
 
 def _rpr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
@@ -184,45 +207,43 @@ def _rpr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     P, VP, AP = pl.point(a, pj.point)
     Q, VQ, AQ = pl.point(c, pk.point)
     e = pl.offset(pin, j, pj.point) - pl.offset(pin, k, pk.point)   # (P - Q) x d, constant
-    PQ = P - Q
-    rho = np.linalg.norm(PQ, axis=-1)
+    QP = P - Q
+    rho = np.abs(QP)
     pl.reachable(g, rho**2 - e**2, pl.L**2, f"{pj.point} comes closer than the guide offset to {pk.point}")
     s = np.arcsin(np.clip(e / rho, -1.0, 1.0))
-    delta = np.arctan2(PQ[:, 1], PQ[:, 0]) + (s if g.branch > 0 else np.pi - s)
-    d = np.stack([np.cos(delta), np.sin(delta)], axis=-1)
+    delta = np.angle(QP) + (s if g.branch > 0 else np.pi - s)
+    d = np.exp(1j * delta)
     th_k = delta - pin.alpha
     # v_P = v_Q + w_k x QP + v_r d ;  a_P = a_Q - w_k^2 QP + e_k x QP + 2 w_k x v_r d + a_r d
-    wk, vr, cond = decompose(VP - VQ, rot90(PQ), d, pl.L, 1.0)
-    ek, ar, _ = decompose(AP - AQ + wk[:, None] ** 2 * PQ - 2 * (wk * vr)[:, None] * rot90(d),
-                          rot90(PQ), d, pl.L, 1.0)
+    wk, vr = decompose(VP - VQ, 1j * QP, d)
+    ek, ar = decompose(AP - AQ + wk**2 * QP - 2j * wk * vr * d, 1j * QP, d)
     pl.set_link(k, th_k, Q, pl.local(k, pk.point), wk, VQ, ek, AQ)
     pl.set_link(j, th_k + pin.alpha, P, pl.local(j, pj.point), wk, VP, ek, AP)
     pl.slide(pin, j, vr, ar)
-    return cond
+    return condition(1j * QP, d, pl.L, 1.0)
 
 
 def _prp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     th_j, th_k = pl.turned(pj, j, pl.th[:, a]), pl.turned(pk, k, pl.th[:, c])
     da, dc = pl.guide(pj, j, th_j), pl.guide(pk, k, th_k)
-    Ka = pl.point(a, pl.anchor(pj, a))[0] - pl.offset(pj, j, pin.point) * rot90(da)
-    Kc = pl.point(c, pl.anchor(pk, c))[0] - pl.offset(pk, k, pin.point) * rot90(dc)
-    t, _, cond = decompose(Kc - Ka, da, -dc)        # B on both lines
-    B = Ka + t[:, None] * da
+    Ka = pl.point(a, pl.anchor(pj, a))[0] - pl.offset(pj, j, pin.point) * 1j * da
+    Kc = pl.point(c, pl.anchor(pk, c))[0] - pl.offset(pk, k, pin.point) * 1j * dc
+    t, _ = decompose(Kc - Ka, da, -dc)        # B on both lines
+    B = Ka + t * da
     VBa, ABa = pl.at(a, B)
     VBc, ABc = pl.at(c, B)
     wa, wc = pl.w[:, a], pl.w[:, c]
     # v_B = v_B(a) + v1 d_a = v_B(c) + v2 d_c ; accelerations with the Coriolis terms
-    v1, v2, _ = decompose(VBc - VBa, da, -dc)
-    a1, a2, _ = decompose(ABc + 2 * (wc * v2)[:, None] * rot90(dc) - ABa - 2 * (wa * v1)[:, None] * rot90(da),
-                          da, -dc)
-    VB = VBa + v1[:, None] * da
-    AB = ABa + 2 * (wa * v1)[:, None] * rot90(da) + a1[:, None] * da
+    v1, v2 = decompose(VBc - VBa, da, -dc)
+    a1, a2 = decompose(ABc + 2j * wc * v2 * dc - ABa - 2j * wa * v1 * da, da, -dc)
+    VB = VBa + v1 * da
+    AB = ABa + (2j * wa * v1 + a1) * da
     pl.set_link(j, th_j, B, pl.local(j, pin.point), wa, VB, pl.e[:, a], AB)
     pl.set_link(k, th_k, B, pl.local(k, pin.point), wc, VB, pl.e[:, c], AB)
     pl.slide(pj, j, v1, a1)
     pl.slide(pk, k, v2, a2)
-    return cond
+    return condition(da, dc)
 
 
 def _rpp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
@@ -231,27 +252,25 @@ def _rpp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     th_k = pl.turned(pk, k, pl.th[:, c])
     th_j = pl.turned(pin, j, th_k)
     d_in, dc = pl.guide(pin, k, th_k), pl.guide(pk, k, th_k)
-    rP = rotate(pl.local(j, pj.point), th_j)
-    Oj = P - rP
-    Kj = Oj + rotate(pl.local(j, pl.anchor(pin, j)), th_j)        # on the inner guide line
+    rot_j, rot_k = np.exp(1j * th_j), np.exp(1j * th_k)
+    Oj = P - pl.local(j, pj.point) * rot_j
+    Kj = Oj + pl.local(j, pl.anchor(pin, j)) * rot_j             # on the inner guide line
     Kc = pl.point(c, pl.anchor(pk, c))[0]                         # on the outer guide line
-    rY = rotate(pl.local(k, pl.anchor(pin, k)), th_k)
-    rX = rotate(pl.local(k, pl.anchor(pk, k)), th_k)
+    rY = pl.local(k, pl.anchor(pin, k)) * rot_k
+    rX = pl.local(k, pl.anchor(pk, k)) * rot_k
     # k's anchor Y = Kj + s d_in on the inner line, its anchor X = Y + rX - rY on the outer line
-    _, s, cond = decompose(Kj + rX - rY - Kc, dc, -d_in)
-    Ok = Kj + s[:, None] * d_in - rY
+    _, s = decompose(Kj + rX - rY - Kc, dc, -d_in)
+    Ok = Kj + s * d_in - rY
     wc, ec = pl.w[:, c], pl.e[:, c]
     VPc, APc = pl.at(c, P)
     # v_P = v_P(c) + v2 d_c + v1 d_in ; a_P = a_P(c) + 2 w x (v2 d_c + v1 d_in) + a2 d_c + a1 d_in
-    v1, v2, _ = decompose(VP - VPc, d_in, dc)
-    a1, a2, _ = decompose(AP - APc - 2 * wc[:, None] * (v1[:, None] * rot90(d_in) + v2[:, None] * rot90(dc)),
-                          d_in, dc)
+    v1, v2 = decompose(VP - VPc, d_in, dc)
+    a1, a2 = decompose(AP - APc - 2j * wc * (v1 * d_in + v2 * dc), d_in, dc)
     pl.set_link(j, th_j, P, pl.local(j, pj.point), wc, VP, ec, AP)
-    pl.set_link(k, th_k, P, rotate(P - Ok, -th_k), wc, VPc + v2[:, None] * dc,
-                ec, APc + 2 * (wc * v2)[:, None] * rot90(dc) + a2[:, None] * dc)
+    pl.set_link(k, th_k, P, (P - Ok) / rot_k, wc, VPc + v2 * dc, ec, APc + (2j * wc * v2 + a2) * dc)
     pl.slide(pin, j, v1, a1)
     pl.slide(pk, k, v2, a2)
-    return cond
+    return condition(d_in, dc)
 
 
 _GROUP_SOLVERS: dict[str, Callable[[_Plan, "AssurGroup"], np.ndarray]] = {
@@ -268,12 +287,11 @@ def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     pl = _Plan(mech, phi)
     dr = mech.drive
-    crank = mech.links[1]
-    arm = np.subtract(crank.points[dr.point], crank.points[dr.pivot])
-    th1 = np.arctan2(dr.reference[1], dr.reference[0]) + dr.sense * phi - np.arctan2(arm[1], arm[0])
-    O = np.broadcast_to(np.asarray(mech.links[0].points[dr.pivot], float), (len(phi), 2))
-    pl.set_link(1, th1, O, pl.local(1, dr.pivot), np.full_like(phi, dr.sense * dr.omega),
-                np.zeros_like(O), np.full_like(phi, dr.sense * dr.eps), np.zeros_like(O))
+    arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)
+    th1 = np.arctan2(dr.reference[1], dr.reference[0]) + dr.sense * phi - np.angle(arm)
+    zero = np.zeros(len(phi), complex)
+    pl.set_link(1, th1, pl.local(0, dr.pivot) + zero, pl.local(1, dr.pivot), np.full_like(phi, dr.sense * dr.omega),
+                zero, np.full_like(phi, dr.sense * dr.eps), zero)
     groups = mech.structure.groups
     cond = np.ones((len(phi), len(groups)))
     for n, g in enumerate(groups):
@@ -281,7 +299,7 @@ def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     singular = _guard(mech, phi, cond)
     for arr in (pl.w, pl.e, pl.V, pl.A, pl.vs, pl.as_):
         arr[singular] = np.nan
-    return Kinematics(phi, pl.th, pl.O, pl.V, pl.A, pl.w, pl.e, pl.vs, pl.as_, cond, singular)
+    return Kinematics(phi, pl.th, pl.rot, pl.O, pl.V, pl.A, pl.w, pl.e, pl.vs, pl.as_, cond, singular)
 
 
 def _guard(mech: "Mechanism", phi: np.ndarray, cond: np.ndarray) -> np.ndarray:

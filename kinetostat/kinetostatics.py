@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from .planar import cross, decompose, rot90
+from .planar import as_xy, as_z, cross_z, decompose, dot_z, rot90
 
 if TYPE_CHECKING:
     from .kinematics import Kinematics
@@ -33,33 +33,30 @@ class Forces:
 
 
 class _Statics:
-    """Known wrenches per link about its local origin, updated as groups are solved."""
+    """Known wrenches per link about its local origin (complex forces), updated as groups are solved."""
 
     def __init__(self, mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray):
         self.mech, self.kin = mech, kin
         self.F, self.M = F.copy(), M.copy()
         N = len(kin.phi)
-        self.R = np.zeros((N, len(mech.pairs), 2))
+        self.R = np.zeros((N, len(mech.pairs)), complex)
         self.x = np.full((N, len(mech.pairs)), np.nan)
 
     def at(self, k: int, name: str) -> np.ndarray:
-        return self.kin.point(k, self.mech.links[k].points[name])[0]
+        return self.kin.point_z(k, self.mech.links[k].points[name])[0]
 
     def moment(self, k: int, X: np.ndarray) -> np.ndarray:
         """Moment about X of the known loads on link k."""
-        return self.M[:, k] + cross(self.kin.origin[:, k] - X, self.F[:, k])
+        return self.M[:, k] + cross_z(self.kin.origin_z[:, k] - X, self.F[:, k])
 
     def apply(self, k: int, f: np.ndarray, X: np.ndarray, m: np.ndarray | float = 0.0) -> None:
         """Add force f through X (and couple m) to the known loads of link k."""
         self.F[:, k] += f
-        self.M[:, k] += cross(X - self.kin.origin[:, k], f) + m
+        self.M[:, k] += cross_z(X - self.kin.origin_z[:, k], f) + m
 
     def normal(self, p: "Pair") -> np.ndarray:
-        """World unit normal n = rot90(d) of P pair p's guide."""
-        th = self.kin.theta[:, p.links[0]]
-        c, s = np.cos(th), np.sin(th)
-        d = np.stack([c * p.direction[0] - s * p.direction[1], s * p.direction[0] + c * p.direction[1]], -1)
-        return rot90(d)
+        """World unit normal n = i d of P pair p's guide."""
+        return 1j * complex(*p.direction) * self.kin.rot[:, p.links[0]]
 
     def revolute(self, p: "Pair", giver: int, R: np.ndarray) -> None:
         self.R[:, p.index] = R if giver == p.links[0] else -R
@@ -69,22 +66,21 @@ class _Statics:
         along the guide from the slider point: (S + x d - X0) x f = m."""
         self.revolute(p, giver, f)
         n = self.normal(p)
-        N = np.sum(f * n, axis=-1)
+        N = dot_z(n, f)
         S = self.at(p.links[1], p.point)
         with np.errstate(divide="ignore", invalid="ignore"):
-            self.x[:, p.index] = np.where(N != 0, m / N - cross(S - X0, n), np.nan)
+            self.x[:, p.index] = np.where(N != 0, m / N - cross_z(S - X0, n), np.nan)
 
 
 def _rrr(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, B, Q = st.at(j, pj.point), st.at(j, pin.point), st.at(k, pk.point)
-    lj, lk = np.linalg.norm(B - P, axis=-1), np.linalg.norm(B - Q, axis=-1)
-    uj, uk = (B - P) / lj[:, None], (B - Q) / lk[:, None]
+    lj, lk = np.abs(B - P), np.abs(B - Q)
+    uj, uk = (B - P) / lj, (B - Q) / lk
     # tangential parts from the moments of each link about B, normal parts from the polygon
-    tj, tk = st.moment(j, B) / lj, st.moment(k, B) / lk
-    nj, nk = tj[:, None] * rot90(uj), tk[:, None] * rot90(uk)
-    aj, ak, _ = decompose(-(st.F[:, j] + st.F[:, k] + nj + nk), uj, uk)
-    R_aj, R_ck = aj[:, None] * uj + nj, ak[:, None] * uk + nk
+    nj, nk = 1j * uj * (st.moment(j, B) / lj), 1j * uk * (st.moment(k, B) / lk)
+    aj, ak = decompose(-(st.F[:, j] + st.F[:, k] + nj + nk), uj, uk)
+    R_aj, R_ck = aj * uj + nj, ak * uk + nk
     st.revolute(pj, a, R_aj)
     st.revolute(pin, k, -(st.F[:, j] + R_aj))
     st.revolute(pk, c, R_ck)
@@ -95,12 +91,11 @@ def _rrr(st: _Statics, g: "AssurGroup") -> None:
 def _rrp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, b) = g.pairs, g.links, g.known
     P, B = st.at(j, pj.point), st.at(j, pin.point)
-    lj = np.linalg.norm(B - P, axis=-1)
-    uj, n = (B - P) / lj[:, None], st.normal(pk)
-    tj = st.moment(j, B) / lj
-    nj = tj[:, None] * rot90(uj)
-    aj, N, _ = decompose(-(st.F[:, j] + st.F[:, k] + nj), uj, n)
-    R_aj, f_bk = aj[:, None] * uj + nj, N[:, None] * n
+    lj = np.abs(B - P)
+    uj, n = (B - P) / lj, st.normal(pk)
+    nj = 1j * uj * (st.moment(j, B) / lj)
+    aj, N = decompose(-(st.F[:, j] + st.F[:, k] + nj), uj, n)
+    R_aj, f_bk = aj * uj + nj, N * n
     mB = st.moment(k, B)
     st.revolute(pj, a, R_aj)
     st.revolute(pin, k, -(st.F[:, j] + R_aj))
@@ -114,8 +109,8 @@ def _rpr(st: _Statics, g: "AssurGroup") -> None:
     P, Q, n = st.at(j, pj.point), st.at(k, pk.point), st.normal(pin)
     mP = st.moment(j, P)
     # moment of the whole group about Q fixes the normal force of the slotted link on the block
-    N = (mP + st.moment(k, Q)) / cross(P - Q, n)
-    f_kj = N[:, None] * n
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f_kj = (mP + st.moment(k, Q)) / cross_z(P - Q, n) * n
     R_aj, R_ck = -st.F[:, j] - f_kj, f_kj - st.F[:, k]
     st.revolute(pj, a, R_aj)
     st.prismatic(pin, k, f_kj, -mP, P)
@@ -127,8 +122,8 @@ def _rpr(st: _Statics, g: "AssurGroup") -> None:
 def _prp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     B, na, nc = st.at(j, pin.point), st.normal(pj), st.normal(pk)
-    Na, Nc, _ = decompose(-(st.F[:, j] + st.F[:, k]), na, nc)
-    f_aj, f_ck = Na[:, None] * na, Nc[:, None] * nc
+    Na, Nc = decompose(-(st.F[:, j] + st.F[:, k]), na, nc)
+    f_aj, f_ck = Na * na, Nc * nc
     mj, mk = st.moment(j, B), st.moment(k, B)
     st.prismatic(pj, a, f_aj, -mj, B)
     st.revolute(pin, k, -(st.F[:, j] + f_aj))
@@ -141,8 +136,8 @@ def _rpp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, n_in, nc = st.at(j, pj.point), st.normal(pin), st.normal(pk)
     # link k: F_k - f_kj + f_ck = 0 with both forces normal to their guides
-    N1, Nc, _ = decompose(st.F[:, k], n_in, -nc)
-    f_kj, f_ck = N1[:, None] * n_in, Nc[:, None] * nc
+    N1, Nc = decompose(st.F[:, k], n_in, -nc)
+    f_kj, f_ck = N1 * n_in, Nc * nc
     mj, mk = st.moment(j, P), st.moment(k, P)
     R_aj = -st.F[:, j] - f_kj
     st.revolute(pj, a, R_aj)
@@ -157,17 +152,16 @@ _GROUP_SOLVERS: dict[str, Callable[[_Statics, "AssurGroup"], None]] = {
 
 
 def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -> Forces:
-    """Reactions in every pair and the balancing load, from the known wrenches F, M per link
-    (applied + inertia, about each link's local origin)."""
+    """Reactions in every pair and the balancing load, from the known wrenches F (complex),
+    M per link (applied + inertia, about each link's local origin)."""
     st = _Statics(mech, kin, F, M)
     for g in reversed(mech.structure.groups):
         _GROUP_SOLVERS[g.kind](st, g)
     dr = mech.drive
-    O = st.at(1, dr.pivot)
-    M_bal = -st.moment(1, O)
-    F_bal = gear_force(dr.gear, M_bal) if dr.kind == "machine" else np.zeros_like(O)
+    M_bal = -st.moment(1, st.at(1, dr.pivot))
+    F_bal = as_z(gear_force(dr.gear, M_bal)) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
-    return Forces(st.R, st.x, M_bal, F_bal)
+    return Forces(as_xy(st.R), st.x, M_bal, as_xy(F_bal))
 
 
 def gear_force(gear: "Gear", M: np.ndarray) -> np.ndarray:
@@ -188,8 +182,9 @@ def lever_moment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndar
     moment about the pole proportional to its power F . v (M omega for a couple); the lever's
     equilibrium is the vanishing of the total, so M_bal omega_1 = -sum(F . v + M omega).
     Reactions do no work and never enter: this route is independent of the group-by-group one.
+    F (N, L) complex and M (N, L): all applied and inertia loads per link about its origin.
     """
-    power = np.sum(F * kin.v_origin, axis=-1) + M * kin.omega
+    power = dot_z(F, kin.v_z) + M * kin.omega
     return -power[:, 1:].sum(axis=1) / kin.omega[:, 1]
 
 

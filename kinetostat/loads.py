@@ -1,7 +1,7 @@
 """Applied loads (seed 000 sec. 2-4): gravity, external forces and moments, springs, inertia.
 
-Every load is reduced to a wrench per link: force F (N, world) and moment M (N m, about +z)
-about the link's local origin, stacked as F (N, L, 2), M (N, L).
+Every load is reduced to a wrench per link: force F (N, world, complex x + iy) and moment M
+(N m, about +z) about the link's local origin, stacked as F (N, L), M (N, L).
 """
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .planar import cross
+from .planar import cross_z, dot_z
 
 if TYPE_CHECKING:
     from .kinematics import Kinematics
@@ -21,33 +21,34 @@ __all__ = ["applied_wrenches", "com_positions", "inertia_loads", "load_magnitude
 
 def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
     F[:, k] += f
-    M[:, k] += cross(X - kin.origin[:, k], f)
+    M[:, k] += cross_z(X - kin.origin_z[:, k], f)
 
 
 def com_positions(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
-    """Positions (N, L, 2) and accelerations (N, L, 2) of the centres of mass (link origin if massless)."""
-    S, aS = kin.origin.copy(), kin.a_origin.copy()
+    """Complex positions (N, L) and accelerations (N, L) of the centres of mass (the link
+    origin where a link has no centre of mass)."""
+    S, aS = kin.origin_z.copy(), kin.a_z.copy()
     for link in mech.links[1:]:
         if link.com:
-            S[:, link.id], _, aS[:, link.id] = kin.point(link.id, link.points[link.com])
+            S[:, link.id], _, aS[:, link.id] = kin.point_z(link.id, link.points[link.com])
     return S, aS
 
 
 def inertia_loads(mech: "Mechanism", kin: "Kinematics", aS: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Main vector F_i = -m a_S (N, L, 2) at the centre of mass and main moment M_i = -I_S eps (N, L)."""
+    """Main vector F_i = -m a_S (N, L) complex, at the centre of mass, and main moment
+    M_i = -I_S eps (N, L)."""
     mass = np.array([link.mass for link in mech.links])
     I_S = np.array([link.I_S for link in mech.links])
-    return -mass[None, :, None] * aS, -I_S[None, :] * kin.eps
+    return -mass * aS, -I_S * kin.eps
 
 
 def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """All applied loads (gravity, external forces and moments, springs; no inertia) on each link
-    as a wrench about its local origin: F (N, L, 2), M (N, L). S: centres of mass (N, L, 2)."""
+    as a wrench about its local origin: F (N, L) complex, M (N, L). S: centres of mass (N, L)."""
     N, L = kin.theta.shape
     mass = np.array([link.mass for link in mech.links])
-    F = np.zeros((N, L, 2))
-    F[:, :, 1] = -mech.g * mass
-    M = cross(S - kin.origin, F)
+    F = np.zeros((N, L), complex) - 1j * mech.g * mass
+    M = cross_z(S - kin.origin_z, F)
     for ld in mech.loads:
         mag = load_magnitude(mech, kin, ld)
         if ld.kind == "moment":
@@ -55,20 +56,20 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tup
                 mag = -np.sign(kin.omega[:, ld.link]) * np.abs(mag)
             M[:, ld.link] += mag
             continue
-        X, V, _ = kin.point(ld.link, mech.links[ld.link].points[ld.point])
+        X, V, _ = kin.point_z(ld.link, mech.links[ld.link].points[ld.point])
         if ld.direction == "against_velocity":
-            speed = np.linalg.norm(V, axis=-1, keepdims=True)
+            speed = np.abs(V)
             # at a dead centre the direction is undefined: no force where the speed is rounding
             moving = speed > 1e-9 * mech.size * mech.drive.omega
             with np.errstate(invalid="ignore", divide="ignore"):
                 e = np.where(moving, -V / speed, 0.0)
         else:
-            e = np.broadcast_to(np.asarray(ld.direction), (N, 2))
-        _add_force(F, M, kin, ld.link, mag[:, None] * e, X)
+            e = complex(*ld.direction)
+        _add_force(F, M, kin, ld.link, mag * e, X)
     for sp in mech.springs:
-        A, _, _ = kin.point(sp.a[0], mech.links[sp.a[0]].points[sp.a[1]])
-        B, _, _ = kin.point(sp.b[0], mech.links[sp.b[0]].points[sp.b[1]])
-        length = np.linalg.norm(B - A, axis=-1, keepdims=True)
+        A = kin.point_z(sp.a[0], mech.links[sp.a[0]].points[sp.a[1]])[0]
+        B = kin.point_z(sp.b[0], mech.links[sp.b[0]].points[sp.b[1]])[0]
+        length = np.abs(B - A)
         f_on_b = -sp.stiffness * (length - sp.free_length) * (B - A) / length
         if sp.b[0]:
             _add_force(F, M, kin, sp.b[0], f_on_b, B)
@@ -86,31 +87,30 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarr
     if t.argument == "phi":
         return t.scale * np.interp(np.degrees(kin.phi) % 360.0, t.x, t.value, period=360.0)
     p = mech.links[ld.link].points[ld.point]
-    axis = np.asarray(t.axis if t.axis is not None else ld.direction)
-    X, V, _ = kin.point(ld.link, p)
-    key = ("stroke", ld.link, tuple(p), tuple(axis))
+    axis = complex(*(t.axis if t.axis is not None else ld.direction))
+    X, V, _ = kin.point_z(ld.link, p)
+    key = ("stroke", ld.link, tuple(p), axis)
     if key not in mech._derived:
         mech._derived[key] = _stroke(mech, ld.link, p, axis)
     lo, hi = mech._derived[key]
-    s = X @ axis
+    s = dot_z(X, axis)
     travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
-    forward = (-(V @ axis) if t.origin == "max" else V @ axis) >= 0
+    forward = (-dot_z(V, axis) if t.origin == "max" else dot_z(V, axis)) >= 0
     fwd = np.interp(travel, t.x, t.value)
     ret = fwd if t.value_return is None else np.interp(travel, t.x, t.value_return)
     return t.scale * np.where(forward, fwd, ret)
 
 
-def _stroke(mech: "Mechanism", k: int, p, axis: np.ndarray) -> tuple[float, float]:
+def _stroke(mech: "Mechanism", k: int, p, axis: complex) -> tuple[float, float]:
     """Extreme projections of a point's path on `axis` over a full cycle, m: the dead centres,
     where ds/dphi = 0, found by Newton's method from a coarse scan with the exact plans."""
     from .kinematics import kinematics
     w, e = mech.drive.omega, mech.drive.eps
 
     def state(phi):
-        kin = kinematics(mech, phi)
-        X, V, A = kin.point(k, p)
-        d1 = (V @ axis) / w                       # ds/dphi
-        return X @ axis, d1, (A @ axis - d1 * e) / w**2
+        X, V, A = kinematics(mech, phi).point_z(k, p)
+        d1 = dot_z(V, axis) / w                   # ds/dphi
+        return dot_z(X, axis), d1, (dot_z(A, axis) - d1 * e) / w**2
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

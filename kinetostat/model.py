@@ -188,6 +188,11 @@ class Mechanism:
     @property
     def size(self) -> float:
         """Characteristic length: the largest distance between two points of one link, m."""
+        if "size" not in self._derived:
+            self._derived["size"] = self._largest_link()
+        return self._derived["size"]
+
+    def _largest_link(self) -> float:
         best = 0.0
         for link in self.links[1:]:
             pts = list(link.points.values())

@@ -1,48 +1,79 @@
-"""Planar vector algebra on stacks of 2-vectors, shape (..., 2)."""
+"""Planar vector algebra. Inside the solver a plane vector is a complex number x + iy (Raven's
+complex-vector method): a turn by theta is a product with e^{i theta}, a turn by +90 deg a
+product with i, and one numpy operation acts on a whole stack of vectors. Public arrays are
+(..., 2) real; `as_xy` views complex stacks that way without copying.
+"""
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["cross", "rot90", "rotate", "unit", "decompose"]
+__all__ = ["as_z", "as_xy", "cross_z", "dot_z", "decompose", "condition",
+           "cross", "rot90", "rotate", "unit"]
 
 
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """z-component of a x b for stacks of 2-vectors: shape (...,)."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+def as_z(p) -> np.ndarray:
+    """(..., 2) real -> (...) complex."""
+    p = np.asarray(p, dtype=float)
+    return p[..., 0] + 1j * p[..., 1]
 
 
-def rot90(a: np.ndarray) -> np.ndarray:
-    """a turned by +90 deg (z x a)."""
-    return np.stack([-a[..., 1], a[..., 0]], axis=-1)
+def as_xy(z: np.ndarray) -> np.ndarray:
+    """(...) complex -> (..., 2) real view (no copy when z is contiguous)."""
+    z = np.asarray(z, dtype=complex)
+    flat = z.reshape(-1)
+    if not flat.flags.c_contiguous:
+        flat = flat.copy()
+    return flat.view(np.float64).reshape(z.shape + (2,))
 
 
-def rotate(p: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """Local vectors p (..., 2) turned by angles theta (...)."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1]], axis=-1)
+def cross_z(a, b):
+    """z-component of a x b for complex plane vectors."""
+    return (np.conj(a) * b).imag
 
 
-def unit(a: np.ndarray) -> np.ndarray:
-    return a / np.linalg.norm(a, axis=-1, keepdims=True)
+def dot_z(a, b):
+    return (np.conj(a) * b).real
 
 
-def decompose(v: np.ndarray, a: np.ndarray, b: np.ndarray,
-              la: float | None = None, lb: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Solve v = alpha a + beta b for every row: the closing of a vector polygon of a plan.
-
-    Returns alpha, beta and the 2-norm condition number of [a/la b/lb], the measure of a
-    singular position (inf where a and b are parallel). `la`, `lb` are reference sizes of
-    the columns (default: their own lengths, which makes the condition number a pure angle
-    measure; pass a length scale for columns that are lengths, so that a vanishing arm counts).
-    """
-    det = cross(a, b)
+def decompose(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Solve v = alpha a + beta b (complex stacks; alpha, beta real): the closing of a vector
+    polygon of a plan. Division by zero where a and b are parallel gives inf/nan there,
+    which the singular-position guard (`condition`) reports and marks."""
+    det = cross_z(a, b)
     with np.errstate(divide="ignore", invalid="ignore"):
-        alpha = cross(v, b) / det
-        beta = cross(a, v) / det
-        sa = np.linalg.norm(a, axis=-1) if la is None else la
-        sb = np.linalg.norm(b, axis=-1) if lb is None else lb
-        p, q = np.sum(a * a, axis=-1) / sa**2, np.sum(b * b, axis=-1) / sb**2
-        r = np.sum(a * b, axis=-1) / (sa * sb)
+        return cross_z(v, b) / det, cross_z(a, v) / det
+
+
+def condition(a: np.ndarray, b: np.ndarray, la: float | None = None, lb: float | None = None) -> np.ndarray:
+    """2-norm condition number of [a/la b/lb], the measure of a singular position (inf where
+    a and b are parallel). `la`, `lb` are reference sizes of the columns (default: their own
+    lengths, a pure angle measure; pass a length scale for columns that are lengths, so that a
+    vanishing arm counts)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sa = np.abs(a) if la is None else la
+        sb = np.abs(b) if lb is None else lb
+        a, b = a / sa, b / sb
+        p, q, r = np.abs(a) ** 2, np.abs(b) ** 2, dot_z(a, b)
         s1 = 0.5 * (p + q) + np.sqrt(0.25 * (p - q) ** 2 + r**2)   # largest squared singular value
-        cond = s1 / np.abs(det / (sa * sb))                       # sigma1 / sigma2 = s1 / |det|
-    return alpha, beta, cond
+        return s1 / np.abs(cross_z(a, b))                           # sigma1 / sigma2 = s1 / |det|
+
+
+# -- the same operations on public (..., 2) arrays
+def cross(a, b) -> np.ndarray:
+    """z-component of a x b for stacks of 2-vectors (..., 2)."""
+    return cross_z(as_z(a), as_z(b))
+
+
+def rot90(a) -> np.ndarray:
+    """(..., 2) vectors turned by +90 deg (z x a)."""
+    return as_xy(1j * as_z(a))
+
+
+def rotate(p, theta) -> np.ndarray:
+    """Local vectors p (..., 2) turned by angles theta (...)."""
+    return as_xy(as_z(p) * np.exp(1j * np.asarray(theta)))
+
+
+def unit(a) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    return a / np.linalg.norm(a, axis=-1, keepdims=True)
