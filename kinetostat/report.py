@@ -236,6 +236,7 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
                 run.rows += list(c.rows)
                 run.results.update(c.results)
                 run.skipped.update(c.skipped)
+                run.errors.update({r: m.splitlines()[0] for r, m in c.failed.items()})
         run.seconds[route] = time.perf_counter() - t0
         if route in TOLERANCES:
             run.tolerances[route] = TOLERANCES[route]

@@ -60,6 +60,15 @@ def test_missing_engine_is_skipped_not_passed(four_bar, monkeypatch):
     assert {r.route for r in c.rows} == {"pinocchio"}
 
 
+def test_a_route_that_raises_fails_the_gate_but_not_the_others(four_bar, monkeypatch):
+    def broken(scene):
+        raise RuntimeError("engine crashed")
+    monkeypatch.setitem(cmp.ROUTES, "pymunk", ("pymunk", broken))
+    c = cmp.compare(four_bar, engines=("pinocchio", "pymunk"), steps=36)
+    assert c.failed == {"pymunk": "RuntimeError: engine crashed"}
+    assert all(r.passed for r in c.rows) and not c.passed
+
+
 def test_unknown_route_is_named(four_bar):
     with pytest.raises(ValueError, match=r"unknown engine route\(s\) \['bullet'\]. Valid names: \['pinocchio'"):
         cmp.compare(four_bar, engines=("bullet",))

@@ -90,11 +90,13 @@ class Comparison:
     rows: tuple[Row, ...]
     results: dict[str, EngineResult]
     skipped: dict[str, str] = field(default_factory=dict)   # route -> reason
+    failed: dict[str, str] = field(default_factory=dict)    # route -> exception raised by it
     solver_seconds: float = 0.0
 
     @property
     def passed(self) -> bool:
-        return all(r.passed for r in self.rows)
+        """Every compared quantity within tolerance, no route raised, something was compared."""
+        return bool(self.rows) and not self.failed and all(r.passed for r in self.rows)
 
     def to_frame(self):
         import pandas as pd
@@ -152,13 +154,17 @@ def compare(mech: Mechanism, engines=tuple(ROUTES), steps: int = 360, res: Analy
         res = analyze(mech, steps=steps)
     solver_seconds = time.perf_counter() - t0
     scene = build_scene(mech, res=res)
-    rows, results, skipped = [], {}, {}
+    rows, results, skipped, failed = [], {}, {}, {}
     for route in engines:
         why = available(route)
         if why:
             skipped[route] = why
             continue
-        er = ROUTES[route][1](scene)
+        try:
+            er = ROUTES[route][1](scene)
+        except Exception as exc:   # one broken route must not hide the others' verdicts
+            failed[route] = f"{type(exc).__name__}: {exc}"
+            continue
         results[route] = er
         rows += errors(res, er, tol[route].peak_relative, route)
-    return Comparison(mech, res, tuple(rows), results, skipped, solver_seconds)
+    return Comparison(mech, res, tuple(rows), results, skipped, failed, solver_seconds)
