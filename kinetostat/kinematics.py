@@ -66,6 +66,10 @@ class Kinematics:
         """(N, L, 2) acceleration of each link's local origin, m/s^2."""
         return as_xy(self.a_z)
 
+    def position_z(self, k: int, p) -> np.ndarray:
+        """Complex position (N,) of local point p of link k."""
+        return self.origin_z[:, k] + complex(p[0], p[1]) * self.rot[:, k]
+
     def point_z(self, k: int, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Complex position, velocity, acceleration (each (N,)) of local point p of link k."""
         r = complex(p[0], p[1]) * self.rot[:, k]
@@ -93,6 +97,9 @@ class _Plan:
         x, y = self.mech.links[k].points[name]
         return complex(x, y)
 
+    def position(self, k: int, name: str) -> np.ndarray:
+        return self.O[:, k] + self.local(k, name) * self.rot[:, k]
+
     def point(self, k: int, name: str):
         r = self.local(k, name) * self.rot[:, k]
         w, e = self.w[:, k], self.e[:, k]
@@ -104,9 +111,9 @@ class _Plan:
         w, e = self.w[:, k], self.e[:, k]
         return self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
 
-    def set_link(self, k: int, th, X, x_local, w, V, e, A) -> None:
-        """Fix link k from its angle and the world state of one of its points."""
-        rot = np.exp(1j * th)
+    def set_link(self, k: int, th, X, x_local, w, V, e, A, rot=None) -> None:
+        """Fix link k from its angle (and e^{i th}, if known) and the world state of one of its points."""
+        rot = np.exp(1j * th) if rot is None else rot
         r = x_local * rot
         self.th[:, k], self.rot[:, k], self.w[:, k], self.e[:, k] = th, rot, w, e
         self.O[:, k] = X - r
@@ -181,7 +188,7 @@ def _rrp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     P, VP, AP = pl.point(a, pj.point)
     th_k = pl.turned(pk, k, pl.th[:, b])
     d = pl.guide(pk, k, th_k)
-    K, _, _ = pl.point(b, pl.anchor(pk, b))
+    K = pl.position(b, pl.anchor(pk, b))
     lj, cB = pl.length(j, pj.point, pin.point), pl.offset(pk, k, pin.point)
     w = K - cB * 1j * d - P                        # B = K + t d - cB n lies on a circle about P
     wd = dot_z(w, d)
@@ -214,11 +221,12 @@ def _rpr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     delta = np.angle(QP) + (s if g.branch > 0 else np.pi - s)
     d = np.exp(1j * delta)
     th_k = delta - pin.alpha
+    rot_k = d / complex(*pin.direction)
     # v_P = v_Q + w_k x QP + v_r d ;  a_P = a_Q - w_k^2 QP + e_k x QP + 2 w_k x v_r d + a_r d
     wk, vr = decompose(VP - VQ, 1j * QP, d)
     ek, ar = decompose(AP - AQ + wk**2 * QP - 2j * wk * vr * d, 1j * QP, d)
-    pl.set_link(k, th_k, Q, pl.local(k, pk.point), wk, VQ, ek, AQ)
-    pl.set_link(j, th_k + pin.alpha, P, pl.local(j, pj.point), wk, VP, ek, AP)
+    pl.set_link(k, th_k, Q, pl.local(k, pk.point), wk, VQ, ek, AQ, rot_k)
+    pl.set_link(j, th_k + pin.alpha, P, pl.local(j, pj.point), wk, VP, ek, AP, d)
     pl.slide(pin, j, vr, ar)
     return condition(1j * QP, d, pl.L, 1.0)
 
@@ -227,8 +235,8 @@ def _prp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     th_j, th_k = pl.turned(pj, j, pl.th[:, a]), pl.turned(pk, k, pl.th[:, c])
     da, dc = pl.guide(pj, j, th_j), pl.guide(pk, k, th_k)
-    Ka = pl.point(a, pl.anchor(pj, a))[0] - pl.offset(pj, j, pin.point) * 1j * da
-    Kc = pl.point(c, pl.anchor(pk, c))[0] - pl.offset(pk, k, pin.point) * 1j * dc
+    Ka = pl.position(a, pl.anchor(pj, a)) - pl.offset(pj, j, pin.point) * 1j * da
+    Kc = pl.position(c, pl.anchor(pk, c)) - pl.offset(pk, k, pin.point) * 1j * dc
     t, _ = decompose(Kc - Ka, da, -dc)        # B on both lines
     B = Ka + t * da
     VBa, ABa = pl.at(a, B)
@@ -255,7 +263,7 @@ def _rpp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     rot_j, rot_k = np.exp(1j * th_j), np.exp(1j * th_k)
     Oj = P - pl.local(j, pj.point) * rot_j
     Kj = Oj + pl.local(j, pl.anchor(pin, j)) * rot_j             # on the inner guide line
-    Kc = pl.point(c, pl.anchor(pk, c))[0]                         # on the outer guide line
+    Kc = pl.position(c, pl.anchor(pk, c))                         # on the outer guide line
     rY = pl.local(k, pl.anchor(pin, k)) * rot_k
     rX = pl.local(k, pl.anchor(pk, k)) * rot_k
     # k's anchor Y = Kj + s d_in on the inner line, its anchor X = Y + rX - rY on the outer line
@@ -297,13 +305,16 @@ def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     for n, g in enumerate(groups):
         cond[:, n] = _GROUP_SOLVERS[g.kind](pl, g)
     singular = _guard(mech, phi, cond)
-    for arr in (pl.w, pl.e, pl.V, pl.A, pl.vs, pl.as_):
-        arr[singular] = np.nan
+    if singular.any():
+        for arr in (pl.w, pl.e, pl.V, pl.A, pl.vs, pl.as_):
+            arr[singular] = np.nan
     return Kinematics(phi, pl.th, pl.rot, pl.O, pl.V, pl.A, pl.w, pl.e, pl.vs, pl.as_, cond, singular)
 
 
 def _guard(mech: "Mechanism", phi: np.ndarray, cond: np.ndarray) -> np.ndarray:
     cond = np.where(np.isnan(cond), np.inf, cond)
+    if not (cond > COND_WARN).any():
+        return np.zeros(len(phi), bool)
     for n, g in enumerate(mech.structure.groups):
         near = cond[:, n] > COND_WARN
         if near.any():

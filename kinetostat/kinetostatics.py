@@ -43,7 +43,7 @@ class _Statics:
         self.x = np.full((N, len(mech.pairs)), np.nan)
 
     def at(self, k: int, name: str) -> np.ndarray:
-        return self.kin.point_z(k, self.mech.links[k].points[name])[0]
+        return self.kin.position_z(k, self.mech.links[k].points[name])
 
     def moment(self, k: int, X: np.ndarray) -> np.ndarray:
         """Moment about X of the known loads on link k."""

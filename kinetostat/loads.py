@@ -26,12 +26,10 @@ def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) ->
 
 def com_positions(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
     """Complex positions (N, L) and accelerations (N, L) of the centres of mass (the link
-    origin where a link has no centre of mass)."""
-    S, aS = kin.origin_z.copy(), kin.a_z.copy()
-    for link in mech.links[1:]:
-        if link.com:
-            S[:, link.id], _, aS[:, link.id] = kin.point_z(link.id, link.points[link.com])
-    return S, aS
+    origin where a link has no centre of mass), all links at once."""
+    com = np.array([complex(*link.points[link.com]) if link.com else 0j for link in mech.links])
+    r = com * kin.rot
+    return kin.origin_z + r, kin.a_z + (1j * kin.eps - kin.omega**2) * r
 
 
 def inertia_loads(mech: "Mechanism", kin: "Kinematics", aS: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -67,8 +65,8 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tup
             e = complex(*ld.direction)
         _add_force(F, M, kin, ld.link, mag * e, X)
     for sp in mech.springs:
-        A = kin.point_z(sp.a[0], mech.links[sp.a[0]].points[sp.a[1]])[0]
-        B = kin.point_z(sp.b[0], mech.links[sp.b[0]].points[sp.b[1]])[0]
+        A = kin.position_z(sp.a[0], mech.links[sp.a[0]].points[sp.a[1]])
+        B = kin.position_z(sp.b[0], mech.links[sp.b[0]].points[sp.b[1]])
         length = np.abs(B - A)
         f_on_b = -sp.stiffness * (length - sp.free_length) * (B - A) / length
         if sp.b[0]:

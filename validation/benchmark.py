@@ -1,38 +1,105 @@
-"""Benchmark: run time of the solver (and of every engine route) per bundled model.
+"""Benchmark: run time against error for the solver and every engine route, per bundled model.
 
-    python -m validation.benchmark            # print the figures
-    python -m validation.benchmark --engines  # also time the engine routes over the same cycle
+    python -m validation.benchmark              # full study: writes reports/benchmark.{md,csv,png}
+    python -m validation.benchmark --quick      # fewer repeats and settings, prints only
 
-Prints figures only; nothing is asserted (speed is measured, not tested).
+Every route runs over the same full cycle (360 angles) and is timed as the median of repeated
+runs in one process; its error is the worst peak-relative error over the driving moment and
+all reactions against the mpmath reference (`validation.reference`, 40 digits). Figures are
+printed and written, never asserted: speed is measured, not tested.
 """
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import statistics
 import time
 import warnings
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 import kinetostat
 from kinetostat.kinematics import kinematics
 
+from .compare import errors
+from .scene import EngineResult, Scene, build_scene
+
 ROOT = Path(__file__).resolve().parents[1]
+ANGLES = 360
 
 
-def median_seconds(fn, repeat: int = 15) -> float:
-    """Median wall time of `fn()` over `repeat` runs after one warm-up, s."""
-    fn()
+def median_seconds(fn: Callable[[], object], repeat: int) -> tuple[float, object]:
+    """Median wall time of `fn()` over `repeat` runs after one warm-up, s, and its last result."""
+    out = fn()
     times = []
     for _ in range(repeat):
         t = time.perf_counter()
-        fn()
+        out = fn()
         times.append(time.perf_counter() - t)
-    return statistics.median(times)
+    return statistics.median(times), out
 
 
-def solver_table(models: list[Path]) -> list[dict]:
+def _solver_result(scene: Scene) -> EngineResult:
+    res = kinetostat.analyze(scene.mech, phi_deg=scene.phi_deg)
+    return EngineResult("kinetostat", "exact", res.phi_deg, res.balancing_moment, res.forces.R)
+
+
+def routes(quick: bool) -> list[tuple[str, str, Callable[[Scene], EngineResult]]]:
+    """(route, setting, runner) for every route and setting of the study."""
+    from . import engine_mujoco, engine_pinocchio, engine_pymunk
+    out = [("kinetostat", "closed form", _solver_result),
+           ("pinocchio", "exact state", engine_pinocchio.solve),
+           ("mujoco", "exact state", engine_mujoco.solve)]
+    for n in ((3600,) if quick else (1800, 3600, 7200)):
+        out.append(("mujoco-sim", f"{n} steps/rev", lambda s, n=n: engine_mujoco.simulate(s, steps_per_rev=n)))
+    for n in ((1440,) if quick else (720, 1440, 2880)):
+        out.append(("pymunk", f"{n} steps/rev", lambda s, n=n: engine_pymunk.simulate(s, steps_per_rev=n)))
+    if not quick:
+        out.append(("pymunk", "1000 iterations", lambda s: engine_pymunk.simulate(s, iterations=1000)))
+        out.append(("pymunk", "Richardson 1440/2880", lambda s: engine_pymunk.simulate(s, richardson=True)))
+    return out
+
+
+def worst_error(res: kinetostat.Analysis, M_ref: np.ndarray, R_ref: np.ndarray, er: EngineResult) -> float:
+    """Worst peak-relative error of an engine result against the reference, over all quantities."""
+    ref = dataclasses.replace(res, forces=dataclasses.replace(res.forces, R=R_ref, M_bal=M_ref))
+    rows = errors(ref, er, np.inf, "")
+    return float(np.nanmax([r.peak_relative for r in rows]))
+
+
+def study(models: list[Path], quick: bool) -> list[dict]:
+    from .reference import reference
+    rows = []
+    for path in models:
+        mech = kinetostat.load(path)
+        scene = build_scene(mech, steps=ANGLES)
+        M_ref, R_ref = reference(mech, scene.phi_deg, res=scene.res)
+        for route, setting, run in routes(quick):
+            repeat = 3 if quick else (20 if route in ("kinetostat", "pinocchio", "mujoco") else 3)
+            seconds, er = median_seconds(lambda: run(scene), repeat)
+            rows.append(dict(model=path.stem, route=route, setting=setting, seconds=seconds,
+                             error=worst_error(scene.res, M_ref, R_ref, er),
+                             magnitudes_only=er.magnitudes_only))
+            print(f"{path.stem:24s} {route:11s} {setting:22s} {seconds * 1e3:10.3f} ms  error {rows[-1]['error']:.2e}",
+                  flush=True)
+    return rows
+
+
+def throughput(mech: kinetostat.Mechanism) -> list[dict]:
+    """The solver's full kinetostatic analysis on large batches of angles."""
+    out = []
+    rng = np.random.default_rng(0)
+    for n in (10**4, 10**5, 10**6):
+        phi = rng.uniform(0.0, 360.0, n)
+        seconds, _ = median_seconds(lambda: kinetostat.analyze(mech, phi_deg=phi), 3 if n < 10**6 else 1)
+        out.append(dict(angles=n, seconds=seconds, per_second=n / seconds))
+    return out
+
+
+def kinematics_table(models: list[Path]) -> list[dict]:
+    """Kinematics and full analysis of a 360-angle cycle, and positions per second (10^5 angles)."""
     rows = []
     phi = np.radians(np.arange(360.0))
     batch = np.radians(np.random.default_rng(0).uniform(0, 360, 100_000))
@@ -40,34 +107,89 @@ def solver_table(models: list[Path]) -> list[dict]:
         mech = kinetostat.load(path)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            t_kin = median_seconds(lambda: kinematics(mech, phi))
-            t_all = median_seconds(lambda: kinetostat.analyze(mech, steps=360))
-            t_batch = median_seconds(lambda: kinematics(mech, batch), repeat=3)
-        rows.append(dict(model=path.stem, kin_ms=t_kin * 1e3, kinetostatics_ms=t_all * 1e3,
+            t_kin, _ = median_seconds(lambda: kinematics(mech, phi), 20)
+            t_all, _ = median_seconds(lambda: kinetostat.analyze(mech, steps=360), 20)
+            t_batch, _ = median_seconds(lambda: kinematics(mech, batch), 3)
+        rows.append(dict(model=path.stem, kinematics_ms=t_kin * 1e3, analysis_ms=t_all * 1e3,
                          positions_per_s=len(batch) / t_batch))
     return rows
 
 
+def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], out: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    out.mkdir(parents=True, exist_ok=True)
+    df = pd.DataFrame(rows)
+    df.to_csv(out / "benchmark.csv", index=False)
+    fig, ax = plt.subplots(figsize=(8.5, 6))
+    markers = dict(zip(sorted(df.model.unique()), "osD^v<>pPX"))
+    colours = dict(zip(df.route.unique(), plt.rcParams["axes.prop_cycle"].by_key()["color"]))
+    for (model, route), g in df.groupby(["model", "route"], sort=False):
+        ax.scatter(g.seconds * 1e3, g.error.clip(lower=1e-17), marker=markers[model], color=colours[route],
+                   s=36, alpha=0.85)
+    for route, c in colours.items():
+        ax.scatter([], [], color=c, label=route)
+    for model, m in markers.items():
+        ax.scatter([], [], color="grey", marker=m, label=model)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(f"wall time of one cycle ({ANGLES} angles), ms (median of repeated runs)")
+    ax.set_ylabel("worst peak-relative error vs 40-digit reference")
+    ax.set_title("Run time against error, per route and setting")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2, loc="center right")
+    fig.tight_layout()
+    fig.savefig(out / "benchmark.png", dpi=120)
+    plt.close(fig)
+
+    lines = ["# Benchmark: run time against error", "",
+             f"Every route runs the same full cycle ({ANGLES} crank angles) of each bundled model; time is the "
+             "median of repeated runs in one process (20 for the exact routes, 3 for simulations), error the "
+             "worst peak-relative error over the driving moment and every reaction against the mpmath reference "
+             "(`validation/reference.py`, 40 digits; pymunk: magnitudes). Regenerate with "
+             "`python -m validation.benchmark`.", "", "![time against error](benchmark.png)", "",
+             "## Solver against the fastest engine route (same run)", "",
+             "| model | solver | its error | fastest engine route | its time | its error | speed-up |",
+             "|---|---|---|---|---|---|---|"]
+    for model, g in df.groupby("model"):
+        s = g[g.route == "kinetostat"].iloc[0]
+        e = g[g.route != "kinetostat"].sort_values("seconds").iloc[0]
+        lines.append(f"| {model} | {s.seconds * 1e3:.3f} ms | {s.error:.1e} | {e.route} ({e.setting}) | "
+                     f"{e.seconds * 1e3:.2f} ms | {e.error:.1e} | {e.seconds / s.seconds:.0f}x |")
+    lines += ["", "## Every route and setting", "", "| model | route | setting | time, ms | error |", "|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['model']} | {r['route']} | {r['setting']} | {r['seconds'] * 1e3:.3f} | {r['error']:.2e} |")
+    lines += ["", "## Solver: a 360-angle cycle, and positions per second", "",
+              "| model | kinematics, ms | full analysis, ms | positions/s (10^5 angles) |", "|---|---|---|---|"]
+    for r in kin_rows:
+        lines.append(f"| {r['model']} | {r['kinematics_ms']:.3f} | {r['analysis_ms']:.3f} | {r['positions_per_s']:.3g} |")
+    lines += ["", "## Solver throughput on large batches (slotted-link shaper, full analysis)", "",
+              "| angles | time, s | angles/s |", "|---|---|---|"]
+    for r in thr:
+        lines.append(f"| {r['angles']:,} | {r['seconds']:.3f} | {r['per_second']:.3g} |")
+    (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--engines", action="store_true", help="also time the engine routes")
+    ap.add_argument("--quick", action="store_true", help="fewer repeats and settings; print only")
+    ap.add_argument("--out", type=Path, default=ROOT / "reports", help="folder for benchmark.{md,csv,png}")
     args = ap.parse_args(argv)
     models = sorted((ROOT / "models").glob("*.toml"))
-    print(f"{'model':26s} {'kinematics 360':>15s} {'full analysis 360':>18s} {'kinematics, 1e5 angles':>24s}")
-    for r in solver_table(models):
-        print(f"{r['model']:26s} {r['kin_ms']:12.3f} ms {r['kinetostatics_ms']:15.3f} ms "
-              f"{r['positions_per_s']:17.3g} pos/s")
-    if args.engines:
-        from validation.compare import ROUTES, available
-        from validation.scene import build_scene
-        print(f"\n{'model':26s} {'route':12s} {'build':>10s} {'cycle (360)':>12s}")
-        for path in models:
-            scene = build_scene(kinetostat.load(path), steps=360)
-            for route, (_, run) in ROUTES.items():
-                if available(route):
-                    continue
-                er = run(scene)
-                print(f"{path.stem:26s} {route:12s} {er.build_seconds * 1e3:7.1f} ms {er.run_seconds * 1e3:9.1f} ms")
+    kin_rows = kinematics_table(models)
+    for r in kin_rows:
+        print(f"{r['model']:24s} kinematics {r['kinematics_ms']:.3f} ms, analysis {r['analysis_ms']:.3f} ms, "
+              f"{r['positions_per_s']:.3g} positions/s")
+    thr = throughput(kinetostat.load(ROOT / "models" / "slotted_link_shaper.toml"))
+    for r in thr:
+        print(f"throughput: {r['angles']:>9,} angles in {r['seconds']:.3f} s = {r['per_second']:.3g} angles/s")
+    rows = study(models, args.quick)
+    if not args.quick:
+        write_report(rows, kin_rows, thr, args.out)
+        print(f"wrote {args.out / 'benchmark.md'}")
 
 
 if __name__ == "__main__":
