@@ -202,6 +202,11 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     if phi_deg.ndim != 1 or not np.all(np.isfinite(phi_deg)):
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     kin = kinematics(mech, np.radians(phi_deg))
+    with np.errstate(divide="ignore", invalid="ignore"):    # NaN only at angles marked singular
+        return _kinetostatics(mech, kin)
+
+
+def _kinetostatics(mech: Mechanism, kin: Kinematics) -> Analysis:
     S, aS = com_positions(mech, kin)
     F_app, M_app = applied_wrenches(mech, kin, S)
     F_i, M_i = inertia_loads(mech, kin, aS)

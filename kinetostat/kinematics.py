@@ -92,10 +92,10 @@ class _Plan:
         self.O, self.V, self.A = (np.zeros((N, L), complex) for _ in range(3))
         self.vs, self.as_ = np.zeros((N, len(mech.pairs))), np.zeros((N, len(mech.pairs)))
         self.L = mech.size
+        self.locals = _locals(mech)
 
     def local(self, k: int, name: str) -> complex:
-        x, y = self.mech.links[k].points[name]
-        return complex(x, y)
+        return self.locals[k][name]
 
     def position(self, k: int, name: str) -> np.ndarray:
         return self.O[:, k] + self.local(k, name) * self.rot[:, k]
@@ -160,6 +160,13 @@ class _Plan:
         if bad.any():
             raise AssemblyError(g.label, np.degrees(self.phi[bad]), why)
         return np.sqrt(np.maximum(disc, 0.0))
+
+
+def _locals(mech: "Mechanism") -> list[dict[str, complex]]:
+    """Local coordinates of every link's points as complex numbers (memoised per mechanism)."""
+    if "locals" not in mech._derived:
+        mech._derived["locals"] = [{n: complex(*xy) for n, xy in link.points.items()} for link in mech.links]
+    return mech._derived["locals"]
 
 
 def _rrr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
@@ -293,6 +300,11 @@ def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     accelerations to NaN where its condition number exceeds COND_MAX.
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    with np.errstate(divide="ignore", invalid="ignore"):    # singular angles: the guard marks them
+        return _solve(mech, phi)
+
+
+def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     pl = _Plan(mech, phi)
     dr = mech.drive
     arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)

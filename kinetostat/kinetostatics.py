@@ -68,8 +68,7 @@ class _Statics:
         n = self.normal(p)
         N = dot_z(n, f)
         S = self.at(p.links[1], p.point)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            self.x[:, p.index] = np.where(N != 0, m / N - cross_z(S - X0, n), np.nan)
+        self.x[:, p.index] = np.where(N != 0, m / N - cross_z(S - X0, n), np.nan)
 
 
 def _rrr(st: _Statics, g: "AssurGroup") -> None:
@@ -109,8 +108,7 @@ def _rpr(st: _Statics, g: "AssurGroup") -> None:
     P, Q, n = st.at(j, pj.point), st.at(k, pk.point), st.normal(pin)
     mP = st.moment(j, P)
     # moment of the whole group about Q fixes the normal force of the slotted link on the block
-    with np.errstate(divide="ignore", invalid="ignore"):
-        f_kj = (mP + st.moment(k, Q)) / cross_z(P - Q, n) * n
+    f_kj = (mP + st.moment(k, Q)) / cross_z(P - Q, n) * n
     R_aj, R_ck = -st.F[:, j] - f_kj, f_kj - st.F[:, k]
     st.revolute(pj, a, R_aj)
     st.prismatic(pin, k, f_kj, -mP, P)
@@ -153,7 +151,9 @@ _GROUP_SOLVERS: dict[str, Callable[[_Statics, "AssurGroup"], None]] = {
 
 def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -> Forces:
     """Reactions in every pair and the balancing load, from the known wrenches F (complex),
-    M per link (applied + inertia, about each link's local origin)."""
+    M per link (applied + inertia, about each link's local origin). Call under
+    np.errstate(divide="ignore", invalid="ignore"), as `analyze` does: at angles the kinematics
+    marked singular the divisions give NaN, by design."""
     st = _Statics(mech, kin, F, M)
     for g in reversed(mech.structure.groups):
         _GROUP_SOLVERS[g.kind](st, g)
@@ -191,16 +191,11 @@ def lever_moment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndar
 def friction_power(mech: "Mechanism", kin: "Kinematics", R: np.ndarray) -> np.ndarray:
     """Power lost in every pair (seed 003), W, (N, n_pairs): R f r |w_i - w_j| in a revolute
     pair, R f |v_rel| in a prismatic one, from the frictionless reactions. Zeros without friction."""
-    out = np.zeros(R.shape[:2])
     fr = mech.friction
     if fr is None:
-        return out
-    mag = np.linalg.norm(R, axis=-1)
-    for p in mech.pairs:
-        if p.kind == "R":
-            r = p.radius if p.radius is not None else fr.radius
-            i, j = p.links
-            out[:, p.index] = mag[:, p.index] * fr.f * r * np.abs(kin.omega[:, i] - kin.omega[:, j])
-        else:
-            out[:, p.index] = mag[:, p.index] * fr.f * np.abs(kin.v_slide[:, p.index])
-    return out
+        return np.zeros(R.shape[:2])
+    i, j = np.array([p.links for p in mech.pairs]).T
+    revolute = np.array([p.kind == "R" for p in mech.pairs])
+    r = np.array([(p.radius if p.radius is not None else fr.radius) if p.kind == "R" else 0.0 for p in mech.pairs])
+    speed = np.where(revolute, r * np.abs(kin.omega[:, i] - kin.omega[:, j]), np.abs(kin.v_slide))
+    return np.abs(as_z(R)) * fr.f * speed

@@ -59,8 +59,7 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tup
             speed = np.abs(V)
             # at a dead centre the direction is undefined: no force where the speed is rounding
             moving = speed > 1e-9 * mech.size * mech.drive.omega
-            with np.errstate(invalid="ignore", divide="ignore"):
-                e = np.where(moving, -V / speed, 0.0)
+            e = np.where(moving, -V / np.where(moving, speed, 1.0), 0.0)
         else:
             e = complex(*ld.direction)
         _add_force(F, M, kin, ld.link, mag * e, X)
@@ -83,7 +82,12 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarr
         return np.full(N, ld.value)
     t = ld.table
     if t.argument == "phi":
-        return t.scale * np.interp(np.degrees(kin.phi) % 360.0, t.x, t.value, period=360.0)
+        key = ("periodic", id(t))
+        if key not in mech._derived:     # the diagram repeated once on each side: no sort per call
+            x = np.asarray(t.x)
+            mech._derived[key] = (np.concatenate([x - 360.0, x, x + 360.0]), np.tile(t.value, 3))
+        xp, vp = mech._derived[key]
+        return t.scale * np.interp(np.degrees(kin.phi) % 360.0, xp, vp)
     p = mech.links[ld.link].points[ld.point]
     axis = complex(*(t.axis if t.axis is not None else ld.direction))
     X, V, _ = kin.point_z(ld.link, p)

@@ -28,20 +28,19 @@ def as_xy(z: np.ndarray) -> np.ndarray:
 
 def cross_z(a, b):
     """z-component of a x b for complex plane vectors."""
-    return (np.conj(a) * b).imag
+    return a.real * b.imag - a.imag * b.real
 
 
 def dot_z(a, b):
-    return (np.conj(a) * b).real
+    return a.real * b.real + a.imag * b.imag
 
 
 def decompose(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Solve v = alpha a + beta b (complex stacks; alpha, beta real): the closing of a vector
-    polygon of a plan. Division by zero where a and b are parallel gives inf/nan there,
-    which the singular-position guard (`condition`) reports and marks."""
+    polygon of a plan. Where a and b are parallel this divides by zero (inf/nan there, the
+    callers run under np.errstate): the singular-position guard (`condition`) reports and marks it."""
     det = cross_z(a, b)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return cross_z(v, b) / det, cross_z(a, v) / det
+    return cross_z(v, b) / det, cross_z(a, v) / det
 
 
 def condition(a: np.ndarray, b: np.ndarray, la: float | None = None, lb: float | None = None) -> np.ndarray:
@@ -49,19 +48,19 @@ def condition(a: np.ndarray, b: np.ndarray, la: float | None = None, lb: float |
     a and b are parallel). `la`, `lb` are reference sizes of the columns (default: their own
     lengths, a pure angle measure; pass a length scale for columns that are lengths, so that a
     vanishing arm counts)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sa = np.abs(a) if la is None else la
-        sb = np.abs(b) if lb is None else lb
-        a, b = a / sa, b / sb
-        p, q, r = np.abs(a) ** 2, np.abs(b) ** 2, dot_z(a, b)
-        s1 = 0.5 * (p + q) + np.sqrt(0.25 * (p - q) ** 2 + r**2)   # largest squared singular value
-        return s1 / np.abs(cross_z(a, b))                           # sigma1 / sigma2 = s1 / |det|
+    sa = np.abs(a) if la is None else la
+    sb = np.abs(b) if lb is None else lb
+    a, b = a / sa, b / sb
+    p, q, r = a.real**2 + a.imag**2, b.real**2 + b.imag**2, dot_z(a, b)
+    s1 = 0.5 * (p + q) + np.sqrt(0.25 * (p - q) ** 2 + r**2)   # largest squared singular value
+    return s1 / np.abs(cross_z(a, b))                           # sigma1 / sigma2 = s1 / |det|
 
 
 # -- the same operations on public (..., 2) arrays
 def cross(a, b) -> np.ndarray:
     """z-component of a x b for stacks of 2-vectors (..., 2)."""
-    return cross_z(as_z(a), as_z(b))
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 def rot90(a) -> np.ndarray:
