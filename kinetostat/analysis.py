@@ -152,7 +152,8 @@ class Analysis:
         Columns (SI): phi_deg; x_P, y_P, vx_P, vy_P, ax_P, ay_P for every point P;
         theta_k, omega_k, eps_k for every link k; Fix_k, Fiy_k, Mi_k, h_k inertia of every
         link with mass or inertia; Rx_i_j, Ry_i_j, R_i_j (force of i on j and its magnitude)
-        for every pair, x_i_j for prismatic pairs; M_bal, M_lever, and for a machine
+        for every pair, x_i_j and m_i_j (line of the normal force, its moment about the slider
+        point) for prismatic pairs; M_bal, M_lever, and for a machine
         F_bal (magnitude) with F_balx, F_baly; Pfr_i_j per pair and Pfr_total when the model has
         friction; cond_<group> per group; singular.
         """
@@ -177,6 +178,7 @@ class Analysis:
             cols[f"R_{i}_{j}"] = np.linalg.norm(R, axis=-1)
             if p.kind == "P":
                 cols[f"x_{i}_{j}"] = self.forces.x[:, p.index]
+                cols[f"m_{i}_{j}"] = self.forces.m[:, p.index]
         cols["M_bal"], cols["M_lever"] = self.balancing_moment, self.lever_moment
         if m.drive.kind == "machine":
             cols["F_balx"], cols["F_baly"] = self.balancing_force[:, 0], self.balancing_force[:, 1]
@@ -194,11 +196,17 @@ class Analysis:
 def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
     or at `steps` equal steps over a full revolution when `phi_deg` is None."""
+    if not isinstance(mech, Mechanism):
+        raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
+                        f"read a model file with kinetostat.load(path)")
     if phi_deg is None:
-        if not isinstance(steps, (int, np.integer)) or steps < 1:
+        if not isinstance(steps, (int, np.integer)) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps: expected a positive integer, got {steps!r}")
         phi_deg = np.arange(steps) * (360.0 / steps)
-    phi_deg = np.atleast_1d(np.asarray(phi_deg, dtype=float))
+    try:
+        phi_deg = np.atleast_1d(np.asarray(phi_deg, dtype=float))
+    except (TypeError, ValueError):
+        raise ValueError(f"phi_deg: expected finite crank angles in degrees, got {phi_deg!r}") from None
     if phi_deg.ndim != 1 or not np.all(np.isfinite(phi_deg)):
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     kin = kinematics(mech, np.radians(phi_deg))

@@ -163,9 +163,9 @@ def _load(path: str | Path):
 
 
 def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
-    """analyze() with AssemblyError as a CLIError and warnings printed as one line each."""
+    """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each."""
     from .analysis import analyze
-    from .errors import AssemblyError
+    from .errors import AssemblyError, ModelError
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -173,6 +173,8 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
             res = analyze(mech, phi_deg=phi_deg, steps=steps)
         except AssemblyError as exc:
             raise CLIError(f"{path}: {exc}") from None
+        except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
+            raise CLIError(_model_error_text(exc)) from None
     seen = set()
     for w in caught:
         text = str(w.message).splitlines()[0]

@@ -22,12 +22,14 @@ if TYPE_CHECKING:
 __all__ = ["Kinematics", "kinematics", "COND_WARN", "COND_MAX"]
 
 #: Above this condition number of a group's plan a SingularPositionWarning names the angles.
-#: Results keep about 16 - log10(cond) significant digits, so 1e3 still leaves ~13.
+#: Near a singular position the forces' sensitivity to the input (one ulp of a length or of
+#: the angle) grows as cond^2 (measured: reports/stability.md), so results keep about
+#: 16 - 2 log10(cond) significant digits: 1e3 still leaves ~10.
 COND_WARN = 1e3
 #: Above this the group is taken as singular (toggle / dead centre of the group): velocities,
 #: accelerations and every force at those angles are set to NaN and the reason is recorded.
-#: Fewer than 8 digits would be meaningful and forces exceed 1e8 times the loads' scale.
-COND_MAX = 1e8
+#: Fewer than ~6 digits would be meaningful.
+COND_MAX = 1e5
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,10 @@ __all__ = ["Forces", "forces", "gear_force", "lever_moment", "friction_power"]
 class Forces:
     """Reactions and balancing loads at N crank angles."""
     R: np.ndarray         # (N, n_pairs, 2) force of pair.links[0] on pair.links[1], N, world
-    x: np.ndarray         # (N, n_pairs) P pairs: line of the normal force at slider point + x d, m (NaN for R)
+    x: np.ndarray         # (N, n_pairs) P pairs: line of the normal force at slider point + x d, m
+                          #   (NaN for R pairs, and where the normal force is exactly 0)
+    m: np.ndarray         # (N, n_pairs) P pairs: moment of the reaction about the slider point, N m
+                          #   (= x N; carries a pure couple where N = 0); 0 for R pairs
     M_bal: np.ndarray     # (N,) moment the drive applies to the crank about +z, N m
     F_bal: np.ndarray     # (N, 2) machine: balancing force at the pitch point, N (zeros for an engine)
 
@@ -41,6 +44,7 @@ class _Statics:
         N = len(kin.phi)
         self.R = np.zeros((N, len(mech.pairs)), complex)
         self.x = np.full((N, len(mech.pairs)), np.nan)
+        self.m = np.zeros((N, len(mech.pairs)))
 
     def at(self, k: int, name: str) -> np.ndarray:
         return self.kin.position_z(k, self.mech.links[k].points[name])
@@ -62,13 +66,14 @@ class _Statics:
         self.R[:, p.index] = R if giver == p.links[0] else -R
 
     def prismatic(self, p: "Pair", giver: int, f: np.ndarray, m: np.ndarray, X0: np.ndarray) -> None:
-        """Record the normal force f of `giver` whose moment about X0 is m; its line is located
-        along the guide from the slider point: (S + x d - X0) x f = m."""
+        """Record the normal force f of `giver` whose moment about X0 is m: its moment about the
+        slider point S, and its line S + x d along the guide ((x d) x (N n) = x N)."""
         self.revolute(p, giver, f)
-        n = self.normal(p)
-        N = dot_z(n, f)
         S = self.at(p.links[1], p.point)
-        self.x[:, p.index] = np.where(N != 0, m / N - cross_z(S - X0, n), np.nan)
+        m_S = m + cross_z(X0 - S, f)
+        N = dot_z(self.normal(p), f)
+        self.m[:, p.index] = m_S if giver == p.links[0] else -m_S
+        self.x[:, p.index] = np.where(N != 0, m_S / np.where(N != 0, N, 1.0), np.nan)
 
 
 def _rrr(st: _Statics, g: "AssurGroup") -> None:
@@ -161,7 +166,7 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
     M_bal = -st.moment(1, st.at(1, dr.pivot))
     F_bal = as_z(gear_force(dr.gear, M_bal)) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
-    return Forces(as_xy(st.R), st.x, M_bal, as_xy(F_bal))
+    return Forces(as_xy(st.R), st.x, st.m, M_bal, as_xy(F_bal))
 
 
 def gear_force(gear: "Gear", M: np.ndarray) -> np.ndarray:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .errors import ModelError, SingularPositionWarning
 from .planar import cross_z, dot_z
 
 if TYPE_CHECKING:
@@ -67,11 +68,16 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tup
         A = kin.position_z(sp.a[0], mech.links[sp.a[0]].points[sp.a[1]])
         B = kin.position_z(sp.b[0], mech.links[sp.b[0]].points[sp.b[1]])
         length = np.abs(B - A)
+        if (length == 0).any():     # no line of action: the forces there are NaN, and said so
+            warnings.warn(f"spring {sp.name!r} has zero length at phi = "
+                          f"{np.round(np.degrees(kin.phi[length == 0]), 9).tolist()} deg: its line of action "
+                          f"is undefined, forces there are NaN", SingularPositionWarning, stacklevel=3)
         f_on_b = -sp.stiffness * (length - sp.free_length) * (B - A) / length
         if sp.b[0]:
             _add_force(F, M, kin, sp.b[0], f_on_b, B)
         if sp.a[0]:
             _add_force(F, M, kin, sp.a[0], -f_on_b, A)
+        F[length == 0], M[length == 0] = np.nan, np.nan    # every force of that position is unknown
     return F, M
 
 
@@ -95,6 +101,10 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarr
     if key not in mech._derived:
         mech._derived[key] = _stroke(mech, ld.link, p, axis)
     lo, hi = mech._derived[key]
+    if not hi - lo > 1e-9 * mech.size:
+        n = mech.loads.index(ld)
+        raise ModelError([f"load[{n}].table: a travel diagram needs a moving point, but {ld.point!r} of link "
+                          f"{ld.link} travels {hi - lo:.3g} m along the axis over the cycle"], source=mech.path or "model")
     s = dot_z(X, axis)
     travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
     forward = (-dot_z(V, axis) if t.origin == "max" else dot_z(V, axis)) >= 0

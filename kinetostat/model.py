@@ -211,15 +211,24 @@ def load(path: str | Path) -> Mechanism:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ModelError([f"cannot read file: {exc.strerror}"], source=str(path)) from None
+    except UnicodeDecodeError as exc:
+        raise ModelError([f"not UTF-8 text: byte 0x{exc.object[exc.start]:02x} at offset {exc.start}"],
+                         source=str(path)) from None
     return loads(text, source=str(path))
 
 
 def loads(text: str, source: str = "<string>") -> Mechanism:
     """Parse a model from TOML text."""
+    for n, line in enumerate(text.splitlines(), 1):
+        key = line if line.lstrip().startswith("[") else line.partition("=")[0]
+        if len(key) > MAX_KEY:   # tomllib's memory grows as the square of a dotted key's depth
+            raise ModelError([f"line {n}: a key of {len(key)} characters (at most {MAX_KEY})"], source=source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
+    except RecursionError:
+        raise ModelError(["TOML nested too deeply (arrays or tables within each other)"], source=source) from None
     return from_dict(data, source=source)
 
 
@@ -227,6 +236,11 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
     """Build a Mechanism from the parsed structure of a model file."""
     return _Reader(data, source).mechanism()
 
+
+#: Longest key (or table header) of a model file, characters.
+MAX_KEY = 10_000
+#: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
+MAX_VALUE = 1e12
 
 _TOP_KEYS = {"mechanism", "drive", "frame", "link", "pair", "group", "load", "spring", "friction"}
 
@@ -256,6 +270,9 @@ class _Reader:
         if not _finite(x):
             self.err(f"{where}.{key}: expected a finite number, got {x!r}")
             return None
+        if abs(x) > MAX_VALUE:
+            self.err(f"{where}.{key}: {x!r} is out of range (|value| <= {MAX_VALUE:g})")
+            return None
         if positive and x <= 0:
             self.err(f"{where}.{key}: must be > 0, got {x!r}")
             return None
@@ -267,6 +284,9 @@ class _Reader:
     def vec(self, x: Any, where: str, *, unit: bool = False) -> Vec | None:
         if not (isinstance(x, list) and len(x) == 2 and all(_finite(c) for c in x)):
             self.err(f"{where}: expected [x, y] with two finite numbers, got {x!r}")
+            return None
+        if max(abs(x[0]), abs(x[1])) > MAX_VALUE:
+            self.err(f"{where}: {x!r} is out of range (|coordinate| <= {MAX_VALUE:g})")
             return None
         if unit:
             n = math.hypot(*x)
@@ -452,16 +472,21 @@ class _Reader:
             if key in seen:
                 self.err(f"pair[{p.index}]: links {sorted(key)} are already joined by pair[{seen[key]}]")
             seen[key] = p.index
-        # a point name on two links must be the revolute pair that joins them
+        # a point name on two links must be the revolute pair that joins them (or a chain of
+        # revolute pairs at that point: several links on one pin)
         owners: dict[str, list[int]] = {}
         for link in links:
             for name in link.points:
                 owners.setdefault(name, []).append(link.id)
-        joined = {(frozenset(p.links), p.point) for p in out if p.kind == "R"}
+        pins: dict[str, list[tuple[int, int]]] = {}
+        for p in out:
+            if p.kind == "R":
+                pins.setdefault(p.point, []).append(p.links)
         for name, ids in owners.items():
-            for a in ids:
-                for b in ids:
-                    if a < b and (frozenset((a, b)), name) not in joined and not _chain(joined, name, a, b):
+            if len(ids) > 1:
+                comp = _components(pins.get(name, []))
+                for a, b in zip(ids, ids[1:]):
+                    if comp.get(a, -a - 1) != comp.get(b, -b - 1):
                         self.err(f"point {name!r} is on links {a} and {b}, which share no revolute pair "
                                  f"at {name!r}: rename one of them")
         return out
@@ -479,8 +504,10 @@ class _Reader:
             self.err(f"drive.link: the crank must be link 1, got {link!r}")
         pivot, point = t.get("pivot"), t.get("point")
         if len(links) > 1:
-            self.point_ok(links, 1, pivot, "drive.pivot")
-            self.point_ok(links, 1, point, "drive.point")
+            if self.point_ok(links, 1, pivot, "drive.pivot") & self.point_ok(links, 1, point, "drive.point") \
+                    and links[1].points[pivot] == links[1].points[point]:
+                self.err(f"drive.point: {point!r} coincides with the pivot {pivot!r} "
+                         f"(zero crank length: the crank angle has no direction)")
             if not any(p.kind == "R" and set(p.links) == {0, 1} and p.point == pivot for p in pairs):
                 self.err(f"drive.pivot: the crank needs a revolute pair with the frame at {pivot!r}")
         ref = self.vec(t.get("reference"), "drive.reference", unit=True)
@@ -526,7 +553,11 @@ class _Reader:
         cd = self.vec(t.get("centre_direction"), f"{w}.centre_direction", unit=True)
         if None in (module, z1, z2, corr, alpha, y, cd):
             return None
-        return Gear(module, z1, z2, corr, alpha, y, cd)
+        gear = Gear(module, z1, z2, corr, alpha, y, cd)
+        if gear.r_w <= 0:
+            self.err(f"{w}.y: the wheel's pitch radius r_w = r (1 + 2y/(z1 + z2)) = {gear.r_w:g} m must be > 0")
+            return None
+        return gear
 
     def groups(self, links: list[Link]) -> dict[frozenset, int]:
         out = {}
@@ -605,6 +636,9 @@ class _Reader:
                 self.err(f"{where}.{nm}: {len(v)} values for {len(xs)} arguments")
         if arg == "phi" and (xs[0] < 0 or xs[-1] > 360):
             self.err(f"{where}.phi_deg: angles must lie in [0, 360]")
+        elif arg == "phi" and xs[0] == 0 and xs[-1] == 360 and len(vs) == len(xs) and vs[0] != vs[-1]:
+            self.err(f"{where}: a crank-angle diagram is periodic, but its value at 0 deg ({vs[0]:g}) "
+                     f"and at 360 deg ({vs[-1]:g}) differ")
         if arg == "travel" and (xs[0] < 0 or xs[-1] > 1):
             self.err(f"{where}.travel: fractions of stroke must lie in [0, 1]")
         if arg == "phi" and ("value_return" in t or "axis" in t or "origin" in t):
@@ -614,8 +648,8 @@ class _Reader:
         return Table(arg, xs, vs, vr, scale, axis, origin)
 
     def series(self, x: Any, where: str) -> tuple[float, ...] | None:
-        if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) for v in x)):
-            self.err(f"{where}: expected a list of at least two finite numbers")
+        if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) and abs(v) <= MAX_VALUE for v in x)):
+            self.err(f"{where}: expected a list of at least two finite numbers (|value| <= {MAX_VALUE:g})")
             return None
         return tuple(float(v) for v in x)
 
@@ -633,6 +667,9 @@ class _Reader:
                 if self.link_ok(links, end.get("link"), f"{where}.{e}.link") and \
                         self.point_ok(links, end["link"], end.get("point"), f"{where}.{e}.point"):
                     ends.append((end["link"], end["point"]))
+            if len(ends) == 2 and ends[0][1] == ends[1][1]:
+                self.err(f"{where}: both ends are the point {ends[0][1]!r}: the spring has no length or direction")
+                ends = []
             k = self.number(t, "stiffness", where, minimum=0.0)
             l0 = self.number(t, "free_length", where, minimum=0.0)
             if len(ends) == 2 and k is not None and l0 is not None:
@@ -652,19 +689,17 @@ class _Reader:
         return None if f is None else Friction(f, r)
 
 
-def _chain(joined: set, name: str, a: int, b: int) -> bool:
-    """True if links a and b are connected through revolute pairs all at point `name`
-    (a multiple joint: three links on one pin)."""
-    adj: dict[int, set[int]] = {}
-    for key, pt in joined:
-        if pt == name:
-            i, j = tuple(key)
-            adj.setdefault(i, set()).add(j)
-            adj.setdefault(j, set()).add(i)
-    seen, todo = {a}, [a]
-    while todo:
-        for nb in adj.get(todo.pop(), ()):
-            if nb not in seen:
-                seen.add(nb)
-                todo.append(nb)
-    return b in seen
+def _components(edges: list[tuple[int, int]]) -> dict[int, int]:
+    """Connected components of the links joined by `edges`: link -> representative."""
+    parent: dict[int, int] = {}
+
+    def root(x: int) -> int:
+        parent.setdefault(x, x)
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    for i, j in edges:
+        parent[root(i)] = root(j)
+    return {x: root(x) for x in parent}
