@@ -8,7 +8,7 @@ import numpy as np
 
 from .kinematics import COND_MAX, Kinematics, kinematics
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from .loads import applied_wrenches, com_positions, inertia_loads
+from .applied import applied_wrenches, com_positions, inertia_loads
 from .planar import as_xy, cross_z
 from .model import Mechanism
 
@@ -144,6 +144,15 @@ class Analysis:
     def friction_power_total(self) -> np.ndarray:
         """(N,) total power lost in friction, W."""
         return self.friction_power.sum(axis=1)
+
+    def friction_energy(self) -> np.ndarray:
+        """(n_pairs,) energy lost in each pair over one revolution, J: the integral of its power
+        over the period (periodic trapezoid rule, exact for the sampled cycle). Needs the angles
+        of a uniform full cycle, as `analyze(mech, steps=N)` gives."""
+        phi = self.phi_deg
+        if not np.allclose(phi, phi[0] + np.arange(len(phi)) * 360.0 / len(phi), rtol=0, atol=1e-9):
+            raise ValueError("friction_energy: needs the angles of a uniform full cycle (analyze with steps=N)")
+        return self.friction_power.mean(axis=0) * 2 * np.pi / self.mech.drive.omega
 
     # -- table
     def to_frame(self):

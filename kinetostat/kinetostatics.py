@@ -199,8 +199,10 @@ def friction_power(mech: "Mechanism", kin: "Kinematics", R: np.ndarray) -> np.nd
     fr = mech.friction
     if fr is None:
         return np.zeros(R.shape[:2])
-    i, j = np.array([p.links for p in mech.pairs]).T
-    revolute = np.array([p.kind == "R" for p in mech.pairs])
-    r = np.array([(p.radius if p.radius is not None else fr.radius) if p.kind == "R" else 0.0 for p in mech.pairs])
+    if "friction" not in mech._derived:
+        mech._derived["friction"] = (
+            *np.array([p.links for p in mech.pairs]).T, np.array([p.kind == "R" for p in mech.pairs]),
+            np.array([(p.radius if p.radius is not None else fr.radius) if p.kind == "R" else 0.0 for p in mech.pairs]))
+    i, j, revolute, r = mech._derived["friction"]
     speed = np.where(revolute, r * np.abs(kin.omega[:, i] - kin.omega[:, j]), np.abs(kin.v_slide))
     return np.abs(as_z(R)) * fr.f * speed

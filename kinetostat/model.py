@@ -12,6 +12,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Literal, Mapping
 
+import numpy as np
+
 from .errors import ModelError, StructureError
 
 __all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Mechanism",
@@ -184,6 +186,15 @@ class Mechanism:
                 return p
         raise KeyError(f"no kinematic pair between links {i} and {j}. "
                        f"Pairs: {[p.label for p in self.pairs]}")
+
+    @property
+    def inertia_arrays(self) -> tuple:
+        """(mass (L,), I_S (L,), centre of mass in the local frame (L,) complex), memoised."""
+        if "inertia" not in self._derived:
+            self._derived["inertia"] = (
+                np.array([link.mass for link in self.links]), np.array([link.I_S for link in self.links]),
+                np.array([complex(*link.points[link.com]) if link.com else 0j for link in self.links]))
+        return self._derived["inertia"]
 
     @property
     def size(self) -> float:

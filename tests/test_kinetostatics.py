@@ -160,6 +160,18 @@ def test_friction_power_by_seed_003(ice):
     assert ice.friction_power[0, mech.pair_between(0, 3).index] == pytest.approx(R03 * f * vB, rel=1e-12)
 
 
+def test_friction_energy_per_cycle():
+    """The energy lost per revolution is the cycle integral of the power: against a fine trapezoid."""
+    mech = kinetostat.load(ROOT / "models" / "ice_crank_slider.toml")
+    res = kinetostat.analyze(mech, steps=720)
+    fine = kinetostat.analyze(mech, phi_deg=np.linspace(0.0, 360.0, 20001))
+    t = np.radians(fine.phi_deg) / mech.drive.omega
+    expected = np.trapezoid(fine.friction_power, t, axis=0)
+    np.testing.assert_allclose(res.friction_energy(), expected, rtol=2e-3)  # diagram kinks: O(h) there
+    with pytest.raises(ValueError, match="uniform full cycle"):
+        kinetostat.analyze(mech, phi_deg=[0.0, 10.0]).friction_energy()
+
+
 # A four-bar that passes through a toggle: coupler + rocker = crank + frame, fully stretched at phi = 180.
 TOGGLE = (FOUR_BAR.replace("B = [0.35, 0.0], S2 = [0.15, 0.02]", "B = [0.2, 0.0], S2 = [0.1, 0.02]")
           .replace("B = [0.3, 0.0], S3", "B = [0.2, 0.0], S3"))

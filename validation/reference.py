@@ -27,9 +27,9 @@ group-by-group closed forms:
 
 Applied loads: gravity, constant forces and moments (with `against_velocity` / `against_omega`
 directions from the reference velocities; a force against the velocity vanishes where its
-point's speed is below 1e-9 x size x omega, kinetostat.loads' dead-centre convention) and springs are evaluated here in mpmath. The
+point's speed is below 1e-9 x size x omega, kinetostat.applied's dead-centre convention) and springs are evaluated here in mpmath. The
 MAGNITUDE of a tabulated load (`[load.table]`, by crank angle or by travel) is taken from
-`kinetostat.loads.load_magnitude` at the solver's kinematics at the same angles (a
+`kinetostat.applied.load_magnitude` at the solver's kinematics at the same angles (a
 piecewise-linear table read in double precision; the travel tables also need the stroke
 extremes that kinetostat finds by sampling); its direction is computed here.
 
@@ -48,7 +48,7 @@ import numpy as np
 from mpmath import mp, mpf
 
 from kinetostat import Analysis, Mechanism, analyze
-from kinetostat.loads import load_magnitude
+from kinetostat.applied import load_magnitude
 
 __all__ = ["DPS", "Reference", "reference", "reference_full", "BranchMismatch"]
 
@@ -319,7 +319,7 @@ def _applied(m: _Model, q, qd, phi_index: int, mags: dict, wrench_F, wrench_M, S
         if ld.direction == "against_velocity":
             v = m.V(q, qd, k, ld.point)
             sp = mp.sqrt(_dot(v, v))
-            # kinetostat.loads' convention: no force where the speed is below 1e-9 size omega
+            # kinetostat.applied's convention: no force where the speed is below 1e-9 size omega
             e = (mpf(0), mpf(0)) if sp <= 1e-9 * m.size * m.omega1 else _mul(-1 / sp, v)
         else:
             e = _unit((mpf(ld.direction[0]), mpf(ld.direction[1])))

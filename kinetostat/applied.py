@@ -28,25 +28,21 @@ def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) ->
 def com_positions(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
     """Complex positions (N, L) and accelerations (N, L) of the centres of mass (the link
     origin where a link has no centre of mass), all links at once."""
-    com = np.array([complex(*link.points[link.com]) if link.com else 0j for link in mech.links])
-    r = com * kin.rot
+    r = mech.inertia_arrays[2] * kin.rot
     return kin.origin_z + r, kin.a_z + (1j * kin.eps - kin.omega**2) * r
 
 
 def inertia_loads(mech: "Mechanism", kin: "Kinematics", aS: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Main vector F_i = -m a_S (N, L) complex, at the centre of mass, and main moment
     M_i = -I_S eps (N, L)."""
-    mass = np.array([link.mass for link in mech.links])
-    I_S = np.array([link.I_S for link in mech.links])
+    mass, I_S, _ = mech.inertia_arrays
     return -mass * aS, -I_S * kin.eps
 
 
 def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """All applied loads (gravity, external forces and moments, springs; no inertia) on each link
     as a wrench about its local origin: F (N, L) complex, M (N, L). S: centres of mass (N, L)."""
-    N, L = kin.theta.shape
-    mass = np.array([link.mass for link in mech.links])
-    F = np.zeros((N, L), complex) - 1j * mech.g * mass
+    F = np.broadcast_to(-1j * mech.g * mech.inertia_arrays[0], kin.theta.shape).copy()
     M = cross_z(S - kin.origin_z, F)
     for ld in mech.loads:
         mag = load_magnitude(mech, kin, ld)
