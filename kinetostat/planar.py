@@ -48,12 +48,11 @@ def condition(a: np.ndarray, b: np.ndarray, la: float | None = None, lb: float |
     a and b are parallel). `la`, `lb` are reference sizes of the columns (default: their own
     lengths, a pure angle measure; pass a length scale for columns that are lengths, so that a
     vanishing arm counts)."""
-    sa = np.abs(a) if la is None else la
-    sb = np.abs(b) if lb is None else lb
-    a, b = a / sa, b / sb
-    p, q, r = a.real**2 + a.imag**2, b.real**2 + b.imag**2, dot_z(a, b)
-    s1 = 0.5 * (p + q) + np.sqrt(0.25 * (p - q) ** 2 + r**2)   # largest squared singular value
-    return s1 / np.abs(cross_z(a, b))                           # sigma1 / sigma2 = s1 / |det|
+    sa2 = a.real**2 + a.imag**2 if la is None else la * la
+    sb2 = b.real**2 + b.imag**2 if lb is None else lb * lb
+    frob = (a.real**2 + a.imag**2) / sa2 + (b.real**2 + b.imag**2) / sb2
+    t = 0.5 * frob / np.abs(cross_z(a, b) / np.sqrt(sa2 * sb2))   # ||M||_F^2 / (2 |det M|)
+    return t + np.sqrt(np.maximum(t * t - 1.0, 0.0))                # kappa + 1/kappa = 2 t
 
 
 # -- the same operations on public (..., 2) arrays
