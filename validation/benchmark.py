@@ -115,6 +115,22 @@ def kinematics_table(models: list[Path]) -> list[dict]:
     return rows
 
 
+def target_line(df) -> str:
+    """The verdict on issue 6's target: the solver at least 50x faster than the fastest engine
+    route of the same run, at an error no worse than 1e-10."""
+    ratios = {}
+    for model, g in df.groupby("model"):
+        s = g[g.route == "kinetostat"].iloc[0]
+        ratios[model] = (g[g.route != "kinetostat"].seconds.min() / s.seconds, s.error)
+    met = [m for m, (r, e) in ratios.items() if r >= 50 and e <= 1e-10]
+    worst = min(ratios.items(), key=lambda kv: kv[1][0])
+    return (f"**Target** (solver >= 50x faster than the fastest engine route, error <= 1e-10): met on "
+            f"{len(met)} of {len(ratios)} models; speed-ups {min(r for r, _ in ratios.values()):.0f}x .. "
+            f"{max(r for r, _ in ratios.values()):.0f}x (slowest relative: {worst[0]}). At 360 angles the "
+            f"solver's time is about half fixed per-call overhead of numpy (~0.2 ms), while MuJoCo's exact "
+            f"route costs 35-55 us per angle in this adapter.")
+
+
 def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], out: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
@@ -151,7 +167,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], out: P
              "worst peak-relative error over the driving moment and every reaction against the mpmath reference "
              "(`validation/reference.py`, 40 digits; pymunk: magnitudes). Regenerate with "
              "`python -m validation.benchmark`.", "", "![time against error](benchmark.png)", "",
-             "## Solver against the fastest engine route (same run)", "",
+             "## Solver against the fastest engine route (same run)", "", target_line(df), "",
              "| model | solver | its error | fastest engine route | its time | its error | speed-up |",
              "|---|---|---|---|---|---|---|"]
     for model, g in df.groupby("model"):
