@@ -32,6 +32,7 @@ point = "A"
 reference = [1.0, 0.0]
 sense = "ccw"
 rpm = 300.0
+eps = 0.0
 kind = "engine"
 [frame]
 O = [0.0, 0.0]
@@ -79,3 +80,13 @@ kind = "moment"
 link = 3
 value = -4.0
 """
+
+
+def four_bar(*edits: tuple[str, str], append: str = "") -> str:
+    """FOUR_BAR with (old, new) text edits, each of which must apply, and tables appended:
+    the variants the engine tests need (other sense, springs, forces) without copies of it."""
+    text = FOUR_BAR
+    for old, new in edits:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    return text + append

@@ -16,6 +16,7 @@ import pytest
 mujoco = pytest.importorskip("mujoco")
 
 import kinetostat  # noqa: E402
+from conftest import four_bar  # noqa: E402
 from validation.engine_mujoco import mjcf, simulate, solve  # noqa: E402
 from validation.scene import build_scene  # noqa: E402
 
@@ -43,74 +44,10 @@ POSE_TOL = 1e-12
 #: change the results by far less than SIM_TOL.
 FLOOR_EFFECT_TOL = 1e-6
 
-FOUR_BAR = """
-[mechanism]
-name = "test four-bar (crank-rocker)"
-g = 9.81
-
-[drive]
-link = 1
-pivot = "O"
-point = "A"
-reference = [1.0, 0.0]
-sense = "ccw"
-rpm = 300.0
-eps = 0.0
-kind = "engine"
-
-[frame]
-O = [0.0, 0.0]
-C = [0.3, 0.0]
-E = [0.1, 0.3]
-
-[[link]]
-id = 1
-name = "crank"
-points = { O = [0.0, 0.0], A = [0.1, 0.0], S1 = [0.05, 0.0] }
-mass = 0.5
-I_S = 4.0e-4
-com = "S1"
-
-[[link]]
-id = 2
-name = "coupler"
-points = { A = [0.0, 0.0], B = [0.35, 0.0], S2 = [0.15, 0.03], D = [0.25, 0.05] }
-mass = 1.2
-I_S = 0.0125
-com = "S2"
-
-[[link]]
-id = 3
-name = "rocker"
-points = { C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.15, 0.0] }
-mass = 0.9
-I_S = 0.00675
-com = "S3"
-
-[[pair]]
-kind = "R"
-links = [0, 1]
-point = "O"
-
-[[pair]]
-kind = "R"
-links = [1, 2]
-point = "A"
-
-[[pair]]
-kind = "R"
-links = [2, 3]
-point = "B"
-
-[[pair]]
-kind = "R"
-links = [0, 3]
-point = "C"
-
-[[group]]
-links = [2, 3]
-branch = 1
-
+FOUR_BAR = four_bar(
+    ("C = [0.3, 0.0]", "C = [0.3, 0.0]\nE = [0.1, 0.3]"),
+    ("S2 = [0.15, 0.02] }", "S2 = [0.15, 0.02], D = [0.25, 0.05] }"),
+    append="""
 [[load]]
 name = "resisting moment on the rocker"
 kind = "moment"
@@ -131,7 +68,7 @@ a = { link = 0, point = "E" }
 b = { link = 2, point = "D" }
 stiffness = 500.0
 free_length = 0.1
-"""
+""")
 
 
 def _massless_blocks_shaper() -> str:

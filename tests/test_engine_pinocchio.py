@@ -12,6 +12,7 @@ import pytest
 pin = pytest.importorskip("pinocchio")
 
 import kinetostat  # noqa: E402
+from conftest import four_bar  # noqa: E402
 from validation.engine_pinocchio import PinocchioScene, forward_round_trip, solve  # noqa: E402
 from validation.scene import build_scene  # noqa: E402
 
@@ -34,74 +35,12 @@ FORWARD = 1e-10
 # A four-bar written only here (nothing in the engine may be model-specific): crank 0.1 m,
 # coupler 0.35 m, rocker 0.3 m, frame points O = (0, 0), C = (0.3, 0); off-axis centres of
 # mass, crank accelerating, clockwise, a force, a moment and a spring as applied loads.
-FOUR_BAR = """
-[mechanism]
-name = "pinocchio-test four-bar"
-g = 9.81
-
-[drive]
-link = 1
-pivot = "O"
-point = "A"
-reference = [0.0, 1.0]
-sense = "cw"
-rpm = 240.0
-eps = 15.0
-kind = "engine"
-
-[frame]
-O = [0.0, 0.0]
-C = [0.3, 0.0]
-E = [0.45, 0.25]
-
-[[link]]
-id = 1
-name = "crank"
-points = { O = [0.0, 0.0], A = [0.1, 0.0], S1 = [0.02, -0.005] }
-mass = 0.6
-I_S = 0.0008
-com = "S1"
-
-[[link]]
-id = 2
-name = "coupler"
-points = { A = [0.0, 0.0], B = [0.35, 0.0], S2 = [0.16, 0.03] }
-mass = 1.4
-I_S = 0.015
-com = "S2"
-
-[[link]]
-id = 3
-name = "rocker"
-points = { C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.14, -0.01], F = [0.2, 0.0] }
-mass = 1.1
-I_S = 0.008
-com = "S3"
-
-[[pair]]
-kind = "R"
-links = [0, 1]
-point = "O"
-
-[[pair]]
-kind = "R"
-links = [1, 2]
-point = "A"
-
-[[pair]]
-kind = "R"
-links = [2, 3]
-point = "B"
-
-[[pair]]
-kind = "R"
-links = [0, 3]
-point = "C"
-
-[[group]]
-links = [2, 3]
-branch = 1
-
+FOUR_BAR = four_bar(
+    ("reference = [1.0, 0.0]", "reference = [0.0, 1.0]"), ('sense = "ccw"', 'sense = "cw"'),
+    ("rpm = 300.0", "rpm = 240.0"), ("eps = 0.0", "eps = 15.0"),
+    ("C = [0.3, 0.0]", "C = [0.3, 0.0]\nE = [0.45, 0.25]"),
+    ("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01], F = [0.2, 0.0] }"),
+    append="""
 [[load]]
 name = "tool force"
 link = 2
@@ -109,19 +48,13 @@ point = "B"
 direction = [0.6, -0.8]
 value = 25.0
 
-[[load]]
-name = "resisting moment"
-kind = "moment"
-link = 3
-value = -3.0
-
 [[spring]]
 name = "return spring"
 a = { link = 0, point = "E" }
 b = { link = 3, point = "F" }
 stiffness = 400.0
 free_length = 0.15
-"""
+""")
 
 
 def _peak_relative(engine: np.ndarray, exact: np.ndarray, fallback: float) -> float:

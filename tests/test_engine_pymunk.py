@@ -35,6 +35,7 @@ import pytest
 pytest.importorskip("pymunk")
 
 import kinetostat  # noqa: E402
+from conftest import four_bar  # noqa: E402
 from validation.engine_pymunk import simulate  # noqa: E402
 from validation.scene import build_scene  # noqa: E402
 
@@ -55,83 +56,14 @@ TOL_CONVERGED_RICHARDSON = 1e-5
 #: Error ratio between 1440 and 2880 steps for an O(dt^2) method: 4 (measured 3.9-4.0).
 ORDER_RATIO = (3.0, 5.0)
 
-FOUR_BAR = """
-# A crank-rocker four-bar written for this test only.
-[mechanism]
-name = "test four-bar"
-source = "tests/test_engine_pymunk.py"
-assumptions = ["dimensions, masses and the load chosen for the test"]
-g = 9.81
-
-[drive]
-link = 1
-pivot = "O"
-point = "A"
-reference = [1.0, 0.0]
-sense = "ccw"
-rpm = 300.0
-eps = 0.0
-kind = "engine"
-
-[frame]
-O = [0.0, 0.0]
-C = [0.3, 0.0]
-
-[[link]]
-id = 1
-name = "crank"
-points = { O = [0.0, 0.0], A = [0.1, 0.0], S1 = [0.05, 0.0] }
-mass = 0.5
-I_S = 4.0e-4
-com = "S1"
-
-[[link]]
-id = 2
-name = "coupler"
-points = { A = [0.0, 0.0], B = [0.35, 0.0], S2 = [0.175, 0.0] }
-mass = 1.2
-I_S = 0.01225
-com = "S2"
-
-[[link]]
-id = 3
-name = "rocker"
-points = { C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.15, 0.0] }
-mass = 1.0
-I_S = 0.0075
-com = "S3"
-
-[[pair]]
-kind = "R"
-links = [0, 1]
-point = "O"
-
-[[pair]]
-kind = "R"
-links = [1, 2]
-point = "A"
-
-[[pair]]
-kind = "R"
-links = [2, 3]
-point = "B"
-
-[[pair]]
-kind = "R"
-links = [0, 3]
-point = "C"
-
-[[group]]
-links = [2, 3]
-branch = 1
-
+FOUR_BAR = four_bar(append="""
 [[load]]
 name = "weight hung at B"
-link = 3
+link = 2
 point = "B"
 direction = [0.0, -1.0]
 value = 50.0
-"""
+""")
 
 
 @functools.lru_cache(maxsize=None)
