@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import kinetostat
@@ -90,3 +91,18 @@ def four_bar(*edits: tuple[str, str], append: str = "") -> str:
         assert old in text, old
         text = text.replace(old, new, 1)
     return text + append
+
+
+def kinetic_energy(mech, phi_deg) -> np.ndarray:
+    """Kinetic energy of all moving links at crank angles phi_deg, J (for energy-balance tests)."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kinetostat.SingularPositionWarning)
+        r = kinetostat.analyze(mech, phi_deg=phi_deg)
+    T = np.zeros(len(r.phi_deg))
+    for link in mech.links[1:]:
+        if link.mass:
+            v = r.kin.point(link.id, link.points[link.com])[1]
+            T += 0.5 * link.mass * np.sum(v * v, axis=-1)
+        T += 0.5 * link.I_S * r.omega(link.id) ** 2
+    return T

@@ -10,7 +10,7 @@ import pytest
 import kinetostat
 from kinetostat import SingularPositionWarning
 from kinetostat.planar import cross, rotate
-from conftest import FOUR_BAR, ROOT
+from conftest import FOUR_BAR, ROOT, kinetic_energy
 import ice_reference as ref
 
 #: Drawn-and-measured force plans (mu_F = 50 N/mm, lengths to 0.01 mm).
@@ -117,19 +117,9 @@ def test_energy_balance(mech):
     phi = np.arange(0.0, 360.0, 3.0)
     res = kinetostat.analyze(mech, phi_deg=phi)
 
-    def kinetic_energy(p):
-        r = kinetostat.analyze(mech, phi_deg=p)
-        T = np.zeros(len(p))
-        for link in mech.links[1:]:
-            if link.mass:
-                v = r.kin.point(link.id, link.points[link.com])[1]
-                T += 0.5 * link.mass * np.sum(v * v, axis=-1)
-            T += 0.5 * link.I_S * r.omega(link.id) ** 2
-        return T
-
     h = np.degrees(1e-3)
-    dT = (kinetic_energy(phi - 2 * h) - 8 * kinetic_energy(phi - h) + 8 * kinetic_energy(phi + h)
-          - kinetic_energy(phi + 2 * h)) / (12 * h)
+    T = lambda p: kinetic_energy(mech, p)
+    dT = (T(phi - 2 * h) - 8 * T(phi - h) + 8 * T(phi + h) - T(phi + 2 * h)) / (12 * h)
     # d/dt = d/dphi * phidot; with crank acceleration eps the energy rate has the same form
     dT_dt = np.degrees(dT) * mech.drive.omega
     P_loads = np.sum(res.F_applied * res.kin.v_origin, axis=-1) + res.M_applied * res.kin.omega

@@ -37,6 +37,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import kinetostat
+from conftest import kinetic_energy
 from kinetostat import AssemblyError, SingularPositionWarning
 from kinetostat.planar import cross, rotate
 
@@ -429,19 +430,6 @@ def dead_centres(res) -> np.ndarray:
         if ld.kind == "force" and ld.direction == "against_velocity":
             out |= _dead_centre(m, res.kin.point(ld.link, m.links[ld.link].points[ld.point])[1])
     return out
-
-
-def kinetic_energy(mech, phi_deg) -> np.ndarray:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SingularPositionWarning)
-        r = kinetostat.analyze(mech, phi_deg=phi_deg)
-    T = np.zeros(len(phi_deg))
-    for link in mech.links[1:]:
-        if link.mass:
-            v = r.kin.point(link.id, link.points[link.com])[1]
-            T += 0.5 * link.mass * np.sum(v * v, axis=-1)
-        T += 0.5 * link.I_S * r.omega(link.id) ** 2
-    return T
 
 
 # ----------------------------------------------------------------------------- properties
