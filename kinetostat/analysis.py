@@ -93,8 +93,14 @@ class Analysis:
         return self.kin.eps[:, self._link(k)]
 
     def slide_velocity(self, i: int, j: int) -> np.ndarray:
-        """(N,) velocity of the slider relative to the guide of prismatic pair (i, j), m/s."""
+        """(N,) velocity of the slider relative to the guide of prismatic pair (i, j), along
+        the guide direction, m/s."""
         return self.kin.v_slide[:, self.mech.pair_between(i, j).index]
+
+    def slide_acceleration(self, i: int, j: int) -> np.ndarray:
+        """(N,) its rate seen from the guide (the relative acceleration of the plans, without
+        the Coriolis part), m/s^2."""
+        return self.kin.a_slide[:, self.mech.pair_between(i, j).index]
 
     # -- kinetostatics
     def reaction(self, i: int, j: int) -> np.ndarray:
@@ -162,7 +168,7 @@ class Analysis:
         theta_k, omega_k, eps_k for every link k; Fix_k, Fiy_k, Mi_k, h_k inertia of every
         link with mass or inertia; Rx_i_j, Ry_i_j, R_i_j (force of i on j and its magnitude)
         for every pair, x_i_j and m_i_j (line of the normal force, its moment about the slider
-        point) for prismatic pairs; M_bal, M_lever, and for a machine
+        point) and vs_i_j, as_i_j (sliding velocity and acceleration) for prismatic pairs; M_bal, M_lever, and for a machine
         F_bal (magnitude) with F_balx, F_baly; Pfr_i_j per pair and Pfr_total when the model has
         friction; cond_<group> per group; singular.
         """
@@ -188,6 +194,8 @@ class Analysis:
             if p.kind == "P":
                 cols[f"x_{i}_{j}"] = self.forces.x[:, p.index]
                 cols[f"m_{i}_{j}"] = self.forces.m[:, p.index]
+                cols[f"vs_{i}_{j}"] = self.kin.v_slide[:, p.index]
+                cols[f"as_{i}_{j}"] = self.kin.a_slide[:, p.index]
         cols["M_bal"], cols["M_lever"] = self.balancing_moment, self.lever_moment
         if m.drive.kind == "machine":
             cols["F_balx"], cols["F_baly"] = self.balancing_force[:, 0], self.balancing_force[:, 1]
