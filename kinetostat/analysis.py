@@ -6,7 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .kinematics import COND_MAX, Kinematics, kinematics
+from .kinematics import Kinematics, kinematics
 from .kinetostatics import Forces, forces, friction_power, lever_moment
 from .applied import applied_wrenches, com_positions, inertia_loads
 from .planar import as_xy, cross_z

@@ -17,6 +17,13 @@ def model_path(request) -> Path:
     return request.param
 
 
+@pytest.fixture(scope="module")
+def ice():
+    """The seed 002 worked example: the ICE crank-slider at 30 deg from top dead centre."""
+    mech = kinetostat.load(ROOT / "models" / "ice_crank_slider.toml")
+    return kinetostat.analyze(mech, phi_deg=[30.0])
+
+
 @pytest.fixture
 def mech(model_path):
     return kinetostat.load(model_path)

@@ -16,12 +16,6 @@ EXACT = 1e-6
 FINITE_DIFF = 1e-6
 
 
-@pytest.fixture(scope="module")
-def ice():
-    mech = kinetostat.load(ROOT / "models" / "ice_crank_slider.toml")
-    return kinetostat.analyze(mech, phi_deg=[30.0])
-
-
 # seed 002, sec. 1.2.2: V_B = 10.94, V_BA = 14.92, V_S2 = 12.2, omega2 = 135.6, a_B = 8311,
 # a_S2 = 7875, eps2 = 33782 (measured on the plans)
 @pytest.mark.parametrize("name, textbook", [

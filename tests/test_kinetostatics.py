@@ -23,12 +23,6 @@ ROUNDING = 1e-9
 ENERGY = 1e-9
 
 
-@pytest.fixture(scope="module")
-def ice():
-    mech = kinetostat.load(ROOT / "models" / "ice_crank_slider.toml")
-    return kinetostat.analyze(mech, phi_deg=[30.0])
-
-
 # seed 002, sec. 1.2.3: F_i2 = 3937.5, F_i3 = 3216.4, M_i2 = 57.43, R12 = 3172, R43 = 780.5,
 # R32 = 6481, M_bal = 102.74 (force plans) / 102.97 (lever)
 @pytest.mark.parametrize("name, textbook", [
