@@ -2,7 +2,7 @@
 
 Groups are solved in the order of attachment. Each group kind has one small function that
 finds the positions in closed form and closes the velocity and acceleration plans with
-`decompose`, exactly as the vector equations of the texts read, for all angles at once.
+`Basis.solve`, exactly as the vector equations of the texts read, for all angles at once.
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from .errors import AssemblyError, SingularPositionWarning, singular_message
-from .planar import as_xy, condition, cross_z, decompose, dot_z
+from .planar import Basis, as_xy, condition, cross_z, dot_z
 
 if TYPE_CHECKING:
     from .model import Mechanism, Pair
@@ -113,31 +113,37 @@ class _Plan:
         w, e = self.w[:, k], self.e[:, k]
         return self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
 
-    def set_link(self, k: int, th, X, x_local, w, V, e, A, rot=None) -> None:
-        """Fix link k from its angle (and e^{i th}, if known) and the world state of one of its points."""
-        rot = np.exp(1j * th) if rot is None else rot
-        r = x_local * rot
+    def set_link(self, k: int, th, rot, X, x_local: complex | np.ndarray, w, V, e, A) -> None:
+        """Fix link k from its angle th, rot = e^{i th}, and the world position, velocity and
+        acceleration X, V, A of its local point x_local (a constant, or (N,) for a point
+        moving in the link)."""
         self.th[:, k], self.rot[:, k], self.w[:, k], self.e[:, k] = th, rot, w, e
-        self.O[:, k] = X - r
-        self.V[:, k] = V - 1j * w * r
-        self.A[:, k] = A - (1j * e - w**2) * r
+        if np.ndim(x_local) or x_local:             # (X is not already the local origin)
+            r = x_local * rot
+            X, V, A = X - r, V - 1j * w * r, A - (1j * e - w**2) * r
+        self.O[:, k], self.V[:, k], self.A[:, k] = X, V, A
 
-    def length(self, k: int, a: str, b: str) -> float:
-        return abs(self.local(k, a) - self.local(k, b))
+    @staticmethod
+    def aligned(x_local: complex, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Angle and e^{i theta} of a link whose local vector x_local is the world vector X
+        (of the same length)."""
+        return np.angle(X) - np.angle(x_local), X / x_local
 
-    def angle_from(self, k: int, a: str, b: str, A: np.ndarray, B: np.ndarray) -> np.ndarray:
-        """Angle of link k whose points a, b are at world A, B."""
-        return np.angle(B - A) - np.angle(self.local(k, b) - self.local(k, a))
+    # --- prismatic pair geometry: the guide line is fixed in both links (equal rotation), and
+    # the slider's local x axis is the guide direction d (its angle alpha in the guide's frame)
+    @staticmethod
+    def turned(p: "Pair", k: int, th: np.ndarray, rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Angle and e^{i theta} of link k of P pair p from those of the pair's other link."""
+        if not p.alpha:
+            return th, rot
+        if k == p.links[1]:
+            return th + p.alpha, rot * complex(*p.direction)
+        return th - p.alpha, rot / complex(*p.direction)
 
-    # --- prismatic pair geometry: the guide line is fixed in both links (equal rotation)
-    def turned(self, p: "Pair", k: int, th_other: np.ndarray) -> np.ndarray:
-        """Angle of link k of P pair p from the angle of the pair's other link."""
-        return th_other + p.alpha if k == p.links[1] else th_other - p.alpha
-
-    def guide(self, p: "Pair", k: int, th_k: np.ndarray) -> np.ndarray:
-        """World unit direction d of pair p's guide, given the angle of its link k."""
-        th_guide = th_k if k == p.links[0] else th_k - p.alpha
-        return complex(*p.direction) * np.exp(1j * th_guide)
+    @staticmethod
+    def guide(p: "Pair", k: int, rot_k: np.ndarray) -> np.ndarray:
+        """World unit direction d of pair p's guide, given e^{i theta} of its link k."""
+        return complex(*p.direction) * rot_k if k == p.links[0] else rot_k
 
     def offset(self, p: "Pair", k: int, name: str) -> float:
         """Signed distance c = (X - G) x d of point `name` of link k from the guide line."""
@@ -171,51 +177,58 @@ def _locals(mech: "Mechanism") -> list[dict[str, complex]]:
     return mech._derived["locals"]
 
 
+# Each solver returns the condition number of its plans' matrix, columns scaled by reference
+# sizes (mech.size for a column that is a length, 1 for a unit direction).
+
 def _rrr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, VP, AP = pl.point(a, pj.point)
     Q, VQ, AQ = pl.point(c, pk.point)
-    lj, lk = pl.length(j, pj.point, pin.point), pl.length(k, pk.point, pin.point)
-    d = np.abs(Q - P)
-    u = (Q - P) / d
+    xj, xk = pl.local(j, pin.point) - pl.local(j, pj.point), pl.local(k, pin.point) - pl.local(k, pk.point)
+    lj, lk = abs(xj), abs(xk)
+    PQ = Q - P
+    d = np.abs(PQ)
     along = (lj**2 - lk**2 + d**2) / (2 * d)
     h = pl.reachable(g, lj**2 - along**2, lj**2, f"|{pj.point}{pk.point}| outside [|l{j} - l{k}|, l{j} + l{k}]")
-    B = P + u * (along + 1j * g.branch * h)
+    B = P + PQ / d * (along + 1j * g.branch * h)
     PB, QB = B - P, B - Q
     # v_B = v_P + w_j x PB = v_Q + w_k x QB ;  a_B = a_P - w_j^2 PB + e_j x PB = ...
-    wj, wk = decompose(VQ - VP, 1j * PB, -1j * QB)
-    VB = VP + 1j * wj * PB
-    ej, ek = decompose(AQ - wk**2 * QB - AP + wj**2 * PB, 1j * PB, -1j * QB)
-    AB = AP + (1j * ej - wj**2) * PB
-    pl.set_link(j, pl.angle_from(j, pj.point, pin.point, P, B), B, pl.local(j, pin.point), wj, VB, ej, AB)
-    pl.set_link(k, pl.angle_from(k, pk.point, pin.point, Q, B), B, pl.local(k, pin.point), wk, VB, ek, AB)
-    return condition(PB, QB, pl.L, pl.L)
+    plan = Basis(1j * PB, -1j * QB)
+    wj, wk = plan.solve(VQ - VP)
+    VB = VP + wj * plan.a
+    ej, ek = plan.solve(AQ - wk**2 * QB - AP + wj**2 * PB)
+    AB = AP + ej * plan.a - wj**2 * PB
+    pl.set_link(j, *pl.aligned(xj, PB), B, pl.local(j, pin.point), wj, VB, ej, AB)
+    pl.set_link(k, *pl.aligned(xk, QB), B, pl.local(k, pin.point), wk, VB, ek, AB)
+    return condition((lj**2 + lk**2) / pl.L**2, plan.det / pl.L**2)
 
 
 def _rrp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     (pj, pin, pk), (j, k), (a, b) = g.pairs, g.links, g.known
     P, VP, AP = pl.point(a, pj.point)
-    th_k = pl.turned(pk, k, pl.th[:, b])
-    d = pl.guide(pk, k, th_k)
+    th_k, rot_k = pl.turned(pk, k, pl.th[:, b], pl.rot[:, b])
+    d = pl.guide(pk, k, rot_k)
     K = pl.position(b, pl.anchor(pk, b))
-    lj, cB = pl.length(j, pj.point, pin.point), pl.offset(pk, k, pin.point)
-    w = K - cB * 1j * d - P                        # B = K + t d - cB n lies on a circle about P
+    xj, cB = pl.local(j, pin.point) - pl.local(j, pj.point), pl.offset(pk, k, pin.point)
+    lj = abs(xj)
+    w = K - 1j * cB * d - P                        # B = K + t d - cB n lies on a circle about P
     wd = dot_z(w, d)
-    root = pl.reachable(g, wd**2 - np.abs(w) ** 2 + lj**2, lj**2,
+    root = pl.reachable(g, wd**2 - dot_z(w, w) + lj**2, lj**2,
                         f"the guide line is farther than l{j} from {pj.point}")
-    B = K + (-wd + g.branch * root - 1j * cB) * d
+    B = K + (g.branch * root - wd - 1j * cB) * d
     PB = B - P
     wb, eb = pl.w[:, b], pl.e[:, b]
     VBb, ABb = pl.at(b, B)
     # v_B = v_P + w_j x PB = v_B(b) + v_r d ; a_B = ... = a_B(b) + 2 w_b x v_r d + a_r d
-    wj, vr = decompose(VBb - VP, 1j * PB, -d)
-    VB = VP + 1j * wj * PB
-    ej, ar = decompose(ABb + 2j * wb * vr * d - AP + wj**2 * PB, 1j * PB, -d)
-    AB = AP + (1j * ej - wj**2) * PB
-    pl.set_link(j, pl.angle_from(j, pj.point, pin.point, P, B), B, pl.local(j, pin.point), wj, VB, ej, AB)
-    pl.set_link(k, th_k, B, pl.local(k, pin.point), wb, VB, eb, AB)
+    plan = Basis(1j * PB, -d)
+    wj, vr = plan.solve(VBb - VP)
+    VB = VP + wj * plan.a
+    ej, ar = plan.solve(ABb + 2j * wb * vr * d - AP + wj**2 * PB)
+    AB = AP + ej * plan.a - wj**2 * PB
+    pl.set_link(j, *pl.aligned(xj, PB), B, pl.local(j, pin.point), wj, VB, ej, AB)
+    pl.set_link(k, th_k, rot_k, B, pl.local(k, pin.point), wb, VB, eb, AB)
     pl.slide(pk, k, vr, ar)
-    return condition(1j * PB, d, pl.L, 1.0)
+    return condition(lj**2 / pl.L**2 + 1.0, plan.det / pl.L)
 
 
 def _rpr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
@@ -224,70 +237,70 @@ def _rpr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     Q, VQ, AQ = pl.point(c, pk.point)
     e = pl.offset(pin, j, pj.point) - pl.offset(pin, k, pk.point)   # (P - Q) x d, constant
     QP = P - Q
-    rho = np.abs(QP)
-    pl.reachable(g, rho**2 - e**2, pl.L**2, f"{pj.point} comes closer than the guide offset to {pk.point}")
-    s = np.arcsin(np.clip(e / rho, -1.0, 1.0))
-    delta = np.angle(QP) + (s if g.branch > 0 else np.pi - s)
-    d = np.exp(1j * delta)
-    th_k = delta - pin.alpha
-    rot_k = d / complex(*pin.direction)
+    rho2 = dot_z(QP, QP)
+    root = pl.reachable(g, rho2 - e**2, pl.L**2, f"{pj.point} comes closer than the guide offset to {pk.point}")
+    d = QP * (g.branch * root + 1j * e) / rho2     # the unit d with QP x d = e, on the branch's side
+    th_j = np.angle(d)
     # v_P = v_Q + w_k x QP + v_r d ;  a_P = a_Q - w_k^2 QP + e_k x QP + 2 w_k x v_r d + a_r d
-    wk, vr = decompose(VP - VQ, 1j * QP, d)
-    ek, ar = decompose(AP - AQ + wk**2 * QP - 2j * wk * vr * d, 1j * QP, d)
-    pl.set_link(k, th_k, Q, pl.local(k, pk.point), wk, VQ, ek, AQ, rot_k)
-    pl.set_link(j, th_k + pin.alpha, P, pl.local(j, pj.point), wk, VP, ek, AP, d)
+    plan = Basis(1j * QP, d)
+    wk, vr = plan.solve(VP - VQ)
+    ek, ar = plan.solve(AP - AQ + wk**2 * QP - 2j * wk * vr * d)
+    pl.set_link(k, *pl.turned(pin, k, th_j, d), Q, pl.local(k, pk.point), wk, VQ, ek, AQ)
+    pl.set_link(j, th_j, d, P, pl.local(j, pj.point), wk, VP, ek, AP)
     pl.slide(pin, j, vr, ar)
-    return condition(1j * QP, d, pl.L, 1.0)
+    return condition(rho2 / pl.L**2 + 1.0, plan.det / pl.L)
 
 
 def _prp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
-    th_j, th_k = pl.turned(pj, j, pl.th[:, a]), pl.turned(pk, k, pl.th[:, c])
-    da, dc = pl.guide(pj, j, th_j), pl.guide(pk, k, th_k)
+    th_j, rot_j = pl.turned(pj, j, pl.th[:, a], pl.rot[:, a])
+    th_k, rot_k = pl.turned(pk, k, pl.th[:, c], pl.rot[:, c])
+    da, dc = pl.guide(pj, j, rot_j), pl.guide(pk, k, rot_k)
     Ka = pl.position(a, pl.anchor(pj, a)) - pl.offset(pj, j, pin.point) * 1j * da
     Kc = pl.position(c, pl.anchor(pk, c)) - pl.offset(pk, k, pin.point) * 1j * dc
-    t, _ = decompose(Kc - Ka, da, -dc)        # B on both lines
+    plan = Basis(da, -dc)
+    t, _ = plan.solve(Kc - Ka)        # B on both lines
     B = Ka + t * da
     VBa, ABa = pl.at(a, B)
     VBc, ABc = pl.at(c, B)
     wa, wc = pl.w[:, a], pl.w[:, c]
     # v_B = v_B(a) + v1 d_a = v_B(c) + v2 d_c ; accelerations with the Coriolis terms
-    v1, v2 = decompose(VBc - VBa, da, -dc)
-    a1, a2 = decompose(ABc + 2j * wc * v2 * dc - ABa - 2j * wa * v1 * da, da, -dc)
+    v1, v2 = plan.solve(VBc - VBa)
+    a1, a2 = plan.solve(ABc + 2j * wc * v2 * dc - ABa - 2j * wa * v1 * da)
     VB = VBa + v1 * da
     AB = ABa + (2j * wa * v1 + a1) * da
-    pl.set_link(j, th_j, B, pl.local(j, pin.point), wa, VB, pl.e[:, a], AB)
-    pl.set_link(k, th_k, B, pl.local(k, pin.point), wc, VB, pl.e[:, c], AB)
+    pl.set_link(j, th_j, rot_j, B, pl.local(j, pin.point), wa, VB, pl.e[:, a], AB)
+    pl.set_link(k, th_k, rot_k, B, pl.local(k, pin.point), wc, VB, pl.e[:, c], AB)
     pl.slide(pj, j, v1, a1)
     pl.slide(pk, k, v2, a2)
-    return condition(da, dc)
+    return condition(2.0, plan.det)
 
 
 def _rpp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, VP, AP = pl.point(a, pj.point)
-    th_k = pl.turned(pk, k, pl.th[:, c])
-    th_j = pl.turned(pin, j, th_k)
-    d_in, dc = pl.guide(pin, k, th_k), pl.guide(pk, k, th_k)
-    rot_j, rot_k = np.exp(1j * th_j), np.exp(1j * th_k)
+    th_k, rot_k = pl.turned(pk, k, pl.th[:, c], pl.rot[:, c])
+    th_j, rot_j = pl.turned(pin, j, th_k, rot_k)
+    d_in, dc = pl.guide(pin, k, rot_k), pl.guide(pk, k, rot_k)
     Oj = P - pl.local(j, pj.point) * rot_j
     Kj = Oj + pl.local(j, pl.anchor(pin, j)) * rot_j             # on the inner guide line
     Kc = pl.position(c, pl.anchor(pk, c))                         # on the outer guide line
     rY = pl.local(k, pl.anchor(pin, k)) * rot_k
     rX = pl.local(k, pl.anchor(pk, k)) * rot_k
     # k's anchor Y = Kj + s d_in on the inner line, its anchor X = Y + rX - rY on the outer line
-    _, s = decompose(Kj + rX - rY - Kc, dc, -d_in)
+    _, s = Basis(dc, -d_in).solve(Kj + rX - rY - Kc)
     Ok = Kj + s * d_in - rY
     wc, ec = pl.w[:, c], pl.e[:, c]
     VPc, APc = pl.at(c, P)
     # v_P = v_P(c) + v2 d_c + v1 d_in ; a_P = a_P(c) + 2 w x (v2 d_c + v1 d_in) + a2 d_c + a1 d_in
-    v1, v2 = decompose(VP - VPc, d_in, dc)
-    a1, a2 = decompose(AP - APc - 2j * wc * (v1 * d_in + v2 * dc), d_in, dc)
-    pl.set_link(j, th_j, P, pl.local(j, pj.point), wc, VP, ec, AP)
-    pl.set_link(k, th_k, P, (P - Ok) / rot_k, wc, VPc + v2 * dc, ec, APc + (2j * wc * v2 + a2) * dc)
+    plan = Basis(d_in, dc)
+    v1, v2 = plan.solve(VP - VPc)
+    a1, a2 = plan.solve(AP - APc - 2j * wc * (v1 * d_in + v2 * dc))
+    pl.set_link(j, th_j, rot_j, P, pl.local(j, pj.point), wc, VP, ec, AP)
+    pl.set_link(k, th_k, rot_k, P, (P - Ok) / rot_k, wc, VPc + v2 * dc, ec, APc + (2j * wc * v2 + a2) * dc)
     pl.slide(pin, j, v1, a1)
     pl.slide(pk, k, v2, a2)
-    return condition(d_in, dc)
+    return condition(2.0, plan.det)
 
 
 _GROUP_SOLVERS: dict[str, Callable[[_Plan, "AssurGroup"], np.ndarray]] = {
@@ -312,8 +325,8 @@ def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)
     th1 = np.arctan2(dr.reference[1], dr.reference[0]) + dr.sense * phi - np.angle(arm)
     zero = np.zeros(len(phi), complex)
-    pl.set_link(1, th1, pl.local(0, dr.pivot) + zero, pl.local(1, dr.pivot), np.full_like(phi, dr.sense * dr.omega),
-                zero, np.full_like(phi, dr.sense * dr.eps), zero)
+    pl.set_link(1, th1, np.exp(1j * th1), pl.local(0, dr.pivot) + zero, pl.local(1, dr.pivot),
+                np.full_like(phi, dr.sense * dr.omega), zero, np.full_like(phi, dr.sense * dr.eps), zero)
     groups = mech.structure.groups
     cond = np.ones((len(phi), len(groups)))
     for n, g in enumerate(groups):

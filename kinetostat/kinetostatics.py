@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from .planar import as_xy, as_z, cross_z, decompose, dot_z, rot90
+from .planar import Basis, as_xy, as_z, cross_z, dot_z, rot90
 
 if TYPE_CHECKING:
     from .kinematics import Kinematics
@@ -83,7 +83,7 @@ def _rrr(st: _Statics, g: "AssurGroup") -> None:
     uj, uk = (B - P) / lj, (B - Q) / lk
     # tangential parts from the moments of each link about B, normal parts from the polygon
     nj, nk = 1j * uj * (st.moment(j, B) / lj), 1j * uk * (st.moment(k, B) / lk)
-    aj, ak = decompose(-(st.F[:, j] + st.F[:, k] + nj + nk), uj, uk)
+    aj, ak = Basis(uj, uk).solve(-(st.F[:, j] + st.F[:, k] + nj + nk))
     R_aj, R_ck = aj * uj + nj, ak * uk + nk
     st.revolute(pj, a, R_aj)
     st.revolute(pin, k, -(st.F[:, j] + R_aj))
@@ -98,7 +98,7 @@ def _rrp(st: _Statics, g: "AssurGroup") -> None:
     lj = np.abs(B - P)
     uj, n = (B - P) / lj, st.normal(pk)
     nj = 1j * uj * (st.moment(j, B) / lj)
-    aj, N = decompose(-(st.F[:, j] + st.F[:, k] + nj), uj, n)
+    aj, N = Basis(uj, n).solve(-(st.F[:, j] + st.F[:, k] + nj))
     R_aj, f_bk = aj * uj + nj, N * n
     mB = st.moment(k, B)
     st.revolute(pj, a, R_aj)
@@ -125,7 +125,7 @@ def _rpr(st: _Statics, g: "AssurGroup") -> None:
 def _prp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     B, na, nc = st.at(j, pin.point), st.normal(pj), st.normal(pk)
-    Na, Nc = decompose(-(st.F[:, j] + st.F[:, k]), na, nc)
+    Na, Nc = Basis(na, nc).solve(-(st.F[:, j] + st.F[:, k]))
     f_aj, f_ck = Na * na, Nc * nc
     mj, mk = st.moment(j, B), st.moment(k, B)
     st.prismatic(pj, a, f_aj, -mj, B)
@@ -139,7 +139,7 @@ def _rpp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, n_in, nc = st.at(j, pj.point), st.normal(pin), st.normal(pk)
     # link k: F_k - f_kj + f_ck = 0 with both forces normal to their guides
-    N1, Nc = decompose(st.F[:, k], n_in, -nc)
+    N1, Nc = Basis(n_in, -nc).solve(st.F[:, k])
     f_kj, f_ck = N1 * n_in, Nc * nc
     mj, mk = st.moment(j, P), st.moment(k, P)
     R_aj = -st.F[:, j] - f_kj

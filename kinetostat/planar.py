@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["as_z", "as_xy", "cross_z", "dot_z", "decompose", "condition",
+__all__ = ["as_z", "as_xy", "cross_z", "dot_z", "Basis", "condition",
            "cross", "rot90", "rotate", "unit"]
 
 
@@ -35,24 +35,29 @@ def dot_z(a, b):
     return a.real * b.real + a.imag * b.imag
 
 
-def decompose(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Solve v = alpha a + beta b (complex stacks; alpha, beta real): the closing of a vector
-    polygon of a plan. Where a and b are parallel this divides by zero (inf/nan there, the
-    callers run under np.errstate): the singular-position guard (`condition`) reports and marks it."""
-    det = cross_z(a, b)
-    return cross_z(v, b) / det, cross_z(a, v) / det
+class Basis:
+    """Two plane directions a, b (complex stacks) along which vector polygons close:
+    v = alpha a + beta b with alpha, beta real. One basis serves a group's velocity and
+    acceleration plans (or its force polygon); det = a x b is formed once."""
+    __slots__ = ("a", "b", "det")
+
+    def __init__(self, a: np.ndarray, b: np.ndarray):
+        self.a, self.b, self.det = a, b, cross_z(a, b)
+
+    def solve(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(alpha, beta) closing the polygon of v. Where a and b are parallel this divides by
+        zero (inf/nan there; the callers run under np.errstate): the singular-position guard
+        (`condition`) reports and marks it."""
+        return cross_z(v, self.b) / self.det, cross_z(self.a, v) / self.det
 
 
-def condition(a: np.ndarray, b: np.ndarray, la: float | None = None, lb: float | None = None) -> np.ndarray:
-    """2-norm condition number of [a/la b/lb], the measure of a singular position (inf where
-    a and b are parallel). `la`, `lb` are reference sizes of the columns (default: their own
-    lengths, a pure angle measure; pass a length scale for columns that are lengths, so that a
-    vanishing arm counts)."""
-    sa2 = a.real**2 + a.imag**2 if la is None else la * la
-    sb2 = b.real**2 + b.imag**2 if lb is None else lb * lb
-    frob = (a.real**2 + a.imag**2) / sa2 + (b.real**2 + b.imag**2) / sb2
-    t = 0.5 * frob / np.abs(cross_z(a, b) / np.sqrt(sa2 * sb2))   # ||M||_F^2 / (2 |det M|)
-    return t + np.sqrt(np.maximum(t * t - 1.0, 0.0))                # kappa + 1/kappa = 2 t
+def condition(frob, det) -> np.ndarray:
+    """2-norm condition number of a 2x2 matrix M from ||M||_F^2 and det M (inf where det is 0):
+    kappa + 1/kappa = ||M||_F^2 / |det M|. Used on the plans' matrices with each column divided
+    by a reference size (a length scale for columns that are lengths, so that a vanishing arm
+    counts), the measure of a singular position."""
+    t = 0.5 * frob / np.abs(det)
+    return t + np.sqrt(np.maximum(t * t - 1.0, 0.0))
 
 
 # -- the same operations on public (..., 2) arrays
