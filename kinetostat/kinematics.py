@@ -6,6 +6,8 @@ finds the positions in closed form and closes the velocity and acceleration plan
 """
 from __future__ import annotations
 
+import cmath
+import math
 import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
@@ -94,21 +96,26 @@ class _Plan:
         self.O, self.V, self.A = (np.zeros((N, L), complex) for _ in range(3))
         self.vs, self.as_ = np.zeros((N, len(mech.pairs))), np.zeros((N, len(mech.pairs)))
         self.L = mech.size
-        self.locals = _locals(mech)
+        self.locals = mech.points_z
 
     def local(self, k: int, name: str) -> complex:
         return self.locals[k][name]
 
-    def position(self, k: int, name: str) -> np.ndarray:
-        return self.O[:, k] + self.local(k, name) * self.rot[:, k]
+    # The frame does not move: its points are constants with no velocity or acceleration.
+    def position(self, k: int, name: str) -> np.ndarray | complex:
+        return self.O[:, k] + self.local(k, name) * self.rot[:, k] if k else self.local(0, name)
 
     def point(self, k: int, name: str):
+        if not k:
+            return self.local(0, name), 0.0, 0.0
         r = self.local(k, name) * self.rot[:, k]
         w, e = self.w[:, k], self.e[:, k]
         return self.O[:, k] + r, self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
 
     def at(self, k: int, X: np.ndarray):
         """Velocity and acceleration of the point of link k that is at world position X."""
+        if not k:
+            return 0.0, 0.0
         r = X - self.O[:, k]
         w, e = self.w[:, k], self.e[:, k]
         return self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
@@ -118,7 +125,7 @@ class _Plan:
         acceleration X, V, A of its local point x_local (a constant, or (N,) for a point
         moving in the link)."""
         self.th[:, k], self.rot[:, k], self.w[:, k], self.e[:, k] = th, rot, w, e
-        if np.ndim(x_local) or x_local:             # (X is not already the local origin)
+        if isinstance(x_local, np.ndarray) or x_local:      # X is not already the local origin
             r = x_local * rot
             X, V, A = X - r, V - 1j * w * r, A - (1j * e - w**2) * r
         self.O[:, k], self.V[:, k], self.A[:, k] = X, V, A
@@ -127,7 +134,7 @@ class _Plan:
     def aligned(x_local: complex, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Angle and e^{i theta} of a link whose local vector x_local is the world vector X
         (of the same length)."""
-        return np.angle(X) - np.angle(x_local), X / x_local
+        return np.angle(X) - cmath.phase(x_local), X / x_local
 
     # --- prismatic pair geometry: the guide line is fixed in both links (equal rotation), and
     # the slider's local x axis is the guide direction d (its angle alpha in the guide's frame)
@@ -168,13 +175,6 @@ class _Plan:
         if bad.any():
             raise AssemblyError(g.label, np.degrees(self.phi[bad]), why)
         return np.sqrt(np.maximum(disc, 0.0))
-
-
-def _locals(mech: "Mechanism") -> list[dict[str, complex]]:
-    """Local coordinates of every link's points as complex numbers (memoised per mechanism)."""
-    if "locals" not in mech._derived:
-        mech._derived["locals"] = [{n: complex(*xy) for n, xy in link.points.items()} for link in mech.links]
-    return mech._derived["locals"]
 
 
 # Each solver returns the condition number of its plans' matrix, columns scaled by reference
@@ -323,7 +323,7 @@ def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     pl = _Plan(mech, phi)
     dr = mech.drive
     arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)
-    th1 = np.arctan2(dr.reference[1], dr.reference[0]) + dr.sense * phi - np.angle(arm)
+    th1 = dr.sense * phi + (math.atan2(dr.reference[1], dr.reference[0]) - cmath.phase(arm))
     zero = np.zeros(len(phi), complex)
     pl.set_link(1, th1, np.exp(1j * th1), pl.local(0, dr.pivot) + zero, pl.local(1, dr.pivot),
                 np.full_like(phi, dr.sense * dr.omega), zero, np.full_like(phi, dr.sense * dr.eps), zero)

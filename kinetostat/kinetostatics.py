@@ -39,24 +39,26 @@ class _Statics:
     """Known wrenches per link about its local origin (complex forces), updated as groups are solved."""
 
     def __init__(self, mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray):
-        self.mech, self.kin = mech, kin
+        self.mech, self.kin, self.locals = mech, kin, mech.points_z
         self.F, self.M = F.copy(), M.copy()
         N = len(kin.phi)
         self.R = np.zeros((N, len(mech.pairs)), complex)
-        self.x = np.full((N, len(mech.pairs)), np.nan)
+        self.N = np.zeros((N, len(mech.pairs)))     # P pairs: normal force along n = i d
         self.m = np.zeros((N, len(mech.pairs)))
 
     def at(self, k: int, name: str) -> np.ndarray:
-        return self.kin.position_z(k, self.mech.links[k].points[name])
+        return self.kin.origin_z[:, k] + self.locals[k][name] * self.kin.rot[:, k]
 
     def moment(self, k: int, X: np.ndarray) -> np.ndarray:
         """Moment about X of the known loads on link k."""
         return self.M[:, k] + cross_z(self.kin.origin_z[:, k] - X, self.F[:, k])
 
     def apply(self, k: int, f: np.ndarray, X: np.ndarray, m: np.ndarray | float = 0.0) -> None:
-        """Add force f through X (and couple m) to the known loads of link k."""
-        self.F[:, k] += f
-        self.M[:, k] += cross_z(X - self.kin.origin_z[:, k], f) + m
+        """Add force f through X (and couple m) to the known loads of link k. The frame's own
+        balance is never asked for, so its loads are not kept."""
+        if k:
+            self.F[:, k] += f
+            self.M[:, k] += cross_z(X - self.kin.origin_z[:, k], f) + m
 
     def normal(self, p: "Pair") -> np.ndarray:
         """World unit normal n = i d of P pair p's guide."""
@@ -65,21 +67,24 @@ class _Statics:
     def revolute(self, p: "Pair", giver: int, R: np.ndarray) -> None:
         self.R[:, p.index] = R if giver == p.links[0] else -R
 
-    def prismatic(self, p: "Pair", giver: int, f: np.ndarray, m: np.ndarray, X0: np.ndarray) -> None:
-        """Record the normal force f of `giver` whose moment about X0 is m: its moment about the
-        slider point S, and its line S + x d along the guide ((x d) x (N n) = x N)."""
-        self.revolute(p, giver, f)
+    def prismatic(self, p: "Pair", giver: int, N: np.ndarray, n: np.ndarray, m: np.ndarray,
+                  X0: np.ndarray) -> np.ndarray:
+        """Record the normal force f = N n (n = self.normal(p)) of `giver` whose moment about X0
+        is m, and its moment about the slider point S; return f."""
+        f = N * n
         S = self.at(p.links[1], p.point)
         m_S = m + cross_z(X0 - S, f)
-        N = dot_z(self.normal(p), f)
-        self.m[:, p.index] = m_S if giver == p.links[0] else -m_S
-        self.x[:, p.index] = np.where(N != 0, m_S / np.where(N != 0, N, 1.0), np.nan)
+        if giver == p.links[0]:
+            self.R[:, p.index], self.N[:, p.index], self.m[:, p.index] = f, N, m_S
+        else:
+            self.R[:, p.index], self.N[:, p.index], self.m[:, p.index] = -f, -N, -m_S
+        return f
 
 
 def _rrr(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, B, Q = st.at(j, pj.point), st.at(j, pin.point), st.at(k, pk.point)
-    lj, lk = np.abs(B - P), np.abs(B - Q)
+    lj, lk = abs(st.locals[j][pin.point] - st.locals[j][pj.point]), abs(st.locals[k][pin.point] - st.locals[k][pk.point])
     uj, uk = (B - P) / lj, (B - Q) / lk
     # tangential parts from the moments of each link about B, normal parts from the polygon
     nj, nk = 1j * uj * (st.moment(j, B) / lj), 1j * uk * (st.moment(k, B) / lk)
@@ -95,15 +100,15 @@ def _rrr(st: _Statics, g: "AssurGroup") -> None:
 def _rrp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, b) = g.pairs, g.links, g.known
     P, B = st.at(j, pj.point), st.at(j, pin.point)
-    lj = np.abs(B - P)
+    lj = abs(st.locals[j][pin.point] - st.locals[j][pj.point])
     uj, n = (B - P) / lj, st.normal(pk)
     nj = 1j * uj * (st.moment(j, B) / lj)
     aj, N = Basis(uj, n).solve(-(st.F[:, j] + st.F[:, k] + nj))
-    R_aj, f_bk = aj * uj + nj, N * n
+    R_aj = aj * uj + nj
     mB = st.moment(k, B)
     st.revolute(pj, a, R_aj)
     st.revolute(pin, k, -(st.F[:, j] + R_aj))
-    st.prismatic(pk, b, f_bk, -mB, B)
+    f_bk = st.prismatic(pk, b, N, n, -mB, B)
     st.apply(a, -R_aj, P)
     st.apply(b, -f_bk, B, mB)
 
@@ -113,10 +118,9 @@ def _rpr(st: _Statics, g: "AssurGroup") -> None:
     P, Q, n = st.at(j, pj.point), st.at(k, pk.point), st.normal(pin)
     mP = st.moment(j, P)
     # moment of the whole group about Q fixes the normal force of the slotted link on the block
-    f_kj = (mP + st.moment(k, Q)) / cross_z(P - Q, n) * n
+    f_kj = st.prismatic(pin, k, (mP + st.moment(k, Q)) / cross_z(P - Q, n), n, -mP, P)
     R_aj, R_ck = -st.F[:, j] - f_kj, f_kj - st.F[:, k]
     st.revolute(pj, a, R_aj)
-    st.prismatic(pin, k, f_kj, -mP, P)
     st.revolute(pk, c, R_ck)
     st.apply(a, -R_aj, P)
     st.apply(c, -R_ck, Q)
@@ -126,11 +130,10 @@ def _prp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     B, na, nc = st.at(j, pin.point), st.normal(pj), st.normal(pk)
     Na, Nc = Basis(na, nc).solve(-(st.F[:, j] + st.F[:, k]))
-    f_aj, f_ck = Na * na, Nc * nc
     mj, mk = st.moment(j, B), st.moment(k, B)
-    st.prismatic(pj, a, f_aj, -mj, B)
+    f_aj = st.prismatic(pj, a, Na, na, -mj, B)
     st.revolute(pin, k, -(st.F[:, j] + f_aj))
-    st.prismatic(pk, c, f_ck, -mk, B)
+    f_ck = st.prismatic(pk, c, Nc, nc, -mk, B)
     st.apply(a, -f_aj, B, mj)
     st.apply(c, -f_ck, B, mk)
 
@@ -140,12 +143,11 @@ def _rpp(st: _Statics, g: "AssurGroup") -> None:
     P, n_in, nc = st.at(j, pj.point), st.normal(pin), st.normal(pk)
     # link k: F_k - f_kj + f_ck = 0 with both forces normal to their guides
     N1, Nc = Basis(n_in, -nc).solve(st.F[:, k])
-    f_kj, f_ck = N1 * n_in, Nc * nc
     mj, mk = st.moment(j, P), st.moment(k, P)
+    f_kj = st.prismatic(pin, k, N1, n_in, -mj, P)
+    f_ck = st.prismatic(pk, c, Nc, nc, -(mj + mk), P)
     R_aj = -st.F[:, j] - f_kj
     st.revolute(pj, a, R_aj)
-    st.prismatic(pin, k, f_kj, -mj, P)
-    st.prismatic(pk, c, f_ck, -(mj + mk), P)
     st.apply(a, -R_aj, P)
     st.apply(c, -f_ck, P, mj + mk)
 
@@ -166,7 +168,9 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
     M_bal = -st.moment(1, st.at(1, dr.pivot))
     F_bal = as_z(gear_force(dr.gear, M_bal)) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
-    return Forces(as_xy(st.R), st.x, st.m, M_bal, as_xy(F_bal))
+    # the line of each normal force, S + x d: (x d) x (N n) = x N is its moment about S
+    x = np.where(st.N != 0, st.m / np.where(st.N != 0, st.N, 1.0), np.nan)
+    return Forces(as_xy(st.R), x, st.m, M_bal, as_xy(F_bal))
 
 
 def gear_force(gear: "Gear", M: np.ndarray) -> np.ndarray:

@@ -197,6 +197,13 @@ class Mechanism:
         return self._derived["inertia"]
 
     @property
+    def points_z(self) -> list[dict[str, complex]]:
+        """Every link's points in its local frame as complex numbers x + iy, memoised."""
+        if "points_z" not in self._derived:
+            self._derived["points_z"] = [{n: complex(*xy) for n, xy in link.points.items()} for link in self.links]
+        return self._derived["points_z"]
+
+    @property
     def size(self) -> float:
         """Characteristic length: the largest distance between two points of one link, m."""
         if "size" not in self._derived:
