@@ -26,13 +26,16 @@ def as_xy(z: np.ndarray) -> np.ndarray:
     return flat.view(np.float64).reshape(z.shape + (2,))
 
 
+# Im and Re of conj(a) b: the same two products and one sum as the component formulas, in
+# fewer array operations (which is what costs at a few hundred angles).
 def cross_z(a, b):
     """z-component of a x b for complex plane vectors."""
-    return a.real * b.imag - a.imag * b.real
+    return (a.conjugate() * b).imag
 
 
 def dot_z(a, b):
-    return a.real * b.real + a.imag * b.imag
+    """Scalar product a . b for complex plane vectors."""
+    return (a.conjugate() * b).real
 
 
 class Basis:
