@@ -8,7 +8,7 @@ import numpy as np
 
 from .kinematics import Kinematics, kinematics
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from .applied import applied_wrenches, com_positions, inertia_loads
+from .applied import applied_wrenches, com_motion, inertia_loads
 from .planar import as_xy, cross_z
 from .model import Mechanism
 
@@ -232,11 +232,11 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
 
 
 def _kinetostatics(mech: Mechanism, kin: Kinematics) -> Analysis:
-    S, aS = com_positions(mech, kin)
-    F_app, M_app = applied_wrenches(mech, kin, S)
+    r, aS = com_motion(mech, kin)
+    F_app, M_app = applied_wrenches(mech, kin, r)
     F_i, M_i = inertia_loads(mech, kin, aS)
     F_all = F_app + F_i
-    M_all = M_app + M_i + cross_z(S - kin.origin_z, F_i)
+    M_all = M_app + M_i + cross_z(r, F_i)
     frc = forces(mech, kin, F_all, M_all)
     lever = lever_moment(mech, kin, F_all, M_all)
     return Analysis(mech, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Load, Mechanism
 
-__all__ = ["applied_wrenches", "com_positions", "inertia_loads", "load_magnitude"]
+__all__ = ["applied_wrenches", "com_motion", "inertia_loads", "load_magnitude"]
 
 
 def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
@@ -25,11 +25,11 @@ def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) ->
     M[:, k] += cross_z(X - kin.origin_z[:, k], f)
 
 
-def com_positions(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
-    """Complex positions (N, L) and accelerations (N, L) of the centres of mass (the link
-    origin where a link has no centre of mass), all links at once."""
+def com_motion(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
+    """Arm r from each link's local origin to its centre of mass (N, L) complex, m (0 where a
+    link has no centre of mass), and the centres' accelerations a_S (N, L) complex, m/s^2."""
     r = mech.inertia_arrays[2] * kin.rot
-    return kin.origin_z + r, kin.a_z + (1j * kin.eps - kin.omega**2) * r
+    return r, kin.a_z + (1j * kin.eps - kin.omega**2) * r
 
 
 def inertia_loads(mech: "Mechanism", kin: "Kinematics", aS: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -39,19 +39,26 @@ def inertia_loads(mech: "Mechanism", kin: "Kinematics", aS: np.ndarray) -> tuple
     return -mass * aS, -I_S * kin.eps
 
 
-def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """All applied loads (gravity, external forces and moments, springs; no inertia) on each link
-    as a wrench about its local origin: F (N, L) complex, M (N, L). S: centres of mass (N, L)."""
-    F = np.broadcast_to(-1j * mech.g * mech.inertia_arrays[0], kin.theta.shape).copy()
-    M = cross_z(S - kin.origin_z, F)
+    as a wrench about its local origin: F (N, L) complex, M (N, L). r: arms to the centres of
+    mass (N, L), as `com_motion` gives."""
+    weight = -1j * mech.g * mech.inertia_arrays[0]
+    F = np.empty(r.shape, complex)
+    F[:] = weight
+    M = cross_z(r, weight)
     for ld in mech.loads:
-        mag = load_magnitude(mech, kin, ld)
         if ld.kind == "moment":
+            mag = load_magnitude(mech, kin, ld)
             if ld.direction == "against_omega":
                 mag = -np.sign(kin.omega[:, ld.link]) * np.abs(mag)
             M[:, ld.link] += mag
             continue
-        X, V, _ = kin.point_z(ld.link, mech.links[ld.link].points[ld.point])
+        p = mech.links[ld.link].points[ld.point]
+        X = kin.position_z(ld.link, p)
+        needs_v = ld.direction == "against_velocity" or (ld.table is not None and ld.table.argument == "travel")
+        V = kin.velocity_z(ld.link, p) if needs_v else None
+        mag = load_magnitude(mech, kin, ld, X, V)
         if ld.direction == "against_velocity":
             speed = np.abs(V)
             # at a dead centre the direction is undefined: no force where the speed is rounding
@@ -77,8 +84,10 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", S: np.ndarray) -> tup
     return F, M
 
 
-def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarray:
-    """Magnitude of load `ld` at every angle: N for a force, N m for a moment."""
+def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarray | None = None,
+                   V: np.ndarray | None = None) -> np.ndarray:
+    """Magnitude of load `ld` at every angle: N for a force, N m for a moment. X, V: complex
+    position and velocity of the load's point, if the caller has them already."""
     N = len(kin.phi)
     if ld.table is None:
         return np.full(N, ld.value)
@@ -92,7 +101,8 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarr
         return t.scale * np.interp(np.degrees(kin.phi) % 360.0, xp, vp)
     p = mech.links[ld.link].points[ld.point]
     axis = complex(*(t.axis if t.axis is not None else ld.direction))
-    X, V, _ = kin.point_z(ld.link, p)
+    if X is None:
+        X, V = kin.position_z(ld.link, p), kin.velocity_z(ld.link, p)
     key = ("stroke", ld.link, tuple(p), axis)
     if key not in mech._derived:
         mech._derived[key] = _stroke(mech, ld.link, p, axis)

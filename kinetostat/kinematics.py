@@ -74,6 +74,10 @@ class Kinematics:
         """Complex position (N,) of local point p of link k."""
         return self.origin_z[:, k] + complex(p[0], p[1]) * self.rot[:, k]
 
+    def velocity_z(self, k: int, p) -> np.ndarray:
+        """Complex velocity (N,) of local point p of link k."""
+        return self.v_z[:, k] + 1j * self.omega[:, k] * (complex(p[0], p[1]) * self.rot[:, k])
+
     def point_z(self, k: int, p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Complex position, velocity, acceleration (each (N,)) of local point p of link k."""
         r = complex(p[0], p[1]) * self.rot[:, k]
