@@ -224,7 +224,7 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
         phi_deg = np.atleast_1d(np.asarray(phi_deg, dtype=float))
     except (TypeError, ValueError):
         raise ValueError(f"phi_deg: expected finite crank angles in degrees, got {phi_deg!r}") from None
-    if phi_deg.ndim != 1 or not np.all(np.isfinite(phi_deg)):
+    if phi_deg.ndim != 1 or not np.isfinite(phi_deg).all():
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     kin = kinematics(mech, np.radians(phi_deg))
     with np.errstate(divide="ignore", invalid="ignore"):    # NaN only at angles marked singular

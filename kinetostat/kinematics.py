@@ -170,8 +170,10 @@ class _Plan:
 
     def slide(self, p: "Pair", mover: int, v, a) -> None:
         """Record the motion of `mover` relative to the pair's other link along d."""
-        s = 1.0 if mover == p.links[1] else -1.0
-        self.vs[:, p.index], self.as_[:, p.index] = s * v, s * a
+        if mover == p.links[1]:
+            self.vs[:, p.index], self.as_[:, p.index] = v, a
+        else:
+            self.vs[:, p.index], self.as_[:, p.index] = -v, -a
 
     def reachable(self, g: "AssurGroup", disc: np.ndarray, scale: float, why: str) -> np.ndarray:
         """sqrt of a discriminant; AssemblyError naming the angles where it is negative."""
@@ -343,9 +345,9 @@ def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
 
 
 def _guard(mech: "Mechanism", phi: np.ndarray, cond: np.ndarray) -> np.ndarray:
-    cond = np.where(np.isnan(cond), np.inf, cond)
-    if not (cond > COND_WARN).any():
+    if (cond <= COND_WARN).all():        # (False for NaN)
         return np.zeros(len(phi), bool)
+    cond = np.where(np.isnan(cond), np.inf, cond)
     for n, g in enumerate(mech.structure.groups):
         near = cond[:, n] > COND_WARN
         if near.any():

@@ -53,12 +53,13 @@ class _Statics:
         """Moment about X of the known loads on link k."""
         return self.M[:, k] + cross_z(self.kin.origin_z[:, k] - X, self.F[:, k])
 
-    def apply(self, k: int, f: np.ndarray, X: np.ndarray, m: np.ndarray | float = 0.0) -> None:
+    def apply(self, k: int, f: np.ndarray, X: np.ndarray, m: np.ndarray | None = None) -> None:
         """Add force f through X (and couple m) to the known loads of link k. The frame's own
         balance is never asked for, so its loads are not kept."""
         if k:
+            dM = cross_z(X - self.kin.origin_z[:, k], f)
             self.F[:, k] += f
-            self.M[:, k] += cross_z(X - self.kin.origin_z[:, k], f) + m
+            self.M[:, k] += dM if m is None else dM + m
 
     def normal(self, p: "Pair") -> np.ndarray:
         """World unit normal n = i d of P pair p's guide."""
@@ -169,7 +170,8 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
     F_bal = as_z(gear_force(dr.gear, M_bal)) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
     # the line of each normal force, S + x d: (x d) x (N n) = x N is its moment about S
-    x = np.where(st.N != 0, st.m / np.where(st.N != 0, st.N, 1.0), np.nan)
+    x = st.m / st.N
+    x[st.N == 0] = np.nan
     return Forces(as_xy(st.R), x, st.m, M_bal, as_xy(F_bal))
 
 
@@ -194,7 +196,9 @@ def lever_moment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndar
     F (N, L) complex and M (N, L): all applied and inertia loads per link about its origin.
     """
     power = dot_z(F, kin.v_z) + M * kin.omega
-    return -power[:, 1:].sum(axis=1) / kin.omega[:, 1]
+    moving = np.ones(mech.n_links)            # the sum over the moving links as one matrix product
+    moving[0] = 0.0
+    return -(power @ moving) / kin.omega[:, 1]
 
 
 def friction_power(mech: "Mechanism", kin: "Kinematics", R: np.ndarray) -> np.ndarray:
