@@ -94,11 +94,12 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
     t = ld.table
     if t.argument == "phi":
         key = ("periodic", id(t))
-        if key not in mech._derived:     # the diagram repeated once on each side: no sort per call
-            x = np.asarray(t.x)
-            mech._derived[key] = (np.concatenate([x - 360.0, x, x + 360.0]), np.tile(t.value, 3))
+        if key not in mech._derived:     # the diagram (rad) repeated over [-4 pi, 4 pi]: fmod lands inside
+            x = np.radians(t.x)
+            mech._derived[key] = (np.concatenate([x + 2 * np.pi * n for n in (-2, -1, 0, 1)]),
+                                  t.scale * np.tile(t.value, 4))
         xp, vp = mech._derived[key]
-        return t.scale * np.interp(np.degrees(kin.phi) % 360.0, xp, vp)
+        return np.interp(np.fmod(kin.phi, 2 * np.pi), xp, vp)
     p = mech.links[ld.link].points[ld.point]
     axis = complex(*(t.axis if t.axis is not None else ld.direction))
     if X is None:

@@ -187,3 +187,22 @@ def test_regular_cycle_does_not_warn(mech):
     with warnings.catch_warnings():
         warnings.simplefilter("error", SingularPositionWarning)
         kinetostat.analyze(mech, steps=360)
+
+
+def test_crank_angle_diagram_wraps_round_at_any_angle():
+    """A moment diagram against phi given on [10, 350] deg only: between its ends it runs
+    straight from 350 to 370 deg, and every angle reads as its remainder mod 360."""
+    mech = kinetostat.loads(FOUR_BAR + """
+[[load]]
+name = "diagram"
+kind = "moment"
+link = 3
+[load.table]
+phi_deg = [10, 100, 350]
+value = [1.0, 4.0, 2.0]
+scale = 10.0
+""")
+    phi = np.array([-355.0, -5.0, 0.0, 5.0, 10.0, 55.0, 350.0, 355.0, 715.0, 1090.0])
+    by_hand = 10.0 * np.array([1.25, 1.75, 1.5, 1.25, 1.0, 2.5, 2.0, 1.75, 1.75, 1.0])
+    res, plain = kinetostat.analyze(mech, phi_deg=phi), kinetostat.analyze(kinetostat.loads(FOUR_BAR), phi_deg=phi)
+    np.testing.assert_allclose(res.M_applied[:, 3] - plain.M_applied[:, 3], by_hand, rtol=1e-12)
