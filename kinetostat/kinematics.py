@@ -95,10 +95,10 @@ class _Plan:
     def __init__(self, mech: "Mechanism", phi: np.ndarray):
         N, L = len(phi), mech.n_links
         self.mech, self.phi = mech, phi
-        self.th, self.w, self.e = np.zeros((N, L)), np.zeros((N, L)), np.zeros((N, L))
+        self.th, self.w, self.e = np.zeros((3, N, L))            # the frame's column stays 0
         self.rot = np.ones((N, L), complex)
-        self.O, self.V, self.A = (np.zeros((N, L), complex) for _ in range(3))
-        self.vs, self.as_ = np.zeros((N, len(mech.pairs))), np.zeros((N, len(mech.pairs)))
+        self.O, self.V, self.A = np.zeros((3, N, L), complex)
+        self.vs, self.as_ = np.zeros((2, N, len(mech.pairs)))
         self.L = mech.size
         self.locals = mech.points_z
 
@@ -330,9 +330,8 @@ def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     dr = mech.drive
     arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)
     th1 = dr.sense * phi + (math.atan2(dr.reference[1], dr.reference[0]) - cmath.phase(arm))
-    zero = np.zeros(len(phi), complex)
-    pl.set_link(1, th1, np.exp(1j * th1), pl.local(0, dr.pivot) + zero, pl.local(1, dr.pivot),
-                np.full_like(phi, dr.sense * dr.omega), zero, np.full_like(phi, dr.sense * dr.eps), zero)
+    pl.set_link(1, th1, np.exp(1j * th1), pl.local(0, dr.pivot), pl.local(1, dr.pivot),
+                dr.sense * dr.omega, 0.0, dr.sense * dr.eps, 0.0)
     groups = mech.structure.groups
     cond = np.ones((len(phi), len(groups)))
     for n, g in enumerate(groups):
