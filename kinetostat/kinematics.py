@@ -124,6 +124,10 @@ class _Plan:
         w, e = self.w[:, k], self.e[:, k]
         return self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
 
+    def coriolis(self, k: int, v: np.ndarray, d: np.ndarray) -> np.ndarray | float:
+        """Coriolis acceleration 2 w_k x (v d) of a point sliding at v along d in link k."""
+        return 2j * self.w[:, k] * v * d if k else 0.0
+
     def set_link(self, k: int, th, rot, X, x_local: complex | np.ndarray, w, V, e, A) -> None:
         """Fix link k from its angle th, rot = e^{i th}, and the world position, velocity and
         acceleration X, V, A of its local point x_local (a constant, or (N,) for a point
@@ -183,10 +187,12 @@ class _Plan:
         return np.sqrt(np.maximum(disc, 0.0))
 
 
-# Each solver returns the condition number of its plans' matrix, columns scaled by reference
-# sizes (mech.size for a column that is a length, 1 for a unit direction).
+# Each solver returns ||M||_F^2 and det M of its plans' matrix M, columns scaled by reference
+# sizes (mech.size for a column that is a length, 1 for a unit direction): `condition` of them
+# is taken once for all groups.
+_Conditioning = tuple[float | np.ndarray, np.ndarray]
 
-def _rrr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
+def _rrr(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, VP, AP = pl.point(a, pj.point)
     Q, VQ, AQ = pl.point(c, pk.point)
@@ -206,10 +212,10 @@ def _rrr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     AB = AP + ej * plan.a - wj**2 * PB
     pl.set_link(j, *pl.aligned(xj, PB), B, pl.local(j, pin.point), wj, VB, ej, AB)
     pl.set_link(k, *pl.aligned(xk, QB), B, pl.local(k, pin.point), wk, VB, ek, AB)
-    return condition((lj**2 + lk**2) / pl.L**2, plan.det / pl.L**2)
+    return (lj**2 + lk**2) / pl.L**2, plan.det / pl.L**2
 
 
-def _rrp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
+def _rrp(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     (pj, pin, pk), (j, k), (a, b) = g.pairs, g.links, g.known
     P, VP, AP = pl.point(a, pj.point)
     th_k, rot_k = pl.turned(pk, k, pl.th[:, b], pl.rot[:, b])
@@ -229,15 +235,15 @@ def _rrp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     plan = Basis(1j * PB, -d)
     wj, vr = plan.solve(VBb - VP)
     VB = VP + wj * plan.a
-    ej, ar = plan.solve(ABb + 2j * wb * vr * d - AP + wj**2 * PB)
+    ej, ar = plan.solve(ABb + pl.coriolis(b, vr, d) - AP + wj**2 * PB)
     AB = AP + ej * plan.a - wj**2 * PB
     pl.set_link(j, *pl.aligned(xj, PB), B, pl.local(j, pin.point), wj, VB, ej, AB)
     pl.set_link(k, th_k, rot_k, B, pl.local(k, pin.point), wb, VB, eb, AB)
     pl.slide(pk, k, vr, ar)
-    return condition(lj**2 / pl.L**2 + 1.0, plan.det / pl.L)
+    return lj**2 / pl.L**2 + 1.0, plan.det / pl.L
 
 
-def _rpr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
+def _rpr(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known   # j slides on k's guide
     P, VP, AP = pl.point(a, pj.point)
     Q, VQ, AQ = pl.point(c, pk.point)
@@ -254,10 +260,10 @@ def _rpr(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     pl.set_link(k, *pl.turned(pin, k, th_j, d), Q, pl.local(k, pk.point), wk, VQ, ek, AQ)
     pl.set_link(j, th_j, d, P, pl.local(j, pj.point), wk, VP, ek, AP)
     pl.slide(pin, j, vr, ar)
-    return condition(rho2 / pl.L**2 + 1.0, plan.det / pl.L)
+    return rho2 / pl.L**2 + 1.0, plan.det / pl.L
 
 
-def _prp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
+def _prp(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     th_j, rot_j = pl.turned(pj, j, pl.th[:, a], pl.rot[:, a])
     th_k, rot_k = pl.turned(pk, k, pl.th[:, c], pl.rot[:, c])
@@ -272,17 +278,17 @@ def _prp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     wa, wc = pl.w[:, a], pl.w[:, c]
     # v_B = v_B(a) + v1 d_a = v_B(c) + v2 d_c ; accelerations with the Coriolis terms
     v1, v2 = plan.solve(VBc - VBa)
-    a1, a2 = plan.solve(ABc + 2j * wc * v2 * dc - ABa - 2j * wa * v1 * da)
+    a1, a2 = plan.solve(ABc + pl.coriolis(c, v2, dc) - ABa - pl.coriolis(a, v1, da))
     VB = VBa + v1 * da
-    AB = ABa + (2j * wa * v1 + a1) * da
+    AB = ABa + pl.coriolis(a, v1, da) + a1 * da
     pl.set_link(j, th_j, rot_j, B, pl.local(j, pin.point), wa, VB, pl.e[:, a], AB)
     pl.set_link(k, th_k, rot_k, B, pl.local(k, pin.point), wc, VB, pl.e[:, c], AB)
     pl.slide(pj, j, v1, a1)
     pl.slide(pk, k, v2, a2)
-    return condition(2.0, plan.det)
+    return 2.0, plan.det
 
 
-def _rpp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
+def _rpp(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, VP, AP = pl.point(a, pj.point)
     th_k, rot_k = pl.turned(pk, k, pl.th[:, c], pl.rot[:, c])
@@ -301,15 +307,15 @@ def _rpp(pl: _Plan, g: "AssurGroup") -> np.ndarray:
     # v_P = v_P(c) + v2 d_c + v1 d_in ; a_P = a_P(c) + 2 w x (v2 d_c + v1 d_in) + a2 d_c + a1 d_in
     plan = Basis(d_in, dc)
     v1, v2 = plan.solve(VP - VPc)
-    a1, a2 = plan.solve(AP - APc - 2j * wc * (v1 * d_in + v2 * dc))
+    a1, a2 = plan.solve(AP - APc - pl.coriolis(c, v1, d_in) - pl.coriolis(c, v2, dc))
     pl.set_link(j, th_j, rot_j, P, pl.local(j, pj.point), wc, VP, ec, AP)
-    pl.set_link(k, th_k, rot_k, P, (P - Ok) / rot_k, wc, VPc + v2 * dc, ec, APc + (2j * wc * v2 + a2) * dc)
+    pl.set_link(k, th_k, rot_k, P, (P - Ok) / rot_k, wc, VPc + v2 * dc, ec, APc + pl.coriolis(c, v2, dc) + a2 * dc)
     pl.slide(pin, j, v1, a1)
     pl.slide(pk, k, v2, a2)
-    return condition(2.0, plan.det)
+    return 2.0, plan.det
 
 
-_GROUP_SOLVERS: dict[str, Callable[[_Plan, "AssurGroup"], np.ndarray]] = {
+_GROUP_SOLVERS: dict[str, Callable[[_Plan, "AssurGroup"], _Conditioning]] = {
     "RRR": _rrr, "RRP": _rrp, "RPR": _rpr, "PRP": _prp, "RPP": _rpp}
 
 
@@ -333,9 +339,10 @@ def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     pl.set_link(1, th1, np.exp(1j * th1), pl.local(0, dr.pivot), pl.local(1, dr.pivot),
                 dr.sense * dr.omega, 0.0, dr.sense * dr.eps, 0.0)
     groups = mech.structure.groups
-    cond = np.ones((len(phi), len(groups)))
+    frob, det = np.empty((2, len(phi), len(groups)))
     for n, g in enumerate(groups):
-        cond[:, n] = _GROUP_SOLVERS[g.kind](pl, g)
+        frob[:, n], det[:, n] = _GROUP_SOLVERS[g.kind](pl, g)
+    cond = condition(frob, det)
     singular = _guard(mech, phi, cond)
     if singular.any():
         for arr in (pl.w, pl.e, pl.V, pl.A, pl.vs, pl.as_):

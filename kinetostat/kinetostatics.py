@@ -53,13 +53,14 @@ class _Statics:
         """Moment about X of the known loads on link k."""
         return self.M[:, k] + cross_z(self.kin.origin_z[:, k] - X, self.F[:, k])
 
-    def apply(self, k: int, f: np.ndarray, X: np.ndarray, m: np.ndarray | None = None) -> None:
-        """Add force f through X (and couple m) to the known loads of link k. The frame's own
-        balance is never asked for, so its loads are not kept."""
+    def carry(self, k: int, R: np.ndarray, X: np.ndarray, m: np.ndarray | None = None) -> None:
+        """Link k exerts force R through X (and couple m) on a solved group: by action and
+        reaction it bears -R and -m. The frame's own balance is never asked for, so its loads
+        are not kept."""
         if k:
-            dM = cross_z(X - self.kin.origin_z[:, k], f)
-            self.F[:, k] += f
-            self.M[:, k] += dM if m is None else dM + m
+            dM = cross_z(X - self.kin.origin_z[:, k], R)
+            self.F[:, k] -= R
+            self.M[:, k] -= dM if m is None else dM + m
 
     def normal(self, p: "Pair") -> np.ndarray:
         """World unit normal n = i d of P pair p's guide."""
@@ -92,10 +93,10 @@ def _rrr(st: _Statics, g: "AssurGroup") -> None:
     aj, ak = Basis(uj, uk).solve(-(st.F[:, j] + st.F[:, k] + nj + nk))
     R_aj, R_ck = aj * uj + nj, ak * uk + nk
     st.revolute(pj, a, R_aj)
-    st.revolute(pin, k, -(st.F[:, j] + R_aj))
+    st.revolute(pin, j, st.F[:, j] + R_aj)
     st.revolute(pk, c, R_ck)
-    st.apply(a, -R_aj, P)
-    st.apply(c, -R_ck, Q)
+    st.carry(a, R_aj, P)
+    st.carry(c, R_ck, Q)
 
 
 def _rrp(st: _Statics, g: "AssurGroup") -> None:
@@ -106,12 +107,12 @@ def _rrp(st: _Statics, g: "AssurGroup") -> None:
     nj = 1j * uj * (st.moment(j, B) / lj)
     aj, N = Basis(uj, n).solve(-(st.F[:, j] + st.F[:, k] + nj))
     R_aj = aj * uj + nj
-    mB = st.moment(k, B)
+    m_bk = -st.moment(k, B)
     st.revolute(pj, a, R_aj)
-    st.revolute(pin, k, -(st.F[:, j] + R_aj))
-    f_bk = st.prismatic(pk, b, N, n, -mB, B)
-    st.apply(a, -R_aj, P)
-    st.apply(b, -f_bk, B, mB)
+    st.revolute(pin, j, st.F[:, j] + R_aj)
+    f_bk = st.prismatic(pk, b, N, n, m_bk, B)
+    st.carry(a, R_aj, P)
+    st.carry(b, f_bk, B, m_bk)
 
 
 def _rpr(st: _Statics, g: "AssurGroup") -> None:
@@ -123,20 +124,20 @@ def _rpr(st: _Statics, g: "AssurGroup") -> None:
     R_aj, R_ck = -st.F[:, j] - f_kj, f_kj - st.F[:, k]
     st.revolute(pj, a, R_aj)
     st.revolute(pk, c, R_ck)
-    st.apply(a, -R_aj, P)
-    st.apply(c, -R_ck, Q)
+    st.carry(a, R_aj, P)
+    st.carry(c, R_ck, Q)
 
 
 def _prp(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     B, na, nc = st.at(j, pin.point), st.normal(pj), st.normal(pk)
     Na, Nc = Basis(na, nc).solve(-(st.F[:, j] + st.F[:, k]))
-    mj, mk = st.moment(j, B), st.moment(k, B)
-    f_aj = st.prismatic(pj, a, Na, na, -mj, B)
-    st.revolute(pin, k, -(st.F[:, j] + f_aj))
-    f_ck = st.prismatic(pk, c, Nc, nc, -mk, B)
-    st.apply(a, -f_aj, B, mj)
-    st.apply(c, -f_ck, B, mk)
+    m_aj, m_ck = -st.moment(j, B), -st.moment(k, B)
+    f_aj = st.prismatic(pj, a, Na, na, m_aj, B)
+    st.revolute(pin, j, st.F[:, j] + f_aj)
+    f_ck = st.prismatic(pk, c, Nc, nc, m_ck, B)
+    st.carry(a, f_aj, B, m_aj)
+    st.carry(c, f_ck, B, m_ck)
 
 
 def _rpp(st: _Statics, g: "AssurGroup") -> None:
@@ -144,13 +145,14 @@ def _rpp(st: _Statics, g: "AssurGroup") -> None:
     P, n_in, nc = st.at(j, pj.point), st.normal(pin), st.normal(pk)
     # link k: F_k - f_kj + f_ck = 0 with both forces normal to their guides
     N1, Nc = Basis(n_in, -nc).solve(st.F[:, k])
-    mj, mk = st.moment(j, P), st.moment(k, P)
+    mj = st.moment(j, P)
+    m_ck = -(mj + st.moment(k, P))
     f_kj = st.prismatic(pin, k, N1, n_in, -mj, P)
-    f_ck = st.prismatic(pk, c, Nc, nc, -(mj + mk), P)
+    f_ck = st.prismatic(pk, c, Nc, nc, m_ck, P)
     R_aj = -st.F[:, j] - f_kj
     st.revolute(pj, a, R_aj)
-    st.apply(a, -R_aj, P)
-    st.apply(c, -f_ck, P, mj + mk)
+    st.carry(a, R_aj, P)
+    st.carry(c, f_ck, P, m_ck)
 
 
 _GROUP_SOLVERS: dict[str, Callable[[_Statics, "AssurGroup"], None]] = {
