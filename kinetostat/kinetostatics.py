@@ -8,12 +8,13 @@ carried to those links with the sign reversed, as the texts do.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from .planar import Basis, as_xy, as_z, cross_z, dot_z, rot90
+from .planar import Basis, as_xy, as_z, cross_z, dot_z
 
 if TYPE_CHECKING:
     from .kinematics import Kinematics
@@ -169,7 +170,7 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
         _GROUP_SOLVERS[g.kind](st, g)
     dr = mech.drive
     M_bal = -st.moment(1, st.at(1, dr.pivot))
-    F_bal = as_z(gear_force(dr.gear, M_bal)) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
+    F_bal = _gear_force_z(dr.gear, M_bal) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
     # the line of each normal force, S + x d: (x d) x (N n) = x N is its moment about S
     x = st.m / st.N
@@ -182,10 +183,14 @@ def gear_force(gear: "Gear", M: np.ndarray) -> np.ndarray:
     the moment M (N,) about the crank axis (seed 000 sec. 7.1): it pushes on the tooth along the
     line of action at alpha_w to the tangent, the one that turns the crank the way M must:
     (r_w e) x F = sign(M) |F| r_b = M."""
-    e = np.asarray(gear.centre_direction)
-    alpha = np.radians(gear.alpha_w_deg)
-    s = np.sign(M)[:, None]
-    return (np.abs(M) / gear.r_b)[:, None] * (s * np.cos(alpha) * rot90(e) - np.sin(alpha) * e)
+    return as_xy(_gear_force_z(gear, np.asarray(M, dtype=float)))
+
+
+def _gear_force_z(gear: "Gear", M: np.ndarray) -> np.ndarray:
+    """`gear_force` as complex x + iy, (N,)."""
+    e = complex(*gear.centre_direction)
+    alpha = math.radians(gear.alpha_w_deg)
+    return (np.abs(M) / gear.r_b) * (np.sign(M) * (math.cos(alpha) * 1j * e) - math.sin(alpha) * e)
 
 
 def lever_moment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -> np.ndarray:
