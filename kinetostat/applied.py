@@ -112,12 +112,19 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
         n = mech.loads.index(ld)
         raise ModelError([f"load[{n}].table: a travel diagram needs a moving point, but {ld.point!r} of link "
                           f"{ld.link} travels {hi - lo:.3g} m along the axis over the cycle"], source=mech.path or "model")
-    s = dot_z(X, axis)
-    travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
-    forward = (-dot_z(V, axis) if t.origin == "max" else dot_z(V, axis)) >= 0
-    fwd = np.interp(travel, t.x, t.value)
-    ret = fwd if t.value_return is None else np.interp(travel, t.x, t.value_return)
-    return t.scale * np.where(forward, fwd, ret)
+    key = ("diagram", id(t))
+    if key not in mech._derived:     # scaled once, as arrays (np.interp would convert tuples per call)
+        mech._derived[key] = (np.asarray(t.x), t.scale * np.asarray(t.value),
+                              None if t.value_return is None else t.scale * np.asarray(t.value_return))
+    xs, fwd, ret = mech._derived[key]
+    s, v = dot_z(X, axis), dot_z(V, axis)
+    if t.origin == "max":
+        travel, forward = (hi - s) / (hi - lo), v <= 0
+    else:
+        travel, forward = (s - lo) / (hi - lo), v >= 0
+    if ret is None:
+        return np.interp(travel, xs, fwd)
+    return np.where(forward, np.interp(travel, xs, fwd), np.interp(travel, xs, ret))
 
 
 def _stroke(mech: "Mechanism", k: int, p, axis: complex) -> tuple[float, float]:

@@ -35,7 +35,7 @@ def cross_z(a, b):
 
 def dot_z(a, b):
     """Scalar product a . b for complex plane vectors."""
-    return (a.conjugate() * b).real
+    return (a * b.conjugate()).real if isinstance(b, complex) else (a.conjugate() * b).real
 
 
 class Basis:
