@@ -207,11 +207,9 @@ def _rrr(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     # v_B = v_P + w_j x PB = v_Q + w_k x QB ;  a_B = a_P - w_j^2 PB + e_j x PB = ...
     plan = Basis(1j * PB, -1j * QB)
     wj, wk = plan.solve(VQ - VP)
-    VB = VP + wj * plan.a
     ej, ek = plan.solve(AQ - wk**2 * QB - AP + wj**2 * PB)
-    AB = AP + ej * plan.a - wj**2 * PB
-    pl.set_link(j, *pl.aligned(xj, PB), B, pl.local(j, pin.point), wj, VB, ej, AB)
-    pl.set_link(k, *pl.aligned(xk, QB), B, pl.local(k, pin.point), wk, VB, ek, AB)
+    pl.set_link(j, *pl.aligned(xj, PB), P, pl.local(j, pj.point), wj, VP, ej, AP)
+    pl.set_link(k, *pl.aligned(xk, QB), Q, pl.local(k, pk.point), wk, VQ, ek, AQ)
     return (lj**2 + lk**2) / pl.L**2, plan.det / pl.L**2
 
 
@@ -237,7 +235,7 @@ def _rrp(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     VB = VP + wj * plan.a
     ej, ar = plan.solve(ABb + pl.coriolis(b, vr, d) - AP + wj**2 * PB)
     AB = AP + ej * plan.a - wj**2 * PB
-    pl.set_link(j, *pl.aligned(xj, PB), B, pl.local(j, pin.point), wj, VB, ej, AB)
+    pl.set_link(j, *pl.aligned(xj, PB), P, pl.local(j, pj.point), wj, VP, ej, AP)
     pl.set_link(k, th_k, rot_k, B, pl.local(k, pin.point), wb, VB, eb, AB)
     pl.slide(pk, k, vr, ar)
     return lj**2 / pl.L**2 + 1.0, plan.det / pl.L
