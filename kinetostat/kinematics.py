@@ -192,6 +192,7 @@ class _Plan:
 # is taken once for all groups.
 _Conditioning = tuple[float | np.ndarray, np.ndarray]
 
+
 def _rrr(pl: _Plan, g: "AssurGroup") -> _Conditioning:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, VP, AP = pl.point(a, pj.point)

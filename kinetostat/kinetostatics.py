@@ -44,7 +44,7 @@ class _Statics:
         self.F, self.M = F.copy(), M.copy()
         N = len(kin.phi)
         self.R = np.zeros((N, len(mech.pairs)), complex)
-        self.N = np.zeros((N, len(mech.pairs)))     # P pairs: normal force along n = i d
+        self.normal_force = np.zeros((N, len(mech.pairs)))     # P pairs: along n = i d
         self.m = np.zeros((N, len(mech.pairs)))
 
     def at(self, k: int, name: str) -> np.ndarray:
@@ -68,6 +68,7 @@ class _Statics:
         return 1j * complex(*p.direction) * self.kin.rot[:, p.links[0]]
 
     def revolute(self, p: "Pair", giver: int, R: np.ndarray) -> None:
+        """Record the force R that `giver` exerts on the other link of pair p."""
         self.R[:, p.index] = R if giver == p.links[0] else -R
 
     def prismatic(self, p: "Pair", giver: int, N: np.ndarray, n: np.ndarray, m: np.ndarray,
@@ -78,16 +79,17 @@ class _Statics:
         S = self.at(p.links[1], p.point)
         m_S = m + cross_z(X0 - S, f)
         if giver == p.links[0]:
-            self.R[:, p.index], self.N[:, p.index], self.m[:, p.index] = f, N, m_S
+            self.R[:, p.index], self.normal_force[:, p.index], self.m[:, p.index] = f, N, m_S
         else:
-            self.R[:, p.index], self.N[:, p.index], self.m[:, p.index] = -f, -N, -m_S
+            self.R[:, p.index], self.normal_force[:, p.index], self.m[:, p.index] = -f, -N, -m_S
         return f
 
 
 def _rrr(st: _Statics, g: "AssurGroup") -> None:
     (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
     P, B, Q = st.at(j, pj.point), st.at(j, pin.point), st.at(k, pk.point)
-    lj, lk = abs(st.locals[j][pin.point] - st.locals[j][pj.point]), abs(st.locals[k][pin.point] - st.locals[k][pk.point])
+    lj = abs(st.locals[j][pin.point] - st.locals[j][pj.point])
+    lk = abs(st.locals[k][pin.point] - st.locals[k][pk.point])
     uj, uk = (B - P) / lj, (B - Q) / lk
     # tangential parts from the moments of each link about B, normal parts from the polygon
     nj, nk = 1j * uj * (st.moment(j, B) / lj), 1j * uk * (st.moment(k, B) / lk)
@@ -173,8 +175,8 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
     F_bal = _gear_force_z(dr.gear, M_bal) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
     # the line of each normal force, S + x d: (x d) x (N n) = x N is its moment about S
-    x = st.m / st.N
-    x[st.N == 0] = np.nan
+    x = st.m / st.normal_force
+    x[st.normal_force == 0] = np.nan
     return Forces(as_xy(st.R), x, st.m, M_bal, as_xy(F_bal))
 
 

@@ -14,6 +14,11 @@ m2, m3, I2 = 4.9 / g, 3.8 / g, 0.0017
 F_gas = np.pi * 0.08**2 / 4 * 0.8 * 2.4e6      # N, at 30 deg, downwards on the piston
 
 
+def cr(a: np.ndarray, b: np.ndarray) -> float:
+    """z-component of a x b for 2-vectors."""
+    return a[0] * b[1] - a[1] * b[0]
+
+
 def kinematics(phi_deg: float) -> dict[str, np.ndarray | float]:
     f = np.radians(phi_deg)
     s, c = np.sin(f), np.cos(f)
@@ -28,7 +33,6 @@ def kinematics(phi_deg: float) -> dict[str, np.ndarray | float]:
     vB, aB = np.array([0.0, dy * w1]), np.array([0.0, ddy * w1**2])
     # rod angle from +x: theta2 = atan2(y - r c, -r s); omega2 from v_B - v_A = w2 x (B - A)
     AB = B - A
-    cr = lambda a, b: a[0] * b[1] - a[1] * b[0]
     w2 = cr(AB, vB - vA) / (AB @ AB)
     rel = aB - aA + w2**2 * AB
     e2 = cr(AB, rel) / (AB @ AB)
@@ -40,7 +44,6 @@ def newton_euler(phi_deg: float) -> dict[str, float | np.ndarray]:
     """Unknowns x = [R12x, R12y, R32x, R32y, R43x, M_bal] (massless crank, slider guide vertical)."""
     kn = kinematics(phi_deg)
     A, B, S = kn["A"], kn["B"], kn["S2"]
-    cr = lambda a, b: a[0] * b[1] - a[1] * b[0]
     M, b = np.zeros((6, 6)), np.zeros(6)
     # rod: R12 + R32 - m2 g y = m2 aS2 ; moment about S2 = I2 e2
     M[0, [0, 2]] = 1

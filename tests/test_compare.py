@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 import pytest
 
 import kinetostat
 from validation import compare as cmp
-from conftest import FOUR_BAR, ROOT
+from conftest import FOUR_BAR
 
 pytest.importorskip("pinocchio")
 pytest.importorskip("mujoco")

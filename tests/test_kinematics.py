@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 
 import kinetostat
-from conftest import ROOT
 import ice_reference as ref
 
 #: Drawn-and-measured plans of the textbook: the text reads lengths to 0.1 mm on ~80 mm vectors.

@@ -78,7 +78,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinetostat.planar import rot90, rotate
+from kinetostat.planar import rotate
 
 from kinetostat.kinetostatics import gear_force
 

@@ -43,7 +43,6 @@ import math
 import warnings
 from dataclasses import dataclass
 
-import mpmath
 import numpy as np
 from mpmath import mp, mpf
 
