@@ -111,7 +111,8 @@ class Analysis:
 
     def reaction_offset(self, i: int, j: int) -> np.ndarray:
         """(N,) prismatic pair (i, j): the normal force acts on the line through the slider
-        point + x d (d the guide direction), x in m; NaN where the normal force is exactly 0."""
+        point + x d (d the guide direction), x in m; NaN where the normal force is 0 or only
+        rounding (below 1e-12 of the largest reaction at that angle, e.g. at a dead centre)."""
         p = self.mech.pair_between(self._link(i), self._link(j))
         if p.kind != "P":
             raise KeyError(f"pair {p.label} is revolute: its reaction passes through {p.point!r}")

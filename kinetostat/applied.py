@@ -56,7 +56,8 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tup
             continue
         p = mech.links[ld.link].points[ld.point]
         X = kin.position_z(ld.link, p)
-        needs_v = ld.direction == "against_velocity" or (ld.table is not None and ld.table.argument == "travel")
+        needs_v = ld.direction == "against_velocity" or (
+            ld.table is not None and ld.table.argument == "travel" and ld.table.value_return is not None)
         V = kin.velocity_z(ld.link, p) if needs_v else None
         mag = load_magnitude(mech, kin, ld, X, V)
         if ld.direction == "against_velocity":
@@ -103,7 +104,7 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
     p = mech.links[ld.link].points[ld.point]
     axis = complex(*(t.axis if t.axis is not None else ld.direction))
     if X is None:
-        X, V = kin.position_z(ld.link, p), kin.velocity_z(ld.link, p)
+        X = kin.position_z(ld.link, p)
     key = ("stroke", ld.link, tuple(p), axis)
     if key not in mech._derived:
         mech._derived[key] = _stroke(mech, ld.link, p, axis)
@@ -117,13 +118,12 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
         mech._derived[key] = (np.asarray(t.x), t.scale * np.asarray(t.value),
                               None if t.value_return is None else t.scale * np.asarray(t.value_return))
     xs, fwd, ret = mech._derived[key]
-    s, v = dot_z(X, axis), dot_z(V, axis)
-    if t.origin == "max":
-        travel, forward = (hi - s) / (hi - lo), v <= 0
-    else:
-        travel, forward = (s - lo) / (hi - lo), v >= 0
+    s = dot_z(X, axis)
+    travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
     if ret is None:
         return np.interp(travel, xs, fwd)
+    v = dot_z(kin.velocity_z(ld.link, p) if V is None else V, axis)
+    forward = v <= 0 if t.origin == "max" else v >= 0
     return np.where(forward, np.interp(travel, xs, fwd), np.interp(travel, xs, ret))
 
 

@@ -43,7 +43,7 @@ class Kinematics:
     Link k's local point p is at origin_z[:, k] + p rot[:, k] (m, world frame).
     """
     phi: np.ndarray        # (N,) crank angle from drive.reference in drive.sense, rad
-    theta: np.ndarray      # (N, L) link angles, rad, about +z
+    theta: np.ndarray      # (N, L) link angles, rad, about +z (modulo 2 pi: no common range)
     rot: np.ndarray        # (N, L) complex e^{i theta}
     origin_z: np.ndarray   # (N, L) complex position of each link's local origin, m
     v_z: np.ndarray        # (N, L) complex velocity of the local origin, m/s
@@ -188,8 +188,8 @@ class _Plan:
 
 
 # Each solver returns ||M||_F^2 and det M of its plans' matrix M, columns scaled by reference
-# sizes (mech.size for a column that is a length, 1 for a unit direction): `condition` of them
-# is taken once for all groups.
+# sizes (mech.size for a column that is a length, 1 for a unit direction: guide directions are
+# unit, as the model reader makes Pair.direction): `condition` of them is taken once for all groups.
 _Conditioning = tuple[float | np.ndarray, np.ndarray]
 
 

@@ -206,3 +206,17 @@ scale = 10.0
     by_hand = 10.0 * np.array([1.25, 1.75, 1.5, 1.25, 1.0, 2.5, 2.0, 1.75, 1.75, 1.0])
     res, plain = kinetostat.analyze(mech, phi_deg=phi), kinetostat.analyze(kinetostat.loads(FOUR_BAR), phi_deg=phi)
     np.testing.assert_allclose(res.M_applied[:, 3] - plain.M_applied[:, 3], by_hand, rtol=1e-12)
+
+
+def test_normal_force_line_is_undefined_at_a_dead_centre():
+    """The ICE's piston with its local frame off the pin: at the dead centres the guide's normal
+    force is rounding (rod, gas force and gravity all lie on the guide), so its line x is NaN,
+    not noise over noise; at 90 deg the line passes through the pin B (x = 0)."""
+    text = (ROOT / "models" / "ice_crank_slider.toml").read_text()
+    assert "points = { B = [0.0, 0.0] }" in text
+    mech = kinetostat.loads(text.replace("points = { B = [0.0, 0.0] }", "points = { B = [0.03, 0.01] }"))
+    res = kinetostat.analyze(mech, phi_deg=[0.0, 90.0, 180.0])
+    N = np.abs(res.reaction(0, 3)).max(axis=1)
+    assert N[0] < 1e-9 and N[2] < 1e-9 and N[1] > 100.0
+    x = res.reaction_offset(0, 3)
+    assert np.isnan(x[[0, 2]]).all() and abs(x[1]) < 1e-12
