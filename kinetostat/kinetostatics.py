@@ -28,13 +28,23 @@ __all__ = ["Forces", "forces", "gear_force", "lever_moment", "friction_power"]
 class Forces:
     """Reactions and balancing loads at N crank angles."""
     R: np.ndarray         # (N, n_pairs, 2) force of pair.links[0] on pair.links[1], N, world
-    x: np.ndarray         # (N, n_pairs) P pairs: line of the normal force at slider point + x d, m
-                          #   (NaN for R pairs, and where the normal force is 0 or below 1e-12 of
-                          #   the largest reaction at that angle: its line is rounding there)
+    normal: np.ndarray    # (N, n_pairs) P pairs: that force along n = i d (d the guide direction,
+                          #   in the guide's frame), N; 0 for R pairs
     m: np.ndarray         # (N, n_pairs) P pairs: moment of the reaction about the slider point, N m
                           #   (= x N; carries a pure couple where N = 0); 0 for R pairs
     M_bal: np.ndarray     # (N,) moment the drive applies to the crank about +z, N m
     F_bal: np.ndarray     # (N, 2) machine: balancing force at the pitch point, N (zeros for an engine)
+
+    @property
+    def x(self) -> np.ndarray:
+        """(N, n_pairs) P pairs: the normal force acts on the line slider point + x d, m, as
+        (x d) x (N n) = x N = m. NaN for R pairs, and where the normal force is 0 or only
+        rounding (a dead centre): below 1e-12 of the largest reaction at that angle."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = self.m / self.normal
+        largest = np.hypot(self.R[..., 0], self.R[..., 1]).max(axis=1, keepdims=True)
+        x[np.abs(self.normal) <= 1e-12 * largest] = np.nan
+        return x
 
 
 class _Statics:
@@ -175,12 +185,7 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
     M_bal = -st.moment(1, st.at(1, dr.pivot))
     F_bal = _gear_force_z(dr.gear, M_bal) if dr.kind == "machine" else np.zeros_like(M_bal, complex)
     st.revolute(mech.pair_between(0, 1), 0, -(st.F[:, 1] + F_bal))
-    # the line of each normal force, S + x d: (x d) x (N n) = x N is its moment about S. It is
-    # undefined where N is 0 or only rounding (a dead centre): below 1e-12 of the largest
-    # reaction at that angle.
-    x = st.m / st.normal_force
-    x[np.abs(st.normal_force) <= 1e-12 * np.abs(st.R).max(axis=1, keepdims=True)] = np.nan
-    return Forces(as_xy(st.R), x, st.m, M_bal, as_xy(F_bal))
+    return Forces(as_xy(st.R), st.normal_force, st.m, M_bal, as_xy(F_bal))
 
 
 def gear_force(gear: "Gear", M: np.ndarray) -> np.ndarray:
