@@ -28,7 +28,7 @@ from .scene import EngineResult, Scene, build_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 ANGLES = 360
-EXACT_SECONDS = 0.2     # an exact route is timed over at least 20 runs and at least this long
+EXACT_SECONDS = 1.0     # an exact route is timed over at least 20 runs and at least this long
 
 
 def median_seconds(fn: Callable[[], object], repeat: int, min_seconds: float = 0.0) -> tuple[float, object]:
