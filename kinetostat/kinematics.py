@@ -94,7 +94,7 @@ class _Plan:
 
     def __init__(self, mech: "Mechanism", phi: np.ndarray):
         N, L = len(phi), mech.n_links
-        self.mech, self.phi = mech, phi
+        self.phi = phi
         self.th, self.w, self.e = np.zeros((3, N, L))            # the frame's column stays 0
         self.rot = np.ones((N, L), complex)
         self.O, self.V, self.A = np.zeros((3, N, L), complex)

@@ -51,7 +51,7 @@ class _Statics:
     """Known wrenches per link about its local origin (complex forces), updated as groups are solved."""
 
     def __init__(self, mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray):
-        self.mech, self.kin, self.locals = mech, kin, mech.points_z
+        self.kin, self.locals = kin, mech.points_z
         self.F, self.M = F.copy(), M.copy()
         N = len(kin.phi)
         self.R = np.zeros((N, len(mech.pairs)), complex)
