@@ -20,7 +20,7 @@ from typing import Sequence
 EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
 
-__all__ = ["main", "build_parser", "exit_code", "bundled_models", "models_dir", "CLIError"]
+__all__ = ["main", "build_parser", "exit_code", "bundled_models", "CLIError"]
 
 
 class CLIError(Exception):
@@ -117,16 +117,8 @@ class _Parser(argparse.ArgumentParser):
 
 # ============================================================================ models and paths
 
-def models_dir() -> Path:
-    """The bundled models: $KINETOSTAT_MODELS if set, else `models/` next to the package."""
-    env = os.environ.get("KINETOSTAT_MODELS")
-    if env:
-        return Path(env).expanduser()
-    import kinetostat
-    return Path(kinetostat.__file__).resolve().parents[1] / "models"
-
-
 def bundled_models() -> list[Path]:
+    from .examples import models_dir
     d = models_dir()
     if not d.is_dir():
         raise CLIError(f"no bundled models: {d} is not a directory "
@@ -212,7 +204,7 @@ def _writable_dir(path: str, option: str) -> Path:
 
 
 def _engines(names: Sequence[str] | None) -> list[str]:
-    from validation.compare import ROUTES
+    from kinetostat_validation.compare import ROUTES
     if names is None:
         return list(ROUTES)
     unknown = [n for n in names if n not in ROUTES]

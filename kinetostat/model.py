@@ -223,8 +223,14 @@ class Mechanism:
 # ----------------------------------------------------------------------------- loading
 
 def load(path: str | Path) -> Mechanism:
-    """Read and validate a model file (TOML). Raises `ModelError` listing every problem."""
+    """Read and validate a model file (TOML), or a bundled model by name (`load("ice_crank_slider")`).
+
+    Raises `ModelError` listing every problem."""
     path = Path(path)
+    if not path.exists() and path.parent == Path(".") and path.suffix in ("", ".toml"):
+        from . import examples
+        if path.stem in examples.names():
+            path = examples.path(path.stem)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:

@@ -196,7 +196,7 @@ def test_validate_fails_on_a_broken_solver_result(ice_cycle):
 def test_route_errors_and_skips_are_reported_not_raised(ice_cycle, monkeypatch):
     """A route that raises becomes an ERROR of that route (others still run); a route whose
     engine is missing is SKIPPED, never passed. JUnit: <error> and <skipped> per quantity."""
-    from validation import compare as cmp
+    from kinetostat_validation import compare as cmp
     mech, res = ice_cycle
 
     def broken(scene):

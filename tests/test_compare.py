@@ -7,7 +7,7 @@ import dataclasses
 import pytest
 
 import kinetostat
-from validation import compare as cmp
+from kinetostat_validation import compare as cmp
 from conftest import FOUR_BAR
 
 pytest.importorskip("pinocchio")

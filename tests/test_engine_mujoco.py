@@ -17,8 +17,8 @@ mujoco = pytest.importorskip("mujoco")
 
 import kinetostat  # noqa: E402
 from conftest import four_bar  # noqa: E402
-from validation.engine_mujoco import mjcf, simulate, solve  # noqa: E402
-from validation.scene import build_scene  # noqa: E402
+from kinetostat_validation.engine_mujoco import mjcf, simulate, solve  # noqa: E402
+from kinetostat_validation.scene import build_scene  # noqa: E402
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
 MODEL_FILES = sorted(MODELS_DIR.glob("*.toml"))

@@ -13,8 +13,8 @@ pin = pytest.importorskip("pinocchio")
 
 import kinetostat  # noqa: E402
 from conftest import four_bar  # noqa: E402
-from validation.engine_pinocchio import PinocchioScene, forward_round_trip, solve  # noqa: E402
-from validation.scene import build_scene  # noqa: E402
+from kinetostat_validation.engine_pinocchio import PinocchioScene, forward_round_trip, solve  # noqa: E402
+from kinetostat_validation.scene import build_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = sorted((ROOT / "models").glob("*.toml"))

@@ -36,8 +36,8 @@ pytest.importorskip("pymunk")
 
 import kinetostat  # noqa: E402
 from conftest import four_bar  # noqa: E402
-from validation.engine_pymunk import simulate  # noqa: E402
-from validation.scene import build_scene  # noqa: E402
+from kinetostat_validation.engine_pymunk import simulate  # noqa: E402
+from kinetostat_validation.scene import build_scene  # noqa: E402
 
 MODELS = sorted((Path(__file__).resolve().parent.parent / "models").glob("*.toml"))
 

@@ -534,8 +534,8 @@ def _peak_errors(M_ref, R_ref, M, R, scale=(0.0, 0.0)):
 @pytest.mark.parametrize("kind", KINDS)
 def test_agrees_with_pinocchio(kind):
     try:
-        from validation.engine_pinocchio import solve
-        from validation.scene import build_scene
+        from kinetostat_validation.engine_pinocchio import solve
+        from kinetostat_validation.scene import build_scene
     except ImportError as exc:          # the adapter is not there (or pinocchio is not installed)
         pytest.skip(f"Pinocchio adapter not importable: {exc}")
 
@@ -554,7 +554,7 @@ def test_agrees_with_pinocchio(kind):
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_agrees_with_mpmath_reference(kind):
-    from validation.reference import reference
+    from kinetostat_validation.reference import reference
 
     @settings(max_examples=EXAMPLES["mpmath"], **_SETTINGS)
     @given(valid(kind), st.floats(0.0, 30.0))
@@ -644,7 +644,7 @@ def test_prismatic_pure_couple_is_recorded():
                          ids=lambda p: p.stem)
 def test_bundled_models_agree_with_mpmath_reference(path):
     """Every bundled model (engines and machines, all five group kinds) at 12 angles."""
-    from validation.reference import reference
+    from kinetostat_validation.reference import reference
     mech = kinetostat.load(path)
     phi = np.arange(0.0, 360.0, 30.0) + 7.0
     res = kinetostat.analyze(mech, phi_deg=phi)

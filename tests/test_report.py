@@ -14,7 +14,8 @@ import pytest
 
 import kinetostat
 from conftest import FOUR_BAR, ROOT
-from kinetostat.report import PUBLISHED, Doc, published_rows, run_validation, write_index, write_report
+from kinetostat.report import PUBLISHED, published_rows, run_validation, write_index, write_report
+from kinetostat.report.document import Doc
 
 pytest.importorskip("matplotlib")
 

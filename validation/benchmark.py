@@ -1,7 +1,7 @@
 """Benchmark: run time against error for the solver and every engine route, per bundled model.
 
-    python -m validation.benchmark              # full study: writes reports/benchmark.{md,csv,png}
-    python -m validation.benchmark --quick      # fewer repeats and settings, prints only
+    python -m kinetostat_validation.benchmark              # full study: writes reports/benchmark.{md,csv,png}
+    python -m kinetostat_validation.benchmark --quick      # fewer repeats and settings, prints only
 
 Every route runs over the same full cycle (360 angles) and is timed as the median of repeated
 runs in one process; its error is the worst peak-relative error over the driving moment and
@@ -203,7 +203,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], out: P
              "simulations: 3 runs), error the "
              "worst peak-relative error over the driving moment and every reaction against the mpmath reference "
              "(`validation/reference.py`, 40 digits; pymunk: magnitudes). Regenerate with "
-             "`python -m validation.benchmark`.", "", "![time against error](benchmark.png)", "",
+             "`python -m kinetostat_validation.benchmark`.", "", "![time against error](benchmark.png)", "",
              "## Solver against the fastest engine route (same run)", "", target_line(df, kin_rows), "",
              "| model | solver | its error | fastest engine route | its time | its error | speed-up |",
              "|---|---|---|---|---|---|---|"]

@@ -22,7 +22,7 @@ worst-conditioned angle of the dense cycle. The error is peak-relative: the larg
 |solver - reference| of the balancing moment over its peak, and of any pair's reaction over the
 peak reaction of all pairs (marked angles left out).
 
-`python -m validation.stability` writes reports/stability.md and reports/stability.png.
+`python -m kinetostat_validation.stability` writes reports/stability.md and reports/stability.png.
 """
 from __future__ import annotations
 
@@ -374,7 +374,7 @@ def write_report(results: dict[str, list[Step]], md: Path, png: Path, seconds: f
     kept = sorted(kept, key=lambda s: -s.err)[:3]
     worst_kept = "; ".join(f"{s.family} {s.value}: error {s.err:.1e} at cond {s.cond_compared:.1e}" for s in kept) or "n/a"
     lines = ["# Numerical stability: error against conditioning", "",
-             "Written by `python -m validation.stability` (validation/stability.py). The reference is the "
+             "Written by `python -m kinetostat_validation.stability` (validation/stability.py). The reference is the "
              "40-digit mpmath solution of validation/reference.py (Newton on all loop closures at once, one "
              "global Newton-Euler system), independent of the solver's group-by-group closed forms.", "",
              "Per step: **cond max** = largest condition number of a group's plan over a cycle of "

@@ -1,0 +1,52 @@
+"""The bundled mechanisms (the seeds' worked cases): where they are, by name, and a copy of them.
+
+The wheel carries the repository's `models/` folder as the package data `kinetostat/models/`; a
+checkout (editable install) reads `models/` beside the package. `$KINETOSTAT_MODELS` overrides both.
+May use: the standard library only (the model reader calls it to resolve a bare name).
+"""
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+__all__ = ["models_dir", "names", "path", "copy"]
+
+
+def models_dir() -> Path:
+    """Folder of the bundled model files (`*.toml`, with `FORMAT.md`)."""
+    env = os.environ.get("KINETOSTAT_MODELS")
+    if env:
+        return Path(env).expanduser()
+    here = Path(__file__).resolve().parent
+    for d in (here / "models", here.parent / "models"):     # wheel, then checkout
+        if (d / "FORMAT.md").is_file():
+            return d
+    return here / "models"
+
+
+def names() -> list[str]:
+    """Names of the bundled models (file stems), sorted."""
+    d = models_dir()
+    return sorted(p.stem for p in d.glob("*.toml")) if d.is_dir() else []
+
+
+def path(name: str) -> Path:
+    """File of the bundled model `name` (stem, with or without `.toml`); FileNotFoundError if none."""
+    stem = name[:-5] if name.endswith(".toml") else name
+    if stem in names():
+        return models_dir() / f"{stem}.toml"
+    raise FileNotFoundError(f"no bundled model named {name!r}; bundled: {', '.join(names()) or 'none'}")
+
+
+def copy(dest: str | Path, overwrite: bool = False) -> list[Path]:
+    """Copy every bundled model and FORMAT.md into `dest` (created); returns the written files.
+
+    An existing file is left alone unless `overwrite` (FileExistsError names it)."""
+    dest = Path(dest)
+    src = [models_dir() / f"{n}.toml" for n in names()] + [models_dir() / "FORMAT.md"]
+    clash = [dest / p.name for p in src if (dest / p.name).exists()]
+    if clash and not overwrite:
+        raise FileExistsError(f"{clash[0]} exists (and {len(clash) - 1} more); pass overwrite to replace")
+    dest.mkdir(parents=True, exist_ok=True)
+    return [Path(shutil.copyfile(p, dest / p.name)) for p in src]

@@ -1,0 +1,412 @@
+"""The report's figures (matplotlib, imported inside the functions: no pyplot, no global state).
+
+May use: numpy, matplotlib, the solver's results and the runs room.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..analysis import Analysis
+from ..model import Mechanism
+from .runs import ModelRun, quantities
+
+
+_ROUTE_STYLE = {"pinocchio": ("tab:blue", (0, (6, 3))), "mujoco": ("tab:orange", (0, (2, 2))),
+                "mujoco-sim": ("tab:green", (0, (6, 2, 1, 2))), "pymunk": ("tab:red", (0, (1, 1.5)))}
+_EXTRA = ["tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
+
+
+def _style(route: str, n: int = 0) -> tuple[str, Any]:
+    return _ROUTE_STYLE.get(route, (_EXTRA[n % len(_EXTRA)], (0, (4, 2))))
+
+
+def _figure(w: float, h: float):
+    from matplotlib.figure import Figure
+    return Figure(figsize=(w, h), layout="constrained")
+
+
+def _save(fig, path: Path) -> Path:
+    """PNG at 110 dpi, reduced to a 256-colour palette without dithering: a third of the size
+    of the RGBA file and visually the same for line plots (the HTML embeds every image)."""
+    import io
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, metadata={"Software": None})
+    try:
+        from PIL import Image
+        img = Image.open(buf).convert("RGB").quantize(colors=256, method=Image.Quantize.FASTOCTREE,
+                                                      dither=Image.Dither.NONE)
+        img.save(path, format="PNG", compress_level=6)
+    except ImportError:       # Pillow comes with matplotlib; keep the plain PNG if it does not
+        Path(path).write_bytes(buf.getvalue())
+    return path
+
+
+def _phi_axis(ax, label: bool = True, step: int = 60):
+    ax.set_xlim(0, 360)
+    ax.set_xticks(range(0, 361, step))
+    if label:
+        ax.set_xlabel("crank angle φ, deg")
+    ax.grid(True, alpha=0.3)
+
+
+def _pair_name(mech: Mechanism, p) -> str:
+    i, j = p.links
+    where = f"at {p.point}" if p.kind == "R" else f"slider {p.point} on guide {p.guide}"
+    return f"R({i},{j}) {where}"
+
+
+def _link_name(mech: Mechanism, k: int) -> str:
+    return "frame" if k == 0 else mech.links[k].name
+
+
+def _wrap(text: str, width: int = 52) -> str:
+    import textwrap
+    return textwrap.fill(text, width)
+
+
+def _grid(n: int) -> tuple[int, int]:
+    cols = 1 if n == 1 else 2 if n <= 4 else 3
+    return math.ceil(n / cols), cols
+
+
+def _closed(phi: np.ndarray, *ys: np.ndarray):
+    """Close a full-cycle curve at 360 deg (phi equally spaced from 0)."""
+    if len(phi) > 2 and abs(phi[0]) < 1e-9 and abs(phi[-1] + (phi[1] - phi[0]) - 360.0) < 1e-6:
+        return (np.append(phi, 360.0),) + tuple(np.concatenate([y, y[:1]]) for y in ys)
+    return (phi,) + ys
+
+
+def _world(res: Analysis, i: int) -> dict[int, dict[str, np.ndarray]]:
+    """World positions of every link's points at angle index i."""
+    m, kin = res.mech, res.kin
+    out = {0: {n: np.asarray(xy, float) for n, xy in m.links[0].points.items()}}
+    for link in m.links[1:]:
+        out[link.id] = {n: kin.point(link.id, np.asarray(xy, float))[0][i] for n, xy in link.points.items()}
+    return out
+
+
+def _hull(pts: np.ndarray) -> np.ndarray:
+    """Convex hull (monotone chain) of a few 2-D points, counter-clockwise."""
+    P = sorted(set(map(tuple, np.round(pts, 12))))
+    if len(P) <= 2:
+        return np.array(P)
+    cross = lambda o, a, b: (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    lower, upper = [], []
+    for p in P:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(P):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
+    """The linkage at res's single angle; `cycle` gives the point paths and guide strokes."""
+    from matplotlib.patches import Polygon
+
+    m = res.mech
+    fig = _figure(8, 6.5)
+    ax = fig.subplots()
+    W = _world(res, 0)
+    size = m.size
+    colors = {k: f"C{k % 10}" for k in range(1, m.n_links)}
+    # point paths over the cycle
+    for link in m.links[1:]:
+        for name, xy in link.points.items():
+            P = cycle.kin.point(link.id, np.asarray(xy, float))[0]
+            if np.ptp(P[:, 0]) + np.ptp(P[:, 1]) > 1e-9 * size:
+                ax.plot(*_closed(cycle.phi_deg, P[:, 0], P[:, 1])[1:], color="0.75", lw=0.8, ls=":", zorder=1)
+    # gear: pitch circle of the wheel on the crank shaft
+    if m.drive.kind == "machine" and m.drive.gear is not None:
+        c = W[0][m.drive.pivot] if m.drive.pivot in W[0] else W[1][m.drive.pivot]
+        t = np.linspace(0, 2 * np.pi, 200)
+        rw = m.drive.gear.r_w
+        ax.plot(c[0] + rw * np.cos(t), c[1] + rw * np.sin(t), color="0.55", lw=1, ls="--", zorder=1,
+                label=f"pitch circle of the crank's wheel, r = {rw:.4g} m")
+    # links
+    from matplotlib.colors import to_rgba
+    for link in m.links[1:]:
+        pts = np.array(list(W[link.id].values()))
+        h = _hull(pts)
+        col = colors[link.id]
+        label = f"{link.id}: {link.name}"
+        area = 0.5 * abs(np.dot(h[:, 0], np.roll(h[:, 1], 1)) - np.dot(h[:, 1], np.roll(h[:, 0], 1))) if len(h) >= 3 else 0.0
+        span = max((np.linalg.norm(a - b) for a in pts for b in pts), default=0.0)
+        if len(h) >= 3 and area > 0.02 * span**2:
+            ax.add_patch(Polygon(h, closed=True, facecolor=to_rgba(col, 0.22), edgecolor=col, lw=2.5,
+                                 joinstyle="round", zorder=3, label=label))
+        elif span > 0:   # two points, or all on a line: a bar between the farthest two
+            i, j = max(((i, j) for i in range(len(pts)) for j in range(len(pts))),
+                       key=lambda ij: np.linalg.norm(pts[ij[0]] - pts[ij[1]]))
+            ax.plot(pts[[i, j], 0], pts[[i, j], 1], color=col, lw=4, solid_capstyle="round", zorder=3, label=label)
+        else:
+            ax.plot([], [], color=col, lw=4, label=label)     # a one-point link: drawn as its block
+    # prismatic pairs: guide line and block
+    blk_l, blk_w = 0.16 * size, 0.08 * size
+    for p in m.pairs:
+        if p.kind != "P":
+            continue
+        g, s = p.links
+        d_loc = np.asarray(p.direction, float)
+        th_g = res.kin.theta[0, g]
+        d = np.array([math.cos(th_g) * d_loc[0] - math.sin(th_g) * d_loc[1],
+                      math.sin(th_g) * d_loc[0] + math.cos(th_g) * d_loc[1]])
+        n = np.array([-d[1], d[0]])
+        G, S = W[g][p.guide], W[s][p.point]
+        # stroke of the slider along the guide over the cycle, in the guide's frame
+        thc = cycle.kin.theta[:, g]
+        Gc = cycle.kin.point(g, np.asarray(m.links[g].points[p.guide], float))[0] if g else \
+            np.broadcast_to(G, (len(thc), 2))
+        Sc = cycle.kin.point(s, np.asarray(m.links[s].points[p.point], float))[0]
+        dc = np.stack([np.cos(thc) * d_loc[0] - np.sin(thc) * d_loc[1],
+                       np.sin(thc) * d_loc[0] + np.cos(thc) * d_loc[1]], -1)
+        u = np.sum((Sc - Gc) * dc, axis=-1)
+        u = u[np.isfinite(u)]
+        lo, hi = (float(u.min()), float(u.max())) if u.size else (0.0, 0.0)
+        lo, hi = lo - 0.6 * blk_l, hi + 0.6 * blk_l
+        a, b = G + lo * d, G + hi * d
+        if g == 0:   # a fixed guide: its axis, two rails and hatching outside them (a cylinder / slideway)
+            a0, b0 = G + min(lo, 0.0) * d, G + max(hi, 0.0) * d     # the axis reaches the guide point
+            ax.plot([a0[0], b0[0]], [a0[1], b0[1]], color="0.45", lw=0.8, ls="-.", zorder=2)
+            for sgn in (-1, 1):
+                r0, r1 = a + sgn * 0.6 * blk_w * n, b + sgn * 0.6 * blk_w * n
+                ax.plot([r0[0], r1[0]], [r0[1], r1[1]], color="0.3", lw=1.4, zorder=2)
+                for t in np.linspace(0.04, 0.96, 12):
+                    q = r0 + t * (r1 - r0)
+                    e = q + sgn * 0.3 * blk_w * n + 0.3 * blk_w * d
+                    ax.plot([q[0], e[0]], [q[1], e[1]], color="0.5", lw=0.7, zorder=2)
+        else:        # a guide on a moving link: the slot, drawn in that link's colour
+            ax.plot([a[0], b[0]], [a[1], b[1]], color=colors[g], lw=2.5, alpha=0.8, zorder=2)
+            for sgn in (-1, 1):
+                r0, r1 = a + sgn * 0.6 * blk_w * n, b + sgn * 0.6 * blk_w * n
+                ax.plot([r0[0], r1[0]], [r0[1], r1[1]], color=colors[g], lw=1.0, zorder=2)
+        corners = [S + a * 0.5 * blk_l * d + b * 0.5 * blk_w * n for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+        ax.add_patch(Polygon(np.array(corners), closed=True, facecolor=colors[s], alpha=0.55,
+                             edgecolor="black", lw=1.2, zorder=4))
+    # springs: zigzag between their ends
+    for sp in m.springs:
+        A, B = W[sp.a[0]][sp.a[1]], W[sp.b[0]][sp.b[1]]
+        t = np.linspace(0, 1, 25)
+        v = B - A
+        L = np.linalg.norm(v) or 1.0
+        nn = np.array([-v[1], v[0]]) / L
+        wig = np.where((np.arange(25) % 2 == 1) & (t > 0.1) & (t < 0.9), 1.0, 0.0) * np.where(np.arange(25) % 4 == 1, 1, -1)
+        Z = A + np.outer(t, v) + np.outer(0.04 * size * wig, nn)
+        ax.plot(Z[:, 0], Z[:, 1], color="tab:gray", lw=1.2, zorder=2, label=f"spring: {sp.name}")
+    # revolute pairs: circles; fixed ones get a ground mark
+    for p in m.pairs:
+        if p.kind != "R":
+            continue
+        k = p.links[1] if p.links[0] == 0 else p.links[0]
+        X = W[k][p.point]
+        if 0 in p.links:
+            tri = np.array([X, X + size * np.array([-0.06, -0.09]), X + size * np.array([0.06, -0.09])])
+            ax.add_patch(Polygon(tri, closed=True, facecolor="0.85", edgecolor="0.3", zorder=2))
+            ax.plot([X[0] - 0.09 * size, X[0] + 0.09 * size], [X[1] - 0.09 * size] * 2, color="0.3", lw=1.5, zorder=2)
+        ax.plot(*X, marker="o", ms=9, mfc="white", mec="black", mew=1.6, zorder=6)
+    # points that are not revolute pairs: centres of mass filled, others hollow, frame points grey
+    placed: dict[str, np.ndarray] = {}
+    for k in range(m.n_links):
+        for name, X in W[k].items():
+            placed.setdefault(name, X)
+    pivots = {p.point for p in m.pairs if p.kind == "R"}
+    coms = {link.com for link in m.links[1:] if link.com}
+    for name, X in placed.items():
+        if name in pivots:
+            continue
+        if name in coms:
+            ax.plot(*X, marker="o", ms=5, color="black", zorder=7)
+        elif name in W[0]:
+            ax.plot(*X, marker="s", ms=5, mfc="0.8", mec="0.3", zorder=7)
+        else:
+            ax.plot(*X, marker="o", ms=4.5, mfc="white", mec="black", zorder=7)
+    # labels: points closer than 3 % of the size share one label ("O1, C1")
+    groups: list[tuple[list[str], np.ndarray]] = []
+    for name, X in placed.items():
+        for names, Y in groups:
+            if np.linalg.norm(X - Y) < 0.03 * size:
+                names.append(name)
+                break
+        else:
+            groups.append(([name], X))
+    centre = np.mean(np.array(list(placed.values())), axis=0)
+    for names, X in groups:
+        off = X - centre
+        off = off / (np.linalg.norm(off) or 1.0)
+        ax.annotate(", ".join(names), X, xytext=(7 * off[0] + 6, 7 * off[1] + 8), textcoords="offset points",
+                    fontsize=10, fontweight="bold", zorder=8,
+                    bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.7))
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    ax.set_xlabel("x, m")
+    ax.set_ylabel("y, m")
+    ax.set_title(f"{m.name}\nat φ = {res.phi_deg[0]:.4g}° (dotted: paths of the points over the cycle)",
+                 fontsize=10)
+    ax.legend(loc="best", fontsize=8, framealpha=0.85)
+    return _save(fig, path)
+
+
+def plot_moment(run: ModelRun, path: Path) -> Path:
+    res, m = run.res, run.mech
+    fig = _figure(9.5, 6.5)
+    ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
+    phi = res.phi_deg
+    ax.plot(*_closed(phi, res.balancing_moment), color="black", lw=2.6, label="kinetostat: group by group")
+    ax.plot(*_closed(phi, res.lever_moment), color="0.55", lw=1.4, ls="--", label="kinetostat: Zhukovsky's lever")
+    for n, (route, er) in enumerate(run.results.items()):
+        col, ls = _style(route, n)
+        ax.plot(*_closed(er.phi_deg, er.M_drive), color=col, ls=ls, lw=1.6, label=f"{route} ({er.route})")
+    ax.axhline(0, color="0.3", lw=0.6)
+    ax.set_ylabel("balancing moment on the crank M_bal, N·m")
+    kind = "moment of the drive on the crank about +z"
+    ax.set_title(f"{m.name}\nbalancing moment ({kind}) over the cycle", fontsize=10)
+    ax.legend(fontsize=8, loc="best")
+    _phi_axis(ax, label=False, step=30)
+    ax2.plot(*_closed(phi, res.lever_discrepancy), color="0.3", lw=1)
+    ax2.set_ylabel("lever − groups, N·m", fontsize=9)
+    ax2.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
+    _phi_axis(ax2, step=30)
+    return _save(fig, path)
+
+
+def plot_reactions(run: ModelRun, path: Path) -> Path:
+    res, m = run.res, run.mech
+    rows, cols = _grid(len(m.pairs))
+    fig = _figure(4.6 * cols + 0.6, 3.0 * rows + 0.9)
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    handles = {}
+    for n_ax, (ax, p) in enumerate(zip(axes, m.pairs)):
+        mag = np.linalg.norm(res.forces.R[:, p.index], axis=-1)
+        h, = ax.plot(*_closed(res.phi_deg, mag), color="black", lw=2.4)
+        handles["kinetostat"] = h
+        for n, (route, er) in enumerate(run.results.items()):
+            col, ls = _style(route, n)
+            h, = ax.plot(*_closed(er.phi_deg, np.linalg.norm(er.R[:, p.index], axis=-1)), color=col, ls=ls, lw=1.5)
+            handles[f"{route} ({er.route})"] = h
+        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9)
+        ax.set_ylabel("|R|, N")
+        ax.set_ylim(bottom=0)
+        _phi_axis(ax, label=n_ax + cols >= len(m.pairs))
+    for ax in axes[len(m.pairs):]:
+        ax.set_visible(False)
+    fig.suptitle(f"{m.name}\nreaction magnitudes over the cycle (R(i,j): force of link i on link j)", fontsize=10)
+    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncols=min(len(handles), 5),
+               fontsize=8)
+    return _save(fig, path)
+
+
+def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, float]]:
+    """quantity -> (phi, |engine - solver|, peak |solver|), as compare.errors measures them."""
+    out = {}
+    m = res.mech
+    items = [("M_drive", res.balancing_moment[:, None], er.M_drive[:, None])]
+    items += [(f"R({p.links[0]},{p.links[1]})", res.forces.R[:, p.index], er.R[:, p.index]) for p in m.pairs]
+    for name, ref, got in items:
+        if er.magnitudes_only:
+            ref = np.linalg.norm(ref, axis=-1, keepdims=True)
+            got = np.linalg.norm(got, axis=-1, keepdims=True)
+        err = np.linalg.norm(got - ref, axis=-1)
+        peak = float(np.nanmax(np.linalg.norm(ref, axis=-1))) if np.any(np.isfinite(ref)) else 0.0
+        out[name] = (er.phi_deg, err, peak)
+    return out
+
+
+def plot_errors(run: ModelRun, path: Path) -> Path:
+    res, m = run.res, run.mech
+    qs = quantities(m)
+    rows, cols = _grid(len(qs))
+    fig = _figure(4.6 * cols + 0.6, 3.0 * rows + 1.1)
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    curves = {route: _error_curves(res, er) for route, er in run.results.items()}
+    handles = {}
+    for n_ax, (ax, q) in enumerate(zip(axes, qs)):
+        unit = "N·m" if q == "M_drive" else "N"
+        any_drawn = False
+        for n, route in enumerate(run.results):
+            col, ls = _style(route, n)
+            phi, err, peak = curves[route][q]
+            e = np.where(err > 0, err, np.nan)
+            if np.any(np.isfinite(e)):
+                h, = ax.semilogy(*_closed(phi, e), color=col, lw=1.3)
+                handles[f"{route}: |engine − kinetostat|"] = h
+                any_drawn = True
+            tol = run.tolerances.get(route)
+            if tol is not None and peak > 0:
+                h = ax.axhline(tol.peak_relative * peak, color=col, ls="--", lw=1)
+                handles[f"{route}: tolerance × peak"] = h
+        if not any_drawn:
+            ax.text(0.5, 0.5, "no differences to draw\n(no engine results, or exactly equal)",
+                    transform=ax.transAxes, ha="center", va="center", fontsize=8, color="0.4")
+            ax.set_yscale("log")
+        title = "M_drive: balancing moment" if q == "M_drive" else \
+            _pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
+        ax.set_title(_wrap(title), fontsize=9)
+        ax.set_ylabel(f"|error|, {unit}")
+        _phi_axis(ax, label=n_ax + cols >= len(qs))
+        ax.grid(True, which="major", alpha=0.3)
+    for ax in axes[len(qs):]:
+        ax.set_visible(False)
+    fig.suptitle(f"{m.name}\nerror of each engine route against kinetostat (log scale; "
+                 f"dashed: the route's tolerance × the cycle's peak)", fontsize=10)
+    if handles:
+        fig.legend(list(handles.values()), list(handles), loc="outside lower center",
+                   ncols=min(len(handles), 4), fontsize=8)
+    return _save(fig, path)
+
+
+def plot_hodographs(run: ModelRun, path: Path) -> Path:
+    """Tip of each revolute pair's reaction vector over the cycle (seed 004, figs. 13-14)."""
+    res, m = run.res, run.mech
+    pairs = [p for p in m.pairs if p.kind == "R"]
+    rows, cols = _grid(len(pairs))
+    fig = _figure(4.8 * cols + 0.4, 4.6 * rows + 0.8)
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    phi = res.phi_deg
+    handles = {}
+    for ax, p in zip(axes, pairs):
+        R = res.forces.R[:, p.index]
+        _, Rx, Ry = _closed(phi, R[:, 0], R[:, 1])
+        h, = ax.plot(Rx, Ry, color="black", lw=2)
+        handles["kinetostat"] = h
+        for n, (route, er) in enumerate(run.results.items()):
+            if er.magnitudes_only:
+                continue
+            col, ls = _style(route, n)
+            E = er.R[:, p.index]
+            h, = ax.plot(*_closed(er.phi_deg, E[:, 0], E[:, 1])[1:], color=col, ls=ls, lw=1.3)
+            handles[f"{route} ({er.route})"] = h
+        ax.plot(0, 0, marker="+", ms=12, color="black")
+        mag = np.linalg.norm(R, axis=-1)
+        fin = np.isfinite(mag)
+        # rays at every 30 deg of the cycle, labelled with the angle
+        for a in range(0, 360, 30):
+            i = int(np.argmin(np.abs(((phi - a) + 180) % 360 - 180)))
+            if abs(((phi[i] - a) + 180) % 360 - 180) > 2.5 or not fin[i] or mag[i] < 0.12 * np.nanmax(mag):
+                continue      # short rays near the origin would only clutter the labels
+            ax.annotate("", xy=R[i], xytext=(0, 0),
+                        arrowprops=dict(arrowstyle="-|>", color="0.6", lw=0.7, shrinkA=0, shrinkB=0))
+            ax.annotate(f"{phi[i]:.0f}°", R[i], xytext=(3, 3), textcoords="offset points", fontsize=7, color="0.25")
+        if fin.any():
+            i = int(np.nanargmax(mag))
+            h, = ax.plot(*R[i], marker="o", ms=6, color="tab:red", ls="none")
+            ax.annotate(f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", R[i], xytext=(6, -14), textcoords="offset points",
+                        fontsize=7, color="tab:red")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+        ax.set_xlabel("R_x, N")
+        ax.set_ylabel("R_y, N")
+        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9)
+    for ax in axes[len(pairs):]:
+        ax.set_visible(False)
+    fig.suptitle(f"{m.name}\nhodographs of the revolute pairs' reactions "
+                 f"(tip of the force vector over the cycle, world frame; grey rays every 30° of φ)", fontsize=10)
+    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncols=min(len(handles), 4),
+               fontsize=8)
+    return _save(fig, path)

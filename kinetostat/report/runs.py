@@ -1,0 +1,120 @@
+"""A validation run: the solver's cycle of one model checked route by route.
+
+May use: numpy, the solver, and the harness (`kinetostat_validation`), imported inside the
+functions that need it. Never matplotlib.
+"""
+from __future__ import annotations
+
+import re
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..analysis import Analysis, analyze
+from ..model import Mechanism
+
+
+def quantities(mech: Mechanism) -> list[str]:
+    """The quantities compare() checks, named as its rows name them."""
+    return ["M_drive"] + [f"R({p.links[0]},{p.links[1]})" for p in mech.pairs]
+
+
+@dataclass
+class ModelRun:
+    """The solver's cycle of one model checked route by route (one `compare` call per route)."""
+    mech: Mechanism
+    res: Analysis
+    path: Path | None = None
+    engines: tuple[str, ...] = ()
+    rows: list = field(default_factory=list)            # kinetostat_validation.compare.Row
+    results: dict = field(default_factory=dict)         # route -> EngineResult
+    skipped: dict[str, str] = field(default_factory=dict)   # route -> reason
+    errors: dict[str, str] = field(default_factory=dict)    # route -> "ExcType: message"
+    warnings: list[str] = field(default_factory=list)       # one line each, de-duplicated
+    seconds: dict[str, float] = field(default_factory=dict)  # route -> wall time of its compare call
+    tolerances: dict = field(default_factory=dict)      # route -> Tolerance
+    solver_seconds: float = 0.0                         # wall time of analyze() over the cycle
+
+    @property
+    def stem(self) -> str:
+        return self.path.stem if self.path is not None else re.sub(r"\W+", "_", self.mech.name).strip("_").lower()
+
+    @property
+    def failed(self) -> list:
+        return [r for r in self.rows if not r.passed]
+
+    @property
+    def passed(self) -> bool:
+        """No row beyond tolerance and no route that raised (skipped routes do not count)."""
+        return not self.failed and not self.errors
+
+    def status(self, route: str) -> str:
+        if route in self.errors:
+            return "ERROR"
+        if route in self.skipped:
+            return "SKIPPED"
+        rows = [r for r in self.rows if r.route == route]
+        return "PASS" if rows and all(r.passed for r in rows) else "FAIL"
+
+    def worst(self, route: str) -> float | None:
+        vals = [r.peak_relative for r in self.rows if r.route == route]
+        if not vals:
+            return None
+        return float(np.nanmax(vals)) if np.any(np.isfinite(vals)) else float("nan")
+
+
+def _one_line(exc: BaseException) -> str:
+    msg = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {msg[0] if msg else ''}".rstrip(": ")
+
+
+def _record(caught, where: str, out: list[str]) -> None:
+    for w in caught:
+        line = f"{where}{w.category.__name__}: {str(w.message).splitlines()[0] if str(w.message) else ''}"
+        if line not in out:
+            out.append(line)
+
+
+def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, res: Analysis | None = None,
+                   path: str | Path | None = None, on_route: Callable[[str], None] | None = None) -> ModelRun:
+    """Check `res` (default: `analyze(mech, steps=steps)`) against every route in `engines`.
+
+    Each route runs in its own `compare(..., engines=[route], res=res)` call; an exception of a
+    route is recorded in `errors` (that route fails) and the other routes still run. Warnings
+    raised meanwhile are collected, one line each, in `warnings`. `on_route(route)` is called
+    after each route (progress bars).
+    """
+    from kinetostat_validation.compare import TOLERANCES, compare
+
+    run = ModelRun(mech, res, Path(path) if path is not None else None, tuple(engines))
+    if res is None:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            t0 = time.perf_counter()
+            run.res = analyze(mech, steps=steps)
+            run.solver_seconds = time.perf_counter() - t0
+        _record(caught, "", run.warnings)
+    for route in engines:
+        t0 = time.perf_counter()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                c = compare(mech, engines=[route], steps=steps, res=run.res)
+            except Exception as exc:          # an adapter's fault is this route's error, not ours
+                run.errors[route] = _one_line(exc)
+            else:
+                run.rows += list(c.rows)
+                run.results.update(c.results)
+                run.skipped.update(c.skipped)
+                run.errors.update({r: m.splitlines()[0] for r, m in c.failed.items()})
+        run.seconds[route] = time.perf_counter() - t0
+        if route in TOLERANCES:
+            run.tolerances[route] = TOLERANCES[route]
+        _record(caught, f"{route}: ", run.warnings)
+        if on_route is not None:
+            on_route(route)
+    return run
