@@ -50,7 +50,7 @@ TOLERANCES: dict[str, Tolerance] = {
 
 def _route(module: str, func: str, **kw) -> Callable[[Scene], EngineResult]:
     def run(scene: Scene) -> EngineResult:
-        mod = importlib.import_module(f"validation.{module}")
+        mod = importlib.import_module(f".{module}", __package__)
         return getattr(mod, func)(scene, **kw)
     return run
 
