@@ -76,6 +76,8 @@ class Row:
     tolerance: float
     n_compared: int        # angles compared (NaN angles of the engine are left out, and counted)
     n_skipped: int
+    unit: str = ""         # unit of max_abs and peak ("N m", "N", ...)
+    phi_deg_max: float = float("nan")   # crank angle of the largest |engine - solver|, deg
 
     @property
     def passed(self) -> bool:
@@ -101,7 +103,7 @@ class Comparison:
     def to_frame(self):
         import pandas as pd
         cols = ["route", "quantity", "max_abs", "peak_relative", "rms_relative", "peak", "tolerance",
-                "n_compared", "n_skipped"]
+                "n_compared", "n_skipped", "unit", "phi_deg_max"]
         df = pd.DataFrame([[getattr(r, c) for c in cols] for r in self.rows], columns=cols)
         df["passed"] = [r.passed for r in self.rows]
         return df
@@ -114,6 +116,7 @@ def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> lis
     items = [("M_drive", (res.balancing_moment[:, None], er.M_drive[:, None]))] + list(pairs.items())
     rows = []
     for name, (ref, got) in items:
+        unit = "N m" if name == "M_drive" else "N"
         if er.magnitudes_only:
             ref = np.linalg.norm(ref, axis=-1, keepdims=True)
             got = np.linalg.norm(got, axis=-1, keepdims=True)
@@ -124,7 +127,8 @@ def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> lis
         rows.append(Row(route, name, float(err.max()) if ok.any() else np.nan,
                         float(err.max() / scale) if ok.any() else np.nan,
                         float(np.sqrt(np.mean(err**2)) / scale) if ok.any() else np.nan,
-                        peak, tolerance, int(ok.sum()), int((~ok).sum())))
+                        peak, tolerance, int(ok.sum()), int((~ok).sum()), unit,
+                        float(res.phi_deg[ok][np.argmax(err)]) if ok.any() else np.nan))
     return rows
 
 

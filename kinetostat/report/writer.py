@@ -126,6 +126,25 @@ def _row_status(r) -> str:
     return "**PASS**" if r.passed else "**FAIL**"
 
 
+def _published_section(doc: Doc, pub, published: list[dict[str, Any]] | None) -> None:
+    """The seed's published numbers beside the exact ones (nothing if the model has none)."""
+    if published is None:
+        return
+    doc.h(2, "Against the published values")
+    doc.p(f"Source: {pub.source}. Evaluated at φ = "
+          + (f"{pub.phi_deg[0]:g}°" if len(pub.phi_deg) == 1 else
+             f"{pub.phi_deg[0]:g}°, {pub.phi_deg[1]:g}°, ..., {pub.phi_deg[-1]:g}° ({len(pub.phi_deg)} positions)")
+          + f". Expected agreement: {pub.accuracy}.")
+    rows = []
+    for r in published:
+        diff = f"{r['diff']:+.3f} %" if r["diff_unit"] == "%" else f"{r['diff']:+.3g}°"
+        tol = f"±{100 * r['tolerance']:g} %" if r["diff_unit"] == "%" else f"±{r['tolerance']:g}°"
+        rows.append([r["symbol"], r["meaning"], f"{r['published']:g}", f"{r['exact']:.6g}", r["unit"], diff, tol,
+                     "yes" if r["ok"] else "**NO**"])
+    doc.table(["quantity", "meaning", "published", "kinetostat (exact)", "unit", "difference", "accepted",
+               "within"], rows, "llrrlrrl")
+
+
 def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dict[str, Any]:
     """Write `out/<stem>/` for one model; returns the summary also saved as summary.json."""
     from kinetostat_validation.compare import TOLERANCES
@@ -225,20 +244,7 @@ def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dic
           "over the cycle, as seed 004 draws them; grey rays every 30° of φ; the red dot marks the maximum.")
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
-    if published is not None:
-        doc.h(2, "Against the published values")
-        doc.p(f"Source: {pub.source}. Evaluated at φ = "
-              + (f"{pub.phi_deg[0]:g}°" if len(pub.phi_deg) == 1 else
-                 f"{pub.phi_deg[0]:g}°, {pub.phi_deg[1]:g}°, ..., {pub.phi_deg[-1]:g}° ({len(pub.phi_deg)} positions)")
-              + f". Expected agreement: {pub.accuracy}.")
-        rows = []
-        for r in published:
-            diff = f"{r['diff']:+.3f} %" if r["diff_unit"] == "%" else f"{r['diff']:+.3g}°"
-            tol = f"±{100 * r['tolerance']:g} %" if r["diff_unit"] == "%" else f"±{r['tolerance']:g}°"
-            rows.append([r["symbol"], r["meaning"], f"{r['published']:g}", f"{r['exact']:.6g}", r["unit"], diff, tol,
-                         "yes" if r["ok"] else "**NO**"])
-        doc.table(["quantity", "meaning", "published", "kinetostat (exact)", "unit", "difference", "accepted",
-                   "within"], rows, "llrrlrrl")
+    _published_section(doc, pub, published)
 
     doc.h(2, "Timings")
     doc.ul([f"kinetostat analysis of the {N} positions: {run.solver_seconds:.3f} s"]
