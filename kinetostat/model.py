@@ -15,6 +15,7 @@ from typing import Any, Literal, Mapping
 import numpy as np
 
 from .errors import ModelError, StructureError
+from .structure import Structure, analyse_structure
 
 __all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Mechanism",
            "load", "loads", "from_dict"]
@@ -64,6 +65,11 @@ class Table:
     scale: float = 1.0
     axis: Vec | None = None                 # travel only: world axis of the stroke
     origin: Literal["max", "min"] = "max"   # travel only: extreme the travel is measured from
+
+    def __repr__(self) -> str:
+        back = ", with a return stroke" if self.value_return is not None else ""
+        return (f"Table({self.argument}, {len(self.x)} points, x={self.x[0]:g}..{self.x[-1]:g}, "
+                f"value={min(self.value):g}..{max(self.value):g}, scale={self.scale:g}{back})")
 
 
 @dataclass(frozen=True)
@@ -148,18 +154,18 @@ class Mechanism:
     drive: Drive
     friction: Friction | None
     path: str | None = None
-    _structure: Any = field(default=None, repr=False, compare=False)
+    #: Structural analysis (mobility, Assur groups, structure formula), derived from the pairs
+    #: when the mechanism is built; raises StructureError for what kinetostat does not analyse.
+    structure: Structure = field(init=False, repr=False, compare=False)
     # memo of quantities derived from the (immutable) data, e.g. the strokes of travel tables
     _derived: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self):
-        from .structure import analyse_structure
-        object.__setattr__(self, "_structure", analyse_structure(self))
+        object.__setattr__(self, "structure", analyse_structure(self.n_links, self.pairs, self.branches))
 
-    @property
-    def structure(self):
-        """Structural analysis: mobility, Assur groups, structure formula."""
-        return self._structure
+    def __repr__(self) -> str:
+        return (f"Mechanism(name={_abbreviate(self.name)!r}, links={self.n_links}, pairs={len(self.pairs)}, "
+                f"structure={self.structure.formula!r}, drive={self.drive.kind} {self.drive.omega:.4g} rad/s)")
 
     @property
     def n_links(self) -> int:
@@ -218,6 +224,11 @@ class Mechanism:
                 for b in pts:
                     best = max(best, math.dist(a, b))
         return best or 1.0
+
+
+def _abbreviate(text: str, limit: int = 90) -> str:
+    """`text` cut to `limit` characters with an ellipsis: a name as a summary shows it."""
+    return text if len(text) <= limit else text[:limit - 1] + "\u2026"
 
 
 # ----------------------------------------------------------------------------- loading

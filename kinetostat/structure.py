@@ -1,19 +1,34 @@
 """Structural analysis (seed 000 sec. 5, seed 002 sec. 1.2.1): mobility by Chebyshev and the
-decomposition into the initial mechanism I(0,1) and class-II Assur groups."""
+decomposition into the initial mechanism I(0,1) and class-II Assur groups.
+
+Works on the model's data only (the number of links, the pairs, the assembly branches): it
+imports nothing of `model`, which calls `analyse_structure` when it builds a Mechanism. May
+use: `errors`.
+"""
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from .errors import StructureError
 
-if TYPE_CHECKING:
-    from .model import Mechanism, Pair
-
-__all__ = ["AssurGroup", "Structure", "analyse_structure", "GROUP_KINDS"]
+__all__ = ["AssurGroup", "Structure", "analyse_structure", "GROUP_KINDS", "KinematicPair"]
 
 # The five kinds of class-II groups, numbered as the texts number them ("вид").
 GROUP_KINDS = {"RRR": 1, "RRP": 2, "RPR": 3, "PRP": 4, "RPP": 5}
+
+
+class KinematicPair(Protocol):
+    """What the structural analysis reads of a pair (`kinetostat.model.Pair` is one)."""
+
+    @property
+    def kind(self) -> str:
+        """"R" (revolute) or "P" (prismatic)."""
+
+    @property
+    def links(self) -> tuple[int, int]:
+        """The two links it joins; P: (guide link, slider link)."""
 
 
 @dataclass(frozen=True)
@@ -26,7 +41,7 @@ class AssurGroup:
     """
     kind: str
     links: tuple[int, int]
-    pairs: tuple["Pair", "Pair", "Pair"]
+    pairs: tuple[KinematicPair, KinematicPair, KinematicPair]   # the model's Pair objects
     known: tuple[int, int]
     branch: int
 
@@ -34,6 +49,10 @@ class AssurGroup:
     def label(self) -> str:
         return f"II({self.links[0]},{self.links[1]})" if self.links[0] < self.links[1] \
             else f"II({self.links[1]},{self.links[0]})"
+
+    def __repr__(self) -> str:
+        pairs = ", ".join(f"{p.kind}({p.links[0]},{p.links[1]})" for p in self.pairs)
+        return f"AssurGroup({self.label} {self.kind}, pairs=[{pairs}], known={self.known}, branch={self.branch:+d})"
 
 
 @dataclass(frozen=True)
@@ -61,28 +80,34 @@ class Structure:
     def order(self) -> int:
         return 2 if self.groups else 1
 
+    def __repr__(self) -> str:
+        return f"Structure(W={self.W}, formula={self.formula!r}, kinds={[g.kind for g in self.groups]})"
+
     def __str__(self) -> str:
         kinds = ", ".join(f"{g.label} {g.kind} (kind {GROUP_KINDS[g.kind]})" for g in self.groups)
         return (f"W = 3*{self.n} - 2*{self.p5} - {self.p4} = {self.W}; {self.formula}; "
                 f"class {self.mechanism_class}, order {self.order}; groups: {kinds or 'none'}")
 
 
-def analyse_structure(mech: "Mechanism") -> Structure:
-    """Mobility and Assur-group decomposition; raises StructureError for what is unsupported."""
-    n = mech.n_links - 1
-    s = Structure(n, len(mech.pairs), 0, ())
+def analyse_structure(n_links: int, pairs: Sequence[KinematicPair],
+                      branches: Mapping[frozenset, int]) -> Structure:
+    """Mobility and Assur-group decomposition of `n_links` links (frame included) joined by
+    `pairs`, each group of kinds RRR, RRP, RPR on its assembly branch `branches[{j, k}]` (+1 or
+    -1). Raises StructureError for what is unsupported."""
+    n = n_links - 1
+    s = Structure(n, len(pairs), 0, ())
     if s.W != 1:
         raise StructureError(f"mobility W = 3*{n} - 2*{s.p5} - 0 = {s.W}; kinetostat analyses "
                              f"mechanisms with one degree of freedom (W = 1) driven at the crank")
-    crank_frame = [p for p in mech.pairs if set(p.links) == {0, 1}]
+    crank_frame = [p for p in pairs if set(p.links) == {0, 1}]
     if len(crank_frame) != 1 or crank_frame[0].kind != "R":
         raise StructureError("the crank (link 1) must be joined to the frame by exactly one revolute pair")
 
     known = {0, 1}
     groups: list[AssurGroup] = []
-    remaining = set(range(2, mech.n_links))
+    remaining = set(range(2, n_links))
     while remaining:
-        group = _next_group(mech, known, remaining)
+        group = _next_group(pairs, branches, known, remaining)
         if group is None:
             raise StructureError(
                 f"links {sorted(remaining)} do not split into class-II Assur groups (dyads); "
@@ -90,28 +115,30 @@ def analyse_structure(mech: "Mechanism") -> Structure:
         groups.append(group)
         known |= set(group.links)
         remaining -= set(group.links)
-    unused = set(mech.branches) - {frozenset(g.links) for g in groups}
+    unused = set(branches) - {frozenset(g.links) for g in groups}
     if unused:
         raise StructureError(f"group: branch given for {[sorted(u) for u in unused]}, "
                              f"which is not an Assur group of this mechanism "
                              f"(groups: {[g.label for g in groups]})")
-    return Structure(n, len(mech.pairs), 0, tuple(groups))
+    return Structure(n, len(pairs), 0, tuple(groups))
 
 
-def _next_group(mech: "Mechanism", known: set[int], remaining: set[int]) -> AssurGroup | None:
+def _next_group(pairs: Sequence[KinematicPair], branches: Mapping[frozenset, int], known: set[int],
+                remaining: set[int]) -> AssurGroup | None:
     for j in sorted(remaining):
         for k in sorted(remaining):
             if j >= k:
                 continue
-            inner = [p for p in mech.pairs if set(p.links) == {j, k}]
-            out_j = [p for p in mech.pairs if j in p.links and (set(p.links) - {j}) <= known]
-            out_k = [p for p in mech.pairs if k in p.links and (set(p.links) - {k}) <= known]
+            inner = [p for p in pairs if set(p.links) == {j, k}]
+            out_j = [p for p in pairs if j in p.links and (set(p.links) - {j}) <= known]
+            out_k = [p for p in pairs if k in p.links and (set(p.links) - {k}) <= known]
             if len(inner) == 1 and len(out_j) == 1 and len(out_k) == 1:
-                return _orient(mech, j, k, out_j[0], inner[0], out_k[0])
+                return _orient(branches, j, k, out_j[0], inner[0], out_k[0])
     return None
 
 
-def _orient(mech: "Mechanism", j: int, k: int, pj: "Pair", pin: "Pair", pk: "Pair") -> AssurGroup:
+def _orient(branches: Mapping[frozenset, int], j: int, k: int, pj: KinematicPair, pin: KinematicPair,
+            pk: KinematicPair) -> AssurGroup:
     kind = pj.kind + pin.kind + pk.kind
     if kind not in GROUP_KINDS or (kind == "RPR" and pin.links[1] != j):
         j, k, pj, pk = k, j, pk, pj
@@ -122,10 +149,10 @@ def _orient(mech: "Mechanism", j: int, k: int, pj: "Pair", pin: "Pair", pk: "Pai
     other = lambda p, x: (set(p.links) - {x}).pop()
     key = frozenset((j, k))
     if kind in ("RRR", "RRP", "RPR"):
-        if key not in mech.branches:
+        if key not in branches:
             raise StructureError(f"group II({min(j, k)},{max(j, k)}) ({kind}): assembly branch missing; "
                                  f"add [[group]] links = [{min(j, k)}, {max(j, k)}], branch = 1 or -1")
-        branch = mech.branches[key]
+        branch = branches[key]
     else:
         branch = 1
     return AssurGroup(kind, (j, k), (pj, pin, pk), (other(pj, j), other(pk, k)), branch)
