@@ -1,4 +1,7 @@
-"""`analyze(mech, phi_deg)`: the whole kinetostatic analysis as one frozen result object."""
+"""`analyze(mech, phi_deg)`: the whole kinetostatic analysis as one frozen result object.
+
+May use: model, kinematics, kinetostatics, applied, planar; pandas only inside `to_frame`.
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -10,9 +13,17 @@ from .kinematics import Kinematics, kinematics
 from .kinetostatics import Forces, forces, friction_power, lever_moment
 from .applied import applied_wrenches, com_motion, inertia_loads
 from .planar import as_xy, cross_z
-from .model import Mechanism
+from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "analyze"]
+__all__ = ["Analysis", "InertiaLoad", "analyze", "FRAME_NOTE"]
+
+#: The frame and sign conventions of every vector, moment and angle of a result (also in
+#: `Analysis.to_frame().attrs["frame"]`).
+FRAME_NOTE = ("SI units; world frame: x right, y up, gravity along -y; moments, angles, angular "
+              "velocities and accelerations about +z (counter-clockwise positive); phi_deg: crank angle "
+              "from the model's drive.reference in the drive's sense; R_i_j, Rx_i_j, Ry_i_j: force exerted "
+              "by link i on link j (R_j_i = -R_i_j); M_bal: moment the drive applies to the crank; inertia "
+              "loads: main vector at the centre of mass and main moment; NaN where singular is True")
 
 
 class InertiaLoad(NamedTuple):
@@ -22,6 +33,9 @@ class InertiaLoad(NamedTuple):
     h: np.ndarray        # (N,) offset |M_i| / |F_i| of the single resultant from S, m
                          #   (0 in translation, inf for a pure couple: rotation about S)
     point: np.ndarray    # (N, 2) a point of the single resultant's line (S where h is 0 or inf)
+
+    def __repr__(self) -> str:
+        return f"InertiaLoad(positions={len(self.moment)}: force (N, 2) N, moment N m, h m, point (N, 2) m)"
 
 
 @dataclass(frozen=True)
@@ -33,6 +47,8 @@ class Analysis:
     velocities, accelerations and all forces are NaN, and `cond` says why.
     """
     mech: Mechanism
+    phi_deg: np.ndarray     # (N,) crank angle from the model's reference direction in its sense, deg
+                            #   (exactly the angles asked for; read-only)
     kin: Kinematics
     F_applied: np.ndarray   # (N, L, 2) applied loads without inertia, per link, N
     M_applied: np.ndarray   # (N, L) their moment about each link's local origin, N m
@@ -42,12 +58,13 @@ class Analysis:
     lever_moment: np.ndarray      # (N,) balancing moment by Zhukovsky's lever, N m
     friction_power: np.ndarray    # (N, n_pairs) power lost in each pair, W
 
-    # -- angles
-    @property
-    def phi_deg(self) -> np.ndarray:
-        """(N,) crank angle from the model's reference direction in its sense, deg."""
-        return np.degrees(self.kin.phi)
+    def __repr__(self) -> str:
+        phi = self.phi_deg
+        span = f"{phi[0]:g}" if len(phi) == 1 else f"{phi.min():g}..{phi.max():g}"
+        return (f"Analysis(mechanism={_abbreviate(self.mech.name)!r}, positions={len(phi)}, "
+                f"phi_deg={span}, singular={int(self.singular.sum())})")
 
+    # -- angles
     @property
     def singular(self) -> np.ndarray:
         """(N,) True where some group is at a singular position (values there are NaN)."""
@@ -165,50 +182,66 @@ class Analysis:
     def to_frame(self):
         """The whole analysis as a pandas DataFrame, one row per crank angle.
 
-        Columns (SI): phi_deg; x_P, y_P, vx_P, vy_P, ax_P, ay_P for every point P;
-        theta_k, omega_k, eps_k for every link k; Fix_k, Fiy_k, Mi_k, h_k inertia of every
-        link with mass or inertia; Rx_i_j, Ry_i_j, R_i_j (force of i on j and its magnitude)
-        for every pair, x_i_j and m_i_j (line of the normal force, its moment about the slider
-        point) and vs_i_j, as_i_j (sliding velocity and acceleration) for prismatic pairs; M_bal, M_lever, and for a machine
-        F_bal (magnitude) with F_balx, F_baly; Pfr_i_j per pair and Pfr_total when the model has
-        friction; cond_<group> per group; singular.
+        Columns (unit in brackets): phi_deg [deg]; for every point P x_P, y_P [m], vx_P, vy_P
+        [m/s], ax_P, ay_P [m/s^2]; for every moving link k theta_k [rad], omega_k [rad/s], eps_k
+        [rad/s^2]; for every link with mass or inertia Fix_k, Fiy_k [N] (inertia main vector at
+        the centre of mass), Mi_k [N m] (main moment), h_k [m] (offset of the single resultant);
+        for every pair Rx_i_j, Ry_i_j, R_i_j [N] (force of link i on link j, its magnitude); for
+        prismatic pairs also x_i_j [m] and m_i_j [N m] (line of the normal force, its moment
+        about the slider point), vs_i_j [m/s] and as_i_j [m/s^2] (sliding velocity and
+        acceleration); M_bal, M_lever [N m]; for a working machine F_balx, F_baly, F_bal [N]; with
+        friction Pfr_i_j per pair and Pfr_total [W]; cond_<group> [1] per Assur group; singular
+        [bool].
+
+        `df.attrs["units"]` maps every column to its unit ("1": dimensionless, "bool": a flag);
+        `df.attrs["frame"]` states the frame and sign conventions; `df.attrs["mechanism"]` the
+        model's name. Vectors are in the world frame (x right, y up, gravity along -y), moments
+        and angles about +z.
         """
         import pandas as pd
         m = self.mech
-        cols: dict[str, np.ndarray] = {"phi_deg": self.phi_deg}
+        cols: dict[str, np.ndarray] = {}
+        units: dict[str, str] = {}
+
+        def put(unit: str, **columns: np.ndarray) -> None:
+            cols.update(columns)
+            units.update(dict.fromkeys(columns, unit))
+
+        put("deg", phi_deg=self.phi_deg)
         for name in m.point_names:
-            P, V, A = self._point(name)
-            for tag, arr in (("", P), ("v", V), ("a", A)):
-                cols[f"{tag}x_{name}"], cols[f"{tag}y_{name}"] = arr[:, 0], arr[:, 1]
+            for tag, arr, unit in zip(("", "v", "a"), self._point(name), ("m", "m/s", "m/s^2")):
+                put(unit, **{f"{tag}x_{name}": arr[:, 0], f"{tag}y_{name}": arr[:, 1]})
         for k in range(1, m.n_links):
-            cols[f"theta_{k}"], cols[f"omega_{k}"], cols[f"eps_{k}"] = self.theta(k), self.omega(k), self.eps(k)
+            put("rad", **{f"theta_{k}": self.theta(k)})
+            put("rad/s", **{f"omega_{k}": self.omega(k)})
+            put("rad/s^2", **{f"eps_{k}": self.eps(k)})
         for link in m.links[1:]:
             if link.mass or link.I_S:
                 il = self.inertia(link.id)
-                cols[f"Fix_{link.id}"], cols[f"Fiy_{link.id}"] = il.force[:, 0], il.force[:, 1]
-                cols[f"Mi_{link.id}"], cols[f"h_{link.id}"] = il.moment, il.h
+                put("N", **{f"Fix_{link.id}": il.force[:, 0], f"Fiy_{link.id}": il.force[:, 1]})
+                put("N m", **{f"Mi_{link.id}": il.moment})
+                put("m", **{f"h_{link.id}": il.h})
         for p in m.pairs:
-            i, j = p.links
+            ij = f"{p.links[0]}_{p.links[1]}"
             R = self.forces.R[:, p.index]
-            cols[f"Rx_{i}_{j}"], cols[f"Ry_{i}_{j}"] = R[:, 0], R[:, 1]
-            cols[f"R_{i}_{j}"] = np.linalg.norm(R, axis=-1)
+            put("N", **{f"Rx_{ij}": R[:, 0], f"Ry_{ij}": R[:, 1], f"R_{ij}": np.linalg.norm(R, axis=-1)})
             if p.kind == "P":
-                cols[f"x_{i}_{j}"] = self.forces.x[:, p.index]
-                cols[f"m_{i}_{j}"] = self.forces.m[:, p.index]
-                cols[f"vs_{i}_{j}"] = self.kin.v_slide[:, p.index]
-                cols[f"as_{i}_{j}"] = self.kin.a_slide[:, p.index]
-        cols["M_bal"], cols["M_lever"] = self.balancing_moment, self.lever_moment
+                put("m", **{f"x_{ij}": self.forces.x[:, p.index]})
+                put("N m", **{f"m_{ij}": self.forces.m[:, p.index]})
+                put("m/s", **{f"vs_{ij}": self.kin.v_slide[:, p.index]})
+                put("m/s^2", **{f"as_{ij}": self.kin.a_slide[:, p.index]})
+        put("N m", M_bal=self.balancing_moment, M_lever=self.lever_moment)
         if m.drive.kind == "machine":
-            cols["F_balx"], cols["F_baly"] = self.balancing_force[:, 0], self.balancing_force[:, 1]
-            cols["F_bal"] = np.linalg.norm(self.balancing_force, axis=-1)
+            F = self.balancing_force
+            put("N", F_balx=F[:, 0], F_baly=F[:, 1], F_bal=np.linalg.norm(F, axis=-1))
         if m.friction is not None:
-            for p in m.pairs:
-                cols[f"Pfr_{p.links[0]}_{p.links[1]}"] = self.friction_power[:, p.index]
-            cols["Pfr_total"] = self.friction_power_total
-        for n, g in enumerate(m.structure.groups):
-            cols[f"cond_{g.label}"] = self.cond[:, n]
-        cols["singular"] = self.singular
-        return pd.DataFrame(cols)
+            put("W", **{f"Pfr_{p.links[0]}_{p.links[1]}": self.friction_power[:, p.index] for p in m.pairs})
+            put("W", Pfr_total=self.friction_power_total)
+        put("1", **{f"cond_{g.label}": self.cond[:, n] for n, g in enumerate(m.structure.groups)})
+        put("bool", singular=self.singular)
+        df = pd.DataFrame(cols)
+        df.attrs.update(mechanism=m.name, units=units, frame=FRAME_NOTE)
+        return df
 
 
 def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
@@ -220,19 +253,20 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     if phi_deg is None:
         if not isinstance(steps, (int, np.integer)) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps: expected a positive integer, got {steps!r}")
-        phi_deg = np.arange(steps) * (360.0 / steps)
+        phi_deg = np.arange(steps) * 360.0 / steps     # k 360 / N rounded once: 30.0 exactly, not 29.999...
     try:
-        phi_deg = np.atleast_1d(np.asarray(phi_deg, dtype=float))
+        phi_deg = np.array(phi_deg, dtype=float, ndmin=1)   # a copy: the result owns its angles
     except (TypeError, ValueError):
         raise ValueError(f"phi_deg: expected finite crank angles in degrees, got {phi_deg!r}") from None
     if phi_deg.ndim != 1 or not np.isfinite(phi_deg).all():
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
+    phi_deg.flags.writeable = False
     kin = kinematics(mech, np.radians(phi_deg))
     with np.errstate(divide="ignore", invalid="ignore"):    # NaN only at angles marked singular
-        return _kinetostatics(mech, kin)
+        return _kinetostatics(mech, phi_deg, kin)
 
 
-def _kinetostatics(mech: Mechanism, kin: Kinematics) -> Analysis:
+def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics) -> Analysis:
     r, aS = com_motion(mech, kin)
     F_app, M_app = applied_wrenches(mech, kin, r)
     F_i, M_i = inertia_loads(mech, kin, aS)
@@ -240,5 +274,5 @@ def _kinetostatics(mech: Mechanism, kin: Kinematics) -> Analysis:
     M_all = M_app + M_i + cross_z(r, F_i)
     frc = forces(mech, kin, F_all, M_all)
     lever = lever_moment(mech, kin, F_all, M_all)
-    return Analysis(mech, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
+    return Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
                     friction_power(mech, kin, frc.R))

@@ -55,6 +55,10 @@ class Kinematics:
     cond: np.ndarray       # (N, n_groups) condition number of each group's plan
     singular: np.ndarray   # (N,) bool: some group's cond > COND_MAX (velocities etc. are NaN)
 
+    def __repr__(self) -> str:
+        N, L = self.theta.shape
+        return f"Kinematics(positions={N}, links={L}, groups={self.cond.shape[1]}, singular={int(self.singular.sum())})"
+
     @property
     def origin(self) -> np.ndarray:
         """(N, L, 2) position of each link's local origin, m."""

@@ -35,6 +35,9 @@ class Forces:
     M_bal: np.ndarray     # (N,) moment the drive applies to the crank about +z, N m
     F_bal: np.ndarray     # (N, 2) machine: balancing force at the pitch point, N (zeros for an engine)
 
+    def __repr__(self) -> str:
+        return f"Forces(positions={self.R.shape[0]}, pairs={self.R.shape[1]})"
+
     @property
     def x(self) -> np.ndarray:
         """(N, n_pairs) P pairs: the normal force acts on the line slider point + x d, m, as
