@@ -492,6 +492,56 @@ def cmd_report(args) -> int:
     return EXIT_OK
 
 
+# ============================================================================ export
+
+def _file_mode(path: Path) -> int:
+    """The mode of the file `path` replaces, or of a new file under the process's umask (a
+    temporary file is created 0600)."""
+    if path.exists():
+        return path.stat().st_mode & 0o7777
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def _write_atomic(path: Path, text: str, option: str) -> None:
+    """Write `text` to `path` through a temporary file in the same folder and os.replace: a
+    reader never sees half a file, and a failed write leaves the old file as it was."""
+    if path.is_dir():
+        raise CLIError(f"cannot write {option} {path}: it is a directory")
+    tmp = None
+    try:
+        with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=path.parent, prefix=f".{path.name}.",
+                                         suffix=".tmp", delete=False) as f:
+            tmp = f.name
+            f.write(text)
+        os.chmod(tmp, _file_mode(path))
+        os.replace(tmp, path)
+    except OSError as exc:
+        if tmp is not None and os.path.exists(tmp):
+            os.unlink(tmp)
+        raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
+
+
+def cmd_export(args) -> int:
+    from .errors import AssemblyError, ModelError
+    path = Path(args.model)
+    mech = _load(path)
+    from kinetostat_validation.export import to_mjcf, to_urdf
+    try:
+        text = to_mjcf(mech) if args.format == "mjcf" else to_urdf(mech)
+    except AssemblyError as exc:
+        raise CLIError(f"{path}: {exc}") from None
+    except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
+        raise CLIError(_model_error_text(exc)) from None
+    if args.output is None or args.output == "-":
+        sys.stdout.write(text)
+        return EXIT_OK
+    _write_atomic(Path(args.output), text, "-o")
+    _Out.write(f"{args.format.upper()} of {path.name} -> {args.output}")
+    return EXIT_OK
+
+
 # ============================================================================ parser and main
 
 def build_parser() -> argparse.ArgumentParser:
@@ -526,6 +576,24 @@ def build_parser() -> argparse.ArgumentParser:
                                    "arithmetic, the Assur groups with their kinds, the structure formula.")
     s.add_argument("model", metavar="MODEL", help="model file (TOML)")
     s.set_defaults(func=cmd_structure)
+
+    e = sub.add_parser("export", help="write a model as MJCF (MuJoCo) or URDF for physics engines",
+                       description="Write MODEL's links (mass, centre of mass, I_S), pairs and gravity as an "
+                                   "engine model, from the scene the validation harness builds. --mjcf: the "
+                                   "spanning tree with the loop-closing pairs as equality constraints and a "
+                                   "keyframe 'phi0' (assembled at phi = 0). --urdf: the spanning tree only; URDF "
+                                   "cannot express closed loops, so each loop-closing pair is written as an XML "
+                                   "comment '<!-- loop closure ... -->' for you to add as a constraint. Loads, "
+                                   "drive and friction are not exported.")
+    e.add_argument("model", metavar="MODEL", help="model file (TOML)")
+    fmt = e.add_mutually_exclusive_group(required=True)
+    fmt.add_argument("--mjcf", dest="format", action="store_const", const="mjcf", help="MuJoCo MJCF")
+    fmt.add_argument("--urdf", dest="format", action="store_const", const="urdf",
+                     help="URDF of the spanning tree, loop closures as comments")
+    e.add_argument("-o", "--output", metavar="FILE",
+                   help="write FILE (atomically: a temporary file in the same folder, then renamed); "
+                        "default: stdout")
+    e.set_defaults(func=cmd_export)
 
     v = sub.add_parser("validate", help="cross-check the solver against the engine routes (exit 1 on failure)",
                        description="Run the accuracy gate: for every MODEL (default: all bundled models) compare "

@@ -84,7 +84,7 @@ from kinetostat.kinetostatics import gear_force
 
 from .scene import EngineResult, Scene
 
-__all__ = ["mjcf", "solve", "simulate", "SIM_FLOOR", "SIM_STEPS_PER_REV"]
+__all__ = ["mjcf", "slot_motion", "solve", "simulate", "SIM_FLOOR", "SIM_STEPS_PER_REV"]
 
 #: Exact route: the MJCF's placeholder mass / inertia of massless bodies, relative to the
 #: scene's largest mass and largest m*size^2. Overwritten with exact zeros after compiling
@@ -253,8 +253,9 @@ def _compile(scene: Scene, floor: float, exact_masses: bool, **options) -> _Mode
     return _Model(m, d, body, joint_dof, slot_dof, rows, eq_id, int(joint_dof[scene.crank_joint]))
 
 
-def _slot_motion(scene: Scene) -> dict:
-    """Travel, rate and second derivative of every cut prismatic pair (its helper's dof)."""
+def slot_motion(scene: Scene) -> dict:
+    """Cut prismatic pair index -> travel (m), rate (m/s) and second derivative (m/s^2), each (N,),
+    of its slider along the guide: the coordinate of its helper body's slide joint `slot<index>`."""
     kin, mech = scene.res.kin, scene.mech
     out = {}
     for p in _slider_cuts(scene):
@@ -272,7 +273,7 @@ def _exact_state(scene: Scene, mm: _Model):
     N, nv = len(scene.phi_deg), mm.m.nv
     qpos, qvel, qacc = (np.zeros((N, nv)) for _ in range(3))
     qpos[:, mm.joint_dof], qvel[:, mm.joint_dof], qacc[:, mm.joint_dof] = scene.q, scene.qd, scene.qdd
-    for idx, (s, v, a) in _slot_motion(scene).items():
+    for idx, (s, v, a) in slot_motion(scene).items():
         dof = mm.slot_dof[idx]
         qpos[:, dof], qvel[:, dof], qacc[:, dof] = s, v, a
     return qpos, qvel, qacc
