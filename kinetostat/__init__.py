@@ -5,6 +5,11 @@
     >>> res = kinetostat.analyze(mech, phi_deg=[30.0])
     >>> mech.structure.formula
     'I(0,1) <- II(2,3)'
+    >>> res
+    Analysis(mechanism='ICE crank-slider (seed 002 worked example)', positions=1, phi_deg=30, singular=0)
+
+The solver's public names. May use: the solver modules only (never the harness
+`kinetostat_validation`, the engines, matplotlib or `kinetostat.report`).
 """
 from .analysis import Analysis, InertiaLoad, analyze
 from .errors import AssemblyError, ModelError, SingularPositionWarning, StructureError
