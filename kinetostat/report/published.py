@@ -69,11 +69,11 @@ def exact_value(res: Analysis, p: Published) -> tuple[float, float]:
     """(value in p.unit, crank angle it belongs to, deg) of `p` from the solver's answer at p.angles."""
     mag = MAGNITUDE[p.quantity](res, p)
     if p.reduce is None:
-        return float(mag[0]), float(res.phi_deg[0])
+        return float(mag[0]), p.angles[0]
     if not np.any(np.isfinite(mag)):
         return math.nan, math.nan
     k = int(np.nanargmin(mag) if p.reduce == "min" else np.nanargmax(mag))
-    at = float(res.phi_deg[k])
+    at = p.angles[k]                  # as the model states it (res.phi_deg went through radians)
     return (at if p.reduce == "angle_of_max" else float(mag[k])), at
 
 
