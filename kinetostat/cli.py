@@ -203,14 +203,25 @@ def _writable_dir(path: str, option: str) -> Path:
     return p
 
 
+#: `--engines none`: no physics engine, only the 40-digit reference route (and the published values).
+NO_ENGINE = "none"
+
+
 def _engines(names: Sequence[str] | None) -> list[str]:
+    """The routes of `--engines` (default: every route); `none` alone means the reference route only."""
     from kinetostat_validation.compare import ROUTES
     if names is None:
         return list(ROUTES)
+    if NO_ENGINE in names:
+        if len(names) > 1:
+            raise CLIError(f"--engines {NO_ENGINE} stands alone (it means no engine: the reference route and the "
+                           f"published values only), got {' '.join(names)}")
+        return ["reference"]
     unknown = [n for n in names if n not in ROUTES]
     if unknown:
         hint = " (put MODEL files before --engines)" if any(n.endswith(".toml") for n in unknown) else ""
-        raise CLIError(f"unknown engine route(s) {', '.join(unknown)}{hint}. Valid names: {', '.join(ROUTES)}")
+        raise CLIError(f"unknown engine route(s) {', '.join(unknown)}{hint}. "
+                       f"Valid names: {', '.join(ROUTES)}, {NO_ENGINE}")
     return list(dict.fromkeys(names))
 
 
@@ -378,35 +389,44 @@ def cmd_structure(args) -> int:
 # ============================================================================ validate
 
 def exit_code(runs) -> int:
-    """The exit code of `validate` for these ModelRuns: 1 if a check failed, a route raised,
-    or nothing at all was compared (every route skipped); else 0."""
+    """The exit code of `validate` for these ModelRuns: 1 if a check (a route's error or a
+    published value) failed, a route raised, or no check ran at all (every route skipped and no
+    published value); else 0."""
     if not runs or any(not r.passed for r in runs):
         return EXIT_FAIL
-    if not any(r.rows for r in runs):
+    if not any(r.checks for r in runs):
         return EXIT_FAIL
     return EXIT_OK
 
 
 def validation_table(run) -> str:
+    """The checks of one ModelRun, one line each: route (or "published"), quantity, error,
+    tolerance, max abs error, verdict; skipped and failed routes one line each."""
+    from .report.runs import PUBLISHED_ROUTE as PUBLISHED
     m = run.mech
+    checks = run.checks
+    w = max([9] + [len(c.quantity) for c in checks])
     lines = [f"== {run.stem}: {m.name}   {m.structure.formula}, {len(run.res.phi_deg)} positions",
-             f"  {'route':<11s} {'quantity':<9s} {'peak-rel err':>12s} {'tolerance':>9s} {'max abs err':>15s}  result"]
-    for route in run.engines:
+             f"  {'route':<11s} {'quantity':<{w}s} {'error':>12s} {'tolerance':>9s} {'max abs err':>15s}  result"]
+    routes = list(run.engines) + ([PUBLISHED] if run.published or PUBLISHED in run.errors else [])
+    for route in routes:
         if route in run.errors:
-            lines.append(f"  {route:<11s} {'(all)':<9s} {'-':>12s} {'-':>9s} {'-':>15s}  ERROR: {run.errors[route]}")
+            lines.append(f"  {route:<11s} {'(all)':<{w}s} {'-':>12s} {'-':>9s} {'-':>15s}  ERROR: {run.errors[route]}")
             continue
         if route in run.skipped:
-            lines.append(f"  {route:<11s} {'(all)':<9s} {'-':>12s} {'-':>9s} {'-':>15s}  SKIPPED: {run.skipped[route]}")
+            lines.append(f"  {route:<11s} {'(all)':<{w}s} {'-':>12s} {'-':>9s} {'-':>15s}  SKIPPED: {run.skipped[route]}")
             continue
-        for r in (r for r in run.rows if r.route == route):
-            unit = "N m" if r.quantity == "M_drive" else "N"
-            extra = f" ({r.n_skipped} NaN angles left out)" if r.n_skipped else ""
-            lines.append(f"  {route:<11s} {r.quantity:<9s} {r.peak_relative:12.2e} {r.tolerance:9.0e} "
-                         f"{r.max_abs:11.3e} {unit:<3s}  {'PASS' if r.passed else 'FAIL'}{extra}")
-    n, f = len(run.rows), len(run.failed)
+        for c in (c for c in checks if c.route == route):
+            row = next((r for r in run.rows if r.route == route and r.quantity == c.quantity), None)
+            extra = f" ({row.n_skipped} NaN angles left out)" if row is not None and row.n_skipped else ""
+            err, tol = ((f"{c.error:8.3g} deg", f"{c.tolerance:5g} deg") if c.measure == "deg"
+                        else (f"{c.error:12.2e}", f"{c.tolerance:9.0e}"))
+            lines.append(f"  {route:<11s} {c.quantity:<{w}s} {err:>12s} {tol:>9s} "
+                         f"{c.max_abs:11.3e} {c.unit:<3s}  {'PASS' if c.passed else 'FAIL'}{extra}")
+    n, f = len(checks), sum(not c.passed for c in checks)
     verdict = "PASS" if run.passed and n else "FAIL" if not run.passed else "NOT CHECKED"
-    lines.append(f"  => {verdict}: {n} checks, {f} failed, {len(run.skipped)} route(s) skipped, "
-                 f"{len(run.errors)} with errors")
+    lines.append(f"  => {verdict}: {n} checks ({len(run.published)} published values), {f} failed, "
+                 f"{len(run.skipped)} route(s) skipped, {len(run.errors)} with errors")
     return "\n".join(lines)
 
 
@@ -414,6 +434,8 @@ def cmd_validate(args) -> int:
     from .report import run_validation
     engines = _engines(args.engines)
     junit = _writable_file(args.junit, "--junit") if args.junit else None
+    to_json = None if args.json is None else args.json if args.json == "-" else _writable_file(args.json, "--json")
+    err = to_json == "-"                 # the JSON on stdout: the people's lines go to stderr
     paths = args.models or bundled_models()
     jobs = _prepare(paths, args.steps)
     runs = []
@@ -427,19 +449,22 @@ def cmd_validate(args) -> int:
             runs.append(run)
             for w in run.warnings:
                 _warn(f"{path.name}: {w}")
-            _Out.write(validation_table(run))
+            _Out.write(validation_table(run), err=err)
     finally:
         _close(bar)
-    rows = [r for run in runs for r in run.rows]
-    n_fail = sum(not r.passed for r in rows)
+    checks = [c for run in runs for c in run.checks]
+    n_fail = sum(not c.passed for c in checks)
+    n_pub = sum(len(run.published) for run in runs)
     n_err = sum(len(run.errors) for run in runs)
     n_skip = sum(len(run.skipped) for run in runs)
     code = exit_code(runs)
-    _Out.write(f"validate: {len(runs)} model(s), {len(rows)} checks: {len(rows) - n_fail} passed, {n_fail} FAILED; "
-               f"{n_err} route error(s), {n_skip} route(s) skipped; {time.perf_counter() - t0:.1f} s"
-               + ("" if code == EXIT_OK else " -> FAIL"))
-    if not rows:
-        _error("nothing was compared: every engine route was skipped or raised")
+    _Out.write(f"validate: {len(runs)} model(s), {len(checks)} checks ({n_pub} published values): "
+               f"{len(checks) - n_fail} passed, {n_fail} FAILED; {n_err} route error(s), {n_skip} route(s) skipped; "
+               f"{time.perf_counter() - t0:.1f} s" + ("" if code == EXIT_OK else " -> FAIL"), err=err)
+    if not checks:
+        _error("nothing was checked: every route was skipped or raised, and no model has published values")
+    if to_json is not None:
+        _write_validation_json(runs, code, to_json)
     if junit is not None:
         from .report import junit_xml
         try:
@@ -448,6 +473,21 @@ def cmd_validate(args) -> int:
             raise CLIError(f"cannot write --junit {junit}: {exc.strerror or exc}") from None
         _Out.write(f"JUnit XML -> {junit}")
     return code
+
+
+def _write_validation_json(runs, code: int, dest) -> None:
+    """`validate --json`: the checks of every run as JSON (NaN as null), to a file or stdout ('-')."""
+    import json
+    from .report import validation_json
+    text = json.dumps(validation_json(runs, code), indent=1, allow_nan=False) + "\n"
+    if dest == "-":
+        sys.stdout.write(text)
+        return
+    try:
+        Path(dest).write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise CLIError(f"cannot write --json {dest}: {exc.strerror or exc}") from None
+    _Out.write(f"JSON -> {dest}")
 
 
 # ============================================================================ report
@@ -554,7 +594,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"kinetostat {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    routes = "pinocchio, mujoco, mujoco-sim, pymunk"
+    routes = "pinocchio, mujoco, mujoco-sim, pymunk, reference (40-digit mpmath, no engine); none: reference only"
 
     a = sub.add_parser("analyze", help="kinematics and kinetostatics of one model: summary and full table",
                        description="Analyse MODEL over the crank cycle (or at given angles): print a summary "
@@ -598,13 +638,20 @@ def build_parser() -> argparse.ArgumentParser:
     v = sub.add_parser("validate", help="cross-check the solver against the engine routes (exit 1 on failure)",
                        description="Run the accuracy gate: for every MODEL (default: all bundled models) compare "
                                    "the solver's balancing moment and every reaction over the cycle with each "
-                                   "engine route, and print route, quantity, peak-relative error, tolerance and "
-                                   "PASS/FAIL. Routes whose engine is not installed are SKIPPED. Exit code 1 "
-                                   "when any check fails or a route raises.")
+                                   "route (the engines, and 'reference': a 40-digit mpmath re-solution that needs "
+                                   "no engine), check the model's published values ([[published]] tables), and "
+                                   "print route, quantity, error, tolerance and PASS/FAIL. Routes whose engine is "
+                                   "not installed are SKIPPED. Exit code 1 when any check fails, a route raises, "
+                                   "or nothing was checked.")
     v.add_argument("models", metavar="MODEL", nargs="*", help="model files (default: every bundled model)")
     v.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")
     v.add_argument("--steps", metavar="N", type=_steps, default=360, help="positions over the cycle (default 360)")
-    v.add_argument("--junit", metavar="FILE", help="also write JUnit XML: one testcase per model x route x quantity")
+    v.add_argument("--junit", metavar="FILE", help="also write JUnit XML: one testcase per model x route x quantity "
+                                                   "and per published value, each with its measured error")
+    v.add_argument("--json", metavar="FILE", nargs="?", const="-",
+                   help="also write every check as JSON (name, route, quantity, error, tolerance, unit, angle, "
+                        "passed; totals; exit code) to FILE, or to stdout with '-' or no FILE (the table then "
+                        "goes to stderr)")
     v.add_argument("--no-progress", action="store_true", help="no progress bar")
     v.set_defaults(func=cmd_validate)
 

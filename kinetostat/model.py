@@ -17,8 +17,8 @@ import numpy as np
 from .errors import ModelError, StructureError
 from .structure import Structure, analyse_structure
 
-__all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Mechanism",
-           "load", "loads", "from_dict"]
+__all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Published", "Mechanism",
+           "PUBLISHED_UNITS", "load", "loads", "from_dict"]
 
 Vec = tuple[float, float]
 
@@ -131,12 +131,42 @@ class Drive:
     eps: float                  # rad/s^2, in `sense`
     kind: Literal["engine", "machine"]
     gear: Gear | None = None
+    design_deg: float = 30.0    # the design position: crank angle of the mechanism's picture, deg
 
 
 @dataclass(frozen=True)
 class Friction:
     f: float                   # reduced friction coefficient
     radius: float | None       # default journal radius, m
+
+
+#: What a `[[published]]` entry may measure -> the SI unit of its magnitude.
+PUBLISHED_UNITS: Mapping[str, str] = MappingProxyType({
+    "velocity": "m/s", "acceleration": "m/s^2", "omega": "rad/s", "eps": "rad/s^2",
+    "inertia_force": "N", "inertia_moment": "N m", "reaction": "N",
+    "balancing_moment": "N m", "lever_moment": "N m", "balancing_force": "N"})
+
+
+@dataclass(frozen=True)
+class Published:
+    """A value a source prints for this model (`[[published]]`), and what it measures.
+
+    The measured quantity is a magnitude at one crank angle, or (`reduce`) its min or max over
+    several angles, or the angle of its max ("angle_of_max", value and tolerance in deg)."""
+    symbol: str                    # as the source names it
+    quantity: str                  # a key of PUBLISHED_UNITS
+    value: float                   # the published number, in `unit`
+    unit: str                      # PUBLISHED_UNITS[quantity], or "deg" for angle_of_max
+    angles: tuple[float, ...]      # crank angles, deg (model's reference and sense)
+    reduce: Literal["min", "max", "angle_of_max"] | None   # None: the value at the single angle
+    tolerance: float               # accepted |difference|: relative, or deg for angle_of_max
+    source: str                    # where the number is printed
+    meaning: str = ""              # what it is, in this project's terms
+    accuracy: str = ""             # why the tolerance is what it is
+    point: str | None = None       # velocity, acceleration: the point
+    relative_to: str | None = None  # ... minus this point's (relative velocity or acceleration)
+    link: int | None = None        # omega, eps, inertia_force, inertia_moment: the link
+    pair: tuple[int, int] | None = None   # reaction: R(i, j), force of link i on link j
 
 
 @dataclass(frozen=True)
@@ -153,6 +183,7 @@ class Mechanism:
     springs: tuple[Spring, ...]
     drive: Drive
     friction: Friction | None
+    published: tuple[Published, ...] = ()   # the sources' printed values for this model
     path: str | None = None
     #: Structural analysis (mobility, Assur groups, structure formula), derived from the pairs
     #: when the mechanism is built; raises StructureError for what kinetostat does not analyse.
@@ -277,7 +308,9 @@ MAX_KEY = 10_000
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
 
-_TOP_KEYS = {"mechanism", "drive", "frame", "link", "pair", "group", "load", "spring", "friction"}
+_TOP_KEYS = {"mechanism", "drive", "frame", "link", "pair", "group", "load", "spring", "friction", "published"}
+#: Most crank angles one `[[published]]` entry may list.
+MAX_PUBLISHED_ANGLES = 3600
 
 
 def _finite(x: Any) -> bool:
@@ -391,6 +424,7 @@ class _Reader:
         loads_ = self.loads(links)
         springs = self.springs(links)
         friction = self.friction()
+        published = self.published(links, pairs, drive)
         if friction is not None and friction.radius is None:
             for p in pairs:
                 if p.kind == "R" and p.radius is None:
@@ -403,7 +437,7 @@ class _Reader:
                              links=tuple(links), pairs=tuple(pairs),
                              branches=MappingProxyType(branches), loads=tuple(loads_),
                              springs=tuple(springs), drive=drive, friction=friction,
-                             path=self.source)
+                             published=tuple(published), path=self.source)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
 
@@ -533,7 +567,7 @@ class _Reader:
             return None
         w = "drive"
         self.unknown_keys(t, {"link", "pivot", "point", "reference", "sense", "rpm", "omega",
-                              "eps", "kind", "gear"}, w)
+                              "eps", "kind", "gear", "design_deg"}, w)
         link = t.get("link", 1)
         if link != 1:
             self.err(f"drive.link: the crank must be link 1, got {link!r}")
@@ -556,15 +590,16 @@ class _Reader:
         else:
             omega = self.number(t, "omega", w, positive=True)
         eps = self.number(t, "eps", w, default=0.0)
+        design = self.number(t, "design_deg", w, default=30.0)
         kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")
         gear = None
         if kind == "machine":
             gear = self.gear(t.get("gear"))
         elif "gear" in t:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
-        if None in (ref, sense, omega, eps) or (kind == "machine" and gear is None):
+        if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
             return None
-        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear)
+        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design)
 
     def gear(self, t: Any) -> Gear | None:
         w = "drive.gear"
@@ -722,6 +757,97 @@ class _Reader:
         f = self.number(t, "f", "friction", minimum=0.0)
         r = self.number(t, "radius", "friction", default=None, positive=True)
         return None if f is None else Friction(f, r)
+
+    def published(self, links: list[Link], pairs: list[Pair], drive: Drive | None) -> list[Published]:
+        out: list[Published] = []
+        first: dict[str, int] = {}
+        for n, t in enumerate(self.table_list("published")):
+            entry = self.published_entry(t, f"published[{n}]", links, pairs, drive)
+            if entry is None:
+                continue
+            if entry.symbol in first:
+                self.err(f"published[{n}].symbol: {entry.symbol!r} is already used by published[{first[entry.symbol]}]")
+                continue
+            first[entry.symbol] = n
+            out.append(entry)
+        return out
+
+    def published_entry(self, t: Mapping, where: str, links: list[Link], pairs: list[Pair],
+                        drive: Drive | None) -> Published | None:
+        quantity = self.string(t, "quantity", where, choices=tuple(PUBLISHED_UNITS))
+        needs = {"velocity": {"point", "relative_to"}, "acceleration": {"point", "relative_to"},
+                 "omega": {"link"}, "eps": {"link"}, "inertia_force": {"link"}, "inertia_moment": {"link"},
+                 "reaction": {"pair"}}.get(quantity, set())
+        self.unknown_keys(t, {"symbol", "meaning", "quantity", "value", "unit", "angle", "reduce", "tolerance",
+                              "tolerance_deg", "source", "accuracy"} | needs, where)
+        n_problems = len(self.problems)
+        symbol = self.string(t, "symbol", where)
+        source = self.string(t, "source", where)
+        meaning = self.string(t, "meaning", where, default="")
+        accuracy = self.string(t, "accuracy", where, default="")
+        value = self.number(t, "value", where)
+        angles = self.published_angles(t.get("angle"), f"{where}.angle")
+        reduce = self.string(t, "reduce", where, choices=("min", "max", "angle_of_max"), default=None)
+        if isinstance(t.get("angle"), list) and reduce is None and "reduce" not in t:
+            self.err(f"{where}.reduce: missing: a list of angles needs reduce = 'min', 'max' or 'angle_of_max'")
+        elif reduce is not None and not isinstance(t.get("angle"), list):
+            self.err(f"{where}.reduce: only with a list of angles (angle = [...])")
+        by_angle = reduce == "angle_of_max"
+        tol_key, other = ("tolerance_deg", "tolerance") if by_angle else ("tolerance", "tolerance_deg")
+        if other in t:
+            self.err(f"{where}.{other}: " + ("the angle of the maximum takes tolerance_deg (deg)" if by_angle
+                                             else "only reduce = 'angle_of_max' takes tolerance_deg; "
+                                                  "give tolerance (relative, e.g. 0.01 for 1 %)"))
+        tolerance = self.number(t, tol_key, where, positive=True)
+        unit = "deg" if by_angle else PUBLISHED_UNITS.get(quantity)
+        if "unit" in t and unit is not None and t["unit"] != unit:
+            self.err(f"{where}.unit: {quantity if not by_angle else 'angle_of_max'} is in {unit!r}, "
+                     f"got {t['unit']!r}")
+        point = relative_to = link = pair = None
+        if "point" in needs:
+            point = self.published_point(t, "point", where, links, required=True)
+            relative_to = self.published_point(t, "relative_to", where, links, required=False)
+        elif "link" in needs:
+            link = t.get("link")
+            if not isinstance(link, int) or isinstance(link, bool) or not 1 <= link < len(links):
+                self.err(f"{where}.link: unknown moving link {link!r}. Valid links: {list(range(1, len(links)))}")
+        elif "pair" in needs:
+            pair = t.get("pair")
+            if not (isinstance(pair, list) and len(pair) == 2
+                    and all(isinstance(x, int) and not isinstance(x, bool) for x in pair)):
+                self.err(f"{where}.pair: expected two link ids [i, j] (R(i, j), force of i on j), got {pair!r}")
+            elif not any(set(p.links) == set(pair) and pair[0] != pair[1] for p in pairs):
+                self.err(f"{where}.pair: no kinematic pair joins links {pair!r}. "
+                         f"Pairs: {[list(p.links) for p in pairs]}")
+            else:
+                pair = (pair[0], pair[1])
+        if quantity == "balancing_force" and drive is not None and drive.kind != "machine":
+            self.err(f"{where}.quantity: a balancing force needs drive.kind = 'machine' (an engine has a moment)")
+        if len(self.problems) > n_problems or None in (symbol, source, quantity, value, angles, tolerance):
+            return None
+        return Published(symbol, quantity, value, unit, angles, reduce, tolerance, source, meaning, accuracy,
+                         point, relative_to, link, pair)
+
+    def published_angles(self, x: Any, where: str) -> tuple[float, ...] | None:
+        items = x if isinstance(x, list) else [x]
+        if x is None or not items or len(items) > MAX_PUBLISHED_ANGLES or \
+                not all(_finite(a) and abs(a) <= MAX_VALUE for a in items):
+            self.err(f"{where}: " + ("missing (a crank angle in deg, or a list of them)" if x is None else
+                                     f"expected a finite number of deg or a list of 1..{MAX_PUBLISHED_ANGLES} "
+                                     f"of them, got {x!r}"[:200]))
+            return None
+        return tuple(float(a) for a in items)
+
+    def published_point(self, t: Mapping, key: str, where: str, links: list[Link], *, required: bool) -> str | None:
+        name = t.get(key)
+        if name is None and not required:
+            return None
+        if not isinstance(name, str) or not any(name in link.points for link in links):
+            known = sorted({p for link in links for p in link.points})
+            self.err(f"{where}.{key}: " + (f"missing (a point name is required). Valid names: {known}" if name is None
+                                           else f"unknown point {name!r}. Valid names: {known}"))
+            return None
+        return name
 
 
 def _components(edges: list[tuple[int, int]]) -> dict[int, int]:

@@ -149,14 +149,16 @@ def test_validate_passes_on_exact_engines_and_writes_junit(tmp_path):
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     n_q = len(quantities(kinetostat.load(ICE)))            # M_drive and 4 reactions
-    assert r.stdout.count("PASS") >= 2 * n_q
+    n_pub = len(kinetostat.load(ICE).published)            # the seed's 15 published values
+    assert r.stdout.count("PASS") >= 2 * n_q + n_pub
     root = ET.parse(junit).getroot()
     assert root.tag == "testsuites"
     assert (root.get("tests"), root.get("failures"), root.get("errors"), root.get("skipped")) == \
-        (str(2 * n_q), "0", "0", "0")
+        (str(2 * n_q + n_pub), "0", "0", "0")
     cases = root.findall("./testsuite/testcase")
-    assert len(cases) == 2 * n_q
-    assert {c.get("classname") for c in cases} == {"ice_crank_slider.pinocchio", "ice_crank_slider.mujoco"}
+    assert len(cases) == 2 * n_q + n_pub
+    assert {c.get("classname") for c in cases} == {"ice_crank_slider.pinocchio", "ice_crank_slider.mujoco",
+                                                   "ice_crank_slider.published"}
 
 
 def test_validate_all_bundled_models_via_env(four_bar, tmp_path):
@@ -212,12 +214,13 @@ def test_route_errors_and_skips_are_reported_not_raised(ice_cycle, monkeypatch):
     assert run_.status("pinocchio") == "PASS" and run_.status("broken") == "ERROR"
     assert exit_code([run_]) == EXIT_FAIL
     root = junit_xml([run_]).getroot()
-    n_q = len(quantities(mech))
+    n_q, n_pub = len(quantities(mech)), len(mech.published)
     assert (root.get("tests"), root.get("failures"), root.get("errors"), root.get("skipped")) == \
-        (str(3 * n_q), "0", str(n_q), str(n_q))
-    # only skipped routes: nothing compared is not a pass
-    only_skipped = run_validation(mech, ["absent"], steps=36, res=res, path=ICE)
-    assert only_skipped.passed and exit_code([only_skipped]) == EXIT_FAIL
+        (str(3 * n_q + n_pub), "0", str(n_q), str(n_q))
+    # only skipped routes on a model without published values: nothing checked is not a pass
+    four = kinetostat.loads(FOUR_BAR)
+    only_skipped = run_validation(four, ["absent"], steps=36)
+    assert only_skipped.passed and not only_skipped.checks and exit_code([only_skipped]) == EXIT_FAIL
 
 
 # ----------------------------------------------------------------------------- bad input

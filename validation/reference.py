@@ -36,10 +36,15 @@ extremes that kinetostat finds by sampling); its direction is computed here.
 Nothing else of kinetostat is used: the model is read from the `Mechanism` object (links,
 points, pairs, loads, drive, and the group decomposition `mech.structure` for the branch check).
 Speed: a 36-angle cycle of a 6-link model takes about a second.
+
+`route(scene)` is the accuracy gate's route "reference" (`compare.ROUTES`): the reference at
+`sample_angles` of the scene's cycle as an `EngineResult`, so that a CI without any physics
+engine can still gate the solver's accuracy.
 """
 from __future__ import annotations
 
 import math
+import time
 import warnings
 from dataclasses import dataclass
 
@@ -49,7 +54,9 @@ from mpmath import mp, mpf
 from kinetostat import Analysis, Mechanism, analyze
 from kinetostat.applied import load_magnitude
 
-__all__ = ["DPS", "Reference", "reference", "reference_full", "BranchMismatch"]
+from .scene import EngineResult, Scene
+
+__all__ = ["DPS", "Reference", "reference", "reference_full", "BranchMismatch", "sample_angles", "route"]
 
 #: Working precision of the reference, decimal digits.
 DPS = 40
@@ -523,3 +530,33 @@ def peak_relative_error(res: Analysis, ref: Reference) -> dict[str, float]:
         err = float(np.max(np.linalg.norm(got[ok] - want[ok], axis=-1)))
         out[name] = err / peak if peak > 0 else err
     return out
+
+
+def sample_angles(res: Analysis, n: int = 12) -> np.ndarray:
+    """Indices of `res`'s angles for the reference route: `n` equally spaced over the cycle and the
+    angle of the largest |M_bal| and of each pair's largest |R| (where the peak-relative error is
+    most likely largest), sorted, without repeats."""
+    N = len(res.phi_deg)
+    idx = set(np.linspace(0, N, min(n, N), endpoint=False).astype(int).tolist())
+    for q in [res.balancing_moment[:, None]] + [res.forces.R[:, p.index] for p in res.mech.pairs]:
+        mag = np.linalg.norm(q, axis=-1)
+        if np.any(np.isfinite(mag)):
+            idx.add(int(np.nanargmax(mag)))
+    return np.array(sorted(idx), dtype=int)
+
+
+def route(scene: Scene, n: int = 12) -> EngineResult:
+    """The gate's route "reference": the 40-digit answer at `sample_angles(scene.res, n)`, each
+    angle taken as the double the solver works with (angle="double"). The Newton start comes
+    from a fresh solver run at those angles, not from the result under test."""
+    mech = scene.mech
+    phi = scene.phi_deg[sample_angles(scene.res, n)]
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        start = analyze(mech, phi_deg=phi)
+    build = time.perf_counter() - t0
+    ref = reference_full(mech, phi, res=start, angle="double")
+    return EngineResult("mpmath", "reference", phi.copy(), ref.M_bal, ref.R, build_seconds=build,
+                        run_seconds=time.perf_counter() - t0 - build,
+                        note=f"{DPS}-digit re-solution at {len(phi)} of the {len(scene.phi_deg)} angles")

@@ -1,18 +1,46 @@
-"""JUnit XML of validation runs, for CI pipelines.
+"""Machine-readable results of validation runs: JUnit XML for CI pipelines, and a JSON document.
+
+Every check is named `<model>.<route>.<quantity>` (routes: the engine routes and "reference";
+published values: `<model>.published.<symbol>`) and carries its measured error and tolerance,
+also when it passes. NaN is written as null.
 
 May use: the standard library and the runs room.
 """
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
-from typing import Sequence
+from typing import Any, Sequence
 
-from .runs import ModelRun, quantities
+from .runs import PUBLISHED_ROUTE, Check, ModelRun, quantities
+
+
+def _number(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _text(x: float) -> str:
+    return "null" if not math.isfinite(x) else repr(float(x))
+
+
+def _case(suite: ET.Element, run: ModelRun, route: str, name: str, secs: float) -> ET.Element:
+    return ET.SubElement(suite, "testcase", classname=f"{run.stem}.{route}", name=name, time=f"{secs:.6f}")
+
+
+def _measured(case: ET.Element, c: Check) -> None:
+    """The check's numbers as <properties> of its testcase, and its one line as <system-out>."""
+    props = ET.SubElement(case, "properties")
+    for key, value in (("error", _text(c.error)), ("measure", c.measure), ("tolerance", _text(c.tolerance)),
+                       ("max_abs", _text(c.max_abs)), ("unit", c.unit), ("phi_deg", _text(c.phi_deg))):
+        ET.SubElement(props, "property", name=key, value=value)
+    ET.SubElement(case, "system-out").text = c.detail
 
 
 def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET.ElementTree:
-    """One testcase per model x route x quantity; failures as <failure>, skipped routes as
-    <skipped>, a route that raised as <error> on each of its quantities."""
+    """One testsuite per model; one testcase per route x quantity and per published value.
+    Failures as <failure>, skipped routes as <skipped>, a route that raised as <error> on each of
+    its quantities; every check that ran carries its error and tolerance (<properties>)."""
     root = ET.Element("testsuites", name=name)
     totals = dict(tests=0, failures=0, errors=0, skipped=0)
     total_time = 0.0
@@ -23,31 +51,34 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
         ET.SubElement(props, "property", name="structure", value=run.mech.structure.formula)
         ET.SubElement(props, "property", name="positions", value=str(len(run.res.phi_deg)))
         counts = dict(tests=0, failures=0, errors=0, skipped=0)
+        checks = {(c.route, c.quantity): c for c in run.checks}
         qs = quantities(run.mech)
-        for route in run.engines:
-            secs = run.seconds.get(route, 0.0) / max(len(qs), 1)
-            rows = {r.quantity: r for r in run.rows if r.route == route}
-            for q in qs:
-                case = ET.SubElement(suite, "testcase", classname=f"{run.stem}.{route}", name=q,
-                                     time=f"{secs:.6f}")
+        cases: list[tuple[str, list[str]]] = [(route, qs) for route in run.engines]
+        symbols = [c.entry.symbol for c in run.published]
+        if PUBLISHED_ROUTE in run.errors:
+            cases.append((PUBLISHED_ROUTE, ["(all)"]))
+        elif symbols:
+            cases.append((PUBLISHED_ROUTE, symbols))
+        for route, names in cases:
+            secs = run.seconds.get(route, 0.0) / max(len(names), 1)
+            for q in names:
+                case = _case(suite, run, route, q, secs)
                 counts["tests"] += 1
+                c = checks.get((route, q))
                 if route in run.errors:
                     ET.SubElement(case, "error", message=run.errors[route], type="RouteError")
                     counts["errors"] += 1
                 elif route in run.skipped:
                     ET.SubElement(case, "skipped", message=run.skipped[route])
                     counts["skipped"] += 1
-                elif q not in rows:
+                elif c is None:
                     ET.SubElement(case, "error", message=f"route {route} returned no row for {q}", type="MissingRow")
                     counts["errors"] += 1
-                elif not rows[q].passed:
-                    r = rows[q]
-                    f = ET.SubElement(case, "failure", type="ToleranceExceeded",
-                                      message=f"peak-relative error {r.peak_relative:.3e} > tolerance {r.tolerance:.1e}"
-                                      if r.n_compared else "no angle compared (engine returned NaN everywhere)")
-                    f.text = (f"max abs {r.max_abs:.6g}, rms relative {r.rms_relative:.3e}, peak {r.peak:.6g}, "
-                              f"{r.n_compared} angles compared, {r.n_skipped} left out")
-                    counts["failures"] += 1
+                else:
+                    if not c.passed:
+                        ET.SubElement(case, "failure", type="ToleranceExceeded", message=c.detail).text = c.detail
+                        counts["failures"] += 1
+                    _measured(case, c)
         t = sum(run.seconds.values())
         total_time += t
         for k, v in counts.items():
@@ -60,3 +91,24 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
     tree = ET.ElementTree(root)
     ET.indent(tree)
     return tree
+
+
+def validation_json(runs: Sequence[ModelRun], exit_code: int) -> dict[str, Any]:
+    """The runs as a JSON-ready dict: per model its checks (name, route, quantity, error, measure,
+    tolerance, max_abs, unit, phi_deg, passed), skipped and failed routes; totals; the exit code."""
+    models = []
+    for run in runs:
+        checks = [dict(name=c.name, route=c.route, quantity=c.quantity, error=_number(c.error), measure=c.measure,
+                       tolerance=_number(c.tolerance), max_abs=_number(c.max_abs), unit=c.unit,
+                       phi_deg=_number(c.phi_deg), passed=bool(c.passed)) for c in run.checks]
+        models.append(dict(model=run.stem, path=None if run.path is None else str(run.path), name=run.mech.name,
+                           structure=run.mech.structure.formula, positions=len(run.res.phi_deg),
+                           passed=bool(run.passed and checks), checks=checks, skipped=dict(run.skipped),
+                           errors=dict(run.errors),
+                           seconds={r: _number(s) for r, s in run.seconds.items()}))
+    every = [c for m in models for c in m["checks"]]
+    totals = dict(models=len(models), checks=len(every), passed=sum(c["passed"] for c in every),
+                  failed=sum(not c["passed"] for c in every),
+                  route_errors=sum(len(m["errors"]) for m in models),
+                  routes_skipped=sum(len(m["skipped"]) for m in models))
+    return dict(passed=exit_code == 0, exit_code=exit_code, totals=totals, models=models)

@@ -80,6 +80,14 @@ def _closed(phi: np.ndarray, *ys: np.ndarray):
     return (phi,) + ys
 
 
+def _line(er, res: Analysis, col, ls, lw: float) -> dict[str, Any]:
+    """Line style of a route's curve: a line over the whole cycle, or markers where the route
+    evaluated only some of the angles (the reference route)."""
+    if len(er.phi_deg) < len(res.phi_deg):
+        return dict(color=col, ls="none", marker="o", ms=3.5)
+    return dict(color=col, ls=ls, lw=lw)
+
+
 def _world(res: Analysis, i: int) -> dict[int, dict[str, np.ndarray]]:
     """World positions of every link's points at angle index i."""
     m, kin = res.mech, res.kin
@@ -262,7 +270,7 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
     ax.plot(*_closed(phi, res.lever_moment), color="0.55", lw=1.4, ls="--", label="kinetostat: Zhukovsky's lever")
     for n, (route, er) in enumerate(run.results.items()):
         col, ls = _style(route, n)
-        ax.plot(*_closed(er.phi_deg, er.M_drive), color=col, ls=ls, lw=1.6, label=f"{route} ({er.route})")
+        ax.plot(*_closed(er.phi_deg, er.M_drive), **_line(er, res, col, ls, 1.6), label=f"{route} ({er.route})")
     ax.axhline(0, color="0.3", lw=0.6)
     ax.set_ylabel("balancing moment on the crank M_bal, N·m")
     kind = "moment of the drive on the crank about +z"
@@ -288,7 +296,7 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
         handles["kinetostat"] = h
         for n, (route, er) in enumerate(run.results.items()):
             col, ls = _style(route, n)
-            h, = ax.plot(*_closed(er.phi_deg, np.linalg.norm(er.R[:, p.index], axis=-1)), color=col, ls=ls, lw=1.5)
+            h, = ax.plot(*_closed(er.phi_deg, np.linalg.norm(er.R[:, p.index], axis=-1)), **_line(er, res, col, ls, 1.5))
             handles[f"{route} ({er.route})"] = h
         ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9)
         ax.set_ylabel("|R|, N")
@@ -303,16 +311,18 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
 
 
 def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, float]]:
-    """quantity -> (phi, |engine - solver|, peak |solver|), as compare.errors measures them."""
+    """quantity -> (phi, |engine - solver|, peak |solver|), as compare.errors measures them, at
+    the route's angles (all of the solver's, or some of them)."""
     out = {}
     m = res.mech
+    at = np.abs(np.asarray(er.phi_deg)[:, None] - res.phi_deg[None, :]).argmin(axis=1)
     items = [("M_drive", res.balancing_moment[:, None], er.M_drive[:, None])]
     items += [(f"R({p.links[0]},{p.links[1]})", res.forces.R[:, p.index], er.R[:, p.index]) for p in m.pairs]
     for name, ref, got in items:
         if er.magnitudes_only:
             ref = np.linalg.norm(ref, axis=-1, keepdims=True)
             got = np.linalg.norm(got, axis=-1, keepdims=True)
-        err = np.linalg.norm(got - ref, axis=-1)
+        err = np.linalg.norm(got - ref[at], axis=-1)
         peak = float(np.nanmax(np.linalg.norm(ref, axis=-1))) if np.any(np.isfinite(ref)) else 0.0
         out[name] = (er.phi_deg, err, peak)
     return out
@@ -334,7 +344,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
             phi, err, peak = curves[route][q]
             e = np.where(err > 0, err, np.nan)
             if np.any(np.isfinite(e)):
-                h, = ax.semilogy(*_closed(phi, e), color=col, lw=1.3)
+                h, = ax.semilogy(*_closed(phi, e), **_line(run.results[route], res, col, "-", 1.3))
                 handles[f"{route}: |engine − kinetostat|"] = h
                 any_drawn = True
             tol = run.tolerances.get(route)
@@ -380,7 +390,7 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
                 continue
             col, ls = _style(route, n)
             E = er.R[:, p.index]
-            h, = ax.plot(*_closed(er.phi_deg, E[:, 0], E[:, 1])[1:], color=col, ls=ls, lw=1.3)
+            h, = ax.plot(*_closed(er.phi_deg, E[:, 0], E[:, 1])[1:], **_line(er, res, col, ls, 1.3))
             handles[f"{route} ({er.route})"] = h
         ax.plot(0, 0, marker="+", ms=12, color="black")
         mag = np.linalg.norm(R, axis=-1)

@@ -1,4 +1,5 @@
-"""A validation run: the solver's cycle of one model checked route by route.
+"""A validation run: the solver's cycle of one model checked route by route, and against the
+model's published values; every check of a run as one `Check`.
 
 May use: numpy, the solver, and the harness (`kinetostat_validation`), imported inside the
 functions that need it. Never matplotlib.
@@ -16,11 +17,54 @@ import numpy as np
 
 from ..analysis import Analysis, analyze
 from ..model import Mechanism
+from .published import PublishedCheck, published_rows
+
+#: The route name under which a model's published values are checked.
+PUBLISHED_ROUTE = "published"
 
 
 def quantities(mech: Mechanism) -> list[str]:
     """The quantities compare() checks, named as its rows name them."""
     return ["M_drive"] + [f"R({p.links[0]},{p.links[1]})" for p in mech.pairs]
+
+
+@dataclass(frozen=True)
+class Check:
+    """One check of a validation run: a route's error on one quantity, or one published value."""
+    model: str           # the model's stem
+    route: str           # engine route, "reference", or "published"
+    quantity: str        # "M_drive", "R(i,j)", or the published symbol
+    error: float         # what the tolerance bounds: peak-relative (routes), relative or deg (published)
+    measure: str         # "peak_relative", "relative" or "deg": the kind of `error` and `tolerance`
+    tolerance: float
+    max_abs: float       # routes: max |route - solver|; published: |exact - published|; in `unit`
+    unit: str
+    phi_deg: float       # crank angle of the largest error (routes) or of the exact value (published), deg
+    passed: bool
+    detail: str          # one line for people
+
+    @property
+    def name(self) -> str:
+        return f"{self.model}.{self.route}.{self.quantity}"
+
+
+def _row_check(model: str, r) -> Check:
+    return Check(model, r.route, r.quantity, r.peak_relative, "peak_relative", r.tolerance, r.max_abs, r.unit,
+                 r.phi_deg_max, r.passed,
+                 f"peak-relative error {r.peak_relative:.3e} (tolerance {r.tolerance:.1e}), max abs {r.max_abs:.6g} "
+                 f"{r.unit} at phi = {r.phi_deg_max:g} deg, peak {r.peak:.6g} {r.unit}, {r.n_compared} angles "
+                 f"compared, {r.n_skipped} left out")
+
+
+def _published_check(model: str, c: PublishedCheck) -> Check:
+    e = c.entry
+    where = f"{e.reduce} over {len(e.angles)} angles" if e.reduce else f"at phi = {e.angles[0]:g} deg"
+    diff = f"{c.difference:+.3g} deg" if c.by_angle else f"{100 * c.difference:+.3f} %"
+    tol = f"{e.tolerance:g} deg" if c.by_angle else f"{100 * e.tolerance:g} %"
+    return Check(model, PUBLISHED_ROUTE, e.symbol, c.error, "deg" if c.by_angle else "relative", e.tolerance,
+                 abs(c.exact - e.value), e.unit, c.phi_deg, c.passed,
+                 f"published {e.value:g} {e.unit}, exact {c.exact:.6g} {e.unit} ({where}): {diff} "
+                 f"(tolerance {tol}); source: {e.source}")
 
 
 @dataclass
@@ -38,6 +82,7 @@ class ModelRun:
     seconds: dict[str, float] = field(default_factory=dict)  # route -> wall time of its compare call
     tolerances: dict = field(default_factory=dict)      # route -> Tolerance
     solver_seconds: float = 0.0                         # wall time of analyze() over the cycle
+    published: list[PublishedCheck] = field(default_factory=list)   # the model's published values
 
     @property
     def stem(self) -> str:
@@ -45,12 +90,18 @@ class ModelRun:
 
     @property
     def failed(self) -> list:
+        """The routes' error rows beyond tolerance."""
         return [r for r in self.rows if not r.passed]
 
     @property
+    def checks(self) -> list[Check]:
+        """Every check that ran: the routes' error rows, then the published values."""
+        return [_row_check(self.stem, r) for r in self.rows] + [_published_check(self.stem, c) for c in self.published]
+
+    @property
     def passed(self) -> bool:
-        """No row beyond tolerance and no route that raised (skipped routes do not count)."""
-        return not self.failed and not self.errors
+        """No check beyond tolerance and no route that raised (skipped routes do not count)."""
+        return not self.errors and all(c.passed for c in self.checks)
 
     def status(self, route: str) -> str:
         if route in self.errors:
@@ -81,7 +132,8 @@ def _record(caught, where: str, out: list[str]) -> None:
 
 def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, res: Analysis | None = None,
                    path: str | Path | None = None, on_route: Callable[[str], None] | None = None) -> ModelRun:
-    """Check `res` (default: `analyze(mech, steps=steps)`) against every route in `engines`.
+    """Check `res` (default: `analyze(mech, steps=steps)`) against every route in `engines`, and
+    the model's published values (an exception there is the error of route "published").
 
     Each route runs in its own `compare(..., engines=[route], res=res)` call; an exception of a
     route is recorded in `errors` (that route fails) and the other routes still run. Warnings
@@ -98,6 +150,16 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
             run.res = analyze(mech, steps=steps)
             run.solver_seconds = time.perf_counter() - t0
         _record(caught, "", run.warnings)
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            run.published = published_rows(mech)
+        except Exception as exc:              # e.g. a published angle where the linkage does not assemble
+            run.errors[PUBLISHED_ROUTE] = _one_line(exc)
+    if mech.published:
+        run.seconds[PUBLISHED_ROUTE] = time.perf_counter() - t0
+    _record(caught, f"{PUBLISHED_ROUTE}: ", run.warnings)
     for route in engines:
         t0 = time.perf_counter()
         with warnings.catch_warnings(record=True) as caught:

@@ -10,7 +10,7 @@ import math
 import re
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from ..model import Mechanism
 from ..structure import GROUP_KINDS
 from .document import Doc, _fe, _fmt
 from .plots import _pair_name, plot_errors, plot_hodographs, plot_mechanism, plot_moment, plot_reactions
-from .published import PUBLISHED, published_rows
+from .published import PublishedCheck
 from .runs import ModelRun
 
 #: Fewer positions than this make the plots over the cycle meaningless.
@@ -126,23 +126,32 @@ def _row_status(r) -> str:
     return "**PASS**" if r.passed else "**FAIL**"
 
 
-def _published_section(doc: Doc, pub, published: list[dict[str, Any]] | None) -> None:
-    """The seed's published numbers beside the exact ones (nothing if the model has none)."""
-    if published is None:
+def _angles(c: PublishedCheck) -> str:
+    a = c.entry.angles
+    if len(a) == 1:
+        return f"{a[0]:g}°"
+    listed = ", ".join(f"{x:g}°" for x in a) if len(a) <= 4 else f"{a[0]:g}°, {a[1]:g}°, ..., {a[-1]:g}°"
+    return f"{c.entry.reduce.replace('_', ' ')} over {listed} ({len(a)} positions)"
+
+
+def _published_section(doc: Doc, published: Sequence[PublishedCheck]) -> None:
+    """The sources' published numbers beside the exact ones (nothing if the model has none)."""
+    if not published:
         return
     doc.h(2, "Against the published values")
-    doc.p(f"Source: {pub.source}. Evaluated at φ = "
-          + (f"{pub.phi_deg[0]:g}°" if len(pub.phi_deg) == 1 else
-             f"{pub.phi_deg[0]:g}°, {pub.phi_deg[1]:g}°, ..., {pub.phi_deg[-1]:g}° ({len(pub.phi_deg)} positions)")
-          + f". Expected agreement: {pub.accuracy}.")
+    doc.p("Numbers printed by the model's sources (its `[[published]]` tables) beside kinetostat's exact "
+          "values of the same quantities. Sources and the agreement to expect:")
+    doc.ul(list(dict.fromkeys(c.entry.source + (f". Expected agreement: {c.entry.accuracy}" if c.entry.accuracy else "")
+                              for c in published)))
     rows = []
-    for r in published:
-        diff = f"{r['diff']:+.3f} %" if r["diff_unit"] == "%" else f"{r['diff']:+.3g}°"
-        tol = f"±{100 * r['tolerance']:g} %" if r["diff_unit"] == "%" else f"±{r['tolerance']:g}°"
-        rows.append([r["symbol"], r["meaning"], f"{r['published']:g}", f"{r['exact']:.6g}", r["unit"], diff, tol,
-                     "yes" if r["ok"] else "**NO**"])
-    doc.table(["quantity", "meaning", "published", "kinetostat (exact)", "unit", "difference", "accepted",
-               "within"], rows, "llrrlrrl")
+    for c in published:
+        e = c.entry
+        diff = f"{c.difference:+.3g}°" if c.by_angle else f"{100 * c.difference:+.3f} %"
+        tol = f"±{e.tolerance:g}°" if c.by_angle else f"±{100 * e.tolerance:g} %"
+        rows.append([e.symbol, e.meaning, _angles(c), f"{e.value:g}", f"{c.exact:.6g}", e.unit, diff, tol,
+                     "yes" if c.passed else "**NO**"])
+    doc.table(["quantity", "meaning", "φ", "published", "kinetostat (exact)", "unit", "difference", "accepted",
+               "within"], rows, "lllrrlrrl")
 
 
 def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dict[str, Any]:
@@ -153,9 +162,8 @@ def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dic
     d = Path(out) / run.stem
     d.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    pub = PUBLISHED.get(run.stem)
-    published = published_rows(m, run.stem) if pub is not None else None
-    pic_deg = pub.picture_deg if pub is not None else 30.0
+    published = run.published
+    pic_deg = m.drive.design_deg
     at = analyze(m, phi_deg=[pic_deg])
     images = {
         "mechanism": plot_mechanism(at, res, d / "mechanism.png"),
@@ -244,7 +252,7 @@ def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dic
           "over the cycle, as seed 004 draws them; grey rays every 30° of φ; the red dot marks the maximum.")
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
-    _published_section(doc, pub, published)
+    _published_section(doc, published)
 
     doc.h(2, "Timings")
     doc.ul([f"kinetostat analysis of the {N} positions: {run.solver_seconds:.3f} s"]
@@ -265,9 +273,9 @@ def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dic
                    passed=run.passed, checks=n_rows, failed=n_fail,
                    routes={r: dict(status=run.status(r), worst=run.worst(r), seconds=run.seconds.get(r),
                                    why=run.skipped.get(r) or run.errors.get(r)) for r in routes},
-                   published=None if published is None else dict(
-                       n=len(published), within=sum(bool(r["ok"]) for r in published),
-                       worst_percent=max((abs(r["diff"]) for r in published if r["diff_unit"] == "%"), default=None)),
+                   published=None if not published else dict(
+                       n=len(published), within=sum(c.passed for c in published),
+                       worst_percent=max((100 * c.error for c in published if not c.by_angle), default=None)),
                    report_seconds=time.perf_counter() - t0,
                    date=datetime.date.today().isoformat())
     (d / "summary.json").write_text(json.dumps(_clean(summary), indent=1, allow_nan=False), encoding="utf-8")
