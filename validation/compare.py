@@ -16,10 +16,12 @@ from typing import Callable
 import numpy as np
 
 from kinetostat import Analysis, Mechanism, analyze
+from kinetostat.kinetostatics import friction_power, gear_force
 
-from .scene import EngineResult, Scene, build_scene
+from .scene import EngineResult, Scene, build_scene, tracked_points
 
-__all__ = ["ROUTES", "TOLERANCES", "Tolerance", "Row", "Comparison", "compare", "errors"]
+__all__ = ["ROUTES", "TOLERANCES", "Tolerance", "Row", "Comparison", "compare", "errors", "series",
+           "quantity_names"]
 
 
 @dataclass(frozen=True)
@@ -68,7 +70,7 @@ ROUTES: dict[str, tuple[str, Callable[[Scene], EngineResult]]] = {
 class Row:
     """One route x quantity of a comparison."""
     route: str
-    quantity: str          # "M_drive" or "R(i,j)" (force of i on j)
+    quantity: str          # "M_drive", "R(i,j)" (force of i on j), "F_bal", "P_f(i,j)", "x(P)", "v(P)", "a(P)"
     max_abs: float         # N m or N
     peak_relative: float   # max |engine - solver| / max |solver|
     rms_relative: float    # RMS of |engine - solver| / max |solver|
@@ -109,17 +111,53 @@ class Comparison:
         return df
 
 
-def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> list[Row]:
-    """Error rows of one engine result against the solver's answer."""
+def quantity_names(mech: Mechanism) -> list[str]:
+    """Names of the quantities `errors` compares for `mech`, in its row order (kinematics rows
+    appear only for an engine result that carries them)."""
+    names = ["M_drive"] + [f"R({p.links[0]},{p.links[1]})" for p in mech.pairs]
+    if mech.drive.kind == "machine":
+        names.append("F_bal")
+    if mech.friction is not None:
+        names += [f"P_f({p.links[0]},{p.links[1]})" for p in mech.pairs]
+    for name, _ in tracked_points(mech):
+        names += [f"x({name})", f"v({name})", f"a({name})"]
+    return names
+
+
+def series(res: Analysis, er: EngineResult) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
+    """(quantity, unit, solver (N, d), engine (N, d)) of every quantity compared, d = 1 or 2.
+
+    M_drive and R(i,j): as the engine gives them (magnitudes if `er.magnitudes_only`).
+    F_bal (working machines): the mesh force of the engine's own M_drive (`gear_force`) against
+    the solver's balancing force. P_f(i,j) (models with friction): seed 003's losses,
+    `friction_power`, applied to the engine's reactions against the solver's losses (the
+    formulas use |R|, so magnitudes suffice). x, v, a of every tracked point: the engine's own
+    kinematics at the state it used (only when it gives them).
+    """
     m = res.mech
-    pairs = {f"R({p.links[0]},{p.links[1]})": (res.forces.R[:, p.index], er.R[:, p.index]) for p in m.pairs}
-    items = [("M_drive", (res.balancing_moment[:, None], er.M_drive[:, None]))] + list(pairs.items())
+    out = [("M_drive", "N m", res.balancing_moment[:, None], er.M_drive[:, None])]
+    out += [(f"R({p.links[0]},{p.links[1]})", "N", res.forces.R[:, p.index], er.R[:, p.index]) for p in m.pairs]
+    if er.magnitudes_only:
+        out = [(q, u, np.linalg.norm(a, axis=-1, keepdims=True), np.linalg.norm(b, axis=-1, keepdims=True))
+               for q, u, a, b in out]
+    if m.drive.kind == "machine":
+        out.append(("F_bal", "N", res.balancing_force, gear_force(m.drive.gear, er.M_drive)))
+    if m.friction is not None:
+        P = friction_power(m, res.kin, er.R)
+        out += [(f"P_f({p.links[0]},{p.links[1]})", "W", res.friction_power[:, p.index, None], P[:, p.index, None])
+                for p in m.pairs]
+    if er.points:
+        for n, (name, k) in enumerate(er.points):
+            ref = res.kin.point(k, m.links[k].points[name])
+            for sym, unit, r, got in zip("xva", ("m", "m/s", "m/s^2"), ref, (er.x, er.v, er.a)):
+                out.append((f"{sym}({name})", unit, r, got[:, n]))
+    return out
+
+
+def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> list[Row]:
+    """Error rows of one engine result against the solver's answer (quantities: `series`)."""
     rows = []
-    for name, (ref, got) in items:
-        unit = "N m" if name == "M_drive" else "N"
-        if er.magnitudes_only:
-            ref = np.linalg.norm(ref, axis=-1, keepdims=True)
-            got = np.linalg.norm(got, axis=-1, keepdims=True)
+    for name, unit, ref, got in series(res, er):
         ok = np.isfinite(got).all(axis=-1) & np.isfinite(ref).all(axis=-1)
         err = np.linalg.norm(got[ok] - ref[ok], axis=-1)
         peak = float(np.max(np.linalg.norm(ref[ok], axis=-1))) if ok.any() else 0.0

@@ -82,7 +82,7 @@ from kinetostat.planar import rotate
 
 from kinetostat.kinetostatics import gear_force
 
-from .scene import EngineResult, Scene
+from .scene import EngineResult, Scene, tracked_points
 
 __all__ = ["mjcf", "solve", "simulate", "SIM_FLOOR", "SIM_STEPS_PER_REV"]
 
@@ -150,6 +150,9 @@ def mjcf(scene: Scene, floor: float = EXACT_FLOOR, timestep: float = 1e-4,
     helpers: dict[int, list[str]] = {}        # guide link -> helper bodies hanging on it
     eqs: list[str] = []
     sr, si = _v(*solref), _v(*solimp)
+    for i, (name, k) in enumerate(tracked_points(mech)):     # the gate's kinematics points
+        x, y = mech.links[k].points[name]
+        sites.setdefault(k, []).append(f'<site name="pt{i}" pos="{_v(x, y, 0)}"/>')
     for p in scene.cuts:
         a, b = p.links
         if p.kind == "R":
@@ -225,6 +228,7 @@ class _Model:
     rows: dict                 # cut pair index -> efc rows (relative to the equality's first row)
     eq_id: dict                # cut pair index -> equality id
     crank_dof: int
+    point_site: np.ndarray     # (n_points,) site of tracked_points(scene.mech)[i]
 
 
 def _compile(scene: Scene, floor: float, exact_masses: bool, **options) -> _Model:
@@ -250,7 +254,9 @@ def _compile(scene: Scene, floor: float, exact_masses: bool, **options) -> _Mode
             k = name(mujoco.mjtObj.mjOBJ_BODY, f"slot{p.index}")
             m.body_mass[k] = 0.0
             m.body_inertia[k] = 0.0
-    return _Model(m, d, body, joint_dof, slot_dof, rows, eq_id, int(joint_dof[scene.crank_joint]))
+    sites = np.array([name(mujoco.mjtObj.mjOBJ_SITE, f"pt{i}") for i in range(len(tracked_points(scene.mech)))],
+                     int)
+    return _Model(m, d, body, joint_dof, slot_dof, rows, eq_id, int(joint_dof[scene.crank_joint]), sites)
 
 
 def _slot_motion(scene: Scene) -> dict:
@@ -328,6 +334,24 @@ def _reactions(scene: Scene, mm: _Model, M_drive: float) -> np.ndarray:
     return R
 
 
+def _point_kinematics(mm: _Model) -> np.ndarray:
+    """(3, n_points, 2) position, velocity and acceleration (world; m, m/s, m/s^2) of the tracked
+    points' sites: site_xpos, mj_objectVelocity and mj_objectAcceleration (classical; reads the
+    cacc of mj_rnePostConstraint, which must have run at this state, and which starts from the
+    world's acceleration -gravity, as an accelerometer: gravity is added back)."""
+    import mujoco
+    m, d = mm.m, mm.d
+    out = np.zeros((3, len(mm.point_site), 2))
+    res = np.zeros(6)
+    for i, sid in enumerate(mm.point_site):
+        out[0, i] = d.site_xpos[sid, :2]
+        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_SITE, sid, res, 0)
+        out[1, i] = res[3:5]
+        mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_SITE, sid, res, 0)
+        out[2, i] = res[3:5] + m.opt.gravity[:2]
+    return out
+
+
 # ----------------------------------------------------------------------------- exact route
 
 def _kinematics(m, d) -> None:
@@ -363,6 +387,7 @@ def solve(scene: Scene, keep_floors: bool = False) -> EngineResult:
     F_ext, M_ext = scene.external()
     M_drive = np.full(N, np.nan)
     R = np.full((N, len(scene.mech.pairs), 2), np.nan)
+    kin = np.full((3, N, len(mm.point_site), 2), np.nan)
     rne = np.zeros(nv)
     S = np.zeros(nv)
     S[mm.crank_dof] = 1.0
@@ -386,13 +411,14 @@ def solve(scene: Scene, keep_floors: bool = False) -> EngineResult:
         mujoco.mj_rnePostConstraint(m, d)               # cfrc_int from qacc, efc_force, xfrc_applied
         M_drive[i] = x[0]
         R[i] = _reactions(scene, mm, x[0])
+        kin[:, i] = _point_kinematics(mm)
     if off_plane > OFF_PLANE_TOL:
         raise RuntimeError(f"an out-of-plane constraint row is not zero (|J| up to {off_plane:.3g}): "
                            f"the MJCF is not planar")
     run = time.perf_counter() - t0
     masses = "placeholder floors kept" if keep_floors else "massless bodies exactly massless"
     return EngineResult("mujoco", "exact", scene.phi_deg.copy(), M_drive, R,
-                        build_seconds=build, run_seconds=run,
+                        points=tracked_points(scene.mech), x=kin[0], v=kin[1], a=kin[2], build_seconds=build, run_seconds=run,
                         note=f"MuJoCo {mujoco.__version__}: [S | J^T][tau; lambda] = mj_rne - applied at the "
                              f"exact state, reactions from cfrc_int (tree) and efc_force (cuts); {masses}; "
                              f"largest loop-closure gap at the exact state {gap:.2g} (m or rad)")

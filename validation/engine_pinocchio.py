@@ -47,7 +47,7 @@ import pinocchio as pin
 
 from kinetostat.kinetostatics import gear_force
 
-from .scene import EngineResult, Scene
+from .scene import EngineResult, Scene, tracked_points
 
 __all__ = ["solve", "forward_round_trip", "PinocchioScene"]
 
@@ -198,6 +198,17 @@ class PinocchioScene:
         aX = ao + al * rr - w * w * r
         return vX, aX, Jp, Jw
 
+    def point_kinematics(self, points, q, v, a) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity and classical acceleration (each (n_points, 2), world; m, m/s,
+        m/s^2) of the (point name, link) `points` by Pinocchio's forwardKinematics(q, v, a)."""
+        pin.forwardKinematics(self.model, self.data, q, v, a)
+        out = np.zeros((3, len(points), 2))
+        for i, (name, k) in enumerate(points):
+            Xw = self.data.oMi[self.jid[k]].act(_v3(self._local(k, name)))
+            vX, aX, _, _ = self._point_motion(k, Xw)
+            out[:, i] = Xw[:2], vX[:2], aX[:2]
+        return out[0], out[1], out[2]
+
     def p_rows(self, with_drift: bool):
         """Rows (2 per P cut) of the P cuts' constraint Jacobian, their drift J-dot v
         (needs data.v, data.a with a = 0), and (X, n) per cut for the forces."""
@@ -267,6 +278,8 @@ def solve(scene: Scene) -> EngineResult:
     N, n_pairs = scene.q.shape[0], len(scene.mech.pairs)
     M_drive = np.full(N, np.nan)
     R = np.full((N, n_pairs, 2), np.nan)
+    points = tracked_points(scene.mech)
+    xp, vp, ap = (np.full((N, len(points), 2), np.nan) for _ in range(3))
     S = np.zeros(ps.nv)
     S[ps.crank_v] = 1.0
     crank_link = scene.joints[scene.crank_joint].child
@@ -320,12 +333,13 @@ def solve(scene: Scene) -> EngineResult:
             jid = ps.jid[j.child]
             fw = data.oMi[jid].rotation @ data.f[jid].linear   # parent on child, world
             R[n, j.pair.index] = fw[:2] if j.pair.links[0] == j.parent else -fw[:2]
+        xp[n], vp[n], ap[n] = ps.point_kinematics(points, q, v, a)
     run = time.perf_counter() - t0
     scale = np.nanmax(np.abs(M_drive)) if np.isfinite(M_drive).any() else 1.0
     note = (f"pin {pin.__version__}; {model.nv} joints, {len(ps.r_cuts)} CONTACT_3D + {len(ps.p_cuts)} "
             f"P-row loop closures; constraint forces fed back as fext reproduce S tau to "
             f"{worst / (scale or 1.0):.1e} of max|tau|")
-    return EngineResult("pinocchio", "exact", scene.phi_deg.copy(), M_drive, R,
+    return EngineResult("pinocchio", "exact", scene.phi_deg.copy(), M_drive, R, points=points, x=xp, v=vp, a=ap,
                         build_seconds=build, run_seconds=run, note=note)
 
 
