@@ -42,13 +42,14 @@ TOLERANCES: dict[str, Tolerance] = {
                                   "the crank tied to a clock flywheel: the error is first order in the step "
                                   "(halving with it). Forces measured worst 1.4e-4 (scotch yoke); the velocities "
                                   "of a semi-implicit Euler state lag half a step, pi/7200 = 4.4e-4 of their "
-                                  "peak (kinematics measured worst 6.1e-4, a(S3) of the scotch yoke); constraints "
+                                  "peak (kinematics measured worst 6.1e-4, a(Y) of the scotch yoke); constraints "
                                   "stay slightly soft (impedance < 1) but the step dominates"),
-    "pymunk": Tolerance(5e-3, "pymunk's iterative impulse solver at 1440 steps per revolution with at least "
-                              "50 iterations (raised automatically where a run goes unstable): error falls "
-                              "as dt^2 on light linkages (~5e-5) but heavy rams behind light blocks are "
-                              "limited by the iteration count (measured worst 2.4e-3, the shaper); the "
-                              "public API gives impulse magnitudes, so magnitudes are compared"),
+    "pymunk": Tolerance(4e-3, "pymunk's iterative impulse solver, Richardson extrapolation (order 2) over 720 and "
+                              "1440 steps per revolution, at least 50 iterations (raised automatically where a "
+                              "run goes unstable): light linkages 2e-7 .. 2e-6, the heavy/light machines 7e-6 .. "
+                              "5e-4 (iteration-limited); worst 1.7e-3, the scotch yoke, whose load flips at a "
+                              "sample; the public API gives impulse magnitudes, so |M_drive| and |R| are "
+                              "compared; positions and velocities of the points, no accelerations"),
 }
 
 
@@ -113,16 +114,21 @@ class Comparison:
         return df
 
 
-def quantity_names(mech: Mechanism) -> list[str]:
-    """Names of the quantities `errors` compares for `mech`, in its row order (kinematics rows
-    appear only for an engine result that carries them)."""
+#: Routes whose results carry no point accelerations (see the adapter's module docstring).
+WITHOUT_ACCELERATIONS = frozenset({"pymunk"})
+
+
+def quantity_names(mech: Mechanism, route: str | None = None) -> list[str]:
+    """Names of the quantities `errors` compares for `mech` (on `route`: without the
+    accelerations of a route in WITHOUT_ACCELERATIONS), in its row order."""
     names = ["M_drive"] + [f"R({p.links[0]},{p.links[1]})" for p in mech.pairs]
     if mech.drive.kind == "machine":
         names.append("F_bal")
     if mech.friction is not None:
         names += [f"P_f({p.links[0]},{p.links[1]})" for p in mech.pairs]
+    kinds = "xv" if route in WITHOUT_ACCELERATIONS else "xva"
     for name, _ in tracked_points(mech):
-        names += [f"x({name})", f"v({name})", f"a({name})"]
+        names += [f"{sym}({name})" for sym in kinds]
     return names
 
 
@@ -134,7 +140,7 @@ def series(res: Analysis, er: EngineResult) -> list[tuple[str, str, np.ndarray, 
     the solver's balancing force. P_f(i,j) (models with friction): seed 003's losses,
     `friction_power`, applied to the engine's reactions against the solver's losses (the
     formulas use |R|, so magnitudes suffice). x, v, a of every tracked point: the engine's own
-    kinematics at the state it used (only when it gives them).
+    kinematics at the state it used (those it gives).
     """
     m = res.mech
     out = [("M_drive", "N m", res.balancing_moment[:, None], er.M_drive[:, None])]
@@ -152,17 +158,35 @@ def series(res: Analysis, er: EngineResult) -> list[tuple[str, str, np.ndarray, 
         for n, (name, k) in enumerate(er.points):
             ref = res.kin.point(k, m.links[k].points[name])
             for sym, unit, r, got in zip("xva", ("m", "m/s", "m/s^2"), ref, (er.x, er.v, er.a)):
-                out.append((f"{sym}({name})", unit, r, got[:, n]))
+                if got is not None:
+                    out.append((f"{sym}({name})", unit, r, got[:, n]))
     return out
 
 
+def _kinematic_scales(res: Analysis, er: EngineResult) -> dict[str, float]:
+    """'x', 'v', 'a' -> the largest solver value of that kind over the cycle and all of the
+    engine's points: the scale of every kinematics row (a point on a fixed pivot, such as a
+    balanced crank's centre of mass, has no peak of its own)."""
+    if not er.points:
+        return {}
+    m = res.mech
+    ref = np.array([res.kin.point(k, m.links[k].points[name]) for name, k in er.points])   # (P, 3, N, 2)
+    peaks = np.nanmax(np.linalg.norm(ref, axis=-1), axis=(0, 2), initial=0.0)
+    return dict(zip("xva", peaks))
+
+
 def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> list[Row]:
-    """Error rows of one engine result against the solver's answer (quantities: `series`)."""
+    """Error rows of one engine result against the solver's answer (quantities: `series`).
+
+    Relative to the quantity's peak over the cycle; a kinematics row (x, v, a of a point)
+    relative to the largest of its kind over all points (`Row.peak` is then that scale)."""
     rows = []
+    kin_scale = _kinematic_scales(res, er)
     for name, unit, ref, got in series(res, er):
         ok = np.isfinite(got).all(axis=-1) & np.isfinite(ref).all(axis=-1)
         err = np.linalg.norm(got[ok] - ref[ok], axis=-1)
         peak = float(np.max(np.linalg.norm(ref[ok], axis=-1))) if ok.any() else 0.0
+        peak = kin_scale.get(name[0], peak) if name[1] == "(" and name[0] in "xva" else peak
         scale = peak if peak > 0 else 1.0
         rows.append(Row(route, name, float(err.max()) if ok.any() else np.nan,
                         float(err.max() / scale) if ok.any() else np.nan,

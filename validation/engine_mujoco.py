@@ -360,21 +360,21 @@ def _reactions(scene: Scene, mm: _Model, M_drive: float) -> np.ndarray:
 
 
 def _point_kinematics(mm: _Model) -> np.ndarray:
-    """(3, n_points, 2) position, velocity and acceleration (world; m, m/s, m/s^2) of the tracked
-    points' sites: site_xpos, mj_objectVelocity and mj_objectAcceleration (classical; reads the
-    cacc of mj_rnePostConstraint, which must have run at this state, and which starts from the
-    world's acceleration -gravity, as an accelerometer: gravity is added back)."""
-    import mujoco
+    """(3, n_points, 2) position, velocity and classical acceleration (world; m, m/s, m/s^2) of
+    the tracked points' sites, from MuJoCo's site_xpos and its body motions cvel and cacc (what
+    mj_objectVelocity and mj_objectAcceleration read: spatial vectors [angular; linear at the
+    tree's subtree_com], shifted to the site, with w x v added for the classical acceleration).
+    cacc comes from mj_rnePostConstraint, which must have run at this state, and starts from
+    the world's acceleration -gravity, as an accelerometer: gravity is added back."""
     m, d = mm.m, mm.d
-    out = np.zeros((3, len(mm.point_site), 2))
-    res = np.zeros(6)
-    for i, sid in enumerate(mm.point_site):
-        out[0, i] = d.site_xpos[sid, :2]
-        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_SITE, sid, res, 0)
-        out[1, i] = res[3:5]
-        mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_SITE, sid, res, 0)
-        out[2, i] = res[3:5] + m.opt.gravity[:2]
-    return out
+    sites = mm.point_site
+    b = m.site_bodyid[sites]
+    p = d.site_xpos[sites]
+    r = p - d.subtree_com[m.body_rootid[b]]
+    w, al = d.cvel[b, :3], d.cacc[b, :3]
+    v = d.cvel[b, 3:] + np.cross(w, r)
+    a = d.cacc[b, 3:] + np.cross(al, r) + np.cross(w, v) + m.opt.gravity
+    return np.stack([p[:, :2], v[:, :2], a[:, :2]])
 
 
 # ----------------------------------------------------------------------------- exact route

@@ -46,6 +46,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinetostat.kinetostatics import gear_force
+from kinetostat.planar import rotate
 
 from .scene import EngineResult, Scene, tracked_points
 
@@ -198,16 +199,36 @@ class PinocchioScene:
         aX = ao + al * rr - w * w * r
         return vX, aX, Jp, Jw
 
-    def point_kinematics(self, points, q, v, a) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, velocity and classical acceleration (each (n_points, 2), world; m, m/s,
-        m/s^2) of the (point name, link) `points` by Pinocchio's forwardKinematics(q, v, a)."""
+    def frame_motion(self, q, v, a) -> np.ndarray:
+        """(L, 9) per link (row 0, the frame: zeros) the motion of its joint frame by Pinocchio's
+        forwardKinematics(q, v, a), world axes: origin x, y (m), angle (rad), origin velocity
+        x, y (m/s), angular velocity (rad/s), classical origin acceleration x, y (m/s^2),
+        angular acceleration (rad/s^2)."""
         pin.forwardKinematics(self.model, self.data, q, v, a)
-        out = np.zeros((3, len(points), 2))
+        out = np.zeros((self.scene.mech.n_links, 9))
+        for k, jid in self.jid.items():
+            if not jid:
+                continue
+            oMi, vj, aj = self.data.oMi[jid], self.data.v[jid], self.data.a[jid]
+            R, vl, w = oMi.rotation, vj.linear, vj.angular[2]
+            ao = R @ (aj.linear + w * np.array([-vl[1], vl[0], 0.0]))    # classical, joint origin
+            out[k] = (*oMi.translation[:2], math.atan2(R[1, 0], R[0, 0]), *(R @ vl)[:2], w, *ao[:2],
+                      aj.angular[2])
+        return out
+
+    def point_kinematics(self, points, frames: np.ndarray) -> np.ndarray:
+        """(3, N, n_points, 2) position, velocity and classical acceleration (world; m, m/s,
+        m/s^2) of the (point name, link) `points` from `frame_motion` at N states (N, L, 9)."""
+        out = np.zeros((3, len(frames), len(points), 2))
         for i, (name, k) in enumerate(points):
-            Xw = self.data.oMi[self.jid[k]].act(_v3(self._local(k, name)))
-            vX, aX, _, _ = self._point_motion(k, Xw)
-            out[:, i] = Xw[:2], vX[:2], aX[:2]
-        return out[0], out[1], out[2]
+            f = frames[:, k]
+            r = rotate(self._local(k, name), f[:, 2])
+            rp = np.stack([-r[:, 1], r[:, 0]], axis=-1)          # z x r
+            w, al = f[:, 5:6], f[:, 8:9]
+            out[0, :, i] = f[:, :2] + r
+            out[1, :, i] = f[:, 3:5] + w * rp
+            out[2, :, i] = f[:, 6:8] + al * rp - w**2 * r
+        return out
 
     def p_rows(self, with_drift: bool):
         """Rows (2 per P cut) of the P cuts' constraint Jacobian, their drift J-dot v
@@ -279,7 +300,7 @@ def solve(scene: Scene) -> EngineResult:
     M_drive = np.full(N, np.nan)
     R = np.full((N, n_pairs, 2), np.nan)
     points = tracked_points(scene.mech)
-    xp, vp, ap = (np.full((N, len(points), 2), np.nan) for _ in range(3))
+    frames = np.full((N, scene.mech.n_links, 9), np.nan)
     S = np.zeros(ps.nv)
     S[ps.crank_v] = 1.0
     crank_link = scene.joints[scene.crank_joint].child
@@ -333,7 +354,8 @@ def solve(scene: Scene) -> EngineResult:
             jid = ps.jid[j.child]
             fw = data.oMi[jid].rotation @ data.f[jid].linear   # parent on child, world
             R[n, j.pair.index] = fw[:2] if j.pair.links[0] == j.parent else -fw[:2]
-        xp[n], vp[n], ap[n] = ps.point_kinematics(points, q, v, a)
+        frames[n] = ps.frame_motion(q, v, a)
+    xp, vp, ap = ps.point_kinematics(points, frames)
     run = time.perf_counter() - t0
     scale = np.nanmax(np.abs(M_drive)) if np.isfinite(M_drive).any() else 1.0
     note = (f"pin {pin.__version__}; {model.nv} joints, {len(ps.r_cuts)} CONTACT_3D + {len(ps.p_cuts)} "

@@ -23,8 +23,8 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
         ET.SubElement(props, "property", name="structure", value=run.mech.structure.formula)
         ET.SubElement(props, "property", name="positions", value=str(len(run.res.phi_deg)))
         counts = dict(tests=0, failures=0, errors=0, skipped=0)
-        qs = quantities(run.mech)
         for route in run.engines:
+            qs = quantities(run.mech, route)
             secs = run.seconds.get(route, 0.0) / max(len(qs), 1)
             rows = {r.quantity: r for r in run.rows if r.route == route}
             for q in qs:

@@ -18,13 +18,14 @@ from ..analysis import Analysis, analyze
 from ..model import Mechanism
 
 
-def quantities(mech: Mechanism) -> list[str]:
-    """The quantities compare() checks, named as its rows name them: the driving moment, every
-    reaction, a machine's F_bal, the friction losses P_f(i,j) where the model has friction, and
-    x, v, a of every tracked point (`kinetostat_validation.compare.quantity_names`)."""
+def quantities(mech: Mechanism, route: str | None = None) -> list[str]:
+    """The quantities compare() checks (on `route`), named as its rows name them: the driving
+    moment, every reaction, a machine's F_bal, the friction losses P_f(i,j) where the model has
+    friction, and x, v, a of every tracked point (no a on a route without accelerations;
+    `kinetostat_validation.compare.quantity_names`)."""
     from kinetostat_validation.compare import quantity_names
 
-    return quantity_names(mech)
+    return quantity_names(mech, route)
 
 
 @dataclass
