@@ -250,6 +250,8 @@ class _Model:
     eq_id: dict                # cut pair index -> equality id
     crank_dof: int
     point_site: np.ndarray     # (n_points,) site of tracked_points(scene.mech)[i]
+    point_body: np.ndarray     # (n_points,) its body
+    point_root: np.ndarray     # (n_points,) the root of its body's tree (cvel, cacc are about its subtree_com)
     clock_dof: int = -1        # simulation: dof of the drive's clock (-1: none)
     drive_eq: int = -1         # simulation: id of the joint equality crank = clock
 
@@ -281,6 +283,7 @@ def _compile(scene: Scene, floor: float, exact_masses: bool, **options) -> _Mode
                      int)
     clock = name(mujoco.mjtObj.mjOBJ_JOINT, "clock")
     return _Model(m, d, body, joint_dof, slot_dof, rows, eq_id, int(joint_dof[scene.crank_joint]), sites,
+                  m.site_bodyid[sites].copy(), m.body_rootid[m.site_bodyid[sites]].copy(),
                   int(m.jnt_dofadr[clock]) if clock >= 0 else -1, name(mujoco.mjtObj.mjOBJ_EQUALITY, "drive"))
 
 
@@ -367,14 +370,16 @@ def _point_kinematics(mm: _Model) -> np.ndarray:
     cacc comes from mj_rnePostConstraint, which must have run at this state, and starts from
     the world's acceleration -gravity, as an accelerometer: gravity is added back."""
     m, d = mm.m, mm.d
-    sites = mm.point_site
-    b = m.site_bodyid[sites]
-    p = d.site_xpos[sites]
-    r = p - d.subtree_com[m.body_rootid[b]]
-    w, al = d.cvel[b, :3], d.cacc[b, :3]
-    v = d.cvel[b, 3:] + np.cross(w, r)
-    a = d.cacc[b, 3:] + np.cross(al, r) + np.cross(w, v) + m.opt.gravity
-    return np.stack([p[:, :2], v[:, :2], a[:, :2]])
+    b = mm.point_body
+    p = d.site_xpos[mm.point_site, :2]
+    r = p - d.subtree_com[mm.point_root, :2]
+    zr = r[:, ::-1] * (-1.0, 1.0)                             # z x r (planar: w, alpha along z)
+    w, al = d.cvel[b, 2:3], d.cacc[b, 2:3]
+    v = d.cvel[b, 3:5] + w * zr
+    a = d.cacc[b, 3:5] + al * zr + w * v[:, ::-1] * (-1.0, 1.0) + m.opt.gravity[:2]
+    out = np.empty((3,) + p.shape)
+    out[0], out[1], out[2] = p, v, a
+    return out
 
 
 # ----------------------------------------------------------------------------- exact route
