@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import pytest
 
 import kinetostat
 from kinetostat_validation import compare as cmp
-from conftest import FOUR_BAR
+from conftest import FOUR_BAR, ROOT
 
 pytest.importorskip("pinocchio")
 pytest.importorskip("mujoco")
@@ -21,8 +22,9 @@ def test_every_route_passes_on_every_bundled_model(mech):
     assert set(c.results) == set(cmp.ROUTES)
     failed = [(r.route, r.quantity, r.peak_relative) for r in c.rows if not r.passed]
     assert not failed
-    # every pair and the drive are compared by every route, at every angle
-    assert len(c.rows) == len(cmp.ROUTES) * (1 + len(mech.pairs))
+    # every quantity (drive, pairs, F_bal, P_f, kinematics) is compared by every route, at every angle
+    for route in cmp.ROUTES:
+        assert [r.quantity for r in c.rows if r.route == route] == cmp.quantity_names(mech, route)
     for r in c.rows:
         if r.route in ("pinocchio", "mujoco"):
             assert r.n_compared == 360 and r.peak_relative < 1e-9
@@ -77,3 +79,44 @@ def test_tolerances_have_reasons():
     for route in cmp.ROUTES:
         tol = cmp.TOLERANCES[route]
         assert 0 < tol.peak_relative < 0.1 and len(tol.reason) > 40
+
+
+@pytest.mark.parametrize("name, expected", [
+    ("compressor", {"F_bal"}),                                       # a working machine
+    ("ice_crank_slider", {"P_f(0,1)", "P_f(1,2)", "P_f(2,3)", "P_f(0,3)"}),   # friction losses
+])
+def test_exact_routes_give_kinematics_f_bal_and_friction_within_1e_9(name, expected):
+    mech = kinetostat.load(ROOT / "models" / f"{name}.toml")
+    c = cmp.compare(mech, engines=("pinocchio", "mujoco"), steps=72)
+    for route in ("pinocchio", "mujoco"):
+        rows = {r.quantity: r for r in c.rows if r.route == route}
+        assert expected <= set(rows)
+        assert {"x(S2)", "v(S2)", "a(S2)", "x(B)", "v(B)", "a(B)"} <= set(rows)
+        assert all(r.peak_relative < 1e-9 and r.n_compared == 72 for r in rows.values()), route
+        assert rows["a(S2)"].unit == "m/s^2" and rows[sorted(expected)[0]].unit in ("N", "W")
+
+
+def test_a_perturbed_acceleration_is_caught(four_bar):
+    """The rocker's reported point accelerations 1 % (of the largest) off, its joint motion (what
+    the engines are given: angles, rates, angular accelerations) untouched: the accelerations of
+    its points fail, nothing else."""
+    res = kinetostat.analyze(four_bar, steps=72)
+    a_z = res.kin.a_z.copy()
+    a_z[:, 3] += 0.01 * np.abs(a_z).max()
+    bad = dataclasses.replace(res, kin=dataclasses.replace(res.kin, a_z=a_z))
+    c = cmp.compare(four_bar, engines=("pinocchio", "mujoco"), res=bad)
+    failing = {(r.route, r.quantity) for r in c.rows if not r.passed}
+    assert failing == {(route, q) for route in ("pinocchio", "mujoco") for q in ("a(S3)", "a(B)", "a(C)")}
+
+
+def test_a_wrong_friction_coefficient_is_caught():
+    """The solver's losses with f = 0.06 instead of the model's 0.05: every P_f row fails."""
+    path = ROOT / "models" / "ice_crank_slider.toml"
+    mech = kinetostat.load(path)
+    wrong = kinetostat.loads(path.read_text(encoding="utf-8").replace("f = 0.05", "f = 0.06"))
+    res = kinetostat.analyze(mech, steps=72)
+    bad = dataclasses.replace(res, friction_power=kinetostat.analyze(wrong, steps=72).friction_power)
+    c = cmp.compare(mech, engines=("pinocchio", "mujoco", "pymunk"), res=bad)
+    failing = {(r.route, r.quantity) for r in c.rows if not r.passed}
+    assert failing == {(route, f"P_f{p.label[1:]}") for route in ("pinocchio", "mujoco", "pymunk")
+                       for p in mech.pairs}

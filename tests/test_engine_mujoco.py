@@ -229,6 +229,22 @@ def test_simulation_floor_masses_do_not_matter(name):
     assert np.max(np.abs(a.M_drive - b.M_drive)) < FLOOR_EFFECT_TOL * np.max(np.abs(sc.M_drive))
 
 
+@pytest.mark.parametrize("model", ["ice_crank_slider", "slotted_link_shaper"])
+def test_rollout_route_within_its_tolerance_at_half_the_steps(model):
+    """The rollout route (mujoco.rollout, crank tied to the clock) at 3600 steps/rev, every
+    quantity the gate compares (forces, F_bal, friction losses, point kinematics): within the
+    route's tolerance scaled by the step (first order: 2x at half the steps)."""
+    from kinetostat_validation.compare import TOLERANCES, errors as gate_errors, quantity_names
+    mech = kinetostat.load(MODELS_DIR / f"{model}.toml")
+    sc = build_scene(mech, steps=72)
+    res = simulate(sc, steps_per_rev=3600)
+    assert "mujoco.rollout" in res.note
+    rows = gate_errors(sc.res, res, 2 * TOLERANCES["mujoco-sim"].peak_relative, "mujoco-sim")
+    assert [r.quantity for r in rows] == quantity_names(mech, "mujoco-sim")
+    bad = {r.quantity: r.peak_relative for r in rows if not (r.passed and r.n_compared == 72)}
+    assert not bad
+
+
 def test_simulation_refuses_an_accelerating_crank():
     mech = kinetostat.loads(FOUR_BAR.replace("eps = 0.0", "eps = 10.0"))
     with pytest.raises(ValueError, match=r"constant speed \(drive.eps = 0\)"):

@@ -13,6 +13,7 @@ import pandas as pd
 import pytest
 
 import kinetostat
+import kinetostat.report
 from conftest import FOUR_BAR, MODELS, ROOT
 from kinetostat.report import published_rows, run_validation, write_index, write_report
 from kinetostat.report.document import Doc
@@ -46,7 +47,8 @@ def test_report_files(ice_report):
     cycle = pd.read_csv(d / "cycle.csv")
     assert len(cycle) == 36 and {"phi_deg", "M_bal", "M_lever", "R_0_1"} <= set(cycle.columns)
     summary = json.loads((d / "summary.json").read_text())
-    assert summary["passed"] and summary["checks"] == 10
+    n_q = sum(len(kinetostat.report.quantities(kinetostat.load(ICE), r)) for r in ("pinocchio", "mujoco"))
+    assert summary["passed"] and summary["checks"] == n_q       # 2 x (M_drive, 4 R, 4 P_f, 4 points x 3)
     assert set(summary["routes"]) == {"pinocchio", "mujoco"}
 
 

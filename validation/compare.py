@@ -17,10 +17,12 @@ from typing import Callable
 import numpy as np
 
 from kinetostat import Analysis, Mechanism, analyze
+from kinetostat.kinetostatics import friction_power, gear_force
 
-from .scene import EngineResult, Scene, build_scene
+from .scene import EngineResult, Scene, build_scene, tracked_points
 
-__all__ = ["ROUTES", "TOLERANCES", "Tolerance", "Row", "Comparison", "compare", "errors", "angle_index"]
+__all__ = ["ROUTES", "TOLERANCES", "Tolerance", "Row", "Comparison", "compare", "errors", "series",
+           "quantity_names", "angle_index"]
 
 
 @dataclass(frozen=True)
@@ -37,15 +39,18 @@ TOLERANCES: dict[str, Tolerance] = {
                                  "equations in another formulation, so rounding only (measured ~1e-13)"),
     "mujoco": Tolerance(1e-9, "MuJoCo's mass matrix, bias forces and equality Jacobian at the exact "
                               "state, solved for torque and constraint forces: rounding only"),
-    "mujoco-sim": Tolerance(5e-4, "MuJoCo's own forward dynamics at 7200 steps per revolution, the crank "
-                                  "servoed to the prescribed motion: the error is first order in the step "
-                                  "(measured worst 1.7e-4, halving with the step); constraints stay slightly "
-                                  "soft (impedance < 1) but the step dominates"),
-    "pymunk": Tolerance(5e-3, "pymunk's iterative impulse solver at 1440 steps per revolution with at least "
-                              "50 iterations (raised automatically where a run goes unstable): error falls "
-                              "as dt^2 on light linkages (~5e-5) but heavy rams behind light blocks are "
-                              "limited by the iteration count (measured worst 2.4e-3, the shaper); the "
-                              "public API gives impulse magnitudes, so magnitudes are compared"),
+    "mujoco-sim": Tolerance(1e-3, "MuJoCo's own forward dynamics (mujoco.rollout) at 7200 steps per revolution, "
+                                  "the crank tied to a clock flywheel: the error is first order in the step "
+                                  "(halving with it). Forces measured worst 1.4e-4 (scotch yoke); the velocities "
+                                  "of a semi-implicit Euler state lag half a step, pi/7200 = 4.4e-4 of their "
+                                  "peak (kinematics measured worst 6.1e-4, a(Y) of the scotch yoke); constraints "
+                                  "stay slightly soft (impedance < 1) but the step dominates"),
+    "pymunk": Tolerance(4e-3, "pymunk's iterative impulse solver, Richardson extrapolation (order 2) over 720 and "
+                              "1440 steps per revolution, at least 50 iterations (raised automatically where a "
+                              "run goes unstable): light linkages 2e-7 .. 2e-6, the heavy/light machines 7e-6 .. "
+                              "5e-4 (iteration-limited); worst 1.7e-3, the scotch yoke, whose load flips at a "
+                              "sample; the public API gives impulse magnitudes, so |M_drive| and |R| are "
+                              "compared; positions and velocities of the points, no accelerations"),
     "reference": Tolerance(1e-11, "the whole problem solved again in mpmath at 40 digits (another formulation: "
                                   "all loop closures at once, one global Newton-Euler system) at 12 equally "
                                   "spaced angles plus the angle of each quantity's peak: the solver's rounding "
@@ -77,7 +82,7 @@ ROUTES: dict[str, tuple[str, Callable[[Scene], EngineResult]]] = {
 class Row:
     """One route x quantity of a comparison."""
     route: str
-    quantity: str          # "M_drive" or "R(i,j)" (force of i on j)
+    quantity: str          # "M_drive", "R(i,j)" (force of i on j), "F_bal", "P_f(i,j)", "x(P)", "v(P)", "a(P)"
     max_abs: float         # N m or N
     peak_relative: float   # max |engine - solver| / max |solver|
     rms_relative: float    # RMS of |engine - solver| / max |solver|
@@ -130,21 +135,84 @@ def angle_index(res: Analysis, phi_deg: np.ndarray) -> np.ndarray:
     return idx
 
 
-def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> list[Row]:
-    """Error rows of one engine result (at all of the solver's angles, or some of them) against
-    the solver's answer; errors relative to the solver's peak over all its angles."""
+#: The point kinematics a route gives, when not all of x, v and a (see the adapter's docstring):
+#: pymunk has no accelerations of its own, the 40-digit reference solves forces only.
+POINT_KINEMATICS = {"pymunk": "xv", "reference": ""}
+
+
+def quantity_names(mech: Mechanism, route: str | None = None) -> list[str]:
+    """Names of the quantities `errors` compares for `mech` (on `route`: only the point
+    kinematics listed in POINT_KINEMATICS), in its row order."""
+    names = ["M_drive"] + [f"R({p.links[0]},{p.links[1]})" for p in mech.pairs]
+    if mech.drive.kind == "machine":
+        names.append("F_bal")
+    if mech.friction is not None:
+        names += [f"P_f({p.links[0]},{p.links[1]})" for p in mech.pairs]
+    kinds = POINT_KINEMATICS.get(route, "xva")
+    for name, _ in tracked_points(mech):
+        names += [f"{sym}({name})" for sym in kinds]
+    return names
+
+
+def series(res: Analysis, er: EngineResult) -> list[tuple[str, str, np.ndarray, np.ndarray]]:
+    """(quantity, unit, solver (N, d) over all its angles, engine (n, d) at `er.phi_deg`) of every
+    quantity compared, d = 1 or 2.
+
+    M_drive and R(i,j): as the engine gives them (magnitudes if `er.magnitudes_only`).
+    F_bal (working machines): the mesh force of the engine's own M_drive (`gear_force`) against
+    the solver's balancing force. P_f(i,j) (models with friction): seed 003's losses,
+    `friction_power`, applied to the engine's reactions against the solver's losses (the
+    formulas use |R|, so magnitudes suffice). x, v, a of every tracked point: the engine's own
+    kinematics at the state it used (those it gives).
+    """
     m = res.mech
-    at = angle_index(res, er.phi_deg)
-    pairs = {f"R({p.links[0]},{p.links[1]})": (res.forces.R[:, p.index], er.R[:, p.index]) for p in m.pairs}
-    items = [("M_drive", (res.balancing_moment[:, None], er.M_drive[:, None]))] + list(pairs.items())
+    out = [("M_drive", "N m", res.balancing_moment[:, None], er.M_drive[:, None])]
+    out += [(f"R({p.links[0]},{p.links[1]})", "N", res.forces.R[:, p.index], er.R[:, p.index]) for p in m.pairs]
+    if er.magnitudes_only:
+        out = [(q, u, np.linalg.norm(a, axis=-1, keepdims=True), np.linalg.norm(b, axis=-1, keepdims=True))
+               for q, u, a, b in out]
+    if m.drive.kind == "machine":
+        out.append(("F_bal", "N", res.balancing_force, gear_force(m.drive.gear, er.M_drive)))
+    if m.friction is not None:
+        at = angle_index(res, er.phi_deg)
+        kin = res.kin if len(at) == len(res.phi_deg) else analyze(m, phi_deg=res.phi_deg[at]).kin
+        P = friction_power(m, kin, er.R)
+        out += [(f"P_f({p.links[0]},{p.links[1]})", "W", res.friction_power[:, p.index, None], P[:, p.index, None])
+                for p in m.pairs]
+    if er.points:
+        for n, (name, k) in enumerate(er.points):
+            ref = res.kin.point(k, m.links[k].points[name])
+            for sym, unit, r, got in zip("xva", ("m", "m/s", "m/s^2"), ref, (er.x, er.v, er.a)):
+                if got is not None:
+                    out.append((f"{sym}({name})", unit, r, got[:, n]))
+    return out
+
+
+def _kinematic_scales(res: Analysis, er: EngineResult) -> dict[str, float]:
+    """'x', 'v', 'a' -> the largest solver value of that kind over the cycle and all of the
+    engine's points: the scale of every kinematics row (a point on a fixed pivot, such as a
+    balanced crank's centre of mass, has no peak of its own)."""
+    if not er.points:
+        return {}
+    m = res.mech
+    ref = np.array([res.kin.point(k, m.links[k].points[name]) for name, k in er.points])   # (P, 3, N, 2)
+    peaks = np.nanmax(np.linalg.norm(ref, axis=-1), axis=(0, 2), initial=0.0)
+    return dict(zip("xva", peaks))
+
+
+def errors(res: Analysis, er: EngineResult, tolerance: float, route: str) -> list[Row]:
+    """Error rows of one engine result against the solver's answer (quantities: `series`).
+
+    Relative to the quantity's peak over the cycle; a kinematics row (x, v, a of a point)
+    relative to the largest of its kind over all points (`Row.peak` is then that scale). A route
+    evaluated at some of the solver's angles is compared there, against the peak over all of them."""
     rows = []
-    for name, (cycle, got) in items:
-        unit = "N m" if name == "M_drive" else "N"
-        if er.magnitudes_only:
-            cycle = np.linalg.norm(cycle, axis=-1, keepdims=True)
-            got = np.linalg.norm(got, axis=-1, keepdims=True)
+    at = angle_index(res, er.phi_deg)
+    kin_scale = _kinematic_scales(res, er)
+    for name, unit, cycle, got in series(res, er):
         finite = np.isfinite(cycle).all(axis=-1)
         peak = float(np.max(np.linalg.norm(cycle[finite], axis=-1))) if finite.any() else 0.0
+        peak = kin_scale.get(name[0], peak) if name[1] == "(" and name[0] in "xva" else peak
         scale = peak if peak > 0 else 1.0
         ref = cycle[at]
         ok = np.isfinite(got).all(axis=-1) & finite[at]

@@ -18,11 +18,19 @@ is the force of the parent on body b's subtree through b's tree joint. `mj_inver
 used: at exactly consistent kinematics it returns zero equality forces (guide/engines.md).
 
 `simulate(scene)` (route "simulation"): MuJoCo's own constrained forward dynamics with soft
-equality constraints, from the exact initial state. The crank's motion is prescribed at the
-acceleration level (computed torque, see `simulate`): at every step the crank torque is the
-one for which MuJoCo's forward dynamics gives the crank the prescribed acceleration (plus a
-weak feedback on the crank's own angle and rate). The solver's torque is never fed in.
-Reactions are read from `efc_force` (cut pairs) and `cfrc_int` (tree pairs) at the samples.
+equality constraints, from the exact initial state, stepped by `mujoco.rollout` (MuJoCo's C++
+multi-step rollout: no Python loop over the steps). The crank's motion is prescribed by a
+"clock": a flywheel on its own hinge, far heavier than the mechanism, turning at the crank
+speed, to which a joint equality ties the crank; that constraint's force is the driving
+moment. The solver's torque is never fed in. The applied loads of every step are the
+rollout's open-loop control (`xfrc_applied`). At the samples, the rollout's recorded states
+are evaluated again by `mj_forward` (the constraint forces `efc_force`, as in that step) and
+`mj_rnePostConstraint` (`cfrc_int`, the sites' accelerations); reactions are read from
+`efc_force` (cut pairs) and `cfrc_int` (tree pairs).
+
+Kinematics (both routes): a site at every point of `tracked_points` (each link's centre of
+mass, each pair's point); positions `site_xpos`, velocities `mj_objectVelocity`, accelerations
+`mj_objectAcceleration` (classical, gravity taken back out of cacc), at the state used.
 
 MJCF (see `mjcf`)
 -----------------
@@ -82,7 +90,7 @@ from kinetostat.planar import rotate
 
 from kinetostat.kinetostatics import gear_force
 
-from .scene import EngineResult, Scene
+from .scene import EngineResult, Scene, tracked_points
 
 __all__ = ["mjcf", "slot_motion", "solve", "simulate", "SIM_FLOOR", "SIM_STEPS_PER_REV"]
 
@@ -102,6 +110,10 @@ SIM_FLOOR = 1e-7
 OFF_PLANE_TOL = 1e-12
 #: Simulation route: default number of time steps per crank revolution.
 SIM_STEPS_PER_REV = 7200
+#: Simulation route: the drive's clock flywheel has this many times (a bound of the driving
+#: moment) / omega^2 as its moment of inertia: its speed changes by at most 2 pi / CLOCK_INERTIA
+#: (6e-9) in a revolution.
+CLOCK_INERTIA = 1e9
 
 
 # ----------------------------------------------------------------------------- MJCF
@@ -133,9 +145,12 @@ def _slider_cuts(scene: Scene):
 
 def mjcf(scene: Scene, floor: float = EXACT_FLOOR, timestep: float = 1e-4,
          solref: tuple[float, float] = (0.02, 1.0),
-         solimp: tuple[float, ...] = (0.9, 0.95, 0.001, 0.5, 2.0)) -> str:
+         solimp: tuple[float, ...] = (0.9, 0.95, 0.001, 0.5, 2.0), clock_inertia: float = 0.0) -> str:
     """The scene as an MJCF document (see the module docstring for the layout).
 
+    `clock_inertia` > 0 (simulation): adds the drive's clock, a flywheel body `clock` on its own
+    hinge with that moment of inertia (kg m^2), and a joint equality `drive` that ties the
+    crank's joint to it (same solref and solimp as the loops).
     `floor`: placeholder mass / inertia, relative to the scene's scales, of bodies whose mass or
     I_S is zero (MuJoCo requires positive values). `timestep`, `solref`, `solimp`: options of
     the equality constraints for forward simulation (the exact route does not use them).
@@ -150,6 +165,9 @@ def mjcf(scene: Scene, floor: float = EXACT_FLOOR, timestep: float = 1e-4,
     helpers: dict[int, list[str]] = {}        # guide link -> helper bodies hanging on it
     eqs: list[str] = []
     sr, si = _v(*solref), _v(*solimp)
+    for i, (name, k) in enumerate(tracked_points(mech)):     # the gate's kinematics points
+        x, y = mech.links[k].points[name]
+        sites.setdefault(k, []).append(f'<site name="pt{i}" pos="{_v(x, y, 0)}"/>')
     for p in scene.cuts:
         a, b = p.links
         if p.kind == "R":
@@ -204,6 +222,12 @@ def mjcf(scene: Scene, floor: float = EXACT_FLOOR, timestep: float = 1e-4,
     lines += [f'    {h}' for h in helpers.get(0, [])]
     for c in children.get(0, []):
         lines += body(c, "    ")
+    if clock_inertia > 0:
+        lines.append(f'    <body name="clock"><joint name="clock" type="hinge" axis="0 0 1"/>'
+                     f'<inertial pos="0 0 0" mass="{_f(m_scale)}" diaginertia="{_v(*[clock_inertia] * 3)}"/></body>')
+        crank = scene.joints[scene.crank_joint].pair.index
+        eqs.append(f'<joint name="drive" joint1="pair{crank}" joint2="clock" polycoef="0 1 0 0 0" '
+                   f'solref="{sr}" solimp="{si}"/>')
     lines += ['  </worldbody>', '  <equality>'] + [f'    {e}' for e in eqs] + ['  </equality>', '</mujoco>']
     return "\n".join(lines) + "\n"
 
@@ -225,6 +249,11 @@ class _Model:
     rows: dict                 # cut pair index -> efc rows (relative to the equality's first row)
     eq_id: dict                # cut pair index -> equality id
     crank_dof: int
+    point_site: np.ndarray     # (n_points,) site of tracked_points(scene.mech)[i]
+    point_body: np.ndarray     # (n_points,) its body
+    point_root: np.ndarray     # (n_points,) the root of its body's tree (cvel, cacc are about its subtree_com)
+    clock_dof: int = -1        # simulation: dof of the drive's clock (-1: none)
+    drive_eq: int = -1         # simulation: id of the joint equality crank = clock
 
 
 def _compile(scene: Scene, floor: float, exact_masses: bool, **options) -> _Model:
@@ -250,7 +279,12 @@ def _compile(scene: Scene, floor: float, exact_masses: bool, **options) -> _Mode
             k = name(mujoco.mjtObj.mjOBJ_BODY, f"slot{p.index}")
             m.body_mass[k] = 0.0
             m.body_inertia[k] = 0.0
-    return _Model(m, d, body, joint_dof, slot_dof, rows, eq_id, int(joint_dof[scene.crank_joint]))
+    sites = np.array([name(mujoco.mjtObj.mjOBJ_SITE, f"pt{i}") for i in range(len(tracked_points(scene.mech)))],
+                     int)
+    clock = name(mujoco.mjtObj.mjOBJ_JOINT, "clock")
+    return _Model(m, d, body, joint_dof, slot_dof, rows, eq_id, int(joint_dof[scene.crank_joint]), sites,
+                  m.site_bodyid[sites].copy(), m.body_rootid[m.site_bodyid[sites]].copy(),
+                  int(m.jnt_dofadr[clock]) if clock >= 0 else -1, name(mujoco.mjtObj.mjOBJ_EQUALITY, "drive"))
 
 
 def slot_motion(scene: Scene) -> dict:
@@ -329,6 +363,26 @@ def _reactions(scene: Scene, mm: _Model, M_drive: float) -> np.ndarray:
     return R
 
 
+def _point_kinematics(mm: _Model) -> np.ndarray:
+    """(3, n_points, 2) position, velocity and classical acceleration (world; m, m/s, m/s^2) of
+    the tracked points' sites, from MuJoCo's site_xpos and its body motions cvel and cacc (what
+    mj_objectVelocity and mj_objectAcceleration read: spatial vectors [angular; linear at the
+    tree's subtree_com], shifted to the site, with w x v added for the classical acceleration).
+    cacc comes from mj_rnePostConstraint, which must have run at this state, and starts from
+    the world's acceleration -gravity, as an accelerometer: gravity is added back."""
+    m, d = mm.m, mm.d
+    b = mm.point_body
+    p = d.site_xpos[mm.point_site, :2]
+    r = p - d.subtree_com[mm.point_root, :2]
+    zr = r[:, ::-1] * (-1.0, 1.0)                             # z x r (planar: w, alpha along z)
+    w, al = d.cvel[b, 2:3], d.cacc[b, 2:3]
+    v = d.cvel[b, 3:5] + w * zr
+    a = d.cacc[b, 3:5] + al * zr + w * v[:, ::-1] * (-1.0, 1.0) + m.opt.gravity[:2]
+    out = np.empty((3,) + p.shape)
+    out[0], out[1], out[2] = p, v, a
+    return out
+
+
 # ----------------------------------------------------------------------------- exact route
 
 def _kinematics(m, d) -> None:
@@ -364,6 +418,7 @@ def solve(scene: Scene, keep_floors: bool = False) -> EngineResult:
     F_ext, M_ext = scene.external()
     M_drive = np.full(N, np.nan)
     R = np.full((N, len(scene.mech.pairs), 2), np.nan)
+    kin = np.full((3, N, len(mm.point_site), 2), np.nan)
     rne = np.zeros(nv)
     S = np.zeros(nv)
     S[mm.crank_dof] = 1.0
@@ -387,13 +442,14 @@ def solve(scene: Scene, keep_floors: bool = False) -> EngineResult:
         mujoco.mj_rnePostConstraint(m, d)               # cfrc_int from qacc, efc_force, xfrc_applied
         M_drive[i] = x[0]
         R[i] = _reactions(scene, mm, x[0])
+        kin[:, i] = _point_kinematics(mm)
     if off_plane > OFF_PLANE_TOL:
         raise RuntimeError(f"an out-of-plane constraint row is not zero (|J| up to {off_plane:.3g}): "
                            f"the MJCF is not planar")
     run = time.perf_counter() - t0
     masses = "placeholder floors kept" if keep_floors else "massless bodies exactly massless"
     return EngineResult("mujoco", "exact", scene.phi_deg.copy(), M_drive, R,
-                        build_seconds=build, run_seconds=run,
+                        points=tracked_points(scene.mech), x=kin[0], v=kin[1], a=kin[2], build_seconds=build, run_seconds=run,
                         note=f"MuJoCo {mujoco.__version__}: [S | J^T][tau; lambda] = mj_rne - applied at the "
                              f"exact state, reactions from cfrc_int (tree) and efc_force (cuts); {masses}; "
                              f"largest loop-closure gap at the exact state {gap:.2g} (m or rad)")
@@ -404,38 +460,43 @@ def solve(scene: Scene, keep_floors: bool = False) -> EngineResult:
 def simulate(scene: Scene, steps_per_rev: int = SIM_STEPS_PER_REV, run_in_deg: float = 30.0,
              timeconst_steps: float = 2.0, impedance: float = 0.9999,
              floor: float = SIM_FLOOR) -> EngineResult:
-    """Driving moment and reactions from MuJoCo's forward dynamics (route "simulation").
+    """Driving moment, reactions and point kinematics from MuJoCo's forward dynamics (route
+    "simulation"), stepped by MuJoCo's own multi-step rollout (`mujoco.rollout`, C++), without a
+    Python loop over the steps.
 
     The mechanism starts `run_in_deg` before the first sample angle in the exact state there
     (joint coordinates and rates from the scene's motion) and is integrated by MuJoCo
-    (semi-implicit Euler, `mj_Euler`) with `steps_per_rev` steps per crank revolution; the
-    sample instants are inserted into the time grid, so every sample is a step boundary.
+    (semi-implicit Euler, `mj_step`) at `steps_per_rev` uniform steps per crank revolution.
 
-    Drive (prescribed crank motion, computed torque): MuJoCo's constrained forward dynamics is
-    affine in the crank torque tau (the equality-only constraint problem is quadratic and
-    solved exactly by the Newton solver), so at every step the accelerations are evaluated for
-    tau = 0 and tau = 1 and tau is chosen to give the crank the acceleration
-    qdd_ref + kv (qd_ref - qd) + kp (q_ref - q) of the prescribed motion (constant speed: the
-    feedback terms only catch integration round-off; kp, kv put a critically damped pole at 20
-    times the crank speed). tau, the reactions and everything else come from MuJoCo's own
-    dynamics at the simulated state; the solver's torque and reactions are never used.
+    Drive (prescribed crank motion): a "clock", a flywheel on its own hinge with an inertia
+    CLOCK_INERTIA times a bound of the driving moment over omega^2 (it loses at most
+    2 pi / CLOCK_INERTIA of its speed in a revolution), turns at the crank speed, and a joint
+    equality constraint ties the crank's angle to it (the crank's weight in the constraint's
+    regularisation is the clock's, so the tie is stiff: it follows the Baumgarte reference of the
+    loop constraints with no extra softness). The driving moment is that constraint's force:
+    MuJoCo's own, at the simulated state. The solver's torque and reactions are never used.
 
     Loop closures are MuJoCo's soft equality constraints made as stiff as MuJoCo allows:
     solref time constant `timeconst_steps` time steps (MuJoCo's stability floor is 2 steps)
     with critical damping, constant impedance `impedance` (MuJoCo's maximum is 0.9999).
-    Accuracy (measured, see tests/test_engine_mujoco.py): the error falls as 1/steps_per_rev
-    (first order: semi-implicit Euler with the Baumgarte stabilisation tied to the step) and
-    does not depend on the impedance between 0.999 and 0.9999; 7200 steps/rev give 2e-7 ..
-    1.7e-4 of each quantity's peak on the project's models.
+    The error falls as 1/steps_per_rev (first order: semi-implicit Euler with the Baumgarte
+    stabilisation tied to the step).
 
     Applied loads (gas force tables, forces against the velocity, springs) are evaluated by
-    kinetostat's load model at the exact state of each step's crank angle and applied through
-    `xfrc_applied` at the centres of mass (the simulated state differs from the exact one by
-    the constraints' softness only). A working machine's drive is the gear mesh force, as in
-    `solve`. Needs a constant crank speed (drive.eps = 0): kinetostat's state at every angle
-    has omega = drive.omega, and a crank that accelerates passes through no two of them.
+    kinetostat's load model at the exact state of each step's crank angle and passed to the
+    rollout as its open-loop control (`xfrc_applied` at the centres of mass, per step).
+
+    Samples: the rollout returns the state after every step. At each sample instant (the
+    previous step's state, advanced by one partial step where the instant falls between
+    steps) `mj_forward` recomputes what MuJoCo computed in that step: the constraint forces
+    (`efc_force`), then `mj_rnePostConstraint` the joint forces `cfrc_int` and the sites'
+    accelerations; the loads there are the solver's at that angle (a load against the velocity
+    flips at a dead centre). A working machine's drive is the gear mesh force, as in `solve`.
+    Needs a constant crank speed (drive.eps = 0): kinetostat's state at every angle has
+    omega = drive.omega, and a crank that accelerates passes through no two of them.
     """
     import mujoco
+    from mujoco import rollout
     mech = scene.mech
     if mech.drive.eps != 0.0:
         raise ValueError(f"simulate: the crank must turn at a constant speed (drive.eps = 0), got "
@@ -448,77 +509,99 @@ def simulate(scene: Scene, steps_per_rev: int = SIM_STEPS_PER_REV, run_in_deg: f
     T = 2 * math.pi / omega
     dt = T / steps_per_rev
     tc = timeconst_steps * dt
-    mm = _compile(scene, floor, exact_masses=False, timestep=dt, solref=(tc, 1.0),
-                  solimp=(impedance, impedance, 0.001, 0.5, 2.0))
-    m, d = mm.m, mm.d
-    if timeconst_steps < 2.0:
-        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_REFSAFE
-    _regularisation_weights(scene, mm)
 
-    # time grid: uniform steps from the run-in start, with the sample instants inserted
+    # uniform steps from the run-in start; the sample instants (between steps or on them)
     phi = scene.phi_deg
     N = len(phi)
     t_sample = run_in_deg / 360 * T + ((phi - phi[0]) % 360.0) / 360.0 * T
-    n_end = int(math.ceil(t_sample.max() / dt - 1e-9))
-    t_grid = np.union1d(np.arange(n_end + 1) * dt, t_sample)
-    t_grid = t_grid[np.concatenate([[True], np.diff(t_grid) > 1e-9 * dt])]
-    k_sample = np.array([int(np.argmin(np.abs(t_grid - t))) for t in t_sample])
-    phi_grid = phi[0] - run_in_deg + np.degrees(omega * t_grid)
-    dense = _dense_scene(scene, phi_grid)
+    n_steps = int(math.ceil(t_sample.max() / dt - 1e-9))
+    t_grid = np.arange(n_steps + 1) * dt
+    dense = _dense_scene(scene, phi[0] - run_in_deg + np.degrees(omega * t_grid))
     if dense.res.singular.any():
         bad = np.unique(np.round(dense.phi_deg[dense.res.singular] % 360.0, 3))
         raise ValueError(f"simulate: the motion passes through singular positions at phi = {bad.tolist()} deg; "
                          f"a simulation cannot follow it there (use the exact route)")
+    F_ext, M_ext = dense.external()
+    mm = _compile(scene, floor, exact_masses=False, timestep=dt, solref=(tc, 1.0),
+                  solimp=(impedance, impedance, 0.001, 0.5, 2.0),
+                  clock_inertia=CLOCK_INERTIA * _moment_bound(scene, F_ext, M_ext) / omega**2)
+    m, d = mm.m, mm.d
+    if timeconst_steps < 2.0:
+        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_REFSAFE
+    _regularisation_weights(scene, mm)
+    m.dof_invweight0[mm.crank_dof] = m.dof_invweight0[mm.clock_dof]
     build = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     qpos, qvel, _ = _exact_state(dense, mm)
-    F_ext, M_ext = dense.external()
-    F_s, M_s = scene.external()          # at the samples: the very loads the solver had (a load
-    F_ext[k_sample], M_ext[k_sample] = F_s, M_s   # against the velocity flips at a dead centre)
-    cj = scene.crank_joint
-    q_ref = np.unwrap(dense.q[:, cj])
-    qd_ref, qdd_ref = dense.qd[:, cj], dense.qdd[:, cj]
-    wn = 20.0 * omega
-    kp, kv = wn**2, 2.0 * wn
-    c = mm.crank_dof
+    c, q_ref = mm.crank_dof, np.unwrap(dense.q[:, scene.crank_joint])
     d.qpos[:], d.qvel[:] = qpos[0], qvel[0]
-    d.qpos[c] = q_ref[0]
-    d.time = t_grid[0]
-    samples_at = {}
-    for k, n in enumerate(k_sample):
-        samples_at.setdefault(int(n), []).append(k)
+    d.qpos[c] = d.qpos[mm.clock_dof] = q_ref[0]
+    d.qvel[mm.clock_dof] = dense.qd[0, scene.crank_joint]
+    d.time = 0.0
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state0 = np.zeros(mujoco.mj_stateSize(m, spec))
+    mujoco.mj_getState(m, d, state0, spec)
+    xfrc = _xfrc(scene, mm, F_ext, M_ext)
+    states, _ = rollout.rollout(m, d, state0[None], xfrc[None, :n_steps].reshape(1, n_steps, -1),
+                                control_spec=mujoco.mjtState.mjSTATE_XFRC_APPLIED, nstep=n_steps)
+    states = np.concatenate([state0[None], states[0]])          # state at every grid instant
+
+    F_s, M_s = scene.external()          # at the samples: the very loads the solver had
+    x_s = _xfrc(scene, mm, F_s, M_s)
     M_drive = np.full(N, np.nan)
     R = np.full((N, len(mech.pairs), 2), np.nan)
+    kin = np.full((3, N, len(mm.point_site), 2), np.nan)
     drift = 0.0
-    for n in range(len(t_grid)):
-        _applied(scene, mm, F_ext[n], M_ext[n])
-        d.qfrc_applied[:] = 0.0
+    for k, t in enumerate(t_sample):
+        n = int(math.floor(t / dt + 1e-9))
+        mujoco.mj_setState(m, d, states[n], spec)
+        if t - n * dt > 1e-9 * dt:                              # a partial step to the instant
+            d.xfrc_applied[:] = xfrc[n]
+            m.opt.timestep = t - n * dt
+            mujoco.mj_step(m, d)
+            m.opt.timestep = dt
+        d.xfrc_applied[:] = x_s[k]
         mujoco.mj_forward(m, d)
-        a0 = d.qacc[c]
-        d.qfrc_applied[c] = 1.0
-        mujoco.mj_forwardSkip(m, d, mujoco.mjtStage.mjSTAGE_VEL, 0)
-        b = d.qacc[c] - a0
-        target = qdd_ref[n] + kv * (qd_ref[n] - d.qvel[c]) + kp * (q_ref[n] - d.qpos[c])
-        tau = (target - a0) / b
-        d.qfrc_applied[c] = tau
-        mujoco.mj_forwardSkip(m, d, mujoco.mjtStage.mjSTAGE_VEL, 0)
-        if n in samples_at:
-            mujoco.mj_rnePostConstraint(m, d)
-            r = _reactions(scene, mm, tau)
-            for k in samples_at[n]:
-                M_drive[k], R[k] = tau, r
-            drift = max(drift, float(np.max(np.abs(d.efc_pos[:d.ne]))))
-        if n + 1 < len(t_grid):
-            m.opt.timestep = t_grid[n + 1] - t_grid[n]
-            mujoco.mj_Euler(m, d)
+        mujoco.mj_rnePostConstraint(m, d)
+        M_drive[k] = d.efc_force[_drive_row(mm)]
+        R[k] = _reactions(scene, mm, M_drive[k])
+        kin[:, k] = _point_kinematics(mm)
+        drift = max(drift, float(np.max(np.abs(d.efc_pos[:d.ne]))))
     run = time.perf_counter() - t0
-    return EngineResult("mujoco", "simulation", phi.copy(), M_drive, R, build_seconds=build, run_seconds=run,
-                        note=f"MuJoCo {mujoco.__version__} forward dynamics, semi-implicit Euler, "
-                             f"{steps_per_rev} steps/rev (dt = {dt:.3g} s), run-in {run_in_deg} deg; crank "
-                             f"by computed torque; equality solref ({tc:.3g} s, 1), impedance {impedance}; "
-                             f"mass/inertia floor {floor} x scale; largest constraint violation at the "
-                             f"samples {drift:.2g} (m or rad)")
+    return EngineResult("mujoco", "simulation", phi.copy(), M_drive, R, points=tracked_points(mech),
+                        x=kin[0], v=kin[1], a=kin[2], build_seconds=build, run_seconds=run,
+                        note=f"MuJoCo {mujoco.__version__} forward dynamics by mujoco.rollout, semi-implicit "
+                             f"Euler, {steps_per_rev} steps/rev (dt = {dt:.3g} s), run-in {run_in_deg} deg; "
+                             f"crank tied to a clock flywheel (joint equality); equality solref ({tc:.3g} s, 1), "
+                             f"impedance {impedance}; mass/inertia floor {floor} x scale; largest constraint "
+                             f"violation at the samples {drift:.2g} (m or rad)")
+
+
+def _moment_bound(scene: Scene, F_ext: np.ndarray, M_ext: np.ndarray) -> float:
+    """A bound of the driving moment's size from the model alone, N m: inertia (the largest
+    m size^2 or I_S, times omega^2), weights and applied loads times the mechanism's size."""
+    _, I = _scales(scene)
+    size, omega = scene.mech.size, scene.mech.drive.omega
+    weight = sum(b.mass for b in scene.bodies) * scene.g
+    loads = np.nanmax(np.linalg.norm(F_ext, axis=-1).sum(axis=-1), initial=0.0)
+    return I * omega**2 + size * (weight + loads) + np.nanmax(np.abs(M_ext).sum(axis=-1), initial=0.0)
+
+
+def _xfrc(scene: Scene, mm: _Model, F: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """(N, nbody, 6) xfrc_applied of the loads F (N, L, 2) at the centres of mass and moments
+    M (N, L): force then torque, world frame."""
+    out = np.zeros((len(F), mm.m.nbody, 6))
+    for b in scene.bodies:
+        k = mm.body[b.link]
+        out[:, k, :2] = F[:, b.link]
+        out[:, k, 5] = M[:, b.link]
+    return out
+
+
+def _drive_row(mm: _Model) -> int:
+    """efc row of the clock's joint equality (its force is the torque on the crank)."""
+    return int(np.flatnonzero(mm.d.efc_id[:mm.d.ne] == mm.drive_eq)[0])
 
 
 def _regularisation_weights(scene: Scene, mm: _Model) -> None:

@@ -46,8 +46,9 @@ import numpy as np
 import pinocchio as pin
 
 from kinetostat.kinetostatics import gear_force
+from kinetostat.planar import rotate
 
-from .scene import EngineResult, Scene
+from .scene import EngineResult, Scene, tracked_points
 
 __all__ = ["solve", "forward_round_trip", "PinocchioScene"]
 
@@ -198,6 +199,37 @@ class PinocchioScene:
         aX = ao + al * rr - w * w * r
         return vX, aX, Jp, Jw
 
+    def frame_motion(self, q, v, a) -> np.ndarray:
+        """(L, 9) per link (row 0, the frame: zeros) the motion of its joint frame by Pinocchio's
+        forwardKinematics(q, v, a), world axes: origin x, y (m), angle (rad), origin velocity
+        x, y (m/s), angular velocity (rad/s), classical origin acceleration x, y (m/s^2),
+        angular acceleration (rad/s^2)."""
+        pin.forwardKinematics(self.model, self.data, q, v, a)
+        out = np.zeros((self.scene.mech.n_links, 9))
+        for k, jid in self.jid.items():
+            if not jid:
+                continue
+            oMi, vj, aj = self.data.oMi[jid], self.data.v[jid], self.data.a[jid]
+            R, vl, w = oMi.rotation, vj.linear, vj.angular[2]
+            ao = R @ (aj.linear + w * np.array([-vl[1], vl[0], 0.0]))    # classical, joint origin
+            out[k] = (*oMi.translation[:2], math.atan2(R[1, 0], R[0, 0]), *(R @ vl)[:2], w, *ao[:2],
+                      aj.angular[2])
+        return out
+
+    def point_kinematics(self, points, frames: np.ndarray) -> np.ndarray:
+        """(3, N, n_points, 2) position, velocity and classical acceleration (world; m, m/s,
+        m/s^2) of the (point name, link) `points` from `frame_motion` at N states (N, L, 9)."""
+        out = np.zeros((3, len(frames), len(points), 2))
+        for i, (name, k) in enumerate(points):
+            f = frames[:, k]
+            r = rotate(self._local(k, name), f[:, 2])
+            rp = np.stack([-r[:, 1], r[:, 0]], axis=-1)          # z x r
+            w, al = f[:, 5:6], f[:, 8:9]
+            out[0, :, i] = f[:, :2] + r
+            out[1, :, i] = f[:, 3:5] + w * rp
+            out[2, :, i] = f[:, 6:8] + al * rp - w**2 * r
+        return out
+
     def p_rows(self, with_drift: bool):
         """Rows (2 per P cut) of the P cuts' constraint Jacobian, their drift J-dot v
         (needs data.v, data.a with a = 0), and (X, n) per cut for the forces."""
@@ -267,6 +299,8 @@ def solve(scene: Scene) -> EngineResult:
     N, n_pairs = scene.q.shape[0], len(scene.mech.pairs)
     M_drive = np.full(N, np.nan)
     R = np.full((N, n_pairs, 2), np.nan)
+    points = tracked_points(scene.mech)
+    frames = np.full((N, scene.mech.n_links, 9), np.nan)
     S = np.zeros(ps.nv)
     S[ps.crank_v] = 1.0
     crank_link = scene.joints[scene.crank_joint].child
@@ -320,12 +354,14 @@ def solve(scene: Scene) -> EngineResult:
             jid = ps.jid[j.child]
             fw = data.oMi[jid].rotation @ data.f[jid].linear   # parent on child, world
             R[n, j.pair.index] = fw[:2] if j.pair.links[0] == j.parent else -fw[:2]
+        frames[n] = ps.frame_motion(q, v, a)
+    xp, vp, ap = ps.point_kinematics(points, frames)
     run = time.perf_counter() - t0
     scale = np.nanmax(np.abs(M_drive)) if np.isfinite(M_drive).any() else 1.0
     note = (f"pin {pin.__version__}; {model.nv} joints, {len(ps.r_cuts)} CONTACT_3D + {len(ps.p_cuts)} "
             f"P-row loop closures; constraint forces fed back as fext reproduce S tau to "
             f"{worst / (scale or 1.0):.1e} of max|tau|")
-    return EngineResult("pinocchio", "exact", scene.phi_deg.copy(), M_drive, R,
+    return EngineResult("pinocchio", "exact", scene.phi_deg.copy(), M_drive, R, points=points, x=xp, v=vp, a=ap,
                         build_seconds=build, run_seconds=run, note=note)
 
 

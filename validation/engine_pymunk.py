@@ -66,6 +66,13 @@ cpSimpleMotor.c, cpSpaceStep.c):
 - External loads (everything but gravity, which is pymunk's) come from `Scene.external()` of the
   same mechanism on the step grid: force at the centre of mass and moment about it, at the exact
   state of each step's angle.
+- Point kinematics: positions and velocities of the tracked points (`scene.tracked_points`)
+  from the bodies' own positions, angles and velocities (the velocity at a step's positions is
+  the mean of the half-step velocities either side). No accelerations: pymunk's state has none
+  (its solver works on velocities), and differences of the velocities carry the impulse
+  solver's iteration residual and every load jump (measured up to 1.3e-2 of the peak on the
+  slotted-link shaper at 1440 steps, 5.7e-3 at the scotch yoke's load flip), so they would
+  compare the difference quotient, not pymunk.
 - `drive.eps` != 0: the solver's state (constant omega with a nonzero eps at every angle) is not
   a motion a simulation can follow; all values are NaN with a note.
 """
@@ -81,9 +88,9 @@ import numpy as np
 from kinetostat import SingularPositionWarning, analyze
 from kinetostat.planar import rotate
 
-from .scene import EngineResult, Scene, build_scene
+from .scene import EngineResult, Scene, build_scene, tracked_points
 
-__all__ = ["simulate", "RICHARDSON_ORDER", "POSITION_CORRECTION", "MAX_DOUBLINGS",
+__all__ = ["simulate", "richardson_extrapolate", "RICHARDSON_ORDER", "POSITION_CORRECTION", "MAX_DOUBLINGS",
            "BRANCH_ANGLE_TOL", "BRANCH_POSITION_TOL", "JITTER_TOL", "BRANCH_BAND_DEG", "LEAD_DEG"]
 
 #: Order p of the step-size error f(dt) = f + c dt^p; Richardson: (2^p f(dt/2) - f(dt)) / (2^p - 1).
@@ -115,14 +122,19 @@ BRANCH_BAND_DEG = 5.0
 LEAD_DEG = 10.0
 
 
-def simulate(scene: Scene, steps_per_rev: int = 1440, iterations: int = 50,
-             richardson: bool = False) -> EngineResult:
+def simulate(scene: Scene, steps_per_rev: int = 720, iterations: int = 50,
+             richardson: bool = True) -> EngineResult:
     """Simulate one crank revolution of `scene` in pymunk: the reactions' magnitudes and the
     signed driving moment at the scene's angles (see the module docstring).
 
     steps_per_rev: time steps per crank revolution; iterations: pymunk `Space.iterations` to
     start with (doubled on instability); richardson: also run at 2 * steps_per_rev and
-    extrapolate with RICHARDSON_ORDER (both levels with the same iterations).
+    extrapolate with RICHARDSON_ORDER (both levels with the same iterations). The default,
+    Richardson over 720 and 1440 steps, costs ~1.5-2.5x one run at 1440 and is 15-300x more
+    accurate on five of the eight bundled models, 8x on the rotating slotted link, equal on the
+    scotch yoke (a load jump sets its error) and 2.6x less accurate on the furnace loader (its
+    two levels end at different iteration counts); measured in the benchmark and the table of
+    tests/test_engine_pymunk.py.
     """
     if not isinstance(steps_per_rev, (int, np.integer)) or steps_per_rev < 36:
         raise ValueError(f"steps_per_rev: expected an integer >= 36, got {steps_per_rev!r}")
@@ -131,8 +143,10 @@ def simulate(scene: Scene, steps_per_rev: int = 1440, iterations: int = 50,
     mech = scene.mech
     N, n_pairs = len(scene.phi_deg), len(mech.pairs)
     if mech.drive.eps != 0:
+        nan = np.full((N, len(tracked_points(mech)), 2), np.nan)
         return EngineResult("pymunk", "simulation", np.array(scene.phi_deg, float), np.full(N, np.nan),
                             np.full((N, n_pairs, 2), np.nan), magnitudes_only=True,
+                            points=tracked_points(mech), x=nan, v=nan,
                             note="drive.eps != 0: the solver's state (constant omega, nonzero eps at "
                                  "every angle) is not a motion a simulation can follow; all values NaN")
     n = int(steps_per_rev)
@@ -156,29 +170,35 @@ def simulate(scene: Scene, steps_per_rev: int = 1440, iterations: int = 50,
     for c in cycles:
         if c.warning:
             notes.append(c.warning)
-        M, R = c.M.copy(), c.R.copy()
+        M, R, kin = c.M.copy(), c.R.copy(), c.kin.copy()
         if c.bad.any():
             notes.append(c.failure + f"; values within {BRANCH_BAND_DEG:g} deg are NaN")
             band = _widen(c.bad, max(1, int(round(BRANCH_BAND_DEG / c.prep.dphi))))
-            M[band], R[band] = np.nan, np.nan
-        outs.append(_sample(c.prep, M, R))
+            M[band], R[band], kin[band] = np.nan, np.nan, np.nan
+        outs.append([_sample(c.prep, v) for v in (M, R, kin)])
     if richardson:
-        w = 2.0 ** RICHARDSON_ORDER
-        (M1, R1), (M2, R2) = outs
-        M_out, R_out = (w * M2 - M1) / (w - 1), (w * R2 - R1) / (w - 1)
+        M_out, R_out, kin = (richardson_extrapolate(c, f) for c, f in zip(*outs))
         head = f"Richardson (order {RICHARDSON_ORDER}) over {n} and {2 * n} steps/rev"
     else:
-        (M_out, R_out), = outs
+        (M_out, R_out, kin), = outs
         head = f"{n} steps/rev"
     notes.insert(0, f"{head}, {its} iterations; R[:, i] = [|R_i|, 0] (pymunk impulses are "
-                    f"magnitudes); M_drive signed (bias torque)")
+                    f"magnitudes); M_drive signed (bias torque); point positions and velocities from "
+                    f"the bodies' states (no accelerations: see the module docstring)")
     for p in preps:
         notes += p.notes
     R = np.zeros(R_out.shape + (2,))
     R[..., 0] = R_out
     return EngineResult("pymunk", "simulation", np.array(scene.phi_deg, float), M_out, R,
-                        magnitudes_only=True, build_seconds=build, run_seconds=run,
-                        note="; ".join(dict.fromkeys(notes)))
+                        magnitudes_only=True, points=preps[0].points, x=kin[:, 0], v=kin[:, 1],
+                        build_seconds=build, run_seconds=run, note="; ".join(dict.fromkeys(notes)))
+
+
+def richardson_extrapolate(coarse: np.ndarray, fine: np.ndarray, order: int = RICHARDSON_ORDER) -> np.ndarray:
+    """Richardson extrapolation of values at steps h (`coarse`) and h/2 (`fine`) whose error is
+    c h^order: (2^order fine - coarse) / (2^order - 1)."""
+    w = 2.0 ** order
+    return (w * fine - coarse) / (w - 1)
 
 
 class _Prep:
@@ -215,6 +235,7 @@ class _Prep:
         self.dt = 2 * math.pi / abs(self.omega1) / n
         self.machine = dr.kind == "machine"
         self.links = [b.link for b in scene.bodies]
+        self.points = tracked_points(mech)
         masses = [b.mass for b in scene.bodies if b.mass > 0]
         m_ref = max(masses) if masses else 1.0
         I_ref = max([b.I_S for b in scene.bodies if b.I_S > 0] or [m_ref * (mech.size / 4) ** 2])
@@ -269,6 +290,7 @@ class _Run:
     jitter: np.ndarray       # (n,) worst velocity jitter / JITTER_TOL
     tau_min: float           # smallest motor torque magnitude, N m
     M_all: np.ndarray        # (lead + n,) signed driving moment at every step, lead-in included
+    kin: np.ndarray          # (n, 2, n_points, 2) position and velocity of the tracked points
     build_seconds: float
     run_seconds: float
 
@@ -279,6 +301,7 @@ class _Cyc:
     prep: _Prep
     M: np.ndarray
     R: np.ndarray
+    kin: np.ndarray
     bad: np.ndarray          # (n,) step failed a check
     failure: str = ""        # which checks failed where
     warning: str = ""        # anything else the reader must know
@@ -312,17 +335,17 @@ def _cycle(prep: _Prep, iterations: int) -> _Cyc:
     warn = ""
     if min(r.tau_min for r in runs) <= 0.05 * K:
         warn = f"{prep.n} steps: the bias torque did not cover the driving moment: sign of M_drive uncertain"
-    return _Cyc(prep, last.M, last.R, pose_bad | jit_bad, "; ".join(fails), warn,
+    return _Cyc(prep, last.M, last.R, last.kin, pose_bad | jit_bad, "; ".join(fails), warn,
                 sum(r.build_seconds for r in runs), sum(r.run_seconds for r in runs))
 
 
-def _sample(prep: _Prep, M: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Step values (at phi0 + (k+1) dphi) interpolated in crank angle to the scene's angles."""
+def _sample(prep: _Prep, values: np.ndarray) -> np.ndarray:
+    """Step values (n, ...) at phi0 + (k+1) dphi, interpolated in crank angle to the scene's angles."""
     x = (np.arange(prep.n) + 1.0) * prep.dphi
     rel = (np.asarray(prep.scene.phi_deg, float) - prep.phi0) % 360.0
-    M_out = np.interp(rel, x, M, period=360.0)
-    R_out = np.stack([np.interp(rel, x, R[:, i], period=360.0) for i in range(R.shape[1])], axis=-1)
-    return M_out, R_out
+    flat = values.reshape(prep.n, -1)
+    out = np.stack([np.interp(rel, x, flat[:, i], period=360.0) for i in range(flat.shape[1])], axis=-1)
+    return out.reshape((len(rel),) + values.shape[1:])
 
 
 def _simulate(prep: _Prep, iterations: int, K: float, M_first: np.ndarray | None) -> _Run:
@@ -440,7 +463,25 @@ def _simulate(prep: _Prep, iterations: int, K: float, M_first: np.ndarray | None
     M_all = K + M_mesh - tau / f_u
     s = slice(lead, steps)
     return _Run(M_all[s], imp[s] / f_u, pose[s], jitter[s], float(np.min(tau[s])) / f_u, M_all,
-                build, run)
+                _point_kinematics(prep, state)[s], build, run)
+
+
+def _point_kinematics(prep: _Prep, state: np.ndarray) -> np.ndarray:
+    """(steps, 2, n_points, 2) position and velocity (world; m, m/s) of the tracked points from
+    the bodies' states, at the angle each step's positions reach. The velocities in `state` are
+    half a step ahead of the positions: the velocity there is the mean of the step's and the
+    previous step's (second order; the first step has no previous one and is NaN)."""
+    steps = len(state)
+    out = np.full((steps, 2, len(prep.points), 2), np.nan)
+    for n, (name, k) in enumerate(prep.points):
+        i = prep.links.index(k)
+        S, th, V, w = state[:, i, :2], state[:, i, 2], state[:, i, 3:5], state[:, i, 5]
+        r = rotate(np.asarray(prep.mech.links[k].points[name], float) - prep.com[k], th)
+        rp = np.stack([-r[:, 1], r[:, 0]], axis=-1)              # z x r
+        V_mid, w_mid = 0.5 * (V[1:] + V[:-1]), 0.5 * (w[1:] + w[:-1])
+        out[:, 0, n] = S + r
+        out[1:, 1, n] = V_mid + w_mid[:, None] * rp[1:]
+    return out
 
 
 def _groove(prep: _Prep, p, bodies):

@@ -30,7 +30,7 @@ from kinetostat import Analysis, Mechanism, analyze
 from kinetostat.model import Pair
 from kinetostat.planar import cross, rotate
 
-__all__ = ["Joint", "Body", "Scene", "EngineResult", "build_scene"]
+__all__ = ["Joint", "Body", "Scene", "EngineResult", "build_scene", "tracked_points"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +98,21 @@ class Scene:
     def M_drive(self) -> np.ndarray:
         """The solver's driving moment on the crank about +z, (N,), N m."""
         return self.res.balancing_moment
+
+
+def tracked_points(mech: Mechanism) -> tuple[tuple[str, int], ...]:
+    """The points whose kinematics the gate compares, as (point name, link): every moving link's
+    centre of mass and every pair's point (R: the joint, on its moving link; P: the slider
+    point, on the slider), each name once. Points of the frame (fixed) are left out."""
+    out: dict[str, int] = {}
+    for k, link in enumerate(mech.links):
+        if k and link.com is not None:
+            out.setdefault(link.com, k)
+    for p in mech.pairs:
+        k = p.links[1] if p.kind == "P" or p.links[1] != 0 else p.links[0]
+        if k != 0:
+            out.setdefault(p.point, k)
+    return tuple(out.items())
 
 
 def build_scene(mech: Mechanism, phi_deg=None, steps: int = 360, res: Analysis | None = None) -> Scene:
@@ -181,6 +196,10 @@ class EngineResult:
     M_drive: np.ndarray         # (N,) driving moment on the crank about +z, N m
     R: np.ndarray               # (N, n_pairs, 2) force of pair.links[0] on pair.links[1], N, world
     magnitudes_only: bool = False   # True: only |M_drive| and |R| are meaningful (pymunk)
+    points: tuple[tuple[str, int], ...] = ()   # (point name, link) of the kinematics below
+    x: np.ndarray | None = None  # (N, n_points, 2) positions of `points`, world, m (engine's own)
+    v: np.ndarray | None = None  # (N, n_points, 2) their velocities, m/s
+    a: np.ndarray | None = None  # (N, n_points, 2) their accelerations, m/s^2
     build_seconds: float = 0.0  # wall time to build the engine model
     run_seconds: float = 0.0    # wall time of the cycle
     note: str = ""              # anything the reader must know (step size, iterations, ...)

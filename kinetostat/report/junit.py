@@ -52,8 +52,7 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
         ET.SubElement(props, "property", name="positions", value=str(len(run.res.phi_deg)))
         counts = dict(tests=0, failures=0, errors=0, skipped=0)
         checks = {(c.route, c.quantity): c for c in run.checks}
-        qs = quantities(run.mech)
-        cases: list[tuple[str, list[str]]] = [(route, qs) for route in run.engines]
+        cases: list[tuple[str, list[str]]] = [(route, quantities(run.mech, route)) for route in run.engines]
         symbols = [c.entry.symbol for c in run.published]
         if PUBLISHED_ROUTE in run.errors:
             cases.append((PUBLISHED_ROUTE, ["(all)"]))

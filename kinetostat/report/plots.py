@@ -330,7 +330,7 @@ def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, 
 
 def plot_errors(run: ModelRun, path: Path) -> Path:
     res, m = run.res, run.mech
-    qs = quantities(m)
+    qs = [q for q in quantities(m) if q == "M_drive" or q.startswith("R(")]   # the force quantities
     rows, cols = _grid(len(qs))
     fig = _figure(4.6 * cols + 0.6, 3.0 * rows + 1.1)
     axes = fig.subplots(rows, cols, squeeze=False).ravel()

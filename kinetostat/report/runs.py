@@ -23,9 +23,14 @@ from .published import PublishedCheck, published_rows
 PUBLISHED_ROUTE = "published"
 
 
-def quantities(mech: Mechanism) -> list[str]:
-    """The quantities compare() checks, named as its rows name them."""
-    return ["M_drive"] + [f"R({p.links[0]},{p.links[1]})" for p in mech.pairs]
+def quantities(mech: Mechanism, route: str | None = None) -> list[str]:
+    """The quantities compare() checks (on `route`), named as its rows name them: the driving
+    moment, every reaction, a machine's F_bal, the friction losses P_f(i,j) where the model has
+    friction, and x, v, a of every tracked point (only those a route gives, POINT_KINEMATICS;
+    `kinetostat_validation.compare.quantity_names`)."""
+    from kinetostat_validation.compare import quantity_names
+
+    return quantity_names(mech, route)
 
 
 @dataclass(frozen=True)
