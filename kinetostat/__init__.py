@@ -6,6 +6,7 @@
     >>> mech.structure.formula
     'I(0,1) <- II(2,3)'
 """
+from . import examples
 from .analysis import Analysis, InertiaLoad, analyze
 from .errors import AssemblyError, ModelError, SingularPositionWarning, StructureError
 from .kinematics import COND_MAX, COND_WARN
@@ -14,5 +15,5 @@ from .structure import AssurGroup, Structure
 
 __all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
-           "SingularPositionWarning", "COND_WARN", "COND_MAX"]
+           "SingularPositionWarning", "COND_WARN", "COND_MAX", "examples"]
 __version__ = "0.1.0"
