@@ -496,6 +496,8 @@ def cmd_report(args) -> int:
 
 def cmd_examples(args) -> int:
     from . import examples
+    if args.force and args.copy is None:
+        raise CLIError("--force only goes with --copy DIR (it replaces files already in DIR)")
     if args.copy is not None:
         try:
             written = examples.copy(args.copy, overwrite=args.force)

@@ -111,6 +111,8 @@ def test_examples_copy_then_refuse_then_force(cli, tmp_path):
     assert (dest / "FORMAT.md").read_bytes() == (ROOT / "models" / "FORMAT.md").read_bytes()
     r = cli("examples", "--copy", dest / "FORMAT.md")
     assert r.returncode == EXIT_USAGE and "is not a directory" in r.stderr
+    r = cli("examples", "--force")
+    assert r.returncode == EXIT_USAGE and "--force only goes with --copy" in r.stderr
 
 
 # ----------------------------------------------------------------------------- no clash with validation/
