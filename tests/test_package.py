@@ -32,6 +32,11 @@ def _run(*cmd, cwd: Path, timeout: float = 600) -> subprocess.CompletedProcess:
                           timeout=timeout, stdin=subprocess.DEVNULL)
 
 
+@pytest.fixture(autouse=True)
+def bundled_models_only(monkeypatch):
+    monkeypatch.delenv("KINETOSTAT_MODELS", raising=False)
+
+
 @pytest.fixture
 def foreign_cwd(tmp_path) -> Path:
     """A working directory holding a user's own `validation/` package that fails on import."""
