@@ -11,6 +11,7 @@
 The solver's public names. May use: the solver modules only (never the harness
 `kinetostat_validation`, the engines, matplotlib or `kinetostat.report`).
 """
+from . import examples
 from .analysis import Analysis, InertiaLoad, analyze
 from .errors import AssemblyError, ModelError, SingularPositionWarning, StructureError
 from .kinematics import COND_MAX, COND_WARN
@@ -19,5 +20,5 @@ from .structure import AssurGroup, Structure
 
 __all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
-           "SingularPositionWarning", "COND_WARN", "COND_MAX"]
+           "SingularPositionWarning", "COND_WARN", "COND_MAX", "examples"]
 __version__ = "0.1.0"

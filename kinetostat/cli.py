@@ -1,4 +1,4 @@
-"""The command line: `kinetostat analyze | structure | validate | report` (also `python -m kinetostat`).
+"""The command line: `kinetostat analyze | structure | validate | report | examples` (also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
 nothing to compare; 2 bad input or options (model file, structure, assembly, angles, engine
@@ -582,6 +582,31 @@ def cmd_export(args) -> int:
     return EXIT_OK
 
 
+# ============================================================================ examples
+
+def cmd_examples(args) -> int:
+    from . import examples
+    if args.force and args.copy is None:
+        raise CLIError("--force only goes with --copy DIR (it replaces files already in DIR)")
+    if args.copy is not None:
+        try:
+            written = examples.copy(args.copy, overwrite=args.force)
+        except FileExistsError as exc:
+            raise CLIError(f"--copy {args.copy}: {exc.filename} {exc.strerror}; nothing copied "
+                           f"(--force replaces them)") from None
+        except OSError as exc:
+            raise CLIError(f"cannot write --copy {args.copy}: {exc.strerror or exc}") from None
+        _Out.write(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}")
+        return EXIT_OK
+    lines = [f"bundled models in {examples.models_dir()} (by name: kinetostat.load(NAME); "
+             f"copies: kinetostat examples --copy DIR):"]
+    for path in bundled_models():
+        m = _load(path)
+        lines.append(f"  {path.stem:<24s} {m.structure.formula:<34s} {m.source or m.name}")
+    _Out.write("\n".join(lines))
+    return EXIT_OK
+
+
 # ============================================================================ parser and main
 
 def build_parser() -> argparse.ArgumentParser:
@@ -590,7 +615,8 @@ def build_parser() -> argparse.ArgumentParser:
                 description="Kinetostatic analysis of planar linkages (graphical-analytic method, computed "
                             "exactly over the crank cycle) and its cross-validation against physics engines.",
                 epilog="Exit codes: 0 ok; 1 validation failed; 2 bad input or options. "
-                       "Bundled models: models/*.toml next to the package, or $KINETOSTAT_MODELS.")
+                       "Bundled models ship inside the package ('kinetostat examples' lists them); "
+                       "$KINETOSTAT_MODELS names another folder of *.toml models to use instead.")
     p.add_argument("--version", action="version", version=f"kinetostat {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
@@ -643,7 +669,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "print route, quantity, error, tolerance and PASS/FAIL. Routes whose engine is "
                                    "not installed are SKIPPED. Exit code 1 when any check fails, a route raises, "
                                    "or nothing was checked.")
-    v.add_argument("models", metavar="MODEL", nargs="*", help="model files (default: every bundled model)")
+    v.add_argument("models", metavar="MODEL", nargs="*",
+                   help="model files (default: every bundled model, see 'kinetostat examples')")
     v.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")
     v.add_argument("--steps", metavar="N", type=_steps, default=360, help="positions over the cycle (default 360)")
     v.add_argument("--junit", metavar="FILE", help="also write JUnit XML: one testcase per model x route x quantity "
@@ -662,12 +689,21 @@ def build_parser() -> argparse.ArgumentParser:
                                    "values where known, and cycle.csv; plus OUT/index.md and OUT/index.html. "
                                    "Exits 0 once the reports are written, also when checks fail (use "
                                    "'kinetostat validate' as the gate).")
-    r.add_argument("models", metavar="MODEL", nargs="*", help="model files (default: every bundled model)")
+    r.add_argument("models", metavar="MODEL", nargs="*",
+                   help="model files (default: every bundled model, see 'kinetostat examples')")
     r.add_argument("--out", metavar="DIR", default="reports", help="output directory (default: ./reports)")
     r.add_argument("--steps", metavar="N", type=_steps, default=360, help="positions over the cycle (default 360)")
     r.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_report)
+
+    e = sub.add_parser("examples", help="list the bundled models, or copy them (with FORMAT.md) into a folder",
+                       description="List the bundled models (the seeds' worked cases shipped inside the package, "
+                                   "or the *.toml files of $KINETOSTAT_MODELS): name, structure formula, source. "
+                                   "With --copy DIR, copy them and FORMAT.md into DIR to edit and run them.")
+    e.add_argument("--copy", metavar="DIR", help="copy every bundled model and FORMAT.md into DIR (created)")
+    e.add_argument("--force", action="store_true", help="with --copy: replace files already in DIR")
+    e.set_defaults(func=cmd_examples)
     return p
 
 

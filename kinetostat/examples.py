@@ -1,11 +1,18 @@
 """The bundled mechanisms (the seeds' worked cases): where they are, by name, and a copy of them.
 
+    >>> import kinetostat
+    >>> kinetostat.examples.names()[:2]
+    ['chain_unit_four_bar', 'compressor']
+    >>> mech = kinetostat.load("ice_crank_slider")          # a bundled model by name
+    >>> kinetostat.examples.copy("my_models")               # doctest: +SKIP
+
 The wheel carries the repository's `models/` folder as the package data `kinetostat/models/`; a
 checkout (editable install) reads `models/` beside the package. `$KINETOSTAT_MODELS` overrides both.
 May use: the standard library only (the model reader calls it to resolve a bare name).
 """
 from __future__ import annotations
 
+import errno
 import os
 import shutil
 from pathlib import Path
@@ -40,13 +47,17 @@ def path(name: str) -> Path:
 
 
 def copy(dest: str | Path, overwrite: bool = False) -> list[Path]:
-    """Copy every bundled model and FORMAT.md into `dest` (created); returns the written files.
+    """Copy every bundled model and FORMAT.md into the folder `dest` (created); returns the written files.
 
-    An existing file is left alone unless `overwrite` (FileExistsError names it)."""
+    Nothing is written if a file of that name is already there, unless `overwrite`: FileExistsError,
+    its `filename` the first such file. NotADirectoryError if `dest` is a file."""
     dest = Path(dest)
+    if dest.exists() and not dest.is_dir():
+        raise NotADirectoryError(f"{dest} is not a directory")
     src = [models_dir() / f"{n}.toml" for n in names()] + [models_dir() / "FORMAT.md"]
     clash = [dest / p.name for p in src if (dest / p.name).exists()]
     if clash and not overwrite:
-        raise FileExistsError(f"{clash[0]} exists (and {len(clash) - 1} more); pass overwrite to replace")
+        more = f" (and {len(clash) - 1} more of the {len(src)} files)" if len(clash) > 1 else ""
+        raise FileExistsError(errno.EEXIST, f"already exists{more}", str(clash[0]))
     dest.mkdir(parents=True, exist_ok=True)
     return [Path(shutil.copyfile(p, dest / p.name)) for p in src]

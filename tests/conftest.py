@@ -1,6 +1,9 @@
-"""Shared fixtures: the bundled models and a base model text for mutation tests."""
+"""Shared fixtures: the bundled models, a base model text for mutation tests, and the command
+line run in this process (`cli`)."""
 from __future__ import annotations
 
+import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +30,39 @@ def ice():
 @pytest.fixture
 def mech(model_path):
     return kinetostat.load(model_path)
+
+
+@dataclass(frozen=True)
+class CLIRun:
+    """What a run of the command line gave: exit code and the text of stdout and stderr."""
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+@pytest.fixture
+def cli(capsys, monkeypatch):
+    """`cli(*args, env=None, cwd=None)`: `kinetostat.cli.main(args)` run in this process, as
+    `python -m kinetostat` would run (exit code, stdout, stderr; an uncaught exception fails the
+    test, as a traceback would). $KINETOSTAT_MODELS is unset unless `env` sets it; the working
+    directory is the checkout unless `cwd`. A separate process proves nothing more, except for
+    the interpreter's own exit status and the entry points (kept as subprocess tests)."""
+    from kinetostat.cli import main
+
+    def run(*args, env: dict | None = None, cwd: Path | None = None) -> CLIRun:
+        monkeypatch.delenv("KINETOSTAT_MODELS", raising=False)
+        for k, v in (env or {}).items():
+            monkeypatch.setenv(k, v)
+        monkeypatch.chdir(cwd or ROOT)
+        monkeypatch.setattr(warnings, "showwarning", warnings.showwarning)   # main() replaces it
+        capsys.readouterr()
+        try:
+            code = main([str(a) for a in args])
+        except SystemExit as exc:            # --help and --version exit through argparse
+            code = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+        out, err = capsys.readouterr()
+        return CLIRun(code, out, err)
+    return run
 
 
 # A small four-bar written only here: frame O=(0,0), C=(0.3,0); crank 0.1, coupler 0.35, rocker 0.3.

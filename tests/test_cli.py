@@ -1,6 +1,9 @@
-"""The command line, run as the real program (`python -m kinetostat` and the `kinetostat` script):
-happy paths of every command, the validation gate's exit codes and JUnit file, and every bad
-input giving exit code 2, one line naming the problem and no traceback."""
+"""The command line: happy paths of every command, the validation gate's exit codes and JUnit
+file, and every bad input giving exit code 2, one line naming the problem and no traceback.
+
+Most tests call `kinetostat.cli.main` in this process (the `cli` fixture of conftest); the real
+program (`python -m kinetostat`, the `kinetostat` script) runs where only a process shows it:
+the interpreter's exit status, the entry points, output to a real pipe."""
 from __future__ import annotations
 
 import json
@@ -25,7 +28,8 @@ ICE = ROOT / "models" / "ice_crank_slider.toml"
 EXACT = ["pinocchio", "mujoco"]          # the fast engine routes
 
 
-def run(*args, env: dict | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess:
+def run_process(*args, env: dict | None = None, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """`python -m kinetostat ARGS` as a separate process."""
     e = dict(os.environ)
     e.pop("KINETOSTAT_MODELS", None)
     e.update(env or {})
@@ -42,20 +46,20 @@ def four_bar(tmp_path) -> Path:
 
 # ----------------------------------------------------------------------------- help and entry points
 
-def test_help_of_every_command():
-    top = run("--help")
+def test_help_of_every_command(cli):
+    top = cli("--help")
     assert top.returncode == 0
-    for cmd in ("analyze", "structure", "validate", "report"):
+    for cmd in ("analyze", "structure", "validate", "report", "examples"):
         assert cmd in top.stdout
-        h = run(cmd, "--help")
+        h = cli(cmd, "--help")
         assert h.returncode == 0, h.stderr
         assert "usage: kinetostat " + cmd in h.stdout
-    assert "--junit" in run("validate", "--help").stdout
-    assert "--at" in run("analyze", "--help").stdout
+    assert "--junit" in cli("validate", "--help").stdout
+    assert "--at" in cli("analyze", "--help").stdout
 
 
 def test_console_script_entry_point():
-    exe = shutil.which("kinetostat")
+    exe = shutil.which("kinetostat", path=os.path.dirname(sys.executable)) or shutil.which("kinetostat")
     if exe is None:
         pytest.skip("console script not installed (pip install -e .)")
     r = subprocess.run([exe, "structure", str(ICE)], capture_output=True, text=True, timeout=120)
@@ -63,31 +67,34 @@ def test_console_script_entry_point():
     assert "I(0,1) <- II(2,3)" in r.stdout
 
 
-def test_no_command_is_a_usage_error():
-    r = run()
+@pytest.mark.parametrize("args", [[], ["analyze", "no_such_model.toml"]], ids=["no command", "missing file"])
+def test_usage_error_is_the_process_exit_status(args, tmp_path):
+    """The real program: exit status 2 and one error line, no traceback (also from another folder)."""
+    r = run_process(*args, cwd=tmp_path)
     assert r.returncode == EXIT_USAGE
     assert "Traceback" not in r.stderr and r.stderr.startswith("kinetostat: error:")
+    assert len(r.stderr.strip().splitlines()) == 1
 
 
 # ----------------------------------------------------------------------------- structure and analyze
 
-def test_structure_ice():
-    r = run("structure", ICE)
+def test_structure_ice(cli):
+    r = cli("structure", ICE)
     assert r.returncode == 0, r.stderr
     assert "W = 3n - 2p5 - p4 = 3*3 - 2*4 - 0 = 1" in r.stdout
     assert "II(2,3)  RRP (kind 2)" in r.stdout
     assert "structure formula: I(0,1) <- II(2,3)" in r.stdout
 
 
-def test_structure_four_bar(four_bar):
-    r = run("structure", four_bar)
+def test_structure_four_bar(cli, four_bar):
+    r = cli("structure", four_bar)
     assert r.returncode == 0, r.stderr
     assert "RRR (kind 1)" in r.stdout and "= 1" in r.stdout
 
 
-def test_analyze_cycle_to_csv(tmp_path):
+def test_analyze_cycle_to_csv(cli, tmp_path):
     out = tmp_path / "ice.csv"
-    r = run("analyze", ICE, "--steps", 36, "--out", out)
+    r = cli("analyze", ICE, "--steps", 36, "--out", out)
     assert r.returncode == 0, r.stderr
     df = pd.read_csv(out)
     res = kinetostat.analyze(kinetostat.load(ICE), steps=36)
@@ -97,9 +104,9 @@ def test_analyze_cycle_to_csv(tmp_path):
         assert text in r.stdout
 
 
-def test_analyze_at_angles_to_json(four_bar, tmp_path):
+def test_analyze_at_angles_to_json(cli, four_bar, tmp_path):
     out = tmp_path / "fb.json"
-    r = run("analyze", four_bar, "--at", 0, 45, -90.5, "--out", out)
+    r = cli("analyze", four_bar, "--at", 0, 45, -90.5, "--out", out)
     assert r.returncode == 0, r.stderr
     rows = json.loads(out.read_text())
     res = kinetostat.analyze(kinetostat.load(four_bar), phi_deg=[0, 45, -90.5])
@@ -108,17 +115,17 @@ def test_analyze_at_angles_to_json(four_bar, tmp_path):
     assert "-90.5" in r.stdout       # the per-angle values are printed for a few angles
 
 
-def test_analyze_csv_to_stdout():
-    r = run("analyze", ICE, "--at", 30, "--out", "-")
+def test_analyze_csv_to_stdout(cli):
+    r = cli("analyze", ICE, "--at", 30, "--out", "-")
     assert r.returncode == 0, r.stderr
     assert r.stdout.splitlines()[0].startswith("phi_deg,")
     assert len(r.stdout.strip().splitlines()) == 2
     assert "balancing moment" in r.stderr       # the summary moves to stderr
 
 
-def test_analyze_parquet(tmp_path):
+def test_analyze_parquet(cli, tmp_path):
     out = tmp_path / "ice.parquet"
-    r = run("analyze", ICE, "--steps", 12, "--out", out)
+    r = cli("analyze", ICE, "--steps", 12, "--out", out)
     try:
         import pyarrow  # noqa: F401
     except ImportError:
@@ -130,12 +137,12 @@ def test_analyze_parquet(tmp_path):
         assert len(pd.read_parquet(out)) == 12
 
 
-def test_singular_position_warning_is_one_line(tmp_path):
+def test_singular_position_warning_is_one_line(cli, tmp_path):
     # rocker 0.05 m: at phi = 180 deg |AC| = 0.4 = l2 + l3, the dyad is stretched (toggle)
     p = tmp_path / "toggle.toml"
     p.write_text(FOUR_BAR.replace("C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.12, -0.01]",
                                   "C = [0.0, 0.0], B = [0.05, 0.0], S3 = [0.02, -0.01]"))
-    r = run("analyze", p, "--at", 179.9, 180.1)
+    r = cli("analyze", p, "--at", 179.9, 180.1)
     assert r.returncode == 0, r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("kinetostat: warning:") and "singular" in lines[0]
@@ -143,9 +150,9 @@ def test_singular_position_warning_is_one_line(tmp_path):
 
 # ----------------------------------------------------------------------------- validate
 
-def test_validate_passes_on_exact_engines_and_writes_junit(tmp_path):
+def test_validate_passes_on_exact_engines_and_writes_junit(cli, tmp_path):
     junit = tmp_path / "junit.xml"
-    r = run("validate", ICE, "--engines", *EXACT, "--junit", junit)
+    r = cli("validate", ICE, "--engines", *EXACT, "--junit", junit)
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     n_q = len(quantities(kinetostat.load(ICE)))            # M_drive and 4 reactions
@@ -161,9 +168,9 @@ def test_validate_passes_on_exact_engines_and_writes_junit(tmp_path):
                                                    "ice_crank_slider.published"}
 
 
-def test_validate_all_bundled_models_via_env(four_bar, tmp_path):
+def test_validate_all_bundled_models_via_env(cli, four_bar, tmp_path):
     """Without MODEL: every *.toml of $KINETOSTAT_MODELS (here a directory holding the four-bar)."""
-    r = run("validate", "--engines", "pinocchio", "--steps", 24, env={"KINETOSTAT_MODELS": str(four_bar.parent)})
+    r = cli("validate", "--engines", "pinocchio", "--steps", 24, env={"KINETOSTAT_MODELS": str(four_bar.parent)})
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert "== four_bar:" in r.stdout and "1 model(s)" in r.stdout
 
@@ -266,11 +273,11 @@ CASES = ["missing file", "missing file (validate)", "toml syntax", "unknown engi
 
 
 @pytest.mark.parametrize("case", CASES)
-def test_bad_input_exit_2_one_line_no_traceback(case, tmp_path, four_bar):
+def test_bad_input_exit_2_one_line_no_traceback(cli, case, tmp_path, four_bar):
     args, phrase = _bad_cases(tmp_path, four_bar)[case]
     empty = tmp_path / "empty"
     empty.mkdir()
-    r = run(*args, env={"KINETOSTAT_MODELS": str(empty)})
+    r = cli(*args, env={"KINETOSTAT_MODELS": str(empty)})
     assert r.returncode == EXIT_USAGE, (r.stdout, r.stderr)
     assert "Traceback" not in r.stderr
     lines = r.stderr.strip().splitlines()
@@ -278,9 +285,9 @@ def test_bad_input_exit_2_one_line_no_traceback(case, tmp_path, four_bar):
     assert lines[0].startswith("kinetostat: error:") and phrase in lines[0], lines[0]
 
 
-def test_model_error_lists_every_problem(tmp_path):
+def test_model_error_lists_every_problem(cli, tmp_path):
     p = tmp_path / "bad.toml"
     p.write_text(FOUR_BAR.replace("mass = 1.5", "mass = -1.5").replace("I_S = 0.009", "I_S = 'big'"))
-    r = run("analyze", p)
+    r = cli("analyze", p)
     assert r.returncode == EXIT_USAGE and "Traceback" not in r.stderr
     assert "2 problems" in r.stderr and "mass: must be >= 0" in r.stderr and "I_S: expected a finite number" in r.stderr

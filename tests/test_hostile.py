@@ -1,6 +1,7 @@
 """Hostile inputs: every bad model file or option must give one clear error naming the field or
 the crank angle, from the API (`kinetostat.load` / `analyze`) and from the command line
-(`python -m kinetostat analyze FILE`: exit code 2, no traceback, no partial output).
+(`kinetostat analyze FILE`, run in this process by conftest's `cli`: exit code 2, no
+traceback, no partial output).
 
 The corpus is `tests/hostile/*.toml`; each file starts with a header read by this module:
 
@@ -127,21 +128,16 @@ def test_api_gives_a_clear_error(c: Case):
 
 # ----------------------------------------------------------------------------- the CLI
 
-def run_cli(*args, timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "kinetostat", *map(str, args)], capture_output=True,
-                          text=True, cwd=ROOT, timeout=timeout)
-
-
 def _cli_available() -> bool:
     return (ROOT / "kinetostat" / "cli.py").exists()
 
 
 @pytest.mark.skipif(not _cli_available(), reason="kinetostat/cli.py not written yet")
 @pytest.mark.parametrize("c", _params(CASES))
-def test_cli_exits_cleanly(c: Case, tmp_path):
+def test_cli_exits_cleanly(c: Case, tmp_path, cli):
     out = tmp_path / "table.csv"
     angles = ["--at", *map(str, c.phi_deg)] if c.phi_deg else ["--steps", "12"]
-    p = run_cli("analyze", c.path, *angles, "--out", out)
+    p = cli("analyze", c.path, *angles, "--out", out)
     assert "Traceback" not in p.stderr, p.stderr
     assert p.returncode == c.cli, (p.returncode, p.stderr)
     if c.cli:
@@ -201,17 +197,17 @@ def test_missing_file_and_directory(tmp_path):
     (["--steps", "10", "--at", "0"], "not allowed with argument"),
     (["--out", "table.xlsx"], "unknown table format '.xlsx'"),
 ])
-def test_cli_bad_options(args, message, tmp_path):
+def test_cli_bad_options(args, message, tmp_path, cli):
     args = [str(tmp_path / a) if a.startswith("table.") else a for a in args]
-    p = run_cli("analyze", ROOT / "models" / "ice_crank_slider.toml", *args)
+    p = cli("analyze", ROOT / "models" / "ice_crank_slider.toml", *args)
     assert p.returncode == 2 and "Traceback" not in p.stderr, p.stderr
     assert message in p.stderr
     assert not list(tmp_path.iterdir())
 
 
 @pytest.mark.skipif(not _cli_available(), reason="kinetostat/cli.py not written yet")
-def test_cli_missing_model_file(tmp_path):
-    p = run_cli("analyze", tmp_path / "none.toml", "--out", tmp_path / "t.csv")
+def test_cli_missing_model_file(tmp_path, cli):
+    p = cli("analyze", tmp_path / "none.toml", "--out", tmp_path / "t.csv")
     assert p.returncode == 2 and "Traceback" not in p.stderr
     assert "model file not found" in p.stderr
     assert not (tmp_path / "t.csv").exists()
@@ -219,7 +215,7 @@ def test_cli_missing_model_file(tmp_path):
 
 # ----------------------------------------------------------------------------- huge and deep files
 
-def test_five_megabytes_of_comments_load_fast(tmp_path):
+def test_five_megabytes_of_comments_load_fast(tmp_path, cli):
     text = FOUR_BAR + ("# " + "x" * 78 + "\n") * 65_000          # 5.3 MB
     t0 = time.perf_counter()
     mech = kinetostat.loads(text)
@@ -228,7 +224,7 @@ def test_five_megabytes_of_comments_load_fast(tmp_path):
     if _cli_available():
         path = tmp_path / "commented.toml"
         path.write_text(text, encoding="utf-8")
-        p = run_cli("analyze", path, "--steps", "12")
+        p = cli("analyze", path, "--steps", "12")
         assert p.returncode == 0 and "Traceback" not in p.stderr
 
 

@@ -1,0 +1,179 @@
+"""The package as users get it: the bundled models by name (`kinetostat.examples`, `kinetostat
+examples`), the harness not shadowed by a user's own `validation/` folder, and (slow) the wheel
+installed into a fresh virtual environment and run from a folder outside the checkout."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+import kinetostat
+from conftest import MODELS, ROOT
+from kinetostat import examples
+from kinetostat.cli import EXIT_OK, EXIT_USAGE
+
+NAMES = [p.stem for p in MODELS]
+FOREIGN = 'raise ImportError("the foreign validation package of the working directory was imported")\n'
+
+
+def _env() -> dict:
+    """This environment less what could point a child process at the checkout's models or code."""
+    e = {k: v for k, v in os.environ.items() if k not in ("KINETOSTAT_MODELS", "PYTHONPATH")}
+    e["PIP_DISABLE_PIP_VERSION_CHECK"] = "1"
+    return e
+
+
+def _run(*cmd, cwd: Path, timeout: float = 600) -> subprocess.CompletedProcess:
+    return subprocess.run([str(c) for c in cmd], cwd=cwd, env=_env(), capture_output=True, text=True,
+                          timeout=timeout, stdin=subprocess.DEVNULL)
+
+
+@pytest.fixture(autouse=True)
+def bundled_models_only(monkeypatch):
+    monkeypatch.delenv("KINETOSTAT_MODELS", raising=False)
+
+
+@pytest.fixture
+def foreign_cwd(tmp_path) -> Path:
+    """A working directory holding a user's own `validation/` package that fails on import."""
+    work = tmp_path / "work"
+    (work / "validation").mkdir(parents=True)
+    for name in ("__init__.py", "compare.py"):
+        (work / "validation" / name).write_text(FOREIGN, encoding="utf-8")
+    shadow = _run(sys.executable, "-c", "import validation", cwd=work)     # it is in the way there
+    assert shadow.returncode != 0 and "foreign validation package" in shadow.stderr
+    return work
+
+
+# ----------------------------------------------------------------------------- kinetostat.examples
+
+def test_names_and_paths_are_the_checkout_models():
+    assert examples.names() == NAMES
+    assert [examples.path(n) for n in NAMES] == [examples.path(n + ".toml") for n in NAMES]
+    assert [examples.path(n).read_bytes() for n in NAMES] == [p.read_bytes() for p in MODELS]
+    assert (examples.models_dir() / "FORMAT.md").is_file()
+    with pytest.raises(FileNotFoundError, match="no bundled model named 'nope'; bundled: chain_unit_four_bar"):
+        examples.path("nope")
+
+
+def test_load_by_name_is_the_file():
+    by_name = kinetostat.load("ice_crank_slider")
+    by_file = kinetostat.load(ROOT / "models" / "ice_crank_slider.toml")
+    assert by_name.structure.formula == by_file.structure.formula == "I(0,1) <- II(2,3)"
+    assert by_name.links == by_file.links and by_name.pairs == by_file.pairs
+
+
+def test_copy_refuses_to_overwrite(tmp_path):
+    dest = tmp_path / "models"
+    written = examples.copy(dest)
+    assert sorted(p.name for p in written) == sorted([f"{n}.toml" for n in NAMES] + ["FORMAT.md"])
+    assert all((dest / p.name).read_bytes() == p.read_bytes() for p in MODELS)
+    (dest / "scotch_yoke.toml").write_text("# my edit\n")
+    with pytest.raises(FileExistsError) as exc:
+        examples.copy(dest)
+    assert exc.value.filename == str(dest / f"{NAMES[0]}.toml")                 # the first one there
+    assert (dest / "scotch_yoke.toml").read_text() == "# my edit\n"          # nothing written
+    examples.copy(dest, overwrite=True)
+    assert (dest / "scotch_yoke.toml").read_bytes() == (ROOT / "models" / "scotch_yoke.toml").read_bytes()
+    with pytest.raises(NotADirectoryError):
+        examples.copy(dest / "FORMAT.md")
+
+
+# ----------------------------------------------------------------------------- kinetostat examples
+
+def test_examples_lists_name_formula_and_source(cli):
+    r = cli("examples")
+    assert r.returncode == EXIT_OK, r.stderr
+    rows = r.stdout.splitlines()[1:]
+    assert [row.split()[0] for row in rows] == NAMES
+    for name, row in zip(NAMES, rows):
+        m = kinetostat.load(name)
+        assert m.structure.formula in row and m.source in row
+
+
+def test_examples_follow_kinetostat_models(cli, tmp_path):
+    (tmp_path / "mine.toml").write_text((ROOT / "models" / "scotch_yoke.toml").read_text())
+    r = cli("examples", env={"KINETOSTAT_MODELS": str(tmp_path)})
+    assert r.returncode == EXIT_OK and [row.split()[0] for row in r.stdout.splitlines()[1:]] == ["mine"]
+
+
+def test_examples_copy_then_refuse_then_force(cli, tmp_path):
+    dest = tmp_path / "mine"
+    r = cli("examples", "--copy", dest)
+    assert r.returncode == EXIT_OK, r.stderr
+    assert sorted(p.name for p in dest.iterdir()) == sorted([f"{n}.toml" for n in NAMES] + ["FORMAT.md"])
+    (dest / "FORMAT.md").write_text("my notes\n")
+    r = cli("examples", "--copy", dest)
+    assert r.returncode == EXIT_USAGE
+    line, = r.stderr.strip().splitlines()
+    assert line.startswith("kinetostat: error: --copy") and str(dest / "chain_unit_four_bar.toml") in line
+    assert "--force" in line and (dest / "FORMAT.md").read_text() == "my notes\n"
+    assert cli("examples", "--copy", dest, "--force").returncode == EXIT_OK
+    assert (dest / "FORMAT.md").read_bytes() == (ROOT / "models" / "FORMAT.md").read_bytes()
+    r = cli("examples", "--copy", dest / "FORMAT.md")
+    assert r.returncode == EXIT_USAGE and "is not a directory" in r.stderr
+    r = cli("examples", "--force")
+    assert r.returncode == EXIT_USAGE and "--force only goes with --copy" in r.stderr
+
+
+# ----------------------------------------------------------------------------- no clash with validation/
+
+def test_a_foreign_validation_folder_does_not_shadow_the_harness(foreign_cwd):
+    """`python -m` puts the working directory first on sys.path: the harness must not be `validation`."""
+    pytest.importorskip("pinocchio")
+    r = _run(sys.executable, "-m", "kinetostat", "validate", "--engines", "pinocchio", "--steps", 36,
+             "--no-progress", cwd=foreign_cwd)
+    assert r.returncode == EXIT_OK, r.stdout + r.stderr
+    assert f"validate: {len(NAMES)} model(s)" in r.stdout and " 0 FAILED" in r.stdout
+
+
+# ----------------------------------------------------------------------------- the wheel, installed
+
+@pytest.mark.slow
+def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
+    """Build the wheel, install it with [all] into a new virtual environment (no system site
+    packages, nothing of the checkout), and run the commands from a folder outside the checkout
+    that holds a foreign `validation/` package. ~1.5 min: the install (~35 s) and the report."""
+    dist = tmp_path / "dist"
+    r = _run(sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", dist, ROOT, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    wheel, = dist.glob("kinetostat-*.whl")
+    venv.create(tmp_path / "venv", with_pip=True)
+    bin_ = tmp_path / "venv" / ("Scripts" if os.name == "nt" else "bin")
+    py, exe = bin_ / "python", bin_ / "kinetostat"
+    r = _run(py, "-m", "pip", "install", "--quiet", f"{wheel}[all]", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+
+    work = foreign_cwd
+    r = _run(py, "-c", "import kinetostat, kinetostat_validation; kinetostat.load('ice_crank_slider'); "
+                       "print(kinetostat.examples.models_dir()); print(kinetostat_validation.__file__)", cwd=work)
+    assert r.returncode == 0, r.stderr
+    models_dir, harness = r.stdout.split()
+    for where in (models_dir, harness):               # the installed package, not the checkout
+        assert str(tmp_path / "venv") in where and str(ROOT) not in where
+
+    r = _run(exe, "validate", "--engines", "pinocchio", "mujoco", "--steps", 36, "--no-progress", cwd=work)
+    assert r.returncode == EXIT_OK, r.stdout + r.stderr
+    assert f"validate: {len(NAMES)} model(s)" in r.stdout and " 0 FAILED" in r.stdout
+
+    r = _run(exe, "report", "--out", work / "out", "--steps", 36, "--engines", "pinocchio", "--no-progress", cwd=work)
+    assert r.returncode == EXIT_OK, r.stdout + r.stderr
+    assert (work / "out" / "index.md").is_file()
+    assert all((work / "out" / n / "index.html").is_file() for n in NAMES)
+
+    r = _run(exe, "examples", "--copy", work / "mine", cwd=work)
+    assert r.returncode == EXIT_OK, r.stderr
+    assert sorted(p.name for p in (work / "mine").iterdir()) == sorted([f"{n}.toml" for n in NAMES] + ["FORMAT.md"])
+
+    # two models by file; and report's default output folder is ./reports of the working directory
+    r = _run(exe, "validate", "mine/ice_crank_slider.toml", "mine/scotch_yoke.toml", "--engines", "pinocchio",
+             "--steps", 36, "--no-progress", cwd=work)
+    assert r.returncode == EXIT_OK and "validate: 2 model(s)" in r.stdout, r.stdout + r.stderr
+    r = _run(exe, "report", "mine/scotch_yoke.toml", "--steps", 36, "--engines", "pinocchio", "--no-progress",
+             cwd=work)
+    assert r.returncode == EXIT_OK, r.stdout + r.stderr
+    assert (work / "reports" / "scotch_yoke" / "index.md").is_file()
