@@ -1,0 +1,1 @@
+"""The graphical method drawn: plans as data (`core`), built from the exact solution."""

@@ -1,0 +1,95 @@
+"""The data of a drawn plan (issue: the graphical method): named points in millimetres on the
+sheet, lettered segments, and the scale that turns a drawn length into the quantity it stands for.
+
+Every plan of the method (positions, velocity, acceleration, a group's plan and force plan, the
+initial link, Zhukovsky's lever) is a `Plan`: data first, drawn later (SVG sheets, matplotlib
+figures) by other rooms of this package. A segment's drawn length times the plan's scale is the
+magnitude of the quantity it stands for (`Segment.value`, SI).
+
+May use: numpy and the standard library. Never matplotlib at import time, never the harness.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Mapping
+
+__all__ = ["Scale", "Segment", "Plan", "SEGMENT_COLUMNS"]
+
+#: Columns of segments.csv, in order.
+SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
+                   "value", "unit", "scale")
+
+
+@dataclass(frozen=True)
+class Scale:
+    """A drawing scale: `value` SI units of the quantity per millimetre drawn (the texts' μ)."""
+    symbol: str          # "mu_l", "mu_v", "mu_a", "mu_F"
+    value: float         # e.g. 0.001 for mu_l = 0.001 m/mm
+    unit: str            # "m/mm", "m/(s mm)", "m/(s^2 mm)", "N/mm"
+
+    def __str__(self) -> str:
+        return f"{self.symbol} = {self.value:g} {self.unit}"
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One drawn segment from point `start` to point `end` of its plan.
+
+    `name` is lettered as the texts letter it (`p-b`, `a-n2`, `R12`, `h_G2`); `value` is the
+    quantity it stands for in SI units (signed where the texts sign it, else a magnitude), so that
+    |value| = drawn length x scale for a vector or an arm drawn at the plan's scale; `kind` says how
+    it is drawn: "vector" (an arrow), "link" (a link of the mechanism), "arm" (a moment arm),
+    "line" (a construction line: a direction, a path). A segment whose quantity is not at the plan's
+    scale (a link of a lever, a path) has `value` NaN and unit "".
+    """
+    name: str
+    start: str
+    end: str
+    value: float
+    unit: str
+    kind: str = "vector"
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A plan of the method at one crank angle: points on the sheet (mm, x right, y up, the world's
+    orientation unless the plan says otherwise, e.g. the lever turned by 90 deg), its segments,
+    and its scale. `kind` is one of "positions", "velocity", "acceleration", "group:<i,j>",
+    "forces:<i,j>", "crank", "lever" (the `plan` column of segments.csv)."""
+    kind: str
+    title: str
+    scale: Scale
+    phi_deg: float
+    points: Mapping[str, complex]          # name -> x + 1j*y on the sheet, mm
+    segments: tuple[Segment, ...]
+    paths: Mapping[str, tuple[complex, ...]] = field(default_factory=dict)   # polylines (mm), e.g. paths of S
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "points", MappingProxyType(dict(self.points)))
+        object.__setattr__(self, "paths", MappingProxyType({k: tuple(v) for k, v in self.paths.items()}))
+
+    def length_mm(self, name: str) -> float:
+        """Drawn length of the segment `name`, mm."""
+        s = self.segment(name)
+        return abs(self.points[s.end] - self.points[s.start])
+
+    def segment(self, name: str) -> Segment:
+        for s in self.segments:
+            if s.name == name:
+                return s
+        raise KeyError(f"{self.kind}: no segment {name!r}; segments: {', '.join(s.name for s in self.segments)}")
+
+    def rows(self) -> list[dict]:
+        """One dict per segment with the columns of segments.csv (SEGMENT_COLUMNS)."""
+        out = []
+        for s in self.segments:
+            a, b = self.points[s.start], self.points[s.end]
+            out.append({"plan": self.kind, "segment": s.name, "from": s.start, "to": s.end,
+                        "x0_mm": a.real, "y0_mm": a.imag, "x1_mm": b.real, "y1_mm": b.imag,
+                        "length_mm": abs(b - a), "value": s.value, "unit": s.unit, "scale": str(self.scale)})
+        return out
+
+    def __repr__(self) -> str:
+        return (f"Plan({self.kind!r}, phi_deg={self.phi_deg:g}, {self.scale}, points={len(self.points)}, "
+                f"segments={len(self.segments)})")
