@@ -24,9 +24,46 @@ def _style(route: str, n: int = 0) -> tuple[str, Any]:
     return _ROUTE_STYLE.get(route, (_EXTRA[n % len(_EXTRA)], (0, (4, 2))))
 
 
-def _figure(w: float, h: float):
+def _figure(w: float, h: float, left: float, right: float, top: float, bottom: float):
+    """A figure w x h inches with a fixed layout: the margins around its axes grid in inches
+    (no constrained layout: it was three quarters of the report's time)."""
     from matplotlib.figure import Figure
-    return Figure(figsize=(w, h), layout="constrained")
+    fig = Figure(figsize=(w, h), layout=None)
+    fig.subplots_adjust(left=left / w, right=1 - right / w, top=1 - top / h, bottom=bottom / h)
+    return fig
+
+
+#: Grid of small panels, inches: panel size, gaps (room for tick labels, a two-line title and
+#: the y label), margins (a two-line suptitle on top, the x label and legend below).
+_CELL_W, _CELL_H, _GAP_W, _GAP_H, _LEFT, _RIGHT = 4.0, 2.4, 0.95, 0.85, 0.85, 0.2
+_LINE_10PT, _LEGEND_ROW, _CHARS_PER_INCH_10PT = 0.19, 0.22, 12.5
+#: characters of a 9 pt panel title on one line of a panel
+_TITLE_CHARS = int(_CELL_W * _CHARS_PER_INCH_10PT * 10 / 9)
+
+
+def _panels(n: int, title: str, n_legend: int, ncols_legend: int, cell_h: float = _CELL_H):
+    """Figure, its axes (a rows x cols grid for n panels, flat) and cols: the title on top
+    (wrapped to the width), room for a legend of n_legend entries in ncols_legend columns below."""
+    rows, cols = _grid(n)
+    w = _LEFT + _RIGHT + cols * _CELL_W + (cols - 1) * _GAP_W
+    lines = "\n".join(_wrap(t, int(w * _CHARS_PER_INCH_10PT), 3) for t in title.splitlines())
+    top = 0.15 + _LINE_10PT * (lines.count("\n") + 1) + 0.45       # the title, then a two-line panel title
+    bottom = 0.55 + _LEGEND_ROW * math.ceil(n_legend / max(ncols_legend, 1)) + 0.1
+    h = top + bottom + rows * cell_h + (rows - 1) * _GAP_H
+    fig = _figure(w, h, _LEFT, _RIGHT, top, bottom)
+    fig.subplots_adjust(wspace=_GAP_W / _CELL_W, hspace=_GAP_H / cell_h)
+    fig.suptitle(lines, fontsize=10, y=1 - 0.1 / h, va="top")
+    return fig, fig.subplots(rows, cols, squeeze=False).ravel(), cols
+
+
+def _legend(fig, handles: dict, ncols: int) -> None:
+    if handles:
+        fig.legend(list(handles.values()), list(handles), loc="lower center", ncols=ncols, fontsize=8,
+                   bbox_to_anchor=(0.5, 0.02 / fig.get_figheight()), frameon=False)
+
+
+def _legend_cols(n: int, most: int) -> int:
+    return max(1, min(n, most))
 
 
 def _save(fig, path: Path) -> Path:
@@ -63,9 +100,10 @@ def _link_name(mech: Mechanism, k: int) -> str:
     return "frame" if k == 0 else mech.links[k].name
 
 
-def _wrap(text: str, width: int = 52) -> str:
+def _wrap(text: str, width: int = _TITLE_CHARS, lines: int = 2) -> str:
+    """text on at most `lines` lines of `width` characters (cut with "…" beyond)."""
     import textwrap
-    return textwrap.fill(text, width)
+    return textwrap.fill(text, width, max_lines=lines, placeholder=" …")
 
 
 def _grid(n: int) -> tuple[int, int]:
@@ -112,7 +150,7 @@ def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
     from matplotlib.patches import Polygon
 
     m = res.mech
-    fig = _figure(8, 6.5)
+    fig = _figure(8, 6.5, left=0.8, right=0.2, top=0.6, bottom=0.6)
     ax = fig.subplots()
     W = _world(res, 0)
     size = m.size
@@ -255,7 +293,8 @@ def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
 
 def plot_moment(run: ModelRun, path: Path) -> Path:
     res, m = run.res, run.mech
-    fig = _figure(9.5, 6.5)
+    fig = _figure(9.5, 6.5, left=1.0, right=0.2, top=0.6, bottom=0.6)
+    fig.subplots_adjust(hspace=0.15)
     ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
     phi = res.phi_deg
     ax.plot(*_closed(phi, res.balancing_moment), color="black", lw=2.6, label="kinetostat: group by group")
@@ -278,9 +317,9 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
 
 def plot_reactions(run: ModelRun, path: Path) -> Path:
     res, m = run.res, run.mech
-    rows, cols = _grid(len(m.pairs))
-    fig = _figure(4.6 * cols + 0.6, 3.0 * rows + 0.9)
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    ncols = _legend_cols(1 + len(run.results), 5)
+    fig, axes, cols = _panels(len(m.pairs), f"{m.name}\nreaction magnitudes over the cycle "
+                              f"(R(i,j): force of link i on link j)", 1 + len(run.results), ncols)
     handles = {}
     for n_ax, (ax, p) in enumerate(zip(axes, m.pairs)):
         mag = np.linalg.norm(res.forces.R[:, p.index], axis=-1)
@@ -296,9 +335,7 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
         _phi_axis(ax, label=n_ax + cols >= len(m.pairs))
     for ax in axes[len(m.pairs):]:
         ax.set_visible(False)
-    fig.suptitle(f"{m.name}\nreaction magnitudes over the cycle (R(i,j): force of link i on link j)", fontsize=10)
-    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncols=min(len(handles), 5),
-               fontsize=8)
+    _legend(fig, handles, ncols)
     return _save(fig, path)
 
 
@@ -321,9 +358,9 @@ def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, 
 def plot_errors(run: ModelRun, path: Path) -> Path:
     res, m = run.res, run.mech
     qs = quantities(m)
-    rows, cols = _grid(len(qs))
-    fig = _figure(4.6 * cols + 0.6, 3.0 * rows + 1.1)
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    ncols = _legend_cols(2 * len(run.results), 4)
+    fig, axes, cols = _panels(len(qs), f"{m.name}\nerror of each engine route against kinetostat (log scale; "
+                                       f"dashed: the route's tolerance × the cycle's peak)", 2 * len(run.results), ncols)
     curves = {route: _error_curves(res, er) for route, er in run.results.items()}
     handles = {}
     for n_ax, (ax, q) in enumerate(zip(axes, qs)):
@@ -353,11 +390,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
         ax.grid(True, which="major", alpha=0.3)
     for ax in axes[len(qs):]:
         ax.set_visible(False)
-    fig.suptitle(f"{m.name}\nerror of each engine route against kinetostat (log scale; "
-                 f"dashed: the route's tolerance × the cycle's peak)", fontsize=10)
-    if handles:
-        fig.legend(list(handles.values()), list(handles), loc="outside lower center",
-                   ncols=min(len(handles), 4), fontsize=8)
+    _legend(fig, handles, ncols)
     return _save(fig, path)
 
 
@@ -365,9 +398,11 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
     """Tip of each revolute pair's reaction vector over the cycle (seed 004, figs. 13-14)."""
     res, m = run.res, run.mech
     pairs = [p for p in m.pairs if p.kind == "R"]
-    rows, cols = _grid(len(pairs))
-    fig = _figure(4.8 * cols + 0.4, 4.6 * rows + 0.8)
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    n_legend = 1 + sum(not er.magnitudes_only for er in run.results.values())
+    ncols = _legend_cols(n_legend, 4)
+    fig, axes, cols = _panels(len(pairs), f"{m.name}\nhodographs of the revolute pairs' reactions (tip of the force "
+                                          f"vector over the cycle, world frame; grey rays every 30° of φ)",
+                              n_legend, ncols, cell_h=3.6)
     phi = res.phi_deg
     handles = {}
     for ax, p in zip(axes, pairs):
@@ -405,8 +440,25 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
         ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9)
     for ax in axes[len(pairs):]:
         ax.set_visible(False)
-    fig.suptitle(f"{m.name}\nhodographs of the revolute pairs' reactions "
-                 f"(tip of the force vector over the cycle, world frame; grey rays every 30° of φ)", fontsize=10)
-    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncols=min(len(handles), 4),
-               fontsize=8)
+    _legend(fig, handles, ncols)
+    return _save(fig, path)
+
+
+def plot_balancing_force(res: Analysis, path: Path) -> Path:
+    """Working machine: the balancing force of the pinion on the crank's wheel over the cycle,
+    its magnitude and its world components (it acts along the fixed line of action)."""
+    m = res.mech
+    fig = _figure(9.5, 4.8, left=1.0, right=0.2, top=0.6, bottom=0.6)
+    ax = fig.subplots()
+    F = res.balancing_force
+    phi = res.phi_deg
+    ax.plot(*_closed(phi, np.linalg.norm(F, axis=-1)), color="black", lw=2.4, label="|F_bal|")
+    ax.plot(*_closed(phi, F[:, 0]), color="tab:blue", lw=1.4, ls="--", label="F_bal,x")
+    ax.plot(*_closed(phi, F[:, 1]), color="tab:orange", lw=1.4, ls=(0, (2, 2)), label="F_bal,y")
+    ax.axhline(0, color="0.3", lw=0.6)
+    ax.set_ylabel("balancing force, N")
+    ax.set_title(f"{m.name}\nbalancing force of the pinion on the crank's wheel (pitch point, line of action)",
+                 fontsize=10)
+    ax.legend(fontsize=8, loc="best")
+    _phi_axis(ax, step=30)
     return _save(fig, path)
