@@ -150,16 +150,25 @@ class Doc:
     def markdown(self) -> str:
         parts = ["" if b[0] == "toc" else self._block(b) for b in self.blocks]
         if any(b[0] == "toc" for b in self.blocks):
-            heads = [(lvl, text, sid) for lvl, text, sid in _headings("\n\n".join(parts)) if lvl == 2]
-            toc = "\n".join(f"- [{text}](#{sid})" for _, text, sid in heads)
+            # the headings alone parse as they do in the whole document (each is one line)
+            heads = _headings("\n\n".join(s for b, s in zip(self.blocks, parts) if b[0] == "h"))
+            toc = "\n".join(f"- [{text}](#{sid})" for lvl, text, sid in heads if lvl == 2)
             parts = [toc if b[0] == "toc" else s for b, s in zip(self.blocks, parts)]
         return "\n\n".join(s for s in parts if s) + "\n"
 
+    def write(self, folder: Path, name: str = "index") -> Path:
+        """`folder/name.md` and `folder/name.html` (the HTML rendered from that Markdown); the .md path."""
+        text = self.markdown()
+        (Path(folder) / f"{name}.md").write_text(text, encoding="utf-8")
+        (Path(folder) / f"{name}.html").write_text(self.html(folder, text), encoding="utf-8")
+        return Path(folder) / f"{name}.md"
+
     # -- HTML
-    def html(self, base: Path | None = None) -> str:
-        """The page rendered from `markdown()`; images read from `base` (the report's folder)."""
+    def html(self, base: Path | None = None, markdown: str | None = None) -> str:
+        """The page rendered from `markdown()` (or the given `markdown`, the same text already
+        written); images read from `base` (the report's folder)."""
         md = _markdown_it()
-        tokens = md.parse(self.markdown())
+        tokens = md.parse(self.markdown() if markdown is None else markdown)
         seen: dict[str, int] = {}
         for n, t in enumerate(tokens):
             if t.type == "heading_open":

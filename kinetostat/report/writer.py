@@ -312,8 +312,7 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
     doc.ul([f"[{p.name}]({p.name})" for p in images.values()] + ["[cycle.csv](cycle.csv): `res.to_frame()` of the cycle",
                                                                   "[summary.json](summary.json)"])
 
-    (d / "index.md").write_text(doc.markdown(), encoding="utf-8")
-    (d / "index.html").write_text(doc.html(d), encoding="utf-8")
+    doc.write(d)
 
     summary = dict(stem=run.stem, name=m.name, formula=m.structure.formula, positions=N,
                    passed=run.passed, checks=len(run.rows), failed=len(run.failed),
@@ -381,6 +380,4 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
     doc.table(["model", "mechanism", "structure formula", *routes, "published values", "result"], rows,
               "lll" + "r" * len(routes) + "ll")
     doc.p("The tolerances and why: see each report's table *Routes and their tolerances*.")
-    (out / "index.md").write_text(doc.markdown(), encoding="utf-8")
-    (out / "index.html").write_text(doc.html(out), encoding="utf-8")
-    return out / "index.md"
+    return doc.write(out)
