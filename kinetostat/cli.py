@@ -17,7 +17,7 @@ import warnings
 from pathlib import Path
 from typing import Sequence
 
-EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
+EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
 
 __all__ = ["main", "build_parser", "exit_code", "bundled_models", "CLIError"]
@@ -453,9 +453,8 @@ def cmd_validate(args) -> int:
 # ============================================================================ report
 
 def _report_job(path: str, engines: list[str], steps: int, out: str) -> dict:
-    """One model's report, in a worker process or in-process: load, analyse, run the routes,
-    write `out/<stem>/`. Returns {"summary", "warnings", "seconds"} or {"error"} (one line);
-    never raises, and Ctrl-C in a worker returns {"interrupted": True}."""
+    """One model's report: load, analyse, run the routes, write `out/<stem>/`. Returns
+    {"summary", "warnings", "seconds"} or {"error"} (one line); raises only KeyboardInterrupt."""
     from .report import run_validation, write_report
     t0 = time.perf_counter()
     try:
@@ -469,14 +468,20 @@ def _report_job(path: str, engines: list[str], steps: int, out: str) -> dict:
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
         summary = write_report(run, Path(out))
-    except KeyboardInterrupt:
-        return {"interrupted": True}
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
         msg = str(exc).strip().splitlines()
         return {"error": f"{type(exc).__name__}: {msg[0] if msg else ''}".rstrip(": ")}
     return {"summary": summary, "warnings": run.warnings, "seconds": time.perf_counter() - t0}
+
+
+def _worker_init() -> None:
+    """A report worker ends at once, silently, on Ctrl-C (the terminal sends it to the whole
+    process group): the main process reports the interruption. A KeyboardInterrupt would not
+    do, as it can land in a garbage-collection callback, which swallows it."""
+    import signal
+    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(EXIT_INTERRUPTED))
 
 
 def _jobs(text: str) -> int:
@@ -492,25 +497,24 @@ def _jobs(text: str) -> int:
 
 def _report_results(paths: list[Path], engines: list[str], steps: int, out: Path, jobs: int):
     """Yield (path, result of _report_job) as each model finishes; `jobs` > 1 runs them in a
-    process pool (only paths and names cross to the workers), 1 in this process."""
+    process pool (only paths and names cross to the workers, so any start method works), 1 in
+    this process. Ctrl-C cancels the models not started and raises KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
         for p in paths:
-            r = _report_job(str(p), engines, steps, str(out))
-            if r.get("interrupted"):
-                raise KeyboardInterrupt
-            yield p, r
+            yield p, _report_job(str(p), engines, steps, str(out))
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)))
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
     try:
         futures = {pool.submit(_report_job, str(p), engines, steps, str(out)): p for p in paths}
         for f in as_completed(futures):
-            r = f.result()
-            if r.get("interrupted"):
-                raise KeyboardInterrupt
+            try:
+                r = f.result()
+            except Exception as exc:          # noqa: BLE001 -- a worker that died (BrokenProcessPool)
+                r = {"error": f"its worker process failed ({type(exc).__name__}: {exc})"}
             yield futures[f], r
     except BaseException:
-        pool.shutdown(wait=True, cancel_futures=True)    # workers got the Ctrl-C too: they end at once
+        pool.shutdown(wait=True, cancel_futures=True)
         raise
     pool.shutdown(wait=True)
 
@@ -640,7 +644,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.code
     except KeyboardInterrupt:
         _error("interrupted")
-        return 130
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         try:
             sys.stdout = open(os.devnull, "w")

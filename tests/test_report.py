@@ -3,6 +3,7 @@ and the comparison with the seeds' published values."""
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 import re
 import subprocess
@@ -216,6 +217,12 @@ def test_report_cli_errors_become_one_line(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err
     assert code == 1 and "Traceback" not in err
     assert "kinetostat: error: ice_crank_slider.toml: RuntimeError: plotting failed (no report written)" in err
+    if multiprocessing.get_start_method() == "fork":     # the workers inherit the broken write_report
+        code = cli.main(["report", str(ICE), str(SHAPER), "--out", str(tmp_path), "--steps", "12",
+                         "--engines", "pinocchio", "--jobs", "2", "--no-progress"])
+        err = capsys.readouterr().err
+        assert code == 1 and "Traceback" not in err
+        assert err.count("RuntimeError: plotting failed (no report written)") == 2
     assert cli.main(["report", str(ICE), "--out", str(tmp_path), "--jobs", "0"]) == 2
     assert "invalid number of jobs '0'" in capsys.readouterr().err
 
