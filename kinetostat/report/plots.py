@@ -36,7 +36,7 @@ def _figure(w: float, h: float, left: float, right: float, top: float, bottom: f
 
 #: Grid of small panels, inches: panel size, gaps (room for tick labels, a two-line title and
 #: the y label), margins (a two-line suptitle on top, the x label and legend below).
-_CELL_W, _CELL_H, _GAP_W, _GAP_H, _LEFT, _RIGHT = 4.0, 2.4, 0.95, 0.85, 0.85, 0.2
+_CELL_W, _CELL_H, _GAP_W, _GAP_H, _LEFT, _RIGHT = 3.7, 2.3, 0.95, 0.85, 0.85, 0.2
 _LINE_10PT, _LEGEND_ROW, _CHARS_PER_INCH_10PT = 0.19, 0.22, 12.5
 #: characters of a 9 pt panel title on one line of a panel
 _TITLE_CHARS = int(_CELL_W * _CHARS_PER_INCH_10PT * 10 / 9)
@@ -120,7 +120,9 @@ def _wrap(text: str, width: int = _TITLE_CHARS, lines: int = 2) -> str:
 
 
 def _grid(n: int) -> tuple[int, int]:
-    cols = 1 if n == 1 else 2 if n <= 4 else 3
+    """rows, cols of n panels: at most two columns, so that a page 800 px wide shows the
+    figure at three quarters of its size or more (readable tick labels)."""
+    cols = 1 if n == 1 else 2
     return math.ceil(n / cols), cols
 
 
@@ -410,6 +412,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
 
 def plot_hodographs(run: ModelRun, path: Path) -> Path:
     """Tip of each revolute pair's reaction vector over the cycle (seed 004, figs. 13-14)."""
+    from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     pairs = [p for p in m.pairs if p.kind == "R"]
     n_legend = 1 + sum(not er.magnitudes_only for er in run.results.values())
@@ -448,6 +451,7 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
             ax.annotate(f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", R[i], xytext=(6, -14), textcoords="offset points",
                         fontsize=7, color="tab:red")
         ax.set_aspect("equal", adjustable="datalim")
+        ax.xaxis.set_major_locator(MaxNLocator(5))      # room for "−4000" on a narrow panel
         ax.grid(True, alpha=0.3)
         ax.set_xlabel("R_x, N")
         ax.set_ylabel("R_y, N")
