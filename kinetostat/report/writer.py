@@ -1,4 +1,4 @@
-"""Writes a model's report folder and the index over all reports.
+"""Writes a model's report folder and the index over the reports of one run.
 
 May use: every other room, the solver, and the harness's tolerances.
 """
