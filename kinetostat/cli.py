@@ -1,8 +1,8 @@
 """The command line: `kinetostat analyze | structure | validate | report | examples` (also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
-nothing to compare; 2 bad input or options (model file, structure, assembly, angles, engine
-names, output path). Expected problems print one `kinetostat: error: ...` line (a model file's
+nothing to compare, or `report` could not make a model's report; 2 bad input or options (model
+file, structure, assembly, angles, engine names, output path). Expected problems print one `kinetostat: error: ...` line (a model file's
 problem list prints one line per problem) and never a traceback; warnings print one line each.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ import warnings
 from pathlib import Path
 from typing import Sequence
 
-EXIT_OK, EXIT_FAIL, EXIT_USAGE = 0, 1, 2
+EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
 
 __all__ = ["main", "build_parser", "exit_code", "bundled_models", "CLIError"]
@@ -492,44 +492,115 @@ def _write_validation_json(runs, code: int, dest) -> None:
 
 # ============================================================================ report
 
+def _report_job(path: str, engines: list[str], steps: int, out: str) -> dict:
+    """One model's report: load, analyse, run the routes, write `out/<stem>/`. Returns
+    {"summary", "warnings", "seconds"} or {"error"} (one line); raises only KeyboardInterrupt."""
+    from .report import run_validation, write_report
+    t0 = time.perf_counter()
+    try:
+        from .analysis import analyze
+        mech = _load(path)
+        with warnings.catch_warnings():       # the main process printed the analysis' warnings
+            warnings.simplefilter("ignore")
+            t1 = time.perf_counter()
+            res = analyze(mech, steps=steps)
+            secs = time.perf_counter() - t1
+        run = run_validation(mech, engines, steps, res=res, path=path)
+        run.solver_seconds = secs
+        summary = write_report(run, Path(out))
+    except OSError as exc:
+        return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
+    except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
+        msg = str(exc).strip().splitlines()
+        return {"error": f"{type(exc).__name__}: {msg[0] if msg else ''}".rstrip(": ")}
+    return {"summary": summary, "warnings": run.warnings, "seconds": time.perf_counter() - t0}
+
+
+def _worker_init() -> None:
+    """A report worker ends at once, silently, on Ctrl-C (the terminal sends it to the whole
+    process group): the main process reports the interruption. A KeyboardInterrupt would not
+    do, as it can land in a garbage-collection callback, which swallows it."""
+    import signal
+    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(EXIT_INTERRUPTED))
+
+
+def _jobs(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"invalid number of jobs {text!r}: expected a positive integer, "
+                                         f"e.g. --jobs 4")
+    return n
+
+
+def _report_results(paths: list[Path], engines: list[str], steps: int, out: Path, jobs: int):
+    """Yield (path, result of _report_job) as each model finishes; `jobs` > 1 runs them in a
+    process pool (only paths and names cross to the workers, so any start method works), 1 in
+    this process. Ctrl-C cancels the models not started and raises KeyboardInterrupt here."""
+    if jobs == 1 or len(paths) == 1:
+        for p in paths:
+            yield p, _report_job(str(p), engines, steps, str(out))
+        return
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
+    try:
+        futures = {pool.submit(_report_job, str(p), engines, steps, str(out)): p for p in paths}
+        for f in as_completed(futures):
+            try:
+                r = f.result()
+            except Exception as exc:          # noqa: BLE001 -- a worker that died (BrokenProcessPool)
+                r = {"error": f"its worker process failed ({type(exc).__name__}: {exc})"}
+            yield futures[f], r
+    except BaseException:
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
 def cmd_report(args) -> int:
     import importlib.util
     if importlib.util.find_spec("matplotlib") is None:
         raise CLIError("kinetostat report needs matplotlib: pip install 'kinetostat[reports]'")
-    from .report import MIN_REPORT_STEPS, run_validation, write_index, write_report
+    from .report import MIN_REPORT_STEPS, write_index
     if args.steps < MIN_REPORT_STEPS:
         raise CLIError(f"--steps {args.steps}: a report over the cycle needs at least {MIN_REPORT_STEPS} positions")
     engines = _engines(args.engines)
     out = _writable_dir(args.out, "--out")
     paths = args.models or bundled_models()
-    jobs = _prepare(paths, args.steps)
+    prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
+    order = [p for p, *_ in prepared]
     t0 = time.perf_counter()
-    n_fail = 0
-    bar = _progress(len(jobs) * (len(engines) + 1), "report", not args.no_progress)
+    summaries: dict[Path, dict] = {}
+    n_fail, n_err = 0, 0
+    bar = _progress(len(order), "report", not args.no_progress)
     try:
-        for path, mech, res, secs in jobs:
-            bar.set_postfix_str(path.stem)
-            t1 = time.perf_counter()
-            run = run_validation(mech, engines, args.steps, res=res, path=path, on_route=lambda r: bar.update())
-            run.solver_seconds = secs
-            for w in run.warnings:
-                _warn(f"{path.name}: {w}")
-            try:
-                write_report(run, out)
-            except OSError as exc:
-                raise CLIError(f"cannot write the report of {path.name} into {out}: {exc.strerror or exc}") from None
+        for path, r in _report_results(order, engines, args.steps, out, args.jobs or os.cpu_count() or 1):
             bar.update()
-            n_fail += not run.passed
-            status = "PASS" if run.passed and run.rows else "FAIL" if not run.passed else "NOT CHECKED"
-            routes = ", ".join(f"{r} {run.status(r)}" for r in engines)
-            _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {time.perf_counter() - t1:5.1f} s"
-                       f"  -> {out / path.stem / 'index.html'}")
-        index = write_index(out)
+            if "error" in r:
+                n_err += 1
+                _error(f"{path.name}: {r['error']} (no report written)")
+                continue
+            for w in r["warnings"]:
+                _warn(f"{path.name}: {w}")
+            s = r["summary"]
+            summaries[path] = s
+            n_fail += not s["passed"]
+            status = "PASS" if s["passed"] and s["checks"] else "FAIL" if not s["passed"] else "NOT CHECKED"
+            routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
+            _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
+                       f"  -> {out / s['stem'] / 'index.html'}")
+        try:
+            index = write_index(out, [summaries[p] for p in order if p in summaries])
+        except OSError as exc:
+            raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
         _close(bar)
-    _Out.write(f"report: {len(jobs)} mechanism(s), {n_fail} with failed checks; index -> {index} and "
-               f"{index.with_suffix('.html')}; {time.perf_counter() - t0:.1f} s")
-    return EXIT_OK
+    _Out.write(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
+               + (f", {n_err} without a report (errors above)" if n_err else "")
+               + f"; index -> {index} and {index.with_suffix('.html')}; {time.perf_counter() - t0:.1f} s")
+    return EXIT_FAIL if n_err else EXIT_OK
 
 
 # ============================================================================ export
@@ -687,13 +758,18 @@ def build_parser() -> argparse.ArgumentParser:
                                    "(default: all bundled models) with the mechanism's data, its picture, "
                                    "plots over the cycle, error tables per engine route, the seeds' published "
                                    "values where known, and cycle.csv; plus OUT/index.md and OUT/index.html. "
-                                   "Exits 0 once the reports are written, also when checks fail (use "
-                                   "'kinetostat validate' as the gate).")
+                                   "The files carry no dates or run times (a rerun reproduces them byte for "
+                                   "byte); run times are printed here only. Exits 0 once the reports are "
+                                   "written, also when checks fail (use 'kinetostat validate' as the gate); "
+                                   "1 when a model's report could not be made.")
     r.add_argument("models", metavar="MODEL", nargs="*",
                    help="model files (default: every bundled model, see 'kinetostat examples')")
     r.add_argument("--out", metavar="DIR", default="reports", help="output directory (default: ./reports)")
     r.add_argument("--steps", metavar="N", type=_steps, default=360, help="positions over the cycle (default 360)")
     r.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")
+    r.add_argument("--jobs", "-j", metavar="N", type=_jobs, default=None,
+                   help="models reported in parallel by N worker processes (default: the number of cores; "
+                        "1: in this process)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_report)
 
@@ -719,7 +795,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.code
     except KeyboardInterrupt:
         _error("interrupted")
-        return 130
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         try:
             sys.stdout = open(os.devnull, "w")

@@ -3,12 +3,14 @@ and the comparison with the seeds' published values."""
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -21,20 +23,48 @@ from kinetostat.report.document import Doc
 pytest.importorskip("matplotlib")
 
 ICE = ROOT / "models" / "ice_crank_slider.toml"
+SHAPER = ROOT / "models" / "slotted_link_shaper.toml"      # a working machine
 PNGS = ["mechanism.png", "balancing_moment.png", "reactions.png", "errors.png", "hodographs.png"]
 
 
-@pytest.fixture(scope="module")
-def ice_report(tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("reports")
+def _report(out: Path, *args: str) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if k != "KINETOSTAT_MODELS"}
-    r = subprocess.run([sys.executable, "-m", "kinetostat", "report", str(ICE), "--out", str(out),
-                        "--steps", "36", "--engines", "pinocchio", "mujoco"],
+    r = subprocess.run([sys.executable, "-m", "kinetostat", "report", str(ICE), str(SHAPER), "--out", str(out),
+                        "--steps", "36", "--engines", "pinocchio", "mujoco", "--no-progress", *args],
                        capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
-    assert "ice_crank_slider" in r.stdout and "PASS" in r.stdout
-    return out
+    return r
+
+
+@pytest.fixture(scope="module")
+def reports(tmp_path_factory) -> tuple[Path, Path]:
+    """The same two reports written twice: in parallel (into a folder holding a stale report of
+    an earlier run) and in this process."""
+    parallel, serial = tmp_path_factory.mktemp("parallel"), tmp_path_factory.mktemp("serial")
+    stale = parallel / "stale_model"
+    stale.mkdir()
+    (stale / "summary.json").write_text(json.dumps(dict(stem="stale_model", name="stale", formula="x",
+                                                        passed=True, checks=1, routes={}, published=None)))
+    r = _report(parallel, "--jobs", "2")
+    assert "ice_crank_slider" in r.stdout and "slotted_link_shaper" in r.stdout and "PASS" in r.stdout
+    _report(serial, "--jobs", "1")
+    return parallel, serial
+
+
+@pytest.fixture(scope="module")
+def ice_report(reports) -> Path:
+    return reports[0]
+
+
+def test_reruns_are_byte_identical_and_jobs_do_not_matter(reports):
+    """No date, run time or process-dependent byte in any file: a second run (here in one process
+    instead of two workers) reproduces every file exactly."""
+    parallel, serial = reports
+    files = sorted(p.relative_to(serial) for p in serial.rglob("*") if p.is_file())
+    assert len(files) == 2 + 9 + 10       # the index; ice: 5 png, md, html, csv, json; the shaper + 1 png
+    for f in files:
+        assert (parallel / f).read_bytes() == (serial / f).read_bytes(), f
 
 
 def test_report_files(ice_report):
@@ -48,8 +78,45 @@ def test_report_files(ice_report):
     assert len(cycle) == 36 and {"phi_deg", "M_bal", "M_lever", "R_0_1"} <= set(cycle.columns)
     summary = json.loads((d / "summary.json").read_text())
     n_q = sum(len(kinetostat.report.quantities(kinetostat.load(ICE), r)) for r in ("pinocchio", "mujoco"))
-    assert summary["passed"] and summary["checks"] == n_q       # 2 x (M_drive, 4 R, 4 P_f, 4 points x 3)
+    n_q += len(kinetostat.load(ICE).published)      # 2 x (M_drive, 4 R, 4 P_f, 4 points x 3) + 15 published
+    assert summary["passed"] and summary["checks"] == n_q
     assert set(summary["routes"]) == {"pinocchio", "mujoco"}
+    assert summary["routes"]["pinocchio"]["tolerance"] == 1e-9
+    text = (d / "summary.json").read_text() + (d / "index.md").read_text()
+    assert not re.search(r"20\d\d-\d\d-\d\d|seconds", text)     # no dates, no run times
+
+
+def test_verdict_failed_checks_and_contents_on_top(ice_report):
+    md = (ice_report / "ice_crank_slider" / "index.md").read_text()
+    head = md.split("\n## ")[0]
+    lines = [ln for ln in head.splitlines() if ln]
+    n = json.loads((ice_report / "ice_crank_slider" / "summary.json").read_text())["checks"]
+    assert n > 15 and lines[1].startswith(f"**PASS**: all {n} checks within tolerance")
+    assert lines[2] == "Failed checks: none."
+    toc = re.findall(r"^- \[(.+)\]\(#([^)]+)\)$", head, re.M)
+    sections = re.findall(r"^## (.+)$", md, re.M)
+    assert [t for t, _ in toc] == sections and "Errors against the engines" in sections
+    # the links of the contents land on the headings' ids in the HTML (a browser decodes the %-escapes)
+    from urllib.parse import unquote
+    html = (ice_report / "ice_crank_slider" / "index.html").read_text()
+    hrefs = [unquote(h) for h in re.findall(r'href="#([^"]+)"', html)]
+    ids = re.findall(r'<h2 id="([^"]+)"', html)
+    assert hrefs == [a for _, a in toc] == ids
+
+
+def test_failed_checks_are_listed(tmp_path):
+    """A solver answer that is wrong on purpose: the report says FAIL and names the checks."""
+    from dataclasses import replace
+    mech = kinetostat.load(ICE)
+    res = kinetostat.analyze(mech, steps=24)
+    wrong = replace(res, forces=replace(res.forces, M_bal=res.forces.M_bal * 1.01))
+    run = run_validation(mech, ["pinocchio"], steps=24, res=wrong, path=ICE)
+    summary = write_report(run, tmp_path)
+    md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
+    assert not summary["passed"] and summary["failed"] == 1
+    assert f"**FAIL**: 1 of {len(run.checks)} checks beyond tolerance" in md.split("## ")[0]
+    assert re.search(r"^- pinocchio M_drive: peak-relative error 9\.9\de-03 > tolerance 1e-09 "
+                     r"\(max [\d.]+ N m at φ = [\d.]+°\)$", md, re.M)
 
 
 def test_report_markdown_has_data_tables_and_images(ice_report):
@@ -57,38 +124,63 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     mech = kinetostat.load(ICE)
     # mechanism data, structure, assumptions
     assert mech.name in md and mech.source in md and "g** = 9.81" in md
-    assert mech.assumptions[0] in md
     assert "| id | name | mass, kg | I_S, kg m² |" in md and "| P(0,3) | prismatic |" in md
     assert "3·3 − 2·4 − 0 = **1**" in md and "`I(0,1) <- II(2,3)`" in md
-    # the error table: every route x quantity with its tolerance and verdict
-    assert "| route | quantity | max abs error | RMS relative | peak relative | tolerance |" in md
-    rows = re.findall(r"^\| (pinocchio|mujoco) \| (M_drive|R\(\d,\d\)) \|.*\| \*\*PASS\*\* \|$", md, re.M)
+    # the error table: every route x quantity with the angle of its maximum, its tolerance and verdict
+    assert ("| route | quantity | max abs error | at φ, deg | peak relative | tolerance | RMS relative |"
+            in md)
+    rows = re.findall(r"^\| (pinocchio|mujoco) \| (M_drive|R\(\d,\d\)) \| (.*?) \| (.*?) \| (.*?) \| 1e-09 \|"
+                      r".*\| \*\*PASS\*\* \|$", md, re.M)
     assert len(rows) == 10
+    # exact routes agree to rounding: shown as such, never as a meaningless "8.0452e-14 N"
+    assert all(r[2] == "≈ 0 (rounding)" and r[3] == "-" and r[4] == "rounding" for r in rows), rows
+    assert not re.search(r"\de-1[3-9] N", md)
     assert "| route | kind | tolerance (peak-relative) | why this tolerance |" in md
     # the seed's published values, with the difference in %
     assert "## Against the published values" in md
     for symbol, value in [("V_B", "10.94"), ("R32", "6481"), ("M_bal (lever)", "102.97")]:
         assert re.search(rf"^\| {re.escape(symbol)} \|.*\| {value} \|.*%", md, re.M), symbol
-    # images linked next to the markdown
+    # images linked next to the markdown; an engine has no balancing force section
     for png in PNGS:
         assert f"]({png})" in md
+    assert "## Balancing force" not in md
 
 
-def test_report_html_is_self_contained(ice_report):
-    html = (ice_report / "ice_crank_slider" / "index.html").read_text()
+def test_machine_report_shows_the_balancing_force(ice_report):
+    d = ice_report / "slotted_link_shaper"
+    md = (d / "index.md").read_text()
+    assert "## Balancing force" in md and "](balancing_force.png)" in md
+    res = kinetostat.analyze(kinetostat.load(SHAPER), steps=36)
+    F = np.linalg.norm(res.balancing_force, axis=-1)
+    i = int(np.argmax(F))
+    assert f"| \\|F_bal\\| | {F[i]:.5g} | {res.phi_deg[i]:.4g} |" in md
+    assert (d / "balancing_force.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_report_html_is_markdown_it_rendering(ice_report):
+    from markdown_it import MarkdownIt
+    d = ice_report / "ice_crank_slider"
+    html = (d / "index.html").read_text()
     assert html.count('src="data:image/png;base64,') == len(PNGS)
     assert not re.search(r'src="(?!data:)', html)
-    assert "<table>" in html and 'class="pass"' in html
-    assert 'href="../index.html"' in html
+    assert '<div class="scroll"><table>' in html and 'class="pass"' in html
+    assert 'href="../index.html"' in html and 'href="cycle.csv"' in html
+    # the body is markdown-it's rendering of the Markdown file (tables as it renders them)
+    cell = MarkdownIt("commonmark").enable("table").render("| a |\n|---:|\n| **PASS** |\n")
+    assert '<td style="text-align:right"><strong>PASS</strong></td>' in cell
+    assert '<td style="text-align:right">' in html and "<strong>PASS</strong>" in html
 
 
-def test_index_over_reports(ice_report):
+def test_index_lists_only_this_run(ice_report):
     md = (ice_report / "index.md").read_text()
     assert "| model | mechanism | structure formula | pinocchio | mujoco |" in md
     assert "[ice_crank_slider](ice_crank_slider/index.md)" in md and "`I(0,1) <- II(2,3)`" in md
+    assert "[slotted_link_shaper](slotted_link_shaper/index.md)" in md
+    assert "stale" not in md
+    assert "rounding ≤ 1e-09 PASS" in md          # beside each error the route's tolerance
     assert "15/15 within" in md
     html = (ice_report / "index.html").read_text()
-    assert 'href="ice_crank_slider/index.html"' in html
+    assert 'href="ice_crank_slider/index.html"' in html and "stale" not in html
 
 
 def test_report_of_a_model_without_published_values(tmp_path):
@@ -100,7 +192,7 @@ def test_report_of_a_model_without_published_values(tmp_path):
     md = (tmp_path / "out" / "four_bar" / "index.md").read_text()
     assert summary["passed"] and summary["published"] is None
     assert "published values" not in md and "| pinocchio | R(0,3) |" in md
-    write_index(tmp_path / "out")
+    write_index(tmp_path / "out", [summary])
     assert "[four_bar](four_bar/index.md)" in (tmp_path / "out" / "index.md").read_text()
 
 
@@ -118,12 +210,58 @@ def test_published_values_agree(path):
     assert rows and all(r.passed for r in rows), [(r.entry.symbol, r.difference) for r in rows if not r.passed]
 
 
+def test_model_strings_cannot_inject_html_or_links(tmp_path):
+    """A model's name is text: markdown-it (raw HTML off) escapes tags; no javascript: link."""
+    p = tmp_path / "evil.toml"
+    p.write_text(FOUR_BAR.replace('name = "test four-bar"',
+                                  'name = "<script>alert(1)</script> [x](javascript:alert(1)) *b*"'))
+    run = run_validation(kinetostat.load(p), ["pinocchio"], steps=12, path=p)
+    write_report(run, tmp_path / "out")
+    html = (tmp_path / "out" / "evil" / "index.html").read_text()
+    assert "<script>" not in html and "&lt;script&gt;alert(1)&lt;/script&gt;" in html
+    assert 'href="javascript' not in html and "<em>b</em>" not in html
+
+
+def test_report_cli_errors_become_one_line(tmp_path, monkeypatch, capsys):
+    """A model whose report fails is its error line (exit 1), not a traceback; --jobs 0 is bad input."""
+    from kinetostat import cli
+    from kinetostat import report
+
+    def broken(run, out):
+        raise RuntimeError("plotting failed\nsecond line")
+    monkeypatch.setattr(report, "write_report", broken)
+    code = cli.main(["report", str(ICE), "--out", str(tmp_path), "--steps", "12", "--engines", "pinocchio",
+                     "--jobs", "1", "--no-progress"])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    assert "kinetostat: error: ice_crank_slider.toml: RuntimeError: plotting failed (no report written)" in err
+    if multiprocessing.get_start_method() == "fork":     # the workers inherit the broken write_report
+        code = cli.main(["report", str(ICE), str(SHAPER), "--out", str(tmp_path), "--steps", "12",
+                         "--engines", "pinocchio", "--jobs", "2", "--no-progress"])
+        err = capsys.readouterr().err
+        assert code == 1 and "Traceback" not in err
+        assert err.count("RuntimeError: plotting failed (no report written)") == 2
+    assert cli.main(["report", str(ICE), "--out", str(tmp_path), "--jobs", "0"]) == 2
+    assert "invalid number of jobs '0'" in capsys.readouterr().err
+
+
 def test_doc_renders_markdown_and_html():
     doc = Doc("t")
     doc.h(2, "A <b> title")
     doc.table(["a", "b"], [["x|y", "**FAIL**"]], "lr")
-    doc.p("see [here](x.md) and `code`")
+    doc.p("see [here](x.md) and `code` and [bad](javascript:alert(1))")
     md, html = doc.markdown(), doc.html()
     assert "| x\\|y | **FAIL** |" in md and "|---|---:|" in md
-    assert "A &lt;b&gt; title" in html and '<td class="fail"><b>FAIL</b></td>' in html
-    assert '<a href="x.md">here</a>' in html and "<code>code</code>" in html
+    assert '<h2 id="a-b-title">A &lt;b&gt; title</h2>' in html
+    assert '<td style="text-align:right" class="fail"><strong>FAIL</strong></td>' in html
+    assert '<a href="x.html">here</a>' in html and "<code>code</code>" in html
+    assert 'href="javascript' not in html
+
+
+def test_rounding_is_shown_as_such():
+    """The rule: below 1000 ulp of the peak (2.2e-13 of it) an error is rounding."""
+    from kinetostat.report.document import ROUNDING, _err, _rel
+    assert ROUNDING == pytest.approx(2.22e-13, rel=1e-3)
+    assert _err(8.0452e-14, 1200.0, "N") == "≈ 0 (rounding)"
+    assert _err(8.0452e-14, 0.1, "N") == "8.05e-14 N"         # 8e-13 of a 0.1 N peak: a real number
+    assert _rel(1.1e-15) == "rounding" and _rel(3e-13) == "3.00e-13"

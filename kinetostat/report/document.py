@@ -1,6 +1,12 @@
-"""A small document model rendered to Markdown and to self-contained HTML, and number formats.
+"""A small document model written as Markdown, and that same Markdown rendered to one
+self-contained HTML page by markdown-it-py; number formats of the reports.
 
-May use: the standard library only.
+The HTML is markdown-it's CommonMark rendering (tables enabled, raw HTML off, so any HTML or
+`javascript:` link in a model's strings comes out escaped or as text) with: heading ids by
+GitHub's rule (the table of contents links work in both), `.md` links to sibling reports turned
+into `.html`, images embedded as data URIs, tables wrapped in a horizontally scrolling box.
+
+May use: the standard library and markdown-it-py (imported inside `Doc.html`).
 """
 from __future__ import annotations
 
@@ -8,8 +14,14 @@ import base64
 import html
 import math
 import re
+import sys
+import unicodedata
 from pathlib import Path
 from typing import Any, Sequence
+
+#: An error smaller than this fraction of the cycle's peak is rounding (1000 units in the last
+#: place of the peak): an exact route that agrees to machine precision reads "rounding", not a number.
+ROUNDING = 1000 * sys.float_info.epsilon
 
 
 def _fmt(x: float | None, digits: int = 4) -> str:
@@ -29,11 +41,60 @@ def _fe(x: float | None) -> str:
     return "0" if x == 0 else f"{x:.2e}"
 
 
-class Doc:
-    """A small document model rendered both to Markdown and to self-contained HTML.
+def _rel(x: float | None) -> str:
+    """A peak-relative error: "rounding" below ROUNDING, else three significant digits."""
+    return "rounding" if _is_rounding(x) else _fe(x)
 
-    Inline text uses Markdown's `code`, **bold** and [text](href); everything else is literal.
-    """
+
+def _is_rounding(x: float | None) -> bool:
+    return x is not None and math.isfinite(x) and abs(x) < ROUNDING
+
+
+def _err(x: float | None, peak: float, unit: str) -> str:
+    """An absolute error in `unit`: "≈ 0 (rounding)" where it is below ROUNDING × peak."""
+    if x is not None and math.isfinite(x) and abs(x) < ROUNDING * abs(peak):
+        return "≈ 0 (rounding)"
+    return f"{_fmt(x)} {unit}" if x is not None and math.isfinite(x) else "n/a"
+
+
+#: Markup characters that act anywhere in a line (an underscore only at a word's edge); '|' is
+#: escaped by the table cells.
+_MD_SPECIAL = re.compile(r"([\\`*\[\]<]|(?<![A-Za-z0-9])_|_(?![A-Za-z0-9]))")
+#: Markup that acts at the start of a block (heading, quote, list, thematic break).
+_MD_START = re.compile(r"^(\s*)([#>+=~-]|\d+(?=[.)]))")
+
+
+def esc(text: Any) -> str:
+    """Text from a model file as literal Markdown (one line): its markup characters backslash-escaped."""
+    s = _MD_SPECIAL.sub(r"\\\1", " ".join(str(text).splitlines()))
+    return _MD_START.sub(lambda m: m[1] + (m[2] + "\\" if m[2][0].isdigit() else "\\" + m[2]), s)
+
+
+def slug(text: str, seen: dict[str, int] | None = None) -> str:
+    """GitHub's heading id: lower case, only letters, digits, '_', '-' and spaces (as '-');
+    a repeated id gets -1, -2, ... (pass the same `seen` for one document)."""
+    s = "".join(c for c in text.lower() if c in " -_" or unicodedata.category(c)[0] in "LN")
+    s = s.replace(" ", "-")
+    if seen is not None:
+        n = seen.get(s, 0)
+        seen[s] = n + 1
+        if n:
+            s = f"{s}-{n}"
+    return s
+
+
+def _markdown_it():
+    from markdown_it import MarkdownIt
+    return MarkdownIt("commonmark", {"html": False}).enable("table")
+
+
+def _plain(inline) -> str:
+    """The text of an inline token as GitHub sees it for a heading id (markup dropped)."""
+    return "".join(t.content for t in (inline.children or []) if t.type in ("text", "code_inline"))
+
+
+class Doc:
+    """Blocks of a report, written as Markdown (`markdown()`) and rendered from it (`html()`)."""
 
     def __init__(self, title: str):
         self.title = title
@@ -60,87 +121,98 @@ class Doc:
     def pre(self, text: str):
         self.blocks.append(("pre", text))
 
+    def toc(self):
+        """A list of links to every level-2 heading of the document (written where it is called)."""
+        self.blocks.append(("toc",))
+
     # -- Markdown
+    def _block(self, b: tuple) -> str:
+        kind = b[0]
+        if kind == "h":
+            return "#" * b[1] + " " + b[2]
+        if kind == "p":
+            return b[1]
+        if kind == "ul":
+            return "\n".join(f"- {i}" for i in b[1])
+        if kind == "table":
+            _, header, rows, align = b
+            cell = lambda s: str(s).replace("|", "\\|").replace("\n", " ")
+            lines = ["| " + " | ".join(cell(h) for h in header) + " |",
+                     "|" + "|".join("---:" if a == "r" else "---" for a in align) + "|"]
+            lines += ["| " + " | ".join(cell(c) for c in r) + " |" for r in rows]
+            return "\n".join(lines)
+        if kind == "img":
+            return f"![{b[2]}]({b[1].name})\n\n*{b[2]}*"
+        if kind == "pre":
+            return "```\n" + b[1].rstrip("\n") + "\n```"
+        raise ValueError(f"unknown block {kind!r}")
+
     def markdown(self) -> str:
-        out = []
-        for b in self.blocks:
-            kind = b[0]
-            if kind == "h":
-                out.append("#" * b[1] + " " + b[2])
-            elif kind == "p":
-                out.append(b[1])
-            elif kind == "ul":
-                out.append("\n".join(f"- {i}" for i in b[1]))
-            elif kind == "table":
-                _, header, rows, align = b
-                cell = lambda s: str(s).replace("|", "\\|").replace("\n", " ")
-                lines = ["| " + " | ".join(cell(h) for h in header) + " |",
-                         "|" + "|".join("---:" if a == "r" else "---" for a in align) + "|"]
-                lines += ["| " + " | ".join(cell(c) for c in r) + " |" for r in rows]
-                out.append("\n".join(lines))
-            elif kind == "img":
-                out.append(f"![{b[2]}]({b[1].name})\n\n*{b[2]}*")
-            elif kind == "pre":
-                out.append("```\n" + b[1].rstrip("\n") + "\n```")
-        return "\n\n".join(out) + "\n"
+        parts = ["" if b[0] == "toc" else self._block(b) for b in self.blocks]
+        if any(b[0] == "toc" for b in self.blocks):
+            # the headings alone parse as they do in the whole document (each is one line)
+            heads = _headings("\n\n".join(s for b, s in zip(self.blocks, parts) if b[0] == "h"))
+            toc = "\n".join(f"- [{text}](#{sid})" for lvl, text, sid in heads if lvl == 2)
+            parts = [toc if b[0] == "toc" else s for b, s in zip(self.blocks, parts)]
+        return "\n\n".join(s for s in parts if s) + "\n"
+
+    def write(self, folder: Path, name: str = "index") -> Path:
+        """`folder/name.md` and `folder/name.html` (the HTML rendered from that Markdown); the .md path."""
+        text = self.markdown()
+        (Path(folder) / f"{name}.md").write_text(text, encoding="utf-8")
+        (Path(folder) / f"{name}.html").write_text(self.html(folder, text), encoding="utf-8")
+        return Path(folder) / f"{name}.md"
 
     # -- HTML
-    @staticmethod
-    def inline(text: str) -> str:
-        s = html.escape(str(text), quote=False)
-        s = re.sub(r"`([^`]+)`", r"<code>\1</code>", s)
-        s = re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", s)
-        s = re.sub(r"\[([^\]]+)\]\(([^)\s]+)\)", lambda m: f'<a href="{html.escape(m[2])}">{m[1]}</a>', s)
-        return s
+    def html(self, base: Path | None = None, markdown: str | None = None) -> str:
+        """The page rendered from `markdown()` (or the given `markdown`, the same text already
+        written); images read from `base` (the report's folder)."""
+        md = _markdown_it()
+        tokens = md.parse(self.markdown() if markdown is None else markdown)
+        seen: dict[str, int] = {}
+        for n, t in enumerate(tokens):
+            if t.type == "heading_open":
+                t.attrSet("id", slug(_plain(tokens[n + 1]), seen))
+            elif t.type == "td_open" and tokens[n + 1].content.startswith(("**FAIL", "**ERROR", "**PASS")):
+                t.attrSet("class", "pass" if tokens[n + 1].content.startswith("**PASS") else "fail")
+            for c in t.children or []:
+                if c.type == "link_open":
+                    href = str(c.attrGet("href") or "")
+                    if not re.match(r"^[a-z][a-z0-9+.-]*:", href) and href.endswith(".md"):
+                        c.attrSet("href", href[:-3] + ".html")
+                elif c.type == "image" and base is not None:
+                    f = Path(base) / str(c.attrGet("src") or "")
+                    if f.is_file() and f.suffix == ".png":
+                        c.attrSet("src", "data:image/png;base64," + base64.b64encode(f.read_bytes()).decode("ascii"))
+        md.add_render_rule("table_open", lambda *a: '<div class="scroll"><table>\n')
+        md.add_render_rule("table_close", lambda *a: "</table></div>\n")
+        body = md.renderer.render(tokens, md.options, {})
+        return _HTML.format(title=html.escape(self.title), body=body)
 
-    def html(self) -> str:
-        body = []
-        for b in self.blocks:
-            kind = b[0]
-            if kind == "h":
-                body.append(f"<h{b[1]}>{self.inline(b[2])}</h{b[1]}>")
-            elif kind == "p":
-                body.append(f"<p>{self.inline(b[1])}</p>")
-            elif kind == "ul":
-                body.append("<ul>" + "".join(f"<li>{self.inline(i)}</li>" for i in b[1]) + "</ul>")
-            elif kind == "table":
-                _, header, rows, align = b
-                cls = lambda a: ' class="r"' if a == "r" else ""
-                head = "".join(f"<th{cls(a)}>{self.inline(h)}</th>" for h, a in zip(header, align))
-                trs = []
-                for r in rows:
-                    tds = []
-                    for c, a in zip(r, align):
-                        mark = ' class="fail"' if c.startswith(("**FAIL", "**ERROR")) else \
-                            ' class="pass"' if c.startswith("**PASS") else ""
-                        tds.append(f"<td{cls(a) if not mark else mark}>{self.inline(c)}</td>")
-                    trs.append("<tr>" + "".join(tds) + "</tr>")
-                body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(trs)}</tbody></table>")
-            elif kind == "img":
-                data = base64.b64encode(b[1].read_bytes()).decode("ascii")
-                body.append(f'<figure><img src="data:image/png;base64,{data}" alt="{html.escape(b[2])}">'
-                            f"<figcaption>{self.inline(b[2])}</figcaption></figure>")
-            elif kind == "pre":
-                body.append(f"<pre>{html.escape(b[1])}</pre>")
-        return _HTML.format(title=html.escape(self.title), body="\n".join(body))
+
+def _headings(markdown: str) -> list[tuple[int, str, str]]:
+    """(level, Markdown text, id) of every heading, ids as `Doc.html` and GitHub give them."""
+    tokens = _markdown_it().parse(markdown)
+    seen: dict[str, int] = {}
+    return [(int(t.tag[1]), tokens[n + 1].content, slug(_plain(tokens[n + 1]), seen))
+            for n, t in enumerate(tokens) if t.type == "heading_open"]
 
 
 _HTML = """<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{title}</title>
 <meta name="viewport" content="width=device-width, initial-scale=1">
 <style>
-body {{ font-family: system-ui, -apple-system, "Segoe UI", sans-serif; max-width: 1100px; margin: 2em auto;
-       padding: 0 1em; color: #222; line-height: 1.45; }}
-table {{ border-collapse: collapse; margin: 0.8em 0; font-size: 0.92em; }}
-th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }}
+body {{ font-family: system-ui, -apple-system, "Segoe UI", sans-serif; max-width: 60em; margin: 1.5em auto;
+       padding: 0 1em; color: #222; line-height: 1.45; overflow-wrap: break-word; }}
+.scroll {{ overflow-x: auto; max-width: 100%; margin: 0.8em 0; }}
+table {{ border-collapse: collapse; font-size: 0.9em; }}
+th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; vertical-align: top; }}
 th {{ background: #f2f2f2; }}
-td.r, th.r {{ text-align: right; font-variant-numeric: tabular-nums; }}
+td {{ font-variant-numeric: tabular-nums; }}
 td.pass {{ background: #e6f4e6; }} td.fail {{ background: #fbe3e3; }}
-figure {{ margin: 1em 0; }} img {{ max-width: 100%; }}
-figcaption {{ font-style: italic; color: #555; }}
+img {{ max-width: 100%; height: auto; }}
 code, pre {{ background: #f6f6f6; }} pre {{ padding: 0.6em; overflow-x: auto; }}
 </style></head>
 <body>
-{body}
-</body></html>
+{body}</body></html>
 """

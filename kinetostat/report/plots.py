@@ -24,25 +24,75 @@ def _style(route: str, n: int = 0) -> tuple[str, Any]:
     return _ROUTE_STYLE.get(route, (_EXTRA[n % len(_EXTRA)], (0, (4, 2))))
 
 
-def _figure(w: float, h: float):
+def _figure(w: float, h: float, left: float, right: float, top: float, bottom: float):
+    """A figure w x h inches with a fixed layout: the margins around its axes grid in inches
+    (no constrained layout: it measured every text of the figure, and drew it twice). Titles
+    are set with y=1.0: a fixed place, not one found by measuring the axes' tick labels."""
     from matplotlib.figure import Figure
-    return Figure(figsize=(w, h), layout="constrained")
+    fig = Figure(figsize=(w, h), layout=None)
+    fig.subplots_adjust(left=left / w, right=1 - right / w, top=1 - top / h, bottom=bottom / h)
+    return fig
+
+
+#: Grid of small panels, inches: panel size, gaps (room for tick labels, a two-line title and
+#: the y label), margins (a two-line suptitle on top, the x label and legend below).
+_CELL_W, _CELL_H, _GAP_W, _GAP_H, _LEFT, _RIGHT = 3.7, 2.3, 0.95, 0.85, 0.85, 0.2
+_LINE_10PT, _LEGEND_ROW, _CHARS_PER_INCH_10PT = 0.19, 0.22, 12.5
+#: characters of a 9 pt panel title on one line of a panel
+_TITLE_CHARS = int(_CELL_W * _CHARS_PER_INCH_10PT * 10 / 9)
+
+
+def _panels(n: int, title: str, n_legend: int, ncols_legend: int, cell_h: float = _CELL_H):
+    """Figure, its axes (a rows x cols grid for n panels, flat) and cols: the title on top
+    (wrapped to the width), room for a legend of n_legend entries in ncols_legend columns below."""
+    rows, cols = _grid(n)
+    w = _LEFT + _RIGHT + cols * _CELL_W + (cols - 1) * _GAP_W
+    lines = "\n".join(_wrap(t, int(w * _CHARS_PER_INCH_10PT), 3) for t in title.splitlines())
+    top = 0.15 + _LINE_10PT * (lines.count("\n") + 1) + 0.45       # the title, then a two-line panel title
+    bottom = 0.55 + _LEGEND_ROW * math.ceil(n_legend / max(ncols_legend, 1)) + 0.1
+    h = top + bottom + rows * cell_h + (rows - 1) * _GAP_H
+    fig = _figure(w, h, _LEFT, _RIGHT, top, bottom)
+    fig.subplots_adjust(wspace=_GAP_W / _CELL_W, hspace=_GAP_H / cell_h)
+    fig.suptitle(lines, fontsize=10, y=1 - 0.1 / h, va="top")
+    return fig, fig.subplots(rows, cols, squeeze=False).ravel(), cols
+
+
+def _legend(fig, handles: dict, ncols: int) -> None:
+    if handles:
+        fig.legend(list(handles.values()), list(handles), loc="lower center", ncols=ncols, fontsize=8,
+                   bbox_to_anchor=(0.5, 0.02 / fig.get_figheight()), frameon=False)
+
+
+def _legend_cols(n: int, most: int) -> int:
+    return max(1, min(n, most))
+
+
+#: Resolution of the PNGs, dots per inch.
+DPI = 110
 
 
 def _save(fig, path: Path) -> Path:
-    """PNG at 110 dpi, reduced to a 256-colour palette without dithering: a third of the size
-    of the RGBA file and visually the same for line plots (the HTML embeds every image)."""
-    import io
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, metadata={"Software": None})
-    try:
-        from PIL import Image
-        img = Image.open(buf).convert("RGB").quantize(colors=256, method=Image.Quantize.FASTOCTREE,
-                                                      dither=Image.Dither.NONE)
-        img.save(path, format="PNG", compress_level=6)
-    except ImportError:       # Pillow comes with matplotlib; keep the plain PNG if it does not
-        Path(path).write_bytes(buf.getvalue())
+    """PNG at DPI, reduced to a 256-colour palette without dithering: a third of the size of
+    the RGBA file and visually the same for line plots (the HTML embeds every image). The Agg
+    canvas' pixels go to Pillow (matplotlib's dependency) directly: no PNG written and read back.
+    Pillow writes no time or software chunk, so the file depends on the figure only."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+    canvas = FigureCanvasAgg(fig)
+    fig.set_dpi(DPI)
+    canvas.draw()
+    img = Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
+    img.convert("RGB").quantize(colors=256, method=Image.Quantize.FASTOCTREE,
+                                dither=Image.Dither.NONE).save(path, format="PNG", compress_level=6)
     return path
+
+
+def _log_ticks(ax) -> None:
+    """A log axis with at most 6 labelled decades and no minor ticks (each tick is an artist
+    to lay out: the minor ones were a quarter of the error plot's time)."""
+    from matplotlib.ticker import LogLocator, NullLocator
+    ax.yaxis.set_major_locator(LogLocator(numticks=6))
+    ax.yaxis.set_minor_locator(NullLocator())
 
 
 def _phi_axis(ax, label: bool = True, step: int = 60):
@@ -63,13 +113,16 @@ def _link_name(mech: Mechanism, k: int) -> str:
     return "frame" if k == 0 else mech.links[k].name
 
 
-def _wrap(text: str, width: int = 52) -> str:
+def _wrap(text: str, width: int = _TITLE_CHARS, lines: int = 2) -> str:
+    """text on at most `lines` lines of `width` characters (cut with "…" beyond)."""
     import textwrap
-    return textwrap.fill(text, width)
+    return textwrap.fill(text, width, max_lines=lines, placeholder=" …")
 
 
 def _grid(n: int) -> tuple[int, int]:
-    cols = 1 if n == 1 else 2 if n <= 4 else 3
+    """rows, cols of n panels: at most two columns, so that a page 800 px wide shows the
+    figure at three quarters of its size or more (readable tick labels)."""
+    cols = 1 if n == 1 else 2
     return math.ceil(n / cols), cols
 
 
@@ -120,7 +173,7 @@ def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
     from matplotlib.patches import Polygon
 
     m = res.mech
-    fig = _figure(8, 6.5)
+    fig = _figure(8, 6.5, left=0.8, right=0.2, top=0.6, bottom=0.6)
     ax = fig.subplots()
     W = _world(res, 0)
     size = m.size
@@ -256,14 +309,15 @@ def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
     ax.set_xlabel("x, m")
     ax.set_ylabel("y, m")
     ax.set_title(f"{m.name}\nat φ = {res.phi_deg[0]:.4g}° (dotted: paths of the points over the cycle)",
-                 fontsize=10)
+                 fontsize=10, y=1.0)
     ax.legend(loc="best", fontsize=8, framealpha=0.85)
     return _save(fig, path)
 
 
 def plot_moment(run: ModelRun, path: Path) -> Path:
     res, m = run.res, run.mech
-    fig = _figure(9.5, 6.5)
+    fig = _figure(9.5, 6.5, left=1.0, right=0.2, top=0.6, bottom=0.6)
+    fig.subplots_adjust(hspace=0.15)
     ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
     phi = res.phi_deg
     ax.plot(*_closed(phi, res.balancing_moment), color="black", lw=2.6, label="kinetostat: group by group")
@@ -274,7 +328,7 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
     ax.axhline(0, color="0.3", lw=0.6)
     ax.set_ylabel("balancing moment on the crank M_bal, N·m")
     kind = "moment of the drive on the crank about +z"
-    ax.set_title(f"{m.name}\nbalancing moment ({kind}) over the cycle", fontsize=10)
+    ax.set_title(f"{m.name}\nbalancing moment ({kind}) over the cycle", fontsize=10, y=1.0)
     ax.legend(fontsize=8, loc="best")
     _phi_axis(ax, label=False, step=30)
     ax2.plot(*_closed(phi, res.lever_discrepancy), color="0.3", lw=1)
@@ -286,9 +340,9 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
 
 def plot_reactions(run: ModelRun, path: Path) -> Path:
     res, m = run.res, run.mech
-    rows, cols = _grid(len(m.pairs))
-    fig = _figure(4.6 * cols + 0.6, 3.0 * rows + 0.9)
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    ncols = _legend_cols(1 + len(run.results), 5)
+    fig, axes, cols = _panels(len(m.pairs), f"{m.name}\nreaction magnitudes over the cycle "
+                              f"(R(i,j): force of link i on link j)", 1 + len(run.results), ncols)
     handles = {}
     for n_ax, (ax, p) in enumerate(zip(axes, m.pairs)):
         mag = np.linalg.norm(res.forces.R[:, p.index], axis=-1)
@@ -298,15 +352,13 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
             col, ls = _style(route, n)
             h, = ax.plot(*_closed(er.phi_deg, np.linalg.norm(er.R[:, p.index], axis=-1)), **_line(er, res, col, ls, 1.5))
             handles[f"{route} ({er.route})"] = h
-        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9)
+        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
         ax.set_ylabel("|R|, N")
         ax.set_ylim(bottom=0)
         _phi_axis(ax, label=n_ax + cols >= len(m.pairs))
     for ax in axes[len(m.pairs):]:
         ax.set_visible(False)
-    fig.suptitle(f"{m.name}\nreaction magnitudes over the cycle (R(i,j): force of link i on link j)", fontsize=10)
-    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncols=min(len(handles), 5),
-               fontsize=8)
+    _legend(fig, handles, ncols)
     return _save(fig, path)
 
 
@@ -331,9 +383,9 @@ def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, 
 def plot_errors(run: ModelRun, path: Path) -> Path:
     res, m = run.res, run.mech
     qs = [q for q in quantities(m) if q == "M_drive" or q.startswith("R(")]   # the force quantities
-    rows, cols = _grid(len(qs))
-    fig = _figure(4.6 * cols + 0.6, 3.0 * rows + 1.1)
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    ncols = _legend_cols(2 * len(run.results), 4)
+    fig, axes, cols = _panels(len(qs), f"{m.name}\nerror of each engine route against kinetostat (log scale; "
+                                       f"dashed: the route's tolerance × the cycle's peak)", 2 * len(run.results), ncols)
     curves = {route: _error_curves(res, er) for route, er in run.results.items()}
     handles = {}
     for n_ax, (ax, q) in enumerate(zip(axes, qs)):
@@ -357,27 +409,27 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
             ax.set_yscale("log")
         title = "M_drive: balancing moment" if q == "M_drive" else \
             _pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
-        ax.set_title(_wrap(title), fontsize=9)
+        ax.set_title(_wrap(title), fontsize=9, y=1.0)
+        _log_ticks(ax)
         ax.set_ylabel(f"|error|, {unit}")
         _phi_axis(ax, label=n_ax + cols >= len(qs))
         ax.grid(True, which="major", alpha=0.3)
     for ax in axes[len(qs):]:
         ax.set_visible(False)
-    fig.suptitle(f"{m.name}\nerror of each engine route against kinetostat (log scale; "
-                 f"dashed: the route's tolerance × the cycle's peak)", fontsize=10)
-    if handles:
-        fig.legend(list(handles.values()), list(handles), loc="outside lower center",
-                   ncols=min(len(handles), 4), fontsize=8)
+    _legend(fig, handles, ncols)
     return _save(fig, path)
 
 
 def plot_hodographs(run: ModelRun, path: Path) -> Path:
     """Tip of each revolute pair's reaction vector over the cycle (seed 004, figs. 13-14)."""
+    from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     pairs = [p for p in m.pairs if p.kind == "R"]
-    rows, cols = _grid(len(pairs))
-    fig = _figure(4.8 * cols + 0.4, 4.6 * rows + 0.8)
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    n_legend = 1 + sum(not er.magnitudes_only for er in run.results.values())
+    ncols = _legend_cols(n_legend, 4)
+    fig, axes, cols = _panels(len(pairs), f"{m.name}\nhodographs of the revolute pairs' reactions (tip of the force "
+                                          f"vector over the cycle, world frame; grey rays every 30° of φ)",
+                              n_legend, ncols, cell_h=3.6)
     phi = res.phi_deg
     handles = {}
     for ax, p in zip(axes, pairs):
@@ -409,14 +461,32 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
             ax.annotate(f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", R[i], xytext=(6, -14), textcoords="offset points",
                         fontsize=7, color="tab:red")
         ax.set_aspect("equal", adjustable="datalim")
+        ax.xaxis.set_major_locator(MaxNLocator(5))      # room for "−4000" on a narrow panel
         ax.grid(True, alpha=0.3)
         ax.set_xlabel("R_x, N")
         ax.set_ylabel("R_y, N")
-        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9)
+        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
     for ax in axes[len(pairs):]:
         ax.set_visible(False)
-    fig.suptitle(f"{m.name}\nhodographs of the revolute pairs' reactions "
-                 f"(tip of the force vector over the cycle, world frame; grey rays every 30° of φ)", fontsize=10)
-    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncols=min(len(handles), 4),
-               fontsize=8)
+    _legend(fig, handles, ncols)
+    return _save(fig, path)
+
+
+def plot_balancing_force(res: Analysis, path: Path) -> Path:
+    """Working machine: the balancing force of the pinion on the crank's wheel over the cycle,
+    its magnitude and its world components (it acts along the fixed line of action)."""
+    m = res.mech
+    fig = _figure(9.5, 4.8, left=1.0, right=0.2, top=0.6, bottom=0.6)
+    ax = fig.subplots()
+    F = res.balancing_force
+    phi = res.phi_deg
+    ax.plot(*_closed(phi, np.linalg.norm(F, axis=-1)), color="black", lw=2.4, label="|F_bal|")
+    ax.plot(*_closed(phi, F[:, 0]), color="tab:blue", lw=1.4, ls="--", label="F_bal,x")
+    ax.plot(*_closed(phi, F[:, 1]), color="tab:orange", lw=1.4, ls=(0, (2, 2)), label="F_bal,y")
+    ax.axhline(0, color="0.3", lw=0.6)
+    ax.set_ylabel("balancing force, N")
+    ax.set_title(f"{m.name}\nbalancing force of the pinion on the crank's wheel (pitch point, line of action)",
+                 fontsize=10, y=1.0)
+    ax.legend(fontsize=8, loc="best")
+    _phi_axis(ax, step=30)
     return _save(fig, path)

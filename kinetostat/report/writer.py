@@ -1,14 +1,11 @@
-"""Writes a model's report folder and the index over all reports.
+"""Writes a model's report folder and the index over the reports of one run.
 
 May use: every other room, the solver, and the harness's tolerances.
 """
 from __future__ import annotations
 
-import datetime
 import json
 import math
-import re
-import time
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -17,8 +14,9 @@ import numpy as np
 from ..analysis import analyze
 from ..model import Mechanism
 from ..structure import GROUP_KINDS
-from .document import Doc, _fe, _fmt
-from .plots import _pair_name, plot_errors, plot_hodographs, plot_mechanism, plot_moment, plot_reactions
+from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
+from .plots import (_pair_name, plot_balancing_force, plot_errors, plot_hodographs, plot_mechanism, plot_moment,
+                    plot_reactions)
 from .published import PublishedCheck
 from .runs import ModelRun
 
@@ -46,7 +44,7 @@ def _vec(v) -> str:
 def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
     d = m.drive
     doc.h(2, "Mechanism data")
-    items = [f"**Name**: {m.name}", f"**Source**: {m.source or 'not stated'}"]
+    items = [f"**Name**: {esc(m.name)}", f"**Source**: {esc(m.source or 'not stated')}"]
     if path is not None:
         items.append(f"**Model file**: `{path.name}`")
     items.append(f"**g** = {m.g:g} m/s² along −y")
@@ -68,7 +66,7 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
         items.append("**Friction**: none")
     doc.ul(items)
     doc.h(3, "Assumptions")
-    doc.ul(list(m.assumptions) or ["none stated"])
+    doc.ul([esc(a) for a in m.assumptions] or ["none stated"])
     doc.h(3, "Links")
     rows = []
     for link in m.links:
@@ -76,7 +74,7 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
         if link.id == 0:
             rows.append([0, "frame", "-", "-", "-", pts + " (world)"])
         else:
-            rows.append([link.id, link.name, f"{link.mass:.6g}", f"{link.I_S:.6g}", link.com or "-", pts])
+            rows.append([link.id, esc(link.name), f"{link.mass:.6g}", f"{link.I_S:.6g}", link.com or "-", pts])
     doc.table(["id", "name", "mass, kg", "I_S, kg m²", "centre of mass", "points (local frame), m"], rows, "llrrll")
     doc.h(3, "Kinematic pairs")
     rows = []
@@ -100,12 +98,12 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
             else:
                 val = f"{ld.value:.6g}"
             direction = ld.direction if isinstance(ld.direction, str) or ld.direction is None else _vec(ld.direction)
-            rows.append([ld.name, ld.kind, ld.link, ld.point or "-", direction or "-", val])
+            rows.append([esc(ld.name), ld.kind, ld.link, ld.point or "-", direction or "-", val])
         doc.table(["name", "kind", "link", "point", "direction", "value (N or N m)"], rows)
     if m.springs:
         doc.h(3, "Springs")
         doc.table(["name", "end a", "end b", "stiffness, N/m", "free length, m"],
-                  [[s.name, f"link {s.a[0]} {s.a[1]}", f"link {s.b[0]} {s.b[1]}", f"{s.stiffness:g}",
+                  [[esc(s.name), f"link {s.a[0]} {s.a[1]}", f"link {s.b[0]} {s.b[1]}", f"{s.stiffness:g}",
                     f"{s.free_length:g}"] for s in m.springs])
 
 
@@ -154,20 +152,89 @@ def _published_section(doc: Doc, published: Sequence[PublishedCheck]) -> None:
                "within"], rows, "lllrrlrrl")
 
 
-def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dict[str, Any]:
-    """Write `out/<stem>/` for one model; returns the summary also saved as summary.json."""
-    from kinetostat_validation.compare import TOLERANCES
+def _verdict(run: ModelRun) -> str:
+    n_checks, n_fail = len(run.checks), sum(not c.passed for c in run.checks)
+    if run.passed and n_checks:
+        return f"**PASS**: all {n_checks} checks within tolerance"
+    if run.passed:
+        return "**NOT CHECKED**: no route ran and the model has no published values"
+    return f"**FAIL**: {n_fail} of {n_checks} checks beyond tolerance" + \
+        (f", routes with errors: {', '.join(run.errors)}" if run.errors else "")
 
+
+def _failed_checks(run: ModelRun, published: Sequence[PublishedCheck]) -> list[str]:
+    """One line per check beyond tolerance, route that raised, or published value not within."""
+    out = [f"{r.route} {r.quantity}: peak-relative error {_rel(r.peak_relative)} > tolerance {r.tolerance:.0e} "
+           f"(max {_err(r.max_abs, r.peak, r.unit)} at φ = {r.phi_deg_max:.4g}°)" for r in run.failed]
+    out += [f"{route}: **ERROR** {esc(why)}" for route, why in run.errors.items()]
+    out += [f"published value {esc(c.entry.symbol)} not within the accepted difference"
+            for c in published if not c.passed]
+    return out
+
+
+def _extremes(values: np.ndarray, phi: np.ndarray) -> list[str]:
+    """max, its φ, min, its φ of a quantity over the cycle (n/a where it is all NaN)."""
+    if not np.any(np.isfinite(values)):
+        return ["n/a"] * 4
+    i, j = int(np.nanargmax(values)), int(np.nanargmin(values))
+    return [f"{values[i]:.5g}", f"{phi[i]:.4g}", f"{values[j]:.5g}", f"{phi[j]:.4g}"]
+
+
+def _balancing_force_section(doc: Doc, res, image: Path) -> None:
+    """Working machine: the force of the pinion on the crank's wheel, plot and extremes."""
+    doc.h(2, "Balancing force")
+    F = res.balancing_force
+    doc.p("The unknown of a working machine: the force of the pinion on the crank's wheel at the pitch point, "
+          "along the line of action of the mesh (world frame); M_bal above is its moment about the crank's "
+          "pivot.")
+    doc.img(image, "Balancing force over the cycle: magnitude and world components, N")
+    phi = res.phi_deg
+    doc.table(["quantity", "max, N", "at φ, deg", "min, N", "at φ, deg"],
+              [["|F_bal|", *_extremes(np.linalg.norm(F, axis=-1), phi)],
+               ["F_bal,x", *_extremes(F[:, 0], phi)],
+               ["F_bal,y", *_extremes(F[:, 1], phi)]], "lrrrr")
+
+
+def _error_rows(run: ModelRun) -> list[list[str]]:
+    rows = []
+    for r in run.rows:
+        rows.append([r.route, r.quantity, _err(r.max_abs, r.peak, r.unit),
+                     f"{r.phi_deg_max:.4g}" if math.isfinite(r.phi_deg_max) and not _is_rounding(r.peak_relative)
+                     else "-",
+                     _rel(r.peak_relative), f"{r.tolerance:.0e}", _rel(r.rms_relative),
+                     f"{r.n_compared}" + (f" ({r.n_skipped} NaN left out)" if r.n_skipped else ""),
+                     _row_status(r)])
+    for route, why in run.skipped.items():
+        rows.append([route, "all", "-", "-", "-", "-", "-", "-", f"SKIPPED: {esc(why)}"])
+    for route, why in run.errors.items():
+        rows.append([route, "all", "-", "-", "-", "-", "-", "-", f"**ERROR**: {esc(why)}"])
+    return rows
+
+
+def _tolerance(run: ModelRun, route: str):
+    """The route's Tolerance as the run used it (the harness's default otherwise), or None."""
+    from kinetostat_validation.compare import TOLERANCES
+    return run.tolerances.get(route) or TOLERANCES.get(route)
+
+
+def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
+    """Write `out/<stem>/` for one model; returns the summary also saved as summary.json.
+
+    Every file depends only on the model, the routes and the steps (and the libraries' versions):
+    no dates and no run times, so a rerun reproduces them byte for byte. Run times are printed
+    by the command line only.
+    """
     m, res = run.mech, run.res
     d = Path(out) / run.stem
     d.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
     published = run.published
     pic_deg = m.drive.design_deg
     at = analyze(m, phi_deg=[pic_deg])
+    machine = m.drive.kind == "machine"
     images = {
         "mechanism": plot_mechanism(at, res, d / "mechanism.png"),
         "moment": plot_moment(run, d / "balancing_moment.png"),
+        **({"force": plot_balancing_force(res, d / "balancing_force.png")} if machine else {}),
         "reactions": plot_reactions(run, d / "reactions.png"),
         "errors": plot_errors(run, d / "errors.png"),
         "hodographs": plot_hodographs(run, d / "hodographs.png"),
@@ -175,77 +242,67 @@ def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dic
     res.to_frame().to_csv(d / "cycle.csv", index=False)
 
     N = len(res.phi_deg)
-    doc = Doc(f"{m.name}: kinetostat error report")
-    doc.h(1, f"{m.name}")
-    doc.p(f"Error report of `{run.stem}` over {N} crank positions (every {360 / N:.4g}°). "
-          f"Generated {datetime.date.today().isoformat()} with {_versions()}. "
-          f"Full table of the cycle: [cycle.csv](cycle.csv). [All mechanisms](../index.md)")
     routes = list(run.engines)
-    n_rows, n_fail = len(run.rows), len(run.failed)
-    if run.passed and n_rows:
-        verdict = f"**PASS**: all {n_rows} checks within tolerance"
-    elif run.passed:
-        verdict = "**NOT CHECKED**: no engine route ran"
+    doc = Doc(f"{m.name}: kinetostat error report")
+    doc.h(1, esc(m.name))
+    doc.p(_verdict(run) + ". Routes: " + ", ".join(f"{r} {run.status(r)}" for r in routes) + ".")
+    failed = _failed_checks(run, published)
+    if failed:
+        doc.p("Failed checks:")
+        doc.ul(failed)
     else:
-        verdict = f"**FAIL**: {n_fail} of {n_rows} checks beyond tolerance" + \
-            (f", routes with errors: {', '.join(run.errors)}" if run.errors else "")
-    doc.p(verdict + ". Routes: " + ", ".join(f"{r} {run.status(r)}" for r in routes) + ".")
+        doc.p("Failed checks: none.")
+    doc.p(f"Error report of `{run.stem}` over {N} crank positions (every {360 / N:.4g}°), made with "
+          f"{_versions()}. Full table of the cycle: [cycle.csv](cycle.csv). [All mechanisms](../index.md)")
+    doc.p("Contents:")
+    doc.toc()
 
     _mechanism_section(doc, m, run.path)
     _structure_section(doc, m)
 
     doc.h(2, f"The mechanism at φ = {pic_deg:g}°")
-    doc.img(images["mechanism"], f"{m.name} at φ = {pic_deg:g}°: links as lines/polygons between their points, "
-                                 f"revolute pairs as circles, prismatic pairs as a guide with a block; metres")
+    doc.img(images["mechanism"], f"{esc(m.name)} at φ = {pic_deg:g}°: links as lines/polygons between their "
+                                 f"points, revolute pairs as circles, prismatic pairs as a guide with a block; metres")
 
     doc.h(2, "Balancing moment")
     lever = np.nanmax(np.abs(res.lever_discrepancy)) if np.any(np.isfinite(res.lever_discrepancy)) else float("nan")
+    peak_m = np.nanmax(np.abs(res.balancing_moment)) if np.any(np.isfinite(res.balancing_moment)) else 0.0
     doc.p(f"Group by group (force analysis from the last Assur group to the crank) against Zhukovsky's lever "
           f"and against each engine route's driving moment. Largest |lever − groups| over the cycle: "
-          f"{_fe(lever)} N·m.")
+          f"{_err(lever, peak_m, 'N·m')}.")
     doc.img(images["moment"], "Balancing moment on the crank over the cycle, N·m")
+    doc.table(["quantity", "max, N·m", "at φ, deg", "min, N·m", "at φ, deg"],
+              [["M_bal", *_extremes(res.balancing_moment, res.phi_deg)]], "lrrrr")
+    if machine:
+        _balancing_force_section(doc, res, images["force"])
 
     doc.h(2, "Reactions")
     doc.p("Magnitude of every pair's reaction R(i,j) (force of link i on link j), kinetostat and each "
           "engine route overlaid.")
     doc.img(images["reactions"], "Reaction magnitudes over the cycle, N")
-    pk = []
-    for p in m.pairs:
-        mag = np.linalg.norm(res.forces.R[:, p.index], axis=-1)
-        if np.any(np.isfinite(mag)):
-            i, j = int(np.nanargmax(mag)), int(np.nanargmin(mag))
-            pk.append([_pair_name(m, p), f"{mag[i]:.5g}", f"{res.phi_deg[i]:.4g}", f"{mag[j]:.5g}", f"{res.phi_deg[j]:.4g}"])
-    doc.table(["pair", "max |R|, N", "at φ, deg", "min |R|, N", "at φ, deg"], pk, "lrrrr")
+    doc.table(["pair", "max |R|, N", "at φ, deg", "min |R|, N", "at φ, deg"],
+              [[_pair_name(m, p), *_extremes(np.linalg.norm(res.forces.R[:, p.index], axis=-1), res.phi_deg)]
+               for p in m.pairs], "lrrrr")
 
     doc.h(2, "Errors against the engines")
-    doc.p("Per route and quantity: max |engine − kinetostat| over the cycle (absolute), RMS and maximum of "
-          "the error relative to the cycle's peak |kinetostat| (peak-relative), against the route's "
-          "tolerance. Routes that only give magnitudes (pymunk) are compared in magnitude.")
+    doc.p("Per route and quantity: max |engine − kinetostat| over the cycle (absolute) and the crank angle "
+          "where it occurs, the maximum (peak relative) and RMS of the error relative to the cycle's peak "
+          "|kinetostat|, beside the route's tolerance. Routes that only give magnitudes (pymunk) are compared "
+          f"in magnitude. An error below {ROUNDING:.1e} of the peak (1000 units in the last place) is "
+          "rounding and reads so (the two agree to machine precision; its angle is then left out).")
     if run.results:
         doc.img(images["errors"], "|engine − kinetostat| over the cycle, log scale; dashed: tolerance × peak")
-    rows = []
-    for r in run.rows:
-        unit = "N·m" if r.quantity == "M_drive" else "N"
-        rows.append([r.route, r.quantity, f"{_fmt(r.max_abs)} {unit}", _fe(r.rms_relative), _fe(r.peak_relative),
-                     f"{r.tolerance:.0e}", f"{r.n_compared}" + (f" ({r.n_skipped} NaN left out)" if r.n_skipped else ""),
-                     _row_status(r)])
-    for route, why in run.skipped.items():
-        rows.append([route, "all", "-", "-", "-", "-", "-", f"SKIPPED: {why}"])
-    for route, why in run.errors.items():
-        rows.append([route, "all", "-", "-", "-", "-", "-", f"**ERROR**: {why}"])
-    doc.table(["route", "quantity", "max abs error", "RMS relative", "peak relative", "tolerance",
-               "angles compared", "result"], rows, "llrrrrrl")
+    doc.table(["route", "quantity", "max abs error", "at φ, deg", "peak relative", "tolerance", "RMS relative",
+               "angles compared", "result"], _error_rows(run), "llrrrrrrl")
     doc.h(3, "Routes and their tolerances")
     rows = []
     for route in routes:
-        tol = run.tolerances.get(route) or TOLERANCES.get(route)
+        tol = _tolerance(run, route)
         er = run.results.get(route)
         rows.append([route, er.route if er else "-", f"{tol.peak_relative:.0e}" if tol else "-",
                      tol.reason if tol else "-",
-                     f"{er.build_seconds:.3f}" if er else "-", f"{er.run_seconds:.3f}" if er else "-",
-                     (er.note if er and er.note else "") or run.skipped.get(route, run.errors.get(route, ""))])
-    doc.table(["route", "kind", "tolerance (peak-relative)", "why this tolerance", "build, s", "run, s", "note"],
-              rows, "llrlrrl")
+                     esc((er.note if er and er.note else "") or run.skipped.get(route, run.errors.get(route, "")))])
+    doc.table(["route", "kind", "tolerance (peak-relative)", "why this tolerance", "note"], rows, "llrll")
 
     doc.h(2, "Hodographs of the reactions")
     doc.p("The tip of each revolute pair's reaction vector (force of link i on link j, world frame) traced "
@@ -254,32 +311,27 @@ def write_report(run: ModelRun, out: Path, steps_note: str | None = None) -> dic
 
     _published_section(doc, published)
 
-    doc.h(2, "Timings")
-    doc.ul([f"kinetostat analysis of the {N} positions: {run.solver_seconds:.3f} s"]
-           + [f"route {r}: {s:.3f} s wall time (scene, engine build and run, error rows)"
-              for r, s in run.seconds.items()])
     sing = int(np.sum(res.singular))
     if run.warnings or sing:
         doc.h(2, "Warnings")
-        doc.ul(([f"{sing} positions are singular (values there are NaN)"] if sing else []) + run.warnings)
+        doc.ul(([f"{sing} positions are singular (values there are NaN)"] if sing else [])
+               + [esc(w) for w in run.warnings])
     doc.h(2, "Files")
     doc.ul([f"[{p.name}]({p.name})" for p in images.values()] + ["[cycle.csv](cycle.csv): `res.to_frame()` of the cycle",
                                                                   "[summary.json](summary.json)"])
 
-    (d / "index.md").write_text(doc.markdown(), encoding="utf-8")
-    (d / "index.html").write_text(doc.html().replace('href="../index.md"', 'href="../index.html"'), encoding="utf-8")
+    doc.write(d)
 
     summary = dict(stem=run.stem, name=m.name, formula=m.structure.formula, positions=N,
-                   passed=run.passed, checks=n_rows, failed=n_fail,
-                   routes={r: dict(status=run.status(r), worst=run.worst(r), seconds=run.seconds.get(r),
+                   passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
+                   routes={r: dict(status=run.status(r), worst=run.worst(r),
+                                   tolerance=_tolerance(run, r).peak_relative if _tolerance(run, r) else None,
                                    why=run.skipped.get(r) or run.errors.get(r)) for r in routes},
                    published=None if not published else dict(
                        n=len(published), within=sum(c.passed for c in published),
-                       worst_percent=max((100 * c.error for c in published if not c.by_angle), default=None)),
-                   report_seconds=time.perf_counter() - t0,
-                   date=datetime.date.today().isoformat())
-    (d / "summary.json").write_text(json.dumps(_clean(summary), indent=1, allow_nan=False), encoding="utf-8")
-    return summary
+                       worst_percent=max((100 * c.error for c in published if not c.by_angle), default=None)))
+    (d / "summary.json").write_text(json.dumps(_clean(summary), indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    return _clean(summary)
 
 
 def _clean(x):
@@ -297,15 +349,11 @@ def _clean(x):
     return x
 
 
-def write_index(out: Path) -> Path:
-    """`out/index.md` and `out/index.html` over every report (`*/summary.json`) in `out`."""
+def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
+    """`out/index.md` and `out/index.html` over the reports of this run (`summaries`, as
+    `write_report` returns them, in the order given); other folders in `out` are not listed."""
     out = Path(out)
-    sums = []
-    for f in sorted(out.glob("*/summary.json")):
-        try:
-            sums.append(json.loads(f.read_text(encoding="utf-8")))
-        except (OSError, ValueError):
-            continue
+    sums = list(summaries)
     routes: list[str] = []
     for s in sums:
         for r in s["routes"]:
@@ -315,8 +363,9 @@ def write_index(out: Path) -> Path:
     doc.h(1, "kinetostat error reports")
     n_pass = sum(1 for s in sums if s["passed"] and s["checks"])
     doc.p(f"{len(sums)} mechanisms, {n_pass} pass every check. Each cell: the worst peak-relative error "
-          f"of the route over the mechanism's quantities (driving moment, every reaction) and its verdict "
-          f"against the route's tolerance. Generated {datetime.date.today().isoformat()} with {_versions()}.")
+          f"of the route over the mechanism's quantities (driving moment, every reaction), the route's "
+          f"tolerance, and the verdict. An error below {ROUNDING:.1e} of the peak is rounding. "
+          f"Made with {_versions()}.")
     rows = []
     for s in sums:
         cells = []
@@ -327,16 +376,16 @@ def write_index(out: Path) -> Path:
             elif info["status"] in ("SKIPPED", "ERROR"):
                 cells.append(info["status"] if info["status"] == "SKIPPED" else "**ERROR**")
             else:
-                cells.append(f"{_fe(info['worst'])} {'PASS' if info['status'] == 'PASS' else '**FAIL**'}")
+                tol = f" ≤ {info['tolerance']:.0e}" if info.get("tolerance") is not None else ""
+                verdict = "PASS" if info["status"] == "PASS" else "**FAIL**"
+                cells.append(f"{_rel(info['worst'])}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
         pub = s.get("published")
         pubcell = "-" if not pub else f"{pub['within']}/{pub['n']} within" + \
             (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")
         verdict = "**PASS**" if s["passed"] and s["checks"] else "**FAIL**" if not s["passed"] else "not checked"
-        rows.append([f"[{s['stem']}]({s['stem']}/index.md)", s["name"], f"`{s['formula']}`", *cells, pubcell, verdict])
+        rows.append([f"[{s['stem']}]({s['stem']}/index.md)", esc(s["name"]), f"`{s['formula']}`", *cells, pubcell,
+                     verdict])
     doc.table(["model", "mechanism", "structure formula", *routes, "published values", "result"], rows,
               "lll" + "r" * len(routes) + "ll")
-    doc.p("Tolerances (peak-relative): see each report's table *Routes and their tolerances*.")
-    (out / "index.md").write_text(doc.markdown(), encoding="utf-8")
-    (out / "index.html").write_text(re.sub(r'href="([\w.-]+)/index\.md"', r'href="\1/index.html"', doc.html()),
-                                    encoding="utf-8")
-    return out / "index.md"
+    doc.p("The tolerances and why: see each report's table *Routes and their tolerances*.")
+    return doc.write(out)
