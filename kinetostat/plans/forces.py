@@ -243,7 +243,7 @@ def _outer(mech: "Mechanism", res: "Analysis", g: "AssurGroup", side: int) -> _P
     return _Parts(whole, n, whole.force - n)
 
 
-def _moment_equations(mech: "Mechanism", res: "Analysis", g: "AssurGroup") -> list[tuple[tuple[int, ...], str]]:
+def _moment_equations(g: "AssurGroup") -> list[tuple[tuple[int, ...], str]]:
     """(links, point) of each moment equation the texts write for this group kind: R^tau of a
     pin from its link about the inner joint (RRR, RRP); the slot's normal force from the whole
     group about the slotted link's pivot (RPR). PRP and RPP: offsets x only."""
@@ -342,7 +342,7 @@ def group_plans(mech: "Mechanism", res: "Analysis", mu_l) -> list[Plan]:
         for p, on in ((g.pairs[0], j), (g.pairs[1], j), (g.pairs[2], k)):
             if p.kind == "P":
                 _offset(mech, res, p, on, pts, segs, mu_l)
-        for links, M_name in _moment_equations(mech, res, g):
+        for links, M_name in _moment_equations(g):
             M = _world(res, next(x for x in links[::-1] if M_name in mech.links[x].points), M_name)
             for x in links:
                 for ld in loads[x]:
