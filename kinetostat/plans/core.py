@@ -41,7 +41,8 @@ class Segment:
     |value| = drawn length x scale for a vector or an arm drawn at the plan's scale; `kind` says how
     it is drawn: "vector" (an arrow), "link" (a link of the mechanism), "arm" (a moment arm),
     "line" (a construction line: a direction, a path). A segment whose quantity is not at the plan's
-    scale (a link of a lever, a path) has `value` NaN and unit "".
+    scale (a link of a lever, a path) has `value` NaN and unit "", unless it names its own `scale`
+    (a force drawn on a group plan: |value| = drawn length x segment.scale).
     """
     name: str
     start: str
@@ -49,6 +50,8 @@ class Segment:
     value: float
     unit: str
     kind: str = "vector"
+    scale: Scale | None = None   # a segment drawn at another scale than its plan's (the loads on a
+                                 # group plan, at a force scale); None: the plan's scale
 
 
 @dataclass(frozen=True)
@@ -87,7 +90,8 @@ class Plan:
             a, b = self.points[s.start], self.points[s.end]
             out.append({"plan": self.kind, "segment": s.name, "from": s.start, "to": s.end,
                         "x0_mm": a.real, "y0_mm": a.imag, "x1_mm": b.real, "y1_mm": b.imag,
-                        "length_mm": abs(b - a), "value": s.value, "unit": s.unit, "scale": str(self.scale)})
+                        "length_mm": abs(b - a), "value": s.value, "unit": s.unit,
+                        "scale": str(s.scale or self.scale)})
         return out
 
     def __repr__(self) -> str:
