@@ -6,7 +6,7 @@ Every load is reduced to a wrench per link: force F (N, world, complex x + iy) a
 from __future__ import annotations
 
 import warnings
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Load, Mechanism
 
-__all__ = ["applied_wrenches", "com_motion", "inertia_loads", "load_magnitude"]
+__all__ = ["applied_wrenches", "com_motion", "inertia_loads", "load_magnitude", "point_forces", "PointForce", "applied_moment"]
 
 
 def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
@@ -49,10 +49,40 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tup
     M = cross_z(r, weight)
     for ld in mech.loads:
         if ld.kind == "moment":
-            mag = load_magnitude(mech, kin, ld)
-            if ld.direction == "against_omega":
-                mag = -np.sign(kin.omega[:, ld.link]) * np.abs(mag)
-            M[:, ld.link] += mag
+            M[:, ld.link] += applied_moment(mech, kin, ld)
+    for f in point_forces(mech, kin):
+        if f.link:
+            _add_force(F, M, kin, f.link, f.force, f.X)
+        unknown = np.isnan(f.force)
+        if unknown.any():                    # e.g. a spring of zero length: every force there is unknown
+            F[unknown], M[unknown] = np.nan, np.nan
+    return F, M
+
+
+def applied_moment(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarray:
+    """(N,) the moment load `ld` on its link about +z, N m ("against_omega": opposing its rotation)."""
+    mag = load_magnitude(mech, kin, ld)
+    if ld.direction == "against_omega":
+        mag = -np.sign(kin.omega[:, ld.link]) * np.abs(mag)
+    return mag
+
+
+class PointForce(NamedTuple):
+    """One applied force at a point of a link, over the angles."""
+    name: str            # the load's or spring's name
+    link: int
+    point: str           # the point of application, as the model names it
+    X: np.ndarray        # (N,) complex: its world position, m
+    force: np.ndarray    # (N,) complex: the force on `link`, N (world frame)
+
+
+def point_forces(mech: "Mechanism", kin: "Kinematics") -> list[PointForce]:
+    """Every external force load and both ends of every spring, as forces at points (gravity,
+    moments and inertia are not here). A spring of zero length has no line of action: its force
+    is NaN there, with a SingularPositionWarning naming the angles."""
+    out = []
+    for ld in mech.loads:
+        if ld.kind == "moment":
             continue
         p = mech.links[ld.link].points[ld.point]
         X = kin.position_z(ld.link, p)
@@ -67,7 +97,7 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tup
             e = np.where(moving, -V / np.where(moving, speed, 1.0), 0.0)
         else:
             e = complex(*ld.direction)
-        _add_force(F, M, kin, ld.link, mag * e, X)
+        out.append(PointForce(ld.name, ld.link, ld.point, X, mag * e))
     for sp in mech.springs:
         A = kin.position_z(sp.a[0], mech.links[sp.a[0]].points[sp.a[1]])
         B = kin.position_z(sp.b[0], mech.links[sp.b[0]].points[sp.b[1]])
@@ -77,12 +107,9 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tup
                           f"{np.round(np.degrees(kin.phi[length == 0]), 9).tolist()} deg: its line of action "
                           f"is undefined, forces there are NaN", SingularPositionWarning, stacklevel=3)
         f_on_b = -sp.stiffness * (length - sp.free_length) * (B - A) / length
-        if sp.b[0]:
-            _add_force(F, M, kin, sp.b[0], f_on_b, B)
-        if sp.a[0]:
-            _add_force(F, M, kin, sp.a[0], -f_on_b, A)
-        F[length == 0], M[length == 0] = np.nan, np.nan    # every force of that position is unknown
-    return F, M
+        out.append(PointForce(sp.name, sp.b[0], sp.b[1], B, f_on_b))
+        out.append(PointForce(sp.name, sp.a[0], sp.a[1], A, -f_on_b))
+    return out
 
 
 def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarray | None = None,

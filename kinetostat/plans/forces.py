@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..applied import load_magnitude
+from ..applied import applied_moment, point_forces
 from .core import Plan, Scale, Segment
 
 if TYPE_CHECKING:
@@ -139,26 +139,8 @@ def _world(res: "Analysis", k: int, name: str) -> complex:
 
 def _applied(mech: "Mechanism", res: "Analysis", k: int) -> list[Load]:
     """The model's force loads and spring forces on link k at angle 0 of `res`."""
-    kin, out = res.kin, []
-    for ld in mech.loads:
-        if ld.link != k or ld.kind != "force":
-            continue
-        p = mech.links[k].points[ld.point]
-        X, V = kin.position_z(k, p), kin.velocity_z(k, p)
-        mag = load_magnitude(mech, kin, ld, X, V)[0]
-        if ld.direction == "against_velocity":
-            speed = abs(V[0])
-            e = -V[0] / speed if speed > 1e-9 * mech.size * mech.drive.omega else 0j
-        else:
-            e = complex(*ld.direction)
-        out.append(Load("", k, complex(X[0]), mag * e, ld.point))
-    for sp in mech.springs:
-        A, B = _world(res, sp.a[0], sp.a[1]), _world(res, sp.b[0], sp.b[1])
-        f_on_b = -sp.stiffness * (abs(B - A) - sp.free_length) * (B - A) / abs(B - A)
-        if sp.b[0] == k:
-            out.append(Load("", k, B, f_on_b, sp.b[1]))
-        if sp.a[0] == k:
-            out.append(Load("", k, A, -f_on_b, sp.a[1]))
+    out = [Load("", k, complex(f.X[0]), complex(f.force[0]), f.point)
+           for f in point_forces(mech, res.kin) if f.link == k]
     if len(out) == 1:
         return [Load(f"P{k}", k, out[0].point, out[0].force, out[0].at)]
     return [Load(f"P{k}{string.ascii_lowercase[n]}", k, ld.point, ld.force, ld.at) for n, ld in enumerate(out)]
@@ -184,9 +166,7 @@ def link_couples(mech: "Mechanism", res: "Analysis", k: int) -> list[Couple]:
         out.append(Couple(f"M_i{k}", k, float(res.inertia(k).moment[0])))
     moments = [ld for ld in mech.loads if ld.link == k and ld.kind == "moment"]
     for n, ld in enumerate(moments):
-        mag = load_magnitude(mech, res.kin, ld)[0]
-        if ld.direction == "against_omega":
-            mag = -np.sign(res.omega(k)[0]) * abs(mag)
+        mag = applied_moment(mech, res.kin, ld)[0]
         suffix = string.ascii_lowercase[n] if len(moments) > 1 else ""
         out.append(Couple(f"M{k}{suffix}", k, float(mag)))
     return out
