@@ -358,7 +358,8 @@ class _Sheet:
                 R = res.reaction(other, d.link)[0]
                 X = res.position(p.point)[0]
                 self.vector("crank", f"R_{other}_{d.link}", f"R{other}{d.link}", R, "N", f"= -R{d.link}{other}")
-                arm = abs(np.cross(X - O, R)) / np.hypot(*R) / self.mu_l
+                r = X - O
+                arm = abs(r[0] * R[1] - r[1] * R[0]) / np.hypot(*R) / self.mu_l
                 self.add("crank", f"h_R{other}{d.link}", f"h_R{other}{d.link}", arm, "mm", "",
                          "arm about the crank axis, on the crank's plan")
         M = res.balancing_moment[0]
