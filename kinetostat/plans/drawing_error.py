@@ -173,7 +173,8 @@ class _Plans:
         a_a = dr.draw(_z(res.acceleration(d.point)[0]) / sc.mu_a)
         self.v = {0: (0j, zero, 0.0), d.link: (O, zero, a_v / (A - O))}
         self.a = {0: (0j, zero, 0.0), d.link: (O, zero, a_a / (A - O))}
-        self.omega = {d.link: zero + res.omega(d.link)[0]}
+        self.omega = {d.link: zero + res.omega(d.link)[0]}     # signed, as read off the plans
+        self.eps = {d.link: zero + res.eps(d.link)[0]}
         self.pa = a_v
         for g in m.structure.groups:
             {"RRR": self._rrr, "RRP": self._rrp, "RPR": self._rpr}.get(g.kind, self._unsupported)(g)
@@ -217,6 +218,7 @@ class _Plans:
         for link, X, nX in ((j, P, nP), (k, Q, nQ)):
             e = self._link_plan(X, B, nX, ab, sc.mu_a, "at", "m/s^2")
             self.put(f"eps_{link}", e, "rad/s^2")
+            self.eps[link] = np.sign(res.eps(link)[0]) * e
         self.v[j] = (W[P], pP, (b - pP) / (W[B] - W[P]))
         self.v[k] = (W[Q], pQ, (b - pQ) / (W[B] - W[Q]))
         aP, aQ = self.at(self.a, a, W[P]), self.at(self.a, c, W[Q])
@@ -242,7 +244,9 @@ class _Plans:
         nP = self._normal(self.a, a, j, P, B)
         ab = dr.meet(nP, dr.turn(1j * (W[B] - W[P])), zero, dr.turn(guide))
         self.put(f"a_{B}", dr.read(ab) * sc.mu_a, "m/s^2")
-        self.put(f"eps_{j}", self._link_plan(P, B, nP, ab, sc.mu_a, "at", "m/s^2"), "rad/s^2")
+        e = self._link_plan(P, B, nP, ab, sc.mu_a, "at", "m/s^2")
+        self.put(f"eps_{j}", e, "rad/s^2")
+        self.eps[j], self.eps[k] = np.sign(res.eps(j)[0]) * e, zero
         self.v[j] = (W[P], pP, (b - pP) / (W[B] - W[P]))
         self.a[j] = (W[P], aP, (ab - aP) / (W[B] - W[P]))
         self.v[k], self.a[k] = (W[B], b, 0.0), (W[B], ab, 0.0)
@@ -267,7 +271,9 @@ class _Plans:
         sign_vr = np.sign((guide * np.conj(dvec)).real) if abs(guide) else 1.0
         cor = dr.draw(2j * w * sign_vr * vr * dvec / sc.mu_a)
         ak = dr.meet(nQ, dr.turn(1j * (W[P] - W[Q])), aP - cor, dr.turn(dvec))
-        self.put(f"eps_{k}", dr.read(ak - nQ) * sc.mu_a / l, "rad/s^2")
+        e = dr.read(ak - nQ) * sc.mu_a / l
+        self.put(f"eps_{k}", e, "rad/s^2")
+        self.eps[j] = self.eps[k] = np.sign(res.eps(k)[0]) * e
         f_v, f_a = (pk_ - pQ) / (W[P] - W[Q]), (ak - aQ) / (W[P] - W[Q])
         self.v[k], self.a[k] = (W[Q], pQ, f_v), (W[Q], aQ, f_a)
         self.v[j], self.a[j] = (W[P], pP, f_v), (W[P], aP, f_a)
@@ -290,8 +296,7 @@ class _Plans:
                 Fi = mass[k] * dr.read(aS) * sc.mu_a
                 self.put(f"F_i{k}", Fi, "N")
                 fl.append((-Fi * dr.turn(_unit(aS)), S))
-            eps = self.out.get(f"eps_{k}", np.zeros(dr.n)) * np.sign(res.eps(k)[0])
-            Mi = -I_S[k] * eps
+            Mi = -I_S[k] * self.eps[k]
             if I_S[k]:
                 self.put(f"M_i{k}", np.abs(Mi), "N m")
             ext = _z(res.F_applied[0, k]) - G
