@@ -368,7 +368,7 @@ class _Plans:
         for k in range(1, m.n_links):
             for F, Y in forces[k]:
                 x = self.at(self.v, k, Y)
-                x = dr.like(x, x - self.at(self.v, k, W[d.pivot] if k == d.link else Y))
+                x = dr.like(x, x - self.v[k][1])      # by similarity from the link's known plan point
                 u = dr.turn(_unit(F))
                 total = total + np.abs(F) * ((x * np.conj(u)).real + dr._err(dr.dl))
             if np.any(couples[k] != 0):
