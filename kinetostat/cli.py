@@ -318,6 +318,22 @@ def _write_json(df, path: str) -> None:
         f.write("\n")
 
 
+def _worksheet_lines(mech, phi: float) -> list[str]:
+    """The worksheet's kinematic and inertia values at one position, as a student compares them."""
+    import warnings
+
+    from .plans.worksheet import worksheet
+    with warnings.catch_warnings():          # the analysis above has warned already
+        warnings.simplefilter("ignore")
+        ws = worksheet(mech, at=phi)
+    lines = [f"worksheet at phi = {phi:g} deg (kinematics, inertia and loads; mu_l = {ws.mu_l:g} m/mm):"]
+    for r in ws.rows:
+        if r.section in ("kinematics", "accelerations", "inertia"):
+            sense = r.direction if r.direction in ("cw", "ccw") else ""
+            lines.append(f"  {r.symbol:<14s} {_fmt(r.value, r.unit):>18s}  {sense}".rstrip())
+    return lines
+
+
 def cmd_analyze(args) -> int:
     out = args.out
     if out is not None and out != "-":
@@ -335,6 +351,8 @@ def cmd_analyze(args) -> int:
     mech = _load(path)
     res, _ = _analyze(mech, path, phi_deg=args.at, steps=args.steps)
     lines = _summary(res, path)
+    if len(res.phi_deg) == 1:
+        lines += _worksheet_lines(mech, float(res.phi_deg[0]))
     if out is not None:
         df = res.to_frame()
         if out == "-":

@@ -1,0 +1,444 @@
+"""The error of drawing (issue 12, item 4): how far a careful hand-drawn solution of the
+graphical-analytic method lands from the exact one, by Monte Carlo over the constructions.
+
+Every act of the drawing carries an error: a vector laid off at a scale has its length wrong by
+up to ±`length_mm` and its direction by up to ±`angle_deg`; a line drawn in a known direction
+(⟂ AB, ∥ the guide) has its direction wrong by up to ±`angle_deg`; a length or an arm read off
+the sheet is wrong by up to ±`length_mm` (each error uniform in its interval, independent).
+The constructions are those of seed 002 sec. 1.2 and seed 000 secs. 6-8, all reduced to one
+operation: a point found as the intersection of two lines through known points with known
+directions (`_Drafter.meet`), evaluated for all samples at once (numpy arrays of shape (n,)).
+
+What is drawn, in order: the velocity plan (pa, then per group the two lines whose
+intersection is the inner joint's point, like points by similarity), the acceleration plan (the
+normal components from the read angular velocities, the tangential lines, the intersection),
+the inertia loads from the read accelerations, the group plan (arms read for the moment
+equation of R^τ), the force polygon closed by two lines, the crank (the arm of R21) and
+Zhukovsky's lever (the velocity plan again, arms of the turned loads about the pole).
+
+Kinematics and inertia loads: groups RRR, RRP with its guide on the frame, and RPR (anything
+else raises NotImplementedError naming it). Force plans, crank and lever: mechanisms of one
+group, RRR or RRP with its guide on the frame (seed 002's ICE, the compressor, the chain-unit
+four-bar); for the others `simulate` draws the kinematics and the inertia loads only.
+
+May use: the solver (`analysis`, `applied`), `plans.worksheet`, numpy. Never matplotlib.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Mapping
+
+import numpy as np
+
+from ..analysis import Analysis, analyze
+from ..model import Mechanism
+from .worksheet import crank_scale, round_scale
+
+__all__ = ["Scales", "DrawnSolution", "default_scales", "draws_forces", "simulate", "SUPPORTED"]
+
+#: What `simulate` draws completely (forces included).
+SUPPORTED = "one Assur group, RRR or RRP with its guide on the frame"
+
+
+@dataclass(frozen=True)
+class Scales:
+    """The drawing scales: μ_l m/mm, μ_v m/(s mm), μ_a m/(s^2 mm), μ_F N/mm."""
+    mu_l: float
+    mu_v: float
+    mu_a: float
+    mu_F: float
+
+
+def default_scales(mech: Mechanism, at: float | None = None) -> Scales:
+    """The scales as seed 002 chooses them: OA 30-35 mm, pa and πa 70-90 mm, the largest known
+    force of the force plans 100-200 mm, each a round value."""
+    res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at])
+    d = mech.drive
+    F = np.hypot(*np.moveaxis(np.concatenate([res.F_applied[0, 1:], res.F_i[0, 1:]]), -1, 0))
+    return Scales(crank_scale(mech), round_scale(np.hypot(*res.velocity(d.point)[0]), 70, 90),
+                  round_scale(np.hypot(*res.acceleration(d.point)[0]), 70, 90), round_scale(F.max(), 100, 200))
+
+
+@dataclass(frozen=True)
+class DrawnSolution:
+    """Samples of every value a drawn solution reads, keyed as the worksheet keys them
+    (`V_BA`, `eps_2`, `R_1_2`, `M_bal`, ...), and the exact values."""
+    mechanism: str
+    phi_deg: float
+    scales: Scales
+    length_mm: float
+    angle_deg: float
+    forces_drawn: bool      # False: only the kinematics and the inertia loads (see `draws_forces`)
+    samples: Mapping[str, np.ndarray]
+    exact: Mapping[str, float]
+    units: Mapping[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name in ("samples", "exact", "units"):
+            object.__setattr__(self, name, MappingProxyType(dict(getattr(self, name))))
+
+    def __repr__(self) -> str:
+        n = len(next(iter(self.samples.values()))) if self.samples else 0
+        return (f"DrawnSolution({self.mechanism!r}, phi_deg={self.phi_deg:g}, ±{self.length_mm:g} mm, "
+                f"±{self.angle_deg:g} deg, samples={n}, values={len(self.samples)})")
+
+    def spread(self, key: str) -> dict:
+        """Exact value, mean, σ, the 2.5 and 97.5 % points of a drawn value's samples."""
+        s = self.samples[key]
+        lo, hi = np.percentile(s, [2.5, 97.5])
+        return {"key": key, "exact": self.exact[key], "mean": float(s.mean()), "sd": float(s.std()),
+                "p2_5": float(lo), "p97_5": float(hi), "unit": self.units.get(key, "")}
+
+    def percentile_of(self, key: str, value: float) -> float:
+        """Where `value` falls among the samples of `key`, % (0-100)."""
+        s = self.samples[key]
+        return float(100.0 * (np.sum(s < value) + 0.5 * np.sum(s == value)) / len(s))
+
+
+class _Drafter:
+    """The acts of drawing, each with its error, for n samples at once (complex numbers, mm)."""
+
+    def __init__(self, n: int, length_mm: float, angle_deg: float, seed: int):
+        self.n, self.dl, self.da = n, length_mm, math.radians(angle_deg)
+        self.rng = np.random.default_rng(seed)
+
+    def _err(self, bound: float) -> np.ndarray:
+        return self.rng.uniform(-bound, bound, self.n) if bound else np.zeros(self.n)
+
+    def turn(self, u) -> np.ndarray:
+        """A direction drawn (parallel or perpendicular to something drawn): u turned by its error."""
+        return u * np.exp(1j * self._err(self.da))
+
+    def draw(self, v) -> np.ndarray:
+        """A vector laid off at its scale (v in mm): length and direction each with its error."""
+        v = np.asarray(v, complex)
+        mag = np.abs(v)
+        return np.where(mag > 0, (mag + self._err(self.dl)) * self.turn(_unit(v)), 0.0)
+
+    def read(self, z) -> np.ndarray:
+        """A length read off the sheet, mm."""
+        return np.abs(z) + self._err(self.dl)
+
+    def arm(self, r, u) -> np.ndarray:
+        """Signed arm (mm) about a point of a line through r (mm from the point) along unit u
+        (counter-clockwise positive for a force along u), read off the sheet."""
+        return (r.real * u.imag - r.imag * u.real) + self._err(self.dl)
+
+    def like(self, x, along) -> np.ndarray:
+        """A like point found by similarity: its distance along `along` measured with error."""
+        return x + self._err(self.dl) * _unit(along)
+
+    @staticmethod
+    def meet(P1, u1, P2, u2) -> np.ndarray:
+        """Intersection of the line through P1 along u1 with the line through P2 along u2."""
+        d = P2 - P1
+        s = (d.real * u2.imag - d.imag * u2.real) / (u1.real * u2.imag - u1.imag * u2.real)
+        return P1 + s * u1
+
+
+def _z(v: np.ndarray) -> complex:
+    return complex(v[0], v[1])
+
+
+class _Plans:
+    """The drawn plans of one position: for each link, a known plan point x of its world point X
+    and the factor f of similarity (plan point of Z = x + f (Z - X))."""
+
+    def __init__(self, res: Analysis, sc: Scales, dr: _Drafter):
+        self.res, self.m, self.sc, self.dr = res, res.mech, sc, dr
+        self.world = {name: _z(res.position(name)[0]) for name in self.m.point_names}
+        self.out: dict[str, np.ndarray] = {}
+        self.units: dict[str, str] = {}
+
+    def put(self, key: str, value: np.ndarray, unit: str) -> None:
+        self.out[key], self.units[key] = value, unit
+
+    def at(self, reg, k: int, Z: complex) -> np.ndarray:
+        X, x, f = reg[k]
+        return x + f * (Z - X)
+
+    def like(self, reg, k: int, name: str) -> np.ndarray:
+        X, x, f = reg[k]
+        return self.dr.like(x + f * (self.world[name] - X), f * (self.world[name] - X))
+
+    # ---- velocity and acceleration plans
+    def kinematics(self) -> None:
+        res, m, sc, dr, W = self.res, self.m, self.sc, self.dr, self.world
+        d = m.drive
+        O, A = W[d.pivot], W[d.point]
+        zero = np.zeros(dr.n, complex)
+        a_v = dr.draw(_z(res.velocity(d.point)[0]) / sc.mu_v)
+        a_a = dr.draw(_z(res.acceleration(d.point)[0]) / sc.mu_a)
+        self.v = {0: (0j, zero, 0.0), d.link: (O, zero, a_v / (A - O))}
+        self.a = {0: (0j, zero, 0.0), d.link: (O, zero, a_a / (A - O))}
+        self.omega = {d.link: zero + res.omega(d.link)[0]}     # signed, as read off the plans
+        self.eps = {d.link: zero + res.eps(d.link)[0]}
+        self.pa = a_v
+        for g in m.structure.groups:
+            {"RRR": self._rrr, "RRP": self._rrp, "RPR": self._rpr}.get(g.kind, self._unsupported)(g)
+        for k in range(1, m.n_links):
+            com = m.links[k].com
+            if com and f"V_{com}" not in self.out:
+                self.put(f"V_{com}", dr.read(self.like(self.v, k, com)) * sc.mu_v, "m/s")
+            if com and f"a_{com}" not in self.out:
+                self.put(f"a_{com}", dr.read(self.like(self.a, k, com)) * sc.mu_a, "m/s^2")
+
+    @staticmethod
+    def _unsupported(g) -> None:
+        raise NotImplementedError(f"drawing error: group {g.label} of kind {g.kind} is not drawn "
+                                  f"(kinematics: RRR, RRP with its guide on the frame, RPR)")
+
+    def _link_plan(self, P: str, B: str, pP, b, scale: float, key: str, unit: str):
+        """Link PB: the relative value (V_BP or a^τ_BP) read off the plan, and it over l_PB (ω or ε)."""
+        rel = self.dr.read(b - pP) * scale
+        self.put(f"{key}_{B}{P}", rel, unit)
+        return rel / abs(self.world[B] - self.world[P])
+
+    def _normal(self, reg, a: int, k: int, P: str, B: str):
+        """n_k: the end of a^n_BP (link k, ω_k as read) laid off from the plan point of P (on link a)."""
+        W = self.world
+        return self.at(reg, a, W[P]) + self.dr.draw(-self.omega[k] ** 2 * (W[B] - W[P]) / self.sc.mu_a)
+
+    def _rrr(self, g) -> None:
+        (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
+        P, B, Q = pj.point, pin.point, pk.point
+        dr, sc, W, res = self.dr, self.sc, self.world, self.res
+        pP, pQ = self.at(self.v, a, W[P]), self.at(self.v, c, W[Q])
+        b = dr.meet(pP, dr.turn(1j * (W[B] - W[P])), pQ, dr.turn(1j * (W[B] - W[Q])))
+        self.put(f"V_{B}", dr.read(b) * sc.mu_v, "m/s")
+        for link, X, pX in ((j, P, pP), (k, Q, pQ)):
+            w = np.sign(res.omega(link)[0]) * self._link_plan(X, B, pX, b, sc.mu_v, "V", "m/s")
+            self.omega[link] = w
+            self.put(f"omega_{link}", np.abs(w), "rad/s")
+        nP, nQ = self._normal(self.a, a, j, P, B), self._normal(self.a, c, k, Q, B)
+        ab = dr.meet(nP, dr.turn(1j * (W[B] - W[P])), nQ, dr.turn(1j * (W[B] - W[Q])))
+        self.put(f"a_{B}", dr.read(ab) * sc.mu_a, "m/s^2")
+        for link, X, nX in ((j, P, nP), (k, Q, nQ)):
+            e = self._link_plan(X, B, nX, ab, sc.mu_a, "at", "m/s^2")
+            self.put(f"eps_{link}", e, "rad/s^2")
+            self.eps[link] = np.sign(res.eps(link)[0]) * e
+        self.v[j] = (W[P], pP, (b - pP) / (W[B] - W[P]))
+        self.v[k] = (W[Q], pQ, (b - pQ) / (W[B] - W[Q]))
+        aP, aQ = self.at(self.a, a, W[P]), self.at(self.a, c, W[Q])
+        self.a[j] = (W[P], aP, (ab - aP) / (W[B] - W[P]))
+        self.a[k] = (W[Q], aQ, (ab - aQ) / (W[B] - W[Q]))
+
+    def _rrp(self, g) -> None:
+        (pj, pin, pk), (j, k), (a, b_) = g.pairs, g.links, g.known
+        if b_ != 0:
+            raise NotImplementedError(f"drawing error: group {g.label} RRP with its guide on moving link {b_} "
+                                      f"is not drawn (only guides on the frame)")
+        P, B = pj.point, pin.point
+        dr, sc, W, res = self.dr, self.sc, self.world, self.res
+        guide = complex(*pk.direction)
+        pP = self.at(self.v, a, W[P])
+        zero = np.zeros(dr.n, complex)
+        b = dr.meet(pP, dr.turn(1j * (W[B] - W[P])), zero, dr.turn(guide))
+        self.put(f"V_{B}", dr.read(b) * sc.mu_v, "m/s")
+        w = np.sign(res.omega(j)[0]) * self._link_plan(P, B, pP, b, sc.mu_v, "V", "m/s")
+        self.omega[j] = w
+        self.put(f"omega_{j}", np.abs(w), "rad/s")
+        aP = self.at(self.a, a, W[P])
+        nP = self._normal(self.a, a, j, P, B)
+        ab = dr.meet(nP, dr.turn(1j * (W[B] - W[P])), zero, dr.turn(guide))
+        self.put(f"a_{B}", dr.read(ab) * sc.mu_a, "m/s^2")
+        e = self._link_plan(P, B, nP, ab, sc.mu_a, "at", "m/s^2")
+        self.put(f"eps_{j}", e, "rad/s^2")
+        self.eps[j], self.eps[k] = np.sign(res.eps(j)[0]) * e, zero
+        self.v[j] = (W[P], pP, (b - pP) / (W[B] - W[P]))
+        self.a[j] = (W[P], aP, (ab - aP) / (W[B] - W[P]))
+        self.v[k], self.a[k] = (W[B], b, 0.0), (W[B], ab, 0.0)
+        self.omega[k] = zero
+
+    def _rpr(self, g) -> None:
+        (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
+        P, Q = pj.point, pk.point
+        dr, sc, W, res = self.dr, self.sc, self.world, self.res
+        guide = _z(res.velocity(P)[0]) - _z(_velocity_of(res, k, W[P]))     # v_r d, world
+        dvec = guide / abs(guide) if abs(guide) else complex(*res.kin.rot[0, k]) * complex(*pin.direction)
+        pP, pQ = self.at(self.v, a, W[P]), self.at(self.v, c, W[Q])
+        pk_ = dr.meet(pQ, dr.turn(1j * (W[P] - W[Q])), pP, dr.turn(dvec))
+        l = abs(W[P] - W[Q])
+        w = np.sign(res.omega(k)[0]) * dr.read(pk_ - pQ) * sc.mu_v / l
+        vr = dr.read(pP - pk_) * sc.mu_v
+        self.omega[j] = self.omega[k] = w
+        self.put(f"omega_{k}", np.abs(w), "rad/s")
+        self.put(f"V_rel_{pin.links[0]}_{pin.links[1]}", vr, "m/s")
+        aP, aQ = self.at(self.a, a, W[P]), self.at(self.a, c, W[Q])
+        nQ = aQ + dr.draw(-w ** 2 * (W[P] - W[Q]) / sc.mu_a)
+        sign_vr = np.sign((guide * np.conj(dvec)).real) if abs(guide) else 1.0
+        cor = dr.draw(2j * w * sign_vr * vr * dvec / sc.mu_a)
+        ak = dr.meet(nQ, dr.turn(1j * (W[P] - W[Q])), aP - cor, dr.turn(dvec))
+        e = dr.read(ak - nQ) * sc.mu_a / l
+        self.put(f"eps_{k}", e, "rad/s^2")
+        self.eps[j] = self.eps[k] = np.sign(res.eps(k)[0]) * e
+        f_v, f_a = (pk_ - pQ) / (W[P] - W[Q]), (ak - aQ) / (W[P] - W[Q])
+        self.v[k], self.a[k] = (W[Q], pQ, f_v), (W[Q], aQ, f_a)
+        self.v[j], self.a[j] = (W[P], pP, f_v), (W[P], aP, f_a)
+
+    # ---- loads, group plan, force polygon, crank, lever
+    def loads(self):
+        """Per moving link: [(force N (n,) complex drawn direction, world point)], couple N m (n,)."""
+        res, m, sc, dr, W = self.res, self.m, self.sc, self.dr, self.world
+        forces, couples = {}, {}
+        mass, I_S, _ = m.inertia_arrays
+        for link in m.links[1:]:
+            k = link.id
+            S = W[link.com] if link.com else _z(res.kin.origin[0, k])
+            fl = []
+            G = -1j * m.g * mass[k]
+            if G:
+                fl.append((G * np.ones(dr.n), S))
+            if mass[k]:
+                aS = self.at(self.a, k, S) if not link.com else self.like(self.a, k, link.com)
+                Fi = mass[k] * dr.read(aS) * sc.mu_a
+                self.put(f"F_i{k}", Fi, "N")
+                fl.append((-Fi * dr.turn(_unit(aS)), S))
+            Mi = -I_S[k] * self.eps[k]
+            if I_S[k]:
+                self.put(f"M_i{k}", np.abs(Mi), "N m")
+            ext = _z(res.F_applied[0, k]) - G
+            Mext = res.M_applied[0, k] - _cross(S - _z(res.kin.origin[0, k]), G)
+            if abs(ext) > 1e-12 * max(1.0, abs(_z(res.F_applied[0, k]))):
+                X = _z(res.kin.origin[0, k]) + (-Mext / abs(ext) ** 2) * 1j * ext
+                fl.append((ext * np.ones(dr.n), X))
+                Mext = 0.0
+            forces[k], couples[k] = fl, Mi + Mext
+        return forces, couples
+
+    def group_forces(self, forces, couples):
+        m, sc, dr, W, res = self.m, self.sc, self.dr, self.world, self.res
+        g = m.structure.groups[0]
+        (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
+        B = W[pin.point]
+
+        def tangential(link, X):           # Σ M_B = 0 of the link: R^τ along i (B - X)/|BX|
+            l = abs(B - X)
+            tot = couples[link] / sc.mu_l
+            for F, Y in forces[link]:
+                tot = tot + np.abs(F) * dr.arm((Y - B) / sc.mu_l, _unit(F))
+            return tot / (l / sc.mu_l), 1j * (B - X) / l
+
+        Rt_j, t_j = tangential(j, W[pj.point])
+        self.put(f"Rt_{a}_{j}", np.abs(Rt_j), "N")
+        pts = [np.zeros(dr.n, complex)]
+        pts.append(pts[-1] + dr.draw(Rt_j * t_j / sc.mu_F))
+        for F, _ in forces[j]:
+            pts.append(pts[-1] + dr.draw(F / sc.mu_F))
+        end_j = pts[-1]
+        for F, _ in forces[k]:
+            pts.append(pts[-1] + dr.draw(F / sc.mu_F))
+        end_k = pts[-1]
+        if g.kind == "RRR":
+            Rt_k, t_k = tangential(k, W[pk.point])
+            pts.append(pts[-1] + dr.draw(Rt_k * t_k / sc.mu_F))
+            last = (W[pk.point] - B) / abs(W[pk.point] - B)
+        else:
+            last = 1j * complex(*pk.direction)
+        K = dr.meet(pts[0], dr.turn((B - W[pj.point]) / abs(B - W[pj.point])), pts[-1], dr.turn(last))
+        R_aj = pts[1] - K
+        self.put(f"R_{a}_{j}", dr.read(R_aj) * sc.mu_F, "N")
+        self.put(f"R_{c}_{k}", dr.read(K - end_k) * sc.mu_F, "N")
+        self.put(f"R_{k}_{j}", dr.read(K - end_j) * sc.mu_F, "N")
+        return R_aj
+
+    def crank(self, R12, forces, couples) -> np.ndarray:
+        m, sc, dr, W = self.m, self.sc, self.dr, self.world
+        d = m.drive
+        O, A = W[d.pivot], W[d.point]
+        other = m.structure.groups[0].links[0]
+        R21 = self.out[f"R_{d.link}_{other}"]
+        u21 = dr.turn(-_unit(R12))
+        h = dr.arm((A - O) / sc.mu_l, u21)
+        self.put(f"h_R{other}{d.link}", np.abs(h), "mm")
+        M = R21 * h * sc.mu_l + couples[d.link]
+        for F, Y in forces[d.link]:
+            M = M + np.abs(F) * dr.arm((Y - O) / sc.mu_l, _unit(F)) * sc.mu_l
+        self.put("M_bal", -M, "N m")
+        if d.kind == "machine":
+            self.put("F_bal", np.abs(M) / (dr.read(d.gear.r_b / sc.mu_l) * sc.mu_l), "N")
+        return -M
+
+    def lever(self, forces, couples) -> np.ndarray:
+        m, sc, dr, W, res = self.m, self.sc, self.dr, self.world, self.res
+        d = m.drive
+        total = np.zeros(dr.n)
+        for k in range(1, m.n_links):
+            for F, Y in forces[k]:
+                x = self.at(self.v, k, Y)
+                x = dr.like(x, x - self.v[k][1])      # by similarity from the link's known plan point
+                u = dr.turn(_unit(F))
+                total = total + np.abs(F) * ((x * np.conj(u)).real + dr._err(dr.dl))
+            if np.any(couples[k] != 0):
+                X, x, f = self.v[k]
+                # the couple's moment on the lever: M_k omega_k / mu_v, omega_k from a link of the plan
+                ref = max((n for n in m.links[k].points), key=lambda n: abs(W[n] - X))
+                l = abs(W[ref] - X)
+                total = total + couples[k] * np.sign(res.omega(k)[0]) * dr.read(f * (W[ref] - X)) / l
+        pa = dr.read(self.pa)
+        l1 = abs(W[d.point] - W[d.pivot])
+        M = -total * l1 / (np.sign(res.omega(d.link)[0]) * pa)
+        self.put("F_bal_lever", np.abs(M) / l1, "N")
+        self.put("M_bal_lever", M, "N m")
+        return M
+
+
+def _unit(z) -> np.ndarray:
+    """z / |z|, and 0 where z is 0 (a load that vanishes has no direction to draw)."""
+    mag = np.abs(z)
+    return np.where(mag > 0, z / np.where(mag > 0, mag, 1.0), 0.0)
+
+
+def _cross(a: complex, b: complex) -> float:
+    return a.real * b.imag - a.imag * b.real
+
+
+def _velocity_of(res: Analysis, k: int, X: complex) -> np.ndarray:
+    """Velocity (2,) of the point of link k at world position X."""
+    r = X - _z(res.kin.origin[0, k])
+    w = res.omega(k)[0]
+    return res.kin.v_origin[0, k] + w * np.array([-r.imag, r.real])
+
+
+def draws_forces(mech: Mechanism) -> bool:
+    """Whether `simulate` draws the force plans, the crank and the lever of `mech` (SUPPORTED)."""
+    groups = mech.structure.groups
+    return len(groups) == 1 and (groups[0].kind == "RRR" or (groups[0].kind == "RRP" and groups[0].known[1] == 0))
+
+
+def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length_mm: float = 0.25,
+             angle_deg: float = 0.25, scales: Scales | None = None, seed: int = 0) -> DrawnSolution:
+    """`n` drawn solutions of `mech` at crank angle `at` (deg; default its design position),
+    each act of drawing wrong by up to ±length_mm (lengths, arms, readings) and ±angle_deg
+    (directions), at `scales` (default: the texts' choice). Reproducible for a given seed."""
+    from .worksheet import worksheet
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise ValueError(f"n: expected a positive number of samples, got {n!r}")
+    for name, v in (("length_mm", length_mm), ("angle_deg", angle_deg)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+            raise ValueError(f"{name}: expected a finite precision >= 0, got {v!r}")
+    at = mech.drive.design_deg if at is None else float(at)
+    sc = scales or default_scales(mech, at)
+    res = analyze(mech, phi_deg=[at])
+    dr = _Drafter(int(n), float(length_mm), float(angle_deg), seed)
+    pl = _Plans(res, sc, dr)
+    pl.kinematics()
+    forces, couples = pl.loads()
+    drawn = draws_forces(mech)
+    if drawn:
+        R12 = pl.group_forces(forces, couples)
+        M = pl.crank(R12, forces, couples)
+        ML = pl.lever(forces, couples)
+        pl.put("delta_pct", (ML - M) / ML * 100.0, "%")
+    ws = worksheet(mech, at=at, mu_l=sc.mu_l)
+    exact = {}
+    for key in pl.out:
+        try:
+            exact[key] = ws.value(key)
+        except KeyError:
+            continue
+    samples = {k: v.real if np.iscomplexobj(v) else v for k, v in pl.out.items() if k in exact}
+    return DrawnSolution(mech.name, at, sc, float(length_mm), float(angle_deg), drawn, samples, exact,
+                         {k: pl.units[k] for k in samples})

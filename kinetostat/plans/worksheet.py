@@ -1,0 +1,409 @@
+"""The worksheet of the graphical-analytic method (issue 12, item 3): every intermediate value the
+texts write down at one crank position, in their order (seed 002 sec. 1.2.2-1.2.3, seed 000
+secs. 4, 6-8), with units and senses, taken from the exact solution (`analyze`).
+
+Order: the initial link and each Assur group in the order of attachment (velocities, then
+accelerations), the inertia loads and the applied loads, the reactions group by group from the
+last group attached back to the crank, the crank, Zhukovsky's lever and the difference of the two
+balancing moments. Outputs: Markdown, HTML, a pandas frame, CSV and JSON (written atomically).
+
+May use: the solver (`analysis`, `applied`, `model`), numpy; pandas and markdown-it-py inside the
+output methods only. Never matplotlib, never the harness.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis import Analysis, analyze
+from ..applied import load_magnitude
+from ..model import Mechanism
+
+__all__ = ["Row", "Worksheet", "worksheet", "round_scale", "crank_scale", "COLUMNS"]
+
+#: Columns of the worksheet's table (CSV, JSON, frame).
+COLUMNS = ("section", "key", "symbol", "value", "unit", "direction", "note")
+
+_WORDS = {
+    "en": {"kinematics": "Kinematics", "accelerations": "Accelerations", "inertia": "Inertia and loads",
+           "reactions": "Reactions", "crank": "The initial link and Zhukovsky's lever",
+           "cw": "clockwise", "ccw": "counter-clockwise", "angle": "at {:.2f} deg to x",
+           "title": "Worksheet: {name}, phi = {phi:g} deg", "scale": "scale mu_l = {:g} m/mm",
+           "head": ("Symbol", "Value", "Unit", "Sense / direction", "How obtained"),
+           "group": "group {}"},
+    "uk": {"kinematics": "Кінематика: швидкості", "accelerations": "Кінематика: прискорення",
+           "inertia": "Сили інерції та навантаження", "reactions": "Реакції в кінематичних парах",
+           "crank": "Початкова ланка і важіль Жуковського",
+           "cw": "за годинниковою стрілкою", "ccw": "проти годинникової стрілки",
+           "angle": "під кутом {:.2f} град до осі x",
+           "title": "Розрахунковий лист: {name}, φ = {phi:g} град", "scale": "масштаб μ_l = {:g} м/мм",
+           "head": ("Позначення", "Значення", "Одиниця", "Напрямок", "Як отримано"),
+           "group": "група {}"},
+}
+
+
+@dataclass(frozen=True)
+class Row:
+    """One written-down value: `key` a stable ASCII name (e.g. `V_BA`, `omega_2`, `R_1_2`),
+    `symbol` as the texts write it, `value` in SI (`unit`; mm for arms and z), `direction` the
+    sense of a rotation ("cw"/"ccw") or the angle of a vector from +x in degrees (as text),
+    `note` the formula or the plan it is read from."""
+    section: str
+    key: str
+    symbol: str
+    value: float
+    unit: str
+    direction: str = ""
+    note: str = ""
+
+
+def round_scale(value: float, drawn_lo: float, drawn_hi: float) -> float:
+    """The round scale (1, 2, 2.5 or 5 x 10^k units per mm) that draws `value` closest to the
+    range [drawn_lo, drawn_hi] mm (inside it where one does; the smaller drawing on a tie)."""
+    value = abs(value)
+    if not math.isfinite(value) or value == 0:
+        raise ValueError(f"round_scale: needs a finite nonzero quantity, got {value!r}")
+    k0 = math.floor(math.log10(value / drawn_hi)) - 1
+    candidates = [m * 10.0 ** k for k in range(k0, k0 + 4) for m in (1, 2, 2.5, 5)]
+
+    def miss(mu: float) -> float:
+        drawn = value / mu
+        return max(drawn_lo - drawn, drawn - drawn_hi, 0.0)
+
+    return min(candidates, key=lambda mu: (miss(mu), -mu))
+
+
+def crank_scale(mech: Mechanism) -> float:
+    """μ_l, m/mm, as seed 002 chooses it: the crank OA drawn 30-35 mm at a round scale."""
+    d = mech.drive
+    pts = mech.links[d.link].points
+    return round_scale(math.dist(pts[d.pivot], pts[d.point]), 30.0, 35.0)
+
+
+@dataclass(frozen=True)
+class Worksheet:
+    """The worksheet of `mech` at crank angle `phi_deg` (rows in the texts' order)."""
+    mechanism: str
+    phi_deg: float
+    mu_l: float
+    rows: tuple[Row, ...]
+    lang: str = "en"
+
+    def __repr__(self) -> str:
+        return f"Worksheet({self.mechanism!r}, phi_deg={self.phi_deg:g}, mu_l={self.mu_l:g}, rows={len(self.rows)})"
+
+    def row(self, key: str) -> Row:
+        for r in self.rows:
+            if r.key == key:
+                return r
+        raise KeyError(f"worksheet: no value {key!r}; keys: {', '.join(r.key for r in self.rows)}")
+
+    def value(self, key: str) -> float:
+        """The value of row `key`, SI (mm for arms)."""
+        return self.row(key).value
+
+    def section(self, name: str) -> tuple[Row, ...]:
+        return tuple(r for r in self.rows if r.section == name)
+
+    # -- outputs
+    def records(self) -> list[dict]:
+        w = _WORDS[self.lang]
+        return [{"section": w[r.section], "key": r.key, "symbol": r.symbol, "value": r.value, "unit": r.unit,
+                 "direction": _direction(r.direction, w), "note": r.note} for r in self.rows]
+
+    def frame(self):
+        """The rows as a pandas DataFrame (columns COLUMNS)."""
+        import pandas as pd
+        df = pd.DataFrame(self.records(), columns=list(COLUMNS))
+        df.attrs.update(mechanism=self.mechanism, phi_deg=self.phi_deg, mu_l=self.mu_l)
+        return df
+
+    def markdown(self) -> str:
+        """The worksheet as Markdown: a title, then one table per section."""
+        w = _WORDS[self.lang]
+        out = [f"# {w['title'].format(name=self.mechanism, phi=self.phi_deg)}", "", w["scale"].format(self.mu_l)]
+        section = None
+        for rec in self.records():
+            if rec["section"] != section:
+                section = rec["section"]
+                out += ["", f"## {section}", "", "| " + " | ".join(w["head"]) + " |", "|---|---:|---|---|---|"]
+            cells = (rec["symbol"], _number(rec["value"]), rec["unit"], rec["direction"], rec["note"])
+            out.append("| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |")
+        return "\n".join(out) + "\n"
+
+    def html(self) -> str:
+        """The Markdown rendered to HTML (CommonMark with tables; raw HTML is not passed through)."""
+        from markdown_it import MarkdownIt
+        return MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
+
+    def to_csv(self, path: str | Path) -> None:
+        """Write the rows as CSV (atomic: a temporary file in the same folder, then replaced)."""
+        _atomic_write(path, self.frame().to_csv(index=False))
+
+    def to_json(self, path: str | Path) -> None:
+        """Write the rows as a JSON list of objects, NaN as null (atomic)."""
+        recs = [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()}
+                for r in self.records()]
+        doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l, "rows": recs}
+        _atomic_write(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")
+
+
+def _number(x: float) -> str:
+    return "n/a" if not math.isfinite(x) else f"{x:.6g}"
+
+
+def _direction(d: str, w: dict) -> str:
+    if d in ("cw", "ccw"):
+        return w[d]
+    if d.startswith("angle:"):
+        return w["angle"].format(float(d[6:]))
+    return d
+
+
+def _atomic_write(path: str | Path, text: str) -> None:
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+# ----------------------------------------------------------------------------- building
+
+def _angle(v: np.ndarray) -> str:
+    return f"angle:{math.degrees(math.atan2(v[1], v[0])):.6f}"
+
+
+def _sense(x: float) -> str:
+    return "ccw" if x > 0 else "cw" if x < 0 else ""
+
+
+class _Sheet:
+    """Collects the rows of one position (index 0 of a one-angle Analysis)."""
+
+    def __init__(self, res: Analysis, mu_l: float):
+        self.res, self.mech, self.mu_l, self.rows = res, res.mech, mu_l, []
+        self.seen: set[str] = set()
+
+    def add(self, section, key, symbol, value, unit, direction="", note=""):
+        self.rows.append(Row(section, key, symbol, float(value), unit, direction, note))
+
+    def vector(self, section, key, symbol, v: np.ndarray, unit, note=""):
+        self.add(section, key, symbol, np.hypot(*v), unit, _angle(v), note)
+
+    # ---- kinematics
+    def link_points(self, k: int, pairs) -> list[str]:
+        link = self.mech.links[k]
+        names = [p.point for p in pairs if k in p.links and p.point in link.points]
+        if link.com:
+            names.append(link.com)
+        return list(dict.fromkeys(names))
+
+    def velocity_rows(self, names: list[str]) -> None:
+        """V_X of each point not written yet (the crank pin is written first)."""
+        for name in names:
+            if name not in self.seen and name != self.mech.drive.point:
+                self.seen.add(name)
+                self.vector("kinematics", f"V_{name}", f"V_{name}", self.res.velocity(name)[0], "m/s",
+                            f"p{name.lower()} μ_v")
+
+    def kinematics(self) -> None:
+        res, m, d = self.res, self.mech, self.mech.drive
+        w1 = res.omega(d.link)[0]
+        self.add("kinematics", f"omega_{d.link}", f"ω{d.link}", abs(w1), "rad/s", _sense(w1), "π n1 / 30")
+        self.vector("kinematics", f"V_{d.point}", f"V_{d.point}", res.velocity(d.point)[0], "m/s",
+                    f"ω{d.link} l_{d.pivot}{d.point}")
+        accel = [("a", d.point, None)]
+        for g in m.structure.groups:
+            (pj, pin, pk), (j, k) = g.pairs, g.links
+            for link, outer in ((j, pj), (k, pk)):
+                pts = self.link_points(link, (pj, pin, pk))
+                com = self.mech.links[link].com
+                self.velocity_rows([n for n in pts if n != com])
+                if outer.kind == "R" and pin.kind == "R":
+                    rel = res.velocity(pin.point)[0] - res.velocity(outer.point)[0]
+                    sym = f"V_{pin.point}{outer.point}"
+                    self.vector("kinematics", sym, sym, rel, "m/s", f"{outer.point.lower()}{pin.point.lower()} μ_v")
+                    accel.append(("rel", link, (outer.point, pin.point)))
+                self.velocity_rows([com] if com else [])
+                wk = res.omega(link)[0]
+                if not (wk == 0 and res.eps(link)[0] == 0):      # a translating link has no ω
+                    self.add("kinematics", f"omega_{link}", f"ω{link}", abs(wk), "rad/s", _sense(wk),
+                             f"V_{pin.point}{outer.point} / l_{outer.point}{pin.point}" if outer.kind == pin.kind == "R" else "")
+                accel += [("a", name, None) for name in pts]
+            for p in (pj, pin, pk):
+                if p.kind == "P":
+                    vr = res.slide_velocity(*p.links)[0]
+                    sym = f"V_rel({p.links[0]},{p.links[1]})"
+                    self.add("kinematics", sym, sym, abs(vr), "m/s", "", f"along the guide of link {p.links[0]}")
+                    accel.append(("cor", p, vr))
+            accel.append(("eps", (j, k), None))
+        self.accelerations(accel)
+
+    def accelerations(self, steps) -> None:
+        res, d = self.res, self.mech.drive
+        done: set = set()
+        e1 = res.eps(d.link)[0]
+        for what, a, b in steps:
+            if what == "a" and a not in done:
+                done.add(a)
+                note = f"ω{d.link}² l_{d.pivot}{d.point}" if a == d.point and not e1 else f"π{a.lower()} μ_a"
+                self.vector("accelerations", f"a_{a}", f"a_{a}", res.acceleration(a)[0], "m/s^2", note)
+            elif what == "rel":
+                k, (outer, inner) = a, b
+                r = res.position(inner)[0] - res.position(outer)[0]
+                l, w, e = np.hypot(*r), res.omega(k)[0], res.eps(k)[0]
+                self.vector("accelerations", f"an_{inner}{outer}", f"a^n_{inner}{outer}", -w * w * r, "m/s^2",
+                            f"ω{k}² l_{outer}{inner}")
+                self.vector("accelerations", f"at_{inner}{outer}", f"a^τ_{inner}{outer}", e * np.array([-r[1], r[0]]),
+                            "m/s^2", f"n{k}{inner.lower()} μ_a")
+            elif what == "cor":
+                p, vr = a, b
+                wg = res.omega(p.links[0])[0]
+                if wg:
+                    dvec = res.velocity(p.point)[0] - _point_of(res, p.links[0], p.point)
+                    cor = 2 * wg * np.array([-dvec[1], dvec[0]])
+                    sym = f"a^Cor({p.links[0]},{p.links[1]})"
+                    self.vector("accelerations", f"aCor_{p.links[0]}_{p.links[1]}", sym, cor, "m/s^2",
+                                f"2 ω{p.links[0]} V_rel")
+                ar = res.slide_acceleration(*p.links)[0]
+                sym = f"a^r({p.links[0]},{p.links[1]})"
+                self.add("accelerations", f"ar_{p.links[0]}_{p.links[1]}", sym, abs(ar), "m/s^2", "", "along the guide")
+            elif what == "eps":
+                for k in a:
+                    if ("eps", k) in done:
+                        continue
+                    done.add(("eps", k))
+                    ek = res.eps(k)[0]
+                    if ek == 0 and res.omega(k)[0] == 0:
+                        continue
+                    self.add("accelerations", f"eps_{k}", f"ε{k}", abs(ek), "rad/s^2", _sense(ek), "a^τ / l")
+        if e1:
+            self.add("accelerations", f"eps_{d.link}", f"ε{d.link}", abs(e1), "rad/s^2", _sense(e1), "given")
+
+    # ---- loads
+    def loads(self) -> None:
+        res, m = self.res, self.mech
+        for link in m.links[1:]:
+            if not (link.mass or link.I_S):
+                continue
+            k = link.id
+            il = res.inertia(k)
+            self.add("inertia", f"m_{k}", f"m{k}", link.mass, "kg", "", f"G{k} / g")
+            self.add("inertia", f"G_{k}", f"G{k}", link.mass * m.g, "N", _angle(np.array([0.0, -1.0])), f"m{k} g")
+            S = link.com or "S"
+            self.vector("inertia", f"F_i{k}", f"F_i{k}", il.force[0], "N", f"m{k} a_{S}, against a_{S}")
+            if link.I_S:
+                self.add("inertia", f"M_i{k}", f"M_i{k}", abs(il.moment[0]), "N m", _sense(il.moment[0]),
+                         f"I_S{k} ε{k}, against ε{k}")
+            if il.moment[0] and np.isfinite(il.h[0]):
+                self.add("inertia", f"h_{k}", f"h{k}", il.h[0], "m", "", f"M_i{k} / F_i{k}")
+                self.add("inertia", f"z_{k}", f"z{k}", il.h[0] / self.mu_l, "mm", "", f"h{k} / μ_l")
+        for n, ld in enumerate(m.loads):
+            mag = load_magnitude(m, res.kin, ld)[0]
+            unit = "N m" if ld.kind == "moment" else "N"
+            self.add("inertia", f"load_{n}", ld.name, abs(mag), unit, "",
+                     "read from its diagram" if ld.table is not None else "given")
+
+    # ---- reactions
+    def reactions(self) -> None:
+        res, m = self.res, self.mech
+        for g in reversed(m.structure.groups):
+            (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
+            for link, outer, other in ((j, pj, a), (k, pk, c)):
+                if outer.kind == "R" and pin.kind == "R":
+                    R = res.reaction(other, link)[0]
+                    r = res.position(pin.point)[0] - res.position(outer.point)[0]
+                    l = np.hypot(*r)
+                    e = r / l
+                    t = np.array([-e[1], e[0]])
+                    arm = l / self.mu_l
+                    self.add("reactions", f"Rt_{other}_{link}", f"R^τ_{other}{link}", abs(R @ t), "N",
+                             _angle(np.sign(R @ t) * t), f"Σ M_{pin.point} = 0 of link {link}, arm {outer.point}{pin.point} = {arm:.4g} mm")
+            for link, outer, other in ((j, pj, a), (k, pk, c)):
+                if outer.kind == "R" and pin.kind == "R":
+                    R = res.reaction(other, link)[0]
+                    r = res.position(pin.point)[0] - res.position(outer.point)[0]
+                    e = r / np.hypot(*r)
+                    self.add("reactions", f"Rn_{other}_{link}", f"R^n_{other}{link}", abs(R @ e), "N",
+                             _angle(np.sign(R @ e) * e), "force plan of the group")
+            for link, other in ((j, a), (k, c)):
+                self.vector("reactions", f"R_{other}_{link}", f"R{other}{link}", res.reaction(other, link)[0], "N",
+                            "force plan of the group")
+            self.vector("reactions", f"R_{k}_{j}", f"R{k}{j}", res.reaction(k, j)[0], "N",
+                        f"force plan of link {j}")
+            for p in (pj, pin, pk):
+                if p.kind == "P":
+                    x = res.reaction_offset(*p.links)[0]
+                    self.add("reactions", f"x_{p.links[0]}_{p.links[1]}", f"x{p.links[0]}{p.links[1]}", x, "m", "",
+                             f"Σ M_{p.point} = 0 of link {p.links[1]}")
+
+    # ---- crank and lever
+    def crank(self) -> None:
+        res, m, d = self.res, self.mech, self.mech.drive
+        O = res.position(d.pivot)[0]
+        for p in m.pairs:
+            if d.link in p.links and 0 not in p.links:
+                other = p.links[0] if p.links[1] == d.link else p.links[1]
+                R = res.reaction(other, d.link)[0]
+                X = res.position(p.point)[0]
+                self.vector("crank", f"R_{other}_{d.link}", f"R{other}{d.link}", R, "N", f"= -R{d.link}{other}")
+                r = X - O
+                arm = abs(r[0] * R[1] - r[1] * R[0]) / np.hypot(*R) / self.mu_l
+                self.add("crank", f"h_R{other}{d.link}", f"h_R{other}{d.link}", arm, "mm", "",
+                         "arm about the crank axis, on the crank's plan")
+        M = res.balancing_moment[0]
+        self.add("crank", "M_bal", "M_bal", M, "N m", _sense(M), "Σ M_O = 0 of the crank (signed about +z)")
+        if d.kind == "machine":
+            F = res.balancing_force[0]
+            self.vector("crank", "F_bal", "F_bal", F, "N", "F21 h / r_b, at the pitch point on the line of action")
+            self.add("crank", "r_b", "r_b", d.gear.r_b, "m", "", "r_w cos α_w")
+        R01 = res.reaction(0, d.link)[0]
+        self.vector("crank", f"R_0_{d.link}", f"R0{d.link}", R01, "N", "force plan of the crank")
+        l1 = math.dist(*(m.links[d.link].points[n] for n in (d.pivot, d.point)))
+        ML = res.lever_moment[0]
+        self.add("crank", "F_bal_lever", "F'_bal", abs(ML) / l1, "N", "", f"at {d.point}, ⟂ p{d.point.lower()}: Σ M_p = 0 on the lever")
+        self.add("crank", "M_bal_lever", "M'_bal", ML, "N m", _sense(ML), f"F'_bal l_{d.pivot}{d.point}")
+        self.add("crank", "delta_pct", "δ", (ML - M) / ML * 100 if ML else math.nan, "%", "",
+                 "(M'_bal - M_bal) / M'_bal 100 %")
+
+
+def _point_of(res: Analysis, k: int, name: str) -> np.ndarray:
+    """Velocity (2,) of the point of link k at the current position of point `name`."""
+    X = res.position(name)[0]
+    O = res.kin.origin[0, k]
+    w = res.omega(k)[0]
+    r = X - O
+    return res.kin.v_origin[0, k] + w * np.array([-r[1], r[0]])
+
+
+def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = None, lang: str = "en") -> Worksheet:
+    """The worksheet of `mech` at crank angle `at` (deg; default the model's design position).
+
+    mu_l: the scale of the plan of positions, m/mm, for the arms and z in mm (default: the
+    crank drawn 30-35 mm at a round scale, as seed 002 chooses it). lang: "en" or "uk"."""
+    if lang not in _WORDS:
+        raise ValueError(f"lang: expected one of {sorted(_WORDS)}, got {lang!r}")
+    if at is None:
+        at = mech.drive.design_deg
+    if mu_l is None:
+        mu_l = crank_scale(mech)
+    if not (isinstance(mu_l, (int, float)) and math.isfinite(mu_l) and mu_l > 0):
+        raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
+    res = analyze(mech, phi_deg=[float(at)])
+    sheet = _Sheet(res, float(mu_l))
+    sheet.kinematics()
+    sheet.loads()
+    sheet.reactions()
+    sheet.crank()
+    return Worksheet(mech.name, float(at), float(mu_l), tuple(sheet.rows), lang)

@@ -1,0 +1,68 @@
+"""The error of drawing (issue 12, item 4): the Monte Carlo over the constructions is the exact
+solution when nothing is drawn wrong, its spread is linear in a small precision, and it is
+reproducible for a fixed seed."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat.plans.drawing_error import Scales, default_scales, draws_forces, simulate
+from kinetostat.plans.worksheet import worksheet
+
+DRAWN = ["ice_crank_slider", "chain_unit_four_bar", "compressor"]          # forces, crank and lever
+KINEMATICS_ONLY = ["furnace_loader_six_bar", "opposed_twin", "rotating_slotted_link"]   # RPR among them
+
+
+@pytest.mark.parametrize("name", DRAWN + KINEMATICS_ONLY)
+def test_zero_error_is_the_exact_solution(name):
+    mech = kinetostat.load(name)
+    sol = simulate(mech, n=4, length_mm=0.0, angle_deg=0.0)
+    ws = worksheet(mech, mu_l=sol.scales.mu_l)
+    assert sol.forces_drawn == (name in DRAWN) == draws_forces(mech)
+    assert len(sol.samples) >= 15
+    for key, s in sol.samples.items():
+        exact = ws.value(key)                      # the worksheet is analyze (tests/test_worksheet.py)
+        scale = 1.0 if key == "delta_pct" else max(1.0, abs(exact))
+        assert np.all(np.abs(s - exact) <= 1e-9 * scale), key
+    if name in DRAWN:
+        assert {"R_1_2", "M_bal", "M_bal_lever", "delta_pct"} <= set(sol.samples)
+
+
+def test_spread_is_linear_in_a_small_precision():
+    mech = kinetostat.load("ice_crank_slider")
+    wide = simulate(mech, n=40000, length_mm=0.25, angle_deg=0.25, seed=1)
+    narrow = simulate(mech, n=40000, length_mm=0.125, angle_deg=0.125, seed=2)   # independent draws
+    for key in ("V_B", "omega_2", "eps_2", "F_i2", "R_1_2", "R_0_3", "M_bal", "M_bal_lever", "delta_pct"):
+        ratio = narrow.spread(key)["sd"] / wide.spread(key)["sd"]
+        assert ratio == pytest.approx(0.5, rel=0.10), key
+        # a uniform error of +-0.25 mm has sd 0.144 mm: no value is read better than one reading
+        assert wide.spread(key)["sd"] > 0
+
+
+def test_reproducible_with_a_fixed_seed():
+    mech = kinetostat.load("chain_unit_four_bar")
+    a, b = simulate(mech, n=500, seed=7), simulate(mech, n=500, seed=7)
+    c = simulate(mech, n=500, seed=8)
+    assert all(np.array_equal(a.samples[k], b.samples[k]) for k in a.samples)
+    assert not np.array_equal(a.samples["M_bal"], c.samples["M_bal"])
+
+
+def test_seed_002_scales_and_spread():
+    """Seed 002's own scales are the default choice; the published V_B lies inside the spread."""
+    mech = kinetostat.load("ice_crank_slider")
+    assert default_scales(mech) == Scales(0.001, 0.2, 100.0, 50.0)
+    sol = simulate(mech, n=20000, seed=0)
+    s = sol.spread("V_B")
+    assert s["p2_5"] < 10.94 < s["p97_5"]
+    assert 0 < sol.percentile_of("V_B", 10.94) < 100
+
+
+def test_unsupported_and_bad_input():
+    with pytest.raises(NotImplementedError, match="RPP"):
+        simulate(kinetostat.load("scotch_yoke"), n=2)
+    mech = kinetostat.load("ice_crank_slider")
+    with pytest.raises(ValueError, match="length_mm"):
+        simulate(mech, length_mm=-1)
+    with pytest.raises(ValueError, match="n:"):
+        simulate(mech, n=0)

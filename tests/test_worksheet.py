@@ -1,0 +1,110 @@
+"""The worksheet (issue 12, item 3): seed 002's published values at 30 deg, every value against
+`analyze`, the senses by the text's own rule, every bundled model without NaN, the outputs."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat.plans.worksheet import worksheet
+
+# seed 002 sec. 1.2.2-1.2.3 at phi = 30 deg (drawn and measured: the text rounds)
+SEED_002 = {"V_B": 10.94, "V_BA": 14.92, "V_S2": 12.2, "omega_2": 135.6, "a_A": 7994.38, "a_B": 8311,
+            "a_S2": 7875, "eps_2": 33782, "F_i2": 3937.5, "F_i3": 3216.4, "M_i2": 57.43, "R_1_2": 3172,
+            "R_0_3": 780.5, "R_3_2": 6481, "M_bal": 102.74, "M_bal_lever": 102.97}
+
+
+@pytest.fixture(scope="module")
+def ice_sheet():
+    return worksheet(kinetostat.load("ice_crank_slider"), at=30.0)
+
+
+@pytest.mark.parametrize("key", SEED_002)
+def test_seed_002_published_values(ice_sheet, key):
+    assert abs(ice_sheet.value(key)) == pytest.approx(SEED_002[key], rel=0.005)
+
+
+def test_seed_002_order_and_scale(ice_sheet):
+    keys = [r.key for r in ice_sheet.rows]
+    text_order = ["V_A", "V_B", "V_BA", "V_S2", "omega_2", "a_A", "an_BA", "at_BA", "a_B", "a_S2", "eps_2",
+                  "m_2", "F_i2", "M_i2", "Rt_1_2", "R_1_2", "R_0_3", "R_3_2", "M_bal", "F_bal_lever", "M_bal_lever"]
+    assert [k for k in keys if k in text_order] == text_order
+    assert ice_sheet.mu_l == 0.001                       # seed 002: mu_l = 0.036 / 36
+    assert ice_sheet.value("Rt_1_2") == pytest.approx(1326.37, rel=0.005)
+    assert ice_sheet.value("load_0") == pytest.approx(9650.97, rel=1e-6)     # F_p = 0.8 p_max pi d^2 / 4
+    assert ice_sheet.value("h_R21") == pytest.approx(32.39, rel=0.005)       # the crank's arm, mm
+    assert abs(ice_sheet.value("delta_pct")) < 1e-9
+
+
+def test_senses_by_the_texts_rule(ice_sheet):
+    """Seed 002: the sense of omega2 is that of B turning about A with V_BA moved to B; of eps2,
+    that of a^tau_BA moved to B. Here from the worksheet's own vectors' directions."""
+    res = kinetostat.analyze(kinetostat.load("ice_crank_slider"), phi_deg=[30.0])
+    AB = res.position("B")[0] - res.position("A")[0]
+    for key, sym in (("omega_2", "V_BA"), ("eps_2", "at_BA")):
+        ang = math.radians(float(ice_sheet.row(sym).direction[6:]))
+        turn = AB[0] * math.sin(ang) - AB[1] * math.cos(ang)
+        assert ice_sheet.row(key).direction == ("ccw" if turn > 0 else "cw")
+    assert ice_sheet.row("omega_2").direction == "ccw" and ice_sheet.row("eps_2").direction == "cw"
+    assert ice_sheet.row("omega_1").direction == "cw"                     # the model's crank turns clockwise
+
+
+def test_every_value_is_analyze_exactly(mech):
+    at = getattr(mech.drive, "design_deg", 30.0)
+    ws = worksheet(mech, at=at)
+    res = kinetostat.analyze(mech, phi_deg=[at])
+    expect = {"M_bal": res.balancing_moment[0], "M_bal_lever": res.lever_moment[0]}
+    for p in mech.pairs:
+        i, j = p.links
+        expect[f"R_{i}_{j}"] = np.hypot(*res.reaction(i, j)[0])
+    for k in range(1, mech.n_links):
+        expect[f"omega_{k}"] = abs(res.omega(k)[0])
+        expect[f"eps_{k}"] = abs(res.eps(k)[0])
+        if mech.links[k].mass:
+            expect[f"F_i{k}"] = np.hypot(*res.F_i[0, k])
+    for name in mech.point_names:
+        expect[f"V_{name}"] = np.hypot(*res.velocity(name)[0])
+        expect[f"a_{name}"] = np.hypot(*res.acceleration(name)[0])
+    checked = 0
+    for r in ws.rows:
+        if r.key in expect:
+            assert r.value == pytest.approx(expect[r.key], rel=1e-12, abs=1e-12 * max(1.0, abs(expect[r.key])))
+            checked += 1
+        assert math.isfinite(r.value), r.key
+    assert checked >= 8
+
+
+def test_outputs(ice_sheet, tmp_path):
+    md = ice_sheet.markdown()
+    assert "| V_BA | 14.8925 | m/s |" in md
+    html = ice_sheet.html()
+    assert "<table>" in html and "<td>V_BA</td>" in html
+    df = ice_sheet.frame()
+    assert list(df.columns) == ["section", "key", "symbol", "value", "unit", "direction", "note"]
+    ice_sheet.to_csv(tmp_path / "w.csv")
+    ice_sheet.to_json(tmp_path / "w.json")
+    doc = json.loads((tmp_path / "w.json").read_text(encoding="utf-8"))
+    assert doc["rows"][0]["key"] == "omega_1" and len(doc["rows"]) == len(ice_sheet.rows)
+    assert (tmp_path / "w.csv").read_text(encoding="utf-8").splitlines()[0] == "section,key,symbol,value,unit,direction,note"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w.csv", "w.json"]     # no temporary left
+    uk = worksheet(kinetostat.load("ice_crank_slider"), lang="uk")
+    assert "за годинниковою стрілкою" in uk.markdown() and "Реакції" in uk.markdown()
+
+
+def test_bad_options():
+    mech = kinetostat.load("ice_crank_slider")
+    with pytest.raises(ValueError, match="lang"):
+        worksheet(mech, lang="fr")
+    with pytest.raises(ValueError, match="mu_l"):
+        worksheet(mech, mu_l=-1.0)
+
+
+def test_analyze_at_prints_the_worksheet(cli):
+    r = cli("analyze", "models/ice_crank_slider.toml", "--at", 30)
+    assert r.returncode == 0
+    assert "V_BA" in r.stdout and "14.893 m/s" in r.stdout and "ε2" in r.stdout and "F_i2" in r.stdout
+    r = cli("analyze", "models/ice_crank_slider.toml", "--at", 30, 60)
+    assert "worksheet" not in r.stdout
