@@ -309,7 +309,7 @@ class _Plans:
         return forces, couples
 
     def group_forces(self, forces, couples):
-        m, sc, dr, W, res = self.m, self.sc, self.dr, self.world, self.res
+        m, sc, dr, W = self.m, self.sc, self.dr, self.world
         g = m.structure.groups[0]
         (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
         B = W[pin.point]
@@ -362,7 +362,7 @@ class _Plans:
         return -M
 
     def lever(self, forces, couples) -> np.ndarray:
-        m, sc, dr, W, res = self.m, self.sc, self.dr, self.world, self.res
+        m, dr, W, res = self.m, self.dr, self.world, self.res
         d = m.drive
         total = np.zeros(dr.n)
         for k in range(1, m.n_links):

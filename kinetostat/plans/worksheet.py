@@ -262,13 +262,13 @@ class _Sheet:
             elif what == "rel":
                 k, (outer, inner) = a, b
                 r = res.position(inner)[0] - res.position(outer)[0]
-                l, w, e = np.hypot(*r), res.omega(k)[0], res.eps(k)[0]
+                w, e = res.omega(k)[0], res.eps(k)[0]
                 self.vector("accelerations", f"an_{inner}{outer}", f"a^n_{inner}{outer}", -w * w * r, "m/s^2",
                             f"ω{k}² l_{outer}{inner}")
                 self.vector("accelerations", f"at_{inner}{outer}", f"a^τ_{inner}{outer}", e * np.array([-r[1], r[0]]),
                             "m/s^2", f"n{k}{inner.lower()} μ_a")
             elif what == "cor":
-                p, vr = a, b
+                p = a
                 wg = res.omega(p.links[0])[0]
                 if wg:
                     dvec = res.velocity(p.point)[0] - _point_of(res, p.links[0], p.point)
