@@ -152,14 +152,10 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     return Plans(mech, float(at), sc, plans)
 
 
-#: Captions of the report's pictures, by plan kind and language.
-_CAPTIONS = {"en": "{title}, {scale}", "uk": "{title}, {scale}"}
-
-
 def report_images(mech, out_dir: str | Path, lang: str = "en", at: float | None = None) -> list[tuple[Path, str]]:
     """PNG pictures of every plan at the model's design position (or `at`) for the per-model
     report: [(path, caption)], written into `out_dir` (created) as plan_<kind>.png."""
-    from .draw import figure, title_of
+    from .draw import figure, scale_text, title_of
     import matplotlib.pyplot as plt
     plans = build(mech, at=at)
     out = Path(out_dir)
@@ -170,5 +166,5 @@ def report_images(mech, out_dir: str | Path, lang: str = "en", at: float | None 
         path = out / ("plan_" + plan_file_name(plan, ".png"))
         fig.savefig(path, dpi=110)
         plt.close(fig)
-        images.append((path, _CAPTIONS[lang].format(title=title_of(plan, lang), scale=plan.scale)))
+        images.append((path, f"{title_of(plan, lang)}, {scale_text(plan, lang)}"))
     return images
