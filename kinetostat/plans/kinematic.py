@@ -319,7 +319,7 @@ def _position_names(mech) -> tuple[dict[str, int], callable]:
 
 def _outline(mech, k: int) -> list[str]:
     """The model points a link is drawn through: its pins, and for a guide the slot up to the
-    block (the guide point and the block's point); a block alone is one point."""
+    block (the guide point and the block's point); a link with one pin through its other points."""
     pts: list[str] = []
     for p in mech.pairs:
         if k not in p.links:
@@ -327,6 +327,8 @@ def _outline(mech, k: int) -> list[str]:
         for n in ([p.point] if p.kind == "R" else ([p.guide, p.point] if p.links[0] == k else [p.point])):
             if n not in pts:
                 pts.append(n)
+    if len(pts) == 1:           # a block or a ram: drawn through its other points (tool, centre of mass)
+        pts += [n for n in mech.links[k].points if n not in pts]
     return pts
 
 
