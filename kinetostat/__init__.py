@@ -8,10 +8,13 @@
     >>> res
     Analysis(mechanism='ICE crank-slider (seed 002 worked example)', positions=1, phi_deg=30, singular=0)
 
+The plans of the graphical method: `kinetostat.plans.build(mech, at=30)` (a module cannot be
+called, so the issue's `kinetostat.plans(mech, at=30)` is spelled with `.build`).
+
 The solver's public names. May use: the solver modules only (never the harness
 `kinetostat_validation`, the engines, matplotlib or `kinetostat.report`).
 """
-from . import examples
+from . import examples, plans
 from .analysis import Analysis, InertiaLoad, analyze
 from .errors import AssemblyError, ModelError, SingularPositionWarning, StructureError
 from .kinematics import COND_MAX, COND_WARN
@@ -20,5 +23,5 @@ from .structure import AssurGroup, Structure
 
 __all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
-           "SingularPositionWarning", "COND_WARN", "COND_MAX", "examples"]
+           "SingularPositionWarning", "COND_WARN", "COND_MAX", "examples", "plans"]
 __version__ = "0.1.0"

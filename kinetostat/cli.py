@@ -1,4 +1,4 @@
-"""The command line: `kinetostat analyze | structure | validate | report | examples` (also `python -m kinetostat`).
+"""The command line: `kinetostat analyze | structure | plans | validate | report | examples` (also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
 nothing to compare, or `report` could not make a model's report; 2 bad input or options (model
@@ -671,6 +671,56 @@ def cmd_export(args) -> int:
     return EXIT_OK
 
 
+# ============================================================================ plans
+
+def _scale_item(text: str) -> tuple[str, float]:
+    from .plans.scales import SCALE_UNITS
+    key, eq, value = text.partition("=")
+    if not eq or key not in SCALE_UNITS:
+        raise argparse.ArgumentTypeError(f"invalid --scale {text!r}: expected KEY=VALUE with KEY one of "
+                                         f"{', '.join(SCALE_UNITS)}, e.g. --scale mu_l=0.001 mu_v=0.2")
+    try:
+        x = float(value)
+    except ValueError:
+        x = math.nan
+    if not (math.isfinite(x) and x > 0):
+        raise argparse.ArgumentTypeError(f"invalid --scale {text!r}: {key} must be a positive number "
+                                         f"in {SCALE_UNITS[key]}")
+    return key, x
+
+
+def _plan_names(text: str) -> list[str]:
+    from .plans import BUILDERS
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    valid = [n for n, _ in BUILDERS]
+    bad = [n for n in names if n not in valid]
+    if bad or not names:
+        raise argparse.ArgumentTypeError(f"invalid --only {text!r}: expected plan names from {', '.join(valid)}, "
+                                         f"comma-separated")
+    return names
+
+
+def cmd_plans(args) -> int:
+    from .plans import build
+    path = Path(args.model)
+    mech = _load(path)
+    out = _writable_dir(args.out, "--out")
+    only = [n for group in (args.only or []) for n in group] or None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
+    except ValueError as exc:
+        raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
+    try:
+        written = plans.write(out, lang=args.lang)
+    except OSError as exc:
+        raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
+    scales = ", ".join(str(s) for s in plans.scales.values())
+    _Out.write(f"{path.name} at phi = {plans.at:g} deg ({scales}): {len(written)} files -> {out}")
+    return EXIT_OK
+
+
 # ============================================================================ examples
 
 def cmd_examples(args) -> int:
@@ -790,6 +840,27 @@ def build_parser() -> argparse.ArgumentParser:
                         "1: in this process)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.set_defaults(func=cmd_report)
+
+    pl = sub.add_parser("plans", help="draw the plans of the graphical method (SVG sheets, segments.csv)",
+                        description="Draw MODEL's plans at one crank angle as the course texts draw them: the plan "
+                                    "of positions (12 positions from the dead centre, the design position, the "
+                                    "paths of the centres of mass, the assembly branches), the velocity and "
+                                    "acceleration plans; one SVG sheet per plan (A3, true to scale in mm) and "
+                                    "DIR/segments.csv (every drawn segment: its length in mm, the value it stands "
+                                    "for, the scale). --only positions is the quick preview of a model.")
+    pl.add_argument("model", metavar="MODEL", help="model file (TOML)")
+    pl.add_argument("--at", metavar="DEG", type=_angle,
+                    help="crank angle in degrees (default: the model's design position, drive.design_deg)")
+    pl.add_argument("--scale", metavar="KEY=VALUE", nargs="+", type=_scale_item,
+                    help="scales to use instead of the texts' rule: mu_l [m/mm], mu_v [m/(s mm)], "
+                         "mu_a [m/(s^2 mm)], mu_F [N/mm], e.g. --scale mu_l=0.001 mu_v=0.2 mu_a=100 mu_F=50")
+    pl.add_argument("--starting", metavar="DEG", type=_angle,
+                    help="position 0 of the plan of positions (default: found, crank and rod in line)")
+    pl.add_argument("--lang", choices=("en", "uk"), default="en", help="language of the sheets (default en)")
+    pl.add_argument("--only", metavar="PLANS", type=_plan_names, action="append",
+                    help="draw only these plans, comma-separated: positions, velocity, acceleration")
+    pl.add_argument("--out", metavar="DIR", required=True, help="output directory (created)")
+    pl.set_defaults(func=cmd_plans)
 
     e = sub.add_parser("examples", help="list the bundled models, or copy them (with FORMAT.md) into a folder",
                        description="List the bundled models (the seeds' worked cases shipped inside the package, "

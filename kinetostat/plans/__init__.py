@@ -1,1 +1,170 @@
-"""The graphical method drawn: plans as data (`core`), built from the exact solution."""
+"""The graphical method drawn: the plans of the texts as data, built from the exact solution.
+
+    >>> import kinetostat, kinetostat.plans
+    >>> mech = kinetostat.load("ice_crank_slider")
+    >>> plans = kinetostat.plans.build(mech, at=30)
+    >>> round(plans["velocity"].length_mm("p-b"), 1)        # seed 002: pb = 54.7 mm at mu_v = 0.2
+    54.7
+    >>> fig = plans["acceleration"].figure(lang="uk")       # a matplotlib Figure (notebooks)
+    >>> plans.write("out", lang="en")                       # one SVG sheet per plan + segments.csv
+
+`build` -> `Plans`, a frozen mapping kind -> `Plan` (`core`); scales by the texts' rule or given
+(`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
+there and only when a figure is drawn).
+
+May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`); pandas only inside
+`Plans.segments_frame`; never the harness or `kinetostat.report`.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import os
+import tempfile
+from collections.abc import Mapping
+from functools import partial
+from pathlib import Path
+from types import MappingProxyType
+from typing import Callable, Iterable
+
+from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
+from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
+from .scales import choose_scales
+
+__all__ = ["build", "Plans", "BUILDERS", "report_images", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS",
+           "choose_scales", "starting_position", "plan_file_name"]
+
+#: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
+#: Plan or list of Plans). The force plans, the crank and the lever join with one line each.
+BUILDERS: tuple[tuple[str, Callable], ...] = (
+    ("positions", positions_plan),
+    ("velocity", velocity_plan),
+    ("acceleration", acceleration_plan),
+)
+
+
+class Plans(Mapping):
+    """The plans of one mechanism at one crank angle: a frozen mapping kind -> Plan (kinds as in
+    the `plan` column of segments.csv), with the scales they are drawn at."""
+
+    def __init__(self, mech, at: float, scales: Mapping[str, Scale], plans: Iterable[Plan]):
+        self.mech, self.at = mech, float(at)
+        self.scales = MappingProxyType(dict(scales))
+        self._plans = MappingProxyType({p.kind: p for p in plans})
+
+    def __getitem__(self, kind: str) -> Plan:
+        try:
+            return self._plans[kind]
+        except KeyError:
+            raise KeyError(f"no plan {kind!r}; plans: {', '.join(self._plans)}") from None
+
+    def __iter__(self):
+        return iter(self._plans)
+
+    def __len__(self) -> int:
+        return len(self._plans)
+
+    def __repr__(self) -> str:
+        scales = ", ".join(str(s) for s in self.scales.values())
+        return f"Plans(phi_deg={self.at:g}, [{', '.join(self._plans)}], {scales})"
+
+    def rows(self) -> list[dict]:
+        return [r for p in self._plans.values() for r in p.rows()]
+
+    def segments_frame(self):
+        """Every drawn segment as a pandas DataFrame with the columns of segments.csv."""
+        import pandas as pd
+        return pd.DataFrame(self.rows(), columns=list(SEGMENT_COLUMNS))
+
+    def segments_csv(self) -> str:
+        buf = io.StringIO()
+        w = csv.DictWriter(buf, fieldnames=SEGMENT_COLUMNS, lineterminator="\n")
+        w.writeheader()
+        for r in self.rows():
+            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+        return buf.getvalue()
+
+    def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
+        """Write one SVG sheet per plan (`plan_file_name`) and segments.csv into `out_dir`
+        (created), each atomically; returns the paths written."""
+        from .draw import svg
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        written = []
+        for plan in self._plans.values():
+            path = out / plan_file_name(plan)
+            _write_atomic(path, svg(plan, lang=lang, mechanism=self.mech.name))
+            written.append(path)
+        _write_atomic(out / "segments.csv", self.segments_csv())
+        return written + [out / "segments.csv"]
+
+
+def plan_file_name(plan: Plan, suffix: str = ".svg") -> str:
+    """File name of a plan's sheet: its kind with ':' and ',' made safe (group:2,3 -> group_2-3)."""
+    return plan.kind.replace(":", "_").replace(",", "-") + suffix
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    """Write through a temporary file in the same folder and os.replace (no half-written file)."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def build(mech, at: float | None = None, scales: Mapping[str, float] | None = None,
+          starting_deg: float | None = None, only: Iterable[str] | None = None) -> Plans:
+    """The plans of `mech` at crank angle `at` (deg; default: the model's design position
+    `drive.design_deg`). `scales`: any of mu_l [m/mm], mu_v [m/(s mm)], mu_a [m/(s^2 mm)],
+    mu_F [N/mm] (the others chosen by the texts' rule, `choose_scales`); `starting_deg`: position
+    0 of the plan of positions (default: found, `starting_position`); `only`: names of BUILDERS
+    to draw (default all). ValueError for a bad angle, scale or name."""
+    import math
+
+    from ..analysis import analyze
+    if at is None:
+        at = getattr(mech.drive, "design_deg", 30.0)
+    if isinstance(at, bool) or not isinstance(at, (int, float)) or not math.isfinite(at):
+        raise ValueError(f"at: expected a finite crank angle in degrees, got {at!r}")
+    names = [n for n, _ in BUILDERS]
+    chosen = list(names if only is None else only)
+    unknown = [n for n in chosen if n not in names]
+    if unknown:
+        raise ValueError(f"unknown plan {unknown[0]!r}: expected one of {', '.join(names)}")
+    res = analyze(mech, phi_deg=[float(at)])
+    if res.singular[0]:
+        raise ValueError(f"at {at:g} deg the mechanism is at a singular position "
+                         f"(cond {res.cond[0].max():.3g}): velocities and accelerations undefined")
+    sc = choose_scales(mech, res, scales)
+    steps = dict(BUILDERS)
+    steps["positions"] = partial(positions_plan, starting_deg=starting_deg)
+    plans: list[Plan] = []
+    for name in names:
+        if name in chosen:
+            made = steps[name](mech, res, sc)
+            plans.extend(made if isinstance(made, (list, tuple)) else [made])
+    return Plans(mech, float(at), sc, plans)
+
+
+def report_images(mech, out_dir: str | Path, lang: str = "en", at: float | None = None) -> list[tuple[Path, str]]:
+    """PNG pictures of every plan at the model's design position (or `at`) for the per-model
+    report: [(path, caption)], written into `out_dir` (created) as plan_<kind>.png."""
+    from .draw import figure, scale_text, title_of
+    import matplotlib.pyplot as plt
+    plans = build(mech, at=at)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    images = []
+    for plan in plans.values():
+        fig = figure(plan, lang=lang)
+        path = out / ("plan_" + plan_file_name(plan, ".png"))
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        images.append((path, f"{title_of(plan, lang)}, {scale_text(plan, lang)}"))
+    return images

@@ -39,7 +39,8 @@ class Segment:
     `name` is lettered as the texts letter it (`p-b`, `a-n2`, `R12`, `h_G2`); `value` is the
     quantity it stands for in SI units (signed where the texts sign it, else a magnitude), so that
     |value| = drawn length x scale for a vector or an arm drawn at the plan's scale; `kind` says how
-    it is drawn: "vector" (an arrow), "link" (a link of the mechanism), "arm" (a moment arm),
+    it is drawn: "vector" (an arrow), "link" (a link of the mechanism), "position" (a link at one
+    of the other positions of the plan of positions, drawn thin), "arm" (a moment arm),
     "line" (a construction line: a direction, a path). A segment whose quantity is not at the plan's
     scale (a link of a lever, a path) has `value` NaN and unit "", unless it names its own `scale`
     (a force drawn on a group plan: |value| = drawn length x segment.scale).
@@ -67,10 +68,12 @@ class Plan:
     points: Mapping[str, complex]          # name -> x + 1j*y on the sheet, mm
     segments: tuple[Segment, ...]
     paths: Mapping[str, tuple[complex, ...]] = field(default_factory=dict)   # polylines (mm), e.g. paths of S
+    notes: tuple[str, ...] = ()            # lines of text the sheet shows beside the plan (e.g. the branches)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", MappingProxyType(dict(self.points)))
         object.__setattr__(self, "paths", MappingProxyType({k: tuple(v) for k, v in self.paths.items()}))
+        object.__setattr__(self, "notes", tuple(self.notes))
 
     def length_mm(self, name: str) -> float:
         """Drawn length of the segment `name`, mm."""
@@ -93,6 +96,16 @@ class Plan:
                         "length_mm": abs(b - a), "value": s.value, "unit": s.unit,
                         "scale": str(s.scale or self.scale)})
         return out
+
+    def figure(self, lang: str = "en", ax=None):
+        """The plan as a matplotlib Figure (equal aspect, mm axes); `lang` "en" or "uk"."""
+        from .draw import figure
+        return figure(self, lang=lang, ax=ax)
+
+    def svg(self, lang: str = "en", mechanism: str = "") -> str:
+        """The plan as an SVG sheet (A3 landscape, true to scale in mm)."""
+        from .draw import svg
+        return svg(self, lang=lang, mechanism=mechanism)
 
     def __repr__(self) -> str:
         return (f"Plan({self.kind!r}, phi_deg={self.phi_deg:g}, {self.scale}, points={len(self.points)}, "

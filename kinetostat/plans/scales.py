@@ -1,0 +1,117 @@
+"""Scale factors of the plans (the texts' μ), chosen as the texts choose them or given by the user.
+
+The rule (seed 002 sec. 1.2.2): a reference quantity is drawn at a recommended length and the
+scale is its value over that length, rounded to a value an engineer can multiply by in the head.
+Here a round scale is m x 10^k with the mantissa m one of ROUND_MANTISSAS = (1, 2, 2.5, 4, 5);
+of the round scales, the one whose drawn reference length is nearest the recommended range (in
+ratio; ties go to the larger drawing) is taken, then made coarser step by step while the plan
+would not fit the drawing area of an A3 sheet (FIT_MM).
+
+    mu_l: the crank O-A drawn 30..35 mm (seed 002 draws 36 mm at mu_l = 0.001 m/mm);
+    mu_v: the crank pin's velocity p-a drawn 70..90 mm (seed 002: 85 mm, mu_v = 0.2);
+    mu_a: the crank pin's acceleration pi-a drawn 70..90 mm (seed 002: 79.94 mm, mu_a = 100);
+    mu_F: the largest force at that angle (a reaction, an applied load or an inertia force)
+          drawn 70..90 mm.
+
+May use: numpy, `kinetostat.analysis` (the exact results), `.core`.
+"""
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+import numpy as np
+
+from .core import Scale
+
+__all__ = ["choose_scales", "round_scale", "check_given", "SCALE_UNITS", "ROUND_MANTISSAS", "FIT_MM"]
+
+#: Unit of each scale, per millimetre drawn.
+SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F": "N/mm"}
+#: Mantissas of a round scale.
+ROUND_MANTISSAS = (1.0, 2.0, 2.5, 4.0, 5.0)
+#: Recommended drawn length of each scale's reference quantity, mm.
+TARGET_MM = {"mu_l": (30.0, 35.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (70.0, 90.0)}
+#: Drawing area of an A3 landscape sheet a plan must fit (width, height), mm: inside the frame,
+#: above the title block.
+FIT_MM = (380.0, 220.0)
+
+
+def _round_candidates(value: float) -> list[float]:
+    """Round scales around `value`, ascending."""
+    k0 = math.floor(math.log10(value))
+    return sorted(m * 10.0 ** k for k in range(k0 - 2, k0 + 3) for m in ROUND_MANTISSAS)
+
+
+def round_scale(reference: float, lo_mm: float, hi_mm: float, extent: tuple[float, float] = (0.0, 0.0),
+                fit_mm: tuple[float, float] = FIT_MM) -> float:
+    """The round scale (SI per mm) that draws `reference` (SI) nearest [lo_mm, hi_mm] and the
+    plan's extent (width, height, SI) within `fit_mm`."""
+    if not (reference > 0 and math.isfinite(reference)):
+        reference = max(extent)
+        if not (reference > 0 and math.isfinite(reference)):
+            return 1.0                # nothing to draw: any scale will do
+    cands = _round_candidates(reference / hi_mm)
+
+    def miss(c: float) -> float:      # how far the drawn length lies outside [lo, hi], in log ratio
+        length = reference / c
+        return max(math.log(lo_mm / length), math.log(length / hi_mm), 0.0)
+
+    best = min(cands, key=lambda c: (round(miss(c), 12), c))
+    for c in cands[cands.index(best):]:
+        if extent[0] / c <= fit_mm[0] and extent[1] / c <= fit_mm[1]:
+            return c
+    k = max(extent[0] / fit_mm[0], extent[1] / fit_mm[1])     # beyond the candidates: next round value
+    return min(m * 10.0 ** math.ceil(math.log10(k) - math.log10(m)) for m in ROUND_MANTISSAS)
+
+
+def check_given(given: Mapping[str, float] | None) -> dict[str, float]:
+    """The user's scales, checked: known keys, finite positive numbers (ValueError naming the key)."""
+    out = {}
+    for key, value in (given or {}).items():
+        if key not in SCALE_UNITS:
+            raise ValueError(f"unknown scale {key!r}: expected one of {', '.join(SCALE_UNITS)}")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise ValueError(f"scale {key}: expected a positive number in {SCALE_UNITS[key]}, got {value!r}")
+        out[key] = float(value)
+    return out
+
+
+def _extent(z: np.ndarray) -> tuple[float, float]:
+    z = np.asarray(z)[np.isfinite(z)]
+    if not len(z):
+        return (0.0, 0.0)
+    return (float(np.ptp(z.real)), float(np.ptp(z.imag)))
+
+
+def choose_scales(mech, res, given: Mapping[str, float] | None = None,
+                  cycle=None) -> dict[str, Scale]:
+    """Scales mu_l, mu_v, mu_a, mu_F for the plans of `res` (an Analysis at one crank angle):
+    the given ones as given, the others by the texts' rule (module docstring). `cycle`: an
+    Analysis over the cycle whose positions the plan of positions must fit (default: 72 steps)."""
+    from ..analysis import analyze
+    given = check_given(given)
+    d = mech.drive
+    crank = mech.links[d.link].points
+    l_oa = math.dist(crank[d.pivot], crank[d.point])
+    vA, aA = res.velocity(d.point)[0], res.acceleration(d.point)[0]
+    if cycle is None:
+        cycle = analyze(mech, steps=72)
+    pos = np.concatenate([cycle.kin.point_z(k, p)[0] for k, link in enumerate(mech.links) if k
+                          for p in link.points.values()] + [np.array([complex(*p) for p in mech.links[0].points.values()])])
+    vel = np.array([0j] + [complex(*res.velocity(n)[0]) for n in mech.point_names])
+    acc = np.array([0j] + [complex(*res.acceleration(n)[0]) for n in mech.point_names])
+    forces = np.concatenate([np.hypot(*np.moveaxis(a[0], -1, 0)).ravel()
+                             for a in (res.forces.R, res.F_applied, res.F_i)])
+    reference = {"mu_l": (l_oa, _extent(pos)), "mu_v": (float(np.hypot(*vA)), _extent(vel)),
+                 "mu_a": (float(np.hypot(*aA)), _extent(acc)),
+                 "mu_F": (float(np.nanmax(forces, initial=0.0)), (0.0, 0.0))}
+    out = {}
+    for key, unit in SCALE_UNITS.items():
+        if key in given:
+            value = given[key]
+        else:
+            ref, ext = reference[key]
+            value = round_scale(ref, *TARGET_MM[key], extent=ext)
+        out[key] = Scale(key, value, unit)
+    return out
