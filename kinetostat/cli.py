@@ -702,6 +702,7 @@ def _plan_names(text: str) -> list[str]:
 
 def cmd_plans(args) -> int:
     from .plans import build
+    from .plans.worksheet import worksheet
     path = Path(args.model)
     mech = _load(path)
     out = _writable_dir(args.out, "--out")
@@ -710,10 +711,13 @@ def cmd_plans(args) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
+            sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
     try:
         written = plans.write(out, lang=args.lang)
+        if sheet is not None:
+            written += sheet.write(out)
     except OSError as exc:
         raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
     scales = ", ".join(str(s) for s in plans.scales.values())

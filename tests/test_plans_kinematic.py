@@ -66,6 +66,9 @@ def _exact_values(mech, res, plans):
     return exp
 
 
+KINEMATIC = ("positions", "velocity", "acceleration")
+
+
 @pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
 def test_every_segment_is_the_exact_value(path):
     """At the design position and three other angles: drawn length x scale = |value| (1e-9),
@@ -73,7 +76,7 @@ def test_every_segment_is_the_exact_value(path):
     and the velocity polygons p-a + a-b = p-b close to 1e-9 of the largest side."""
     mech = kinetostat.load(path)
     for at in (mech.drive.design_deg, 75.0, 160.0, 290.0):
-        plans = P.build(mech, at=at)
+        plans = P.build(mech, at=at, only=KINEMATIC)      # the force plans: tests/test_plans_forces.py
         res = kinetostat.analyze(mech, phi_deg=[at])
         for plan in plans.values():
             big = max(abs(z) for z in plan.points.values()) * plan.scale.value
@@ -137,7 +140,8 @@ def test_positions_plan_has_twelve_positions_design_and_paths(ice_plans):
 
 def test_svg_sheet(ice_plans, tmp_path):
     written = ice_plans.write(tmp_path, lang="uk")
-    assert {p.name for p in written} == {"positions.svg", "velocity.svg", "acceleration.svg", "segments.csv"}
+    assert {p.name for p in written} == {"positions.svg", "velocity.svg", "acceleration.svg", "group_2-3.svg",
+                                         "forces_2-3.svg", "crank.svg", "lever.svg", "segments.csv"}
     for p in written[:-1]:
         root = ET.parse(p).getroot()
         assert root.get("width") == "420mm" and root.get("height") == "297mm" and root.get("viewBox") == "0 0 420 297"
@@ -161,25 +165,31 @@ def test_svg_escapes_model_text():
 
 @pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
 def test_figures_render(path, tmp_path):
-    import matplotlib
-    matplotlib.use("Agg")
+    """Every plan of every bundled model, force plans and lever included, as a Figure (PNG) and as
+    an SVG sheet."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     mech = kinetostat.load(path)
-    images = P.report_images(mech, tmp_path, lang="uk")
-    assert [p.name for p, _ in images] == ["plan_positions.png", "plan_velocity.png", "plan_acceleration.png"]
-    assert all(p.stat().st_size > 5000 and "μ" in c for p, c in images)
-    for p in P.build(mech).values():
-        ET.fromstring(P.draw.svg(p, lang="en", mechanism=mech.name))
+    plans = P.build(mech)
+    assert {"positions", "velocity", "acceleration", "crank", "lever"} <= set(plans)
+    assert any(k.startswith("forces:") for k in plans) and any(k.startswith("group:") for k in plans)
+    for plan in plans.values():
+        fig = plan.figure(lang="uk")
+        FigureCanvasAgg(fig).print_png(tmp_path / "plan.png")
+        assert (tmp_path / "plan.png").stat().st_size > 5000
+        ET.fromstring(P.draw.svg(plan, lang="en", mechanism=mech.name))
 
 
 def test_cli_plans(cli, tmp_path):
     r = cli("plans", "models/ice_crank_slider.toml", "--at", "30", "--scale", "mu_l=0.001", "mu_v=0.2", "mu_a=100",
             "mu_F=50", "--lang", "uk", "--out", tmp_path / "all")
     assert r.returncode == 0, r.stderr
-    assert {p.name for p in (tmp_path / "all").iterdir()} == {"positions.svg", "velocity.svg", "acceleration.svg",
-                                                               "segments.csv"}
+    assert {p.name for p in (tmp_path / "all").iterdir()} == {
+        "positions.svg", "velocity.svg", "acceleration.svg", "group_2-3.svg", "forces_2-3.svg", "crank.svg",
+        "lever.svg", "segments.csv", "worksheet.md", "worksheet.html", "worksheet.csv", "worksheet.json"}
     with open(tmp_path / "all" / "segments.csv", newline="", encoding="utf-8") as f:
         rows = {(row["plan"], row["segment"]): row for row in csv.DictReader(f)}
     assert float(rows[("velocity", "p-b")]["length_mm"]) == pytest.approx(54.7, rel=0.015)
+    assert float(rows[("forces:2,3", "R32")]["length_mm"]) == pytest.approx(129.62, rel=0.015)    # seed 002
     r = cli("plans", "models/slotted_link_shaper.toml", "--only", "positions", "--out", tmp_path / "pos")
     assert r.returncode == 0, r.stderr
     assert {p.name for p in (tmp_path / "pos").iterdir()} == {"positions.svg", "segments.csv"}
@@ -187,7 +197,7 @@ def test_cli_plans(cli, tmp_path):
 
 @pytest.mark.parametrize("args, names", [
     (["--scale", "mu_x=1"], "--scale"), (["--scale", "mu_v=-0.2"], "--scale"), (["--scale", "mu_v"], "--scale"),
-    (["--only", "lever"], "--only"), (["--at", "abc"], "--at")])
+    (["--only", "nonsense"], "--only"), (["--at", "abc"], "--at")])
 def test_cli_plans_bad_options(cli, tmp_path, args, names):
     r = cli("plans", "models/ice_crank_slider.toml", *args, "--out", tmp_path)
     assert r.returncode == 2 and names in r.stderr and "Traceback" not in r.stderr

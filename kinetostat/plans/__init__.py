@@ -28,18 +28,24 @@ from types import MappingProxyType
 from typing import Callable, Iterable
 
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
+from .forces import crank_plan, force_plans, group_plans
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
+from .lever import lever_plan
 from .scales import choose_scales
 
-__all__ = ["build", "Plans", "BUILDERS", "report_images", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS",
+__all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS",
            "choose_scales", "starting_position", "plan_file_name"]
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
-#: Plan or list of Plans). The force plans, the crank and the lever join with one line each.
+#: Plan or list of Plans).
 BUILDERS: tuple[tuple[str, Callable], ...] = (
     ("positions", positions_plan),
     ("velocity", velocity_plan),
     ("acceleration", acceleration_plan),
+    ("groups", lambda mech, res, sc: group_plans(mech, res, sc["mu_l"])),
+    ("forces", lambda mech, res, sc: force_plans(mech, res, sc["mu_F"])),
+    ("crank", lambda mech, res, sc: crank_plan(mech, res, sc["mu_l"], sc["mu_F"])),
+    ("lever", lambda mech, res, sc: lever_plan(mech, res, sc["mu_v"])),
 )
 
 
@@ -150,21 +156,3 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
             made = steps[name](mech, res, sc)
             plans.extend(made if isinstance(made, (list, tuple)) else [made])
     return Plans(mech, float(at), sc, plans)
-
-
-def report_images(mech, out_dir: str | Path, lang: str = "en", at: float | None = None) -> list[tuple[Path, str]]:
-    """PNG pictures of every plan at the model's design position (or `at`) for the per-model
-    report: [(path, caption)], written into `out_dir` (created) as plan_<kind>.png."""
-    from .draw import figure, scale_text, title_of
-    import matplotlib.pyplot as plt
-    plans = build(mech, at=at)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    images = []
-    for plan in plans.values():
-        fig = figure(plan, lang=lang)
-        path = out / ("plan_" + plan_file_name(plan, ".png"))
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        images.append((path, f"{title_of(plan, lang)}, {scale_text(plan, lang)}"))
-    return images

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import re
-from xml.sax.saxutils import escape, quoteattr
+from xml.sax.saxutils import escape
 
 from .core import Plan, Segment
 
@@ -106,6 +106,12 @@ def _note(text: str, lang: str) -> str:
 _LABEL = re.compile(r"^([^\d_']*)([\d_]*)('*)$")
 
 
+def labelled(name: str) -> bool:
+    """Whether a point is lettered on the drawing: the texts' points are; a construction point (an
+    arrow's tip or an arm's foot, named '<segment>:to', '<segment>:foot') is not."""
+    return ":" not in name
+
+
 def _label_parts(name: str) -> tuple[str, str, str]:
     """A point name as (letters, subscript, primes): 's2' -> ('s', '2', ''), 'S2_3' -> ('S', '2,3', ''),
     'pi' -> ('π', '', ''), "B'" -> ('B', '', '′')."""
@@ -158,7 +164,7 @@ def _svg_text(x: float, y: float, text: str, size: float, anchor: str = "start",
 
 def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
     """The plan on an A3 landscape sheet, true to scale (1 user unit = 1 mm), as SVG text."""
-    i = _lang(lang)
+    _lang(lang)
     x0, y0, x1, y1 = _bbox(plan)
     ax0, ay0, ax1, ay1 = _AREA
     tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
@@ -167,7 +173,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         return z.real + tx, ty - z.imag
 
     W, H = SHEET_MM
-    out = [f'<?xml version="1.0" encoding="UTF-8"?>',
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
            f'<svg xmlns="http://www.w3.org/2000/svg" width="{W:g}mm" height="{H:g}mm" viewBox="0 0 {W:g} {H:g}" '
            f'font-family="DejaVu Sans, Arial, sans-serif">',
            f'<title>{escape(title_of(plan, lang))}, {escape(scale_text(plan, lang))}</title>',
@@ -176,7 +182,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
            f'<rect x="0" y="0" width="{W:g}" height="{H:g}" fill="#fff"/>',
            f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
            f'fill="none" stroke="#000" stroke-width="0.7"/>',
-           f'<g id="plan" stroke-linecap="round">']
+           '<g id="plan" stroke-linecap="round">']
     for name, path in plan.paths.items():
         pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in (P(z) for z in path if _finite(z)))
         out.append(f'<polyline points="{pts}" fill="none" stroke="#1f5fa8" stroke-width="0.25">'
@@ -190,9 +196,11 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         attrs += ' marker-end="url(#arrow)"' if s.kind == "vector" else ""
         out.append(f'<line x1="{a:.3f}" y1="{b:.3f}" x2="{c:.3f}" y2="{d:.3f}" stroke="{colour}" '
                    f'stroke-width="{width}"{attrs}><title>{escape(s.name)}</title></line>')
+        if not labelled(s.end):            # a load or an arm ends at a construction point: letter the segment
+            out.append(_svg_text(c + 1.0, d - 1.0, s.name, 2.8))
     small = plan.kind == "positions"
     for name, z in plan.points.items():
-        if not _finite(z):
+        if not _finite(z) or not labelled(name):
             continue
         a, b = P(z)
         numbered = small and bool(re.search(r"\d$", name)) and name not in _frame_like(plan)
@@ -276,7 +284,9 @@ def figure(plan: Plan, lang: str = "en", ax=None):
         from matplotlib.figure import Figure
         x0, y0, x1, y1 = _bbox(plan)
         w, h = max(x1 - x0, 1.0), max(y1 - y0, 1.0)
-        fig = Figure(figsize=(8.0, min(max(8.0 * h / w, 3.0), 10.0) + 0.8), layout="constrained")
+        height = min(max(8.0 * h / w, 3.0), 10.0) + 0.8
+        fig = Figure(figsize=(8.0, height), layout=None)     # a fixed layout: margins in inches
+        fig.subplots_adjust(left=0.7 / 8.0, right=1 - 0.2 / 8.0, bottom=0.55 / height, top=1 - 0.6 / height)
         ax = fig.add_subplot()
     else:
         fig = ax.figure
@@ -293,10 +303,13 @@ def figure(plan: Plan, lang: str = "en", ax=None):
         else:
             ax.plot([a.real, b.real], [a.imag, b.imag], color=colour, lw=width * 3,
                     ls=(0, tuple(float(v) * 2 for v in dash.split(","))) if dash else "-")
+        if not labelled(s.end):            # a load or an arm ends at a construction point: letter the segment
+            ax.annotate(s.name, (b.real, b.imag), xytext=(3, -9), textcoords="offset points", fontsize=8,
+                        color=colour)
     small = plan.kind == "positions"
     frame = _frame_like(plan) if small else set()
     for name, z in plan.points.items():
-        if not _finite(z):
+        if not _finite(z) or not labelled(name):
             continue
         numbered = small and bool(re.search(r"\d$", name)) and name not in frame
         ax.plot([z.real], [z.imag], "o", color="k", ms=1.5 if numbered else 3)

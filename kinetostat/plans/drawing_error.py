@@ -34,7 +34,7 @@ import numpy as np
 
 from ..analysis import Analysis, analyze
 from ..model import Mechanism
-from .worksheet import crank_scale, round_scale
+from .scales import choose_scales
 
 __all__ = ["Scales", "DrawnSolution", "default_scales", "draws_forces", "simulate", "SUPPORTED"]
 
@@ -52,13 +52,10 @@ class Scales:
 
 
 def default_scales(mech: Mechanism, at: float | None = None) -> Scales:
-    """The scales as seed 002 chooses them: OA 30-35 mm, pa and πa 70-90 mm, the largest known
-    force of the force plans 100-200 mm, each a round value."""
+    """The scales the plans are drawn at (`scales.choose_scales`: as seed 002 chooses them)."""
     res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at])
-    d = mech.drive
-    F = np.hypot(*np.moveaxis(np.concatenate([res.F_applied[0, 1:], res.F_i[0, 1:]]), -1, 0))
-    return Scales(crank_scale(mech), round_scale(np.hypot(*res.velocity(d.point)[0]), 70, 90),
-                  round_scale(np.hypot(*res.acceleration(d.point)[0]), 70, 90), round_scale(F.max(), 100, 200))
+    sc = choose_scales(mech, res)
+    return Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, sc["mu_F"].value)
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..applied import applied_moment, point_forces
 from .core import Plan, Scale, Segment
+from .scales import round_scale
 
 if TYPE_CHECKING:
     from ..analysis import Analysis
@@ -108,21 +109,11 @@ def _scale(mu, symbol: str, unit: str) -> Scale:
     return Scale(symbol, value, unit)
 
 
-def _round_scale(x: float) -> float:
-    """The smallest 1, 2, 2.5 or 5 x 10^n not below x."""
-    if not x > 0:
-        return 1.0
-    e = math.floor(math.log10(x))
-    for m in (1.0, 2.0, 2.5, 5.0, 10.0):
-        if m * 10.0**e >= x * (1 - 1e-12):
-            return m * 10.0**e
-    return 10.0 ** (e + 1)
-
-
 def force_scale(forces, longest_mm: float = 40.0) -> Scale:
-    """A round force scale (N/mm) at which the largest of `forces` (N) is at most `longest_mm`."""
+    """A round force scale (N/mm) at which the largest of `forces` (N) is drawn between half of
+    `longest_mm` and `longest_mm` (`scales.round_scale`)."""
     largest = max((abs(f) for f in forces), default=0.0)
-    return Scale("mu_F", _round_scale(largest / longest_mm), "N/mm")
+    return Scale("mu_F", round_scale(largest, longest_mm / 2, longest_mm), "N/mm")
 
 
 def default_mu_F(mech: "Mechanism", res: "Analysis") -> Scale:

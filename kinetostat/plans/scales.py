@@ -11,7 +11,8 @@ would not fit the drawing area of an A3 sheet (FIT_MM).
     mu_v: the crank pin's velocity p-a drawn 70..90 mm (seed 002: 85 mm, mu_v = 0.2);
     mu_a: the crank pin's acceleration pi-a drawn 70..90 mm (seed 002: 79.94 mm, mu_a = 100);
     mu_F: the largest force at that angle (a reaction, an applied load or an inertia force)
-          drawn 70..90 mm.
+          drawn 100..200 mm: the texts give the force plan a sheet of its own (seed 002 draws
+          its 9651 N gas force 193 mm long at mu_F = 50 N/mm).
 
 May use: numpy, `kinetostat.analysis` (the exact results), `.core`.
 """
@@ -31,7 +32,7 @@ SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F":
 #: Mantissas of a round scale.
 ROUND_MANTISSAS = (1.0, 2.0, 2.5, 4.0, 5.0)
 #: Recommended drawn length of each scale's reference quantity, mm.
-TARGET_MM = {"mu_l": (30.0, 35.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (70.0, 90.0)}
+TARGET_MM = {"mu_l": (30.0, 35.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (100.0, 200.0)}
 #: Drawing area of an A3 landscape sheet a plan must fit (width, height), mm: inside the frame,
 #: above the title block.
 FIT_MM = (380.0, 220.0)

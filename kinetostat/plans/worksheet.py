@@ -24,8 +24,9 @@ import numpy as np
 from ..analysis import Analysis, analyze
 from ..applied import load_magnitude
 from ..model import Mechanism
+from .scales import choose_scales
 
-__all__ = ["Row", "Worksheet", "worksheet", "round_scale", "crank_scale", "COLUMNS"]
+__all__ = ["Row", "Worksheet", "worksheet", "COLUMNS"]
 
 #: Columns of the worksheet's table (CSV, JSON, frame).
 COLUMNS = ("section", "key", "symbol", "value", "unit", "direction", "note")
@@ -61,29 +62,6 @@ class Row:
     unit: str
     direction: str = ""
     note: str = ""
-
-
-def round_scale(value: float, drawn_lo: float, drawn_hi: float) -> float:
-    """The round scale (1, 2, 2.5 or 5 x 10^k units per mm) that draws `value` closest to the
-    range [drawn_lo, drawn_hi] mm (inside it where one does; the smaller drawing on a tie)."""
-    value = abs(value)
-    if not math.isfinite(value) or value == 0:
-        raise ValueError(f"round_scale: needs a finite nonzero quantity, got {value!r}")
-    k0 = math.floor(math.log10(value / drawn_hi)) - 1
-    candidates = [m * 10.0 ** k for k in range(k0, k0 + 4) for m in (1, 2, 2.5, 5)]
-
-    def miss(mu: float) -> float:
-        drawn = value / mu
-        return max(drawn_lo - drawn, drawn - drawn_hi, 0.0)
-
-    return min(candidates, key=lambda mu: (miss(mu), -mu))
-
-
-def crank_scale(mech: Mechanism) -> float:
-    """μ_l, m/mm, as seed 002 chooses it: the crank OA drawn 30-35 mm at a round scale."""
-    d = mech.drive
-    pts = mech.links[d.link].points
-    return round_scale(math.dist(pts[d.pivot], pts[d.point]), 30.0, 35.0)
 
 
 @dataclass(frozen=True)
@@ -152,6 +130,16 @@ class Worksheet:
                 for r in self.records()]
         doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l, "rows": recs}
         _atomic_write(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")
+
+    def write(self, out_dir: str | Path) -> list[Path]:
+        """worksheet.md, .html, .csv and .json into `out_dir` (each atomic); returns the paths."""
+        out = Path(out_dir)
+        paths = [out / f"worksheet.{ext}" for ext in ("md", "html", "csv", "json")]
+        _atomic_write(paths[0], self.markdown())
+        _atomic_write(paths[1], self.html())
+        self.to_csv(paths[2])
+        self.to_json(paths[3])
+        return paths
 
 
 def _number(x: float) -> str:
@@ -396,11 +384,11 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
         raise ValueError(f"lang: expected one of {sorted(_WORDS)}, got {lang!r}")
     if at is None:
         at = mech.drive.design_deg
-    if mu_l is None:
-        mu_l = crank_scale(mech)
-    if not (isinstance(mu_l, (int, float)) and math.isfinite(mu_l) and mu_l > 0):
+    if mu_l is not None and not (isinstance(mu_l, (int, float)) and math.isfinite(mu_l) and mu_l > 0):
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
     res = analyze(mech, phi_deg=[float(at)])
+    if mu_l is None:
+        mu_l = choose_scales(mech, res)["mu_l"].value
     sheet = _Sheet(res, float(mu_l))
     sheet.kinematics()
     sheet.loads()

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -15,7 +16,7 @@ from ..analysis import analyze
 from ..model import Mechanism
 from ..structure import GROUP_KINDS
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
-from .plots import (_pair_name, plot_balancing_force, plot_errors, plot_hodographs, plot_mechanism, plot_moment,
+from .plots import (_pair_name, _save, plot_balancing_force, plot_errors, plot_hodographs, plot_mechanism, plot_moment,
                     plot_reactions)
 from .published import PublishedCheck
 from .runs import ModelRun
@@ -150,6 +151,38 @@ def _published_section(doc: Doc, published: Sequence[PublishedCheck]) -> None:
                      "yes" if c.passed else "**NO**"])
     doc.table(["quantity", "meaning", "φ", "published", "kinetostat (exact)", "unit", "difference", "accepted",
                "within"], rows, "lllrrlrrl")
+
+
+def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
+    """The plans of the graphical method at the model's design position (`kinetostat.plans`),
+    one picture each, with their segments.csv and the worksheet beside them; returns the files."""
+    from ..plans import build, plan_file_name
+    from ..plans.worksheet import worksheet
+    at = m.drive.design_deg
+    doc.h(2, f"The graphical method at φ = {at:g}°")
+    try:
+        with warnings.catch_warnings():         # the cycle's warnings are reported below
+            warnings.simplefilter("ignore")
+            plans = build(m)
+            sheet = worksheet(m, mu_l=plans.scales["mu_l"].value)
+    except ValueError as exc:
+        doc.p(f"No plans at this position: {esc(str(exc))}")
+        return []
+    doc.p("The plans as the course texts draw them, from the exact solution, at the scales "
+          + ", ".join(f"`{s}`" for s in plans.scales.values())
+          + ": positions, velocities, accelerations, each Assur group with its loads and arms, the "
+            "force polygons, the initial link and Zhukovsky's lever. Every drawn segment with its length "
+            "and the quantity it stands for: [segments.csv](segments.csv); every value the texts write "
+            "down at this position: [worksheet.csv](worksheet.csv). `kinetostat plans` draws them as "
+            "A3 SVG sheets true to scale.")
+    files = []
+    for plan in plans.values():
+        path = _save(plan.figure(), d / ("plan_" + plan_file_name(plan, ".png")))
+        doc.img(path, f"{esc(plan.title)}, {plan.scale}")
+        files.append(path)
+    (d / "segments.csv").write_text(plans.segments_csv(), encoding="utf-8")
+    sheet.to_csv(d / "worksheet.csv")
+    return files + [d / "segments.csv", d / "worksheet.csv"]
 
 
 def _verdict(run: ModelRun) -> str:
@@ -310,6 +343,7 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
     _published_section(doc, published)
+    plan_files = _plans_section(doc, m, d)
 
     sing = int(np.sum(res.singular))
     if run.warnings or sing:
@@ -317,7 +351,8 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
         doc.ul(([f"{sing} positions are singular (values there are NaN)"] if sing else [])
                + [esc(w) for w in run.warnings])
     doc.h(2, "Files")
-    doc.ul([f"[{p.name}]({p.name})" for p in images.values()] + ["[cycle.csv](cycle.csv): `res.to_frame()` of the cycle",
+    doc.ul([f"[{p.name}]({p.name})" for p in [*images.values(), *plan_files]]
+           + ["[cycle.csv](cycle.csv): `res.to_frame()` of the cycle",
                                                                   "[summary.json](summary.json)"])
 
     doc.write(d)
