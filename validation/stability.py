@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 import kinetostat
-from kinetostat import COND_MAX, COND_WARN, SingularPositionWarning
+from kinetostat import COND_CHECK as COND_WARN, COND_MAX, SingularPositionWarning
 
 from .reference import BranchMismatch, reference_full
 
