@@ -82,7 +82,7 @@ class Analysis:
     def error(self) -> np.ndarray:
         """(N,) estimated relative error of the values at each angle: the largest relative change
         of the kinematics (`kinematic_deviation`) and of the forces (`force_deviation`) when the
-        inputs move by a few ulps (where cond > COND_CHECK; A_PRIORI cond^4 elsewhere); inf
+        inputs move by a few ulps (where cond > COND_CHECK; A_PRIORI cond^3 elsewhere); inf
         where singular."""
         return self.kin.error
 
@@ -298,10 +298,10 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
 
 
 def force_deviation(a: Analysis, b: Analysis) -> np.ndarray:
-    """(N,) how far b's forces are from a's: the largest change of any reaction over the largest
-    reaction at that angle, and of the balancing moment (and force) over max(|M_bal|, that
-    reaction x kinematic_size)."""
-    R = np.linalg.norm(a.forces.R, axis=-1).max(axis=1, initial=0.0)
+    """(N,) how far b's forces are from a's: the largest change of any reaction over the force
+    scale at that angle (the largest reaction, applied or inertia force), and of the balancing
+    moment (and force) over max(|M_bal|, that scale x kinematic_size)."""
+    R = np.max([np.linalg.norm(x, axis=-1).max(axis=1, initial=0.0) for x in (a.forces.R, a.F_applied, a.F_i)], axis=0)
     dR = np.linalg.norm(b.forces.R - a.forces.R, axis=-1)
     return np.max([relative_change(dR, 0.0, R[:, None]),
                    relative_change(b.forces.M_bal, a.forces.M_bal, R * kinematic_size(a.mech)),

@@ -36,11 +36,12 @@ __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", 
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
-#: at most A_PRIORI cond^4 of the values' scale, 1e-11 at COND_CHECK (11 digits or more).
+#: at most A_PRIORI cond^3, 2e-12 at COND_CHECK (more than 11 digits).
 COND_CHECK = 10.0
-#: The a-priori relative error at cond (used below COND_CHECK): the worst family measured, a
-#: four-bar at its change point, loses 1e-16 cond^4 in its angular accelerations.
-A_PRIORI = 1e-15
+#: The a-priori relative error at cond (used below COND_CHECK): the worst families measured, a
+#: four-bar at its change point and a slotted link whose block passes its pivot, lose up to
+#: 1.3e-15 cond^3 (a dyad's toggle or dead centre only ~3e-16 cond^2).
+A_PRIORI = 2e-15
 #: Above this condition number the group is taken as singular (toggle / dead centre of the
 #: group) whatever the estimate says: the perturbation is no longer small against the distance
 #: to the singular position. Velocities, accelerations and every force there are NaN.
@@ -78,7 +79,7 @@ class Kinematics:
     singular: np.ndarray   # (N,) bool: some group's cond > COND_MAX, or fewer than DIGITS_MIN
                            #   digits left (velocities, accelerations etc. are NaN)
     error: np.ndarray      # (N,) estimated relative error (see `kinematic_deviation`): measured
-                           #   where cond > COND_CHECK, A_PRIORI cond^4 elsewhere; inf where singular
+                           #   where cond > COND_CHECK, A_PRIORI cond^3 elsewhere; inf where singular
 
     def __repr__(self) -> str:
         N, L = self.theta.shape
@@ -464,10 +465,10 @@ def group_scales(mech: "Mechanism") -> list[float]:
 
 # -- the accuracy estimate and the guard
 def a_priori_error(cond: np.ndarray) -> np.ndarray:
-    """(N,) relative error bound from the largest group cond at each angle: A_PRIORI cond^4
-    (the measured law; valid below COND_CHECK, where it gives 11 digits or more)."""
+    """(N,) relative error bound from the largest group cond at each angle: A_PRIORI cond^3
+    (the measured law; used below COND_CHECK, where it leaves more than 11 digits)."""
     c = np.where(np.isnan(cond), np.inf, cond).max(axis=1, initial=1.0)
-    return A_PRIORI * c**4
+    return A_PRIORI * c**3
 
 
 def digits(error: np.ndarray) -> np.ndarray:
