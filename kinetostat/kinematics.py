@@ -401,15 +401,18 @@ def _signs(n: int, draw: int, key: str) -> np.ndarray:
 
 def _perturbed_points(mech: "Mechanism", draw: int) -> list[dict[str, complex]]:
     """Every point's local coordinates moved by PERTURB_ULPS ulps of the point (|x + iy|), each
-    coordinate with its own sign."""
-    out = []
-    for link, pts in zip(mech.links, mech.points_z):
-        moved = {}
-        for name, z in pts.items():
-            sx, sy = _signs(2, draw, f"{link.id}:{name}")
-            moved[name] = z + PERTURB_ULPS * _EPS * abs(z) * complex(sx, sy)
-        out.append(moved)
-    return out
+    coordinate with its own sign (memoised per draw)."""
+    key = f"perturbed_points_{draw}"
+    if key not in mech._derived:
+        out = []
+        for link, pts in zip(mech.links, mech.points_z):
+            moved = {}
+            for name, z in pts.items():
+                sx, sy = _signs(2, draw, f"{link.id}:{name}")
+                moved[name] = z + PERTURB_ULPS * _EPS * abs(z) * complex(sx, sy)
+            out.append(moved)
+        mech._derived[key] = out
+    return mech._derived[key]
 
 
 def _solve(mech: "Mechanism", phi: np.ndarray, locals_: list[dict[str, complex]]) -> Kinematics:
@@ -458,9 +461,11 @@ def kinematic_size(mech: "Mechanism") -> float:
 def group_scales(mech: "Mechanism") -> list[float]:
     """Per Assur group, its length scale for the condition number, m: the largest distance
     between two joint points of one of its links or of the moving links it is attached to."""
-    ext = _joint_extents(mech)
-    return [max((ext[k] for k in (*g.links, *g.known) if k), default=0.0) or kinematic_size(mech)
-            for g in mech.structure.groups]
+    if "group_scales" not in mech._derived:
+        ext = _joint_extents(mech)
+        mech._derived["group_scales"] = [max((ext[k] for k in (*g.links, *g.known) if k), default=0.0)
+                                         or kinematic_size(mech) for g in mech.structure.groups]
+    return mech._derived["group_scales"]
 
 
 # -- the accuracy estimate and the guard
@@ -504,6 +509,8 @@ def guard(mech: "Mechanism", kin: Kinematics, error: np.ndarray, stacklevel: int
     DIGITS_MIN digits are left or cond > COND_MAX (`singular`), and a SingularPositionWarning
     per group for the angles with fewer than DIGITS_WARN digits left (named by the group with
     the largest cond there)."""
+    if (error <= 10.0**-DIGITS_WARN).all() and (kin.cond <= COND_MAX).all():     # the regular case
+        return replace(kin, error=error)
     cond = np.where(np.isnan(kin.cond), np.inf, kin.cond)
     error = np.where((cond > COND_MAX).any(axis=1), np.inf, np.where(np.isnan(error), np.inf, error))
     singular = ~(error <= 10.0**-DIGITS_MIN)
