@@ -16,7 +16,7 @@ from .applied import applied_wrenches, com_motion, inertia_loads
 from .planar import as_xy, cross_z
 from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "analyze", "FRAME_NOTE"]
+__all__ = ["Analysis", "InertiaLoad", "analyze", "FRAME_NOTE", "deviation", "force_deviation"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
 #: `Analysis.to_frame().attrs["frame"]`).

@@ -32,7 +32,8 @@ if TYPE_CHECKING:
     from .structure import AssurGroup
 
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
-           "kinematic_size", "kinematic_deviation"]
+           "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
+           "a_priori_error", "relative_change", "digits"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):

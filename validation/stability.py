@@ -551,7 +551,7 @@ def _near_lines(near: dict[str, list[Near]]) -> list[str]:
              "was needed: the loss near these positions is the problem's own sensitivity.",
              "- **The sensitivity is not a function of cond alone.** Fitted slope of log(ulp-sensitivity) against "
              "log(cond) over the sampled angles, and its upper envelopes max sens / cond^2 and max sens / cond^3 for "
-             f"COND_CHECK < cond <= COND_MAX: " + "; ".join(f"{k} slope {v['slope']:.2f}, {v['c2']:.1g} cond^2, "
+             "COND_CHECK < cond <= COND_MAX: " + "; ".join(f"{k} slope {v['slope']:.2f}, {v['c2']:.1g} cond^2, "
              f"{v['c3']:.1g} cond^3" for k, v in summ.items()) + ". At the dead centre itself a dyad (crank-slider "
              "l -> r, a four-bar just off its Grashof limit at its toggle) loses ~1e-16 cond^2, the law the "
              "README stated; but beside it (cond is then smaller while the position is still nearly double), at "
@@ -567,7 +567,7 @@ def _near_lines(near: dict[str, list[Near]]) -> list[str]:
              "moves every input by a few ulps at once). Angles set to NaN: "
              + ", ".join(f"{k} {v['marked']} of {v['n']}" for k, v in summ.items()) + ".",
              "",
-             f"![error, sensitivity and estimate against cond](stability.png)", ""]
+             "![error, sensitivity and estimate against cond](stability.png)", ""]
     for name, steps in near.items():
         title, param = NEAR[name][0], NEAR[name][1]
         lines += [f"### {name}: {title}", "",
