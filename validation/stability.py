@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import copy
 import math
+import textwrap
 import time
 import warnings
 from dataclasses import dataclass, replace
@@ -443,7 +444,7 @@ def write_plot(results: dict[str, list[Step]], near: dict[str, list[Near]], path
     _plot_cycles(results, ax[0, 0], ax[0, 1])
     _plot_near(near, [ax[0, 2], *ax[1]])
     fig.suptitle("kinetostat near singular positions. Top left two: error against conditioning over cycles (filled), "
-                 "the reference's change for one ulp of the crank length or angle (hollow). Other four: at angles "
+                 "the reference's change for one ulp of the crank length or angle (hollow).\nOther four: at angles "
                  "approaching the singular one, forward error, one-ulp sensitivity and the guard's estimate", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
@@ -466,7 +467,7 @@ def _plot_near(near: dict[str, list[Near]], axes) -> None:
         ax.axhline(10.0**-DIGITS_MIN, color="red", lw=0.8, ls="-.", label=f"{DIGITS_MIN} digits (NaN below)")
         ax.axhline(10.0**-DIGITS_WARN, color="orange", lw=0.8, ls="-.", label=f"{DIGITS_WARN} digits (warning below)")
         ax.set_ylim(1e-17, 1e3)
-        ax.set_title(f"{name}: {NEAR[name][0]}", fontsize=8)
+        ax.set_title(textwrap.fill(f"{name}: {NEAR[name][0]}", 80), fontsize=8)
         ax.set_xlabel("largest condition number of a group plan")
         ax.grid(True, which="major", alpha=0.3)
     axes[0].set_ylabel("relative error (the guard's measure)")
