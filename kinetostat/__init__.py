@@ -8,8 +8,7 @@
     >>> res
     Analysis(mechanism='ICE crank-slider (seed 002 worked example)', positions=1, phi_deg=30, singular=0)
 
-The plans of the graphical method: `kinetostat.plans.build(mech, at=30)` (a module cannot be
-called, so the issue's `kinetostat.plans(mech, at=30)` is spelled with `.build`).
+The plans of the graphical method: `kinetostat.plans.build(mech, at=30)`.
 
 The solver's public names. May use: the solver modules only (never the harness
 `kinetostat_validation`, the engines, matplotlib or `kinetostat.report`).
@@ -17,11 +16,11 @@ The solver's public names. May use: the solver modules only (never the harness
 from . import examples, plans
 from .analysis import Analysis, InertiaLoad, analyze
 from .errors import AssemblyError, ModelError, SingularPositionWarning, StructureError
-from .kinematics import COND_MAX, COND_WARN
+from .kinematics import COND_CHECK, COND_MAX, DIGITS_MIN, DIGITS_WARN
 from .model import Mechanism, from_dict, load, loads
 from .structure import AssurGroup, Structure
 
 __all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
-           "SingularPositionWarning", "COND_WARN", "COND_MAX", "examples", "plans"]
+           "SingularPositionWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN", "examples", "plans"]
 __version__ = "0.1.0"

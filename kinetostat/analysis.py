@@ -4,18 +4,19 @@ May use: model, kinematics, kinetostatics, applied, planar; pandas only inside `
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
 
-from .kinematics import Kinematics, kinematics
+from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation, kinematic_size, relative_change,
+                         solve_checked)
 from .kinetostatics import Forces, forces, friction_power, lever_moment
 from .applied import applied_wrenches, com_motion, inertia_loads
 from .planar import as_xy, cross_z
 from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "analyze", "FRAME_NOTE"]
+__all__ = ["Analysis", "InertiaLoad", "analyze", "FRAME_NOTE", "deviation", "force_deviation"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
 #: `Analysis.to_frame().attrs["frame"]`).
@@ -43,8 +44,10 @@ class Analysis:
     """Kinematics and kinetostatics of `mech` at N crank angles. Arrays lead with N.
 
     Units: SI; world frame; moments about +z. `R` follows the convention R_ij = force of
-    link i on link j. Where `singular` is True (a group's condition number above COND_MAX)
-    velocities, accelerations and all forces are NaN, and `cond` says why.
+    link i on link j. `error` is the estimated relative error at each angle (measured by a
+    perturbed re-solve where a group's cond exceeds COND_CHECK). Where `singular` is True (cond
+    above COND_MAX, or fewer than DIGITS_MIN digits left) velocities, accelerations and all
+    forces are NaN, and `cond` and `error` say why.
     """
     mech: Mechanism
     phi_deg: np.ndarray     # (N,) crank angle from the model's reference direction in its sense, deg
@@ -74,6 +77,19 @@ class Analysis:
     def cond(self) -> np.ndarray:
         """(N, n_groups) condition number of each group's plan (groups in attachment order)."""
         return self.kin.cond
+
+    @property
+    def error(self) -> np.ndarray:
+        """(N,) estimated relative error of the values at each angle: the largest relative change
+        of the kinematics (`kinematic_deviation`) and of the forces (`force_deviation`) when the
+        inputs move by a few ulps (where cond > COND_CHECK; A_PRIORI cond^3 elsewhere); inf
+        where singular."""
+        return self.kin.error
+
+    @property
+    def digits(self) -> np.ndarray:
+        """(N,) estimated significant digits left at each angle, -log10(error) within [0, 16]."""
+        return self.kin.digits
 
     # -- kinematics
     def _point(self, name: str):
@@ -150,6 +166,14 @@ class Analysis:
     def lever_discrepancy(self) -> np.ndarray:
         """(N,) lever_moment - balancing_moment, N m (rounding only, for an exact solver)."""
         return self.lever_moment - self.balancing_moment
+
+    def take(self, idx: np.ndarray) -> "Analysis":
+        """The analysis at the angles `idx` only."""
+        f = self.forces
+        return Analysis(self.mech, self.phi_deg[idx], self.kin.take(idx), self.F_applied[idx],
+                        self.M_applied[idx], self.F_i[idx], self.M_i[idx],
+                        type(f)(f.R[idx], f.normal[idx], f.m[idx], f.M_bal[idx], f.F_bal[idx]),
+                        self.lever_moment[idx], self.friction_power[idx])
 
     def inertia(self, k: int) -> InertiaLoad:
         """Inertia force, moment, offset h and a point of the single resultant of link k."""
@@ -261,9 +285,32 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     if phi_deg.ndim != 1 or not np.isfinite(phi_deg).all():
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     phi_deg.flags.writeable = False
-    kin = kinematics(mech, np.radians(phi_deg))
-    with np.errstate(divide="ignore", invalid="ignore"):    # NaN only at angles marked singular
-        return _kinetostatics(mech, phi_deg, kin)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # NaN only at angles marked singular
+        kin, checked, trials = solve_checked(mech, np.radians(phi_deg))
+        res = _kinetostatics(mech, phi_deg, kin)
+        error = a_priori_error(kin.cond)
+        if len(checked):
+            nominal = res.take(checked)
+            error[checked] = np.max([deviation(nominal, _kinetostatics(mech, phi_deg[checked], t))
+                                     for t in trials], axis=0)
+        kin = guard(mech, kin, error)
+        return _kinetostatics(mech, phi_deg, kin) if kin.singular.any() else replace(res, kin=kin)
+
+
+def force_deviation(a: Analysis, b: Analysis) -> np.ndarray:
+    """(N,) how far b's forces are from a's: the largest change of any reaction over the force
+    scale at that angle (the largest reaction, applied or inertia force), and of the balancing
+    moment (and force) over max(|M_bal|, that scale x kinematic_size)."""
+    R = np.max([np.linalg.norm(x, axis=-1).max(axis=1, initial=0.0) for x in (a.forces.R, a.F_applied, a.F_i)], axis=0)
+    dR = np.linalg.norm(b.forces.R - a.forces.R, axis=-1)
+    return np.max([relative_change(dR, 0.0, R[:, None]),
+                   relative_change(b.forces.M_bal, a.forces.M_bal, R * kinematic_size(a.mech)),
+                   relative_change(b.forces.F_bal, a.forces.F_bal, R[:, None])], axis=0)
+
+
+def deviation(a: Analysis, b: Analysis) -> np.ndarray:
+    """(N,) the measure of `Analysis.error`: max of the kinematic and the force deviation."""
+    return np.maximum(kinematic_deviation(a.mech, a.kin, b.kin), force_deviation(a, b))
 
 
 def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics) -> Analysis:

@@ -3,13 +3,23 @@
 Groups are solved in the order of attachment. Each group kind has one small function that
 finds the positions in closed form and closes the velocity and acceleration plans with
 `Basis.solve`, exactly as the vector equations of the texts read, for all angles at once.
+
+The singular-position guard: near a dead centre or toggle of a group the answer itself is that
+sensitive to its inputs, so where a group plan's condition number exceeds COND_CHECK the
+accuracy is measured, not inferred from the condition number: the kinematics is solved again
+with every input (each point of the linkage, the crank angle) moved by PERTURB_ULPS ulps, and
+the change is the error estimate (`Kinematics.error`). Fewer than DIGITS_WARN digits left: a
+SingularPositionWarning names the angles and the digits; fewer than DIGITS_MIN: NaN.
+
+May use: planar, errors (model and structure for type hints only).
 """
 from __future__ import annotations
 
 import cmath
 import math
 import warnings
-from dataclasses import dataclass
+import zlib
+from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
@@ -21,17 +31,31 @@ if TYPE_CHECKING:
     from .model import Mechanism, Pair
     from .structure import AssurGroup
 
-__all__ = ["Kinematics", "kinematics", "COND_WARN", "COND_MAX"]
+__all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
+           "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
+           "a_priori_error", "relative_change", "digits"]
 
-#: Above this condition number of a group's plan a SingularPositionWarning names the angles.
-#: Near a singular position the forces' sensitivity to the input (one ulp of a length or of
-#: the angle) grows as cond^2 (measured: reports/stability.md), so results keep about
-#: 16 - 2 log10(cond) significant digits: 1e3 still leaves ~10.
-COND_WARN = 1e3
-#: Above this the group is taken as singular (toggle / dead centre of the group): velocities,
-#: accelerations and every force at those angles are set to NaN and the reason is recorded.
-#: Fewer than ~6 digits would be meaningful.
+#: Above this condition number of a group's plan the accuracy is measured by a second solve on
+#: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
+#: at most A_PRIORI cond^3, 2e-12 at COND_CHECK (more than 11 digits).
+COND_CHECK = 10.0
+#: The a-priori relative error at cond (used below COND_CHECK): the worst families measured, a
+#: four-bar at its change point and a slotted link whose block passes its pivot, lose up to
+#: 1.3e-15 cond^3 (a dyad's toggle or dead centre only ~3e-16 cond^2).
+A_PRIORI = 2e-15
+#: Above this condition number the group is taken as singular (toggle / dead centre of the
+#: group) whatever the estimate says: the perturbation is no longer small against the distance
+#: to the singular position. Velocities, accelerations and every force there are NaN.
 COND_MAX = 1e5
+#: Fewer significant digits than this (estimated) left: a SingularPositionWarning names the angles.
+DIGITS_WARN = 10
+#: Fewer than this: the values at that angle are set to NaN (`singular` True).
+DIGITS_MIN = 6
+#: Size of the input perturbation of the accuracy check, in units of the double-precision
+#: rounding of each input; two solves with independent signs per input.
+PERTURB_ULPS = 4
+_EPS = np.finfo(float).eps
+_TINY = np.finfo(float).tiny
 
 
 @dataclass(frozen=True)
@@ -53,11 +77,23 @@ class Kinematics:
     v_slide: np.ndarray    # (N, n_pairs) velocity of slider relative to guide along the guide, m/s (0 for R)
     a_slide: np.ndarray    # (N, n_pairs) its rate in the guide's frame, m/s^2
     cond: np.ndarray       # (N, n_groups) condition number of each group's plan
-    singular: np.ndarray   # (N,) bool: some group's cond > COND_MAX (velocities etc. are NaN)
+    singular: np.ndarray   # (N,) bool: some group's cond > COND_MAX, or fewer than DIGITS_MIN
+                           #   digits left (velocities, accelerations etc. are NaN)
+    error: np.ndarray      # (N,) estimated relative error (see `kinematic_deviation`): measured
+                           #   where cond > COND_CHECK, A_PRIORI cond^3 elsewhere; inf where singular
 
     def __repr__(self) -> str:
         N, L = self.theta.shape
         return f"Kinematics(positions={N}, links={L}, groups={self.cond.shape[1]}, singular={int(self.singular.sum())})"
+
+    @property
+    def digits(self) -> np.ndarray:
+        """(N,) estimated significant digits left, -log10(error) within [0, 16]."""
+        return digits(self.error)
+
+    def take(self, idx: np.ndarray) -> "Kinematics":
+        """The same motion at the angles `idx` only."""
+        return Kinematics(*(getattr(self, f.name)[idx] for f in fields(self)))
 
     @property
     def origin(self) -> np.ndarray:
@@ -96,15 +132,15 @@ class Kinematics:
 class _Plan:
     """Work arrays filled group by group (internal; the public result is `Kinematics`)."""
 
-    def __init__(self, mech: "Mechanism", phi: np.ndarray):
+    def __init__(self, mech: "Mechanism", phi: np.ndarray, locals_: list[dict[str, complex]]):
         N, L = len(phi), mech.n_links
         self.phi = phi
         self.th, self.w, self.e = np.zeros((3, N, L))            # the frame's column stays 0
         self.rot = np.ones((N, L), complex)
         self.O, self.V, self.A = np.zeros((3, N, L), complex)
         self.vs, self.as_ = np.zeros((2, N, len(mech.pairs)))
-        self.L = mech.size
-        self.locals = mech.points_z
+        self.L = 1.0          # the length scale of the group being solved (set by `_solve`)
+        self.locals = locals_
 
     def local(self, k: int, name: str) -> complex:
         return self.locals[k][name]
@@ -192,8 +228,9 @@ class _Plan:
 
 
 # Each solver returns ||M||_F^2 and det M of its plans' matrix M, columns scaled by reference
-# sizes (mech.size for a column that is a length, 1 for a unit direction: guide directions are
-# unit, as the model reader makes Pair.direction): `condition` of them is taken once for all groups.
+# sizes (the group's own length scale pl.L, `group_scale`, for a column that is a length, 1 for a
+# unit direction: guide directions are unit, as the model reader makes Pair.direction):
+# `condition` of them is taken once for all groups.
 _Conditioning = tuple[float | np.ndarray, np.ndarray]
 
 
@@ -325,17 +362,62 @@ _GROUP_SOLVERS: dict[str, Callable[[_Plan, "AssurGroup"], _Conditioning]] = {
 def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     """Positions, velocities and accelerations of every link at crank angles `phi` (rad, (N,)).
 
-    Raises AssemblyError naming the angles where a group cannot be assembled; warns
-    (SingularPositionWarning) where a group's plan is ill-conditioned and sets velocities and
-    accelerations to NaN where its condition number exceeds COND_MAX.
+    Raises AssemblyError naming the angles where a group cannot be assembled. Where a group's
+    plan is ill-conditioned (cond > COND_CHECK) the accuracy is measured (`Kinematics.error`);
+    a SingularPositionWarning names the angles with fewer than DIGITS_WARN digits left, and
+    velocities and accelerations are NaN where fewer than DIGITS_MIN are left or cond > COND_MAX.
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    with np.errstate(divide="ignore", invalid="ignore"):    # singular angles: the guard marks them
-        return _solve(mech, phi)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # singular angles: the guard marks them
+        kin, checked, trials = solve_checked(mech, phi)
+        error = a_priori_error(kin.cond)
+        if len(checked):
+            nominal = kin.take(checked)
+            error[checked] = np.max([kinematic_deviation(mech, nominal, t) for t in trials], axis=0)
+    return guard(mech, kin, error)
 
 
-def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
-    pl = _Plan(mech, phi)
+def solve_checked(mech: "Mechanism", phi: np.ndarray) -> tuple[Kinematics, np.ndarray, list[Kinematics]]:
+    """The kinematics at `phi` (unguarded: nothing NaN yet, `error` not set), the indices of the
+    angles where some group's cond exceeds COND_CHECK, and the kinematics at those angles solved
+    again on inputs moved by PERTURB_ULPS ulps (one per sign pattern). Call under np.errstate
+    as `kinematics` does."""
+    kin = _solve(mech, phi, mech.points_z)
+    checked = np.flatnonzero(~(kin.cond <= COND_CHECK).all(axis=1))       # NaN cond: checked
+    trials = []
+    if len(checked):
+        sub = phi[checked]
+        for draw in (0, 1):
+            trials.append(_solve(mech, sub + _signs(len(sub), draw, "phi") * PERTURB_ULPS * _EPS
+                                 * np.maximum(np.abs(sub), math.pi), _perturbed_points(mech, draw)))
+    return kin, checked, trials
+
+
+def _signs(n: int, draw: int, key: str) -> np.ndarray:
+    """n signs +-1, fixed by (draw, key) alone, so that the pattern of one input does not depend
+    on which other points the model has."""
+    seed = zlib.crc32(f"{draw}:{key}".encode())
+    return np.where(np.random.default_rng(seed).integers(0, 2, n) == 1, 1.0, -1.0)
+
+
+def _perturbed_points(mech: "Mechanism", draw: int) -> list[dict[str, complex]]:
+    """Every point's local coordinates moved by PERTURB_ULPS ulps of the point (|x + iy|), each
+    coordinate with its own sign (memoised per draw)."""
+    key = f"perturbed_points_{draw}"
+    if key not in mech._derived:
+        out = []
+        for link, pts in zip(mech.links, mech.points_z):
+            moved = {}
+            for name, z in pts.items():
+                sx, sy = _signs(2, draw, f"{link.id}:{name}")
+                moved[name] = z + PERTURB_ULPS * _EPS * abs(z) * complex(sx, sy)
+            out.append(moved)
+        mech._derived[key] = out
+    return mech._derived[key]
+
+
+def _solve(mech: "Mechanism", phi: np.ndarray, locals_: list[dict[str, complex]]) -> Kinematics:
+    pl = _Plan(mech, phi, locals_)
     dr = mech.drive
     arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)
     th1 = dr.sense * phi + (math.atan2(dr.reference[1], dr.reference[0]) - cmath.phase(arm))
@@ -343,24 +425,111 @@ def _solve(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
                 dr.sense * dr.omega, 0.0, dr.sense * dr.eps, 0.0)
     groups = mech.structure.groups
     frob, det = np.empty((2, len(phi), len(groups)))
-    for n, g in enumerate(groups):
+    for n, (g, scale) in enumerate(zip(groups, group_scales(mech))):
+        pl.L = scale
         frob[:, n], det[:, n] = _GROUP_SOLVERS[g.kind](pl, g)
     cond = condition(frob, det)
-    singular = _guard(mech, phi, cond)
-    if singular.any():
-        for arr in (pl.w, pl.e, pl.V, pl.A, pl.vs, pl.as_):
-            arr[singular] = np.nan
-    return Kinematics(phi, pl.th, pl.rot, pl.O, pl.V, pl.A, pl.w, pl.e, pl.vs, pl.as_, cond, singular)
+    N = len(phi)
+    return Kinematics(phi, pl.th, pl.rot, pl.O, pl.V, pl.A, pl.w, pl.e, pl.vs, pl.as_, cond,
+                      np.zeros(N, bool), np.zeros(N))
 
 
-def _guard(mech: "Mechanism", phi: np.ndarray, cond: np.ndarray) -> np.ndarray:
-    if (cond <= COND_WARN).all():        # (False for NaN)
-        return np.zeros(len(phi), bool)
-    cond = np.where(np.isnan(cond), np.inf, cond)
-    for n, g in enumerate(mech.structure.groups):
-        near = cond[:, n] > COND_WARN
-        if near.any():
-            warnings.warn(singular_message(g.label, np.degrees(phi[near]), cond[near, n],
-                                           marked=bool((cond[near, n] > COND_MAX).any())),
-                          SingularPositionWarning, stacklevel=3)
-    return (cond > COND_MAX).any(axis=1)
+# -- length scales: only the points of the pairs (the joints) count; a point that carries a load,
+# a centre of mass, or no pair at all plays no part in a group's geometry.
+def _joint_extents(mech: "Mechanism") -> list[float]:
+    """Per link: the largest distance between two of its joint points (points of its pairs), m."""
+    if "joint_extents" not in mech._derived:
+        joints: list[set[str]] = [set() for _ in mech.links]
+        for p in mech.pairs:
+            if p.kind == "R":
+                joints[p.links[0]].add(p.point)
+                joints[p.links[1]].add(p.point)
+            else:
+                joints[p.links[0]].add(p.guide)
+                joints[p.links[1]].add(p.point)
+        mech._derived["joint_extents"] = [
+            max((abs(pts[a] - pts[b]) for a in names for b in names), default=0.0)
+            for pts, names in zip(mech.points_z, joints)]
+    return mech._derived["joint_extents"]
+
+
+def kinematic_size(mech: "Mechanism") -> float:
+    """The linkage's length scale for the accuracy measure: the largest distance between two
+    joint points of one moving link, m (mech.size if no link has two)."""
+    return max(_joint_extents(mech)[1:], default=0.0) or mech.size
+
+
+def group_scales(mech: "Mechanism") -> list[float]:
+    """Per Assur group, its length scale for the condition number, m: the largest distance
+    between two joint points of one of its links or of the moving links it is attached to."""
+    if "group_scales" not in mech._derived:
+        ext = _joint_extents(mech)
+        mech._derived["group_scales"] = [max((ext[k] for k in (*g.links, *g.known) if k), default=0.0)
+                                         or kinematic_size(mech) for g in mech.structure.groups]
+    return mech._derived["group_scales"]
+
+
+# -- the accuracy estimate and the guard
+def a_priori_error(cond: np.ndarray) -> np.ndarray:
+    """(N,) relative error bound from the largest group cond at each angle: A_PRIORI cond^3
+    (the measured law; used below COND_CHECK, where it leaves more than 11 digits)."""
+    c = np.where(np.isnan(cond), np.inf, cond).max(axis=1, initial=1.0)
+    return A_PRIORI * c**3
+
+
+def digits(error: np.ndarray) -> np.ndarray:
+    """Significant digits left for a relative error: -log10(error) within [0, 16]."""
+    with np.errstate(divide="ignore"):
+        return np.clip(-np.log10(error), 0.0, 16.0)
+
+
+def relative_change(new: np.ndarray, old: np.ndarray, floor: float | np.ndarray) -> np.ndarray:
+    """(N,) per angle (axis 0): the largest |new - old| / max(|old|, floor) over the other
+    axes; inf where `new` is not finite and `old` is."""
+    d = np.abs(new - old) / np.maximum(np.maximum(np.abs(old), floor), _TINY)
+    d = np.where(np.isnan(d), np.inf, d).reshape(len(d), -1)
+    return d.max(axis=1, initial=0.0)
+
+
+def kinematic_deviation(mech: "Mechanism", a: Kinematics, b: Kinematics) -> np.ndarray:
+    """(N,) how far the motion b is from a: the largest relative change of any link's position,
+    orientation, angular velocity and acceleration, velocity and acceleration, and of any
+    sliding velocity and acceleration, each against max(|value|, scale) with the scales
+    L (kinematic_size), 1, w, e, L w, L e (w = |omega_1|, e = omega_1^2 + |eps_1|)."""
+    L, w = kinematic_size(mech), abs(mech.drive.omega)
+    e = w * w + abs(mech.drive.eps)
+    return np.max([relative_change(b.origin_z, a.origin_z, L), relative_change(b.rot, a.rot, 1.0),
+                   relative_change(b.omega, a.omega, w), relative_change(b.eps, a.eps, e),
+                   relative_change(b.v_z, a.v_z, L * w), relative_change(b.a_z, a.a_z, L * e),
+                   relative_change(b.v_slide, a.v_slide, L * w), relative_change(b.a_slide, a.a_slide, L * e)],
+                  axis=0)
+
+
+def guard(mech: "Mechanism", kin: Kinematics, error: np.ndarray, stacklevel: int = 3) -> Kinematics:
+    """`kin` with its error estimate set, NaN velocities and accelerations where fewer than
+    DIGITS_MIN digits are left or cond > COND_MAX (`singular`), and a SingularPositionWarning
+    per group for the angles with fewer than DIGITS_WARN digits left (named by the group with
+    the largest cond there)."""
+    if (error <= 10.0**-DIGITS_WARN).all() and (kin.cond <= COND_MAX).all():     # the regular case
+        return replace(kin, error=error)
+    cond = np.where(np.isnan(kin.cond), np.inf, kin.cond)
+    error = np.where((cond > COND_MAX).any(axis=1), np.inf, np.where(np.isnan(error), np.inf, error))
+    singular = ~(error <= 10.0**-DIGITS_MIN)
+    low = ~(error <= 10.0**-DIGITS_WARN)
+    if low.any():
+        worst = np.argmax(cond, axis=1)
+        left = digits(error)
+        phi_deg = np.degrees(kin.phi)
+        for n, g in enumerate(mech.structure.groups):
+            at = low & (worst == n)
+            if at.any():
+                warnings.warn(SingularPositionWarning(
+                    singular_message(g.label, phi_deg[at], cond[at, n], left[at], DIGITS_MIN),
+                    group=g.label, phi_deg=phi_deg[at], cond=cond[at, n], digits=left[at]),
+                    stacklevel=stacklevel)
+    if not singular.any():
+        return replace(kin, error=error)
+    arrays = {name: getattr(kin, name).copy() for name in ("omega", "eps", "v_z", "a_z", "v_slide", "a_slide")}
+    for arr in arrays.values():
+        arr[singular] = np.nan
+    return replace(kin, error=error, singular=singular, **arrays)

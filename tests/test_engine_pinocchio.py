@@ -24,7 +24,7 @@ STEPS = 360
 #: the max of |solver|). Both sides are exact linear solves at the same exact state, so only
 #: rounding separates them: measured 2e-16 .. 1e-14, and 2e-12 for a bearing whose small load
 #: is the difference of large opposed forces (opposed twin, R(0,1)). Near (not at) a singular
-#: position the group plans lose up to log10(COND_WARN) = 3 digits more. A modelling error
+#: position the group plans lose up to DIGITS_WARN = 10 digits (then warned). A modelling error
 #: (wrong frame, sign, stale constraint Jacobian) shows up at 1e-3 .. 1e0.
 EXACT = 1e-9
 #: Crank acceleration of the forward round trip, relative to the cycle's acceleration scale

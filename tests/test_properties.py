@@ -652,7 +652,7 @@ LONG_CRANK = (PURE_COUPLE.replace("g = 0.0", "g = 9.81")
               .replace("value = 5.0", "value = -300.0"))
 
 
-# Hard cases for the reference, which random drawing (kept away from COND_WARN) rarely meets.
+# Hard cases for the reference, which random drawing (kept away from singular positions) rarely meets.
 # The four-bar (crank 0.1, frame 0.3) with coupler 0.25 and rocker 0.15 + 1e-5 m is 1e-5 m short
 # of a stretched dyad at phi = 180 deg (|AC| = 0.4): cond ~ 155 there, reactions ~ 1/sin of the
 # transmission angle. (Measured: the error grows as cond^2, ~1e-11 here, ~7e-11 at cond 490.)
