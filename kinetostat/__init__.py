@@ -17,8 +17,9 @@ from .errors import AssemblyError, ModelError, SingularPositionWarning, Structur
 from .kinematics import COND_MAX, COND_WARN
 from .model import Mechanism, from_dict, load, loads
 from .structure import AssurGroup, Structure
+from .virtual_work import VirtualWork, virtual_work
 
-__all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
+__all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
            "SingularPositionWarning", "COND_WARN", "COND_MAX", "examples"]
 __version__ = "0.1.0"

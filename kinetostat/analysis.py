@@ -15,7 +15,7 @@ from .applied import applied_wrenches, com_motion, inertia_loads
 from .planar import as_xy, cross_z
 from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "analyze", "FRAME_NOTE"]
+__all__ = ["Analysis", "InertiaLoad", "analyze", "crank_angles", "FRAME_NOTE"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
 #: `Analysis.to_frame().attrs["frame"]`).
@@ -244,12 +244,9 @@ class Analysis:
         return df
 
 
-def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
-    """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
-    or at `steps` equal steps over a full revolution when `phi_deg` is None."""
-    if not isinstance(mech, Mechanism):
-        raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
-                        f"read a model file with kinetostat.load(path)")
+def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
+    """The crank angles asked for, deg, as a read-only (N,) copy: `phi_deg` (array-like), or
+    `steps` equal steps over a full revolution when it is None. ValueError naming the argument."""
     if phi_deg is None:
         if not isinstance(steps, (int, np.integer)) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps: expected a positive integer, got {steps!r}")
@@ -261,6 +258,16 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     if phi_deg.ndim != 1 or not np.isfinite(phi_deg).all():
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     phi_deg.flags.writeable = False
+    return phi_deg
+
+
+def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
+    """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
+    or at `steps` equal steps over a full revolution when `phi_deg` is None."""
+    if not isinstance(mech, Mechanism):
+        raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
+                        f"read a model file with kinetostat.load(path)")
+    phi_deg = crank_angles(phi_deg, steps)
     kin = kinematics(mech, np.radians(phi_deg))
     with np.errstate(divide="ignore", invalid="ignore"):    # NaN only at angles marked singular
         return _kinetostatics(mech, phi_deg, kin)
