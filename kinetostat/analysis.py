@@ -302,7 +302,7 @@ class Analysis:
         [m/s], ax_P, ay_P [m/s^2]; for every moving link k theta_k [rad], omega_k [rad/s], eps_k
         [rad/s^2]; for every link with mass or inertia Fix_k, Fiy_k [N] (inertia main vector at
         the centre of mass), Mi_k [N m] (main moment), h_k [m] (offset of the single resultant);
-        for every link with mass xK_k, yK_k, l_SK_k [m] (centre of oscillation K of the inertia
+        for every link with mass xK_k, yK_k, lSK_k [m] (centre of oscillation K of the inertia
         resultant, |SK|); for every pair Rx_i_j, Ry_i_j, R_i_j [N] (force of link i on link j, its
         magnitude), angle_R_i_j [deg] (its direction from +x, counter-clockwise); for
         prismatic pairs also x_i_j [m] and m_i_j [N m] (line of the normal force, its moment
@@ -342,7 +342,7 @@ class Analysis:
                 put("m", **{f"h_{link.id}": il.h})
                 if link.mass:
                     K = self.centre_of_oscillation(link.id)
-                    put("m", **{f"xK_{link.id}": K.point[:, 0], f"yK_{link.id}": K.point[:, 1], f"l_SK_{link.id}": K.l_SK})
+                    put("m", **{f"xK_{link.id}": K.point[:, 0], f"yK_{link.id}": K.point[:, 1], f"lSK_{link.id}": K.l_SK})
         for p in m.pairs:
             ij = f"{p.links[0]}_{p.links[1]}"
             R = self.forces.R[:, p.index]

@@ -86,7 +86,7 @@ def test_centre_of_oscillation_translation_and_pure_couple():
     np.testing.assert_array_equal(res.centre_of_oscillation(3).point, res.position("B"))   # the piston translates
     np.testing.assert_array_equal(res.centre_of_oscillation(3).l_SK, 0.0)
     units = res.to_frame().attrs["units"]
-    assert units["l_SK_2"] == units["xK_2"] == "m" and units["Fax_2"] == "N"
+    assert units["lSK_2"] == units["xK_2"] == "m" and units["Fax_2"] == "N"
 
 
 @pytest.mark.parametrize("name", ["ice_crank_slider", "compressor", "scotch_yoke", "furnace_loader_six_bar"])
