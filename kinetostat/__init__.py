@@ -19,8 +19,9 @@ from .errors import AssemblyError, ModelError, SingularPositionWarning, Structur
 from .kinematics import COND_CHECK, COND_MAX, DIGITS_MIN, DIGITS_WARN
 from .model import Mechanism, from_dict, load, loads
 from .structure import AssurGroup, Structure
+from .virtual_work import VirtualWork, virtual_work
 
-__all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
+__all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
            "SingularPositionWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN", "examples", "plans"]
 __version__ = "0.1.0"

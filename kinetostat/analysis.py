@@ -5,18 +5,20 @@ May use: model, kinematics, kinetostatics, applied, planar; pandas only inside `
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import NamedTuple
+from types import MappingProxyType
+from typing import Mapping, NamedTuple
 
 import numpy as np
 
 from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation, kinematic_size, relative_change,
                          solve_checked)
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from .applied import applied_wrenches, com_motion, inertia_loads
-from .planar import as_xy, cross_z
+from .applied import applied_moment, applied_wrenches, com_motion, inertia_loads, point_forces
+from .planar import as_xy, as_z, cross_z, dot_z
 from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "analyze", "FRAME_NOTE", "deviation", "force_deviation"]
+__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "analyze", "crank_angles", "FRAME_NOTE", "deviation",
+           "force_deviation"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
 #: `Analysis.to_frame().attrs["frame"]`).
@@ -37,6 +39,15 @@ class InertiaLoad(NamedTuple):
 
     def __repr__(self) -> str:
         return f"InertiaLoad(positions={len(self.moment)}: force (N, 2) N, moment N m, h m, point (N, 2) m)"
+
+
+class CentreOfOscillation(NamedTuple):
+    """Centre of oscillation K of a link's inertia resultant (seed 000 sec. 4)."""
+    point: np.ndarray    # (N, 2) K, m (S where the link translates; inf where a_S = 0: a pure couple)
+    l_SK: np.ndarray     # (N,) distance S-K = rho_S^2 / l_QS, m (Q the centre of accelerations)
+
+    def __repr__(self) -> str:
+        return f"CentreOfOscillation(positions={len(self.l_SK)}: point (N, 2) m, l_SK m)"
 
 
 @dataclass(frozen=True)
@@ -188,6 +199,64 @@ class Analysis:
             shift = np.where((F2 > 0)[:, None], (-M / F2)[:, None] * np.stack([-F[:, 1], F[:, 0]], -1), 0.0)
         return InertiaLoad(F, M, h, S + shift)
 
+    def reaction_angle(self, i: int, j: int) -> np.ndarray:
+        """(N,) direction of reaction(i, j), deg from +x, counter-clockwise, in (-180, 180]."""
+        R = self.reaction(i, j)
+        return np.degrees(np.arctan2(R[:, 1], R[:, 0]))
+
+    def _two_pins(self, k: int) -> tuple:
+        """The two revolute pairs of a two-pin link k, or KeyError saying why it is not one."""
+        k = self._link(k)
+        pairs = [p for p in self.mech.pairs if k in p.links]
+        if k == 0 or len(pairs) != 2 or any(p.kind != "R" for p in pairs) or pairs[0].point == pairs[1].point:
+            raise KeyError(f"link {k} is not a two-pin link (exactly two revolute pairs at two points); "
+                           f"its pairs: {[p.label for p in pairs]}")
+        return pairs
+
+    def axial_force(self, k: int, at: str | None = None) -> np.ndarray:
+        """(N,) axial force of two-pin link k, N: tension positive, compression negative.
+
+        At each pin, the component of the force the other link exerts on k along the line of
+        the pins, pointing away from the link's other pin (it pulls: tension). `at`: that pin's
+        point name; None: the mean of the two ends, the axial force at the middle of a bar whose
+        own loads (gravity, inertia, loads on it) are carried by the pins. The two ends are equal
+        when the link carries no load along its line."""
+        pairs = self._two_pins(k)
+        ends = {}
+        for p, q in (pairs, pairs[::-1]):
+            other = p.links[0] if p.links[1] == k else p.links[1]
+            u = self.position(p.point) - self.position(q.point)
+            u /= np.linalg.norm(u, axis=-1, keepdims=True)
+            ends[p.point] = np.sum(self.reaction(other, k) * u, axis=-1)
+        if at is None:
+            return 0.5 * sum(ends.values())
+        if at not in ends:
+            raise KeyError(f"axial_force: link {k}'s pins are {list(ends)}, got at={at!r}")
+        return ends[at]
+
+    def centre_of_oscillation(self, k: int) -> CentreOfOscillation:
+        """Centre of oscillation K of link k and l_SK, m (seed 000 sec. 4).
+
+        Rotation about a fixed axis O: the inertia resultant passes through K on the line OS,
+        beyond S, l_SK = rho_S^2 / l_OS with rho_S^2 = I_S / m. In general plane motion the same
+        holds with O replaced by the centre of accelerations Q (the point of zero acceleration,
+        S - Q = a_S / (i eps - omega^2)): K = S + rho_S^2 (S - Q) / |S - Q|^2, on the line of
+        the single resultant (`inertia(k)`). Translation: K = S; a_S = 0 (a pure couple): inf.
+        NaN for a link without mass."""
+        k = self._link(k)
+        mass, I_S, _ = self.mech.inertia_arrays
+        com = self.mech.links[k].com
+        S, aS = (as_z(self.position(com)), as_z(self.acceleration(com))) if com else \
+            (self.kin.origin_z[:, k], self.kin.a_z[:, k])
+        rho2 = I_S[k] / mass[k] if mass[k] > 0 else np.nan
+        w, e = self.kin.omega[:, k], self.kin.eps[:, k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            SK = rho2 * np.conj(1j * e - w**2) / np.conj(aS)        # rho^2 (S - Q) / |S - Q|^2
+        SK[(aS == 0) & (rho2 != 0)] = np.inf
+        K = as_xy(S + np.where(np.isinf(SK), 0.0, SK))
+        K[np.isinf(SK)] = np.inf
+        return CentreOfOscillation(K, np.abs(SK))
+
     @property
     def friction_power_total(self) -> np.ndarray:
         """(N,) total power lost in friction, W."""
@@ -197,10 +266,58 @@ class Analysis:
         """(n_pairs,) energy lost in each pair over one revolution, J: the integral of its power
         over the period (periodic trapezoid rule, exact for the sampled cycle). Needs the angles
         of a uniform full cycle, as `analyze(mech, steps=N)` gives."""
+        return self._cycle_integral(self.friction_power, "friction_energy")
+
+    def _cycle_integral(self, power: np.ndarray, who: str) -> np.ndarray:
+        """Integral over one revolution of a power (N, ...) W, J: the mean of P / (dphi/dt) over
+        the uniform full cycle of angles times 2 pi (the periodic trapezoid rule, spectrally
+        accurate for a smooth periodic integrand). ValueError naming `who` otherwise."""
         phi = self.phi_deg
         if not np.allclose(phi, phi[0] + np.arange(len(phi)) * 360.0 / len(phi), rtol=0, atol=1e-9):
-            raise ValueError("friction_energy: needs the angles of a uniform full cycle (analyze with steps=N)")
-        return self.friction_power.mean(axis=0) * 2 * np.pi / self.mech.drive.omega
+            raise ValueError(f"{who}: needs the angles of a uniform full cycle (analyze with steps=N)")
+        rate = self.mech.drive.sense * self.omega(1)          # dphi/dt, rad/s
+        return (power / rate.reshape((-1,) + (1,) * (power.ndim - 1))).mean(axis=0) * 2 * np.pi
+
+    def work(self) -> Mapping[str, float]:
+        """Work of each load over one revolution, J (positive: the load drives the mechanism),
+        from its power F . v + M omega. Needs the angles of a uniform full cycle.
+
+        Keys: "gravity k" and "inertia k" per link with mass or inertia (inertia: F_i = -m a_S at
+        S and M_i = -I_S eps; -(change of kinetic energy), 0 over a steady cycle); "load NAME"
+        per applied force or moment (loads of one name summed); "spring NAME" (both ends);
+        "balancing moment" (M_bal omega_1; for a working machine the pinion's force, the same
+        power); with friction "friction R(i,j)" per pair, the energy lost (negative). The balancing
+        moment is frictionless: every entry but friction sums to 0 (to rounding) at any speed
+        law, and the friction entries are what the drive must supply on top (seed 003)."""
+        m, kin = self.mech, self.kin
+        power: dict[str, np.ndarray] = {}
+
+        def add(name: str, P: np.ndarray) -> None:
+            power[name] = power.get(name, 0.0) + P
+
+        r, _ = com_motion(m, kin)
+        vS = kin.v_z + 1j * kin.omega * r
+        mass, I_S, _ = m.inertia_arrays
+        for k in range(1, m.n_links):
+            if mass[k]:
+                add(f"gravity {k}", -m.g * mass[k] * vS[:, k].imag)
+            if mass[k] or I_S[k]:
+                il = self.inertia(k)
+                add(f"inertia {k}", dot_z(as_z(il.force), vS[:, k]) + il.moment * kin.omega[:, k])
+        for ld in m.loads:
+            if ld.kind == "moment":
+                add(f"load {ld.name}", applied_moment(m, kin, ld) * kin.omega[:, ld.link])
+        n_loads = sum(ld.kind == "force" for ld in m.loads)      # point_forces: the loads, then the springs' ends
+        for n, f in enumerate(point_forces(m, kin)):
+            v = kin.v_z[:, f.link] + 1j * kin.omega[:, f.link] * (f.X - kin.origin_z[:, f.link])
+            add(f"{'load' if n < n_loads else 'spring'} {f.name}", dot_z(f.force, v))
+        add("balancing moment", self.balancing_moment * self.omega(1))
+        if m.friction is not None:
+            for p in m.pairs:
+                add(f"friction {p.label}", -self.friction_power[:, p.index])
+        names = list(power)
+        W = self._cycle_integral(np.stack([power[n] for n in names], axis=-1), "work")
+        return MappingProxyType(dict(zip(names, W.tolist())))
 
     # -- table
     def to_frame(self):
@@ -210,10 +327,13 @@ class Analysis:
         [m/s], ax_P, ay_P [m/s^2]; for every moving link k theta_k [rad], omega_k [rad/s], eps_k
         [rad/s^2]; for every link with mass or inertia Fix_k, Fiy_k [N] (inertia main vector at
         the centre of mass), Mi_k [N m] (main moment), h_k [m] (offset of the single resultant);
-        for every pair Rx_i_j, Ry_i_j, R_i_j [N] (force of link i on link j, its magnitude); for
+        for every link with mass xK_k, yK_k, lSK_k [m] (centre of oscillation K of the inertia
+        resultant, |SK|); for every pair Rx_i_j, Ry_i_j, R_i_j [N] (force of link i on link j, its
+        magnitude), angle_R_i_j [deg] (its direction from +x, counter-clockwise); for
         prismatic pairs also x_i_j [m] and m_i_j [N m] (line of the normal force, its moment
         about the slider point), vs_i_j [m/s] and as_i_j [m/s^2] (sliding velocity and
-        acceleration); M_bal, M_lever [N m]; for a working machine F_balx, F_baly, F_bal [N]; with
+        acceleration); Fax_k [N] for every two-pin link (axial force, tension positive, the mean of
+        its two ends: `axial_force`); M_bal, M_lever [N m]; for a working machine F_balx, F_baly, F_bal [N]; with
         friction Pfr_i_j per pair and Pfr_total [W]; cond_<group> [1] per Assur group; singular
         [bool].
 
@@ -245,15 +365,24 @@ class Analysis:
                 put("N", **{f"Fix_{link.id}": il.force[:, 0], f"Fiy_{link.id}": il.force[:, 1]})
                 put("N m", **{f"Mi_{link.id}": il.moment})
                 put("m", **{f"h_{link.id}": il.h})
+                if link.mass:
+                    K = self.centre_of_oscillation(link.id)
+                    put("m", **{f"xK_{link.id}": K.point[:, 0], f"yK_{link.id}": K.point[:, 1], f"lSK_{link.id}": K.l_SK})
         for p in m.pairs:
             ij = f"{p.links[0]}_{p.links[1]}"
             R = self.forces.R[:, p.index]
             put("N", **{f"Rx_{ij}": R[:, 0], f"Ry_{ij}": R[:, 1], f"R_{ij}": np.linalg.norm(R, axis=-1)})
+            put("deg", **{f"angle_R_{ij}": self.reaction_angle(*p.links)})
             if p.kind == "P":
                 put("m", **{f"x_{ij}": self.forces.x[:, p.index]})
                 put("N m", **{f"m_{ij}": self.forces.m[:, p.index]})
                 put("m/s", **{f"vs_{ij}": self.kin.v_slide[:, p.index]})
                 put("m/s^2", **{f"as_{ij}": self.kin.a_slide[:, p.index]})
+        for link in m.links[1:]:
+            try:
+                put("N", **{f"Fax_{link.id}": self.axial_force(link.id)})
+            except KeyError:        # not a two-pin link
+                pass
         put("N m", M_bal=self.balancing_moment, M_lever=self.lever_moment)
         if m.drive.kind == "machine":
             F = self.balancing_force
@@ -268,12 +397,9 @@ class Analysis:
         return df
 
 
-def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
-    """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
-    or at `steps` equal steps over a full revolution when `phi_deg` is None."""
-    if not isinstance(mech, Mechanism):
-        raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
-                        f"read a model file with kinetostat.load(path)")
+def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
+    """The crank angles asked for, deg, as a read-only (N,) copy: `phi_deg` (array-like), or
+    `steps` equal steps over a full revolution when it is None. ValueError naming the argument."""
     if phi_deg is None:
         if not isinstance(steps, (int, np.integer)) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps: expected a positive integer, got {steps!r}")
@@ -285,6 +411,16 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     if phi_deg.ndim != 1 or not np.isfinite(phi_deg).all():
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     phi_deg.flags.writeable = False
+    return phi_deg
+
+
+def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
+    """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
+    or at `steps` equal steps over a full revolution when `phi_deg` is None."""
+    if not isinstance(mech, Mechanism):
+        raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
+                        f"read a model file with kinetostat.load(path)")
+    phi_deg = crank_angles(phi_deg, steps)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # NaN only at angles marked singular
         kin, checked, trials = solve_checked(mech, np.radians(phi_deg))
         res = _kinetostatics(mech, phi_deg, kin)

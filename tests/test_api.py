@@ -97,7 +97,7 @@ UNIT_OF_PREFIX = {   # column family -> unit, written out here independently of 
     "theta": "rad", "omega": "rad/s", "eps": "rad/s^2", "Fix": "N", "Fiy": "N", "Mi": "N m", "h": "m",
     "Rx": "N", "Ry": "N", "R": "N", "m": "N m", "vs": "m/s", "as": "m/s^2", "M_bal": "N m",
     "M_lever": "N m", "F_balx": "N", "F_baly": "N", "F_bal": "N", "Pfr": "W", "Pfr_total": "W",
-    "cond": "1", "singular": "bool",
+    "cond": "1", "singular": "bool", "xK": "m", "yK": "m", "lSK": "m", "angle": "deg", "Fax": "N",
 }
 
 

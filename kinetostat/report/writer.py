@@ -14,6 +14,7 @@ import numpy as np
 
 from ..analysis import analyze
 from ..model import Mechanism
+from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
 from .plots import (_pair_name, _save, plot_balancing_force, plot_errors, plot_hodographs, plot_mechanism, plot_moment,
@@ -228,6 +229,35 @@ def _balancing_force_section(doc: Doc, res, image: Path) -> None:
                ["F_bal,y", *_extremes(F[:, 1], phi)]], "lrrrr")
 
 
+def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
+    """The balancing moment and the reactions by the three routes of the texts: group by group,
+    Zhukovsky's lever (balancing moment only) and d'Alembert-Lagrange (seed 004, `virtual_work`)."""
+    vw = virtual_work(m, phi_deg=res.phi_deg)
+
+    def worst(a, b) -> tuple[float, float]:
+        ok = np.isfinite(a).all(axis=tuple(range(1, a.ndim))) & np.isfinite(b).all(axis=tuple(range(1, b.ndim)))
+        size = (lambda x: np.abs(x)) if a.ndim == 1 else (lambda x: np.linalg.norm(x, axis=-1))
+        if not ok.any():
+            return float("nan"), 0.0
+        return float(np.max(size(a[ok] - b[ok]))), float(np.max(size(b[ok])))
+
+    doc.h(2, "Three routes")
+    doc.p("The balancing moment and every reaction by three independent routes sharing only the kinematics: "
+          "group by group (the solver), Zhukovsky's lever (the balancing moment from the velocity plan) and "
+          "d'Alembert–Lagrange (seed 004: each reaction component from the virtual work of all loads, inertia "
+          "included, in the virtual motion of the mechanism with that one constraint released; "
+          "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak.")
+    def row(quantity: str, route: str, a, b, unit: str) -> list[str]:
+        x, peak = worst(a, b)
+        return [quantity, route, _err(x, peak, unit), f"{x / peak:.1e}" if peak > 0 and math.isfinite(x) else "n/a"]
+
+    rows = [row("M_bal", "Zhukovsky's lever", res.lever_moment, res.balancing_moment, "N·m"),
+            row("M_bal", "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
+    rows += [row(_pair_name(m, p), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
+             for p in m.pairs]
+    doc.table(["quantity", "route against group by group", "max |difference|", "peak relative"], rows, "llrr")
+
+
 def _error_rows(run: ModelRun) -> list[list[str]]:
     rows = []
     for r in run.rows:
@@ -316,6 +346,8 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
     doc.table(["pair", "max |R|, N", "at φ, deg", "min |R|, N", "at φ, deg"],
               [[_pair_name(m, p), *_extremes(np.linalg.norm(res.forces.R[:, p.index], axis=-1), res.phi_deg)]
                for p in m.pairs], "lrrrr")
+
+    _three_routes_section(doc, m, res)
 
     doc.h(2, "Errors against the engines")
     doc.p("Per route and quantity: max |engine − kinetostat| over the cycle (absolute) and the crank angle "
