@@ -12,7 +12,10 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Iterator
 
-__all__ = ["atomic", "write_text", "write_bytes", "safe_name", "unique_names", "inside"]
+__all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside"]
+
+#: The temporary files of the writes in progress in this process (`remove_temporary`).
+_PENDING: set[str] = set()
 
 
 def _file_mode(path: Path) -> int:
@@ -40,6 +43,7 @@ def atomic(path: str | Path, binary: bool = False) -> Iterator[IO]:
     if path.is_dir():
         raise IsADirectoryError(21, "it is a directory", str(path))
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".kinetostat-", suffix=".tmp")
+    _PENDING.add(tmp)
     try:
         with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8", newline="")) as f:
             yield f
@@ -51,6 +55,18 @@ def atomic(path: str | Path, binary: bool = False) -> Iterator[IO]:
         except OSError:
             pass
         raise
+    finally:
+        _PENDING.discard(tmp)
+
+
+def remove_temporary() -> None:
+    """Remove the temporary files of the writes in progress: for a process about to end at once
+    (`os._exit` in a signal handler), which leaves no `atomic` block to clean up after itself."""
+    for tmp in list(_PENDING):
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
 
 
 def write_text(path: str | Path, text: str) -> Path:

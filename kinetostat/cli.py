@@ -658,9 +658,14 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
 def _worker_init() -> None:
     """A report worker ends at once, silently, on Ctrl-C (the terminal sends it to the whole
     process group): the main process reports the interruption. A KeyboardInterrupt would not
-    do, as it can land in a garbage-collection callback, which swallows it."""
-    import signal
-    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(EXIT_INTERRUPTED))
+    do, as it can land in a garbage-collection callback, which swallows it. The temporary file
+    of a write in progress is removed first (the files already written stay as they are)."""
+    from ._io import remove_temporary
+
+    def end(signum, frame):
+        remove_temporary()
+        os._exit(EXIT_INTERRUPTED)
+    signal.signal(signal.SIGINT, end)
 
 
 def _jobs(text: str) -> int:
@@ -735,15 +740,20 @@ def cmd_report(args) -> int:
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
             _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
                        f"  -> {out / s['stem'] / 'index.html'}")
-        try:
-            index = write_index(out, [summaries[n] for n in range(len(order)) if n in summaries])
-        except OSError as exc:
-            raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
+        index = out / "index.md"
+        keep = n_err and index.exists()     # a model without a report: the earlier index is not lost
+        if not keep:
+            try:
+                index = write_index(out, [summaries[n] for n in range(len(order)) if n in summaries])
+            except OSError as exc:
+                raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
         _close(bar)
     _Out.write(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
                + (f", {n_err} without a report (errors above)" if n_err else "")
-               + f"; index -> {index} and {index.with_suffix('.html')}; {time.perf_counter() - t0:.1f} s")
+               + (f"; the earlier index {index} stays as it was" if keep else
+                  f"; index -> {index} and {index.with_suffix('.html')}")
+               + f"; {time.perf_counter() - t0:.1f} s")
     return EXIT_FAIL if n_err else EXIT_OK
 
 
@@ -874,9 +884,13 @@ def build_parser() -> argparse.ArgumentParser:
                                    "plots over the cycle, error tables per engine route, the seeds' published "
                                    "values where known, and cycle.csv; plus OUT/index.md and OUT/index.html. "
                                    "The files carry no dates or run times (a rerun reproduces them byte for "
-                                   "byte); run times are printed here only. Exits 0 once the reports are "
-                                   "written, also when checks fail (use 'kinetostat validate' as the gate); "
-                                   "1 when a model's report could not be made.")
+                                   "byte); run times are printed here only. Every file is written atomically: "
+                                   "Ctrl-C (exit 130) or a full disk leaves the earlier files as they were, and "
+                                   "when a model's report cannot be made the earlier index stays. Folders are "
+                                   "named after the model files (ASCII letters, digits, '_', '-'; a repeated "
+                                   "name gets -2, -3). Exits 0 once the reports are written, also when checks "
+                                   "fail (use 'kinetostat validate' as the gate); 1 when a model's report could "
+                                   "not be made.")
     r.add_argument("models", metavar="MODEL", nargs="*",
                    help="model files (default: every bundled model, see 'kinetostat examples')")
     r.add_argument("--out", metavar="DIR", default="reports", help="output directory (default: ./reports)")
