@@ -72,8 +72,6 @@ def test_model_strings_are_text_in_every_report_file(tmp_path, cli):
         hrefs = {t.attrGet("href") for t in tokens if t.type == "link_open"} | \
                 {t.attrGet("src") for t in tokens if t.type == "image"}
         assert all(h in own or h.startswith("#") or h.endswith(".png") and "/" not in h for h in hrefs), hrefs
-        assert not [t for t in tokens if t.type in ("s_open", "em_open", "strong_open") and
-                    "javascript" in str(t.map)]
         rows = [t for t in tokens if t.type in ("tr_open", "th_open", "td_open", "tr_close")]
         cells, widths = 0, []
         for t in rows:
@@ -81,7 +79,7 @@ def test_model_strings_are_text_in_every_report_file(tmp_path, cli):
             if t.type == "tr_close":
                 widths.append(cells)
                 cells = 0
-        assert widths
+        assert widths and all(w == widths[0] for w in widths[:2])
         text = " ".join(t.content for t in tokens if t.type in ("text", "code_inline"))
         if md.parent.name == "injection":
             for s in strings:
@@ -233,7 +231,7 @@ def test_ctrl_c_stops_the_report_and_keeps_every_earlier_file(tmp_path):
         _, err = p.communicate(timeout=300)
         if running:
             stopped += 1
-            assert p.returncode in (EXIT := 130, -signal.SIGINT), (fraction, p.returncode, err)
+            assert p.returncode in (130, -signal.SIGINT), (fraction, p.returncode, err)
             assert "Traceback" not in err, err
         assert _files(out) == before, fraction
         assert _temporary(out) == [], fraction
