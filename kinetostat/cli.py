@@ -2,20 +2,28 @@
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
 nothing to compare, or `report` could not make a model's report; 2 bad input or options (model
-file, structure, assembly, angles, engine names, output path). Expected problems print one `kinetostat: error: ...` line (a model file's
-problem list prints one line per problem) and never a traceback; warnings print one line each.
+file, structure, assembly, angles, engine names, output path, stdout that cannot be written);
+130 interrupted (Ctrl-C). Expected problems print one `kinetostat: error: ...` line (a model
+file's problem list prints one line per problem) and never a traceback; warnings print one line
+each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
+disk leaves the previous file as it was.
 """
 from __future__ import annotations
 
 import argparse
+import errno
 import math
 import os
+import signal
 import sys
 import tempfile
 import time
 import warnings
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Sequence
+from typing import IO, Callable, Iterator, Sequence
+
+from ._io import atomic, unique_names
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -40,15 +48,87 @@ class _Out:
     @classmethod
     def write(cls, text: str, err: bool = False) -> None:
         stream = sys.stderr if err else sys.stdout
-        if cls.bar is not None:
-            from tqdm import tqdm
-            tqdm.write(text, file=stream)
-        else:
-            print(text, file=stream)
+        try:
+            if cls.bar is not None:
+                from tqdm import tqdm
+                tqdm.write(text, file=stream)
+            else:
+                print(text, file=stream)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:           # stdout on a full disk: one error line, not a traceback
+            raise CLIError(f"cannot write to {'stderr' if err else 'stdout'}: {exc.strerror or exc}") from None
 
 
 def _error(msg: str) -> None:
-    _Out.write(f"kinetostat: error: {msg}", err=True)
+    try:
+        _Out.write(f"kinetostat: error: {msg}", err=True)
+    except (CLIError, OSError):          # stderr itself cannot be written: the exit code says it
+        pass
+
+
+def _readable_streams() -> None:
+    """stdout and stderr write what their encoding cannot hold (a non-ASCII model name under
+    LC_ALL=C or PYTHONIOENCODING=latin-1, a non-UTF-8 file name) as backslash escapes."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):
+            pass
+
+
+def _quiet_stdout() -> None:
+    """After stdout failed (a closed pipe, a full disk): what is still buffered goes to
+    /dev/null, so that the interpreter's own flush at exit does not fail again."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (AttributeError, ValueError, OSError):
+        pass
+
+
+class _Interrupt:
+    """Ctrl-C while a command runs. The handler records it before it raises KeyboardInterrupt:
+    an interrupt that lands in a garbage-collection callback or a __del__ is swallowed there
+    ("Exception ignored in ..."), and the next `_checkpoint` raises it again."""
+    seen = False
+
+
+def _on_sigint(signum, frame) -> None:
+    _Interrupt.seen = True
+    raise KeyboardInterrupt
+
+
+def _checkpoint() -> None:
+    """Raise KeyboardInterrupt if Ctrl-C was pressed, also if its first raise was swallowed."""
+    if _Interrupt.seen:
+        raise KeyboardInterrupt
+
+
+@contextmanager
+def _interrupts() -> Iterator[None]:
+    """`_on_sigint` as the SIGINT handler while a command runs (main thread only), then the old one."""
+    _Interrupt.seen = False
+    try:
+        old = signal.signal(signal.SIGINT, _on_sigint)
+    except ValueError:                   # not the main thread: leave the handler as it is
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bool = False) -> None:
+    """`write(file)` into `path` atomically (`kinetostat._io.atomic`); a failure is a CLIError
+    naming `option`, and the old file stays as it was."""
+    try:
+        with atomic(path, binary=binary) as f:
+            write(f)
+    except OSError as exc:
+        raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
 
 
 def _warn(msg: str) -> None:
@@ -154,10 +234,77 @@ def _load(path: str | Path):
         raise CLIError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
 
 
+def _size(n: float) -> str:
+    """A number of bytes for people: "1.3 kB", "8.1 TB", "1.3e+23 bytes" beyond yottabytes."""
+    for unit in ("bytes", "kB", "MB", "GB", "TB", "PB", "EB", "ZB", "YB"):
+        if n < 999.5:
+            return f"{n:.3g} {unit}"
+        n /= 1000
+    return f"{n * 1e24:.3g} bytes"
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available now (Linux: MemAvailable; else free physical pages), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def _result_bytes(x, seen: set[int] | None = None) -> int:
+    """Bytes of the numpy arrays an analysis result holds (the mechanism itself not counted)."""
+    import numpy as np
+    from .model import Mechanism
+    seen = set() if seen is None else seen
+    if id(x) in seen or isinstance(x, (Mechanism, str, bytes, int, float, type(None))):
+        return 0
+    seen.add(id(x))
+    if isinstance(x, np.ndarray):
+        return x.nbytes
+    if isinstance(x, dict):
+        return sum(_result_bytes(v, seen) for v in x.values())
+    if isinstance(x, (list, tuple)):
+        return sum(_result_bytes(v, seen) for v in x)
+    fields = getattr(x, "__dict__", None)
+    return sum(_result_bytes(v, seen) for v in fields.values()) if fields else 0
+
+
+#: `--steps` is refused where the result alone would need more than the memory available now.
+#: The bytes per crank position are measured on this many positions of the model.
+_SAMPLE_STEPS = 4
+
+
+def _check_memory(mech, steps: int) -> None:
+    """Refuse `steps` before anything is allocated where the result's arrays (measured per crank
+    position on a few positions of this model) would not fit in the memory available now."""
+    from .analysis import analyze
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            per_angle = _result_bytes(analyze(mech, steps=_SAMPLE_STEPS)) / _SAMPLE_STEPS
+        except Exception:                # noqa: BLE001 -- the real analysis reports the fault
+            return
+    need, free = steps * per_angle, _available_memory()
+    if free is not None and need > free:
+        raise CLIError(f"--steps {steps}: the result alone would need {_size(need)} of memory "
+                       f"({_size(per_angle)} per crank position for this model), and {_size(free)} is "
+                       f"available; use fewer steps (at most about {int(free // per_angle):,})")
+
+
 def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
-    """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each."""
+    """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each;
+    `steps` that would not fit in memory are refused before anything is allocated."""
     from .analysis import analyze
     from .errors import AssemblyError, ModelError
+    if phi_deg is None:
+        _check_memory(mech, steps)
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -177,18 +324,18 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
 
 
 def _writable_file(path: str, option: str) -> Path:
-    """Check that `path` can be written now (so that a long run does not fail at its end)."""
+    """Check that `path` can be written now (so that a long run does not fail at its end): its
+    folder takes a temporary file, and the name itself is one the file system can hold."""
     p = Path(path)
-    if p.is_dir():
-        raise CLIError(f"cannot write {option} {p}: it is a directory")
-    existed = p.exists()
     try:
-        with open(p, "a", encoding="utf-8"):
+        if p.is_dir():
+            raise CLIError(f"cannot write {option} {p}: it is a directory")
+        if len(os.fsencode(p.name)) > os.pathconf(p.parent, "PC_NAME_MAX"):
+            raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
+        with tempfile.NamedTemporaryFile(dir=p.parent, prefix=".kinetostat-probe-"):
             pass
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
-    if not existed:
-        p.unlink()
     return p
 
 
@@ -298,7 +445,7 @@ def _summary(res, path: Path) -> list[str]:
     return lines
 
 
-def _write_json(df, path: str) -> None:
+def _write_json(df, f: IO) -> None:
     """Records (one object per crank position), floats as Python writes them, NaN as null."""
     import json
 
@@ -313,9 +460,8 @@ def _write_json(df, path: str) -> None:
         return x if math.isfinite(x) else None
 
     records = [{k: plain(v) for k, v in zip(df.columns, row)} for row in df.itertuples(index=False, name=None)]
-    with open(path, "w", encoding="utf-8") as f:
-        json.dump(records, f, indent=1, allow_nan=False)
-        f.write("\n")
+    json.dump(records, f, indent=1, allow_nan=False)
+    f.write("\n")
 
 
 def _worksheet_lines(mech, phi: float) -> list[str]:
@@ -356,18 +502,15 @@ def cmd_analyze(args) -> int:
     if out is not None:
         df = res.to_frame()
         if out == "-":
-            df.to_csv(sys.stdout, index=False)
+            _Out.write(df.to_csv(index=False).rstrip("\n"))
         else:
             suffix = Path(out).suffix.lower()
-            try:
-                if suffix == ".csv":
-                    df.to_csv(out, index=False)
-                elif suffix == ".json":
-                    _write_json(df, out)
-                else:
-                    df.to_parquet(out, index=False)
-            except OSError as exc:
-                raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
+            if suffix == ".csv":
+                _save(out, "--out", lambda f: df.to_csv(f, index=False))
+            elif suffix == ".json":
+                _save(out, "--out", lambda f: _write_json(df, f))
+            else:
+                _save(out, "--out", lambda f: df.to_parquet(f, index=False), binary=True)
             lines.append(f"table: {len(df)} rows x {len(df.columns)} columns -> {out}")
     else:
         lines.append("(the full table: --out FILE.csv | FILE.parquet | FILE.json)")
@@ -462,7 +605,8 @@ def cmd_validate(args) -> int:
     try:
         for path, mech, res, secs in jobs:
             bar.set_postfix_str(path.stem)
-            run = run_validation(mech, engines, args.steps, res=res, path=path, on_route=lambda r: bar.update())
+            run = run_validation(mech, engines, args.steps, res=res, path=path,
+                                 on_route=lambda r: (_checkpoint(), bar.update()))
             run.solver_seconds = secs
             runs.append(run)
             for w in run.warnings:
@@ -485,10 +629,8 @@ def cmd_validate(args) -> int:
         _write_validation_json(runs, code, to_json)
     if junit is not None:
         from .report import junit_xml
-        try:
-            junit_xml(runs).write(junit, encoding="utf-8", xml_declaration=True)
-        except OSError as exc:
-            raise CLIError(f"cannot write --junit {junit}: {exc.strerror or exc}") from None
+        tree = junit_xml(runs)
+        _save(junit, "--junit", lambda f: tree.write(f, encoding="utf-8", xml_declaration=True), binary=True)
         _Out.write(f"JUnit XML -> {junit}")
     return code
 
@@ -499,19 +641,16 @@ def _write_validation_json(runs, code: int, dest) -> None:
     from .report import validation_json
     text = json.dumps(validation_json(runs, code), indent=1, allow_nan=False) + "\n"
     if dest == "-":
-        sys.stdout.write(text)
+        _Out.write(text.rstrip("\n"))
         return
-    try:
-        Path(dest).write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise CLIError(f"cannot write --json {dest}: {exc.strerror or exc}") from None
+    _save(dest, "--json", lambda f: f.write(text))
     _Out.write(f"JSON -> {dest}")
 
 
 # ============================================================================ report
 
-def _report_job(path: str, engines: list[str], steps: int, out: str) -> dict:
-    """One model's report: load, analyse, run the routes, write `out/<stem>/`. Returns
+def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str) -> dict:
+    """One model's report: load, analyse, run the routes, write `out/<folder>/`. Returns
     {"summary", "warnings", "seconds"} or {"error"} (one line); raises only KeyboardInterrupt."""
     from .report import run_validation, write_report
     t0 = time.perf_counter()
@@ -525,7 +664,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str) -> dict:
             secs = time.perf_counter() - t1
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
-        summary = write_report(run, Path(out))
+        summary = write_report(run, Path(out), folder)
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
@@ -537,9 +676,14 @@ def _report_job(path: str, engines: list[str], steps: int, out: str) -> dict:
 def _worker_init() -> None:
     """A report worker ends at once, silently, on Ctrl-C (the terminal sends it to the whole
     process group): the main process reports the interruption. A KeyboardInterrupt would not
-    do, as it can land in a garbage-collection callback, which swallows it."""
-    import signal
-    signal.signal(signal.SIGINT, lambda signum, frame: os._exit(EXIT_INTERRUPTED))
+    do, as it can land in a garbage-collection callback, which swallows it. The temporary file
+    of a write in progress is removed first (the files already written stay as they are)."""
+    from ._io import remove_temporary
+
+    def end(signum, frame):
+        remove_temporary()
+        os._exit(EXIT_INTERRUPTED)
+    signal.signal(signal.SIGINT, end)
 
 
 def _jobs(text: str) -> int:
@@ -553,18 +697,20 @@ def _jobs(text: str) -> int:
     return n
 
 
-def _report_results(paths: list[Path], engines: list[str], steps: int, out: Path, jobs: int):
-    """Yield (path, result of _report_job) as each model finishes; `jobs` > 1 runs them in a
-    process pool (only paths and names cross to the workers, so any start method works), 1 in
-    this process. Ctrl-C cancels the models not started and raises KeyboardInterrupt here."""
+def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int):
+    """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
+    them in a process pool (only paths and names cross to the workers, so any start method
+    works), 1 in this process. Ctrl-C cancels the models not started and raises
+    KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
-        for p in paths:
-            yield p, _report_job(str(p), engines, steps, str(out))
+        for n, p in enumerate(paths):
+            yield n, _report_job(str(p), engines, steps, str(out), folders[n])
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
     try:
-        futures = {pool.submit(_report_job, str(p), engines, steps, str(out)): p for p in paths}
+        futures = {pool.submit(_report_job, str(p), engines, steps, str(out), folders[n]): n
+                   for n, p in enumerate(paths)}
         for f in as_completed(futures):
             try:
                 r = f.result()
@@ -589,12 +735,15 @@ def cmd_report(args) -> int:
     paths = args.models or bundled_models()
     prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
     order = [p for p, *_ in prepared]
+    folders = unique_names([p.stem for p in order])     # never '.', '..' or a path; two a.toml: a, a-2
     t0 = time.perf_counter()
-    summaries: dict[Path, dict] = {}
+    summaries: dict[int, dict] = {}
     n_fail, n_err = 0, 0
     bar = _progress(len(order), "report", not args.no_progress)
     try:
-        for path, r in _report_results(order, engines, args.steps, out, args.jobs or os.cpu_count() or 1):
+        for n, r in _report_results(order, folders, engines, args.steps, out, args.jobs or os.cpu_count() or 1):
+            _checkpoint()
+            path = order[n]
             bar.update()
             if "error" in r:
                 n_err += 1
@@ -603,54 +752,30 @@ def cmd_report(args) -> int:
             for w in r["warnings"]:
                 _warn(f"{path.name}: {w}")
             s = r["summary"]
-            summaries[path] = s
+            summaries[n] = s
             n_fail += not s["passed"]
             status = "PASS" if s["passed"] and s["checks"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
             _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
                        f"  -> {out / s['stem'] / 'index.html'}")
-        try:
-            index = write_index(out, [summaries[p] for p in order if p in summaries])
-        except OSError as exc:
-            raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
+        index = out / "index.md"
+        keep = n_err and index.exists()     # a model without a report: the earlier index is not lost
+        if not keep:
+            try:
+                index = write_index(out, [summaries[n] for n in range(len(order)) if n in summaries])
+            except OSError as exc:
+                raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
         _close(bar)
     _Out.write(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
                + (f", {n_err} without a report (errors above)" if n_err else "")
-               + f"; index -> {index} and {index.with_suffix('.html')}; {time.perf_counter() - t0:.1f} s")
+               + (f"; the earlier index {index} stays as it was" if keep else
+                  f"; index -> {index} and {index.with_suffix('.html')}")
+               + f"; {time.perf_counter() - t0:.1f} s")
     return EXIT_FAIL if n_err else EXIT_OK
 
 
 # ============================================================================ export
-
-def _file_mode(path: Path) -> int:
-    """The mode of the file `path` replaces, or of a new file under the process's umask (a
-    temporary file is created 0600)."""
-    if path.exists():
-        return path.stat().st_mode & 0o7777
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask
-
-
-def _write_atomic(path: Path, text: str, option: str) -> None:
-    """Write `text` to `path` through a temporary file in the same folder and os.replace: a
-    reader never sees half a file, and a failed write leaves the old file as it was."""
-    if path.is_dir():
-        raise CLIError(f"cannot write {option} {path}: it is a directory")
-    tmp = None
-    try:
-        with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=path.parent, prefix=f".{path.name}.",
-                                         suffix=".tmp", delete=False) as f:
-            tmp = f.name
-            f.write(text)
-        os.chmod(tmp, _file_mode(path))
-        os.replace(tmp, path)
-    except OSError as exc:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
-        raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
-
 
 def cmd_export(args) -> int:
     from .errors import AssemblyError, ModelError
@@ -664,9 +789,9 @@ def cmd_export(args) -> int:
     except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
         raise CLIError(_model_error_text(exc)) from None
     if args.output is None or args.output == "-":
-        sys.stdout.write(text)
+        _Out.write(text.rstrip("\n"))
         return EXIT_OK
-    _write_atomic(Path(args.output), text, "-o")
+    _save(args.output, "-o", lambda f: f.write(text))
     _Out.write(f"{args.format.upper()} of {path.name} -> {args.output}")
     return EXIT_OK
 
@@ -831,9 +956,13 @@ def build_parser() -> argparse.ArgumentParser:
                                    "plots over the cycle, error tables per engine route, the seeds' published "
                                    "values where known, and cycle.csv; plus OUT/index.md and OUT/index.html. "
                                    "The files carry no dates or run times (a rerun reproduces them byte for "
-                                   "byte); run times are printed here only. Exits 0 once the reports are "
-                                   "written, also when checks fail (use 'kinetostat validate' as the gate); "
-                                   "1 when a model's report could not be made.")
+                                   "byte); run times are printed here only. Every file is written atomically: "
+                                   "Ctrl-C (exit 130) or a full disk leaves the earlier files as they were, and "
+                                   "when a model's report cannot be made the earlier index stays. Folders are "
+                                   "named after the model files (ASCII letters, digits, '_', '-'; a repeated "
+                                   "name gets -2, -3). Exits 0 once the reports are written, also when checks "
+                                   "fail (use 'kinetostat validate' as the gate); 1 when a model's report could "
+                                   "not be made.")
     r.add_argument("models", metavar="MODEL", nargs="*",
                    help="model files (default: every bundled model, see 'kinetostat examples')")
     r.add_argument("--out", metavar="DIR", default="reports", help="output directory (default: ./reports)")
@@ -879,22 +1008,29 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `kinetostat` console script; returns the exit code."""
     warnings.showwarning = _showwarning
-    try:
-        parser = build_parser()
-        args = parser.parse_args(argv)
-        return args.func(args)
-    except CLIError as exc:
-        _error(str(exc))
-        return exc.code
-    except KeyboardInterrupt:
-        _error("interrupted")
-        return EXIT_INTERRUPTED
-    except BrokenPipeError:
+    _readable_streams()
+    with _interrupts():
         try:
-            sys.stdout = open(os.devnull, "w")
-        except OSError:
-            pass
-        return EXIT_OK
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            code = args.func(args)
+            _checkpoint()
+            sys.stdout.flush()           # stdout on a full disk fails here, not at the interpreter's exit
+            return code
+        except CLIError as exc:
+            _error(str(exc))
+            return exc.code
+        except KeyboardInterrupt:
+            _error("interrupted")
+            return EXIT_INTERRUPTED
+        except BrokenPipeError:          # `kinetostat ... | head`: the reader has what it wanted
+            _quiet_stdout()
+            return EXIT_OK
+        except OSError as exc:           # stdout on a full disk, a name the file system cannot hold
+            _quiet_stdout()
+            where = f"{exc.filename}: " if exc.filename else "cannot write to stdout: "
+            _error(f"{where}{exc.strerror or exc}")
+            return EXIT_USAGE
 
 
 if __name__ == "__main__":

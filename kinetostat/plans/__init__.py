@@ -19,14 +19,13 @@ from __future__ import annotations
 
 import csv
 import io
-import os
-import tempfile
 from collections.abc import Mapping
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
 from typing import Callable, Iterable
 
+from .._io import write_text
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .forces import crank_plan, force_plans, group_plans
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
@@ -99,29 +98,15 @@ class Plans(Mapping):
         written = []
         for plan in self._plans.values():
             path = out / plan_file_name(plan)
-            _write_atomic(path, svg(plan, lang=lang, mechanism=self.mech.name))
+            write_text(path, svg(plan, lang=lang, mechanism=self.mech.name))
             written.append(path)
-        _write_atomic(out / "segments.csv", self.segments_csv())
+        write_text(out / "segments.csv", self.segments_csv())
         return written + [out / "segments.csv"]
 
 
 def plan_file_name(plan: Plan, suffix: str = ".svg") -> str:
     """File name of a plan's sheet: its kind with ':' and ',' made safe (group:2,3 -> group_2-3)."""
     return plan.kind.replace(":", "_").replace(",", "-") + suffix
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    """Write through a temporary file in the same folder and os.replace (no half-written file)."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def build(mech, at: float | None = None, scales: Mapping[str, float] | None = None,

@@ -271,7 +271,11 @@ def _svg_notes(plan: Plan, lang: str, fits: bool) -> list[str]:
 # ----------------------------------------------------------------------------- matplotlib
 
 def _tex(name: str) -> str:
+    """A point name as mathtext (letters with a subscript), or as it is where it is anything
+    else: `figure` then draws it with mathtext off (a model's point may be named anything)."""
     head, sub, primes = _label_parts(name)
+    if not re.fullmatch(r"[A-Za-zπ]+", head):
+        return name
     head = r"\pi" if head == "π" else re.sub(r"([\\{}_^$#%&~])", r"\\\1", head)
     return f"${head}" + (f"_{{{sub}}}" if sub else "") + ("'" * len(primes)) + "$"
 
@@ -313,7 +317,8 @@ def figure(plan: Plan, lang: str = "en", ax=None):
             continue
         numbered = small and bool(re.search(r"\d$", name)) and name not in frame
         ax.plot([z.real], [z.imag], "o", color="k", ms=1.5 if numbered else 3)
-        ax.annotate(_tex(name), (z.real, z.imag), xytext=(3, 3), textcoords="offset points",
+        label = _tex(name)
+        ax.annotate(label, (z.real, z.imag), xytext=(3, 3), textcoords="offset points", parse_math=label != name,
                     fontsize=6 if numbered else 10)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(_unit("mm", lang))

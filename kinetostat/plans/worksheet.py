@@ -14,8 +14,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +21,7 @@ import numpy as np
 
 from ..analysis import Analysis, analyze
 from ..applied import load_magnitude
+from .._io import write_text
 from ..model import Mechanism
 from .scales import choose_scales
 
@@ -122,21 +121,21 @@ class Worksheet:
 
     def to_csv(self, path: str | Path) -> None:
         """Write the rows as CSV (atomic: a temporary file in the same folder, then replaced)."""
-        _atomic_write(path, self.frame().to_csv(index=False))
+        write_text(path, self.frame().to_csv(index=False))
 
     def to_json(self, path: str | Path) -> None:
         """Write the rows as a JSON list of objects, NaN as null (atomic)."""
         recs = [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()}
                 for r in self.records()]
         doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l, "rows": recs}
-        _atomic_write(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")
+        write_text(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")
 
     def write(self, out_dir: str | Path) -> list[Path]:
         """worksheet.md, .html, .csv and .json into `out_dir` (each atomic); returns the paths."""
         out = Path(out_dir)
         paths = [out / f"worksheet.{ext}" for ext in ("md", "html", "csv", "json")]
-        _atomic_write(paths[0], self.markdown())
-        _atomic_write(paths[1], self.html())
+        write_text(paths[0], self.markdown())
+        write_text(paths[1], self.html())
         self.to_csv(paths[2])
         self.to_json(paths[3])
         return paths
@@ -152,18 +151,6 @@ def _direction(d: str, w: dict) -> str:
     if d.startswith("angle:"):
         return w["angle"].format(float(d[6:]))
     return d
-
-
-def _atomic_write(path: str | Path, text: str) -> None:
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
 
 
 # ----------------------------------------------------------------------------- building

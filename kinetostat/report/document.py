@@ -6,7 +6,8 @@ The HTML is markdown-it's CommonMark rendering (tables enabled, raw HTML off, so
 GitHub's rule (the table of contents links work in both), `.md` links to sibling reports turned
 into `.html`, images embedded as data URIs, tables wrapped in a horizontally scrolling box.
 
-May use: the standard library and markdown-it-py (imported inside `Doc.html`).
+May use: the standard library, `kinetostat._io` (atomic writes) and markdown-it-py (imported inside
+`Doc.html`).
 """
 from __future__ import annotations
 
@@ -18,6 +19,8 @@ import sys
 import unicodedata
 from pathlib import Path
 from typing import Any, Sequence
+
+from .._io import write_text
 
 #: An error smaller than this fraction of the cycle's peak is rounding (1000 units in the last
 #: place of the peak): an exact route that agrees to machine precision reads "rounding", not a number.
@@ -57,16 +60,20 @@ def _err(x: float | None, peak: float, unit: str) -> str:
     return f"{_fmt(x)} {unit}" if x is not None and math.isfinite(x) else "n/a"
 
 
-#: Markup characters that act anywhere in a line (an underscore only at a word's edge); '|' is
-#: escaped by the table cells.
-_MD_SPECIAL = re.compile(r"([\\`*\[\]<]|(?<![A-Za-z0-9])_|_(?![A-Za-z0-9]))")
-#: Markup that acts at the start of a block (heading, quote, list, thematic break).
-_MD_START = re.compile(r"^(\s*)([#>+=~-]|\d+(?=[.)]))")
+#: Markup characters that act anywhere in a line: code, emphasis, links and images, autolinks and
+#: raw HTML, entities (`&lt;`, `&#106;`), GitHub's strikethrough, a heading's closing '#', an
+#: underscore at a word's edge; '|' is escaped by the table cells.
+_MD_SPECIAL = re.compile(r"([\\`*\[\]<>&~#]|(?<![A-Za-z0-9])_|_(?![A-Za-z0-9]))")
+#: Markup that acts at the start of a block (list, thematic break, setext underline).
+_MD_START = re.compile(r"^(\s*)([+=-]|\d+(?=[.)]))")
 
 
 def esc(text: Any) -> str:
-    """Text from a model file as literal Markdown (one line): its markup characters backslash-escaped."""
-    s = _MD_SPECIAL.sub(r"\\\1", " ".join(str(text).splitlines()))
+    """Text from a model file (or a file name) as literal Markdown on one line: its markup
+    characters backslash-escaped, line breaks as spaces, characters that UTF-8 cannot hold (a
+    non-UTF-8 file name's bytes) as backslash escapes. Every string of a model goes through it."""
+    s = str(text).encode("utf-8", "backslashreplace").decode("utf-8")
+    s = _MD_SPECIAL.sub(r"\\\1", " ".join(s.splitlines()))
     return _MD_START.sub(lambda m: m[1] + (m[2] + "\\" if m[2][0].isdigit() else "\\" + m[2]), s)
 
 
@@ -159,8 +166,8 @@ class Doc:
     def write(self, folder: Path, name: str = "index") -> Path:
         """`folder/name.md` and `folder/name.html` (the HTML rendered from that Markdown); the .md path."""
         text = self.markdown()
-        (Path(folder) / f"{name}.md").write_text(text, encoding="utf-8")
-        (Path(folder) / f"{name}.html").write_text(self.html(folder, text), encoding="utf-8")
+        write_text(Path(folder) / f"{name}.md", text)
+        write_text(Path(folder) / f"{name}.html", self.html(folder, text))
         return Path(folder) / f"{name}.md"
 
     # -- HTML

@@ -1,15 +1,21 @@
-"""The report's figures (matplotlib, imported inside the functions: no pyplot, no global state).
+"""The report's figures (matplotlib, imported inside the functions: no pyplot, no global state
+beyond `plain_text`'s settings while the figures are made).
 
-May use: numpy, matplotlib, the solver's results and the runs room.
+Every text of a figure is plain text: a model's name or a point's name is never parsed as a
+mathtext formula or given to LaTeX (`plain_text`).
+
+May use: numpy, matplotlib, the solver's results, the runs room and `kinetostat._io` (atomic writes).
 """
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
+from .._io import atomic
 from ..analysis import Analysis
 from ..model import Mechanism
 from .runs import ModelRun, quantities
@@ -67,6 +73,15 @@ def _legend_cols(n: int, most: int) -> int:
     return max(1, min(n, most))
 
 
+@contextmanager
+def plain_text() -> Iterator[None]:
+    """Figures made in this block take every text literally: no mathtext (a model named
+    "$\\frac{$" would abort the drawing) and no LaTeX, whatever the user's matplotlibrc says."""
+    import matplotlib
+    with matplotlib.rc_context({"text.parse_math": False, "text.usetex": False}):
+        yield
+
+
 #: Resolution of the PNGs, dots per inch.
 DPI = 110
 
@@ -75,15 +90,17 @@ def _save(fig, path: Path) -> Path:
     """PNG at DPI, reduced to a 256-colour palette without dithering: a third of the size of
     the RGBA file and visually the same for line plots (the HTML embeds every image). The Agg
     canvas' pixels go to Pillow (matplotlib's dependency) directly: no PNG written and read back.
-    Pillow writes no time or software chunk, so the file depends on the figure only."""
+    Pillow writes no time or software chunk, so the file depends on the figure only. The file
+    is written atomically (an interrupt leaves the previous file as it was)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from PIL import Image
     canvas = FigureCanvasAgg(fig)
     fig.set_dpi(DPI)
     canvas.draw()
     img = Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
-    img.convert("RGB").quantize(colors=256, method=Image.Quantize.FASTOCTREE,
-                                dither=Image.Dither.NONE).save(path, format="PNG", compress_level=6)
+    pal = img.convert("RGB").quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
+    with atomic(path, binary=True) as f:
+        pal.save(f, format="PNG", compress_level=6)
     return path
 
 

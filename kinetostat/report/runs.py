@@ -6,7 +6,6 @@ functions that need it. Never matplotlib.
 """
 from __future__ import annotations
 
-import re
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -15,6 +14,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from .._io import safe_name
 from ..analysis import Analysis, analyze
 from ..model import Mechanism
 from .published import PublishedCheck, published_rows
@@ -91,7 +91,9 @@ class ModelRun:
 
     @property
     def stem(self) -> str:
-        return self.path.stem if self.path is not None else re.sub(r"\W+", "_", self.mech.name).strip("_").lower()
+        """The model's name in file names and check names: its file's stem (or its name), only
+        ASCII letters, digits, '_' and '-' (`kinetostat._io.safe_name`)."""
+        return safe_name(self.path.stem) if self.path is not None else safe_name(self.mech.name).lower()
 
     @property
     def failed(self) -> list:

@@ -1,6 +1,7 @@
 """Writes a model's report folder and the index over the reports of one run.
 
-May use: every other room, the solver, and the harness's tolerances.
+May use: every other room, the solver, `kinetostat._io` (atomic writes, safe folder names) and the
+harness's tolerances.
 """
 from __future__ import annotations
 
@@ -12,13 +13,14 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from .._io import atomic, inside, safe_name, write_text
 from ..analysis import analyze
 from ..model import Mechanism
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
-from .plots import (_pair_name, _save, plot_balancing_force, plot_errors, plot_hodographs, plot_mechanism, plot_moment,
-                    plot_reactions)
+from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
+                    plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
 from .runs import ModelRun
 
@@ -48,11 +50,11 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
     doc.h(2, "Mechanism data")
     items = [f"**Name**: {esc(m.name)}", f"**Source**: {esc(m.source or 'not stated')}"]
     if path is not None:
-        items.append(f"**Model file**: `{path.name}`")
+        items.append(f"**Model file**: {esc(path.name)}")
     items.append(f"**g** = {m.g:g} m/s² along −y")
     rpm = d.omega * 30 / math.pi
-    items.append(f"**Drive** ({d.kind}): crank 1 turns about {d.pivot}; φ = angle from the world direction "
-                 f"{_vec(d.reference)} to {d.pivot}→{d.point}, positive {'counter-clockwise' if d.sense > 0 else 'clockwise'}; "
+    items.append(f"**Drive** ({d.kind}): crank 1 turns about {esc(d.pivot)}; φ = angle from the world "
+                 f"direction {_vec(d.reference)} to {esc(d.pivot)}→{esc(d.point)}, positive {'counter-clockwise' if d.sense > 0 else 'clockwise'}; "
                  f"ω₁ = {d.omega:.6g} rad/s ({rpm:.6g} rpm), ε₁ = {d.eps:g} rad/s²; "
                  + ("the unknown is the balancing moment on the crank" if d.kind == "engine" else
                     "the unknown is the balancing force of the pinion on the crank's wheel"))
@@ -72,19 +74,20 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
     doc.h(3, "Links")
     rows = []
     for link in m.links:
-        pts = ", ".join(f"{n} {_vec(xy)}" for n, xy in link.points.items())
+        pts = ", ".join(f"{esc(n)} {_vec(xy)}" for n, xy in link.points.items())
         if link.id == 0:
             rows.append([0, "frame", "-", "-", "-", pts + " (world)"])
         else:
-            rows.append([link.id, esc(link.name), f"{link.mass:.6g}", f"{link.I_S:.6g}", link.com or "-", pts])
+            rows.append([link.id, esc(link.name), f"{link.mass:.6g}", f"{link.I_S:.6g}", esc(link.com or "-"), pts])
     doc.table(["id", "name", "mass, kg", "I_S, kg m²", "centre of mass", "points (local frame), m"], rows, "llrrll")
     doc.h(3, "Kinematic pairs")
     rows = []
     for p in m.pairs:
         if p.kind == "R":
-            geo = f"point {p.point}"
+            geo = f"point {esc(p.point)}"
         else:
-            geo = f"guide point {p.guide} on link {p.links[0]}, direction {_vec(p.direction)} (guide frame), slider point {p.point}"
+            geo = (f"guide point {esc(p.guide)} on link {p.links[0]}, direction {_vec(p.direction)} (guide frame), "
+                   f"slider point {esc(p.point)}")
         r = p.radius if p.radius is not None else (m.friction.radius if m.friction and m.friction.radius else None)
         rows.append([p.label, "revolute" if p.kind == "R" else "prismatic", f"{p.links[0]}, {p.links[1]}", geo,
                      f"{r:g}" if r else "-"])
@@ -100,12 +103,12 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
             else:
                 val = f"{ld.value:.6g}"
             direction = ld.direction if isinstance(ld.direction, str) or ld.direction is None else _vec(ld.direction)
-            rows.append([esc(ld.name), ld.kind, ld.link, ld.point or "-", direction or "-", val])
+            rows.append([esc(ld.name), ld.kind, ld.link, esc(ld.point or "-"), esc(direction or "-"), val])
         doc.table(["name", "kind", "link", "point", "direction", "value (N or N m)"], rows)
     if m.springs:
         doc.h(3, "Springs")
         doc.table(["name", "end a", "end b", "stiffness, N/m", "free length, m"],
-                  [[esc(s.name), f"link {s.a[0]} {s.a[1]}", f"link {s.b[0]} {s.b[1]}", f"{s.stiffness:g}",
+                  [[esc(s.name), f"link {s.a[0]} {esc(s.a[1])}", f"link {s.b[0]} {esc(s.b[1])}", f"{s.stiffness:g}",
                     f"{s.free_length:g}"] for s in m.springs])
 
 
@@ -141,14 +144,14 @@ def _published_section(doc: Doc, published: Sequence[PublishedCheck]) -> None:
     doc.h(2, "Against the published values")
     doc.p("Numbers printed by the model's sources (its `[[published]]` tables) beside kinetostat's exact "
           "values of the same quantities. Sources and the agreement to expect:")
-    doc.ul(list(dict.fromkeys(c.entry.source + (f". Expected agreement: {c.entry.accuracy}" if c.entry.accuracy else "")
-                              for c in published)))
+    doc.ul(list(dict.fromkeys(esc(c.entry.source) + (f". Expected agreement: {esc(c.entry.accuracy)}"
+                                                     if c.entry.accuracy else "") for c in published)))
     rows = []
     for c in published:
         e = c.entry
         diff = f"{c.difference:+.3g}°" if c.by_angle else f"{100 * c.difference:+.3f} %"
         tol = f"±{e.tolerance:g}°" if c.by_angle else f"±{100 * e.tolerance:g} %"
-        rows.append([e.symbol, e.meaning, _angles(c), f"{e.value:g}", f"{c.exact:.6g}", e.unit, diff, tol,
+        rows.append([esc(e.symbol), esc(e.meaning), _angles(c), f"{e.value:g}", f"{c.exact:.6g}", esc(e.unit), diff, tol,
                      "yes" if c.passed else "**NO**"])
     doc.table(["quantity", "meaning", "φ", "published", "kinetostat (exact)", "unit", "difference", "accepted",
                "within"], rows, "lllrrlrrl")
@@ -177,11 +180,11 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
             "down at this position: [worksheet.csv](worksheet.csv). `kinetostat plans` draws them as "
             "A3 SVG sheets true to scale.")
     files = []
-    for plan in plans.values():
+    for plan in plans.values():      # point labels are mathtext made safe by the plans' own escaping
         path = _save(plan.figure(), d / ("plan_" + plan_file_name(plan, ".png")))
         doc.img(path, f"{esc(plan.title)}, {plan.scale}")
         files.append(path)
-    (d / "segments.csv").write_text(plans.segments_csv(), encoding="utf-8")
+    write_text(d / "segments.csv", plans.segments_csv())
     sheet.to_csv(d / "worksheet.csv")
     return files + [d / "segments.csv", d / "worksheet.csv"]
 
@@ -198,7 +201,7 @@ def _verdict(run: ModelRun) -> str:
 
 def _failed_checks(run: ModelRun, published: Sequence[PublishedCheck]) -> list[str]:
     """One line per check beyond tolerance, route that raised, or published value not within."""
-    out = [f"{r.route} {r.quantity}: peak-relative error {_rel(r.peak_relative)} > tolerance {r.tolerance:.0e} "
+    out = [f"{r.route} {esc(r.quantity)}: peak-relative error {_rel(r.peak_relative)} > tolerance {r.tolerance:.0e} "
            f"(max {_err(r.max_abs, r.peak, r.unit)} at φ = {r.phi_deg_max:.4g}°)" for r in run.failed]
     out += [f"{route}: **ERROR** {esc(why)}" for route, why in run.errors.items()]
     out += [f"published value {esc(c.entry.symbol)} not within the accepted difference"
@@ -253,7 +256,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
 
     rows = [row("M_bal", "Zhukovsky's lever", res.lever_moment, res.balancing_moment, "N·m"),
             row("M_bal", "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
-    rows += [row(_pair_name(m, p), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
+    rows += [row(esc(_pair_name(m, p)), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
              for p in m.pairs]
     doc.table(["quantity", "route against group by group", "max |difference|", "peak relative"], rows, "llrr")
 
@@ -261,7 +264,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
 def _error_rows(run: ModelRun) -> list[list[str]]:
     rows = []
     for r in run.rows:
-        rows.append([r.route, r.quantity, _err(r.max_abs, r.peak, r.unit),
+        rows.append([r.route, esc(r.quantity), _err(r.max_abs, r.peak, r.unit),
                      f"{r.phi_deg_max:.4g}" if math.isfinite(r.phi_deg_max) and not _is_rounding(r.peak_relative)
                      else "-",
                      _rel(r.peak_relative), f"{r.tolerance:.0e}", _rel(r.rms_relative),
@@ -280,29 +283,39 @@ def _tolerance(run: ModelRun, route: str):
     return run.tolerances.get(route) or TOLERANCES.get(route)
 
 
-def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
-    """Write `out/<stem>/` for one model; returns the summary also saved as summary.json.
+def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[str, Any]:
+    """Write `out/<folder>/` for one model (default folder: `run.stem`); returns the summary
+    also saved as summary.json.
 
-    Every file depends only on the model, the routes and the steps (and the libraries' versions):
-    no dates and no run times, so a rerun reproduces them byte for byte. Run times are printed
-    by the command line only.
+    `folder` is a name of ASCII letters, digits, '_' and '-' (`kinetostat._io.safe_name`), and
+    the folder must resolve to a place inside `out` (ValueError otherwise). Every file is
+    written atomically: an interrupted or failed run leaves each earlier file as it was. Every
+    file depends only on the model, the routes and the steps (and the libraries' versions): no
+    dates and no run times, so a rerun reproduces them byte for byte. Run times are printed by
+    the command line only.
     """
     m, res = run.mech, run.res
-    d = Path(out) / run.stem
+    folder = run.stem if folder is None else folder
+    if folder != safe_name(folder):
+        raise ValueError(f"report folder {folder!r}: expected a name of ASCII letters, digits, '_' and '-'")
+    d = Path(out) / folder
     d.mkdir(parents=True, exist_ok=True)
+    inside(out, d)
     published = run.published
     pic_deg = m.drive.design_deg
     at = analyze(m, phi_deg=[pic_deg])
     machine = m.drive.kind == "machine"
-    images = {
-        "mechanism": plot_mechanism(at, res, d / "mechanism.png"),
-        "moment": plot_moment(run, d / "balancing_moment.png"),
-        **({"force": plot_balancing_force(res, d / "balancing_force.png")} if machine else {}),
-        "reactions": plot_reactions(run, d / "reactions.png"),
-        "errors": plot_errors(run, d / "errors.png"),
-        "hodographs": plot_hodographs(run, d / "hodographs.png"),
-    }
-    res.to_frame().to_csv(d / "cycle.csv", index=False)
+    with plain_text():
+        images = {
+            "mechanism": plot_mechanism(at, res, d / "mechanism.png"),
+            "moment": plot_moment(run, d / "balancing_moment.png"),
+            **({"force": plot_balancing_force(res, d / "balancing_force.png")} if machine else {}),
+            "reactions": plot_reactions(run, d / "reactions.png"),
+            "errors": plot_errors(run, d / "errors.png"),
+            "hodographs": plot_hodographs(run, d / "hodographs.png"),
+        }
+    with atomic(d / "cycle.csv") as f:
+        res.to_frame().to_csv(f, index=False)
 
     N = len(res.phi_deg)
     routes = list(run.engines)
@@ -315,7 +328,7 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
         doc.ul(failed)
     else:
         doc.p("Failed checks: none.")
-    doc.p(f"Error report of `{run.stem}` over {N} crank positions (every {360 / N:.4g}°), made with "
+    doc.p(f"Error report of `{folder}` over {N} crank positions (every {360 / N:.4g}°), made with "
           f"{_versions()}. Full table of the cycle: [cycle.csv](cycle.csv). [All mechanisms](../index.md)")
     doc.p("Contents:")
     doc.toc()
@@ -344,7 +357,7 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
           "engine route overlaid.")
     doc.img(images["reactions"], "Reaction magnitudes over the cycle, N")
     doc.table(["pair", "max |R|, N", "at φ, deg", "min |R|, N", "at φ, deg"],
-              [[_pair_name(m, p), *_extremes(np.linalg.norm(res.forces.R[:, p.index], axis=-1), res.phi_deg)]
+              [[esc(_pair_name(m, p)), *_extremes(np.linalg.norm(res.forces.R[:, p.index], axis=-1), res.phi_deg)]
                for p in m.pairs], "lrrrr")
 
     _three_routes_section(doc, m, res)
@@ -389,7 +402,7 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
 
     doc.write(d)
 
-    summary = dict(stem=run.stem, name=m.name, formula=m.structure.formula, positions=N,
+    summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N,
                    passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
                    routes={r: dict(status=run.status(r), worst=run.worst(r),
                                    tolerance=_tolerance(run, r).peak_relative if _tolerance(run, r) else None,
@@ -397,7 +410,7 @@ def write_report(run: ModelRun, out: Path) -> dict[str, Any]:
                    published=None if not published else dict(
                        n=len(published), within=sum(c.passed for c in published),
                        worst_percent=max((100 * c.error for c in published if not c.by_angle), default=None)))
-    (d / "summary.json").write_text(json.dumps(_clean(summary), indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    write_text(d / "summary.json", json.dumps(_clean(summary), indent=1, allow_nan=False) + "\n")
     return _clean(summary)
 
 
