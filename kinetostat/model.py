@@ -5,8 +5,12 @@ kg, moments of inertia in kg m^2, angles in radians unless the name says `_deg`.
 """
 from __future__ import annotations
 
+import difflib
 import math
+import re
+import stat
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -14,7 +18,7 @@ from typing import Any, Literal, Mapping
 
 import numpy as np
 
-from .errors import ModelError, StructureError
+from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
 from .structure import Structure, analyse_structure
 
 __all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Published", "Mechanism",
@@ -267,35 +271,71 @@ def _abbreviate(text: str, limit: int = 90) -> str:
 def load(path: str | Path) -> Mechanism:
     """Read and validate a model file (TOML), or a bundled model by name (`load("ice_crank_slider")`).
 
-    Raises `ModelError` listing every problem."""
+    Raises `ModelError` listing every problem (`ModelFileNotFound`, also a FileNotFoundError,
+    where the file does not exist)."""
     path = Path(path)
     if not path.exists() and path.parent == Path(".") and path.suffix in ("", ".toml"):
         from . import examples
         if path.stem in examples.names():
             path = examples.path(path.stem)
+    return loads(_read_text(path), source=str(path))
+
+
+def _read_text(path: Path) -> str:
+    """The text of a model file: a regular file (never a FIFO or a device, which would block or
+    never end) of at most MAX_FILE_BYTES, UTF-8."""
     try:
-        text = path.read_text(encoding="utf-8")
+        st = path.stat()
+        if not stat.S_ISREG(st.st_mode):
+            what = "a directory" if stat.S_ISDIR(st.st_mode) else "not a regular file (a FIFO, device or socket)"
+            raise ModelError([f"cannot read file: {what}; a model is a regular TOML file"], source=str(path))
+        if st.st_size > MAX_FILE_BYTES:
+            raise ModelError([f"file of {st.st_size} bytes is too large for a model (at most {MAX_FILE_BYTES})"],
+                             source=str(path))
+        with open(path, "rb") as f:
+            raw = f.read(MAX_FILE_BYTES + 1)      # the size may change between stat and read
+    except FileNotFoundError:
+        raise ModelFileNotFound(str(path)) from None
     except OSError as exc:
         raise ModelError([f"cannot read file: {exc.strerror}"], source=str(path)) from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ModelError([f"file is too large for a model (more than {MAX_FILE_BYTES} bytes)"], source=str(path))
+    try:
+        return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ModelError([f"not UTF-8 text: byte 0x{exc.object[exc.start]:02x} at offset {exc.start}"],
                          source=str(path)) from None
-    return loads(text, source=str(path))
 
 
 def loads(text: str, source: str = "<string>") -> Mechanism:
     """Parse a model from TOML text."""
-    for n, line in enumerate(text.splitlines(), 1):
-        key = line if line.lstrip().startswith("[") else line.partition("=")[0]
-        if len(key) > MAX_KEY:   # tomllib's memory grows as the square of a dotted key's depth
-            raise ModelError([f"line {n}: a key of {len(key)} characters (at most {MAX_KEY})"], source=source)
+    _check_key_cost(text, source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
     except RecursionError:
         raise ModelError(["TOML nested too deeply (arrays or tables within each other)"], source=source) from None
-    return from_dict(data, source=source)
+    return _Reader(data, source, text).mechanism()
+
+
+def _check_key_cost(text: str, source: str) -> None:
+    """Refuse keys whose parsing would take too much memory, before tomllib sees them: tomllib
+    keeps the path of every level of every key, so memory grows with the number of keys and as
+    the square of their depth (measured: 65 keys 3000 levels deep, 390 kB, took 2.3 GB)."""
+    cost = 0
+    for n, line in enumerate(text.splitlines(), 1):
+        head = line.lstrip()
+        key = head if head.startswith("[") else line.partition("=")[0]
+        if len(key) > MAX_KEY:
+            raise ModelError([f"line {n}: a key of {len(key)} characters (at most {MAX_KEY})"], source=source)
+        if "=" in line or head.startswith("["):
+            cost += _KEY_BYTES + _LEVEL_BYTES * (key.count(".") + 1) ** 2
+            if cost > MAX_KEY_MEMORY:
+                raise ModelError([f"line {n}: the keys up to here would take about {cost / 2**20:.0f} MiB to "
+                                  f"parse (at most {MAX_KEY_MEMORY / 2**20:.0f} MiB): too many keys, or keys "
+                                  f"nested too deeply (this one has {key.count('.') + 1} dotted parts)"],
+                                 source=source)
 
 
 def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
@@ -303,8 +343,82 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
     return _Reader(data, source).mechanism()
 
 
+def _suggest(name: Any, valid) -> str:
+    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else ""."""
+    if not isinstance(name, str):
+        return ""
+    close = difflib.get_close_matches(name, [str(v) for v in valid], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+class _Lines:
+    """Where each table and key of a TOML text sits: field path -> line number (best effort:
+    tomllib gives no positions, so the text is scanned for table headers and keys)."""
+
+    _HEADER = re.compile(r"\s*(\[\[?)\s*([^\]]+?)\s*\]")
+    _KEY = re.compile(r"\s*([A-Za-z0-9_\-.\"' ]+?)\s*=")
+    _INLINE_KEY = re.compile(r"[{,]\s*([A-Za-z0-9_\-]+|\"[^\"]*\"|'[^']*')\s*=")
+
+    def __init__(self, text: str):
+        self.at: dict[tuple, int] = {}
+        arrays: dict[tuple, int] = {}         # array-of-tables path -> tables seen so far
+        current: tuple = ()
+        in_string = False
+        for n, line in enumerate(text.splitlines(), 1):
+            if (line.count('"""') + line.count("\'\'\'")) % 2:
+                in_string = not in_string
+                if not in_string:
+                    continue
+            if in_string:
+                continue
+            head = self._HEADER.match(line)
+            if head:
+                parts = self._split(head[2])
+                if head[1] == "[[":
+                    parts = self._resolve(parts[:-1], arrays) + parts[-1:]
+                    arrays[parts] = arrays.get(parts, 0) + 1
+                    current = parts + (arrays[parts] - 1,)
+                else:
+                    current = self._resolve(parts, arrays)
+                self.at.setdefault(current, n)
+                continue
+            key = self._KEY.match(line)
+            if key:
+                path = current + self._split(key[1])
+                self.at.setdefault(path, n)
+                for inner in self._INLINE_KEY.findall(line):
+                    self.at.setdefault(path + (inner.strip("\"'"),), n)
+
+    @staticmethod
+    def _split(key: str) -> tuple:
+        return tuple(p.strip().strip("\"'") for p in key.split("."))
+
+    @staticmethod
+    def _resolve(parts: tuple, arrays: dict[tuple, int]) -> tuple:
+        out: tuple = ()
+        for p in parts:
+            out += (p,)
+            if out in arrays:
+                out += (arrays[out] - 1,)
+        return out
+
+    def line(self, path: tuple) -> int | None:
+        """Line of `path` or of its nearest enclosing table or key."""
+        for end in range(len(path), 0, -1):
+            if path[:end] in self.at:
+                return self.at[path[:end]]
+        return None
+
+
 #: Longest key (or table header) of a model file, characters.
 MAX_KEY = 10_000
+#: Largest model file read, bytes (a model is a few kB; 4000 links take 0.8 MB).
+MAX_FILE_BYTES = 32 * 2**20
+#: Memory tomllib may take for the keys of one file, estimated as _KEY_BYTES per key plus
+#: _LEVEL_BYTES per square of its depth (fitted to measurements: 266k two-level keys of a
+#: 4 MB file took 220 MB, 29k keys of 64 levels 1.1 GB).
+MAX_KEY_MEMORY = 256 * 2**20
+_KEY_BYTES, _LEVEL_BYTES = 800, 9
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
 
@@ -320,11 +434,40 @@ def _finite(x: Any) -> bool:
 class _Reader:
     """Reads the raw TOML structure, collecting every problem instead of stopping at the first."""
 
-    def __init__(self, data: Mapping[str, Any], source: str):
-        self.data, self.source, self.problems = data, source, []
+    def __init__(self, data: Mapping[str, Any], source: str, text: str | None = None):
+        self.data, self.source, self.problems, self.lines = data, source, [], []
+        self.where_lines = _Lines(text) if text is not None else None
+        self.link_table: dict[int, int] = {}      # link id -> index of its [[link]] table
+        # causes already reported, whose consequences are not reported again:
+        self.ids_unknown = False                  # some [[link]] has no valid id: "unknown link" follows
+        self.points_unread: set[tuple[int, str | None]] = set()   # (link, point) that failed (None: all)
+        self.misspelled: set[str] = set()         # field paths given under a near-miss name
 
     def err(self, msg: str) -> None:
+        path = msg.partition(": ")[0]
+        if path in self.misspelled and msg[len(path):].startswith(": missing"):
+            return          # "mass: missing" after "masss: unknown field (did you mean 'mass'?)"
         self.problems.append(msg)
+        self.lines.append(self.line_of(path))
+
+    _STEP = re.compile(r"(\[\[(\w+)\]\] #(\d+)|[^.\[]+)(?:\[(id=)?(\d+)\])?")
+
+    def line_of(self, path: str) -> int | None:
+        """Line of the file where the field `path` of a message (e.g. `link[id=2].mass`) sits."""
+        if self.where_lines is None or " " in path.replace("<top level>", "").replace("[[link]] #", ""):
+            return None
+        steps: tuple = ()
+        for part in path.split("."):
+            m = self._STEP.fullmatch(part)
+            if m is None:
+                return None
+            if m[2]:                                  # [[link]] #3: the third table
+                steps += (m[2], int(m[3]) - 1)
+                continue
+            steps += () if m[1] == "<top level>" else (m[1],)
+            if m[5] is not None:
+                steps += (self.link_table.get(int(m[5]), -1) if m[4] else int(m[5]),)
+        return self.where_lines.line(steps) if steps else None
 
     # -- typed getters: each returns None after recording a problem
     def number(self, tab: Mapping, key: str, where: str, *, default: Any = "required",
@@ -376,7 +519,7 @@ class _Reader:
             self.err(f"{where}.{key}: expected a string, got {x!r}")
             return None
         if choices and x not in choices:
-            self.err(f"{where}.{key}: invalid value {x!r}. Valid values: {list(choices)}")
+            self.err(f"{where}.{key}: invalid value {x!r}{_suggest(x, choices)}. Valid values: {list(choices)}")
             return None
         return x
 
@@ -398,7 +541,10 @@ class _Reader:
     def unknown_keys(self, tab: Mapping, allowed: set[str], where: str) -> None:
         for k in tab:
             if k not in allowed:
-                self.err(f"{where}.{k}: unknown field. Valid fields: {sorted(allowed)}")
+                hint = _suggest(k, sorted(allowed - set(tab)))
+                if hint:
+                    self.misspelled.add(f"{where}.{hint.split(chr(39))[1]}")
+                self.err(f"{where}.{k}: unknown field{hint}. Valid fields: {sorted(allowed)}")
 
     # -- sections
     def mechanism(self) -> Mechanism:
@@ -431,7 +577,7 @@ class _Reader:
                     self.err(f"pair[{p.index}].radius: missing; friction losses need the journal radius "
                              f"of every revolute pair (or a default friction.radius)")
         if self.problems:
-            raise ModelError(self.problems, source=self.source)
+            raise ModelError(self.problems, source=self.source, lines=self.lines)
         try:
             return Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
                              links=tuple(links), pairs=tuple(pairs),
@@ -441,34 +587,45 @@ class _Reader:
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
 
-    def points(self, raw: Any, where: str) -> dict[str, Vec]:
+    def points(self, raw: Any, where: str, lid: int | None = None) -> dict[str, Vec]:
+        """A table of named points; those that fail are recorded in points_unread for link `lid`."""
         if not isinstance(raw, dict) or not raw:
             self.err(f"{where}: expected a table of named points {{A = [x, y], ...}}")
+            self.points_unread.add((lid, None))
             return {}
         out = {}
         for name, xy in raw.items():
             v = self.vec(xy, f"{where}.{name}")
             if v is not None:
                 out[name] = v
+            else:
+                self.points_unread.add((lid, name))
         return out
 
     def links(self, g: float | None) -> list[Link]:
-        frame_raw = self.data.get("frame")
-        frame = Link(0, "frame", MappingProxyType(self.points(frame_raw, "frame")))
+        frame = Link(0, "frame", MappingProxyType(self.points(self.data.get("frame"), "frame", 0)))
         raw = self.table_list("link")
         by_id: dict[int, Link] = {}
         allowed = {"id", "name", "points", "mass", "weight", "I_S", "com"}
         for n, t in enumerate(raw):
-            where = f"link[{n}]"
+            lid = t.get("id")
+            valid_id = isinstance(lid, int) and not isinstance(lid, bool) and lid > 0
+            # named by its id, as the texts number links; by its table's place only without one
+            where = f"link[id={lid}]" if valid_id and lid not in by_id else f"[[link]] #{n + 1}"
             self.unknown_keys(t, allowed, where)
-            lid = self.integer(t, "id", where)
-            if lid is not None:
-                where = f"link[{n}] (id {lid})"
-                if lid <= 0:
-                    self.err(f"{where}.id: moving links are numbered from 1 (0 is the frame)")
-                elif lid in by_id:
-                    self.err(f"{where}.id: duplicate link id {lid}")
-            pts = self.points(t.get("points"), f"{where}.points")
+            if valid_id and lid in by_id:
+                self.err(f"{where}.id: duplicate link id {lid} (link[id={lid}] is [[link]] "
+                         f"#{self.link_table[lid] + 1})")
+            elif isinstance(lid, int) and not isinstance(lid, bool) and lid <= 0:
+                self.err(f"{where}.id: moving links are numbered from 1 (0 is the frame), got {lid}")
+            elif not valid_id:
+                self.integer(t, "id", where)
+            if not valid_id or lid in by_id:
+                self.ids_unknown = True
+                lid = None
+            else:
+                self.link_table[lid] = n
+            pts = self.points(t.get("points"), f"{where}.points", lid)
             if "mass" in t and "weight" in t:
                 self.err(f"{where}: give mass or weight, not both")
             if "weight" in t:
@@ -476,35 +633,46 @@ class _Reader:
                 mass = None if (w is None or not g) else w / g
                 if w is not None and not g:
                     self.err(f"{where}.weight: a weight needs mechanism.g > 0 to give a mass")
+                elif mass is not None and not mass <= MAX_VALUE:
+                    self.err(f"{where}.weight: {w:g} N / g = {w:g} / {g:g} m/s^2 gives a mass of {mass:g} kg, "
+                             f"out of range (<= {MAX_VALUE:g} kg): is mechanism.g right?")
+                    mass = None
             else:
                 mass = self.number(t, "mass", where, default=0.0, minimum=0.0)
             I_S = self.number(t, "I_S", where, default=0.0, minimum=0.0)
             com = self.string(t, "com", where, default=None)
             if com is not None and pts and com not in pts:
-                self.err(f"{where}.com: unknown point {com!r}. Valid names: {sorted(pts)}")
+                self.err(f"{where}.com: unknown point {com!r}{_suggest(com, pts)}. Valid names: {sorted(pts)}")
             if mass and com is None:
                 self.err(f"{where}.com: missing (a link with mass needs its centre-of-mass point)")
             if len(pts) >= 2 and max(math.dist(a, b) for a in pts.values() for b in pts.values()) == 0:
                 self.err(f"{where}.points: all points coincide (zero-length link)")
-            if lid is not None and lid > 0 and lid not in by_id:
+            if lid is not None:
                 by_id[lid] = Link(lid, self.string(t, "name", where, default=f"link {lid}"),
                                   MappingProxyType(pts), mass or 0.0, I_S or 0.0, com)
         ids = sorted(by_id)
-        if ids != list(range(1, len(ids) + 1)):
-            self.err(f"link: ids must be 1..n without gaps, got {ids}")
+        if ids != list(range(1, len(ids) + 1)) or self.ids_unknown:
+            if not self.ids_unknown:        # a table without a valid id is the cause of any gap
+                self.err(f"link: ids must be 1..n without gaps, got {ids}")
+            self.ids_unknown = True
             return [frame]
         return [frame] + [by_id[i] for i in ids]
 
-    def link_ok(self, links: list[Link], lid: Any, where: str) -> bool:
-        if not isinstance(lid, int) or isinstance(lid, bool) or not 0 <= lid < len(links):
-            self.err(f"{where}: unknown link {lid!r}. Valid links: {list(range(len(links)))}")
+    def link_ok(self, links: list[Link], lid: Any, where: str, *, first: int = 0) -> bool:
+        """Is `lid` the id of a link (>= `first`)? Unknown ids are not reported while some
+        [[link]] table has no valid id: that table's problem is the cause."""
+        if not isinstance(lid, int) or isinstance(lid, bool) or not first <= lid < len(links):
+            if not self.ids_unknown:
+                moving = " moving" if first else ""
+                self.err(f"{where}: unknown{moving} link {lid!r}. Valid links: {list(range(first, len(links)))}")
             return False
         return True
 
     def point_ok(self, links: list[Link], lid: int, name: Any, where: str) -> bool:
         if not isinstance(name, str) or name not in links[lid].points:
-            self.err(f"{where}: link {lid} has no point {name!r}. "
-                     f"Valid names: {sorted(links[lid].points)}")
+            if (lid, None) not in self.points_unread and (lid, name) not in self.points_unread:
+                self.err(f"{where}: link {lid} has no point {name!r}{_suggest(name, links[lid].points)}. "
+                         f"Valid names: {sorted(links[lid].points)}")
             return False
         return True
 
@@ -809,8 +977,7 @@ class _Reader:
             relative_to = self.published_point(t, "relative_to", where, links, required=False)
         elif "link" in needs:
             link = t.get("link")
-            if not isinstance(link, int) or isinstance(link, bool) or not 1 <= link < len(links):
-                self.err(f"{where}.link: unknown moving link {link!r}. Valid links: {list(range(1, len(links)))}")
+            self.link_ok(links, link, f"{where}.link", first=1)
         elif "pair" in needs:
             pair = t.get("pair")
             if not (isinstance(pair, list) and len(pair) == 2
