@@ -9,6 +9,7 @@ import difflib
 import math
 import re
 import stat
+import sys
 import tomllib
 import warnings
 from dataclasses import dataclass, field
@@ -421,6 +422,9 @@ MAX_KEY_MEMORY = 256 * 2**20
 _KEY_BYTES, _LEVEL_BYTES = 800, 9
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
+#: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,
+#: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
+LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
 
 _TOP_KEYS = {"mechanism", "drive", "frame", "link", "pair", "group", "load", "spring", "friction", "published"}
 #: Most crank angles one `[[published]]` entry may list.
@@ -429,6 +433,11 @@ MAX_PUBLISHED_ANGLES = 3600
 
 def _finite(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _subnormal(x: float) -> bool:
+    """Nonzero but below the smallest normal double: no model number is meant so."""
+    return 0 < abs(x) < sys.float_info.min
 
 
 class _Reader:
@@ -442,6 +451,9 @@ class _Reader:
         self.ids_unknown = False                  # some [[link]] has no valid id: "unknown link" follows
         self.points_unread: set[tuple[int, str | None]] = set()   # (link, point) that failed (None: all)
         self.misspelled: set[str] = set()         # field paths given under a near-miss name
+        self.group_tables: dict[frozenset, tuple[int, tuple]] = {}   # group -> (its [[group]], links as listed)
+        self.coincident: dict[int, str] = {}      # links whose points all coincide -> their field path
+        self.slider_axes: set[int] = set()        # P pairs (index) whose slider frame the file states
 
     def err(self, msg: str) -> None:
         path = msg.partition(": ")[0]
@@ -484,6 +496,10 @@ class _Reader:
         if abs(x) > MAX_VALUE:
             self.err(f"{where}.{key}: {x!r} is out of range (|value| <= {MAX_VALUE:g})")
             return None
+        if _subnormal(x):
+            self.err(f"{where}.{key}: {x!r} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
+                     f"digits, and its products turn into 0, NaN or inf; write 0 or the value meant")
+            return None
         if positive and x <= 0:
             self.err(f"{where}.{key}: must be > 0, got {x!r}")
             return None
@@ -495,6 +511,10 @@ class _Reader:
     def vec(self, x: Any, where: str, *, unit: bool = False) -> Vec | None:
         if not (isinstance(x, list) and len(x) == 2 and all(_finite(c) for c in x)):
             self.err(f"{where}: expected [x, y] with two finite numbers, got {x!r}")
+            return None
+        if any(_subnormal(c) for c in x):
+            self.err(f"{where}: {x!r} has a subnormal coordinate (0 < |x| < {sys.float_info.min:.3g}); write 0 "
+                     f"or the value meant")
             return None
         if max(abs(x[0]), abs(x[1])) > MAX_VALUE:
             self.err(f"{where}: {x!r} is out of range (|coordinate| <= {MAX_VALUE:g})")
@@ -579,13 +599,48 @@ class _Reader:
         if self.problems:
             raise ModelError(self.problems, source=self.source, lines=self.lines)
         try:
-            return Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
+            mech = Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
                              links=tuple(links), pairs=tuple(pairs),
                              branches=MappingProxyType(branches), loads=tuple(loads_),
                              springs=tuple(springs), drive=drive, friction=friction,
                              published=tuple(published), path=self.source)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
+        for path, msg in self.doubts(mech):
+            line = self.line_of(path)
+            warnings.warn(f"{self.source}: {'' if line is None else f'line {line}: '}{path}: {msg}",
+                          ModelWarning, stacklevel=4)
+        return mech
+
+    def doubts(self, mech: Mechanism):
+        """(field path, message) for what loads but looks like a mistake: a number far out of
+        the usual, or a rule the file relies on that is easily misread."""
+        crank = mech.links[1].points
+        r = math.dist(crank[mech.drive.pivot], crank[mech.drive.point])
+        if mech.size > LARGEST_LINK or r * mech.drive.omega > FASTEST_PIN:
+            yield "link", (f"the largest link spans {mech.size:.4g} m and the crank pin moves at "
+                           f"{r * mech.drive.omega:.4g} m/s: lengths are read in metres; was the model drawn "
+                           f"in millimetres? (warned above {LARGEST_LINK:g} m or {FASTEST_PIN:g} m/s)")
+        for g in mech.structure.groups:
+            n, listed = self.group_tables.get(frozenset(g.links), (None, ()))
+            if g.kind == "RRR" and n is not None and listed[0] > listed[1]:
+                yield f"group[{n}].links", (
+                    f"{list(listed)}: in an RRR group j is the lower id, {listed[1]} (P on link {listed[1]}), "
+                    f"whatever the order listed; if branch was computed with j = {listed[0]}, flip its sign; "
+                    f"list the links as {sorted(listed)} to silence this warning")
+        for p in mech.pairs:
+            slider = mech.links[p.links[1]]
+            if p.kind != "P" or not p.alpha or p.index in self.slider_axes:
+                continue
+            y0 = slider.points[p.point][1]
+            off = [n for n, xy in slider.points.items() if abs(xy[1] - y0) > 1e-9 * mech.size]
+            if off:
+                yield f"pair[{p.index}]", (
+                    f"slider link {slider.id}'s points are read in a frame whose x axis runs along the guide "
+                    f"(direction {list(p.direction)} in link {p.links[0]}'s frame), and {off[0]!r} lies "
+                    f"{abs(slider.points[off[0]][1] - y0):.4g} m off the guide line in it; if the points were "
+                    f"drawn in another frame (e.g. the world's), give slider_axis = the guide direction in "
+                    f"that frame (slider_axis = [1.0, 0.0] confirms the default)")
 
     def points(self, raw: Any, where: str, lid: int | None = None) -> dict[str, Vec]:
         """A table of named points; those that fail are recorded in points_unread for link `lid`."""
@@ -646,7 +701,7 @@ class _Reader:
             if mass and com is None:
                 self.err(f"{where}.com: missing (a link with mass needs its centre-of-mass point)")
             if len(pts) >= 2 and max(math.dist(a, b) for a in pts.values() for b in pts.values()) == 0:
-                self.err(f"{where}.points: all points coincide (zero-length link)")
+                self.coincident[lid if lid is not None else -n - 1] = where     # refused unless in a P pair
             if lid is not None:
                 by_id[lid] = Link(lid, self.string(t, "name", where, default=f"link {lid}"),
                                   MappingProxyType(pts), mass or 0.0, I_S or 0.0, com)
@@ -668,10 +723,10 @@ class _Reader:
             return False
         return True
 
-    def point_ok(self, links: list[Link], lid: int, name: Any, where: str) -> bool:
+    def point_ok(self, links: list[Link], lid: int, name: Any, where: str, why: str = "") -> bool:
         if not isinstance(name, str) or name not in links[lid].points:
             if (lid, None) not in self.points_unread and (lid, name) not in self.points_unread:
-                self.err(f"{where}: link {lid} has no point {name!r}{_suggest(name, links[lid].points)}. "
+                self.err(f"{where}: link {lid} has no point {name!r}{_suggest(name, links[lid].points)}{why}. "
                          f"Valid names: {sorted(links[lid].points)}")
             return False
         return True
@@ -682,7 +737,7 @@ class _Reader:
             where = f"pair[{n}]"
             kind = self.string(t, "kind", where, choices=("R", "P"))
             self.unknown_keys(t, {"kind", "links", "point", "radius"} | (
-                {"guide", "direction"} if kind == "P" else set()), where)
+                {"guide", "direction", "slider_axis"} if kind == "P" else set()), where)
             lk = t.get("links")
             if not (isinstance(lk, list) and len(lk) == 2):
                 self.err(f"{where}.links: expected two link ids [i, j], got {lk!r}")
@@ -698,17 +753,44 @@ class _Reader:
                 if all(self.point_ok(links, x, pt, f"{where}.point") for x in lk):
                     out.append(Pair(len(out), "R", tuple(lk), pt, radius=radius))
             elif kind == "P":
-                ok = self.point_ok(links, lk[1], t.get("point"), f"{where}.point")
-                ok &= self.point_ok(links, lk[0], t.get("guide"), f"{where}.guide")
+                pt, gd = t.get("point"), t.get("guide")
+                pts = lambda k: links[k].points
+                if pt not in pts(lk[1]) and gd not in pts(lk[0]) and pt in pts(lk[0]) and gd in pts(lk[1]):
+                    self.err(f"{where}.links: a prismatic pair lists [guide link, slider link], and {lk} reads "
+                             f"reversed: point {pt!r} is on link {lk[0]} and guide {gd!r} on link {lk[1]}; "
+                             f"write links = [{lk[1]}, {lk[0]}]")
+                    continue
+                order = f" (links = [guide link, slider link]: the {{}} is on link {{}})"
+                ok = self.point_ok(links, lk[1], pt, f"{where}.point", order.format("point", lk[1]))
+                ok &= self.point_ok(links, lk[0], gd, f"{where}.guide", order.format("guide point", lk[0]))
                 d = self.vec(t.get("direction"), f"{where}.direction", unit=True)
-                if ok and d is not None:
-                    out.append(Pair(len(out), "P", tuple(lk), t["point"], t["guide"], d, radius))
+                axis = self.vec(t["slider_axis"], f"{where}.slider_axis", unit=True) if "slider_axis" in t else None
+                if ok and d is not None and ("slider_axis" not in t or axis is not None):
+                    if axis is not None:
+                        self.slider_axes.add(len(out))
+                        links[lk[1]] = _turned_slider(links[lk[1]], axis)
+                    out.append(Pair(len(out), "P", tuple(lk), pt, gd, d, radius))
         seen: dict[frozenset, int] = {}
         for p in out:
             key = frozenset(p.links)
             if key in seen:
                 self.err(f"pair[{p.index}]: links {sorted(key)} are already joined by pair[{seen[key]}]")
             seen[key] = p.index
+        in_p = {k for p in out if p.kind == "P" for k in p.links}
+        for lid, where in self.coincident.items():
+            if lid not in in_p:     # a guide or a slider takes its direction from its pair
+                self.err(f"{where}.points: all points coincide (zero-length link)")
+        sliders = [p.links[1] for p in out if p.kind == "P"]
+        for n in self.slider_axes:
+            if sliders.count(out[n].links[1]) > 1:
+                self.err(f"pair[{n}].slider_axis: link {out[n].links[1]} slides in more than one prismatic pair; "
+                         f"give its points in the frame of its guides instead")
+        # the CSV columns of a point (x_P, vx_P, ...) must not be those of a prismatic pair (x_i_j)
+        for p in out:
+            name = f"{p.links[0]}_{p.links[1]}"
+            if p.kind == "P" and any(name in link.points for link in links):
+                self.err(f"point {name!r}: its table column x_{name} would be that of prismatic pair "
+                         f"{p.label} (x_{name}, the line of its normal force): rename the point")
         # a point name on two links must be the revolute pair that joins them (or a chain of
         # revolute pairs at that point: several links on one pin)
         owners: dict[str, list[int]] = {}
@@ -809,10 +891,18 @@ class _Reader:
                     self.err(f"{where}.links: expected two link ids, got {lk!r}")
                 continue
             b = t.get("branch")
-            if b not in (1, -1) or isinstance(b, bool):
-                self.err(f"{where}.branch: expected +1 or -1, got {b!r}")
+            if not isinstance(b, int) or isinstance(b, bool) or b not in (1, -1):
+                self.err(f"{where}.branch: expected +1 or -1, got {b!r}"
+                         + (" (an integer: write it without a decimal point)" if isinstance(b, float) else ""))
                 continue
-            out[frozenset(lk)] = b
+            key = frozenset(lk)
+            if key in out and out[key] != b:
+                first = self.group_tables[key][0]
+                self.err(f"{where}.branch: group {sorted(key)} is already given branch = {out[key]:+d} by "
+                         f"group[{first}]; this entry says {b:+d}: keep one")
+                continue
+            out[key] = b
+            self.group_tables.setdefault(key, (n, tuple(lk)))
         return out
 
     def loads(self, links: list[Link]) -> list[Load]:
@@ -846,6 +936,16 @@ class _Reader:
                 continue
             value = self.number(t, "value", where) if "value" in t else None
             table = self.table(t["table"], f"{where}.table") if "table" in t else None
+            if table is not None and table.argument == "travel":
+                if kind == "moment":
+                    self.err(f"{where}.table.travel: a moment acts on a link, not at a point, so it has no "
+                             f"travel to follow; use phi_deg (the crank angle), or make it a force at a point")
+                    continue
+                if table.axis is None and direction == "against_velocity":
+                    self.err(f"{where}.table.axis: missing: the travel is measured along axis, and a force "
+                             f"directed 'against_velocity' has no fixed direction to take it from (give the "
+                             f"world direction of the stroke, e.g. axis = [0.0, 1.0])")
+                    continue
             if kind == "force" and direction is None:
                 continue
             if value is not None or table is not None:
@@ -888,6 +988,9 @@ class _Reader:
     def series(self, x: Any, where: str) -> tuple[float, ...] | None:
         if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) and abs(v) <= MAX_VALUE for v in x)):
             self.err(f"{where}: expected a list of at least two finite numbers (|value| <= {MAX_VALUE:g})")
+            return None
+        if any(_subnormal(v) for v in x):
+            self.err(f"{where}: a subnormal value (0 < |value| < {sys.float_info.min:.3g}); write 0 or the value meant")
             return None
         return tuple(float(v) for v in x)
 
@@ -1015,6 +1118,14 @@ class _Reader:
                                            else f"unknown point {name!r}. Valid names: {known}"))
             return None
         return name
+
+
+def _turned_slider(link: Link, axis: Vec) -> Link:
+    """The slider `link` with its points turned from the author's frame, in which the guide runs
+    along `axis`, into the documented one, whose x axis runs along the guide."""
+    turn = complex(*axis).conjugate()
+    pts = {n: ((z := complex(*xy) * turn).real, z.imag) for n, xy in link.points.items()}
+    return Link(link.id, link.name, MappingProxyType(pts), link.mass, link.I_S, link.com)
 
 
 def _components(edges: list[tuple[int, int]]) -> dict[int, int]:
