@@ -4,7 +4,7 @@ May use: model, kinematics, kinetostatics, applied, planar; pandas only inside `
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import NamedTuple
 
 import numpy as np
@@ -274,5 +274,16 @@ def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics) -> Ana
     M_all = M_app + M_i + cross_z(r, F_i)
     frc = forces(mech, kin, F_all, M_all)
     lever = lever_moment(mech, kin, F_all, M_all)
-    return Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
-                    friction_power(mech, kin, frc.R))
+    return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
+                               friction_power(mech, kin, frc.R)))
+
+
+def _read_only(res: Analysis) -> Analysis:
+    """`res` with every array it holds (its own, its Kinematics' and Forces') read-only: a
+    frozen result whose numbers no caller can change in place."""
+    for part in (res, res.kin, res.forces):
+        for f in fields(part):
+            value = getattr(part, f.name)
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
+    return res

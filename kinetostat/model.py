@@ -15,7 +15,7 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Literal, Mapping
+from typing import Any, Callable, Literal, Mapping
 
 import numpy as np
 
@@ -229,28 +229,34 @@ class Mechanism:
         raise KeyError(f"no kinematic pair between links {i} and {j}. "
                        f"Pairs: {[p.label for p in self.pairs]}")
 
-    @property
-    def inertia_arrays(self) -> tuple:
-        """(mass (L,), I_S (L,), centre of mass in the local frame (L,) complex), memoised."""
-        if "inertia" not in self._derived:
-            self._derived["inertia"] = (
-                np.array([link.mass for link in self.links]), np.array([link.I_S for link in self.links]),
-                np.array([complex(*link.points[link.com]) if link.com else 0j for link in self.links]))
-        return self._derived["inertia"]
+    def memo(self, key: Any, make: Callable[[], Any]) -> Any:
+        """make(), computed once per key and kept; its arrays (alone or in a tuple) read-only, so
+        that no caller can change what later analyses read."""
+        if key not in self._derived:
+            value = make()
+            for a in value if isinstance(value, tuple) else (value,):
+                if isinstance(a, np.ndarray):
+                    a.flags.writeable = False
+            self._derived[key] = value
+        return self._derived[key]
 
     @property
-    def points_z(self) -> list[dict[str, complex]]:
-        """Every link's points in its local frame as complex numbers x + iy, memoised."""
-        if "points_z" not in self._derived:
-            self._derived["points_z"] = [{n: complex(*xy) for n, xy in link.points.items()} for link in self.links]
-        return self._derived["points_z"]
+    def inertia_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(mass (L,), I_S (L,), centre of mass in the local frame (L,) complex), read-only."""
+        return self.memo("inertia", lambda: (
+            np.array([link.mass for link in self.links]), np.array([link.I_S for link in self.links]),
+            np.array([complex(*link.points[link.com]) if link.com else 0j for link in self.links])))
+
+    @property
+    def points_z(self) -> tuple[Mapping[str, complex], ...]:
+        """Every link's points in its local frame as complex numbers x + iy, read-only."""
+        return self.memo("points_z", lambda: tuple(
+            MappingProxyType({n: complex(*xy) for n, xy in link.points.items()}) for link in self.links))
 
     @property
     def size(self) -> float:
         """Characteristic length: the largest distance between two points of one link, m."""
-        if "size" not in self._derived:
-            self._derived["size"] = self._largest_link()
-        return self._derived["size"]
+        return self.memo("size", self._largest_link)
 
     def _largest_link(self) -> float:
         best = 0.0
@@ -422,6 +428,9 @@ MAX_KEY_MEMORY = 256 * 2**20
 _KEY_BYTES, _LEVEL_BYTES = 800, 9
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
+#: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
+#: lengths stay normal numbers.
+MIN_LENGTH = 1e-150
 #: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,
 #: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
 LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
@@ -496,7 +505,7 @@ class _Reader:
         if abs(x) > MAX_VALUE:
             self.err(f"{where}.{key}: {x!r} is out of range (|value| <= {MAX_VALUE:g})")
             return None
-        if _subnormal(x):
+        if (positive or key == "g") and _subnormal(x):     # a speed, module, radius or g: a divisor somewhere
             self.err(f"{where}.{key}: {x!r} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
                      f"digits, and its products turn into 0, NaN or inf; write 0 or the value meant")
             return None
@@ -511,10 +520,6 @@ class _Reader:
     def vec(self, x: Any, where: str, *, unit: bool = False) -> Vec | None:
         if not (isinstance(x, list) and len(x) == 2 and all(_finite(c) for c in x)):
             self.err(f"{where}: expected [x, y] with two finite numbers, got {x!r}")
-            return None
-        if any(_subnormal(c) for c in x):
-            self.err(f"{where}: {x!r} has a subnormal coordinate (0 < |x| < {sys.float_info.min:.3g}); write 0 "
-                     f"or the value meant")
             return None
         if max(abs(x[0]), abs(x[1])) > MAX_VALUE:
             self.err(f"{where}: {x!r} is out of range (|coordinate| <= {MAX_VALUE:g})")
@@ -700,8 +705,12 @@ class _Reader:
                 self.err(f"{where}.com: unknown point {com!r}{_suggest(com, pts)}. Valid names: {sorted(pts)}")
             if mass and com is None:
                 self.err(f"{where}.com: missing (a link with mass needs its centre-of-mass point)")
-            if len(pts) >= 2 and max(math.dist(a, b) for a in pts.values() for b in pts.values()) == 0:
+            span = max((math.dist(a, b) for a in pts.values() for b in pts.values()), default=None)
+            if span == 0 and len(pts) >= 2:
                 self.coincident[lid if lid is not None else -n - 1] = where     # refused unless in a P pair
+            elif span is not None and 0 < span < MIN_LENGTH:
+                self.err(f"{where}.points: the link spans only {span:.3g} m: below {MIN_LENGTH:g} m the squares of "
+                         f"its lengths underflow (accelerations and forces turn into 0 or NaN); is the unit right?")
             if lid is not None:
                 by_id[lid] = Link(lid, self.string(t, "name", where, default=f"link {lid}"),
                                   MappingProxyType(pts), mass or 0.0, I_S or 0.0, com)
@@ -988,9 +997,6 @@ class _Reader:
     def series(self, x: Any, where: str) -> tuple[float, ...] | None:
         if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) and abs(v) <= MAX_VALUE for v in x)):
             self.err(f"{where}: expected a list of at least two finite numbers (|value| <= {MAX_VALUE:g})")
-            return None
-        if any(_subnormal(v) for v in x):
-            self.err(f"{where}: a subnormal value (0 < |value| < {sys.float_info.min:.3g}); write 0 or the value meant")
             return None
         return tuple(float(v) for v in x)
 
