@@ -259,13 +259,15 @@ class Mechanism:
         return self.memo("size", self._largest_link)
 
     def _largest_link(self) -> float:
-        best = 0.0
-        for link in self.links[1:]:
-            pts = list(link.points.values())
-            for a in pts:
-                for b in pts:
-                    best = max(best, math.dist(a, b))
-        return best or 1.0
+        return max((_span(link.points.values()) for link in self.links[1:]), default=0.0) or 1.0
+
+
+def _span(points) -> float:
+    """Largest distance between two of `points` ((x, y) pairs), m; rows in blocks, so that
+    10^4 points take a second and bounded memory."""
+    z = np.array([complex(*xy) for xy in points])
+    return max((float(np.abs(z[i:i + 512, None] - z[None, :]).max()) for i in range(0, len(z), 512)),
+               default=0.0)
 
 
 def _abbreviate(text: str, limit: int = 90) -> str:
@@ -428,6 +430,8 @@ MAX_KEY_MEMORY = 256 * 2**20
 _KEY_BYTES, _LEVEL_BYTES = 800, 9
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
+#: Most points of one link (the largest distance between them costs n^2).
+MAX_POINTS = 10_000
 #: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
 #: lengths stay normal numbers.
 MIN_LENGTH = 1e-150
@@ -649,8 +653,9 @@ class _Reader:
 
     def points(self, raw: Any, where: str, lid: int | None = None) -> dict[str, Vec]:
         """A table of named points; those that fail are recorded in points_unread for link `lid`."""
-        if not isinstance(raw, dict) or not raw:
-            self.err(f"{where}: expected a table of named points {{A = [x, y], ...}}")
+        if not isinstance(raw, dict) or not raw or len(raw) > MAX_POINTS:
+            self.err(f"{where}: expected a table of named points {{A = [x, y], ...}}"
+                     + (f", at most {MAX_POINTS} of them, got {len(raw)}" if raw and isinstance(raw, dict) else ""))
             self.points_unread.add((lid, None))
             return {}
         out = {}
@@ -672,6 +677,8 @@ class _Reader:
             valid_id = isinstance(lid, int) and not isinstance(lid, bool) and lid > 0
             # named by its id, as the texts number links; by its table's place only without one
             where = f"link[id={lid}]" if valid_id and lid not in by_id else f"[[link]] #{n + 1}"
+            if valid_id and lid not in by_id:
+                self.link_table[lid] = n
             self.unknown_keys(t, allowed, where)
             if valid_id and lid in by_id:
                 self.err(f"{where}.id: duplicate link id {lid} (link[id={lid}] is [[link]] "
@@ -683,15 +690,13 @@ class _Reader:
             if not valid_id or lid in by_id:
                 self.ids_unknown = True
                 lid = None
-            else:
-                self.link_table[lid] = n
             pts = self.points(t.get("points"), f"{where}.points", lid)
             if "mass" in t and "weight" in t:
                 self.err(f"{where}: give mass or weight, not both")
             if "weight" in t:
                 w = self.number(t, "weight", where, minimum=0.0)
                 mass = None if (w is None or not g) else w / g
-                if w is not None and not g:
+                if w is not None and g == 0:     # (a missing or invalid g is reported already)
                     self.err(f"{where}.weight: a weight needs mechanism.g > 0 to give a mass")
                 elif mass is not None and not mass <= MAX_VALUE:
                     self.err(f"{where}.weight: {w:g} N / g = {w:g} / {g:g} m/s^2 gives a mass of {mass:g} kg, "
@@ -705,7 +710,7 @@ class _Reader:
                 self.err(f"{where}.com: unknown point {com!r}{_suggest(com, pts)}. Valid names: {sorted(pts)}")
             if mass and com is None:
                 self.err(f"{where}.com: missing (a link with mass needs its centre-of-mass point)")
-            span = max((math.dist(a, b) for a in pts.values() for b in pts.values()), default=None)
+            span = _span(pts.values()) if pts else None
             if span == 0 and len(pts) >= 2:
                 self.coincident[lid if lid is not None else -n - 1] = where     # refused unless in a P pair
             elif span is not None and 0 < span < MIN_LENGTH:
@@ -797,9 +802,11 @@ class _Reader:
         # the CSV columns of a point (x_P, vx_P, ...) must not be those of a prismatic pair (x_i_j)
         for p in out:
             name = f"{p.links[0]}_{p.links[1]}"
-            if p.kind == "P" and any(name in link.points for link in links):
-                self.err(f"point {name!r}: its table column x_{name} would be that of prismatic pair "
-                         f"{p.label} (x_{name}, the line of its normal force): rename the point")
+            for link in links if p.kind == "P" else ():
+                if name in link.points:
+                    self.err(f"{'frame' if link.id == 0 else f'link[id={link.id}].points'}.{name}: the point's "
+                             f"table column x_{name} would be that of prismatic pair {p.label} (x_{name}, the "
+                             f"line of its normal force): rename the point")
         # a point name on two links must be the revolute pair that joins them (or a chain of
         # revolute pairs at that point: several links on one pin)
         owners: dict[str, list[int]] = {}
