@@ -654,7 +654,7 @@ class _Reader:
     def points(self, raw: Any, where: str, lid: int | None = None) -> dict[str, Vec]:
         """A table of named points; those that fail are recorded in points_unread for link `lid`."""
         if not isinstance(raw, dict) or not raw or len(raw) > MAX_POINTS:
-            self.err(f"{where}: expected a table of named points {{A = [x, y], ...}}"
+            self.err(f"{where}: {'missing: ' if raw is None else ''}expected a table of named points {{A = [x, y], ...}}"
                      + (f", at most {MAX_POINTS} of them, got {len(raw)}" if raw and isinstance(raw, dict) else ""))
             self.points_unread.add((lid, None))
             return {}
