@@ -338,7 +338,7 @@ def _check_key_cost(text: str, source: str) -> None:
         key = head if head.startswith("[") else line.partition("=")[0]
         if len(key) > MAX_KEY:
             raise ModelError([f"line {n}: a key of {len(key)} characters (at most {MAX_KEY})"], source=source)
-        if "=" in line or head.startswith("["):
+        if not head.startswith("#") and ("=" in line or head.startswith("[")):
             cost += _KEY_BYTES + _LEVEL_BYTES * (key.count(".") + 1) ** 2
             if cost > MAX_KEY_MEMORY:
                 raise ModelError([f"line {n}: the keys up to here would take about {cost / 2**20:.0f} MiB to "
