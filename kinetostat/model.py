@@ -435,6 +435,8 @@ MAX_POINTS = 10_000
 #: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
 #: lengths stay normal numbers.
 MIN_LENGTH = 1e-150
+#: Smallest base radius of the drive's gear wheel, relative to the largest link.
+MIN_GEAR = 1e-6
 #: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,
 #: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
 LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
@@ -860,14 +862,15 @@ class _Reader:
         kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")
         gear = None
         if kind == "machine":
-            gear = self.gear(t.get("gear"))
+            gear = self.gear(t.get("gear"), max((_span(k.points.values()) for k in links[1:]), default=0.0))
         elif "gear" in t:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
         if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
             return None
         return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design)
 
-    def gear(self, t: Any) -> Gear | None:
+    def gear(self, t: Any, size: float) -> Gear | None:
+        """[drive.gear]; `size`: the largest link, m (the wheel must not be vanishingly small beside it)."""
         w = "drive.gear"
         if not isinstance(t, dict):
             self.err(f"{w}: a working machine needs the table [drive.gear] (module, z_pinion, z_wheel, ...)")
@@ -892,6 +895,11 @@ class _Reader:
         gear = Gear(module, z1, z2, corr, alpha, y, cd)
         if gear.r_w <= 0:
             self.err(f"{w}.y: the wheel's pitch radius r_w = r (1 + 2y/(z1 + z2)) = {gear.r_w:g} m must be > 0")
+            return None
+        if gear.r_b < MIN_GEAR * size:
+            self.err(f"{w}.module: the wheel's base radius r_b = {gear.r_b:.3g} m is below {MIN_GEAR:g} of the "
+                     f"largest link ({size:.3g} m): the balancing force M_bal / r_b would be out of range; "
+                     f"is the module in metres (0.010 for 10 mm)?")
             return None
         return gear
 
