@@ -13,12 +13,13 @@ The solver's public names. May use: the solver modules only (never the harness
 """
 from . import examples
 from .analysis import Analysis, InertiaLoad, analyze
-from .errors import AssemblyError, ModelError, SingularPositionWarning, StructureError
+from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning, SingularPositionWarning,
+                     StructureError)
 from .kinematics import COND_MAX, COND_WARN
 from .model import Mechanism, from_dict, load, loads
 from .structure import AssurGroup, Structure
 
 __all__ = ["load", "loads", "from_dict", "analyze", "Mechanism", "Analysis", "InertiaLoad",
-           "AssurGroup", "Structure", "ModelError", "StructureError", "AssemblyError",
+           "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError", "AssemblyError",
            "SingularPositionWarning", "COND_WARN", "COND_MAX", "examples"]
 __version__ = "0.1.0"

@@ -632,6 +632,9 @@ class _Reader:
             yield "link", (f"the largest link spans {mech.size:.4g} m and the crank pin moves at "
                            f"{r * mech.drive.omega:.4g} m/s: lengths are read in metres; was the model drawn "
                            f"in millimetres? (warned above {LARGEST_LINK:g} m or {FASTEST_PIN:g} m/s)")
+        if mech.g and not 1.0 <= mech.g <= 100.0:
+            yield "mechanism.g", (f"{mech.g:g} m/s^2 is far from the 9.81 of the texts (warned outside 1..100): "
+                                  f"is it in m/s^2? (0 switches gravity off)")
         for g in mech.structure.groups:
             n, listed = self.group_tables.get(frozenset(g.links), (None, ()))
             if g.kind == "RRR" and n is not None and listed[0] > listed[1]:

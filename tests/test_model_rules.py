@@ -331,3 +331,10 @@ def test_massless_lever_whose_slot_passes_its_pivot_is_no_zero_length_link():
     exc = _problems(four_bar(("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01] }"),
                              ("C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.12, -0.01]", "C = [0.0, 0.0], B = [0.0, 0.0], S3 = [0.0, 0.0]")))
     assert any("all points coincide (zero-length link)" in p for p in exc.problems)
+
+
+def test_a_tiny_g_with_weights_is_warned_with_its_number():
+    """g = 1e-11 with a weight of 1 N gives a finite mass of 1e11 kg: loads, with a warning."""
+    with pytest.warns(ModelWarning, match=r"line 4: mechanism\.g: 1e-11 m/s\^2 is far from the 9\.81"):
+        mech = kinetostat.loads(four_bar(("g = 9.81", "g = 1e-11"), ("mass = 1.5", "weight = 1.0")))
+    assert mech.links[2].mass == pytest.approx(1e11)
