@@ -365,7 +365,8 @@ class _Lines:
     tomllib gives no positions, so the text is scanned for table headers and keys)."""
 
     _HEADER = re.compile(r"\s*(\[\[?)\s*([^\]]+?)\s*\]")
-    _KEY = re.compile(r"\s*([A-Za-z0-9_\-.\"' ]+?)\s*=")
+    _PART = r"""(?:[A-Za-z0-9_\-]+|"[^"]*"|'[^']*')"""
+    _KEY = re.compile(rf"\s*({_PART}(?:\s*\.\s*{_PART})*)\s*=")
     _INLINE_KEY = re.compile(r"[{,]\s*([A-Za-z0-9_\-]+|\"[^\"]*\"|'[^']*')\s*=")
 
     def __init__(self, text: str):

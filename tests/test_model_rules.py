@@ -338,3 +338,10 @@ def test_a_tiny_g_with_weights_is_warned_with_its_number():
     with pytest.warns(ModelWarning, match=r"line 4: mechanism\.g: 1e-11 m/s\^2 is far from the 9\.81"):
         mech = kinetostat.loads(four_bar(("g = 9.81", "g = 1e-11"), ("mass = 1.5", "weight = 1.0")))
     assert mech.links[2].mass == pytest.approx(1e11)
+
+
+def test_line_is_found_past_strings_that_look_like_keys():
+    text = FOUR_BAR.replace('g = 9.81', 'assumptions = [\n  "rpm = 300 as in the text",\n  """\nrpm = 1\n""",\n]\ng = 9.81', 1)
+    exc = _problems(text.replace("rpm = 300.0", "rpm = -300.0"))
+    assert exc.problems == ["drive.rpm: must be > 0, got -300.0"]
+    assert exc.lines == [_line(text, "rpm = 300.0")]
