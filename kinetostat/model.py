@@ -364,7 +364,7 @@ class _Lines:
     """Where each table and key of a TOML text sits: field path -> line number (best effort:
     tomllib gives no positions, so the text is scanned for table headers and keys)."""
 
-    _HEADER = re.compile(r"\s*(\[\[?)\s*([^\]]+?)\s*\]")
+    _HEADER = re.compile(r"\s*(\[\[?)\s*([A-Za-z0-9_\-.\"' ]+?)\s*\]\]?\s*(#.*)?$")   # not a row [x, y],
     _PART = r"""(?:[A-Za-z0-9_\-]+|"[^"]*"|'[^']*')"""
     _KEY = re.compile(rf"\s*({_PART}(?:\s*\.\s*{_PART})*)\s*=")
     _INLINE_KEY = re.compile(r"[{,]\s*([A-Za-z0-9_\-]+|\"[^\"]*\"|'[^']*')\s*=")

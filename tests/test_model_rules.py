@@ -345,3 +345,10 @@ def test_line_is_found_past_strings_that_look_like_keys():
     exc = _problems(text.replace("rpm = 300.0", "rpm = -300.0"))
     assert exc.problems == ["drive.rpm: must be > 0, got -300.0"]
     assert exc.lines == [_line(text, "rpm = 300.0")]
+
+
+def test_line_is_found_past_rows_of_an_array_that_look_like_headers():
+    text = FOUR_BAR.replace("[[link]]\nid = 2", 'extra = [\n  [0.0, 1.0],\n  [2.0, 3.0],\n]\n[[link]]\nid = 2', 1)
+    exc = _problems(text.replace("mass = 1.5", "mass = -1.5"))
+    n = exc.problems.index("link[id=2].mass: must be >= 0.0, got -1.5")
+    assert exc.lines[n] == _line(text, "mass = 1.5")
