@@ -4,7 +4,7 @@ May use: model, kinematics, kinetostatics, applied, planar; pandas only inside `
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from types import MappingProxyType
 from typing import Mapping, NamedTuple
 
@@ -430,7 +430,7 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
             error[checked] = np.max([deviation(nominal, _kinetostatics(mech, phi_deg[checked], t))
                                      for t in trials], axis=0)
         kin = guard(mech, kin, error)
-        return _kinetostatics(mech, phi_deg, kin) if kin.singular.any() else replace(res, kin=kin)
+        return _kinetostatics(mech, phi_deg, kin) if kin.singular.any() else _read_only(replace(res, kin=kin))
 
 
 def force_deviation(a: Analysis, b: Analysis) -> np.ndarray:
@@ -457,5 +457,16 @@ def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics) -> Ana
     M_all = M_app + M_i + cross_z(r, F_i)
     frc = forces(mech, kin, F_all, M_all)
     lever = lever_moment(mech, kin, F_all, M_all)
-    return Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
-                    friction_power(mech, kin, frc.R))
+    return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
+                               friction_power(mech, kin, frc.R)))
+
+
+def _read_only(res: Analysis) -> Analysis:
+    """`res` with every array it holds (its own, its Kinematics' and Forces') read-only: a
+    frozen result whose numbers no caller can change in place."""
+    for part in (res, res.kin, res.forces):
+        for f in fields(part):
+            value = getattr(part, f.name)
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
+    return res

@@ -121,30 +121,21 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
         return np.full(N, ld.value)
     t = ld.table
     if t.argument == "phi":
-        key = ("periodic", id(t))
-        if key not in mech._derived:     # the diagram (rad) repeated over [-4 pi, 4 pi]: fmod lands inside
-            x = np.radians(t.x)
-            mech._derived[key] = (np.concatenate([x + 2 * np.pi * n for n in (-2, -1, 0, 1)]),
-                                  t.scale * np.tile(t.value, 4))
-        xp, vp = mech._derived[key]
+        xp, vp = mech.memo(("periodic", id(t)), lambda: (   # the diagram (rad) over [-4 pi, 4 pi]: fmod lands inside
+            np.concatenate([np.radians(t.x) + 2 * np.pi * n for n in (-2, -1, 0, 1)]), t.scale * np.tile(t.value, 4)))
         return np.interp(np.fmod(kin.phi, 2 * np.pi), xp, vp)
     p = mech.links[ld.link].points[ld.point]
     axis = complex(*(t.axis if t.axis is not None else ld.direction))
     if X is None:
         X = kin.position_z(ld.link, p)
-    key = ("stroke", ld.link, tuple(p), axis)
-    if key not in mech._derived:
-        mech._derived[key] = _stroke(mech, ld.link, p, axis)
-    lo, hi = mech._derived[key]
+    lo, hi = mech.memo(("stroke", ld.link, tuple(p), axis), lambda: _stroke(mech, ld.link, p, axis))
     if not hi - lo > 1e-9 * mech.size:
         n = mech.loads.index(ld)
         raise ModelError([f"load[{n}].table: a travel diagram needs a moving point, but {ld.point!r} of link "
                           f"{ld.link} travels {hi - lo:.3g} m along the axis over the cycle"], source=mech.path or "model")
-    key = ("diagram", id(t))
-    if key not in mech._derived:     # scaled once, as arrays (np.interp would convert tuples per call)
-        mech._derived[key] = (np.asarray(t.x), t.scale * np.asarray(t.value),
-                              None if t.value_return is None else t.scale * np.asarray(t.value_return))
-    xs, fwd, ret = mech._derived[key]
+    xs, fwd, ret = mech.memo(("diagram", id(t)), lambda: (   # scaled once: np.interp converts tuples per call
+        np.asarray(t.x), t.scale * np.asarray(t.value),
+        None if t.value_return is None else t.scale * np.asarray(t.value_return)))
     s = dot_z(X, axis)
     travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
     if ret is None:

@@ -211,9 +211,10 @@ def bundled_models() -> list[Path]:
 
 
 def _model_error_text(exc) -> str:
-    if len(exc.problems) == 1:
-        return f"{exc.source}: {exc.problems[0]}"
-    return f"{exc.source}: {len(exc.problems)} problems:\n" + "\n".join(f"  - {p}" for p in exc.problems)
+    """A ModelError as the CLI prints it: the file, then each problem led by its line."""
+    if len(exc.located) == 1:
+        return f"{exc.source}: {exc.located[0]}"
+    return f"{exc.source}: {len(exc.located)} problems:\n" + "\n".join(f"  - {p}" for p in exc.located)
 
 
 def _load(path: str | Path):

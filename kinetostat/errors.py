@@ -1,21 +1,47 @@
 """Errors and warnings of kinetostat: every message names the field path or the crank angles."""
 from __future__ import annotations
 
+import errno
 from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["ModelError", "AssemblyError", "StructureError", "SingularPositionWarning"]
+__all__ = ["ModelError", "ModelFileNotFound", "ModelWarning", "AssemblyError", "StructureError",
+           "SingularPositionWarning"]
 
 
 class ModelError(ValueError):
-    """A model file or a model object is invalid. `problems` lists every fault found."""
+    """A model file or a model object is invalid. `problems` lists every fault found; `lines`
+    (same length) the line of the TOML file where each sits, or None where none is known."""
 
-    def __init__(self, problems: Sequence[str], source: str = "model"):
+    def __init__(self, problems: Sequence[str], source: str = "model",
+                 lines: Sequence[int | None] | None = None):
         self.problems = list(problems)
         self.source = source
-        lines = "\n".join(f"  - {p}" for p in self.problems)
-        super().__init__(f"{source}: {len(self.problems)} problem(s):\n{lines}")
+        self.lines = list(lines) if lines is not None else [None] * len(self.problems)
+        text = "\n".join(f"  - {p}" for p in self.located)
+        super().__init__(f"{source}: {len(self.problems)} problem(s):\n{text}")
+
+    @property
+    def located(self) -> list[str]:
+        """The problems, each led by its line in the file ("line 12: ...") where it is known."""
+        return [p if n is None else f"line {n}: {p}" for p, n in zip(self.problems, self.lines)]
+
+
+class ModelFileNotFound(ModelError, FileNotFoundError):
+    """The model file does not exist (`except FileNotFoundError` catches it too)."""
+
+    def __init__(self, path: str):
+        super().__init__(["cannot read file: no such file"], source=path)
+        self.errno, self.strerror, self.filename = errno.ENOENT, "No such file or directory", path
+
+    def __str__(self) -> str:
+        return self.args[0]      # the ModelError text, not "[Errno 2] ..."
+
+
+class ModelWarning(UserWarning):
+    """A model loads, but a number or a rule it relies on looks like a mistake (the message
+    gives the number and its likely cause)."""
 
 
 class StructureError(ValueError):

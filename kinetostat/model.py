@@ -5,16 +5,21 @@ kg, moments of inertia in kg m^2, angles in radians unless the name says `_deg`.
 """
 from __future__ import annotations
 
+import difflib
 import math
+import re
+import stat
+import sys
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Literal, Mapping
+from typing import Any, Callable, Literal, Mapping
 
 import numpy as np
 
-from .errors import ModelError, StructureError
+from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
 from .structure import Structure, analyse_structure
 
 __all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Published", "Mechanism",
@@ -224,37 +229,45 @@ class Mechanism:
         raise KeyError(f"no kinematic pair between links {i} and {j}. "
                        f"Pairs: {[p.label for p in self.pairs]}")
 
-    @property
-    def inertia_arrays(self) -> tuple:
-        """(mass (L,), I_S (L,), centre of mass in the local frame (L,) complex), memoised."""
-        if "inertia" not in self._derived:
-            self._derived["inertia"] = (
-                np.array([link.mass for link in self.links]), np.array([link.I_S for link in self.links]),
-                np.array([complex(*link.points[link.com]) if link.com else 0j for link in self.links]))
-        return self._derived["inertia"]
+    def memo(self, key: Any, make: Callable[[], Any]) -> Any:
+        """make(), computed once per key and kept; its arrays (alone or in a tuple) read-only, so
+        that no caller can change what later analyses read."""
+        if key not in self._derived:
+            value = make()
+            for a in value if isinstance(value, tuple) else (value,):
+                if isinstance(a, np.ndarray):
+                    a.flags.writeable = False
+            self._derived[key] = value
+        return self._derived[key]
 
     @property
-    def points_z(self) -> list[dict[str, complex]]:
-        """Every link's points in its local frame as complex numbers x + iy, memoised."""
-        if "points_z" not in self._derived:
-            self._derived["points_z"] = [{n: complex(*xy) for n, xy in link.points.items()} for link in self.links]
-        return self._derived["points_z"]
+    def inertia_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(mass (L,), I_S (L,), centre of mass in the local frame (L,) complex), read-only."""
+        return self.memo("inertia", lambda: (
+            np.array([link.mass for link in self.links]), np.array([link.I_S for link in self.links]),
+            np.array([complex(*link.points[link.com]) if link.com else 0j for link in self.links])))
+
+    @property
+    def points_z(self) -> tuple[Mapping[str, complex], ...]:
+        """Every link's points in its local frame as complex numbers x + iy, read-only."""
+        return self.memo("points_z", lambda: tuple(
+            MappingProxyType({n: complex(*xy) for n, xy in link.points.items()}) for link in self.links))
 
     @property
     def size(self) -> float:
         """Characteristic length: the largest distance between two points of one link, m."""
-        if "size" not in self._derived:
-            self._derived["size"] = self._largest_link()
-        return self._derived["size"]
+        return self.memo("size", self._largest_link)
 
     def _largest_link(self) -> float:
-        best = 0.0
-        for link in self.links[1:]:
-            pts = list(link.points.values())
-            for a in pts:
-                for b in pts:
-                    best = max(best, math.dist(a, b))
-        return best or 1.0
+        return max((_span(link.points.values()) for link in self.links[1:]), default=0.0) or 1.0
+
+
+def _span(points) -> float:
+    """Largest distance between two of `points` ((x, y) pairs), m; rows in blocks, so that
+    10^4 points take a second and bounded memory."""
+    z = np.array([complex(*xy) for xy in points])
+    return max((float(np.abs(z[i:i + 512, None] - z[None, :]).max()) for i in range(0, len(z), 512)),
+               default=0.0)
 
 
 def _abbreviate(text: str, limit: int = 90) -> str:
@@ -267,35 +280,71 @@ def _abbreviate(text: str, limit: int = 90) -> str:
 def load(path: str | Path) -> Mechanism:
     """Read and validate a model file (TOML), or a bundled model by name (`load("ice_crank_slider")`).
 
-    Raises `ModelError` listing every problem."""
+    Raises `ModelError` listing every problem (`ModelFileNotFound`, also a FileNotFoundError,
+    where the file does not exist)."""
     path = Path(path)
     if not path.exists() and path.parent == Path(".") and path.suffix in ("", ".toml"):
         from . import examples
         if path.stem in examples.names():
             path = examples.path(path.stem)
+    return loads(_read_text(path), source=str(path))
+
+
+def _read_text(path: Path) -> str:
+    """The text of a model file: a regular file (never a FIFO or a device, which would block or
+    never end) of at most MAX_FILE_BYTES, UTF-8."""
     try:
-        text = path.read_text(encoding="utf-8")
+        st = path.stat()
+        if not stat.S_ISREG(st.st_mode):
+            what = "a directory" if stat.S_ISDIR(st.st_mode) else "not a regular file (a FIFO, device or socket)"
+            raise ModelError([f"cannot read file: {what}; a model is a regular TOML file"], source=str(path))
+        if st.st_size > MAX_FILE_BYTES:
+            raise ModelError([f"file of {st.st_size} bytes is too large for a model (at most {MAX_FILE_BYTES})"],
+                             source=str(path))
+        with open(path, "rb") as f:
+            raw = f.read(MAX_FILE_BYTES + 1)      # the size may change between stat and read
+    except FileNotFoundError:
+        raise ModelFileNotFound(str(path)) from None
     except OSError as exc:
         raise ModelError([f"cannot read file: {exc.strerror}"], source=str(path)) from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ModelError([f"file is too large for a model (more than {MAX_FILE_BYTES} bytes)"], source=str(path))
+    try:
+        return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ModelError([f"not UTF-8 text: byte 0x{exc.object[exc.start]:02x} at offset {exc.start}"],
                          source=str(path)) from None
-    return loads(text, source=str(path))
 
 
 def loads(text: str, source: str = "<string>") -> Mechanism:
     """Parse a model from TOML text."""
-    for n, line in enumerate(text.splitlines(), 1):
-        key = line if line.lstrip().startswith("[") else line.partition("=")[0]
-        if len(key) > MAX_KEY:   # tomllib's memory grows as the square of a dotted key's depth
-            raise ModelError([f"line {n}: a key of {len(key)} characters (at most {MAX_KEY})"], source=source)
+    _check_key_cost(text, source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
     except RecursionError:
         raise ModelError(["TOML nested too deeply (arrays or tables within each other)"], source=source) from None
-    return from_dict(data, source=source)
+    return _Reader(data, source, text).mechanism()
+
+
+def _check_key_cost(text: str, source: str) -> None:
+    """Refuse keys whose parsing would take too much memory, before tomllib sees them: tomllib
+    keeps the path of every level of every key, so memory grows with the number of keys and as
+    the square of their depth (measured: 65 keys 3000 levels deep, 390 kB, took 2.3 GB)."""
+    cost = 0
+    for n, line in enumerate(text.splitlines(), 1):
+        head = line.lstrip()
+        key = head if head.startswith("[") else line.partition("=")[0]
+        if len(key) > MAX_KEY:
+            raise ModelError([f"line {n}: a key of {len(key)} characters (at most {MAX_KEY})"], source=source)
+        if not head.startswith("#") and ("=" in line or head.startswith("[")):
+            cost += _KEY_BYTES + _LEVEL_BYTES * (key.count(".") + 1) ** 2
+            if cost > MAX_KEY_MEMORY:
+                raise ModelError([f"line {n}: the keys up to here would take about {cost / 2**20:.0f} MiB to "
+                                  f"parse (at most {MAX_KEY_MEMORY / 2**20:.0f} MiB): too many keys, or keys "
+                                  f"nested too deeply (this one has {key.count('.') + 1} dotted parts)"],
+                                 source=source)
 
 
 def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
@@ -303,10 +352,95 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
     return _Reader(data, source).mechanism()
 
 
+def _suggest(name: Any, valid) -> str:
+    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else ""."""
+    if not isinstance(name, str):
+        return ""
+    close = difflib.get_close_matches(name, [str(v) for v in valid], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+class _Lines:
+    """Where each table and key of a TOML text sits: field path -> line number (best effort:
+    tomllib gives no positions, so the text is scanned for table headers and keys)."""
+
+    _HEADER = re.compile(r"\s*(\[\[?)\s*([A-Za-z0-9_\-.\"' ]+?)\s*\]\]?\s*(#.*)?$")   # not a row [x, y],
+    _PART = r"""(?:[A-Za-z0-9_\-]+|"[^"]*"|'[^']*')"""
+    _KEY = re.compile(rf"\s*({_PART}(?:\s*\.\s*{_PART})*)\s*=")
+    _INLINE_KEY = re.compile(r"[{,]\s*([A-Za-z0-9_\-]+|\"[^\"]*\"|'[^']*')\s*=")
+
+    def __init__(self, text: str):
+        self.at: dict[tuple, int] = {}
+        arrays: dict[tuple, int] = {}         # array-of-tables path -> tables seen so far
+        current: tuple = ()
+        in_string = False
+        for n, line in enumerate(text.splitlines(), 1):
+            if (line.count('"""') + line.count("\'\'\'")) % 2:
+                in_string = not in_string
+                if not in_string:
+                    continue
+            if in_string:
+                continue
+            head = self._HEADER.match(line)
+            if head:
+                parts = self._split(head[2])
+                if head[1] == "[[":
+                    parts = self._resolve(parts[:-1], arrays) + parts[-1:]
+                    arrays[parts] = arrays.get(parts, 0) + 1
+                    current = parts + (arrays[parts] - 1,)
+                else:
+                    current = self._resolve(parts, arrays)
+                self.at.setdefault(current, n)
+                continue
+            key = self._KEY.match(line)
+            if key:
+                path = current + self._split(key[1])
+                self.at.setdefault(path, n)
+                for inner in self._INLINE_KEY.findall(line):
+                    self.at.setdefault(path + (inner.strip("\"'"),), n)
+
+    @staticmethod
+    def _split(key: str) -> tuple:
+        return tuple(p.strip().strip("\"'") for p in key.split("."))
+
+    @staticmethod
+    def _resolve(parts: tuple, arrays: dict[tuple, int]) -> tuple:
+        out: tuple = ()
+        for p in parts:
+            out += (p,)
+            if out in arrays:
+                out += (arrays[out] - 1,)
+        return out
+
+    def line(self, path: tuple) -> int | None:
+        """Line of `path` or of its nearest enclosing table or key."""
+        for end in range(len(path), 0, -1):
+            if path[:end] in self.at:
+                return self.at[path[:end]]
+        return None
+
+
 #: Longest key (or table header) of a model file, characters.
 MAX_KEY = 10_000
+#: Largest model file read, bytes (a model is a few kB; 4000 links take 0.8 MB).
+MAX_FILE_BYTES = 32 * 2**20
+#: Memory tomllib may take for the keys of one file, estimated as _KEY_BYTES per key plus
+#: _LEVEL_BYTES per square of its depth (fitted to measurements: 266k two-level keys of a
+#: 4 MB file took 220 MB, 29k keys of 64 levels 1.1 GB).
+MAX_KEY_MEMORY = 256 * 2**20
+_KEY_BYTES, _LEVEL_BYTES = 800, 9
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
+#: Most points of one link (the largest distance between them costs n^2).
+MAX_POINTS = 10_000
+#: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
+#: lengths stay normal numbers.
+MIN_LENGTH = 1e-150
+#: Smallest base radius of the drive's gear wheel, relative to the largest link.
+MIN_GEAR = 1e-6
+#: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,
+#: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
+LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
 
 _TOP_KEYS = {"mechanism", "drive", "frame", "link", "pair", "group", "load", "spring", "friction", "published"}
 #: Most crank angles one `[[published]]` entry may list.
@@ -317,14 +451,51 @@ def _finite(x: Any) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
+def _subnormal(x: float) -> bool:
+    """Nonzero but below the smallest normal double: no model number is meant so."""
+    return 0 < abs(x) < sys.float_info.min
+
+
 class _Reader:
     """Reads the raw TOML structure, collecting every problem instead of stopping at the first."""
 
-    def __init__(self, data: Mapping[str, Any], source: str):
-        self.data, self.source, self.problems = data, source, []
+    def __init__(self, data: Mapping[str, Any], source: str, text: str | None = None):
+        self.data, self.source, self.problems, self.lines = data, source, [], []
+        self.where_lines = _Lines(text) if text is not None else None
+        self.link_table: dict[int, int] = {}      # link id -> index of its [[link]] table
+        # causes already reported, whose consequences are not reported again:
+        self.ids_unknown = False                  # some [[link]] has no valid id: "unknown link" follows
+        self.points_unread: set[tuple[int, str | None]] = set()   # (link, point) that failed (None: all)
+        self.misspelled: set[str] = set()         # field paths given under a near-miss name
+        self.group_tables: dict[frozenset, tuple[int, tuple]] = {}   # group -> (its [[group]], links as listed)
+        self.coincident: dict[int, str] = {}      # links whose points all coincide -> their field path
+        self.slider_axes: set[int] = set()        # P pairs (index) whose slider frame the file states
 
     def err(self, msg: str) -> None:
+        path = msg.partition(": ")[0]
+        if path in self.misspelled and msg[len(path):].startswith(": missing"):
+            return          # "mass: missing" after "masss: unknown field (did you mean 'mass'?)"
         self.problems.append(msg)
+        self.lines.append(self.line_of(path))
+
+    _STEP = re.compile(r"(\[\[(\w+)\]\] #(\d+)|[^.\[]+)(?:\[(id=)?(\d+)\])?")
+
+    def line_of(self, path: str) -> int | None:
+        """Line of the file where the field `path` of a message (e.g. `link[id=2].mass`) sits."""
+        if self.where_lines is None or " " in path.replace("<top level>", "").replace("[[link]] #", ""):
+            return None
+        steps: tuple = ()
+        for part in path.split("."):
+            m = self._STEP.fullmatch(part)
+            if m is None:
+                return None
+            if m[2]:                                  # [[link]] #3: the third table
+                steps += (m[2], int(m[3]) - 1)
+                continue
+            steps += () if m[1] == "<top level>" else (m[1],)
+            if m[5] is not None:
+                steps += (self.link_table.get(int(m[5]), -1) if m[4] else int(m[5]),)
+        return self.where_lines.line(steps) if steps else None
 
     # -- typed getters: each returns None after recording a problem
     def number(self, tab: Mapping, key: str, where: str, *, default: Any = "required",
@@ -340,6 +511,10 @@ class _Reader:
             return None
         if abs(x) > MAX_VALUE:
             self.err(f"{where}.{key}: {x!r} is out of range (|value| <= {MAX_VALUE:g})")
+            return None
+        if (positive or key == "g") and _subnormal(x):     # a speed, module, radius or g: a divisor somewhere
+            self.err(f"{where}.{key}: {x!r} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
+                     f"digits, and its products turn into 0, NaN or inf; write 0 or the value meant")
             return None
         if positive and x <= 0:
             self.err(f"{where}.{key}: must be > 0, got {x!r}")
@@ -376,7 +551,7 @@ class _Reader:
             self.err(f"{where}.{key}: expected a string, got {x!r}")
             return None
         if choices and x not in choices:
-            self.err(f"{where}.{key}: invalid value {x!r}. Valid values: {list(choices)}")
+            self.err(f"{where}.{key}: invalid value {x!r}{_suggest(x, choices)}. Valid values: {list(choices)}")
             return None
         return x
 
@@ -398,7 +573,10 @@ class _Reader:
     def unknown_keys(self, tab: Mapping, allowed: set[str], where: str) -> None:
         for k in tab:
             if k not in allowed:
-                self.err(f"{where}.{k}: unknown field. Valid fields: {sorted(allowed)}")
+                hint = _suggest(k, sorted(allowed - set(tab)))
+                if hint:
+                    self.misspelled.add(f"{where}.{hint.split(chr(39))[1]}")
+                self.err(f"{where}.{k}: unknown field{hint}. Valid fields: {sorted(allowed)}")
 
     # -- sections
     def mechanism(self) -> Mechanism:
@@ -431,80 +609,145 @@ class _Reader:
                     self.err(f"pair[{p.index}].radius: missing; friction losses need the journal radius "
                              f"of every revolute pair (or a default friction.radius)")
         if self.problems:
-            raise ModelError(self.problems, source=self.source)
+            raise ModelError(self.problems, source=self.source, lines=self.lines)
         try:
-            return Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
+            mech = Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
                              links=tuple(links), pairs=tuple(pairs),
                              branches=MappingProxyType(branches), loads=tuple(loads_),
                              springs=tuple(springs), drive=drive, friction=friction,
                              published=tuple(published), path=self.source)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
+        for path, msg in self.doubts(mech):
+            line = self.line_of(path)
+            warnings.warn(f"{self.source}: {'' if line is None else f'line {line}: '}{path}: {msg}",
+                          ModelWarning, stacklevel=4)
+        return mech
 
-    def points(self, raw: Any, where: str) -> dict[str, Vec]:
-        if not isinstance(raw, dict) or not raw:
-            self.err(f"{where}: expected a table of named points {{A = [x, y], ...}}")
+    def doubts(self, mech: Mechanism):
+        """(field path, message) for what loads but looks like a mistake: a number far out of
+        the usual, or a rule the file relies on that is easily misread."""
+        crank = mech.links[1].points
+        r = math.dist(crank[mech.drive.pivot], crank[mech.drive.point])
+        if mech.size > LARGEST_LINK or r * mech.drive.omega > FASTEST_PIN:
+            yield "link", (f"the largest link spans {mech.size:.4g} m and the crank pin moves at "
+                           f"{r * mech.drive.omega:.4g} m/s: lengths are read in metres; was the model drawn "
+                           f"in millimetres? (warned above {LARGEST_LINK:g} m or {FASTEST_PIN:g} m/s)")
+        if mech.g and not 1.0 <= mech.g <= 100.0:
+            yield "mechanism.g", (f"{mech.g:g} m/s^2 is far from the 9.81 of the texts (warned outside 1..100): "
+                                  f"is it in m/s^2? (0 switches gravity off)")
+        for g in mech.structure.groups:
+            n, listed = self.group_tables.get(frozenset(g.links), (None, ()))
+            if g.kind == "RRR" and n is not None and listed[0] > listed[1]:
+                yield f"group[{n}].links", (
+                    f"{list(listed)}: in an RRR group j is the lower id, {listed[1]} (P on link {listed[1]}), "
+                    f"whatever the order listed; if branch was computed with j = {listed[0]}, flip its sign; "
+                    f"list the links as {sorted(listed)} to silence this warning")
+        for p in mech.pairs:
+            slider = mech.links[p.links[1]]
+            if p.kind != "P" or not p.alpha or p.index in self.slider_axes:
+                continue
+            y0 = slider.points[p.point][1]
+            off = [n for n, xy in slider.points.items() if abs(xy[1] - y0) > 1e-9 * mech.size]
+            if off:
+                yield f"pair[{p.index}]", (
+                    f"slider link {slider.id}'s points are read in a frame whose x axis runs along the guide "
+                    f"(direction {list(p.direction)} in link {p.links[0]}'s frame), and {off[0]!r} lies "
+                    f"{abs(slider.points[off[0]][1] - y0):.4g} m off the guide line in it; if the points were "
+                    f"drawn in another frame (e.g. the world's), give slider_axis = the guide direction in "
+                    f"that frame (slider_axis = [1.0, 0.0] confirms the default)")
+
+    def points(self, raw: Any, where: str, lid: int | None = None) -> dict[str, Vec]:
+        """A table of named points; those that fail are recorded in points_unread for link `lid`."""
+        if not isinstance(raw, dict) or not raw or len(raw) > MAX_POINTS:
+            self.err(f"{where}: {'missing: ' if raw is None else ''}expected a table of named points {{A = [x, y], ...}}"
+                     + (f", at most {MAX_POINTS} of them, got {len(raw)}" if raw and isinstance(raw, dict) else ""))
+            self.points_unread.add((lid, None))
             return {}
         out = {}
         for name, xy in raw.items():
             v = self.vec(xy, f"{where}.{name}")
             if v is not None:
                 out[name] = v
+            else:
+                self.points_unread.add((lid, name))
         return out
 
     def links(self, g: float | None) -> list[Link]:
-        frame_raw = self.data.get("frame")
-        frame = Link(0, "frame", MappingProxyType(self.points(frame_raw, "frame")))
+        frame = Link(0, "frame", MappingProxyType(self.points(self.data.get("frame"), "frame", 0)))
         raw = self.table_list("link")
         by_id: dict[int, Link] = {}
         allowed = {"id", "name", "points", "mass", "weight", "I_S", "com"}
         for n, t in enumerate(raw):
-            where = f"link[{n}]"
+            lid = t.get("id")
+            valid_id = isinstance(lid, int) and not isinstance(lid, bool) and lid > 0
+            # named by its id, as the texts number links; by its table's place only without one
+            where = f"link[id={lid}]" if valid_id and lid not in by_id else f"[[link]] #{n + 1}"
+            if valid_id and lid not in by_id:
+                self.link_table[lid] = n
             self.unknown_keys(t, allowed, where)
-            lid = self.integer(t, "id", where)
-            if lid is not None:
-                where = f"link[{n}] (id {lid})"
-                if lid <= 0:
-                    self.err(f"{where}.id: moving links are numbered from 1 (0 is the frame)")
-                elif lid in by_id:
-                    self.err(f"{where}.id: duplicate link id {lid}")
-            pts = self.points(t.get("points"), f"{where}.points")
+            if valid_id and lid in by_id:
+                self.err(f"{where}.id: duplicate link id {lid} (link[id={lid}] is [[link]] "
+                         f"#{self.link_table[lid] + 1})")
+            elif isinstance(lid, int) and not isinstance(lid, bool) and lid <= 0:
+                self.err(f"{where}.id: moving links are numbered from 1 (0 is the frame), got {lid}")
+            elif not valid_id:
+                self.integer(t, "id", where)
+            if not valid_id or lid in by_id:
+                self.ids_unknown = True
+                lid = None
+            pts = self.points(t.get("points"), f"{where}.points", lid)
             if "mass" in t and "weight" in t:
                 self.err(f"{where}: give mass or weight, not both")
             if "weight" in t:
                 w = self.number(t, "weight", where, minimum=0.0)
                 mass = None if (w is None or not g) else w / g
-                if w is not None and not g:
+                if w is not None and g == 0:     # (a missing or invalid g is reported already)
                     self.err(f"{where}.weight: a weight needs mechanism.g > 0 to give a mass")
+                elif mass is not None and not mass <= MAX_VALUE:
+                    self.err(f"{where}.weight: {w:g} N / g = {w:g} / {g:g} m/s^2 gives a mass of {mass:g} kg, "
+                             f"out of range (<= {MAX_VALUE:g} kg): is mechanism.g right?")
+                    mass = None
             else:
                 mass = self.number(t, "mass", where, default=0.0, minimum=0.0)
             I_S = self.number(t, "I_S", where, default=0.0, minimum=0.0)
             com = self.string(t, "com", where, default=None)
             if com is not None and pts and com not in pts:
-                self.err(f"{where}.com: unknown point {com!r}. Valid names: {sorted(pts)}")
+                self.err(f"{where}.com: unknown point {com!r}{_suggest(com, pts)}. Valid names: {sorted(pts)}")
             if mass and com is None:
                 self.err(f"{where}.com: missing (a link with mass needs its centre-of-mass point)")
-            if len(pts) >= 2 and max(math.dist(a, b) for a in pts.values() for b in pts.values()) == 0:
-                self.err(f"{where}.points: all points coincide (zero-length link)")
-            if lid is not None and lid > 0 and lid not in by_id:
+            span = _span(pts.values()) if pts else None
+            if span == 0 and len(pts) >= 2:
+                self.coincident[lid if lid is not None else -n - 1] = where     # refused unless in a P pair
+            elif span is not None and 0 < span < MIN_LENGTH:
+                self.err(f"{where}.points: the link spans only {span:.3g} m: below {MIN_LENGTH:g} m the squares of "
+                         f"its lengths underflow (accelerations and forces turn into 0 or NaN); is the unit right?")
+            if lid is not None:
                 by_id[lid] = Link(lid, self.string(t, "name", where, default=f"link {lid}"),
                                   MappingProxyType(pts), mass or 0.0, I_S or 0.0, com)
         ids = sorted(by_id)
-        if ids != list(range(1, len(ids) + 1)):
-            self.err(f"link: ids must be 1..n without gaps, got {ids}")
+        if ids != list(range(1, len(ids) + 1)) or self.ids_unknown:
+            if not self.ids_unknown:        # a table without a valid id is the cause of any gap
+                self.err(f"link: ids must be 1..n without gaps, got {ids}")
+            self.ids_unknown = True
             return [frame]
         return [frame] + [by_id[i] for i in ids]
 
-    def link_ok(self, links: list[Link], lid: Any, where: str) -> bool:
-        if not isinstance(lid, int) or isinstance(lid, bool) or not 0 <= lid < len(links):
-            self.err(f"{where}: unknown link {lid!r}. Valid links: {list(range(len(links)))}")
+    def link_ok(self, links: list[Link], lid: Any, where: str, *, first: int = 0) -> bool:
+        """Is `lid` the id of a link (>= `first`)? Unknown ids are not reported while some
+        [[link]] table has no valid id: that table's problem is the cause."""
+        if not isinstance(lid, int) or isinstance(lid, bool) or not first <= lid < len(links):
+            if not self.ids_unknown:
+                moving = " moving" if first else ""
+                self.err(f"{where}: unknown{moving} link {lid!r}. Valid links: {list(range(first, len(links)))}")
             return False
         return True
 
-    def point_ok(self, links: list[Link], lid: int, name: Any, where: str) -> bool:
+    def point_ok(self, links: list[Link], lid: int, name: Any, where: str, why: str = "") -> bool:
         if not isinstance(name, str) or name not in links[lid].points:
-            self.err(f"{where}: link {lid} has no point {name!r}. "
-                     f"Valid names: {sorted(links[lid].points)}")
+            if (lid, None) not in self.points_unread and (lid, name) not in self.points_unread:
+                self.err(f"{where}: link {lid} has no point {name!r}{_suggest(name, links[lid].points)}{why}. "
+                         f"Valid names: {sorted(links[lid].points)}")
             return False
         return True
 
@@ -514,7 +757,7 @@ class _Reader:
             where = f"pair[{n}]"
             kind = self.string(t, "kind", where, choices=("R", "P"))
             self.unknown_keys(t, {"kind", "links", "point", "radius"} | (
-                {"guide", "direction"} if kind == "P" else set()), where)
+                {"guide", "direction", "slider_axis"} if kind == "P" else set()), where)
             lk = t.get("links")
             if not (isinstance(lk, list) and len(lk) == 2):
                 self.err(f"{where}.links: expected two link ids [i, j], got {lk!r}")
@@ -530,17 +773,46 @@ class _Reader:
                 if all(self.point_ok(links, x, pt, f"{where}.point") for x in lk):
                     out.append(Pair(len(out), "R", tuple(lk), pt, radius=radius))
             elif kind == "P":
-                ok = self.point_ok(links, lk[1], t.get("point"), f"{where}.point")
-                ok &= self.point_ok(links, lk[0], t.get("guide"), f"{where}.guide")
+                pt, gd = t.get("point"), t.get("guide")
+                pts = lambda k: links[k].points
+                if pt not in pts(lk[1]) and gd not in pts(lk[0]) and pt in pts(lk[0]) and gd in pts(lk[1]):
+                    self.err(f"{where}.links: a prismatic pair lists [guide link, slider link], and {lk} reads "
+                             f"reversed: point {pt!r} is on link {lk[0]} and guide {gd!r} on link {lk[1]}; "
+                             f"write links = [{lk[1]}, {lk[0]}]")
+                    continue
+                order = " (links = [guide link, slider link]: the {} is on link {})"
+                ok = self.point_ok(links, lk[1], pt, f"{where}.point", order.format("point", lk[1]))
+                ok &= self.point_ok(links, lk[0], gd, f"{where}.guide", order.format("guide point", lk[0]))
                 d = self.vec(t.get("direction"), f"{where}.direction", unit=True)
-                if ok and d is not None:
-                    out.append(Pair(len(out), "P", tuple(lk), t["point"], t["guide"], d, radius))
+                axis = self.vec(t["slider_axis"], f"{where}.slider_axis", unit=True) if "slider_axis" in t else None
+                if ok and d is not None and ("slider_axis" not in t or axis is not None):
+                    if axis is not None:
+                        self.slider_axes.add(len(out))
+                        links[lk[1]] = _turned_slider(links[lk[1]], axis)
+                    out.append(Pair(len(out), "P", tuple(lk), pt, gd, d, radius))
         seen: dict[frozenset, int] = {}
         for p in out:
             key = frozenset(p.links)
             if key in seen:
                 self.err(f"pair[{p.index}]: links {sorted(key)} are already joined by pair[{seen[key]}]")
             seen[key] = p.index
+        in_p = {k for p in out if p.kind == "P" for k in p.links}
+        for lid, where in self.coincident.items():
+            if lid not in in_p:     # a guide or a slider takes its direction from its pair
+                self.err(f"{where}.points: all points coincide (zero-length link)")
+        sliders = [p.links[1] for p in out if p.kind == "P"]
+        for n in self.slider_axes:
+            if sliders.count(out[n].links[1]) > 1:
+                self.err(f"pair[{n}].slider_axis: link {out[n].links[1]} slides in more than one prismatic pair; "
+                         f"give its points in the frame of its guides instead")
+        # the CSV columns of a point (x_P, vx_P, ...) must not be those of a prismatic pair (x_i_j)
+        for p in out:
+            name = f"{p.links[0]}_{p.links[1]}"
+            for link in links if p.kind == "P" else ():
+                if name in link.points:
+                    self.err(f"{'frame' if link.id == 0 else f'link[id={link.id}].points'}.{name}: the point's "
+                             f"table column x_{name} would be that of prismatic pair {p.label} (x_{name}, the "
+                             f"line of its normal force): rename the point")
         # a point name on two links must be the revolute pair that joins them (or a chain of
         # revolute pairs at that point: several links on one pin)
         owners: dict[str, list[int]] = {}
@@ -594,14 +866,15 @@ class _Reader:
         kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")
         gear = None
         if kind == "machine":
-            gear = self.gear(t.get("gear"))
+            gear = self.gear(t.get("gear"), max((_span(k.points.values()) for k in links[1:]), default=0.0))
         elif "gear" in t:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
         if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
             return None
         return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design)
 
-    def gear(self, t: Any) -> Gear | None:
+    def gear(self, t: Any, size: float) -> Gear | None:
+        """[drive.gear]; `size`: the largest link, m (the wheel must not be vanishingly small beside it)."""
         w = "drive.gear"
         if not isinstance(t, dict):
             self.err(f"{w}: a working machine needs the table [drive.gear] (module, z_pinion, z_wheel, ...)")
@@ -627,6 +900,11 @@ class _Reader:
         if gear.r_w <= 0:
             self.err(f"{w}.y: the wheel's pitch radius r_w = r (1 + 2y/(z1 + z2)) = {gear.r_w:g} m must be > 0")
             return None
+        if gear.r_b < MIN_GEAR * size:
+            self.err(f"{w}.module: the wheel's base radius r_b = {gear.r_b:.3g} m is below {MIN_GEAR:g} of the "
+                     f"largest link ({size:.3g} m): the balancing force M_bal / r_b would be out of range; "
+                     f"is the module in metres (0.010 for 10 mm)?")
+            return None
         return gear
 
     def groups(self, links: list[Link]) -> dict[frozenset, int]:
@@ -641,10 +919,18 @@ class _Reader:
                     self.err(f"{where}.links: expected two link ids, got {lk!r}")
                 continue
             b = t.get("branch")
-            if b not in (1, -1) or isinstance(b, bool):
-                self.err(f"{where}.branch: expected +1 or -1, got {b!r}")
+            if not isinstance(b, int) or isinstance(b, bool) or b not in (1, -1):
+                self.err(f"{where}.branch: expected +1 or -1, got {b!r}"
+                         + (" (an integer: write it without a decimal point)" if isinstance(b, float) else ""))
                 continue
-            out[frozenset(lk)] = b
+            key = frozenset(lk)
+            if key in out and out[key] != b:
+                first = self.group_tables[key][0]
+                self.err(f"{where}.branch: group {sorted(key)} is already given branch = {out[key]:+d} by "
+                         f"group[{first}]; this entry says {b:+d}: keep one")
+                continue
+            out[key] = b
+            self.group_tables.setdefault(key, (n, tuple(lk)))
         return out
 
     def loads(self, links: list[Link]) -> list[Load]:
@@ -678,6 +964,16 @@ class _Reader:
                 continue
             value = self.number(t, "value", where) if "value" in t else None
             table = self.table(t["table"], f"{where}.table") if "table" in t else None
+            if table is not None and table.argument == "travel":
+                if kind == "moment":
+                    self.err(f"{where}.table.travel: a moment acts on a link, not at a point, so it has no "
+                             f"travel to follow; use phi_deg (the crank angle), or make it a force at a point")
+                    continue
+                if table.axis is None and direction == "against_velocity":
+                    self.err(f"{where}.table.axis: missing: the travel is measured along axis, and a force "
+                             f"directed 'against_velocity' has no fixed direction to take it from (give the "
+                             f"world direction of the stroke, e.g. axis = [0.0, 1.0])")
+                    continue
             if kind == "force" and direction is None:
                 continue
             if value is not None or table is not None:
@@ -809,8 +1105,7 @@ class _Reader:
             relative_to = self.published_point(t, "relative_to", where, links, required=False)
         elif "link" in needs:
             link = t.get("link")
-            if not isinstance(link, int) or isinstance(link, bool) or not 1 <= link < len(links):
-                self.err(f"{where}.link: unknown moving link {link!r}. Valid links: {list(range(1, len(links)))}")
+            self.link_ok(links, link, f"{where}.link", first=1)
         elif "pair" in needs:
             pair = t.get("pair")
             if not (isinstance(pair, list) and len(pair) == 2
@@ -848,6 +1143,14 @@ class _Reader:
                                            else f"unknown point {name!r}. Valid names: {known}"))
             return None
         return name
+
+
+def _turned_slider(link: Link, axis: Vec) -> Link:
+    """The slider `link` with its points turned from the author's frame, in which the guide runs
+    along `axis`, into the documented one, whose x axis runs along the guide."""
+    turn = complex(*axis).conjugate()
+    pts = {n: ((z := complex(*xy) * turn).real, z.imag) for n, xy in link.points.items()}
+    return Link(link.id, link.name, MappingProxyType(pts), link.mass, link.I_S, link.com)
 
 
 def _components(edges: list[tuple[int, int]]) -> dict[int, int]:

@@ -182,8 +182,48 @@ def test_analyze_of_a_path_says_what_it_wants():
 def test_missing_file_and_directory(tmp_path):
     with pytest.raises(ModelError, match="cannot read file"):
         kinetostat.load(tmp_path / "none.toml")
-    with pytest.raises(ModelError, match="cannot read file"):
+    with pytest.raises(FileNotFoundError) as exc:          # also what `except FileNotFoundError` catches
+        kinetostat.load(tmp_path / "none.toml")
+    assert isinstance(exc.value, ModelError) and exc.value.filename == str(tmp_path / "none.toml")
+    with pytest.raises(ModelError, match="cannot read file: a directory"):
         kinetostat.load(tmp_path)
+
+
+def _load_within(path, seconds: float = 10.0):
+    """kinetostat.load(path) in a thread: its exception, or a failure if it does not return."""
+    import threading
+    out: list = []
+
+    def run():
+        try:
+            kinetostat.load(path)
+            out.append(None)
+        except Exception as exc:       # noqa: BLE001 (handed to the test)
+            out.append(exc)
+    t = threading.Thread(target=run, daemon=True)
+    t.start()
+    t.join(seconds)
+    assert out, f"load({path}) did not return within {seconds} s"
+    return out[0]
+
+
+@pytest.mark.skipif(not Path("/dev/zero").exists() or not hasattr(__import__("os"), "mkfifo"), reason="POSIX only")
+def test_fifo_and_device_are_refused_without_reading(tmp_path):
+    import os
+    fifo = tmp_path / "model.toml"
+    os.mkfifo(fifo)                          # opening it for reading would block until a writer comes
+    for path in (fifo, Path("/dev/zero")):   # /dev/zero would never end
+        exc = _load_within(path)
+        assert isinstance(exc, ModelError) and "not a regular file" in str(exc), exc
+
+
+def test_oversized_file_is_refused_before_reading(tmp_path):
+    from kinetostat.model import MAX_FILE_BYTES
+    big = tmp_path / "big.toml"
+    with open(big, "wb") as f:               # sparse: no disk used, nothing read
+        f.truncate(MAX_FILE_BYTES + 1)
+    exc = _load_within(big)
+    assert isinstance(exc, ModelError) and f"at most {MAX_FILE_BYTES}" in str(exc), exc
 
 
 @pytest.mark.skipif(not _cli_available(), reason="kinetostat/cli.py not written yet")
@@ -288,3 +328,43 @@ def test_deep_dotted_key_is_refused_in_bounded_time():
     with pytest.raises(ModelError, match=r"<top level>\.a: unknown field"):
         kinetostat.loads(text)
     assert time.perf_counter() - t0 < 10.0
+
+
+@pytest.mark.parametrize("keys, depth, header", [
+    (200, 401, False),         # many moderately deep keys (200 x 400 levels, 160 kB)
+    (200, 401, True),          # as table headers
+    (400_000, 2, False),       # very many shallow keys (5.6 MB)
+], ids=["deep-keys", "deep-headers", "many-keys"])
+def test_costly_keys_are_refused_before_parsing(keys, depth, header):
+    """tomllib's memory grows with the number of keys and the square of their depth (65 keys of
+    3000 levels: 2.3 GB measured): the estimate refuses before tomllib runs."""
+    dotted = ".".join(["a"] * (depth - 1))
+    text = "".join((f"[k{i}.{dotted}]\nx = 1\n" if header else f"k{i}.{dotted} = 1\n") for i in range(keys))
+    t0 = time.perf_counter()
+    with pytest.raises(ModelError, match=rf"MiB to parse .*this one has {depth} dotted parts"):
+        kinetostat.loads(text + FOUR_BAR)
+    assert time.perf_counter() - t0 < 10.0
+
+
+def test_deep_inline_tables_and_arrays_are_refused():
+    for text in ("x = " + "{a = " * 3000 + "1" + "}" * 3000 + "\n", "x = " + "[" * 3000 + "]" * 3000 + "\n"):
+        with pytest.raises(ModelError, match="nested too deeply"):
+            kinetostat.loads(text + FOUR_BAR)
+
+
+def test_huge_array_and_many_points_load_in_bounded_time():
+    """A 2*10^5-value diagram and a link of 5000 points (the largest distance between them costs
+    n^2) load in bounded time (10^6 values and 9000 points: ~9 s measured)."""
+    table = FOUR_BAR + ('[[load]]\nname = "big"\nlink = 3\npoint = "B"\ndirection = [0.0, -1.0]\n[load.table]\n'
+                        'phi_deg = [' + ", ".join(f"{360 * i / 199_999:.6f}" for i in range(200_000)) + ']\n'
+                        'value = [' + ", ".join(["1.0"] * 200_000) + ']\n')
+    pts = ", ".join(f"P{i} = [{i * 1e-5}, 0.0]" for i in range(5000))
+    many = FOUR_BAR.replace("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01], " + pts + " }")
+    t0 = time.perf_counter()
+    assert len(kinetostat.loads(table).loads[-1].table.x) == 200_000
+    assert kinetostat.loads(many).size == pytest.approx(0.35)
+    assert time.perf_counter() - t0 < 30.0
+    from kinetostat.model import MAX_POINTS
+    too_many = ", ".join(f"P{i} = [{i * 1e-6}, 0.0]" for i in range(MAX_POINTS + 1))
+    with pytest.raises(ModelError, match=f"at most {MAX_POINTS} of them"):
+        kinetostat.loads(FOUR_BAR.replace("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01], " + too_many + " }"))

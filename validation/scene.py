@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinetostat import Analysis, Mechanism, analyze
-from kinetostat.model import Pair
+from kinetostat.model import MAX_VALUE, Pair
 from kinetostat.planar import cross, rotate
 
 __all__ = ["Joint", "Body", "Scene", "EngineResult", "build_scene", "tracked_points"]
@@ -145,7 +145,14 @@ def build_scene(mech: Mechanism, phi_deg=None, steps: int = 360, res: Analysis |
 
 
 def _body(mech: Mechanism, k: int) -> Body:
+    """Link k as a body; refused here, before any engine sees it, where its mass or inertia is
+    not a finite number in the model's range: pymunk aborts the process on an infinite mass
+    (measured: SIGABRT in cpBodySetMass with mass = inf from weight / g, g = 5e-320)."""
     link = mech.links[k]
+    for what, x in (("mass", link.mass), ("I_S", link.I_S)):
+        if not (math.isfinite(x) and 0 <= x <= MAX_VALUE):
+            raise ValueError(f"link {k}: {what} = {x!r} is not a finite number in [0, {MAX_VALUE:g}]: "
+                             f"no engine is given it")
     com = np.asarray(link.points[link.com], float) if link.com else np.zeros(2)
     return Body(k, link.mass, link.I_S, com)
 
