@@ -645,8 +645,8 @@ class _Reader:
                     f"list the links as {sorted(listed)} to silence this warning")
         for p in mech.pairs:
             slider = mech.links[p.links[1]]
-            if p.kind != "P" or not p.alpha or p.index in self.slider_axes:
-                continue
+            if p.kind != "P" or abs(p.alpha) <= 1e-9 or p.index in self.slider_axes:
+                continue                  # a guide along x (to rounding): both readings are the same
             y0 = slider.points[p.point][1]
             off = [n for n, xy in slider.points.items() if abs(xy[1] - y0) > 1e-9 * mech.size]
             if off:
