@@ -222,11 +222,16 @@ def test_ctrl_c_stops_the_report_and_keeps_every_earlier_file(tmp_path):
     took = time.perf_counter() - t0
     assert first.returncode == 0, first.stderr
     before = _files(out)
+    # the moments are taken after the interpreter has imported the command (a signal during
+    # Python's own start-up is Python's, not the run's), early enough that a run still goes on
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "import kinetostat.cli"], check=True, env=env, cwd=ROOT, timeout=300)
+    startup = time.perf_counter() - t0
     stopped = 0
-    for fraction in (0.1, 0.2, 0.3, 0.4, 0.55):     # early enough that a run still goes on when the load drops
+    for fraction in (0.1, 0.2, 0.3, 0.4, 0.55):
         p = subprocess.Popen(_report_cmd(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
                              cwd=ROOT)
-        time.sleep(fraction * took)
+        time.sleep(startup + fraction * max(took - startup, 0.0))
         running = p.poll() is None
         p.send_signal(signal.SIGINT)
         _, err = p.communicate(timeout=300)

@@ -326,8 +326,9 @@ def _assembled(data: dict, steps: int = 120):
     try:
         mech = kinetostat.from_dict(data)
     except kinetostat.ModelError as exc:
-        # the drawn extra points of a small slider may all fall on its pin (hypothesis likes 0)
-        if all("all points coincide" in p for p in exc.problems):
+        # the drawn extra points of a small slider may all fall on its pin, or within 1e-150 m of
+        # it (hypothesis likes 0 and the tiniest floats): a degenerate link, refused as such
+        if all("all points coincide" in p or "the link spans only" in p for p in exc.problems):
             return None
         raise
     with warnings.catch_warnings():
