@@ -177,15 +177,21 @@ def _angle(text: str) -> float:
     return x
 
 
-def _steps(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        n = 0
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"invalid number of positions {text!r}: expected a positive integer, "
-                                         f"e.g. --steps 360")
-    return n
+def _positive(what: str, example: str):
+    """An argparse type: a positive integer, or an error naming `what` with an example."""
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            n = 0
+        if n < 1:
+            raise argparse.ArgumentTypeError(f"invalid {what} {text!r}: expected a positive integer, e.g. {example}")
+        return n
+    return parse
+
+
+_steps = _positive("number of positions", "--steps 360")
+_jobs = _positive("number of jobs", "--jobs 4")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -685,17 +691,6 @@ def _worker_init() -> None:
         remove_temporary()
         os._exit(EXIT_INTERRUPTED)
     signal.signal(signal.SIGINT, end)
-
-
-def _jobs(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        n = 0
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"invalid number of jobs {text!r}: expected a positive integer, "
-                                         f"e.g. --jobs 4")
-    return n
 
 
 def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int):
