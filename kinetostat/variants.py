@@ -33,7 +33,7 @@ all 1000 of each task are distinct models.
    no column, and p_max = 2.4 (columns 0, 5), G3 = 3.8 (4, 5), G2 = 4.9 (4, 9) contradict а = б = 1.
    The intro's "479" only illustrates the rule. The bundled `models/ice_crank_slider.toml` is the
    example; `build(1, WORKED_EXAMPLE)` feeds its data through this builder (the nearest code is
-   110: n1, l_OA, phi1 agree, the other seven rows differ).
+   110: n1, l_OA, phi1 and l_AS2/l_AB agree, the other six rows differ).
 4. Columns that break a table's pattern are taken as printed: table 1.1 I_S2 column 5 = 0.0023
    (then 0.0018 ... 0.0021); table 1.3 l_OA columns 7 and 8 both 0.08, n1 column 9 = 360;
    table 1.2 l_OA, d, p_max, G columns without a trend.
@@ -62,6 +62,7 @@ May use: the solver (`model`, `analysis`), `kinetostat.plans` (the key's plans a
 """
 from __future__ import annotations
 
+import copy
 import json
 import math
 import textwrap
@@ -356,14 +357,19 @@ def _model(task: int, v: Mapping[str, float], label: str, assumptions: list[str]
 
 @dataclass(frozen=True)
 class Variant:
-    """One variant of a seed 002 task: its code, the columns and values it selects, the model as a
-    dict (`kinetostat.from_dict` input) and the TOML file's header (comment lines)."""
+    """One variant of a seed 002 task: its code, the columns and values it selects, the model
+    (`model`: a fresh dict each time, `kinetostat.from_dict` input) and the TOML file's header."""
     task: int
     code: str | None
     columns: Mapping[str, int]
     values: Mapping[str, float]
-    model: Mapping[str, Any]
+    _model: Mapping[str, Any]
     header: tuple[str, ...]
+
+    @property
+    def model(self) -> dict[str, Any]:
+        """The model as a dict (a deep copy: editing it leaves the variant as it is)."""
+        return copy.deepcopy(self._model)
 
     @property
     def name(self) -> str:
@@ -371,11 +377,11 @@ class Variant:
         return f"task{self.task}_{self.code or 'custom'}"
 
     def mechanism(self) -> Mechanism:
-        return from_dict(self.model, source=self.name)
+        return from_dict(self._model, source=self.name)
 
     def toml(self) -> str:
         """The model as a readable TOML file: the header, then the tables."""
-        return to_toml(self.model, self.header)
+        return to_toml(self._model, self.header)
 
 
 def build(task: int, v: Mapping[str, float], code: str | None = None, columns: Mapping[str, int] | None = None
