@@ -1,4 +1,5 @@
-"""The command line: `kinetostat analyze | structure | plans | validate | report | examples | variant` (also `python -m kinetostat`).
+"""The command line: `kinetostat analyze | structure | plans | validate | report | examples | variant`
+(also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
 nothing to compare, or `report` could not make a model's report; 2 bad input or options (model

@@ -212,7 +212,8 @@ _ASSUMED = {
         "column of table 1.3, so it holds for every code. Force pi/4 d^2 p on the crown towards the crank."],
 }
 _COMMON = ["Every number not derived from the table is an assumption of the bundled model named in these "
-           "items (models/<name>.toml, whose header gives the reasons); the table's values are used as printed (columns that break a pattern included).",
+           "items (models/<name>.toml, whose header gives the reasons); the table's values are used as "
+           "printed (columns that break a pattern included).",
            "l_AB = (l_AB/l_OA) * l_OA exactly (not rounded as in the worked example); l_AS = (l_AS/l_AB) * l_AB.",
            "Constant crank speed (eps = 0), no friction (the text ignores it, line 334), g = 9.81 (line 350); "
            "design position phi1 of the table."]
