@@ -1,4 +1,5 @@
-"""The command line: `kinetostat analyze | structure | plans | validate | report | examples` (also `python -m kinetostat`).
+"""The command line: `kinetostat analyze | structure | plans | validate | report | examples | variant`
+(also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
 nothing to compare, or `report` could not make a model's report; 2 bad input or options (model
@@ -871,6 +872,68 @@ def cmd_examples(args) -> int:
     return EXIT_OK
 
 
+# ============================================================================ variant
+
+def cmd_variant(args) -> int:
+    from . import variants
+    from .errors import AssemblyError, ModelError
+    try:
+        tasks = list(variants.TASKS) if args.task is None else [variants.check_task(args.task, "TASK")]
+        if args.all and args.code is not None:
+            raise CLIError(f"CODE {args.code!r}: not with --all (--all writes every code of the task)")
+        if not args.all:
+            if args.task is None or args.code is None:
+                raise CLIError("TASK and CODE are required (e.g. 'kinetostat variant 1 479'), or --all")
+            jobs = [variants.variant(tasks[0], variants.check_code(args.code, tasks[0], "CODE"))]
+        else:
+            jobs = [(t, c) for t in tasks for c in variants.codes()]
+    except ValueError as exc:
+        raise CLIError(f"{exc} (see 'kinetostat variant --help')") from None
+    default = "seed002_variants" if args.all else jobs[0].name
+    out = _writable_dir(args.out or default, "--out")
+    t0 = time.perf_counter()
+    keys = []
+    bar = _progress(len(jobs), "variants", args.all and not args.no_progress)
+    try:
+        for job in jobs:
+            _checkpoint()
+            v = job if not args.all else variants.variant(*job)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:
+                    keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
+                                                   cycle_csv=not args.all))
+                except (AssemblyError, ModelError, ValueError) as exc:
+                    raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
+                except OSError as exc:
+                    raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
+            bar.update()
+        if args.all:
+            try:
+                index = variants.write_index(out, keys)
+            except OSError as exc:
+                raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
+    finally:
+        _close(bar)
+    if args.all:
+        _Out.write(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
+                   f"index -> {index}; {time.perf_counter() - t0:.1f} s")
+        return EXIT_OK
+    v, k = jobs[0], keys[0]
+    spec = variants.TASKS[v.task]
+    lines = [f"seed 002, task {v.task} ({spec.title}), variant {v.code}: table {spec.table} columns "
+             + " ".join(f"{ch}={v.code[i]}" for ch, i in variants.LETTERS.items())]
+    lines += [f"  {r.letter}  {r.symbol:<22s} = {v.values[r.key]:g} {r.unit if r.unit != '1' else ''}".rstrip()
+              for r in spec.rows]
+    lines += [f"at phi1 = {k.phi1:g} deg: M_bal = {_fmt(k.M_bal, 'N m')}, largest reaction |{k.largest}| = "
+              f"{_fmt(k.R_max, 'N')}",
+              f"over the cycle: max |M_bal| = {_fmt(k.cycle_M_max, 'N m')}, max |R| = {_fmt(k.cycle_R_max, 'N')}",
+              f"model {v.name}.toml (assumptions in its header), worksheet, plans and cycle.csv: "
+              f"{len(k.files)} files -> {out}"]
+    _Out.write("\n".join(lines))
+    return EXIT_OK
+
+
 # ============================================================================ parser and main
 
 def build_parser() -> argparse.ArgumentParser:
@@ -998,6 +1061,26 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--copy", metavar="DIR", help="copy every bundled model and FORMAT.md into DIR (created)")
     e.add_argument("--force", action="store_true", help="with --copy: replace files already in DIR")
     e.set_defaults(func=cmd_examples)
+
+    va = sub.add_parser("variant", help="seed 002's task variants (tables 1.1-1.3): the model and its answer key",
+                        description="Build the model of seed 002's task TASK (1: ICE crank-slider, table 1.1; 2: "
+                                    "opposed-cylinder ICE, table 1.2; 3: air compressor, table 1.3) for the three-"
+                                    "digit variant CODE (the digits, written twice, select the columns of the rows "
+                                    "labelled а б в г д е), run it, and write into DIR the model file "
+                                    "task<T>_<CODE>.toml (its header states the columns and every assumption the "
+                                    "text leaves open), its answer key at the design position phi1 (worksheet.md/"
+                                    "html/csv/json and the plans' SVG sheets with segments.csv) and cycle.csv. "
+                                    "--all writes the keys of every code (of TASK, or of all three tasks) into "
+                                    "DIR/task<T>_<CODE>/ (no cycle.csv) with DIR/index.md, code -> M_bal and the "
+                                    "largest reaction.")
+    va.add_argument("task", metavar="TASK", nargs="?", help="task of seed 002: 1, 2 or 3 (with --all: default all)")
+    va.add_argument("code", metavar="CODE", nargs="?", help="three-digit variant 000..999, e.g. 479")
+    va.add_argument("--all", action="store_true", help="every code of TASK (or of every task), for a teacher")
+    va.add_argument("--out", metavar="DIR", help="output directory (created; default ./task<T>_<CODE>, "
+                                                 "with --all ./seed002_variants)")
+    va.add_argument("--lang", choices=("en", "uk"), default="en", help="language of the key (default en)")
+    va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
+    va.set_defaults(func=cmd_variant)
     return p
 
 
