@@ -1,4 +1,4 @@
-"""The command line: `kinetostat analyze | structure | plans | validate | report | examples | variant`
+"""The command line: `kinetostat analyze | structure | plans | validate | report | export | examples | variant`
 (also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or

@@ -49,7 +49,7 @@ def four_bar(tmp_path) -> Path:
 def test_help_of_every_command(cli):
     top = cli("--help")
     assert top.returncode == 0
-    for cmd in ("analyze", "structure", "validate", "report", "examples"):
+    for cmd in ("analyze", "structure", "validate", "report", "examples", "export", "plans", "variant"):
         assert cmd in top.stdout
         h = cli(cmd, "--help")
         assert h.returncode == 0, h.stderr
