@@ -133,7 +133,7 @@ class Drive:
     point: str
     reference: Vec              # unit world direction of phi = 0
     sense: int                  # +1 ccw, -1 cw
-    omega: float                # rad/s, > 0, in `sense`
+    omega: float                # rad/s, >= 0 (0: statics), in `sense`
     eps: float                  # rad/s^2, in `sense`
     kind: Literal["engine", "machine"]
     gear: Gear | None = None
@@ -955,10 +955,10 @@ class _Reader:
             self.err("drive: give exactly one of rpm or omega")
             omega = None
         elif "rpm" in t:
-            rpm = self.number(t, "rpm", w, positive=True)
+            rpm = self.number(t, "rpm", w, minimum=0.0)
             omega = None if rpm is None else rpm * math.pi / 30
         else:
-            omega = self.number(t, "omega", w, positive=True)
+            omega = self.number(t, "omega", w, minimum=0.0)     # 0: statics
         eps = self.number(t, "eps", w, default=0.0)
         design = self.number(t, "design_deg", w, default=30.0)
         kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")
