@@ -252,17 +252,20 @@ def test_the_chain_unit_at_standstill_is_in_static_equilibrium():
     def cross_row(r):       # the moment of a force F about a point, r x F = [-r_y, r_x] . F
         return [-r[1], r[0]]
 
+    def _cross(r, F):
+        return r[0] * F[1] - r[1] * F[0]
+
     for n in range(len(phi)):
         p = {k: v[n] for k, v in P.items()}
         A = np.zeros((9, 9))
         b = np.zeros(9)
         # unknowns: F_O1 (0 on 1), F_A (1 on 2), F_B (2 on 3), F_O2 (0 on 3), M (on the crank)
         A[0:2, 0:2], A[0:2, 2:4], b[0:2] = np.eye(2), -np.eye(2), -W[0]
-        A[2, 2:4], A[2, 8], b[2] = np.negative(cross_row(p["A"] - p["O1"])), 1.0, -np.cross(p["C1"] - p["O1"], W[0])
+        A[2, 2:4], A[2, 8], b[2] = np.negative(cross_row(p["A"] - p["O1"])), 1.0, -_cross(p["C1"] - p["O1"], W[0])
         A[3:5, 2:4], A[3:5, 4:6], b[3:5] = np.eye(2), -np.eye(2), -W[1]
-        A[5, 4:6], b[5] = np.negative(cross_row(p["B"] - p["A"])), -np.cross(p["C2"] - p["A"], W[1])
+        A[5, 4:6], b[5] = np.negative(cross_row(p["B"] - p["A"])), -_cross(p["C2"] - p["A"], W[1])
         A[6:8, 4:6], A[6:8, 6:8], b[6:8] = np.eye(2), np.eye(2), -W[2]
-        A[8, 4:6], b[8] = cross_row(p["B"] - p["O2"]), -np.cross(p["S3"] - p["O2"], W[2])
+        A[8, 4:6], b[8] = cross_row(p["B"] - p["O2"]), -_cross(p["S3"] - p["O2"], W[2])
         x = np.linalg.solve(A, b)
         np.testing.assert_allclose(res.reaction(0, 1)[n], x[0:2], rtol=0, atol=1e-9 * np.abs(x).max())
         np.testing.assert_allclose(res.reaction(0, 3)[n], x[6:8], rtol=0, atol=1e-9 * np.abs(x).max())
