@@ -650,7 +650,9 @@ class _Reader:
         return x
 
     def integer(self, tab: Mapping, key: str, where: str) -> int | None:
-        x = tab.get(key)
+        x = self.scalar(tab.get(key), f"{where}.{key}")     # an expression must give a whole number
+        if isinstance(x, float) and x.is_integer() and isinstance(tab.get(key), str):
+            x = int(x)
         if not isinstance(x, int) or isinstance(x, bool):
             self.err(f"{where}.{key}: expected an integer, got {x!r}" if key in tab
                      else f"{where}.{key}: missing (an integer is required)")
