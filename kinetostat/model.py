@@ -602,7 +602,7 @@ class _Reader:
         if abs(x) > MAX_VALUE:
             self.err(f"{where}.{key}: {shown} is out of range (|value| <= {MAX_VALUE:g})")
             return None
-        if (positive or key == "g") and _subnormal(x):     # a speed, module, radius or g: a divisor somewhere
+        if (positive or key in ("g", "rpm", "omega")) and _subnormal(x):   # a speed, module, radius or g: a divisor
             self.err(f"{where}.{key}: {shown} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
                      f"digits, and its products turn into 0, NaN or inf; write 0 or the value meant")
             return None
