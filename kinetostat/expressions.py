@@ -41,7 +41,7 @@ def bar_inertia(m: float, l: float) -> float:
 
 
 def mass_from_density(q: float, l: float) -> float:
-    """m = q l, kg: a link of linear density q (kg/m) and length l (m) (seed 002's q of the links)."""
+    """m = q l, kg: a link of linear density q (kg/m) and length l (m) (seed 000 sec. 6.1, line 373)."""
     return q * l
 
 
