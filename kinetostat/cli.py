@@ -551,6 +551,11 @@ def cmd_structure(args) -> int:
         lines.append("  none")
     lines.append(f"structure formula: {s.formula}")
     lines.append(f"class {s.mechanism_class}, order {s.order}")
+    if m.parameters:
+        lines.append("parameters: " + ", ".join(f"{n} = {v:.10g}" for n, v in m.parameters.items()))
+    if m.expressions:
+        lines.append("numbers from expressions:")
+        lines += [f"  {path} = {text} = {v:.10g}" for path, (text, v) in m.expressions.items()]
     _Out.write("\n".join(lines))
     return EXIT_OK
 

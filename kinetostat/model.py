@@ -20,9 +20,10 @@ from typing import Any, Callable, Literal, Mapping
 import numpy as np
 
 from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
+from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse as parse_expression, resolve as resolve_parameters
 from .structure import Structure, analyse_structure
 
-__all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Published", "Mechanism",
+__all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Published", "Study", "Mechanism",
            "PUBLISHED_UNITS", "load", "loads", "from_dict"]
 
 Vec = tuple[float, float]
@@ -132,7 +133,7 @@ class Drive:
     point: str
     reference: Vec              # unit world direction of phi = 0
     sense: int                  # +1 ccw, -1 cw
-    omega: float                # rad/s, > 0, in `sense`
+    omega: float                # rad/s, >= 0 (0: statics), in `sense`
     eps: float                  # rad/s^2, in `sense`
     kind: Literal["engine", "machine"]
     gear: Gear | None = None
@@ -175,6 +176,16 @@ class Published:
 
 
 @dataclass(frozen=True)
+class Study:
+    """A parameter study the model declares (`[study]`): the largest |R(i,j)| of one pair over the
+    cycle for every combination of the parameters' values (first parameter: rows, second: columns)."""
+    title: str
+    vary: tuple[tuple[str, tuple[float, ...]], ...]   # (parameter, its values), one or two
+    pair: tuple[int, int]                             # R(i, j): force of link i on link j
+    steps: int                                        # crank angles per cycle, equally spaced from 0
+
+
+@dataclass(frozen=True)
 class Mechanism:
     """A planar one-degree-of-freedom linkage. Build with `kinetostat.load`; never mutated."""
     name: str
@@ -190,6 +201,11 @@ class Mechanism:
     friction: Friction | None
     published: tuple[Published, ...] = ()   # the sources' printed values for this model
     path: str | None = None
+    #: `[parameters]`: name -> value, in the file's order (overrides applied)
+    parameters: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+    #: every field and parameter given as an expression: field path -> (expression, value)
+    expressions: Mapping[str, tuple[str, float]] = field(default_factory=lambda: MappingProxyType({}))
+    study: Study | None = None
     #: Structural analysis (mobility, Assur groups, structure formula), derived from the pairs
     #: when the mechanism is built; raises StructureError for what kinetostat does not analyse.
     structure: Structure = field(init=False, repr=False, compare=False)
@@ -277,8 +293,9 @@ def _abbreviate(text: str, limit: int = 90) -> str:
 
 # ----------------------------------------------------------------------------- loading
 
-def load(path: str | Path) -> Mechanism:
+def load(path: str | Path, parameters: Mapping[str, Any] | None = None) -> Mechanism:
     """Read and validate a model file (TOML), or a bundled model by name (`load("ice_crank_slider")`).
+    `parameters`: values (numbers or expressions) that replace those of the file's `[parameters]`.
 
     Raises `ModelError` listing every problem (`ModelFileNotFound`, also a FileNotFoundError,
     where the file does not exist)."""
@@ -287,7 +304,7 @@ def load(path: str | Path) -> Mechanism:
         from . import examples
         if path.stem in examples.names():
             path = examples.path(path.stem)
-    return loads(_read_text(path), source=str(path))
+    return loads(_read_text(path), source=str(path), parameters=parameters)
 
 
 def _read_text(path: Path) -> str:
@@ -316,8 +333,8 @@ def _read_text(path: Path) -> str:
                          source=str(path)) from None
 
 
-def loads(text: str, source: str = "<string>") -> Mechanism:
-    """Parse a model from TOML text."""
+def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | None = None) -> Mechanism:
+    """Parse a model from TOML text; `parameters` as for `load`."""
     _check_key_cost(text, source)
     try:
         data = tomllib.loads(text)
@@ -325,7 +342,7 @@ def loads(text: str, source: str = "<string>") -> Mechanism:
         raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
     except RecursionError:
         raise ModelError(["TOML nested too deeply (arrays or tables within each other)"], source=source) from None
-    return _Reader(data, source, text).mechanism()
+    return _Reader(data, source, text, parameters).mechanism()
 
 
 def _check_key_cost(text: str, source: str) -> None:
@@ -347,9 +364,10 @@ def _check_key_cost(text: str, source: str) -> None:
                                  source=source)
 
 
-def from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Mechanism:
-    """Build a Mechanism from the parsed structure of a model file."""
-    return _Reader(data, source).mechanism()
+def from_dict(data: Mapping[str, Any], source: str = "<dict>",
+              parameters: Mapping[str, Any] | None = None) -> Mechanism:
+    """Build a Mechanism from the parsed structure of a model file; `parameters` as for `load`."""
+    return _Reader(data, source, overrides=parameters).mechanism()
 
 
 def _suggest(name: Any, valid) -> str:
@@ -442,9 +460,16 @@ MIN_GEAR = 1e-6
 #: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
 LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
 
-_TOP_KEYS = {"mechanism", "drive", "frame", "link", "pair", "group", "load", "spring", "friction", "published"}
+_TOP_KEYS = {"mechanism", "parameters", "drive", "frame", "link", "pair", "group", "load", "spring", "friction",
+             "published", "study"}
+#: Most parameters of one file, and most values one parameter takes in a study.
+MAX_PARAMETERS, MAX_STUDY_VALUES = 1000, 50
 #: Most crank angles one `[[published]]` entry may list.
 MAX_PUBLISHED_ANGLES = 3600
+
+
+#: Characters of an expression quoted in a message.
+MAX_SHOWN = 120
 
 
 def _finite(x: Any) -> bool:
@@ -459,8 +484,13 @@ def _subnormal(x: float) -> bool:
 class _Reader:
     """Reads the raw TOML structure, collecting every problem instead of stopping at the first."""
 
-    def __init__(self, data: Mapping[str, Any], source: str, text: str | None = None):
+    def __init__(self, data: Mapping[str, Any], source: str, text: str | None = None,
+                 overrides: Mapping[str, Any] | None = None):
         self.data, self.source, self.problems, self.lines = data, source, [], []
+        self.overrides = dict(overrides or {})
+        self.values: dict[str, float] = {}        # parameters and g, as expressions read them
+        self.failed: set[str] = set()             # parameters (or g) whose value is in error
+        self.expressions: dict[str, tuple[str, float]] = {}   # field path -> (expression, value)
         self.where_lines = _Lines(text) if text is not None else None
         self.link_table: dict[int, int] = {}      # link id -> index of its [[link]] table
         # causes already reported, whose consequences are not reported again:
@@ -497,6 +527,63 @@ class _Reader:
                 steps += (self.link_table.get(int(m[5]), -1) if m[4] else int(m[5]),)
         return self.where_lines.line(steps) if steps else None
 
+    # -- parameters and expressions
+    def read_parameters(self, head: Mapping) -> None:
+        """Evaluate `[parameters]` (with the overrides) and g (mechanism.g, which expressions read
+        as `g`), in any order, into self.values; problems are recorded against each parameter."""
+        t = self.data.get("parameters", {})
+        if not isinstance(t, dict):
+            self.err("parameters: expected a table of named numbers and expressions")
+            t = {}
+        if len(t) > MAX_PARAMETERS:
+            self.err(f"parameters: {len(t)} parameters, at most {MAX_PARAMETERS}")
+            t = {}
+        raw = dict(t)
+        for name in raw:
+            if name == "g":
+                self.err("parameters.g: g is mechanism.g (m/s^2), which expressions read as g: give it there")
+            elif name in FUNCTIONS or name in CONSTANTS:
+                self.err(f"parameters.{name}: {name!r} is the name of a function or constant of expressions")
+            elif not name.isidentifier() or name.startswith("__"):
+                self.err(f"parameters.{name}: a parameter's name is a Python-style identifier (letters, digits, _)")
+        for name, x in self.overrides.items():
+            if name != "g" and name not in raw:
+                self.err(f"parameters: cannot override {name!r}: the model has no such parameter"
+                         f"{_suggest(name, [*raw, 'g'])}. Parameters: {sorted(raw)}")
+            elif name != "g":
+                raw[name] = x
+        raw = {n: x for n, x in raw.items() if n != "g"}
+        if "g" in head or "g" in self.overrides:
+            raw["g"] = self.overrides.get("g", head.get("g"))
+        values, problems = resolve_parameters(raw)
+        for name, msg in problems.items():
+            if name != "g":             # mechanism.g reports its own problem when read
+                self.err(f"parameters.{name}: {msg}")
+        self.values, self.failed = values, set(problems)
+        for name, x in raw.items():
+            if isinstance(x, str) and name in values:
+                self.expressions["mechanism.g" if name == "g" else f"parameters.{name}"] = (x, values[name])
+
+    def scalar(self, x: Any, path: str) -> Any:
+        """`x` itself, or the value of the expression `x` (a string) over the parameters; None
+        after recording a problem (naming `path` and the parameter that fails)."""
+        if not isinstance(x, str):
+            return x
+        if path == "mechanism.g" and "g" in self.values:
+            return self.values["g"]
+        try:
+            e = parse_expression(x)
+            bad = sorted(n for n in e.names if n in self.failed)
+            if bad:
+                raise ExpressionError(f"reads {', '.join(map(repr, bad))}, which has an error (see "
+                                      f"{', '.join('mechanism.g' if n == 'g' else f'parameters.{n}' for n in bad)})")
+            value = e(self.values)
+        except ExpressionError as exc:
+            self.err(f'{path}: expression "{x:.{MAX_SHOWN}}": {exc}')
+            return None
+        self.expressions[path] = (x, value)
+        return value
+
     # -- typed getters: each returns None after recording a problem
     def number(self, tab: Mapping, key: str, where: str, *, default: Any = "required",
                minimum: float | None = None, positive: bool = False) -> float | None:
@@ -505,26 +592,33 @@ class _Reader:
                 self.err(f"{where}.{key}: missing (a number is required)")
                 return None
             return default
-        x = tab[key]
+        x = self.scalar(tab[key], f"{where}.{key}")
+        if x is None:
+            return None
+        shown = repr(x) if not isinstance(tab[key], str) else f'{x!r} (= "{tab[key]:.{MAX_SHOWN}}")'
         if not _finite(x):
-            self.err(f"{where}.{key}: expected a finite number, got {x!r}")
+            self.err(f"{where}.{key}: expected a finite number, got {shown}")
             return None
         if abs(x) > MAX_VALUE:
-            self.err(f"{where}.{key}: {x!r} is out of range (|value| <= {MAX_VALUE:g})")
+            self.err(f"{where}.{key}: {shown} is out of range (|value| <= {MAX_VALUE:g})")
             return None
-        if (positive or key == "g") and _subnormal(x):     # a speed, module, radius or g: a divisor somewhere
-            self.err(f"{where}.{key}: {x!r} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
+        if (positive or key in ("g", "rpm", "omega")) and _subnormal(x):   # a speed, module, radius or g: a divisor
+            self.err(f"{where}.{key}: {shown} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
                      f"digits, and its products turn into 0, NaN or inf; write 0 or the value meant")
             return None
         if positive and x <= 0:
-            self.err(f"{where}.{key}: must be > 0, got {x!r}")
+            self.err(f"{where}.{key}: must be > 0, got {shown}")
             return None
         if minimum is not None and x < minimum:
-            self.err(f"{where}.{key}: must be >= {minimum}, got {x!r}")
+            self.err(f"{where}.{key}: must be >= {minimum}, got {shown}")
             return None
         return float(x)
 
     def vec(self, x: Any, where: str, *, unit: bool = False) -> Vec | None:
+        if isinstance(x, list) and len(x) == 2:
+            x = [self.scalar(c, f"{where}[{i}]") for i, c in enumerate(x)]
+            if None in x:
+                return None
         if not (isinstance(x, list) and len(x) == 2 and all(_finite(c) for c in x)):
             self.err(f"{where}: expected [x, y] with two finite numbers, got {x!r}")
             return None
@@ -556,7 +650,9 @@ class _Reader:
         return x
 
     def integer(self, tab: Mapping, key: str, where: str) -> int | None:
-        x = tab.get(key)
+        x = self.scalar(tab.get(key), f"{where}.{key}")     # an expression must give a whole number
+        if isinstance(x, float) and x.is_integer() and isinstance(tab.get(key), str):
+            x = int(x)
         if not isinstance(x, int) or isinstance(x, bool):
             self.err(f"{where}.{key}: expected an integer, got {x!r}" if key in tab
                      else f"{where}.{key}: missing (an integer is required)")
@@ -587,6 +683,7 @@ class _Reader:
             self.err("mechanism: expected a table")
             head = {}
         self.unknown_keys(head, {"name", "source", "assumptions", "g"}, "mechanism")
+        self.read_parameters(head)
         name = self.string(head, "name", "mechanism", default="unnamed")
         source = self.string(head, "source", "mechanism", default="")
         assumptions = head.get("assumptions", [])
@@ -603,6 +700,7 @@ class _Reader:
         springs = self.springs(links)
         friction = self.friction()
         published = self.published(links, pairs, drive)
+        study = self.study(pairs)
         if friction is not None and friction.radius is None:
             for p in pairs:
                 if p.kind == "R" and p.radius is None:
@@ -615,7 +713,9 @@ class _Reader:
                              links=tuple(links), pairs=tuple(pairs),
                              branches=MappingProxyType(branches), loads=tuple(loads_),
                              springs=tuple(springs), drive=drive, friction=friction,
-                             published=tuple(published), path=self.source)
+                             published=tuple(published), path=self.source,
+                             parameters=MappingProxyType({n: v for n, v in self.values.items() if n != "g"}),
+                             expressions=MappingProxyType(self.expressions), study=study)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
         for path, msg in self.doubts(mech):
@@ -857,10 +957,10 @@ class _Reader:
             self.err("drive: give exactly one of rpm or omega")
             omega = None
         elif "rpm" in t:
-            rpm = self.number(t, "rpm", w, positive=True)
+            rpm = self.number(t, "rpm", w, minimum=0.0)
             omega = None if rpm is None else rpm * math.pi / 30
         else:
-            omega = self.number(t, "omega", w, positive=True)
+            omega = self.number(t, "omega", w, minimum=0.0)     # 0: statics
         eps = self.number(t, "eps", w, default=0.0)
         design = self.number(t, "design_deg", w, default=30.0)
         kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")
@@ -1014,6 +1114,10 @@ class _Reader:
         return Table(arg, xs, vs, vr, scale, axis, origin)
 
     def series(self, x: Any, where: str) -> tuple[float, ...] | None:
+        if isinstance(x, list):
+            x = [self.scalar(v, f"{where}[{i}]") for i, v in enumerate(x)]
+            if None in x:
+                return None
         if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) and abs(v) <= MAX_VALUE for v in x)):
             self.err(f"{where}: expected a list of at least two finite numbers (|value| <= {MAX_VALUE:g})")
             return None
@@ -1041,6 +1145,43 @@ class _Reader:
             if len(ends) == 2 and k is not None and l0 is not None:
                 out.append(Spring(self.string(t, "name", where, default=f"spring {n}"), ends[0], ends[1], k, l0))
         return out
+
+    def study(self, pairs: list[Pair]) -> Study | None:
+        """[study]: vary = { name = [values], ... } (one or two parameters), pair = [i, j], steps."""
+        t = self.data.get("study")
+        if t is None:
+            return None
+        if not isinstance(t, dict):
+            self.err("study: expected a table")
+            return None
+        self.unknown_keys(t, {"title", "vary", "pair", "steps"}, "study")
+        title = self.string(t, "title", "study", default="parameter study")
+        vary, v = [], t.get("vary")
+        if not (isinstance(v, dict) and 1 <= len(v) <= 2):
+            self.err(f"study.vary: expected a table of one or two parameters and their values, "
+                     f"e.g. {{ r = [0.05, 0.08], n_k = [60, 120] }}, got {v!r:.80}")
+        else:
+            for name, xs in v.items():
+                if name not in self.values or name == "g":
+                    self.err(f"study.vary.{name}: not a parameter of the model{_suggest(name, self.values)}. "
+                             f"Parameters: {sorted(n for n in self.values if n != 'g')}")
+                elif not (isinstance(xs, list) and 1 <= len(xs) <= MAX_STUDY_VALUES and all(_finite(x) for x in xs)):
+                    self.err(f"study.vary.{name}: expected a list of 1..{MAX_STUDY_VALUES} finite numbers")
+                else:
+                    vary.append((name, tuple(float(x) for x in xs)))
+        pair = t.get("pair")
+        if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(i, int) for i in pair)
+                and any(set(p.links) == set(pair) and pair[0] != pair[1] for p in pairs)):
+            self.err(f"study.pair: expected [i, j] of a kinematic pair (R(i, j), force of link i on link j), "
+                     f"got {pair!r:.60}. Pairs: {[list(p.links) for p in pairs]}")
+            return None
+        steps = t.get("steps", 36)
+        if not (isinstance(steps, int) and not isinstance(steps, bool) and 1 <= steps <= 3600):
+            self.err(f"study.steps: expected an integer 1..3600 (crank angles per cycle), got {steps!r}")
+            return None
+        if not isinstance(v, dict) or len(vary) != len(v):
+            return None
+        return Study(title, tuple(vary), (pair[0], pair[1]), steps)
 
     def friction(self) -> Friction | None:
         t = self.data.get("friction")
@@ -1124,7 +1265,10 @@ class _Reader:
                          point, relative_to, link, pair)
 
     def published_angles(self, x: Any, where: str) -> tuple[float, ...] | None:
-        items = x if isinstance(x, list) else [x]
+        items = [self.scalar(a, f"{where}[{i}]") for i, a in enumerate(x)] if isinstance(x, list) \
+            else [self.scalar(x, where)]
+        if None in items and x is not None:
+            return None
         if x is None or not items or len(items) > MAX_PUBLISHED_ANGLES or \
                 not all(_finite(a) and abs(a) <= MAX_VALUE for a in items):
             self.err(f"{where}: " + ("missing (a crank angle in deg, or a list of them)" if x is None else

@@ -40,7 +40,7 @@ def _problems(text: str) -> list[str]:
     ('points = { C = [0.0, 0.0], B = [0.3, 0.0], S3 = [0.12, -0.01] }',
      'points = { C = [0.0, 0.0], B = [0.0, 0.0], S3 = [0.0, 0.0] }',
      "link[id=3].points: all points coincide (zero-length link)"),
-    ("I_S = 0.016", 'I_S = "heavy"', "link[id=2].I_S: expected a finite number, got 'heavy'"),
+    ("I_S = 0.016", 'I_S = "heavy"', "link[id=2].I_S: expression \"heavy\": unknown name 'heavy'"),
     ('sense = "ccw"', 'sense = "left"', "drive.sense: invalid value 'left'. Valid values: ['ccw', 'cw']"),
     ("rpm = 300.0", "rpm = nan", "drive.rpm: expected a finite number, got nan"),
     ('com = "S2"', 'com = "S9"', "link[id=2].com: unknown point 'S9'. Valid names: ['A', 'B', 'S2']"),

@@ -15,7 +15,8 @@ import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
 from ..analysis import analyze
-from ..model import Mechanism
+from ..errors import AssemblyError, ModelError
+from ..model import Mechanism, load
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
@@ -45,6 +46,63 @@ def _vec(v) -> str:
     return "(" + ", ".join(f"{c:.6g}" for c in v) + ")"
 
 
+def _parameters_section(doc: Doc, m: Mechanism) -> None:
+    """The model's [parameters] and every number an expression produced (shown where there are any)."""
+    given = m.expressions
+    if m.parameters:
+        doc.h(3, "Parameters")
+        doc.table(["parameter", "given as", "value"],
+                  [[esc(n), esc(given[f"parameters.{n}"][0]) if f"parameters.{n}" in given else "number", f"{v:.10g}"]
+                   for n, v in m.parameters.items()], "llr")
+    fields = [(path, e) for path, e in given.items() if not path.startswith("parameters.")]
+    if fields:
+        doc.h(3, "Numbers from expressions")
+        doc.table(["field", "expression", "value"], [[esc(path), esc(text), f"{v:.10g}"] for path, (text, v) in fields],
+                  "llr")
+
+
+def study_table(m: Mechanism) -> np.ndarray:
+    """The model's `[study]`: the largest |R(i,j)| over the cycle, N, for every case, shape (values of
+    the first parameter, values of the second or 1). Each case is the model file `m.path` loaded
+    with that case's parameters (`load(path, parameters=...)`) and analysed at `steps` crank angles
+    from 0; NaN where the case does not load or assemble."""
+    st = m.study
+    (first, xs), (second, ys) = st.vary[0], (st.vary[1] if len(st.vary) > 1 else (None, (None,)))
+    out = np.full((len(xs), len(ys)), np.nan)
+    for a, x in enumerate(xs):
+        for b, y in enumerate(ys):
+            case = {first: x} | ({second: y} if second is not None else {})
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    mech = load(m.path, parameters=case)
+                    res = analyze(mech, steps=st.steps)
+            except (ModelError, AssemblyError):
+                continue
+            p = mech.pair_between(*st.pair)
+            out[a, b] = np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))
+    return out
+
+
+def _study_section(doc: Doc, m: Mechanism) -> None:
+    """The table of the model's `[study]`, when it declares one and its file can be read again."""
+    if m.study is None or m.path is None or not Path(m.path).is_file():
+        return
+    st = m.study
+    table = study_table(m)
+    i, j = st.pair
+    doc.h(2, "Parameter study")
+    doc.p(f"{esc(st.title)}. Largest |R({i},{j})| over the cycle, N ({st.steps} crank angles from 0°, every "
+          f"{360 / st.steps:.4g}°); each case is the model file loaded with its parameter values "
+          f"(`kinetostat.load(path, parameters=...)`); \u2014: the case does not load or assemble.")
+    (first, xs) = st.vary[0]
+    second, ys = st.vary[1] if len(st.vary) > 1 else ("", ())
+    header = ([f"{esc(first)} \\ {esc(second)}", *(f"{y:g}" for y in ys)] if second
+              else [esc(first), f"max |R({i},{j})|, N"])
+    doc.table(header, [[f"{x:g}"] + [f"{v:.1f}" if np.isfinite(v) else "\u2014" for v in row]
+                       for x, row in zip(xs, table)], "r" * len(header))
+
+
 def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
     d = m.drive
     doc.h(2, "Mechanism data")
@@ -69,6 +127,7 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
     else:
         items.append("**Friction**: none")
     doc.ul(items)
+    _parameters_section(doc, m)
     doc.h(3, "Assumptions")
     doc.ul([esc(a) for a in m.assumptions] or ["none stated"])
     doc.h(3, "Links")
@@ -361,6 +420,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
                for p in m.pairs], "lrrrr")
 
     _three_routes_section(doc, m, res)
+    _study_section(doc, m)
 
     doc.h(2, "Errors against the engines")
     doc.p("Per route and quantity: max |engine − kinetostat| over the cycle (absolute) and the crank angle "

@@ -1,0 +1,267 @@
+"""Arithmetic expressions of model files: the `[parameters]` table and numeric fields written as
+strings ("3.05 * r", "G2 / g", "bar_inertia(m2, l_AB)").
+
+An expression is parsed with `ast` and evaluated by walking the tree; only number literals,
+names, + - * / **, unary + and -, parentheses and calls of FUNCTIONS (by name, positional
+arguments) are allowed; nothing is ever executed. All arithmetic is in floats; every
+intermediate result must be finite and real.
+
+May use: the standard library only.
+"""
+from __future__ import annotations
+
+import ast
+import difflib
+import math
+import operator
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["ExpressionError", "Expression", "FUNCTIONS", "CONSTANTS", "HELPERS", "MAX_EXPRESSION",
+           "MAX_EXPONENT", "parse", "resolve", "bar_inertia", "mass_from_density", "mass_from_weight",
+           "inertia_from_gyration", "gear_wheel_mass"]
+
+#: Longest expression, characters.
+MAX_EXPRESSION = 500
+#: Largest |exponent| of a power, checked before the power is computed.
+MAX_EXPONENT = 1000.0
+
+
+class ExpressionError(ValueError):
+    """An expression that cannot be read or evaluated; the message names no field (the caller does)."""
+
+
+# ----------------------------------------------------------------------------- helpers of the texts
+
+def bar_inertia(m: float, l: float) -> float:
+    """I_S = m l^2 / 12, kg m^2: a uniform bar of mass m (kg) and length l (m) about its centre
+    (seed 004, line 133)."""
+    return m * l * l / 12
+
+
+def mass_from_density(q: float, l: float) -> float:
+    """m = q l, kg: a link of linear density q (kg/m) and length l (m) (seed 000 sec. 6.1, line 373)."""
+    return q * l
+
+
+def mass_from_weight(G: float, g: float) -> float:
+    """m = G / g, kg: a link of weight G (N) at gravity g (m/s^2) (seed 002: G2, G3)."""
+    return G / g
+
+
+def inertia_from_gyration(m: float, rho: float) -> float:
+    """I_S = m rho^2, kg m^2: a link of mass m (kg) and radius of gyration rho (m) about its centre."""
+    return m * rho * rho
+
+
+def gear_wheel_mass(m_g: float) -> float:
+    """m_1 = 1.3 m_g, kg: the mass of the gear wheel on the crank shaft estimated from the mass m_g
+    of its rim (seed 000, sec. 7.2: "m_1 = 1,3 m_g, де m_g - маса вінця колеса")."""
+    return 1.3 * m_g
+
+
+#: The helpers of the texts, by name (documented in models/FORMAT.md with formula and source).
+HELPERS: Mapping[str, Callable[..., float]] = {
+    "bar_inertia": bar_inertia, "mass_from_density": mass_from_density, "mass_from_weight": mass_from_weight,
+    "inertia_from_gyration": inertia_from_gyration, "gear_wheel_mass": gear_wheel_mass}
+
+
+def _at_least_two(f: Callable[..., float]) -> Callable[..., float]:
+    def call(*args: float) -> float:
+        if len(args) < 2:
+            raise TypeError(f"{f.__name__}() takes at least 2 arguments ({len(args)} given)")
+        return f(*args)
+    return call
+
+
+#: Every function an expression may call: name -> (function, number of arguments or None for 2+).
+FUNCTIONS: Mapping[str, tuple[Callable[..., float], int | None]] = {
+    **{n: (getattr(math, n), 1) for n in ("sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "radians",
+                                          "degrees", "exp", "log")},
+    "atan2": (math.atan2, 2), "hypot": (math.hypot, 2), "abs": (abs, 1),
+    "min": (_at_least_two(min), None), "max": (_at_least_two(max), None),
+    **{n: (f, f.__code__.co_argcount) for n, f in HELPERS.items()}}
+#: Names an expression may use besides the parameters.
+CONSTANTS: Mapping[str, float] = {"pi": math.pi}
+
+_BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
+           ast.Pow: operator.pow}
+_UNARY = {ast.USub: operator.neg, ast.UAdd: operator.pos}
+_WHAT = {ast.Attribute: "attribute access", ast.Subscript: "subscripts", ast.Lambda: "lambdas",
+         ast.ListComp: "comprehensions", ast.SetComp: "comprehensions", ast.DictComp: "comprehensions",
+         ast.GeneratorExp: "comprehensions", ast.Compare: "comparisons", ast.BoolOp: "'and'/'or'",
+         ast.IfExp: "'if ... else'", ast.NamedExpr: "':='", ast.Starred: "'*' arguments",
+         ast.JoinedStr: "strings", ast.List: "lists", ast.Tuple: "tuples", ast.Dict: "dicts", ast.Set: "sets",
+         ast.Await: "'await'", ast.Yield: "'yield'", ast.YieldFrom: "'yield'"}
+_ALLOWED = "numbers, parameter names, + - * / ** and parentheses, and calls of " + ", ".join(
+    sorted(FUNCTIONS)) + "; constant pi"
+
+
+@dataclass(frozen=True)
+class Expression:
+    """A checked expression: its text, its tree, and the names it reads (parameters, g)."""
+    text: str
+    tree: ast.Expression
+    names: frozenset[str]
+
+    def __call__(self, values: Mapping[str, float]) -> float:
+        """The value with the names in `values` (unknown names are refused with a suggestion)."""
+        try:
+            x = _eval(self.tree.body, values)
+        except (OverflowError, ZeroDivisionError, ValueError, TypeError) as exc:
+            if isinstance(exc, ExpressionError):
+                raise
+            raise ExpressionError(_arith_message(exc)) from None
+        return _checked(x)
+
+
+def parse(text: str) -> Expression:
+    """Check `text` and return it as an Expression; ExpressionError says what is not allowed."""
+    if len(text) > MAX_EXPRESSION:
+        raise ExpressionError(f"{len(text)} characters, at most {MAX_EXPRESSION}")
+    if not text.strip():
+        raise ExpressionError("empty")
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as exc:
+        raise ExpressionError(f"syntax error: {exc.msg}") from None
+    except (RecursionError, MemoryError, ValueError):
+        raise ExpressionError("nested too deeply") from None
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        _check_node(node, names)
+    return Expression(text, tree, frozenset(names) - set(CONSTANTS))
+
+
+def _check_node(node: ast.AST, names: set[str]) -> None:
+    if isinstance(node, (ast.Expression, ast.Load, *_BINARY, *_UNARY)):
+        return
+    if isinstance(node, ast.Constant):
+        if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
+            raise ExpressionError(f"{type(node.value).__name__} literal {node.value!r:.40} is not allowed "
+                                  f"(only numbers)")
+    elif isinstance(node, ast.Name):
+        if node.id in FUNCTIONS:
+            return          # checked as a call's function
+        names.add(node.id)
+    elif isinstance(node, ast.BinOp):
+        if type(node.op) not in _BINARY:
+            raise ExpressionError(f"operator {type(node.op).__name__} is not allowed (only + - * / **)")
+    elif isinstance(node, ast.UnaryOp):
+        if type(node.op) not in _UNARY:
+            raise ExpressionError(f"operator {type(node.op).__name__} is not allowed (only + - * / **)")
+    elif isinstance(node, ast.Call):
+        f = node.func
+        if not isinstance(f, ast.Name) or f.id not in FUNCTIONS:
+            called = f.id if isinstance(f, ast.Name) else _WHAT.get(type(f), type(f).__name__)
+            raise ExpressionError(f"call of {called!r} is not allowed{_suggest(called, FUNCTIONS)}; "
+                                  f"functions: {', '.join(sorted(FUNCTIONS))}")
+        if node.keywords:
+            raise ExpressionError(f"{f.id}() takes positional arguments only")
+        n = FUNCTIONS[f.id][1]
+        if n is not None and len(node.args) != n:
+            raise ExpressionError(f"{f.id}() takes {n} argument{'s' if n > 1 else ''}, got {len(node.args)}")
+        if n is None and len(node.args) < 2:
+            raise ExpressionError(f"{f.id}() takes at least 2 arguments, got {len(node.args)}")
+    else:
+        what = _WHAT.get(type(node), type(node).__name__)
+        raise ExpressionError(f"{what} not allowed; an expression has {_ALLOWED}")
+    if isinstance(node, ast.Name) and node.id.startswith("__"):
+        raise ExpressionError(f"name {node.id!r} is not allowed")
+
+
+def _eval(node: ast.AST, values: Mapping[str, float]) -> float:
+    if isinstance(node, ast.Constant):
+        return _checked(float(node.value))
+    if isinstance(node, ast.Name):
+        if node.id in CONSTANTS:
+            return CONSTANTS[node.id]
+        if node.id in FUNCTIONS:
+            raise ExpressionError(f"{node.id!r} is a function: call it, {node.id}(...)")
+        if node.id not in values:
+            raise ExpressionError(f"unknown name {node.id!r}{_suggest(node.id, [*values, *CONSTANTS])}")
+        return values[node.id]
+    if isinstance(node, ast.UnaryOp):
+        return _UNARY[type(node.op)](_eval(node.operand, values))
+    if isinstance(node, ast.BinOp):
+        a, b = _eval(node.left, values), _eval(node.right, values)
+        if isinstance(node.op, ast.Pow) and abs(b) > MAX_EXPONENT:
+            raise ExpressionError(f"exponent {b:g} is too large (|exponent| <= {MAX_EXPONENT:g})")
+        if isinstance(node.op, ast.Pow) and a < 0 and b != int(b):
+            raise ExpressionError(f"({a:g}) ** {b:g}: a negative number to a fractional power is not real")
+        return _checked(_BINARY[type(node.op)](a, b))
+    if isinstance(node, ast.Call):
+        return _checked(float(FUNCTIONS[node.func.id][0](*(_eval(a, values) for a in node.args))))
+    raise ExpressionError(f"{type(node).__name__} not allowed")     # parse() lets none through
+
+
+def _checked(x: float) -> float:
+    if not math.isfinite(x):
+        raise ExpressionError(f"the result {x} is not a finite number")
+    return x
+
+
+def _arith_message(exc: Exception) -> str:
+    if isinstance(exc, ZeroDivisionError):
+        return "division by zero"
+    if isinstance(exc, OverflowError):
+        return "the result is too large (overflow)"
+    return f"math domain error ({exc})" if "domain" in str(exc) else str(exc)
+
+
+def _suggest(name: str, valid) -> str:
+    close = difflib.get_close_matches(name, [str(v) for v in valid], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+# ----------------------------------------------------------------------------- a table of parameters
+
+def resolve(raw: Mapping[str, Any]) -> tuple[dict[str, float], dict[str, str]]:
+    """Evaluate named values that may read each other in any order.
+
+    `raw`: name -> a number or an expression string. Returns (values of those that evaluate,
+    name -> problem of those that do not). A cycle is refused naming it ("a -> b -> a"); a value
+    that reads a failed one is refused naming it."""
+    values: dict[str, float] = {}
+    problems: dict[str, str] = {}
+    parsed: dict[str, Expression] = {}
+    for name, x in raw.items():
+        if isinstance(x, str):
+            try:
+                parsed[name] = parse(x)
+            except ExpressionError as exc:
+                problems[name] = f'expression "{x}": {exc}'
+        elif isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x):
+            values[name] = float(x)
+        else:
+            problems[name] = f"expected a number or an expression string, got {x!r:.60}"
+    state: dict[str, int] = {}          # 1: being evaluated, 2: done
+
+    def visit(name: str, chain: tuple[str, ...]) -> None:
+        if state.get(name) == 2 or name in values or name in problems:
+            return
+        if state.get(name) == 1:
+            cycle = chain[chain.index(name):] + (name,)
+            for n in cycle[:-1]:
+                problems.setdefault(n, f'expression "{raw[n]}": cycle {" -> ".join(cycle)}')
+            return
+        state[name] = 1
+        e = parsed[name]
+        for dep in sorted(e.names):
+            if dep in parsed:
+                visit(dep, chain + (name,))
+        if name not in problems:
+            bad = sorted(d for d in e.names if d in problems)
+            if bad:
+                problems[name] = f'expression "{e.text}": reads {", ".join(map(repr, bad))}, which has an error'
+            else:
+                try:
+                    values[name] = e(values)
+                except ExpressionError as exc:
+                    problems[name] = f'expression "{e.text}": {exc}'
+        state[name] = 2
+
+    for name in parsed:
+        visit(name, ())
+    return {n: values[n] for n in raw if n in values}, problems
