@@ -85,7 +85,7 @@ def _line(text: str, fragment: str) -> int:
     ("mass = 1.5", "masss = 1.5", "link[id=2].masss: unknown field (did you mean 'mass'?)", "masss"),
     ('com = "S2"', 'com = "S22"', "link[id=2].com: unknown point 'S22' (did you mean 'S2'?)", 'com = "S22"'),
     ('links = [2, 3]\npoint = "B"', 'links = [2, 7]\npoint = "B"', "pair[2].links: unknown link 7", "links = [2, 7]"),
-    ("rpm = 300.0", "rpm = -3.0", "drive.rpm: must be > 0", "rpm = -3.0"),
+    ("rpm = 300.0", "rpm = -3.0", "drive.rpm: must be >= 0", "rpm = -3.0"),
     ('sense = "ccw"', 'sense = "cww"', "drive.sense: invalid value 'cww' (did you mean 'cw'?)", "cww"),
     ("branch = 1", "branch = 2", "group[0].branch: expected +1 or -1, got 2", "branch = 2"),
     ('link = 3\nvalue = -4.0', 'link = 3\nvalue = -4.0\ndirektion = [0.0, 1.0]',
@@ -343,7 +343,7 @@ def test_a_tiny_g_with_weights_is_warned_with_its_number():
 def test_line_is_found_past_strings_that_look_like_keys():
     text = FOUR_BAR.replace('g = 9.81', 'assumptions = [\n  "rpm = 300 as in the text",\n  """\nrpm = 1\n""",\n]\ng = 9.81', 1)
     exc = _problems(text.replace("rpm = 300.0", "rpm = -300.0"))
-    assert exc.problems == ["drive.rpm: must be > 0, got -300.0"]
+    assert exc.problems == ["drive.rpm: must be >= 0.0, got -300.0"]
     assert exc.lines == [_line(text, "rpm = 300.0")]
 
 
