@@ -187,7 +187,7 @@ class SpeedLaw:
             h = 1e-30                         # complex step: exact derivative, no cancellation
             z = np.broadcast_to(_evaluate(self.expression, {"phi": phi + 1j * h}), phi.shape)
             return z.real.astype(float), z.imag / h
-        x, y, m = _periodic_spline(np.radians(self.phi_deg), np.asarray(self.omega))
+        x, y, m = _periodic_spline(self.phi_deg, self.omega)
         return _spline_at(x, y, m, phi)
 
 
@@ -405,10 +405,11 @@ def _evaluate(text: str, names: Mapping[str, Any]) -> Any:
 
 
 @functools.lru_cache(maxsize=64)
-def _periodic_spline(x: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _periodic_spline(x_deg: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Knots x (rad, increasing, within one period 2 pi; a last knot at x[0] + 2 pi repeats the
-    first and is dropped), values y and second derivatives m of the periodic cubic spline."""
-    x, y = np.asarray(x, float), np.asarray(y, float)
+    first and is dropped), values y and second derivatives m of the periodic cubic spline
+    through the points (x_deg, deg; y)."""
+    x, y = np.radians(x_deg), np.asarray(y, float)
     if np.isclose(x[-1] - x[0], 2 * np.pi, rtol=0, atol=1e-12):
         x, y = x[:-1], y[:-1]
     n = len(x)
