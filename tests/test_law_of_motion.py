@@ -356,3 +356,26 @@ def test_bad_bodies_are_refused_by_name(body, message):
     with pytest.raises(ModelError, match=r"link\[id=3\]\.body\[0\]") as exc:
         kinetostat.loads(text)
     assert message in str(exc.value)
+
+
+# ----------------------------------------------------------------------------- engines
+
+def test_exact_engine_routes_check_a_varying_speed_and_the_rest_say_why_not():
+    """Pinocchio and MuJoCo take q, v, a and the applied loads from the scene (the solver's exact
+    motion, omega(phi) included): they must agree to rounding; the simulations and the mpmath
+    reference are skipped with their reason."""
+    pytest.importorskip("pinocchio")
+    pytest.importorskip("mujoco")
+    from kinetostat_validation.compare import compare
+    mech = kinetostat.loads(_with_drive(CRANK_SLIDER, EXPRESSION) + SLIDE_DAMPER + MOTOR)
+    c = compare(mech, steps=72)
+    assert not c.failed
+    assert {r.route for r in c.rows} == {"pinocchio", "mujoco"}
+    assert max(r.peak_relative for r in c.rows) <= 1e-9
+    assert set(c.skipped) == {"mujoco-sim", "pymunk", "reference"}
+    assert all("law of motion" in why for why in c.skipped.values())
+    still = compare(kinetostat.loads(CRANK_SLIDER.replace("rpm = 300.0", "rpm = 0")), steps=36,
+                    engines=("pinocchio", "reference", "pymunk"))
+    assert {r.route for r in still.rows} == {"pinocchio", "reference"} and not still.failed
+    assert max(r.peak_relative for r in still.rows) <= 1e-9
+    assert "standstill" in still.skipped["pymunk"]
