@@ -1506,7 +1506,7 @@ def _turned_slider(link: Link, axis: Vec) -> Link:
     along `axis`, into the documented one, whose x axis runs along the guide."""
     turn = complex(*axis).conjugate()
     pts = {n: ((z := complex(*xy) * turn).real, z.imag) for n, xy in link.points.items()}
-    return Link(link.id, link.name, MappingProxyType(pts), link.mass, link.I_S, link.com)
+    return Link(link.id, link.name, MappingProxyType(pts), link.mass, link.I_S, link.com, link.bodies)
 
 
 def _components(edges: list[tuple[int, int]]) -> dict[int, int]:

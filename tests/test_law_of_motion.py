@@ -379,3 +379,18 @@ def test_exact_engine_routes_check_a_varying_speed_and_the_rest_say_why_not():
     assert {r.route for r in still.rows} == {"pinocchio", "reference"} and not still.failed
     assert max(r.peak_relative for r in still.rows) <= 1e-9
     assert "standstill" in still.skipped["pymunk"]
+
+
+@pytest.mark.parametrize("text", [
+    _with_drive(four_bar(), TABLE) + MOTOR + ROTARY_DAMPER, _with_drive(CRANK_SLIDER, EXPRESSION) + SLIDE_DAMPER,
+    CRANK_SLIDER.replace("rpm = 300.0", "rpm = 0")], ids=["table-motor-damper", "expression-damper", "standstill"])
+def test_virtual_work_route_agrees_at_any_speed_law(text):
+    """The d'Alembert-Lagrange route (its own constraint Jacobian, sharing only the kinematics)
+    against the group route, with omega(phi), speed-dependent loads, and at standstill."""
+    mech = kinetostat.loads(text)
+    phi = np.arange(0.0, 360.0, 10.0) + 1.0
+    vw, res = kinetostat.virtual_work(mech, phi), kinetostat.analyze(mech, phi_deg=phi)
+    peak = np.abs(res.forces.R).max()
+    assert np.abs(vw.balancing_moment - res.balancing_moment).max() <= 1e-9 * np.abs(res.balancing_moment).max()
+    for p in mech.pairs:
+        assert np.abs(vw.reaction(*p.links) - res.reaction(*p.links)).max() <= 1e-9 * peak
