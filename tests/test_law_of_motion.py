@@ -394,3 +394,9 @@ def test_virtual_work_route_agrees_at_any_speed_law(text):
     assert np.abs(vw.balancing_moment - res.balancing_moment).max() <= 1e-9 * np.abs(res.balancing_moment).max()
     for p in mech.pairs:
         assert np.abs(vw.reaction(*p.links) - res.reaction(*p.links)).max() <= 1e-9 * peak
+
+
+def test_standstill_has_no_plans_to_draw_but_says_why():
+    from kinetostat.plans import build
+    with pytest.raises(ValueError, match=r"stands still \(omega_1 = 0\)"):
+        build(kinetostat.load(Path(__file__).parent / "hostile" / "rpm_zero.toml"))
