@@ -369,6 +369,8 @@ def _parse(text: str) -> ast.expr:
         tree = ast.parse(text, mode="eval").body
     except SyntaxError as exc:
         raise ValueError(f"syntax error: {exc.msg}") from None
+    except (RecursionError, MemoryError):
+        raise ValueError("nested too deeply") from None
     for node in ast.walk(tree):
         if isinstance(node, ast.Call):
             if not (isinstance(node.func, ast.Name) and node.func.id in _FUNCTIONS and len(node.args) == 1
@@ -387,7 +389,7 @@ def _evaluate(text: str, names: Mapping[str, Any]) -> Any:
     ValueError for an unknown name or what `_parse` refuses."""
     def ev(node: ast.expr) -> Any:
         if isinstance(node, ast.Constant):
-            return float(node.value)
+            return np.float64(node.value)      # numpy semantics: 1/0 is inf, not an exception
         if isinstance(node, ast.Name):
             if node.id in names:
                 return names[node.id]
@@ -400,8 +402,12 @@ def _evaluate(text: str, names: Mapping[str, Any]) -> Any:
         if isinstance(node, ast.UnaryOp):
             return _OPERATORS[type(node.op)](ev(node.operand))
         return _FUNCTIONS[node.func.id](ev(node.args[0]))
+    tree = _parse(text)
     with np.errstate(all="ignore"):
-        return ev(_parse(text))
+        try:
+            return ev(tree)
+        except RecursionError:
+            raise ValueError("nested too deeply") from None
 
 
 @functools.lru_cache(maxsize=64)
