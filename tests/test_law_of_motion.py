@@ -160,7 +160,7 @@ def test_expression_law_gives_its_exact_derivative():
     ('omega = "sin(phi)"', "must be >= 0"),
     ('omega = "1 + fi"', "unknown name 'fi'"),
     ('omega = "1/0 + 0*phi"', "not finite"),
-    ('omega = "' + "(" * 300 + "phi" + ")" * 300 + '"', "nested too deeply"),
+    ('omega = "' + "(" * 300 + "phi" + ")" * 300 + '"', "nested"),
     ('omega = "10"\neps = 3.0\n', "drive.eps: a law of motion gives eps"),
     ("[drive.omega_table]\nphi_deg = [0.0, 180.0]\nomega = [1.0, 2.0]\n", "at least 3 angles"),
     ("[drive.omega_table]\nphi_deg = [0.0, 180.0, 360.0]\nomega = [1.0, 2.0, 3.0]\n", "the law is periodic"),
