@@ -10,10 +10,10 @@ from typing import Mapping, NamedTuple
 
 import numpy as np
 
-from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation, kinematic_size, relative_change,
-                         solve_checked)
+from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation, kinematic_size, kinematics,
+                         relative_change, solve_checked)
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from .applied import applied_moment, applied_wrenches, com_motion, inertia_loads, point_forces
+from .applied import applied_moment, applied_wrenches, com_motion, inertia_loads, load_magnitude, point_forces
 from .planar import as_xy, as_z, cross_z, dot_z
 from .model import Mechanism, _abbreviate
 
@@ -264,59 +264,71 @@ class Analysis:
 
     def friction_energy(self) -> np.ndarray:
         """(n_pairs,) energy lost in each pair over one revolution, J: the integral of its power
-        over the period (periodic trapezoid rule, exact for the sampled cycle). Needs the angles
-        of a uniform full cycle, as `analyze(mech, steps=N)` gives."""
-        return self._cycle_integral(self.friction_power, "friction_energy")
+        over the crank angle (`_cycle_integral`). Needs the angles of a uniform full cycle, as
+        `analyze(mech, steps=N)` gives."""
+        return self._cycle_integral(friction_power(self.mech, self._unit_motion(), self.forces.R), "friction_energy")
 
-    def _cycle_integral(self, power: np.ndarray, who: str) -> np.ndarray:
-        """Integral over one revolution of a power (N, ...) W, J: the mean of P / (dphi/dt) over
-        the uniform full cycle of angles times 2 pi (the periodic trapezoid rule, spectrally
-        accurate for a smooth periodic integrand). ValueError naming `who` otherwise."""
+    def _unit_motion(self) -> Kinematics:
+        """The motion at the same angles at unit crank speed (d phi/dt = 1 rad/s): its velocities
+        are d/d phi, so a load's power there is its work per radian of crank turn."""
+        return kinematics(self.mech, np.radians(self.phi_deg), unit_speed=True)
+
+    def _cycle_integral(self, per_radian: np.ndarray, who: str) -> np.ndarray:
+        """Integral over one revolution of a work per radian of crank turn (N, ...) J/rad (a power
+        at unit crank speed), J: the mean over the uniform full cycle of angles times 2 pi (the
+        periodic trapezoid rule, spectrally accurate for a smooth periodic integrand). Over the
+        crank angle, not time: defined at any speed law, standstill included. ValueError naming
+        `who` otherwise."""
         phi = self.phi_deg
         if not np.allclose(phi, phi[0] + np.arange(len(phi)) * 360.0 / len(phi), rtol=0, atol=1e-9):
             raise ValueError(f"{who}: needs the angles of a uniform full cycle (analyze with steps=N)")
-        rate = self.mech.drive.sense * self.omega(1)          # dphi/dt, rad/s
-        return (power / rate.reshape((-1,) + (1,) * (power.ndim - 1))).mean(axis=0) * 2 * np.pi
+        return per_radian.mean(axis=0) * 2 * np.pi
 
     def work(self) -> Mapping[str, float]:
-        """Work of each load over one revolution, J (positive: the load drives the mechanism),
-        from its power F . v + M omega. Needs the angles of a uniform full cycle.
+        """Work of each load over one revolution, J (positive: the load drives the mechanism): the
+        integral over the crank angle of its power per unit crank speed, F . dv/dphi + M
+        d omega/dphi (the same as the time integral of F . v + M omega where the crank turns, and
+        defined at standstill, as the texts' J per revolution). Needs a uniform full cycle of angles.
 
         Keys: "gravity k" and "inertia k" per link with mass or inertia (inertia: F_i = -m a_S at
         S and M_i = -I_S eps; -(change of kinetic energy), 0 over a steady cycle); "load NAME"
         per applied force or moment (loads of one name summed); "spring NAME" (both ends);
-        "balancing moment" (M_bal omega_1; for a working machine the pinion's force, the same
-        power); with friction "friction R(i,j)" per pair, the energy lost (negative). The balancing
-        moment is frictionless: every entry but friction sums to 0 (to rounding) at any speed
-        law, and the friction entries are what the drive must supply on top (seed 003)."""
-        m, kin = self.mech, self.kin
-        power: dict[str, np.ndarray] = {}
+        "damper NAME" (both links: -(energy dissipated)); "balancing moment" (M_bal omega_1; for
+        a working machine the pinion's force, the same power); with friction "friction R(i,j)" per
+        pair, the energy lost (negative). The balancing moment is frictionless: every entry but
+        friction sums to 0 (to rounding) at any speed law, and the friction entries are what the
+        drive must supply on top (seed 003)."""
+        m, kin, u = self.mech, self.kin, self._unit_motion()
+        per_radian: dict[str, np.ndarray] = {}
 
         def add(name: str, P: np.ndarray) -> None:
-            power[name] = power.get(name, 0.0) + P
+            per_radian[name] = per_radian.get(name, 0.0) + P
 
         r, _ = com_motion(m, kin)
-        vS = kin.v_z + 1j * kin.omega * r
+        vS = u.v_z + 1j * u.omega * r
         mass, I_S, _ = m.inertia_arrays
         for k in range(1, m.n_links):
             if mass[k]:
                 add(f"gravity {k}", -m.g * mass[k] * vS[:, k].imag)
             if mass[k] or I_S[k]:
                 il = self.inertia(k)
-                add(f"inertia {k}", dot_z(as_z(il.force), vS[:, k]) + il.moment * kin.omega[:, k])
+                add(f"inertia {k}", dot_z(as_z(il.force), vS[:, k]) + il.moment * u.omega[:, k])
         for ld in m.loads:
             if ld.kind == "moment":
-                add(f"load {ld.name}", applied_moment(m, kin, ld) * kin.omega[:, ld.link])
-        n_loads = sum(ld.kind == "force" for ld in m.loads)      # point_forces: the loads, then the springs' ends
-        for n, f in enumerate(point_forces(m, kin)):
-            v = kin.v_z[:, f.link] + 1j * kin.omega[:, f.link] * (f.X - kin.origin_z[:, f.link])
-            add(f"{'load' if n < n_loads else 'spring'} {f.name}", dot_z(f.force, v))
-        add("balancing moment", self.balancing_moment * self.omega(1))
+                add(f"load {ld.name}", applied_moment(m, kin, ld) * u.omega[:, ld.link])
+            elif ld.kind == "damper" and m.pair_between(*ld.pair).kind == "R":
+                i, j = ld.pair
+                add(f"damper {ld.name}", load_magnitude(m, kin, ld) * (u.omega[:, j] - u.omega[:, i]))
+        for f in point_forces(m, kin):
+            v = u.v_z[:, f.link] + 1j * u.omega[:, f.link] * (f.X - u.origin_z[:, f.link])
+            add(f"{f.source} {f.name}", dot_z(f.force, v))
+        add("balancing moment", self.balancing_moment * u.omega[:, 1])
         if m.friction is not None:
+            lost = friction_power(m, u, self.forces.R)
             for p in m.pairs:
-                add(f"friction {p.label}", -self.friction_power[:, p.index])
-        names = list(power)
-        W = self._cycle_integral(np.stack([power[n] for n in names], axis=-1), "work")
+                add(f"friction {p.label}", -lost[:, p.index])
+        names = list(per_radian)
+        W = self._cycle_integral(np.stack([per_radian[n] for n in names], axis=-1), "work")
         return MappingProxyType(dict(zip(names, W.tolist())))
 
     # -- table

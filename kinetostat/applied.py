@@ -50,6 +50,11 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tup
     for ld in mech.loads:
         if ld.kind == "moment":
             M[:, ld.link] += applied_moment(mech, kin, ld)
+        elif ld.kind == "damper" and mech.pair_between(*ld.pair).kind == "R":
+            m = load_magnitude(mech, kin, ld)            # on link pair[1]; the opposite on pair[0]
+            M[:, ld.pair[1]] += m
+            if ld.pair[0]:
+                M[:, ld.pair[0]] -= m
     for f in point_forces(mech, kin):
         if f.link:
             _add_force(F, M, kin, f.link, f.force, f.X)
@@ -74,6 +79,7 @@ class PointForce(NamedTuple):
     point: str           # the point of application, as the model names it
     X: np.ndarray        # (N,) complex: its world position, m
     force: np.ndarray    # (N,) complex: the force on `link`, N (world frame)
+    source: str = "load"  # what gives it: "load", "spring" or "damper"
 
 
 def point_forces(mech: "Mechanism", kin: "Kinematics") -> list[PointForce]:
@@ -83,6 +89,9 @@ def point_forces(mech: "Mechanism", kin: "Kinematics") -> list[PointForce]:
     out = []
     for ld in mech.loads:
         if ld.kind == "moment":
+            continue
+        if ld.kind == "damper":
+            out.extend(_damper_forces(mech, kin, ld))
             continue
         p = mech.links[ld.link].points[ld.point]
         X = kin.position_z(ld.link, p)
@@ -107,9 +116,22 @@ def point_forces(mech: "Mechanism", kin: "Kinematics") -> list[PointForce]:
                           f"{np.round(np.degrees(kin.phi[length == 0]), 9).tolist()} deg: its line of action "
                           f"is undefined, forces there are NaN", SingularPositionWarning, stacklevel=3)
         f_on_b = -sp.stiffness * (length - sp.free_length) * (B - A) / length
-        out.append(PointForce(sp.name, sp.b[0], sp.b[1], B, f_on_b))
-        out.append(PointForce(sp.name, sp.a[0], sp.a[1], A, -f_on_b))
+        out.append(PointForce(sp.name, sp.b[0], sp.b[1], B, f_on_b, "spring"))
+        out.append(PointForce(sp.name, sp.a[0], sp.a[1], A, -f_on_b, "spring"))
     return out
+
+
+def _damper_forces(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> list[PointForce]:
+    """A damper on a prismatic pair: -c v_rel along the guide on the slider at its point, the
+    opposite on the guide at the same place ([] for a revolute pair: its moments are couples)."""
+    p = mech.pair_between(*ld.pair)
+    if p.kind != "P":
+        return []
+    guide, slider = p.links
+    X = kin.position_z(slider, mech.links[slider].points[p.point])
+    d = complex(*p.direction) * kin.rot[:, guide] if guide else complex(*p.direction)
+    f = -ld.value * kin.v_slide[:, p.index] * d
+    return [PointForce(ld.name, slider, p.point, X, f, "damper"), PointForce(ld.name, guide, p.point, X, -f, "damper")]
 
 
 def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarray | None = None,
@@ -117,6 +139,13 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
     """Magnitude of load `ld` at every angle: N for a force, N m for a moment. X, V: complex
     position and velocity of the load's point, if the caller has them already."""
     N = len(kin.phi)
+    if ld.kind == "damper":           # on link pair[1]: -c (w_j - w_i), or -c v_rel along the guide
+        p = mech.pair_between(*ld.pair)
+        i, j = ld.pair
+        return -ld.value * (kin.omega[:, j] - kin.omega[:, i] if p.kind == "R" else kin.v_slide[:, p.index])
+    if ld.characteristic is not None:   # M(omega), both in the drive's sense
+        s = mech.drive.sense
+        return s * ld.characteristic(s * kin.omega[:, ld.link])
     if ld.table is None:
         return np.full(N, ld.value)
     t = ld.table
@@ -149,12 +178,10 @@ def _stroke(mech: "Mechanism", k: int, p, axis: complex) -> tuple[float, float]:
     """Extreme projections of a point's path on `axis` over a full cycle, m: the dead centres,
     where ds/dphi = 0, found by Newton's method from a coarse scan with the exact plans."""
     from .kinematics import kinematics
-    w, e = mech.drive.omega, mech.drive.eps
 
-    def state(phi):
-        X, V, A = kinematics(mech, phi).point_z(k, p)
-        d1 = dot_z(V, axis) / w                   # ds/dphi
-        return dot_z(X, axis), d1, (dot_z(A, axis) - d1 * e) / w**2
+    def state(phi):                               # s, ds/dphi, d2s/dphi2
+        X, V, A = kinematics(mech, phi, unit_speed=True).point_z(k, p)
+        return dot_z(X, axis), dot_z(V, axis), dot_z(A, axis)
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

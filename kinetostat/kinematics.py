@@ -359,8 +359,13 @@ _GROUP_SOLVERS: dict[str, Callable[[_Plan, "AssurGroup"], _Conditioning]] = {
     "RRR": _rrr, "RRP": _rrp, "RPR": _rpr, "PRP": _prp, "RPP": _rpp}
 
 
-def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
+def kinematics(mech: "Mechanism", phi: np.ndarray, unit_speed: bool = False) -> Kinematics:
     """Positions, velocities and accelerations of every link at crank angles `phi` (rad, (N,)).
+
+    The crank turns as the drive says (a constant omega and eps, or the law omega(phi)); with
+    `unit_speed`, at d phi/dt = 1 rad/s and eps = 0, so that velocities are the derivatives d/d phi
+    (the plans' analogues: per unit crank speed, defined at standstill too) and accelerations
+    d^2/d phi^2.
 
     Raises AssemblyError naming the angles where a group cannot be assembled. Where a group's
     plan is ill-conditioned (cond > COND_CHECK) the accuracy is measured (`Kinematics.error`);
@@ -369,7 +374,7 @@ def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # singular angles: the guard marks them
-        kin, checked, trials = solve_checked(mech, phi)
+        kin, checked, trials = solve_checked(mech, phi, unit_speed)
         error = a_priori_error(kin.cond)
         if len(checked):
             nominal = kin.take(checked)
@@ -377,19 +382,20 @@ def kinematics(mech: "Mechanism", phi: np.ndarray) -> Kinematics:
     return guard(mech, kin, error)
 
 
-def solve_checked(mech: "Mechanism", phi: np.ndarray) -> tuple[Kinematics, np.ndarray, list[Kinematics]]:
+def solve_checked(mech: "Mechanism", phi: np.ndarray,
+                  unit_speed: bool = False) -> tuple[Kinematics, np.ndarray, list[Kinematics]]:
     """The kinematics at `phi` (unguarded: nothing NaN yet, `error` not set), the indices of the
     angles where some group's cond exceeds COND_CHECK, and the kinematics at those angles solved
     again on inputs moved by PERTURB_ULPS ulps (one per sign pattern). Call under np.errstate
     as `kinematics` does."""
-    kin = _solve(mech, phi, mech.points_z)
+    kin = _solve(mech, phi, mech.points_z, unit_speed)
     checked = np.flatnonzero(~(kin.cond <= COND_CHECK).all(axis=1))       # NaN cond: checked
     trials = []
     if len(checked):
         sub = phi[checked]
         for draw in (0, 1):
             trials.append(_solve(mech, sub + _signs(len(sub), draw, "phi") * PERTURB_ULPS * _EPS
-                                 * np.maximum(np.abs(sub), math.pi), _perturbed_points(mech, draw)))
+                                 * np.maximum(np.abs(sub), math.pi), _perturbed_points(mech, draw), unit_speed))
     return kin, checked, trials
 
 
@@ -416,13 +422,15 @@ def _perturbed_points(mech: "Mechanism", draw: int) -> list[dict[str, complex]]:
     return mech._derived[key]
 
 
-def _solve(mech: "Mechanism", phi: np.ndarray, locals_: list[dict[str, complex]]) -> Kinematics:
+def _solve(mech: "Mechanism", phi: np.ndarray, locals_: list[dict[str, complex]],
+           unit_speed: bool = False) -> Kinematics:
     pl = _Plan(mech, phi, locals_)
     dr = mech.drive
     arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)
     th1 = dr.sense * phi + (math.atan2(dr.reference[1], dr.reference[0]) - cmath.phase(arm))
+    w, e = (1.0, 0.0) if unit_speed else dr.speed(phi)      # the constants, or per angle by the law
     pl.set_link(1, th1, np.exp(1j * th1), pl.local(0, dr.pivot), pl.local(1, dr.pivot),
-                dr.sense * dr.omega, 0.0, dr.sense * dr.eps, 0.0)
+                dr.sense * w, 0.0, dr.sense * e, 0.0)
     groups = mech.structure.groups
     frob, det = np.empty((2, len(phi), len(groups)))
     for n, (g, scale) in enumerate(zip(groups, group_scales(mech))):
@@ -495,14 +503,22 @@ def kinematic_deviation(mech: "Mechanism", a: Kinematics, b: Kinematics) -> np.n
     """(N,) how far the motion b is from a: the largest relative change of any link's position,
     orientation, angular velocity and acceleration, velocity and acceleration, and of any
     sliding velocity and acceleration, each against max(|value|, scale) with the scales
-    L (kinematic_size), 1, w, e, L w, L e (w = |omega_1|, e = omega_1^2 + |eps_1|)."""
-    L, w = kinematic_size(mech), abs(mech.drive.omega)
-    e = w * w + abs(mech.drive.eps)
+    L (kinematic_size), 1, w, e, L w, L e (w = |omega_1|, e = omega_1^2 + |eps_1|: the drive's
+    constants, or the largest of a's crank over its angles, as for a law of motion or a motion at
+    unit crank speed)."""
+    L = kinematic_size(mech)
+    w = max(abs(mech.drive.omega), _largest(a.omega[:, 1]))
+    e = w * w + max(abs(mech.drive.eps), _largest(a.eps[:, 1]))
     return np.max([relative_change(b.origin_z, a.origin_z, L), relative_change(b.rot, a.rot, 1.0),
                    relative_change(b.omega, a.omega, w), relative_change(b.eps, a.eps, e),
                    relative_change(b.v_z, a.v_z, L * w), relative_change(b.a_z, a.a_z, L * e),
                    relative_change(b.v_slide, a.v_slide, L * w), relative_change(b.a_slide, a.a_slide, L * e)],
                   axis=0)
+
+
+def _largest(x: np.ndarray) -> float:
+    """Largest finite |x|, 0 if none."""
+    return float(np.max(np.abs(x), initial=0.0, where=np.isfinite(x)))
 
 
 def guard(mech: "Mechanism", kin: Kinematics, error: np.ndarray, stacklevel: int = 3) -> Kinematics:

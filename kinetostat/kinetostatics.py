@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+from .kinematics import kinematics
 from .planar import Basis, as_xy, as_z, cross_z, dot_z
 
 if TYPE_CHECKING:
@@ -210,15 +211,24 @@ def lever_moment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndar
     """Zhukovsky's rigid lever: the balancing moment from the velocity plan alone.
 
     Every applied and inertia load moved to its like point of the plan turned by 90 deg has a
-    moment about the pole proportional to its power F . v (M omega for a couple); the lever's
-    equilibrium is the vanishing of the total, so M_bal omega_1 = -sum(F . v + M omega).
+    moment about the pole proportional to its virtual power per unit crank speed, F . v' (M w'
+    for a couple), v' = dv/d(omega_1) the velocity plan drawn for omega_1 = 1; the lever's
+    equilibrium is the vanishing of the total, so M_bal = -sum(F . v' + M w'). Velocities are
+    linear in omega_1, so v' = v / omega_1 where the crank turns; at standstill (omega_1 = 0)
+    v' comes from the plan at unit speed: the route never divides by zero.
     Reactions do no work and never enter: this route is independent of the group-by-group one.
     F (N, L) complex and M (N, L): all applied and inertia loads per link about its origin.
     """
-    power = dot_z(F, kin.v_z) + M * kin.omega
+    v, w = kin.v_z, kin.omega
+    still = w[:, 1] == 0
+    if still.any():                           # standstill: the plan at unit crank speed there
+        unit = kinematics(mech, kin.phi[still], unit_speed=True)
+        v, w = v.copy(), w.copy()
+        v[still], w[still] = unit.v_z, unit.omega
+    power = dot_z(F, v) + M * w
     moving = np.ones(mech.n_links)            # the sum over the moving links as one matrix product
     moving[0] = 0.0
-    return -(power @ moving) / kin.omega[:, 1]
+    return -(power @ moving) / w[:, 1]
 
 
 def friction_power(mech: "Mechanism", kin: "Kinematics", R: np.ndarray) -> np.ndarray:

@@ -5,7 +5,9 @@ kg, moments of inertia in kg m^2, angles in radians unless the name says `_deg`.
 """
 from __future__ import annotations
 
+import ast
 import difflib
+import functools
 import math
 import re
 import stat
@@ -23,21 +25,43 @@ from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
 from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse as parse_expression, resolve as resolve_parameters
 from .structure import Structure, analyse_structure
 
-__all__ = ["Link", "Pair", "Table", "Load", "Spring", "Gear", "Drive", "Friction", "Published", "Study", "Mechanism",
+__all__ = ["Link", "Body", "Pair", "Table", "Load", "Characteristic", "SpeedLaw", "combine", "Spring", "Gear", "Drive", "Friction", "Published", "Study", "Mechanism",
            "PUBLISHED_UNITS", "load", "loads", "from_dict"]
 
 Vec = tuple[float, float]
 
 
 @dataclass(frozen=True)
+class Body:
+    """One of several bodies that make up a link (`[[link.body]]`), as the file gives it."""
+    name: str
+    mass: float                # kg
+    com: Vec                   # its centre of mass, link's local frame, m
+    I_S: float = 0.0           # kg m^2, about its own centre (0: a point mass)
+
+
+@dataclass(frozen=True)
 class Link:
-    """A rigid link. `points`: name -> local coordinates (m); link 0 (frame): world coordinates."""
+    """A rigid link. `points`: name -> local coordinates (m); link 0 (frame): world coordinates.
+    With `bodies`, mass, com and I_S are theirs combined (I_S by the parallel-axis theorem)."""
     id: int
     name: str
     points: Mapping[str, Vec]
     mass: float = 0.0          # kg
     I_S: float = 0.0           # kg m^2, about the centre of mass
     com: str | None = None     # name of the centre-of-mass point
+    bodies: tuple[Body, ...] = ()
+
+
+def combine(bodies: tuple[Body, ...]) -> tuple[float, Vec, float]:
+    """Total mass (kg), centre of mass (local, m) and I_S about it (kg m^2) of `bodies`:
+    m = sum m_b, S = sum m_b S_b / m, I_S = sum (I_b + m_b |S_b - S|^2)."""
+    m = math.fsum(b.mass for b in bodies)
+    if m == 0:
+        return 0.0, (0.0, 0.0), 0.0
+    S = (math.fsum(b.mass * b.com[0] for b in bodies) / m, math.fsum(b.mass * b.com[1] for b in bodies) / m)
+    I_S = math.fsum(b.I_S + b.mass * ((b.com[0] - S[0]) ** 2 + (b.com[1] - S[1]) ** 2) for b in bodies)
+    return m, S, I_S
 
 
 @dataclass(frozen=True)
@@ -79,15 +103,35 @@ class Table:
 
 
 @dataclass(frozen=True)
+class Characteristic:
+    """A speed-dependent moment M(omega): a motor's mechanical characteristic (seed 000 sec. 1).
+    Both omega (rad/s) and M (N m) are measured in the drive's sense; a table is interpolated
+    linearly (its end values held outside it), an expression is a function of `omega`."""
+    omega: tuple[float, ...] = ()
+    M: tuple[float, ...] = ()
+    expression: str | None = None
+
+    def __call__(self, omega: np.ndarray) -> np.ndarray:
+        """M (N m) at the angular velocities `omega` (rad/s), both in the drive's sense."""
+        if self.expression is not None:
+            return np.broadcast_to(_evaluate(self.expression, {"omega": omega}), np.shape(omega)).astype(float)
+        return np.interp(omega, self.omega, self.M)
+
+
+@dataclass(frozen=True)
 class Load:
-    """An external force at a point (`kind='force'`) or a moment on a link (`kind='moment'`)."""
+    """An external force at a point (`kind='force'`), a moment on a link (`kind='moment'`), or a
+    viscous damper on a pair (`kind='damper'`: `value` is its coefficient c, N m s/rad for a
+    revolute pair, N s/m for a prismatic one; `pair` the pair's links, `link` its second)."""
     name: str
-    kind: Literal["force", "moment"]
+    kind: Literal["force", "moment", "damper"]
     link: int
     point: str | None
     direction: Vec | Literal["against_velocity", "against_omega"] | None
     value: float | None
     table: Table | None
+    characteristic: Characteristic | None = None   # moment only: M(omega of `link`)
+    pair: tuple[int, int] | None = None            # damper only: the pair's links, as listed
 
 
 @dataclass(frozen=True)
@@ -126,6 +170,29 @@ class Gear:
 
 
 @dataclass(frozen=True)
+class SpeedLaw:
+    """The crank's law of motion omega(phi) over one revolution (seed 000 sec. 1, seed 003).
+
+    A table (`phi_deg`, `omega`) is interpolated by the periodic cubic spline through its points
+    (C2: omega, d omega/d phi and eps = omega d omega/d phi are continuous, on any spacing of the
+    angles); an expression is a function of `phi` (rad), differentiated exactly by the complex
+    step. omega in rad/s, >= 0, in the drive's sense."""
+    phi_deg: tuple[float, ...] = ()
+    omega: tuple[float, ...] = ()
+    expression: str | None = None
+
+    def __call__(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(omega, d omega / d phi) at crank angles `phi` (rad), rad/s and rad/s per rad."""
+        phi = np.asarray(phi, dtype=float)
+        if self.expression is not None:
+            h = 1e-30                         # complex step: exact derivative, no cancellation
+            z = np.broadcast_to(_evaluate(self.expression, {"phi": phi + 1j * h}), phi.shape)
+            return z.real.astype(float), z.imag / h
+        x, y, m = _periodic_spline(self.phi_deg, self.omega)
+        return _spline_at(x, y, m, phi)
+
+
+@dataclass(frozen=True)
 class Drive:
     """The initial link I(0,1): crank angle reference, sense, speed."""
     link: int
@@ -133,11 +200,25 @@ class Drive:
     point: str
     reference: Vec              # unit world direction of phi = 0
     sense: int                  # +1 ccw, -1 cw
-    omega: float                # rad/s, >= 0 (0: statics), in `sense`
-    eps: float                  # rad/s^2, in `sense`
+    omega: float                # rad/s, >= 0 (0: statics), in `sense` (with a law: its largest value, the speed scale)
+    eps: float                  # rad/s^2, in `sense` (with a law: the largest |eps| over the cycle)
     kind: Literal["engine", "machine"]
     gear: Gear | None = None
     design_deg: float = 30.0    # the design position: crank angle of the mechanism's picture, deg
+    law: SpeedLaw | None = None   # omega(phi); None: the constant omega and eps above
+
+    @property
+    def steady(self) -> bool:
+        """Does the crank turn at one constant speed (no law, eps = 0)?"""
+        return self.law is None and self.eps == 0.0
+
+    def speed(self, phi: np.ndarray) -> tuple[np.ndarray | float, np.ndarray | float]:
+        """(omega, eps) of the crank at angles `phi` (rad), in the drive's sense: the constants,
+        or omega(phi) and eps = omega d omega / d phi of the law."""
+        if self.law is None:
+            return self.omega, self.eps
+        w, dw = self.law(phi)
+        return w, w * dw
 
 
 @dataclass(frozen=True)
@@ -276,6 +357,106 @@ class Mechanism:
 
     def _largest_link(self) -> float:
         return max((_span(link.points.values()) for link in self.links[1:]), default=0.0) or 1.0
+
+
+# ----------------------------------------------------------------------------- laws and characteristics
+
+#: Functions an expression of a law of motion or a characteristic may call (numpy's, so that they
+#: take arrays and complex arguments: the complex step differentiates through them).
+_FUNCTIONS: Mapping[str, Callable] = MappingProxyType({
+    "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "acos": np.arccos, "atan": np.arctan,
+    "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "exp": np.exp, "log": np.log, "sqrt": np.sqrt})
+_CONSTANTS: Mapping[str, float] = MappingProxyType({"pi": math.pi, "e": math.e})
+_OPERATORS: Mapping[type, Callable] = MappingProxyType({
+    ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b, ast.Mult: lambda a, b: a * b,
+    ast.Div: lambda a, b: a / b, ast.Pow: lambda a, b: a ** b,
+    ast.USub: lambda a: -a, ast.UAdd: lambda a: +a})
+#: Longest expression, characters.
+MAX_EXPRESSION = 1000
+
+
+@functools.lru_cache(maxsize=256)
+def _parse(text: str) -> ast.expr:
+    """The syntax tree of an arithmetic expression; ValueError naming what is not allowed
+    (only numbers, names, + - * / **, and calls of _FUNCTIONS: no attribute, subscript or code)."""
+    if len(text) > MAX_EXPRESSION:
+        raise ValueError(f"longer than {MAX_EXPRESSION} characters")
+    try:
+        tree = ast.parse(text, mode="eval").body
+    except SyntaxError as exc:
+        raise ValueError(f"syntax error: {exc.msg}") from None
+    except (RecursionError, MemoryError):
+        raise ValueError("nested too deeply") from None
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            if not (isinstance(node.func, ast.Name) and node.func.id in _FUNCTIONS and len(node.args) == 1
+                    and not node.keywords):
+                raise ValueError(f"only the functions {sorted(_FUNCTIONS)} of one argument may be called")
+        elif isinstance(node, ast.Constant):
+            if not _finite(node.value):
+                raise ValueError(f"{node.value!r} is not a number")
+        elif not isinstance(node, (ast.BinOp, ast.UnaryOp, ast.Name, ast.Load, *_OPERATORS)):
+            raise ValueError(f"{type(node).__name__} is not allowed (numbers, names, + - * / ** and functions only)")
+    return tree
+
+
+def _evaluate(text: str, names: Mapping[str, Any]) -> Any:
+    """The value of expression `text` with `names` (arrays or numbers) and pi, e bound;
+    ValueError for an unknown name or what `_parse` refuses."""
+    def ev(node: ast.expr) -> Any:
+        if isinstance(node, ast.Constant):
+            return np.float64(node.value)      # numpy semantics: 1/0 is inf, not an exception
+        if isinstance(node, ast.Name):
+            if node.id in names:
+                return names[node.id]
+            if node.id in _CONSTANTS:
+                return _CONSTANTS[node.id]
+            raise ValueError(f"unknown name {node.id!r}{_suggest(node.id, [*names, *_CONSTANTS])}; "
+                             f"known: {sorted([*names, *_CONSTANTS])}")
+        if isinstance(node, ast.BinOp):
+            return _OPERATORS[type(node.op)](ev(node.left), ev(node.right))
+        if isinstance(node, ast.UnaryOp):
+            return _OPERATORS[type(node.op)](ev(node.operand))
+        return _FUNCTIONS[node.func.id](ev(node.args[0]))
+    tree = _parse(text)
+    with np.errstate(all="ignore"):
+        try:
+            return ev(tree)
+        except RecursionError:
+            raise ValueError("nested too deeply") from None
+
+
+@functools.lru_cache(maxsize=64)
+def _periodic_spline(x_deg: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Knots x (rad, increasing, within one period 2 pi; a last knot at x[0] + 2 pi repeats the
+    first and is dropped), values y and second derivatives m of the periodic cubic spline
+    through the points (x_deg, deg; y)."""
+    x, y = np.radians(x_deg), np.asarray(y, float)
+    if np.isclose(x[-1] - x[0], 2 * np.pi, rtol=0, atol=1e-12):
+        x, y = x[:-1], y[:-1]
+    n = len(x)
+    h = np.diff(np.append(x, x[0] + 2 * np.pi))           # h[i] = x[i+1] - x[i], cyclically
+    slope = (np.roll(y, -1) - y) / h
+    A = np.zeros((n, n))
+    for i in range(n):
+        A[i, i - 1] += h[i - 1]
+        A[i, i] += 2 * (h[i - 1] + h[i])
+        A[i, (i + 1) % n] += h[i]
+    m = np.linalg.solve(A, 6 * (slope - np.roll(slope, 1)))
+    return x, y, m
+
+
+def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Value and first derivative of the periodic cubic spline (x, y, m) at `phi` (rad)."""
+    xe, ye, me = np.append(x, x[0] + 2 * np.pi), np.append(y, y[0]), np.append(m, m[0])
+    t = x[0] + np.mod(phi - x[0], 2 * np.pi)
+    i = np.clip(np.searchsorted(xe, t, side="right") - 1, 0, len(x) - 1)
+    h = xe[i + 1] - xe[i]
+    a, b = xe[i + 1] - t, t - xe[i]
+    ca, cb = ye[i] / h - me[i] * h / 6, ye[i + 1] / h - me[i + 1] * h / 6
+    value = (me[i] * a**3 + me[i + 1] * b**3) / (6 * h) + ca * a + cb * b
+    slope = (-me[i] * a**2 + me[i + 1] * b**2) / (2 * h) - ca + cb
+    return value, slope
 
 
 def _span(points) -> float:
@@ -696,7 +877,7 @@ class _Reader:
         pairs = self.pairs(links)
         drive = self.drive(links, pairs)
         branches = self.groups(links)
-        loads_ = self.loads(links)
+        loads_ = self.loads(links, pairs)
         springs = self.springs(links)
         friction = self.friction()
         published = self.published(links, pairs, drive)
@@ -777,7 +958,7 @@ class _Reader:
         frame = Link(0, "frame", MappingProxyType(self.points(self.data.get("frame"), "frame", 0)))
         raw = self.table_list("link")
         by_id: dict[int, Link] = {}
-        allowed = {"id", "name", "points", "mass", "weight", "I_S", "com"}
+        allowed = {"id", "name", "points", "mass", "weight", "I_S", "com", "body"}
         for n, t in enumerate(raw):
             lid = t.get("id")
             valid_id = isinstance(lid, int) and not isinstance(lid, bool) and lid > 0
@@ -797,6 +978,20 @@ class _Reader:
                 self.ids_unknown = True
                 lid = None
             pts = self.points(t.get("points"), f"{where}.points", lid)
+            bodies: tuple[Body, ...] = ()
+            if "body" in t:
+                bodies = self.bodies(t, where, pts, g)
+                if bodies:
+                    m_total, S, I_total = combine(bodies)
+                    com = t.get("com", f"S{lid if lid is not None else n + 1}")
+                    if not isinstance(com, str) or com in pts:
+                        self.err(f"{where}.com: with bodies, com names the new point of their combined centre "
+                                 f"of mass; got {com!r}" + (", already a point of the link" if com in pts else ""))
+                    elif lid is not None:
+                        pts[com] = S
+                        by_id[lid] = Link(lid, self.string(t, "name", where, default=f"link {lid}"),
+                                          MappingProxyType(pts), m_total, I_total, com, bodies)
+                continue
             if "mass" in t and "weight" in t:
                 self.err(f"{where}: give mass or weight, not both")
             if "weight" in t:
@@ -832,6 +1027,41 @@ class _Reader:
             self.ids_unknown = True
             return [frame]
         return [frame] + [by_id[i] for i in ids]
+
+    def bodies(self, t: Mapping, where: str, pts: dict[str, Vec], g: float | None) -> tuple[Body, ...]:
+        """[[link.body]]: each with mass (or weight), com (a point of the link or [x, y]) and
+        I_S about its own centre (default 0, a point mass); () after recording a problem."""
+        raw = t["body"]
+        for key in ("mass", "weight", "I_S"):
+            if key in t:
+                self.err(f"{where}.{key}: a link given by bodies takes its {key} from them; remove it")
+        if not (isinstance(raw, list) and raw and all(isinstance(b, dict) for b in raw)):
+            self.err(f"{where}.body: expected an array of tables [[link.body]] (mass, com, I_S)")
+            return ()
+        n0, out = len(self.problems), []
+        for n, b in enumerate(raw):
+            w = f"{where}.body[{n}]"
+            self.unknown_keys(b, {"name", "mass", "weight", "com", "I_S"}, w)
+            if ("mass" in b) == ("weight" in b):
+                self.err(f"{w}: give exactly one of mass or weight")
+                continue
+            mass = self.number(b, "mass", w, minimum=0.0) if "mass" in b else None
+            if "weight" in b:
+                wt = self.number(b, "weight", w, minimum=0.0)
+                if wt is not None and not g:
+                    self.err(f"{w}.weight: a weight needs mechanism.g > 0 to give a mass")
+                mass = None if wt is None or not g else wt / g
+            raw_com = b.get("com")
+            if isinstance(raw_com, str):
+                com = pts.get(raw_com)
+                if com is None:
+                    self.err(f"{w}.com: unknown point {raw_com!r}{_suggest(raw_com, pts)}. Valid names: {sorted(pts)}")
+            else:
+                com = self.vec(raw_com, f"{w}.com")
+            I_S = self.number(b, "I_S", w, default=0.0, minimum=0.0)
+            if None not in (mass, com, I_S):
+                out.append(Body(self.string(b, "name", w, default=f"body {n + 1}"), mass, com, I_S))
+        return tuple(out) if len(self.problems) == n0 else ()
 
     def link_ok(self, links: list[Link], lid: Any, where: str, *, first: int = 0) -> bool:
         """Is `lid` the id of a link (>= `first`)? Unknown ids are not reported while some
@@ -938,7 +1168,7 @@ class _Reader:
             self.err("drive: missing table [drive]")
             return None
         w = "drive"
-        self.unknown_keys(t, {"link", "pivot", "point", "reference", "sense", "rpm", "omega",
+        self.unknown_keys(t, {"link", "pivot", "point", "reference", "sense", "rpm", "omega", "omega_table",
                               "eps", "kind", "gear", "design_deg"}, w)
         link = t.get("link", 1)
         if link != 1:
@@ -953,15 +1183,24 @@ class _Reader:
                 self.err(f"drive.pivot: the crank needs a revolute pair with the frame at {pivot!r}")
         ref = self.vec(t.get("reference"), "drive.reference", unit=True)
         sense = self.string(t, "sense", w, choices=("ccw", "cw"))
-        if ("rpm" in t) == ("omega" in t):
-            self.err("drive: give exactly one of rpm or omega")
+        law = None
+        if sum(k in t for k in ("rpm", "omega", "omega_table")) != 1:
+            self.err("drive: give exactly one of rpm, omega (a number, or an expression of phi) or omega_table")
             omega = None
+        elif "omega_table" in t:
+            law = self.speed_table(t["omega_table"], "drive.omega_table")
+        elif isinstance(t.get("omega"), str):
+            law = self.speed_expression(t["omega"], "drive.omega")
         elif "rpm" in t:
             rpm = self.number(t, "rpm", w, minimum=0.0)
             omega = None if rpm is None else rpm * math.pi / 30
         else:
-            omega = self.number(t, "omega", w, minimum=0.0)     # 0: statics
+            omega = self.number(t, "omega", w, minimum=0.0)
+        if law is not None and "eps" in t:
+            self.err("drive.eps: a law of motion gives eps = omega d omega / d phi itself; remove eps")
         eps = self.number(t, "eps", w, default=0.0)
+        if "omega_table" in t or isinstance(t.get("omega"), str):
+            omega, eps = (None, None) if law is None else self.law_scales(law)
         design = self.number(t, "design_deg", w, default=30.0)
         kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")
         gear = None
@@ -971,7 +1210,71 @@ class _Reader:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
         if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
             return None
-        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design)
+        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law)
+
+    def speed_table(self, t: Any, where: str) -> SpeedLaw | None:
+        """[drive.omega_table]: phi_deg and omega (rad/s) or rpm over one revolution."""
+        if not isinstance(t, dict):
+            self.err(f"{where}: expected a table {{ phi_deg = [...], omega = [...] }} (or rpm = [...])")
+            return None
+        self.unknown_keys(t, {"phi_deg", "omega", "rpm"}, where)
+        if ("omega" in t) == ("rpm" in t):
+            self.err(f"{where}: give exactly one of omega (rad/s) or rpm")
+            return None
+        xs = self.series(t.get("phi_deg"), f"{where}.phi_deg")
+        key = "omega" if "omega" in t else "rpm"
+        vs = self.series(t.get(key), f"{where}.{key}")
+        if xs is None or vs is None:
+            return None
+        n = len(self.problems)
+        if len(vs) != len(xs):
+            self.err(f"{where}.{key}: {len(vs)} values for {len(xs)} angles")
+        if len(xs) < 3:
+            self.err(f"{where}.phi_deg: a periodic spline needs at least 3 angles, got {len(xs)}")
+        if any(b <= a for a, b in zip(xs, xs[1:])):
+            self.err(f"{where}.phi_deg: the angles must increase strictly")
+        elif not xs[-1] - xs[0] <= 360:
+            self.err(f"{where}.phi_deg: the angles must lie within one revolution (last - first <= 360)")
+        elif xs[-1] - xs[0] == 360 and len(vs) == len(xs) and vs[0] != vs[-1]:
+            self.err(f"{where}.{key}: the law is periodic, but its values at {xs[0]:g} and {xs[-1]:g} deg "
+                     f"({vs[0]:g}, {vs[-1]:g}) differ")
+        if any(v < 0 for v in vs):
+            self.err(f"{where}.{key}: the crank turns in the drive's sense: speeds must be >= 0")
+        if len(self.problems) > n:
+            return None
+        scale = 1.0 if key == "omega" else math.pi / 30
+        return SpeedLaw(xs, tuple(v * scale for v in vs))
+
+    def speed_expression(self, text: str, where: str) -> SpeedLaw | None:
+        """drive.omega as an expression of phi (rad), periodic over a revolution."""
+        law = SpeedLaw(expression=text)
+        try:
+            law(np.zeros(1))
+        except ValueError as exc:
+            self.err(f"{where}: {text!r}: {exc}")
+            return None
+        return law
+
+    def law_scales(self, law: SpeedLaw) -> tuple[float | None, float | None]:
+        """The largest omega and |eps| of `law` over a revolution, after checking that omega is
+        finite, >= 0 and periodic; (None, None) after recording a problem."""
+        where = "drive.omega_table" if law.expression is None else "drive.omega"
+        phi = np.linspace(0.0, 2 * np.pi, 721)
+        w, dw = law(phi)
+        if not (np.isfinite(w).all() and np.isfinite(dw).all()):
+            self.err(f"{where}: omega(phi) is not finite over the whole revolution")
+        elif (w < 0).any():
+            self.err(f"{where}: omega(phi) must be >= 0 (in the drive's sense); it is "
+                     f"{w.min():.4g} rad/s at phi = {np.degrees(phi[np.argmin(w)]):.4g} deg")
+        elif np.abs(w.max()) > MAX_VALUE:
+            self.err(f"{where}: omega(phi) reaches {w.max():.4g} rad/s (at most {MAX_VALUE:g})")
+        elif law.expression is not None and not (
+                abs(w[-1] - w[0]) <= 1e-9 * max(abs(w).max(), 1.0) and abs(dw[-1] - dw[0]) <= 1e-9 * max(abs(dw).max(), 1.0)):
+            self.err(f"{where}: omega(phi) must be periodic over a revolution (value and slope at 0 and 2 pi): "
+                     f"omega = {w[0]:.6g}, {w[-1]:.6g}; d omega/d phi = {dw[0]:.6g}, {dw[-1]:.6g}")
+        else:
+            return float(w.max()), float(np.abs(w * dw).max())
+        return None, None
 
     def gear(self, t: Any, size: float) -> Gear | None:
         """[drive.gear]; `size`: the largest link, m (the wheel must not be vanishingly small beside it)."""
@@ -1033,13 +1336,20 @@ class _Reader:
             self.group_tables.setdefault(key, (n, tuple(lk)))
         return out
 
-    def loads(self, links: list[Link]) -> list[Load]:
+    def loads(self, links: list[Link], pairs: list[Pair]) -> list[Load]:
         out = []
         for n, t in enumerate(self.table_list("load")):
             where = f"load[{n}]"
-            kind = self.string(t, "kind", where, choices=("force", "moment"), default="force")
-            self.unknown_keys(t, {"name", "kind", "link", "point", "direction", "value", "table"}, where)
+            kind = self.string(t, "kind", where, choices=("force", "moment", "damper"), default="force")
             name = self.string(t, "name", where, default=f"load {n}")
+            if kind == "damper":
+                self.unknown_keys(t, {"name", "kind", "pair", "c"}, where)
+                damper = self.damper(t, where, name, links, pairs)
+                if damper is not None:
+                    out.append(damper)
+                continue
+            self.unknown_keys(t, {"name", "kind", "link", "point", "direction", "value", "table"}
+                              | ({"characteristic"} if kind == "moment" else set()), where)
             lid = t.get("link")
             if not self.link_ok(links, lid, f"{where}.link"):
                 continue
@@ -1059,11 +1369,20 @@ class _Reader:
                 if raw not in (None, "against_omega"):
                     self.err(f"{where}.direction: a moment takes no direction or 'against_omega', got {raw!r}")
                 direction = raw
-            if ("value" in t) == ("table" in t):
-                self.err(f"{where}: give exactly one of value or table")
+            if sum(k in t for k in ("value", "table", "characteristic")) != 1:
+                self.err(f"{where}: give exactly one of value or table"
+                         + (" or characteristic" if kind == "moment" else ""))
                 continue
             value = self.number(t, "value", where) if "value" in t else None
             table = self.table(t["table"], f"{where}.table") if "table" in t else None
+            if "characteristic" in t:
+                if direction is not None:
+                    self.err(f"{where}.direction: a characteristic M(omega) gives its own sign")
+                    continue
+                characteristic = self.characteristic(t["characteristic"], f"{where}.characteristic")
+                if characteristic is not None:
+                    out.append(Load(name, kind, lid, None, None, None, None, characteristic))
+                continue
             if table is not None and table.argument == "travel":
                 if kind == "moment":
                     self.err(f"{where}.table.travel: a moment acts on a link, not at a point, so it has no "
@@ -1079,6 +1398,49 @@ class _Reader:
             if value is not None or table is not None:
                 out.append(Load(name, kind, lid, point, direction, value, table))
         return out
+
+    def characteristic(self, t: Any, where: str) -> Characteristic | None:
+        """A motor's M(omega): { omega = [...], M = [...] } or an expression of omega."""
+        if isinstance(t, str):
+            c = Characteristic(expression=t)
+            try:
+                value = c(np.array([0.0, 1.0]))
+            except ValueError as exc:
+                self.err(f"{where}: {t!r}: {exc}")
+                return None
+            if not np.isfinite(value).all():
+                self.err(f"{where}: {t!r} is not finite at omega = 0 or 1 rad/s")
+                return None
+            return c
+        if not isinstance(t, dict):
+            self.err(f"{where}: expected {{ omega = [...], M = [...] }} (rad/s, N m) or an expression of omega")
+            return None
+        self.unknown_keys(t, {"omega", "M"}, where)
+        ws, ms = self.series(t.get("omega"), f"{where}.omega"), self.series(t.get("M"), f"{where}.M")
+        if ws is None or ms is None:
+            return None
+        if len(ws) != len(ms):
+            self.err(f"{where}.M: {len(ms)} values for {len(ws)} speeds")
+        elif any(b <= a for a, b in zip(ws, ws[1:])):
+            self.err(f"{where}.omega: the speeds must increase strictly")
+        else:
+            return Characteristic(ws, ms)
+        return None
+
+    def damper(self, t: Mapping, where: str, name: str, links: list[Link], pairs: list[Pair]) -> Load | None:
+        """A viscous damper on the pair `pair` = [i, j]: coefficient c >= 0."""
+        lk = t.get("pair")
+        c = self.number(t, "c", where, minimum=0.0)
+        if not (isinstance(lk, list) and len(lk) == 2 and all(self.link_ok(links, x, f"{where}.pair") for x in lk)):
+            if not isinstance(lk, list) or len(lk) != 2:
+                self.err(f"{where}.pair: expected the two link ids [i, j] of a pair, got {lk!r}")
+            return None
+        if not any(set(p.links) == set(lk) for p in pairs):
+            self.err(f"{where}.pair: no kinematic pair joins links {lk}. Pairs: {[list(p.links) for p in pairs]}")
+            return None
+        if c is None:
+            return None
+        return Load(name, "damper", lk[1], None, None, c, None, None, (lk[0], lk[1]))
 
     def table(self, t: Any, where: str) -> Table | None:
         if not isinstance(t, dict):
@@ -1294,7 +1656,7 @@ def _turned_slider(link: Link, axis: Vec) -> Link:
     along `axis`, into the documented one, whose x axis runs along the guide."""
     turn = complex(*axis).conjugate()
     pts = {n: ((z := complex(*xy) * turn).real, z.imag) for n, xy in link.points.items()}
-    return Link(link.id, link.name, MappingProxyType(pts), link.mass, link.I_S, link.com)
+    return Link(link.id, link.name, MappingProxyType(pts), link.mass, link.I_S, link.com, link.bodies)
 
 
 def _components(edges: list[tuple[int, int]]) -> dict[int, int]:

@@ -235,6 +235,28 @@ def available(route: str) -> str | None:
     return None
 
 
+def unsupported(route: str, mech: Mechanism) -> str | None:
+    """None if the route can check `mech`, else why it is skipped: the simulations follow a crank
+    turning at one constant speed > 0 (not a law of motion omega(phi), not standstill); the
+    mpmath reference integrates the constant omega and eps itself and evaluates the loads it
+    knows (not a motor characteristic or a damper). The exact routes (pinocchio, mujoco) take q,
+    v, a and the applied loads from the scene, so they check every model."""
+    dr = mech.drive
+    if route in ("mujoco-sim", "pymunk"):
+        if dr.law is not None:
+            return "the crank follows a law of motion omega(phi): a simulation here drives it at one constant speed"
+        if dr.omega == 0:
+            return "standstill (omega = 0): a simulation has no motion to follow"
+    if route == "reference":
+        if dr.law is not None:
+            return "the crank follows a law of motion omega(phi): the reference integrates a constant omega and eps"
+        kinds = sorted({"motor characteristic" if ld.characteristic is not None else "damper"
+                        for ld in mech.loads if ld.kind == "damper" or ld.characteristic is not None})
+        if kinds:
+            return f"speed-dependent loads ({', '.join(kinds)}): the reference evaluates only the loads it knows"
+    return None
+
+
 def compare(mech: Mechanism, engines=tuple(ROUTES), steps: int = 360, res: Analysis | None = None,
             tolerances: dict[str, Tolerance] | None = None) -> Comparison:
     """Cross-validate `mech` (or a given solver result `res` of it) against engine routes.
@@ -253,7 +275,7 @@ def compare(mech: Mechanism, engines=tuple(ROUTES), steps: int = 360, res: Analy
     scene = build_scene(mech, res=res)
     rows, results, skipped, failed = [], {}, {}, {}
     for route in engines:
-        why = available(route)
+        why = available(route) or unsupported(route, mech)
         if why:
             skipped[route] = why
             continue

@@ -132,6 +132,9 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     if res.singular[0]:
         raise ValueError(f"at {at:g} deg the mechanism is at a singular position "
                          f"(cond {res.cond[0].max():.3g}): velocities and accelerations undefined")
+    if res.omega(1)[0] == 0:
+        raise ValueError("the crank stands still (omega_1 = 0): the velocity and acceleration plans have no "
+                         "size to draw; the statics is in the tables (reactions, balancing moment)")
     sc = choose_scales(mech, res, scales)
     steps = dict(BUILDERS)
     steps["positions"] = partial(positions_plan, starting_deg=starting_deg)

@@ -113,7 +113,9 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
     rpm = d.omega * 30 / math.pi
     items.append(f"**Drive** ({d.kind}): crank 1 turns about {esc(d.pivot)}; φ = angle from the world "
                  f"direction {_vec(d.reference)} to {esc(d.pivot)}→{esc(d.point)}, positive {'counter-clockwise' if d.sense > 0 else 'clockwise'}; "
-                 f"ω₁ = {d.omega:.6g} rad/s ({rpm:.6g} rpm), ε₁ = {d.eps:g} rad/s²; "
+                 + (f"ω₁ = {d.omega:.6g} rad/s ({rpm:.6g} rpm), ε₁ = {d.eps:g} rad/s²; " if d.law is None else
+                    f"ω₁(φ) by a law of motion ({'ω = ' + esc(d.law.expression) if d.law.expression else f'periodic cubic spline through {len(d.law.phi_deg)} points'}), "
+                    f"ω₁ up to {d.omega:.6g} rad/s, |ε₁| = |ω₁ dω₁/dφ| up to {d.eps:.6g} rad/s²; ")
                  + ("the unknown is the balancing moment on the crank" if d.kind == "engine" else
                     "the unknown is the balancing force of the pinion on the crank's wheel"))
     if d.gear is not None:
@@ -159,6 +161,11 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
                 t = ld.table
                 val = (f"table over {'φ, deg' if t.argument == 'phi' else 'fraction of stroke'} "
                        f"({len(t.x)} points), scale {t.scale:.6g}")
+            elif ld.characteristic is not None:
+                c = ld.characteristic
+                val = (f"M(ω) = {esc(c.expression)}" if c.expression else f"M(ω) table ({len(c.omega)} points)")
+            elif ld.kind == "damper":
+                val = f"c = {ld.value:.6g} on pair {ld.pair[0]}–{ld.pair[1]}"
             else:
                 val = f"{ld.value:.6g}"
             direction = ld.direction if isinstance(ld.direction, str) or ld.direction is None else _vec(ld.direction)
