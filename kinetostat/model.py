@@ -375,6 +375,15 @@ _OPERATORS: Mapping[type, Callable] = MappingProxyType({
 MAX_EXPRESSION = 1000
 
 
+def _mentions_phi(text: str) -> bool:
+    """Whether a drive's `omega` string is a law of motion (an expression of `phi`) rather than
+    a constant speed written over the model's parameters (`"n1 * pi / 30"`)."""
+    try:
+        return any(isinstance(n, ast.Name) and n.id == "phi" for n in ast.walk(_parse(text)))
+    except ValueError:
+        return True                  # not a valid expression: the law's reader says why
+
+
 @functools.lru_cache(maxsize=256)
 def _parse(text: str) -> ast.expr:
     """The syntax tree of an arithmetic expression; ValueError naming what is not allowed
@@ -1189,7 +1198,7 @@ class _Reader:
             omega = None
         elif "omega_table" in t:
             law = self.speed_table(t["omega_table"], "drive.omega_table")
-        elif isinstance(t.get("omega"), str):
+        elif isinstance(t.get("omega"), str) and _mentions_phi(t["omega"]):
             law = self.speed_expression(t["omega"], "drive.omega")
         elif "rpm" in t:
             rpm = self.number(t, "rpm", w, minimum=0.0)
@@ -1199,7 +1208,7 @@ class _Reader:
         if law is not None and "eps" in t:
             self.err("drive.eps: a law of motion gives eps = omega d omega / d phi itself; remove eps")
         eps = self.number(t, "eps", w, default=0.0)
-        if "omega_table" in t or isinstance(t.get("omega"), str):
+        if "omega_table" in t or isinstance(t.get("omega"), str) and _mentions_phi(t["omega"]):
             omega, eps = (None, None) if law is None else self.law_scales(law)
         design = self.number(t, "design_deg", w, default=30.0)
         kind = self.string(t, "kind", w, choices=("engine", "machine"), default="engine")

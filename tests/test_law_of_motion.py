@@ -161,7 +161,7 @@ def test_expression_law_gives_its_exact_derivative():
     ('omega = "1 + fi"', "unknown name 'fi'"),
     ('omega = "1/0 + 0*phi"', "not finite"),
     ('omega = "' + "(" * 300 + "phi" + ")" * 300 + '"', "nested"),
-    ('omega = "10"\neps = 3.0\n', "drive.eps: a law of motion gives eps"),
+    ('omega = "10 + sin(phi)"\neps = 3.0\n', "drive.eps: a law of motion gives eps"),
     ("[drive.omega_table]\nphi_deg = [0.0, 180.0]\nomega = [1.0, 2.0]\n", "at least 3 angles"),
     ("[drive.omega_table]\nphi_deg = [0.0, 180.0, 360.0]\nomega = [1.0, 2.0, 3.0]\n", "the law is periodic"),
 ])
@@ -402,3 +402,15 @@ def test_standstill_has_no_plans_to_draw_but_says_why():
     from kinetostat.plans import build
     with pytest.raises(ValueError, match=r"stands still \(omega_1 = 0\)"):
         build(kinetostat.load(Path(__file__).parent / "hostile" / "rpm_zero.toml"))
+
+
+def test_omega_string_without_phi_is_a_constant_speed_over_parameters():
+    """`omega = "n1 * pi / 30"` is the constant speed its parameters give (no law of motion);
+    `omega = "400 + 50*sin(phi)"` is a law: the reader tells them apart by the name phi."""
+    text = kinetostat.examples.path("ice_crank_slider").read_text(encoding="utf-8")
+    assert 'rpm = "n1"' in text
+    plain = kinetostat.loads(text)
+    by_omega = kinetostat.loads(text.replace('rpm = "n1"', 'omega = "n1 * pi / 30"'))
+    assert by_omega.drive.law is None and by_omega.drive.omega == pytest.approx(plain.drive.omega, rel=1e-15)
+    law = kinetostat.loads(text.replace('rpm = "n1"', 'omega = "400 + 50*sin(phi)"').replace("eps = 0.0\n", ""))
+    assert law.drive.law is not None and law.drive.omega == pytest.approx(450.0, rel=1e-6)
