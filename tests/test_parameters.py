@@ -289,7 +289,7 @@ def test_the_report_prints_the_parameters_their_numbers_and_the_study(tmp_path):
     write_report(run_validation(mech, [], steps=36, path=CHAIN), tmp_path)
     md = (tmp_path / "chain_unit_four_bar" / "index.md").read_text()
     assert "| l | sqrt(r\\*\\*2 + c\\*\\*2) | 0.5458937626 |" in md       # markdown-escaped
-    assert "| link\\[id=3\\].mass | M3 | 17.445 |" in md and "| M3 | m3 + m_tb | 17.445 |" in md
+    assert "| link\\[id=3\\].body\\[1\\].mass | m_tb | 12.749 |" in md and "| m_tb | number | 12.749 |" in md
     assert "## Parameter study" in md
     row = next(s for s in md.splitlines() if s.startswith("| 0.08 |"))
     assert row.split("|")[4].strip() == f"{study_table(mech)[2, 2]:.1f}" == "287.7"
