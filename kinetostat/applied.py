@@ -2,6 +2,8 @@
 
 Every load is reduced to a wrench per link: force F (N, world, complex x + iy) and moment M
 (N m, about +z) about the link's local origin, stacked as F (N, L), M (N, L).
+
+May use: numpy, model, kinematics (its results), planar, errors.
 """
 from __future__ import annotations
 

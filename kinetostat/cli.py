@@ -8,6 +8,9 @@ file, structure, assembly, angles, engine names, output path, stdout that cannot
 file's problem list prints one line per problem) and never a traceback; warnings print one line
 each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
 disk leaves the previous file as it was.
+
+May use: every room of the package, and the harness inside the commands that need it
+(imported there, so that `import kinetostat.cli` loads no engine).
 """
 from __future__ import annotations
 

@@ -1,4 +1,7 @@
-"""Errors and warnings of kinetostat: every message names the field path or the crank angles."""
+"""Errors and warnings of kinetostat: every message names the field path or the crank angles.
+
+May use: the standard library only.
+"""
 from __future__ import annotations
 
 import errno

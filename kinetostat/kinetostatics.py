@@ -5,6 +5,8 @@ Groups are taken from the last attached to the first. In each, the known loads o
 links (applied, inertia, and the reactions carried back from groups already solved) are
 balanced by the reactions of its three pairs; the reactions on the outer links are then
 carried to those links with the sign reversed, as the texts do.
+
+May use: numpy, model, structure, kinematics (its results), planar.
 """
 from __future__ import annotations
 

@@ -2,6 +2,8 @@
 
 Field meanings and units are those of `models/FORMAT.md`. All coordinates in metres, masses in
 kg, moments of inertia in kg m^2, angles in radians unless the name says `_deg`.
+
+May use: the standard library, numpy, errors, expressions, structure, examples.
 """
 from __future__ import annotations
 

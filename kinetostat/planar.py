@@ -2,6 +2,8 @@
 complex-vector method): a turn by theta is a product with e^{i theta}, a turn by +90 deg a
 product with i, and one numpy operation acts on a whole stack of vectors. Public arrays are
 (..., 2) real; `as_xy` views complex stacks that way without copying.
+
+May use: numpy only.
 """
 from __future__ import annotations
 

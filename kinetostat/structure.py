@@ -4,6 +4,8 @@ decomposition into the initial mechanism I(0,1) and class-II Assur groups.
 Works on the model's data only (the number of links, the pairs, the assembly branches): it
 imports nothing of `model`, which calls `analyse_structure` when it builds a Mechanism. May
 use: `errors`.
+
+May use: errors only (never the model: the dependency runs model -> structure).
 """
 from __future__ import annotations
 

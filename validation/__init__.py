@@ -1,1 +1,4 @@
-"""Cross-validation of kinetostat against Pinocchio, MuJoCo and pymunk (see compare.py)."""
+"""Cross-validation of kinetostat against Pinocchio, MuJoCo and pymunk (see compare.py).
+
+May use: kinetostat; each engine adapter its own engine.
+"""

@@ -7,6 +7,8 @@ Every route runs over the same full cycle (360 angles) and is timed as the media
 runs in one process; its error is the worst peak-relative error over the driving moment and
 all reactions against the mpmath reference (`validation.reference`, 40 digits). Figures are
 printed and written, never asserted: speed is measured, not tested.
+
+May use: kinetostat, the scene, compare, reference, the engine adapters, matplotlib.
 """
 from __future__ import annotations
 

@@ -6,6 +6,8 @@ absolute error, the max error relative to the cycle's peak, the RMS (relative to
 and pass/fail against the route's tolerance in `TOLERANCES`. An engine that is not installed
 is reported as skipped, never passed. The route "reference" needs no engine, only mpmath: the
 40-digit re-solution of `reference.py` at a sample of the cycle's angles.
+
+May use: kinetostat, the scene, and each route's adapter (imported when the route runs).
 """
 from __future__ import annotations
 

@@ -8,6 +8,8 @@ over the reading precision, the scales and the crank angle, and writes reports/d
 and reports/drawing_error.png (fixed seed, fixed layout, no timestamps: the same files every run).
 
 `python -m kinetostat_validation.drawing_error`
+
+May use: kinetostat.plans, matplotlib.
 """
 from __future__ import annotations
 

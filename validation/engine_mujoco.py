@@ -77,6 +77,8 @@ about +z. For a working machine (drive.kind = "machine") the drive is the pinion
 the crank's gear at the pitch point, not a couple: its moment about the crank axis is the
 torque found here, its line of action that of the model's gear pair, and the frame's reaction
 on the crank is the joint force minus that mesh force (as kinetostat defines it).
+
+May use: kinetostat (planar, gear_force), the scene, mujoco.
 """
 from __future__ import annotations
 

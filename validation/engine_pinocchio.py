@@ -36,6 +36,8 @@ crank's gear, not a pure couple. The driving moment is the same (the crank turns
 pivot), but the frame's reaction on the crank differs by F_bal; it is computed from this
 engine's own tau with the solver's gear convention (`gear_force`, see `Scene` docstring) and
 applied to the crank as an external force in the second rnea.
+
+May use: kinetostat (planar, gear_force), the scene, pinocchio.
 """
 from __future__ import annotations
 

@@ -75,6 +75,8 @@ cpSimpleMotor.c, cpSpaceStep.c):
   compare the difference quotient, not pymunk.
 - `drive.eps` != 0: the solver's state (constant omega with a nonzero eps at every angle) is not
   a motion a simulation can follow; all values are NaN with a note.
+
+May use: kinetostat (analysis, planar), the scene, pymunk.
 """
 from __future__ import annotations
 

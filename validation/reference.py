@@ -40,6 +40,8 @@ Speed: a 36-angle cycle of a 6-link model takes about a second.
 `route(scene)` is the accuracy gate's route "reference" (`compare.ROUTES`): the reference at
 `sample_angles` of the scene's cycle as an `EngineResult`, so that a CI without any physics
 engine can still gate the solver's accuracy.
+
+May use: kinetostat (model, analysis, applied loads), the scene, mpmath.
 """
 from __future__ import annotations
 

@@ -18,6 +18,8 @@ The drive: an engine's crank is driven by a pure moment about its pivot. A worki
 crank (`mech.drive.kind == "machine"`) is driven by the pinion's force on its gear at the pitch
 point, `kinetostat.kinetostatics.gear_force(mech.drive.gear, M)`: same driving moment M, but the
 frame's reaction on the crank carries that force too, so adapters must apply it to compare R(0,1).
+
+May use: kinetostat (model, analysis, planar), numpy.
 """
 from __future__ import annotations
 

@@ -33,6 +33,8 @@ the 40-digit answer when one input, a coordinate of a point or the crank angle, 
 ulp), and the guard's **estimate** (`res.error`).
 
 `python -m kinetostat_validation.stability` writes reports/stability.md and reports/stability.png.
+
+May use: kinetostat, the scene, reference, the pymunk adapter, matplotlib.
 """
 from __future__ import annotations
 
