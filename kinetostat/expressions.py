@@ -3,10 +3,12 @@ strings ("3.05 * r", "G2 / g", "bar_inertia(m2, l_AB)").
 
 An expression is parsed with `ast` and evaluated by walking the tree; only number literals,
 names, + - * / **, unary + and -, parentheses and calls of FUNCTIONS (by name, positional
-arguments) are allowed; nothing is ever executed. All arithmetic is in floats; every
-intermediate result must be finite and real.
+arguments) are allowed; nothing is ever executed. A parameter or a field is evaluated in floats
+(`Expression.__call__`): every intermediate result must be finite and real. A law of motion
+omega(phi) or a motor's M(omega) is evaluated over arrays (`over_arrays`), with numpy, so that the
+complex step can differentiate it.
 
-May use: the standard library only.
+May use: the standard library and numpy.
 """
 from __future__ import annotations
 
@@ -18,8 +20,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["ExpressionError", "Expression", "FUNCTIONS", "CONSTANTS", "HELPERS", "MAX_EXPRESSION",
-           "MAX_EXPONENT", "parse", "resolve", "bar_inertia", "mass_from_density", "mass_from_weight",
+import numpy as np
+
+__all__ = ["ExpressionError", "Expression", "FUNCTIONS", "ARRAY_FUNCTIONS", "CONSTANTS", "HELPERS", "MAX_EXPRESSION",
+           "MAX_EXPONENT", "parse", "over_arrays", "resolve", "bar_inertia", "mass_from_density", "mass_from_weight",
            "inertia_from_gyration", "gear_wheel_mass"]
 
 #: Longest expression, characters.
@@ -77,8 +81,8 @@ def _at_least_two(f: Callable[..., float]) -> Callable[..., float]:
 
 #: Every function an expression may call: name -> (function, number of arguments or None for 2+).
 FUNCTIONS: Mapping[str, tuple[Callable[..., float], int | None]] = {
-    **{n: (getattr(math, n), 1) for n in ("sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "radians",
-                                          "degrees", "exp", "log")},
+    **{n: (getattr(math, n), 1) for n in ("sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh",
+                                          "tanh", "radians", "degrees", "exp", "log")},
     "atan2": (math.atan2, 2), "hypot": (math.hypot, 2), "abs": (abs, 1),
     "min": (_at_least_two(min), None), "max": (_at_least_two(max), None),
     **{n: (f, f.__code__.co_argcount) for n, f in HELPERS.items()}}
@@ -114,6 +118,42 @@ class Expression:
                 raise
             raise ExpressionError(_arith_message(exc)) from None
         return _checked(x)
+
+
+#: The functions an expression over arrays may call (a law of motion omega(phi), a motor's
+#: M(omega)), in numpy's form: they take arrays and complex numbers, and their complex extension is
+#: analytic, so the complex step differentiates through them (abs, min, max, atan2 and hypot are
+#: not analytic, and are refused there).
+ARRAY_FUNCTIONS: Mapping[str, Callable] = {
+    "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "acos": np.arccos,
+    "atan": np.arctan, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "exp": np.exp, "log": np.log,
+    "radians": lambda x: x * (math.pi / 180.0), "degrees": lambda x: x * (180.0 / math.pi), **HELPERS}
+
+
+def over_arrays(expr: Expression, values: Mapping[str, Any]) -> Any:
+    """The value of `expr` with `values` bound to arrays (real or complex) or numbers, with numpy's
+    semantics (1/0 is inf: the caller checks that the result is finite). ExpressionError for an
+    unknown name or a function of FUNCTIONS that is not in ARRAY_FUNCTIONS."""
+    def ev(node: ast.AST) -> Any:
+        if isinstance(node, ast.Constant):
+            return np.float64(node.value)
+        if isinstance(node, ast.Name):
+            if node.id in CONSTANTS:
+                return CONSTANTS[node.id]
+            if node.id not in values:
+                raise ExpressionError(f"unknown name {node.id!r}{_suggest(node.id, [*values, *CONSTANTS])}")
+            return values[node.id]
+        if isinstance(node, ast.UnaryOp):
+            return _UNARY[type(node.op)](ev(node.operand))
+        if isinstance(node, ast.BinOp):
+            return _BINARY[type(node.op)](ev(node.left), ev(node.right))
+        name = node.func.id
+        if name not in ARRAY_FUNCTIONS:
+            raise ExpressionError(f"{name}() is not allowed here: it is not smooth, and omega(phi) and M(omega) "
+                                  f"are differentiated; functions: {', '.join(sorted(ARRAY_FUNCTIONS))}")
+        return ARRAY_FUNCTIONS[name](*(ev(a) for a in node.args))
+    with np.errstate(all="ignore"):
+        return ev(expr.tree.body)
 
 
 def parse(text: str) -> Expression:

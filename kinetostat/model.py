@@ -7,7 +7,6 @@ May use: the standard library, numpy, errors, expressions, structure, examples.
 """
 from __future__ import annotations
 
-import ast
 import difflib
 import functools
 import math
@@ -24,7 +23,8 @@ from typing import Any, Callable, Literal, Mapping
 import numpy as np
 
 from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
-from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse as parse_expression, resolve as resolve_parameters
+from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression
+from .expressions import resolve as resolve_parameters
 from .structure import Structure, analyse_structure
 
 __all__ = ["Link", "Body", "Pair", "Table", "Load", "Characteristic", "SpeedLaw", "combine", "Spring", "Gear", "Drive", "Friction", "Published", "Study", "Mechanism",
@@ -112,11 +112,13 @@ class Characteristic:
     omega: tuple[float, ...] = ()
     M: tuple[float, ...] = ()
     expression: str | None = None
+    parameters: tuple[tuple[str, float], ...] = ()   # the model's parameters the expression may read
 
     def __call__(self, omega: np.ndarray) -> np.ndarray:
         """M (N m) at the angular velocities `omega` (rad/s), both in the drive's sense."""
         if self.expression is not None:
-            return np.broadcast_to(_evaluate(self.expression, {"omega": omega}), np.shape(omega)).astype(float)
+            value = over_arrays(_expression(self.expression), {**dict(self.parameters), "omega": omega})
+            return np.broadcast_to(value, np.shape(omega)).astype(float)
         return np.interp(omega, self.omega, self.M)
 
 
@@ -182,13 +184,15 @@ class SpeedLaw:
     phi_deg: tuple[float, ...] = ()
     omega: tuple[float, ...] = ()
     expression: str | None = None
+    parameters: tuple[tuple[str, float], ...] = ()   # the model's parameters the expression may read
 
     def __call__(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(omega, d omega / d phi) at crank angles `phi` (rad), rad/s and rad/s per rad."""
         phi = np.asarray(phi, dtype=float)
         if self.expression is not None:
             h = 1e-30                         # complex step: exact derivative, no cancellation
-            z = np.broadcast_to(_evaluate(self.expression, {"phi": phi + 1j * h}), phi.shape)
+            z = np.broadcast_to(over_arrays(_expression(self.expression),
+                                            {**dict(self.parameters), "phi": phi + 1j * h}), phi.shape)
             return z.real.astype(float), z.imag / h
         x, y, m = _periodic_spline(self.phi_deg, self.omega)
         return _spline_at(x, y, m, phi)
@@ -363,78 +367,17 @@ class Mechanism:
 
 # ----------------------------------------------------------------------------- laws and characteristics
 
-#: Functions an expression of a law of motion or a characteristic may call (numpy's, so that they
-#: take arrays and complex arguments: the complex step differentiates through them).
-_FUNCTIONS: Mapping[str, Callable] = MappingProxyType({
-    "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "acos": np.arccos, "atan": np.arctan,
-    "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "exp": np.exp, "log": np.log, "sqrt": np.sqrt})
-_CONSTANTS: Mapping[str, float] = MappingProxyType({"pi": math.pi, "e": math.e})
-_OPERATORS: Mapping[type, Callable] = MappingProxyType({
-    ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b, ast.Mult: lambda a, b: a * b,
-    ast.Div: lambda a, b: a / b, ast.Pow: lambda a, b: a ** b,
-    ast.USub: lambda a: -a, ast.UAdd: lambda a: +a})
-#: Longest expression, characters.
-MAX_EXPRESSION = 1000
-
-
 def _mentions_phi(text: str) -> bool:
     """Whether a drive's `omega` string is a law of motion (an expression of `phi`) rather than
     a constant speed written over the model's parameters (`"n1 * pi / 30"`)."""
     try:
-        return any(isinstance(n, ast.Name) and n.id == "phi" for n in ast.walk(_parse(text)))
-    except ValueError:
+        return "phi" in _expression(text).names
+    except ExpressionError:
         return True                  # not a valid expression: the law's reader says why
 
 
-@functools.lru_cache(maxsize=256)
-def _parse(text: str) -> ast.expr:
-    """The syntax tree of an arithmetic expression; ValueError naming what is not allowed
-    (only numbers, names, + - * / **, and calls of _FUNCTIONS: no attribute, subscript or code)."""
-    if len(text) > MAX_EXPRESSION:
-        raise ValueError(f"longer than {MAX_EXPRESSION} characters")
-    try:
-        tree = ast.parse(text, mode="eval").body
-    except SyntaxError as exc:
-        raise ValueError(f"syntax error: {exc.msg}") from None
-    except (RecursionError, MemoryError):
-        raise ValueError("nested too deeply") from None
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Call):
-            if not (isinstance(node.func, ast.Name) and node.func.id in _FUNCTIONS and len(node.args) == 1
-                    and not node.keywords):
-                raise ValueError(f"only the functions {sorted(_FUNCTIONS)} of one argument may be called")
-        elif isinstance(node, ast.Constant):
-            if not _finite(node.value):
-                raise ValueError(f"{node.value!r} is not a number")
-        elif not isinstance(node, (ast.BinOp, ast.UnaryOp, ast.Name, ast.Load, *_OPERATORS)):
-            raise ValueError(f"{type(node).__name__} is not allowed (numbers, names, + - * / ** and functions only)")
-    return tree
-
-
-def _evaluate(text: str, names: Mapping[str, Any]) -> Any:
-    """The value of expression `text` with `names` (arrays or numbers) and pi, e bound;
-    ValueError for an unknown name or what `_parse` refuses."""
-    def ev(node: ast.expr) -> Any:
-        if isinstance(node, ast.Constant):
-            return np.float64(node.value)      # numpy semantics: 1/0 is inf, not an exception
-        if isinstance(node, ast.Name):
-            if node.id in names:
-                return names[node.id]
-            if node.id in _CONSTANTS:
-                return _CONSTANTS[node.id]
-            raise ValueError(f"unknown name {node.id!r}{_suggest(node.id, [*names, *_CONSTANTS])}; "
-                             f"known: {sorted([*names, *_CONSTANTS])}")
-        if isinstance(node, ast.BinOp):
-            return _OPERATORS[type(node.op)](ev(node.left), ev(node.right))
-        if isinstance(node, ast.UnaryOp):
-            return _OPERATORS[type(node.op)](ev(node.operand))
-        return _FUNCTIONS[node.func.id](ev(node.args[0]))
-    tree = _parse(text)
-    with np.errstate(all="ignore"):
-        try:
-            return ev(tree)
-        except RecursionError:
-            raise ValueError("nested too deeply") from None
+#: A checked expression, parsed once (laws of motion and characteristics are evaluated per call).
+_expression = functools.lru_cache(maxsize=256)(parse_expression)
 
 
 @functools.lru_cache(maxsize=64)
@@ -1258,7 +1201,7 @@ class _Reader:
 
     def speed_expression(self, text: str, where: str) -> SpeedLaw | None:
         """drive.omega as an expression of phi (rad), periodic over a revolution."""
-        law = SpeedLaw(expression=text)
+        law = SpeedLaw(expression=text, parameters=tuple(self.values.items()))
         try:
             law(np.zeros(1))
         except ValueError as exc:
@@ -1413,7 +1356,7 @@ class _Reader:
     def characteristic(self, t: Any, where: str) -> Characteristic | None:
         """A motor's M(omega): { omega = [...], M = [...] } or an expression of omega."""
         if isinstance(t, str):
-            c = Characteristic(expression=t)
+            c = Characteristic(expression=t, parameters=tuple(self.values.items()))
             try:
                 value = c(np.array([0.0, 1.0]))
             except ValueError as exc:
