@@ -228,10 +228,12 @@ def _model_error_text(exc) -> str:
 
 
 def _load(path: str | Path):
-    """Load a model; every expected fault becomes a CLIError naming the file."""
+    """Load a model file, or a bundled model by name; every expected fault becomes a CLIError
+    naming the file."""
     from .errors import ModelError, StructureError
+    from .examples import resolve
     from .model import load
-    p = Path(path)
+    p = resolve(path)
     if not p.exists():
         raise CLIError(f"model file not found: {p}")
     if p.is_dir():
@@ -961,7 +963,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Analyse MODEL over the crank cycle (or at given angles): print a summary "
                                    "(structure formula, peak reaction of every pair and where, balancing moment "
                                    "range, lever discrepancy) and write the full table of res.to_frame().")
-    a.add_argument("model", metavar="MODEL", help="model file (TOML, see models/FORMAT.md)")
+    a.add_argument("model", metavar="MODEL", help="model file (TOML, see models/FORMAT.md) or a bundled model's name")
     g = a.add_mutually_exclusive_group()
     g.add_argument("--at", metavar="DEG", nargs="+", type=_angle,
                    help="crank angles in degrees (model's reference and sense), e.g. --at 0 30 90")
@@ -975,7 +977,7 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("structure", help="mobility, Assur groups and structure formula of one model",
                        description="Structural analysis of MODEL: mobility W by Chebyshev's formula with its "
                                    "arithmetic, the Assur groups with their kinds, the structure formula.")
-    s.add_argument("model", metavar="MODEL", help="model file (TOML)")
+    s.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
     s.set_defaults(func=cmd_structure)
 
     e = sub.add_parser("export", help="write a model as MJCF (MuJoCo) or URDF for physics engines",
@@ -986,7 +988,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "cannot express closed loops, so each loop-closing pair is written as an XML "
                                    "comment '<!-- loop closure ... -->' for you to add as a constraint. Loads, "
                                    "drive and friction are not exported.")
-    e.add_argument("model", metavar="MODEL", help="model file (TOML)")
+    e.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
     fmt = e.add_mutually_exclusive_group(required=True)
     fmt.add_argument("--mjcf", dest="format", action="store_const", const="mjcf", help="MuJoCo MJCF")
     fmt.add_argument("--urdf", dest="format", action="store_const", const="urdf",
@@ -1005,7 +1007,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "not installed are SKIPPED. Exit code 1 when any check fails, a route raises, "
                                    "or nothing was checked.")
     v.add_argument("models", metavar="MODEL", nargs="*",
-                   help="model files (default: every bundled model, see 'kinetostat examples')")
+                   help="model files or bundled models' names (default: every bundled model, see 'kinetostat examples')")
     v.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")
     v.add_argument("--steps", metavar="N", type=_steps, default=360, help="positions over the cycle (default 360)")
     v.add_argument("--junit", metavar="FILE", help="also write JUnit XML: one testcase per model x route x quantity "
@@ -1031,7 +1033,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "fail (use 'kinetostat validate' as the gate); 1 when a model's report could "
                                    "not be made.")
     r.add_argument("models", metavar="MODEL", nargs="*",
-                   help="model files (default: every bundled model, see 'kinetostat examples')")
+                   help="model files or bundled models' names (default: every bundled model, see 'kinetostat examples')")
     r.add_argument("--out", metavar="DIR", default="reports", help="output directory (default: ./reports)")
     r.add_argument("--steps", metavar="N", type=_steps, default=360, help="positions over the cycle (default 360)")
     r.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")
@@ -1048,7 +1050,7 @@ def build_parser() -> argparse.ArgumentParser:
                                     "acceleration plans; one SVG sheet per plan (A3, true to scale in mm) and "
                                     "DIR/segments.csv (every drawn segment: its length in mm, the value it stands "
                                     "for, the scale). --only positions is the quick preview of a model.")
-    pl.add_argument("model", metavar="MODEL", help="model file (TOML)")
+    pl.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
     pl.add_argument("--at", metavar="DEG", type=_angle,
                     help="crank angle in degrees (default: the model's design position, drive.design_deg)")
     pl.add_argument("--scale", metavar="KEY=VALUE", nargs="+", type=_scale_item,

@@ -17,7 +17,7 @@ import os
 import shutil
 from pathlib import Path
 
-__all__ = ["models_dir", "names", "path", "copy"]
+__all__ = ["models_dir", "names", "path", "resolve", "copy"]
 
 
 def models_dir() -> Path:
@@ -44,6 +44,15 @@ def path(name: str) -> Path:
     if stem in names():
         return models_dir() / f"{stem}.toml"
     raise FileNotFoundError(f"no bundled model named {name!r}; bundled: {', '.join(names()) or 'none'}")
+
+
+def resolve(model: str | Path) -> Path:
+    """The file a user means by `model`: the path as given, or, where no such file exists and
+    `model` is a bare name (`ice_crank_slider`, `ice_crank_slider.toml`), that bundled model."""
+    p = Path(model)
+    if not p.exists() and p.parent == Path(".") and p.suffix in ("", ".toml") and p.stem in names():
+        return path(p.stem)
+    return p
 
 
 def copy(dest: str | Path, overwrite: bool = False) -> list[Path]:

@@ -434,11 +434,8 @@ def load(path: str | Path, parameters: Mapping[str, Any] | None = None) -> Mecha
 
     Raises `ModelError` listing every problem (`ModelFileNotFound`, also a FileNotFoundError,
     where the file does not exist)."""
-    path = Path(path)
-    if not path.exists() and path.parent == Path(".") and path.suffix in ("", ".toml"):
-        from . import examples
-        if path.stem in examples.names():
-            path = examples.path(path.stem)
+    from .examples import resolve
+    path = resolve(path)
     return loads(_read_text(path), source=str(path), parameters=parameters)
 
 

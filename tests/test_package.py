@@ -177,3 +177,18 @@ def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
              cwd=work)
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert (work / "reports" / "scotch_yoke" / "index.md").is_file()
+
+
+def test_the_commands_take_a_bundled_models_name(cli, tmp_path):
+    """`kinetostat analyze ice_crank_slider` means the bundled model, as kinetostat.load does;
+    a file of that name in the working folder would come first, and a name that is neither
+    is still 'model file not found'."""
+    by_name = cli("analyze", "ice_crank_slider", "--at", "30", cwd=tmp_path)
+    by_path = cli("analyze", kinetostat.examples.path("ice_crank_slider"), "--at", "30", cwd=tmp_path)
+    assert by_name.returncode == 0, by_name.stderr
+    # the same analysis: every line after the first, which echoes the MODEL as given
+    assert by_name.stdout.splitlines()[1:] == by_path.stdout.splitlines()[1:] and len(by_name.stdout) > 500
+    r = cli("validate", "chain_unit_four_bar", "--engines", "none", "--steps", "36", "--no-progress", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    missing = cli("analyze", "no_such_model", cwd=tmp_path)
+    assert missing.returncode == 2 and "model file not found: no_such_model" in missing.stderr
