@@ -1,6 +1,6 @@
 """`analyze(mech, phi_deg)`: the whole kinetostatic analysis as one frozen result object.
 
-May use: model, kinematics, kinetostatics, applied, planar; pandas only inside `to_frame`.
+May use: model, groups, kinematics, kinetostatics, applied, planar, fast; pandas only inside `to_frame`.
 """
 from __future__ import annotations
 
@@ -13,11 +13,12 @@ import numpy as np
 from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation, kinematic_size, kinematics,
                          relative_change, solve_checked)
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from .applied import applied_moment, applied_wrenches, com_motion, inertia_loads, load_magnitude, point_forces
+from . import groups
+from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, cross_z, dot_z
 from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "analyze", "crank_angles", "FRAME_NOTE", "deviation",
+__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "analyze", "exact", "crank_angles", "FRAME_NOTE", "deviation",
            "force_deviation"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
@@ -428,11 +429,23 @@ def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
 
 def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
-    or at `steps` equal steps over a full revolution when `phi_deg` is None."""
+    or at `steps` equal steps over a full revolution when `phi_deg` is None.
+
+    From fast.FAST_MIN angles on it runs the compiled kernel (`fast.analyze_fast`), below them
+    the numpy path (`exact`): the same results to rounding (tests/test_fast.py)."""
     if not isinstance(mech, Mechanism):
         raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
                         f"read a model file with kinetostat.load(path)")
     phi_deg = crank_angles(phi_deg, steps)
+    from . import fast
+    if len(phi_deg) >= fast.FAST_MIN and fast.available():
+        return fast.analyze_fast(mech, phi_deg)
+    return exact(mech, phi_deg)
+
+
+def exact(mech: Mechanism, phi_deg: np.ndarray) -> Analysis:
+    """`analyze` by the numpy path at the crank angles `phi_deg` (deg, (N,)), with the accuracy
+    guard: where a group's cond exceeds COND_CHECK the error is measured by perturbed re-solves."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # NaN only at angles marked singular
         kin, checked, trials = solve_checked(mech, np.radians(phi_deg))
         res = _kinetostatics(mech, phi_deg, kin)
@@ -462,11 +475,10 @@ def deviation(a: Analysis, b: Analysis) -> np.ndarray:
 
 
 def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics) -> Analysis:
-    r, aS = com_motion(mech, kin)
+    mass, I_S, com = mech.inertia_arrays
+    r, F_i, M_i = groups.inertia(kin.a_z, kin.omega, kin.eps, kin.rot, com, mass, I_S)
     F_app, M_app = applied_wrenches(mech, kin, r)
-    F_i, M_i = inertia_loads(mech, kin, aS)
-    F_all = F_app + F_i
-    M_all = M_app + M_i + cross_z(r, F_i)
+    F_all, M_all = groups.wrench(F_app, M_app, F_i, M_i, r)
     frc = forces(mech, kin, F_all, M_all)
     lever = lever_moment(mech, kin, F_all, M_all)
     return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,

@@ -3,7 +3,7 @@
 Every load is reduced to a wrench per link: force F (N, world, complex x + iy) and moment M
 (N m, about +z) about the link's local origin, stacked as F (N, L), M (N, L).
 
-May use: numpy, model, kinematics (its results), planar, errors.
+May use: numpy, groups, model, kinematics (its results), planar, errors.
 """
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from . import groups
 from .errors import ModelError, SingularPositionWarning
 from .planar import cross_z, dot_z
 
@@ -45,10 +46,9 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tup
     """All applied loads (gravity, external forces and moments, springs; no inertia) on each link
     as a wrench about its local origin: F (N, L) complex, M (N, L). r: arms to the centres of
     mass (N, L), as `com_motion` gives."""
-    weight = -1j * mech.g * mech.inertia_arrays[0]
+    weight, M = groups.weight(r, mech.inertia_arrays[0], mech.g)
     F = np.empty(r.shape, complex)
     F[:] = weight
-    M = cross_z(r, weight)
     for ld in mech.loads:
         if ld.kind == "moment":
             M[:, ld.link] += applied_moment(mech, kin, ld)

@@ -1,8 +1,9 @@
 """Exact kinematics over arrays of crank angles (seed 002 sec. 1.2.2, computed instead of drawn).
 
-Groups are solved in the order of attachment. Each group kind has one small function that
-finds the positions in closed form and closes the velocity and acceleration plans with
-`Basis.solve`, exactly as the vector equations of the texts read, for all angles at once.
+Groups are solved in the order of attachment. Each group kind has one small elementwise
+function (`kinetostat.groups`) that finds the positions in closed form and closes the velocity
+and acceleration plans, exactly as the vector equations of the texts read; `kinetostat.program`
+strings them into the mechanism's program, run here over all angles at once.
 
 The singular-position guard: near a dead centre or toggle of a group the answer itself is that
 sensitive to its inputs, so where a group plan's condition number exceeds COND_CHECK the
@@ -11,29 +12,28 @@ with every input (each point of the linkage, the crank angle) moved by PERTURB_U
 the change is the error estimate (`Kinematics.error`). Fewer than DIGITS_WARN digits left: a
 SingularPositionWarning names the angles and the digits; fewer than DIGITS_MIN: NaN.
 
-May use: planar, errors (model and structure for type hints only).
+May use: program, planar, errors (model and structure for type hints only).
 """
 from __future__ import annotations
 
-import cmath
 import math
 import warnings
 import zlib
 from dataclasses import dataclass, fields, replace
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from .errors import AssemblyError, SingularPositionWarning, singular_message
-from .planar import Basis, as_xy, condition, cross_z, dot_z
+from .errors import SingularPositionWarning, singular_message
+from .planar import as_xy
+from .program import constants, motion_program, run
 
 if TYPE_CHECKING:
-    from .model import Mechanism, Pair
-    from .structure import AssurGroup
+    from .model import Mechanism
 
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
-           "a_priori_error", "relative_change", "digits"]
+           "a_priori_error", "relative_change", "digits", "assemble"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
@@ -129,236 +129,6 @@ class Kinematics:
         return tuple(as_xy(z) for z in self.point_z(k, p))
 
 
-class _Plan:
-    """Work arrays filled group by group (internal; the public result is `Kinematics`)."""
-
-    def __init__(self, mech: "Mechanism", phi: np.ndarray, locals_: list[dict[str, complex]]):
-        N, L = len(phi), mech.n_links
-        self.phi = phi
-        self.th, self.w, self.e = np.zeros((3, N, L))            # the frame's column stays 0
-        self.rot = np.ones((N, L), complex)
-        self.O, self.V, self.A = np.zeros((3, N, L), complex)
-        self.vs, self.as_ = np.zeros((2, N, len(mech.pairs)))
-        self.L = 1.0          # the length scale of the group being solved (set by `_solve`)
-        self.locals = locals_
-
-    def local(self, k: int, name: str) -> complex:
-        return self.locals[k][name]
-
-    # The frame does not move: its points are constants with no velocity or acceleration.
-    def position(self, k: int, name: str) -> np.ndarray | complex:
-        return self.O[:, k] + self.local(k, name) * self.rot[:, k] if k else self.local(0, name)
-
-    def point(self, k: int, name: str):
-        if not k:
-            return self.local(0, name), 0.0, 0.0
-        r = self.local(k, name) * self.rot[:, k]
-        w, e = self.w[:, k], self.e[:, k]
-        return self.O[:, k] + r, self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
-
-    def at(self, k: int, X: np.ndarray):
-        """Velocity and acceleration of the point of link k that is at world position X."""
-        if not k:
-            return 0.0, 0.0
-        r = X - self.O[:, k]
-        w, e = self.w[:, k], self.e[:, k]
-        return self.V[:, k] + 1j * w * r, self.A[:, k] + (1j * e - w**2) * r
-
-    def coriolis(self, k: int, v: np.ndarray, d: np.ndarray) -> np.ndarray | float:
-        """Coriolis acceleration 2 w_k x (v d) of a point sliding at v along d in link k."""
-        return 2j * self.w[:, k] * v * d if k else 0.0
-
-    def set_link(self, k: int, th, rot, X, x_local: complex | np.ndarray, w, V, e, A) -> None:
-        """Fix link k from its angle th, rot = e^{i th}, and the world position, velocity and
-        acceleration X, V, A of its local point x_local (a constant, or (N,) for a point
-        moving in the link)."""
-        self.th[:, k], self.rot[:, k], self.w[:, k], self.e[:, k] = th, rot, w, e
-        if isinstance(x_local, np.ndarray) or x_local:      # X is not already the local origin
-            r = x_local * rot
-            X, V, A = X - r, V - 1j * w * r, A - (1j * e - w**2) * r
-        self.O[:, k], self.V[:, k], self.A[:, k] = X, V, A
-
-    @staticmethod
-    def aligned(x_local: complex, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Angle and e^{i theta} of a link whose local vector x_local is the world vector X
-        (of the same length)."""
-        return np.angle(X) - cmath.phase(x_local), X / x_local
-
-    # --- prismatic pair geometry: the guide line is fixed in both links (equal rotation), and
-    # the slider's local x axis is the guide direction d (its angle alpha in the guide's frame)
-    @staticmethod
-    def turned(p: "Pair", k: int, th: np.ndarray, rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Angle and e^{i theta} of link k of P pair p from those of the pair's other link."""
-        if not p.alpha:
-            return th, rot
-        if k == p.links[1]:
-            return th + p.alpha, rot * complex(*p.direction)
-        return th - p.alpha, rot / complex(*p.direction)
-
-    @staticmethod
-    def guide(p: "Pair", k: int, rot_k: np.ndarray) -> np.ndarray:
-        """World unit direction d of pair p's guide, given e^{i theta} of its link k."""
-        return complex(*p.direction) * rot_k if k == p.links[0] else rot_k
-
-    def offset(self, p: "Pair", k: int, name: str) -> float:
-        """Signed distance c = (X - G) x d of point `name` of link k from the guide line."""
-        x = self.local(k, name)
-        if k == p.links[0]:
-            return float(cross_z(x - self.local(k, p.guide), complex(*p.direction)))
-        return float(-(x - self.local(k, p.point)).imag)
-
-    @staticmethod
-    def anchor(p: "Pair", k: int) -> str:
-        """A point of link k that lies on the guide line (c = 0)."""
-        return p.guide if k == p.links[0] else p.point
-
-    def slide(self, p: "Pair", mover: int, v, a) -> None:
-        """Record the motion of `mover` relative to the pair's other link along d."""
-        if mover == p.links[1]:
-            self.vs[:, p.index], self.as_[:, p.index] = v, a
-        else:
-            self.vs[:, p.index], self.as_[:, p.index] = -v, -a
-
-    def reachable(self, g: "AssurGroup", disc: np.ndarray, scale: float, why: str) -> np.ndarray:
-        """sqrt of a discriminant; AssemblyError naming the angles where it is negative."""
-        bad = disc < -1e-12 * scale
-        if bad.any():
-            raise AssemblyError(g.label, np.degrees(self.phi[bad]), why)
-        return np.sqrt(np.maximum(disc, 0.0))
-
-
-# Each solver returns ||M||_F^2 and det M of its plans' matrix M, columns scaled by reference
-# sizes (the group's own length scale pl.L, `group_scale`, for a column that is a length, 1 for a
-# unit direction: guide directions are unit, as the model reader makes Pair.direction):
-# `condition` of them is taken once for all groups.
-_Conditioning = tuple[float | np.ndarray, np.ndarray]
-
-
-def _rrr(pl: _Plan, g: "AssurGroup") -> _Conditioning:
-    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
-    P, VP, AP = pl.point(a, pj.point)
-    Q, VQ, AQ = pl.point(c, pk.point)
-    xj, xk = pl.local(j, pin.point) - pl.local(j, pj.point), pl.local(k, pin.point) - pl.local(k, pk.point)
-    lj, lk = abs(xj), abs(xk)
-    PQ = Q - P
-    d = np.abs(PQ)
-    along = (lj**2 - lk**2 + d**2) / (2 * d)
-    h = pl.reachable(g, lj**2 - along**2, lj**2, f"|{pj.point}{pk.point}| outside [|l{j} - l{k}|, l{j} + l{k}]")
-    B = P + PQ / d * (along + 1j * g.branch * h)
-    PB, QB = B - P, B - Q
-    # v_B = v_P + w_j x PB = v_Q + w_k x QB ;  a_B = a_P - w_j^2 PB + e_j x PB = ...
-    plan = Basis(1j * PB, -1j * QB)
-    wj, wk = plan.solve(VQ - VP)
-    ej, ek = plan.solve(AQ - wk**2 * QB - AP + wj**2 * PB)
-    pl.set_link(j, *pl.aligned(xj, PB), P, pl.local(j, pj.point), wj, VP, ej, AP)
-    pl.set_link(k, *pl.aligned(xk, QB), Q, pl.local(k, pk.point), wk, VQ, ek, AQ)
-    return (lj**2 + lk**2) / pl.L**2, plan.det / pl.L**2
-
-
-def _rrp(pl: _Plan, g: "AssurGroup") -> _Conditioning:
-    (pj, pin, pk), (j, k), (a, b) = g.pairs, g.links, g.known
-    P, VP, AP = pl.point(a, pj.point)
-    th_k, rot_k = pl.turned(pk, k, pl.th[:, b], pl.rot[:, b])
-    d = pl.guide(pk, k, rot_k)
-    K = pl.position(b, pl.anchor(pk, b))
-    xj, cB = pl.local(j, pin.point) - pl.local(j, pj.point), pl.offset(pk, k, pin.point)
-    lj = abs(xj)
-    w = K - 1j * cB * d - P                        # B = K + t d - cB n lies on a circle about P
-    wd = dot_z(w, d)
-    root = pl.reachable(g, wd**2 - dot_z(w, w) + lj**2, lj**2,
-                        f"the guide line is farther than l{j} from {pj.point}")
-    B = K + (g.branch * root - wd - 1j * cB) * d
-    PB = B - P
-    wb, eb = pl.w[:, b], pl.e[:, b]
-    VBb, ABb = pl.at(b, B)
-    # v_B = v_P + w_j x PB = v_B(b) + v_r d ; a_B = ... = a_B(b) + 2 w_b x v_r d + a_r d
-    plan = Basis(1j * PB, -d)
-    wj, vr = plan.solve(VBb - VP)
-    VB = VP + wj * plan.a
-    ej, ar = plan.solve(ABb + pl.coriolis(b, vr, d) - AP + wj**2 * PB)
-    AB = AP + ej * plan.a - wj**2 * PB
-    pl.set_link(j, *pl.aligned(xj, PB), P, pl.local(j, pj.point), wj, VP, ej, AP)
-    pl.set_link(k, th_k, rot_k, B, pl.local(k, pin.point), wb, VB, eb, AB)
-    pl.slide(pk, k, vr, ar)
-    return lj**2 / pl.L**2 + 1.0, plan.det / pl.L
-
-
-def _rpr(pl: _Plan, g: "AssurGroup") -> _Conditioning:
-    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known   # j slides on k's guide
-    P, VP, AP = pl.point(a, pj.point)
-    Q, VQ, AQ = pl.point(c, pk.point)
-    e = pl.offset(pin, j, pj.point) - pl.offset(pin, k, pk.point)   # (P - Q) x d, constant
-    QP = P - Q
-    rho2 = dot_z(QP, QP)
-    root = pl.reachable(g, rho2 - e**2, pl.L**2, f"{pj.point} comes closer than the guide offset to {pk.point}")
-    d = QP * (g.branch * root + 1j * e) / rho2     # the unit d with QP x d = e, on the branch's side
-    th_j = np.angle(d)
-    # v_P = v_Q + w_k x QP + v_r d ;  a_P = a_Q - w_k^2 QP + e_k x QP + 2 w_k x v_r d + a_r d
-    plan = Basis(1j * QP, d)
-    wk, vr = plan.solve(VP - VQ)
-    ek, ar = plan.solve(AP - AQ + wk**2 * QP - 2j * wk * vr * d)
-    pl.set_link(k, *pl.turned(pin, k, th_j, d), Q, pl.local(k, pk.point), wk, VQ, ek, AQ)
-    pl.set_link(j, th_j, d, P, pl.local(j, pj.point), wk, VP, ek, AP)
-    pl.slide(pin, j, vr, ar)
-    return rho2 / pl.L**2 + 1.0, plan.det / pl.L
-
-
-def _prp(pl: _Plan, g: "AssurGroup") -> _Conditioning:
-    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
-    th_j, rot_j = pl.turned(pj, j, pl.th[:, a], pl.rot[:, a])
-    th_k, rot_k = pl.turned(pk, k, pl.th[:, c], pl.rot[:, c])
-    da, dc = pl.guide(pj, j, rot_j), pl.guide(pk, k, rot_k)
-    Ka = pl.position(a, pl.anchor(pj, a)) - pl.offset(pj, j, pin.point) * 1j * da
-    Kc = pl.position(c, pl.anchor(pk, c)) - pl.offset(pk, k, pin.point) * 1j * dc
-    plan = Basis(da, -dc)
-    t, _ = plan.solve(Kc - Ka)        # B on both lines
-    B = Ka + t * da
-    VBa, ABa = pl.at(a, B)
-    VBc, ABc = pl.at(c, B)
-    wa, wc = pl.w[:, a], pl.w[:, c]
-    # v_B = v_B(a) + v1 d_a = v_B(c) + v2 d_c ; accelerations with the Coriolis terms
-    v1, v2 = plan.solve(VBc - VBa)
-    a1, a2 = plan.solve(ABc + pl.coriolis(c, v2, dc) - ABa - pl.coriolis(a, v1, da))
-    VB = VBa + v1 * da
-    AB = ABa + pl.coriolis(a, v1, da) + a1 * da
-    pl.set_link(j, th_j, rot_j, B, pl.local(j, pin.point), wa, VB, pl.e[:, a], AB)
-    pl.set_link(k, th_k, rot_k, B, pl.local(k, pin.point), wc, VB, pl.e[:, c], AB)
-    pl.slide(pj, j, v1, a1)
-    pl.slide(pk, k, v2, a2)
-    return 2.0, plan.det
-
-
-def _rpp(pl: _Plan, g: "AssurGroup") -> _Conditioning:
-    (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
-    P, VP, AP = pl.point(a, pj.point)
-    th_k, rot_k = pl.turned(pk, k, pl.th[:, c], pl.rot[:, c])
-    th_j, rot_j = pl.turned(pin, j, th_k, rot_k)
-    d_in, dc = pl.guide(pin, k, rot_k), pl.guide(pk, k, rot_k)
-    Oj = P - pl.local(j, pj.point) * rot_j
-    Kj = Oj + pl.local(j, pl.anchor(pin, j)) * rot_j             # on the inner guide line
-    Kc = pl.position(c, pl.anchor(pk, c))                         # on the outer guide line
-    rY = pl.local(k, pl.anchor(pin, k)) * rot_k
-    rX = pl.local(k, pl.anchor(pk, k)) * rot_k
-    # k's anchor Y = Kj + s d_in on the inner line, its anchor X = Y + rX - rY on the outer line
-    _, s = Basis(dc, -d_in).solve(Kj + rX - rY - Kc)
-    Ok = Kj + s * d_in - rY
-    wc, ec = pl.w[:, c], pl.e[:, c]
-    VPc, APc = pl.at(c, P)
-    # v_P = v_P(c) + v2 d_c + v1 d_in ; a_P = a_P(c) + 2 w x (v2 d_c + v1 d_in) + a2 d_c + a1 d_in
-    plan = Basis(d_in, dc)
-    v1, v2 = plan.solve(VP - VPc)
-    a1, a2 = plan.solve(AP - APc - pl.coriolis(c, v1, d_in) - pl.coriolis(c, v2, dc))
-    pl.set_link(j, th_j, rot_j, P, pl.local(j, pj.point), wc, VP, ec, AP)
-    pl.set_link(k, th_k, rot_k, P, (P - Ok) / rot_k, wc, VPc + v2 * dc, ec, APc + pl.coriolis(c, v2, dc) + a2 * dc)
-    pl.slide(pin, j, v1, a1)
-    pl.slide(pk, k, v2, a2)
-    return 2.0, plan.det
-
-
-_GROUP_SOLVERS: dict[str, Callable[[_Plan, "AssurGroup"], _Conditioning]] = {
-    "RRR": _rrr, "RRP": _rrp, "RPR": _rpr, "PRP": _prp, "RPP": _rpp}
-
-
 def kinematics(mech: "Mechanism", phi: np.ndarray, unit_speed: bool = False) -> Kinematics:
     """Positions, velocities and accelerations of every link at crank angles `phi` (rad, (N,)).
 
@@ -422,24 +192,35 @@ def _perturbed_points(mech: "Mechanism", draw: int) -> list[dict[str, complex]]:
     return mech._derived[key]
 
 
-def _solve(mech: "Mechanism", phi: np.ndarray, locals_: list[dict[str, complex]],
+def _solve(mech: "Mechanism", phi: np.ndarray, locals_: tuple[Mapping[str, complex], ...],
            unit_speed: bool = False) -> Kinematics:
-    pl = _Plan(mech, phi, locals_)
-    dr = mech.drive
-    arm = pl.local(1, dr.point) - pl.local(1, dr.pivot)
-    th1 = dr.sense * phi + (math.atan2(dr.reference[1], dr.reference[0]) - cmath.phase(arm))
-    w, e = (1.0, 0.0) if unit_speed else dr.speed(phi)      # the constants, or per angle by the law
-    pl.set_link(1, th1, np.exp(1j * th1), pl.local(0, dr.pivot), pl.local(1, dr.pivot),
-                dr.sense * w, 0.0, dr.sense * e, 0.0)
-    groups = mech.structure.groups
-    frob, det = np.empty((2, len(phi), len(groups)))
-    for n, (g, scale) in enumerate(zip(groups, group_scales(mech))):
-        pl.L = scale
-        frob[:, n], det[:, n] = _GROUP_SOLVERS[g.kind](pl, g)
-    cond = condition(frob, det)
-    N = len(phi)
-    return Kinematics(phi, pl.th, pl.rot, pl.O, pl.V, pl.A, pl.w, pl.e, pl.vs, pl.as_, cond,
-                      np.zeros(N, bool), np.zeros(N))
+    """The motion program of `mech` run over the angles `phi` with the local points `locals_`."""
+    w, e = (1.0, 0.0) if unit_speed else mech.drive.speed(phi)      # the constants, or per angle by the law
+    env = dict(mech.memo(("constants", id(locals_)), lambda: constants(mech, locals_)))
+    env.update(phi=phi, w_in=w, e_in=e)
+    return assemble(mech, phi, run(motion_program(mech), env))
+
+
+def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Kinematics:
+    """The Kinematics (unguarded) from a run of the motion program: the per-link names of the
+    environment stacked into (N, L) arrays (the frame's column at rest)."""
+    N, L, G = phi.shape[-1], mech.n_links, len(mech.structure.groups)
+    lead = phi.shape[:-1]
+
+    def stack(stem: str, count: int, rest, dtype, start: int = 1):
+        if xp is np:          # columns written in place: the cheapest at a few hundred angles
+            out = np.empty(lead + (N, count), dtype)
+            for k in range(count):
+                out[..., k] = env.get(f"{stem}{k}", rest) if k >= start else rest
+            return out
+        return xp.stack([xp.broadcast_to(xp.asarray(env.get(f"{stem}{k}", rest) if k >= start else rest, dtype=dtype),
+                                         lead + (N,)) for k in range(count)], axis=-1)
+
+    f, c = xp.float64, xp.complex128
+    return Kinematics(phi, stack("th", L, 0.0, f), stack("rot", L, 1.0, c), stack("O", L, 0.0, c),
+                      stack("V", L, 0.0, c), stack("A", L, 0.0, c), stack("w", L, 0.0, f), stack("e", L, 0.0, f),
+                      stack("vs", len(mech.pairs), 0.0, f, 0), stack("as", len(mech.pairs), 0.0, f, 0),
+                      stack("cond", G, 0.0, f, 0), xp.zeros(lead + (N,), dtype=xp.bool), xp.zeros(lead + (N,), dtype=f))
 
 
 # -- length scales: only the points of the pairs (the joints) count; a point that carries a load,

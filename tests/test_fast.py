@@ -1,0 +1,163 @@
+"""The compiled path (kinetostat.fast) against the numpy path: both run the same group
+equations (kinetostat.groups), one per angle inside a numba kernel, the other over arrays; they
+must agree to 1e-13 of each quantity's peak. A sample runs by default (each new structure costs
+a few seconds of compilation); every bundled model with -m slow."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat import fast
+from kinetostat.analysis import crank_angles, exact
+
+TOL = 1e-13
+
+
+def _close(a, b, floor: float = 0.0) -> float:
+    """max |a - b| over the peak of |b| or `floor` (NaN where b is NaN must be NaN in a too)."""
+    a, b = np.asarray(a), np.asarray(b)
+    assert np.array_equal(np.isnan(a), np.isnan(b))
+    ok = np.isfinite(b)
+    peak = max(np.max(np.abs(b[ok]), initial=0.0), floor)
+    return float(np.max(np.abs(a[ok] - b[ok]), initial=0.0) / peak) if peak else float(np.max(np.abs(a[ok]), initial=0.0))
+
+
+def _agree(mech, phi_deg) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        a = fast.analyze_fast(mech, crank_angles(phi_deg))
+        b = exact(mech, crank_angles(phi_deg))
+    force = np.nanmax(np.abs(b.forces.R))          # a quantity that is rounding only (the moment of a
+    moment = force * mech.size                     # piston's reaction about its pin) against its kind's scale
+    floors = {"normal": force, "F_bal": force, "m": moment, "M_bal": moment, "lever": moment}
+    for name, x, y in [("R", a.forces.R, b.forces.R), ("M_bal", a.balancing_moment, b.balancing_moment),
+                       ("F_bal", a.balancing_force, b.balancing_force), ("lever", a.lever_moment, b.lever_moment),
+                       ("normal", a.forces.normal, b.forces.normal), ("m", a.forces.m, b.forces.m),
+                       ("omega", a.kin.omega, b.kin.omega), ("eps", a.kin.eps, b.kin.eps),
+                       ("origin", a.kin.origin, b.kin.origin), ("v", a.kin.v_origin, b.kin.v_origin),
+                       ("a", a.kin.a_origin, b.kin.a_origin), ("rot", a.kin.rot, b.kin.rot),
+                       ("v_slide", a.kin.v_slide, b.kin.v_slide), ("a_slide", a.kin.a_slide, b.kin.a_slide),
+                       ("cond", a.cond, b.cond), ("F_i", a.F_i, b.F_i), ("M_i", a.M_i, b.M_i),
+                       ("F_applied", a.F_applied, b.F_applied), ("M_applied", a.M_applied, b.M_applied),
+                       ("friction", a.friction_power, b.friction_power)]:
+        assert _close(x, y, floors.get(name, 0.0)) < TOL, (mech.name, name, _close(x, y, floors.get(name, 0.0)))
+    assert np.array_equal(a.singular, b.singular)
+    np.testing.assert_allclose(a.error, b.error, rtol=1e-6)
+
+
+SAMPLE = ["chain_unit_four_bar", "ice_crank_slider"]
+
+
+@pytest.mark.parametrize("name", SAMPLE)
+def test_both_paths_agree_on_a_sample_of_the_bundled_models(name):
+    _agree(kinetostat.load(name), np.arange(0.0, 360.0, 0.5))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(set(kinetostat.examples.names()) - set(SAMPLE)))
+def test_both_paths_agree_on_every_bundled_model(name):
+    _agree(kinetostat.load(name), np.arange(0.0, 360.0, 0.5))
+
+
+def _four_bar(rng) -> kinetostat.Mechanism:
+    """A random Grashof crank-rocker with random masses, speed and acceleration."""
+    r, l, h, b = 0.05 + 0.05 * rng.random(), 0.3 + 0.2 * rng.random(), 0.3 + 0.2 * rng.random(), 0.4 + 0.1 * rng.random()
+    text = f"""
+[mechanism]
+name = "random four-bar"
+g = 9.81
+[drive]
+link = 1
+pivot = "O1"
+point = "A"
+reference = [1.0, 0.0]
+sense = "ccw"
+kind = "engine"
+rpm = {50 + 400 * rng.random()}
+eps = {50 * rng.standard_normal()}
+[frame]
+O1 = [0.0, 0.0]
+O2 = [{b}, {0.1 * rng.standard_normal()}]
+[[link]]
+id = 1
+points = {{ O1 = [0.0, 0.0], A = [{r}, 0.0], S1 = [{r / 3}, 0.0] }}
+com = "S1"
+mass = {rng.random()}
+I_S = {0.01 * rng.random()}
+[[link]]
+id = 2
+points = {{ A = [0.0, 0.0], B = [{l}, 0.0], S2 = [{l / 2}, {0.02 * rng.standard_normal()}] }}
+mass = {1 + rng.random()}
+I_S = {0.05 * rng.random()}
+com = "S2"
+[[link]]
+id = 3
+points = {{ O2 = [0.0, 0.0], B = [{h}, 0.0], S3 = [{h / 2}, 0.0] }}
+mass = {1 + rng.random()}
+I_S = {0.05 * rng.random()}
+com = "S3"
+[[pair]]
+kind = "R"
+links = [0, 1]
+point = "O1"
+[[pair]]
+kind = "R"
+links = [1, 2]
+point = "A"
+[[pair]]
+kind = "R"
+links = [2, 3]
+point = "B"
+[[pair]]
+kind = "R"
+links = [0, 3]
+point = "O2"
+[[group]]
+links = [2, 3]
+branch = {rng.choice([-1, 1])}
+"""
+    return kinetostat.loads(text)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_both_paths_agree_on_random_four_bars(seed):
+    _agree(_four_bar(np.random.default_rng(seed)), np.random.default_rng(seed).uniform(0, 360, 2000))
+
+
+def test_peaks_of_a_batch_of_designs_equal_a_loop_of_analyze():
+    """One kernel call over 6 random designs x 720 angles keeps each design's largest |R| and
+    |M_bal|: the same as the numpy path design by design."""
+    mechs = [_four_bar(np.random.default_rng(10 + d)) for d in range(6)]
+    phi = np.arange(0.0, 360.0, 0.5)
+    pk = fast.peaks(mechs, phi, threads=2)
+    for d, m in enumerate(mechs):
+        res = exact(m, crank_angles(phi))
+        R = np.linalg.norm(res.forces.R, axis=-1).max(axis=0)
+        np.testing.assert_allclose(pk.R[d], R, rtol=TOL, atol=0)
+        assert abs(pk.M_bal[d] - np.abs(res.balancing_moment).max()) <= TOL * np.abs(res.balancing_moment).max()
+
+
+def test_analyze_takes_the_compiled_path_from_fast_min_angles_and_gives_the_same():
+    m = kinetostat.load("chain_unit_four_bar")
+    big = kinetostat.analyze(m, steps=fast.FAST_MIN)
+    ref = exact(m, crank_angles(None, fast.FAST_MIN))
+    assert _close(big.forces.R, ref.forces.R) < TOL and _close(big.balancing_moment, ref.balancing_moment) < TOL
+    assert not big.forces.R.flags.writeable
+
+
+def test_the_guard_angles_are_the_numpy_paths():
+    """Angles with cond > COND_CHECK are solved again by the numpy path with its accuracy check:
+    a four-bar passing near its toggle gets the same errors, singular flags and warnings."""
+    m = kinetostat.load("chain_unit_four_bar")
+    phi = np.concatenate([np.arange(0.0, 360.0, 1.0)])
+    with warnings.catch_warnings(record=True) as w1:
+        warnings.simplefilter("always")
+        a = fast.analyze_fast(m, crank_angles(phi))
+    with warnings.catch_warnings(record=True) as w2:
+        warnings.simplefilter("always")
+        b = exact(m, crank_angles(phi))
+    assert [str(x.message) for x in w1] == [str(x.message) for x in w2]
+    np.testing.assert_array_equal(a.singular, b.singular)
