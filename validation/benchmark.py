@@ -8,7 +8,12 @@ runs in one process; its error is the worst peak-relative error over the driving
 all reactions against the mpmath reference (`validation.reference`, 40 digits). Figures are
 printed and written, never asserted: speed is measured, not tested.
 
-May use: kinetostat, the scene, compare, reference, the engine adapters, matplotlib.
+The section "Against the engines' compiled kernels and the machine's limit" sets the solver's
+time per angle (360 and 10^6 angles) beside MuJoCo's and Pinocchio's own kernels and the
+machine's limit (`kernels`), all measured in the same run; `fast_path_rows` is the hook that
+times any `fast(mech, N)` the same way (the solver's rows come from it too).
+
+May use: kinetostat, the scene, compare, reference, the engine adapters, kernels, matplotlib.
 """
 from __future__ import annotations
 
@@ -119,11 +124,12 @@ def throughput(mech: kinetostat.Mechanism) -> list[dict]:
 
 
 def _nbytes(obj, seen: set | None = None) -> int:
-    """Memory held by the arrays of a result object and the result objects inside it, bytes."""
+    """Memory held by the arrays of a result object (a dataclass or a dict of arrays) and the
+    result objects inside it, bytes."""
     seen = set() if seen is None else seen
     total = 0
-    for f in dataclasses.fields(obj):
-        v = getattr(obj, f.name)
+    items = obj.items() if isinstance(obj, dict) else ((f.name, getattr(obj, f.name)) for f in dataclasses.fields(obj))
+    for _, v in items:
         if isinstance(v, np.ndarray):
             base = v if v.base is None else v.base
             if id(base) not in seen:
@@ -132,6 +138,102 @@ def _nbytes(obj, seen: set | None = None) -> int:
         elif dataclasses.is_dataclass(v) and not isinstance(v, kinetostat.Mechanism):
             total += _nbytes(v, seen)
     return total
+
+
+LARGE = 10**6           # the large batch of the kernel comparison, angles
+
+
+def fast_path_rows(models: list[Path], fast: Callable[[kinetostat.Mechanism, int], object], label: str,
+                   flops_per_angle: Callable[[kinetostat.Mechanism], int] | None = None,
+                   sizes: tuple[int, ...] = (ANGLES, LARGE), repeat: int = 3) -> list[dict]:
+    """The hook for a route of the solver: `fast(mech, N)` analyses N crank angles of `mech` and
+    returns its result (a dataclass or a dict of arrays); each model and size gives a row with
+    the seconds per angle (median of `repeat` calls after one warm-up, the previous result
+    released), the result's bytes per angle, the flops per angle when `flops_per_angle` is
+    given (e.g. `kernels.count_flops` of the route's per-angle body) and the machine's limit
+    for them (bytes only without flops)."""
+    from .kernels import machine_limit
+    rows = []
+    for path in models:
+        mech = kinetostat.load(path)
+        flops = flops_per_angle(mech) if flops_per_angle is not None else None
+        for n in sizes:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                seconds, res = median_seconds(lambda: fast(mech, n), repeat)
+            size = _nbytes(res) / n
+            del res
+            rows.append(dict(model=path.stem, route=label, angles=n, seconds_per_angle=seconds / n,
+                             bytes_per_angle=size, flops_per_angle=flops,
+                             limit=machine_limit(flops or 0.0, size)))
+    return rows
+
+
+def _analyze(mech: kinetostat.Mechanism, n: int) -> kinetostat.Analysis:
+    """Today's solver on n crank angles spread over the cycle (the fixed cost included)."""
+    return kinetostat.analyze(mech, phi_deg=np.linspace(0.0, 360.0, n, endpoint=False))
+
+
+def kernel_study(models: list[Path], quick: bool, extra_routes: tuple = (),
+                 sizes: tuple[int, ...] = (ANGLES, LARGE)) -> dict:
+    """The solver (by `fast_path_rows`, at `sizes` angles), MuJoCo's and Pinocchio's kernels
+    (360 angles) per model, and the machine's rates, measured in one run. `extra_routes`:
+    (fast, label, flops_per_angle or None) of further routes of the solver, e.g. a compiled
+    fast path, each timed by `fast_path_rows` beside today's."""
+    from .kernels import machine_rates, mujoco_kernel, pinocchio_kernel
+    rates = machine_rates()
+    repeat = 1 if quick else 3
+    solver = fast_path_rows(models, _analyze, "kinetostat.analyze", sizes=sizes, repeat=repeat)
+    extra = [r for fast, label, flops in extra_routes
+             for r in fast_path_rows(models, fast, label, flops, sizes=sizes, repeat=repeat)]
+    engines = []
+    for path in models:
+        scene = build_scene(kinetostat.load(path), steps=ANGLES)
+        for kernel in (mujoco_kernel, pinocchio_kernel):
+            k = kernel(scene, repeat=3 if quick else 11)
+            engines.append(dict(model=path.stem, engine=k.engine, seconds_per_angle=k.seconds_per_angle,
+                                overhead_per_angle=k.overhead_per_angle, note=k.note))
+    return dict(rates=rates, solver=solver, engines=engines, extra=extra)
+
+
+def kernel_lines(study: dict) -> list[str]:
+    """The report's section on the engines' compiled kernels and the machine's limit."""
+    rates = study["rates"]
+    eng = {(e["model"], e["engine"]): e for e in study["engines"]}
+    notes = {e["engine"]: e["note"] for e in study["engines"]}
+    us = lambda s: f"{s * 1e6:.3g}"
+    lines = ["## Against the engines' compiled kernels and the machine's limit", "",
+             f"Per angle, all measured in this run. **MuJoCo kernels**: a C program compiled with gcc against "
+             f"the mujoco wheel's headers and library times the loop over {ANGLES} angles, zero Python "
+             f"(state -> mj_kinematics, mj_comPos, mj_makeConstraint, mj_comVel, mj_rne, mj_applyFT, the "
+             f"square solve of [S | J^T][tau; lambda], mj_rnePostConstraint; {notes['mujoco']}). "
+             f"**Pinocchio kernels**: no Eigen headers ship with the pin wheel, so a Python loop calls the "
+             f"bound C++ (computeJointJacobians, the loop closures' calc, getConstraintsJacobian, rnea, "
+             f"numpy's solve, rnea again for the tree joints' forces; {notes['pinocchio']}); the loop's own "
+             f"Python, measured by the same loop with stubs, is shown in brackets and is NOT subtracted. "
+             f"Both give the exact routes' driving moment (tested). **Machine**: one core does "
+             f"{rates.flops_per_second / 1e9:.3g} GFLOP/s, memory takes {rates.bytes_per_second / 1e9:.3g} GB/s "
+             f"of writes ({rates.note}); the limit of a route is max(flops / flop rate, bytes of its result / "
+             f"bandwidth), from the bytes alone where its flops are not counted (today's solver is numpy: "
+             f"no compiled per-angle body to count).", "",
+             "| model | route | angles | per angle, us | result, B/angle | flops/angle | machine limit, us | "
+             "/ MuJoCo kernel | / Pinocchio kernel | / machine limit |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for model in dict.fromkeys(r["model"] for r in study["solver"]):
+        mj, pn = eng[(model, "mujoco")], eng[(model, "pinocchio")]
+        lines.append(f"| {model} | MuJoCo kernels (C loop) | {ANGLES} | {us(mj['seconds_per_angle'])} | | | | 1 | "
+                     f"{mj['seconds_per_angle'] / pn['seconds_per_angle']:.2g} | |")
+        lines.append(f"| {model} | Pinocchio kernels (Python loop [its own Python]) | {ANGLES} | "
+                     f"{us(pn['seconds_per_angle'])} [{us(pn['overhead_per_angle'])}] | | | | "
+                     f"{pn['seconds_per_angle'] / mj['seconds_per_angle']:.2g} | 1 | |")
+        for r in (r for r in study["solver"] + study["extra"] if r["model"] == model):
+            flops = "-" if r["flops_per_angle"] is None else f"{r['flops_per_angle']:.0f}"
+            lines.append(f"| {model} | {r['route']} | {r['angles']:,} | {us(r['seconds_per_angle'])} | "
+                         f"{r['bytes_per_angle']:.0f} | {flops} | {r['limit'] * 1e6:.2g} | "
+                         f"{r['seconds_per_angle'] / mj['seconds_per_angle']:.2g} | "
+                         f"{r['seconds_per_angle'] / pn['seconds_per_angle']:.2g} | "
+                         f"{r['seconds_per_angle'] / r['limit']:.3g} |")
+    return lines
 
 
 def kinematics_table(models: list[Path]) -> list[dict]:
@@ -173,7 +275,7 @@ def target_line(df, kin_rows: list[dict]) -> str:
             f"per angle in this adapter.")
 
 
-def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], out: Path) -> None:
+def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernels: dict, out: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -234,6 +336,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], out: P
               "| angles | first call, s | repeated, s | angles/s (repeated) |", "|---|---|---|---|"]
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['seconds']:.3f} | {r['per_second']:.3g} |")
+    lines += [""] + kernel_lines(kernels)
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -252,9 +355,11 @@ def main(argv: list[str] | None = None) -> None:
     for r in thr:
         print(f"throughput: {r['angles']:>9,} angles in {r['seconds']:.3f} s (first call {r['first_seconds']:.3f} s) "
               f"= {r['per_second']:.3g} angles/s")
+    kern = kernel_study(models, args.quick)
+    print("\n".join(kernel_lines(kern)))
     rows = study(models, args.quick)
     if not args.quick:
-        write_report(rows, kin_rows, thr, args.out)
+        write_report(rows, kin_rows, thr, kern, args.out)
         print(f"wrote {args.out / 'benchmark.md'}")
 
 

@@ -1,0 +1,77 @@
+"""The benchmark's kernel timers do the real work (the driving moment of the engines' exact
+routes) and the flop counter counts what a kernel computes."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numba
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat_validation import engine_mujoco, engine_pinocchio, kernels
+from kinetostat_validation.scene import build_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module", params=["chain_unit_four_bar", "slotted_link_shaper"])
+def scene(request):
+    """A four-bar (revolute loop closure) and the shaper (a prismatic one), 12 angles."""
+    return build_scene(kinetostat.load(ROOT / "models" / f"{request.param}.toml"), steps=12)
+
+
+def _same_moment(k: kernels.KernelTiming, M: np.ndarray) -> None:
+    assert np.isfinite(k.M_drive).sum() == np.isfinite(M).sum() > 0
+    np.testing.assert_allclose(k.M_drive, M, rtol=0, atol=1e-12 * np.nanmax(np.abs(M)))
+    assert k.seconds_per_angle > 0
+
+
+def test_mujoco_kernel_gives_the_exact_routes_moment(scene):
+    k = kernels.mujoco_kernel(scene, repeat=1)
+    _same_moment(k, engine_mujoco.solve(scene).M_drive)
+
+
+def test_pinocchio_kernel_gives_the_exact_routes_moment(scene):
+    k = kernels.pinocchio_kernel(scene, repeat=1)
+    _same_moment(k, engine_pinocchio.solve(scene).M_drive)
+    assert 0 < k.overhead_per_angle < k.seconds_per_angle
+
+
+@numba.njit
+def _known(x, y):
+    """5 flops: a multiply, a divide, an add, a square root, a subtract."""
+    return x * y + x / y - math.sqrt(x)
+
+
+def test_count_flops_on_a_known_kernel():
+    assert _known(4.0, 2.0) == 8.0
+    assert kernels.count_flops(_known) == 5
+
+
+def test_count_flops_ir_counts_vector_lanes_and_fma_twice():
+    ir = ("B0:\n  %a = fmul fast <4 x double> %x, %y\n  %b = fadd double %p, %q\n"
+          "  %c = call fast <2 x double> @llvm.fma.v2f64(<2 x double> %u, <2 x double> %v, <2 x double> %w)\n"
+          "  %d = fcmp olt double %p, %q\n  ret void\n")
+    assert kernels.count_flops_ir(ir) == 4 + 1 + 2 * 2
+
+
+def test_count_flops_refuses_a_loop():
+    @numba.njit
+    def total(a):
+        s = 0.0
+        for v in a:
+            s += v
+        return s
+    total(np.ones(3))
+    with pytest.raises(ValueError, match="per-angle body"):
+        kernels.count_flops(total)
+
+
+def test_machine_limit_is_the_slower_of_arithmetic_and_memory():
+    rates = kernels.MachineRates(1e10, 1e9, "given")
+    assert kernels.machine_limit(500, 100, rates=rates) == pytest.approx(1e-7)      # memory bound
+    assert kernels.machine_limit(5000, 1, rates=rates) == pytest.approx(5e-7)       # arithmetic bound
+    assert kernels.machine_limit(5000, 1, cores=2, rates=rates) == pytest.approx(2.5e-7)
+    assert kernels.bytes_per_angle({"M": np.zeros(10), "R": np.zeros((10, 4, 2))}, 10) == 72.0

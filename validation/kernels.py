@@ -1,0 +1,413 @@
+"""The engines' compiled kernels per angle, and this machine's limit: the honest yardsticks of speed.
+
+Engines, with as little Python as possible, doing what their exact routes do for the driving
+moment and the reactions at a set state (`engine_mujoco.solve`, `engine_pinocchio.solve`):
+
+- MuJoCo (`mujoco_kernel`): a small C program, compiled here with gcc against the mujoco wheel's
+  own headers and libmujoco, loads the very model the exact route compiles (`engine_mujoco`'s
+  model with the exact masses written back, saved as MJB: the MJCF alone carries placeholder
+  masses) and times, in C, the loop over the angles: the state written to qpos/qvel/qacc,
+  mj_kinematics, mj_comPos, mj_makeConstraint, mj_comVel (mj_fwdPosition + mj_fwdVelocity
+  without factorising the inertia matrix), mj_rne, the applied loads (xfrc_applied, mj_applyFT),
+  the square solve [S | J^T][tau; lambda] = rne - Q (Gaussian elimination, partial pivoting)
+  and mj_rnePostConstraint (the tree joints' forces cfrc_int). Zero Python inside the loop.
+- Pinocchio (`pinocchio_kernel`): the pin wheel ships no Eigen headers, so no C++ program can be
+  built against it here; the loop is Python calling the bound C++ per angle:
+  computeJointJacobians, each loop closure's calc, getConstraintsJacobian, rnea (applied loads
+  as fext), numpy's solve of [S | Jc^T][tau; lambda] = b, and a second rnea (the pass that gives
+  the tree joints' forces; its fext here are the applied loads only: the same compiled work,
+  without the adapter's Python that maps lambda to fext). A prismatic loop closure is a
+  CONTACT_6D model whose normal and rotation rows are kept (they span the adapter's own rows,
+  so tau is the same). The loop's own Python is measured by running the identical loop with
+  every engine and numpy call replaced by a stub returning a preallocated result, and is
+  reported beside the total, never subtracted.
+
+The machine (`machine_rates`, `machine_limit`): the write bandwidth of memory (a numba loop
+filling a 256 MiB buffer that is reused, so no page faults) and the double-precision throughput
+of one core (a numba loop of independent multiply-adds, fused to FMAs by fastmath); a per-angle
+limit is max(flops / flop rate, bytes / bandwidth). `count_flops` counts the floating-point
+operations of a compiled per-angle numba function from its LLVM IR (a vector operation counts
+its lanes).
+
+May use: kinetostat, the scene, engine_mujoco and engine_pinocchio (their models and states),
+mujoco, pinocchio, numba, numpy; gcc on the PATH for the MuJoCo kernel.
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+import math
+import re
+import shutil
+import statistics
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .scene import Scene
+
+__all__ = ["KernelTiming", "mujoco_kernel", "pinocchio_kernel", "MachineRates", "machine_rates",
+           "machine_limit", "count_flops", "count_flops_ir", "bytes_per_angle"]
+
+
+@dataclass(frozen=True)
+class KernelTiming:
+    """An engine kernel over the scene's regular angles: seconds per angle (median of the
+    repeats), the loop's own Python overhead per angle where the loop is Python (NaN for C), and
+    the driving moment it computed at every angle (NaN at singular angles), N m."""
+    engine: str
+    seconds_per_angle: float
+    overhead_per_angle: float
+    M_drive: np.ndarray
+    note: str
+
+
+# ----------------------------------------------------------------------------- MuJoCo, in C
+
+_MUJOCO_C = r"""
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <mujoco/mujoco.h>
+
+static double now(void) {
+  struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+/* solve A x = b in place (A n x n, row-major), partial pivoting; 0 if singular */
+static int solve(double *A, double *b, int n) {
+  for (int c = 0; c < n; c++) {
+    int p = c;
+    for (int r = c + 1; r < n; r++) if (fabs(A[r*n+c]) > fabs(A[p*n+c])) p = r;
+    if (A[p*n+c] == 0.0) return 0;
+    if (p != c) {
+      for (int k = 0; k < n; k++) { double t = A[c*n+k]; A[c*n+k] = A[p*n+k]; A[p*n+k] = t; }
+      double t = b[c]; b[c] = b[p]; b[p] = t;
+    }
+    for (int r = c + 1; r < n; r++) {
+      double f = A[r*n+c] / A[c*n+c];
+      for (int k = c; k < n; k++) A[r*n+k] -= f * A[c*n+k];
+      b[r] -= f * b[c];
+    }
+  }
+  for (int c = n - 1; c >= 0; c--) {
+    for (int k = c + 1; k < n; k++) b[c] -= A[c*n+k] * b[k];
+    b[c] /= A[c*n+c];
+  }
+  return 1;
+}
+
+/* argv: model.mjb states.bin N repeat crank_dof out.bin row0 row1 ...
+   states.bin: qpos (N nq), qvel (N nv), qacc (N nv), xfrc (N nbody 6), doubles
+   out.bin: tau (N), then the seconds of each repeat */
+int main(int argc, char **argv) {
+  mjModel *m = mj_loadModel(argv[1], NULL);
+  if (!m) { fprintf(stderr, "cannot load %s\n", argv[1]); return 2; }
+  mjData *d = mj_makeData(m);
+  int N = atoi(argv[3]), repeat = atoi(argv[4]), crank = atoi(argv[5]);
+  int nrows = argc - 7, nq = m->nq, nv = m->nv, nb = m->nbody, n = 1 + nrows;
+  int *rows = malloc(sizeof(int) * (nrows + 1));
+  for (int k = 0; k < nrows; k++) rows[k] = atoi(argv[7 + k]);
+  if (n != nv) { fprintf(stderr, "system not square: %d unknowns, nv = %d\n", n, nv); return 2; }
+  size_t len = (size_t)N * (nq + 2 * nv + 6 * nb);
+  double *st = malloc(sizeof(double) * len);
+  FILE *f = fopen(argv[2], "rb");
+  if (!f || fread(st, sizeof(double), len, f) != len) { fprintf(stderr, "cannot read states\n"); return 2; }
+  fclose(f);
+  double *qpos = st, *qvel = qpos + (size_t)N * nq, *qacc = qvel + (size_t)N * nv, *xfrc = qacc + (size_t)N * nv;
+  double *tau = malloc(sizeof(double) * N), *secs = malloc(sizeof(double) * repeat);
+  double *rne = malloc(sizeof(double) * nv), *qfrc = malloc(sizeof(double) * nv);
+  double *A = malloc(sizeof(double) * n * n), *x = malloc(sizeof(double) * n);
+  for (int r = 0; r < repeat; r++) {
+    double t0 = now();
+    for (int i = 0; i < N; i++) {
+      mju_copy(d->qpos, qpos + (size_t)i * nq, nq);
+      mju_copy(d->qvel, qvel + (size_t)i * nv, nv);
+      mju_copy(d->qacc, qacc + (size_t)i * nv, nv);
+      mj_kinematics(m, d); mj_comPos(m, d); mj_makeConstraint(m, d); mj_comVel(m, d);
+      mj_rne(m, d, 1, rne);
+      mju_zero(qfrc, nv);
+      mju_copy(d->xfrc_applied, xfrc + (size_t)i * nb * 6, nb * 6);
+      for (int b = 1; b < nb; b++) {
+        const double *w = d->xfrc_applied + 6 * b;
+        if (w[0] != 0 || w[1] != 0 || w[2] != 0 || w[3] != 0 || w[4] != 0 || w[5] != 0)
+          mj_applyFT(m, d, w, w + 3, d->xipos + 3 * b, b, qfrc);
+      }
+      for (int a = 0; a < nv; a++) {
+        A[a * n] = (a == crank);
+        for (int k = 0; k < nrows; k++) A[a * n + 1 + k] = d->efc_J[rows[k] * nv + a];
+        x[a] = rne[a] - qfrc[a];
+      }
+      if (!solve(A, x, n)) { tau[i] = NAN; continue; }
+      mju_zero(d->efc_force, d->nefc);
+      for (int k = 0; k < nrows; k++) d->efc_force[rows[k]] = x[1 + k];
+      mj_rnePostConstraint(m, d);
+      tau[i] = x[0];
+    }
+    secs[r] = now() - t0;
+  }
+  f = fopen(argv[6], "wb");
+  fwrite(tau, sizeof(double), N, f); fwrite(secs, sizeof(double), repeat, f); fclose(f);
+  mj_deleteData(d); mj_deleteModel(m);
+  return 0;
+}
+"""
+
+
+@functools.cache
+def _mujoco_program() -> Path:
+    """The MuJoCo kernel's executable, compiled once per process (gcc -O2 against the wheel's
+    include/ and libmujoco.so); RuntimeError when gcc or the wheel's headers are missing."""
+    import mujoco
+    pkg = Path(mujoco.__file__).parent
+    libs = sorted(pkg.glob("libmujoco.so*"))
+    gcc = shutil.which("gcc")
+    if not (gcc and libs and (pkg / "include" / "mujoco" / "mujoco.h").exists()):
+        raise RuntimeError(f"the MuJoCo kernel needs gcc and the wheel's include/ and libmujoco.so "
+                           f"(gcc: {gcc}, library: {libs}, headers in {pkg / 'include'})")
+    folder = Path(tempfile.mkdtemp(prefix="kinetostat-kernel-"))
+    src, exe = folder / "mujoco_kernel.c", folder / "mujoco_kernel"
+    src.write_text(_MUJOCO_C)
+    subprocess.run([gcc, "-O2", "-o", str(exe), str(src), f"-I{pkg / 'include'}", f"-L{pkg}",
+                    f"-l:{libs[0].name}", f"-Wl,-rpath,{pkg}", "-lm"], check=True, capture_output=True, text=True)
+    return exe
+
+
+def mujoco_kernel(scene: Scene, repeat: int = 5) -> KernelTiming:
+    """MuJoCo's compiled inverse dynamics, timed in C over the scene's regular angles (see the
+    module docstring): median over `repeat` runs of the loop, seconds per angle."""
+    import mujoco
+    from . import engine_mujoco as em
+    mm = em._compile(scene, em.EXACT_FLOOR, exact_masses=True)
+    m, d = mm.m, mm.d
+    em._kinematics(m, d)                          # every equality is always active: fixed rows
+    rows = np.concatenate([em._rows(mm, p.index) for p in scene.cuts] + [np.zeros(0, int)])
+    ok = ~scene.res.singular
+    qpos, qvel, qacc = (a[ok] for a in em._exact_state(scene, mm))
+    F, M = scene.external()
+    xfrc = em._xfrc(scene, mm, F[ok], M[ok])
+    N = int(ok.sum())
+    with tempfile.TemporaryDirectory(prefix="kinetostat-mj-") as tmp:
+        tmp = Path(tmp)
+        mujoco.mj_saveModel(m, str(tmp / "model.mjb"), None)
+        np.concatenate([a.ravel() for a in (qpos, qvel, qacc, xfrc)]).astype(np.float64).tofile(tmp / "states.bin")
+        subprocess.run([str(_mujoco_program()), str(tmp / "model.mjb"), str(tmp / "states.bin"), str(N),
+                        str(repeat), str(mm.crank_dof), str(tmp / "out.bin"), *map(str, rows)],
+                       check=True, capture_output=True, text=True)
+        out = np.fromfile(tmp / "out.bin", dtype=np.float64)
+    M_drive = np.full(len(ok), np.nan)
+    M_drive[ok] = out[:N]
+    return KernelTiming("mujoco", statistics.median(out[N:]) / N, math.nan, M_drive,
+                        f"MuJoCo {mujoco.__version__}, C loop (gcc -O2) over {N} angles, median of {repeat}")
+
+
+# ----------------------------------------------------------------------------- Pinocchio, a Python loop
+
+def _pin_loop(calls, model, data, calcs, cmodels, cdatas, states, fexts, A, keep, tau) -> None:
+    """The Pinocchio kernel's loop over the angles; `calls` = (computeJointJacobians,
+    getConstraintsJacobian, rnea, solve), the real ones or stubs (to time the loop's own Python)."""
+    jacobians, constraints_jacobian, rnea, solve = calls
+    for i, (q, v, a) in enumerate(states):
+        jacobians(model, data, q)
+        for calc, cd in zip(calcs, cdatas):
+            calc(model, data, cd)
+        A[:, 1:] = constraints_jacobian(model, data, cmodels, cdatas)[keep].T
+        x = solve(A, rnea(model, data, q, v, a, fexts[i]))
+        rnea(model, data, q, v, a, fexts[i])           # the tree joints' forces pass (data.f)
+        tau[i] = x[0]
+
+
+def _pin_closures(ps):
+    """The adapter's loop closures as Pinocchio constraint models and the kept rows: a revolute
+    cut's CONTACT_3D (rows x, y), a prismatic cut's CONTACT_6D in the guide's frame, x along the
+    guide, both frames aligned at assembly (rows: normal y, rotation z)."""
+    import pinocchio as pin
+    from .engine_pinocchio import _rz, _v3
+    cmodels, keep, first = pin.StdVec_RigidConstraintModel(), [], 0
+    for cm in ps.cmodels:
+        cmodels.append(cm)
+        keep += [first, first + 1]
+        first += 3
+    for pair, x_slider, d_guide in ps.p_cuts:
+        g, s = pair.links
+        beta = math.atan2(d_guide[1], d_guide[0])
+        m1 = pin.SE3(_rz(beta), _v3(ps._local(g, pair.guide)))
+        m2 = pin.SE3(_rz(beta - pair.alpha), x_slider)
+        cmodels.append(pin.RigidConstraintModel(pin.ContactType.CONTACT_6D, ps.model, ps.jid[g], m1,
+                                                ps.jid[s], m2, pin.ReferenceFrame.LOCAL))
+        keep += [first + 1, first + 5]
+        first += 6
+    cdatas = pin.StdVec_RigidConstraintData()
+    for cm in cmodels:
+        cdatas.append(cm.createData())
+    return cmodels, cdatas, np.array(keep)
+
+
+def pinocchio_kernel(scene: Scene, repeat: int = 5) -> KernelTiming:
+    """Pinocchio's compiled calls in a Python loop over the scene's regular angles (see the
+    module docstring): median over `repeat` runs, seconds per angle, and the same loop with
+    stubs for every engine and numpy call (the loop's own Python), seconds per angle."""
+    import pinocchio as pin
+    from .engine_pinocchio import PinocchioScene
+    ps = PinocchioScene(scene)
+    model, data = ps.model, ps.data
+    cmodels, cdatas, keep = _pin_closures(ps)
+    ok = np.flatnonzero(~scene.res.singular)
+    states = [ps.state(n) for n in ok]
+    fexts = []
+    for n, (q, v, a) in zip(ok, states):
+        pin.forwardKinematics(model, data, q)                 # data.oMi for the loads' frames
+        fexts.append(ps.applied_fext(n))
+    A = np.zeros((ps.nv, ps.nv))
+    A[ps.crank_v, 0] = 1.0
+    tau = np.full(len(ok), np.nan)
+    calcs = [cm.calc for cm in cmodels]
+    real = (pin.computeJointJacobians, pin.getConstraintsJacobian, pin.rnea, np.linalg.solve)
+    Jc, b, x = pin.getConstraintsJacobian(model, data, cmodels, cdatas).copy(), np.zeros(ps.nv), np.zeros(ps.nv)
+    nothing = lambda *args: None
+    stubs = (nothing, lambda *args: Jc, lambda *args: b, lambda *args: x)
+
+    def run(calls, calc_fns):
+        t = time.perf_counter()
+        _pin_loop(calls, model, data, calc_fns, cmodels, cdatas, states, fexts, A, keep, tau)
+        return time.perf_counter() - t
+
+    run(real, calcs)
+    seconds = statistics.median(run(real, calcs) for _ in range(repeat)) / len(ok)
+    M_drive = np.full(len(scene.phi_deg), np.nan)
+    M_drive[ok] = tau
+    overhead = statistics.median(run(stubs, [nothing] * len(calcs)) for _ in range(repeat)) / len(ok)
+    return KernelTiming("pinocchio", seconds, overhead, M_drive,
+                        f"pin {pin.__version__}, Python loop over {len(ok)} angles, {4 + len(calcs)} bound calls "
+                        f"per angle, median of {repeat}")
+
+
+# ----------------------------------------------------------------------------- flops of a compiled kernel
+
+_TYPE = r"(?:[a-z]+\s+)*(?:<(\d+) x (?:double|float)>|double|float)"
+_ARITH = re.compile(r"=\s*(?:fadd|fsub|fmul|fdiv|frem)\s+" + _TYPE)
+_CALL = re.compile(r"call\s+" + _TYPE + r"\s+@(?:llvm\.)?(fma|fmuladd|sqrt|sin|cos|tan|atan2|atan|asin|acos|exp|log|pow|hypot)\b")
+_LABEL = re.compile(r"^([\w.$-]+):")
+_TARGET = re.compile(r"label %([\w.$-]+)")
+
+
+def count_flops_ir(ir: str) -> int:
+    """Floating-point operations in one LLVM IR function body (straight-line code): fadd, fsub,
+    fmul, fdiv, frem count 1, fma and fmuladd 2, a call of sqrt or of a libm function (sin, cos,
+    atan2, exp, ...) 1; a vector operation counts its lanes. ValueError if the body loops (its
+    control-flow graph has a cycle): the count is then not per call."""
+    flops = 0
+    blocks: dict[str, set[str]] = {}
+    current = "entry"
+    for line in ir.splitlines():
+        if (m := _LABEL.match(line)) is not None:
+            current = m.group(1)
+        blocks.setdefault(current, set())
+        blocks[current].update(_TARGET.findall(line))     # br, switch and its case lines
+        if (m := _ARITH.search(line)) is not None:
+            flops += int(m.group(1) or 1)
+        elif (m := _CALL.search(line)) is not None:
+            flops += int(m.group(1) or 1) * (2 if m.group(2) in ("fma", "fmuladd") else 1)
+    if _has_cycle(blocks):
+        raise ValueError("the kernel loops: count_flops wants the per-angle body (a function of "
+                         "scalars without loops), whose flops are then flops per angle")
+    return flops
+
+
+def _has_cycle(succ: dict[str, set[str]]) -> bool:
+    state: dict[str, int] = {}                    # 1 on the DFS stack, 2 done
+
+    def visit(b: str) -> bool:
+        state[b] = 1
+        for c in succ.get(b, ()):
+            if state.get(c) == 1 or (c not in state and visit(c)):
+                return True
+        state[b] = 2
+        return False
+
+    return any(b not in state and visit(b) for b in list(succ))
+
+
+def count_flops(dispatcher, signature=None) -> int:
+    """Floating-point operations of one call of a compiled numba function (its first compiled
+    signature unless `signature` is given), counted in its optimised LLVM IR (`count_flops_ir`);
+    meant for the per-angle body of a kernel, whose count is then flops per angle."""
+    sig = signature if signature is not None else dispatcher.signatures[0]
+    name = dispatcher.overloads[sig].fndesc.mangled_name
+    lines = dispatcher.inspect_llvm(sig).splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("define") and f"@{name}(" in line)
+    end = next(i for i in range(start, len(lines)) if lines[i].startswith("}"))
+    return count_flops_ir("\n".join(lines[start + 1:end]))
+
+
+# ----------------------------------------------------------------------------- the machine's limit
+
+#: The throughput kernel's independent accumulators: enough chains to hide the FMA latency
+#: (4-5 cycles, 2 units) at any vector width up to AVX-512.
+_CHAINS = 64
+
+
+def _fma_chains(n: int, acc: np.ndarray) -> None:
+    """n rounds of acc[k] = acc[k] * b + c over _CHAINS independent chains (2 flops each)."""
+    b, c = 0.999999999, 1e-9
+    for _ in range(n):
+        for k in range(_CHAINS):
+            acc[k] = acc[k] * b + c
+
+
+def _fill(buf: np.ndarray, x: float) -> None:
+    for i in range(buf.size):
+        buf[i] = x
+
+
+@dataclass(frozen=True)
+class MachineRates:
+    """One core's double-precision arithmetic throughput (flop/s) and memory write bandwidth
+    (bytes/s), measured here, best of the repeats; how they were measured."""
+    flops_per_second: float
+    bytes_per_second: float
+    note: str
+
+
+@functools.cache
+def machine_rates(repeat: int = 5, buffer_bytes: int = 256 * 2**20) -> MachineRates:
+    """Measure the machine once per process (see the module docstring): best of `repeat` runs."""
+    import numba
+    fma = numba.njit(fastmath=True)(_fma_chains)
+    fill = numba.njit(_fill)
+    acc = np.ones(_CHAINS)
+    rounds = 2_000_000
+    fma(10, acc)
+    t_fma = min(_timed(lambda: fma(rounds, acc)) for _ in range(repeat))
+    buf = np.empty(buffer_bytes // 8)
+    fill(buf, 0.5)                                          # every page touched before timing
+    t_fill = min(_timed(lambda: fill(buf, 1.5)) for _ in range(repeat))
+    return MachineRates(2 * _CHAINS * rounds / t_fma, buf.nbytes / t_fill,
+                        f"numba {numba.__version__}: {_CHAINS} independent multiply-add chains (fastmath, FMA), "
+                        f"one core; a numba loop writing a reused {buffer_bytes / 2**20:.0f} MiB buffer")
+
+
+def _timed(fn) -> float:
+    t = time.perf_counter()
+    fn()
+    return time.perf_counter() - t
+
+
+def machine_limit(flops_per_angle: float, bytes_per_angle: float, cores: int = 1,
+                  rates: MachineRates | None = None) -> float:
+    """The least time per angle this machine allows, s: max(flops / flop rate of `cores` cores,
+    bytes / write bandwidth), the bandwidth shared by the cores."""
+    rates = rates if rates is not None else machine_rates()
+    return max(flops_per_angle / (rates.flops_per_second * cores), bytes_per_angle / rates.bytes_per_second)
+
+
+def bytes_per_angle(arrays, n_angles: int) -> float:
+    """Bytes written per angle by a result given as a dict of arrays (or of their nbytes), over
+    n_angles angles."""
+    return sum(a if isinstance(a, (int, float)) else a.nbytes for a in arrays.values()) / n_angles
