@@ -33,6 +33,9 @@ def _agree(mech, phi_deg) -> None:
     force = np.nanmax(np.abs(b.forces.R))          # a quantity that is rounding only (the moment of a
     moment = force * mech.size                     # piston's reaction about its pin) against its kind's scale
     floors = {"normal": force, "F_bal": force, "m": moment, "M_bal": moment, "lever": moment}
+    # the condition number is a diagnostic, not a result: near a toggle |det| is itself a difference
+    # of nearly equal products, so its rounding is amplified (6.7e-13 of the peak on the furnace loader)
+    tolerance = {"cond": 1e-10}
     for name, x, y in [("R", a.forces.R, b.forces.R), ("M_bal", a.balancing_moment, b.balancing_moment),
                        ("F_bal", a.balancing_force, b.balancing_force), ("lever", a.lever_moment, b.lever_moment),
                        ("normal", a.forces.normal, b.forces.normal), ("m", a.forces.m, b.forces.m),
@@ -43,7 +46,7 @@ def _agree(mech, phi_deg) -> None:
                        ("cond", a.cond, b.cond), ("F_i", a.F_i, b.F_i), ("M_i", a.M_i, b.M_i),
                        ("F_applied", a.F_applied, b.F_applied), ("M_applied", a.M_applied, b.M_applied),
                        ("friction", a.friction_power, b.friction_power)]:
-        assert _close(x, y, floors.get(name, 0.0)) < TOL, (mech.name, name, _close(x, y, floors.get(name, 0.0)))
+        assert _close(x, y, floors.get(name, 0.0)) < tolerance.get(name, TOL), (mech.name, name, _close(x, y, floors.get(name, 0.0)))
     assert np.array_equal(a.singular, b.singular)
     np.testing.assert_allclose(a.error, b.error, rtol=1e-6)
 
