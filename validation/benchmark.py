@@ -28,6 +28,8 @@ from typing import Callable
 import numpy as np
 
 import kinetostat
+from kinetostat import fast
+from kinetostat.analysis import crank_angles, exact
 from kinetostat.kinematics import kinematics
 
 from .compare import errors
@@ -196,6 +198,40 @@ def kernel_study(models: list[Path], quick: bool, extra_routes: tuple = (),
     return dict(rates=rates, solver=solver, engines=engines, extra=extra)
 
 
+def _fast_peaks(mech: kinetostat.Mechanism, N: int):
+    return fast.peaks([mech], crank_angles(None, N))
+
+
+def fast_throughput(models: list[Path], quick: bool, sizes: tuple[int, ...] = (10**4, 10**5, 10**6, 10**7)) -> list[dict]:
+    """The compiled path's throughput, positions (designs x angles) per second, on 1 and on
+    every core: keeping each design's peaks (fast.peaks) and writing every array of the full
+    result (fast.analyze_fast, to 10^6 angles: 10^7 would be ~8 GB), and the peak memory the
+    call allocates per angle (tracemalloc: numpy's allocations, the result's arrays included)."""
+    import tracemalloc
+    rows = []
+    for path in models:
+        mech = kinetostat.load(path)
+        fast.peaks([mech], np.arange(4.0))
+        fast.analyze_fast(mech, crank_angles(None, 4))
+        for N in sizes[:2] if quick else sizes:
+            phi = crank_angles(None, N)
+            for kind, run in (("peaks", lambda t: fast.peaks([mech], phi, threads=t)),
+                              ("full", lambda t: fast.analyze_fast(mech, phi, threads=t))):
+                if kind == "full" and N > 10**6:
+                    continue
+                for threads in sorted({1, fast.THREADS}):
+                    sec, _ = median_seconds(lambda: run(threads), 1 if quick or N >= 10**6 else 3)
+                    tracemalloc.start()
+                    run(threads)
+                    peak = tracemalloc.get_traced_memory()[1]
+                    tracemalloc.stop()
+                    rows.append(dict(model=path.stem, kind=kind, angles=N, threads=threads, seconds=sec,
+                                     per_core=N / sec / threads, bytes_per_angle=peak / N))
+                    print(f"fast {path.stem} {kind} N={N:.0e} threads={threads}: {N / sec / 1e6:.2f} M positions/s "
+                          f"({N / sec / threads / 1e6:.2f} M/s per core), {peak / N:.0f} B/angle allocated")
+    return rows
+
+
 def kernel_lines(study: dict) -> list[str]:
     """The report's section on the engines' compiled kernels and the machine's limit."""
     rates = study["rates"]
@@ -233,6 +269,20 @@ def kernel_lines(study: dict) -> list[str]:
                          f"{r['seconds_per_angle'] / mj['seconds_per_angle']:.2g} | "
                          f"{r['seconds_per_angle'] / pn['seconds_per_angle']:.2g} | "
                          f"{r['seconds_per_angle'] / r['limit']:.3g} |")
+    if study.get("fast"):
+        lines += ["", "## The compiled path's throughput", "",
+                  f"`kinetostat.fast` (one numba kernel per structure, nogil, its blocks of {fast.BLOCK} angles shared "
+                  f"among threads; compilation excluded: a first call per structure and kind compiles for 1-4 s). "
+                  f"'peaks': what a sweep keeps (the largest |R| of every pair, |M_bal|, |F_bal|); 'full': every "
+                  f"array of the Analysis written (`kinetostat.analyze` from {fast.FAST_MIN:,} angles). Positions per "
+                  f"second, per core = total / threads; memory: the peak that the call allocates (tracemalloc), "
+                  f"per angle. A model with loads besides gravity and inertia (the six-link furnace loader) takes "
+                  f"two passes with the numpy loads between them for 'full', and the numpy path for 'peaks'.", "",
+                  "| model | kept | angles | threads | M positions/s | M/s per core | B allocated per angle |",
+                  "|---|---|---|---|---|---|---|"]
+        for r in study["fast"]:
+            lines.append(f"| {r['model']} | {r['kind']} | {r['angles']:,} | {r['threads']} | "
+                         f"{r['angles'] / r['seconds'] / 1e6:.2f} | {r['per_core'] / 1e6:.2f} | {r['bytes_per_angle']:.0f} |")
     return lines
 
 
@@ -355,7 +405,11 @@ def main(argv: list[str] | None = None) -> None:
     for r in thr:
         print(f"throughput: {r['angles']:>9,} angles in {r['seconds']:.3f} s (first call {r['first_seconds']:.3f} s) "
               f"= {r['per_second']:.3g} angles/s")
-    kern = kernel_study(models, args.quick)
+    kern = kernel_study(models, args.quick, extra_routes=(
+        (_fast_peaks, "compiled path, peaks kept (sweep)", None),
+        (lambda mech, N: exact(mech, crank_angles(None, N)), "numpy path (analyze below FAST_MIN)", None)))
+    kern["fast"] = fast_throughput([ROOT / "models" / "chain_unit_four_bar.toml", ROOT / "models" / "furnace_loader_six_bar.toml"],
+                                   args.quick)
     print("\n".join(kernel_lines(kern)))
     rows = study(models, args.quick)
     if not args.quick:
