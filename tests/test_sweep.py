@@ -4,6 +4,7 @@ the same table as the sweep in this process; a design that fails keeps its row."
 from __future__ import annotations
 
 import itertools
+import shutil
 
 import numpy as np
 import pandas as pd
@@ -164,3 +165,18 @@ def test_cli_sweep_bad_options_are_named(cli, tmp_path, args, message):
     r = cli("sweep", "chain_unit_four_bar", *args, cwd=tmp_path)
     assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr
     assert not list(tmp_path.iterdir())
+
+
+def test_the_reports_study_is_the_sweep_its_command_line_writes(cli, tmp_path):
+    """The chain-unit report's r x n_k table: study_table equals the table `kinetostat sweep` writes
+    from the command line the report prints."""
+    from kinetostat.report.writer import study_command, study_table
+    mech = kinetostat.load(CHAIN)
+    command = study_command(mech)
+    assert command == ("kinetostat sweep chain_unit_four_bar.toml --param r=0.05,0.065,0.08,0.095,0.11 "
+                       "--param n_k=0,60,120,240,487 --steps 36 --out study.csv")
+    shutil.copy(CHAIN, tmp_path)
+    r = cli(*command.split()[1:], "--no-progress", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    written = pd.read_csv(tmp_path / "study.csv")
+    np.testing.assert_array_equal(written["peak_R_0_1"].to_numpy().reshape(5, 5), study_table(mech))
