@@ -1014,8 +1014,8 @@ def cmd_sweep(args) -> int:
                    chunk=args.chunk, progress=not args.no_progress and sys.stderr.isatty())
     except ValueError as exc:
         raise CLIError(f"--param: {str(exc).removeprefix('sweep: ')}") from None
-    except OSError as exc:               # a distributed scheduler that cannot be reached
-        raise CLIError(f"--scheduler {args.scheduler}: {exc}") from None
+    except ConnectionError as exc:       # no distributed scheduler at that address
+        raise CLIError(f"--scheduler {args.scheduler}: {str(exc).partition(': ')[2]}") from None
     secs = time.perf_counter() - t0
     _save(out, "--out", lambda f: write(sw.table, f), binary)
     lines = [f"{mech.name}   [{path}]",

@@ -81,7 +81,8 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     `progress`: a tqdm bar over the chunks on stderr.
 
     ValueError names an unknown parameter, an empty or non-finite list of values, or a bad
-    `chunk`; the model itself must load with its own parameters (ModelError otherwise)."""
+    `chunk`; the model itself must load with its own parameters (ModelError otherwise);
+    ConnectionError: no `distributed` scheduler at the address."""
     text, source, base = _model_text(model)
     names = list(params)
     valid = [*base.parameters, "g"]
@@ -216,7 +217,12 @@ def _distributed(tasks: list, scheduler: Any, bar) -> list:
     """The tasks' results from a `distributed` scheduler (an address, or a Client)."""
     from distributed import Client, as_completed
     if isinstance(scheduler, str):
-        with Client(scheduler) as client:
+        try:
+            client = Client(scheduler)
+        except (OSError, ValueError) as exc:
+            raise ConnectionError(f"scheduler {scheduler!r}: no distributed scheduler there ({exc}); "
+                                  f"or use {' or '.join(map(repr, LOCAL_SCHEDULERS))}") from None
+        with client:
             return _gather(client, tasks, bar, as_completed)
     if not isinstance(scheduler, Client):
         raise TypeError(f"scheduler: expected None, {' or '.join(map(repr, LOCAL_SCHEDULERS))}, a distributed "

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import shutil
+import sys
 
 import numpy as np
 import pandas as pd
@@ -89,24 +90,46 @@ def test_full_keeps_every_angle_with_the_design_first():
     assert a.attrs["units"]["R_0_1"] == "N" and a.attrs["units"]["r"] == "model's unit"
 
 
+class _Bar:
+    """A progress bar that counts the chunks it is told of."""
+    def __init__(self, total: int, enabled: bool):
+        self.total, self.done, self.closed = total, 0, False
+
+    def update(self, n: int = 1) -> None:
+        self.done += n
+
+    def close(self) -> None:
+        self.closed = True
+
+
+@pytest.fixture
+def bars(monkeypatch) -> list[_Bar]:
+    """The progress bars the sweeps of a test make."""
+    made: list[_Bar] = []
+    monkeypatch.setattr(sys.modules["kinetostat.sweep"], "_bar", lambda *a: made.append(_Bar(*a)) or made[-1])
+    return made
+
+
 @pytest.mark.parametrize("scheduler", ["threads", "processes"])
-def test_dask_local_schedulers_give_the_same_table(scheduler):
+def test_dask_local_schedulers_give_the_same_table(scheduler, bars):
     params = {"r": [0.05, 0.08, 0.9], "n_k": [0.0, 487.0]}
     here = kinetostat.sweep(CHAIN, params, steps=36, full=True)
-    there = kinetostat.sweep(CHAIN, params, steps=36, full=True, scheduler=scheduler, chunk=2)
+    there = kinetostat.sweep(CHAIN, params, steps=36, full=True, scheduler=scheduler, chunk=2, progress=True)
     pd.testing.assert_frame_equal(here.table, there.table, check_exact=True)
     pd.testing.assert_frame_equal(here.angles, there.angles, check_exact=True)
+    assert [(b.total, b.done, b.closed) for b in bars] == [(1, 1, True), (3, 3, True)]   # 6 designs, 2 a chunk
 
 
-def test_a_local_cluster_of_two_workers_gives_the_same_table():
+def test_a_local_cluster_of_two_workers_gives_the_same_table(bars):
     distributed = pytest.importorskip("distributed")
     here = kinetostat.sweep(CHAIN, STUDY, steps=360)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as lc, \
             distributed.Client(lc) as client:
-        by_client = kinetostat.sweep(CHAIN, STUDY, steps=360, scheduler=client, chunk=4)
+        by_client = kinetostat.sweep(CHAIN, STUDY, steps=360, scheduler=client, chunk=4, progress=True)
         by_address = kinetostat.sweep(CHAIN, STUDY, steps=360, scheduler=lc.scheduler_address, chunk=7)
     pd.testing.assert_frame_equal(here.table, by_client.table, check_exact=True)
     pd.testing.assert_frame_equal(here.table, by_address.table, check_exact=True)
+    assert [(b.total, b.done) for b in bars] == [(1, 1), (7, 7), (4, 4)]      # 25 designs: 7 chunks of 4, 4 of 7
 
 
 # ----------------------------------------------------------------------------- the command line
@@ -158,6 +181,7 @@ def test_cli_sweep_full_writes_the_angles_beside_out(cli, tmp_path):
     (["--param", "r=a,b"], "invalid --param 'r=a,b': expected numbers"),
     (["--param", "r=0.05", "--param", "r=0.06"], "--param r: given more than once"),
     (["--param", "r=0.05", "--out", "sweep.txt"], "--out sweep.txt: unknown table format '.txt'"),
+    (["--param", "r=0.05", "--scheduler", "nowhere"], "--scheduler nowhere: no distributed scheduler there"),
 ])
 def test_cli_sweep_bad_options_are_named(cli, tmp_path, args, message):
     if "--out" not in args:
