@@ -1040,6 +1040,7 @@ def cmd_sweep(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
+    from .sweep import CHUNK
     p = _Parser(prog="kinetostat",
                 description="Kinetostatic analysis of planar linkages (graphical-analytic method, computed "
                             "exactly over the crank cycle) and its cross-validation against physics engines.",
@@ -1208,8 +1209,8 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--scheduler", metavar="WHERE",
                     help="run the chunks over Dask: 'threads' or 'processes' (this machine), or the address of a "
                          "distributed scheduler, e.g. tcp://10.0.0.5:8786 (default: in this process, no Dask)")
-    sw.add_argument("--chunk", metavar="N", type=_positive("number of designs per task", "--chunk 32"), default=32,
-                    help="designs per task (default 32)")
+    sw.add_argument("--chunk", metavar="N", type=_positive("number of designs per task", "--chunk 32"), default=CHUNK,
+                    help=f"designs per task (default {CHUNK})")
     sw.add_argument("--no-progress", action="store_true", help="no progress bar")
     sw.set_defaults(func=cmd_sweep)
     return p

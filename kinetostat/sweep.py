@@ -15,7 +15,8 @@ A design whose mechanism does not load, build or assemble keeps its row: NaN pea
 reason in the `error` column (the sweep goes on). Warnings (singular positions, doubts about a
 model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular.
 
-May use: model, analysis, errors, examples; pandas; dask and distributed (imported only for a
+May use: model, analysis, errors, examples; pandas (imported when a sweep runs, so that
+`import kinetostat` does not load it); dask and distributed (imported only for a
 Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
 `kinetostat.report`.
 """
@@ -27,14 +28,16 @@ import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 import numpy as np
-import pandas as pd
 
 from .analysis import Analysis, analyze, crank_angles
 from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["Sweep", "sweep", "CHUNK", "LOCAL_SCHEDULERS"]
 
@@ -83,6 +86,7 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     ValueError names an unknown parameter, an empty or non-finite list of values, or a bad
     `chunk`; the model itself must load with its own parameters (ModelError otherwise);
     ConnectionError: no `distributed` scheduler at the address."""
+    import pandas as pd
     text, source, base = _model_text(model)
     names = list(params)
     valid = [*base.parameters, "g"]
@@ -113,6 +117,7 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
     """The rows of `designs` (each: parameter -> value) of the model `text`: one per design (its
     parameters, peaks, singular angles, error), and with `full` every angle's row (None without).
     A Dask task: plain, picklable arguments."""
+    import pandas as pd
     rows, frames = [], []
     with _quiet():
         for design in designs:
@@ -159,6 +164,7 @@ def _reason(exc: Exception) -> str:
 
 def _with_design(df: pd.DataFrame, design: Mapping[str, float]) -> pd.DataFrame:
     """`df` (one analysis's cycle table) led by the design's parameters as columns."""
+    import pandas as pd
     lead = pd.DataFrame({name: np.full(len(df), value) for name, value in design.items()})
     out = pd.concat([lead, df], axis=1)
     out.attrs["units"] = _units([df], list(design))

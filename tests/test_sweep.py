@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import shutil
+import subprocess
 import sys
 
 import numpy as np
@@ -46,6 +47,13 @@ def test_seed_004_study_as_a_sweep_equals_a_loop_of_analyze():
     assert sw.peak("R_0_1")[2, 2] == pytest.approx(288.3, abs=0.05)
     assert (sw.table["n_singular"] == 0).all() and (sw.table["error"] == "").all()
     assert sw.table.attrs["units"]["peak_M_bal"] == "N m" and sw.table.attrs["units"]["peak_R_0_1"] == "N"
+
+
+def test_import_kinetostat_leaves_pandas_and_dask_unloaded():
+    """The sweep is exported by the package, yet a one-shot command does not pay for pandas or Dask."""
+    code = "import sys, kinetostat; print(sorted({'pandas', 'dask', 'distributed'} & set(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
 
 
 def test_unknown_parameters_and_bad_values_are_named():
