@@ -20,10 +20,11 @@ from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning,
 from .kinematics import COND_CHECK, COND_MAX, DIGITS_MIN, DIGITS_WARN
 from .model import Mechanism, from_dict, load, loads
 from .structure import AssurGroup, Structure
+from .sweep import Sweep, sweep
 from .virtual_work import VirtualWork, virtual_work
 
 __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
            "AssemblyError", "SingularPositionWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
-           "examples", "plans"]
+           "examples", "plans", "sweep", "Sweep"]
 __version__ = "0.1.0"

@@ -1,4 +1,4 @@
-"""The command line: `kinetostat analyze | structure | plans | validate | report | export | examples | variant`
+"""The command line: `kinetostat analyze | structure | plans | validate | report | export | examples | variant | sweep`
 (also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
@@ -944,10 +944,103 @@ def cmd_variant(args) -> int:
     return EXIT_OK
 
 
+# ============================================================================ sweep
+
+def _param(text: str) -> tuple[str, list[float]]:
+    """`--param NAME=VALUES`: a range start:stop:step that includes its stop, a list a,b,c, or one value."""
+    name, eq, spec = text.partition("=")
+    name = name.strip()
+    if not eq or not name or not spec.strip():
+        raise argparse.ArgumentTypeError(f"invalid --param {text!r}: expected NAME=VALUES, e.g. --param r=0.05:0.11:0.015 "
+                                         f"(start:stop:step, stop included), --param n_k=0,60,120 or --param c=0.54")
+    try:
+        if ":" in spec:
+            return name, _range(*(float(x) for x in spec.split(":")))
+        values = [float(x) for x in spec.split(",")]
+    except (TypeError, ValueError) as exc:
+        why = str(exc) if isinstance(exc, _RangeError) else "expected numbers"
+        raise argparse.ArgumentTypeError(f"invalid --param {text!r}: {why} (a range start:stop:step includes its "
+                                         f"stop; a list a,b,c)") from None
+    if not all(map(math.isfinite, values)):
+        raise argparse.ArgumentTypeError(f"invalid --param {text!r}: expected finite numbers")
+    return name, values
+
+
+class _RangeError(ValueError):
+    pass
+
+
+def _range(start: float, stop: float, step: float) -> list[float]:
+    """start, start + step, ..., stop (included, as the texts' ranges are), each start + k step
+    rounded to 12 digits of the range's scale; the step must divide stop - start."""
+    if not all(map(math.isfinite, (start, stop, step))) or step == 0:
+        raise _RangeError("the range's start, stop and step must be finite and the step non-zero")
+    n = (stop - start) / step
+    k = round(n)
+    if n < -1e-9 or abs(n - k) > 1e-9 * max(1.0, abs(n)):
+        raise _RangeError(f"the step {step:g} does not go from {start:g} to {stop:g} in whole steps")
+    if k >= 100_000:
+        raise _RangeError(f"{k + 1} values: at most 100000 per parameter")
+    decimals = 12 - math.floor(math.log10(max(abs(start), abs(stop), abs(step))))
+    return [round(start + i * step, decimals) for i in range(k)] + [stop]
+
+
+def _table_writer(out: str):
+    """How `--out` is written, by its suffix: (write(df, file), binary)."""
+    suffix = Path(out).suffix.lower()
+    if suffix == ".csv":
+        return (lambda df, f: df.to_csv(f, index=False)), False
+    if suffix == ".parquet":
+        return (lambda df, f: df.to_parquet(f, index=False)), True
+    raise CLIError(f"--out {out}: unknown table format {suffix or '(no suffix)'!r}; use .parquet or .csv")
+
+
+def cmd_sweep(args) -> int:
+    from .sweep import sweep
+    write, binary = _table_writer(args.out)
+    names = [n for n, _ in args.param]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise CLIError(f"--param {twice[0]}: given more than once; give all its values in one --param")
+    out = _writable_file(args.out, "--out")
+    angles_out = out.with_name(f"{out.stem}.angles{out.suffix}") if args.full else None
+    if angles_out is not None:
+        _writable_file(str(angles_out), "--out")
+    path = Path(args.model)
+    mech = _load(path)
+    t0 = time.perf_counter()
+    try:
+        sw = sweep(mech, dict(args.param), steps=args.steps, full=args.full, scheduler=args.scheduler,
+                   chunk=args.chunk, progress=not args.no_progress and sys.stderr.isatty())
+    except ValueError as exc:
+        raise CLIError(f"--param: {str(exc).removeprefix('sweep: ')}") from None
+    except ConnectionError as exc:       # no distributed scheduler at that address
+        raise CLIError(f"--scheduler {args.scheduler}: {str(exc).partition(': ')[2]}") from None
+    secs = time.perf_counter() - t0
+    _save(out, "--out", lambda f: write(sw.table, f), binary)
+    lines = [f"{mech.name}   [{path}]",
+             f"{len(sw.table)} designs ({' x '.join(f'{n} {k}' for n, k in zip(names, sw.shape))}) x "
+             f"{len(sw.phi_deg)} crank positions in {secs:.2f} s",
+             f"table: {len(sw.table)} rows x {len(sw.table.columns)} columns -> {out}"]
+    if angles_out is not None:
+        _save(angles_out, "--out", lambda f: write(sw.angles, f), binary)
+        lines.append(f"every angle: {len(sw.angles)} rows x {len(sw.angles.columns)} columns -> {angles_out}")
+    failed = sw.table[sw.table["error"] != ""]
+    if len(failed):
+        lines.append(f"{len(failed)} design(s) failed (NaN peaks, the reason in the column 'error'), the first: "
+                     f"{failed['error'].iloc[0]}")
+    singular = int((sw.table["n_singular"].fillna(0) > 0).sum())
+    if singular:
+        lines.append(f"{singular} design(s) pass through singular positions (columns n_singular, singular_deg)")
+    _Out.write("\n".join(lines))
+    return EXIT_OK
+
+
 # ============================================================================ parser and main
 
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
+    from .sweep import CHUNK
     p = _Parser(prog="kinetostat",
                 description="Kinetostatic analysis of planar linkages (graphical-analytic method, computed "
                             "exactly over the crank cycle) and its cross-validation against physics engines.",
@@ -1091,6 +1184,35 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--lang", choices=("en", "uk"), default="en", help="language of the key (default en)")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
     va.set_defaults(func=cmd_variant)
+
+    sw = sub.add_parser("sweep", help="analyse every combination of some parameters' values: a row of peaks per design",
+                        description="Load MODEL once for every combination of the --param values (the first "
+                                    "parameter the slowest), analyse it over the crank cycle and write one row per "
+                                    "design: its parameters (in the model's units), peak_R_i_j (max |R(i,j)| over "
+                                    "the cycle) for every pair, peak_M_bal (max |M_bal|), for a working machine "
+                                    "peak_F_bal, n_singular and singular_deg (its singular crank angles), and "
+                                    "error (why a design did not load or assemble; its peaks are then empty). "
+                                    "The chunks of designs run in this process, or over Dask with --scheduler.")
+    sw.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
+    sw.add_argument("--param", metavar="NAME=VALUES", type=_param, action="append", required=True,
+                    help="a parameter of the model's [parameters] (or g) and its values: a range start:stop:step "
+                         "that includes its stop (r=0.05:0.11:0.015 is 0.05, 0.065, 0.08, 0.095, 0.11), a list "
+                         "(n_k=0,60,120,240,487) or one value; repeat for each parameter")
+    sw.add_argument("--steps", metavar="N", type=_steps, default=360,
+                    help="N equal steps over a revolution for every design (default 360)")
+    sw.add_argument("--out", metavar="FILE", required=True,
+                    help="the table, one row per design: FILE.parquet or FILE.csv (written atomically)")
+    sw.add_argument("--full", action="store_true",
+                    help="also write every angle's row of every design (the design's parameters, then the "
+                         "columns of 'kinetostat analyze --out') to <stem>.angles<suffix> beside --out, e.g. "
+                         "sweep.angles.parquet")
+    sw.add_argument("--scheduler", metavar="WHERE",
+                    help="run the chunks over Dask: 'threads' or 'processes' (this machine), or the address of a "
+                         "distributed scheduler, e.g. tcp://10.0.0.5:8786 (default: in this process, no Dask)")
+    sw.add_argument("--chunk", metavar="N", type=_positive("number of designs per task", "--chunk 32"), default=CHUNK,
+                    help=f"designs per task (default {CHUNK})")
+    sw.add_argument("--no-progress", action="store_true", help="no progress bar")
+    sw.set_defaults(func=cmd_sweep)
     return p
 
 

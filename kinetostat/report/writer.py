@@ -15,10 +15,10 @@ import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
 from ..analysis import analyze
-from ..errors import AssemblyError, ModelError
-from ..model import Mechanism, load
+from ..model import Mechanism
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
+from ..sweep import sweep
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
 from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
@@ -63,25 +63,19 @@ def _parameters_section(doc: Doc, m: Mechanism) -> None:
 
 def study_table(m: Mechanism) -> np.ndarray:
     """The model's `[study]`: the largest |R(i,j)| over the cycle, N, for every case, shape (values of
-    the first parameter, values of the second or 1). Each case is the model file `m.path` loaded
-    with that case's parameters (`load(path, parameters=...)`) and analysed at `steps` crank angles
-    from 0; NaN where the case does not load or assemble."""
+    the first parameter, values of the second or 1). Computed as a design sweep (`kinetostat.sweep`
+    of the model file `m.path` over the study's parameters, `steps` crank angles from 0); NaN where
+    the case does not load or assemble."""
     st = m.study
-    (first, xs), (second, ys) = st.vary[0], (st.vary[1] if len(st.vary) > 1 else (None, (None,)))
-    out = np.full((len(xs), len(ys)), np.nan)
-    for a, x in enumerate(xs):
-        for b, y in enumerate(ys):
-            case = {first: x} | ({second: y} if second is not None else {})
-            try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    mech = load(m.path, parameters=case)
-                    res = analyze(mech, steps=st.steps)
-            except (ModelError, AssemblyError):
-                continue
-            p = mech.pair_between(*st.pair)
-            out[a, b] = np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))
-    return out
+    p = m.pair_between(*st.pair)
+    sw = sweep(m.path, dict(st.vary), steps=st.steps)
+    return sw.peak(f"R_{p.links[0]}_{p.links[1]}").reshape(len(st.vary[0][1]), -1)
+
+
+def study_command(m: Mechanism) -> str:
+    """The `kinetostat sweep` command line that computes the model's `[study]`."""
+    params = " ".join(f"--param {name}={','.join(f'{x:.15g}' for x in xs)}" for name, xs in m.study.vary)
+    return f"kinetostat sweep {Path(m.path).name} {params} --steps {m.study.steps} --out study.csv"
 
 
 def _study_section(doc: Doc, m: Mechanism) -> None:
@@ -91,10 +85,13 @@ def _study_section(doc: Doc, m: Mechanism) -> None:
     st = m.study
     table = study_table(m)
     i, j = st.pair
+    command = study_command(m)
     doc.h(2, "Parameter study")
     doc.p(f"{esc(st.title)}. Largest |R({i},{j})| over the cycle, N ({st.steps} crank angles from 0°, every "
-          f"{360 / st.steps:.4g}°); each case is the model file loaded with its parameter values "
-          f"(`kinetostat.load(path, parameters=...)`); \u2014: the case does not load or assemble.")
+          f"{360 / st.steps:.4g}°); computed as a design sweep, each case the model file loaded with its "
+          f"parameter values; the same table (column peak_R_{'_'.join(map(str, m.pair_between(i, j).links))}) "
+          f"comes from {f'`{command}`' if esc(command) == command else esc(command)}; \u2014: the case does not "
+          f"load or assemble.")
     (first, xs) = st.vary[0]
     second, ys = st.vary[1] if len(st.vary) > 1 else ("", ())
     header = ([f"{esc(first)} \\ {esc(second)}", *(f"{y:g}" for y in ys)] if second

@@ -1,0 +1,311 @@
+"""Design sweeps: one model analysed for every combination of some of its parameters' values.
+
+    >>> import kinetostat
+    >>> sw = kinetostat.sweep("chain_unit_four_bar", {"r": [0.05, 0.08, 0.11], "n_k": [0, 120]}, steps=36)
+    >>> sw.shape, sw.peak("R_0_1").shape
+    ((3, 2), (3, 2))
+
+The designs are the Cartesian product of the values (first parameter the slowest), split into
+chunks; each chunk is one task, `_chunk`, run in this process or on Dask (local threads or
+processes, or a `distributed` scheduler). A task's arguments are plain and picklable: the model
+file's text and source name and the designs' parameter values; the worker rebuilds each
+Mechanism with `kinetostat.model.loads`.
+
+A design whose mechanism does not load, build or assemble keeps its row: NaN peaks and its
+reason in the `error` column (the sweep goes on). Warnings (singular positions, doubts about a
+model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular.
+
+May use: model, analysis, errors, examples; pandas (imported when a sweep runs, so that
+`import kinetostat` does not load it); dask and distributed (imported only for a
+Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
+`kinetostat.report`.
+"""
+from __future__ import annotations
+
+import itertools
+import threading
+import warnings
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
+
+import numpy as np
+
+from .analysis import Analysis, analyze, crank_angles
+from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
+from .model import Mechanism, _read_text, _suggest, load, loads
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["Sweep", "sweep", "CHUNK", "LOCAL_SCHEDULERS"]
+
+#: Designs per Dask task, by default.
+CHUNK = 32
+#: The `scheduler` names of Dask's local schedulers; any other string is a `distributed` address.
+LOCAL_SCHEDULERS = ("threads", "processes")
+#: The unit `attrs["units"]` gives a design's parameter: the one its model file uses.
+PARAMETER_UNIT = "model's unit"
+
+
+@dataclass(frozen=True, eq=False)
+class Sweep:
+    """The result of `sweep`: one row per design, and every angle's rows when asked for."""
+    table: pd.DataFrame          # one row per design: its parameters, peak_<col>, n_singular, singular_deg, error
+    angles: pd.DataFrame | None  # the designs' parameters, then `Analysis.to_frame`'s columns; None unless full
+    shape: tuple[int, ...]       # the design axes: the number of values of each parameter, in order
+    phi_deg: np.ndarray          # (N,) the crank angles of every design, deg
+
+    def __repr__(self) -> str:
+        failed = int((self.table["error"] != "").sum())
+        return (f"Sweep(designs={len(self.table)}, shape={self.shape}, positions={len(self.phi_deg)}, "
+                f"failed={failed}, angles={'kept' if self.angles is not None else 'not kept'})")
+
+    def peak(self, col: str) -> np.ndarray:
+        """The peak of the cycle table's column `col` ("R_0_1" or "peak_R_0_1") over the cycle
+        for every design, shape `shape` (NaN where a design failed)."""
+        name = col if col.startswith("peak_") else f"peak_{col}"
+        valid = [c for c in self.table.columns if c.startswith("peak_")]
+        if name not in valid:
+            raise KeyError(f"no peak of {col!r}{_suggest(name, valid)}. Peaks: {[c[5:] for c in valid]}")
+        return self.table[name].to_numpy(dtype=float).reshape(self.shape)
+
+
+def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: int = 360, phi_deg=None,
+          full: bool = False, scheduler: Any = None, chunk: int = CHUNK, progress: bool = False) -> Sweep:
+    """Analyse `model` (a file, a bundled model's name, or a Mechanism read from a file) for every
+    combination of `params` (name -> values, array-like; the first parameter the slowest) at
+    `steps` crank angles over a cycle, or at `phi_deg` (deg).
+
+    `full`: also keep every angle's row (`Sweep.angles`). `scheduler`: None runs in this
+    process (no Dask); "threads" or "processes": Dask's local schedulers; another string: the
+    address of a `distributed` scheduler; or a `distributed.Client`. `chunk`: designs per task.
+    `progress`: a tqdm bar over the chunks on stderr.
+
+    ValueError names an unknown parameter, an empty or non-finite list of values, or a bad
+    `chunk`; the model itself must load with its own parameters (ModelError otherwise);
+    ConnectionError: no `distributed` scheduler at the address."""
+    import pandas as pd
+    text, source, base = _model_text(model)
+    names = list(params)
+    valid = [*base.parameters, "g"]
+    for name in names:
+        if name not in valid:
+            raise ValueError(f"sweep: {name!r} is not a parameter of the model{_suggest(name, valid)}. "
+                             f"Parameters: {', '.join(valid)}")
+    values = [_values(name, params[name]) for name in names]
+    if not isinstance(chunk, (int, np.integer)) or isinstance(chunk, bool) or chunk < 1:
+        raise ValueError(f"chunk: expected a positive number of designs per task, got {chunk!r}")
+    phi_deg = crank_angles(phi_deg, steps)
+    designs = [dict(zip(names, d)) for d in itertools.product(*values)]
+    parts = [designs[k:k + chunk] for k in range(0, len(designs), chunk)]
+    results = _run(parts, text, source, phi_deg, full, scheduler, progress)
+    table = _tidy(pd.concat([rows for rows, _ in results], ignore_index=True), names, base)
+    angles = None
+    if full:
+        frames = [a for _, a in results if a is not None and len(a)]
+        angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=names)
+        angles.attrs.update(mechanism=base.name, units=_units(frames, names))
+    return Sweep(table, angles, tuple(len(v) for v in values), phi_deg)
+
+
+# ----------------------------------------------------------------------------- one chunk of designs
+
+def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.ndarray,
+           full: bool) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+    """The rows of `designs` (each: parameter -> value) of the model `text`: one per design (its
+    parameters, peaks, singular angles, error), and with `full` every angle's row (None without).
+    A Dask task: plain, picklable arguments."""
+    import pandas as pd
+    rows, frames = [], []
+    with _quiet():
+        for design in designs:
+            try:
+                mech = loads(text, source, parameters=design)
+                res = analyze(mech, phi_deg=phi_deg)
+            except (ModelError, StructureError, AssemblyError) as exc:
+                rows.append({**design, "error": _reason(exc)})
+                continue
+            sing = res.phi_deg[res.singular]
+            rows.append({**design, **{name: _peak(column(res)) for name, column in _peak_columns(mech).items()},
+                         "n_singular": len(sing), "singular_deg": " ".join(f"{x:g}" for x in sing), "error": ""})
+            if full:
+                frames.append(_with_design(res.to_frame(), design))
+    if not full:
+        return pd.DataFrame(rows), None
+    angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=list(designs[0]))
+    angles.attrs["units"] = _units(frames, list(designs[0]))
+    return pd.DataFrame(rows), angles
+
+
+def _peak_columns(m: Mechanism) -> dict[str, Callable[[Analysis], np.ndarray]]:
+    """The cycle table's force columns whose peaks a sweep keeps, named `peak_<col>`, each with
+    how to read it from an analysis: every pair's |R_i_j|, M_bal, a working machine's |F_bal|."""
+    cols: dict[str, Callable[[Analysis], np.ndarray]] = {
+        f"peak_R_{p.links[0]}_{p.links[1]}": lambda res, k=p.index: np.linalg.norm(res.forces.R[:, k], axis=-1)
+        for p in m.pairs}
+    cols["peak_M_bal"] = lambda res: res.balancing_moment
+    if m.drive.kind == "machine":
+        cols["peak_F_bal"] = lambda res: np.linalg.norm(res.balancing_force, axis=-1)
+    return cols
+
+
+def _peak(x: np.ndarray) -> float:
+    """max |x| over the cycle, ignoring singular (NaN) angles; NaN where every angle is singular."""
+    return float(np.fmax.reduce(np.abs(x)))
+
+
+def _reason(exc: Exception) -> str:
+    """Why a design failed, on one line."""
+    text = "; ".join(exc.located) if isinstance(exc, ModelError) else str(exc)
+    return f"{type(exc).__name__}: {' '.join(text.split())}"
+
+
+def _with_design(df: pd.DataFrame, design: Mapping[str, float]) -> pd.DataFrame:
+    """`df` (one analysis's cycle table) led by the design's parameters as columns."""
+    import pandas as pd
+    lead = pd.DataFrame({name: np.full(len(df), value) for name, value in design.items()})
+    out = pd.concat([lead, df], axis=1)
+    out.attrs["units"] = _units([df], list(design))
+    return out
+
+
+@contextmanager
+def _quiet() -> Iterator[None]:
+    """kinetostat's warnings silenced (the rows say where a design is singular). On the main
+    thread for the block only; on another thread (Dask's thread pool, a `distributed` worker)
+    the filter stays in that process, since `catch_warnings` is not thread-safe: `sweep` itself
+    restores the filters around Dask's local threads."""
+    if threading.current_thread() is threading.main_thread():
+        with warnings.catch_warnings():
+            for category in (ModelWarning, SingularPositionWarning):
+                warnings.simplefilter("ignore", category)
+            yield
+    else:
+        for category in (ModelWarning, SingularPositionWarning):
+            warnings.simplefilter("ignore", category)
+        yield
+
+
+# ----------------------------------------------------------------------------- running the chunks
+
+def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: np.ndarray, full: bool,
+         scheduler: Any, progress: bool) -> list[tuple[pd.DataFrame, pd.DataFrame | None]]:
+    """Every chunk's result, in the order of `parts`: in this process, or over Dask."""
+    bar = _bar(len(parts), progress)
+    try:
+        if scheduler is None:
+            out = []
+            for part in parts:
+                out.append(_chunk(text, source, part, phi_deg, full))
+                bar.update()
+            return out
+        import dask
+        keys = [f"kinetostat-sweep-chunk-{k}" for k in range(len(parts))]
+        tasks = [dask.delayed(_chunk, pure=True)(text, source, part, phi_deg, full, dask_key_name=key)
+                 for part, key in zip(parts, keys)]
+        if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS:
+            from dask.callbacks import Callback
+            finished = set(keys)
+
+            def count(key, result, dsk, state, worker_id):
+                if key in finished:
+                    bar.update()
+            with warnings.catch_warnings(), Callback(posttask=count):
+                return list(dask.compute(*tasks, scheduler=scheduler))
+        return _distributed(tasks, scheduler, bar)
+    finally:
+        bar.close()
+
+
+def _distributed(tasks: list, scheduler: Any, bar) -> list:
+    """The tasks' results from a `distributed` scheduler (an address, or a Client)."""
+    from distributed import Client, as_completed
+    if isinstance(scheduler, str):
+        try:
+            client = Client(scheduler)
+        except (OSError, ValueError) as exc:
+            raise ConnectionError(f"scheduler {scheduler!r}: no distributed scheduler there ({exc}); "
+                                  f"or use {' or '.join(map(repr, LOCAL_SCHEDULERS))}") from None
+        with client:
+            return _gather(client, tasks, bar, as_completed)
+    if not isinstance(scheduler, Client):
+        raise TypeError(f"scheduler: expected None, {' or '.join(map(repr, LOCAL_SCHEDULERS))}, a distributed "
+                        f"scheduler's address or a distributed.Client, got {type(scheduler).__name__}")
+    return _gather(scheduler, tasks, bar, as_completed)
+
+
+def _gather(client, tasks: list, bar, as_completed) -> list:
+    futures = client.compute(tasks)
+    for _ in as_completed(futures):
+        bar.update()
+    return client.gather(futures)
+
+
+class _NoBar:
+    def update(self, n: int = 1) -> None: ...
+    def close(self) -> None: ...
+
+
+def _bar(total: int, enabled: bool):
+    """A tqdm bar over the chunks on stderr, or a no-op."""
+    if not enabled:
+        return _NoBar()
+    from tqdm import tqdm
+    return tqdm(total=total, desc="designs' chunks", unit="chunk", leave=False, dynamic_ncols=True)
+
+
+# ----------------------------------------------------------------------------- inputs and the table
+
+def _model_text(model: str | Path | Mechanism) -> tuple[str, str, Mechanism]:
+    """The model file's text, its source name, and the mechanism it gives with its own parameters.
+    A Mechanism is read again from its file (`.path`): ValueError where it has none, or where it
+    differs from what its file gives now (loaded with overrides, or the file changed)."""
+    if isinstance(model, Mechanism):
+        if model.path is None:
+            raise ValueError("sweep: the Mechanism was not read from a file (its .path is None); give the "
+                             "model file, or write the model to one")
+        base = load(model.path)
+        if dict(base.parameters) != dict(model.parameters):
+            raise ValueError(f"sweep: the Mechanism's parameters differ from those of its file {model.path} (loaded "
+                             f"with parameters=..., or the file changed); give the file and sweep those parameters")
+        path = Path(model.path)
+    else:
+        from .examples import resolve
+        path = resolve(model)
+        base = load(path)
+    return _read_text(path), str(path), base
+
+
+def _values(name: str, x: Any) -> list[float]:
+    """The values of parameter `name`: a number or a 1-D array-like of finite numbers."""
+    try:
+        v = np.array(x, dtype=float, ndmin=1)
+    except (TypeError, ValueError):
+        raise ValueError(f"sweep: {name}: expected numbers, got {x!r:.60}") from None
+    if v.ndim != 1 or len(v) == 0 or not np.isfinite(v).all():
+        raise ValueError(f"sweep: {name}: expected a non-empty list of finite numbers, got {x!r:.60}")
+    return [float(a) for a in v]
+
+
+def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFrame:
+    """The rows in the sweep's column order (NaN peaks for a failed design), with their units."""
+    peaks = list(_peak_columns(base))
+    table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "error"])
+    table[peaks] = table[peaks].astype(float)
+    table["n_singular"] = table["n_singular"].astype("Int64")
+    table["singular_deg"] = table["singular_deg"].fillna("").astype(str)
+    table["error"] = table["error"].fillna("").astype(str)
+    table.attrs.update(mechanism=base.name, units={
+        **dict.fromkeys(names, PARAMETER_UNIT), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
+        "n_singular": "1", "singular_deg": "deg", "error": "text"})
+    return table
+
+
+def _units(frames: list[pd.DataFrame], names: list[str]) -> dict[str, str]:
+    """The units of the columns of `frames`, led by the parameters `names`."""
+    units = dict.fromkeys(names, PARAMETER_UNIT)
+    for f in frames:
+        units.update(f.attrs.get("units", {}))
+    return units
