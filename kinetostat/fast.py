@@ -183,13 +183,13 @@ def kernel(mech: "Mechanism", kind: str, loads: bool = False):
             import numba
             scope = dict(vars(bind(np, _njit)))
             exec(compile(_source(mech, lay, kind, loads), f"<kinetostat {kind} kernel>", "exec"), scope)
-            _KERNELS[key] = (numba.njit(nogil=True)(scope["kernel"]), lay)
+            _KERNELS[key] = (numba.njit(nogil=True, error_model="numpy")(scope["kernel"]), lay)
         return _KERNELS[key]
 
 
 def _njit(fn):
     import numba
-    return numba.njit(fn)
+    return numba.njit(fn, error_model="numpy")      # x / 0 is inf or NaN, as in numpy: the guard flags it
 
 
 # ----------------------------------------------------------------------------- running

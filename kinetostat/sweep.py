@@ -118,25 +118,58 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
     parameters, peaks, singular angles, error), and with `full` every angle's row (None without).
     A Dask task: plain, picklable arguments."""
     import pandas as pd
-    rows, frames = [], []
+    from . import fast
+    compiled = not full and len(designs) * len(phi_deg) >= fast.FAST_MIN    # where the kernel's compilation pays
+    rows, frames, built = [], [], []
     with _quiet():
         for design in designs:
             try:
                 mech = loads(text, source, parameters=design)
-                res = analyze(mech, phi_deg=phi_deg)
+                res = None if compiled else analyze(mech, phi_deg=phi_deg)
             except (ModelError, StructureError, AssemblyError) as exc:
                 rows.append({**design, "error": _reason(exc)})
+                continue
+            if compiled:
+                rows.append({**design, "error": ""})
+                built.append((len(rows) - 1, mech))
                 continue
             sing = res.phi_deg[res.singular]
             rows.append({**design, **{name: _peak(column(res)) for name, column in _peak_columns(mech).items()},
                          "n_singular": len(sing), "singular_deg": " ".join(f"{x:g}" for x in sing), "error": ""})
             if full:
                 frames.append(_with_design(res.to_frame(), design))
+        if built:       # the peaks of every design of the chunk in one call of the compiled kernel
+            _peaks_into(rows, built, np.asarray(phi_deg, float))
     if not full:
         return pd.DataFrame(rows), None
     angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=list(designs[0]))
     angles.attrs["units"] = _units(frames, list(designs[0]))
     return pd.DataFrame(rows), angles
+
+
+def _peaks_into(rows: list[dict], built: list[tuple[int, Mechanism]], phi_deg: np.ndarray) -> None:
+    """Fill each built design's row with its peaks and singular angles (`fast.peaks`: one kernel
+    call per structure; a design that cannot be assembled at some angle keeps its error row)."""
+    from . import fast
+    try:
+        pk = fast.peaks([m for _, m in built], phi_deg)
+    except AssemblyError:             # some design: find which, one by one
+        for n, m in built:
+            try:
+                _peaks_into(rows, [(n, m)], phi_deg)
+            except AssemblyError as exc:
+                rows[n]["error"] = _reason(exc)
+        return
+    for q, (n, m) in enumerate(built):
+        sing = pk.singular_deg[q]
+        everything = len(sing) == len(phi_deg)          # no regular angle: no peak
+        peak = dict(zip((f"peak_R_{p.links[0]}_{p.links[1]}" for p in m.pairs), pk.R[q]))
+        peak["peak_M_bal"] = pk.M_bal[q]
+        if m.drive.kind == "machine":
+            peak["peak_F_bal"] = pk.F_bal[q]
+        rows[n].update({k: np.nan if everything else float(v) for k, v in peak.items()},
+                       n_singular=len(sing), singular_deg=" ".join(f"{x:g}" for x in sing))
+        rows[n] = {**{k: v for k, v in rows[n].items() if k != "error"}, "error": rows[n]["error"]}
 
 
 def _peak_columns(m: Mechanism) -> dict[str, Callable[[Analysis], np.ndarray]]:
