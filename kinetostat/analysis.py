@@ -15,7 +15,7 @@ from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation,
 from .kinetostatics import Forces, forces, friction_power, lever_moment
 from . import groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
-from .planar import as_xy, as_z, cross_z, dot_z
+from .planar import as_xy, as_z, dot_z
 from .model import Mechanism, _abbreviate
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "analyze", "exact", "crank_angles", "FRAME_NOTE", "deviation",

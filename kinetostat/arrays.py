@@ -9,13 +9,12 @@ covered: loads besides gravity and inertia (their tables and characteristics are
 laws of motion, and the accuracy guard (no perturbed re-solve): `solve` refuses the first two
 by name and returns `cond` so the caller can see ill-conditioned angles.
 
-May use: numpy, array-api-compat, program, groups, kinematics (names only).
+May use: array-api-compat, program, groups.
 """
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Mapping
 
-import numpy as np
 
 from .program import bind, constants, motion_program, run, statics_program
 
