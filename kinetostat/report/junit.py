@@ -2,7 +2,8 @@
 
 Every check is named `<model>.<route>.<quantity>` (routes: the engine routes and "reference";
 published values: `<model>.published.<symbol>`) and carries its measured error and tolerance,
-also when it passes. NaN is written as null.
+also when it passes, and what it rests on (trust: an independent engine, the 40-digit
+re-solution, a published value). NaN is written as null.
 
 May use: the standard library and the runs room.
 """
@@ -13,7 +14,7 @@ import re
 import xml.etree.ElementTree as ET
 from typing import Any, Sequence
 
-from .runs import PUBLISHED_ROUTE, Check, ModelRun, quantities
+from .runs import PUBLISHED_ROUTE, Check, ModelRun, quantities, trust
 
 
 #: Characters XML 1.0 cannot hold, even as a character reference (ElementTree writes them as they are).
@@ -47,11 +48,17 @@ def _case(suite: ET.Element, run: ModelRun, route: str, name: str, secs: float) 
     return ET.SubElement(suite, "testcase", classname=f"{run.stem}.{route}", name=name, time=f"{secs:.6f}")
 
 
+def _trust(case: ET.Element, what: str) -> None:
+    """A check that did not run (skipped route) still says what it would rest on."""
+    ET.SubElement(ET.SubElement(case, "properties"), "property", name="trust", value=what)
+
+
 def _measured(case: ET.Element, c: Check) -> None:
     """The check's numbers as <properties> of its testcase, and its one line as <system-out>."""
     props = ET.SubElement(case, "properties")
     for key, value in (("error", _text(c.error)), ("measure", c.measure), ("tolerance", _text(c.tolerance)),
-                       ("max_abs", _text(c.max_abs)), ("unit", c.unit), ("phi_deg", _text(c.phi_deg))):
+                       ("max_abs", _text(c.max_abs)), ("unit", c.unit), ("phi_deg", _text(c.phi_deg)),
+                       ("trust", c.trust)):
         ET.SubElement(props, "property", name=key, value=value)
     ET.SubElement(case, "system-out").text = c.detail
 
@@ -88,6 +95,7 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
                     counts["errors"] += 1
                 elif route in run.skipped:
                     ET.SubElement(case, "skipped", message=run.skipped[route])
+                    _trust(case, trust(route))
                     counts["skipped"] += 1
                 elif c is None:
                     ET.SubElement(case, "error", message=f"route {route} returned no row for {q}", type="MissingRow")
@@ -114,12 +122,13 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
 
 def validation_json(runs: Sequence[ModelRun], exit_code: int) -> dict[str, Any]:
     """The runs as a JSON-ready dict: per model its checks (name, route, quantity, error, measure,
-    tolerance, max_abs, unit, phi_deg, passed), skipped and failed routes; totals; the exit code."""
+    tolerance, max_abs, unit, phi_deg, passed, trust: what it rests on), skipped and failed
+    routes; totals; the exit code."""
     models = []
     for run in runs:
         checks = [dict(name=c.name, route=c.route, quantity=c.quantity, error=_number(c.error), measure=c.measure,
                        tolerance=_number(c.tolerance), max_abs=_number(c.max_abs), unit=c.unit,
-                       phi_deg=_number(c.phi_deg), passed=bool(c.passed)) for c in run.checks]
+                       phi_deg=_number(c.phi_deg), passed=bool(c.passed), trust=c.trust) for c in run.checks]
         models.append(dict(model=run.stem, path=None if run.path is None else str(run.path), name=run.mech.name,
                            structure=run.mech.structure.formula, positions=len(run.res.phi_deg),
                            passed=bool(run.passed and checks), checks=checks, skipped=dict(run.skipped),

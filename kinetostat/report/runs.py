@@ -22,6 +22,23 @@ from .published import PublishedCheck, published_rows
 #: The route name under which a model's published values are checked.
 PUBLISHED_ROUTE = "published"
 
+#: What a route's checks rest on (JUnit property "trust", JSON "trust"): an independent engine,
+#: the 40-digit re-solution, or (route "published") the source's printed value.
+TRUST: dict[str, str] = {
+    "pinocchio": "independent engine: Pinocchio's constrained inverse dynamics at the solver's state",
+    "mujoco": "independent engine: MuJoCo's inverse dynamics at the solver's state",
+    "mujoco-sim": "independent engine: MuJoCo's own forward simulation of the cycle",
+    "pymunk": "independent engine: pymunk's impulse solver simulating the cycle",
+    "reference": "40-digit re-solution: the whole problem solved again in mpmath, another formulation",
+}
+
+
+def trust(route: str, source: str = "") -> str:
+    """What a check of `route` rests on; `source`: where a published value is printed."""
+    if route == PUBLISHED_ROUTE:
+        return f"published value: {source}" if source else "published value"
+    return TRUST.get(route, f"route {route}")
+
 
 def quantities(mech: Mechanism, route: str | None = None) -> list[str]:
     """The quantities compare() checks (on `route`), named as its rows name them: the driving
@@ -47,6 +64,7 @@ class Check:
     phi_deg: float       # crank angle of the largest error (routes) or of the exact value (published), deg
     passed: bool
     detail: str          # one line for people
+    trust: str = ""      # what the check rests on (`trust`)
 
     @property
     def name(self) -> str:
@@ -58,7 +76,7 @@ def _row_check(model: str, r) -> Check:
                  r.phi_deg_max, r.passed,
                  f"peak-relative error {r.peak_relative:.3e} (tolerance {r.tolerance:.1e}), max abs {r.max_abs:.6g} "
                  f"{r.unit} at phi = {r.phi_deg_max:g} deg, peak {r.peak:.6g} {r.unit}, {r.n_compared} angles "
-                 f"compared, {r.n_skipped} left out")
+                 f"compared, {r.n_skipped} left out", trust(r.route))
 
 
 def _published_check(model: str, c: PublishedCheck) -> Check:
@@ -69,7 +87,7 @@ def _published_check(model: str, c: PublishedCheck) -> Check:
     return Check(model, PUBLISHED_ROUTE, e.symbol, c.error, "deg" if c.by_angle else "relative", e.tolerance,
                  abs(c.exact - e.value), e.unit, c.phi_deg, c.passed,
                  f"published {e.value:g} {e.unit}, exact {c.exact:.6g} {e.unit} ({where}): {diff} "
-                 f"(tolerance {tol}); source: {e.source}")
+                 f"(tolerance {tol}); source: {e.source}", trust(PUBLISHED_ROUTE, e.source))
 
 
 @dataclass
