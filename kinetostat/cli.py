@@ -643,6 +643,7 @@ def cmd_validate(args) -> int:
                f"{time.perf_counter() - t0:.1f} s" + ("" if code == EXIT_OK else " -> FAIL"), err=err)
     if not checks:
         _error("nothing was checked: every route was skipped or raised, and no model has published values")
+    _github(runs, err)
     if to_json is not None:
         _write_validation_json(runs, code, to_json)
     if junit is not None:
@@ -651,6 +652,23 @@ def cmd_validate(args) -> int:
         _save(junit, "--junit", lambda f: tree.write(f, encoding="utf-8", xml_declaration=True), binary=True)
         _Out.write(f"JUnit XML -> {junit}")
     return code
+
+
+def _github(runs, err: bool) -> None:
+    """Under GitHub Actions: an `::error file=...,line=...` command per failed check (the model
+    file's line; on stderr when `err`, the JSON then holding stdout) and the Markdown summary,
+    verdict first, appended to $GITHUB_STEP_SUMMARY (wherever that variable is set)."""
+    if os.environ.get("GITHUB_ACTIONS") != "true" and not os.environ.get("GITHUB_STEP_SUMMARY"):
+        return
+    from .report import ci
+    outcomes = ci.run_outcomes(runs)
+    if os.environ.get("GITHUB_ACTIONS") == "true":
+        for line in ci.annotations(outcomes):
+            _Out.write(line, err=err)
+    try:
+        ci.write_summary(ci.summary_markdown(outcomes, "kinetostat validate"))
+    except OSError as exc:
+        _warn(f"cannot write the summary to $GITHUB_STEP_SUMMARY: {exc.strerror or exc}")
 
 
 def _write_validation_json(runs, code: int, dest) -> None:

@@ -155,7 +155,8 @@ def failure_text(c: Check, where: Where | None, tolerance_at: Where | None) -> s
     lines = [verdict_line(c, where), "",
              "  " + "  ".join(h.ljust(n) for h, n in zip(head, w)),
              "  " + "  ".join(r.ljust(n) for r, n in zip(row, w)), "",
-             f"  {c.detail}", f"  trust: {c.trust}"]
+             f"  {c.detail}",
+             f"  trust: {c.trust if c.route != PUBLISHED_ROUTE else 'the published value (source above)'}"]
     if tolerance_at is not None:
         lines.append(f"  tolerance set at {tolerance_at}")
     return "\n".join(lines)
@@ -168,14 +169,14 @@ def _escape(text: str, prop: bool = False) -> str:
 
 def annotation(where: Where, title: str, message: str, workspace: str | None = None) -> str:
     """GitHub Actions' `::error file=...,line=...,title=...::message` command; the file relative
-    to `workspace` ($GITHUB_WORKSPACE), as a pull request's diff names it."""
+    to `workspace` (default $GITHUB_WORKSPACE, else the working directory), as a pull request's
+    diff names it."""
     file = where.file
-    base = workspace if workspace is not None else os.environ.get("GITHUB_WORKSPACE")
-    if base:
-        try:
-            file = os.path.relpath(os.path.abspath(file), base)
-        except ValueError:                  # another drive (Windows)
-            pass
+    base = workspace or os.environ.get("GITHUB_WORKSPACE") or os.getcwd()
+    try:
+        file = os.path.relpath(os.path.abspath(file), base)
+    except ValueError:                      # another drive (Windows)
+        pass
     loc = f"file={_escape(file.replace(os.sep, '/'), True)}"
     if where.line is not None:
         loc += f",line={where.line}"

@@ -1,0 +1,287 @@
+"""The accuracy gate as a pytest plugin (entry point `pytest11`, name "kinetostat"): model files
+collected as tests, one item per route and quantity and one per published value, e.g.
+`models/ice_crank_slider.toml::reference::R_1_2` and `...::published::M_bal_lever`.
+
+Opt-in: `pytest --kinetostat [PATHS]` collects every visited `*.toml` with a `[mechanism]` table;
+the ini option `kinetostat_models` (glob patterns relative to the rootdir, like
+`--doctest-glob`) collects the visited TOML files it matches, also without `--kinetostat`.
+Otherwise nothing is collected and no hook but the options' runs. Engine routes carry the marker
+`engines` (`-m "not engines"`: the engine-free gate, the 40-digit reference and the published
+values); a route whose engine is not installed is SKIPPED with the reason. A failure names the
+model file and the line of the published value (route checks: the pair, drive or point of the
+quantity, and the line of the route's tolerance), then a verdict line and a small table. Each
+item's JUnit <properties>: error, measure, tolerance, max_abs, unit, phi_deg, trust, route, file,
+line. Under GitHub Actions: `::error file=...,line=...` commands and a Markdown summary in
+$GITHUB_STEP_SUMMARY. The fixture `kinetostat_regression` is `kinetostat.testing.check_cycle`
+with the expected file beside the test (`--kinetostat-regen` rewrites it).
+
+It lives in the harness so that pytest's start-up imports only this module (no numpy, no
+solver); everything else is imported when a model file is collected.
+
+May use: pytest and the standard library at import; kinetostat and the harness inside functions.
+"""
+from __future__ import annotations
+
+import fnmatch
+import os
+import re
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, Callable
+
+import pytest
+
+#: Marker of the engine routes' items, and the routes that need no engine.
+ENGINES_MARK = "engines"
+ENGINE_FREE = ("reference", "published")
+_MECHANISM = re.compile(rb"^\s*\[\s*mechanism\s*\]", re.MULTILINE)
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("kinetostat", "kinetostat accuracy gate")
+    group.addoption("--kinetostat", action="store_true",
+                    help="collect kinetostat model files (*.toml with a [mechanism] table) among the given paths: "
+                         "one test per route x quantity and per published value")
+    group.addoption("--kinetostat-steps", type=int, default=None, metavar="N",
+                    help="crank positions over the cycle of each model (default: ini kinetostat_steps, 360)")
+    group.addoption("--kinetostat-regen", action="store_true",
+                    help="kinetostat_regression: rewrite the expected CSV files instead of comparing")
+    parser.addini("kinetostat_models", type="args", default=[],
+                  help="glob patterns (relative to the rootdir) of kinetostat model files to collect; "
+                       "when set the gate runs without --kinetostat")
+    parser.addini("kinetostat_steps", default="360", help="crank positions over the cycle of each model")
+
+
+def _active(config: pytest.Config) -> bool:
+    return bool(config.getoption("kinetostat") or config.getini("kinetostat_models"))
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", "kinetostat: a check of kinetostat's accuracy gate (a model file's item)")
+    config.addinivalue_line("markers", f"{ENGINES_MARK}: a kinetostat check against a physics engine route "
+                                       "(deselect with -m 'not engines')")
+    if _active(config):
+        config.pluginmanager.register(_Gate(config), "kinetostat-gate")
+
+
+def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Collector | None:
+    if file_path.suffix != ".toml" or not _active(parent.config):
+        return None
+    patterns = parent.config.getini("kinetostat_models")
+    if patterns:
+        rel = file_path.relative_to(parent.config.rootpath).as_posix() \
+            if file_path.is_relative_to(parent.config.rootpath) else file_path.as_posix()
+        if not any(fnmatch.fnmatch(rel, p) for p in patterns):
+            return None
+    else:
+        try:
+            if not _MECHANISM.search(file_path.read_bytes()):
+                return None
+        except OSError:
+            return None
+    return ModelFile.from_parent(parent, path=file_path)
+
+
+def _node_name(text: str, taken: set[str]) -> str:
+    """`text` as a node name that -k can select: "R(1,2)" -> "R_1_2", "M_bal (lever)" -> "M_bal_lever"."""
+    base = re.sub(r"\W+", "_", text).strip("_") or "value"
+    name, n = base, 2
+    while name in taken:
+        name, n = f"{base}_{n}", n + 1
+    taken.add(name)
+    return name
+
+
+class CheckFailed(Exception):
+    """A check beyond its tolerance, or a route that raised: the text pytest shows."""
+
+
+class ModelFile(pytest.File):
+    """A model file: its routes (engines, "reference") and its published values as collectors."""
+
+    def collect(self):
+        from kinetostat import load
+        from kinetostat.report import quantities
+        from kinetostat.report.ci import model_lines
+        from kinetostat_validation.compare import ROUTES
+
+        self.mech = load(self.path)
+        self.lines = model_lines(self.mech, self.path.read_text(encoding="utf-8"))
+        self._res = None
+        self._runs: dict[str, Any] = {}
+        self.add_marker("kinetostat")
+        for route in ROUTES:
+            yield Route.from_parent(self, name=route, quantities=quantities(self.mech, route))
+        if self.mech.published:
+            from kinetostat.report.runs import PUBLISHED_ROUTE
+            yield Route.from_parent(self, name=PUBLISHED_ROUTE, quantities=[e.symbol for e in self.mech.published])
+
+    def steps(self) -> int:
+        opt = self.config.getoption("kinetostat_steps")
+        return int(opt if opt is not None else self.config.getini("kinetostat_steps"))
+
+    def run(self, route: str):
+        """The ModelRun of one route (`kinetostat.report.run_validation`), computed once per
+        session; the published values as route "published"; the cycle analysed once."""
+        if route not in self._runs:
+            from kinetostat import analyze
+            from kinetostat.report import run_validation
+            from kinetostat.report.runs import PUBLISHED_ROUTE
+
+            if self._res is None:
+                self._res = analyze(self.mech, steps=self.steps())
+            engines = [] if route == PUBLISHED_ROUTE else [route]
+            self._runs[route] = run_validation(self.mech, engines, self.steps(), res=self._res, path=self.path)
+        return self._runs[route]
+
+    def repr_failure(self, excinfo, style=None):
+        from kinetostat.errors import AssemblyError, ModelError, StructureError
+        if isinstance(excinfo.value, (ModelError, StructureError, AssemblyError)):
+            return f"{self.path}: {excinfo.value}"
+        return super().repr_failure(excinfo, style)
+
+
+class Route(pytest.Collector):
+    """One route of a model file: an item per quantity (published values: per symbol)."""
+
+    def __init__(self, *, quantities: list[str], **kw):
+        super().__init__(**kw)
+        self.quantities = quantities
+        if self.name not in ENGINE_FREE:
+            self.add_marker(ENGINES_MARK)
+
+    def collect(self):
+        taken: set[str] = set()
+        for q in self.quantities:
+            yield CheckItem.from_parent(self, name=_node_name(q, taken), quantity=q)
+
+
+class CheckItem(pytest.Item):
+    """One check: a route's error on one quantity over the cycle, or one published value."""
+
+    def __init__(self, *, quantity: str, **kw):
+        super().__init__(**kw)
+        self.quantity = quantity
+        self.route = self.parent.name
+        self.model: ModelFile = self.parent.parent
+        from kinetostat.report.ci import check_where
+        from kinetostat.report.runs import trust
+        self.where = check_where(self.model.lines, self._rel(self.path), self.route, quantity)
+        source = next((e.source for e in self.model.mech.published if e.symbol == quantity), "") \
+            if self.route == "published" else ""
+        self.user_properties += [("route", self.route), ("quantity", quantity), ("trust", trust(self.route, source)),
+                                 ("file", self.where.file), ("line", self.where.line or "")]
+
+    def _rel(self, path: Path | str) -> str:
+        """`path` relative to the rootdir, as pytest's node ids name files."""
+        p = Path(path)
+        return p.relative_to(self.config.rootpath).as_posix() if p.is_relative_to(self.config.rootpath) else str(p)
+
+    def runtest(self) -> None:
+        from kinetostat.report.ci import failure_text, tolerance_where
+
+        run = self.model.run(self.route)
+        if self.route in run.errors:
+            raise CheckFailed(f"{self.where}: route {self.route} raised on {run.stem}: {run.errors[self.route]}")
+        if self.route in run.skipped:
+            pytest.skip(f"route {self.route}: {run.skipped[self.route]}")
+        c = next((c for c in run.checks if c.route == self.route and c.quantity == self.quantity), None)
+        if c is None:
+            raise CheckFailed(f"{self.where}: route {self.route} returned no row for {self.quantity}")
+        self.user_properties += [("check", c.name), ("error", c.error), ("measure", c.measure),
+                                 ("tolerance", c.tolerance), ("max_abs", c.max_abs), ("unit", c.unit),
+                                 ("phi_deg", c.phi_deg), ("passed", c.passed), ("detail", c.detail)]
+        if not c.passed:
+            tol = tolerance_where(self.model.lines, self.where.file, self.route, self.quantity)
+            if tol is not None and Path(tol.file).is_absolute():
+                tol = type(tol)(self._rel(tol.file), tol.line)
+            raise CheckFailed(failure_text(c, self.where, tol))
+
+    def repr_failure(self, excinfo, style=None):
+        if isinstance(excinfo.value, CheckFailed):
+            return str(excinfo.value)
+        return super().repr_failure(excinfo, style)
+
+    def reportinfo(self):
+        return self.path, (self.where.line - 1 if self.where.line else None), f"{self.route} {self.quantity}"
+
+
+class _Gate:
+    """The active gate's session hooks: each item's outcome kept for GitHub Actions' annotations
+    and step summary (from the reports' user_properties, so that pytest-xdist's workers count)."""
+
+    def __init__(self, config: pytest.Config):
+        self.config = config
+        self.outcomes: list = []
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        props = dict(report.user_properties)
+        if "trust" not in props or "route" not in props:
+            return
+        if report.when == "call" or (report.when == "setup" and not report.passed):
+            self.outcomes.append(_outcome(report, props))
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_makereport(self, item: pytest.Item, call):
+        """A skipped check is reported at its model file (no line: one line of `-rs` per route)."""
+        report = yield
+        if isinstance(item, CheckItem) and report.skipped and isinstance(report.longrepr, tuple):
+            report.longrepr = (item._rel(item.path), None, report.longrepr[2])
+        return report
+
+    def pytest_collectreport(self, report: pytest.CollectReport) -> None:
+        if report.failed and report.nodeid.endswith(".toml"):
+            from kinetostat.report.ci import Outcome, Where
+            self.outcomes.append(Outcome(report.nodeid, "error", "(model file)", Where(report.nodeid), "",
+                                         message=str(report.longrepr).strip().splitlines()[-1]))
+
+    def pytest_terminal_summary(self, terminalreporter, exitstatus: int, config: pytest.Config) -> None:
+        if not self.outcomes:
+            return
+        from kinetostat.report import ci
+        if os.environ.get("GITHUB_ACTIONS") == "true" and \
+                not config.pluginmanager.hasplugin("pytest_github_actions_annotate_failures"):
+            root = config.rootpath
+            for line in ci.annotations(replace(o, where=o.where and replace(o.where, file=str(root / o.where.file)))
+                                       for o in self.outcomes):
+                terminalreporter.write_line(line)
+        if ci.write_summary(ci.summary_markdown(self.outcomes, "kinetostat (pytest)")):
+            terminalreporter.write_line("kinetostat: summary -> $GITHUB_STEP_SUMMARY")
+
+
+def _outcome(report: pytest.TestReport, props: dict):
+    """A report of a CheckItem as a `kinetostat.report.ci.Outcome`."""
+    from kinetostat.report.ci import Outcome, Where
+    from kinetostat.report.runs import Check
+
+    where = Where(props["file"], props["line"] or None)
+    check = None
+    if "error" in props:
+        model = Path(props["file"]).stem
+        check = Check(model, props["route"], props["quantity"], props["error"], props["measure"], props["tolerance"],
+                      props["max_abs"], props["unit"], props["phi_deg"], props["passed"], props["detail"],
+                      props["trust"])
+    status = "passed" if report.passed else "skipped" if report.skipped else "failed" if check else "error"
+    message = ""
+    if report.skipped and isinstance(report.longrepr, tuple):
+        message = report.longrepr[2].removeprefix("Skipped: ").partition(": ")[2]
+    elif report.failed and check is None:
+        message = str(report.longrepr).strip().splitlines()[0]
+    return Outcome(report.nodeid, status, props["route"], where, props["trust"], check, message)
+
+
+@pytest.fixture
+def kinetostat_regression(request: pytest.FixtureRequest) -> Callable[..., Path]:
+    """`check(model, expected=None, **kw)`: `kinetostat.testing.check_cycle` with the expected CSV
+    at `<test file's folder>/<test module>/<test name>.csv` unless `expected` is given;
+    `--kinetostat-regen` rewrites it (keywords as check_cycle's: rtol, atol, steps, columns)."""
+    from kinetostat.testing import check_cycle
+
+    def check(model, expected: str | Path | None = None, **kw) -> Path:
+        if expected is None:
+            test = request.node
+            expected = test.path.parent / test.path.stem / (re.sub(r"\W+", "_", test.name).strip("_") + ".csv")
+        if request.config.getoption("kinetostat_regen"):
+            kw.setdefault("regenerate", True)
+        return check_cycle(model, expected, **kw)
+    return check
