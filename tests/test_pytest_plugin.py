@@ -1,0 +1,184 @@
+"""The accuracy gate in pytest (`kinetostat_validation.pytest_plugin`, run in process with
+pytester): model files as items, a failure at the published value's line, engine routes
+skipped when their engines are hidden, JUnit properties, GitHub Actions' annotations and
+summary (plugin and `kinetostat validate`); the regression fixture `kinetostat.testing`."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from importlib.metadata import entry_points
+
+import numpy as np
+import pytest
+
+import kinetostat
+from conftest import ROOT, four_bar
+from kinetostat.report import quantities
+from kinetostat.testing import CycleMismatch, check_cycle, obtained_path
+
+pytest_plugins = ["pytester"]
+
+CHAIN = ROOT / "models" / "chain_unit_four_bar.toml"
+ENGINES = ("pinocchio", "mujoco", "pymunk")
+TEXT = CHAIN.read_text(encoding="utf-8")
+#: the chain unit's first published value (F_O1 min = 38.4 N, tolerance 1 %), raised by 5 %
+ALTERED = TEXT.replace("\nvalue = 38.4\n", "\nvalue = 40.32\n", 1)
+BAD_LINE = ALTERED.splitlines().index("value = 40.32") + 1
+N_REFERENCE = len(quantities(kinetostat.load(CHAIN), "reference"))
+N_PUBLISHED = 3
+
+
+def run(pytester, *args):
+    """pytest in this process, in pytester's folder; without the cache and hypothesis's plugin
+    (which pytester would import and assertion-rewrite again on every run)."""
+    return pytester.runpytest_inprocess(*args, "-p", "no:cacheprovider", "-p", "no:hypothesispytest")
+
+
+@pytest.fixture
+def folder(pytester):
+    """models/good.toml (the chain unit), models/bad.toml (one published value altered) and a
+    TOML file that is no model."""
+    assert ALTERED != TEXT
+    (pytester.path / "models").mkdir()
+    (pytester.path / "models" / "good.toml").write_text(TEXT, encoding="utf-8")
+    (pytester.path / "models" / "bad.toml").write_text(ALTERED, encoding="utf-8")
+    (pytester.path / "models" / "settings.toml").write_text("[tool]\nname = 'x'\n", encoding="utf-8")
+    return pytester
+
+
+def test_the_plugin_is_installed_as_an_entry_point():
+    (ep,) = [ep for ep in entry_points(group="pytest11") if ep.name == "kinetostat"]
+    assert ep.value == "kinetostat_validation.pytest_plugin"
+
+
+def test_loading_the_plugin_imports_neither_numpy_nor_the_solver():
+    code = ("import sys, kinetostat_validation.pytest_plugin\n"
+            "print(sorted(m for m in ('numpy', 'kinetostat', 'pandas', 'mpmath') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout.strip() == "[]", out.stderr
+
+
+def test_one_altered_published_value_fails_at_its_line(folder):
+    r = run(folder, "--kinetostat", "models", "-m", "not engines", "--junitxml=j.xml")
+    r.assert_outcomes(failed=1, passed=2 * (N_REFERENCE + N_PUBLISHED) - 1)
+    out = r.stdout.str()
+    assert f"models/bad.toml:{BAD_LINE}: published value F_O1 min of bad: error 4.76 % > tolerance 1 %" in out
+    assert "error   tolerance  max |diff|  unit  angle   route" in out
+    assert f"tolerance set at models/bad.toml:{BAD_LINE + 2}" in out
+    assert "FAILED models/bad.toml::published::F_O1_min" in out and "settings.toml" not in out
+    # the JUnit file: error, tolerance and trust for every item
+    cases = ET.parse(folder.path / "j.xml").getroot().findall(".//testcase")
+    assert len(cases) == 2 * (N_REFERENCE + N_PUBLISHED)
+    for case in cases:
+        props = {p.get("name"): p.get("value") for p in case.findall("./properties/property")}
+        assert float(props["error"]) >= 0 and float(props["tolerance"]) > 0, props
+        if props["route"] == "reference":
+            assert props["trust"].startswith("40-digit re-solution") and float(props["error"]) < 1e-13
+        else:
+            assert props["trust"].startswith("published value: seed 004") and props["file"].startswith("models/")
+        failed = case.find("failure") is not None
+        assert failed == (props["file"] == "models/bad.toml" and props["line"] == str(BAD_LINE))
+        assert failed == (props["passed"] == "False")
+
+
+def test_engines_hidden_skip_the_engine_routes_and_the_rest_pass(folder, monkeypatch):
+    for name in ENGINES:
+        monkeypatch.setitem(sys.modules, name, None)
+    r = run(folder, "--kinetostat", "models/good.toml", "-rs")
+    mech = kinetostat.load(CHAIN)
+    n_engine = sum(len(quantities(mech, route)) for route in ("pinocchio", "mujoco", "mujoco-sim", "pymunk"))
+    r.assert_outcomes(passed=N_REFERENCE + N_PUBLISHED, skipped=n_engine)
+    for route, engine in (("pinocchio", "pinocchio"), ("mujoco", "mujoco"), ("mujoco-sim", "mujoco"),
+                          ("pymunk", "pymunk")):
+        r.stdout.fnmatch_lines([f"SKIPPED [[]*[]] models/good.toml: route {route}: {engine} not installed*"])
+
+
+def test_selection_by_marker_and_keyword(folder):
+    r = run(folder, "--kinetostat", "models/good.toml", "--collect-only", "-q", "-m", "engines",
+                                   "-k", "pinocchio and R_1_2")
+    r.stdout.fnmatch_lines(["models/good.toml::pinocchio::R_1_2", "1/* tests collected*"])
+
+
+def test_opt_in_only_and_the_ini_option_collects_only_what_it_names(folder):
+    r = run(folder, "models")
+    assert r.ret == pytest.ExitCode.NO_TESTS_COLLECTED
+    folder.makeini("[pytest]\nkinetostat_models = models/g*.toml\n")
+    r = run(folder, "models", "--collect-only", "-q", "-k", "published")
+    assert r.stdout.lines[:N_PUBLISHED] == [f"models/good.toml::published::{s}"
+                                            for s in ("F_O1_min", "F_O1_max", "phi_k_at_F_O1_max")]
+    assert "bad.toml" not in r.stdout.str() and "settings.toml" not in r.stdout.str()
+
+
+def test_github_annotation_and_summary(folder, monkeypatch):
+    summary = folder.path / "summary.md"
+    monkeypatch.setenv("GITHUB_ACTIONS", "true")
+    monkeypatch.setenv("GITHUB_WORKSPACE", str(folder.path))
+    monkeypatch.setenv("GITHUB_STEP_SUMMARY", str(summary))
+    r = run(folder, "--kinetostat", "models", "-k", "published")
+    r.assert_outcomes(failed=1, passed=2 * N_PUBLISHED - 1)
+    (line,) = [ln for ln in r.stdout.lines if ln.startswith("::error ")]
+    assert line.startswith(f"::error file=models/bad.toml,line={BAD_LINE},title=kinetostat%3A ")
+    text = summary.read_text(encoding="utf-8")
+    assert text.startswith("## kinetostat (pytest): FAIL\n\n5 passed, 1 failed, 0 errors, 0 skipped.")
+    assert f"| models/bad.toml::published::F_O1_min | models/bad.toml:{BAD_LINE} | 4.76 % | 1 % | N |" in text
+
+
+def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch):
+    (tmp_path / "bad.toml").write_text(ALTERED, encoding="utf-8")
+    summary = tmp_path / "summary.md"
+    r = cli("validate", "bad.toml", "--engines", "reference", "--no-progress", "--json", "v.json",
+            env={"GITHUB_ACTIONS": "true", "GITHUB_STEP_SUMMARY": str(summary), "GITHUB_WORKSPACE": str(tmp_path)},
+            cwd=tmp_path)
+    assert r.returncode == 1
+    assert f"::error file=bad.toml,line={BAD_LINE},title=kinetostat%3A bad.published.F_O1 min::" in r.stdout
+    text = summary.read_text(encoding="utf-8")
+    assert text.startswith(f"## kinetostat validate: FAIL\n\n{N_REFERENCE + N_PUBLISHED - 1} passed, 1 failed")
+    checks = json.loads((tmp_path / "v.json").read_text())["models"][0]["checks"]
+    assert {c["trust"].partition(":")[0] for c in checks} == {"40-digit re-solution", "published value"}
+
+
+# ----------------------------------------------------------------------------- regression fixture
+
+def test_check_cycle_catches_a_tenth_of_a_percent_of_one_mass(tmp_path):
+    expected = tmp_path / "four_bar.csv"
+    with pytest.raises(CycleMismatch, match="did not exist"):          # a first run is never a pass
+        check_cycle(kinetostat.loads(four_bar()), expected, steps=72)
+    assert check_cycle(kinetostat.loads(four_bar()), expected, steps=72) == expected
+    heavier = kinetostat.loads(four_bar(("mass = 1.5", "mass = 1.5015")))      # the coupler, +0.1 %
+    with pytest.raises(CycleMismatch) as exc:
+        check_cycle(heavier, expected, steps=72)
+    diffs = {d.column: d for d in exc.value.diffs}
+    assert obtained_path(expected).exists() and "obtained written to" in str(exc.value)
+    # the differences, in each column's unit, are the two solutions' own
+    old, new = (kinetostat.analyze(m, steps=72) for m in (kinetostat.loads(four_bar()), heavier))
+    d = diffs["M_bal"]
+    assert d.unit == "N m" and d.max_abs == pytest.approx(np.max(np.abs(new.balancing_moment - old.balancing_moment)),
+                                                          rel=1e-12)
+    assert diffs["R_1_2"].unit == "N" and "x_B" not in diffs and "theta_3" not in diffs   # kinematics unchanged
+    assert "R_1_2" in str(exc.value) and " N " in str(exc.value)
+    # forces within 1 N pass by their unit's tolerance; the inertia moment's N m still fails
+    with pytest.raises(CycleMismatch) as exc:
+        check_cycle(heavier, expected, steps=72, atol={"N": 1.0, "m": 1.0, "deg": 1.0})
+    assert {d.unit for d in exc.value.diffs} == {"N m"}
+    check_cycle(heavier, expected, steps=72, regenerate=True)
+    assert check_cycle(heavier, expected, steps=72) == expected and not obtained_path(expected).exists()
+
+
+def test_regression_fixture_regenerates_with_the_flag(pytester):
+    pytester.path.joinpath("m.toml").write_text(four_bar(), encoding="utf-8")
+    pytester.makepyfile(test_press="""
+        def test_design(kinetostat_regression):
+            kinetostat_regression("m.toml", steps=36)
+    """)
+    expected = pytester.path / "test_press" / "test_design.csv"
+    run(pytester).assert_outcomes(failed=1)     # written
+    assert expected.exists()
+    run(pytester).assert_outcomes(passed=1)
+    pytester.path.joinpath("m.toml").write_text(four_bar(("mass = 1.2", "mass = 1.2012")), encoding="utf-8")
+    r = run(pytester)
+    r.assert_outcomes(failed=1)
+    assert obtained_path(expected).exists() and "columns beyond tolerance" in r.stdout.str()
+    run(pytester, "--kinetostat-regen").assert_outcomes(passed=1)
+    run(pytester).assert_outcomes(passed=1)
