@@ -182,3 +182,26 @@ def test_regression_fixture_regenerates_with_the_flag(pytester):
     assert obtained_path(expected).exists() and "columns beyond tolerance" in r.stdout.str()
     run(pytester, "--kinetostat-regen").assert_outcomes(passed=1)
     run(pytester).assert_outcomes(passed=1)
+
+
+def test_a_route_failure_names_the_pair_and_the_routes_tolerance(folder, monkeypatch):
+    from kinetostat_validation import compare as cmp
+    monkeypatch.setitem(cmp.TOLERANCES, "reference", cmp.Tolerance(1e-30, "below any rounding: every check fails"))
+    r = run(folder, "--kinetostat", "models/good.toml", "-k", "reference and R_1_2")
+    r.assert_outcomes(failed=1)
+    lines = TEXT.splitlines()
+    at = lines.index("links = [1, 2]")
+    pair = at - lines[at::-1].index("[[pair]]") + 1          # the line of that pair's [[pair]] header
+    tol_line = cmp.__file__, next(n for n, ln in enumerate(open(cmp.__file__, encoding="utf-8"), 1)
+                                  if ln.lstrip().startswith('"reference": Tolerance('))
+    out = r.stdout.str()
+    assert f"models/good.toml:{pair}: R(1,2) of good on route reference: error " in out
+    assert "> tolerance 1e-30" in out and "trust: 40-digit re-solution" in out
+    assert out.count("tolerance set at ") == 1 and f"compare.py:{tol_line[1]}" in out
+
+
+def test_a_broken_model_file_is_one_collection_error_without_traceback(folder):
+    (folder.path / "models" / "good.toml").write_text(TEXT.replace("mass = ", "masss = ", 1), encoding="utf-8")
+    r = run(folder, "--kinetostat", "models/good.toml")
+    assert r.ret == pytest.ExitCode.INTERRUPTED and "1 error" in r.stdout.str()
+    assert "masss: unknown field (did you mean 'mass'?)" in r.stdout.str() and "Traceback" not in r.stdout.str()

@@ -23,7 +23,7 @@ from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
 from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
-from .runs import ModelRun
+from .runs import ModelRun, trust
 
 #: Fewer positions than this make the plots over the cycle meaningless.
 MIN_REPORT_STEPS = 8
@@ -443,8 +443,10 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
         er = run.results.get(route)
         rows.append([route, er.route if er else "-", f"{tol.peak_relative:.0e}" if tol else "-",
                      tol.reason if tol else "-",
-                     esc((er.note if er and er.note else "") or run.skipped.get(route, run.errors.get(route, "")))])
-    doc.table(["route", "kind", "tolerance (peak-relative)", "why this tolerance", "note"], rows, "llrll")
+                     esc((er.note if er and er.note else "") or run.skipped.get(route, run.errors.get(route, ""))),
+                     esc(trust(route))])
+    doc.table(["route", "kind", "tolerance (peak-relative)", "why this tolerance", "note", "rests on"], rows,
+              "llrlll")
 
     doc.h(2, "Hodographs of the reactions")
     doc.p("The tip of each revolute pair's reaction vector (force of link i on link j, world frame) traced "
