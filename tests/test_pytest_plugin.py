@@ -128,7 +128,7 @@ def test_github_annotation_and_summary(folder, monkeypatch):
 def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch):
     (tmp_path / "bad.toml").write_text(ALTERED, encoding="utf-8")
     summary = tmp_path / "summary.md"
-    r = cli("validate", "bad.toml", "--engines", "reference", "--no-progress", "--json", "v.json",
+    r = cli("validate", "bad.toml", "--engines", "reference", "--no-progress", "--json", "v.json", "--junit", "v.xml",
             env={"GITHUB_ACTIONS": "true", "GITHUB_STEP_SUMMARY": str(summary), "GITHUB_WORKSPACE": str(tmp_path)},
             cwd=tmp_path)
     assert r.returncode == 1
@@ -137,6 +137,8 @@ def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch)
     assert text.startswith(f"## kinetostat validate: FAIL\n\n{N_REFERENCE + N_PUBLISHED - 1} passed, 1 failed")
     checks = json.loads((tmp_path / "v.json").read_text())["models"][0]["checks"]
     assert {c["trust"].partition(":")[0] for c in checks} == {"40-digit re-solution", "published value"}
+    trusts = [p.get("value") for p in ET.parse(tmp_path / "v.xml").getroot().iter("property") if p.get("name") == "trust"]
+    assert trusts == [c["trust"] for c in checks]
 
 
 # ----------------------------------------------------------------------------- regression fixture

@@ -2,7 +2,8 @@
 
 Rooms: `published` (a model's published values beside the exact ones), `runs` (a validation run, route by
 route), `junit` (JUnit XML and JSON of validation runs), `document` (Markdown and HTML), `plots` (matplotlib figures),
-`writer` (a model's report folder and the index). The solver never imports this package.
+`writer` (a model's report folder and the index), `ci` (a check's line in its model file, GitHub
+annotations and step summary). The solver never imports this package.
 
 May use: its rooms.
 """
