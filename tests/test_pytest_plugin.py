@@ -207,3 +207,24 @@ def test_a_broken_model_file_is_one_collection_error_without_traceback(folder):
     r = run(folder, "--kinetostat", "models/good.toml")
     assert r.ret == pytest.ExitCode.INTERRUPTED and "1 error" in r.stdout.str()
     assert "masss: unknown field (did you mean 'mass'?)" in r.stdout.str() and "Traceback" not in r.stdout.str()
+
+
+def test_the_exact_engine_routes_pass_and_say_so(folder):
+    """A sample of the engine routes (Pinocchio and MuJoCo at the solver's state; the simulated
+    routes run in `kinetostat validate`'s own tests)."""
+    pytest.importorskip("pinocchio")
+    pytest.importorskip("mujoco")
+    r = run(folder, "--kinetostat", "models/good.toml", "-m", "engines", "-k", "pinocchio or (mujoco and not sim)",
+            "--junitxml=j.xml")
+    n = len(quantities(kinetostat.load(CHAIN), "pinocchio")) + len(quantities(kinetostat.load(CHAIN), "mujoco"))
+    r.assert_outcomes(passed=n)
+    for case in ET.parse(folder.path / "j.xml").getroot().iter("testcase"):
+        props = {p.get("name"): p.get("value") for p in case.findall("./properties/property")}
+        assert props["trust"].startswith("independent engine: ") and float(props["error"]) < 1e-12, props
+
+
+@pytest.mark.slow
+def test_every_route_of_a_bundled_model_passes_in_pytest(pytester):
+    """The whole gate of the bundled models with every installed engine, as `pytest --kinetostat`."""
+    r = run(pytester, "--kinetostat", str(ROOT / "models"), "-q")
+    assert r.ret == 0 and r.parseoutcomes()["passed"] > 800, r.stdout.str()[-2000:]
