@@ -104,6 +104,8 @@ def test_selection_by_marker_and_keyword(folder):
 def test_opt_in_only_and_the_ini_option_collects_only_what_it_names(folder):
     r = run(folder, "models")
     assert r.ret == pytest.ExitCode.NO_TESTS_COLLECTED
+    r = run(folder, "--kinetostat", "models", "--kinetostat-steps", "0")
+    assert r.ret == pytest.ExitCode.USAGE_ERROR and "must be a positive integer, got 0" in r.stderr.str()
     folder.makeini("[pytest]\nkinetostat_models = models/g*.toml\n")
     r = run(folder, "models", "--collect-only", "-q", "-k", "published")
     assert r.stdout.lines[:N_PUBLISHED] == [f"models/good.toml::published::{s}"

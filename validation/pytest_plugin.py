@@ -61,7 +61,21 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", f"{ENGINES_MARK}: a kinetostat check against a physics engine route "
                                        "(deselect with -m 'not engines')")
     if _active(config):
+        _steps(config)
         config.pluginmanager.register(_Gate(config), "kinetostat-gate")
+
+
+def _steps(config: pytest.Config) -> int:
+    """Crank positions per cycle: --kinetostat-steps, else the ini option (a usage error if not a positive integer)."""
+    opt = config.getoption("kinetostat_steps")
+    raw = opt if opt is not None else config.getini("kinetostat_steps")
+    try:
+        steps = int(raw)
+    except (TypeError, ValueError):
+        steps = 0
+    if steps < 1:
+        raise pytest.UsageError(f"kinetostat: the number of positions must be a positive integer, got {raw!r}")
+    return steps
 
 
 def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Collector | None:
@@ -116,10 +130,6 @@ class ModelFile(pytest.File):
             from kinetostat.report.runs import PUBLISHED_ROUTE
             yield Route.from_parent(self, name=PUBLISHED_ROUTE, quantities=[e.symbol for e in self.mech.published])
 
-    def steps(self) -> int:
-        opt = self.config.getoption("kinetostat_steps")
-        return int(opt if opt is not None else self.config.getini("kinetostat_steps"))
-
     def run(self, route: str):
         """The ModelRun of one route (`kinetostat.report.run_validation`), computed once per
         session; the published values as route "published"; the cycle analysed once."""
@@ -129,9 +139,9 @@ class ModelFile(pytest.File):
             from kinetostat.report.runs import PUBLISHED_ROUTE
 
             if self._res is None:
-                self._res = analyze(self.mech, steps=self.steps())
+                self._res = analyze(self.mech, steps=_steps(self.config))
             engines = [] if route == PUBLISHED_ROUTE else [route]
-            self._runs[route] = run_validation(self.mech, engines, self.steps(), res=self._res, path=self.path)
+            self._runs[route] = run_validation(self.mech, engines, _steps(self.config), res=self._res, path=self.path)
         return self._runs[route]
 
     def repr_failure(self, excinfo, style=None):
