@@ -139,7 +139,8 @@ def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch)
     assert text.startswith(f"## kinetostat validate: FAIL\n\n{N_REFERENCE + N_PUBLISHED - 1} passed, 1 failed")
     checks = json.loads((tmp_path / "v.json").read_text())["models"][0]["checks"]
     assert {c["trust"].partition(":")[0] for c in checks} == {"40-digit re-solution", "published value"}
-    trusts = [p.get("value") for p in ET.parse(tmp_path / "v.xml").getroot().iter("property") if p.get("name") == "trust"]
+    props = ET.parse(tmp_path / "v.xml").getroot().iter("property")
+    trusts = [p.get("value") for p in props if p.get("name") == "trust"]
     assert trusts == [c["trust"] for c in checks]
 
 

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,10 +19,6 @@ from typing import Iterable, Sequence
 
 from ..model import Mechanism, _Lines
 from .runs import PUBLISHED_ROUTE, Check, ModelRun, trust
-
-#: A quantity name of a route's rows: "R(1,2)", "P_f(0,3)", "x(B)".
-_NAMED = re.compile(r"(\w+)\((.*)\)")
-
 
 @dataclass(frozen=True)
 class Where:
