@@ -2,6 +2,7 @@
 line run in this process (`cli`)."""
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,6 +14,18 @@ import kinetostat
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = sorted((ROOT / "models").glob("*.toml"))
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config: pytest.Config) -> None:
+    """The whole suite (`python -m pytest`, no paths given) runs on every core when pytest-xdist
+    is installed (`-n 0` or `-p no:xdist` runs it in one process; a run of chosen files or
+    tests stays in one process unless `-n` says otherwise)."""
+    if (config.pluginmanager.hasplugin("xdist") and config.option.numprocesses is None
+            and config.args_source == pytest.Config.ArgsSource.TESTPATHS
+            and "PYTEST_XDIST_WORKER" not in os.environ):
+        config.option.numprocesses = "auto"
+        config.option.dist = "worksteal"
 
 
 @pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])
