@@ -579,7 +579,7 @@ MAX_KEY_MEMORY = 256 * 2**20
 _KEY_BYTES, _LEVEL_BYTES = 800, 9
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
-#: Most points of one link (the largest distance between them costs n^2).
+#: Most points of one link.
 MAX_POINTS = 10_000
 #: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
 #: lengths stay normal numbers.
