@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 
 from .errors import SingularPositionWarning, singular_message
-from .planar import as_xy
+from .planar import as_xy, diameter
 from .program import constants, motion_program, run
 
 if TYPE_CHECKING:
@@ -236,9 +236,8 @@ def _joint_extents(mech: "Mechanism") -> list[float]:
             else:
                 joints[p.links[0]].add(p.guide)
                 joints[p.links[1]].add(p.point)
-        mech._derived["joint_extents"] = [
-            max((abs(pts[a] - pts[b]) for a in names for b in names), default=0.0)
-            for pts, names in zip(mech.points_z, joints)]
+        mech._derived["joint_extents"] = [diameter(pts[a] for a in names)
+                                          for pts, names in zip(mech.points_z, joints)]
     return mech._derived["joint_extents"]
 
 

@@ -3,7 +3,7 @@
 Field meanings and units are those of `models/FORMAT.md`. All coordinates in metres, masses in
 kg, moments of inertia in kg m^2, angles in radians unless the name says `_deg`.
 
-May use: the standard library, numpy, errors, expressions, structure, examples.
+May use: the standard library, numpy, errors, expressions, planar, structure, examples.
 """
 from __future__ import annotations
 
@@ -25,6 +25,7 @@ import numpy as np
 from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
 from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression
 from .expressions import resolve as resolve_parameters
+from .planar import diameter
 from .structure import Structure, analyse_structure
 
 __all__ = ["Link", "Body", "Pair", "Table", "Load", "Characteristic", "SpeedLaw", "combine", "Spring", "Gear", "Drive", "Friction", "Published", "Study", "Mechanism",
@@ -414,11 +415,8 @@ def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> 
 
 
 def _span(points) -> float:
-    """Largest distance between two of `points` ((x, y) pairs), m; rows in blocks, so that
-    10^4 points take a second and bounded memory."""
-    z = np.array([complex(*xy) for xy in points])
-    return max((float(np.abs(z[i:i + 512, None] - z[None, :]).max()) for i in range(0, len(z), 512)),
-               default=0.0)
+    """Largest distance between two of `points` ((x, y) pairs), m."""
+    return diameter(complex(*xy) for xy in points)
 
 
 def _abbreviate(text: str, limit: int = 90) -> str:
@@ -581,7 +579,7 @@ MAX_KEY_MEMORY = 256 * 2**20
 _KEY_BYTES, _LEVEL_BYTES = 800, 9
 #: Largest magnitude of any number in a model file (m, kg, N, ...): beyond it squares overflow.
 MAX_VALUE = 1e12
-#: Most points of one link (the largest distance between them costs n^2).
+#: Most points of one link.
 MAX_POINTS = 10_000
 #: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
 #: lengths stay normal numbers.

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["as_z", "as_xy", "cross_z", "dot_z", "Basis", "condition",
+__all__ = ["as_z", "as_xy", "cross_z", "dot_z", "Basis", "condition", "diameter",
            "cross", "rot90", "rotate", "unit"]
 
 
@@ -85,3 +85,29 @@ def rotate(p, theta) -> np.ndarray:
 def unit(a) -> np.ndarray:
     a = np.asarray(a, dtype=float)
     return a / np.linalg.norm(a, axis=-1, keepdims=True)
+
+
+def diameter(points) -> float:
+    """Largest distance between two of `points` (complex), 0 for fewer than two: the convex hull
+    (monotone chain), then its antipodal pairs (rotating calipers). Work O(n log n)."""
+    pts = sorted(set(points), key=lambda z: (z.real, z.imag))
+    turn = lambda o, a, b: (a.real - o.real) * (b.imag - o.imag) - (a.imag - o.imag) * (b.real - o.real)
+
+    def chain(seq) -> list[complex]:
+        h: list[complex] = []
+        for p in seq:
+            while len(h) >= 2 and turn(h[-2], h[-1], p) <= 0:
+                h.pop()
+            h.append(p)
+        return h[:-1]
+
+    hull = chain(pts) + chain(reversed(pts))        # counter-clockwise, no collinear vertices
+    if len(hull) < 3:
+        return abs(pts[-1] - pts[0]) if pts else 0.0
+    n, j, best = len(hull), 1, 0.0
+    for i in range(n):
+        a, b = hull[i], hull[(i + 1) % n]
+        while turn(a, b, hull[(j + 1) % n]) > turn(a, b, hull[j]):
+            j = (j + 1) % n
+        best = max(best, abs(a - hull[j]), abs(b - hull[j]))
+    return best

@@ -461,11 +461,17 @@ def code(program: Program, var: Callable[[str], str], check: Callable[[int, str,
     """The program as straight-line Python statements: each step one call of a group equation
     (by its name in `groups`), names turned into identifiers by `var`, literals written out;
     the assembly test written by `check(step index, discriminant, scale)`. A step that only
-    names a value (`same`, or a product with 1) costs nothing: later steps read the value."""
-    alias: dict[str, str] = {}
+    names a value (`same`, or a product with 1) costs nothing: later steps read the value.
+    Work linear in the number of steps: each alias is written out at most once, found through
+    the name it stands for."""
+    alias: dict[str, str] = {}                     # name -> the name whose value it reads
+    readers: dict[str, dict[str, None]] = {}       # that name -> its aliases, in order given
 
     def name(a) -> str:
         return var(alias.get(a, a)) if isinstance(a, str) else repr(a)
+
+    def forget(a: str) -> None:
+        readers[alias.pop(a)].pop(a)
 
     lines = []
     for i, st in enumerate(program.steps):
@@ -473,15 +479,20 @@ def code(program: Program, var: Callable[[str], str], check: Callable[[int, str,
             lines.append(check(i, *map(name, st.args)))
         elif isinstance(st.args[0], str) and (st.fn == "same" or (
                 st.fn in ("scaled", "revolute_pair") and st.args[1] == 1.0)):
-            alias[st.out[0]] = alias.get(st.args[0], st.args[0])
+            t = alias.get(st.args[0], st.args[0])
+            if st.out[0] in alias:
+                forget(st.out[0])
+            alias[st.out[0]] = t
+            readers.setdefault(t, {})[st.out[0]] = None
         else:
-            for a, t in list(alias.items()):       # a name read later keeps the value it was given
-                if t in st.out:
+            for t in st.out:                        # a name read later keeps the value it was given
+                for a in readers.pop(t, ()):
                     lines.append(f"{var(a)} = {var(t)}")
                     del alias[a]
             lines.append(f"{', '.join(var(o) for o in st.out)} = {st.fn}({', '.join(map(name, st.args))})")
             for o in st.out:
-                alias.pop(o, None)
+                if o in alias:
+                    forget(o)
     lines.extend(f"{var(a)} = {name(a)}" for a in alias)      # every name given stays readable
     return lines
 

@@ -9,6 +9,7 @@ May use: errors only (never the model: the dependency runs model -> structure).
 """
 from __future__ import annotations
 
+import heapq
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -105,18 +106,12 @@ def analyse_structure(n_links: int, pairs: Sequence[KinematicPair],
     if len(crank_frame) != 1 or crank_frame[0].kind != "R":
         raise StructureError("the crank (link 1) must be joined to the frame by exactly one revolute pair")
 
-    known = {0, 1}
-    groups: list[AssurGroup] = []
-    remaining = set(range(2, n_links))
-    while remaining:
-        group = _next_group(pairs, branches, known, remaining)
-        if group is None:
-            raise StructureError(
-                f"links {sorted(remaining)} do not split into class-II Assur groups (dyads); "
-                f"a class-III or higher group (e.g. a triad) is not supported by kinetostat")
-        groups.append(group)
-        known |= set(group.links)
-        remaining -= set(group.links)
+    groups = _dyads(n_links, pairs, branches)
+    remaining = set(range(2, n_links)).difference(*(g.links for g in groups))
+    if remaining:
+        raise StructureError(
+            f"links {sorted(remaining)} do not split into class-II Assur groups (dyads); "
+            f"a class-III or higher group (e.g. a triad) is not supported by kinetostat")
     unused = set(branches) - {frozenset(g.links) for g in groups}
     if unused:
         raise StructureError(f"group: branch given for {[sorted(u) for u in unused]}, "
@@ -125,18 +120,46 @@ def analyse_structure(n_links: int, pairs: Sequence[KinematicPair],
     return Structure(n, len(pairs), 0, tuple(groups))
 
 
-def _next_group(pairs: Sequence[KinematicPair], branches: Mapping[frozenset, int], known: set[int],
-                remaining: set[int]) -> AssurGroup | None:
-    for j in sorted(remaining):
-        for k in sorted(remaining):
-            if j >= k:
-                continue
-            inner = [p for p in pairs if set(p.links) == {j, k}]
-            out_j = [p for p in pairs if j in p.links and (set(p.links) - {j}) <= known]
-            out_k = [p for p in pairs if k in p.links and (set(p.links) - {k}) <= known]
-            if len(inner) == 1 and len(out_j) == 1 and len(out_k) == 1:
-                return _orient(branches, j, k, out_j[0], inner[0], out_k[0])
-    return None
+def _dyads(n_links: int, pairs: Sequence[KinematicPair], branches: Mapping[frozenset, int]) -> list[AssurGroup]:
+    """The groups in the order of attachment: each time, of the links not yet attached, the
+    first (j, k), j < k, joined to each other by one pair and each to the attached links by one
+    pair. Stops where no such dyad is left. Work O(pairs x log links): per link its pairs to the
+    attached links, kept as links attach; a heap of the dyads that may be next."""
+    at: list[list[KinematicPair]] = [[] for _ in range(n_links)]
+    between: dict[frozenset, int] = {}
+    for p in pairs:
+        for x in p.links:
+            at[x].append(p)
+        between[frozenset(p.links)] = between.get(frozenset(p.links), 0) + 1
+    known: set[int] = set()
+    out: list[list[KinematicPair]] = [[] for _ in range(n_links)]    # pairs to attached links
+    heap: list[tuple[int, int]] = []
+    other = lambda p, x: p.links[1] if p.links[0] == x else p.links[0]
+
+    def attach(*links: int) -> None:
+        known.update(links)
+        for x in links:
+            for p in at[x]:
+                y = other(p, x)
+                if y in known:
+                    continue
+                out[y].append(p)
+                if len(out[y]) == 1:                 # y may now close a dyad with a neighbour
+                    for q in at[y]:
+                        z = other(q, y)
+                        if z not in known and len(out[z]) == 1 and between[frozenset((y, z))] == 1:
+                            heapq.heappush(heap, (min(y, z), max(y, z)))
+
+    attach(0, 1)
+    groups: list[AssurGroup] = []
+    while heap:
+        j, k = heapq.heappop(heap)
+        if j in known or k in known or len(out[j]) != 1 or len(out[k]) != 1:
+            continue                                 # attached since, or joined twice
+        inner = next(p for p in at[j] if other(p, j) == k)
+        groups.append(_orient(branches, j, k, out[j][0], inner, out[k][0]))
+        attach(j, k)
+    return groups
 
 
 def _orient(branches: Mapping[frozenset, int], j: int, k: int, pj: KinematicPair, pin: KinematicPair,

@@ -2,6 +2,7 @@
 line run in this process (`cli`)."""
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,6 +14,29 @@ import kinetostat
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = sorted((ROOT / "models").glob("*.toml"))
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config: pytest.Config) -> None:
+    """The whole suite (`python -m pytest`, no paths given) runs on every core when pytest-xdist
+    is installed (`-n 0` or `-p no:xdist` runs it in one process; a run of chosen files or
+    tests stays in one process unless `-n` says otherwise)."""
+    if (config.pluginmanager.hasplugin("xdist") and config.option.numprocesses is None
+            and config.args_source == pytest.Config.ArgsSource.TESTPATHS
+            and "PYTEST_XDIST_WORKER" not in os.environ):
+        config.option.numprocesses = "auto"
+        config.option.dist = "loadfile"         # a module's fixtures and compiled kernels built once
+
+
+#: Bundled models that together hold every group kind (RRR, RRP, RPR, PRP, RPP), engines and
+#: machines: the default suite's sample where a test over every model is costly.
+EVERY_KIND = ("chain_unit_four_bar", "ice_crank_slider", "scotch_yoke", "slotted_link_shaper")
+
+
+def sampled(paths, keep=EVERY_KIND) -> list:
+    """`paths` as pytest parameters (ids: their stems): those named in `keep` run by default,
+    the others with -m slow."""
+    return [pytest.param(p, id=p.stem, marks=() if p.stem in keep else pytest.mark.slow) for p in paths]
 
 
 @pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])
@@ -63,6 +87,29 @@ def cli(capsys, monkeypatch):
         out, err = capsys.readouterr()
         return CLIRun(code, out, err)
     return run
+
+
+@pytest.fixture
+def sketched_plots(monkeypatch):
+    """A report's plots and plan pictures each written as a 1-pixel PNG under its own name
+    (atomically, as the real ones): for tests of what a report does with its folders, files
+    and tables, at a tenth of the time. test_report and the injection tests draw them."""
+    import io
+
+    from PIL import Image
+
+    from kinetostat._io import atomic
+    from kinetostat.report import writer
+    buf = io.BytesIO()
+    Image.new("RGB", (1, 1)).save(buf, format="PNG")
+
+    def sketch(*args) -> Path:
+        with atomic(args[-1], binary=True) as f:
+            f.write(buf.getvalue())
+        return Path(args[-1])
+    for name in ("plot_mechanism", "plot_moment", "plot_balancing_force", "plot_reactions", "plot_errors",
+                 "plot_hodographs", "_save"):
+        monkeypatch.setattr(writer, name, sketch)
 
 
 # A small four-bar written only here: frame O=(0,0), C=(0.3,0); crank 0.1, coupler 0.35, rocker 0.3.

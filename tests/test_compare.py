@@ -9,14 +9,16 @@ import pytest
 
 import kinetostat
 from kinetostat_validation import compare as cmp
-from conftest import FOUR_BAR, ROOT
+from conftest import FOUR_BAR, MODELS, ROOT, sampled
 
 pytest.importorskip("pinocchio")
 pytest.importorskip("mujoco")
 pytest.importorskip("pymunk")
 
 
-def test_every_route_passes_on_every_bundled_model(mech):
+@pytest.mark.parametrize("path", sampled(MODELS))
+def test_every_route_passes_on_every_bundled_model(path):
+    mech = kinetostat.load(path)
     c = cmp.compare(mech, steps=360)
     assert not c.skipped
     assert set(c.results) == set(cmp.ROUTES)

@@ -35,7 +35,7 @@ import pytest
 pytest.importorskip("pymunk")
 
 import kinetostat  # noqa: E402
-from conftest import FOUR_BAR as LIGHT_FOUR_BAR, four_bar  # noqa: E402
+from conftest import FOUR_BAR as LIGHT_FOUR_BAR, four_bar, sampled  # noqa: E402
 from kinetostat_validation.compare import errors as gate_errors  # noqa: E402
 from kinetostat_validation.engine_pymunk import simulate  # noqa: E402
 from kinetostat_validation.scene import build_scene  # noqa: E402
@@ -112,7 +112,7 @@ def _fmt(err: dict[str, float]) -> str:
     return ", ".join(f"{k} {v:.1e}" for k, v in err.items())
 
 
-@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+@pytest.mark.parametrize("path", sampled(MODELS))
 def test_every_model_at_1440_steps(path):
     scene = _model_scene(path)
     res = _run(str(path))
@@ -121,7 +121,7 @@ def test_every_model_at_1440_steps(path):
     assert max(err.values()) < TOL_1440, f"{_fmt(err)}; {res.note}"
 
 
-@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+@pytest.mark.parametrize("path", sampled(MODELS))
 def test_every_model_with_richardson(path):
     scene = _model_scene(path)
     res = _run(str(path), richardson=True)

@@ -51,7 +51,7 @@ def _agree(mech, phi_deg) -> None:
     np.testing.assert_allclose(a.error, b.error, rtol=1e-6)
 
 
-SAMPLE = ["chain_unit_four_bar", "ice_crank_slider"]
+SAMPLE = ["chain_unit_four_bar"]      # the structure most other tests here compile anyway
 
 
 @pytest.mark.parametrize("name", SAMPLE)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
-import time
+import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -266,9 +266,7 @@ def test_cli_missing_model_file(tmp_path, cli):
 
 def test_five_megabytes_of_comments_load_fast(tmp_path, cli):
     text = FOUR_BAR + ("# " + "x" * 78 + "\n") * 65_000          # 5.3 MB
-    t0 = time.perf_counter()
     mech = kinetostat.loads(text)
-    assert time.perf_counter() - t0 < 10.0
     assert np.isfinite(kinetostat.analyze(mech, steps=12).balancing_moment).all()
     if _cli_available():
         path = tmp_path / "commented.toml"
@@ -279,9 +277,7 @@ def test_five_megabytes_of_comments_load_fast(tmp_path, cli):
 
 def test_five_megabyte_string_loads_fast():
     text = FOUR_BAR.replace('name = "test four-bar"', 'name = "' + "x" * 5_000_000 + '"')
-    t0 = time.perf_counter()
     assert len(kinetostat.loads(text).name) == 5_000_000
-    assert time.perf_counter() - t0 < 10.0
 
 
 def chain_text(n_dyads: int, one_pin: bool = False) -> str:
@@ -306,37 +302,55 @@ def chain_text(n_dyads: int, one_pin: bool = False) -> str:
     return "".join(parts)
 
 
-def test_four_thousand_links_in_bounded_time():
-    """4001 links (2000 dyads, a 0.8 MB file): load ~2 s, analyze ~1 s. Load time grows as n^2
-    (structure analysis); 10^4 links take ~15 s to load, ~3 s to analyse (measured)."""
-    text = chain_text(2000)
-    t0 = time.perf_counter()
-    mech = kinetostat.loads(text)
-    res = kinetostat.analyze(mech, steps=12)
-    assert time.perf_counter() - t0 < 60.0
-    assert mech.n_links == 4002 and len(mech.structure.groups) == 2000
-    # every dyad carries the same load: the balancing moment is 2000 times one four-bar's
-    one = kinetostat.analyze(kinetostat.loads(chain_text(1)), steps=12).balancing_moment
-    np.testing.assert_allclose(res.balancing_moment, 2000 * one, rtol=1e-9)
+def own_lines(fn) -> int:
+    """The lines of kinetostat's own Python that `fn()` runs (line events of the tracer): its
+    work, independent of the clock and the machine's load."""
+    root = str(Path(kinetostat.__file__).resolve().parent)
+    count = 0
 
+    def line(frame, event, arg):
+        nonlocal count
+        count += event == "line"
+        return line
 
-def test_many_links_on_one_pin_load_in_bounded_time():
-    code = ("import sys; sys.path.insert(0, 'tests'); from test_hostile import chain_text; import kinetostat; "
-            "kinetostat.loads(chain_text(600, one_pin=True))")
+    previous = sys.gettrace()
+    sys.settrace(lambda frame, event, arg: line if frame.f_code.co_filename.startswith(root) else None)
     try:
-        subprocess.run([sys.executable, "-c", code], cwd=ROOT, timeout=5.0, check=True, capture_output=True)
-    except subprocess.TimeoutExpired:
-        pytest.fail("1201 links on one pin: load() did not finish within 5 s")
+        fn()
+    finally:
+        sys.settrace(previous)
+    return count
+
+
+@pytest.mark.parametrize("one_pin", [False, True], ids=["own-pins", "one-pin"])
+def test_load_and_analyze_work_grows_linearly_with_the_groups(one_pin):
+    """Loading and analysing a chain of n dyads (steps=12; each on its own crank pin, or all on
+    one) runs kinetostat code in proportion to n: from 16 to 32 dyads the work grows by the
+    same amount as from 8 to 16, times 2 (a quadratic step, such as a scan of all pairs per
+    group, makes that factor 4)."""
+    work = [own_lines(lambda n=n: kinetostat.analyze(kinetostat.loads(chain_text(n, one_pin)), steps=12))
+            for n in (8, 16, 32)]
+    growth = (work[2] - work[1]) / (work[1] - work[0])
+    assert 1.9 < growth < 2.1, (work, growth)
+
+
+@pytest.mark.parametrize("n", [200, pytest.param(2000, marks=pytest.mark.slow)])
+def test_a_chain_of_dyads_carries_the_sum_of_its_dyads(n):
+    """n dyads on one crank (2000: 4001 links, a 0.8 MB file): the balancing moment is n times
+    one four-bar's."""
+    mech = kinetostat.loads(chain_text(n))
+    res = kinetostat.analyze(mech, steps=12)
+    assert mech.n_links == 2 * n + 2 and len(mech.structure.groups) == n
+    one = kinetostat.analyze(kinetostat.loads(chain_text(1)), steps=12).balancing_moment
+    np.testing.assert_allclose(res.balancing_moment, n * one, rtol=1e-9)
 
 
 def test_deep_dotted_key_is_refused_in_bounded_time():
     # tomllib keeps the key path of every level: memory grows as depth^2 (3000 levels: ~50 MB,
     # 10^4 levels (20 kB of text): ~400 MB, 10^5: out of memory). 3000 is safe to run.
     text = "a" + ".a" * 3000 + " = 1\n" + FOUR_BAR
-    t0 = time.perf_counter()
     with pytest.raises(ModelError, match=r"<top level>\.a: unknown field"):
         kinetostat.loads(text)
-    assert time.perf_counter() - t0 < 10.0
 
 
 @pytest.mark.parametrize("keys, depth, header", [
@@ -344,15 +358,14 @@ def test_deep_dotted_key_is_refused_in_bounded_time():
     (200, 401, True),          # as table headers
     (400_000, 2, False),       # very many shallow keys (5.6 MB)
 ], ids=["deep-keys", "deep-headers", "many-keys"])
-def test_costly_keys_are_refused_before_parsing(keys, depth, header):
+def test_costly_keys_are_refused_before_parsing(keys, depth, header, monkeypatch):
     """tomllib's memory grows with the number of keys and the square of their depth (65 keys of
     3000 levels: 2.3 GB measured): the estimate refuses before tomllib runs."""
     dotted = ".".join(["a"] * (depth - 1))
     text = "".join((f"[k{i}.{dotted}]\nx = 1\n" if header else f"k{i}.{dotted} = 1\n") for i in range(keys))
-    t0 = time.perf_counter()
+    monkeypatch.setattr(tomllib, "loads", lambda *a, **k: pytest.fail("tomllib ran on a refused file"))
     with pytest.raises(ModelError, match=rf"MiB to parse .*this one has {depth} dotted parts"):
         kinetostat.loads(text + FOUR_BAR)
-    assert time.perf_counter() - t0 < 10.0
 
 
 def test_deep_inline_tables_and_arrays_are_refused():
@@ -361,18 +374,20 @@ def test_deep_inline_tables_and_arrays_are_refused():
             kinetostat.loads(text + FOUR_BAR)
 
 
-def test_huge_array_and_many_points_load_in_bounded_time():
-    """A 2*10^5-value diagram and a link of 5000 points (the largest distance between them costs
-    n^2) load in bounded time (10^6 values and 9000 points: ~9 s measured)."""
+@pytest.mark.parametrize("values, points", [(20_000, 1000), pytest.param(200_000, 5000, marks=pytest.mark.slow)])
+def test_huge_array_and_many_points_load(values, points):
+    """A diagram of many values and a link of many points load (the largest distance between
+    the points: hull and calipers, n log n)."""
     table = FOUR_BAR + ('[[load]]\nname = "big"\nlink = 3\npoint = "B"\ndirection = [0.0, -1.0]\n[load.table]\n'
-                        'phi_deg = [' + ", ".join(f"{360 * i / 199_999:.6f}" for i in range(200_000)) + ']\n'
-                        'value = [' + ", ".join(["1.0"] * 200_000) + ']\n')
-    pts = ", ".join(f"P{i} = [{i * 1e-5}, 0.0]" for i in range(5000))
+                        'phi_deg = [' + ", ".join(f"{360 * i / (values - 1):.6f}" for i in range(values)) + ']\n'
+                        'value = [' + ", ".join(["1.0"] * values) + ']\n')
+    pts = ", ".join(f"P{i} = [{i * 1e-5}, 0.0]" for i in range(points))
     many = FOUR_BAR.replace("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01], " + pts + " }")
-    t0 = time.perf_counter()
-    assert len(kinetostat.loads(table).loads[-1].table.x) == 200_000
+    assert len(kinetostat.loads(table).loads[-1].table.x) == values
     assert kinetostat.loads(many).size == pytest.approx(0.35)
-    assert time.perf_counter() - t0 < 30.0
+
+
+def test_too_many_points_are_refused():
     from kinetostat.model import MAX_POINTS
     too_many = ", ".join(f"P{i} = [{i * 1e-6}, 0.0]" for i in range(MAX_POINTS + 1))
     with pytest.raises(ModelError, match=f"at most {MAX_POINTS} of them"):

@@ -116,3 +116,18 @@ def test_batch_equals_one_by_one(mech):
         one = kinetostat.analyze(mech, phi_deg=[p])
         np.testing.assert_allclose(one.kin.origin[0], batch.kin.origin[n], rtol=0, atol=1e-13)
         np.testing.assert_allclose(one.balancing_moment[0], batch.balancing_moment[n], rtol=1e-13)
+
+
+def test_diameter_equals_the_largest_pairwise_distance():
+    """planar.diameter (hull and calipers) gives the very float of the all-pairs maximum: random
+    clouds, points on a circle, grids full of ties and collinear runs, fewer than three points."""
+    from kinetostat.planar import diameter
+    rng = np.random.default_rng(19)
+    for trial in range(400):
+        n = int(rng.integers(0, 30))
+        z = [rng.normal(size=n) + 1j * rng.normal(size=n),
+             np.exp(2j * np.pi * rng.integers(0, 12, n) / 12) * rng.choice([1.0, 2.0], n),
+             rng.integers(-3, 4, n) + 1j * rng.integers(-3, 4, n),
+             rng.integers(-3, 4, n) * (1 + 2j) + 0.5][trial % 4]
+        pts = [complex(c) for c in z]
+        assert diameter(pts) == max((abs(a - b) for a in pts for b in pts), default=0.0), pts

@@ -48,18 +48,22 @@ def _temporary(folder: Path) -> list[Path]:
 
 # ============================================================================ script injection
 
-def test_model_strings_are_text_in_every_report_file(tmp_path, cli):
+@pytest.mark.parametrize("others", [(), pytest.param((ICE,), id="and-ice", marks=pytest.mark.slow)],
+                         ids=["alone", "and-ice"])
+def test_model_strings_are_text_in_every_report_file(tmp_path, cli, others):
     """javascript:, data:, vbscript: links, autolinks, a reference-style link over a newline, raw
     HTML, entities, backticks, '|' and '$' in the name, source, assumptions, link, point, load,
     spring names and the published fields: the .md files (as GitHub reads them) hold no raw HTML
     and no link but the report's own, each string reads back as its text, every table row keeps
     its cells; the HTML has no script, no javascript:/data:/vbscript: link. The name is also a
-    mathtext error ($\\frac{$): the plots take it as text, and the other model is reported too."""
+    mathtext error ($\\frac{$): the plots take it as text, and another model is reported too
+    (with -m slow)."""
     import tomllib
     out = tmp_path / "out"
-    r = cli("report", INJECTION, ICE, "--out", out, *QUICK)
+    r = cli("report", INJECTION, *others, "--out", out, *QUICK)
     assert r.returncode == 0, r.stderr
-    assert (out / "injection" / "mechanism.png").stat().st_size > 1000 and (out / "ice_crank_slider").is_dir()
+    assert (out / "injection" / "mechanism.png").stat().st_size > 1000
+    assert all((out / p.stem / "index.md").is_file() for p in others)
     data = tomllib.loads(INJECTION.read_text(encoding="utf-8"))
     strings = [data["mechanism"]["name"], data["mechanism"]["source"], *data["mechanism"]["assumptions"],
                data["drive"]["point"], *[t["name"] for t in data["link"]], *data["frame"],
@@ -107,7 +111,7 @@ def test_doc_tables_keep_their_cells():
 
 # ============================================================================ paths
 
-def test_report_folders_stay_inside_out_and_never_overwrite_each_other(tmp_path, cli):
+def test_report_folders_stay_inside_out_and_never_overwrite_each_other(tmp_path, cli, sketched_plots):
     """A model file '...toml' (stem '..'), a stem of markup, a non-UTF-8 file name with a control
     character, and two files with the same stem: one folder each inside --out, nothing outside."""
     models = tmp_path / "models"
@@ -192,6 +196,8 @@ def full_disk(monkeypatch):
 def test_a_full_disk_leaves_the_old_files(args, written, tmp_path, cli, request):
     """A rerun on a full disk: one error line naming the file, exit non-zero, every file of the
     first run as it was (no truncated table, no 0-byte image or index), no temporary file."""
+    if args[0] == "report":
+        request.getfixturevalue("sketched_plots")
     if args[-1] == "t.parquet":
         pytest.importorskip("pyarrow")
     first = cli(*args, cwd=tmp_path)
@@ -211,37 +217,87 @@ def _report_cmd(out: Path) -> list[str]:
             "--engines", "none", "--jobs", "1", "--no-progress"]
 
 
-def test_ctrl_c_stops_the_report_and_keeps_every_earlier_file(tmp_path):
-    """SIGINT at five moments of a `report` run (imports, analysis, plots, files): each run stops
-    with exit 130 and one line, every file of the earlier run stays byte for byte, no
-    temporary file is left."""
+def _interrupt_when(cmd: list[str], out: Path, written: int) -> subprocess.Popen:
+    """Run `cmd` and send it SIGINT once `written` of its files have been begun in `out` (a
+    temporary file of this run holding data, or a file already renamed into place): a moment
+    inside the run, chosen by what it has done, not by the clock. (A signal between a temporary
+    file's creation and its registration leaves it behind: test_an_interrupt_as_the_temporary_
+    file_is_made_leaves_nothing.)"""
     env = {k: v for k, v in os.environ.items() if k != "KINETOSTAT_MODELS"}
-    out = tmp_path / "out"
-    t0 = time.perf_counter()
-    first = subprocess.run(_report_cmd(out), capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
-    took = time.perf_counter() - t0
+    inodes = {p: p.stat().st_ino for p in out.rglob("*")}
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=ROOT)
+    seen: set[str] = set()
+    while p.poll() is None:
+        for f in out.rglob("*"):
+            try:
+                if (f.name.startswith(".kinetostat-") and f.stat().st_size) or f.stat().st_ino != inodes.get(f):
+                    seen.add(f.name)
+            except FileNotFoundError:         # renamed or removed meanwhile
+                pass
+        if len(seen) >= written:
+            p.send_signal(signal.SIGINT)
+            break
+        time.sleep(0.001)
+    return p
+
+
+def _ctrl_c_trials(cmd: list[str], out: Path, moments: tuple[int, ...], enough: int = 0) -> int:
+    """SIGINT at each moment (files begun) of a rerun of `cmd` into `out`: every run that was
+    still going stops with exit 130 and no traceback, every file of the earlier run stays byte
+    for byte, no temporary file is left. Returns how many runs were stopped (at most `enough`
+    where given: the trials end there)."""
+    first = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=600)
     assert first.returncode == 0, first.stderr
     before = _files(out)
-    # the moments are taken after the interpreter has imported the command (a signal during
-    # Python's own start-up is Python's, not the run's), early enough that a run still goes on
-    t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-c", "import kinetostat.cli"], check=True, env=env, cwd=ROOT, timeout=300)
-    startup = time.perf_counter() - t0
     stopped = 0
-    for fraction in (0.1, 0.2, 0.3, 0.4, 0.55):
-        p = subprocess.Popen(_report_cmd(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-                             cwd=ROOT)
-        time.sleep(startup + fraction * max(took - startup, 0.0))
-        running = p.poll() is None
-        p.send_signal(signal.SIGINT)
-        _, err = p.communicate(timeout=300)
+    for written in moments:
+        p = _interrupt_when(cmd, out, written)
+        running = p.returncode is None
+        _, err = p.communicate(timeout=600)
         if running:
             stopped += 1
-            assert p.returncode in (130, -signal.SIGINT), (fraction, p.returncode, err)
+            assert p.returncode in (130, -signal.SIGINT), (written, p.returncode, err)
             assert "Traceback" not in err, err
-        assert _files(out) == before, fraction
-        assert _temporary(out) == [], fraction
-    assert stopped >= 3
+        assert _files(out) == before, written
+        assert _temporary(out) == [], written
+        if stopped == enough:
+            break
+    return stopped
+
+
+def test_ctrl_c_while_a_table_is_written_keeps_the_earlier_table(tmp_path):
+    """SIGINT while `analyze` writes a table (6 MB): exit 130, the earlier table as it was (up to
+    three tries, should a run finish before its temporary file is seen)."""
+    cmd = [sys.executable, "-m", "kinetostat", "analyze", str(ICE), "--steps", "5000", "--out",
+           str(tmp_path / "t.csv")]
+    assert _ctrl_c_trials(cmd, tmp_path, (1, 1, 1), enough=1) == 1
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_the_report_and_keeps_every_earlier_file(tmp_path):
+    """SIGINT at five moments of a `report` run (after 1 to 20 files begun): each run stops with
+    exit 130 and one line, every file of the earlier run stays byte for byte, no temporary file
+    is left."""
+    out = tmp_path / "out"
+    assert _ctrl_c_trials(_report_cmd(out), out, (1, 2, 5, 10, 20)) >= 3
+
+
+@pytest.mark.xfail(strict=True, reason="kinetostat._io.atomic: an interrupt right after mkstemp, before the "
+                   "try block, leaves the temporary file (seen by the Ctrl-C trials)")
+def test_an_interrupt_as_the_temporary_file_is_made_leaves_nothing(tmp_path, monkeypatch):
+    import tempfile
+
+    from kinetostat._io import atomic
+    real = tempfile.mkstemp
+
+    def interrupted(*args, **kwargs):
+        real(*args, **kwargs)
+        raise KeyboardInterrupt           # Ctrl-C as mkstemp returns
+    monkeypatch.setattr(tempfile, "mkstemp", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        with atomic(tmp_path / "a.md") as f:
+            f.write("new")
+    assert _temporary(tmp_path) == []
 
 
 def test_a_write_interrupted_removes_its_temporary_file(tmp_path):

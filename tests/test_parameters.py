@@ -282,7 +282,7 @@ def test_structure_prints_the_numbers_the_expressions_produced(cli):
     assert "  load[0].table.scale = pi / 4 * d**2 * p_max = 12063.71579" in r.stdout
 
 
-def test_the_report_prints_the_parameters_their_numbers_and_the_study(tmp_path):
+def test_the_report_prints_the_parameters_their_numbers_and_the_study(tmp_path, sketched_plots):
     pytest.importorskip("matplotlib")
     from kinetostat.report import run_validation, write_report
     mech = kinetostat.load(CHAIN)

@@ -13,7 +13,7 @@ import kinetostat
 import kinetostat.plans as P
 from kinetostat.plans.core import SEGMENT_COLUMNS
 
-from conftest import MODELS, ROOT
+from conftest import MODELS, ROOT, sampled
 
 SEED_002_SCALES = {"mu_l": 0.001, "mu_v": 0.2, "mu_a": 100.0, "mu_F": 50.0}
 
@@ -163,7 +163,7 @@ def test_svg_escapes_model_text():
     assert "<b>&" in "".join(root.itertext()) and "<script>" in "".join(root.itertext())
 
 
-@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+@pytest.mark.parametrize("path", sampled(MODELS))
 def test_figures_render(path, tmp_path):
     """Every plan of every bundled model, force plans and lever included, as a Figure (PNG) and as
     an SVG sheet."""

@@ -21,8 +21,8 @@ a spring, random g, speed, crank acceleration, sense, reference direction, and e
 machine drive. A drawn mechanism is kept only if the solver assembles it over a whole cycle
 without a SingularPositionWarning (`hypothesis.assume`).
 
-Number of examples per property and kind: `EXAMPLES` (hypothesis runs exactly that many valid
-examples unless it finds a failure); `RAN` counts them in a session.
+Number of examples per property and kind: `QUICK` by default, `EXAMPLES` with -m slow (hypothesis
+runs exactly that many valid examples unless it finds a failure); `RAN` counts them in a session.
 """
 from __future__ import annotations
 
@@ -39,19 +39,24 @@ from hypothesis import strategies as st
 import kinetostat
 from conftest import four_bar, kinetic_energy
 from kinetostat import AssemblyError, SingularPositionWarning
+from kinetostat.model import FASTEST_PIN
 from kinetostat.planar import cross, rotate
 
 KINDS = ["RRR", "RRP", "RPR", "PRP", "RPP", "RRR+RRP"]
 
-#: The drawn models are valid as the format documents them (a slider's points in its guide's frame,
-#: whatever the guide's direction): the loader's warnings for files that may mean otherwise are noise here.
-pytestmark = pytest.mark.filterwarnings("ignore::kinetostat.ModelWarning")
+#: The drawn models are plausible (metres, g near 9.81, RRR groups listed j < k, slider frames
+#: confirmed): a ModelWarning is a fault of the strategies.
+pytestmark = pytest.mark.filterwarnings("error::kinetostat.ModelWarning")
 
-#: Valid examples per property and per kind (6 kinds): 6 x (150 + 150 + 50 + 15 + 4) = 2214 checks
-#: on 6 x (150 + 50 + 15 + 4) = 1314 drawn mechanisms (equilibrium and lever share theirs).
-#: The 40-digit reference is slow (~0.15 s a mechanism): few random ones, plus the hand-made hard
-#: cases of HARD (near a toggle, extreme ratios) and every bundled model.
+#: Valid examples per property and per kind (6 kinds) with -m slow: 6 x (150 + 150 + 50 + 15 + 4) =
+#: 2214 checks on 6 x (150 + 50 + 15 + 4) = 1314 drawn mechanisms (equilibrium and lever share
+#: theirs). The 40-digit reference is slow (~0.15 s a mechanism): few random ones, plus the
+#: hand-made hard cases of HARD (near a toggle, extreme ratios) and every bundled model.
 EXAMPLES = {"equilibrium": 150, "lever": 150, "power": 50, "pinocchio": 15, "mpmath": 4}
+#: The sample of the default suite: 6 x (20 + 20 + 8 + 3 + 1) checks on 6 x 32 mechanisms.
+QUICK = {"equilibrium": 20, "lever": 20, "power": 8, "pinocchio": 3, "mpmath": 1}
+SIZES = {"quick": QUICK, "full": EXAMPLES}
+SIZE = pytest.mark.parametrize("size", ["quick", pytest.param("full", marks=pytest.mark.slow)])
 #: Identities that hold to rounding, relative to the cycle's peak force / moment.
 ROUNDING = 1e-9
 #: Power balance with dT/dphi by 9-point central differences at h = 5e-4 rad: truncation
@@ -129,10 +134,11 @@ class _Builder:
 
     def P(self, guide, slider, guide_point, direction, point):
         self.pairs.append({"kind": "P", "links": [guide, slider], "guide": guide_point,
-                           "direction": [float(x) for x in direction], "point": point})
+                           "direction": [float(x) for x in direction], "point": point,
+                           "slider_axis": [1.0, 0.0]})     # confirmed: points in the guide's frame
 
     def group(self, j, k):
-        self.groups.append({"links": [j, k], "branch": self.draw(st.sampled_from([1, -1]))})
+        self.groups.append({"links": sorted([j, k]), "branch": self.draw(st.sampled_from([1, -1]))})
 
     def model(self) -> dict:
         draw, s = self.draw, self.s
@@ -158,7 +164,8 @@ class _Builder:
         arm = np.subtract(self.links[1]["points"]["A"], self.links[1]["points"]["O"])
         drive = {"link": 1, "pivot": "O", "point": "A",
                  "reference": [x * _log(draw, 0.5, 2.0) for x in _dir(_u(draw, -math.pi, math.pi))],
-                 "sense": draw(st.sampled_from(["ccw", "cw"])), "rpm": _log(draw, 1.0, 3000.0)}
+                 "sense": draw(st.sampled_from(["ccw", "cw"])),
+                 "rpm": _log(draw, 1.0, min(3000.0, 0.9 * FASTEST_PIN / np.linalg.norm(arm) * 30 / math.pi))}
         w = drive["rpm"] * math.pi / 30
         drive["eps"] = _u(draw, -1.0, 1.0) * w**2 if draw(st.booleans()) else 0.0
         if draw(st.integers(0, 3)) == 0:
@@ -255,7 +262,7 @@ def _slotted(draw, b: _Builder, swinging: bool):
 def mechanism_dict(kind: str):
     @st.composite
     def build(draw):
-        s = _log(draw, 0.02, 5.0)
+        s = _log(draw, 0.02, 2.0)
         b = _Builder(draw, s)
         if kind == "RRR":
             _four_bar(draw, b)
@@ -442,7 +449,7 @@ def dead_centres(res) -> np.ndarray:
 
 # ----------------------------------------------------------------------------- properties
 
-def every_link_is_in_equilibrium(mech, res, kind) -> None:
+def every_link_is_in_equilibrium(mech, res, kind, size) -> None:
     F, M, peak, mscale = residuals(res)
     F0, L0 = load_scale(res)
     assume(F0 > 0)                   # everything massless and unloaded: nothing to check
@@ -450,10 +457,10 @@ def every_link_is_in_equilibrium(mech, res, kind) -> None:
     assert np.isfinite(res.forces.R).all() and np.isfinite(res.balancing_moment).all()
     assert np.max(np.abs(F), initial=0.0) <= ROUNDING * peak, (np.max(np.abs(F)) / peak)
     assert np.max(np.abs(M), initial=0.0) <= ROUNDING * mscale, (np.max(np.abs(M)) / mscale)
-    RAN["equilibrium", kind] += 1
+    RAN["equilibrium", kind, size] += 1
 
 
-def lever_equals_group_by_group(mech, res, kind) -> None:
+def lever_equals_group_by_group(mech, res, kind, size) -> None:
     # peak |M_bal|; where M_bal is a cancellation of much larger powers (e.g. a mass on the
     # crank pin, whose inertia force passes through the pivot) rounding follows those
     power = np.sum(np.abs((res.F_applied + res.F_i) * res.kin.v_origin), axis=-1) \
@@ -467,27 +474,31 @@ def lever_equals_group_by_group(mech, res, kind) -> None:
         e = np.asarray(mech.drive.gear.centre_direction)
         np.testing.assert_allclose(cross(mech.drive.gear.r_w * e, res.balancing_force),
                                    res.balancing_moment, rtol=0, atol=ROUNDING * peak)
-    RAN["lever", kind] += 1
+    RAN["lever", kind, size] += 1
 
 
+@SIZE
 @pytest.mark.parametrize("kind", KINDS)
-def test_equilibrium_and_lever(kind):
+def test_equilibrium_and_lever(kind, size):
+    examples = SIZES[size]
     """Every link in equilibrium, and Zhukovsky's lever equal to the group-by-group balancing
     moment, on the same drawn mechanisms (drawing, not checking, is most of the time)."""
-    @settings(max_examples=max(EXAMPLES["equilibrium"], EXAMPLES["lever"]), **_SETTINGS)
+    @settings(max_examples=max(examples["equilibrium"], examples["lever"]), **_SETTINGS)
     @given(valid(kind))
     def check(mr):
         mech, res = mr
-        lever_equals_group_by_group(mech, res, kind)
-        every_link_is_in_equilibrium(mech, res, kind)          # its assume() comes last
+        lever_equals_group_by_group(mech, res, kind, size)
+        every_link_is_in_equilibrium(mech, res, kind, size)    # its assume() comes last
     check()
 
 
+@SIZE
 @pytest.mark.parametrize("kind", KINDS)
-def test_power_balance(kind):
+def test_power_balance(kind, size):
+    examples = SIZES[size]
     """M_bal omega_1 + power of the applied loads = dT/dt, T by 9-point differences along the
     cycle (dT/dt = dT/dphi omega + 2 T eps / omega for a crank accelerating at eps)."""
-    @settings(max_examples=EXAMPLES["power"], **_SETTINGS)
+    @settings(max_examples=examples["power"], **_SETTINGS)
     @given(valid(kind), st.floats(0.0, 5.0))
     def check(mr, offset):
         mech, _ = mr
@@ -514,7 +525,7 @@ def test_power_balance(kind):
         scale = max(np.max(np.abs(P_drive)), np.max(np.abs(dT_dt)), np.max(np.abs(P_loads)),
                     dr.omega * np.max(T[0]), 1e-4 * dr.omega * T_coord, P_R)
         assert np.max(np.abs(residual)) <= POWER * scale, np.max(np.abs(residual)) / scale
-        RAN["power", kind] += 1
+        RAN["power", kind, size] += 1
     check()
 
 
@@ -543,15 +554,17 @@ def _peak_errors(M_ref, R_ref, M, R, scale=(0.0, 0.0)):
     return eM, eR
 
 
+@SIZE
 @pytest.mark.parametrize("kind", KINDS)
-def test_agrees_with_pinocchio(kind):
+def test_agrees_with_pinocchio(kind, size):
+    examples = SIZES[size]
     try:
         from kinetostat_validation.engine_pinocchio import solve
         from kinetostat_validation.scene import build_scene
     except ImportError as exc:          # the adapter is not there (or pinocchio is not installed)
         pytest.skip(f"Pinocchio adapter not importable: {exc}")
 
-    @settings(max_examples=EXAMPLES["pinocchio"], **_SETTINGS)
+    @settings(max_examples=examples["pinocchio"], **_SETTINGS)
     @given(valid(kind))
     def check(mr):
         mech, _ = mr
@@ -560,15 +573,17 @@ def test_agrees_with_pinocchio(kind):
         eM, eR = _peak_errors(scene.res.balancing_moment, scene.res.forces.R, er.M_drive, er.R,
                               load_scale(scene.res))
         assert eM <= PINOCCHIO and eR <= PINOCCHIO, (eM, eR)
-        RAN["pinocchio", kind] += 1
+        RAN["pinocchio", kind, size] += 1
     check()
 
 
+@SIZE
 @pytest.mark.parametrize("kind", KINDS)
-def test_agrees_with_mpmath_reference(kind):
+def test_agrees_with_mpmath_reference(kind, size):
+    examples = SIZES[size]
     from kinetostat_validation.reference import reference
 
-    @settings(max_examples=EXAMPLES["mpmath"], **_SETTINGS)
+    @settings(max_examples=examples["mpmath"], **_SETTINGS)
     @given(valid(kind), st.floats(0.0, 30.0))
     def check(mr, offset):
         mech, _ = mr
@@ -579,14 +594,14 @@ def test_agrees_with_mpmath_reference(kind):
         assume(np.isfinite(M_ref).any())
         eM, eR = _peak_errors(M_ref, R_ref, res.balancing_moment, res.forces.R, load_scale(res))
         assert eM <= MPMATH and eR <= MPMATH, (eM, eR)
-        RAN["mpmath", kind] += 1
+        RAN["mpmath", kind, size] += 1
     check()
 
 
 def test_example_counts():
     """Every property that ran in this session ran its full number of valid examples."""
-    for (prop, kind), n in RAN.items():
-        assert n >= EXAMPLES[prop], (prop, kind, n)
+    for (prop, kind, size), n in RAN.items():
+        assert n >= SIZES[size][prop], (prop, kind, size, n)
 
 
 # A massless crank-slider (g = 0) whose slider carries a pure moment: the frame's guide must

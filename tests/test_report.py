@@ -38,35 +38,44 @@ def _report(out: Path, *args: str) -> subprocess.CompletedProcess:
 
 
 @pytest.fixture(scope="module")
-def reports(tmp_path_factory) -> tuple[Path, Path]:
-    """The same two reports written twice: in parallel (into a folder holding a stale report of
-    an earlier run) and in this process."""
-    parallel, serial = tmp_path_factory.mktemp("parallel"), tmp_path_factory.mktemp("serial")
+def ice_report(tmp_path_factory) -> Path:
+    """Two reports written by two worker processes into a folder holding a stale report of an
+    earlier run."""
+    parallel = tmp_path_factory.mktemp("parallel")
     stale = parallel / "stale_model"
     stale.mkdir()
     (stale / "summary.json").write_text(json.dumps(dict(stem="stale_model", name="stale", formula="x",
                                                         passed=True, checks=1, routes={}, published=None)))
     r = _report(parallel, "--jobs", "2")
     assert "ice_crank_slider" in r.stdout and "slotted_link_shaper" in r.stdout and "PASS" in r.stdout
-    _report(serial, "--jobs", "1")
-    return parallel, serial
+    return parallel
 
 
-@pytest.fixture(scope="module")
-def ice_report(reports) -> Path:
-    return reports[0]
-
-
-def test_reruns_are_byte_identical_and_jobs_do_not_matter(reports):
+@pytest.mark.slow
+def test_reruns_are_byte_identical_and_jobs_do_not_matter(ice_report, tmp_path):
     """No date, run time or process-dependent byte in any file: a second run (here in one process
     instead of two workers) reproduces every file exactly."""
-    parallel, serial = reports
+    serial = tmp_path / "serial"
+    _report(serial, "--jobs", "1")
     files = sorted(p.relative_to(serial) for p in serial.rglob("*") if p.is_file())
+    for f in files:
+        assert (ice_report / f).read_bytes() == (serial / f).read_bytes(), f
     plans = {m: len(kinetostat.plans.build(kinetostat.load(p))) for m, p in (("ice", ICE), ("shaper", SHAPER))}
     # the index; ice: 5 png, md, html, csv, json, a png per plan, segments.csv, worksheet.csv; the shaper + 1 png
     assert len(files) == 2 + (9 + plans["ice"] + 2) + (10 + plans["shaper"] + 2)
+
+
+def test_a_rerun_writes_the_same_text_files(tmp_path, sketched_plots):
+    """The sample of the above: the text files of a four-bar's report (Markdown, HTML, tables,
+    summary), written twice, are the same bytes (the PNGs' own reruns: -m slow)."""
+    p = tmp_path / "four_bar.toml"
+    p.write_text(FOUR_BAR)
+    for out in ("a", "b"):
+        write_report(run_validation(kinetostat.load(p), [], steps=12, path=p), tmp_path / out)
+    files = sorted(f.relative_to(tmp_path / "a") for f in (tmp_path / "a").rglob("*") if f.is_file())
+    assert {f.suffix for f in files} >= {".md", ".html", ".csv", ".json"}
     for f in files:
-        assert (parallel / f).read_bytes() == (serial / f).read_bytes(), f
+        assert (tmp_path / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes(), f
 
 
 def test_report_files(ice_report):
@@ -106,7 +115,7 @@ def test_verdict_failed_checks_and_contents_on_top(ice_report):
     assert hrefs == [a for _, a in toc] == ids
 
 
-def test_failed_checks_are_listed(tmp_path):
+def test_failed_checks_are_listed(tmp_path, sketched_plots):
     """A solver answer that is wrong on purpose: the report says FAIL and names the checks."""
     from dataclasses import replace
     mech = kinetostat.load(ICE)
@@ -185,7 +194,7 @@ def test_index_lists_only_this_run(ice_report):
     assert 'href="ice_crank_slider/index.html"' in html and "stale" not in html
 
 
-def test_report_of_a_model_without_published_values(tmp_path):
+def test_report_of_a_model_without_published_values(tmp_path, sketched_plots):
     p = tmp_path / "four_bar.toml"
     p.write_text(FOUR_BAR)
     mech = kinetostat.load(p)
@@ -212,7 +221,7 @@ def test_published_values_agree(path):
     assert rows and all(r.passed for r in rows), [(r.entry.symbol, r.difference) for r in rows if not r.passed]
 
 
-def test_model_strings_cannot_inject_html_or_links(tmp_path):
+def test_model_strings_cannot_inject_html_or_links(tmp_path, sketched_plots):
     """A model's name is text: markdown-it (raw HTML off) escapes tags; no javascript: link."""
     p = tmp_path / "evil.toml"
     p.write_text(FOUR_BAR.replace('name = "test four-bar"',

@@ -13,6 +13,9 @@ import kinetostat
 from conftest import ROOT
 from test_properties import KINDS, _SETTINGS, _peak_errors, load_scale, valid
 
+#: The drawn mechanisms are plausible (as in test_properties): no ModelWarning.
+pytestmark = pytest.mark.filterwarnings("error::kinetostat.ModelWarning")
+
 #: Both routes are exact: they agree to rounding, relative to the peak (as test_properties).
 ROUNDING = 1e-9
 MODELS = sorted((ROOT / "models").glob("*.toml"))
@@ -43,9 +46,10 @@ def test_bundled_models_agree_with_the_group_route(path):
         np.testing.assert_allclose(vw.balancing_force, res.balancing_force, rtol=0, atol=ROUNDING * peak)
 
 
+@pytest.mark.parametrize("examples", [8, pytest.param(25, marks=pytest.mark.slow)])
 @pytest.mark.parametrize("kind", KINDS)
-def test_random_mechanisms_agree_with_the_group_route(kind):
-    @settings(max_examples=25, **_SETTINGS)
+def test_random_mechanisms_agree_with_the_group_route(kind, examples):
+    @settings(max_examples=examples, **_SETTINGS)
     @given(valid(kind))
     def check(mr):
         mech, res = mr
