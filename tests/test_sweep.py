@@ -225,3 +225,43 @@ def test_a_large_sweep_runs_the_compiled_kernel_and_equals_the_loop_of_analyze()
         got = row[[f"peak_R_{p.links[0]}_{p.links[1]}" for p in res.mech.pairs]].astype(float).to_numpy()
         np.testing.assert_allclose(got, R, rtol=1e-13, atol=0)
         assert abs(row["peak_M_bal"] - np.abs(res.balancing_moment).max()) <= 1e-13 * max(np.abs(res.balancing_moment).max(), 1.0)
+
+
+
+@pytest.mark.parametrize("designs", [[0.6], [0.6, 0.9]])
+def test_failing_designs_keep_their_rows_on_the_compiled_path(monkeypatch, designs):
+    """The compiled path (fast.FAST_MIN lowered to 0) with designs that cannot be assembled: each
+    keeps its row with the reason, and each is tried once alone after its chunk failed (once a
+    RecursionError: a failing design was retried by itself, forever). The kernel's stand-in
+    raises what the kernel raises, the AssemblyError of the first design that fails (the real
+    kernel: the slow test below)."""
+    from kinetostat import fast
+    monkeypatch.setattr(fast, "FAST_MIN", 0)
+    calls = []
+
+    def peaks(mechs, phi_deg):
+        calls.append(len(mechs))
+        with monkeypatch.context() as numpy_path:       # analyze itself on its numpy path
+            numpy_path.setattr(fast, "FAST_MIN", 10**9)
+            for m in mechs:
+                kinetostat.analyze(m, phi_deg=phi_deg)
+        raise AssertionError("every design here fails")
+    monkeypatch.setattr(fast, "peaks", peaks)
+    sw = kinetostat.sweep(CHAIN, {"r": designs}, steps=36)
+    assert calls == ([1] if len(designs) == 1 else [2, 1, 1])     # the chunk, then each design once
+    for _, bad in sw.table.iterrows():
+        assert bad["error"].startswith("AssemblyError: group II(2,3) cannot be assembled")
+        assert bad[PEAKS].isna().all()
+
+
+@pytest.mark.slow
+def test_a_failing_design_beside_a_good_one_in_the_compiled_kernel(monkeypatch):
+    """The issue's reproducer in small: the real kernel, r = 0.08 m (assembles) and 0.6 m (does not)."""
+    from kinetostat import fast
+    monkeypatch.setattr(fast, "FAST_MIN", 0)
+    sw = kinetostat.sweep(CHAIN, {"r": [0.08, 0.6]}, steps=36)
+    ok, bad = sw.table.iloc[0], sw.table.iloc[1]
+    assert bad["error"].startswith("AssemblyError: group II(2,3) cannot be assembled") and bad[PEAKS].isna().all()
+    ref = _loop_peaks({"r": [0.08]}, 36)
+    assert ok["error"] == ""
+    np.testing.assert_allclose(ok[PEAKS].astype(float).to_numpy(), [ref[c][0] for c in PEAKS], rtol=1e-13)
