@@ -1,10 +1,12 @@
 """The command line: `kinetostat analyze | structure | plans | validate | report | export | examples | variant | sweep`
 (also `python -m kinetostat`).
 
-Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
-nothing to compare, or `report` could not make a model's report; 2 bad input or options (model
-file, structure, assembly, angles, engine names, output path, stdout that cannot be written);
-130 interrupted (Ctrl-C). Expected problems print one `kinetostat: error: ...` line (a model
+Exit codes: 0 success; 1 `validate` found a check beyond tolerance or a route that raised, or
+`report` could not make a model's report; 2 bad input or options (model file, structure,
+assembly, angles, engine names, output path, stdout that cannot be written); 3 `validate`: no
+failure, but a model that nothing checked (every route skipped, no published values); 130
+interrupted (Ctrl-C). `sweep` exits 0 once its table is written, also where designs failed
+(each keeps its row with the reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model
 file's problem list prints one line per problem) and never a traceback; warnings print one line
 each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
 disk leaves the previous file as it was.
@@ -29,7 +31,7 @@ from typing import IO, Callable, Iterator, Sequence
 
 from ._io import atomic, unique_names
 
-EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
 
 __all__ = ["main", "build_parser", "exit_code", "bundled_models", "CLIError"]
@@ -568,14 +570,29 @@ def cmd_structure(args) -> int:
 # ============================================================================ validate
 
 def exit_code(runs) -> int:
-    """The exit code of `validate` for these ModelRuns: 1 if a check (a route's error or a
-    published value) failed, a route raised, or no check ran at all (every route skipped and no
-    published value); else 0."""
-    if not runs or any(not r.passed for r in runs):
+    """The exit code of `validate` for these ModelRuns: 1 (EXIT_FAIL) if a check (a route's error
+    or a published value) failed or a route raised; else 3 (EXIT_NOT_CHECKED) if a model, or the
+    run, has no check at all (every route skipped, no published value); else 0."""
+    if any(not r.passed for r in runs):
         return EXIT_FAIL
-    if not any(r.checks for r in runs):
-        return EXIT_FAIL
+    if not runs or any(not r.checks for r in runs):
+        return EXIT_NOT_CHECKED
     return EXIT_OK
+
+
+def _coverage(run) -> str:
+    """One line for people: what checked this model (routes with their number of quantities,
+    the published values) and what was skipped, and why."""
+    from .report.runs import PUBLISHED_ROUTE as PUBLISHED
+    done = [f"{route} ({n} quantities)" for route in run.engines
+            if (n := sum(c.route == route for c in run.checks))]
+    if run.published:
+        done.append(f"{PUBLISHED} ({len(run.published)} values)")
+    skipped = [f"{route} ({why})" for route, why in run.skipped.items()]
+    if not run.published and PUBLISHED not in run.errors:
+        skipped.append(f"{PUBLISHED} (the model has no [[published]] values)")
+    return (f"  checked by: {', '.join(done) or 'nothing'}"
+            + (f"; not checked by: {'; '.join(skipped)}" if skipped else ""))
 
 
 def validation_table(run) -> str:
@@ -603,7 +620,8 @@ def validation_table(run) -> str:
             lines.append(f"  {route:<11s} {c.quantity:<{w}s} {err:>12s} {tol:>9s} "
                          f"{c.max_abs:11.3e} {c.unit:<3s}  {'PASS' if c.passed else 'FAIL'}{extra}")
     n, f = len(checks), sum(not c.passed for c in checks)
-    verdict = "PASS" if run.passed and n else "FAIL" if not run.passed else "NOT CHECKED"
+    verdict = "PASS" if run.passed and n else "FAIL" if not run.passed else "NOT CHECKED (nothing compared)"
+    lines.append(_coverage(run))
     lines.append(f"  => {verdict}: {n} checks ({len(run.published)} published values), {f} failed, "
                  f"{len(run.skipped)} route(s) skipped, {len(run.errors)} with errors")
     return "\n".join(lines)
@@ -638,9 +656,12 @@ def cmd_validate(args) -> int:
     n_err = sum(len(run.errors) for run in runs)
     n_skip = sum(len(run.skipped) for run in runs)
     code = exit_code(runs)
+    unchecked = [run.stem for run in runs if not run.checks]
     _Out.write(f"validate: {len(runs)} model(s), {len(checks)} checks ({n_pub} published values): "
                f"{len(checks) - n_fail} passed, {n_fail} FAILED; {n_err} route error(s), {n_skip} route(s) skipped; "
-               f"{time.perf_counter() - t0:.1f} s" + ("" if code == EXIT_OK else " -> FAIL"), err=err)
+               f"{len(unchecked)} model(s) NOT CHECKED{': ' + ', '.join(unchecked) if unchecked else ''}; "
+               f"{time.perf_counter() - t0:.1f} s"
+               + {EXIT_OK: "", EXIT_FAIL: " -> FAIL", EXIT_NOT_CHECKED: " -> NOT CHECKED (exit 3)"}[code], err=err)
     if not checks:
         _error("nothing was checked: every route was skipped or raised, and no model has published values")
     if to_json is not None:
@@ -1096,9 +1117,11 @@ def build_parser() -> argparse.ArgumentParser:
                                    "the solver's balancing moment and every reaction over the cycle with each "
                                    "route (the engines, and 'reference': a 40-digit mpmath re-solution that needs "
                                    "no engine), check the model's published values ([[published]] tables), and "
-                                   "print route, quantity, error, tolerance and PASS/FAIL. Routes whose engine is "
-                                   "not installed are SKIPPED. Exit code 1 when any check fails, a route raises, "
-                                   "or nothing was checked.")
+                                   "print route, quantity, error, tolerance and PASS/FAIL, and per model what checked it "
+                                   "and what did not, and why. Routes whose engine is not installed (or that cannot "
+                                   "check a model) are SKIPPED, never passed. Exit code 0: every model checked and "
+                                   "every check passed; 1: a check failed or a route raised; 3: no failure, but a "
+                                   "model that nothing checked (NOT CHECKED).")
     v.add_argument("models", metavar="MODEL", nargs="*",
                    help="model files or bundled models' names (default: every bundled model, see 'kinetostat examples')")
     v.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")

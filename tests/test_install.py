@@ -1,0 +1,100 @@
+"""Every install runs every command it offers, and `validate` says what it did not check.
+
+Default: `validate`'s statement per model (what checked it, what did not and why) and its exit
+code 3 for a model that nothing checked. Slow: the wheel installed WITHOUT extras into a fresh
+venv runs analyze, structure, plans, variant, sweep (in process, CSV) and validate --engines none."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+from conftest import FOUR_BAR, ROOT
+from kinetostat.cli import EXIT_NOT_CHECKED, EXIT_OK
+
+ICE = ROOT / "models" / "ice_crank_slider.toml"
+
+
+@pytest.fixture
+def absent_route(monkeypatch):
+    """A route "absent" whose engine package is not installed (so every model skips it)."""
+    from kinetostat_validation import compare as cmp
+    monkeypatch.setitem(cmp.ROUTES, "absent", ("no_such_engine_pkg", None))
+    monkeypatch.setitem(cmp.TOLERANCES, "absent", cmp.Tolerance(1e-9, "test"))
+    return "absent"
+
+
+def test_a_model_nothing_checked_is_not_checked_exit_3(cli, tmp_path, absent_route):
+    """The ICE model has 15 published values (checked); the four-bar has none and its only route
+    is skipped: it is NOT CHECKED (never a pass), the run exits 3, and the JSON says the same."""
+    (tmp_path / "four_bar.toml").write_text(FOUR_BAR)
+    r = cli("validate", ICE, tmp_path / "four_bar.toml", "--engines", absent_route, "--steps", "12",
+            "--json", tmp_path / "v.json", "--no-progress")
+    assert r.returncode == EXIT_NOT_CHECKED == 3, r.stderr
+    blocks = r.stdout.split("== ")
+    ice, four = blocks[1], blocks[2]
+    assert "checked by: published (15 values); not checked by: absent (" in ice and "=> PASS" in ice
+    assert "checked by: nothing; not checked by: absent (" in four
+    assert "published (the model has no [[published]] values)" in four
+    assert "=> NOT CHECKED" in four and "PASS" not in four
+    assert "1 model(s) NOT CHECKED: four_bar" in r.stdout
+    doc = json.loads((tmp_path / "v.json").read_text())
+    assert doc["exit_code"] == 3 and not doc["passed"] and doc["totals"]["not_checked"] == 1
+    assert [m["status"] for m in doc["models"]] == ["passed", "not checked"]
+
+
+def test_every_model_checked_exits_0_and_names_its_routes(cli):
+    r = cli("validate", ICE, "--engines", "none", "--steps", "12", "--no-progress")
+    assert r.returncode == EXIT_OK, r.stderr
+    assert "checked by: reference (9 quantities), published (15 values)" in r.stdout
+    assert "0 model(s) NOT CHECKED" in r.stdout
+
+
+# ----------------------------------------------------------------------------- the wheel, no extras
+
+def _venv_without_extras(tmp: Path) -> Path:
+    """A fresh venv with the wheel built from this checkout installed, no extras; its bin/."""
+    dist = tmp / "dist"
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", dist, ROOT],
+                   check=True, timeout=600)
+    wheel = next(dist.glob("kinetostat-*.whl"))
+    env_dir = tmp / "venv"
+    venv.create(env_dir, with_pip=True)
+    py = env_dir / "bin" / "python"
+    subprocess.run([py, "-m", "pip", "install", "-q", wheel], check=True, timeout=900)
+    return env_dir / "bin"
+
+
+@pytest.mark.slow
+def test_the_wheel_without_extras_runs_every_command(tmp_path):
+    bindir = _venv_without_extras(tmp_path)
+    py = bindir / "python"
+    missing = subprocess.run([py, "-c", "import importlib.util as u; print([m for m in ('matplotlib', 'tqdm', "
+                              "'dask', 'pyarrow', 'pytest', 'pinocchio', 'mujoco', 'pymunk') if u.find_spec(m)])"],
+                             capture_output=True, text=True, check=True).stdout.strip()
+    assert missing == "[]", f"the venv has extras installed: {missing}"
+    work = tmp_path / "work"
+    work.mkdir()
+    env = {k: v for k, v in os.environ.items() if k not in ("KINETOSTAT_MODELS", "PYTHONPATH")}
+    commands = [
+        ["analyze", "ice_crank_slider", "--at", "30"],
+        ["analyze", "chain_unit_four_bar", "--steps", "36", "--out", "cycle.csv"],
+        ["structure", "slotted_link_shaper"],
+        ["plans", "ice_crank_slider", "--out", "plans"],
+        ["variant", "1", "479", "--out", "key_479"],
+        ["sweep", "chain_unit_four_bar", "--param", "r=0.05,0.08", "--steps", "36", "--out", "sweep.csv"],
+        ["validate", "--engines", "none", "--steps", "36", "--no-progress"],
+    ]
+    for args in commands:
+        r = subprocess.run([bindir / "kinetostat", *args], capture_output=True, text=True, cwd=work, env=env,
+                           timeout=600)
+        assert r.returncode == 0, (args, r.stdout[-2000:], r.stderr[-2000:])
+        assert "Traceback" not in r.stderr, (args, r.stderr[-2000:])
+    assert (work / "plans" / "worksheet.html").is_file() and (work / "key_479" / "worksheet.html").is_file()
+    assert (work / "key_479" / "cycle.csv").is_file() and (work / "sweep.csv").is_file()
+    assert "0 model(s) NOT CHECKED" in r.stdout and " 0 FAILED" in r.stdout
