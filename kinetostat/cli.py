@@ -460,25 +460,6 @@ def _summary(res, path: Path) -> list[str]:
     return lines
 
 
-def _write_json(df, f: IO) -> None:
-    """Records (one object per crank position), floats as Python writes them, NaN as null."""
-    import json
-
-    import numpy as np
-
-    def plain(x):
-        if isinstance(x, (np.bool_, bool)):
-            return bool(x)
-        if isinstance(x, (np.integer, int)):
-            return int(x)
-        x = float(x)
-        return x if math.isfinite(x) else None
-
-    records = [{k: plain(v) for k, v in zip(df.columns, row)} for row in df.itertuples(index=False, name=None)]
-    json.dump(records, f, indent=1, allow_nan=False)
-    f.write("\n")
-
-
 def _worksheet_lines(mech, phi: float) -> list[str]:
     """The worksheet's kinematic and inertia values at one position, as a student compares them."""
     import warnings
@@ -515,17 +496,14 @@ def cmd_analyze(args) -> int:
     if len(res.phi_deg) == 1:
         lines += _worksheet_lines(mech, float(res.phi_deg[0]))
     if out is not None:
+        from . import tables
         df = res.to_frame()
         if out == "-":
-            _Out.write(df.to_csv(index=False).rstrip("\n"))
+            _Out.write(tables.csv_text(df).rstrip("\n"))
         else:
             suffix = Path(out).suffix.lower()
-            if suffix == ".csv":
-                _save(out, "--out", lambda f: df.to_csv(f, index=False))
-            elif suffix == ".json":
-                _save(out, "--out", lambda f: _write_json(df, f))
-            else:
-                _save(out, "--out", lambda f: df.to_parquet(f, index=False), binary=True)
+            write = {".csv": tables.write_csv, ".json": tables.write_json}.get(suffix, tables.write_parquet)
+            _save(out, "--out", lambda f: write(df, f), binary=suffix == ".parquet")
             lines.append(f"table: {len(df)} rows x {len(df.columns)} columns -> {out}")
     else:
         lines.append("(the full table: --out FILE.csv | FILE.parquet | FILE.json)")
@@ -1008,11 +986,12 @@ def _range(start: float, stop: float, step: float) -> list[float]:
 
 def _table_writer(out: str):
     """How `--out` is written, by its suffix: (write(df, file), binary)."""
+    from . import tables
     suffix = Path(out).suffix.lower()
     if suffix == ".csv":
-        return (lambda df, f: df.to_csv(f, index=False)), False
+        return tables.write_csv, False
     if suffix == ".parquet":
-        return (lambda df, f: df.to_parquet(f, index=False)), True
+        return tables.write_parquet, True
     raise CLIError(f"--out {out}: unknown table format {suffix or '(no suffix)'!r}; use .parquet or .csv")
 
 

@@ -19,6 +19,7 @@ from ..model import Mechanism
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from ..sweep import sweep
+from ..tables import error, write_csv
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
 from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
@@ -378,7 +379,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
             "hodographs": plot_hodographs(run, d / "hodographs.png"),
         }
     with atomic(d / "cycle.csv") as f:
-        res.to_frame().to_csv(f, index=False)
+        write_csv(res.to_frame(), f)
 
     N = len(res.phi_deg)
     routes = list(run.engines)
@@ -468,14 +469,20 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
 
     summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N,
                    passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
-                   routes={r: dict(status=run.status(r), worst=run.worst(r),
+                   routes={r: dict(status=run.status(r), worst=_worst(run, r),
                                    tolerance=_tolerance(run, r).peak_relative if _tolerance(run, r) else None,
                                    why=run.skipped.get(r) or run.errors.get(r)) for r in routes},
                    published=None if not published else dict(
                        n=len(published), within=sum(c.passed for c in published),
-                       worst_percent=max((100 * c.error for c in published if not c.by_angle), default=None)))
+                       worst_percent=error(max((100 * c.error for c in published if not c.by_angle), default=float("nan")))))
     write_text(d / "summary.json", json.dumps(_clean(summary), indent=1, allow_nan=False) + "\n")
     return _clean(summary)
+
+
+def _worst(run: ModelRun, route: str) -> float | None:
+    """The route's worst peak-relative error to `ERROR_DIGITS` (`kinetostat.tables.error`)."""
+    w = run.worst(route)
+    return None if w is None else error(w)
 
 
 def _clean(x):
