@@ -171,7 +171,14 @@ class Analysis:
     @property
     def balancing_force(self) -> np.ndarray:
         """(N, 2) working machine: balancing force of the pinion on the crank's gear at the
-        pitch point, on the line of action, N. Zeros for an engine."""
+        pitch point, on the line of action, N. An engine has none (its drive applies the couple
+        `balancing_moment`): AttributeError with that reason, so `hasattr(res, "balancing_force")`
+        is False (never a force of 0 N)."""
+        if self.mech.drive.kind != "machine":
+            raise AttributeError(f"balancing_force: {_abbreviate(self.mech.name)!r} is an engine (drive.kind = "
+                                 f"'{self.mech.drive.kind}'): its drive applies the couple balancing_moment (N m) to "
+                                 f"the crank, no force; only a working machine (a gear mesh, drive.kind = 'machine') "
+                                 f"has a balancing force")
         return self.forces.F_bal
 
     @property

@@ -98,3 +98,24 @@ def test_the_wheel_without_extras_runs_every_command(tmp_path):
     assert (work / "plans" / "worksheet.html").is_file() and (work / "key_479" / "worksheet.html").is_file()
     assert (work / "key_479" / "cycle.csv").is_file() and (work / "sweep.csv").is_file()
     assert "0 model(s) NOT CHECKED" in r.stdout and " 0 FAILED" in r.stdout
+
+
+# ----------------------------------------------------------------------------- quick fixes a new user meets
+
+def test_an_engine_has_no_balancing_force_and_says_why(ice):
+    """ice_crank_slider is an engine: no silent zeros, an AttributeError naming the moment instead."""
+    with pytest.raises(AttributeError, match=r"is an engine .*balancing_moment \(N m\)"):
+        ice.balancing_force
+    assert not hasattr(ice, "balancing_force") and "F_bal" not in ice.to_frame().columns
+
+
+def test_a_machine_has_its_balancing_force():
+    import numpy as np
+
+    import kinetostat
+    res = kinetostat.analyze(kinetostat.load("compressor"), phi_deg=[30.0])
+    F = res.balancing_force
+    gear = res.mech.drive.gear
+    r = gear.r_w * np.asarray(gear.centre_direction)
+    assert F.shape == (1, 2) and np.hypot(*F[0]) > 0
+    assert abs(r[0] * F[0, 1] - r[1] * F[0, 0] - res.balancing_moment[0]) <= 1e-12 * abs(res.balancing_moment[0])
