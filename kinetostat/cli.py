@@ -845,6 +845,8 @@ def cmd_plans(args) -> int:
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
+    if args.at is not None and plans.at != args.at:
+        _warn(f"--at {args.at:g} is outside [0, 360) deg: taken modulo 360 as {plans.at:g} deg (the same crank position)")
     try:
         written = plans.write(out, lang=args.lang)
         if sheet is not None:
