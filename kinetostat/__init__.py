@@ -15,8 +15,8 @@ The solver's public names. May use: the solver modules only (never the harness
 """
 from . import examples, plans, variants
 from .analysis import Analysis, InertiaLoad, analyze
-from .errors import (AngleWarning, AssemblyError, ModelError, ModelFileNotFound, ModelWarning,
-                     SingularPositionWarning, StructureError)
+from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning, SingularPositionWarning,
+                     StructureError)
 from .kinematics import COND_CHECK, COND_MAX, DIGITS_MIN, DIGITS_WARN
 from .model import Mechanism, from_dict, load, loads
 from .structure import AssurGroup, Structure
@@ -25,6 +25,6 @@ from .virtual_work import VirtualWork, virtual_work
 
 __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
-           "AssemblyError", "SingularPositionWarning", "AngleWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
+           "AssemblyError", "SingularPositionWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "examples", "plans", "variants", "sweep", "Sweep"]
 __version__ = "0.1.0"

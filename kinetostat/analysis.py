@@ -1,10 +1,9 @@
 """`analyze(mech, phi_deg)`: the whole kinetostatic analysis as one frozen result object.
 
-May use: model, errors, groups, kinematics, kinetostatics, applied, planar, fast; pandas only inside `to_frame`.
+May use: model, groups, kinematics, kinetostatics, applied, planar, fast; pandas only inside `to_frame`.
 """
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, fields, replace
 from types import MappingProxyType
 from typing import Mapping, NamedTuple
@@ -17,7 +16,6 @@ from .kinetostatics import Forces, forces, friction_power, lever_moment
 from . import groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, dot_z
-from .errors import AngleWarning
 from .model import Mechanism, _abbreviate
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "analyze", "exact", "crank_angles", "FRAME_NOTE", "deviation",
@@ -420,10 +418,11 @@ class Analysis:
 
 
 def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
-    """The crank angles asked for, deg, as a read-only (N,) copy in [0, 360): `phi_deg`
-    (array-like), or `steps` equal steps over a full revolution when it is None. ValueError
-    naming the argument. An angle outside [0, 360) is taken modulo 360 (the same position of
-    the crank), and an `AngleWarning` lists those angles and what they became."""
+    """The crank angles asked for, deg, as a read-only (N,) copy: `phi_deg` (array-like), or
+    `steps` equal steps over a full revolution when it is None. ValueError naming the argument.
+    Any finite angle is accepted as given: an angle outside [0, 360) is the crank position of
+    that angle modulo 360 (a run over several turns, a finite difference across 0 keep their
+    angle axis); the command line takes a typed angle modulo 360 and says so."""
     if phi_deg is None:
         if not isinstance(steps, (int, np.integer)) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps: expected a positive integer, got {steps!r}")
@@ -434,15 +433,6 @@ def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
         raise ValueError(f"phi_deg: expected finite crank angles in degrees, got {phi_deg!r}") from None
     if phi_deg.ndim != 1 or not np.isfinite(phi_deg).all():
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
-    outside = (phi_deg < 0.0) | (phi_deg >= 360.0)
-    if outside.any():
-        turned = np.mod(phi_deg, 360.0)
-        turned[turned == 360.0] = 0.0                   # -1e-20 % 360 rounds to 360
-        pairs = [f"{a:g} -> {b:g}" for a, b in zip(phi_deg[outside][:6], turned[outside][:6])]
-        more = f", ... ({int(outside.sum())} angles in all)" if outside.sum() > 6 else ""
-        warnings.warn(f"phi_deg outside [0, 360) deg taken modulo 360 (the same crank position): "
-                      f"{', '.join(pairs)}{more}", AngleWarning, stacklevel=3)
-        phi_deg = turned + 0.0                         # -0.0 as 0.0
     phi_deg.flags.writeable = False
     return phi_deg
 

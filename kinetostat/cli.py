@@ -183,6 +183,20 @@ def _angle(text: str) -> float:
     return x
 
 
+def _turn(deg, option: str):
+    """Typed crank angle(s) (a float, a list, or None) in [0, 360): one outside is the same crank
+    position as the angle modulo 360 and is taken so, with a warning line naming it."""
+    if deg is None:
+        return None
+    many = isinstance(deg, list)
+    given = deg if many else [deg]
+    taken = [x % 360.0 if x % 360.0 != 360.0 else 0.0 for x in given]      # -1e-20 % 360 rounds to 360
+    moved = [f"{a:g} -> {b:g}" for a, b in zip(given, taken) if a != b]
+    if moved:
+        _warn(f"{option}: angles outside [0, 360) deg taken modulo 360 (the same crank position): {', '.join(moved)}")
+    return taken if many else taken[0]
+
+
 def _positive(what: str, example: str):
     """An argparse type: a positive integer, or an error naming `what` with an example."""
     def parse(text: str) -> int:
@@ -491,7 +505,7 @@ def cmd_analyze(args) -> int:
         _writable_file(out, "--out")
     path = Path(args.model)
     mech = _load(path)
-    res, _ = _analyze(mech, path, phi_deg=args.at, steps=args.steps)
+    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps)
     lines = _summary(res, path)
     if len(res.phi_deg) == 1:
         lines += _worksheet_lines(mech, float(res.phi_deg[0]))
@@ -838,6 +852,7 @@ def cmd_plans(args) -> int:
     mech = _load(path)
     out = _writable_dir(args.out, "--out")
     only = [n for group in (args.only or []) for n in group] or None
+    args.at, args.starting = _turn(args.at, "--at"), _turn(args.starting, "--starting")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -845,8 +860,6 @@ def cmd_plans(args) -> int:
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
-    if args.at is not None and plans.at != args.at:
-        _warn(f"--at {args.at:g} is outside [0, 360) deg: taken modulo 360 as {plans.at:g} deg (the same crank position)")
     try:
         written = plans.write(out, lang=args.lang)
         if sheet is not None:

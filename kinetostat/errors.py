@@ -10,7 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 __all__ = ["ModelError", "ModelFileNotFound", "ModelWarning", "AssemblyError", "StructureError",
-           "SingularPositionWarning", "AngleWarning"]
+           "SingularPositionWarning"]
 
 
 class ModelError(ValueError):
@@ -45,11 +45,6 @@ class ModelFileNotFound(ModelError, FileNotFoundError):
 class ModelWarning(UserWarning):
     """A model loads, but a number or a rule it relies on looks like a mistake (the message
     gives the number and its likely cause)."""
-
-
-class AngleWarning(UserWarning):
-    """Crank angles outside [0, 360) deg were taken modulo 360 (the message lists them and what
-    they became); the result's `phi_deg` holds the angles in [0, 360)."""
 
 
 class StructureError(ValueError):

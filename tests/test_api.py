@@ -34,7 +34,7 @@ def test_phi_deg_30_is_30_and_a_frame_filter_finds_it():
 
 
 def test_given_angles_come_back_as_given_and_read_only():
-    asked = [0.1, 29.999999999999996, 1e-300, 359.5, 359.9999999999999]
+    asked = [0.1, 29.999999999999996, 1e-300, -720.5, 359.9999999999999]
     res = kinetostat.analyze(kinetostat.load(ICE), phi_deg=asked)
     assert res.phi_deg.tolist() == asked
     with pytest.raises(ValueError):

@@ -110,14 +110,15 @@ def test_analyze_cycle_to_csv(cli, tmp_path):
 
 def test_analyze_at_angles_to_json(cli, four_bar, tmp_path):
     out = tmp_path / "fb.json"
-    r = cli("analyze", four_bar, "--at", 0, 45, 269.5, "--out", out)
+    r = cli("analyze", four_bar, "--at", 0, 45, -90.5, "--out", out)
     assert r.returncode == 0, r.stderr
     doc = json.loads(out.read_text())
     rows = doc["rows"]
     res = kinetostat.analyze(kinetostat.load(four_bar), phi_deg=[0, 45, 269.5])
     assert len(rows) == 3 and doc["units"]["R_0_1"] == "N" and doc["units"]["phi_deg"] == "deg"
     assert [row["R_0_1"] for row in rows] == pytest.approx(np.linalg.norm(res.reaction(0, 1), axis=-1), rel=1e-11)
-    assert "269.5" in r.stdout       # the per-angle values are printed for a few angles
+    assert "269.5" in r.stdout       # the per-angle values are printed for a few angles (-90.5 as 269.5)
+    assert "-90.5 -> 269.5" in r.stderr
 
 
 def test_analyze_csv_to_stdout(cli):

@@ -129,7 +129,6 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     if unknown:
         raise ValueError(f"unknown plan {unknown[0]!r}: expected one of {', '.join(names)}")
     res = analyze(mech, phi_deg=[float(at)])
-    at = float(res.phi_deg[0])              # in [0, 360): an angle outside was taken modulo 360 (AngleWarning)
     if res.singular[0]:
         raise ValueError(f"at {at:g} deg the mechanism is at a singular position "
                          f"(cond {res.cond[0].max():.3g}): velocities and accelerations undefined")
