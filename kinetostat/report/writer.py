@@ -468,6 +468,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
     doc.write(d)
 
     summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N,
+                   units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|)",
+                              tolerance="1 (of the peak)", worst_percent="%"),
                    passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
                    routes={r: dict(status=run.status(r), worst=_worst(run, r),
                                    tolerance=_tolerance(run, r).peak_relative if _tolerance(run, r) else None,
