@@ -25,7 +25,7 @@ from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "value", "error", "header", "write_csv", "csv_text", "json_document",
+__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "value", "error", "header", "write_csv", "csv_text", "plain", "json_document",
            "write_json", "write_parquet", "read_csv"]
 
 #: Significant digits of a value in a text output, counted on its column's largest |value|.
@@ -86,7 +86,7 @@ def csv_text(df) -> str:
     return buf.getvalue()
 
 
-def _plain(x: Any) -> Any:
+def plain(x: Any) -> Any:
     """A cell as JSON: Python bool/int/float/str, NaN as None."""
     if isinstance(x, (bool, np.bool_)):
         return bool(x)
@@ -100,7 +100,7 @@ def _plain(x: Any) -> Any:
 def json_document(df) -> dict[str, Any]:
     """`df` as a JSON-ready dict: mechanism, units, frame (where `attrs` has them) and rows."""
     df_r = rounded(df)
-    rows = [{k: _plain(v) for k, v in zip(df_r.columns, row)} for row in df_r.itertuples(index=False, name=None)]
+    rows = [{k: plain(v) for k, v in zip(df_r.columns, row)} for row in df_r.itertuples(index=False, name=None)]
     meta = {k: df.attrs[k] for k in ("mechanism", "units", "frame") if k in df.attrs}
     return {**meta, "rows": rows}
 

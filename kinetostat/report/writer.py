@@ -19,7 +19,7 @@ from ..model import Mechanism
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from ..sweep import sweep
-from ..tables import error, write_csv
+from ..tables import error, plain, write_csv
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
 from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
@@ -493,13 +493,7 @@ def _clean(x):
         return {str(k): _clean(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [_clean(v) for v in x]
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (int, np.integer)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        return float(x) if math.isfinite(x) else None
-    return x
+    return plain(x)
 
 
 def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
