@@ -143,3 +143,18 @@ def test_the_cli_tells_the_user_which_angle_it_took(cli, tmp_path):
     r = cli("plans", "ice_crank_slider", "--at", "390", "--only", "positions", "--out", tmp_path)
     assert r.returncode == 0 and "at phi = 30 deg" in r.stdout
     assert "--at: angles outside [0, 360) deg taken modulo 360 (the same crank position): 390 -> 30" in r.stderr
+
+
+@pytest.mark.slow
+def test_the_issues_sweep_keeps_the_failing_design_and_exits_0(cli, tmp_path):
+    """The issue's reproducer as written: 2 designs x 25,000 angles run the compiled kernel; r = 0.6 m
+    cannot be assembled. Exit 0 (the table is written), one line naming the failure, no traceback."""
+    from kinetostat.tables import read_csv
+    r = cli("sweep", "chain_unit_four_bar", "--param", "r=0.08,0.6", "--steps", "25000", "--out", tmp_path / "s.csv",
+            "--no-progress")
+    assert r.returncode == 0 and "Traceback" not in r.stderr + r.stdout
+    assert "1 design(s) failed" in r.stdout + r.stderr
+    table = read_csv(tmp_path / "s.csv")
+    assert table["error"].iloc[0] != table["error"].iloc[0] or table["error"].iloc[0] == ""    # NaN or empty: no error
+    assert table["error"].iloc[1].startswith("AssemblyError: group II(2,3) cannot be assembled")
+    assert table["peak_R_0_1"].iloc[0] > 0 and table["peak_R_0_1"].isna().iloc[1]

@@ -313,10 +313,11 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
           "group by group (the solver), Zhukovsky's lever (the balancing moment from the velocity plan) and "
           "d'Alembert–Lagrange (seed 004: each reaction component from the virtual work of all loads, inertia "
           "included, in the virtual motion of the mechanism with that one constraint released; "
-          "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak.")
+          "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak "
+          f"(\"rounding\" below {ROUNDING:.1e}: the digits of a rounding error differ between machines).")
     def row(quantity: str, route: str, a, b, unit: str) -> list[str]:
         x, peak = worst(a, b)
-        return [quantity, route, _err(x, peak, unit), f"{x / peak:.1e}" if peak > 0 and math.isfinite(x) else "n/a"]
+        return [quantity, route, _err(x, peak, unit), _rel(x / peak) if peak > 0 and math.isfinite(x) else "n/a"]
 
     rows = [row("M_bal", "Zhukovsky's lever", res.lever_moment, res.balancing_moment, "N·m"),
             row("M_bal", "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
