@@ -469,7 +469,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
     doc.write(d)
 
     summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N,
-                   units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|)",
+                   units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|; "
+                                    f"'rounding' below {ROUNDING:.1e})",
                               tolerance="1 (of the peak)", worst_percent="%"),
                    passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
                    routes={r: dict(status=run.status(r), worst=_worst(run, r),
@@ -482,10 +483,11 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
     return _clean(summary)
 
 
-def _worst(run: ModelRun, route: str) -> float | None:
-    """The route's worst peak-relative error to `ERROR_DIGITS` (`kinetostat.tables.error`)."""
+def _worst(run: ModelRun, route: str) -> float | str | None:
+    """The route's worst peak-relative error to `ERROR_DIGITS` (`kinetostat.tables.error`), or
+    "rounding" below ROUNDING (its digits differ between machines)."""
     w = run.worst(route)
-    return None if w is None else error(w)
+    return None if w is None else "rounding" if _is_rounding(w) else error(w)
 
 
 def _clean(x):
@@ -526,7 +528,7 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
             else:
                 tol = f" ≤ {info['tolerance']:.0e}" if info.get("tolerance") is not None else ""
                 verdict = "PASS" if info["status"] == "PASS" else "**FAIL**"
-                cells.append(f"{_rel(info['worst'])}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
+                cells.append(f"{_rel(info['worst']) if info['worst'] != 'rounding' else 'rounding'}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
         pub = s.get("published")
         pubcell = "-" if not pub else f"{pub['within']}/{pub['n']} within" + \
             (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")
