@@ -4,7 +4,8 @@
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance or a route that raised, or
 `report` could not make a model's report; 2 bad input or options (model file, structure,
 assembly, angles, engine names, output path, stdout that cannot be written); 3 `validate`: no
-failure, but a model that nothing checked (every route skipped, no published values); 130
+failure, but a model that nothing checked (every route skipped, no published values), or a
+route named with --engines whose engine is not installed; 130
 interrupted (Ctrl-C). `sweep` exits 0 once its table is written, also where designs failed
 (each keeps its row with the reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model
 file's problem list prints one line per problem) and never a traceback; warnings print one line
@@ -561,13 +562,14 @@ def cmd_structure(args) -> int:
 
 # ============================================================================ validate
 
-def exit_code(runs) -> int:
+def exit_code(runs, absent: Sequence[str] = ()) -> int:
     """The exit code of `validate` for these ModelRuns: 1 (EXIT_FAIL) if a check (a route's error
     or a published value) failed or a route raised; else 3 (EXIT_NOT_CHECKED) if a model, or the
-    run, has no check at all (every route skipped, no published value); else 0."""
+    run, has no check at all (every route skipped, no published value), or a route named with
+    --engines is `absent` (its engine not installed); else 0."""
     if any(not r.passed for r in runs):
         return EXIT_FAIL
-    if not runs or any(not r.checks for r in runs):
+    if not runs or any(not r.checks for r in runs) or absent:
         return EXIT_NOT_CHECKED
     return EXIT_OK
 
@@ -647,7 +649,9 @@ def cmd_validate(args) -> int:
     n_pub = sum(len(run.published) for run in runs)
     n_err = sum(len(run.errors) for run in runs)
     n_skip = sum(len(run.skipped) for run in runs)
-    code = exit_code(runs)
+    from kinetostat_validation.compare import available
+    absent = [r for r in engines if args.engines and available(r)]     # named, and not installed
+    code = exit_code(runs, absent)
     unchecked = [run.stem for run in runs if not run.checks]
     _Out.write(f"validate: {len(runs)} model(s), {len(checks)} checks ({n_pub} published values): "
                f"{len(checks) - n_fail} passed, {n_fail} FAILED; {n_err} route error(s), {n_skip} route(s) skipped; "
@@ -656,6 +660,9 @@ def cmd_validate(args) -> int:
                + {EXIT_OK: "", EXIT_FAIL: " -> FAIL", EXIT_NOT_CHECKED: " -> NOT CHECKED (exit 3)"}[code], err=err)
     if not checks:
         _error("nothing was checked: every route was skipped or raised, and no model has published values")
+    if absent:
+        _error(f"--engines {' '.join(absent)}: not installed, so nothing was checked by "
+               f"{'it' if len(absent) == 1 else 'them'} (pip install 'kinetostat[engines]')")
     if to_json is not None:
         _write_validation_json(runs, code, to_json)
     if junit is not None:
@@ -1115,7 +1122,9 @@ def build_parser() -> argparse.ArgumentParser:
                                    "and what did not, and why. Routes whose engine is not installed (or that cannot "
                                    "check a model) are SKIPPED, never passed. Exit code 0: every model checked and "
                                    "every check passed; 1: a check failed or a route raised; 3: no failure, but a "
-                                   "model that nothing checked (NOT CHECKED).")
+                                   "model that nothing checked (NOT CHECKED), or a route named with --engines that "
+                                   "is not installed. Without --engines, the routes whose engine is not installed "
+                                   "are skipped and named, and the others decide.")
     v.add_argument("models", metavar="MODEL", nargs="*",
                    help="model files or bundled models' names (default: every bundled model, see 'kinetostat examples')")
     v.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")

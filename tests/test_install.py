@@ -48,6 +48,14 @@ def test_a_model_nothing_checked_is_not_checked_exit_3(cli, tmp_path, absent_rou
     assert [m["status"] for m in doc["models"]] == ["passed", "not checked"]
 
 
+def test_a_named_route_that_is_not_installed_exits_3(cli, absent_route):
+    """--engines names the route: its absence is not a pass, even where other checks passed."""
+    r = cli("validate", ICE, "--engines", "reference", absent_route, "--steps", "12", "--no-progress")
+    assert r.returncode == EXIT_NOT_CHECKED, r.stderr
+    assert "checked by: reference (9 quantities), published (15 values); not checked by: absent (" in r.stdout
+    assert "kinetostat: error: --engines absent: not installed, so nothing was checked by it" in r.stderr
+
+
 def test_every_model_checked_exits_0_and_names_its_routes(cli):
     r = cli("validate", ICE, "--engines", "none", "--steps", "12", "--no-progress")
     assert r.returncode == EXIT_OK, r.stderr
