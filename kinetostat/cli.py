@@ -5,11 +5,10 @@ Exit codes: 0 success; 1 `validate` found a check beyond tolerance or a route th
 `report` could not make a model's report; 2 bad input or options (model file, structure,
 assembly, angles, engine names, output path, stdout that cannot be written); 3 `validate`: no
 failure, but a model that nothing checked (every route skipped, no published values), or a
-route named with --engines whose engine is not installed; 130
-interrupted (Ctrl-C). `sweep` exits 0 once its table is written, also where designs failed
-(each keeps its row with the reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model
-file's problem list prints one line per problem) and never a traceback; warnings print one line
-each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
+route named with --engines whose engine is not installed; 130 interrupted (Ctrl-C). `sweep`
+exits 0 once its table is written, also where designs failed (each keeps its row with the
+reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model file's
+problem list prints one line per problem) and never a traceback; warnings print one line each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
 disk leaves the previous file as it was.
 
 May use: every room of the package, and the harness inside the commands that need it
