@@ -498,10 +498,7 @@ def cmd_analyze(args) -> int:
             raise CLIError(f"--out {out}: unknown table format {suffix or '(no suffix)'!r}; "
                            f"use one of {', '.join(TABLE_SUFFIXES)} (or '-' for CSV on stdout)")
         if suffix == ".parquet":
-            import importlib.util
-            if importlib.util.find_spec("pyarrow") is None and importlib.util.find_spec("fastparquet") is None:
-                raise CLIError(f"--out {out}: writing .parquet needs pyarrow (pip install pyarrow); "
-                               f"or write .csv / .json")
+            _parquet_engine(f"--out {out}", ".csv / .json")
         _writable_file(out, "--out")
     path = Path(args.model)
     mech = _load(path)
@@ -1005,6 +1002,14 @@ def _range(start: float, stop: float, step: float) -> list[float]:
     return [round(start + i * step, decimals) for i in range(k)] + [stop]
 
 
+def _parquet_engine(option: str, instead: str) -> None:
+    """CLIError naming `option` where no Parquet engine (pyarrow, fastparquet) is installed."""
+    import importlib.util
+    if importlib.util.find_spec("pyarrow") is None and importlib.util.find_spec("fastparquet") is None:
+        raise CLIError(f"{option}: writing .parquet needs pyarrow (pip install 'kinetostat[sweep]' or pyarrow); "
+                       f"or write {instead}")
+
+
 def _table_writer(out: str):
     """How `--out` is written, by its suffix: (write(df, file), binary)."""
     from . import tables
@@ -1012,6 +1017,7 @@ def _table_writer(out: str):
     if suffix == ".csv":
         return tables.write_csv, False
     if suffix == ".parquet":
+        _parquet_engine(f"--out {out}", ".csv")
         return tables.write_parquet, True
     raise CLIError(f"--out {out}: unknown table format {suffix or '(no suffix)'!r}; use .parquet or .csv")
 
@@ -1023,6 +1029,14 @@ def cmd_sweep(args) -> int:
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise CLIError(f"--param {twice[0]}: given more than once; give all its values in one --param")
+    if args.scheduler is not None:
+        import importlib.util
+        from .sweep import LOCAL_SCHEDULERS
+        needs = ["dask"] + ([] if args.scheduler in LOCAL_SCHEDULERS else ["distributed"])
+        missing = [m for m in needs if importlib.util.find_spec(m) is None]
+        if missing:
+            raise CLIError(f"--scheduler {args.scheduler}: needs {' and '.join(missing)} (pip install "
+                           f"'kinetostat[sweep]'); without --scheduler the designs run in this process")
     out = _writable_file(args.out, "--out")
     angles_out = out.with_name(f"{out.stem}.angles{out.suffix}") if args.full else None
     if angles_out is not None:

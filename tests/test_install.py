@@ -103,6 +103,15 @@ def test_the_wheel_without_extras_runs_every_command(tmp_path):
                            timeout=600)
         assert r.returncode == 0, (args, r.stdout[-2000:], r.stderr[-2000:])
         assert "Traceback" not in r.stderr, (args, r.stderr[-2000:])
+    for args, phrase in ((["sweep", "chain_unit_four_bar", "--param", "r=0.05", "--out", "s.parquet"],
+                          "--out s.parquet: writing .parquet needs pyarrow"),
+                         (["sweep", "chain_unit_four_bar", "--param", "r=0.05", "--scheduler", "threads", "--out",
+                           "s2.csv"], "--scheduler threads: needs dask"),
+                         (["analyze", "ice_crank_slider", "--out", "c.parquet"], "writing .parquet needs pyarrow")):
+        r2 = subprocess.run([bindir / "kinetostat", *args], capture_output=True, text=True, cwd=work, env=env,
+                            timeout=600)
+        assert r2.returncode == 2 and "Traceback" not in r2.stderr, (args, r2.stderr[-2000:])
+        assert r2.stderr.count("\n") == 1 and phrase in r2.stderr, r2.stderr
     assert (work / "plans" / "worksheet.html").is_file() and (work / "key_479" / "worksheet.html").is_file()
     assert (work / "key_479" / "cycle.csv").is_file() and (work / "sweep.csv").is_file()
     assert "0 model(s) NOT CHECKED" in r.stdout and " 0 FAILED" in r.stdout
