@@ -1,5 +1,5 @@
 """The tables a user gets (`analyze --out`, a report's cycle.csv, sweep tables, a variant's
-cycle.csv), written one way: CSV, JSON or Parquet of a pandas DataFrame whose `attrs["units"]`
+cycle.csv; segments.csv and the worksheets round with `rounded` and `value`), written one way: CSV, JSON or Parquet of a pandas DataFrame whose `attrs["units"]`
 gives each column's unit, with the units in every format and the numbers of the text formats
 to the digits that mean something.
 
@@ -25,8 +25,8 @@ from typing import IO, Any
 
 import numpy as np
 
-__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "value", "error", "header", "write_csv", "csv_text", "plain", "json_document",
-           "write_json", "write_parquet", "read_csv"]
+__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "value", "error", "header", "write_csv", "csv_text", "plain",
+           "json_document", "write_json", "write_parquet", "read_csv"]
 
 #: Significant digits of a value in a text output, counted on its column's largest |value|.
 DIGITS = 12
@@ -51,10 +51,13 @@ def error(x: float) -> float:
 def _column_rounded(col: np.ndarray) -> np.ndarray:
     finite = np.abs(col[np.isfinite(col)])
     peak = float(finite.max()) if finite.size else 0.0
-    if peak == 0.0:
-        return col + 0.0                     # -0.0 as 0.0
-    decimals = DIGITS - 1 - math.floor(math.log10(peak))
-    return np.round(col, decimals) + 0.0
+    decimals = DIGITS - 1 - math.floor(math.log10(peak)) if peak > 0.0 else 0
+    if decimals > 290:                       # a column of subnormal-sized values: 10**decimals overflows
+        return col + 0.0
+    if decimals < 0:                         # peak >= 1e12: np.round would multiply by 10**-decimals, inexactly
+        q = 10.0 ** -decimals
+        return np.array([float(f"{round(x / q):.0f}e{-decimals}") if math.isfinite(x) else x for x in col]) + 0.0
+    return np.round(col, decimals) + 0.0     # + 0.0: -0.0 as 0.0
 
 
 def rounded(df):
