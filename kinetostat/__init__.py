@@ -13,7 +13,7 @@ The plans of the graphical method: `kinetostat.plans.build(mech, at=30)`.
 The solver's public names. May use: the solver modules only (never the harness
 `kinetostat_validation`, the engines, matplotlib or `kinetostat.report`).
 """
-from . import examples, plans
+from . import examples, plans, variants
 from .analysis import Analysis, InertiaLoad, analyze
 from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning, SingularPositionWarning,
                      StructureError)
@@ -26,5 +26,5 @@ from .virtual_work import VirtualWork, virtual_work
 __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
            "AssemblyError", "SingularPositionWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
-           "examples", "plans", "sweep", "Sweep"]
+           "examples", "plans", "variants", "sweep", "Sweep"]
 __version__ = "0.1.0"

@@ -171,7 +171,14 @@ class Analysis:
     @property
     def balancing_force(self) -> np.ndarray:
         """(N, 2) working machine: balancing force of the pinion on the crank's gear at the
-        pitch point, on the line of action, N. Zeros for an engine."""
+        pitch point, on the line of action, N. An engine has none (its drive applies the couple
+        `balancing_moment`): AttributeError with that reason, so `hasattr(res, "balancing_force")`
+        is False (never a force of 0 N)."""
+        if self.mech.drive.kind != "machine":
+            raise AttributeError(f"balancing_force: {_abbreviate(self.mech.name)!r} is an engine (drive.kind = "
+                                 f"'{self.mech.drive.kind}'): its drive applies the couple balancing_moment (N m) to "
+                                 f"the crank, no force; only a working machine (a gear mesh, drive.kind = 'machine') "
+                                 f"has a balancing force")
         return self.forces.F_bal
 
     @property
@@ -412,7 +419,10 @@ class Analysis:
 
 def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
     """The crank angles asked for, deg, as a read-only (N,) copy: `phi_deg` (array-like), or
-    `steps` equal steps over a full revolution when it is None. ValueError naming the argument."""
+    `steps` equal steps over a full revolution when it is None. ValueError naming the argument.
+    Any finite angle is accepted as given: an angle outside [0, 360) is the crank position of
+    that angle modulo 360 (a run over several turns, a finite difference across 0 keep their
+    angle axis); the command line takes a typed angle modulo 360 and says so."""
     if phi_deg is None:
         if not isinstance(steps, (int, np.integer)) or isinstance(steps, bool) or steps < 1:
             raise ValueError(f"steps: expected a positive integer, got {steps!r}")

@@ -1,12 +1,14 @@
 """The command line: `kinetostat analyze | structure | plans | validate | report | export | examples | variant | sweep`
 (also `python -m kinetostat`).
 
-Exit codes: 0 success; 1 `validate` found a check beyond tolerance, a route that raised, or
-nothing to compare, or `report` could not make a model's report; 2 bad input or options (model
-file, structure, assembly, angles, engine names, output path, stdout that cannot be written);
-130 interrupted (Ctrl-C). Expected problems print one `kinetostat: error: ...` line (a model
-file's problem list prints one line per problem) and never a traceback; warnings print one line
-each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
+Exit codes: 0 success; 1 `validate` found a check beyond tolerance or a route that raised, or
+`report` could not make a model's report; 2 bad input or options (model file, structure,
+assembly, angles, engine names, output path, stdout that cannot be written); 3 `validate`: no
+failure, but a model that nothing checked (every route skipped, no published values), or a
+route named with --engines whose engine is not installed; 130 interrupted (Ctrl-C). `sweep`
+exits 0 once its table is written, also where designs failed (each keeps its row with the
+reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model file's
+problem list prints one line per problem) and never a traceback; warnings print one line each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
 disk leaves the previous file as it was.
 
 May use: every room of the package, and the harness inside the commands that need it
@@ -29,7 +31,7 @@ from typing import IO, Callable, Iterator, Sequence
 
 from ._io import atomic, unique_names
 
-EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
 
 __all__ = ["main", "build_parser", "exit_code", "bundled_models", "CLIError"]
@@ -179,6 +181,20 @@ def _angle(text: str) -> float:
     if not math.isfinite(x):
         raise argparse.ArgumentTypeError(f"invalid crank angle {text!r}: expected a finite number of degrees")
     return x
+
+
+def _turn(deg, option: str):
+    """Typed crank angle(s) (a float, a list, or None) in [0, 360): one outside is the same crank
+    position as the angle modulo 360 and is taken so, with a warning line naming it."""
+    if deg is None:
+        return None
+    many = isinstance(deg, list)
+    given = deg if many else [deg]
+    taken = [x % 360.0 if x % 360.0 != 360.0 else 0.0 for x in given]      # -1e-20 % 360 rounds to 360
+    moved = [f"{a:g} -> {b:g}" for a, b in zip(given, taken) if a != b]
+    if moved:
+        _warn(f"{option}: angles outside [0, 360) deg taken modulo 360 (the same crank position): {', '.join(moved)}")
+    return taken if many else taken[0]
 
 
 def _positive(what: str, example: str):
@@ -458,25 +474,6 @@ def _summary(res, path: Path) -> list[str]:
     return lines
 
 
-def _write_json(df, f: IO) -> None:
-    """Records (one object per crank position), floats as Python writes them, NaN as null."""
-    import json
-
-    import numpy as np
-
-    def plain(x):
-        if isinstance(x, (np.bool_, bool)):
-            return bool(x)
-        if isinstance(x, (np.integer, int)):
-            return int(x)
-        x = float(x)
-        return x if math.isfinite(x) else None
-
-    records = [{k: plain(v) for k, v in zip(df.columns, row)} for row in df.itertuples(index=False, name=None)]
-    json.dump(records, f, indent=1, allow_nan=False)
-    f.write("\n")
-
-
 def _worksheet_lines(mech, phi: float) -> list[str]:
     """The worksheet's kinematic and inertia values at one position, as a student compares them."""
     import warnings
@@ -501,29 +498,23 @@ def cmd_analyze(args) -> int:
             raise CLIError(f"--out {out}: unknown table format {suffix or '(no suffix)'!r}; "
                            f"use one of {', '.join(TABLE_SUFFIXES)} (or '-' for CSV on stdout)")
         if suffix == ".parquet":
-            import importlib.util
-            if importlib.util.find_spec("pyarrow") is None and importlib.util.find_spec("fastparquet") is None:
-                raise CLIError(f"--out {out}: writing .parquet needs pyarrow (pip install pyarrow); "
-                               f"or write .csv / .json")
+            _parquet_engine(f"--out {out}", ".csv / .json")
         _writable_file(out, "--out")
     path = Path(args.model)
     mech = _load(path)
-    res, _ = _analyze(mech, path, phi_deg=args.at, steps=args.steps)
+    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps)
     lines = _summary(res, path)
     if len(res.phi_deg) == 1:
         lines += _worksheet_lines(mech, float(res.phi_deg[0]))
     if out is not None:
+        from . import tables
         df = res.to_frame()
         if out == "-":
-            _Out.write(df.to_csv(index=False).rstrip("\n"))
+            _Out.write(tables.csv_text(df).rstrip("\n"))
         else:
             suffix = Path(out).suffix.lower()
-            if suffix == ".csv":
-                _save(out, "--out", lambda f: df.to_csv(f, index=False))
-            elif suffix == ".json":
-                _save(out, "--out", lambda f: _write_json(df, f))
-            else:
-                _save(out, "--out", lambda f: df.to_parquet(f, index=False), binary=True)
+            write = {".csv": tables.write_csv, ".json": tables.write_json}.get(suffix, tables.write_parquet)
+            _save(out, "--out", lambda f: write(df, f), binary=suffix == ".parquet")
             lines.append(f"table: {len(df)} rows x {len(df.columns)} columns -> {out}")
     else:
         lines.append("(the full table: --out FILE.csv | FILE.parquet | FILE.json)")
@@ -567,15 +558,31 @@ def cmd_structure(args) -> int:
 
 # ============================================================================ validate
 
-def exit_code(runs) -> int:
-    """The exit code of `validate` for these ModelRuns: 1 if a check (a route's error or a
-    published value) failed, a route raised, or no check ran at all (every route skipped and no
-    published value); else 0."""
-    if not runs or any(not r.passed for r in runs):
+def exit_code(runs, absent: Sequence[str] = ()) -> int:
+    """The exit code of `validate` for these ModelRuns: 1 (EXIT_FAIL) if a check (a route's error
+    or a published value) failed or a route raised; else 3 (EXIT_NOT_CHECKED) if a model, or the
+    run, has no check at all (every route skipped, no published value), or a route named with
+    --engines is `absent` (its engine not installed); else 0."""
+    if any(not r.passed for r in runs):
         return EXIT_FAIL
-    if not any(r.checks for r in runs):
-        return EXIT_FAIL
+    if not runs or any(not r.checks for r in runs) or absent:
+        return EXIT_NOT_CHECKED
     return EXIT_OK
+
+
+def _coverage(run) -> str:
+    """One line for people: what checked this model (routes with their number of quantities,
+    the published values) and what was skipped, and why."""
+    from .report.runs import PUBLISHED_ROUTE as PUBLISHED
+    done = [f"{route} ({n} quantities)" for route in run.engines
+            if (n := sum(c.route == route for c in run.checks))]
+    if run.published:
+        done.append(f"{PUBLISHED} ({len(run.published)} values)")
+    skipped = [f"{route} ({why})" for route, why in run.skipped.items()]
+    if not run.published and PUBLISHED not in run.errors:
+        skipped.append(f"{PUBLISHED} (the model has no [[published]] values)")
+    return (f"  checked by: {', '.join(done) or 'nothing'}"
+            + (f"; not checked by: {'; '.join(skipped)}" if skipped else ""))
 
 
 def validation_table(run) -> str:
@@ -603,7 +610,8 @@ def validation_table(run) -> str:
             lines.append(f"  {route:<11s} {c.quantity:<{w}s} {err:>12s} {tol:>9s} "
                          f"{c.max_abs:11.3e} {c.unit:<3s}  {'PASS' if c.passed else 'FAIL'}{extra}")
     n, f = len(checks), sum(not c.passed for c in checks)
-    verdict = "PASS" if run.passed and n else "FAIL" if not run.passed else "NOT CHECKED"
+    verdict = "PASS" if run.passed and n else "FAIL" if not run.passed else "NOT CHECKED (nothing compared)"
+    lines.append(_coverage(run))
     lines.append(f"  => {verdict}: {n} checks ({len(run.published)} published values), {f} failed, "
                  f"{len(run.skipped)} route(s) skipped, {len(run.errors)} with errors")
     return "\n".join(lines)
@@ -637,12 +645,20 @@ def cmd_validate(args) -> int:
     n_pub = sum(len(run.published) for run in runs)
     n_err = sum(len(run.errors) for run in runs)
     n_skip = sum(len(run.skipped) for run in runs)
-    code = exit_code(runs)
+    from kinetostat_validation.compare import available
+    absent = [r for r in engines if args.engines and available(r)]     # named, and not installed
+    code = exit_code(runs, absent)
+    unchecked = [run.stem for run in runs if not run.checks]
     _Out.write(f"validate: {len(runs)} model(s), {len(checks)} checks ({n_pub} published values): "
                f"{len(checks) - n_fail} passed, {n_fail} FAILED; {n_err} route error(s), {n_skip} route(s) skipped; "
-               f"{time.perf_counter() - t0:.1f} s" + ("" if code == EXIT_OK else " -> FAIL"), err=err)
+               f"{len(unchecked)} model(s) NOT CHECKED{': ' + ', '.join(unchecked) if unchecked else ''}; "
+               f"{time.perf_counter() - t0:.1f} s"
+               + {EXIT_OK: "", EXIT_FAIL: " -> FAIL", EXIT_NOT_CHECKED: " -> NOT CHECKED (exit 3)"}[code], err=err)
     if not checks:
         _error("nothing was checked: every route was skipped or raised, and no model has published values")
+    if absent:
+        _error(f"--engines {' '.join(absent)}: not installed, so nothing was checked by "
+               f"{'it' if len(absent) == 1 else 'them'} (pip install 'kinetostat[engines]')")
     _github(runs, err)
     if to_json is not None:
         _write_validation_json(runs, code, to_json)
@@ -857,6 +873,7 @@ def cmd_plans(args) -> int:
     mech = _load(path)
     out = _writable_dir(args.out, "--out")
     only = [n for group in (args.only or []) for n in group] or None
+    args.at, args.starting = _turn(args.at, "--at"), _turn(args.starting, "--starting")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -1003,13 +1020,23 @@ def _range(start: float, stop: float, step: float) -> list[float]:
     return [round(start + i * step, decimals) for i in range(k)] + [stop]
 
 
+def _parquet_engine(option: str, instead: str) -> None:
+    """CLIError naming `option` where no Parquet engine (pyarrow, fastparquet) is installed."""
+    import importlib.util
+    if importlib.util.find_spec("pyarrow") is None and importlib.util.find_spec("fastparquet") is None:
+        raise CLIError(f"{option}: writing .parquet needs pyarrow (pip install 'kinetostat[sweep]' or pyarrow); "
+                       f"or write {instead}")
+
+
 def _table_writer(out: str):
     """How `--out` is written, by its suffix: (write(df, file), binary)."""
+    from . import tables
     suffix = Path(out).suffix.lower()
     if suffix == ".csv":
-        return (lambda df, f: df.to_csv(f, index=False)), False
+        return tables.write_csv, False
     if suffix == ".parquet":
-        return (lambda df, f: df.to_parquet(f, index=False)), True
+        _parquet_engine(f"--out {out}", ".csv")
+        return tables.write_parquet, True
     raise CLIError(f"--out {out}: unknown table format {suffix or '(no suffix)'!r}; use .parquet or .csv")
 
 
@@ -1020,6 +1047,14 @@ def cmd_sweep(args) -> int:
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise CLIError(f"--param {twice[0]}: given more than once; give all its values in one --param")
+    if args.scheduler is not None:
+        import importlib.util
+        from .sweep import LOCAL_SCHEDULERS
+        needs = ["dask"] + ([] if args.scheduler in LOCAL_SCHEDULERS else ["distributed"])
+        missing = [m for m in needs if importlib.util.find_spec(m) is None]
+        if missing:
+            raise CLIError(f"--scheduler {args.scheduler}: needs {' and '.join(missing)} (pip install "
+                           f"'kinetostat[sweep]'); without --scheduler the designs run in this process")
     out = _writable_file(args.out, "--out")
     angles_out = out.with_name(f"{out.stem}.angles{out.suffix}") if args.full else None
     if angles_out is not None:
@@ -1114,9 +1149,13 @@ def build_parser() -> argparse.ArgumentParser:
                                    "the solver's balancing moment and every reaction over the cycle with each "
                                    "route (the engines, and 'reference': a 40-digit mpmath re-solution that needs "
                                    "no engine), check the model's published values ([[published]] tables), and "
-                                   "print route, quantity, error, tolerance and PASS/FAIL. Routes whose engine is "
-                                   "not installed are SKIPPED. Exit code 1 when any check fails, a route raises, "
-                                   "or nothing was checked.")
+                                   "print route, quantity, error, tolerance and PASS/FAIL, and per model what checked it "
+                                   "and what did not, and why. Routes whose engine is not installed (or that cannot "
+                                   "check a model) are SKIPPED, never passed. Exit code 0: every model checked and "
+                                   "every check passed; 1: a check failed or a route raised; 3: no failure, but a "
+                                   "model that nothing checked (NOT CHECKED), or a route named with --engines that "
+                                   "is not installed. Without --engines, the routes whose engine is not installed "
+                                   "are skipped and named, and the others decide.")
     v.add_argument("models", metavar="MODEL", nargs="*",
                    help="model files or bundled models' names (default: every bundled model, see 'kinetostat examples')")
     v.add_argument("--engines", metavar="ROUTE", nargs="+", help=f"engine routes to run (default: all): {routes}")

@@ -351,6 +351,6 @@ def peaks(mechs: Sequence["Mechanism"], phi_deg: np.ndarray, threads: int | None
         if ok.any():
             R[d] = np.maximum(R[d], np.linalg.norm(res.forces.R[ok], axis=-1).max(axis=0))
             M[d] = max(M[d], np.abs(res.balancing_moment[ok]).max())
-            F[d] = max(F[d], np.linalg.norm(res.balancing_force[ok], axis=-1).max())
+            F[d] = max(F[d], np.linalg.norm(res.forces.F_bal[ok], axis=-1).max())
         singular[d] = res.phi_deg[res.singular]
     return Peaks(R, M, F, tuple(singular))

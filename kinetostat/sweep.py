@@ -153,12 +153,12 @@ def _peaks_into(rows: list[dict], built: list[tuple[int, Mechanism]], phi_deg: n
     from . import fast
     try:
         pk = fast.peaks([m for _, m in built], phi_deg)
-    except AssemblyError:             # some design: find which, one by one
-        for n, m in built:
-            try:
-                _peaks_into(rows, [(n, m)], phi_deg)
-            except AssemblyError as exc:
-                rows[n]["error"] = _reason(exc)
+    except AssemblyError as exc:      # this design fails; of several: find which, one by one
+        if len(built) == 1:
+            rows[built[0][0]]["error"] = _reason(exc)
+        else:
+            for one in built:
+                _peaks_into(rows, [one], phi_deg)
         return
     for q, (n, m) in enumerate(built):
         sing = pk.singular_deg[q]
@@ -328,8 +328,8 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFram
     table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "error"])
     table[peaks] = table[peaks].astype(float)
     table["n_singular"] = table["n_singular"].astype("Int64")
-    table["singular_deg"] = table["singular_deg"].fillna("").astype(str)
-    table["error"] = table["error"].fillna("").astype(str)
+    for text in ("singular_deg", "error"):          # every design failed: a column of NaN, no text
+        table[text] = table[text].astype(object).fillna("").astype(str)
     table.attrs.update(mechanism=base.name, units={
         **dict.fromkeys(names, PARAMETER_UNIT), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
         "n_singular": "1", "singular_deg": "deg", "error": "text"})

@@ -58,7 +58,7 @@ all 1000 of each task are distinct models.
    the crank's sense; the key (worksheet, plans) is drawn there.
 
 May use: the solver (`model`, `analysis`), `kinetostat.plans` (the key's plans and worksheet),
-`examples` (the bundled models' assumptions), `_io`; never the harness, the engines or `report`.
+`examples` (the bundled models' assumptions), `_io`, `tables`; never the harness, the engines or `report`.
 """
 from __future__ import annotations
 
@@ -525,6 +525,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     from .analysis import analyze
     from .plans import build as build_plans
     from .plans.worksheet import worksheet
+    from .tables import csv_text
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     mech = v.mechanism()
@@ -536,7 +537,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     files = [write_text(out / f"{v.name}.toml", v.toml())]
     files += plans.write(out, lang=lang) + sheet.write(out)
     if cycle_csv:
-        files.append(write_text(out / "cycle.csv", res.to_frame().to_csv(index=False)))
+        files.append(write_text(out / "cycle.csv", csv_text(res.to_frame())))
     label, R = _largest(at, mech)
     R_cycle = max(float(np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))) for p in mech.pairs)
     return KeySummary(v.name, phi1, float(at.balancing_moment[0]), label, R,

@@ -21,8 +21,9 @@ import pytest
 
 import kinetostat
 from conftest import FOUR_BAR, ROOT
-from kinetostat.cli import EXIT_FAIL, EXIT_OK, EXIT_USAGE, exit_code
+from kinetostat.cli import EXIT_FAIL, EXIT_NOT_CHECKED, EXIT_OK, EXIT_USAGE, exit_code
 from kinetostat.report import junit_xml, quantities, run_validation
+from kinetostat.tables import read_csv
 
 ICE = ROOT / "models" / "ice_crank_slider.toml"
 EXACT = ["pinocchio", "mujoco"]          # the fast engine routes
@@ -96,10 +97,13 @@ def test_analyze_cycle_to_csv(cli, tmp_path):
     out = tmp_path / "ice.csv"
     r = cli("analyze", ICE, "--steps", 36, "--out", out)
     assert r.returncode == 0, r.stderr
-    df = pd.read_csv(out)
-    res = kinetostat.analyze(kinetostat.load(ICE), steps=36)
-    assert len(df) == 36 and list(df.columns) == list(res.to_frame().columns)
-    np.testing.assert_allclose(df["M_bal"], res.balancing_moment, rtol=1e-12)
+    df = read_csv(out)
+    frame = kinetostat.analyze(kinetostat.load(ICE), steps=36).to_frame()
+    assert len(df) == 36 and list(df.columns) == list(frame.columns)
+    assert df.attrs["units"] == frame.attrs["units"]            # the header: "M_bal [N m]"
+    assert "M_bal [N m]" in out.read_text().splitlines()[0]
+    M = frame["M_bal"].to_numpy()
+    np.testing.assert_allclose(df["M_bal"], M, rtol=0, atol=6e-12 * np.abs(M).max())   # 12 digits of the peak
     for text in ("I(0,1) <- II(2,3)", "R(0,1) at O", "balancing moment M_bal:", "lever discrepancy"):
         assert text in r.stdout
 
@@ -108,17 +112,19 @@ def test_analyze_at_angles_to_json(cli, four_bar, tmp_path):
     out = tmp_path / "fb.json"
     r = cli("analyze", four_bar, "--at", 0, 45, -90.5, "--out", out)
     assert r.returncode == 0, r.stderr
-    rows = json.loads(out.read_text())
-    res = kinetostat.analyze(kinetostat.load(four_bar), phi_deg=[0, 45, -90.5])
-    assert len(rows) == 3
-    assert [row["R_0_1"] for row in rows] == pytest.approx(np.linalg.norm(res.reaction(0, 1), axis=-1), rel=1e-12)
-    assert "-90.5" in r.stdout       # the per-angle values are printed for a few angles
+    doc = json.loads(out.read_text())
+    rows = doc["rows"]
+    res = kinetostat.analyze(kinetostat.load(four_bar), phi_deg=[0, 45, 269.5])
+    assert len(rows) == 3 and doc["units"]["R_0_1"] == "N" and doc["units"]["phi_deg"] == "deg"
+    assert [row["R_0_1"] for row in rows] == pytest.approx(np.linalg.norm(res.reaction(0, 1), axis=-1), rel=1e-11)
+    assert "269.5" in r.stdout       # the per-angle values are printed for a few angles (-90.5 as 269.5)
+    assert "-90.5 -> 269.5" in r.stderr
 
 
 def test_analyze_csv_to_stdout(cli):
     r = cli("analyze", ICE, "--at", 30, "--out", "-")
     assert r.returncode == 0, r.stderr
-    assert r.stdout.splitlines()[0].startswith("phi_deg,")
+    assert r.stdout.splitlines()[0].startswith("phi_deg [deg],")
     assert len(r.stdout.strip().splitlines()) == 2
     assert "balancing moment" in r.stderr       # the summary moves to stderr
 
@@ -134,7 +140,8 @@ def test_analyze_parquet(cli, tmp_path):
         assert not out.exists()
     else:
         assert r.returncode == 0, r.stderr
-        assert len(pd.read_parquet(out)) == 12
+        df = pd.read_parquet(out)
+        assert len(df) == 12 and df.attrs["units"]["R_0_1"] == "N" and "world frame" in df.attrs["frame"]
 
 
 def test_singular_position_warning_is_one_line(cli, tmp_path):
@@ -227,7 +234,8 @@ def test_route_errors_and_skips_are_reported_not_raised(ice_cycle, monkeypatch):
     # only skipped routes on a model without published values: nothing checked is not a pass
     four = kinetostat.loads(FOUR_BAR)
     only_skipped = run_validation(four, ["absent"], steps=36)
-    assert only_skipped.passed and not only_skipped.checks and exit_code([only_skipped]) == EXIT_FAIL
+    assert only_skipped.passed and not only_skipped.checks and exit_code([only_skipped]) == EXIT_NOT_CHECKED
+    assert exit_code([run_validation(mech, EXACT, steps=36, res=res, path=ICE), only_skipped]) == EXIT_NOT_CHECKED
 
 
 # ----------------------------------------------------------------------------- bad input

@@ -37,7 +37,7 @@ def _agree(mech, phi_deg) -> None:
     # of nearly equal products, so its rounding is amplified (6.7e-13 of the peak on the furnace loader)
     tolerance = {"cond": 1e-10}
     for name, x, y in [("R", a.forces.R, b.forces.R), ("M_bal", a.balancing_moment, b.balancing_moment),
-                       ("F_bal", a.balancing_force, b.balancing_force), ("lever", a.lever_moment, b.lever_moment),
+                       ("F_bal", a.forces.F_bal, b.forces.F_bal), ("lever", a.lever_moment, b.lever_moment),
                        ("normal", a.forces.normal, b.forces.normal), ("m", a.forces.m, b.forces.m),
                        ("omega", a.kin.omega, b.kin.omega), ("eps", a.kin.eps, b.kin.eps),
                        ("origin", a.kin.origin, b.kin.origin), ("v", a.kin.v_origin, b.kin.v_origin),

@@ -153,7 +153,8 @@ def test_svg_sheet(ice_plans, tmp_path):
         rows = list(csv.DictReader(f))
     assert tuple(rows[0]) == SEGMENT_COLUMNS
     pb = next(r for r in rows if r["plan"] == "velocity" and r["segment"] == "p-b")
-    assert float(pb["length_mm"]) * 0.2 == pytest.approx(float(pb["value"]), rel=1e-12)
+    # the file holds 12 significant digits of each column's largest value (kinetostat.tables)
+    assert float(pb["length_mm"]) * 0.2 == pytest.approx(float(pb["value"]), rel=1e-10)
 
 
 def test_svg_escapes_model_text():

@@ -11,7 +11,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 import pytest
 
 import kinetostat
@@ -19,6 +18,7 @@ import kinetostat.report
 from conftest import FOUR_BAR, MODELS, ROOT
 from kinetostat.report import published_rows, run_validation, write_index, write_report
 from kinetostat.report.document import Doc
+from kinetostat.tables import read_csv
 
 pytest.importorskip("matplotlib")
 
@@ -85,8 +85,9 @@ def test_report_files(ice_report):
     for png in PNGS:
         data = (d / png).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000, png
-    cycle = pd.read_csv(d / "cycle.csv")
+    cycle = read_csv(d / "cycle.csv")
     assert len(cycle) == 36 and {"phi_deg", "M_bal", "M_lever", "R_0_1"} <= set(cycle.columns)
+    assert cycle.attrs["units"]["R_0_1"] == "N" and cycle.attrs["units"]["M_bal"] == "N m"
     summary = json.loads((d / "summary.json").read_text())
     n_q = sum(len(kinetostat.report.quantities(kinetostat.load(ICE), r)) for r in ("pinocchio", "mujoco"))
     n_q += len(kinetostat.load(ICE).published)      # 2 x (M_drive, 4 R, 4 P_f, 4 points x 3) + 15 published

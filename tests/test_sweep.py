@@ -14,6 +14,7 @@ import pytest
 
 import kinetostat
 from kinetostat.cli import _param, _range, _RangeError
+from kinetostat.tables import read_csv
 
 from conftest import ROOT
 
@@ -169,8 +170,11 @@ def test_cli_sweep_writes_the_study_as_parquet_and_csv(cli, tmp_path):
     pd.testing.assert_frame_equal(df, sw.table, check_exact=True, check_dtype=False)
     r = cli(*args, "--out", tmp_path / "sweep.csv")
     assert r.returncode == 0, r.stderr
-    csv = pd.read_csv(tmp_path / "sweep.csv")
-    np.testing.assert_array_equal(csv[PEAKS].to_numpy(), sw.table[PEAKS].to_numpy())   # CSV keeps 17 digits
+    csv = read_csv(tmp_path / "sweep.csv")
+    assert csv.attrs["units"]["peak_R_0_1"] == "N" and csv.attrs["units"]["peak_M_bal"] == "N m"
+    for c in PEAKS:                     # CSV: 12 significant digits of the column's largest value
+        peak = sw.table[c].abs().max()
+        np.testing.assert_allclose(csv[c].to_numpy(), sw.table[c].to_numpy(), rtol=0, atol=6e-12 * peak)
     assert not (tmp_path / "sweep.angles.csv").exists()
 
 
@@ -178,7 +182,7 @@ def test_cli_sweep_full_writes_the_angles_beside_out(cli, tmp_path):
     r = cli("sweep", "chain_unit_four_bar", "--param", "r=0.05,0.08", "--steps", "12", "--full",
             "--scheduler", "threads", "--out", tmp_path / "s.csv")
     assert r.returncode == 0, r.stderr
-    angles = pd.read_csv(tmp_path / "s.angles.csv")
+    angles = read_csv(tmp_path / "s.angles.csv")
     assert len(angles) == 24 and list(angles.columns[:2]) == ["r", "phi_deg"] and "s.angles.csv" in r.stdout
 
 
@@ -210,8 +214,10 @@ def test_the_reports_study_is_the_sweep_its_command_line_writes(cli, tmp_path):
     shutil.copy(CHAIN, tmp_path)
     r = cli(*command.split()[1:], "--no-progress", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    written = pd.read_csv(tmp_path / "study.csv")
-    np.testing.assert_array_equal(written["peak_R_0_1"].to_numpy().reshape(5, 5), study_table(mech))
+    written = read_csv(tmp_path / "study.csv")
+    table = study_table(mech)
+    np.testing.assert_allclose(written["peak_R_0_1"].to_numpy().reshape(5, 5), table, rtol=0,
+                               atol=6e-12 * np.nanmax(table))
 
 
 def test_a_large_sweep_runs_the_compiled_kernel_and_equals_the_loop_of_analyze():
@@ -225,3 +231,43 @@ def test_a_large_sweep_runs_the_compiled_kernel_and_equals_the_loop_of_analyze()
         got = row[[f"peak_R_{p.links[0]}_{p.links[1]}" for p in res.mech.pairs]].astype(float).to_numpy()
         np.testing.assert_allclose(got, R, rtol=1e-13, atol=0)
         assert abs(row["peak_M_bal"] - np.abs(res.balancing_moment).max()) <= 1e-13 * max(np.abs(res.balancing_moment).max(), 1.0)
+
+
+
+@pytest.mark.parametrize("designs", [[0.6], [0.6, 0.9]])
+def test_failing_designs_keep_their_rows_on_the_compiled_path(monkeypatch, designs):
+    """The compiled path (fast.FAST_MIN lowered to 0) with designs that cannot be assembled: each
+    keeps its row with the reason, and each is tried once alone after its chunk failed (once a
+    RecursionError: a failing design was retried by itself, forever). The kernel's stand-in
+    raises what the kernel raises, the AssemblyError of the first design that fails (the real
+    kernel: the slow test below)."""
+    from kinetostat import fast
+    monkeypatch.setattr(fast, "FAST_MIN", 0)
+    calls = []
+
+    def peaks(mechs, phi_deg):
+        calls.append(len(mechs))
+        with monkeypatch.context() as numpy_path:       # analyze itself on its numpy path
+            numpy_path.setattr(fast, "FAST_MIN", 10**9)
+            for m in mechs:
+                kinetostat.analyze(m, phi_deg=phi_deg)
+        raise AssertionError("every design here fails")
+    monkeypatch.setattr(fast, "peaks", peaks)
+    sw = kinetostat.sweep(CHAIN, {"r": designs}, steps=36)
+    assert calls == ([1] if len(designs) == 1 else [2, 1, 1])     # the chunk, then each design once
+    for _, bad in sw.table.iterrows():
+        assert bad["error"].startswith("AssemblyError: group II(2,3) cannot be assembled")
+        assert bad[PEAKS].isna().all()
+
+
+@pytest.mark.slow
+def test_a_failing_design_beside_a_good_one_in_the_compiled_kernel(monkeypatch):
+    """The issue's reproducer in small: the real kernel, r = 0.08 m (assembles) and 0.6 m (does not)."""
+    from kinetostat import fast
+    monkeypatch.setattr(fast, "FAST_MIN", 0)
+    sw = kinetostat.sweep(CHAIN, {"r": [0.08, 0.6]}, steps=36)
+    ok, bad = sw.table.iloc[0], sw.table.iloc[1]
+    assert bad["error"].startswith("AssemblyError: group II(2,3) cannot be assembled") and bad[PEAKS].isna().all()
+    ref = _loop_peaks({"r": [0.08]}, 36)
+    assert ok["error"] == ""
+    np.testing.assert_allclose(ok[PEAKS].astype(float).to_numpy(), [ref[c][0] for c in PEAKS], rtol=1e-13)

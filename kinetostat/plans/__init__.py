@@ -13,12 +13,10 @@
 there and only when a figure is drawn).
 
 May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`); pandas only inside
-`Plans.segments_frame`; never the harness or `kinetostat.report`.
+`Plans.segments_frame` and `Plans.segments_csv`; never the harness or `kinetostat.report`.
 """
 from __future__ import annotations
 
-import csv
-import io
 from collections.abc import Mapping
 from functools import partial
 from pathlib import Path
@@ -26,6 +24,7 @@ from types import MappingProxyType
 from typing import Callable, Iterable
 
 from .._io import write_text
+from ..tables import rounded, value
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .forces import crank_plan, force_plans, group_plans
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
@@ -82,12 +81,13 @@ class Plans(Mapping):
         return pd.DataFrame(self.rows(), columns=list(SEGMENT_COLUMNS))
 
     def segments_csv(self) -> str:
-        buf = io.StringIO()
-        w = csv.DictWriter(buf, fieldnames=SEGMENT_COLUMNS, lineterminator="\n")
-        w.writeheader()
-        for r in self.rows():
-            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
-        return buf.getvalue()
+        """segments.csv, plain numbers: the drawing's coordinates and lengths to 12 significant
+        digits of their column's largest value (`kinetostat.tables.rounded`), each value (of
+        mixed units) to 12 significant digits."""
+        df = self.segments_frame()
+        out = rounded(df)
+        out["value"] = [value(x) for x in df["value"]]
+        return out.to_csv(index=False, lineterminator="\n")
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
         """Write one SVG sheet per plan (`plan_file_name`) and segments.csv into `out_dir`

@@ -23,6 +23,7 @@ from ..analysis import Analysis, analyze
 from ..applied import load_magnitude
 from .._io import write_text
 from ..model import Mechanism
+from ..tables import value
 from .scales import choose_scales
 
 __all__ = ["Row", "Worksheet", "worksheet", "COLUMNS"]
@@ -120,12 +121,15 @@ class Worksheet:
         return MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
 
     def to_csv(self, path: str | Path) -> None:
-        """Write the rows as CSV (atomic: a temporary file in the same folder, then replaced)."""
-        write_text(path, self.frame().to_csv(index=False))
+        """Write the rows as CSV, values to 12 significant digits (atomic: a temporary file in the
+        same folder, then replaced)."""
+        df = self.frame()
+        df["value"] = [value(x) for x in df["value"]]       # 12 significant digits (`kinetostat.tables`)
+        write_text(path, df.to_csv(index=False))
 
     def to_json(self, path: str | Path) -> None:
         """Write the rows as a JSON list of objects, NaN as null (atomic)."""
-        recs = [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()}
+        recs = [{k: (None if not math.isfinite(v) else value(v)) if isinstance(v, float) else v for k, v in r.items()}
                 for r in self.records()]
         doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l, "rows": recs}
         write_text(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")

@@ -122,8 +122,8 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
 
 def validation_json(runs: Sequence[ModelRun], exit_code: int) -> dict[str, Any]:
     """The runs as a JSON-ready dict: per model its checks (name, route, quantity, error, measure,
-    tolerance, max_abs, unit, phi_deg, passed, trust: what it rests on), skipped and failed
-    routes; totals; the exit code."""
+    tolerance, max_abs, unit, phi_deg, passed, trust: what it rests on), skipped and failed routes,
+    its status ("passed", "failed", or "not checked": nothing compared it); totals; the exit code."""
     models = []
     for run in runs:
         checks = [dict(name=c.name, route=c.route, quantity=c.quantity, error=_number(c.error), measure=c.measure,
@@ -131,12 +131,15 @@ def validation_json(runs: Sequence[ModelRun], exit_code: int) -> dict[str, Any]:
                        phi_deg=_number(c.phi_deg), passed=bool(c.passed), trust=c.trust) for c in run.checks]
         models.append(dict(model=run.stem, path=None if run.path is None else str(run.path), name=run.mech.name,
                            structure=run.mech.structure.formula, positions=len(run.res.phi_deg),
-                           passed=bool(run.passed and checks), checks=checks, skipped=dict(run.skipped),
+                           passed=bool(run.passed and checks),
+                           status="failed" if not run.passed else "passed" if checks else "not checked",
+                           checks=checks, skipped=dict(run.skipped),
                            errors=dict(run.errors),
                            seconds={r: _number(s) for r, s in run.seconds.items()}))
     every = [c for m in models for c in m["checks"]]
     totals = dict(models=len(models), checks=len(every), passed=sum(c["passed"] for c in every),
                   failed=sum(not c["passed"] for c in every),
                   route_errors=sum(len(m["errors"]) for m in models),
-                  routes_skipped=sum(len(m["skipped"]) for m in models))
+                  routes_skipped=sum(len(m["skipped"]) for m in models),
+                  not_checked=sum(m["status"] == "not checked" for m in models))
     return dict(passed=exit_code == 0, exit_code=exit_code, totals=totals, models=models)

@@ -19,6 +19,7 @@ from ..model import Mechanism
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from ..sweep import sweep
+from ..tables import error, plain, write_csv
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
 from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
@@ -312,10 +313,11 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
           "group by group (the solver), Zhukovsky's lever (the balancing moment from the velocity plan) and "
           "d'Alembert–Lagrange (seed 004: each reaction component from the virtual work of all loads, inertia "
           "included, in the virtual motion of the mechanism with that one constraint released; "
-          "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak.")
+          "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak "
+          f"(\"rounding\" below {ROUNDING:.1e}: the digits of a rounding error differ between machines).")
     def row(quantity: str, route: str, a, b, unit: str) -> list[str]:
         x, peak = worst(a, b)
-        return [quantity, route, _err(x, peak, unit), f"{x / peak:.1e}" if peak > 0 and math.isfinite(x) else "n/a"]
+        return [quantity, route, _err(x, peak, unit), _rel(x / peak) if peak > 0 and math.isfinite(x) else "n/a"]
 
     rows = [row("M_bal", "Zhukovsky's lever", res.lever_moment, res.balancing_moment, "N·m"),
             row("M_bal", "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
@@ -378,7 +380,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
             "hodographs": plot_hodographs(run, d / "hodographs.png"),
         }
     with atomic(d / "cycle.csv") as f:
-        res.to_frame().to_csv(f, index=False)
+        write_csv(res.to_frame(), f)
 
     N = len(res.phi_deg)
     routes = list(run.engines)
@@ -469,15 +471,25 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
     doc.write(d)
 
     summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N,
+                   units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|; "
+                                    f"'rounding' below {ROUNDING:.1e})",
+                              tolerance="1 (of the peak)", worst_percent="%"),
                    passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
-                   routes={r: dict(status=run.status(r), worst=run.worst(r),
+                   routes={r: dict(status=run.status(r), worst=_worst(run, r),
                                    tolerance=_tolerance(run, r).peak_relative if _tolerance(run, r) else None,
                                    why=run.skipped.get(r) or run.errors.get(r)) for r in routes},
                    published=None if not published else dict(
                        n=len(published), within=sum(c.passed for c in published),
-                       worst_percent=max((100 * c.error for c in published if not c.by_angle), default=None)))
+                       worst_percent=error(max((100 * c.error for c in published if not c.by_angle), default=float("nan")))))
     write_text(d / "summary.json", json.dumps(_clean(summary), indent=1, allow_nan=False) + "\n")
     return _clean(summary)
+
+
+def _worst(run: ModelRun, route: str) -> float | str | None:
+    """The route's worst peak-relative error to `ERROR_DIGITS` (`kinetostat.tables.error`), or
+    "rounding" below ROUNDING (its digits differ between machines)."""
+    w = run.worst(route)
+    return None if w is None else "rounding" if _is_rounding(w) else error(w)
 
 
 def _clean(x):
@@ -486,13 +498,7 @@ def _clean(x):
         return {str(k): _clean(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [_clean(v) for v in x]
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (int, np.integer)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        return float(x) if math.isfinite(x) else None
-    return x
+    return plain(x)
 
 
 def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
@@ -524,7 +530,7 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
             else:
                 tol = f" ≤ {info['tolerance']:.0e}" if info.get("tolerance") is not None else ""
                 verdict = "PASS" if info["status"] == "PASS" else "**FAIL**"
-                cells.append(f"{_rel(info['worst'])}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
+                cells.append(f"{_rel(info['worst']) if info['worst'] != 'rounding' else 'rounding'}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
         pub = s.get("published")
         pubcell = "-" if not pub else f"{pub['within']}/{pub['n']} within" + \
             (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")

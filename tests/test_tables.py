@@ -1,0 +1,57 @@
+"""The tables a user gets (kinetostat.tables): units in every format, plain numbers, and the
+digits that mean something, so that a last-ulp difference between machines prints the same."""
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pandas as pd
+
+import kinetostat
+from kinetostat import tables
+
+
+def _frame(values: dict, units: dict) -> pd.DataFrame:
+    df = pd.DataFrame(values)
+    df.attrs.update(mechanism="m", units=units, frame="world frame")
+    return df
+
+
+def test_a_last_ulp_difference_and_rounding_noise_print_the_same():
+    x = np.array([2862.81234567891, -1234.5, 3e-17, 0.1 + 0.2])
+    y = np.nextafter(x, np.inf)                        # one ulp up: another machine's rounding
+    y[2] = -5e-17                                      # a zero within rounding, other sign
+    units = {"R": "N"}
+    a, b = tables.csv_text(_frame({"R": x}, units)), tables.csv_text(_frame({"R": y}, units))
+    assert a == b == "R [N]\n2862.81234568\n-1234.5\n0.0\n0.3\n"     # 12 digits of the column's peak
+
+
+def test_units_in_the_header_and_read_back():
+    df = _frame({"phi_deg": [0.0, 30.0], "R_0_1": [1.5, np.nan], "error": ["", "AssemblyError: x"]},
+                {"phi_deg": "deg", "R_0_1": "N", "error": "text"})
+    text = tables.csv_text(df)
+    assert text.splitlines()[0] == "phi_deg [deg],R_0_1 [N],error"
+    back = tables.read_csv(io.StringIO(text))
+    assert list(back.columns) == ["phi_deg", "R_0_1", "error"] and back.attrs["units"]["R_0_1"] == "N"
+    doc = tables.json_document(df)
+    assert doc["units"] == df.attrs["units"] and doc["frame"] == "world frame"
+    assert doc["rows"][1] == {"phi_deg": 30.0, "R_0_1": None, "error": "AssemblyError: x"}
+    json.dumps(doc, allow_nan=False)
+
+
+def test_segments_and_worksheet_hold_plain_numbers(tmp_path):
+    """segments.csv held repr() of numpy scalars (np.float64(20.16...)); every number cell parses."""
+    plans = kinetostat.plans.build(kinetostat.load("ice_crank_slider"), at=30.0, only=["velocity"])
+    text = plans.segments_csv()
+    assert "np." not in text
+    seg = pd.read_csv(io.StringIO(text))
+    pb = seg[seg.segment == "p-b"].iloc[0]
+    assert abs(pb.length_mm - 54.6) < 0.01 and abs(pb.length_mm * 0.2 - pb.value) <= 1e-10 * pb.value
+    from kinetostat.plans.worksheet import worksheet
+    sheet = worksheet(kinetostat.load("ice_crank_slider"), 30.0)
+    sheet.to_csv(tmp_path / "w.csv")
+    w = pd.read_csv(tmp_path / "w.csv")
+    assert "np." not in (tmp_path / "w.csv").read_text() and w["value"].dtype == float
+    exact = sheet.value("omega_1")
+    assert float(w.loc[w.key == "omega_1", "value"].iloc[0]) == float(f"{exact:.12g}")
