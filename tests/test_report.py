@@ -63,7 +63,7 @@ def test_reruns_are_byte_identical_and_jobs_do_not_matter(reports):
     parallel, serial = reports
     files = sorted(p.relative_to(serial) for p in serial.rglob("*") if p.is_file())
     plans = {m: len(kinetostat.plans.build(kinetostat.load(p))) for m, p in (("ice", ICE), ("shaper", SHAPER))}
-    # the index; ice: 5 png, md, html, csv, json, a png per plan, segments.csv, worksheet.csv; the shaper + 1 png
+    # the index; ice: 5 png, md, html, csv, json, an svg per plan, segments.csv, worksheet.csv; the shaper + 1 png
     assert len(files) == 2 + (9 + plans["ice"] + 2) + (10 + plans["shaper"] + 2)
     for f in files:
         assert (parallel / f).read_bytes() == (serial / f).read_bytes(), f
@@ -163,7 +163,14 @@ def test_report_html_is_markdown_it_rendering(ice_report):
     from markdown_it import MarkdownIt
     d = ice_report / "ice_crank_slider"
     html = (d / "index.html").read_text()
-    assert html.count('src="data:image/png;base64,') == len(PNGS) + len(kinetostat.plans.build(kinetostat.load(ICE)))
+    plans = kinetostat.plans.build(kinetostat.load(ICE))
+    assert html.count('src="data:image/png;base64,') == len(PNGS)
+    # the plans: the sheets of `kinetostat plans`, embedded, each a link to its SVG file
+    assert html.count('src="data:image/svg+xml;base64,') == len(plans)
+    for plan in plans.values():
+        name = "plan_" + kinetostat.plans.plan_file_name(plan)
+        assert f'<a href="{name}"><img' in html
+        assert (d / name).read_text() == plan.svg(mechanism=kinetostat.load(ICE).name)
     assert not re.search(r'src="(?!data:)', html)
     assert '<div class="scroll"><table>' in html and 'class="pass"' in html
     assert 'href="../index.html"' in html and 'href="cycle.csv"' in html

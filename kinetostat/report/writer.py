@@ -20,7 +20,7 @@ from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from ..sweep import sweep
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
-from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
+from .plots import (_pair_name, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
 from .runs import ModelRun
@@ -238,14 +238,15 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
     doc.p("The plans as the course texts draw them, from the exact solution, at the scales "
           + ", ".join(f"`{s}`" for s in plans.scales.values())
           + ": positions, velocities, accelerations, each Assur group with its loads and arms, the "
-            "force polygons, the initial link and Zhukovsky's lever. Every drawn segment with its length "
-            "and the quantity it stands for: [segments.csv](segments.csv); every value the texts write "
-            "down at this position: [worksheet.csv](worksheet.csv). `kinetostat plans` draws them as "
-            "A3 SVG sheets true to scale.")
+            "force polygons, the initial link and Zhukovsky's lever, each on an A3 sheet true to scale in mm "
+            "(the SVG sheets of `kinetostat plans`; open a sheet to see it at full size). Every drawn segment "
+            "with its length and the quantity it stands for: [segments.csv](segments.csv); every value the "
+            "texts write down at this position: [worksheet.csv](worksheet.csv).")
     files = []
-    for plan in plans.values():      # point labels are mathtext made safe by the plans' own escaping
-        path = _save(plan.figure(), d / ("plan_" + plan_file_name(plan, ".png")))
-        doc.img(path, f"{esc(plan.title)}, {plan.scale}")
+    for plan in plans.values():
+        path = d / ("plan_" + plan_file_name(plan, ".svg"))
+        write_text(path, plan.svg(mechanism=m.name))
+        doc.img(path, f"{esc(plan.title)}, {plan.scale}", link=True)
         files.append(path)
     write_text(d / "segments.csv", plans.segments_csv())
     sheet.to_csv(d / "worksheet.csv")
