@@ -3,8 +3,8 @@ self-contained HTML page by markdown-it-py; number formats of the reports.
 
 The HTML is markdown-it's CommonMark rendering (tables enabled, raw HTML off, so any HTML or
 `javascript:` link in a model's strings comes out escaped or as text) with: heading ids by
-GitHub's rule (the table of contents links work in both), `.md` links to sibling reports turned
-into `.html`, images (PNG, SVG) embedded as data URIs, tables wrapped in a horizontally scrolling box.
+GitHub's rule (the table of contents links work in both), links to a report's `index.md` turned
+into its `index.html` (other `.md` files, the studies, stay Markdown), images (PNG, SVG) embedded as data URIs, tables wrapped in a horizontally scrolling box.
 
 May use: the standard library, `kinetostat._io` (atomic writes) and markdown-it-py (imported inside
 `Doc.html`).
@@ -188,8 +188,9 @@ class Doc:
             for c in t.children or []:
                 if c.type == "link_open":
                     href = str(c.attrGet("href") or "")
-                    if not re.match(r"^[a-z][a-z0-9+.-]*:", href) and href.endswith(".md"):
-                        c.attrSet("href", href[:-3] + ".html")
+                    path, hash_, frag = href.partition("#")
+                    if not re.match(r"^[a-z][a-z0-9+.-]*:", href) and (path == "index.md" or path.endswith("/index.md")):
+                        c.attrSet("href", path[:-3] + ".html" + hash_ + frag)
                 elif c.type == "image" and base is not None:
                     f = Path(base) / str(c.attrGet("src") or "")
                     if f.is_file() and f.suffix in _MIME:
