@@ -129,7 +129,7 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     assert "| id | name | mass, kg | I_S, kg m² |" in md and "| P(0,3) | prismatic |" in md
     assert "3·3 − 2·4 − 0 = **1**" in md and "`I(0,1) <- II(2,3)`" in md
     # the error table: every route x quantity with the angle of its maximum, its tolerance and verdict
-    assert ("| route | quantity | max abs error | at φ, deg | peak relative | tolerance | RMS relative |"
+    assert ("| route | quantity | max abs error | at φ, deg | peak relative, 1 | tolerance, 1 | RMS relative, 1 |"
             in md)
     rows = re.findall(r"^\| (pinocchio|mujoco) \| (M_drive|R\(\d,\d\)) \| (.*?) \| (.*?) \| (.*?) \| 1e-09 \|"
                       r".*\| \*\*PASS\*\* \|$", md, re.M)
@@ -137,7 +137,7 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     # exact routes agree to rounding: shown as such, never as a meaningless "8.0452e-14 N"
     assert all(r[2] == "≈ 0 (rounding)" and r[3] == "-" and r[4] == "rounding" for r in rows), rows
     assert not re.search(r"\de-1[3-9] N", md)
-    assert "| route | kind | tolerance (peak-relative) | why this tolerance |" in md
+    assert "| route | kind | tolerance (peak-relative, 1) | why this tolerance |" in md
     # the seed's published values, with the difference in %
     assert "## Against the published values" in md
     for symbol, value in [("V_B", "10.94"), ("R32", "6481"), ("M_bal (lever)", "102.97")]:

@@ -452,7 +452,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
 
 
 def plot_hodographs(run: ModelRun, path: Path) -> Path:
-    """Tip of each revolute pair's reaction vector over the cycle (seed 004, figs. 13-14)."""
+    """Tip of each revolute pair's reaction vector over the cycle (as Potapov 2024 draws them, figs. 13-14)."""
     from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     pairs = [p for p in m.pairs if p.kind == "R"]

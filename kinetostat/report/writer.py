@@ -381,7 +381,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
             row("M_bal", "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
     rows += [row(esc(_pair_name(m, p)), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
              for p in m.pairs]
-    doc.table(["quantity", "route against group by group", "max |difference|", "peak relative"], rows, "llrr")
+    doc.table(["quantity", "route against group by group", "max |difference|", "peak relative, 1"], rows, "llrr")
 
 
 def _error_rows(run: ModelRun) -> list[list[str]]:
@@ -494,7 +494,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
           "rounding and reads so (the two agree to machine precision; its angle is then left out).")
     if run.results:
         doc.img(images["errors"], "|engine − kinetostat| over the cycle, log scale; dashed: tolerance × peak")
-    doc.table(["route", "quantity", "max abs error", "at φ, deg", "peak relative", "tolerance", "RMS relative",
+    doc.table(["route", "quantity", "max abs error", "at φ, deg", "peak relative, 1", "tolerance, 1", "RMS relative, 1",
                "angles compared", "result"], _error_rows(run), "llrrrrrrl")
     doc.h(3, "Routes and their tolerances")
     rows = []
@@ -504,7 +504,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
         rows.append([route, er.route if er else "-", f"{tol.peak_relative:.0e}" if tol else "-",
                      tol.reason if tol else "-",
                      esc((er.note if er and er.note else "") or run.skipped.get(route, run.errors.get(route, "")))])
-    doc.table(["route", "kind", "tolerance (peak-relative)", "why this tolerance", "note"], rows, "llrll")
+    doc.table(["route", "kind", "tolerance (peak-relative, 1)", "why this tolerance", "note"], rows, "llrll")
 
     doc.h(2, "Hodographs of the reactions")
     doc.p("The tip of each revolute pair's reaction vector (force of link i on link j, world frame) traced "
