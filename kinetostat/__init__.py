@@ -6,7 +6,7 @@
     >>> mech.structure.formula
     'I(0,1) <- II(2,3)'
     >>> res
-    Analysis(mechanism='ICE crank-slider (seed 002 worked example)', positions=1, phi_deg=30, singular=0)
+    Analysis(mechanism='ICE crank-slider (worked example of Logvinenko, Nadtoka 2021)', positions=1, phi_deg=30, singular=0)
 
 The plans of the graphical method: `kinetostat.plans.build(mech, at=30)`.
 

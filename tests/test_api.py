@@ -76,10 +76,10 @@ def test_every_repr_of_a_bundled_model_is_a_short_summary(path):
 
 def test_repr_of_the_ice_model_and_its_result():
     mech = kinetostat.load(ICE)
-    assert repr(mech) == ("Mechanism(name='ICE crank-slider (seed 002 worked example)', links=4, pairs=4, "
+    assert repr(mech) == ("Mechanism(name='ICE crank-slider (worked example of Logvinenko, Nadtoka 2021)', links=4, pairs=4, "
                           "structure='I(0,1) <- II(2,3)', drive=engine 471.2 rad/s)")
     assert repr(kinetostat.analyze(mech, phi_deg=[30.0])) == (
-        "Analysis(mechanism='ICE crank-slider (seed 002 worked example)', positions=1, phi_deg=30, singular=0)")
+        "Analysis(mechanism='ICE crank-slider (worked example of Logvinenko, Nadtoka 2021)', positions=1, phi_deg=30, singular=0)")
     assert repr(mech.structure) == "Structure(W=1, formula='I(0,1) <- II(2,3)', kinds=['RRP'])"
 
 

@@ -61,7 +61,7 @@ def test_reruns_are_byte_identical_and_jobs_do_not_matter(ice_report, tmp_path):
     for f in files:
         assert (ice_report / f).read_bytes() == (serial / f).read_bytes(), f
     plans = {m: len(kinetostat.plans.build(kinetostat.load(p))) for m, p in (("ice", ICE), ("shaper", SHAPER))}
-    # the index; ice: 5 png, md, html, csv, json, a png per plan, segments.csv, worksheet.csv; the shaper + 1 png
+    # the index; ice: 5 png, md, html, csv, json, an svg per plan, segments.csv, worksheet.csv; the shaper + 1 png
     assert len(files) == 2 + (9 + plans["ice"] + 2) + (10 + plans["shaper"] + 2)
 
 
@@ -139,7 +139,7 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     assert "| id | name | mass, kg | I_S, kg m² |" in md and "| P(0,3) | prismatic |" in md
     assert "3·3 − 2·4 − 0 = **1**" in md and "`I(0,1) <- II(2,3)`" in md
     # the error table: every route x quantity with the angle of its maximum, its tolerance and verdict
-    assert ("| route | quantity | max abs error | at φ, deg | peak relative | tolerance | RMS relative |"
+    assert ("| route | quantity | max abs error | at φ, deg | peak relative, 1 | tolerance, 1 | RMS relative, 1 |"
             in md)
     rows = re.findall(r"^\| (pinocchio|mujoco) \| (M_drive|R\(\d,\d\)) \| (.*?) \| (.*?) \| (.*?) \| 1e-09 \|"
                       r".*\| \*\*PASS\*\* \|$", md, re.M)
@@ -147,7 +147,7 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     # exact routes agree to rounding: shown as such, never as a meaningless "8.0452e-14 N"
     assert all(r[2] == "≈ 0 (rounding)" and r[3] == "-" and r[4] == "rounding" for r in rows), rows
     assert not re.search(r"\de-1[3-9] N", md)
-    assert "| route | kind | tolerance (peak-relative) | why this tolerance |" in md
+    assert "| route | kind | tolerance (peak-relative, 1) | why this tolerance |" in md
     # the seed's published values, with the difference in %
     assert "## Against the published values" in md
     for symbol, value in [("V_B", "10.94"), ("R32", "6481"), ("M_bal (lever)", "102.97")]:
@@ -173,7 +173,14 @@ def test_report_html_is_markdown_it_rendering(ice_report):
     from markdown_it import MarkdownIt
     d = ice_report / "ice_crank_slider"
     html = (d / "index.html").read_text()
-    assert html.count('src="data:image/png;base64,') == len(PNGS) + len(kinetostat.plans.build(kinetostat.load(ICE)))
+    plans = kinetostat.plans.build(kinetostat.load(ICE))
+    assert html.count('src="data:image/png;base64,') == len(PNGS)
+    # the plans: the sheets of `kinetostat plans`, embedded, each a link to its SVG file
+    assert html.count('src="data:image/svg+xml;base64,') == len(plans)
+    for plan in plans.values():
+        name = "plan_" + kinetostat.plans.plan_file_name(plan)
+        assert f'<a href="{name}"><img' in html
+        assert (d / name).read_text() == plan.svg(mechanism=kinetostat.load(ICE).name)
     assert not re.search(r'src="(?!data:)', html)
     assert '<div class="scroll"><table>' in html and 'class="pass"' in html
     assert 'href="../index.html"' in html and 'href="cycle.csv"' in html
@@ -185,14 +192,61 @@ def test_report_html_is_markdown_it_rendering(ice_report):
 
 def test_index_lists_only_this_run(ice_report):
     md = (ice_report / "index.md").read_text()
-    assert "| model | mechanism | structure formula | pinocchio | mujoco |" in md
-    assert "[ice_crank_slider](ice_crank_slider/index.md)" in md and "`I(0,1) <- II(2,3)`" in md
+    # the verdict second, in a table of five columns; the errors route by route in a second table
+    assert "| model | result | mechanism; structure formula | published values | plans |" in md
+    assert "| model | pinocchio | mujoco |" in md
+    assert "[ice_crank_slider](ice_crank_slider/index.md) | **PASS** |" in md and "`I(0,1) <- II(2,3)`" in md
+    assert "[plans](ice_crank_slider/index.md#plans-of-the-graphical-method)" in md
     assert "[slotted_link_shaper](slotted_link_shaper/index.md)" in md
     assert "stale" not in md
     assert "rounding ≤ 1e-09 PASS" in md          # beside each error the route's tolerance
     assert "15/15 within" in md
     html = (ice_report / "index.html").read_text()
     assert 'href="ice_crank_slider/index.html"' in html and "stale" not in html
+    assert 'href="ice_crank_slider/index.html#plans-of-the-graphical-method"' in html
+    ice = (ice_report / "ice_crank_slider" / "index.html").read_text()
+    assert 'id="plans-of-the-graphical-method"' in ice
+    # the sources the reports cite, in full
+    assert "## Sources" in md and "**Logvinenko, Nadtoka 2021**: Логвіненко О. А., Надтока О. В." in md
+
+
+def test_index_links_the_studies_in_its_folder(tmp_path, ice_report):
+    summary = json.loads((ice_report / "ice_crank_slider" / "summary.json").read_text())
+    write_index(tmp_path, [summary])
+    assert "## Studies" not in (tmp_path / "index.md").read_text()
+    (tmp_path / "stability.md").write_text("# study\n")
+    write_index(tmp_path, [summary])
+    md = (tmp_path / "index.md").read_text()
+    assert "## Studies" in md and "](stability.md)" in md and "drawing_error.md" not in md
+    assert 'href="stability.md"' in (tmp_path / "index.html").read_text()     # a study stays Markdown
+
+
+def test_reports_cite_their_sources_and_show_no_seed_or_line_number(ice_report):
+    """No "seed 00x" and no line number of a source file anywhere a reader sees: the short citations
+    ("Logvinenko, Nadtoka 2021") resolve to full references in each report's Sources."""
+    for md in ice_report.rglob("index.md"):
+        text = md.read_text()
+        assert not re.search(r"\bseed 00\d|\blines? \d", text, re.I), md
+        if md.parent == ice_report:
+            continue                                    # the index lists what the reports cite
+        for key in re.findall(r"\*\*([^*]+)\*\*: ", text.partition("## Sources")[2].partition("## Files")[0]):
+            assert key in text.partition("## Sources")[0], (md, key)
+    md = (ice_report / "ice_crank_slider" / "index.md").read_text()
+    assert "- **Potapov 2024**: Потапов В. А." in md and "- **Logvinenko, Nadtoka 2021**:" in md
+
+
+def test_every_parameter_shows_its_unit():
+    from kinetostat.report.writer import parameter_units
+    for path in MODELS:
+        units = parameter_units(kinetostat.load(path))
+        assert "not stated" not in units.values(), (path.stem, units)
+    units = parameter_units(kinetostat.load(ICE))
+    assert (units["n1"], units["l_AB"], units["AS2_AB"], units["p_max"], units["I_S2"]) == ("rpm", "m", "1", "Pa", "kg m²")
+
+
+def test_log_ticks_are_plain_text():
+    from kinetostat.report.plots import _decade
+    assert [_decade(v) for v in (1e-15, 1e-3, 1.0, 100.0)] == ["1e-15", "1e-3", "1", "1e2"]
 
 
 def test_report_of_a_model_without_published_values(tmp_path, sketched_plots):
@@ -261,12 +315,13 @@ def test_doc_renders_markdown_and_html():
     doc = Doc("t")
     doc.h(2, "A <b> title")
     doc.table(["a", "b"], [["x|y", "**FAIL**"]], "lr")
-    doc.p("see [here](x.md) and `code` and [bad](javascript:alert(1))")
+    doc.p("see [here](x/index.md#a) and [study](s.md) and `code` and [bad](javascript:alert(1))")
     md, html = doc.markdown(), doc.html()
     assert "| x\\|y | **FAIL** |" in md and "|---|---:|" in md
     assert '<h2 id="a-b-title">A &lt;b&gt; title</h2>' in html
     assert '<td style="text-align:right" class="fail"><strong>FAIL</strong></td>' in html
-    assert '<a href="x.html">here</a>' in html and "<code>code</code>" in html
+    assert '<a href="x/index.html#a">here</a>' in html and "<code>code</code>" in html
+    assert '<a href="s.md">study</a>' in html         # only a report's index.md becomes its HTML page
     assert 'href="javascript' not in html
 
 

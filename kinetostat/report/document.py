@@ -3,8 +3,8 @@ self-contained HTML page by markdown-it-py; number formats of the reports.
 
 The HTML is markdown-it's CommonMark rendering (tables enabled, raw HTML off, so any HTML or
 `javascript:` link in a model's strings comes out escaped or as text) with: heading ids by
-GitHub's rule (the table of contents links work in both), `.md` links to sibling reports turned
-into `.html`, images embedded as data URIs, tables wrapped in a horizontally scrolling box.
+GitHub's rule (the table of contents links work in both), links to a report's `index.md` turned
+into its `index.html` (other `.md` files, the studies, stay Markdown), images (PNG, SVG) embedded as data URIs, tables wrapped in a horizontally scrolling box.
 
 May use: the standard library, `kinetostat._io` (atomic writes) and markdown-it-py (imported inside
 `Doc.html`).
@@ -122,8 +122,10 @@ class Doc:
         self.blocks.append(("table", list(header), [[str(c) for c in r] for r in rows],
                             align or "l" * len(header)))
 
-    def img(self, path: Path, caption: str):
-        self.blocks.append(("img", Path(path), caption))
+    def img(self, path: Path, caption: str, link: bool = False):
+        """A PNG or SVG image with its caption; `link`: the image links to its file (a sheet to
+        open at full size)."""
+        self.blocks.append(("img", Path(path), caption, link))
 
     def pre(self, text: str):
         self.blocks.append(("pre", text))
@@ -149,7 +151,8 @@ class Doc:
             lines += ["| " + " | ".join(cell(c) for c in r) + " |" for r in rows]
             return "\n".join(lines)
         if kind == "img":
-            return f"![{b[2]}]({b[1].name})\n\n*{b[2]}*"
+            image = f"![{b[2]}]({b[1].name})"
+            return (f"[{image}]({b[1].name})" if b[3] else image) + f"\n\n*{b[2]}*"
         if kind == "pre":
             return "```\n" + b[1].rstrip("\n") + "\n```"
         raise ValueError(f"unknown block {kind!r}")
@@ -185,16 +188,21 @@ class Doc:
             for c in t.children or []:
                 if c.type == "link_open":
                     href = str(c.attrGet("href") or "")
-                    if not re.match(r"^[a-z][a-z0-9+.-]*:", href) and href.endswith(".md"):
-                        c.attrSet("href", href[:-3] + ".html")
+                    path, hash_, frag = href.partition("#")
+                    if not re.match(r"^[a-z][a-z0-9+.-]*:", href) and (path == "index.md" or path.endswith("/index.md")):
+                        c.attrSet("href", path[:-3] + ".html" + hash_ + frag)
                 elif c.type == "image" and base is not None:
                     f = Path(base) / str(c.attrGet("src") or "")
-                    if f.is_file() and f.suffix == ".png":
-                        c.attrSet("src", "data:image/png;base64," + base64.b64encode(f.read_bytes()).decode("ascii"))
+                    if f.is_file() and f.suffix in _MIME:
+                        c.attrSet("src", f"data:{_MIME[f.suffix]};base64," + base64.b64encode(f.read_bytes()).decode("ascii"))
         md.add_render_rule("table_open", lambda *a: '<div class="scroll"><table>\n')
         md.add_render_rule("table_close", lambda *a: "</table></div>\n")
         body = md.renderer.render(tokens, md.options, {})
         return _HTML.format(title=html.escape(self.title), body=body)
+
+
+#: Images embedded in the HTML as data URIs, by file suffix.
+_MIME = {".png": "image/png", ".svg": "image/svg+xml"}
 
 
 def _headings(markdown: str) -> list[tuple[int, str, str]]:

@@ -76,9 +76,10 @@ def _legend_cols(n: int, most: int) -> int:
 @contextmanager
 def plain_text() -> Iterator[None]:
     """Figures made in this block take every text literally: no mathtext (a model named
-    "$\\frac{$" would abort the drawing) and no LaTeX, whatever the user's matplotlibrc says."""
+    "$\\frac{$" would abort the drawing) and no LaTeX, whatever the user's matplotlibrc says;
+    tick labels and offsets as plain numbers (1e-13, not a mathtext power of ten)."""
     import matplotlib
-    with matplotlib.rc_context({"text.parse_math": False, "text.usetex": False}):
+    with matplotlib.rc_context({"text.parse_math": False, "text.usetex": False, "axes.formatter.use_mathtext": False}):
         yield
 
 
@@ -104,12 +105,25 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
+def _decade(value: float, pos=None) -> str:
+    """A log axis' tick label as plain text: 1e-3, 1, 1e+2 (matplotlib's own log labels are
+    mathtext, which `plain_text` prints literally)."""
+    if not value > 0:
+        return ""
+    e = round(math.log10(value))
+    if abs(math.log10(value) - e) > 1e-9:
+        return f"{value:.0e}".replace("e-0", "e-").replace("e+0", "e")
+    return "1" if e == 0 else f"1e{e}"
+
+
 def _log_ticks(ax) -> None:
-    """A log axis with at most 6 labelled decades and no minor ticks (each tick is an artist
-    to lay out: the minor ones were a quarter of the error plot's time)."""
-    from matplotlib.ticker import LogLocator, NullLocator
+    """A log axis with at most 6 labelled decades, labelled in plain text (`_decade`), and no
+    minor ticks (each tick is an artist to lay out: the minor ones were a quarter of the error
+    plot's time)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
     ax.yaxis.set_major_locator(LogLocator(numticks=6))
     ax.yaxis.set_minor_locator(NullLocator())
+    ax.yaxis.set_major_formatter(FuncFormatter(_decade))
 
 
 def _phi_axis(ax, label: bool = True, step: int = 60):
@@ -438,7 +452,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
 
 
 def plot_hodographs(run: ModelRun, path: Path) -> Path:
-    """Tip of each revolute pair's reaction vector over the cycle (seed 004, figs. 13-14)."""
+    """Tip of each revolute pair's reaction vector over the cycle (as Potapov 2024 draws them, figs. 13-14)."""
     from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     pairs = [p for p in m.pairs if p.kind == "R"]

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from pathlib import Path
 from typing import Any, Sequence
@@ -20,14 +21,21 @@ from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from ..sweep import sweep
 from ..tables import error, plain, write_csv
-from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc
-from .plots import (_pair_name, _save, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
+from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc, slug
+from .plots import (_pair_name, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
 from .runs import ModelRun, trust
+from .sources import WORKS, Work, cited
 
 #: Fewer positions than this make the plots over the cycle meaningless.
 MIN_REPORT_STEPS = 8
+#: The heading of a report's plans (the index links to it).
+PLANS_HEADING = "Plans of the graphical method"
+#: The project's studies, linked from the index where their files are in its folder.
+STUDIES = (("stability.md", "Stability: the solver's accuracy near singular positions"),
+           ("drawing_error.md", "Drawing error: the spread of a careful drawing of the plans"),
+           ("benchmark.md", "Benchmark: speed of the solver and the engines"))
 
 
 def _versions() -> str:
@@ -47,19 +55,61 @@ def _vec(v) -> str:
     return "(" + ", ".join(f"{c:.6g}" for c in v) + ")"
 
 
+#: Unit of a model field by its last name (models/FORMAT.md: SI throughout); points are in m.
+_FIELD_UNITS = {"mass": "kg", "I_S": "kg m²", "rpm": "rpm", "omega": "rad/s", "eps": "rad/s²", "module": "m",
+                "z_wheel": "1", "z_pinion": "1", "scale": "N", "stiffness": "N/m", "free_length": "m", "radius": "m",
+                "f": "1", "value": "N or N m"}
+#: Units a model file's comment may state for a parameter ("r = 0.080  # crank length, m").
+_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", "Pa", "m^2", "rad/s",
+                 "rad/s^2", "deg", "m/s^2", "s", "1"}
+
+
+def _unit_text(unit: str) -> str:
+    return unit.replace("^2", "²").replace("^3", "³")
+
+
+def _field_unit(path: str) -> str | None:
+    """The unit of a model field given by its path ("link[id=2].mass"), None where unknown."""
+    if ".points." in path or path.startswith("frame."):
+        return "m"
+    return _FIELD_UNITS.get(re.sub(r"\[[^\]]*\]$", "", path).rsplit(".", 1)[-1])
+
+
+def parameter_units(m: Mechanism) -> dict[str, str]:
+    """The unit of each of the model's [parameters]: that of a field given as the parameter's name
+    alone, else the one the model file's comment on the parameter states ("# crank length, m"; a
+    ratio "l_AB / l_OA" is 1), else "not stated"."""
+    text = Path(m.path).read_text(encoding="utf-8") if m.path and Path(m.path).is_file() else ""
+    out = {}
+    for name in m.parameters:
+        unit = next((u for path, (expr, _) in m.expressions.items()
+                     if not path.startswith("parameters.") and expr.strip() == name
+                     and (u := _field_unit(path)) is not None), None)
+        said = re.search(rf"^[ \t]*{re.escape(name)}[ \t]*=[^#\n]*#([^\n]*)", text, re.M)
+        if unit is None and said:
+            comment = re.sub(r"\([^)]*\)", "", said[1])
+            unit = next((t.strip() for t in re.split(r"[,:;]", comment) if t.strip() in _STATED_UNITS), None)
+            if unit is None and re.match(r"\s*\w+ / \w+", comment):
+                unit = "1"
+        out[name] = _unit_text(unit) if unit else "not stated"
+    return out
+
+
 def _parameters_section(doc: Doc, m: Mechanism) -> None:
     """The model's [parameters] and every number an expression produced (shown where there are any)."""
     given = m.expressions
     if m.parameters:
+        units = parameter_units(m)
         doc.h(3, "Parameters")
-        doc.table(["parameter", "given as", "value"],
-                  [[esc(n), esc(given[f"parameters.{n}"][0]) if f"parameters.{n}" in given else "number", f"{v:.10g}"]
-                   for n, v in m.parameters.items()], "llr")
+        doc.table(["parameter", "given as", "value", "unit"],
+                  [[esc(n), esc(given[f"parameters.{n}"][0]) if f"parameters.{n}" in given else "number", f"{v:.10g}",
+                    units[n]] for n, v in m.parameters.items()], "llrl")
     fields = [(path, e) for path, e in given.items() if not path.startswith("parameters.")]
     if fields:
         doc.h(3, "Numbers from expressions")
-        doc.table(["field", "expression", "value"], [[esc(path), esc(text), f"{v:.10g}"] for path, (text, v) in fields],
-                  "llr")
+        doc.table(["field", "expression", "value", "unit"],
+                  [[esc(path), esc(text), f"{v:.10g}", _field_unit(path) or "not stated"] for path, (text, v) in fields],
+                  "llrl")
 
 
 def study_table(m: Mechanism) -> np.ndarray:
@@ -95,8 +145,10 @@ def _study_section(doc: Doc, m: Mechanism) -> None:
           f"load or assemble.")
     (first, xs) = st.vary[0]
     second, ys = st.vary[1] if len(st.vary) > 1 else ("", ())
-    header = ([f"{esc(first)} \\ {esc(second)}", *(f"{y:g}" for y in ys)] if second
-              else [esc(first), f"max |R({i},{j})|, N"])
+    units = parameter_units(m)
+    header = ([f"{esc(first)}, {units.get(first, 'not stated')} \\ {esc(second)}, {units.get(second, 'not stated')}",
+               *(f"{y:g}" for y in ys)] if second
+              else [f"{esc(first)}, {units.get(first, 'not stated')}", f"max |R({i},{j})|, N"])
     doc.table(header, [[f"{x:g}"] + [f"{v:.1f}" if np.isfinite(v) else "\u2014" for v in row]
                        for x, row in zip(xs, table)], "r" * len(header))
 
@@ -166,9 +218,16 @@ def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
                 val = f"c = {ld.value:.6g} on pair {ld.pair[0]}–{ld.pair[1]}"
             else:
                 val = f"{ld.value:.6g}"
+            unit = {"moment": "N m", "force": "N"}.get(ld.kind)
+            if ld.kind == "damper":
+                unit = "N m s/rad" if m.pair_between(*ld.pair).kind == "R" else "N s/m"
+            elif ld.characteristic is not None:
+                unit = "N m (ω in rad/s)"
+            elif ld.table is not None:
+                unit = unit + " (the scale)"
             direction = ld.direction if isinstance(ld.direction, str) or ld.direction is None else _vec(ld.direction)
-            rows.append([esc(ld.name), ld.kind, ld.link, esc(ld.point or "-"), esc(direction or "-"), val])
-        doc.table(["name", "kind", "link", "point", "direction", "value (N or N m)"], rows)
+            rows.append([esc(ld.name), ld.kind, ld.link, esc(ld.point or "-"), esc(direction or "-"), val, unit])
+        doc.table(["name", "kind", "link", "point", "direction", "value", "unit"], rows)
     if m.springs:
         doc.h(3, "Springs")
         doc.table(["name", "end a", "end b", "stiffness, N/m", "free length, m"],
@@ -227,7 +286,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
     from ..plans import build, plan_file_name
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
-    doc.h(2, f"The graphical method at φ = {at:g}°")
+    doc.h(2, PLANS_HEADING)
     try:
         with warnings.catch_warnings():         # the cycle's warnings are reported below
             warnings.simplefilter("ignore")
@@ -236,17 +295,18 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
     except ValueError as exc:
         doc.p(f"No plans at this position: {esc(str(exc))}")
         return []
-    doc.p("The plans as the course texts draw them, from the exact solution, at the scales "
+    doc.p(f"The plans at φ = {at:g}° as the course texts draw them, from the exact solution, at the scales "
           + ", ".join(f"`{s}`" for s in plans.scales.values())
           + ": positions, velocities, accelerations, each Assur group with its loads and arms, the "
-            "force polygons, the initial link and Zhukovsky's lever. Every drawn segment with its length "
-            "and the quantity it stands for: [segments.csv](segments.csv); every value the texts write "
-            "down at this position: [worksheet.csv](worksheet.csv). `kinetostat plans` draws them as "
-            "A3 SVG sheets true to scale.")
+            "force polygons, the initial link and Zhukovsky's lever, each on an A3 sheet true to scale in mm "
+            "(the SVG sheets of `kinetostat plans`; open a sheet to see it at full size). Every drawn segment "
+            "with its length and the quantity it stands for: [segments.csv](segments.csv); every value the "
+            "texts write down at this position: [worksheet.csv](worksheet.csv).")
     files = []
-    for plan in plans.values():      # point labels are mathtext made safe by the plans' own escaping
-        path = _save(plan.figure(), d / ("plan_" + plan_file_name(plan, ".png")))
-        doc.img(path, f"{esc(plan.title)}, {plan.scale}")
+    for plan in plans.values():
+        path = d / ("plan_" + plan_file_name(plan, ".svg"))
+        write_text(path, plan.svg(mechanism=m.name))
+        doc.img(path, f"{esc(plan.title)}, {plan.scale}", link=True)
         files.append(path)
     write_text(d / "segments.csv", plans.segments_csv())
     sheet.to_csv(d / "worksheet.csv")
@@ -298,7 +358,7 @@ def _balancing_force_section(doc: Doc, res, image: Path) -> None:
 
 def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
     """The balancing moment and the reactions by the three routes of the texts: group by group,
-    Zhukovsky's lever (balancing moment only) and d'Alembert-Lagrange (seed 004, `virtual_work`)."""
+    Zhukovsky's lever (balancing moment only) and d'Alembert-Lagrange (Potapov 2024, `virtual_work`)."""
     vw = virtual_work(m, phi_deg=res.phi_deg)
 
     def worst(a, b) -> tuple[float, float]:
@@ -311,7 +371,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
     doc.h(2, "Three routes")
     doc.p("The balancing moment and every reaction by three independent routes sharing only the kinematics: "
           "group by group (the solver), Zhukovsky's lever (the balancing moment from the velocity plan) and "
-          "d'Alembert–Lagrange (seed 004: each reaction component from the virtual work of all loads, inertia "
+          "d'Alembert–Lagrange (Potapov 2024: each reaction component from the virtual work of all loads, inertia "
           "included, in the virtual motion of the mechanism with that one constraint released; "
           "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak "
           f"(\"rounding\" below {ROUNDING:.1e}: the digits of a rounding error differ between machines).")
@@ -323,7 +383,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
             row("M_bal", "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
     rows += [row(esc(_pair_name(m, p)), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
              for p in m.pairs]
-    doc.table(["quantity", "route against group by group", "max |difference|", "peak relative"], rows, "llrr")
+    doc.table(["quantity", "route against group by group", "max |difference|", "peak relative, 1"], rows, "llrr")
 
 
 def _error_rows(run: ModelRun) -> list[list[str]]:
@@ -436,7 +496,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
           "rounding and reads so (the two agree to machine precision; its angle is then left out).")
     if run.results:
         doc.img(images["errors"], "|engine − kinetostat| over the cycle, log scale; dashed: tolerance × peak")
-    doc.table(["route", "quantity", "max abs error", "at φ, deg", "peak relative", "tolerance", "RMS relative",
+    doc.table(["route", "quantity", "max abs error", "at φ, deg", "peak relative, 1", "tolerance, 1", "RMS relative, 1",
                "angles compared", "result"], _error_rows(run), "llrrrrrrl")
     doc.h(3, "Routes and their tolerances")
     rows = []
@@ -447,12 +507,12 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
                      tol.reason if tol else "-",
                      esc((er.note if er and er.note else "") or run.skipped.get(route, run.errors.get(route, ""))),
                      esc(trust(route))])
-    doc.table(["route", "kind", "tolerance (peak-relative)", "why this tolerance", "note", "rests on"], rows,
+    doc.table(["route", "kind", "tolerance (peak-relative, 1)", "why this tolerance", "note", "rests on"], rows,
               "llrlll")
 
     doc.h(2, "Hodographs of the reactions")
     doc.p("The tip of each revolute pair's reaction vector (force of link i on link j, world frame) traced "
-          "over the cycle, as seed 004 draws them; grey rays every 30° of φ; the red dot marks the maximum.")
+          "over the cycle, as Potapov 2024 draws them; grey rays every 30° of φ; the red dot marks the maximum.")
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
     _published_section(doc, published)
@@ -463,6 +523,10 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
         doc.h(2, "Warnings")
         doc.ul(([f"{sing} positions are singular (values there are NaN)"] if sing else [])
                + [esc(w) for w in run.warnings])
+    works = cited([doc.markdown()])
+    if works:
+        doc.h(2, "Sources")
+        doc.ul([_work(w) for w in works])
     doc.h(2, "Files")
     doc.ul([f"[{p.name}]({p.name})" for p in [*images.values(), *plan_files]]
            + ["[cycle.csv](cycle.csv): `res.to_frame()` of the cycle",
@@ -470,7 +534,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
 
     doc.write(d)
 
-    summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N,
+    summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N, plans=bool(plan_files),
+                   sources=[w.key for w in works],
                    units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|; "
                                     f"'rounding' below {ROUNDING:.1e})",
                               tolerance="1 (of the peak)", worst_percent="%"),
@@ -492,6 +557,10 @@ def _worst(run: ModelRun, route: str) -> float | str | None:
     return None if w is None else "rounding" if _is_rounding(w) else error(w)
 
 
+def _work(w: Work) -> str:
+    return f"**{esc(w.key)}**: {esc(w.reference)}"
+
+
 def _clean(x):
     """JSON-safe copy: NaN/inf -> None, numpy scalars -> Python."""
     if isinstance(x, dict):
@@ -503,7 +572,9 @@ def _clean(x):
 
 def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
     """`out/index.md` and `out/index.html` over the reports of this run (`summaries`, as
-    `write_report` returns them, in the order given); other folders in `out` are not listed."""
+    `write_report` returns them, in the order given); other folders in `out` are not listed. The
+    verdicts come first, in a table narrow enough for a page 800 px wide; the errors route by route
+    in a second table; then the studies found in `out` and the sources the reports cite."""
     out = Path(out)
     sums = list(summaries)
     routes: list[str] = []
@@ -514,10 +585,22 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
     doc = Doc("kinetostat: error reports")
     doc.h(1, "kinetostat error reports")
     n_pass = sum(1 for s in sums if s["passed"] and s["checks"])
-    doc.p(f"{len(sums)} mechanisms, {n_pass} pass every check. Each cell: the worst peak-relative error "
-          f"of the route over the mechanism's quantities (driving moment, every reaction), the route's "
-          f"tolerance, and the verdict. An error below {ROUNDING:.1e} of the peak is rounding. "
-          f"Made with {_versions()}.")
+    doc.p(f"{len(sums)} mechanisms, {n_pass} pass every check. Made with {_versions()}.")
+    rows = []
+    for s in sums:
+        pub = s.get("published")
+        pubcell = "-" if not pub else f"{pub['within']}/{pub['n']} within" + \
+            (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")
+        verdict = "**PASS**" if s["passed"] and s["checks"] else "**FAIL**" if not s["passed"] else "not checked"
+        plans = f"[plans]({s['stem']}/index.md#{slug(PLANS_HEADING)})" if s.get("plans") else "-"
+        rows.append([f"[{s['stem']}]({s['stem']}/index.md)", verdict, f"{esc(s['name'])}; `{s['formula']}`", pubcell,
+                     plans])
+    doc.table(["model", "result", "mechanism; structure formula", "published values", "plans"], rows, "lllll")
+    doc.h(2, "Errors route by route")
+    doc.p(f"Each cell: the worst peak-relative error of the route over the mechanism's quantities (driving "
+          f"moment, every reaction; |route − kinetostat| over the cycle's peak |kinetostat|, dimensionless), "
+          f"the route's tolerance, and the verdict. An error below {ROUNDING:.1e} of the peak is rounding. "
+          f"The tolerances and why: each report's table *Routes and their tolerances*.")
     rows = []
     for s in sums:
         cells = []
@@ -531,13 +614,15 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
                 tol = f" ≤ {info['tolerance']:.0e}" if info.get("tolerance") is not None else ""
                 verdict = "PASS" if info["status"] == "PASS" else "**FAIL**"
                 cells.append(f"{_rel(info['worst']) if info['worst'] != 'rounding' else 'rounding'}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
-        pub = s.get("published")
-        pubcell = "-" if not pub else f"{pub['within']}/{pub['n']} within" + \
-            (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")
-        verdict = "**PASS**" if s["passed"] and s["checks"] else "**FAIL**" if not s["passed"] else "not checked"
-        rows.append([f"[{s['stem']}]({s['stem']}/index.md)", esc(s["name"]), f"`{s['formula']}`", *cells, pubcell,
-                     verdict])
-    doc.table(["model", "mechanism", "structure formula", *routes, "published values", "result"], rows,
-              "lll" + "r" * len(routes) + "ll")
-    doc.p("The tolerances and why: see each report's table *Routes and their tolerances*.")
+        rows.append([f"[{s['stem']}]({s['stem']}/index.md)", *cells])
+    doc.table(["model", *routes], rows, "l" + "r" * len(routes))
+    studies = [(name, title) for name, title in STUDIES if (out / name).is_file()]
+    if studies:
+        doc.h(2, "Studies")
+        doc.ul([f"[{title}]({name})" for name, title in studies])
+    keys = {k for s in sums for k in s.get("sources", ())}
+    if keys:
+        doc.h(2, "Sources")
+        doc.p("The works the reports cite.")
+        doc.ul([_work(w) for w in WORKS if w.key in keys])
     return doc.write(out)
