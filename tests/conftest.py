@@ -108,7 +108,7 @@ def sketched_plots(monkeypatch):
             f.write(buf.getvalue())
         return Path(args[-1])
     for name in ("plot_mechanism", "plot_moment", "plot_balancing_force", "plot_reactions", "plot_errors",
-                 "plot_hodographs", "_save"):
+                 "plot_hodographs"):
         monkeypatch.setattr(writer, name, sketch)
 
 
