@@ -1,7 +1,8 @@
-"""Shared fixtures: the bundled models, a base model text for mutation tests, and the command
-line run in this process (`cli`)."""
+"""Shared fixtures: the bundled models, a base model text for mutation tests, the command
+line run in this process (`cli`), and the compiled kernels' cache in a folder of the session."""
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,6 +14,20 @@ import kinetostat
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = sorted((ROOT / "models").glob("*.toml"))
+
+
+@pytest.fixture(scope="session", autouse=True)
+def kernel_cache(tmp_path_factory) -> Path:
+    """The compiled kernels' cache folder ($KINETOSTAT_CACHE): one per test session, so a
+    session compiles each kernel it needs once and never reads or writes the user's cache."""
+    folder = tmp_path_factory.mktemp("kernels")
+    old = os.environ.get("KINETOSTAT_CACHE")
+    os.environ["KINETOSTAT_CACHE"] = str(folder)
+    yield folder
+    if old is None:
+        os.environ.pop("KINETOSTAT_CACHE")
+    else:
+        os.environ["KINETOSTAT_CACHE"] = old
 
 
 @pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])
