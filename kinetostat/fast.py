@@ -21,9 +21,9 @@ under the hash of its source and compiled with numba's disk cache: compiled once
 
 Angles where a group's plan is ill-conditioned (cond > COND_CHECK), cannot be assembled, or
 give a non-finite peak, are flagged by the kernel and solved again by the numpy path with its
-accuracy guard. Loads other than gravity and inertia (tables, diagrams, springs, dampers) are
-evaluated by `applied.applied_wrenches` per chunk of CHUNK angles, between a motion kernel that
-writes the chunk's motion and the kernel that reads the loads from the same buffer.
+accuracy guard. Loads other than gravity and inertia (tables, diagrams, springs, dampers, laws
+of motion) are evaluated by `applied.applied_wrenches` per chunk of CHUNK angles, on the motion
+a first pass of the full kernel wrote, and read by the second pass (or the peaks kernel).
 
 May use: numpy, numba, program, groups, kinematics, kinetostatics, applied, analysis (results),
 model and structure (for type hints).
@@ -57,8 +57,10 @@ __all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "CH
            "cache_dir", "kernel", "vector_report"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
-#: compiled path (measured: below it the numpy path is as fast, once the kernel is cached).
-FAST_MIN = 2_000
+#: compiled path. Measured with the kernel cached: it is the faster from about 300 angles (the
+#: four-bar) to 3,000 (the ICE crank-slider, with its loads); below 10^4 the gain is under
+#: 3 ms a call, less than loading the kernel (~1 s) the first time in a process.
+FAST_MIN = 10_000
 #: Angles per chunk: `chunks`' default size, and the run of angles whose loads are evaluated at once.
 CHUNK = 1 << 14
 #: Angles per block of the kernel's loop (not a multiple of 512: 4 KiB aliasing of the rows in L1).
@@ -159,7 +161,6 @@ _KERNELS: dict[tuple, Any] = {}
 #: are filled by numpy after the kernel).
 REAL = ("th", "w", "e", "vs", "as", "cond", "M_app", "M_i", "normal", "m", "M_bal", "lever", "friction", "error")
 COMPLEX = ("rot", "O", "V", "A", "F_app", "F_i", "R", "F_bal")
-MOTION = ("th", "w", "e", "vs", "as", "cond", "rot", "O", "V", "A")
 
 
 def _has_loads(mech: "Mechanism") -> bool:
@@ -187,9 +188,47 @@ class _Layout:
         return next(r for n, r, _ in self.rows if n == name)
 
 
+_GROUP_MOTION = ("rrr_motion", "rrp_motion", "rpr_motion", "prp_motion", "rpp_motion")
+
+
+def _motion(mech: "Mechanism") -> Program:
+    """`mech`'s kinematics program with each group's assembly branch read from the constant
+    branch<n> instead of written in: one kernel serves every choice of branches."""
+    def make() -> Program:
+        steps = []
+        groups_seen = 0
+        for st in motion_program(mech).steps:
+            if st.fn in _GROUP_MOTION:            # one per group, in the groups' order
+                params = list(inspect.signature(getattr(groups, st.fn)).parameters)
+                if "branch" in params:
+                    args = list(st.args)
+                    args[params.index("branch")] = f"branch{groups_seen}"
+                    st = st._replace(args=tuple(args))
+                groups_seen += 1
+            steps.append(st)
+        prog = motion_program(mech)
+        return Program(tuple(steps), prog.inputs, prog.outputs)
+    return mech.memo(("fast motion", _branches(mech)), make)
+
+
+def _branches(mech: "Mechanism") -> tuple[int, ...]:
+    return tuple(g.branch for g in mech.structure.groups)
+
+
+def _constants(mech: "Mechanism") -> dict[str, Any]:
+    """The base constants of `mech`'s kernels: `program.constants` and the branches (memoised)."""
+    return mech.memo(("fast constants", id(mech.points_z), _branches(mech)), lambda: {
+        **constants(mech), **{f"branch{n}": float(b) for n, b in enumerate(_branches(mech))}})
+
+
 def _layout(mech: "Mechanism") -> _Layout:
-    motion, statics = motion_program(mech), statics_program(mech)
-    base = constants(mech)
+    """The layout of `mech`'s kernels and buffer (memoised per mechanism)."""
+    return mech.memo(("fast layout", _branches(mech)), lambda: _make_layout(mech))
+
+
+def _make_layout(mech: "Mechanism") -> _Layout:
+    motion, statics = _motion(mech), statics_program(mech)
+    base = _constants(mech)
     consts = tuple(dict.fromkeys(n for n in free_names(motion) + free_names(statics) if n in base)) + tuple(
         f"{s}{k}" for k in range(1, mech.n_links) for s in ("com", "mass", "I_S")) + ("g",)
     consts = tuple(dict.fromkeys(consts))
@@ -224,16 +263,15 @@ def buffer(mech: "Mechanism", n: int) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- code generation
-def _value_map(lay: _Layout, v, kind: str) -> dict[tuple[str, int], str]:
-    """(array, column) -> the kernel's expression of its value at an angle, for what `kind` writes."""
+def _value_map(lay: _Layout, v) -> dict[tuple[str, int], str]:
+    """(array, column) -> the kernel's expression of its value at an angle, for every column the
+    full kernel writes (the frame's, a revolute pair's normal force, an engine's F_bal: never)."""
     L = lay.L
     value = {}
     for s in ("th", "w", "e", "rot", "O", "V", "A"):
         value.update({(s, k): v(f"{s}{k}") for k in range(1, L)})
     value.update({(s, p): v(f"{s}{p}") for s in ("vs", "as") for p in lay.slides})
     value.update({("cond", n): v(f"cond{n}") for n in range(lay.G)})
-    if kind == "motion":
-        return value
     for k in range(1, L):
         value.update({("M_i", k): f"Mi{k}", ("F_i", k): f"Fi{k}", ("M_app", k): f"Ma{k}", ("F_app", k): f"Fa{k}"})
     value.update({("R", p): v(f"R{p}") for p in range(lay.P)})
@@ -244,35 +282,45 @@ def _value_map(lay: _Layout, v, kind: str) -> dict[tuple[str, int], str]:
     return value
 
 
-def _source(mech: "Mechanism", lay: _Layout, kind: str, loads: bool) -> str:
+def _scratch_rows(lay: _Layout) -> int:
+    """Rows of BLOCK values in a thread's scratch: the speeds, the loads (a complex column in
+    two rows), and every row the kernel may write or the squares it keeps."""
+    return 2 + 3 * lay.L + lay.n_rows + lay.P + 2
+
+
+def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     """The kernel's Python source (compiled by numba): the programs' steps inside a loop over
-    blocks (design, first angle, count) and an unsigned loop over each block's angles.
-    "full" writes every array of the result into the flat buffer S (rows of n angles); "motion"
-    its motion only; "peaks" keeps per block the largest |R| of each pair, |M_bal| and |F_bal|
-    (PK), by the squares written to the thread's scratch T. All flag in FL the angles the exact
-    guard must see. `loads`: the applied loads are read from S's F_app, M_app rows."""
+    blocks (design, first angle, count) and an unsigned loop over each block's angles that reads
+    and writes the thread's scratch T only, at compile-time rows of BLOCK values (so LLVM sees
+    no aliasing and vectorises it). Before it, the block's speeds and the loads besides gravity
+    (X's rows, or zero where X is empty) are copied into T; after it, "full" copies every array
+    of the result (a complex one interleaved) into the flat buffer S (rows of n angles);
+    "peaks" keeps per block the largest |R| of each pair, |M_bal| and |F_bal| (PK) from the
+    squares in T. Both flag in FL the angles the exact guard must see."""
     from .kinematics import COND_CHECK
-    motion, statics = motion_program(mech), statics_program(mech)
+    motion, statics = _motion(mech), statics_program(mech)
     v = Identifiers().__getitem__
     L, P = lay.L, lay.P
-    head = ["def kernel(phi, W, E, C, bd, b0, bn, n, FL, S, T, PK):",
+    row = iter(range(_scratch_rows(lay)))
+    t = lambda: f"U({next(row) * BLOCK})"          # the next scratch row
+    head = ["def kernel(phi, W, E, C, X, bd, b0, bn, n, FL, S, T, PK):",
             "    for b in range(bd.shape[0]):",
             "        d = bd[b]",
             "        i0 = b0[b]",
             "        m = bn[b]",
             "        fl = d * n + i0"]
-    for q, X in enumerate("WE"):       # the crank's speeds of the block into the scratch rows 0, 1
-        head += [f"        {X.lower()}d = d if {X}.shape[0] > 1 else U(0)",
-                 f"        if {X}.shape[1] > 1:",
-                 "            for j in range(m):",
-                 f"                T[U({q * BLOCK}) + j] = {X}[{X.lower()}d, i0 + j]",
-                 "        else:",
-                 "            for j in range(m):",
-                 f"                T[U({q * BLOCK}) + j] = {X}[{X.lower()}d, 0]"]
+    pre, post = [], []
+    speeds = []
+    for X in "WE":          # the crank's speeds of the block, (D or 1, N or 1) broadcast
+        tr = t()
+        speeds.append(f"T[{tr} + j]")
+        pre += [f"{X.lower()}d = d if {X}.shape[0] > 1 else U(0)", f"if {X}.shape[1] > 1:",
+                "    for j in range(m):", f"        T[{tr} + j] = {X}[{X.lower()}d, i0 + j]",
+                "else:", "    for j in range(m):", f"        T[{tr} + j] = {X}[{X.lower()}d, 0]"]
     pro = [f"{v(n)} = C[d, {j}]" + (".real" if real else "") for j, (n, real) in enumerate(zip(lay.consts, lay.real))]
     fixed = set(lay.consts)               # hoisted: the steps that read constants only
     hoisted, moving = [], []
-    for st in motion.steps + (statics.steps if kind != "motion" else ()):
+    for st in motion.steps + statics.steps:
         if st.fn != "check" and all(not isinstance(a, str) or a in fixed for a in st.args):
             fixed.update(st.out)
             hoisted.append(st)
@@ -281,52 +329,52 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str, loads: bool) -> str:
     pro += code(Program(tuple(hoisted), (), ()), v, lambda *a: "")
     check = lambda i, disc, scale: f"ok &= {disc} >= -1e-12 * {scale}"
     in_motion = set(motion.steps)
-    body = ["i = i0 + j", "j2 = j + j", f"{v('phi')} = phi[i]", f"{v('w_in')} = T[j]",
-            f"{v('e_in')} = T[U({BLOCK}) + j]", "ok = True"]
+    body = [f"{v('phi')} = phi[i0 + j]", f"{v('w_in')} = {speeds[0]}", f"{v('e_in')} = {speeds[1]}", "ok = True"]
     body += code(Program(tuple(st for st in moving if st in in_motion), (), motion.outputs), v, check)
     body += [f"ok &= {v(f'cond{n}')} <= {COND_CHECK!r}" for n in range(lay.G)]
-    real_rows = {name: (r, w) for name, r, w in lay.rows}
-    if kind != "motion":
-        for k in range(1, L):
-            body.append(f"r{k}, Fi{k}, Mi{k} = inertia({v(f'A{k}')}, {v(f'w{k}')}, {v(f'e{k}')}, {v(f'rot{k}')}, "
-                        f"{v(f'com{k}')}, {v(f'mass{k}')}, {v(f'I_S{k}')})")
-            if loads:
-                f, mm = real_rows["F_app"][0] + 2 * k, real_rows["M_app"][0] + k
-                pro += [f"f{k} = U({f}) * n + i0 + i0", f"g{k} = f{k} + U(1)", f"h{k} = U({mm}) * n + i0"]
-                body.append(f"Fa{k}, Ma{k} = complex(S[f{k} + j2], S[g{k} + j2]), S[h{k} + j]")
-            else:
-                body.append(f"Fa{k}, Ma{k} = weight(r{k}, {v(f'mass{k}')}, {v('g')})")
-            body.append(f"{v(f'F{k}')}, {v(f'M{k}')} = wrench(Fa{k}, Ma{k}, Fi{k}, Mi{k}, r{k})")
-        if kind == "full":       # Zhukovsky's lever, before the groups change the known wrenches
-            pw = " + ".join(f"power({v(f'F{k}')}, {v(f'M{k}')}, {v(f'V{k}')}, {v(f'w{k}')})" for k in range(1, L))
-            body.append(f"lever = -({pw}) / {v('w1')}")
-        body += code(Program(tuple(st for st in moving if st not in in_motion), (), statics.outputs), v, check)
-    tail = []
+    first = {name: r for name, r, _ in lay.rows}
+    for k in range(1, L):
+        body.append(f"r{k}, Fi{k}, Mi{k} = inertia({v(f'A{k}')}, {v(f'w{k}')}, {v(f'e{k}')}, {v(f'rot{k}')}, "
+                    f"{v(f'com{k}')}, {v(f'mass{k}')}, {v(f'I_S{k}')})")
+        f, g, h = t(), t(), t()       # the loads besides gravity: X's rows, or zero
+        pre += ["if X.shape[0] > 0:", "    for j in range(m):", f"        T[{f} + j] = X[{3 * k - 3}, i0 + j]",
+                f"        T[{g} + j] = X[{3 * k - 2}, i0 + j]", f"        T[{h} + j] = X[{3 * k - 1}, i0 + j]",
+                "else:", "    for j in range(m):", f"        T[{f} + j] = 0.0", f"        T[{g} + j] = 0.0",
+                f"        T[{h} + j] = 0.0"]
+        body.append(f"Fa{k}, Ma{k} = weight(r{k}, {v(f'mass{k}')}, {v('g')})")
+        body.append(f"Fa{k}, Ma{k} = Fa{k} + complex(T[{f} + j], T[{g} + j]), Ma{k} + T[{h} + j]")
+        body.append(f"{v(f'F{k}')}, {v(f'M{k}')} = wrench(Fa{k}, Ma{k}, Fi{k}, Mi{k}, r{k})")
+    if kind == "full":       # Zhukovsky's lever, before the groups change the known wrenches
+        pw = " + ".join(f"power({v(f'F{k}')}, {v(f'M{k}')}, {v(f'V{k}')}, {v(f'w{k}')})" for k in range(1, L))
+        body.append(f"lever = -({pw}) / {v('w1')}")
+    body += code(Program(tuple(st for st in moving if st not in in_motion), (), statics.outputs), v, check)
     if kind == "peaks":
         sq = [f"square({v(f'R{p}')}.real) + square({v(f'R{p}')}.imag)" for p in range(P)] + [f"square({v('M_bal')})"]
         sq += [f"square({v('F_bal')}.real) + square({v('F_bal')}.imag)"] if lay.machine else []
-        for q, s in enumerate(sq):
-            body.append(f"q{q} = {s}")
+        body += [f"q{q} = {x}" for q, x in enumerate(sq)]
         body.append(f"ok &= math.isfinite({' + '.join(f'q{q}' for q in range(len(sq)))})")
-        for q in range(len(sq)):
-            body.append(f"T[U({(2 + q) * BLOCK}) + j] = q{q} if ok else 0.0")
         for q in range(P + 2):
-            tail += ["top = 0.0", "for j in range(m):", f"    top = max(top, T[U({(2 + q) * BLOCK}) + j])",
-                     f"PK[b, {q}] = math.sqrt(top)"] if q < len(sq) else [f"PK[b, {q}] = 0.0"]
-    else:
-        n_base = 0
-        for (name, col), val in _value_map(lay, v, kind).items():
-            r, _ = real_rows[name]
-            n_base += 1
-            if name in COMPLEX:
-                pro += [f"c{n_base} = U({r + 2 * col}) * n + i0 + i0", f"c{n_base}i = c{n_base} + U(1)"]
-                body += [f"S[c{n_base} + j2] = {val}.real", f"S[c{n_base}i + j2] = {val}.imag"]
+            if q < len(sq):
+                tr = t()
+                body.append(f"T[{tr} + j] = q{q} if ok else 0.0")
+                post += ["top = 0.0", "for j in range(m):", f"    top = max(top, T[{tr} + j])",
+                         f"PK[b, {q}] = math.sqrt(top)"]
             else:
-                pro.append(f"c{n_base} = U({r + col}) * n + i0")
-                body.append(f"S[c{n_base} + j] = {val}")
+                post.append(f"PK[b, {q}] = 0.0")
+    else:
+        for (name, col), val in _value_map(lay, v).items():
+            if name in COMPLEX:
+                re_, im = t(), t()
+                body += [f"T[{re_} + j] = {val}.real", f"T[{im} + j] = {val}.imag"]
+                post += [f"c = U({first[name] + 2 * col}) * n + i0 + i0", "for j in range(m):",
+                         f"    S[c + j + j] = T[{re_} + j]", f"    S[c + j + j + U(1)] = T[{im} + j]"]
+            else:
+                tr = t()
+                body.append(f"T[{tr} + j] = {val}")
+                post += [f"c = U({first[name] + col}) * n + i0", "for j in range(m):", f"    S[c + j] = T[{tr} + j]"]
     body.append("FL[fl + j] = not ok")
     loop = ["for j in range(m):"] + ["    " + ln for ln in body]
-    return "\n".join(head + ["        " + ln for ln in pro + loop + tail]) + "\n"
+    return "\n".join(head + ["        " + ln for ln in pre + pro + loop + post]) + "\n"
 
 
 def _module(kernel_source: str) -> str:
@@ -367,16 +415,16 @@ def _load(text: str) -> Any:
     return module
 
 
-def kernel(mech: "Mechanism", kind: str, loads: bool = False):
-    """The compiled kernel of `mech`'s structure for `kind` ("full", "motion" or "peaks") and
-    its layout: generated once per structure (designs enter through C), loaded from the cache
-    folder's compiled module where an earlier process compiled it."""
+def kernel(mech: "Mechanism", kind: str):
+    """The compiled kernel of `mech`'s structure for `kind` ("full" or "peaks") and its layout:
+    generated once per structure (designs enter through C; structures whose programs differ
+    only in names share one), loaded from the cache folder where an earlier process compiled it."""
     lay = _layout(mech)
-    key = (motion_program(mech).steps, statics_program(mech).steps, lay, kind, loads)
+    src = mech.memo(("kernel source", kind), lambda: _source(mech, lay, kind))
     with _LOCK:
-        if key not in _KERNELS:
-            _KERNELS[key] = (_load(_module(_source(mech, lay, kind, loads))).kernel, lay)
-        return _KERNELS[key]
+        if src not in _KERNELS:
+            _KERNELS[src] = _load(_module(src)).kernel
+        return _KERNELS[src], lay
 
 
 def vector_report(fn) -> dict[str, int]:
@@ -394,7 +442,7 @@ def _table(mechs: Sequence["Mechanism"], lay: _Layout) -> np.ndarray:
     """The base constants of every design, (D, K) complex."""
     C = np.empty((len(mechs), len(lay.consts)), complex)
     for d, m in enumerate(mechs):
-        c = m.memo(("constants", id(m.points_z)), lambda: constants(m))
+        c = _constants(m)
         C[d] = [c[n] for n in lay.consts]
     return C
 
@@ -415,12 +463,14 @@ def _blocks(D: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return bd, b0, np.minimum(b0 + np.uint64(BLOCK), np.uint64(b)) - b0
 
 
-def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, loads: bool = False, S: np.ndarray | None = None,
-         span: tuple[int, int] | None = None, FL: np.ndarray | None = None, threads: int | None = None):
+def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, X: np.ndarray | None = None,
+         S: np.ndarray | None = None, span: tuple[int, int] | None = None, FL: np.ndarray | None = None,
+         threads: int | None = None):
     """The kernel over all designs and the angles span (default all) of `phi` (rad), S the flat
-    buffer of len(phi) angles, its blocks shared among `threads` threads (default THREADS), one
-    scratch each. Returns the flags (D, len(phi)), the peaks per block and the blocks' designs."""
-    fn, lay = kernel(mechs[0], kind, loads)
+    buffer of len(phi) angles, X the loads besides gravity ((3 (L - 1), len(phi)): F_x, F_y, M
+    of each moving link) or None, its blocks shared among `threads` threads (default THREADS),
+    one scratch each. Returns the flags (D, len(phi)), the peaks per block and the blocks' designs."""
+    fn, lay = kernel(mechs[0], kind)
     D, N = len(mechs), len(phi)
     a, b = span or (0, N)
     W, E = _speeds(mechs, phi)
@@ -433,8 +483,8 @@ def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, loads: bool =
     parts = [slice(q * len(bd) // n, (q + 1) * len(bd) // n) for q in range(n)]
 
     def part(s: slice) -> None:
-        T = np.empty((lay.P + 4) * BLOCK)
-        fn(phi, W, E, C, bd[s], b0[s], bn[s], np.uint64(N), FL.reshape(-1), S, T, PK[s])
+        T = np.empty(_scratch_rows(lay) * BLOCK)
+        fn(phi, W, E, C, _NO_LOADS if X is None else X, bd[s], b0[s], bn[s], np.uint64(N), FL.reshape(-1), S, T, PK[s])
 
     if n == 1:
         part(parts[0])
@@ -444,16 +494,31 @@ def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, loads: bool =
     return FL, PK, bd
 
 
+_NO_LOADS = np.zeros((0, 1))
+
+
 def _kinematics(mech: "Mechanism", phi: np.ndarray, r: dict[str, np.ndarray], error: np.ndarray):
     from .kinematics import Kinematics
     return Kinematics(phi, r["th"], r["rot"], r["O"], r["V"], r["A"], r["w"], r["e"], r["vs"], r["as"],
                       r["cond"], np.zeros(len(phi), bool), error)
 
 
-def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | None) -> tuple[dict, np.ndarray]:
-    """Run the full kernel over the angles `phi` (rad) into `buf` (loads, where `mech` has them,
-    per chunk of CHUNK angles between the motion kernel and the full one): the views and flags."""
+def _loads(mech: "Mechanism", phi: np.ndarray, r: dict[str, np.ndarray]) -> np.ndarray:
+    """The loads on `mech` besides gravity at the motion in the views `r` (angles phi, rad), as
+    the kernel reads them: (3 (L - 1), N) rows F_x, F_y, M of each moving link about its origin."""
     from .applied import applied_wrenches
+    kin = _kinematics(mech, phi, r, r["error"][:, 0])
+    arm = mech.inertia_arrays[2] * kin.rot
+    F, M = applied_wrenches(mech, kin, arm)
+    W, M_W = groups.weight(arm, mech.inertia_arrays[0], mech.g)
+    F, M = (F - W)[:, 1:], (M - M_W)[:, 1:]
+    return np.stack([F.real, F.imag, M], axis=-1).reshape(len(phi), -1).T.copy()
+
+
+def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | None) -> tuple[dict, np.ndarray]:
+    """Run the full kernel over the angles `phi` (rad) into `buf`; where `mech` has loads besides
+    gravity, per chunk of CHUNK angles: the kernel (its motion), the loads, the kernel with them.
+    The views and the flags."""
     lay = _layout(mech)
     N = len(phi)
     r = _views(lay, buf, N)
@@ -462,14 +527,12 @@ def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | No
         FL, _, _ = _run([mech], phi, "full", S=buf, threads=threads)
         return r, FL
     FL = np.zeros((1, N), bool)
+    X = np.empty((3 * (lay.L - 1), N))
     for a in range(0, N, CHUNK):
         span = (a, min(a + CHUNK, N))
-        _run([mech], phi, "motion", S=buf, span=span, FL=FL, threads=threads)
-        part = {k: x[span[0]:span[1]] for k, x in r.items()}
-        kin = _kinematics(mech, phi[span[0]:span[1]], part, part["error"][:, 0])
-        F, M = applied_wrenches(mech, kin, mech.inertia_arrays[2] * kin.rot)
-        part["F_app"][:, 1:], part["M_app"][:, 1:] = F[:, 1:], M[:, 1:]
-        _run([mech], phi, "full", True, S=buf, span=span, FL=FL, threads=threads)
+        _run([mech], phi, "full", S=buf, span=span, FL=FL, threads=threads)
+        X[:, span[0]:span[1]] = _loads(mech, phi[span[0]:span[1]], {k: x[span[0]:span[1]] for k, x in r.items()})
+        _run([mech], phi, "full", X, S=buf, span=span, FL=FL, threads=threads)
     return r, FL
 
 
@@ -553,9 +616,8 @@ class Peaks:
 
 
 def _loaded_peaks(mech: "Mechanism", phi: np.ndarray, threads: int | None) -> tuple[np.ndarray, np.ndarray]:
-    """Peaks per block and flags of one design with loads: per chunk, the motion kernel, the
-    loads by numpy into the chunk's buffer, the peaks kernel reading them."""
-    from .applied import applied_wrenches
+    """Peaks per block and flags of one design with loads besides gravity: per chunk of CHUNK
+    angles, the full kernel (its motion) into a reused buffer, the loads, the peaks kernel."""
     lay = _layout(mech)
     N = len(phi)
     buf = buffer(mech, min(CHUNK, N))
@@ -564,13 +626,10 @@ def _loaded_peaks(mech: "Mechanism", phi: np.ndarray, threads: int | None) -> tu
         part = phi[a:a + CHUNK]
         n = len(part)
         S = buf[:lay.n_rows * n]
-        fl, _, _ = _run([mech], part, "motion", S=S, threads=threads)
         r = _views(lay, S, n)
         r["rot"][:, 0] = 1.0
-        kin = _kinematics(mech, part, r, r["error"][:, 0])
-        F, M = applied_wrenches(mech, kin, mech.inertia_arrays[2] * kin.rot)
-        r["F_app"][:, 1:], r["M_app"][:, 1:] = F[:, 1:], M[:, 1:]
-        fl2, pk, _ = _run([mech], part, "peaks", True, S=S, threads=threads)
+        fl, _, _ = _run([mech], part, "full", S=S, threads=threads)
+        fl2, pk, _ = _run([mech], part, "peaks", _loads(mech, part, r), threads=threads)
         FL[0, a:a + n] = fl[0] | fl2[0]
         PK.append(pk)
     return FL, np.concatenate(PK)
@@ -591,7 +650,7 @@ def peaks(mechs: Sequence["Mechanism"], phi_deg: np.ndarray, threads: int | None
     compiled = [d for d, m in enumerate(mechs) if m.drive.law or m.drive.omega]
     kinds: dict[tuple, list[int]] = {}          # one kernel per structure and branches
     for d in compiled:
-        kinds.setdefault((motion_program(mechs[d]).steps, statics_program(mechs[d]).steps,
+        kinds.setdefault((_motion(mechs[d]).steps, statics_program(mechs[d]).steps,
                           _has_loads(mechs[d])), []).append(d)
     todo = {d: np.arange(len(phi_deg)) for d in range(D) if d not in compiled}
     P = R.shape[1]
