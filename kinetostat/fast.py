@@ -567,10 +567,10 @@ def _analysis(mech: "Mechanism", phi_deg: np.ndarray, buf: np.ndarray, threads: 
 def _check_buffer(mech: "Mechanism", out: np.ndarray, n: int) -> np.ndarray:
     need = _layout(mech).n_rows * n
     if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.ndim == 1 and out.flags.c_contiguous
-            and out.flags.writeable and out.size >= need):
-        raise ValueError(f"out: a writeable contiguous float64 buffer of at least {need} values "
+            and out.flags.writeable and out.size == need):
+        raise ValueError(f"out: a writeable contiguous float64 buffer of {need} values "
                          f"(fast.buffer(mech, {n})) for {n} angles of {mech.name!r}")
-    return out[:need]
+    return out
 
 
 def analyze_fast(mech: "Mechanism", phi_deg: np.ndarray, threads: int | None = None,
@@ -593,7 +593,9 @@ def chunks(mech: "Mechanism", phi_deg: np.ndarray, size: int = CHUNK, threads: i
     buf = buffer(mech, size)
     for a in range(0, len(phi_deg), size):
         part = phi_deg[a:a + size]
-        yield _analysis(mech, part, buf[:_layout(mech).n_rows * len(part)] if len(part) < size else buf, threads)
+        if len(part) < size:           # the last, shorter chunk: a buffer of its own layout
+            buf = buffer(mech, len(part))
+        yield _analysis(mech, part, buf, threads)
 
 
 def _scatter(res: "Analysis", part: "Analysis", idx: np.ndarray) -> None:
@@ -620,15 +622,15 @@ def _loaded_peaks(mech: "Mechanism", phi: np.ndarray, threads: int | None) -> tu
     angles, the full kernel (its motion) into a reused buffer, the loads, the peaks kernel."""
     lay = _layout(mech)
     N = len(phi)
-    buf = buffer(mech, min(CHUNK, N))
-    FL, PK = np.zeros((1, N), bool), []
+    FL, PK, buf = np.zeros((1, N), bool), [], None
     for a in range(0, N, CHUNK):
         part = phi[a:a + CHUNK]
         n = len(part)
-        S = buf[:lay.n_rows * n]
-        r = _views(lay, S, n)
+        if buf is None or len(buf) != lay.n_rows * n:       # one buffer for every whole chunk
+            buf = buffer(mech, n)
+        r = _views(lay, buf, n)
         r["rot"][:, 0] = 1.0
-        fl, _, _ = _run([mech], part, "full", S=S, threads=threads)
+        fl, _, _ = _run([mech], part, "full", S=buf, threads=threads)
         fl2, pk, _ = _run([mech], part, "peaks", _loads(mech, part, r), threads=threads)
         FL[0, a:a + n] = fl[0] | fl2[0]
         PK.append(pk)
