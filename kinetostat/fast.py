@@ -54,7 +54,7 @@ if TYPE_CHECKING:
     from .model import Mechanism
 
 __all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "CHUNK", "BLOCK", "available",
-           "cache_dir", "kernel", "vector_report"]
+           "cache_dir", "kernel", "vector_report", "bytes_per_angle"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
 #: compiled path. Measured with the kernel cached: it is the faster from about 300 angles (the
@@ -243,6 +243,14 @@ def _make_layout(mech: "Mechanism") -> _Layout:
                    tuple(p.index for p in mech.pairs if p.kind == "P"),
                    tuple(sorted(int(o[2:]) for o in motion.outputs if o.startswith("vs"))), G,
                    mech.drive.kind == "machine", tuple(rows), r)
+
+
+def bytes_per_angle(mech: "Mechanism") -> int:
+    """Bytes the full kernel writes per angle into the flat buffer (the columns it fills: not the
+    frame's, nor a revolute pair's normal force, nor an engine's F_bal) and its guard flag."""
+    lay = _layout(mech)
+    values = _value_map(lay, Identifiers().__getitem__)
+    return 1 + sum(16 if name in COMPLEX else 8 for name, _ in values)
 
 
 def _views(lay: _Layout, buf: np.ndarray, n: int) -> dict[str, np.ndarray]:
