@@ -519,8 +519,10 @@ def _loads(mech: "Mechanism", phi: np.ndarray, r: dict[str, np.ndarray]) -> np.n
     arm = mech.inertia_arrays[2] * kin.rot
     F, M = applied_wrenches(mech, kin, arm)
     W, M_W = groups.weight(arm, mech.inertia_arrays[0], mech.g)
-    F, M = (F - W)[:, 1:], (M - M_W)[:, 1:]
-    return np.stack([F.real, F.imag, M], axis=-1).reshape(len(phi), -1).T.copy()
+    X = np.empty((mech.n_links - 1, 3, len(phi)))
+    F -= W
+    X[:, 0], X[:, 1], X[:, 2] = F.real[:, 1:].T, F.imag[:, 1:].T, (M - M_W)[:, 1:].T
+    return X.reshape(-1, len(phi))
 
 
 def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | None) -> tuple[dict, np.ndarray]:

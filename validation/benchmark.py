@@ -392,8 +392,10 @@ def kernel_lines(study: dict) -> list[str]:
              f"Both give the exact routes' driving moment (tested). **Machine**: one core does "
              f"{rates.flops_per_second / 1e9:.3g} GFLOP/s, memory takes {rates.bytes_per_second / 1e9:.3g} GB/s "
              f"of writes ({rates.note}); the limit of a route is max(flops / flop rate, bytes of its result / "
-             f"bandwidth), from the bytes alone where its flops are not counted (today's solver is numpy: "
-             f"no compiled per-angle body to count).", "",
+             f"bandwidth), from the bytes alone where its flops are not counted: these rows are full results "
+             f"(`kinetostat.analyze`: the numpy path at 360 angles, the compiled full kernel from "
+             f"{fast.FAST_MIN:,}), whose limit is their bytes; the peaks path is set against its flops in the "
+             f"next section.", "",
              "| model | route | angles | per angle, us | result, B/angle | flops/angle | machine limit, us | "
              "/ MuJoCo kernel | / Pinocchio kernel | / machine limit |",
              "|---|---|---|---|---|---|---|---|---|---|"]
