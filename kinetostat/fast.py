@@ -497,9 +497,19 @@ def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, X: np.ndarray
     if n == 1:
         part(parts[0])
     else:                     # the kernel releases the GIL: one thread per core, each on its own blocks
-        with ThreadPoolExecutor(n) as pool:
-            list(pool.map(part, parts))
+        list(_pool(n).map(part, parts))
     return FL, PK, bd
+
+
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+
+
+def _pool(n: int) -> ThreadPoolExecutor:
+    """A pool of n threads kept for the process (starting threads per call costs ms on a busy machine)."""
+    with _LOCK:
+        if n not in _POOLS:
+            _POOLS[n] = ThreadPoolExecutor(n, thread_name_prefix="kinetostat-fast")
+        return _POOLS[n]
 
 
 _NO_LOADS = np.zeros((0, 1))
