@@ -599,8 +599,9 @@ def analyze_fast(mech: "Mechanism", phi_deg: np.ndarray, threads: int | None = N
     rounding), with the angles the guard must see (cond > COND_CHECK, or not assembled) solved
     by the numpy path. phi_deg: (N,) read-only crank angles, deg, as `analysis.crank_angles`
     gives. Its arrays are (strided) views of one flat buffer: a fresh one (the first touch of
-    its pages costs more than the kernel's arithmetic at 10^6 angles and more), or `out`
-    (`buffer(mech, N)`, reused: it is overwritten, and the previous Analysis with it)."""
+    its pages costs about as much as the kernel's work on the four-bar, 3x more on the six-link:
+    reports/benchmark.md), or `out` (`buffer(mech, N)`, reused: it is overwritten, and the
+    previous Analysis with it)."""
     N = len(phi_deg)
     buf = buffer(mech, N) if out is None else _check_buffer(mech, out, N)
     return _analysis(mech, phi_deg, buf, threads)
