@@ -4,10 +4,13 @@ the rigid-body transfers between them, as pure elementwise functions of complex 
 x + iy and real numbers.
 
 Elementwise means each function reads its inputs one position at a time: the same code runs
-on numpy arrays over the angles (and designs), on any Array API library's arrays, and on
-scalars inside a compiled loop over the angles (`program` binds `xp` to the namespace at hand:
-numpy, an array-api-compat namespace, or numpy under numba). So the functions use only
-arithmetic and xp.sqrt, atan2, maximum, exp, conj, real, imag, sign; no branch on a value.
+on numpy arrays over the angles (and designs), on any Array API library's arrays (`program.bind`
+binds `xp` to the namespace at hand), and on scalars inside a compiled loop over the angles
+(`fast` compiles this very source). So the functions use only arithmetic, xp.sqrt, maximum,
+conj, real, imag, sign and five named primitives, no branch on a value. The primitives
+(`magnitude`, `over`, `ratio`, `cis`, `phase`) are the operations a compiler lowers badly
+(libm calls, division with branches); here they are today's operators, and `fast` binds
+branch-free inline versions of the same five names.
 
 May use: nothing but the namespace `xp` it is bound to (numpy by default).
 """
@@ -15,12 +18,38 @@ from __future__ import annotations
 
 import numpy as xp
 
-__all__ = ["cross", "dot", "solve2", "condition", "point_motion", "origin_motion", "motion_at",
-           "aligned", "same", "scaled", "sub", "add", "length", "square", "phase", "guide_offset",
+__all__ = ["magnitude", "over", "ratio", "cis", "phase", "cross", "dot", "solve2", "condition", "point_motion", "origin_motion", "motion_at",
+           "aligned", "same", "scaled", "sub", "add", "length", "square", "guide_offset",
            "slider_offset", "turn", "unturn", "place", "local_of", "off_line", "times", "crank", "rrr_motion", "rrp_motion", "rpr_motion",
            "prp_motion", "rpp_motion", "moment_about", "carry", "revolute_pair", "prismatic_pair",
            "rrr_polygon", "rrp_polygon", "rpr_polygon", "prp_polygon", "rpp_polygon", "inertia", "weight", "wrench",
            "gear_force", "power"]
+
+
+# -- the primitives (`fast` rebinds these five names)
+def magnitude(z):
+    """|z| of a plane vector."""
+    return abs(z)
+
+
+def over(z, r):
+    """A plane vector over a real number, z / r."""
+    return z / r
+
+
+def ratio(z, w):
+    """A plane vector over a plane vector, z / w (complex division)."""
+    return z / w
+
+
+def cis(th):
+    """e^{i th}: the unit vector at angle th (rad)."""
+    return xp.exp(1j * th)
+
+
+def phase(x):
+    """The angle of the plane vector x, rad, in (-pi, pi]."""
+    return xp.atan2(xp.imag(x), xp.real(x))
 
 
 # -- plane vector algebra (Raven's complex vectors: Im and Re of conj(a) b)
@@ -71,7 +100,7 @@ def motion_at(O, V, A, w, e, X):
 def aligned(X, x, phase_x):
     """Angle and e^{i theta} of a link whose local vector x (its angle phase_x) is the world
     vector X of the same length."""
-    return xp.atan2(xp.imag(X), xp.real(X)) - phase_x, X / x
+    return phase(X) - phase_x, ratio(X, x)
 
 
 def turn(th, rot, alpha, d):
@@ -81,7 +110,7 @@ def turn(th, rot, alpha, d):
 
 def unturn(th, rot, alpha, d):
     """`turn` undone (a guide's frame from its slider's)."""
-    return th - alpha, rot / d
+    return th - alpha, ratio(rot, d)
 
 
 def place(O, rot, x):
@@ -111,17 +140,12 @@ def add(a, b):
 
 def length(a, b):
     """|a - b|."""
-    return abs(a - b)
+    return magnitude(a - b)
 
 
 def square(x):
     """x^2."""
     return x * x
-
-
-def phase(x):
-    """The angle of the plane vector x, rad."""
-    return xp.atan2(xp.imag(x), xp.real(x))
 
 
 def guide_offset(x, x_guide, d):
@@ -137,7 +161,7 @@ def slider_offset(x, x_point):
 
 def local_of(X, O, rot):
     """The local coordinates of world point X in a link's frame."""
-    return (X - O) / rot
+    return ratio(X - O, rot)
 
 
 def off_line(K, c, d):
@@ -153,7 +177,7 @@ def times(a, b):
 def crank(phi, sense, offset):
     """The initial link's angle and e^{i theta} at crank angle phi (rad)."""
     th = sense * phi + offset
-    return th, xp.exp(1j * th)
+    return th, cis(th)
 
 
 # -- the groups' kinematics: positions in closed form, then the velocity and acceleration
@@ -164,10 +188,10 @@ def rrr_motion(P, VP, AP, Q, VQ, AQ, lj, lk, branch, L):
     """RRR: links j (P-B, length lj) and k (Q-B, length lk) meet at B.
     v_B = v_P + w_j x PB = v_Q + w_k x QB ;  a_B = a_P - w_j^2 PB + e_j x PB = ..."""
     PQ = Q - P
-    d = abs(PQ)
+    d = magnitude(PQ)
     along = (lj**2 - lk**2 + d**2) / (2 * d)
     disc = lj**2 - along**2
-    B = P + PQ / d * (along + 1j * branch * xp.sqrt(xp.maximum(disc, 0.0)))
+    B = P + over(PQ, d) * (along + 1j * branch * xp.sqrt(xp.maximum(disc, 0.0)))
     PB, QB = B - P, B - Q
     a, b = 1j * PB, -1j * QB
     det = cross(a, b)
@@ -199,12 +223,12 @@ def rpr_motion(P, VP, AP, Q, VQ, AQ, e, branch, L):
     QP = P - Q
     rho2 = dot(QP, QP)
     disc = rho2 - e**2
-    d = QP * (branch * xp.sqrt(xp.maximum(disc, 0.0)) + 1j * e) / rho2
+    d = over(QP * (branch * xp.sqrt(xp.maximum(disc, 0.0)) + 1j * e), rho2)
     a = 1j * QP
     det = cross(a, d)
     wk, vr = solve2(a, d, det, VP - VQ)
     ek, ar = solve2(a, d, det, AP - AQ + wk**2 * QP - 2j * wk * vr * d)
-    return disc, d, xp.atan2(xp.imag(d), xp.real(d)), wk, ek, vr, ar, rho2 / L**2 + 1.0, det / L
+    return disc, d, phase(d), wk, ek, vr, ar, rho2 / L**2 + 1.0, det / L
 
 
 def prp_motion(Ka, da, Kc, dc, Oa, Va, Aa, wa, ea, Oc, Vc, Ac, wc, ec):
@@ -261,7 +285,7 @@ def prismatic_pair(N, n, m, X0, S, sign):
 def rrr_polygon(P, B, Q, lj, lk, Fj, Fk, MjB, MkB):
     """RRR: tangential parts of the outer reactions from the moments of each link about B,
     normal parts from the closed force polygon of the group."""
-    uj, uk = (B - P) / lj, (B - Q) / lk
+    uj, uk = over(B - P, lj), over(B - Q, lk)
     nj, nk = 1j * uj * (MjB / lj), 1j * uk * (MkB / lk)
     aj, ak = solve2(uj, uk, cross(uj, uk), -(Fj + Fk + nj + nk))
     R_aj = aj * uj + nj
@@ -271,7 +295,7 @@ def rrr_polygon(P, B, Q, lj, lk, Fj, Fk, MjB, MkB):
 def rrp_polygon(P, B, lj, n, Fj, Fk, MjB, MkB):
     """RRP: the reaction at P from j's moment about B and the polygon; the guide's normal force
     N n on k, its moment about B balancing k's."""
-    uj = (B - P) / lj
+    uj = over(B - P, lj)
     nj = 1j * uj * (MjB / lj)
     aj, N = solve2(uj, n, cross(uj, n), -(Fj + Fk + nj))
     R_aj = aj * uj + nj

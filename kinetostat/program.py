@@ -8,7 +8,8 @@ their inputs and outputs; the numbers of one design (points, directions, masses,
 scales: `constants`) enter as the environment it runs in. The same program runs
 - on numpy arrays over the angles (`run`): today's path;
 - on the arrays of any Array API library (`run` with that namespace: `bind`);
-- on scalars inside a compiled loop over designs and angles (`kinetostat.fast` generates it).
+- on scalars inside a compiled loop over designs and angles (`kinetostat.fast` generates it
+  from `code`, over groups' source with its compiled primitives).
 
 May use: numpy, groups, errors (model and structure for type hints only).
 """
@@ -435,24 +436,24 @@ def statics_program(mech: "Mechanism") -> Program:
 
 
 # ----------------------------------------------------------------------------- running
-_BOUND: dict[tuple[int, int], types.SimpleNamespace] = {}
+_BOUND: dict[int, types.SimpleNamespace] = {}
 
 
-def bind(xp: Any, wrap: Callable[[Callable], Callable] | None = None) -> types.SimpleNamespace:
+def bind(xp: Any) -> types.SimpleNamespace:
     """The group equations with `xp` as their array namespace (numpy, an array-api-compat
     namespace): every function of `groups` rebuilt over a copy of its globals in which `xp` is
-    the given namespace, and each wrapped by `wrap` (numba.njit for the compiled path), so that
-    they also call each other bound (memoised per namespace and wrapper)."""
-    key = (id(xp), id(wrap))
+    the given namespace, so that they also call each other bound (memoised per namespace). The
+    five primitives (`groups.magnitude` ...) stay the operators they are in `groups`: results
+    are numpy's. (The compiled path, `kinetostat.fast`, compiles groups' source with its own.)"""
+    key = id(xp)
     if key not in _BOUND:
-        if xp is np and wrap is None:
+        if xp is np:
             _BOUND[key] = types.SimpleNamespace(**{n: getattr(groups, n) for n in groups.__all__})
         else:
             env = dict(vars(groups), xp=xp)
             for n in groups.__all__:
                 f = getattr(groups, n)
-                g = types.FunctionType(f.__code__, env, n, f.__defaults__, f.__closure__)
-                env[n] = wrap(g) if wrap is not None else g
+                env[n] = types.FunctionType(f.__code__, env, n, f.__defaults__, f.__closure__)
             _BOUND[key] = types.SimpleNamespace(**{n: env[n] for n in groups.__all__})
     return _BOUND[key]
 

@@ -1,5 +1,5 @@
-"""Shared fixtures: the bundled models, a base model text for mutation tests, and the command
-line run in this process (`cli`)."""
+"""Shared fixtures: the bundled models, a base model text for mutation tests, the command
+line run in this process (`cli`), and the compiled kernels' cache in a folder of the session."""
 from __future__ import annotations
 
 import os
@@ -37,6 +37,23 @@ def sampled(paths, keep=EVERY_KIND) -> list:
     """`paths` as pytest parameters (ids: their stems): those named in `keep` run by default,
     the others with -m slow."""
     return [pytest.param(p, id=p.stem, marks=() if p.stem in keep else pytest.mark.slow) for p in paths]
+
+
+@pytest.fixture(scope="session", autouse=True)
+def kernel_cache(tmp_path_factory) -> Path:
+    """The compiled kernels' cache folder ($KINETOSTAT_CACHE): one per test run, shared by the
+    run's xdist workers, so a run compiles each kernel it needs once and never reads or writes
+    the user's cache."""
+    root = tmp_path_factory.getbasetemp()
+    folder = (root.parent if "PYTEST_XDIST_WORKER" in os.environ else root) / "kernels"
+    folder.mkdir(exist_ok=True)
+    old = os.environ.get("KINETOSTAT_CACHE")
+    os.environ["KINETOSTAT_CACHE"] = str(folder)
+    yield folder
+    if old is None:
+        os.environ.pop("KINETOSTAT_CACHE")
+    else:
+        os.environ["KINETOSTAT_CACHE"] = old
 
 
 @pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])

@@ -75,3 +75,25 @@ def test_machine_limit_is_the_slower_of_arithmetic_and_memory():
     assert kernels.machine_limit(5000, 1, rates=rates) == pytest.approx(5e-7)       # arithmetic bound
     assert kernels.machine_limit(5000, 1, cores=2, rates=rates) == pytest.approx(2.5e-7)
     assert kernels.bytes_per_angle({"M": np.zeros(10), "R": np.zeros((10, 4, 2))}, 10) == 72.0
+
+
+def test_count_flops_loop_counts_the_vector_body_per_iteration():
+    """16 lanes of arithmetic in a vector.body that steps 8 angles: 2 flops per angle; the
+    scalar remainder and the epilogue's vector loop are not the loop."""
+    ir = ("entry:\n  br label %vector.body\n"
+          "vector.body:                                      ; preds = %vector.body, %entry\n"
+          "  %a = fmul <8 x double> %x, %y\n  %b = fadd <8 x double> %a, %y\n"
+          "  %index.next = add nuw i64 %index, 8\n  br i1 %c, label %tail, label %vector.body\n"
+          "vec.epilog.vector.body:\n  %e = fmul <4 x double> %x, %y\n  %index.next9 = add nuw i64 %index8, 4\n"
+          "tail:\n  %s = fadd double %p, %q\n  ret void\n")
+    assert kernels.count_flops_loop(ir) == 2.0
+    with pytest.raises(ValueError, match="no vectorised loop"):
+        kernels.count_flops_loop("entry:\n  %s = fadd double %p, %q\n  ret void\n")
+
+
+def test_cpu_info_names_the_cpu_and_its_vector_flags():
+    info = kernels.cpu_info()
+    flags = next((ln.split(":", 1)[1].split() for ln in open("/proc/cpuinfo") if ln.startswith("flags")), [])
+    assert ("avx2" in info["vector_flags"].split()) == ("avx2" in flags)
+    assert ("avx512f" in info["vector_flags"].split()) == ("avx512f" in flags)
+    assert info["model"] and info["llvm_target"] and len(info["load"].split()) == 3

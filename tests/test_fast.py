@@ -1,9 +1,13 @@
 """The compiled path (kinetostat.fast) against the numpy path: both run the same group
 equations (kinetostat.groups), one per angle inside a numba kernel, the other over arrays; they
 must agree to 1e-13 of each quantity's peak. A sample runs by default (each new structure costs
-a few seconds of compilation); every bundled model with -m slow."""
+a few seconds of compilation, once per session: the kernels' cache is the session's folder);
+every bundled model, full result and peaks, with -m slow."""
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -59,10 +63,33 @@ def test_both_paths_agree_on_a_sample_of_the_bundled_models(name):
     _agree(kinetostat.load(name), np.arange(0.0, 360.0, 0.5))
 
 
+def _peaks_agree(mech, phi_deg) -> None:
+    """fast.peaks (the peaks kernel) against the numpy path's largest |R|, |M_bal|, |F_bal|
+    over the angles that are not singular: to 1e-13 of each."""
+    pk = fast.peaks([mech], phi_deg)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = exact(mech, crank_angles(phi_deg))
+    ok = ~res.singular
+    for got, want in [(pk.R[0], np.linalg.norm(res.forces.R[ok], axis=-1).max(axis=0)),
+                      (pk.M_bal[0], np.abs(res.balancing_moment[ok]).max()),
+                      (pk.F_bal[0], np.linalg.norm(res.balancing_force[ok], axis=-1).max())]:
+        np.testing.assert_allclose(got, want, rtol=TOL, atol=TOL * np.max(want))
+    np.testing.assert_array_equal(pk.singular_deg[0], res.phi_deg[res.singular])
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(set(kinetostat.examples.names()) - set(SAMPLE)))
 def test_both_paths_agree_on_every_bundled_model(name):
     _agree(kinetostat.load(name), np.arange(0.0, 360.0, 0.5))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(kinetostat.examples.names()))
+def test_peaks_agree_on_every_bundled_model(name):
+    """Every model's sweep takes the peaks kernel: the loads besides gravity (the ICE's gas
+    diagram, the furnace loader's springs ...) evaluated per chunk between two passes."""
+    _peaks_agree(kinetostat.load(name), np.arange(0.0, 360.0, 0.25))
 
 
 def _four_bar(rng) -> kinetostat.Mechanism:
@@ -164,3 +191,77 @@ def test_the_guard_angles_are_the_numpy_paths():
         b = exact(m, crank_angles(phi))
     assert [str(x.message) for x in w1] == [str(x.message) for x in w2]
     np.testing.assert_array_equal(a.singular, b.singular)
+
+
+def test_chunks_and_out_give_the_same_analysis_in_reused_memory():
+    """`chunks` hands out read-only Analyses of `size` angles, views of one reused buffer, equal
+    to `analyze_fast` of the whole run; `out=` writes into the caller's buffer."""
+    m = kinetostat.load("chain_unit_four_bar")
+    phi = crank_angles(np.arange(0.0, 360.0, 0.3))
+    whole = fast.analyze_fast(m, phi)
+    bases, start = set(), 0
+    for part in fast.chunks(m, phi, size=400):
+        n = len(part.phi_deg)
+        assert not part.forces.R.flags.writeable and not part.kin.rot.flags.writeable
+        np.testing.assert_array_equal(part.forces.R, whole.forces.R[start:start + n])
+        np.testing.assert_array_equal(part.kin.a_z, whole.kin.a_z[start:start + n])
+        bases.add(part.forces.R.base.__array_interface__["data"][0])
+        start += n
+    assert start == len(phi) and len(bases) == 1            # 3 chunks, one buffer
+    out = fast.buffer(m, len(phi))
+    again = fast.analyze_fast(m, phi, out=out)
+    assert np.shares_memory(again.forces.R, out) and np.shares_memory(again.balancing_moment, out)
+    np.testing.assert_array_equal(again.balancing_moment, whole.balancing_moment)
+    with pytest.raises(ValueError, match="out: a writeable contiguous float64 buffer of"):
+        fast.analyze_fast(m, phi, out=np.zeros(10))
+
+
+def test_the_kernel_vectorises():
+    """LLVM vectorised the kernel's loop: its assembly holds packed double arithmetic (and
+    the full kernel does as well as the peaks one)."""
+    m = kinetostat.load("chain_unit_four_bar")
+    for kind in ("peaks", "full"):
+        fast.kernel(m, kind)[0](*_args(m, kind))
+        counts = fast.vector_report(fast.kernel(m, kind)[0])
+        assert counts["packed_ymm"] + counts["packed_zmm"] > 300, (kind, counts)
+
+
+def _args(m, kind):
+    """The arguments of one kernel call over 3 angles (the kernel compiled or loaded by it)."""
+    lay = fast._layout(m)
+    phi = np.radians([0.0, 1.0, 2.0])
+    W, E = fast._speeds([m], phi)
+    bd, b0, bn = fast._blocks(1, 0, 3)
+    return (phi, W, E, fast._table([m], lay), fast._NO_LOADS, bd, b0, bn, np.uint64(3), np.zeros(3, bool),
+            fast.buffer(m, 3), np.empty(fast._scratch_rows(lay) * fast.BLOCK), np.zeros((1, lay.P + 2)))
+
+
+def test_a_later_process_loads_the_kernel_from_the_cache(kernel_cache):
+    """The generated module lies in the cache folder under its source's hash, and a new process
+    takes the compiled kernel from numba's cache: one hit, no compilation."""
+    m = kinetostat.load("chain_unit_four_bar")
+    fast.kernel(m, "full")[0](*_args(m, "full"))
+    assert any(p.suffix == ".py" for p in kernel_cache.iterdir())
+    script = ("import kinetostat, numpy as np; from kinetostat import fast; import test_fast as t; "
+              "m = kinetostat.load('chain_unit_four_bar'); fn = fast.kernel(m, 'full')[0]; fn(*t._args(m, 'full')); "
+              "print(sum(fn.stats.cache_hits.values()), sum(fn.stats.cache_misses.values()), len(fn.overloads))")
+    env = dict(os.environ, KINETOSTAT_CACHE=str(kernel_cache), PYTHONPATH=os.path.dirname(__file__))
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True)
+    hits, misses, overloads = out.stdout.split()[-3:]
+    assert (hits, misses, overloads) == ("1", "0", "1")
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 30.0, 1e5])
+def test_the_compiled_primitives_are_numpys_to_an_ulp(scale):
+    """cis (polynomial sincos) and phase (polynomial atan2) against numpy's exp and arctan2,
+    compiled as the kernel compiles them; NaN stays NaN; phase(0) = 0 as arctan2(0, 0)."""
+    import numba
+    cis, phase = numba.njit(fast.cis), numba.njit(fast.phase)
+    rng = np.random.default_rng(int(scale * 7))
+    th = scale * rng.standard_normal(2000)
+    got = np.array([cis(t) for t in th])
+    assert np.max(np.abs(got - np.exp(1j * th))) <= 2.5e-16 * max(1.0, scale * 1e-3)
+    z = scale * (rng.standard_normal(2000) + 1j * rng.standard_normal(2000))
+    z[:4] = [1.0, -1.0, 1j, -1j]
+    assert np.max(np.abs(np.array([phase(w) for w in z]) - np.angle(z))) <= 4.5e-16
+    assert phase(0j) == 0.0 and np.isnan(phase(complex(np.nan, 1.0))) and np.isnan(cis(np.nan).real)

@@ -11,7 +11,11 @@ printed and written, never asserted: speed is measured, not tested.
 The section "Against the engines' compiled kernels and the machine's limit" sets the solver's
 time per angle (360 and 10^6 angles) beside MuJoCo's and Pinocchio's own kernels and the
 machine's limit (`kernels`), all measured in the same run; `fast_path_rows` is the hook that
-times any `fast(mech, N)` the same way (the solver's rows come from it too).
+times any `fast(mech, N)` the same way (the solver's rows come from it too). The section "The
+compiled path" (`speed_study`) times `kinetostat.fast` (peaks on 1 and 2 threads, full results
+in reused chunks, into one reused buffer and into fresh memory) beside the scalar kernel of
+commit BEFORE, the numpy path and MuJoCo's kernels, in interleaved rounds, CPU and wall time,
+each against its own limit, with the CPU, its flags and its load recorded.
 
 May use: kinetostat, the scene, compare, reference, the engine adapters, kernels, matplotlib.
 """
@@ -19,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 import statistics
 import time
 import warnings
@@ -198,38 +203,175 @@ def kernel_study(models: list[Path], quick: bool, extra_routes: tuple = (),
     return dict(rates=rates, solver=solver, engines=engines, extra=extra)
 
 
-def _fast_peaks(mech: kinetostat.Mechanism, N: int):
-    return fast.peaks([mech], crank_angles(None, N))
+SPEED_MODELS = ("chain_unit_four_bar", "furnace_loader_six_bar")
+BEFORE = "f1f4d95"      # the commit whose compiled kernel (scalar) the speed study times beside today's
 
 
-def fast_throughput(models: list[Path], quick: bool, sizes: tuple[int, ...] = (10**4, 10**5, 10**6, 10**7)) -> list[dict]:
-    """The compiled path's throughput, positions (designs x angles) per second, on 1 and on
-    every core: keeping each design's peaks (fast.peaks) and writing every array of the full
-    result (fast.analyze_fast, to 10^6 angles: 10^7 would be ~8 GB), and the peak memory the
-    call allocates per angle (tracemalloc: numpy's allocations, the result's arrays included)."""
-    import tracemalloc
-    rows = []
-    for path in models:
-        mech = kinetostat.load(path)
-        fast.peaks([mech], np.arange(4.0))
-        fast.analyze_fast(mech, crank_angles(None, 4))
-        for N in sizes[:2] if quick else sizes:
-            phi = crank_angles(None, N)
-            for kind, run in (("peaks", lambda t: fast.peaks([mech], phi, threads=t)),
-                              ("full", lambda t: fast.analyze_fast(mech, phi, threads=t))):
-                if kind == "full" and N > 10**6:
-                    continue
-                for threads in sorted({1, fast.THREADS}):
-                    sec, _ = median_seconds(lambda: run(threads), 1 if quick or N >= 10**6 else 3)
-                    tracemalloc.start()
-                    run(threads)
-                    peak = tracemalloc.get_traced_memory()[1]
-                    tracemalloc.stop()
-                    rows.append(dict(model=path.stem, kind=kind, angles=N, threads=threads, seconds=sec,
-                                     per_core=N / sec / threads, bytes_per_angle=peak / N))
-                    print(f"fast {path.stem} {kind} N={N:.0e} threads={threads}: {N / sec / 1e6:.2f} M positions/s "
-                          f"({N / sec / threads / 1e6:.2f} M/s per core), {peak / N:.0f} B/angle allocated")
-    return rows
+def _before_fast():
+    """`kinetostat.fast` as it was at commit BEFORE (its scalar kernel), with the `groups` and
+    `program` of that commit, from this checkout's git history, loaded as modules of the installed
+    package (kinetostat._fast_before ...); None where git or the commit is absent."""
+    import importlib.util
+    import subprocess
+    import sys
+    module = None
+    for name in ("groups", "program", "fast"):
+        try:
+            src = subprocess.run(["git", "-C", str(ROOT), "show", f"{BEFORE}:kinetostat/{name}.py"], check=True,
+                                 capture_output=True, text=True).stdout
+        except (OSError, subprocess.CalledProcessError):
+            return None
+        src = src.replace("from . import groups", "import kinetostat._groups_before as groups").replace(
+            "from .program import", "from kinetostat._program_before import")
+        spec = importlib.util.spec_from_loader(f"kinetostat._{name}_before", loader=None)
+        module = importlib.util.module_from_spec(spec)
+        module.__package__ = "kinetostat"
+        sys.modules[spec.name] = module
+        exec(compile(src, f"<kinetostat/{name}.py at {BEFORE}>", "exec"), module.__dict__)
+    return module
+
+
+def _timed(fn: Callable[[], object]) -> tuple[float, float]:
+    """CPU time (this process, all threads) and wall time of one call of fn, s."""
+    c, w = time.process_time(), time.perf_counter()
+    fn()
+    return time.process_time() - c, time.perf_counter() - w
+
+
+def _compile_times(model: str, kinds: tuple[str, ...] = ("peaks", "full")) -> dict:
+    """Fresh processes: the kernels of `model` compiled into an empty cache folder, then loaded
+    from it by a second process; wall and CPU time of `fast.kernel` and its first call, s. The
+    first process also inspects the peaks kernel it compiled (numba cannot inspect a cached one):
+    the flops per angle of its vectorised loop and its packed and scalar instructions."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    script = ("import json, sys, time, numpy as np, kinetostat; from kinetostat import fast; "
+              "from kinetostat_validation.kernels import count_flops_loop; "
+              "m = kinetostat.load(sys.argv[1]); out = {}\n"
+              "for kind in sys.argv[2:]:\n"
+              "    c, w = time.process_time(), time.perf_counter()\n"
+              "    fast._run([m], np.radians([0.0, 1.0]), kind, S=fast.buffer(m, 2))\n"
+              "    out[kind] = [time.process_time() - c, time.perf_counter() - w]\n"
+              "fn = fast.kernel(m, 'peaks')[0]\n"
+              "if fn.stats.cache_misses:\n"
+              "    out['flops'] = count_flops_loop(chr(10).join(fn.inspect_llvm().values()))\n"
+              "    out['vector'] = fast.vector_report(fn)\n"
+              "print(json.dumps(out))")
+    times: dict = {}
+    with tempfile.TemporaryDirectory(prefix="kinetostat-cache-") as folder:
+        env = dict(os.environ, KINETOSTAT_CACHE=folder)
+        for when in ("fresh", "cached"):
+            out = json.loads(subprocess.run([sys.executable, "-c", script, model, *kinds], env=env, check=True,
+                                            capture_output=True, text=True).stdout.splitlines()[-1])
+            times.update({k: out.pop(k) for k in ("flops", "vector") if k in out})
+            for kind, (cpu, wall) in out.items():
+                times[f"{kind} {when}"] = {"cpu": cpu, "wall": wall}
+    return times
+
+
+def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: int = 2 * 10**5) -> dict:
+    """The compiled path against today's scalar kernel (commit BEFORE), the numpy path and
+    MuJoCo's compiled kernels, on the four-bar and the six-link furnace loader (loads: springs),
+    each route timed `repeat` times in interleaved rounds (every route once per round), in CPU
+    time and wall time; the flops per angle of the peaks kernel's vectorised loop and the bytes
+    the full kernel writes, against this machine's rates; compile and cache-load times in fresh
+    processes; the CPU and its load."""
+    from .kernels import cpu_info, machine_rates, mujoco_kernel
+    rates = machine_rates()
+    info = {"before": cpu_info()}
+    before = _before_fast()
+    models, rows = {}, []
+    for name in SPEED_MODELS:
+        mech = kinetostat.load(ROOT / "models" / f"{name}.toml")
+        phi = crank_angles(None, N)
+        out = fast.buffer(mech, N_full)
+        routes = {
+            "numpy path (exact)": (N_numpy, lambda m=mech: exact(m, phi[:N_numpy])),
+            "peaks, 1 thread": (N, lambda m=mech: fast.peaks([m], phi, threads=1)),
+            "peaks, 2 threads": (N, lambda m=mech: fast.peaks([m], phi, threads=2)),
+            "full, reused chunks of 16384 (chunks)": (N, lambda m=mech: [None for _ in fast.chunks(m, phi, threads=1)]),
+            "full, one reused buffer (out=)": (N_full, lambda m=mech, o=out: fast.analyze_fast(m, phi[:N_full], threads=1, out=o)),
+            "full, fresh memory (analyze)": (N_full, lambda m=mech: fast.analyze_fast(m, phi[:N_full], threads=1)),
+        }
+        if before is not None and not fast._has_loads(mech):       # the scalar kernel took no loads: numpy path then
+            routes[f"scalar kernel of {BEFORE}, peaks, 1 thread"] = (N, lambda m=mech: before.peaks([m], phi, threads=1))
+        scene = build_scene(mech, steps=ANGLES)
+        mj: list[float] = []
+        routes["MuJoCo kernels (C loop, its own clock: wall)"] = (ANGLES, lambda s=scene: mj.append(
+            mujoco_kernel(s, repeat=1).seconds_per_angle))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for n, fn in routes.values():          # warm-up: compiled, loaded, memos filled
+                fn()
+            times = {label: [] for label in routes}
+            for _ in range(repeat):                # interleaved rounds
+                for label, (n, fn) in routes.items():
+                    times[label].append(_timed(fn))
+        times["MuJoCo kernels (C loop, its own clock: wall)"] = [(s * ANGLES, s * ANGLES) for s in mj[1:]]
+        compiled = _compile_times(name)
+        flops = compiled.pop("flops")
+        written = fast.bytes_per_angle(mech)
+        for label, (n, _) in routes.items():
+            cpu = [c for c, _ in times[label]]
+            wall = [w for _, w in times[label]]
+            threads = 2 if "2 threads" in label else 1
+            peaks_route = label.startswith("peaks")
+            limit = (flops / rates.flops_per_second if peaks_route else
+                     written / rates.bytes_per_second if label.startswith("full") else math.nan)
+            rows.append(dict(model=name, route=label, angles=n, runs=len(cpu), threads=threads,
+                             cpu_min=min(cpu) / n, cpu_median=statistics.median(cpu) / n,
+                             wall_min=min(wall) / n, wall_median=statistics.median(wall) / n,
+                             limit=limit, limit_kind="flops" if peaks_route else "bytes" if label.startswith("full") else ""))
+            r = rows[-1]
+            print(f"speed {name:24s} {label:44s} cpu {r['cpu_min'] * 1e9:8.1f} / {r['cpu_median'] * 1e9:8.1f} ns, "
+                  f"wall {r['wall_min'] * 1e9:8.1f} / {r['wall_median'] * 1e9:8.1f} ns per angle", flush=True)
+        models[name] = dict(flops=flops, written=written, buffer=fast._layout(mech).n_rows * 8,
+                            vector=compiled.pop("vector"), compile=compiled)
+        print(f"speed {name}: {flops:.0f} flops/angle, {written} B/angle written, {models[name]}", flush=True)
+    info["after"] = cpu_info()
+    return dict(rates=rates, rows=rows, models=models, info=info, repeat=repeat)
+
+
+def speed_lines(sp: dict) -> list[str]:
+    """The report's section on the compiled path (`speed_study`)."""
+    info, rates = sp["info"], sp["rates"]
+    ns = lambda s: f"{s * 1e9:,.1f}"
+    lines = ["## The compiled path: peaks and full results", "",
+             f"**Machine**: {info['before']['model']}, {info['before']['cores']} cores; vector flags in /proc/cpuinfo: "
+             f"{info['before']['vector_flags']}; numba compiles for LLVM's `{info['before']['llvm_target']}`. "
+             f"Load average (1, 5, 15 min) {info['before']['load']} before the study and {info['after']['load']} after "
+             f"it: the machine was shared with other jobs, so CPU time (this process, all its threads) is the "
+             f"figure to read, wall time beside it. One core does {rates.flops_per_second / 1e9:.3g} GFLOP/s and "
+             f"memory takes {rates.bytes_per_second / 1e9:.3g} GB/s of writes ({rates.note}).", "",
+             f"Each route ran {sp['repeat']} times in interleaved rounds (every route once per round) after a warm-up; "
+             "per angle: minimum / median. A route's **limit** is its own: the flops per angle of the peaks kernel's "
+             "vectorised loop (counted in its LLVM IR, lanes included) over the flop rate for 'peaks'; the bytes the "
+             "full kernel writes per angle over the write bandwidth for 'full'. M/s per core = angles / CPU time "
+             "(minimum). The scalar kernel is `kinetostat/fast.py` of commit "
+             f"{BEFORE}, loaded from git history and run in this same process; MuJoCo's kernels are the C loop of "
+             "`validation/kernels.py` (timed by its own clock, wall).", "",
+             "| model | route | angles | CPU ns/angle min / median | wall ns/angle min / median | M/s per core (CPU) | "
+             "M/s (wall) | limit ns/angle | CPU / limit |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in sp["rows"]:
+        lim = "" if math.isnan(r["limit"]) else f"{ns(r['limit'])} ({r['limit_kind']})"
+        ratio = "" if math.isnan(r["limit"]) else f"{r['cpu_min'] / r['limit']:.2g}"
+        lines.append(f"| {r['model']} | {r['route']} | {r['angles']:,} | {ns(r['cpu_min'])} / {ns(r['cpu_median'])} | "
+                     f"{ns(r['wall_min'])} / {ns(r['wall_median'])} | {1e-6 / r['cpu_min']:.3g} | "
+                     f"{1e-6 / r['wall_min']:.3g} | {lim} | {ratio} |")
+    lines += ["", "| model | flops/angle (peaks loop) | bytes written/angle (full) | buffer bytes/angle | packed / scalar "
+              "instructions (peaks kernel) | compile, fresh process: peaks, full (CPU / wall s) | load from the cache: "
+              "peaks, full (CPU / wall s) |", "|---|---|---|---|---|---|---|"]
+    for name, m in sp["models"].items():
+        c = m["compile"]
+        v = m["vector"]
+        cw = lambda k: f"{c[k]['cpu']:.2f} / {c[k]['wall']:.2f}"
+        lines.append(f"| {name} | {m['flops']:.0f} | {m['written']} | {m['buffer']} | "
+                     f"{v['packed_zmm'] + v['packed_ymm'] + v['packed_xmm']} / {v['scalar']} | "
+                     f"{cw('peaks fresh')}; {cw('full fresh')} | {cw('peaks cached')}; {cw('full cached')} |")
+    return lines
 
 
 def kernel_lines(study: dict) -> list[str]:
@@ -250,8 +392,10 @@ def kernel_lines(study: dict) -> list[str]:
              f"Both give the exact routes' driving moment (tested). **Machine**: one core does "
              f"{rates.flops_per_second / 1e9:.3g} GFLOP/s, memory takes {rates.bytes_per_second / 1e9:.3g} GB/s "
              f"of writes ({rates.note}); the limit of a route is max(flops / flop rate, bytes of its result / "
-             f"bandwidth), from the bytes alone where its flops are not counted (today's solver is numpy: "
-             f"no compiled per-angle body to count).", "",
+             f"bandwidth), from the bytes alone where its flops are not counted: these rows are full results "
+             f"(`kinetostat.analyze`: the numpy path at 360 angles, the compiled full kernel from "
+             f"{fast.FAST_MIN:,}), whose limit is their bytes; the peaks path is set against its flops in the "
+             f"next section.", "",
              "| model | route | angles | per angle, us | result, B/angle | flops/angle | machine limit, us | "
              "/ MuJoCo kernel | / Pinocchio kernel | / machine limit |",
              "|---|---|---|---|---|---|---|---|---|---|"]
@@ -269,20 +413,6 @@ def kernel_lines(study: dict) -> list[str]:
                          f"{r['seconds_per_angle'] / mj['seconds_per_angle']:.2g} | "
                          f"{r['seconds_per_angle'] / pn['seconds_per_angle']:.2g} | "
                          f"{r['seconds_per_angle'] / r['limit']:.3g} |")
-    if study.get("fast"):
-        lines += ["", "## The compiled path's throughput", "",
-                  f"`kinetostat.fast` (one numba kernel per structure, nogil, its blocks of {fast.BLOCK} angles shared "
-                  f"among threads; compilation excluded: a first call per structure and kind compiles for 1-4 s). "
-                  f"'peaks': what a sweep keeps (the largest |R| of every pair, |M_bal|, |F_bal|); 'full': every "
-                  f"array of the Analysis written (`kinetostat.analyze` from {fast.FAST_MIN:,} angles). Positions per "
-                  f"second, per core = total / threads; memory: the peak that the call allocates (tracemalloc), "
-                  f"per angle. A model with loads besides gravity and inertia (the six-link furnace loader) takes "
-                  f"two passes with the numpy loads between them for 'full', and the numpy path for 'peaks'.", "",
-                  "| model | kept | angles | threads | M positions/s | M/s per core | B allocated per angle |",
-                  "|---|---|---|---|---|---|---|"]
-        for r in study["fast"]:
-            lines.append(f"| {r['model']} | {r['kind']} | {r['angles']:,} | {r['threads']} | "
-                         f"{r['angles'] / r['seconds'] / 1e6:.2f} | {r['per_core'] / 1e6:.2f} | {r['bytes_per_angle']:.0f} |")
     return lines
 
 
@@ -386,7 +516,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
               "| angles | first call, s | repeated, s | angles/s (repeated) |", "|---|---|---|---|"]
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels)
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -406,11 +536,10 @@ def main(argv: list[str] | None = None) -> None:
         print(f"throughput: {r['angles']:>9,} angles in {r['seconds']:.3f} s (first call {r['first_seconds']:.3f} s) "
               f"= {r['per_second']:.3g} angles/s")
     kern = kernel_study(models, args.quick, extra_routes=(
-        (_fast_peaks, "compiled path, peaks kept (sweep)", None),
-        (lambda mech, N: exact(mech, crank_angles(None, N)), "numpy path (analyze below FAST_MIN)", None)))
-    kern["fast"] = fast_throughput([ROOT / "models" / "chain_unit_four_bar.toml", ROOT / "models" / "furnace_loader_six_bar.toml"],
-                                   args.quick)
+        (lambda mech, N: exact(mech, crank_angles(None, N)), "numpy path (analyze below FAST_MIN)", None),))
     print("\n".join(kernel_lines(kern)))
+    kern["speed"] = speed_study(repeat=3 if args.quick else 5)
+    print("\n".join(speed_lines(kern["speed"])))
     rows = study(models, args.quick)
     if not args.quick:
         write_report(rows, kin_rows, thr, kern, args.out)

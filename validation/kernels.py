@@ -27,7 +27,8 @@ filling a 256 MiB buffer that is reused, so no page faults) and the double-preci
 of one core (a numba loop of independent multiply-adds, fused to FMAs by fastmath); a per-angle
 limit is max(flops / flop rate, bytes / bandwidth). `count_flops` counts the floating-point
 operations of a compiled per-angle numba function from its LLVM IR (a vector operation counts
-its lanes).
+its lanes); `count_flops_loop` the flops per angle of a kernel's vectorised loop. `cpu_info`
+names the CPU, its vector flags and the target numba compiles for, to record with every figure.
 
 May use: kinetostat, the scene, engine_mujoco and engine_pinocchio (their models and states),
 mujoco, pinocchio, numba, numpy; gcc on the PATH for the MuJoCo kernel.
@@ -37,6 +38,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import math
+import os
 import re
 import shutil
 import statistics
@@ -51,7 +53,7 @@ import numpy as np
 from .scene import Scene
 
 __all__ = ["KernelTiming", "mujoco_kernel", "pinocchio_kernel", "MachineRates", "machine_rates",
-           "machine_limit", "count_flops", "count_flops_ir", "bytes_per_angle"]
+           "machine_limit", "count_flops", "count_flops_ir", "count_flops_loop", "bytes_per_angle", "cpu_info"]
 
 
 @dataclass(frozen=True)
@@ -346,10 +348,60 @@ def count_flops(dispatcher, signature=None) -> int:
     return count_flops_ir("\n".join(lines[start + 1:end]))
 
 
+_VECTOR_BODY = re.compile(r"^((?:[\w.$-]*\.)?vector\.body[\w.$-]*):")
+_STEP = re.compile(r"%index\.next[\w.]* = add (?:nuw )?(?:nsw )?i64 %index[\w.]*, (\d+)")
+
+
+def count_flops_loop(ir: str) -> float:
+    """Floating-point operations per iteration of the scalar loop that LLVM vectorised into the
+    largest `vector.body` block of the IR `ir` (a kernel's loop over the angles): the block's
+    flops (as `count_flops_ir` counts them, lanes included) over the iterations one pass of it
+    does (its index step). ValueError if no loop was vectorised."""
+    best, flops, step, current = (0.0, 0), 0, 0, None
+    for line in ir.splitlines() + ["end:"]:
+        if (m := _LABEL.match(line)) is not None:
+            if current is not None and step:
+                best = max(best, (flops / step, flops), key=lambda fs: fs[1])
+            current = m.group(1) if _VECTOR_BODY.match(line) and not m.group(1).startswith("vec.epilog") else None
+            flops, step = 0, 0
+            continue
+        if current is None:
+            continue
+        if (m := _STEP.search(line)) is not None:
+            step = int(m.group(1))
+        if (m := _ARITH.search(line)) is not None:
+            flops += int(m.group(1) or 1)
+        elif (m := _CALL.search(line)) is not None:
+            flops += int(m.group(1) or 1) * (2 if m.group(2) in ("fma", "fmuladd") else 1)
+    if not best[1]:
+        raise ValueError("no vectorised loop (vector.body) in this IR")
+    return best[0]
+
+
+def cpu_info() -> dict[str, str]:
+    """This machine's CPU as /proc/cpuinfo names it, its vector flags (avx2, fma, avx512*), the
+    CPU and features LLVM compiles numba's kernels for, and the load average (1, 5, 15 min)."""
+    import llvmlite.binding as llvm
+    model, flags = "unknown", set()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            key, _, value = line.partition(":")
+            if key.strip() == "model name":
+                model = value.strip()
+            elif key.strip() == "flags":
+                flags = set(value.split())
+    except OSError:
+        pass
+    vector = sorted(f for f in flags if f in ("avx", "avx2", "fma") or f.startswith("avx512"))
+    load = os.getloadavg() if hasattr(os, "getloadavg") else (math.nan,) * 3
+    return {"model": model, "cores": str(os.cpu_count()), "vector_flags": " ".join(vector) or "none",
+            "llvm_target": llvm.get_host_cpu_name(), "load": " ".join(f"{x:.2f}" for x in load)}
+
+
 # ----------------------------------------------------------------------------- the machine's limit
 
 #: The throughput kernel's independent accumulators: enough chains to hide the FMA latency
-#: (4-5 cycles, 2 units) at any vector width up to AVX-512.
+#: (4-5 cycles, 2 units) at the vector widths of x86 (to 8 doubles).
 _CHAINS = 64
 
 
