@@ -39,21 +39,13 @@ def sampled(paths, keep=EVERY_KIND) -> list:
     return [pytest.param(p, id=p.stem, marks=() if p.stem in keep else pytest.mark.slow) for p in paths]
 
 
-@pytest.fixture(scope="session", autouse=True)
-def kernel_cache(tmp_path_factory) -> Path:
-    """The compiled kernels' cache folder ($KINETOSTAT_CACHE): one per test run, shared by the
-    run's xdist workers, so a run compiles each kernel it needs once and never reads or writes
-    the user's cache."""
-    root = tmp_path_factory.getbasetemp()
-    folder = (root.parent if "PYTEST_XDIST_WORKER" in os.environ else root) / "kernels"
-    folder.mkdir(exist_ok=True)
-    old = os.environ.get("KINETOSTAT_CACHE")
-    os.environ["KINETOSTAT_CACHE"] = str(folder)
-    yield folder
-    if old is None:
-        os.environ.pop("KINETOSTAT_CACHE")
-    else:
-        os.environ["KINETOSTAT_CACHE"] = old
+@pytest.fixture(scope="session")
+def kernel_cache() -> Path:
+    """The compiled kernels' cache folder of this machine (`fast.cache_dir()`): the suite loads
+    the kernels it needs from it, as every later process does, and compiles only those it lacks
+    (the first run on a machine, or after a change of the generated code)."""
+    from kinetostat import fast
+    return fast.cache_dir()
 
 
 @pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])
