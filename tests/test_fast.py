@@ -216,9 +216,12 @@ def test_chunks_and_out_give_the_same_analysis_in_reused_memory():
         fast.analyze_fast(m, phi, out=np.zeros(10))
 
 
-def test_the_kernel_vectorises():
+@pytest.mark.slow
+def test_the_kernel_vectorises(tmp_path, monkeypatch):
     """LLVM vectorised the kernel's loop: its assembly holds packed double arithmetic (and
-    the full kernel does as well as the peaks one)."""
+    the full kernel does as well as the peaks one). A kernel loaded from the cache keeps no
+    assembly, so this compiles both afresh in an empty cache (about 15 s of CPU: slow)."""
+    monkeypatch.setenv(fast.CACHE_ENV, str(tmp_path))
     m = kinetostat.load("chain_unit_four_bar")
     for kind in ("peaks", "full"):
         fast.kernel(m, kind)[0](*_args(m, kind))
