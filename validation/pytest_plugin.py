@@ -4,7 +4,8 @@ collected as tests, one item per route and quantity and one per published value,
 
 Opt-in: `pytest --kinetostat [PATHS]` collects every visited `*.toml` with a `[mechanism]` table;
 the ini option `kinetostat_models` (glob patterns relative to the rootdir, like
-`--doctest-glob`) collects the visited TOML files it matches, also without `--kinetostat`.
+`--doctest-glob`) collects the visited TOML files it matches when `--kinetostat` is not given
+(with the flag, the patterns are not applied).
 Otherwise nothing is collected and no hook but the options' runs. Engine routes carry the marker
 `engines` (`-m "not engines"`: the engine-free gate, the 40-digit reference and the published
 values); a route whose engine is not installed is SKIPPED with the reason. A failure names the
@@ -13,7 +14,8 @@ quantity, and the line of the route's tolerance), then a verdict line and a smal
 item's JUnit <properties>: error, measure, tolerance, max_abs, unit, phi_deg, trust, route, file,
 line. Under GitHub Actions: `::error file=...,line=...` commands and a Markdown summary in
 $GITHUB_STEP_SUMMARY. The fixture `kinetostat_regression` is `kinetostat.testing.check_cycle`
-with the expected file beside the test (`--kinetostat-regen` rewrites it).
+with the model and expected files taken from the test file's folder (`--kinetostat-regen`
+rewrites the expected file).
 
 It lives in the harness so that pytest's start-up imports only this module (no numpy, no
 solver); everything else is imported when a model file is collected.
@@ -48,7 +50,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     help="kinetostat_regression: rewrite the expected CSV files instead of comparing")
     parser.addini("kinetostat_models", type="args", default=[],
                   help="glob patterns (relative to the rootdir) of kinetostat model files to collect; "
-                       "when set the gate runs without --kinetostat")
+                       "when set the gate runs without --kinetostat (--kinetostat PATHS overrides them)")
     parser.addini("kinetostat_steps", default="360", help="crank positions over the cycle of each model")
 
 
@@ -81,7 +83,7 @@ def _steps(config: pytest.Config) -> int:
 def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Collector | None:
     if file_path.suffix != ".toml" or not _active(parent.config):
         return None
-    patterns = parent.config.getini("kinetostat_models")
+    patterns = [] if parent.config.getoption("kinetostat") else parent.config.getini("kinetostat_models")
     if patterns:
         rel = file_path.relative_to(parent.config.rootpath).as_posix() \
             if file_path.is_relative_to(parent.config.rootpath) else file_path.as_posix()
@@ -213,7 +215,8 @@ class CheckItem(pytest.Item):
         return super().repr_failure(excinfo, style)
 
     def reportinfo(self):
-        return self.path, (self.where.line - 1 if self.where.line else None), f"{self.route} {self.quantity}"
+        return self.path, (self.where.line - 1 if self.where.line else None), \
+            f"{self.path.stem} {self.route} {self.quantity}"
 
 
 class _Gate:
@@ -255,8 +258,12 @@ class _Gate:
             for line in ci.annotations(replace(o, where=o.where and replace(o.where, file=str(root / o.where.file)))
                                        for o in self.outcomes):
                 terminalreporter.write_line(line)
-        if ci.write_summary(ci.summary_markdown(self.outcomes, "kinetostat (pytest)")):
-            terminalreporter.write_line("kinetostat: summary -> $GITHUB_STEP_SUMMARY")
+        try:
+            if ci.write_summary(ci.summary_markdown(self.outcomes, "kinetostat (pytest)")):
+                terminalreporter.write_line("kinetostat: summary -> $GITHUB_STEP_SUMMARY")
+        except OSError as exc:
+            terminalreporter.write_line(f"kinetostat: warning: cannot write the summary to $GITHUB_STEP_SUMMARY: "
+                                        f"{exc.strerror or exc}", yellow=True)
 
 
 def _outcome(report: pytest.TestReport, props: dict):
@@ -283,15 +290,24 @@ def _outcome(report: pytest.TestReport, props: dict):
 @pytest.fixture
 def kinetostat_regression(request: pytest.FixtureRequest) -> Callable[..., Path]:
     """`check(model, expected=None, **kw)`: `kinetostat.testing.check_cycle` with the expected CSV
-    at `<test file's folder>/<test module>/<test name>.csv` unless `expected` is given;
-    `--kinetostat-regen` rewrites it (keywords as check_cycle's: rtol, atol, steps, columns)."""
-    from kinetostat.testing import check_cycle
+    at `<test file's folder>/<test module>/<test name>.csv` unless `expected` is given. A relative
+    `model` or `expected` path is taken from the test file's folder (not the current directory).
+    `--kinetostat-regen` rewrites the expected file (keywords as check_cycle's: rtol, atol, steps,
+    columns). A mismatch fails the test with check_cycle's message and table alone (no traceback)."""
+    from kinetostat.testing import CycleMismatch, check_cycle
 
     def check(model, expected: str | Path | None = None, **kw) -> Path:
+        __tracebackhide__ = True
+        here = request.node.path.parent
+        if isinstance(model, (str, os.PathLike)):
+            model = here / model
         if expected is None:
             test = request.node
             expected = test.path.parent / test.path.stem / (re.sub(r"\W+", "_", test.name).strip("_") + ".csv")
         if request.config.getoption("kinetostat_regen"):
             kw.setdefault("regenerate", True)
-        return check_cycle(model, expected, **kw)
+        try:
+            return check_cycle(model, here / expected, **kw)
+        except CycleMismatch as exc:
+            pytest.fail(str(exc), pytrace=False)
     return check

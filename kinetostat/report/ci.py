@@ -225,7 +225,8 @@ def summary_markdown(outcomes: Sequence[Outcome], title: str) -> str:
 
 
 def write_summary(markdown: str) -> bool:
-    """Append `markdown` to $GITHUB_STEP_SUMMARY when it is set; True if written."""
+    """Append `markdown` to $GITHUB_STEP_SUMMARY when it is set; True if written. An OSError (a
+    path that cannot be written) is the caller's to report as one warning line."""
     dest = os.environ.get("GITHUB_STEP_SUMMARY")
     if not dest:
         return False
