@@ -568,12 +568,12 @@ def cmd_structure(args) -> int:
 # ============================================================================ validate
 
 def exit_code(runs) -> int:
-    """The exit code of `validate` for these ModelRuns: 1 if a check (a route's error or a
-    published value) failed, a route raised, or no check ran at all (every route skipped and no
-    published value); else 0."""
+    """The exit code of `validate` for these ModelRuns: 1 if a check (a route's error, the lever
+    identity or a published value) failed, a route raised, or nothing was checked beyond the
+    lever identity (every route skipped and no published value); else 0."""
     if not runs or any(not r.passed for r in runs):
         return EXIT_FAIL
-    if not any(r.checks for r in runs):
+    if not any(r.checked for r in runs):
         return EXIT_FAIL
     return EXIT_OK
 
@@ -603,7 +603,7 @@ def validation_table(run) -> str:
             lines.append(f"  {route:<11s} {c.quantity:<{w}s} {err:>12s} {tol:>9s} "
                          f"{c.max_abs:11.3e} {c.unit:<3s}  {'PASS' if c.passed else 'FAIL'}{extra}")
     n, f = len(checks), sum(not c.passed for c in checks)
-    verdict = "PASS" if run.passed and n else "FAIL" if not run.passed else "NOT CHECKED"
+    verdict = "PASS" if run.passed and run.checked else "FAIL" if not run.passed else "NOT CHECKED"
     lines.append(f"  => {verdict}: {n} checks ({len(run.published)} published values), {f} failed, "
                  f"{len(run.skipped)} route(s) skipped, {len(run.errors)} with errors")
     return "\n".join(lines)
@@ -641,8 +641,9 @@ def cmd_validate(args) -> int:
     _Out.write(f"validate: {len(runs)} model(s), {len(checks)} checks ({n_pub} published values): "
                f"{len(checks) - n_fail} passed, {n_fail} FAILED; {n_err} route error(s), {n_skip} route(s) skipped; "
                f"{time.perf_counter() - t0:.1f} s" + ("" if code == EXIT_OK else " -> FAIL"), err=err)
-    if not checks:
-        _error("nothing was checked: every route was skipped or raised, and no model has published values")
+    if not any(run.checked for run in runs):
+        _error("nothing was checked: every route was skipped or raised, and no model has published values "
+               "(the lever identity alone is no independent check)")
     _github(runs, err)
     if to_json is not None:
         _write_validation_json(runs, code, to_json)
@@ -779,7 +780,7 @@ def cmd_report(args) -> int:
             s = r["summary"]
             summaries[n] = s
             n_fail += not s["passed"]
-            status = "PASS" if s["passed"] and s["checks"] else "FAIL" if not s["passed"] else "NOT CHECKED"
+            status = "PASS" if s["passed"] and s["checked"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
             _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
                        f"  -> {out / s['stem'] / 'index.html'}")

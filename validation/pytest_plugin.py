@@ -7,10 +7,13 @@ the ini option `kinetostat_models` (glob patterns relative to the rootdir, like
 `--doctest-glob`) collects the visited TOML files it matches when `--kinetostat` is not given
 (with the flag, the patterns are not applied).
 Otherwise nothing is collected and no hook but the options' runs. Engine routes carry the marker
-`engines` (`-m "not engines"`: the engine-free gate, the 40-digit reference and the published
-values); a route whose engine is not installed is SKIPPED with the reason. A failure names the
-model file and the line of the published value (route checks: the pair, drive or point of the
-quantity, and the line of the route's tolerance), then a verdict line and a small table. Each
+`engines` (`-m "not engines"`: the engine-free gate, the 40-digit reference, the internal lever
+identity and the published values); a route whose engine is not installed is SKIPPED with the
+reason. A session whose gate items checked nothing beyond the lever identity (all skipped) ends
+with exit code 1 and the line "kinetostat: nothing was checked", as `kinetostat validate` does.
+A failure names the model file and the line of the published value (route checks: the pair,
+drive or point of the quantity, and the line of the route's tolerance), then a verdict line and
+a small table, under a header "<model> <route> <quantity>". Each
 item's JUnit <properties>: error, measure, tolerance, max_abs, unit, phi_deg, trust, route, file,
 line. Under GitHub Actions: `::error file=...,line=...` commands and a Markdown summary in
 $GITHUB_STEP_SUMMARY. The fixture `kinetostat_regression` is `kinetostat.testing.check_cycle`
@@ -35,7 +38,7 @@ import pytest
 
 #: Marker of the engine routes' items, and the routes that need no engine.
 ENGINES_MARK = "engines"
-ENGINE_FREE = ("reference", "published")
+ENGINE_FREE = ("reference", "lever", "published")
 _MECHANISM = re.compile(rb"^\s*\[\s*mechanism\s*\]", re.MULTILINE)
 
 
@@ -119,32 +122,35 @@ class ModelFile(pytest.File):
         from kinetostat import load
         from kinetostat.report import quantities
         from kinetostat.report.ci import model_lines
-        from kinetostat_validation.compare import ROUTES
+        from kinetostat_validation.compare import LEVER, ROUTES
 
         self.mech = load(self.path)
         self.lines = model_lines(self.mech, self.path.read_text(encoding="utf-8"))
         self._res = None
         self._runs: dict[str, Any] = {}
         self.add_marker("kinetostat")
-        for route in ROUTES:
+        for route in (*ROUTES, LEVER):
             yield Route.from_parent(self, name=route, quantities=quantities(self.mech, route))
         if self.mech.published:
             from kinetostat.report.runs import PUBLISHED_ROUTE
             yield Route.from_parent(self, name=PUBLISHED_ROUTE, quantities=[e.symbol for e in self.mech.published])
 
     def run(self, route: str):
-        """The ModelRun of one route (`kinetostat.report.run_validation`), computed once per
-        session; the published values as route "published"; the cycle analysed once."""
-        if route not in self._runs:
+        """The ModelRun that holds `route`'s checks (`kinetostat.report.run_validation`), computed
+        once per session: an engine route's own run, or (the lever identity, the published
+        values) the run of no engine route; the cycle analysed once."""
+        from kinetostat_validation.compare import ROUTES
+
+        key = route if route in ROUTES else ""
+        if key not in self._runs:
             from kinetostat import analyze
             from kinetostat.report import run_validation
-            from kinetostat.report.runs import PUBLISHED_ROUTE
 
             if self._res is None:
                 self._res = analyze(self.mech, steps=_steps(self.config))
-            engines = [] if route == PUBLISHED_ROUTE else [route]
-            self._runs[route] = run_validation(self.mech, engines, _steps(self.config), res=self._res, path=self.path)
-        return self._runs[route]
+            self._runs[key] = run_validation(self.mech, [key] if key else [], _steps(self.config), res=self._res,
+                                             path=self.path)
+        return self._runs[key]
 
     def repr_failure(self, excinfo, style=None):
         from kinetostat.errors import AssemblyError, ModelError, StructureError
@@ -248,9 +254,23 @@ class _Gate:
             self.outcomes.append(Outcome(report.nodeid, "error", "(model file)", Where(report.nodeid), "",
                                          message=str(report.longrepr).strip().splitlines()[-1]))
 
+    def _nothing_checked(self) -> bool:
+        """Gate items ran, and every one beyond the lever identity was skipped (or none was there)."""
+        from kinetostat.report.runs import LEVER_ROUTE
+        return bool(self.outcomes) and all(o.status == "skipped" or (o.route == LEVER_ROUTE and o.status == "passed")
+                                           for o in self.outcomes)
+
+    @pytest.hookimpl(tryfirst=True)
+    def pytest_sessionfinish(self, session: pytest.Session) -> None:
+        if self._nothing_checked() and session.exitstatus == pytest.ExitCode.OK:
+            session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
     def pytest_terminal_summary(self, terminalreporter, exitstatus: int, config: pytest.Config) -> None:
         if not self.outcomes:
             return
+        if self._nothing_checked():
+            terminalreporter.write_line("kinetostat: nothing was checked: every gate item was skipped (the lever "
+                                        "identity alone is no independent check) -> exit code 1", red=True)
         from kinetostat.report import ci
         if os.environ.get("GITHUB_ACTIONS") == "true" and \
                 not config.pluginmanager.hasplugin("pytest_github_actions_annotate_failures"):
@@ -309,5 +329,6 @@ def kinetostat_regression(request: pytest.FixtureRequest) -> Callable[..., Path]
         try:
             return check_cycle(model, here / expected, **kw)
         except CycleMismatch as exc:
-            pytest.fail(str(exc), pytrace=False)
+            message = str(exc)
+        pytest.fail(message, pytrace=False)        # outside the except: no "during handling" chain
     return check

@@ -131,7 +131,7 @@ def validation_json(runs: Sequence[ModelRun], exit_code: int) -> dict[str, Any]:
                        phi_deg=_number(c.phi_deg), passed=bool(c.passed), trust=c.trust) for c in run.checks]
         models.append(dict(model=run.stem, path=None if run.path is None else str(run.path), name=run.mech.name,
                            structure=run.mech.structure.formula, positions=len(run.res.phi_deg),
-                           passed=bool(run.passed and checks), checks=checks, skipped=dict(run.skipped),
+                           passed=bool(run.passed and run.checked), checks=checks, skipped=dict(run.skipped),
                            errors=dict(run.errors),
                            seconds={r: _number(s) for r, s in run.seconds.items()}))
     every = [c for m in models for c in m["checks"]]

@@ -254,7 +254,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
 
 def _verdict(run: ModelRun) -> str:
     n_checks, n_fail = len(run.checks), sum(not c.passed for c in run.checks)
-    if run.passed and n_checks:
+    if run.passed and run.checked:
         return f"**PASS**: all {n_checks} checks within tolerance"
     if run.passed:
         return "**NOT CHECKED**: no route ran and the model has no published values"
@@ -469,7 +469,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
     doc.write(d)
 
     summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N,
-                   passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
+                   passed=run.passed, checked=run.checked, checks=len(run.checks),
+                   failed=sum(not c.passed for c in run.checks),
                    routes={r: dict(status=run.status(r), worst=run.worst(r),
                                    tolerance=_tolerance(run, r).peak_relative if _tolerance(run, r) else None,
                                    why=run.skipped.get(r) or run.errors.get(r)) for r in routes},
@@ -507,7 +508,7 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
                 routes.append(r)
     doc = Doc("kinetostat: error reports")
     doc.h(1, "kinetostat error reports")
-    n_pass = sum(1 for s in sums if s["passed"] and s["checks"])
+    n_pass = sum(1 for s in sums if s["passed"] and s["checked"])
     doc.p(f"{len(sums)} mechanisms, {n_pass} pass every check. Each cell: the worst peak-relative error "
           f"of the route over the mechanism's quantities (driving moment, every reaction), the route's "
           f"tolerance, and the verdict. An error below {ROUNDING:.1e} of the peak is rounding. "
@@ -528,7 +529,7 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
         pub = s.get("published")
         pubcell = "-" if not pub else f"{pub['within']}/{pub['n']} within" + \
             (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")
-        verdict = "**PASS**" if s["passed"] and s["checks"] else "**FAIL**" if not s["passed"] else "not checked"
+        verdict = "**PASS**" if s["passed"] and s["checked"] else "**FAIL**" if not s["passed"] else "not checked"
         rows.append([f"[{s['stem']}]({s['stem']}/index.md)", esc(s["name"]), f"`{s['formula']}`", *cells, pubcell,
                      verdict])
     doc.table(["model", "mechanism", "structure formula", *routes, "published values", "result"], rows,
