@@ -269,8 +269,8 @@ class _Gate:
         if not self.outcomes:
             return
         if self._nothing_checked():
-            terminalreporter.write_line("kinetostat: nothing was checked: every gate item was skipped (the lever "
-                                        "identity alone is no independent check) -> exit code 1", red=True)
+            terminalreporter.write_line("kinetostat: nothing was checked: every gate item was skipped but the lever "
+                                        "identity, which alone is no independent check -> exit code 1", red=True)
         from kinetostat.report import ci
         if os.environ.get("GITHUB_ACTIONS") == "true" and \
                 not config.pluginmanager.hasplugin("pytest_github_actions_annotate_failures"):
