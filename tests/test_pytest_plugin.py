@@ -165,6 +165,12 @@ def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch)
                                                              "published value"}
     (lever,) = [c for c in checks if c["route"] == "lever"]
     assert lever["trust"] == LEVER_TRUST and lever["passed"] and lever["error"] < 1e-14
+    # a summary path that cannot be written: one warning line, the gate's verdict unchanged
+    r = cli("validate", "bad.toml", "--engines", "none", "--no-progress", cwd=tmp_path,
+            env={"GITHUB_STEP_SUMMARY": str(tmp_path / "no" / "such" / "folder.md")})
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    (line,) = [ln for ln in r.stderr.splitlines() if "GITHUB_STEP_SUMMARY" in ln]
+    assert line.startswith("kinetostat: warning: cannot write the summary to $GITHUB_STEP_SUMMARY: ")
     props = ET.parse(tmp_path / "v.xml").getroot().iter("property")
     trusts = [p.get("value") for p in props if p.get("name") == "trust"]
     assert trusts == [c["trust"] for c in checks]
