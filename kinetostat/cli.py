@@ -559,13 +559,14 @@ def cmd_structure(args) -> int:
 # ============================================================================ validate
 
 def exit_code(runs, absent: Sequence[str] = ()) -> int:
-    """The exit code of `validate` for these ModelRuns: 1 (EXIT_FAIL) if a check (a route's error
-    or a published value) failed or a route raised; else 3 (EXIT_NOT_CHECKED) if a model, or the
-    run, has no check at all (every route skipped, no published value), or a route named with
-    --engines is `absent` (its engine not installed); else 0."""
+    """The exit code of `validate` for these ModelRuns: 1 (EXIT_FAIL) if a check (a route's error,
+    the lever identity or a published value) failed or a route raised; else 3 (EXIT_NOT_CHECKED)
+    if a model, or the run, has no check beyond the lever identity (every route skipped, no
+    published value), or a route named with --engines is `absent` (its engine not installed);
+    else 0."""
     if any(not r.passed for r in runs):
         return EXIT_FAIL
-    if not runs or any(not r.checks for r in runs) or absent:
+    if not runs or any(not r.checked for r in runs) or absent:
         return EXIT_NOT_CHECKED
     return EXIT_OK
 
@@ -610,7 +611,7 @@ def validation_table(run) -> str:
             lines.append(f"  {route:<11s} {c.quantity:<{w}s} {err:>12s} {tol:>9s} "
                          f"{c.max_abs:11.3e} {c.unit:<3s}  {'PASS' if c.passed else 'FAIL'}{extra}")
     n, f = len(checks), sum(not c.passed for c in checks)
-    verdict = "PASS" if run.passed and n else "FAIL" if not run.passed else "NOT CHECKED (nothing compared)"
+    verdict = "PASS" if run.passed and run.checked else "FAIL" if not run.passed else "NOT CHECKED (nothing compared)"
     lines.append(_coverage(run))
     lines.append(f"  => {verdict}: {n} checks ({len(run.published)} published values), {f} failed, "
                  f"{len(run.skipped)} route(s) skipped, {len(run.errors)} with errors")
@@ -648,14 +649,15 @@ def cmd_validate(args) -> int:
     from kinetostat_validation.compare import available
     absent = [r for r in engines if args.engines and available(r)]     # named, and not installed
     code = exit_code(runs, absent)
-    unchecked = [run.stem for run in runs if not run.checks]
+    unchecked = [run.stem for run in runs if not run.checked]
     _Out.write(f"validate: {len(runs)} model(s), {len(checks)} checks ({n_pub} published values): "
                f"{len(checks) - n_fail} passed, {n_fail} FAILED; {n_err} route error(s), {n_skip} route(s) skipped; "
                f"{len(unchecked)} model(s) NOT CHECKED{': ' + ', '.join(unchecked) if unchecked else ''}; "
                f"{time.perf_counter() - t0:.1f} s"
                + {EXIT_OK: "", EXIT_FAIL: " -> FAIL", EXIT_NOT_CHECKED: " -> NOT CHECKED (exit 3)"}[code], err=err)
-    if not checks:
-        _error("nothing was checked: every route was skipped or raised, and no model has published values")
+    if not any(run.checked for run in runs):
+        _error("nothing was checked: every route was skipped or raised, and no model has published values "
+               "(the lever identity alone is no independent check)")
     if absent:
         _error(f"--engines {' '.join(absent)}: not installed, so nothing was checked by "
                f"{'it' if len(absent) == 1 else 'them'} (pip install 'kinetostat[engines]')")
@@ -795,7 +797,7 @@ def cmd_report(args) -> int:
             s = r["summary"]
             summaries[n] = s
             n_fail += not s["passed"]
-            status = "PASS" if s["passed"] and s["checks"] else "FAIL" if not s["passed"] else "NOT CHECKED"
+            status = "PASS" if s["passed"] and s["checked"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
             _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
                        f"  -> {out / s['stem'] / 'index.html'}")

@@ -155,6 +155,7 @@ def check_cycle(model: Mechanism | str | Path, expected: str | Path, *, rtol: fl
     On a difference `<expected>.obtained.csv` is written and `CycleMismatch` raised (a pass
     removes it). Returns the expected file's path.
     """
+    __tracebackhide__ = True             # pytest: a mismatch shows its table, not this function's source
     path = Path(expected)
     obt = cycle_table(model, steps, columns)
     name = model.name if isinstance(model, Mechanism) else str(model)

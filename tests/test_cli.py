@@ -168,11 +168,11 @@ def test_validate_passes_on_exact_engines_and_writes_junit(cli, tmp_path):
     root = ET.parse(junit).getroot()
     assert root.tag == "testsuites"
     assert (root.get("tests"), root.get("failures"), root.get("errors"), root.get("skipped")) == \
-        (str(2 * n_q + n_pub), "0", "0", "0")
+        (str(2 * n_q + 1 + n_pub), "0", "0", "0")               # 1: the lever identity
     cases = root.findall("./testsuite/testcase")
-    assert len(cases) == 2 * n_q + n_pub
-    assert {c.get("classname") for c in cases} == {"ice_crank_slider.pinocchio", "ice_crank_slider.mujoco",
-                                                   "ice_crank_slider.published"}
+    assert len(cases) == 2 * n_q + 1 + n_pub
+    assert {c.get("classname") for c in cases} == {"ice_crank_slider.lever", "ice_crank_slider.pinocchio",
+                                                   "ice_crank_slider.mujoco", "ice_crank_slider.published"}
 
 
 def test_validate_all_bundled_models_via_env(cli, four_bar, tmp_path):
@@ -230,11 +230,12 @@ def test_route_errors_and_skips_are_reported_not_raised(ice_cycle, monkeypatch):
     root = junit_xml([run_]).getroot()
     n_q, n_pub = len(quantities(mech)), len(mech.published)
     assert (root.get("tests"), root.get("failures"), root.get("errors"), root.get("skipped")) == \
-        (str(3 * n_q + n_pub), "0", str(n_q), str(n_q))
+        (str(3 * n_q + 1 + n_pub), "0", str(n_q), str(n_q))
     # only skipped routes on a model without published values: nothing checked is not a pass
     four = kinetostat.loads(FOUR_BAR)
     only_skipped = run_validation(four, ["absent"], steps=36)
-    assert only_skipped.passed and not only_skipped.checks and exit_code([only_skipped]) == EXIT_NOT_CHECKED
+    assert only_skipped.passed and [c.route for c in only_skipped.checks] == ["lever"]      # the identity alone
+    assert not only_skipped.checked and exit_code([only_skipped]) == EXIT_NOT_CHECKED
     assert exit_code([run_validation(mech, EXACT, steps=36, res=res, path=ICE), only_skipped]) == EXIT_NOT_CHECKED
 
 

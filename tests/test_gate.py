@@ -139,9 +139,27 @@ def test_a_bad_published_entry_names_the_field(case):
 def test_a_failing_published_value_fails_the_run():
     mech = kinetostat.loads(FOUR_BAR + GOOD.replace("value = 100.0", "value = 1.0"))
     run = run_validation(mech, [], steps=24)
-    (check,) = run.checks
+    lever, check = run.checks                      # the lever identity runs in every validation
+    assert lever.route == "lever" and lever.passed
     assert check.name.endswith(".published.R12") and not check.passed and check.error > 0.01
     assert not run.passed
+
+
+def test_the_lever_identity_is_a_check_that_can_fail():
+    """Zhukovsky's lever against the groups' balancing moment: rounding only on the solver; a
+    lever moment off by 1e-6 of itself fails; alone it is no independent check."""
+    mech = kinetostat.loads(FOUR_BAR)
+    res = kinetostat.analyze(mech, steps=24)
+    run = run_validation(mech, [], res=res)
+    (lever,) = run.checks
+    assert lever.name.endswith(".lever.M_drive") and lever.unit == "N m" and lever.passed
+    assert lever.error == pytest.approx(np.max(np.abs(res.lever_discrepancy)) / np.max(np.abs(res.balancing_moment)))
+    assert lever.error < 1e-14 and lever.tolerance == cmp.TOLERANCES["lever"].peak_relative
+    assert lever.trust == "internal identity: Zhukovsky's lever vs group-by-group"
+    assert run.passed and not run.checked
+    off = run_validation(mech, [], res=replace(res, lever_moment=res.lever_moment * (1 + 1e-6)))
+    (lever,) = off.checks
+    assert not lever.passed and lever.error == pytest.approx(1e-6, rel=1e-3) and not off.passed
 
 
 # ----------------------------------------------------------------------------- the reference route
@@ -202,7 +220,8 @@ def test_junit_carries_every_checks_error_also_when_passing():
     names = {f"{c.get('classname')}.{c.get('name')}" for c in cases}
     assert names == {c.name for c in run.checks}
     assert "ice_crank_slider.reference.R(1,2)" in names and "ice_crank_slider.published.M_bal (lever)" in names
-    assert root.get("tests") == str(len(quantities(mech, "reference")) + 15) and root.get("failures") == "0"
+    assert "ice_crank_slider.lever.M_drive" in names
+    assert root.get("tests") == str(len(quantities(mech, "reference")) + 1 + 15) and root.get("failures") == "0"
     for case in cases:
         props = {p.get("name"): p.get("value") for p in case.findall("./properties/property")}
         assert float(props["error"]) <= float(props["tolerance"]) and case.find("system-out").text
@@ -241,12 +260,14 @@ def test_validate_json_with_the_engines_hidden():
     assert r.returncode == 0, r.stderr
     doc = json.loads(r.stdout)
     assert doc["passed"] and doc["exit_code"] == 0
-    assert doc["totals"]["checks"] == N_REFERENCE + 18 and doc["totals"]["failed"] == 0
+    assert doc["totals"]["checks"] == N_REFERENCE + 2 + 18 and doc["totals"]["failed"] == 0   # 2: the lever
     ice = doc["models"][0]
     assert ice["model"] == "ice_crank_slider" and set(ice["skipped"]) == {"pinocchio", "mujoco", "mujoco-sim", "pymunk"}
     checks = {c["name"]: c for c in ice["checks"]}
     ref = checks["ice_crank_slider.reference.M_drive"]
     assert ref["measure"] == "peak_relative" and ref["unit"] == "N m" and 0 <= ref["error"] < ref["tolerance"]
+    lever = checks["ice_crank_slider.lever.M_drive"]
+    assert lever["trust"].startswith("internal identity") and 0 <= lever["error"] < lever["tolerance"]
     pub = checks["ice_crank_slider.published.M_bal (lever)"]
     assert pub["measure"] == "relative" and pub["tolerance"] == 0.005 and pub["passed"]
     assert math.isfinite(pub["error"]) and pub["phi_deg"] == 30.0

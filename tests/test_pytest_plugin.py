@@ -28,12 +28,15 @@ ALTERED = TEXT.replace("\nvalue = 38.4\n", "\nvalue = 40.32\n", 1)
 BAD_LINE = ALTERED.splitlines().index("value = 40.32") + 1
 N_REFERENCE = len(quantities(kinetostat.load(CHAIN), "reference"))
 N_PUBLISHED = 3
+LEVER_TRUST = "internal identity: Zhukovsky's lever vs group-by-group"
 
 
 def run(pytester, *args):
-    """pytest in this process, in pytester's folder; without the cache and hypothesis's plugin
-    (which pytester would import and assertion-rewrite again on every run)."""
-    return pytester.runpytest_inprocess(*args, "-p", "no:cacheprovider", "-p", "no:hypothesispytest")
+    """pytest in this process, in pytester's folder, at 36 positions per cycle (unless `args` say
+    otherwise); without the cache and hypothesis's plugin (which pytester would import and
+    assertion-rewrite again on every run)."""
+    return pytester.runpytest_inprocess("--kinetostat-steps", "36", *args, "-p", "no:cacheprovider",
+                                        "-p", "no:hypothesispytest")
 
 
 @pytest.fixture
@@ -62,20 +65,23 @@ def test_loading_the_plugin_imports_neither_numpy_nor_the_solver():
 
 def test_one_altered_published_value_fails_at_its_line(folder):
     r = run(folder, "--kinetostat", "models", "-m", "not engines", "--junitxml=j.xml")
-    r.assert_outcomes(failed=1, passed=2 * (N_REFERENCE + N_PUBLISHED) - 1)
+    r.assert_outcomes(failed=1, passed=2 * (N_REFERENCE + 1 + N_PUBLISHED) - 1)
     out = r.stdout.str()
+    assert "_ bad published F_O1 min _" in out                       # the header names the model
     assert f"models/bad.toml:{BAD_LINE}: published value F_O1 min of bad: error 4.76 % > tolerance 1 %" in out
     assert "error   tolerance  max |diff|  unit  angle   route" in out
     assert f"tolerance set at models/bad.toml:{BAD_LINE + 2}" in out
     assert "FAILED models/bad.toml::published::F_O1_min" in out and "settings.toml" not in out
     # the JUnit file: error, tolerance and trust for every item
     cases = ET.parse(folder.path / "j.xml").getroot().findall(".//testcase")
-    assert len(cases) == 2 * (N_REFERENCE + N_PUBLISHED)
+    assert len(cases) == 2 * (N_REFERENCE + 1 + N_PUBLISHED)
     for case in cases:
         props = {p.get("name"): p.get("value") for p in case.findall("./properties/property")}
         assert float(props["error"]) >= 0 and float(props["tolerance"]) > 0, props
         if props["route"] == "reference":
             assert props["trust"].startswith("40-digit re-solution") and float(props["error"]) < 1e-13
+        elif props["route"] == "lever":
+            assert props["trust"] == LEVER_TRUST and props["quantity"] == "M_drive" and float(props["error"]) < 1e-14
         else:
             assert props["trust"].startswith("published value: seed 004") and props["file"].startswith("models/")
         failed = case.find("failure") is not None
@@ -89,10 +95,20 @@ def test_engines_hidden_skip_the_engine_routes_and_the_rest_pass(folder, monkeyp
     r = run(folder, "--kinetostat", "models/good.toml", "-rs")
     mech = kinetostat.load(CHAIN)
     n_engine = sum(len(quantities(mech, route)) for route in ("pinocchio", "mujoco", "mujoco-sim", "pymunk"))
-    r.assert_outcomes(passed=N_REFERENCE + N_PUBLISHED, skipped=n_engine)
+    r.assert_outcomes(passed=N_REFERENCE + 1 + N_PUBLISHED, skipped=n_engine)
     for route, engine in (("pinocchio", "pinocchio"), ("mujoco", "mujoco"), ("mujoco-sim", "mujoco"),
                           ("pymunk", "pymunk")):
         r.stdout.fnmatch_lines([f"SKIPPED [[]*[]] models/good.toml: route {route}: {engine} not installed*"])
+
+
+def test_a_gate_that_checked_nothing_fails(folder, monkeypatch):
+    """mpmath hidden, the published values deselected: the reference is skipped and only the
+    internal lever identity runs, which is no independent check (as `kinetostat validate`)."""
+    monkeypatch.setitem(sys.modules, "mpmath", None)
+    r = run(folder, "--kinetostat", "models/good.toml", "-m", "not engines", "-k", "not published")
+    r.assert_outcomes(passed=1, skipped=N_REFERENCE)
+    assert r.ret == pytest.ExitCode.TESTS_FAILED
+    assert "kinetostat: nothing was checked: every gate item was skipped but the lever" in r.stdout.str()
 
 
 def test_selection_by_marker_and_keyword(folder):
@@ -111,6 +127,8 @@ def test_opt_in_only_and_the_ini_option_collects_only_what_it_names(folder):
     assert r.stdout.lines[:N_PUBLISHED] == [f"models/good.toml::published::{s}"
                                             for s in ("F_O1_min", "F_O1_max", "phi_k_at_F_O1_max")]
     assert "bad.toml" not in r.stdout.str() and "settings.toml" not in r.stdout.str()
+    r = run(folder, "--kinetostat", "models/bad.toml", "--collect-only", "-q", "-k", "published")  # the flag wins
+    assert r.stdout.lines[0] == "models/bad.toml::published::F_O1_min" and "good.toml" not in r.stdout.str()
 
 
 def test_github_annotation_and_summary(folder, monkeypatch):
@@ -125,6 +143,11 @@ def test_github_annotation_and_summary(folder, monkeypatch):
     text = summary.read_text(encoding="utf-8")
     assert text.startswith("## kinetostat (pytest): FAIL\n\n5 passed, 1 failed, 0 errors, 0 skipped.")
     assert f"| models/bad.toml::published::F_O1_min | models/bad.toml:{BAD_LINE} | 4.76 % | 1 % | N |" in text
+    monkeypatch.setenv("GITHUB_STEP_SUMMARY", str(folder.path / "no" / "such" / "folder.md"))
+    r = run(folder, "--kinetostat", "models/good.toml", "-k", "published and F_O1_min")
+    r.assert_outcomes(passed=1)
+    (line,) = [ln for ln in r.stdout.lines if "GITHUB_STEP_SUMMARY" in ln]
+    assert line.startswith("kinetostat: warning: cannot write the summary to $GITHUB_STEP_SUMMARY: ")
 
 
 def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch):
@@ -136,9 +159,18 @@ def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch)
     assert r.returncode == 1
     assert f"::error file=bad.toml,line={BAD_LINE},title=kinetostat%3A bad.published.F_O1 min::" in r.stdout
     text = summary.read_text(encoding="utf-8")
-    assert text.startswith(f"## kinetostat validate: FAIL\n\n{N_REFERENCE + N_PUBLISHED - 1} passed, 1 failed")
+    assert text.startswith(f"## kinetostat validate: FAIL\n\n{N_REFERENCE + 1 + N_PUBLISHED - 1} passed, 1 failed")
     checks = json.loads((tmp_path / "v.json").read_text())["models"][0]["checks"]
-    assert {c["trust"].partition(":")[0] for c in checks} == {"40-digit re-solution", "published value"}
+    assert {c["trust"].partition(":")[0] for c in checks} == {"internal identity", "40-digit re-solution",
+                                                             "published value"}
+    (lever,) = [c for c in checks if c["route"] == "lever"]
+    assert lever["trust"] == LEVER_TRUST and lever["passed"] and lever["error"] < 1e-14
+    # a summary path that cannot be written: one warning line, the gate's verdict unchanged
+    r = cli("validate", "bad.toml", "--engines", "none", "--no-progress", cwd=tmp_path,
+            env={"GITHUB_STEP_SUMMARY": str(tmp_path / "no" / "such" / "folder.md")})
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    (line,) = [ln for ln in r.stderr.splitlines() if "GITHUB_STEP_SUMMARY" in ln]
+    assert line.startswith("kinetostat: warning: cannot write the summary to $GITHUB_STEP_SUMMARY: ")
     props = ET.parse(tmp_path / "v.xml").getroot().iter("property")
     trusts = [p.get("value") for p in props if p.get("name") == "trust"]
     assert trusts == [c["trust"] for c in checks]
@@ -149,15 +181,15 @@ def test_validate_writes_the_summary_and_annotations(cli, tmp_path, monkeypatch)
 def test_check_cycle_catches_a_tenth_of_a_percent_of_one_mass(tmp_path):
     expected = tmp_path / "four_bar.csv"
     with pytest.raises(CycleMismatch, match="did not exist"):          # a first run is never a pass
-        check_cycle(kinetostat.loads(four_bar()), expected, steps=72)
-    assert check_cycle(kinetostat.loads(four_bar()), expected, steps=72) == expected
+        check_cycle(kinetostat.loads(four_bar()), expected, steps=36)
+    assert check_cycle(kinetostat.loads(four_bar()), expected, steps=36) == expected
     heavier = kinetostat.loads(four_bar(("mass = 1.5", "mass = 1.5015")))      # the coupler, +0.1 %
     with pytest.raises(CycleMismatch) as exc:
-        check_cycle(heavier, expected, steps=72)
+        check_cycle(heavier, expected, steps=36)
     diffs = {d.column: d for d in exc.value.diffs}
     assert obtained_path(expected).exists() and "obtained written to" in str(exc.value)
     # the differences, in each column's unit, are the two solutions' own
-    old, new = (kinetostat.analyze(m, steps=72) for m in (kinetostat.loads(four_bar()), heavier))
+    old, new = (kinetostat.analyze(m, steps=36) for m in (kinetostat.loads(four_bar()), heavier))
     d = diffs["M_bal"]
     assert d.unit == "N m" and d.max_abs == pytest.approx(np.max(np.abs(new.balancing_moment - old.balancing_moment)),
                                                           rel=1e-12)
@@ -165,28 +197,31 @@ def test_check_cycle_catches_a_tenth_of_a_percent_of_one_mass(tmp_path):
     assert "R_1_2" in str(exc.value) and " N " in str(exc.value)
     # forces within 1 N pass by their unit's tolerance; the inertia moment's N m still fails
     with pytest.raises(CycleMismatch) as exc:
-        check_cycle(heavier, expected, steps=72, atol={"N": 1.0, "m": 1.0, "deg": 1.0})
+        check_cycle(heavier, expected, steps=36, atol={"N": 1.0, "m": 1.0, "deg": 1.0})
     assert {d.unit for d in exc.value.diffs} == {"N m"}
-    check_cycle(heavier, expected, steps=72, regenerate=True)
-    assert check_cycle(heavier, expected, steps=72) == expected and not obtained_path(expected).exists()
+    check_cycle(heavier, expected, steps=36, regenerate=True)
+    assert check_cycle(heavier, expected, steps=36) == expected and not obtained_path(expected).exists()
 
 
 def test_regression_fixture_regenerates_with_the_flag(pytester):
-    pytester.path.joinpath("m.toml").write_text(four_bar(), encoding="utf-8")
-    pytester.makepyfile(test_press="""
-        def test_design(kinetostat_regression):
-            kinetostat_regression("m.toml", steps=36)
-    """)
-    expected = pytester.path / "test_press" / "test_design.csv"
-    run(pytester).assert_outcomes(failed=1)     # written
+    """The test in tests/, run from the folder above: the model's relative path is the test file's."""
+    (pytester.path / "tests").mkdir()
+    model = pytester.path / "tests" / "m.toml"
+    model.write_text(four_bar(), encoding="utf-8")
+    (pytester.path / "tests" / "test_press.py").write_text(
+        "def test_design(kinetostat_regression):\n    kinetostat_regression('m.toml', steps=12)\n", encoding="utf-8")
+    expected = pytester.path / "tests" / "test_press" / "test_design.csv"
+    run(pytester, "tests").assert_outcomes(failed=1)     # written
     assert expected.exists()
-    run(pytester).assert_outcomes(passed=1)
-    pytester.path.joinpath("m.toml").write_text(four_bar(("mass = 1.2", "mass = 1.2012")), encoding="utf-8")
-    r = run(pytester)
+    run(pytester, "tests").assert_outcomes(passed=1)
+    model.write_text(four_bar(("mass = 1.2", "mass = 1.2012")), encoding="utf-8")
+    r = run(pytester, "tests")
     r.assert_outcomes(failed=1)
-    assert obtained_path(expected).exists() and "columns beyond tolerance" in r.stdout.str()
-    run(pytester, "--kinetostat-regen").assert_outcomes(passed=1)
-    run(pytester).assert_outcomes(passed=1)
+    out = r.stdout.str()
+    assert obtained_path(expected).exists() and "columns beyond tolerance" in out
+    assert "def check" not in out and "check_cycle(" not in out and "testing.py" not in out   # the table, no source
+    run(pytester, "tests", "--kinetostat-regen").assert_outcomes(passed=1)
+    run(pytester, "tests").assert_outcomes(passed=1)
 
 
 def test_a_route_failure_names_the_pair_and_the_routes_tolerance(folder, monkeypatch):

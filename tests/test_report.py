@@ -90,9 +90,9 @@ def test_report_files(ice_report):
     assert cycle.attrs["units"]["R_0_1"] == "N" and cycle.attrs["units"]["M_bal"] == "N m"
     summary = json.loads((d / "summary.json").read_text())
     n_q = sum(len(kinetostat.report.quantities(kinetostat.load(ICE), r)) for r in ("pinocchio", "mujoco"))
-    n_q += len(kinetostat.load(ICE).published)      # 2 x (M_drive, 4 R, 4 P_f, 4 points x 3) + 15 published
-    assert summary["passed"] and summary["checks"] == n_q
-    assert set(summary["routes"]) == {"pinocchio", "mujoco"}
+    n_q += 1 + len(kinetostat.load(ICE).published)  # 2 x (M_drive, 4 R, 4 P_f, 4 points x 3) + lever + 15 published
+    assert summary["passed"] and summary["checked"] and summary["checks"] == n_q
+    assert set(summary["routes"]) == {"lever", "pinocchio", "mujoco"}
     assert summary["routes"]["pinocchio"]["tolerance"] == 1e-9
     text = (d / "summary.json").read_text() + (d / "index.md").read_text()
     assert not re.search(r"20\d\d-\d\d-\d\d|seconds", text)     # no dates, no run times
@@ -125,8 +125,9 @@ def test_failed_checks_are_listed(tmp_path, sketched_plots):
     run = run_validation(mech, ["pinocchio"], steps=24, res=wrong, path=ICE)
     summary = write_report(run, tmp_path)
     md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
-    assert not summary["passed"] and summary["failed"] == 1
-    assert f"**FAIL**: 1 of {len(run.checks)} checks beyond tolerance" in md.split("## ")[0]
+    assert not summary["passed"] and summary["failed"] == 2          # pinocchio, and the lever identity
+    assert f"**FAIL**: 2 of {len(run.checks)} checks beyond tolerance" in md.split("## ")[0]
+    assert re.search(r"^- lever M_drive: peak-relative error 9\.9\de-03 > tolerance 1e-11 ", md, re.M)
     assert re.search(r"^- pinocchio M_drive: peak-relative error 9\.9\de-03 > tolerance 1e-09 "
                      r"\(max [\d.]+ N m at φ = [\d.]+°\)$", md, re.M)
 
@@ -194,7 +195,7 @@ def test_index_lists_only_this_run(ice_report):
     md = (ice_report / "index.md").read_text()
     # the verdict second, in a table of five columns; the errors route by route in a second table
     assert "| model | result | mechanism; structure formula | published values | plans |" in md
-    assert "| model | pinocchio | mujoco |" in md
+    assert "| model | lever | pinocchio | mujoco |" in md
     assert "[ice_crank_slider](ice_crank_slider/index.md) | **PASS** |" in md and "`I(0,1) <- II(2,3)`" in md
     assert "[plans](ice_crank_slider/index.md#plans-of-the-graphical-method)" in md
     assert "[slotted_link_shaper](slotted_link_shaper/index.md)" in md

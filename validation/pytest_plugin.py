@@ -4,16 +4,21 @@ collected as tests, one item per route and quantity and one per published value,
 
 Opt-in: `pytest --kinetostat [PATHS]` collects every visited `*.toml` with a `[mechanism]` table;
 the ini option `kinetostat_models` (glob patterns relative to the rootdir, like
-`--doctest-glob`) collects the visited TOML files it matches, also without `--kinetostat`.
+`--doctest-glob`) collects the visited TOML files it matches when `--kinetostat` is not given
+(with the flag, the patterns are not applied).
 Otherwise nothing is collected and no hook but the options' runs. Engine routes carry the marker
-`engines` (`-m "not engines"`: the engine-free gate, the 40-digit reference and the published
-values); a route whose engine is not installed is SKIPPED with the reason. A failure names the
-model file and the line of the published value (route checks: the pair, drive or point of the
-quantity, and the line of the route's tolerance), then a verdict line and a small table. Each
+`engines` (`-m "not engines"`: the engine-free gate, the 40-digit reference, the internal lever
+identity and the published values); a route whose engine is not installed is SKIPPED with the
+reason. A session whose gate items checked nothing beyond the lever identity (all skipped) ends
+with exit code 1 and the line "kinetostat: nothing was checked", as `kinetostat validate` does.
+A failure names the model file and the line of the published value (route checks: the pair,
+drive or point of the quantity, and the line of the route's tolerance), then a verdict line and
+a small table, under a header "<model> <route> <quantity>". Each
 item's JUnit <properties>: error, measure, tolerance, max_abs, unit, phi_deg, trust, route, file,
 line. Under GitHub Actions: `::error file=...,line=...` commands and a Markdown summary in
 $GITHUB_STEP_SUMMARY. The fixture `kinetostat_regression` is `kinetostat.testing.check_cycle`
-with the expected file beside the test (`--kinetostat-regen` rewrites it).
+with the model and expected files taken from the test file's folder (`--kinetostat-regen`
+rewrites the expected file).
 
 It lives in the harness so that pytest's start-up imports only this module (no numpy, no
 solver); everything else is imported when a model file is collected.
@@ -33,7 +38,7 @@ import pytest
 
 #: Marker of the engine routes' items, and the routes that need no engine.
 ENGINES_MARK = "engines"
-ENGINE_FREE = ("reference", "published")
+ENGINE_FREE = ("reference", "lever", "published")
 _MECHANISM = re.compile(rb"^\s*\[\s*mechanism\s*\]", re.MULTILINE)
 
 
@@ -48,7 +53,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     help="kinetostat_regression: rewrite the expected CSV files instead of comparing")
     parser.addini("kinetostat_models", type="args", default=[],
                   help="glob patterns (relative to the rootdir) of kinetostat model files to collect; "
-                       "when set the gate runs without --kinetostat")
+                       "when set the gate runs without --kinetostat (--kinetostat PATHS overrides them)")
     parser.addini("kinetostat_steps", default="360", help="crank positions over the cycle of each model")
 
 
@@ -81,7 +86,7 @@ def _steps(config: pytest.Config) -> int:
 def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Collector | None:
     if file_path.suffix != ".toml" or not _active(parent.config):
         return None
-    patterns = parent.config.getini("kinetostat_models")
+    patterns = [] if parent.config.getoption("kinetostat") else parent.config.getini("kinetostat_models")
     if patterns:
         rel = file_path.relative_to(parent.config.rootpath).as_posix() \
             if file_path.is_relative_to(parent.config.rootpath) else file_path.as_posix()
@@ -117,32 +122,35 @@ class ModelFile(pytest.File):
         from kinetostat import load
         from kinetostat.report import quantities
         from kinetostat.report.ci import model_lines
-        from kinetostat_validation.compare import ROUTES
+        from kinetostat_validation.compare import LEVER, ROUTES
 
         self.mech = load(self.path)
         self.lines = model_lines(self.mech, self.path.read_text(encoding="utf-8"))
         self._res = None
         self._runs: dict[str, Any] = {}
         self.add_marker("kinetostat")
-        for route in ROUTES:
+        for route in (*ROUTES, LEVER):
             yield Route.from_parent(self, name=route, quantities=quantities(self.mech, route))
         if self.mech.published:
             from kinetostat.report.runs import PUBLISHED_ROUTE
             yield Route.from_parent(self, name=PUBLISHED_ROUTE, quantities=[e.symbol for e in self.mech.published])
 
     def run(self, route: str):
-        """The ModelRun of one route (`kinetostat.report.run_validation`), computed once per
-        session; the published values as route "published"; the cycle analysed once."""
-        if route not in self._runs:
+        """The ModelRun that holds `route`'s checks (`kinetostat.report.run_validation`), computed
+        once per session: an engine route's own run, or (the lever identity, the published
+        values) the run of no engine route; the cycle analysed once."""
+        from kinetostat_validation.compare import ROUTES
+
+        key = route if route in ROUTES else ""
+        if key not in self._runs:
             from kinetostat import analyze
             from kinetostat.report import run_validation
-            from kinetostat.report.runs import PUBLISHED_ROUTE
 
             if self._res is None:
                 self._res = analyze(self.mech, steps=_steps(self.config))
-            engines = [] if route == PUBLISHED_ROUTE else [route]
-            self._runs[route] = run_validation(self.mech, engines, _steps(self.config), res=self._res, path=self.path)
-        return self._runs[route]
+            self._runs[key] = run_validation(self.mech, [key] if key else [], _steps(self.config), res=self._res,
+                                             path=self.path)
+        return self._runs[key]
 
     def repr_failure(self, excinfo, style=None):
         from kinetostat.errors import AssemblyError, ModelError, StructureError
@@ -213,7 +221,8 @@ class CheckItem(pytest.Item):
         return super().repr_failure(excinfo, style)
 
     def reportinfo(self):
-        return self.path, (self.where.line - 1 if self.where.line else None), f"{self.route} {self.quantity}"
+        return self.path, (self.where.line - 1 if self.where.line else None), \
+            f"{self.path.stem} {self.route} {self.quantity}"
 
 
 class _Gate:
@@ -245,9 +254,23 @@ class _Gate:
             self.outcomes.append(Outcome(report.nodeid, "error", "(model file)", Where(report.nodeid), "",
                                          message=str(report.longrepr).strip().splitlines()[-1]))
 
+    def _nothing_checked(self) -> bool:
+        """Gate items ran, and every one beyond the lever identity was skipped (or none was there)."""
+        from kinetostat.report.runs import LEVER_ROUTE
+        return bool(self.outcomes) and all(o.status == "skipped" or (o.route == LEVER_ROUTE and o.status == "passed")
+                                           for o in self.outcomes)
+
+    @pytest.hookimpl(tryfirst=True)
+    def pytest_sessionfinish(self, session: pytest.Session) -> None:
+        if self._nothing_checked() and session.exitstatus == pytest.ExitCode.OK:
+            session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
     def pytest_terminal_summary(self, terminalreporter, exitstatus: int, config: pytest.Config) -> None:
         if not self.outcomes:
             return
+        if self._nothing_checked():
+            terminalreporter.write_line("kinetostat: nothing was checked: every gate item was skipped but the lever "
+                                        "identity, which alone is no independent check -> exit code 1", red=True)
         from kinetostat.report import ci
         if os.environ.get("GITHUB_ACTIONS") == "true" and \
                 not config.pluginmanager.hasplugin("pytest_github_actions_annotate_failures"):
@@ -255,8 +278,12 @@ class _Gate:
             for line in ci.annotations(replace(o, where=o.where and replace(o.where, file=str(root / o.where.file)))
                                        for o in self.outcomes):
                 terminalreporter.write_line(line)
-        if ci.write_summary(ci.summary_markdown(self.outcomes, "kinetostat (pytest)")):
-            terminalreporter.write_line("kinetostat: summary -> $GITHUB_STEP_SUMMARY")
+        try:
+            if ci.write_summary(ci.summary_markdown(self.outcomes, "kinetostat (pytest)")):
+                terminalreporter.write_line("kinetostat: summary -> $GITHUB_STEP_SUMMARY")
+        except OSError as exc:
+            terminalreporter.write_line(f"kinetostat: warning: cannot write the summary to $GITHUB_STEP_SUMMARY: "
+                                        f"{exc.strerror or exc}", yellow=True)
 
 
 def _outcome(report: pytest.TestReport, props: dict):
@@ -283,15 +310,25 @@ def _outcome(report: pytest.TestReport, props: dict):
 @pytest.fixture
 def kinetostat_regression(request: pytest.FixtureRequest) -> Callable[..., Path]:
     """`check(model, expected=None, **kw)`: `kinetostat.testing.check_cycle` with the expected CSV
-    at `<test file's folder>/<test module>/<test name>.csv` unless `expected` is given;
-    `--kinetostat-regen` rewrites it (keywords as check_cycle's: rtol, atol, steps, columns)."""
-    from kinetostat.testing import check_cycle
+    at `<test file's folder>/<test module>/<test name>.csv` unless `expected` is given. A relative
+    `model` or `expected` path is taken from the test file's folder (not the current directory).
+    `--kinetostat-regen` rewrites the expected file (keywords as check_cycle's: rtol, atol, steps,
+    columns). A mismatch fails the test with check_cycle's message and table alone (no traceback)."""
+    from kinetostat.testing import CycleMismatch, check_cycle
 
     def check(model, expected: str | Path | None = None, **kw) -> Path:
+        __tracebackhide__ = True
+        here = request.node.path.parent
+        if isinstance(model, (str, os.PathLike)):
+            model = here / model
         if expected is None:
             test = request.node
             expected = test.path.parent / test.path.stem / (re.sub(r"\W+", "_", test.name).strip("_") + ".csv")
         if request.config.getoption("kinetostat_regen"):
             kw.setdefault("regenerate", True)
-        return check_cycle(model, expected, **kw)
+        try:
+            return check_cycle(model, here / expected, **kw)
+        except CycleMismatch as exc:
+            message = str(exc)
+        pytest.fail(message, pytrace=False)        # outside the except: no "during handling" chain
     return check

@@ -131,8 +131,8 @@ def validation_json(runs: Sequence[ModelRun], exit_code: int) -> dict[str, Any]:
                        phi_deg=_number(c.phi_deg), passed=bool(c.passed), trust=c.trust) for c in run.checks]
         models.append(dict(model=run.stem, path=None if run.path is None else str(run.path), name=run.mech.name,
                            structure=run.mech.structure.formula, positions=len(run.res.phi_deg),
-                           passed=bool(run.passed and checks),
-                           status="failed" if not run.passed else "passed" if checks else "not checked",
+                           passed=bool(run.passed and run.checked),
+                           status="failed" if not run.passed else "passed" if run.checked else "not checked",
                            checks=checks, skipped=dict(run.skipped),
                            errors=dict(run.errors),
                            seconds={r: _number(s) for r, s in run.seconds.items()}))

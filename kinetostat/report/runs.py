@@ -21,15 +21,19 @@ from .published import PublishedCheck, published_rows
 
 #: The route name under which a model's published values are checked.
 PUBLISHED_ROUTE = "published"
+#: The route name of the internal identity checked in every run: Zhukovsky's lever against the
+#: balancing moment found group by group (`kinetostat_validation.compare.LEVER`, `lever_row`).
+LEVER_ROUTE = "lever"
 
 #: What a route's checks rest on (JUnit property "trust", JSON "trust"): an independent engine,
-#: the 40-digit re-solution, or (route "published") the source's printed value.
+#: the 40-digit re-solution, an internal identity, or (route "published") the source's printed value.
 TRUST: dict[str, str] = {
     "pinocchio": "independent engine: Pinocchio's constrained inverse dynamics at the solver's state",
     "mujoco": "independent engine: MuJoCo's inverse dynamics at the solver's state",
     "mujoco-sim": "independent engine: MuJoCo's own forward simulation of the cycle",
     "pymunk": "independent engine: pymunk's impulse solver simulating the cycle",
     "reference": "40-digit re-solution: the whole problem solved again in mpmath, another formulation",
+    LEVER_ROUTE: "internal identity: Zhukovsky's lever vs group-by-group",
 }
 
 
@@ -96,7 +100,7 @@ class ModelRun:
     mech: Mechanism
     res: Analysis
     path: Path | None = None
-    engines: tuple[str, ...] = ()
+    engines: tuple[str, ...] = ()                       # the routes run: LEVER_ROUTE, then the engine routes
     rows: list = field(default_factory=list)            # kinetostat_validation.compare.Row
     results: dict = field(default_factory=dict)         # route -> EngineResult
     skipped: dict[str, str] = field(default_factory=dict)   # route -> reason
@@ -128,6 +132,12 @@ class ModelRun:
         """No check beyond tolerance and no route that raised (skipped routes do not count)."""
         return not self.errors and all(c.passed for c in self.checks)
 
+    @property
+    def checked(self) -> bool:
+        """A check beyond the internal lever identity ran: an engine route, the reference or a
+        published value (the identity alone checks nothing against an independent source)."""
+        return any(c.route != LEVER_ROUTE for c in self.checks)
+
     def status(self, route: str) -> str:
         if route in self.errors:
             return "ERROR"
@@ -157,17 +167,18 @@ def _record(caught, where: str, out: list[str]) -> None:
 
 def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, res: Analysis | None = None,
                    path: str | Path | None = None, on_route: Callable[[str], None] | None = None) -> ModelRun:
-    """Check `res` (default: `analyze(mech, steps=steps)`) against every route in `engines`, and
-    the model's published values (an exception there is the error of route "published").
+    """Check `res` (default: `analyze(mech, steps=steps)`) by the internal lever identity (route
+    LEVER_ROUTE, always), against every route in `engines`, and against the model's published
+    values (an exception there is the error of route "published").
 
     Each route runs in its own `compare(..., engines=[route], res=res)` call; an exception of a
     route is recorded in `errors` (that route fails) and the other routes still run. Warnings
     raised meanwhile are collected, one line each, in `warnings`. `on_route(route)` is called
     after each route (progress bars).
     """
-    from kinetostat_validation.compare import TOLERANCES, compare
+    from kinetostat_validation.compare import LEVER, TOLERANCES, compare, lever_row
 
-    run = ModelRun(mech, res, Path(path) if path is not None else None, tuple(engines))
+    run = ModelRun(mech, res, Path(path) if path is not None else None, (LEVER_ROUTE, *engines))
     if res is None:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -175,6 +186,8 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
             run.res = analyze(mech, steps=steps)
             run.solver_seconds = time.perf_counter() - t0
         _record(caught, "", run.warnings)
+    run.rows.append(lever_row(run.res))
+    run.tolerances[LEVER] = TOLERANCES[LEVER]
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

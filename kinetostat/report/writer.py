@@ -315,7 +315,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
 
 def _verdict(run: ModelRun) -> str:
     n_checks, n_fail = len(run.checks), sum(not c.passed for c in run.checks)
-    if run.passed and n_checks:
+    if run.passed and run.checked:
         return f"**PASS**: all {n_checks} checks within tolerance"
     if run.passed:
         return "**NOT CHECKED**: no route ran and the model has no published values"
@@ -539,7 +539,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
                    units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|; "
                                     f"'rounding' below {ROUNDING:.1e})",
                               tolerance="1 (of the peak)", worst_percent="%"),
-                   passed=run.passed, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
+                   passed=run.passed, checked=run.checked, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
                    routes={r: dict(status=run.status(r), worst=_worst(run, r),
                                    tolerance=_tolerance(run, r).peak_relative if _tolerance(run, r) else None,
                                    why=run.skipped.get(r) or run.errors.get(r)) for r in routes},
@@ -584,14 +584,14 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
                 routes.append(r)
     doc = Doc("kinetostat: error reports")
     doc.h(1, "kinetostat error reports")
-    n_pass = sum(1 for s in sums if s["passed"] and s["checks"])
+    n_pass = sum(1 for s in sums if s["passed"] and s["checked"])
     doc.p(f"{len(sums)} mechanisms, {n_pass} pass every check. Made with {_versions()}.")
     rows = []
     for s in sums:
         pub = s.get("published")
         pubcell = "-" if not pub else f"{pub['within']}/{pub['n']} within" + \
             (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")
-        verdict = "**PASS**" if s["passed"] and s["checks"] else "**FAIL**" if not s["passed"] else "not checked"
+        verdict = "**PASS**" if s["passed"] and s["checked"] else "**FAIL**" if not s["passed"] else "not checked"
         plans = f"[plans]({s['stem']}/index.md#{slug(PLANS_HEADING)})" if s.get("plans") else "-"
         rows.append([f"[{s['stem']}]({s['stem']}/index.md)", verdict, f"{esc(s['name'])}; `{s['formula']}`", pubcell,
                      plans])
