@@ -574,15 +574,16 @@ def exit_code(runs, absent: Sequence[str] = ()) -> int:
 def _coverage(run) -> str:
     """One line for people: what checked this model (routes with their number of quantities,
     the published values) and what was skipped, and why."""
-    from .report.runs import PUBLISHED_ROUTE as PUBLISHED
-    done = [f"{route} ({n} quantities)" for route in run.engines
-            if (n := sum(c.route == route for c in run.checks))]
+    from .report.runs import LEVER_ROUTE as LEVER, PUBLISHED_ROUTE as PUBLISHED
+    done = [f"{route} ({n} {'quantity' if n == 1 else 'quantities'})" for route in run.engines
+            if route != LEVER and (n := sum(c.route == route for c in run.checks))]
     if run.published:
         done.append(f"{PUBLISHED} ({len(run.published)} values)")
     skipped = [f"{route} ({why})" for route, why in run.skipped.items()]
     if not run.published and PUBLISHED not in run.errors:
         skipped.append(f"{PUBLISHED} (the model has no [[published]] values)")
-    return (f"  checked by: {', '.join(done) or 'nothing'}"
+    identity = "; the lever identity held" if any(c.route == LEVER and c.passed for c in run.checks) else ""
+    return (f"  checked by: {', '.join(done) or 'nothing'}{identity}"
             + (f"; not checked by: {'; '.join(skipped)}" if skipped else ""))
 
 

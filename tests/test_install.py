@@ -38,8 +38,8 @@ def test_a_model_nothing_checked_is_not_checked_exit_3(cli, tmp_path, absent_rou
     assert r.returncode == EXIT_NOT_CHECKED == 3, r.stderr
     blocks = r.stdout.split("== ")
     ice, four = blocks[1], blocks[2]
-    assert "checked by: published (15 values); not checked by: absent (" in ice and "=> PASS" in ice
-    assert "checked by: nothing; not checked by: absent (" in four
+    assert "checked by: published (15 values); the lever identity held; not checked by: absent (" in ice and "=> PASS" in ice
+    assert "checked by: nothing; the lever identity held; not checked by: absent (" in four
     assert "published (the model has no [[published]] values)" in four
     assert "=> NOT CHECKED" in four and "PASS" not in four
     assert "1 model(s) NOT CHECKED: four_bar" in r.stdout
@@ -52,7 +52,7 @@ def test_a_named_route_that_is_not_installed_exits_3(cli, absent_route):
     """--engines names the route: its absence is not a pass, even where other checks passed."""
     r = cli("validate", ICE, "--engines", "reference", absent_route, "--steps", "12", "--no-progress")
     assert r.returncode == EXIT_NOT_CHECKED, r.stderr
-    assert "checked by: reference (9 quantities), published (15 values); not checked by: absent (" in r.stdout
+    assert "checked by: reference (9 quantities), published (15 values); the lever identity held; not checked by: absent (" in r.stdout
     assert "kinetostat: error: --engines absent: not installed, so nothing was checked by it" in r.stderr
 
 

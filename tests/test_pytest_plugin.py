@@ -83,7 +83,7 @@ def test_one_altered_published_value_fails_at_its_line(folder):
         elif props["route"] == "lever":
             assert props["trust"] == LEVER_TRUST and props["quantity"] == "M_drive" and float(props["error"]) < 1e-14
         else:
-            assert props["trust"].startswith("published value: seed 004") and props["file"].startswith("models/")
+            assert props["trust"].startswith("published value: Potapov 2024") and props["file"].startswith("models/")
         failed = case.find("failure") is not None
         assert failed == (props["file"] == "models/bad.toml" and props["line"] == str(BAD_LINE))
         assert failed == (props["passed"] == "False")
