@@ -41,7 +41,7 @@ def test_a_model_nothing_checked_is_not_checked_exit_3(cli, tmp_path, absent_rou
     assert "checked by: published (15 values); the lever identity held; not checked by: absent (" in ice and "=> PASS" in ice
     assert "checked by: nothing; the lever identity held; not checked by: absent (" in four
     assert "published (the model has no [[published]] values)" in four
-    assert "=> NOT CHECKED" in four and "PASS" not in four
+    assert "=> NOT CHECKED" in four and "=> PASS" not in four
     assert "1 model(s) NOT CHECKED: four_bar" in r.stdout
     doc = json.loads((tmp_path / "v.json").read_text())
     assert doc["exit_code"] == 3 and not doc["passed"] and doc["totals"]["not_checked"] == 1
