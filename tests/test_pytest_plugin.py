@@ -31,6 +31,18 @@ N_PUBLISHED = 3
 LEVER_TRUST = "internal identity: Zhukovsky's lever vs group-by-group"
 
 
+@pytest.fixture(scope="module", autouse=True)
+def engines_imported_before_pytester():
+    """The installed engines imported before any in-process run: pytester puts sys.modules back
+    as it found it after each run, and an engine's compiled extension first imported inside a run
+    and dropped then cannot be imported again (later tests in this process would see it missing)."""
+    for name in ENGINES:
+        try:
+            __import__(name)
+        except ImportError:
+            pass
+
+
 def run(pytester, *args):
     """pytest in this process, in pytester's folder, at 36 positions per cycle (unless `args` say
     otherwise); without the cache and hypothesis's plugin (which pytester would import and
