@@ -1,5 +1,6 @@
-"""Output files: atomic writes (a temporary file in the same folder, renamed into place), folder
-names made from model file names, and the check that a written path stays inside its folder.
+"""Output files: atomic writes (a temporary file in the same folder, renamed into place; a device
+or FIFO named by the user written as a stream), sets of files swapped in as a unit, folder names
+made from model file names, and the check that a written path stays inside its folder.
 
 May use: the standard library only.
 """
@@ -7,12 +8,14 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
+import secrets
+import stat
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Iterator
 
-__all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside"]
+__all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside",
+           "is_stream"]
 
 #: The temporary files of the writes in progress in this process (`remove_temporary`).
 _PENDING: set[str] = set()
@@ -29,8 +32,21 @@ def _file_mode(path: Path) -> int:
         return 0o666 & ~umask
 
 
+def is_stream(path: str | Path) -> bool:
+    """True where `path` (links followed) exists and is not a regular file or folder: a device
+    (/dev/null, /dev/stdout on a terminal or a pipe), a FIFO or a socket."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return False
+    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+
+
+_TEMPORARY_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
+
+
 @contextmanager
-def atomic(path: str | Path, binary: bool = False) -> Iterator[IO]:
+def atomic(path: str | Path, binary: bool = False, stream: bool = False) -> Iterator[IO]:
     """A file opened for writing that becomes `path` only when the block ends normally.
 
     The data go to a temporary file in `path`'s folder (a short name of its own, so that a
@@ -38,25 +54,50 @@ def atomic(path: str | Path, binary: bool = False) -> Iterator[IO]:
     and `os.replace`d onto `path`: a reader never sees half a file. An exception in the block,
     a full disk or an interrupt (KeyboardInterrupt) removes the temporary file and leaves the
     old `path` as it was. Text is UTF-8; a name the file system cannot hold raises OSError.
+
+    Only a regular file (or a link, which is replaced, never followed) is replaced. A device,
+    FIFO or socket at `path` (links followed) is written as a stream where `stream` (a path the
+    user named, e.g. `-o /dev/null`), else refused (OSError) and left as it was.
     """
     path = Path(path)
     if path.is_dir():
         raise IsADirectoryError(21, "it is a directory", str(path))
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".kinetostat-", suffix=".tmp")
-    _PENDING.add(tmp)
+    if is_stream(path):
+        if not stream:
+            raise OSError(22, "not a regular file (a device, FIFO or socket); left as it is", str(path))
+        with open(path, "ab" if binary else "a", **({} if binary else {"encoding": "utf-8", "newline": ""})) as f:
+            yield f
+        return
+    tmp = None
     try:
+        for _ in range(100):     # named before it exists: an interrupt at any moment leaves no file behind
+            tmp = str(path.parent / f".kinetostat-{secrets.token_hex(6)}.tmp")
+            _PENDING.add(tmp)
+            try:
+                fd = os.open(tmp, _TEMPORARY_FLAGS, 0o600)
+                break
+            except FileExistsError:          # another file's name: not ours to remove
+                _PENDING.discard(tmp)
+                tmp = None
+        else:
+            raise FileExistsError(17, "no free temporary name", str(path.parent))
         with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8", newline="")) as f:
             yield f
         os.chmod(tmp, _file_mode(path))
         os.replace(tmp, path)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        _remove(tmp)
         raise
     finally:
         _PENDING.discard(tmp)
+
+
+def _remove(tmp: str | None) -> None:
+    try:
+        if tmp is not None:
+            os.unlink(tmp)
+    except OSError:
+        pass
 
 
 def remove_temporary() -> None:

@@ -27,7 +27,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Callable, Iterator, Sequence
 
-from ._io import atomic, unique_names
+from ._io import atomic, is_stream, unique_names
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -125,11 +125,30 @@ def _interrupts() -> Iterator[None]:
         signal.signal(signal.SIGINT, old)
 
 
-def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bool = False) -> None:
-    """`write(file)` into `path` atomically (`kinetostat._io.atomic`); a failure is a CLIError
-    naming `option`, and the old file stays as it was."""
+def _is_stdout(path: str | Path) -> bool:
+    """`path` is '-' or names this process's stdout (/dev/stdout, /proc/self/fd/1, the file it goes to)."""
+    if str(path) == "-":
+        return True
     try:
-        with atomic(path, binary=binary) as f:
+        return os.path.samestat(os.stat(path), os.fstat(sys.stdout.fileno()))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bool = False) -> None:
+    """`write(file)` into `path` atomically (`kinetostat._io.atomic`); '-' or stdout itself gets the
+    data through sys.stdout, a device or FIFO as a stream (never replaced by a file). A failure is
+    a CLIError naming `option`, and the old file stays as it was."""
+    if _is_stdout(path):
+        import io
+        buf = io.BytesIO() if binary else io.StringIO()
+        write(buf)
+        sys.stdout.flush()
+        (sys.stdout.buffer if binary else sys.stdout).write(buf.getvalue())
+        sys.stdout.flush()
+        return
+    try:
+        with atomic(path, binary=binary, stream=True) as f:
             write(f)
     except OSError as exc:
         raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
@@ -340,6 +359,10 @@ def _writable_file(path: str, option: str) -> Path:
     """Check that `path` can be written now (so that a long run does not fail at its end): its
     folder takes a temporary file, and the name itself is one the file system can hold."""
     p = Path(path)
+    if _is_stdout(p) or is_stream(p):    # written as a stream (`_save`)
+        if str(p) != "-" and not os.access(p, os.W_OK):
+            raise CLIError(f"cannot write {option} {p}: permission denied")
+        return p
     try:
         if p.is_dir():
             raise CLIError(f"cannot write {option} {p}: it is a directory")
@@ -613,7 +636,8 @@ def cmd_validate(args) -> int:
     from .report import run_validation
     engines = _engines(args.engines)
     junit = _writable_file(args.junit, "--junit") if args.junit else None
-    to_json = None if args.json is None else args.json if args.json == "-" else _writable_file(args.json, "--json")
+    to_json = (None if args.json is None else "-" if _is_stdout(args.json)
+               else _writable_file(args.json, "--json"))
     err = to_json == "-"                 # the JSON on stdout: the people's lines go to stderr
     paths = args.models or bundled_models()
     jobs = _prepare(paths, args.steps)
