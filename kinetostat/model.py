@@ -191,9 +191,11 @@ class SpeedLaw:
         phi = np.asarray(phi, dtype=float)
         if self.expression is not None:
             h = 1e-30                         # complex step: exact derivative, no cancellation
-            z = np.broadcast_to(over_arrays(_expression(self.expression),
-                                            {**dict(self.parameters), "phi": phi + 1j * h}), phi.shape)
-            return z.real.astype(float), z.imag / h
+            expr, values = _expression(self.expression), dict(self.parameters)
+            with np.errstate(all="ignore"):   # outside its real domain (sqrt, log of x < 0) omega is NaN
+                w = np.broadcast_to(over_arrays(expr, {**values, "phi": phi}), phi.shape).astype(float)
+                z = np.broadcast_to(over_arrays(expr, {**values, "phi": phi + 1j * h}), phi.shape)
+            return w, np.where(np.isfinite(w), z.imag / h, np.nan)
         x, y, m = _periodic_spline(self.phi_deg, self.omega)
         return _spline_at(x, y, m, phi)
 
@@ -212,6 +214,7 @@ class Drive:
     gear: Gear | None = None
     design_deg: float = 30.0    # the design position: crank angle of the mechanism's picture, deg
     law: SpeedLaw | None = None   # omega(phi); None: the constant omega and eps above
+    source: str = field(default="model", compare=False)   # the model file, for the law's errors
 
     @property
     def steady(self) -> bool:
@@ -224,7 +227,16 @@ class Drive:
         if self.law is None:
             return self.omega, self.eps
         w, dw = self.law(phi)
-        return w, w * dw
+        eps = w * dw
+        bad = ~(np.isfinite(w) & np.isfinite(eps) & (w >= 0))
+        if bad.any():                     # between the angles checked at load: a pole, a NaN band, a dip
+            where = "drive.omega_table" if self.law.expression is None else "drive.omega"
+            at = np.round(np.degrees(np.asarray(phi, float)[bad]), 6)
+            shown = ", ".join(f"{a:g}" for a in at[:8]) + (f", ... ({len(at)} angles)" if len(at) > 8 else "")
+            raise ModelError([f"{where}: the law of motion gives omega = {w[bad][0]:.6g} rad/s, eps = "
+                              f"{eps[bad][0]:.6g} rad/s^2 at phi = {shown} deg: omega must be real, finite and "
+                              f">= 0 (in the drive's sense), eps finite"], source=self.source)
+        return w, eps
 
 
 @dataclass(frozen=True)
@@ -1161,7 +1173,8 @@ class _Reader:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
         if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
             return None
-        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law)
+        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law,
+                     self.source)
 
     def speed_table(self, t: Any, where: str) -> SpeedLaw | None:
         """[drive.omega_table]: phi_deg and omega (rad/s) or rpm over one revolution."""
@@ -1213,7 +1226,10 @@ class _Reader:
         phi = np.linspace(0.0, 2 * np.pi, 721)
         w, dw = law(phi)
         if not (np.isfinite(w).all() and np.isfinite(dw).all()):
-            self.err(f"{where}: omega(phi) is not finite over the whole revolution")
+            at = np.degrees(phi[~(np.isfinite(w) & np.isfinite(dw))])
+            self.err(f"{where}: omega(phi) is not finite (or not real) over the whole revolution: so at phi = "
+                     f"{at[0]:.4g} deg" + (f" ({len(at)} of 721 angles checked, up to {at[-1]:.4g} deg)"
+                                           if len(at) > 1 else ""))
         elif (w < 0).any():
             self.err(f"{where}: omega(phi) must be >= 0 (in the drive's sense); it is "
                      f"{w.min():.4g} rad/s at phi = {np.degrees(phi[np.argmin(w)]):.4g} deg")

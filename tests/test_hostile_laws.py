@@ -1,0 +1,67 @@
+"""Hostile laws of motion and overrides (issue 22, points 2, 3): omega(phi), eps(phi) and a motor's
+M(omega) checked where they are used (real, finite, omega >= 0 in the drive's sense), so that no
+absurd force or silent NaN comes out; `sweep --param g=...` reaches g or is refused."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat import ModelError
+from conftest import FOUR_BAR
+
+
+def _with_law(law: str) -> str:
+    if law.startswith("["):
+        return FOUR_BAR.replace("rpm = 300.0\n", "").replace("eps = 0.0\n", "") + "\n" + law
+    return FOUR_BAR.replace("rpm = 300.0\n", law + "\n").replace("eps = 0.0\n", "")
+
+
+MOTOR_NAN_AT_SPEED = '\n[[load]]\nname = "motor"\nkind = "moment"\nlink = 1\ncharacteristic = "6*sqrt(20 - omega)"\n'
+
+# (model text, angles analysed, the message's parts): each was accepted with exit 0 before
+LAWS = {
+    # the audit's reproducer: the complex step read sqrt(<0)'s imaginary part as a slope (eps 1e31)
+    "sqrt-of-negative": (_with_law('omega = "10 + sqrt(cos(phi) - 0.99)"'), [30.0],
+                         ["drive.omega", "not finite (or not real)", "phi = 8.5 deg"]),
+    # a NaN band 0.006 deg wide between the 721 angles checked at load
+    "nan-band": (_with_law('omega = "10 + sqrt((sin(phi) - 0.3)**2 - 1e-8)"'), [0.0, float(np.degrees(np.arcsin(0.3)))],
+                 ["drive.omega", "phi = 17.4576 deg", "real, finite and >= 0"]),
+    # knots all >= 0, the spline dips below 0 between 90 and 90.3 deg: the crank would turn backwards
+    "spline-dips-below-zero": (_with_law("[drive.omega_table]\nphi_deg = [0.0, 90.0, 90.3, 180.0, 270.0, 360.0]\n"
+                                         "omega = [5.0, 0.0, 0.0, 5.0, 5.0, 5.0]\n"), [90.15],
+                               ["drive.omega_table", "omega = -3.1", "phi = 90.15 deg"]),
+    # the motor's characteristic is NaN at the running speed (300 rpm): M_bal was silently dropped
+    "characteristic-nan-at-speed": (FOUR_BAR + MOTOR_NAN_AT_SPEED, [0.0, 30.0],
+                                    ["load 'motor'", "not finite at omega = 31.4159 rad/s", "phi = 0 deg"]),
+}
+
+
+@pytest.mark.parametrize("name", LAWS)
+def test_a_law_outside_its_domain_is_refused_naming_the_angle(name):
+    text, phi, parts = LAWS[name]
+    with pytest.raises(ModelError) as exc:
+        kinetostat.analyze(kinetostat.loads(text), phi_deg=phi)
+    for part in parts:
+        assert part in str(exc.value), str(exc.value)
+
+
+@pytest.mark.parametrize("name", LAWS)
+def test_the_cli_gives_one_line_and_no_table(name, tmp_path, cli):
+    text, phi, parts = LAWS[name]
+    model, out = tmp_path / "m.toml", tmp_path / "t.csv"
+    model.write_text(text, encoding="utf-8")
+    p = cli("analyze", model, "--at", *phi, "--out", out)
+    assert p.returncode == 2 and "Traceback" not in p.stderr
+    assert p.stderr.startswith("kinetostat: error:") and p.stderr.count("\n") == 1, p.stderr
+    assert parts[-1] in p.stderr and not out.exists()
+
+
+def test_a_real_law_keeps_its_exact_derivative():
+    """The check leaves a law inside its domain as it was: sqrt(2 + cos) and its complex-step slope."""
+    mech = kinetostat.loads(_with_law('omega = "10 + sqrt(2 + cos(phi))"'))
+    phi = np.radians([0.0, 45.0, 200.0])
+    w, eps = mech.drive.speed(phi)
+    root = np.sqrt(2 + np.cos(phi))
+    np.testing.assert_allclose(w, 10 + root, rtol=1e-15)
+    np.testing.assert_allclose(eps, (10 + root) * -np.sin(phi) / (2 * root), rtol=1e-14)
