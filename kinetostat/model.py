@@ -711,10 +711,10 @@ class _Reader:
     def scalar(self, x: Any, path: str) -> Any:
         """`x` itself, or the value of the expression `x` (a string) over the parameters; None
         after recording a problem (naming `path` and the parameter that fails)."""
+        if path == "mechanism.g" and "g" in self.values:      # also a number that an override of g replaces
+            return self.values["g"]
         if not isinstance(x, str):
             return x
-        if path == "mechanism.g" and "g" in self.values:
-            return self.values["g"]
         try:
             e = parse_expression(x)
             bad = sorted(n for n in e.names if n in self.failed)

@@ -65,3 +65,34 @@ def test_a_real_law_keeps_its_exact_derivative():
     root = np.sqrt(2 + np.cos(phi))
     np.testing.assert_allclose(w, 10 + root, rtol=1e-15)
     np.testing.assert_allclose(eps, (10 + root) * -np.sin(phi) / (2 * root), rtol=1e-14)
+
+
+# ============================================================================ 3. an override reaches every field it names
+
+WEIGHTED = FOUR_BAR.replace("mass = 1.5\n", "mass = \"mass_from_weight(19.62, g)\"\n", 1)
+
+
+def test_an_override_of_g_reaches_mechanism_g_and_the_weights():
+    """mechanism.g written as a number was never overridden: g = 1 made a 19.62 N rod 19.62 kg
+    while gravity stayed 9.81. Now both read the override: the rod weighs 19.62 N at any g."""
+    assert WEIGHTED != FOUR_BAR
+    for g in (1.0, 9.81, 50.0):
+        mech = kinetostat.loads(WEIGHTED, parameters={"g": g})
+        assert mech.g == g
+        rod = next(k for k in mech.links if k.mass and k.id == 2)
+        assert rod.mass * mech.g == pytest.approx(19.62, rel=1e-15)
+
+
+def test_a_sweep_over_g_changes_the_gravity_moment(tmp_path):
+    """The audit's reproducer: three identical rows for g = 0, 9.8, 50. At 0 rpm (statics) the
+    balancing moment is affine in g: M(g) = M(0) + g dM/dg at every angle."""
+    static = FOUR_BAR.replace("rpm = 300.0", "rpm = 0.0")
+    model = tmp_path / "m.toml"
+    model.write_text(static, encoding="utf-8")
+    gs = [0.0, 9.8, 50.0]
+    sw = kinetostat.sweep(kinetostat.load(model), {"g": gs}, steps=12, full=True)
+    M = {g: sw.angles[sw.angles["g"] == g]["M_bal"].to_numpy() for g in gs}
+    slope = (M[9.8] - M[0.0]) / 9.8
+    assert np.abs(slope).max() > 0.1                                     # gravity does act
+    np.testing.assert_allclose(M[50.0], M[0.0] + 50.0 * slope, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(sw.table["peak_M_bal"], [np.abs(M[g]).max() for g in gs], rtol=1e-12)
