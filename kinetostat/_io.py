@@ -9,13 +9,16 @@ from __future__ import annotations
 import os
 import re
 import secrets
+import shutil
+import signal
 import stat
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Iterator
 
 __all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside",
-           "is_stream"]
+           "is_stream", "unit"]
 
 #: The temporary files of the writes in progress in this process (`remove_temporary`).
 _PENDING: set[str] = set()
@@ -94,20 +97,90 @@ def atomic(path: str | Path, binary: bool = False, stream: bool = False) -> Iter
 
 def _remove(tmp: str | None) -> None:
     try:
-        if tmp is not None:
+        if tmp is not None and os.path.isdir(tmp) and not os.path.islink(tmp):
+            shutil.rmtree(tmp)
+        elif tmp is not None:
             os.unlink(tmp)
     except OSError:
         pass
+
+
+@contextmanager
+def _sigint_deferred() -> Iterator[None]:
+    """Ctrl-C held back while the block runs (in the main thread; elsewhere nothing changes),
+    then delivered to the handler that was in place."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    seen: list[int] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+        if seen:
+            os.kill(os.getpid(), signal.SIGINT)
+
+
+def _moves(tmp: Path, folder: Path, root: Path) -> list[tuple[Path, Path]]:
+    """(file in `tmp`, its place in `folder`) for every file written into `tmp`; ValueError where
+    a place would lie outside `folder` (a planted link to a folder elsewhere), OSError where it
+    is neither a regular file nor a link (a device, a FIFO: never replaced). Places must resolve
+    inside `root`."""
+    moves = []
+    for src in sorted(p for p in tmp.rglob("*") if not p.is_dir()):
+        dst = folder / src.relative_to(tmp)
+        inside(root, dst.parent)
+        try:
+            mode = os.lstat(dst).st_mode
+        except FileNotFoundError:
+            mode = None
+        if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISLNK(mode)):
+            raise OSError(22, "not a regular file (a device, FIFO, socket or folder); left as it is", str(dst))
+        if mode is not None and stat.S_ISREG(mode):
+            os.chmod(src, mode & 0o7777)        # the mode of the file it replaces
+        moves.append((src, dst))
+    return moves
+
+
+@contextmanager
+def unit(folder: str | Path, root: str | Path | None = None) -> Iterator[Path]:
+    """A set of files written as a unit into `folder` (created). The block writes them into a new
+    hidden folder inside `folder` (the path yielded, same layout); when the block ends normally
+    each file is renamed onto its place in `folder` (links in their way replaced, never
+    followed; a place outside `folder` through a linked subfolder is ValueError, nothing moved),
+    with Ctrl-C held back until the last rename: a reader sees the old set or the new one, never
+    a mix. An exception, a full disk or an interrupt in the block leaves `folder` as it was; the
+    hidden folder is always removed. Files of `folder` the block did not write stay as they are.
+    `root` (default `folder`): `folder` and every place written must resolve inside it (a
+    `folder` that is a planted link to elsewhere: ValueError before anything is written)."""
+    folder = Path(folder)
+    root = folder if root is None else Path(root)
+    if os.path.lexists(folder):
+        inside(root, folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    inside(root, folder)
+    tmp = None
+    try:
+        tmp = str(folder / f".kinetostat-{secrets.token_hex(6)}.tmp")
+        _PENDING.add(tmp)
+        os.mkdir(tmp, 0o700)
+        yield Path(tmp)
+        moves = _moves(Path(tmp), folder, root)
+        with _sigint_deferred():
+            for src, dst in moves:
+                dst.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(src, dst)
+    finally:
+        _remove(tmp)
+        _PENDING.discard(tmp)
 
 
 def remove_temporary() -> None:
     """Remove the temporary files of the writes in progress: for a process about to end at once
     (`os._exit` in a signal handler), which leaves no `atomic` block to clean up after itself."""
     for tmp in list(_PENDING):
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        _remove(tmp)
 
 
 def write_text(path: str | Path, text: str) -> Path:

@@ -27,7 +27,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Callable, Iterator, Sequence
 
-from ._io import atomic, is_stream, unique_names
+from ._io import atomic, is_stream, unique_names, unit
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -706,7 +706,8 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
             secs = time.perf_counter() - t1
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
-        summary = write_report(run, Path(out), folder)
+        with unit(out) as tmp:                # the model's files swapped in as a set at the end
+            summary = write_report(run, tmp, folder)
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
@@ -871,11 +872,10 @@ def cmd_plans(args) -> int:
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
     try:
-        written = plans.write(out, lang=args.lang)
-        if sheet is not None:
-            written += sheet.write(out)
-    except OSError as exc:
-        raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
+        with unit(out) as tmp:                # swapped in as a set: never new sheets beside an old worksheet
+            written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])
+    except (OSError, ValueError) as exc:
+        raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
     scales = ", ".join(str(s) for s in plans.scales.values())
     _Out.write(f"{path.name} at phi = {plans.at:g} deg ({scales}): {len(written)} files -> {out}")
     return EXIT_OK
@@ -936,8 +936,8 @@ def cmd_variant(args) -> int:
                 warnings.simplefilter("ignore")
                 try:
                     keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
-                                                   cycle_csv=not args.all))
-                except (AssemblyError, ModelError, ValueError) as exc:
+                                                   cycle_csv=not args.all, root=out))
+                except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:
                     raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
