@@ -18,7 +18,7 @@ import math
 import operator
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -181,6 +181,8 @@ def _check_node(node: ast.AST, names: set[str]) -> None:
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
             raise ExpressionError(f"{type(node.value).__name__} literal {node.value!r:.40} is not allowed "
                                   f"(only numbers)")
+        if not _finite_number(node.value):
+            raise ExpressionError(f"{shown_number(node.value)} is too large (overflow)")
     elif isinstance(node, ast.Name):
         if node.id in FUNCTIONS:
             return          # checked as a call's function
@@ -236,6 +238,21 @@ def _eval(node: ast.AST, values: Mapping[str, float]) -> float:
     raise ExpressionError(f"{type(node).__name__} not allowed")     # parse() lets none through
 
 
+def _finite_number(x: float) -> bool:
+    """Finite, also as a float (an integer beyond 1.8e308 is not)."""
+    try:
+        return math.isfinite(x)
+    except OverflowError:
+        return False
+
+
+def shown_number(x: Any) -> str:
+    """`x` for a message: an integer too long to show as its digit count ("an integer of 401 digits")."""
+    if isinstance(x, int) and not isinstance(x, bool) and x.bit_length() > 64:
+        return f"an integer of {len(str(abs(x))) if x.bit_length() < 10_000 else 'over 3000'} digits"
+    return repr(x)
+
+
 def _checked(x: float) -> float:
     if not math.isfinite(x):
         raise ExpressionError(f"the result {x} is not a finite number")
@@ -272,25 +289,16 @@ def resolve(raw: Mapping[str, Any]) -> tuple[dict[str, float], dict[str, str]]:
                 parsed[name] = parse(x)
             except ExpressionError as exc:
                 problems[name] = f'expression "{x}": {exc}'
-        elif isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x):
+        elif isinstance(x, (int, float)) and not isinstance(x, bool) and _finite_number(x):
             values[name] = float(x)
+        elif isinstance(x, int) and not isinstance(x, bool):
+            problems[name] = f"{shown_number(x)} is too large for a floating-point number"
         else:
             problems[name] = f"expected a number or an expression string, got {x!r:.60}"
     state: dict[str, int] = {}          # 1: being evaluated, 2: done
 
-    def visit(name: str, chain: tuple[str, ...]) -> None:
-        if state.get(name) == 2 or name in values or name in problems:
-            return
-        if state.get(name) == 1:
-            cycle = chain[chain.index(name):] + (name,)
-            for n in cycle[:-1]:
-                problems.setdefault(n, f'expression "{raw[n]}": cycle {" -> ".join(cycle)}')
-            return
-        state[name] = 1
+    def finish(name: str) -> None:
         e = parsed[name]
-        for dep in sorted(e.names):
-            if dep in parsed:
-                visit(dep, chain + (name,))
         if name not in problems:
             bad = sorted(d for d in e.names if d in problems)
             if bad:
@@ -302,6 +310,25 @@ def resolve(raw: Mapping[str, Any]) -> tuple[dict[str, float], dict[str, str]]:
                     problems[name] = f'expression "{e.text}": {exc}'
         state[name] = 2
 
-    for name in parsed:
-        visit(name, ())
+    def deps(name: str) -> Iterator[str]:
+        return iter(sorted(d for d in parsed[name].names if d in parsed))
+
+    for start in parsed:                # depth first, with a stack of its own: 1000 parameters in a chain
+        if state.get(start) == 2 or start in problems:
+            continue
+        path, todo = [start], [deps(start)]
+        state[start] = 1
+        while path:
+            dep = next(todo[-1], None)
+            if dep is None:
+                todo.pop()
+                finish(path.pop())
+            elif state.get(dep) == 1:
+                cycle = tuple(path[path.index(dep):]) + (dep,)
+                for n in cycle[:-1]:
+                    problems.setdefault(n, f'expression "{raw[n]}": cycle {" -> ".join(cycle)}')
+            elif state.get(dep) != 2 and dep not in problems:
+                state[dep] = 1
+                path.append(dep)
+                todo.append(deps(dep))
     return {n: values[n] for n in raw if n in values}, problems

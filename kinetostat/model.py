@@ -23,7 +23,8 @@ from typing import Any, Callable, Literal, Mapping
 import numpy as np
 
 from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
-from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression
+from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression, shown_number
+from .expressions import _finite_number
 from .expressions import resolve as resolve_parameters
 from .structure import Structure, analyse_structure
 
@@ -403,13 +404,36 @@ def _periodic_spline(x_deg: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray, np
     n = len(x)
     h = np.diff(np.append(x, x[0] + 2 * np.pi))           # h[i] = x[i+1] - x[i], cyclically
     slope = (np.roll(y, -1) - y) / h
-    A = np.zeros((n, n))
-    for i in range(n):
-        A[i, i - 1] += h[i - 1]
-        A[i, i] += 2 * (h[i - 1] + h[i])
-        A[i, (i + 1) % n] += h[i]
-    m = np.linalg.solve(A, 6 * (slope - np.roll(slope, 1)))
-    return x, y, m
+    r = 6 * (slope - np.roll(slope, 1))
+    if n < 3:                                             # both neighbours are one knot
+        return x, y, np.linalg.solve(np.diag(2 * (np.roll(h, 1) + h)) + np.diag(h.sum() * np.ones(n - 1), 1)
+                                     + np.diag(h.sum() * np.ones(n - 1), -1), r)
+    return x, y, _cyclic_tridiagonal(np.roll(h, 1), 2 * (np.roll(h, 1) + h), h, r)
+
+
+def _cyclic_tridiagonal(sub: np.ndarray, diag: np.ndarray, sup: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """x of A x = r, A tridiagonal with corners (n >= 3): A[i, i-1] = sub[i], A[i, i] = diag[i],
+    A[i, i+1] = sup[i], indices cyclic (sub[0] = A[0, n-1], sup[n-1] = A[n-1, 0]). The Thomas
+    algorithm with the Sherman-Morrison correction for the corners: O(n) work and memory."""
+    n = len(diag)
+    beta, alpha, gamma = float(sub[0]), float(sup[-1]), -float(diag[0])
+    b = [float(v) for v in diag]
+    b[0] -= gamma
+    b[-1] -= alpha * beta / gamma
+    a, c, d = [float(v) for v in sub], [float(v) for v in sup], [float(v) for v in r]
+    u = [gamma] + [0.0] * (n - 2) + [alpha]
+    cp, xp, zp = [0.0] * n, [0.0] * n, [0.0] * n       # forward sweep for r and u together
+    cp[0], xp[0], zp[0] = c[0] / b[0], d[0] / b[0], u[0] / b[0]
+    for i in range(1, n):
+        m = b[i] - a[i] * cp[i - 1]
+        cp[i] = c[i] / m
+        xp[i] = (d[i] - a[i] * xp[i - 1]) / m
+        zp[i] = (u[i] - a[i] * zp[i - 1]) / m
+    for i in range(n - 2, -1, -1):
+        xp[i] -= cp[i] * xp[i + 1]
+        zp[i] -= cp[i] * zp[i + 1]
+    x, z = np.array(xp), np.array(zp)
+    return x - z * (x[0] + beta * x[-1] / gamma) / (1 + z[0] + beta * z[-1] / gamma)
 
 
 def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -617,7 +641,8 @@ MAX_SHOWN = 120
 
 
 def _finite(x: Any) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    """A finite number, also as a float (an integer of 400 digits is not)."""
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and _finite_number(x)
 
 
 def _subnormal(x: float) -> bool:
@@ -739,7 +764,7 @@ class _Reader:
         x = self.scalar(tab[key], f"{where}.{key}")
         if x is None:
             return None
-        shown = repr(x) if not isinstance(tab[key], str) else f'{x!r} (= "{tab[key]:.{MAX_SHOWN}}")'
+        shown = shown_number(x) if not isinstance(tab[key], str) else f'{x!r} (= "{tab[key]:.{MAX_SHOWN}}")'
         if not _finite(x):
             self.err(f"{where}.{key}: expected a finite number, got {shown}")
             return None
@@ -1215,7 +1240,7 @@ class _Reader:
         try:
             law(np.zeros(1))
         except ValueError as exc:
-            self.err(f"{where}: {text!r}: {exc}")
+            self.err(f'{where}: "{text:.{MAX_SHOWN}}": {exc}')
             return None
         return law
 
@@ -1373,10 +1398,10 @@ class _Reader:
             try:
                 value = c(np.array([0.0, 1.0]))
             except ValueError as exc:
-                self.err(f"{where}: {t!r}: {exc}")
+                self.err(f'{where}: "{t:.{MAX_SHOWN}}": {exc}')
                 return None
             if not np.isfinite(value).all():
-                self.err(f"{where}: {t!r} is not finite at omega = 0 or 1 rad/s")
+                self.err(f'{where}: "{t:.{MAX_SHOWN}}" is not finite at omega = 0 or 1 rad/s')
                 return None
             return c
         if not isinstance(t, dict):

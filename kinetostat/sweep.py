@@ -23,6 +23,7 @@ Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engin
 from __future__ import annotations
 
 import itertools
+import math
 import threading
 import warnings
 from contextlib import contextmanager
@@ -45,6 +46,10 @@ __all__ = ["Sweep", "sweep", "CHUNK", "LOCAL_SCHEDULERS"]
 CHUNK = 32
 #: The `scheduler` names of Dask's local schedulers; any other string is a `distributed` address.
 LOCAL_SCHEDULERS = ("threads", "processes")
+#: Most designs of one sweep (the product of the parameters' numbers of values), checked before any is made.
+MAX_DESIGNS = 1_000_000
+#: Seconds to wait for a distributed scheduler to answer, and for its first worker.
+CONNECT_TIMEOUT = 10.0
 #: The unit `attrs["units"]` gives a design's parameter: the one its model file uses.
 PARAMETER_UNIT = "model's unit"
 
@@ -95,6 +100,10 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
             raise ValueError(f"sweep: {name!r} is not a parameter of the model{_suggest(name, valid)}. "
                              f"Parameters: {', '.join(valid)}")
     values = [_values(name, params[name]) for name in names]
+    n_designs = math.prod(len(v) for v in values)
+    if n_designs > MAX_DESIGNS:
+        raise ValueError(f"sweep: {' x '.join(str(len(v)) for v in values)} = {n_designs:.3g} designs, at most "
+                         f"{MAX_DESIGNS}; sweep fewer values")
     if not isinstance(chunk, (int, np.integer)) or isinstance(chunk, bool) or chunk < 1:
         raise ValueError(f"chunk: expected a positive number of designs per task, got {chunk!r}")
     phi_deg = crank_angles(phi_deg, steps)
@@ -245,23 +254,40 @@ def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: n
             def count(key, result, dsk, state, worker_id):
                 if key in finished:
                     bar.update()
+            quiet = {"initializer": _ignore_sigint} if scheduler == "processes" else {}
             with warnings.catch_warnings(), Callback(posttask=count):
-                return list(dask.compute(*tasks, scheduler=scheduler))
+                return list(dask.compute(*tasks, scheduler=scheduler, **quiet))
         return _distributed(tasks, scheduler, bar)
     finally:
         bar.close()
+
+
+def _ignore_sigint() -> None:
+    """A worker process ignores Ctrl-C (the terminal sends it to the whole group): the main
+    process reports the interruption, and no worker prints a KeyboardInterrupt traceback."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _distributed(tasks: list, scheduler: Any, bar) -> list:
     """The tasks' results from a `distributed` scheduler (an address, or a Client)."""
     from distributed import Client, as_completed
     if isinstance(scheduler, str):
+        if scheduler.partition("://")[0] in ("tls", "ucx"):
+            raise ConnectionError(f"scheduler {scheduler!r}: a {scheduler.partition('://')[0].upper()} scheduler "
+                                  f"needs its security or transport set up: connect a distributed.Client yourself "
+                                  f"and pass it (the API's scheduler=client)")
         try:
-            client = Client(scheduler)
-        except (OSError, ValueError) as exc:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, ValueError, TypeError) as exc:
             raise ConnectionError(f"scheduler {scheduler!r}: no distributed scheduler there ({exc}); "
                                   f"or use {' or '.join(map(repr, LOCAL_SCHEDULERS))}") from None
         with client:
+            try:
+                client.wait_for_workers(1, timeout=CONNECT_TIMEOUT)
+            except (OSError, TimeoutError) as exc:
+                raise ConnectionError(f"scheduler {scheduler!r}: no worker joined it within {CONNECT_TIMEOUT:g} s "
+                                      f"({type(exc).__name__}); start workers (dask worker {scheduler})") from None
             return _gather(client, tasks, bar, as_completed)
     if not isinstance(scheduler, Client):
         raise TypeError(f"scheduler: expected None, {' or '.join(map(repr, LOCAL_SCHEDULERS))}, a distributed "
