@@ -141,7 +141,7 @@ def over_arrays(expr: Expression, values: Mapping[str, Any]) -> Any:
             if node.id in CONSTANTS:
                 return CONSTANTS[node.id]
             if node.id not in values:
-                raise ExpressionError(f"unknown name {node.id!r}{_suggest(node.id, [*values, *CONSTANTS])}")
+                raise ExpressionError(f"unknown name {node.id!r}{suggest(node.id, [*values, *CONSTANTS])}")
             return values[node.id]
         if isinstance(node, ast.UnaryOp):
             return _UNARY[type(node.op)](ev(node.operand))
@@ -197,7 +197,7 @@ def _check_node(node: ast.AST, names: set[str]) -> None:
         f = node.func
         if not isinstance(f, ast.Name) or f.id not in FUNCTIONS:
             called = f.id if isinstance(f, ast.Name) else _WHAT.get(type(f), type(f).__name__)
-            raise ExpressionError(f"call of {called!r} is not allowed{_suggest(called, FUNCTIONS)}; "
+            raise ExpressionError(f"call of {called!r} is not allowed{suggest(called, FUNCTIONS)}; "
                                   f"functions: {', '.join(sorted(FUNCTIONS))}")
         if node.keywords:
             raise ExpressionError(f"{f.id}() takes positional arguments only")
@@ -222,7 +222,7 @@ def _eval(node: ast.AST, values: Mapping[str, float]) -> float:
         if node.id in FUNCTIONS:
             raise ExpressionError(f"{node.id!r} is a function: call it, {node.id}(...)")
         if node.id not in values:
-            raise ExpressionError(f"unknown name {node.id!r}{_suggest(node.id, [*values, *CONSTANTS])}")
+            raise ExpressionError(f"unknown name {node.id!r}{suggest(node.id, [*values, *CONSTANTS])}")
         return values[node.id]
     if isinstance(node, ast.UnaryOp):
         return _UNARY[type(node.op)](_eval(node.operand, values))
@@ -267,9 +267,21 @@ def _arith_message(exc: Exception) -> str:
     return f"math domain error ({exc})" if "domain" in str(exc) else str(exc)
 
 
-def _suggest(name: str, valid) -> str:
-    close = difflib.get_close_matches(name, [str(v) for v in valid], n=1, cutoff=0.6)
+#: "Did you mean": names longer than this are not compared, nor candidates of a length more than
+#: 3 apart, and at most SUGGEST_CANDIDATES candidates: a suggestion costs at most about
+#: SUGGEST_CANDIDATES x SUGGEST_LENGTH^2 steps, whatever the file holds.
+SUGGEST_LENGTH = 64
+SUGGEST_CANDIDATES = 100
+
+
+def suggest(name: str, valid) -> str:
+    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else ""."""
+    if len(name) > SUGGEST_LENGTH:
+        return ""
+    near = [v for v in map(str, valid) if abs(len(v) - len(name)) <= 3][:SUGGEST_CANDIDATES]
+    close = difflib.get_close_matches(name, near, n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
+
 
 
 # ----------------------------------------------------------------------------- a table of parameters

@@ -7,7 +7,6 @@ May use: the standard library, numpy, errors, expressions, structure, examples.
 """
 from __future__ import annotations
 
-import difflib
 import functools
 import math
 import re
@@ -24,7 +23,7 @@ import numpy as np
 
 from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
 from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression, shown_number
-from .expressions import _finite_number
+from .expressions import _finite_number, suggest
 from .expressions import resolve as resolve_parameters
 from .structure import Structure, analyse_structure
 
@@ -539,11 +538,9 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>",
 
 
 def _suggest(name: Any, valid) -> str:
-    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else ""."""
-    if not isinstance(name, str):
-        return ""
-    close = difflib.get_close_matches(name, [str(v) for v in valid], n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
+    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else "" (bounded
+    work: `expressions.suggest`)."""
+    return suggest(name, valid) if isinstance(name, str) else ""
 
 
 class _Lines:
@@ -638,6 +635,8 @@ MAX_PUBLISHED_ANGLES = 3600
 
 #: Characters of an expression quoted in a message.
 MAX_SHOWN = 120
+#: Most problems listed for one file (the rest are counted): 300,000 unknown keys stay one short list.
+MAX_PROBLEMS = 100
 
 
 def _finite(x: Any) -> bool:
@@ -666,6 +665,7 @@ class _Reader:
         self.ids_unknown = False                  # some [[link]] has no valid id: "unknown link" follows
         self.points_unread: set[tuple[int, str | None]] = set()   # (link, point) that failed (None: all)
         self.misspelled: set[str] = set()         # field paths given under a near-miss name
+        self.unshown = 0                          # problems beyond MAX_PROBLEMS, counted only
         self.group_tables: dict[frozenset, tuple[int, tuple]] = {}   # group -> (its [[group]], links as listed)
         self.coincident: dict[int, str] = {}      # links whose points all coincide -> their field path
         self.slider_axes: set[int] = set()        # P pairs (index) whose slider frame the file states
@@ -674,6 +674,9 @@ class _Reader:
         path = msg.partition(": ")[0]
         if path in self.misspelled and msg[len(path):].startswith(": missing"):
             return          # "mass: missing" after "masss: unknown field (did you mean 'mass'?)"
+        if len(self.problems) >= MAX_PROBLEMS:
+            self.unshown += 1
+            return
         self.problems.append(msg)
         self.lines.append(self.line_of(path))
 
@@ -836,9 +839,12 @@ class _Reader:
         return x
 
     def unknown_keys(self, tab: Mapping, allowed: set[str], where: str) -> None:
+        unused = sorted(allowed.difference(tab))
         for k in tab:
-            if k not in allowed:
-                hint = _suggest(k, sorted(allowed - set(tab)))
+            if k not in allowed and len(self.problems) >= MAX_PROBLEMS:
+                self.unshown += 1
+            elif k not in allowed:
+                hint = _suggest(k, unused)
                 if hint:
                     self.misspelled.add(f"{where}.{hint.split(chr(39))[1]}")
                 self.err(f"{where}.{k}: unknown field{hint}. Valid fields: {sorted(allowed)}")
@@ -876,7 +882,8 @@ class _Reader:
                     self.err(f"pair[{p.index}].radius: missing; friction losses need the journal radius "
                              f"of every revolute pair (or a default friction.radius)")
         if self.problems:
-            raise ModelError(self.problems, source=self.source, lines=self.lines)
+            more = [f"... and {self.unshown} more problems (the first {MAX_PROBLEMS} are shown)"] if self.unshown else []
+            raise ModelError(self.problems + more, source=self.source, lines=self.lines + [None] * len(more))
         try:
             mech = Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
                              links=tuple(links), pairs=tuple(pairs),
