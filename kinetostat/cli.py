@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import IO, Callable, Iterator, Sequence
 
 from ._io import atomic, is_stream, unique_names, unit
+from ._text import visible
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -52,6 +53,7 @@ class _Out:
     @classmethod
     def write(cls, text: str, err: bool = False) -> None:
         stream = sys.stderr if err else sys.stdout
+        text = visible(text)             # a name's ESC [2J or OSC 52 printed as text, never acted on
         try:
             if cls.bar is not None:
                 from tqdm import tqdm

@@ -12,7 +12,7 @@
 (`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
 there and only when a figure is drawn).
 
-May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`); pandas only inside
+May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`; pandas only inside
 `Plans.segments_frame`; never the harness or `kinetostat.report`.
 """
 from __future__ import annotations
@@ -26,6 +26,7 @@ from types import MappingProxyType
 from typing import Callable, Iterable
 
 from .._io import write_text
+from .._text import csv_cell
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .forces import crank_plan, force_plans, group_plans
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
@@ -86,7 +87,7 @@ class Plans(Mapping):
         w = csv.DictWriter(buf, fieldnames=SEGMENT_COLUMNS, lineterminator="\n")
         w.writeheader()
         for r in self.rows():
-            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+            w.writerow({k: (repr(v) if isinstance(v, float) else csv_cell(v)) for k, v in r.items()})
         return buf.getvalue()
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:

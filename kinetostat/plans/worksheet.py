@@ -7,7 +7,7 @@ accelerations), the inertia loads and the applied loads, the reactions group by 
 last group attached back to the crank, the crank, Zhukovsky's lever and the difference of the two
 balancing moments. Outputs: Markdown, HTML, a pandas frame, CSV and JSON (written atomically).
 
-May use: the solver (`analysis`, `applied`, `model`), numpy; pandas and markdown-it-py inside the
+May use: the solver (`analysis`, `applied`, `model`), `_io`, `_text` (safe cells), numpy; pandas and markdown-it-py inside the
 output methods only. Never matplotlib, never the harness.
 """
 from __future__ import annotations
@@ -22,6 +22,7 @@ import numpy as np
 from ..analysis import Analysis, analyze
 from ..applied import load_magnitude
 from .._io import write_text
+from .._text import csv_cell, markdown_text
 from ..model import Mechanism
 from .scales import choose_scales
 
@@ -104,14 +105,15 @@ class Worksheet:
     def markdown(self) -> str:
         """The worksheet as Markdown: a title, then one table per section."""
         w = _WORDS[self.lang]
-        out = [f"# {w['title'].format(name=self.mechanism, phi=self.phi_deg)}", "", w["scale"].format(self.mu_l)]
+        out = [f"# {w['title'].format(name=markdown_text(self.mechanism), phi=self.phi_deg)}", "",
+               w["scale"].format(self.mu_l)]
         section = None
         for rec in self.records():
             if rec["section"] != section:
                 section = rec["section"]
                 out += ["", f"## {section}", "", "| " + " | ".join(w["head"]) + " |", "|---|---:|---|---|---|"]
             cells = (rec["symbol"], _number(rec["value"]), rec["unit"], rec["direction"], rec["note"])
-            out.append("| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |")
+            out.append("| " + " | ".join(markdown_text(str(c)) for c in cells) + " |")
         return "\n".join(out) + "\n"
 
     def html(self) -> str:
@@ -121,7 +123,7 @@ class Worksheet:
 
     def to_csv(self, path: str | Path) -> None:
         """Write the rows as CSV (atomic: a temporary file in the same folder, then replaced)."""
-        write_text(path, self.frame().to_csv(index=False))
+        write_text(path, self.frame().map(csv_cell).to_csv(index=False))   # no cell read as a formula
 
     def to_json(self, path: str | Path) -> None:
         """Write the rows as a JSON list of objects, NaN as null (atomic)."""
