@@ -13,6 +13,7 @@ import re
 import stat
 import sys
 import tomllib
+import unicodedata
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -443,7 +444,8 @@ def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> 
     h = xe[i + 1] - xe[i]
     a, b = xe[i + 1] - t, t - xe[i]
     ca, cb = ye[i] / h - me[i] * h / 6, ye[i + 1] / h - me[i + 1] * h / 6
-    value = (me[i] * a**3 + me[i + 1] * b**3) / (6 * h) + ca * a + cb * b
+    # the same cubic, written so that it is exact at a knot (a table's 0 stays 0, never -1e-21)
+    value = ye[i] * (a / h) + ye[i + 1] * (b / h) + (me[i] * a * (a * a - h * h) + me[i + 1] * b * (b * b - h * h)) / (6 * h)
     slope = (-me[i] * a**2 + me[i + 1] * b**2) / (2 * h) - ca + cb
     return value, slope
 
@@ -535,6 +537,16 @@ def from_dict(data: Mapping[str, Any], source: str = "<dict>",
               parameters: Mapping[str, Any] | None = None) -> Mechanism:
     """Build a Mechanism from the parsed structure of a model file; `parameters` as for `load`."""
     return _Reader(data, source, overrides=parameters).mechanism()
+
+
+#: The variables of laws of motion (phi, rad) and of motor characteristics (omega, rad/s): no parameter's name.
+LAW_VARIABLES = ("phi", "omega")
+
+
+def _code_points(name: str) -> str:
+    """A name with the code points that are not ASCII named: 'µ' -> "'µ' (U+00B5 MICRO SIGN)"."""
+    odd = [f"U+{ord(c):04X} {unicodedata.name(c, '?')}" for c in dict.fromkeys(name) if ord(c) > 127]
+    return f"{name!r}" + (f" ({', '.join(odd[:4])}{', ...' if len(odd) > 4 else ''})" if odd else "")
 
 
 def _suggest(name: Any, valid) -> str:
@@ -716,6 +728,12 @@ class _Reader:
                 self.err("parameters.g: g is mechanism.g (m/s^2), which expressions read as g: give it there")
             elif name in FUNCTIONS or name in CONSTANTS:
                 self.err(f"parameters.{name}: {name!r} is the name of a function or constant of expressions")
+            elif name in LAW_VARIABLES:
+                self.err(f"parameters.{name}: {name!r} is the variable of a law of motion omega(phi) or of a "
+                         f"characteristic M(omega), which would hide this parameter there; choose another name")
+            elif unicodedata.normalize("NFKC", name) != name:
+                self.err(f"parameters.{name}: {_code_points(name)} reads as {_code_points(unicodedata.normalize('NFKC', name))} "
+                         f"in expressions (Unicode NFKC, as Python folds names); write it so")
             elif not name.isidentifier() or name.startswith("__"):
                 self.err(f"parameters.{name}: a parameter's name is a Python-style identifier (letters, digits, _)")
         for name, x in self.overrides.items():

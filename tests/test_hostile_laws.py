@@ -1,7 +1,10 @@
-"""Hostile laws of motion and overrides (issue 22, points 2, 3): omega(phi), eps(phi) and a motor's
-M(omega) checked where they are used (real, finite, omega >= 0 in the drive's sense), so that no
-absurd force or silent NaN comes out; `sweep --param g=...` reaches g or is refused."""
+"""Hostile laws of motion, overrides and parameter names (issue 22, points 2, 3, 11): omega(phi),
+eps(phi) and a motor's M(omega) checked where they are used (real, finite, omega >= 0 in the
+drive's sense), so that no absurd force or silent NaN comes out; `sweep --param g=...` reaches g;
+names that Python's NFKC folding would read as another, and the laws' variables, are refused."""
 from __future__ import annotations
+
+import re
 
 import numpy as np
 import pytest
@@ -96,3 +99,24 @@ def test_a_sweep_over_g_changes_the_gravity_moment(tmp_path):
     assert np.abs(slope).max() > 0.1                                     # gravity does act
     np.testing.assert_allclose(M[50.0], M[0.0] + 50.0 * slope, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(sw.table["peak_M_bal"], [np.abs(M[g]).max() for g in gs], rtol=1e-12)
+
+
+# ============================================================================ 11. look-alike and reserved names
+
+@pytest.mark.parametrize("params, message", [
+    # FULLWIDTH l: Python folds it to l_OA in an expression, so it silently read the other parameter
+    ('"ｌ_OA" = 0.1\nl_OA = 0.2\n', "'ｌ_OA' (U+FF4C FULLWIDTH LATIN SMALL LETTER L) reads as 'l_OA'"),
+    # MICRO SIGN: could not be used, and the message showed the same-looking name
+    ('"µ" = 0.1\n', "'µ' (U+00B5 MICRO SIGN) reads as 'μ' (U+03BC GREEK SMALL LETTER MU)"),
+    # the variables of laws and characteristics shadowed the parameter silently
+    ("omega = 3.0\n", "parameters.omega: 'omega' is the variable of a law of motion"),
+    ("phi = 1.0\n", "parameters.phi: 'phi' is the variable of a law of motion"),
+])
+def test_look_alike_and_reserved_parameter_names_are_refused(params, message, tmp_path, cli):
+    text = FOUR_BAR.replace("[drive]", "[parameters]\n" + params + "[drive]")
+    with pytest.raises(ModelError, match=re.escape(message)):
+        kinetostat.loads(text)
+    model = tmp_path / "m.toml"
+    model.write_text(text, encoding="utf-8")
+    p = cli("analyze", model, "--steps", "4")
+    assert p.returncode == 2 and message in p.stderr and p.stderr.count("\n") == 1, p.stderr
