@@ -842,9 +842,9 @@ def _scale_item(text: str) -> tuple[str, float]:
         x = float(value)
     except ValueError:
         x = math.nan
-    if not (math.isfinite(x) and x > 0):
+    if not (math.isfinite(x) and x >= sys.float_info.min):      # a subnormal scale divides to inf
         raise argparse.ArgumentTypeError(f"invalid --scale {text!r}: {key} must be a positive number "
-                                         f"in {SCALE_UNITS[key]}")
+                                         f"in {SCALE_UNITS[key]} (at least {sys.float_info.min:.3g})")
     return key, x
 
 
@@ -873,6 +873,10 @@ def cmd_plans(args) -> int:
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
+    huge = [r for r in plans.rows() if not all(map(math.isfinite, (r["x0_mm"], r["y0_mm"], r["x1_mm"], r["y1_mm"])))]
+    if huge:                              # a scale so small that a segment's end is beyond any float
+        raise CLIError(f"--scale: the {huge[0]['plan']} plan's segment {huge[0]['segment']} would end beyond "
+                       f"1e308 mm at {huge[0]['scale']}; use a larger scale")
     try:
         with unit(out) as tmp:                # swapped in as a set: never new sheets beside an old worksheet
             written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])

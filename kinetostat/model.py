@@ -636,6 +636,10 @@ MIN_GEAR = 1e-6
 #: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,
 #: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
 LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
+#: Warned: a link whose radius of gyration exceeds this many times its span (I_S in g mm^2?), and a
+#: force diagram whose largest force is below this fraction of the mechanism's weights and
+#: inertia forces (a pressure in MPa times an area in m^2?).
+GYRATION_SPANS, FORCE_SCALE = 10.0, 1e-4
 
 _TOP_KEYS = {"mechanism", "parameters", "drive", "frame", "link", "pair", "group", "load", "spring", "friction",
              "published", "study"}
@@ -930,6 +934,22 @@ class _Reader:
         if mech.g and not 1.0 <= mech.g <= 100.0:
             yield "mechanism.g", (f"{mech.g:g} m/s^2 is far from the 9.81 of the texts (warned outside 1..100): "
                                   f"is it in m/s^2? (0 switches gravity off)")
+        for link in mech.links[1:]:
+            span = _span(link.points.values())
+            if link.mass > 0 and span > 0 and math.sqrt(link.I_S / link.mass) > GYRATION_SPANS * span:
+                yield f"link[id={link.id}].I_S", (
+                    f"{link.I_S:.4g} kg m^2 gives a radius of gyration of {math.sqrt(link.I_S / link.mass):.4g} m, "
+                    f"more than {GYRATION_SPANS:g} times the link's span {span:.4g} m: is it in kg m^2? "
+                    f"(g mm^2 is 1e-9 kg m^2, kg mm^2 1e-6)")
+        scale = FORCE_SCALE * max([mech.g * link.mass for link in mech.links]
+                                  + [link.mass * _span(link.points.values()) * mech.drive.omega**2 for link in mech.links])
+        for n, ld in enumerate(mech.loads):
+            if ld.kind == "force" and ld.table is not None and 0 < max(map(abs, ld.table.value)) * abs(ld.table.scale) < scale:
+                peak = max(map(abs, ld.table.value)) * abs(ld.table.scale)
+                yield f"load[{n}].table.scale", (
+                    f"the diagram's largest force is {peak:.4g} N, below {FORCE_SCALE:g} of the mechanism's weights "
+                    f"and inertia forces ({scale / FORCE_SCALE:.4g} N): is a pressure in MPa multiplied by an area "
+                    f"in m^2? (scale in N per table unit: 1 MPa = 1e6 Pa)")
         for g in mech.structure.groups:
             n, listed = self.group_tables.get(frozenset(g.links), (None, ()))
             if g.kind == "RRR" and n is not None and listed[0] > listed[1]:

@@ -152,3 +152,34 @@ def test_the_periodic_spline_of_a_large_table_takes_linear_memory():
     w, dw = _spline_at(xs, ys, m, phi)
     np.testing.assert_allclose(w, 2.0 + np.sin(phi), atol=1e-12)
     np.testing.assert_allclose(dw, np.cos(phi), atol=1e-9)
+
+
+# ============================================================================ 12. plausibility and scales
+
+def test_an_inertia_in_g_mm2_is_warned():
+    """The coupler's I_S written in g mm^2 (0.016 kg m^2 = 1.6e7 g mm^2): its radius of gyration
+    would be 3.3 m on a 0.35 m link."""
+    with pytest.warns(kinetostat.ModelWarning, match=r"link\[id=2\]\.I_S: 1\.6e\+07 kg m\^2 gives a radius of "
+                                                     r"gyration of 3266 m.*g mm\^2 is 1e-9 kg m\^2"):
+        kinetostat.loads(FOUR_BAR.replace("I_S = 0.016", "I_S = 1.6e7"))
+
+
+def test_a_pressure_in_mpa_is_warned():
+    """The ICE's indicator diagram with p_max in MPa (2.4 instead of 2.4e6 Pa): its largest force
+    0.0121 N instead of 12063.7 N (pi/4 0.08^2 2.4e6)."""
+    text = (ROOT / "models" / "ice_crank_slider.toml").read_text(encoding="utf-8")
+    assert "p_max = 2.4e6" in text
+    with pytest.warns(kinetostat.ModelWarning, match=r"table\.scale: the diagram's largest force is 0\.01206 N.*MPa"):
+        kinetostat.loads(text.replace("p_max = 2.4e6", "p_max = 2.4"))
+
+
+@pytest.mark.parametrize("scale, message", [
+    ("mu_F=5e-324", "mu_F must be a positive number in N/mm (at least 2.23e-308)"),
+    ("mu_F=1e-307", "segment R12t would end beyond 1e308 mm at mu_F = 1e-307 N/mm"),
+])
+def test_a_scale_that_draws_inf_is_refused(scale, message, tmp_path, cli):
+    out = tmp_path / "plans"
+    p = cli("plans", ROOT / "models" / "ice_crank_slider.toml", "--scale", scale, "--out", out)
+    _one_line_exit_2(p)
+    assert message in p.stderr
+    assert not out.exists() or not list(out.iterdir())
