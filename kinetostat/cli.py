@@ -860,6 +860,8 @@ def _plan_names(text: str) -> list[str]:
 
 
 def cmd_plans(args) -> int:
+    import numpy as np
+    from .errors import SingularPositionWarning
     from .plans import build
     from .plans.worksheet import worksheet
     path = Path(args.model)
@@ -867,8 +869,8 @@ def cmd_plans(args) -> int:
     out = _writable_dir(args.out, "--out")
     only = [n for group in (args.only or []) for n in group] or None
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings(record=True) as caught:     # the accuracy at this angle: said below
+            warnings.simplefilter("always")
             plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ValueError as exc:
@@ -883,6 +885,10 @@ def cmd_plans(args) -> int:
     except (OSError, ValueError) as exc:
         raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
     scales = ", ".join(str(s) for s in plans.scales.values())
+    at_plan = [w for w in caught if issubclass(w.category, SingularPositionWarning)
+               and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
+    for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
+        _warn(f"{path.name}: {text}")
     _Out.write(f"{path.name} at phi = {plans.at:g} deg ({scales}): {len(written)} files -> {out}")
     return EXIT_OK
 
@@ -1062,6 +1068,11 @@ def cmd_sweep(args) -> int:
     singular = int((sw.table["n_singular"].fillna(0) > 0).sum())
     if singular:
         lines.append(f"{singular} design(s) pass through singular positions (columns n_singular, singular_deg)")
+    warned = sw.table["worst_digits"].dropna()
+    if len(warned):
+        from .kinematics import DIGITS_WARN
+        lines.append(f"{len(warned)} design(s) keep values with fewer than {DIGITS_WARN} significant digits near a "
+                     f"singular position, down to {warned.min():.1f} (columns worst_digits, warned_deg)")
     _Out.write("\n".join(lines))
     return EXIT_OK
 

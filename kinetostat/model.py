@@ -636,10 +636,11 @@ MIN_GEAR = 1e-6
 #: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,
 #: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
 LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
-#: Warned: a link whose radius of gyration exceeds this many times its span (I_S in g mm^2?), and a
+#: Warned: a link whose radius of gyration exceeds this many times its span (I_S in g mm^2 makes it
+#: 30000 times too long; a flywheel on a crank, a few spans), and a
 #: force diagram whose largest force is below this fraction of the mechanism's weights and
 #: inertia forces (a pressure in MPa times an area in m^2?).
-GYRATION_SPANS, FORCE_SCALE = 10.0, 1e-4
+GYRATION_SPANS, FORCE_SCALE = 100.0, 1e-4
 
 _TOP_KEYS = {"mechanism", "parameters", "drive", "frame", "link", "pair", "group", "load", "spring", "friction",
              "published", "study"}

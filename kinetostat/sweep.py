@@ -13,7 +13,9 @@ Mechanism with `kinetostat.model.loads`.
 
 A design whose mechanism does not load, build or assemble keeps its row: NaN peaks and its
 reason in the `error` column (the sweep goes on). Warnings (singular positions, doubts about a
-model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular.
+model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular
+(values NaN), `warned_deg` and `worst_digits` where its values are kept with fewer than
+DIGITS_WARN digits and the fewest digits there.
 
 May use: model, analysis, errors, examples; pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
@@ -144,7 +146,8 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
                 continue
             sing = res.phi_deg[res.singular]
             rows.append({**design, **{name: _peak(column(res)) for name, column in _peak_columns(mech).items()},
-                         "n_singular": len(sing), "singular_deg": " ".join(f"{x:g}" for x in sing), "error": ""})
+                         "n_singular": len(sing), "singular_deg": " ".join(f"{x:g}" for x in sing),
+                         **_accuracy(*fast.warned_band(res)), "error": ""})
             if full:
                 frames.append(_with_design(res.to_frame(), design))
         if built:       # the peaks of every design of the chunk in one call of the compiled kernel
@@ -177,8 +180,15 @@ def _peaks_into(rows: list[dict], built: list[tuple[int, Mechanism]], phi_deg: n
         if m.drive.kind == "machine":
             peak["peak_F_bal"] = pk.F_bal[q]
         rows[n].update({k: np.nan if everything else float(v) for k, v in peak.items()},
-                       n_singular=len(sing), singular_deg=" ".join(f"{x:g}" for x in sing))
+                       n_singular=len(sing), singular_deg=" ".join(f"{x:g}" for x in sing),
+                       **_accuracy(pk.warned_deg[q], pk.worst_digits[q]))
         rows[n] = {**{k: v for k, v in rows[n].items() if k != "error"}, "error": rows[n]["error"]}
+
+
+def _accuracy(warned_deg: np.ndarray, worst: float) -> dict[str, Any]:
+    """The columns of the warned band: the angles kept with fewer than DIGITS_WARN digits, and the
+    fewest digits there (NaN where none is warned)."""
+    return {"worst_digits": round(float(worst), 1), "warned_deg": " ".join(f"{x:g}" for x in warned_deg)}
 
 
 def _peak_columns(m: Mechanism) -> dict[str, Callable[[Analysis], np.ndarray]]:
@@ -351,14 +361,17 @@ def _values(name: str, x: Any) -> list[float]:
 def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFrame:
     """The rows in the sweep's column order (NaN peaks for a failed design), with their units."""
     peaks = list(_peak_columns(base))
-    table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "error"])
+    table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "worst_digits", "warned_deg",
+                                   "error"])
+    table["worst_digits"] = table["worst_digits"].astype(float)
+    table["warned_deg"] = table["warned_deg"].fillna("").astype(str)
     table[peaks] = table[peaks].astype(float)
     table["n_singular"] = table["n_singular"].astype("Int64")
     table["singular_deg"] = table["singular_deg"].fillna("").astype(str)
     table["error"] = table["error"].fillna("").astype(str)
     table.attrs.update(mechanism=base.name, units={
         **dict.fromkeys(names, PARAMETER_UNIT), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
-        "n_singular": "1", "singular_deg": "deg", "error": "text"})
+        "n_singular": "1", "singular_deg": "deg", "worst_digits": "1", "warned_deg": "deg", "error": "text"})
     return table
 
 

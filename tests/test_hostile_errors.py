@@ -158,7 +158,7 @@ def test_the_periodic_spline_of_a_large_table_takes_linear_memory():
 
 def test_an_inertia_in_g_mm2_is_warned():
     """The coupler's I_S written in g mm^2 (0.016 kg m^2 = 1.6e7 g mm^2): its radius of gyration
-    would be 3.3 m on a 0.35 m link."""
+    would be 3266 m on a 0.35 m link (0.10 m in kg m^2)."""
     with pytest.warns(kinetostat.ModelWarning, match=r"link\[id=2\]\.I_S: 1\.6e\+07 kg m\^2 gives a radius of "
                                                      r"gyration of 3266 m.*g mm\^2 is 1e-9 kg m\^2"):
         kinetostat.loads(FOUR_BAR.replace("I_S = 0.016", "I_S = 1.6e7"))
@@ -183,3 +183,42 @@ def test_a_scale_that_draws_inf_is_refused(scale, message, tmp_path, cli):
     _one_line_exit_2(p)
     assert message in p.stderr
     assert not out.exists() or not list(out.iterdir())
+
+
+# ============================================================================ 8. accuracy near singular positions
+
+TOGGLE = ROOT / "tests" / "hostile" / "singular_toggle.toml"      # stretched at 180 deg: 8.0 digits left at 179
+
+
+@pytest.mark.parametrize("path", ["numpy", "compiled"])
+def test_the_sweep_table_gives_the_warned_band_and_its_worst_digits(path):
+    """sweep silenced the warning and had no column for the warned band (8 digits left,
+    n_singular = 0 where no angle was NaN). Both paths now give the band and the fewest digits,
+    equal to what analyze estimates at those angles."""
+    from kinetostat import fast
+    phi = np.arange(360.0)
+    with pytest.warns(kinetostat.SingularPositionWarning):
+        res = kinetostat.analyze(kinetostat.load(TOGGLE), phi_deg=phi)
+    band = ~res.singular & (res.digits < kinetostat.DIGITS_WARN)
+    assert list(res.phi_deg[band]) == [176, 177, 178, 179, 181, 182, 183, 184]
+    if path == "numpy":
+        sw = kinetostat.sweep(TOGGLE, {"g": [9.81]}, phi_deg=phi)
+        assert sw.table["warned_deg"][0] == "176 177 178 179 181 182 183 184"
+        assert sw.table["worst_digits"][0] == round(float(res.digits[band].min()), 1) and sw.table["n_singular"][0] == 1
+    else:
+        with pytest.warns(kinetostat.SingularPositionWarning):
+            pk = fast.peaks([kinetostat.load(TOGGLE)], phi)
+        assert list(pk.warned_deg[0]) == list(res.phi_deg[band])
+        assert pk.worst_digits[0] == pytest.approx(res.digits[band].min(), abs=1e-9)
+
+
+def test_plans_and_worksheet_at_a_warned_angle_state_the_accuracy(tmp_path, cli):
+    out = tmp_path / "plans"
+    p = cli("plans", TOGGLE, "--at", "179", "--out", out)
+    assert p.returncode == 0, p.stderr
+    assert "kinetostat: warning:" in p.stderr and "phi = [179] deg" in p.stderr and "8.0 to 8.0" in p.stderr
+    assert "about 8.0 significant digits left at this angle" in (out / "worksheet.md").read_text(encoding="utf-8")
+    assert '"digits": 8.0' in (out / "worksheet.json").read_text(encoding="utf-8")
+    calm = tmp_path / "calm"
+    assert cli("plans", TOGGLE, "--at", "90", "--out", calm).returncode == 0
+    assert "Accuracy" not in (calm / "worksheet.md").read_text(encoding="utf-8")

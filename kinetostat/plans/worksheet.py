@@ -21,6 +21,7 @@ import numpy as np
 
 from ..analysis import Analysis, analyze
 from ..applied import load_magnitude
+from ..kinematics import DIGITS_WARN
 from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
@@ -36,6 +37,8 @@ _WORDS = {
            "reactions": "Reactions", "crank": "The initial link and Zhukovsky's lever",
            "cw": "clockwise", "ccw": "counter-clockwise", "angle": "at {:.2f} deg to x",
            "title": "Worksheet: {name}, phi = {phi:g} deg", "scale": "scale mu_l = {:g} m/mm",
+           "accuracy": "**Accuracy:** near a singular position: about {:.1f} significant digits left at this angle "
+                       "(fewer than {}); the last digits of the values below are not reliable",
            "head": ("Symbol", "Value", "Unit", "Sense / direction", "How obtained"),
            "group": "group {}"},
     "uk": {"kinematics": "Кінематика: швидкості", "accelerations": "Кінематика: прискорення",
@@ -44,6 +47,8 @@ _WORDS = {
            "cw": "за годинниковою стрілкою", "ccw": "проти годинникової стрілки",
            "angle": "під кутом {:.2f} град до осі x",
            "title": "Розрахунковий лист: {name}, φ = {phi:g} град", "scale": "масштаб μ_l = {:g} м/мм",
+           "accuracy": "**Точність:** поблизу особливого положення: лишилося близько {:.1f} значущих цифр "
+                       "(менше ніж {}); останні цифри значень нижче ненадійні",
            "head": ("Позначення", "Значення", "Одиниця", "Напрямок", "Як отримано"),
            "group": "група {}"},
 }
@@ -72,6 +77,7 @@ class Worksheet:
     mu_l: float
     rows: tuple[Row, ...]
     lang: str = "en"
+    digits: float = 16.0    # estimated significant digits left at this angle (fewer than DIGITS_WARN: stated)
 
     def __repr__(self) -> str:
         return f"Worksheet({self.mechanism!r}, phi_deg={self.phi_deg:g}, mu_l={self.mu_l:g}, rows={len(self.rows)})"
@@ -107,6 +113,8 @@ class Worksheet:
         w = _WORDS[self.lang]
         out = [f"# {w['title'].format(name=markdown_text(self.mechanism), phi=self.phi_deg)}", "",
                w["scale"].format(self.mu_l)]
+        if self.digits < DIGITS_WARN:
+            out += ["", w["accuracy"].format(self.digits, DIGITS_WARN)]
         section = None
         for rec in self.records():
             if rec["section"] != section:
@@ -129,7 +137,8 @@ class Worksheet:
         """Write the rows as a JSON list of objects, NaN as null (atomic)."""
         recs = [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()}
                 for r in self.records()]
-        doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l, "rows": recs}
+        doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l,
+               "digits": round(self.digits, 1), "rows": recs}
         write_text(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")
 
     def write(self, out_dir: str | Path) -> list[Path]:
@@ -383,4 +392,4 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
     sheet.loads()
     sheet.reactions()
     sheet.crank()
-    return Worksheet(mech.name, float(at), float(mu_l), tuple(sheet.rows), lang)
+    return Worksheet(mech.name, float(at), float(mu_l), tuple(sheet.rows), lang, float(res.digits[0]))
