@@ -18,6 +18,8 @@ import math
 import operator
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any, Iterator
 
 import numpy as np
@@ -269,15 +271,29 @@ def _arith_message(exc: Exception) -> str:
 
 #: "Did you mean": names longer than this are not compared, nor candidates of a length more than
 #: 3 apart, and at most SUGGEST_CANDIDATES candidates: a suggestion costs at most about
-#: SUGGEST_CANDIDATES x SUGGEST_LENGTH^2 steps, whatever the file holds.
-SUGGEST_LENGTH = 64
-SUGGEST_CANDIDATES = 100
+#: SUGGEST_CANDIDATES x SUGGEST_LENGTH^2 steps; and at most SUGGESTIONS are made while one model
+#: is read (`suggestion_budget`), whatever the file holds.
+SUGGEST_LENGTH, SUGGEST_CANDIDATES, SUGGESTIONS = 64, 50, 50
+_SUGGESTIONS_LEFT: ContextVar[list[int] | None] = ContextVar("suggestions_left", default=None)
+
+
+@contextmanager
+def suggestion_budget(n: int = SUGGESTIONS) -> Iterator[None]:
+    """At most `n` suggestions (`suggest`) in the block; after them, none."""
+    token = _SUGGESTIONS_LEFT.set([n])
+    try:
+        yield
+    finally:
+        _SUGGESTIONS_LEFT.reset(token)
 
 
 def suggest(name: str, valid) -> str:
     """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else ""."""
-    if len(name) > SUGGEST_LENGTH:
+    left = _SUGGESTIONS_LEFT.get()
+    if len(name) > SUGGEST_LENGTH or (left is not None and left[0] <= 0):
         return ""
+    if left is not None:
+        left[0] -= 1
     near = [v for v in map(str, valid) if abs(len(v) - len(name)) <= 3][:SUGGEST_CANDIDATES]
     close = difflib.get_close_matches(name, near, n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""

@@ -24,7 +24,7 @@ import numpy as np
 
 from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
 from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression, shown_number
-from .expressions import _finite_number, suggest
+from .expressions import _finite_number, suggest, suggestion_budget
 from .expressions import resolve as resolve_parameters
 from .structure import Structure, analyse_structure
 
@@ -511,7 +511,8 @@ def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | N
         raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
     except RecursionError:
         raise ModelError(["TOML nested too deeply (arrays or tables within each other)"], source=source) from None
-    return _Reader(data, source, text, parameters).mechanism()
+    with suggestion_budget():       # "did you mean" work bounded per model
+        return _Reader(data, source, text, parameters).mechanism()
 
 
 def _check_key_cost(text: str, source: str) -> None:
@@ -536,7 +537,8 @@ def _check_key_cost(text: str, source: str) -> None:
 def from_dict(data: Mapping[str, Any], source: str = "<dict>",
               parameters: Mapping[str, Any] | None = None) -> Mechanism:
     """Build a Mechanism from the parsed structure of a model file; `parameters` as for `load`."""
-    return _Reader(data, source, overrides=parameters).mechanism()
+    with suggestion_budget():       # "did you mean" work bounded per model
+        return _Reader(data, source, overrides=parameters).mechanism()
 
 
 #: The variables of laws of motion (phi, rad) and of motor characteristics (omega, rad/s): no parameter's name.

@@ -222,3 +222,24 @@ def test_plans_and_worksheet_at_a_warned_angle_state_the_accuracy(tmp_path, cli)
     calm = tmp_path / "calm"
     assert cli("plans", TOGGLE, "--at", "90", "--out", calm).returncode == 0
     assert "Accuracy" not in (calm / "worksheet.md").read_text(encoding="utf-8")
+
+
+def test_did_you_mean_work_is_bounded(monkeypatch):
+    """480 parameters of 20 characters and 500 expressions each reading an unknown look-alike:
+    each unknown was compared with every parameter (240,000 difflib ratios; the audit's 15
+    minutes with longer names). Now at most SUGGESTIONS suggestions of SUGGEST_CANDIDATES
+    candidates each are made per model, and at most MAX_PROBLEMS problems are listed."""
+    import difflib
+    from kinetostat.expressions import SUGGEST_CANDIDATES, SUGGESTIONS
+    from kinetostat.model import MAX_PROBLEMS
+    calls = []
+    real = difflib.SequenceMatcher.ratio
+    monkeypatch.setattr(difflib.SequenceMatcher, "ratio", lambda self: calls.append(1) or real(self))
+    params = "".join(f"{'p' * 17}{i:03d} = 1.0\n" for i in range(480))
+    reads = "".join(f'u{i} = "{"p" * 16}x{i:03d}"\n' for i in range(500))
+    with pytest.raises(ModelError) as exc:
+        kinetostat.loads(FOUR_BAR.replace("[drive]", "[parameters]\n" + params + reads + "[drive]"))
+    assert 0 < len(calls) <= 2 * SUGGESTIONS * SUGGEST_CANDIDATES            # get_close_matches: 2 per match
+    problems = exc.value.problems
+    assert len(problems) == MAX_PROBLEMS + 1 and problems[-1] == "... and 400 more problems (the first 100 are shown)"
+    assert "(did you mean 'p" in problems[0]                                   # the first ones still suggest
