@@ -654,6 +654,9 @@ MAX_PUBLISHED_ANGLES = 3600
 
 #: Characters of an expression quoted in a message.
 MAX_SHOWN = 120
+#: Longest name of a point, link, body, load or spring (each labels plots and plans: 10,000
+#: characters took a report two minutes); the mechanism's own name is not limited.
+MAX_NAME = 200
 #: Most problems listed for one file (the rest are counted): 300,000 unknown keys stay one short list.
 MAX_PROBLEMS = 100
 
@@ -844,6 +847,9 @@ class _Reader:
         if choices and x not in choices:
             self.err(f"{where}.{key}: invalid value {x!r}{_suggest(x, choices)}. Valid values: {list(choices)}")
             return None
+        if key == "name" and where != "mechanism" and len(x) > MAX_NAME:
+            self.err(f"{where}.name: {len(x)} characters, at most {MAX_NAME} (it labels plots and plans)")
+            return None
         return x
 
     def integer(self, tab: Mapping, key: str, where: str) -> int | None:
@@ -983,6 +989,11 @@ class _Reader:
             return {}
         out = {}
         for name, xy in raw.items():
+            if len(name) > MAX_NAME:
+                self.err(f"{where}: a point name of {len(name)} characters ({name[:20]!r}...), at most {MAX_NAME} "
+                         f"(it labels plots and plans)")
+                self.points_unread.add((lid, name))
+                continue
             v = self.vec(xy, f"{where}.{name}")
             if v is not None:
                 out[name] = v

@@ -243,3 +243,20 @@ def test_did_you_mean_work_is_bounded(monkeypatch):
     problems = exc.value.problems
     assert len(problems) == MAX_PROBLEMS + 1 and problems[-1] == "... and 400 more problems (the first 100 are shown)"
     assert "(did you mean 'p" in problems[0]                                   # the first ones still suggest
+
+
+@pytest.mark.parametrize("edit, message", [
+    (("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01], " + "N" * 10_000 + " = [0.2, 0.0] }"),
+     "link[id=3].points: a point name of 10000 characters ('NNNNNNNNNNNNNNNNNNNN'...), at most 200"),
+    (('name = "resisting moment"', 'name = "' + "N" * 10_000 + '"'), "load[0].name: 10000 characters, at most 200"),
+])
+def test_a_name_of_10000_characters_is_refused_before_any_plot(edit, message, tmp_path, cli):
+    """A point named with 10,000 characters made a report take two minutes (its labels); names
+    that label plots and plans are refused at load beyond MAX_NAME characters."""
+    from kinetostat.model import MAX_NAME
+    assert MAX_NAME == 200
+    model = tmp_path / "m.toml"
+    model.write_text(FOUR_BAR.replace(*edit), encoding="utf-8")
+    p = cli("plans", model, "--out", tmp_path / "plans")
+    _one_line_exit_2(p)
+    assert message in p.stderr and not (tmp_path / "plans").exists()
