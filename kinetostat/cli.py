@@ -7,7 +7,10 @@ file, structure, assembly, angles, engine names, output path, stdout that cannot
 130 interrupted (Ctrl-C). Expected problems print one `kinetostat: error: ...` line (a model
 file's problem list prints one line per problem) and never a traceback; warnings print one line
 each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
-disk leaves the previous file as it was.
+disk leaves the previous file as it was; a device, FIFO or stdout named as an output is written
+as a stream, never replaced; the files of `plans`, `variant` and each model's `report` are
+swapped in as a set (`kinetostat._io.unit`). Text from a model is printed with its control
+characters visible.
 
 May use: every room of the package, and the harness inside the commands that need it
 (imported there, so that `import kinetostat.cli` loads no engine).
