@@ -13,7 +13,21 @@ The plans of the graphical method: `kinetostat.plans.build(mech, at=30)`.
 The solver's public names. May use: the solver modules only (never the harness
 `kinetostat_validation`, the engines, matplotlib or `kinetostat.report`).
 """
-from . import examples, plans, variants
+import os as _os
+import sys as _sys
+
+
+def _interrupted_while_starting(signum, frame) -> None:
+    """Ctrl-C while the command line imports the package: one line and exit 130, no traceback."""
+    _os.write(2, b"kinetostat: error: interrupted\n")
+    _os._exit(130)
+
+
+if _sys.argv[:1] == ["-m"] or _os.path.basename(_sys.argv[0] if _sys.argv else "") in ("kinetostat", "kinetostat.exe"):
+    import signal as _signal      # the command line starts (`python -m kinetostat`, or its script): cli.main takes over
+    _signal.signal(_signal.SIGINT, _interrupted_while_starting)
+
+from . import examples, plans, variants   # after the handler: these imports take most of the start
 from .analysis import Analysis, InertiaLoad, analyze
 from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning, SingularPositionWarning,
                      StructureError)

@@ -1,5 +1,6 @@
-"""Output files: atomic writes (a temporary file in the same folder, renamed into place), folder
-names made from model file names, and the check that a written path stays inside its folder.
+"""Output files: atomic writes (a temporary file in the same folder, renamed into place; a device
+or FIFO named by the user written as a stream), sets of files swapped in as a unit, folder names
+made from model file names, and the check that a written path stays inside its folder.
 
 May use: the standard library only.
 """
@@ -7,12 +8,17 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
+import secrets
+import shutil
+import signal
+import stat
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Iterator
 
-__all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside"]
+__all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside",
+           "is_stream", "unit"]
 
 #: The temporary files of the writes in progress in this process (`remove_temporary`).
 _PENDING: set[str] = set()
@@ -29,8 +35,21 @@ def _file_mode(path: Path) -> int:
         return 0o666 & ~umask
 
 
+def is_stream(path: str | Path) -> bool:
+    """True where `path` (links followed) exists and is not a regular file or folder: a device
+    (/dev/null, /dev/stdout on a terminal or a pipe), a FIFO or a socket."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return False
+    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+
+
+_TEMPORARY_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
+
+
 @contextmanager
-def atomic(path: str | Path, binary: bool = False) -> Iterator[IO]:
+def atomic(path: str | Path, binary: bool = False, stream: bool = False) -> Iterator[IO]:
     """A file opened for writing that becomes `path` only when the block ends normally.
 
     The data go to a temporary file in `path`'s folder (a short name of its own, so that a
@@ -38,24 +57,122 @@ def atomic(path: str | Path, binary: bool = False) -> Iterator[IO]:
     and `os.replace`d onto `path`: a reader never sees half a file. An exception in the block,
     a full disk or an interrupt (KeyboardInterrupt) removes the temporary file and leaves the
     old `path` as it was. Text is UTF-8; a name the file system cannot hold raises OSError.
+
+    Only a regular file (or a link, which is replaced, never followed) is replaced. A device,
+    FIFO or socket at `path` (links followed) is written as a stream where `stream` (a path the
+    user named, e.g. `-o /dev/null`), else refused (OSError) and left as it was.
     """
     path = Path(path)
     if path.is_dir():
         raise IsADirectoryError(21, "it is a directory", str(path))
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".kinetostat-", suffix=".tmp")
-    _PENDING.add(tmp)
+    if is_stream(path):
+        if not stream:
+            raise OSError(22, "not a regular file (a device, FIFO or socket); left as it is", str(path))
+        with open(path, "ab" if binary else "a", **({} if binary else {"encoding": "utf-8", "newline": ""})) as f:
+            yield f
+        return
+    tmp = None
     try:
+        for _ in range(100):     # named before it exists: an interrupt at any moment leaves no file behind
+            tmp = str(path.parent / f".kinetostat-{secrets.token_hex(6)}.tmp")
+            _PENDING.add(tmp)
+            try:
+                fd = os.open(tmp, _TEMPORARY_FLAGS, 0o600)
+                break
+            except FileExistsError:          # another file's name: not ours to remove
+                _PENDING.discard(tmp)
+                tmp = None
+        else:
+            raise FileExistsError(17, "no free temporary name", str(path.parent))
         with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8", newline="")) as f:
             yield f
         os.chmod(tmp, _file_mode(path))
         os.replace(tmp, path)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        _remove(tmp)
         raise
     finally:
+        _PENDING.discard(tmp)
+
+
+def _remove(tmp: str | None) -> None:
+    try:
+        if tmp is not None and os.path.isdir(tmp) and not os.path.islink(tmp):
+            shutil.rmtree(tmp)
+        elif tmp is not None:
+            os.unlink(tmp)
+    except OSError:
+        pass
+
+
+@contextmanager
+def _sigint_deferred() -> Iterator[None]:
+    """Ctrl-C held back while the block runs (in the main thread; elsewhere nothing changes),
+    then delivered to the handler that was in place."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    seen: list[int] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+        if seen:
+            os.kill(os.getpid(), signal.SIGINT)
+
+
+def _moves(tmp: Path, folder: Path, root: Path) -> list[tuple[Path, Path]]:
+    """(file in `tmp`, its place in `folder`) for every file written into `tmp`; ValueError where
+    a place would lie outside `folder` (a planted link to a folder elsewhere), OSError where it
+    is neither a regular file nor a link (a device, a FIFO: never replaced). Places must resolve
+    inside `root`."""
+    moves = []
+    for src in sorted(p for p in tmp.rglob("*") if not p.is_dir()):
+        dst = folder / src.relative_to(tmp)
+        inside(root, dst.parent)
+        try:
+            mode = os.lstat(dst).st_mode
+        except FileNotFoundError:
+            mode = None
+        if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISLNK(mode)):
+            raise OSError(22, "not a regular file (a device, FIFO, socket or folder); left as it is", str(dst))
+        if mode is not None and stat.S_ISREG(mode):
+            os.chmod(src, mode & 0o7777)        # the mode of the file it replaces
+        moves.append((src, dst))
+    return moves
+
+
+@contextmanager
+def unit(folder: str | Path, root: str | Path | None = None) -> Iterator[Path]:
+    """A set of files written as a unit into `folder` (created). The block writes them into a new
+    hidden folder inside `folder` (the path yielded, same layout); when the block ends normally
+    each file is renamed onto its place in `folder` (links in their way replaced, never
+    followed; a place outside `folder` through a linked subfolder is ValueError, nothing moved),
+    with Ctrl-C held back until the last rename: a reader sees the old set or the new one, never
+    a mix. An exception, a full disk or an interrupt in the block leaves `folder` as it was; the
+    hidden folder is always removed. Files of `folder` the block did not write stay as they are.
+    `root` (default `folder`): `folder` and every place written must resolve inside it (a
+    `folder` that is a planted link to elsewhere: ValueError before anything is written)."""
+    folder = Path(folder)
+    root = folder if root is None else Path(root)
+    if os.path.lexists(folder):
+        inside(root, folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    inside(root, folder)
+    tmp = None
+    try:
+        tmp = str(folder / f".kinetostat-{secrets.token_hex(6)}.tmp")
+        _PENDING.add(tmp)
+        os.mkdir(tmp, 0o700)
+        yield Path(tmp)
+        moves = _moves(Path(tmp), folder, root)
+        with _sigint_deferred():
+            for src, dst in moves:
+                dst.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(src, dst)
+    finally:
+        _remove(tmp)
         _PENDING.discard(tmp)
 
 
@@ -63,10 +180,7 @@ def remove_temporary() -> None:
     """Remove the temporary files of the writes in progress: for a process about to end at once
     (`os._exit` in a signal handler), which leaves no `atomic` block to clean up after itself."""
     for tmp in list(_PENDING):
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        _remove(tmp)
 
 
 def write_text(path: str | Path, text: str) -> Path:

@@ -147,7 +147,16 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
         return -ld.value * (kin.omega[:, j] - kin.omega[:, i] if p.kind == "R" else kin.v_slide[:, p.index])
     if ld.characteristic is not None:   # M(omega), both in the drive's sense
         s = mech.drive.sense
-        return s * ld.characteristic(s * kin.omega[:, ld.link])
+        w = s * kin.omega[:, ld.link]
+        with np.errstate(all="ignore"):
+            M = ld.characteristic(w)
+        bad = ~np.isfinite(M) & np.isfinite(w)
+        if bad.any():                    # never a silent NaN in M_bal: the speed and angle are named
+            raise ModelError([f"load {ld.name!r}: its characteristic M(omega) is not finite at omega = "
+                              f"{w[bad][0]:.6g} rad/s (phi = {np.degrees(kin.phi[bad][0]):.6g} deg"
+                              + (f" and {int(bad.sum()) - 1} more angles)" if bad.sum() > 1 else ")")],
+                             source=mech.path or mech.name)
+        return s * M
     if ld.table is None:
         return np.full(N, ld.value)
     t = ld.table

@@ -9,7 +9,10 @@ route named with --engines whose engine is not installed; 130 interrupted (Ctrl-
 exits 0 once its table is written, also where designs failed (each keeps its row with the
 reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model file's
 problem list prints one line per problem) and never a traceback; warnings print one line each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
-disk leaves the previous file as it was.
+disk leaves the previous file as it was; a device, FIFO or stdout named as an output is written
+as a stream, never replaced; the files of `plans`, `variant` and each model's `report` are
+swapped in as a set (`kinetostat._io.unit`). Text from a model is printed with its control
+characters visible.
 
 May use: every room of the package, and the harness inside the commands that need it
 (imported there, so that `import kinetostat.cli` loads no engine).
@@ -29,7 +32,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Callable, Iterator, Sequence
 
-from ._io import atomic, unique_names
+from ._io import atomic, is_stream, unique_names, unit
+from ._text import visible
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -54,6 +58,7 @@ class _Out:
     @classmethod
     def write(cls, text: str, err: bool = False) -> None:
         stream = sys.stderr if err else sys.stdout
+        text = visible(text)             # a name's ESC [2J or OSC 52 printed as text, never acted on
         try:
             if cls.bar is not None:
                 from tqdm import tqdm
@@ -127,11 +132,30 @@ def _interrupts() -> Iterator[None]:
         signal.signal(signal.SIGINT, old)
 
 
-def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bool = False) -> None:
-    """`write(file)` into `path` atomically (`kinetostat._io.atomic`); a failure is a CLIError
-    naming `option`, and the old file stays as it was."""
+def _is_stdout(path: str | Path) -> bool:
+    """`path` is '-' or names this process's stdout (/dev/stdout, /proc/self/fd/1, the file it goes to)."""
+    if str(path) == "-":
+        return True
     try:
-        with atomic(path, binary=binary) as f:
+        return os.path.samestat(os.stat(path), os.fstat(sys.stdout.fileno()))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bool = False) -> None:
+    """`write(file)` into `path` atomically (`kinetostat._io.atomic`); '-' or stdout itself gets the
+    data through sys.stdout, a device or FIFO as a stream (never replaced by a file). A failure is
+    a CLIError naming `option`, and the old file stays as it was."""
+    if _is_stdout(path):
+        import io
+        buf = io.BytesIO() if binary else io.StringIO()
+        write(buf)
+        sys.stdout.flush()
+        (sys.stdout.buffer if binary else sys.stdout).write(buf.getvalue())
+        sys.stdout.flush()
+        return
+    try:
+        with atomic(path, binary=binary, stream=True) as f:
             write(f)
     except OSError as exc:
         raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
@@ -356,6 +380,10 @@ def _writable_file(path: str, option: str) -> Path:
     """Check that `path` can be written now (so that a long run does not fail at its end): its
     folder takes a temporary file, and the name itself is one the file system can hold."""
     p = Path(path)
+    if _is_stdout(p) or is_stream(p):    # written as a stream (`_save`)
+        if str(p) != "-" and not os.access(p, os.W_OK):
+            raise CLIError(f"cannot write {option} {p}: permission denied")
+        return p
     try:
         if p.is_dir():
             raise CLIError(f"cannot write {option} {p}: it is a directory")
@@ -623,7 +651,8 @@ def cmd_validate(args) -> int:
     from .report import run_validation
     engines = _engines(args.engines)
     junit = _writable_file(args.junit, "--junit") if args.junit else None
-    to_json = None if args.json is None else args.json if args.json == "-" else _writable_file(args.json, "--json")
+    to_json = (None if args.json is None else "-" if _is_stdout(args.json)
+               else _writable_file(args.json, "--json"))
     err = to_json == "-"                 # the JSON on stdout: the people's lines go to stderr
     paths = args.models or bundled_models()
     jobs = _prepare(paths, args.steps)
@@ -719,7 +748,8 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
             secs = time.perf_counter() - t1
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
-        summary = write_report(run, Path(out), folder)
+        with unit(out) as tmp:                # the model's files swapped in as a set at the end
+            summary = write_report(run, tmp, folder)
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
@@ -852,9 +882,9 @@ def _scale_item(text: str) -> tuple[str, float]:
         x = float(value)
     except ValueError:
         x = math.nan
-    if not (math.isfinite(x) and x > 0):
+    if not (math.isfinite(x) and x >= sys.float_info.min):      # a subnormal scale divides to inf
         raise argparse.ArgumentTypeError(f"invalid --scale {text!r}: {key} must be a positive number "
-                                         f"in {SCALE_UNITS[key]}")
+                                         f"in {SCALE_UNITS[key]} (at least {sys.float_info.min:.3g})")
     return key, x
 
 
@@ -870,6 +900,8 @@ def _plan_names(text: str) -> list[str]:
 
 
 def cmd_plans(args) -> int:
+    import numpy as np
+    from .errors import SingularPositionWarning
     from .plans import build
     from .plans.worksheet import worksheet
     path = Path(args.model)
@@ -878,19 +910,26 @@ def cmd_plans(args) -> int:
     only = [n for group in (args.only or []) for n in group] or None
     args.at, args.starting = _turn(args.at, "--at"), _turn(args.starting, "--starting")
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings(record=True) as caught:     # the accuracy at this angle: said below
+            warnings.simplefilter("always")
             plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
+    huge = [r for r in plans.rows() if not all(map(math.isfinite, (r["x0_mm"], r["y0_mm"], r["x1_mm"], r["y1_mm"])))]
+    if huge:                              # a scale so small that a segment's end is beyond any float
+        raise CLIError(f"--scale: the {huge[0]['plan']} plan's segment {huge[0]['segment']} would end beyond "
+                       f"1e308 mm at {huge[0]['scale']}; use a larger scale")
     try:
-        written = plans.write(out, lang=args.lang)
-        if sheet is not None:
-            written += sheet.write(out)
-    except OSError as exc:
-        raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
+        with unit(out) as tmp:                # swapped in as a set: never new sheets beside an old worksheet
+            written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])
+    except (OSError, ValueError) as exc:
+        raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
     scales = ", ".join(str(s) for s in plans.scales.values())
+    at_plan = [w for w in caught if issubclass(w.category, SingularPositionWarning)
+               and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
+    for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
+        _warn(f"{path.name}: {text}")
     _Out.write(f"{path.name} at phi = {plans.at:g} deg ({scales}): {len(written)} files -> {out}")
     return EXIT_OK
 
@@ -950,8 +989,8 @@ def cmd_variant(args) -> int:
                 warnings.simplefilter("ignore")
                 try:
                     keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
-                                                   cycle_csv=not args.all))
-                except (AssemblyError, ModelError, ValueError) as exc:
+                                                   cycle_csv=not args.all, root=out))
+                except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:
                     raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
@@ -1088,6 +1127,11 @@ def cmd_sweep(args) -> int:
     singular = int((sw.table["n_singular"].fillna(0) > 0).sum())
     if singular:
         lines.append(f"{singular} design(s) pass through singular positions (columns n_singular, singular_deg)")
+    warned = sw.table["worst_digits"].dropna()
+    if len(warned):
+        from .kinematics import DIGITS_WARN
+        lines.append(f"{len(warned)} design(s) keep values with fewer than {DIGITS_WARN} significant digits near a "
+                     f"singular position, down to {warned.min():.1f} (columns worst_digits, warned_deg)")
     _Out.write("\n".join(lines))
     return EXIT_OK
 

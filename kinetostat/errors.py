@@ -1,6 +1,6 @@
 """Errors and warnings of kinetostat: every message names the field path or the crank angles.
 
-May use: the standard library only.
+May use: the standard library, numpy and `_text` (one-line problems).
 """
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ import errno
 from collections.abc import Sequence
 
 import numpy as np
+
+from ._text import one_line
 
 __all__ = ["ModelError", "ModelFileNotFound", "ModelWarning", "AssemblyError", "StructureError",
            "SingularPositionWarning"]
@@ -19,7 +21,7 @@ class ModelError(ValueError):
 
     def __init__(self, problems: Sequence[str], source: str = "model",
                  lines: Sequence[int | None] | None = None):
-        self.problems = list(problems)
+        self.problems = [one_line(p) for p in problems]    # a newline in a name cannot forge a line
         self.source = source
         self.lines = list(lines) if lines is not None else [None] * len(self.problems)
         text = "\n".join(f"  - {p}" for p in self.located)

@@ -8,7 +8,7 @@
 
 The wheel carries the repository's `models/` folder as the package data `kinetostat/models/`; a
 checkout (editable install) reads `models/` beside the package. `$KINETOSTAT_MODELS` overrides both.
-May use: the standard library only (the model reader calls it to resolve a bare name).
+May use: the standard library and `_io` (the model reader calls it to resolve a bare name).
 """
 from __future__ import annotations
 
@@ -58,15 +58,20 @@ def resolve(model: str | Path) -> Path:
 def copy(dest: str | Path, overwrite: bool = False) -> list[Path]:
     """Copy every bundled model and FORMAT.md into the folder `dest` (created); returns the written files.
 
-    Nothing is written if a file of that name is already there, unless `overwrite`: FileExistsError,
-    its `filename` the first such file. NotADirectoryError if `dest` is a file."""
+    Nothing is written if a file of that name (or a link, also a dangling one) is already there,
+    unless `overwrite`: FileExistsError, its `filename` the first such file. NotADirectoryError if
+    `dest` is a file. The files are copied as a set (`kinetostat._io.unit`): all or none; a link
+    in the way is replaced, never followed."""
+    from ._io import unit
     dest = Path(dest)
     if dest.exists() and not dest.is_dir():
         raise NotADirectoryError(f"{dest} is not a directory")
     src = [models_dir() / f"{n}.toml" for n in names()] + [models_dir() / "FORMAT.md"]
-    clash = [dest / p.name for p in src if (dest / p.name).exists()]
+    clash = [dest / p.name for p in src if os.path.lexists(dest / p.name)]
     if clash and not overwrite:
         more = f" (and {len(clash) - 1} more of the {len(src)} files)" if len(clash) > 1 else ""
         raise FileExistsError(errno.EEXIST, f"already exists{more}", str(clash[0]))
-    dest.mkdir(parents=True, exist_ok=True)
-    return [Path(shutil.copyfile(p, dest / p.name)) for p in src]
+    with unit(dest) as tmp:
+        for p in src:
+            shutil.copyfile(p, tmp / p.name)
+    return [dest / p.name for p in src]

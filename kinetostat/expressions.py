@@ -18,7 +18,9 @@ import math
 import operator
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -141,7 +143,7 @@ def over_arrays(expr: Expression, values: Mapping[str, Any]) -> Any:
             if node.id in CONSTANTS:
                 return CONSTANTS[node.id]
             if node.id not in values:
-                raise ExpressionError(f"unknown name {node.id!r}{_suggest(node.id, [*values, *CONSTANTS])}")
+                raise ExpressionError(f"unknown name {node.id!r}{suggest(node.id, [*values, *CONSTANTS])}")
             return values[node.id]
         if isinstance(node, ast.UnaryOp):
             return _UNARY[type(node.op)](ev(node.operand))
@@ -181,6 +183,8 @@ def _check_node(node: ast.AST, names: set[str]) -> None:
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
             raise ExpressionError(f"{type(node.value).__name__} literal {node.value!r:.40} is not allowed "
                                   f"(only numbers)")
+        if not _finite_number(node.value):
+            raise ExpressionError(f"{shown_number(node.value)} is too large (overflow)")
     elif isinstance(node, ast.Name):
         if node.id in FUNCTIONS:
             return          # checked as a call's function
@@ -195,7 +199,7 @@ def _check_node(node: ast.AST, names: set[str]) -> None:
         f = node.func
         if not isinstance(f, ast.Name) or f.id not in FUNCTIONS:
             called = f.id if isinstance(f, ast.Name) else _WHAT.get(type(f), type(f).__name__)
-            raise ExpressionError(f"call of {called!r} is not allowed{_suggest(called, FUNCTIONS)}; "
+            raise ExpressionError(f"call of {called!r} is not allowed{suggest(called, FUNCTIONS)}; "
                                   f"functions: {', '.join(sorted(FUNCTIONS))}")
         if node.keywords:
             raise ExpressionError(f"{f.id}() takes positional arguments only")
@@ -220,7 +224,7 @@ def _eval(node: ast.AST, values: Mapping[str, float]) -> float:
         if node.id in FUNCTIONS:
             raise ExpressionError(f"{node.id!r} is a function: call it, {node.id}(...)")
         if node.id not in values:
-            raise ExpressionError(f"unknown name {node.id!r}{_suggest(node.id, [*values, *CONSTANTS])}")
+            raise ExpressionError(f"unknown name {node.id!r}{suggest(node.id, [*values, *CONSTANTS])}")
         return values[node.id]
     if isinstance(node, ast.UnaryOp):
         return _UNARY[type(node.op)](_eval(node.operand, values))
@@ -234,6 +238,21 @@ def _eval(node: ast.AST, values: Mapping[str, float]) -> float:
     if isinstance(node, ast.Call):
         return _checked(float(FUNCTIONS[node.func.id][0](*(_eval(a, values) for a in node.args))))
     raise ExpressionError(f"{type(node).__name__} not allowed")     # parse() lets none through
+
+
+def _finite_number(x: float) -> bool:
+    """Finite, also as a float (an integer beyond 1.8e308 is not)."""
+    try:
+        return math.isfinite(x)
+    except OverflowError:
+        return False
+
+
+def shown_number(x: Any) -> str:
+    """`x` for a message: an integer too long to show as its digit count ("an integer of 401 digits")."""
+    if isinstance(x, int) and not isinstance(x, bool) and x.bit_length() > 64:
+        return f"an integer of {len(str(abs(x))) if x.bit_length() < 10_000 else 'over 3000'} digits"
+    return repr(x)
 
 
 def _checked(x: float) -> float:
@@ -250,9 +269,35 @@ def _arith_message(exc: Exception) -> str:
     return f"math domain error ({exc})" if "domain" in str(exc) else str(exc)
 
 
-def _suggest(name: str, valid) -> str:
-    close = difflib.get_close_matches(name, [str(v) for v in valid], n=1, cutoff=0.6)
+#: "Did you mean": names longer than this are not compared, nor candidates of a length more than
+#: 3 apart, and at most SUGGEST_CANDIDATES candidates: a suggestion costs at most about
+#: SUGGEST_CANDIDATES x SUGGEST_LENGTH^2 steps; and at most SUGGESTIONS are made while one model
+#: is read (`suggestion_budget`), whatever the file holds.
+SUGGEST_LENGTH, SUGGEST_CANDIDATES, SUGGESTIONS = 64, 50, 50
+_SUGGESTIONS_LEFT: ContextVar[list[int] | None] = ContextVar("suggestions_left", default=None)
+
+
+@contextmanager
+def suggestion_budget(n: int = SUGGESTIONS) -> Iterator[None]:
+    """At most `n` suggestions (`suggest`) in the block; after them, none."""
+    token = _SUGGESTIONS_LEFT.set([n])
+    try:
+        yield
+    finally:
+        _SUGGESTIONS_LEFT.reset(token)
+
+
+def suggest(name: str, valid) -> str:
+    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else ""."""
+    left = _SUGGESTIONS_LEFT.get()
+    if len(name) > SUGGEST_LENGTH or (left is not None and left[0] <= 0):
+        return ""
+    if left is not None:
+        left[0] -= 1
+    near = [v for v in map(str, valid) if abs(len(v) - len(name)) <= 3][:SUGGEST_CANDIDATES]
+    close = difflib.get_close_matches(name, near, n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
+
 
 
 # ----------------------------------------------------------------------------- a table of parameters
@@ -272,25 +317,16 @@ def resolve(raw: Mapping[str, Any]) -> tuple[dict[str, float], dict[str, str]]:
                 parsed[name] = parse(x)
             except ExpressionError as exc:
                 problems[name] = f'expression "{x}": {exc}'
-        elif isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x):
+        elif isinstance(x, (int, float)) and not isinstance(x, bool) and _finite_number(x):
             values[name] = float(x)
+        elif isinstance(x, int) and not isinstance(x, bool):
+            problems[name] = f"{shown_number(x)} is too large for a floating-point number"
         else:
             problems[name] = f"expected a number or an expression string, got {x!r:.60}"
     state: dict[str, int] = {}          # 1: being evaluated, 2: done
 
-    def visit(name: str, chain: tuple[str, ...]) -> None:
-        if state.get(name) == 2 or name in values or name in problems:
-            return
-        if state.get(name) == 1:
-            cycle = chain[chain.index(name):] + (name,)
-            for n in cycle[:-1]:
-                problems.setdefault(n, f'expression "{raw[n]}": cycle {" -> ".join(cycle)}')
-            return
-        state[name] = 1
+    def finish(name: str) -> None:
         e = parsed[name]
-        for dep in sorted(e.names):
-            if dep in parsed:
-                visit(dep, chain + (name,))
         if name not in problems:
             bad = sorted(d for d in e.names if d in problems)
             if bad:
@@ -302,6 +338,25 @@ def resolve(raw: Mapping[str, Any]) -> tuple[dict[str, float], dict[str, str]]:
                     problems[name] = f'expression "{e.text}": {exc}'
         state[name] = 2
 
-    for name in parsed:
-        visit(name, ())
+    def deps(name: str) -> Iterator[str]:
+        return iter(sorted(d for d in parsed[name].names if d in parsed))
+
+    for start in parsed:                # depth first, with a stack of its own: 1000 parameters in a chain
+        if state.get(start) == 2 or start in problems:
+            continue
+        path, todo = [start], [deps(start)]
+        state[start] = 1
+        while path:
+            dep = next(todo[-1], None)
+            if dep is None:
+                todo.pop()
+                finish(path.pop())
+            elif state.get(dep) == 1:
+                cycle = tuple(path[path.index(dep):]) + (dep,)
+                for n in cycle[:-1]:
+                    problems.setdefault(n, f'expression "{raw[n]}": cycle {" -> ".join(cycle)}')
+            elif state.get(dep) != 2 and dep not in problems:
+                state[dep] = 1
+                path.append(dep)
+                todo.append(deps(dep))
     return {n: values[n] for n in raw if n in values}, problems

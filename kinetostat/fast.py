@@ -636,6 +636,8 @@ class Peaks:
     M_bal: np.ndarray      # (D,) largest |M_bal|, N m
     F_bal: np.ndarray      # (D,) largest |F_bal|, N (0 for an engine)
     singular_deg: tuple    # per design: the crank angles where the values are NaN (singular), deg
+    warned_deg: tuple = ()  # per design: the angles whose values are kept with fewer than DIGITS_WARN digits, deg
+    worst_digits: np.ndarray | None = None   # (D,) fewest digits left at those angles; NaN where none
 
 
 def _loaded_peaks(mech: "Mechanism", phi: np.ndarray, threads: int | None) -> tuple[np.ndarray, np.ndarray]:
@@ -670,6 +672,7 @@ def peaks(mechs: Sequence["Mechanism"], phi_deg: np.ndarray, threads: int | None
     D = len(mechs)
     R, M, F = np.zeros((D, len(mechs[0].pairs))), np.zeros(D), np.zeros(D)
     singular: list[np.ndarray] = [np.empty(0)] * D
+    warned, worst = [np.empty(0)] * D, np.full(D, np.nan)    # only angles the guard sends on have < 11 digits
     compiled = [d for d, m in enumerate(mechs) if m.drive.law or m.drive.omega]
     kinds: dict[tuple, list[int]] = {}          # one kernel per structure and branches
     for d in compiled:
@@ -696,4 +699,13 @@ def peaks(mechs: Sequence["Mechanism"], phi_deg: np.ndarray, threads: int | None
             M[d] = max(M[d], np.abs(res.balancing_moment[ok]).max())
             F[d] = max(F[d], np.linalg.norm(res.forces.F_bal[ok], axis=-1).max())
         singular[d] = res.phi_deg[res.singular]
-    return Peaks(R, M, F, tuple(singular))
+        warned[d], worst[d] = warned_band(res)
+    return Peaks(R, M, F, tuple(singular), tuple(warned), worst)
+
+
+def warned_band(res) -> tuple[np.ndarray, float]:
+    """The angles (deg) whose values `res` keeps with fewer than DIGITS_WARN digits, and the fewest
+    digits there (NaN where there is none)."""
+    from .kinematics import DIGITS_WARN
+    low = ~res.singular & (res.digits < DIGITS_WARN)
+    return res.phi_deg[low], float(res.digits[low].min()) if low.any() else np.nan

@@ -7,13 +7,13 @@ May use: the standard library, numpy, errors, expressions, planar, structure, ex
 """
 from __future__ import annotations
 
-import difflib
 import functools
 import math
 import re
 import stat
 import sys
 import tomllib
+import unicodedata
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +23,8 @@ from typing import Any, Callable, Literal, Mapping
 import numpy as np
 
 from .errors import ModelError, ModelFileNotFound, ModelWarning, StructureError
-from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression
+from .expressions import CONSTANTS, FUNCTIONS, ExpressionError, over_arrays, parse as parse_expression, shown_number
+from .expressions import _finite_number, suggest, suggestion_budget
 from .expressions import resolve as resolve_parameters
 from .planar import diameter
 from .structure import Structure, analyse_structure
@@ -192,9 +193,11 @@ class SpeedLaw:
         phi = np.asarray(phi, dtype=float)
         if self.expression is not None:
             h = 1e-30                         # complex step: exact derivative, no cancellation
-            z = np.broadcast_to(over_arrays(_expression(self.expression),
-                                            {**dict(self.parameters), "phi": phi + 1j * h}), phi.shape)
-            return z.real.astype(float), z.imag / h
+            expr, values = _expression(self.expression), dict(self.parameters)
+            with np.errstate(all="ignore"):   # outside its real domain (sqrt, log of x < 0) omega is NaN
+                w = np.broadcast_to(over_arrays(expr, {**values, "phi": phi}), phi.shape).astype(float)
+                z = np.broadcast_to(over_arrays(expr, {**values, "phi": phi + 1j * h}), phi.shape)
+            return w, np.where(np.isfinite(w), z.imag / h, np.nan)
         x, y, m = _periodic_spline(self.phi_deg, self.omega)
         return _spline_at(x, y, m, phi)
 
@@ -213,6 +216,7 @@ class Drive:
     gear: Gear | None = None
     design_deg: float = 30.0    # the design position: crank angle of the mechanism's picture, deg
     law: SpeedLaw | None = None   # omega(phi); None: the constant omega and eps above
+    source: str = field(default="model", compare=False)   # the model file, for the law's errors
 
     @property
     def steady(self) -> bool:
@@ -225,7 +229,16 @@ class Drive:
         if self.law is None:
             return self.omega, self.eps
         w, dw = self.law(phi)
-        return w, w * dw
+        eps = w * dw
+        bad = ~(np.isfinite(w) & np.isfinite(eps) & (w >= 0))
+        if bad.any():                     # between the angles checked at load: a pole, a NaN band, a dip
+            where = "drive.omega_table" if self.law.expression is None else "drive.omega"
+            at = np.round(np.degrees(np.asarray(phi, float)[bad]), 6)
+            shown = ", ".join(f"{a:g}" for a in at[:8]) + (f", ... ({len(at)} angles)" if len(at) > 8 else "")
+            raise ModelError([f"{where}: the law of motion gives omega = {w[bad][0]:.6g} rad/s, eps = "
+                              f"{eps[bad][0]:.6g} rad/s^2 at phi = {shown} deg: omega must be real, finite and "
+                              f">= 0 (in the drive's sense), eps finite"], source=self.source)
+        return w, eps
 
 
 @dataclass(frozen=True)
@@ -392,13 +405,36 @@ def _periodic_spline(x_deg: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray, np
     n = len(x)
     h = np.diff(np.append(x, x[0] + 2 * np.pi))           # h[i] = x[i+1] - x[i], cyclically
     slope = (np.roll(y, -1) - y) / h
-    A = np.zeros((n, n))
-    for i in range(n):
-        A[i, i - 1] += h[i - 1]
-        A[i, i] += 2 * (h[i - 1] + h[i])
-        A[i, (i + 1) % n] += h[i]
-    m = np.linalg.solve(A, 6 * (slope - np.roll(slope, 1)))
-    return x, y, m
+    r = 6 * (slope - np.roll(slope, 1))
+    if n < 3:                                             # both neighbours are one knot
+        return x, y, np.linalg.solve(np.diag(2 * (np.roll(h, 1) + h)) + np.diag(h.sum() * np.ones(n - 1), 1)
+                                     + np.diag(h.sum() * np.ones(n - 1), -1), r)
+    return x, y, _cyclic_tridiagonal(np.roll(h, 1), 2 * (np.roll(h, 1) + h), h, r)
+
+
+def _cyclic_tridiagonal(sub: np.ndarray, diag: np.ndarray, sup: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """x of A x = r, A tridiagonal with corners (n >= 3): A[i, i-1] = sub[i], A[i, i] = diag[i],
+    A[i, i+1] = sup[i], indices cyclic (sub[0] = A[0, n-1], sup[n-1] = A[n-1, 0]). The Thomas
+    algorithm with the Sherman-Morrison correction for the corners: O(n) work and memory."""
+    n = len(diag)
+    beta, alpha, gamma = float(sub[0]), float(sup[-1]), -float(diag[0])
+    b = [float(v) for v in diag]
+    b[0] -= gamma
+    b[-1] -= alpha * beta / gamma
+    a, c, d = [float(v) for v in sub], [float(v) for v in sup], [float(v) for v in r]
+    u = [gamma] + [0.0] * (n - 2) + [alpha]
+    cp, xp, zp = [0.0] * n, [0.0] * n, [0.0] * n       # forward sweep for r and u together
+    cp[0], xp[0], zp[0] = c[0] / b[0], d[0] / b[0], u[0] / b[0]
+    for i in range(1, n):
+        m = b[i] - a[i] * cp[i - 1]
+        cp[i] = c[i] / m
+        xp[i] = (d[i] - a[i] * xp[i - 1]) / m
+        zp[i] = (u[i] - a[i] * zp[i - 1]) / m
+    for i in range(n - 2, -1, -1):
+        xp[i] -= cp[i] * xp[i + 1]
+        zp[i] -= cp[i] * zp[i + 1]
+    x, z = np.array(xp), np.array(zp)
+    return x - z * (x[0] + beta * x[-1] / gamma) / (1 + z[0] + beta * z[-1] / gamma)
 
 
 def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -409,7 +445,8 @@ def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> 
     h = xe[i + 1] - xe[i]
     a, b = xe[i + 1] - t, t - xe[i]
     ca, cb = ye[i] / h - me[i] * h / 6, ye[i + 1] / h - me[i + 1] * h / 6
-    value = (me[i] * a**3 + me[i + 1] * b**3) / (6 * h) + ca * a + cb * b
+    # the same cubic, written so that it is exact at a knot (a table's 0 stays 0, never -1e-21)
+    value = ye[i] * (a / h) + ye[i + 1] * (b / h) + (me[i] * a * (a * a - h * h) + me[i + 1] * b * (b * b - h * h)) / (6 * h)
     slope = (-me[i] * a**2 + me[i + 1] * b**2) / (2 * h) - ca + cb
     return value, slope
 
@@ -472,7 +509,8 @@ def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | N
         raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
     except RecursionError:
         raise ModelError(["TOML nested too deeply (arrays or tables within each other)"], source=source) from None
-    return _Reader(data, source, text, parameters).mechanism()
+    with suggestion_budget():       # "did you mean" work bounded per model
+        return _Reader(data, source, text, parameters).mechanism()
 
 
 def _check_key_cost(text: str, source: str) -> None:
@@ -497,15 +535,24 @@ def _check_key_cost(text: str, source: str) -> None:
 def from_dict(data: Mapping[str, Any], source: str = "<dict>",
               parameters: Mapping[str, Any] | None = None) -> Mechanism:
     """Build a Mechanism from the parsed structure of a model file; `parameters` as for `load`."""
-    return _Reader(data, source, overrides=parameters).mechanism()
+    with suggestion_budget():       # "did you mean" work bounded per model
+        return _Reader(data, source, overrides=parameters).mechanism()
+
+
+#: The variables of laws of motion (phi, rad) and of motor characteristics (omega, rad/s): no parameter's name.
+LAW_VARIABLES = ("phi", "omega")
+
+
+def _code_points(name: str) -> str:
+    """A name with the code points that are not ASCII named: 'µ' -> "'µ' (U+00B5 MICRO SIGN)"."""
+    odd = [f"U+{ord(c):04X} {unicodedata.name(c, '?')}" for c in dict.fromkeys(name) if ord(c) > 127]
+    return f"{name!r}" + (f" ({', '.join(odd[:4])}{', ...' if len(odd) > 4 else ''})" if odd else "")
 
 
 def _suggest(name: Any, valid) -> str:
-    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else ""."""
-    if not isinstance(name, str):
-        return ""
-    close = difflib.get_close_matches(name, [str(v) for v in valid], n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
+    """" (did you mean 'mass'?)" when `name` is a near miss of one of `valid`, else "" (bounded
+    work: `expressions.suggest`)."""
+    return suggest(name, valid) if isinstance(name, str) else ""
 
 
 class _Lines:
@@ -589,6 +636,11 @@ MIN_GEAR = 1e-6
 #: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,
 #: m, and the crank pin's speed, m/s (machines of the texts: links below 2 m, pins below 30 m/s).
 LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
+#: Warned: a link whose radius of gyration exceeds this many times its span (I_S in g mm^2 makes it
+#: 30000 times too long; a flywheel on a crank, a few spans), and a
+#: force diagram whose largest force is below this fraction of the mechanism's weights and
+#: inertia forces (a pressure in MPa times an area in m^2?).
+GYRATION_SPANS, FORCE_SCALE = 100.0, 1e-4
 
 _TOP_KEYS = {"mechanism", "parameters", "drive", "frame", "link", "pair", "group", "load", "spring", "friction",
              "published", "study"}
@@ -600,10 +652,16 @@ MAX_PUBLISHED_ANGLES = 3600
 
 #: Characters of an expression quoted in a message.
 MAX_SHOWN = 120
+#: Longest name of a point, link, body, load or spring (each labels plots and plans: 10,000
+#: characters took a report two minutes); the mechanism's own name is not limited.
+MAX_NAME = 200
+#: Most problems listed for one file (the rest are counted): 300,000 unknown keys stay one short list.
+MAX_PROBLEMS = 100
 
 
 def _finite(x: Any) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    """A finite number, also as a float (an integer of 400 digits is not)."""
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and _finite_number(x)
 
 
 def _subnormal(x: float) -> bool:
@@ -627,6 +685,7 @@ class _Reader:
         self.ids_unknown = False                  # some [[link]] has no valid id: "unknown link" follows
         self.points_unread: set[tuple[int, str | None]] = set()   # (link, point) that failed (None: all)
         self.misspelled: set[str] = set()         # field paths given under a near-miss name
+        self.unshown = 0                          # problems beyond MAX_PROBLEMS, counted only
         self.group_tables: dict[frozenset, tuple[int, tuple]] = {}   # group -> (its [[group]], links as listed)
         self.coincident: dict[int, str] = {}      # links whose points all coincide -> their field path
         self.slider_axes: set[int] = set()        # P pairs (index) whose slider frame the file states
@@ -635,6 +694,9 @@ class _Reader:
         path = msg.partition(": ")[0]
         if path in self.misspelled and msg[len(path):].startswith(": missing"):
             return          # "mass: missing" after "masss: unknown field (did you mean 'mass'?)"
+        if len(self.problems) >= MAX_PROBLEMS:
+            self.unshown += 1
+            return
         self.problems.append(msg)
         self.lines.append(self.line_of(path))
 
@@ -674,6 +736,12 @@ class _Reader:
                 self.err("parameters.g: g is mechanism.g (m/s^2), which expressions read as g: give it there")
             elif name in FUNCTIONS or name in CONSTANTS:
                 self.err(f"parameters.{name}: {name!r} is the name of a function or constant of expressions")
+            elif name in LAW_VARIABLES:
+                self.err(f"parameters.{name}: {name!r} is the variable of a law of motion omega(phi) or of a "
+                         f"characteristic M(omega), which would hide this parameter there; choose another name")
+            elif unicodedata.normalize("NFKC", name) != name:
+                self.err(f"parameters.{name}: {_code_points(name)} reads as {_code_points(unicodedata.normalize('NFKC', name))} "
+                         f"in expressions (Unicode NFKC, as Python folds names); write it so")
             elif not name.isidentifier() or name.startswith("__"):
                 self.err(f"parameters.{name}: a parameter's name is a Python-style identifier (letters, digits, _)")
         for name, x in self.overrides.items():
@@ -697,10 +765,10 @@ class _Reader:
     def scalar(self, x: Any, path: str) -> Any:
         """`x` itself, or the value of the expression `x` (a string) over the parameters; None
         after recording a problem (naming `path` and the parameter that fails)."""
+        if path == "mechanism.g" and "g" in self.values:      # also a number that an override of g replaces
+            return self.values["g"]
         if not isinstance(x, str):
             return x
-        if path == "mechanism.g" and "g" in self.values:
-            return self.values["g"]
         try:
             e = parse_expression(x)
             bad = sorted(n for n in e.names if n in self.failed)
@@ -725,7 +793,7 @@ class _Reader:
         x = self.scalar(tab[key], f"{where}.{key}")
         if x is None:
             return None
-        shown = repr(x) if not isinstance(tab[key], str) else f'{x!r} (= "{tab[key]:.{MAX_SHOWN}}")'
+        shown = shown_number(x) if not isinstance(tab[key], str) else f'{x!r} (= "{tab[key]:.{MAX_SHOWN}}")'
         if not _finite(x):
             self.err(f"{where}.{key}: expected a finite number, got {shown}")
             return None
@@ -777,6 +845,9 @@ class _Reader:
         if choices and x not in choices:
             self.err(f"{where}.{key}: invalid value {x!r}{_suggest(x, choices)}. Valid values: {list(choices)}")
             return None
+        if key == "name" and where != "mechanism" and len(x) > MAX_NAME:
+            self.err(f"{where}.name: {len(x)} characters, at most {MAX_NAME} (it labels plots and plans)")
+            return None
         return x
 
     def integer(self, tab: Mapping, key: str, where: str) -> int | None:
@@ -797,9 +868,12 @@ class _Reader:
         return x
 
     def unknown_keys(self, tab: Mapping, allowed: set[str], where: str) -> None:
+        unused = sorted(allowed.difference(tab))
         for k in tab:
-            if k not in allowed:
-                hint = _suggest(k, sorted(allowed - set(tab)))
+            if k not in allowed and len(self.problems) >= MAX_PROBLEMS:
+                self.unshown += 1
+            elif k not in allowed:
+                hint = _suggest(k, unused)
                 if hint:
                     self.misspelled.add(f"{where}.{hint.split(chr(39))[1]}")
                 self.err(f"{where}.{k}: unknown field{hint}. Valid fields: {sorted(allowed)}")
@@ -837,7 +911,8 @@ class _Reader:
                     self.err(f"pair[{p.index}].radius: missing; friction losses need the journal radius "
                              f"of every revolute pair (or a default friction.radius)")
         if self.problems:
-            raise ModelError(self.problems, source=self.source, lines=self.lines)
+            more = [f"... and {self.unshown} more problems (the first {MAX_PROBLEMS} are shown)"] if self.unshown else []
+            raise ModelError(self.problems + more, source=self.source, lines=self.lines + [None] * len(more))
         try:
             mech = Mechanism(name=name, source=source, assumptions=tuple(assumptions), g=g,
                              links=tuple(links), pairs=tuple(pairs),
@@ -866,6 +941,22 @@ class _Reader:
         if mech.g and not 1.0 <= mech.g <= 100.0:
             yield "mechanism.g", (f"{mech.g:g} m/s^2 is far from the 9.81 of the texts (warned outside 1..100): "
                                   f"is it in m/s^2? (0 switches gravity off)")
+        for link in mech.links[1:]:
+            span = _span(link.points.values())
+            if link.mass > 0 and span > 0 and math.sqrt(link.I_S / link.mass) > GYRATION_SPANS * span:
+                yield f"link[id={link.id}].I_S", (
+                    f"{link.I_S:.4g} kg m^2 gives a radius of gyration of {math.sqrt(link.I_S / link.mass):.4g} m, "
+                    f"more than {GYRATION_SPANS:g} times the link's span {span:.4g} m: is it in kg m^2? "
+                    f"(g mm^2 is 1e-9 kg m^2, kg mm^2 1e-6)")
+        scale = FORCE_SCALE * max([mech.g * link.mass for link in mech.links]
+                                  + [link.mass * _span(link.points.values()) * mech.drive.omega**2 for link in mech.links])
+        for n, ld in enumerate(mech.loads):
+            if ld.kind == "force" and ld.table is not None and 0 < max(map(abs, ld.table.value)) * abs(ld.table.scale) < scale:
+                peak = max(map(abs, ld.table.value)) * abs(ld.table.scale)
+                yield f"load[{n}].table.scale", (
+                    f"the diagram's largest force is {peak:.4g} N, below {FORCE_SCALE:g} of the mechanism's weights "
+                    f"and inertia forces ({scale / FORCE_SCALE:.4g} N): is a pressure in MPa multiplied by an area "
+                    f"in m^2? (scale in N per table unit: 1 MPa = 1e6 Pa)")
         for g in mech.structure.groups:
             n, listed = self.group_tables.get(frozenset(g.links), (None, ()))
             if g.kind == "RRR" and n is not None and listed[0] > listed[1]:
@@ -896,6 +987,11 @@ class _Reader:
             return {}
         out = {}
         for name, xy in raw.items():
+            if len(name) > MAX_NAME:
+                self.err(f"{where}: a point name of {len(name)} characters ({name[:20]!r}...), at most {MAX_NAME} "
+                         f"(it labels plots and plans)")
+                self.points_unread.add((lid, name))
+                continue
             v = self.vec(xy, f"{where}.{name}")
             if v is not None:
                 out[name] = v
@@ -1159,7 +1255,8 @@ class _Reader:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
         if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
             return None
-        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law)
+        return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law,
+                     self.source)
 
     def speed_table(self, t: Any, where: str) -> SpeedLaw | None:
         """[drive.omega_table]: phi_deg and omega (rad/s) or rpm over one revolution."""
@@ -1200,7 +1297,7 @@ class _Reader:
         try:
             law(np.zeros(1))
         except ValueError as exc:
-            self.err(f"{where}: {text!r}: {exc}")
+            self.err(f'{where}: "{text:.{MAX_SHOWN}}": {exc}')
             return None
         return law
 
@@ -1211,7 +1308,10 @@ class _Reader:
         phi = np.linspace(0.0, 2 * np.pi, 721)
         w, dw = law(phi)
         if not (np.isfinite(w).all() and np.isfinite(dw).all()):
-            self.err(f"{where}: omega(phi) is not finite over the whole revolution")
+            at = np.degrees(phi[~(np.isfinite(w) & np.isfinite(dw))])
+            self.err(f"{where}: omega(phi) is not finite (or not real) over the whole revolution: so at phi = "
+                     f"{at[0]:.4g} deg" + (f" ({len(at)} of 721 angles checked, up to {at[-1]:.4g} deg)"
+                                           if len(at) > 1 else ""))
         elif (w < 0).any():
             self.err(f"{where}: omega(phi) must be >= 0 (in the drive's sense); it is "
                      f"{w.min():.4g} rad/s at phi = {np.degrees(phi[np.argmin(w)]):.4g} deg")
@@ -1355,10 +1455,10 @@ class _Reader:
             try:
                 value = c(np.array([0.0, 1.0]))
             except ValueError as exc:
-                self.err(f"{where}: {t!r}: {exc}")
+                self.err(f'{where}: "{t:.{MAX_SHOWN}}": {exc}')
                 return None
             if not np.isfinite(value).all():
-                self.err(f"{where}: {t!r} is not finite at omega = 0 or 1 rad/s")
+                self.err(f'{where}: "{t:.{MAX_SHOWN}}" is not finite at omega = 0 or 1 rad/s')
                 return None
             return c
         if not isinstance(t, dict):

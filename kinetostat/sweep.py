@@ -13,7 +13,9 @@ Mechanism with `kinetostat.model.loads`.
 
 A design whose mechanism does not load, build or assemble keeps its row: NaN peaks and its
 reason in the `error` column (the sweep goes on). Warnings (singular positions, doubts about a
-model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular.
+model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular
+(values NaN), `warned_deg` and `worst_digits` where its values are kept with fewer than
+DIGITS_WARN digits and the fewest digits there.
 
 May use: model, analysis, errors, examples; pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
@@ -23,6 +25,7 @@ Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engin
 from __future__ import annotations
 
 import itertools
+import math
 import threading
 import warnings
 from contextlib import contextmanager
@@ -45,6 +48,10 @@ __all__ = ["Sweep", "sweep", "CHUNK", "LOCAL_SCHEDULERS"]
 CHUNK = 32
 #: The `scheduler` names of Dask's local schedulers; any other string is a `distributed` address.
 LOCAL_SCHEDULERS = ("threads", "processes")
+#: Most designs of one sweep (the product of the parameters' numbers of values), checked before any is made.
+MAX_DESIGNS = 1_000_000
+#: Seconds to wait for a distributed scheduler to answer, and for its first worker.
+CONNECT_TIMEOUT = 10.0
 #: The unit `attrs["units"]` gives a design's parameter: the one its model file uses.
 PARAMETER_UNIT = "model's unit"
 
@@ -95,6 +102,10 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
             raise ValueError(f"sweep: {name!r} is not a parameter of the model{_suggest(name, valid)}. "
                              f"Parameters: {', '.join(valid)}")
     values = [_values(name, params[name]) for name in names]
+    n_designs = math.prod(len(v) for v in values)
+    if n_designs > MAX_DESIGNS:
+        raise ValueError(f"sweep: {' x '.join(str(len(v)) for v in values)} = {n_designs:.3g} designs, at most "
+                         f"{MAX_DESIGNS}; sweep fewer values")
     if not isinstance(chunk, (int, np.integer)) or isinstance(chunk, bool) or chunk < 1:
         raise ValueError(f"chunk: expected a positive number of designs per task, got {chunk!r}")
     phi_deg = crank_angles(phi_deg, steps)
@@ -135,7 +146,8 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
                 continue
             sing = res.phi_deg[res.singular]
             rows.append({**design, **{name: _peak(column(res)) for name, column in _peak_columns(mech).items()},
-                         "n_singular": len(sing), "singular_deg": " ".join(f"{x:g}" for x in sing), "error": ""})
+                         "n_singular": len(sing), "singular_deg": " ".join(f"{x:g}" for x in sing),
+                         **_accuracy(*fast.warned_band(res)), "error": ""})
             if full:
                 frames.append(_with_design(res.to_frame(), design))
         if built:       # the peaks of every design of the chunk in one call of the compiled kernel
@@ -168,8 +180,15 @@ def _peaks_into(rows: list[dict], built: list[tuple[int, Mechanism]], phi_deg: n
         if m.drive.kind == "machine":
             peak["peak_F_bal"] = pk.F_bal[q]
         rows[n].update({k: np.nan if everything else float(v) for k, v in peak.items()},
-                       n_singular=len(sing), singular_deg=" ".join(f"{x:g}" for x in sing))
+                       n_singular=len(sing), singular_deg=" ".join(f"{x:g}" for x in sing),
+                       **_accuracy(pk.warned_deg[q], pk.worst_digits[q]))
         rows[n] = {**{k: v for k, v in rows[n].items() if k != "error"}, "error": rows[n]["error"]}
+
+
+def _accuracy(warned_deg: np.ndarray, worst: float) -> dict[str, Any]:
+    """The columns of the warned band: the angles kept with fewer than DIGITS_WARN digits, and the
+    fewest digits there (NaN where none is warned)."""
+    return {"worst_digits": round(float(worst), 1), "warned_deg": " ".join(f"{x:g}" for x in warned_deg)}
 
 
 def _peak_columns(m: Mechanism) -> dict[str, Callable[[Analysis], np.ndarray]]:
@@ -245,23 +264,40 @@ def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: n
             def count(key, result, dsk, state, worker_id):
                 if key in finished:
                     bar.update()
+            quiet = {"initializer": _ignore_sigint} if scheduler == "processes" else {}
             with warnings.catch_warnings(), Callback(posttask=count):
-                return list(dask.compute(*tasks, scheduler=scheduler))
+                return list(dask.compute(*tasks, scheduler=scheduler, **quiet))
         return _distributed(tasks, scheduler, bar)
     finally:
         bar.close()
+
+
+def _ignore_sigint() -> None:
+    """A worker process ignores Ctrl-C (the terminal sends it to the whole group): the main
+    process reports the interruption, and no worker prints a KeyboardInterrupt traceback."""
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _distributed(tasks: list, scheduler: Any, bar) -> list:
     """The tasks' results from a `distributed` scheduler (an address, or a Client)."""
     from distributed import Client, as_completed
     if isinstance(scheduler, str):
+        if scheduler.partition("://")[0] in ("tls", "ucx"):
+            raise ConnectionError(f"scheduler {scheduler!r}: a {scheduler.partition('://')[0].upper()} scheduler "
+                                  f"needs its security or transport set up: connect a distributed.Client yourself "
+                                  f"and pass it (the API's scheduler=client)")
         try:
-            client = Client(scheduler)
-        except (OSError, ValueError) as exc:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, ValueError, TypeError) as exc:
             raise ConnectionError(f"scheduler {scheduler!r}: no distributed scheduler there ({exc}); "
                                   f"or use {' or '.join(map(repr, LOCAL_SCHEDULERS))}") from None
         with client:
+            try:
+                client.wait_for_workers(1, timeout=CONNECT_TIMEOUT)
+            except (OSError, TimeoutError) as exc:
+                raise ConnectionError(f"scheduler {scheduler!r}: no worker joined it within {CONNECT_TIMEOUT:g} s "
+                                      f"({type(exc).__name__}); start workers (dask worker {scheduler})") from None
             return _gather(client, tasks, bar, as_completed)
     if not isinstance(scheduler, Client):
         raise TypeError(f"scheduler: expected None, {' or '.join(map(repr, LOCAL_SCHEDULERS))}, a distributed "
@@ -325,14 +361,17 @@ def _values(name: str, x: Any) -> list[float]:
 def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFrame:
     """The rows in the sweep's column order (NaN peaks for a failed design), with their units."""
     peaks = list(_peak_columns(base))
-    table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "error"])
+    table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "worst_digits", "warned_deg",
+                                   "error"])
+    table["worst_digits"] = table["worst_digits"].astype(float)
+    table["warned_deg"] = table["warned_deg"].fillna("").astype(str)
     table[peaks] = table[peaks].astype(float)
     table["n_singular"] = table["n_singular"].astype("Int64")
     for text in ("singular_deg", "error"):          # every design failed: a column of NaN, no text
         table[text] = table[text].astype(object).fillna("").astype(str)
     table.attrs.update(mechanism=base.name, units={
         **dict.fromkeys(names, PARAMETER_UNIT), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
-        "n_singular": "1", "singular_deg": "deg", "error": "text"})
+        "n_singular": "1", "singular_deg": "deg", "worst_digits": "1", "warned_deg": "deg", "error": "text"})
     return table
 
 

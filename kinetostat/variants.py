@@ -74,7 +74,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._io import write_text
+from ._io import unit, write_text
 from .model import Mechanism, Table, from_dict, load
 
 __all__ = ["TASKS", "Row", "TaskTable", "Variant", "KeySummary", "variant", "build", "codes", "check_task",
@@ -518,26 +518,29 @@ def _largest(res, mech: Mechanism, n: int = 0) -> tuple[str, float]:
 
 
 def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool = True,
-              steps: int = 360) -> KeySummary:
+              steps: int = 360, root: str | Path | None = None) -> KeySummary:
     """Write the variant's model file `<name>.toml` and its answer key into `out_dir` (created): the
     worksheet (worksheet.md/html/csv/json) and the plans (SVG sheets, segments.csv) at the design
-    position, and with `cycle_csv` the analysis over the cycle (cycle.csv, `steps` positions)."""
+    position, and with `cycle_csv` the analysis over the cycle (cycle.csv, `steps` positions).
+    The files are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside
+    `root` (default: itself), ValueError otherwise."""
     from .analysis import analyze
     from .plans import build as build_plans
     from .plans.worksheet import worksheet
     from .tables import csv_text
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
     at = analyze(mech, phi_deg=[phi1])
     res = analyze(mech, steps=steps)
     plans = build_plans(mech, at=phi1)
     sheet = worksheet(mech, phi1, mu_l=plans.scales["mu_l"].value, lang=lang)
-    files = [write_text(out / f"{v.name}.toml", v.toml())]
-    files += plans.write(out, lang=lang) + sheet.write(out)
-    if cycle_csv:
-        files.append(write_text(out / "cycle.csv", csv_text(res.to_frame())))
+    with unit(out, root) as tmp:
+        files = [write_text(tmp / f"{v.name}.toml", v.toml())]
+        files += plans.write(tmp, lang=lang) + sheet.write(tmp)
+        if cycle_csv:
+            files.append(write_text(tmp / "cycle.csv", csv_text(res.to_frame())))
+    files = [out / f.relative_to(tmp) for f in files]
     label, R = _largest(at, mech)
     R_cycle = max(float(np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))) for p in mech.pairs)
     return KeySummary(v.name, phi1, float(at.balancing_moment[0]), label, R,

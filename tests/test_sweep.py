@@ -165,7 +165,7 @@ def test_cli_sweep_writes_the_study_as_parquet_and_csv(cli, tmp_path):
     assert "25 designs (r 5 x n_k 5) x 36 crank positions" in r.stdout
     df = pd.read_parquet(tmp_path / "sweep.parquet")
     assert len(df) == 25
-    assert list(df.columns) == ["r", "n_k", *PEAKS, "n_singular", "singular_deg", "error"]
+    assert list(df.columns) == ["r", "n_k", *PEAKS, "n_singular", "singular_deg", "worst_digits", "warned_deg", "error"]
     sw = kinetostat.sweep(CHAIN, STUDY, steps=36)
     pd.testing.assert_frame_equal(df, sw.table, check_exact=True, check_dtype=False)
     r = cli(*args, "--out", tmp_path / "sweep.csv")

@@ -88,6 +88,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinetostat._text import xml_escape
 from kinetostat.planar import rotate
 
 from kinetostat.kinetostatics import gear_force
@@ -213,7 +214,7 @@ def mjcf(scene: Scene, floor: float = EXACT_FLOOR, timestep: float = 1e-4,
         out.append(f'{indent}</body>')
         return out
 
-    lines = [f'<mujoco model="{_xml_text(mech.name)}">',
+    lines = [f'<mujoco model="{xml_escape(mech.name)}">',
              '  <compiler angle="radian" autolimits="true"/>',
              f'  <option timestep="{_f(timestep)}" gravity="0 {_f(-scene.g)} 0" jacobian="dense" '
              f'integrator="Euler" solver="Newton" iterations="50" tolerance="1e-14">',
@@ -232,10 +233,6 @@ def mjcf(scene: Scene, floor: float = EXACT_FLOOR, timestep: float = 1e-4,
                    f'solref="{sr}" solimp="{si}"/>')
     lines += ['  </worldbody>', '  <equality>'] + [f'    {e}' for e in eqs] + ['  </equality>', '</mujoco>']
     return "\n".join(lines) + "\n"
-
-
-def _xml_text(s: str) -> str:
-    return s.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;")
 
 
 # ----------------------------------------------------------------------------- the compiled model

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from kinetostat import Mechanism
+from kinetostat._text import one_line, xml_clean_tree, xml_safe
 from kinetostat.planar import rotate
 
 from .engine_mujoco import SIM_FLOOR, mjcf, slot_motion
@@ -54,7 +55,8 @@ def _v(*xs: float) -> str:
 
 
 def _comment(text: str) -> str:
-    """Text safe inside an XML comment (no '--')."""
+    """Text safe inside an XML comment: one line, no '--', no character XML cannot hold."""
+    text = xml_safe(one_line(text))
     while "--" in text:
         text = text.replace("--", "- -")
     return text
@@ -128,6 +130,7 @@ def to_urdf(mech: Mechanism) -> str:
                           effort="0", velocity=_f(np.nanmax(np.abs(scene.qd[:, n]))))
     for p in scene.cuts:
         robot.append(ET.Comment(_comment(" " + _loop_closure(mech, p, off) + " ")))
+    xml_clean_tree(robot)              # names of the model may hold anything (U+0001, U+FFFE)
     ET.indent(robot)
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
 

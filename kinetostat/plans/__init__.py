@@ -12,8 +12,9 @@
 (`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
 there and only when a figure is drawn).
 
-May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`); pandas only inside
-`Plans.segments_frame` and `Plans.segments_csv`; never the harness or `kinetostat.report`.
+May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`, `tables`;
+pandas only inside `Plans.segments_frame` and `Plans.segments_csv`; never the harness or
+`kinetostat.report`.
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ from typing import Callable, Iterable
 
 from .._io import write_text
 from ..tables import rounded, value
+from .._text import csv_cell
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .forces import crank_plan, force_plans, group_plans
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
@@ -83,10 +85,11 @@ class Plans(Mapping):
     def segments_csv(self) -> str:
         """segments.csv, plain numbers: the drawing's coordinates and lengths to 12 significant
         digits of their column's largest value (`kinetostat.tables.rounded`), each value (of
-        mixed units) to 12 significant digits."""
+        mixed units) to 12 significant digits; no text cell a spreadsheet reads as a formula."""
         df = self.segments_frame()
         out = rounded(df)
         out["value"] = [value(x) for x in df["value"]]
+        out = out.map(csv_cell)                               # no text cell read as a formula
         return out.to_csv(index=False, lineterminator="\n")
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:

@@ -7,13 +7,13 @@ table of segments; point letters stay as the texts letter them (digits drawn as 
 acceleration pole `pi` as π). The SVG is written with the standard library; every text that
 comes from a model (names, notes) is escaped.
 
-May use: the standard library, `.core`; matplotlib only inside `figure`.
+May use: the standard library, `.core`, `kinetostat._text` (XML-safe text); matplotlib only inside `figure`.
 """
 from __future__ import annotations
 
 import math
 import re
-from xml.sax.saxutils import escape
+from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 
 from .core import Plan, Segment
 

@@ -7,7 +7,7 @@ accelerations), the inertia loads and the applied loads, the reactions group by 
 last group attached back to the crank, the crank, Zhukovsky's lever and the difference of the two
 balancing moments. Outputs: Markdown, HTML, a pandas frame, CSV and JSON (written atomically).
 
-May use: the solver (`analysis`, `applied`, `model`), numpy; pandas and markdown-it-py inside the
+May use: the solver (`analysis`, `applied`, `model`), `_io`, `_text` (safe cells), numpy; pandas and markdown-it-py inside the
 output methods only. Never matplotlib, never the harness.
 """
 from __future__ import annotations
@@ -21,7 +21,9 @@ import numpy as np
 
 from ..analysis import Analysis, analyze
 from ..applied import load_magnitude
+from ..kinematics import DIGITS_WARN
 from .._io import write_text
+from .._text import csv_cell, markdown_text
 from ..model import Mechanism
 from ..tables import value
 from .scales import choose_scales
@@ -36,6 +38,8 @@ _WORDS = {
            "reactions": "Reactions", "crank": "The initial link and Zhukovsky's lever",
            "cw": "clockwise", "ccw": "counter-clockwise", "angle": "at {:.2f} deg to x",
            "title": "Worksheet: {name}, phi = {phi:g} deg", "scale": "scale mu_l = {:g} m/mm",
+           "accuracy": "**Accuracy:** near a singular position: about {:.1f} significant digits left at this angle "
+                       "(fewer than {}); the last digits of the values below are not reliable",
            "head": ("Symbol", "Value", "Unit", "Sense / direction", "How obtained"),
            "group": "group {}"},
     "uk": {"kinematics": "Кінематика: швидкості", "accelerations": "Кінематика: прискорення",
@@ -44,6 +48,8 @@ _WORDS = {
            "cw": "за годинниковою стрілкою", "ccw": "проти годинникової стрілки",
            "angle": "під кутом {:.2f} град до осі x",
            "title": "Розрахунковий лист: {name}, φ = {phi:g} град", "scale": "масштаб μ_l = {:g} м/мм",
+           "accuracy": "**Точність:** поблизу особливого положення: лишилося близько {:.1f} значущих цифр "
+                       "(менше ніж {}); останні цифри значень нижче ненадійні",
            "head": ("Позначення", "Значення", "Одиниця", "Напрямок", "Як отримано"),
            "group": "група {}"},
 }
@@ -72,6 +78,7 @@ class Worksheet:
     mu_l: float
     rows: tuple[Row, ...]
     lang: str = "en"
+    digits: float = 16.0    # estimated significant digits left at this angle (fewer than DIGITS_WARN: stated)
 
     def __repr__(self) -> str:
         return f"Worksheet({self.mechanism!r}, phi_deg={self.phi_deg:g}, mu_l={self.mu_l:g}, rows={len(self.rows)})"
@@ -105,14 +112,17 @@ class Worksheet:
     def markdown(self) -> str:
         """The worksheet as Markdown: a title, then one table per section."""
         w = _WORDS[self.lang]
-        out = [f"# {w['title'].format(name=self.mechanism, phi=self.phi_deg)}", "", w["scale"].format(self.mu_l)]
+        out = [f"# {w['title'].format(name=markdown_text(self.mechanism), phi=self.phi_deg)}", "",
+               w["scale"].format(self.mu_l)]
+        if self.digits < DIGITS_WARN:
+            out += ["", w["accuracy"].format(self.digits, DIGITS_WARN)]
         section = None
         for rec in self.records():
             if rec["section"] != section:
                 section = rec["section"]
                 out += ["", f"## {section}", "", "| " + " | ".join(w["head"]) + " |", "|---|---:|---|---|---|"]
             cells = (rec["symbol"], _number(rec["value"]), rec["unit"], rec["direction"], rec["note"])
-            out.append("| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |")
+            out.append("| " + " | ".join(markdown_text(str(c)) for c in cells) + " |")
         return "\n".join(out) + "\n"
 
     def html(self) -> str:
@@ -121,17 +131,18 @@ class Worksheet:
         return MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
 
     def to_csv(self, path: str | Path) -> None:
-        """Write the rows as CSV, values to 12 significant digits (atomic: a temporary file in the
-        same folder, then replaced)."""
+        """Write the rows as CSV, values to 12 significant digits, no cell read as a formula
+        (atomic: a temporary file in the same folder, then replaced)."""
         df = self.frame()
         df["value"] = [value(x) for x in df["value"]]       # 12 significant digits (`kinetostat.tables`)
-        write_text(path, df.to_csv(index=False))
+        write_text(path, df.map(csv_cell).to_csv(index=False))
 
     def to_json(self, path: str | Path) -> None:
         """Write the rows as a JSON list of objects, NaN as null (atomic)."""
         recs = [{k: (None if not math.isfinite(v) else value(v)) if isinstance(v, float) else v for k, v in r.items()}
                 for r in self.records()]
-        doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l, "rows": recs}
+        doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l,
+               "digits": round(self.digits, 1), "rows": recs}
         write_text(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")
 
     def write(self, out_dir: str | Path) -> list[Path]:
@@ -385,4 +396,4 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
     sheet.loads()
     sheet.reactions()
     sheet.crank()
-    return Worksheet(mech.name, float(at), float(mu_l), tuple(sheet.rows), lang)
+    return Worksheet(mech.name, float(at), float(mu_l), tuple(sheet.rows), lang, float(res.digits[0]))

@@ -5,34 +5,16 @@ published values: `<model>.published.<symbol>`) and carries its measured error a
 also when it passes, and what it rests on (trust: an independent engine, the 40-digit
 re-solution, a published value). NaN is written as null.
 
-May use: the standard library and the runs room.
+May use: the standard library, the runs room and `kinetostat._text` (XML-safe text).
 """
 from __future__ import annotations
 
 import math
-import re
 import xml.etree.ElementTree as ET
 from typing import Any, Sequence
 
+from .._text import xml_clean_tree
 from .runs import PUBLISHED_ROUTE, Check, ModelRun, quantities, trust
-
-
-#: Characters XML 1.0 cannot hold, even as a character reference (ElementTree writes them as they are).
-_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
-
-
-def _xml_safe(s: str) -> str:
-    """`s` with what XML cannot hold (control characters, a non-UTF-8 file name's bytes) as "\\x.."."""
-    s = s.encode("utf-8", "backslashreplace").decode("utf-8")
-    return _NOT_XML.sub(lambda m: m[0].encode("unicode_escape").decode("ascii"), s)
-
-
-def _clean_tree(root: ET.Element) -> None:
-    """Every text and attribute of the tree made writable as XML (strings of a model can hold anything)."""
-    for el in root.iter():
-        el.attrib.update({k: _xml_safe(v) for k, v in el.attrib.items()})
-        if el.text:
-            el.text = _xml_safe(el.text)
 
 
 def _number(x: float) -> float | None:
@@ -114,7 +96,7 @@ def junit_xml(runs: Sequence[ModelRun], name: str = "kinetostat validate") -> ET
     for k, v in totals.items():
         root.set(k, str(v))
     root.set("time", f"{total_time:.6f}")
-    _clean_tree(root)
+    xml_clean_tree(root)
     tree = ET.ElementTree(root)
     ET.indent(tree)
     return tree

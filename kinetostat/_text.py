@@ -1,0 +1,77 @@
+"""Text from a model file (names, notes, expressions) made safe for each place it is written:
+XML (MJCF, URDF, SVG, JUnit), CSV cells opened by spreadsheets, Markdown, and the terminal.
+
+May use: the standard library only.
+"""
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+from typing import Any
+from xml.sax.saxutils import escape
+
+__all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "visible", "one_line"]
+
+#: Characters XML 1.0 cannot hold, even as a character reference.
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
+#: Control characters a terminal acts on (C0 but newline and tab, DEL, C1: ESC [2J, OSC 52, ...).
+_CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+#: The first characters that make a spreadsheet read a cell as a formula (OWASP, CSV injection).
+_FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "\n")
+#: Characters that make emphasis, code, links, table cells or strike-through in Markdown anywhere in a line.
+_MARKDOWN = re.compile(r"([\\`*\[\]|~])")
+
+
+def _escaped(m: re.Match) -> str:
+    return m[0].encode("unicode_escape").decode("ascii")
+
+
+def xml_safe(s: str) -> str:
+    """`s` with what XML cannot hold (control characters, a non-UTF-8 file name's bytes) as "\\x.."."""
+    s = s.encode("utf-8", "backslashreplace").decode("utf-8")
+    return _NOT_XML.sub(_escaped, s)
+
+
+def xml_escape(s: str) -> str:
+    """`s` as XML character data or a quoted attribute's value, on one line: & < > " escaped,
+    newline, return and tab as character references (an attribute keeps them), other controls
+    as "\\x.."."""
+    return escape(xml_safe(s), {'"': "&quot;", "\n": "&#10;", "\r": "&#13;", "\t": "&#9;"})
+
+
+def xml_clean_tree(root: ET.Element) -> ET.Element:
+    """Every text, tail, comment and attribute of the tree made writable as XML; returns `root`."""
+    for el in root.iter():
+        el.attrib.update({k: xml_safe(v) for k, v in el.attrib.items()})
+        if el.text:
+            el.text = xml_safe(el.text)
+        if el.tail:
+            el.tail = xml_safe(el.tail)
+    return root
+
+
+def csv_cell(x: Any) -> Any:
+    """A text cell a spreadsheet would read as a formula ('=1+2', '-2+3+cmd|...', '@SUM(..)')
+    led by a single quote, as OWASP advises; numbers and other text as they are."""
+    if isinstance(x, str) and x.startswith(_FORMULA_START):
+        return "'" + x
+    return x
+
+
+def markdown_text(s: str) -> str:
+    """`s` as literal text inside a Markdown line (a table cell, a heading): \\ ` * [ ] | ~
+    backslash-escaped, & < as entities (no tag, link, emphasis or extra cell from a name),
+    controls visible, one line."""
+    s = _MARKDOWN.sub(r"\\\1", one_line(s))
+    return s.replace("&", "&amp;").replace("<", "&lt;")
+
+
+def visible(s: str) -> str:
+    """`s` with the control characters a terminal would act on written as "\\x1b" etc.; newlines
+    and tabs kept."""
+    return _CONTROL.sub(_escaped, s)
+
+
+def one_line(s: str) -> str:
+    """`s` on one line: every control character, newlines too, written as "\\n" etc."""
+    return _CONTROL.sub(_escaped, s).replace("\n", "\\n").replace("\t", "\\t")
