@@ -28,6 +28,7 @@ from typing import Callable, Iterable
 from .._io import write_text
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .forces import crank_plan, force_plans, group_plans
+from .lettering import lettering
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
 from .scales import choose_scales
@@ -90,15 +91,17 @@ class Plans(Mapping):
         return buf.getvalue()
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
-        """Write one SVG sheet per plan (`plan_file_name`) and segments.csv into `out_dir`
-        (created), each atomically; returns the paths written."""
+        """Write one SVG sheet per plan (`plan_file_name`) in `lang` ("en", "uk", "ru"; the
+        mechanism named as the model's lettering names it in `lang`) and segments.csv into
+        `out_dir` (created), each atomically; returns the paths written."""
         from .draw import svg
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
+        name = lettering(self.mech).name(lang, self.mech.name)
         for plan in self._plans.values():
             path = out / plan_file_name(plan)
-            write_text(path, svg(plan, lang=lang, mechanism=self.mech.name))
+            write_text(path, svg(plan, lang=lang, mechanism=name))
             written.append(path)
         write_text(out / "segments.csv", self.segments_csv())
         return written + [out / "segments.csv"]
