@@ -1,7 +1,7 @@
 """Sheets in a real browser: Debian's headless Chromium driven by Playwright measures every text's
 and arrowhead's box (getBBox, in the SVG's millimetres) and reports the overlaps a reader would
-see. Used by tests/test_sheet_layout.py; `python -m tests.sheet_browser OUT file.svg ...` writes
-PNG screenshots of sheets instead.
+see. Used by tests/test_sheet_layout.py; as a script (`python tests/sheet_browser.py OUT file.svg
+...`) it writes PNG screenshots of sheets.
 
 May use: playwright, the standard library.
 """

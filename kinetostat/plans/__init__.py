@@ -27,11 +27,12 @@ from typing import Callable, Iterable
 
 from .._io import write_text
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
+from .draw import fits
 from .forces import crank_plan, force_plans, group_plans
 from .lettering import lettering
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
-from .scales import choose_scales
+from .scales import choose_scales, coarser
 
 __all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS",
            "choose_scales", "starting_position", "plan_file_name"]
@@ -42,11 +43,25 @@ BUILDERS: tuple[tuple[str, Callable], ...] = (
     ("positions", positions_plan),
     ("velocity", velocity_plan),
     ("acceleration", acceleration_plan),
-    ("groups", lambda mech, res, sc: group_plans(mech, res, sc["mu_l"])),
-    ("forces", lambda mech, res, sc: force_plans(mech, res, sc["mu_F"])),
-    ("crank", lambda mech, res, sc: crank_plan(mech, res, sc["mu_l"], sc["mu_F"])),
-    ("lever", lambda mech, res, sc: lever_plan(mech, res, sc["mu_v"])),
+    ("groups", lambda mech, res, sc: _fitted(lambda mu: group_plans(mech, res, mu), sc["mu_l"])),
+    ("forces", lambda mech, res, sc: _fitted(lambda mu: force_plans(mech, res, mu), sc["mu_F"])),
+    ("crank", lambda mech, res, sc: _fitted(lambda mu: crank_plan(mech, res, mu, None), sc["mu_l"])),
+    ("lever", lambda mech, res, sc: _fitted(lambda mu: lever_plan(mech, res, mu), sc["mu_v"])),
 )
+def _fitted(make: Callable, mu: Scale) -> list[Plan]:
+    """make(mu) -> a Plan or Plans, made again at the next coarser round scale while one of them
+    overflows its sheet (`draw.fits`: a group's reaction far out on its guide, a polygon longer than its
+    largest force, a lever whose forces reach beyond the velocity plan): the sheet states the
+    scale it is drawn at. A few tries at most; the last is kept."""
+    value = mu.value
+    for _ in range(4):
+        made = make(Scale(mu.symbol, value, mu.unit))
+        plans = list(made) if isinstance(made, (list, tuple)) else [made]
+        factor = max(fits(p) for p in plans)
+        if factor <= 1:
+            break
+        value = coarser(value, factor)
+    return plans
 
 
 class Plans(Mapping):

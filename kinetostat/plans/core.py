@@ -10,11 +10,12 @@ May use: numpy and the standard library. Never matplotlib at import time, never 
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Mapping
 
-__all__ = ["Scale", "Segment", "Result", "Plan", "SEGMENT_COLUMNS"]
+__all__ = ["Scale", "Segment", "Result", "Plan", "SEGMENT_COLUMNS", "extent"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -125,3 +126,12 @@ class Plan:
     def __repr__(self) -> str:
         return (f"Plan({self.kind!r}, phi_deg={self.phi_deg:g}, {self.scale}, points={len(self.points)}, "
                 f"segments={len(self.segments)})")
+
+
+def extent(plan: Plan) -> tuple[float, float, float, float]:
+    """(x0, y0, x1, y1) of the plan's finite points and paths, mm."""
+    zs = [z for z in plan.points.values() if math.isfinite(z.real) and math.isfinite(z.imag)]
+    zs += [z for p in plan.paths.values() for z in p if math.isfinite(z.real) and math.isfinite(z.imag)]
+    if not zs:
+        return 0.0, 0.0, 0.0, 0.0
+    return min(z.real for z in zs), min(z.imag for z in zs), max(z.real for z in zs), max(z.imag for z in zs)

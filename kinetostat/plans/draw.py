@@ -20,12 +20,13 @@ import math
 import re
 from xml.sax.saxutils import escape
 
-from .core import Plan, Scale, Segment
+from .core import Plan, Scale, Segment, extent
 from .i18n import LANGS, MESSAGES, check_lang, num, phrase, text, unit
 from .labels import (ASCENT, DESCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_box,
                      text_width)
 
-__all__ = ["svg", "figure", "title_of", "scale_text", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM"]
+__all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM",
+           "ROOM_MM"]
 
 #: The sheet: A3 landscape, mm.
 SHEET_MM = (420.0, 297.0)
@@ -38,6 +39,18 @@ ARROW_MM = (3.5, 0.6)
 TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
 _POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
 _LINE_STEP = 3.3                             # line spacing of the notes, mm
+_LEFT_NOTES_MM = 120.0                       # width of the notes beside a tall plan, mm
+
+#: Room a plan has on its sheet (width, height), mm: above notes of a few lines, or beside a
+#: column of notes at its left.
+ROOM_MM = ((380.0, 185.0), (262.0, 228.0))
+
+
+def fits(plan: Plan) -> float:
+    """By how much the plan exceeds the room of its sheet (ROOM_MM): <= 1 where it fits."""
+    x0, y0, x1, y1 = extent(plan)
+    return min(max((x1 - x0) / w, (y1 - y0) / h) for w, h in ROOM_MM)
+
 
 #: How each kind of segment is drawn: stroke width (mm), dash pattern, colour.
 _STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
@@ -78,14 +91,6 @@ def segment_label(s: Segment, lang: str) -> str:
 
 # ----------------------------------------------------------------------------- geometry shared by both
 
-def _bbox(plan: Plan) -> tuple[float, float, float, float]:
-    zs = [z for z in plan.points.values() if _finite(z)] + [z for p in plan.paths.values() for z in p if _finite(z)]
-    if not zs:
-        return 0.0, 0.0, 0.0, 0.0
-    xs, ys = [z.real for z in zs], [z.imag for z in zs]
-    return min(xs), min(ys), max(xs), max(ys)
-
-
 def _finite(z: complex) -> bool:
     return math.isfinite(z.real) and math.isfinite(z.imag)
 
@@ -94,15 +99,11 @@ def _drawable(plan: Plan) -> list[Segment]:
     return [s for s in plan.segments if _finite(plan.points[s.start]) and _finite(plan.points[s.end])]
 
 
-def _frame_like(plan: Plan) -> set[str]:
-    """Names of points that are the same in every position (the frame's), from the link segments."""
-    return {n for n in plan.points if not any(n in (s.start, s.end) for s in plan.segments if s.kind == "position")}
-
-
-def _numbered(plan: Plan, name: str, frame: set[str]) -> bool:
-    """Whether a point of the plan of positions is one of the numbered positions (A3, S2_3), not
-    the design position's (A, S2) or the frame's."""
-    return name not in frame and re.sub(r"_?\d+$", "", name) in plan.points and re.sub(r"_?\d+$", "", name) != name
+def _numbered(plan: Plan, name: str) -> bool:
+    """Whether a point of the plan of positions is one of the numbered positions (A3, S2_3): its
+    name less the position's number is the design position's point (A, S2)."""
+    base = re.sub(r"_?\d+$", "", name)
+    return base != name and base in plan.points
 
 
 def _polygon_sides(plan: Plan) -> list[Segment]:
@@ -196,19 +197,21 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
     return out
 
 
-def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], fits: bool | None) -> tuple[list[str], float]:
-    """SVG of the notes bottom left, from the frame's bottom up; returns (svg, top y)."""
-    x0, x1, bottom = _FRAME[0] + 3, _TITLE_BLOCK[0] - 3, _FRAME[3] - 1.5
-    width = x1 - x0
+def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool,
+                 nofit: bool = False) -> tuple[list[str], tuple[float, float, float, float]]:
+    """SVG of the notes and the drawing area they leave: below the plan (bottom left, from the
+    frame's bottom up, beside the title block) or, for a tall plan, in a column at its left."""
+    x0 = _FRAME[0] + 3
+    width = _LEFT_NOTES_MM if left else _TITLE_BLOCK[0] - 3 - x0
     lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
-    if fits is False:
+    if nofit:
         lines.append(text("nofit", lang))
-    rows = _table_rows(plan, lang)
+    rows = [w for r in _table_rows(plan, lang) for w in (_wrap(r, _NOTE_MM, width) if left else [r])]
     col_w = max((text_width(r, _NOTE_MM) for r in rows), default=0.0) + 4.0
-    cols = max(1, int(width // col_w)) if rows else 1
+    cols = 1 if left or not rows else max(1, int(width // col_w))
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
-    top = bottom - height
+    top = _AREA[1] if left else _FRAME[3] - 1.5 - height
     out = ['<g id="notes">']
     y = top + ASCENT * _NOTE_MM
     for line in lines:
@@ -217,7 +220,22 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], fits: bool | None)
     for k, r in enumerate(rows):
         out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
     out.append("</g>")
-    return out, top - 1.0
+    if left:
+        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None
+    return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0))
+
+
+def _layout(plan: Plan, lang: str, tiny: dict[str, str]) -> tuple[list[str], tuple[float, float, float, float]]:
+    """The notes and the drawing area: notes below where the plan fits above them, else in a
+    column at its left where it fits beside them, else below with a note that it does not fit
+    (fitting: with MIN_DRAWN_MM to spare on every side, for a vector drawn out of scale)."""
+    x0, y0, x1, y1 = extent(plan)
+    for left in (False, True):
+        notes, area = _notes_block(plan, lang, tiny, left)
+        if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
+                and y1 - y0 + 2 * MIN_DRAWN_MM <= area[3] - area[1]:      # room for a vector drawn out of scale
+            return notes, area
+    return _notes_block(plan, lang, tiny, False, nofit=True)
 
 
 def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
@@ -234,7 +252,7 @@ def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
             f'<line x1="{x0}" y1="{y0 + 24}" x2="{x1}" y2="{y0 + 24}" stroke="#000" stroke-width="0.25"/>',
             _t(x0 + 3, y0 + 8, title, _fit(title, 5.0, w), weight="bold", cls="title"),
             _t(x0 + 3, y0 + 19.5, sc, _fit(sc, 4.5, w), ident="scale", cls="title"),
-            _t(x0 + 3, y0 + 30, mechanism, _fit(mechanism, 3.0, w), cls="title"),
+            _t(x0 + 3, y0 + 30, mechanism, _fit(mechanism, 3.0, w), ident="mechanism", cls="title"),
             _t(x0 + 3, y0 + 36, angle, 3.0, cls="title"),
             _t(x0 + 3, y0 + 42, text("sheet", lang), MIN_TEXT_MM, cls="title"),
             "</g>"]
@@ -258,12 +276,8 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
     """The plan on an A3 landscape sheet, true to scale (1 user unit = 1 mm), as SVG text."""
     _lang(lang)
     tiny = _tiny(plan)
-    x0, y0, x1, y1 = _bbox(plan)
-    notes, top = _notes_block(plan, lang, tiny, None)
-    ax0, ay0, ax1, ay1 = _AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 2.0)
-    if x1 - x0 > ax1 - ax0 or y1 - y0 > ay1 - ay0:
-        notes, top = _notes_block(plan, lang, tiny, False)
-        ay1 = min(_AREA[3], top - 2.0)
+    x0, y0, x1, y1 = extent(plan)
+    notes, (ax0, ay0, ax1, ay1) = _layout(plan, lang, tiny)
     tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
 
     def P(z: complex) -> tuple[float, float]:
@@ -278,7 +292,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
            f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
            f'fill="none" stroke="#000" stroke-width="0.7"/>',
            '<g id="plan" stroke-linecap="round">']
-    placer = Placer((_FRAME[0] + 1, _FRAME[1] + 1, _FRAME[2] - 1, min(top, _TITLE_BLOCK[1]) - 0.5))
+    placer = Placer((ax0 - 4.0, _FRAME[1] + 1, _FRAME[2] - 1, min(ay1 + 4.0, _TITLE_BLOCK[1]) - 0.5))
     placer.block(_TITLE_BLOCK)
     for name, path in plan.paths.items():
         xy = [P(z) for z in path if _finite(z)]
@@ -315,13 +329,12 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         if not labelled(s.end) or (sides is not None and s.kind == "vector") or s.kind == "arm":
             named.append((label, a, b))
     small = plan.kind == "positions"
-    frame = _frame_like(plan) if small else set()
     dots = []
     for name, z in plan.points.items():
         if not _finite(z) or not labelled(name):
             continue
         a, b = P(z)
-        numbered = small and _numbered(plan, name, frame)
+        numbered = small and _numbered(plan, name)
         r = 0.4 if numbered else 0.6
         out.append(f'<circle cx="{a:.3f}" cy="{b:.3f}" r="{r}" fill="#000"/>')
         placer.block((a - r, b - r, a + r, b + r))
@@ -370,7 +383,7 @@ def figure(plan: Plan, lang: str = "en", ax=None):
     _lang(lang)
     if ax is None:
         from matplotlib.figure import Figure
-        x0, y0, x1, y1 = _bbox(plan)
+        x0, y0, x1, y1 = extent(plan)
         w, h = max(x1 - x0, 1.0), max(y1 - y0, 1.0)
         height = min(max(8.0 * h / w, 3.0), 10.0) + 0.8
         fig = Figure(figsize=(8.0, height), layout=None)     # a fixed layout: margins in inches
@@ -395,11 +408,10 @@ def figure(plan: Plan, lang: str = "en", ax=None):
             ax.annotate(s.name, (b.real, b.imag), xytext=(3, -9), textcoords="offset points", fontsize=8,
                         color=colour)
     small = plan.kind == "positions"
-    frame = _frame_like(plan) if small else set()
     for name, z in plan.points.items():
         if not _finite(z) or not labelled(name):
             continue
-        numbered = small and _numbered(plan, name, frame)
+        numbered = small and _numbered(plan, name)
         ax.plot([z.real], [z.imag], "o", color="k", ms=1.5 if numbered else 3)
         label = _tex(name)
         ax.annotate(label, (z.real, z.imag), xytext=(3, 3), textcoords="offset points", parse_math=label != name,

@@ -410,15 +410,23 @@ def force_plans(mech: "Mechanism", res: "Analysis", mu_F) -> list[Plan]:
     return plans
 
 
-def crank_plan(mech: "Mechanism", res: "Analysis", mu_l, mu_F) -> Plan:
+#: The longest force on the plan of the initial link when it takes a force scale of its own, mm.
+CRANK_FORCE_MM = 80.0
+
+
+def crank_plan(mech: "Mechanism", res: "Analysis", mu_l, mu_F=None) -> Plan:
     """The initial link at mu_l with its loads drawn at mu_F (seed 002 fig. 1.11, seed 000
     sec. 7): the reactions of the groups on it (R21 at A, ...), its own weight and inertia, the
     frame's reaction at the pivot (R01; R41 for seed 002's ICE), the arms h_.. of its moment
     equation about the pivot, and the balancing load: an engine's couple M_bal (an arc, its
     value M_bal = sum of the arms' moments); a working machine's gear mesh (pitch circles of
-    wheel and pinion, pitch point P, line of action at alpha_w, F_bal at P and its arm r_b)."""
+    wheel and pinion, pitch point P, line of action at alpha_w, F_bal at P and its arm r_b).
+    mu_F None: a round force scale of its own, the largest reaction at most CRANK_FORCE_MM."""
     _single(res)
-    mu_l, mu_F = _scale(mu_l, "mu_l", "m/mm"), _scale(mu_F, "mu_F", "N/mm")
+    mu_l = _scale(mu_l, "mu_l", "m/mm")
+    if mu_F is None:
+        mu_F = force_scale(np.hypot(*res.forces.R[0].T), CRANK_FORCE_MM)
+    mu_F = _scale(mu_F, "mu_F", "N/mm")
     dr, L = mech.drive, lettering(mech)
     pts: dict[str, complex] = {}
     segs: list[Segment] = []
