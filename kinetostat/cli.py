@@ -835,8 +835,10 @@ def _plan_names(text: str) -> list[str]:
 def cmd_plans(args) -> int:
     from .plans import build
     from .plans.worksheet import worksheet
+    from .plans.lettering import lettering
     path = Path(args.model)
     mech = _load(path)
+    args.lang = args.lang or lettering(mech).language or "en"
     out = _writable_dir(args.out, "--out")
     only = [n for group in (args.only or []) for n in group] or None
     try:
@@ -899,6 +901,7 @@ def cmd_variant(args) -> int:
             jobs = [(t, c) for t in tasks for c in variants.codes()]
     except ValueError as exc:
         raise CLIError(f"{exc} (see 'kinetostat variant --help')") from None
+    args.lang = args.lang or "uk"                   # seed 002's language (its models' [lettering])
     default = "seed002_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
     t0 = time.perf_counter()
@@ -920,7 +923,7 @@ def cmd_variant(args) -> int:
             bar.update()
         if args.all:
             try:
-                index = variants.write_index(out, keys)
+                index = variants.write_index(out, keys, args.lang)
             except OSError as exc:
                 raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
@@ -1151,7 +1154,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "mu_a [m/(s^2 mm)], mu_F [N/mm], e.g. --scale mu_l=0.001 mu_v=0.2 mu_a=100 mu_F=50")
     pl.add_argument("--starting", metavar="DEG", type=_angle,
                     help="position 0 of the plan of positions (default: found, crank and rod in line)")
-    pl.add_argument("--lang", choices=("en", "uk"), default="en", help="language of the sheets (default en)")
+    pl.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
+                    help="language of the sheets and worksheet (default: the language of the model's text, "
+                         "[lettering] language, else en)")
     pl.add_argument("--only", metavar="PLANS", type=_plan_names, action="append",
                     help="draw only these plans, comma-separated: positions, velocity, acceleration")
     pl.add_argument("--out", metavar="DIR", required=True, help="output directory (created)")
@@ -1181,7 +1186,8 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--all", action="store_true", help="every code of TASK (or of every task), for a teacher")
     va.add_argument("--out", metavar="DIR", help="output directory (created; default ./task<T>_<CODE>, "
                                                  "with --all ./seed002_variants)")
-    va.add_argument("--lang", choices=("en", "uk"), default="en", help="language of the key (default en)")
+    va.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
+                    help="language of the key and the index (default uk: the language of seed 002)")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
     va.set_defaults(func=cmd_variant)
 

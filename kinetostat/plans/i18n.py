@@ -88,6 +88,27 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "pitch circle of the pinion": ("pitch circle of the pinion", "початкове коло шестерні",
                                    "начальная окружность шестерни"),
     "mm": ("mm", "мм", "мм"),
+    # the index of the answer keys
+    "ix.title": ("Seed 002: answer keys of the task variants", "Джерело 002: відповіді до варіантів завдань",
+                 "Источник 002: ответы к вариантам заданий"),
+    "ix.intro": ("Each folder holds the variant's model (`task<T>_<CODE>.toml`, its header states the table's "
+                 "columns and every assumption), its worksheet (`worksheet.md`, `.html`, `.csv`, `.json`) and its "
+                 "plans (`SVG` sheets, `segments.csv`) at the design position φ1. R(i,j) is the force of link i on "
+                 "link j; {M} the moment the drive applies to the crank (about +z, N·m).",
+                 "Кожна тека містить модель варіанта (`task<T>_<CODE>.toml`, у заголовку — стовпці таблиці та всі "
+                 "припущення), розрахунковий лист (`worksheet.md`, `.html`, `.csv`, `.json`) і плани (аркуші `SVG`, "
+                 "`segments.csv`) у розрахунковому положенні φ1. R(i,j) — сила дії ланки i на ланку j; {M} — "
+                 "момент, який привод прикладає до кривошипа (відносно осі +z, Н·м).",
+                 "Каждая папка содержит модель варианта (`task<T>_<CODE>.toml`, в заголовке — столбцы таблицы и все "
+                 "допущения), расчётный лист (`worksheet.md`, `.html`, `.csv`, `.json`) и планы (листы `SVG`, "
+                 "`segments.csv`) в расчётном положении φ1. R(i,j) — сила действия звена i на звено j; {M} — "
+                 "момент, который привод прикладывает к кривошипу (относительно оси +z, Н·м)."),
+    "ix.task": ("Task {task}: {title} (table {table})", "Задача {task}: {title} (таблиця {table})",
+                "Задача {task}: {title} (таблица {table})"),
+    "ix.code": ("code", "код", "код"),
+    "ix.at": ("at φ1", "при φ1", "при φ1"),
+    "ix.largest": ("largest reaction at φ1", "найбільша реакція при φ1", "наибольшая реакция при φ1"),
+    "ix.cycle": ("max over the cycle", "найбільше за цикл", "наибольшее за цикл"),
     # the worksheet
     "ws.title": ("Worksheet: {name}, φ = {phi}°", "Розрахунковий лист: {name}, φ = {phi}°",
                  "Расчётный лист: {name}, φ = {phi}°"),
@@ -205,7 +226,7 @@ def phrase(note: str, lang: str) -> str:
 
 
 def words_en() -> set[str]:
-    """The English words (3 letters or more) of the catalogue's English side: none may appear in
-    uk or ru output."""
+    """The English words (3 letters or more) of the catalogue's English side, less its {fields}
+    and `file names`: none may appear in uk or ru output."""
     texts = [m[0] for m in MESSAGES.values()] + [p[0] for p in PHRASES]
-    return {w.lower() for t in texts for w in re.findall(r"[A-Za-z]{3,}", re.sub(r"\{[^}]*\}", "", t))}
+    return {w.lower() for t in texts for w in re.findall(r"[A-Za-z]{3,}", re.sub(r"\{[^}]*\}|`[^`]*`", "", t))}

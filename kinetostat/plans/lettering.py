@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Mapping
 if TYPE_CHECKING:
     from ..model import Mechanism
 
-__all__ = ["Lettering", "lettering", "DEFAULT"]
+__all__ = ["Lettering", "lettering", "with_aliases", "DEFAULT"]
 
 
 @dataclass(frozen=True)
@@ -75,3 +75,24 @@ def lettering(mech: "Mechanism") -> Lettering:
                      loads=MappingProxyType(dict(given.get("loads", {}))),
                      names=MappingProxyType(dict(given.get("name", {}))),
                      language=str(given.get("language", "")))
+
+
+def with_aliases(df, mech: "Mechanism"):
+    """The analysis frame `df` (`Analysis.to_frame`) with the text's names added as copies of
+    their columns, after them: R_4_3 for R_0_3 where the frame is lettered 4 (and Rx_, Ry_,
+    angle_R_, x_ likewise), M_зр for M_bal, M'_зр for M_lever, F_зр for F_bal. Units carried."""
+    L = lettering(mech)
+    units = dict(df.attrs.get("units", {}))
+    alias: dict[str, str] = {}
+    if L.frame:
+        for col in df.columns:
+            m = re.fullmatch(r"(Rx|Ry|R|angle_R|x|m|vs|as)_(\d+)_(\d+)", col)
+            if m and "0" in m.group(2, 3):
+                i, j = (L.frame if g == "0" else g for g in m.group(2, 3))
+                alias[f"{m.group(1)}_{i}_{j}"] = col
+    for symbol, col in ((L.M_bal, "M_bal"), (L.lever(L.M_bal), "M_lever"), (L.F_bal, "F_bal")):
+        if symbol != col and col in df.columns and symbol not in df.columns:
+            alias[symbol] = col
+    out = df.assign(**{a: df[c] for a, c in alias.items()})
+    out.attrs.update(df.attrs, units=units | {a: units.get(c, "") for a, c in alias.items()})
+    return out
