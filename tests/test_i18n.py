@@ -135,3 +135,14 @@ def test_cli_defaults_to_the_texts_language(cli, tmp_path):
     assert "Velocity plan" in (tmp_path / "yoke" / "velocity.svg").read_text(encoding="utf-8")      # none stated: en
     r = cli("plans", "models/ice_crank_slider.toml", "--only", "velocity", "--lang", "ru", "--out", tmp_path / "ru")
     assert "План скоростей" in (tmp_path / "ru" / "velocity.svg").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("table, field", [
+    ('frame = 2', "lettering.frame"), ('frame = "4"', "lettering.frame"), ('M_bal = ""', "lettering.M_bal"),
+    ('loads = { "gass force" = "F_p" }', "lettering.loads.gass force"), ('language = "fr"', "lettering.language"),
+    ('name = { de = "x" }', "lettering.name.de"), ('colour = "red"', "lettering.colour")])
+def test_bad_lettering_is_named(table, field):
+    text_ = (kinetostat.examples.path("ice_crank_slider").read_text(encoding="utf-8").split("[lettering]")[0]
+             + "[lettering]\n" + table + "\n")
+    with pytest.raises(kinetostat.ModelError, match=re.escape(field)):
+        kinetostat.loads(text_)

@@ -30,6 +30,7 @@ from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .draw import fits
 from .forces import crank_plan, force_plans, group_plans
 from .lettering import lettering
+from .mechanism import mechanism_plan
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
 from .scales import choose_scales, coarser
@@ -40,6 +41,7 @@ __all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_CO
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
 #: Plan or list of Plans).
 BUILDERS: tuple[tuple[str, Callable], ...] = (
+    ("mechanism", mechanism_plan),
     ("positions", positions_plan),
     ("velocity", velocity_plan),
     ("acceleration", acceleration_plan),

@@ -99,6 +99,12 @@ def _drawable(plan: Plan) -> list[Segment]:
     return [s for s in plan.segments if _finite(plan.points[s.start]) and _finite(plan.points[s.end])]
 
 
+#: How a path is drawn, by the first word of its name (mechanism sheet) or its first letter (ω, ε):
+#: stroke width (mm), colour; any other path (paths of centres of mass, circles) thin and blue.
+_PATH_STYLE = {"pin": (0.35, "#000"), "block": (0.5, "#000"), "support": (0.35, "#000"), "hatch": (0.25, "#000"),
+               "com": (0.3, "#000"), "ω": (0.35, "#000"), "ε": (0.35, "#a33")}
+
+
 def _numbered(plan: Plan, name: str) -> bool:
     """Whether a point of the plan of positions is one of the numbered positions (A3, S2_3): its
     name less the position's number is the design position's point (A, S2)."""
@@ -294,14 +300,22 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
            '<g id="plan" stroke-linecap="round">']
     placer = Placer((ax0 - 4.0, _FRAME[1] + 1, _FRAME[2] - 1, min(ay1 + 4.0, _TITLE_BLOCK[1]) - 0.5))
     placer.block(_TITLE_BLOCK)
+    named: list[tuple[str, tuple[float, float], tuple[float, float] | None]] = []   # (label, anchor, along)
     for name, path in plan.paths.items():
         xy = [P(z) for z in path if _finite(z)]
+        if len(xy) < 2:
+            continue
+        width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
         pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in xy)
-        out.append(f'<polyline points="{pts}" fill="none" stroke="#1f5fa8" stroke-width="0.25">'
+        out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="{width}">'
                    f'<title>{escape(text(name, lang) if name in MESSAGES else name)}</title></polyline>')
         for (a, b), (c, d) in zip(xy, xy[1:]):
             placer.line(a, b, c, d)
-    named: list[tuple[str, tuple[float, float], tuple[float, float] | None]] = []   # (label, anchor, along)
+        if name[:1] in "ωε":                  # the sense of a rotation: an arrowhead at the arc's end, its name
+            head, box, _ = _arrowhead(xy[-3], xy[-1], 2.5)
+            out.append(head)
+            placer.block(box)
+            named.append((name, xy[len(xy) // 2], None))
     sides = {s.name for s in _polygon_sides(plan)} or None        # a polygon: every side and chord named
     for s in _drawable(plan):
         a, b = P(plan.points[s.start]), P(plan.points[s.end])

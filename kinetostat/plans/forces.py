@@ -262,9 +262,9 @@ def _link_drawing(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: l
         if p.kind == "P" and k in p.links:
             X = _world(res, p.links[1], p.point) / mu_l.value
             d = complex(*p.direction) * complex(res.kin.rot[0, p.links[0]])
-            pts[f"guide {p.label}:from"], pts[f"guide {p.label}:to"] = X - 40 * d, X + 40 * d
-            segs.append(Segment(f"guide {p.label}", f"guide {p.label}:from", f"guide {p.label}:to",
-                                float("nan"), "", "line"))
+            name = f"guide P({_label(mech, p.links[0])},{_label(mech, p.links[1])})"     # the text's numbers
+            pts[f"{name}:from"], pts[f"{name}:to"] = X - 40 * d, X + 40 * d
+            segs.append(Segment(name, f"{name}:from", f"{name}:to", float("nan"), "", "line"))
 
 
 # -- the plans
