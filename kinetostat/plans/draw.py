@@ -99,10 +99,11 @@ def _drawable(plan: Plan) -> list[Segment]:
     return [s for s in plan.segments if _finite(plan.points[s.start]) and _finite(plan.points[s.end])]
 
 
-#: How a path is drawn, by the first word of its name (mechanism sheet) or its first letter (ω, ε):
+#: How a path is drawn, by the first word of its name (mechanism sheet) or its first letter (ω, ε,
+#: a couple M):
 #: stroke width (mm), colour; any other path (paths of centres of mass, circles) thin and blue.
 _PATH_STYLE = {"pin": (0.35, "#000"), "block": (0.5, "#000"), "support": (0.35, "#000"), "hatch": (0.25, "#000"),
-               "com": (0.3, "#000"), "ω": (0.35, "#000"), "ε": (0.35, "#a33")}
+               "com": (0.3, "#000"), "ω": (0.35, "#000"), "ε": (0.35, "#a33"), "M": (0.5, "#000")}
 
 
 def _numbered(plan: Plan, name: str) -> bool:
@@ -311,7 +312,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
                    f'<title>{escape(text(name, lang) if name in MESSAGES else name)}</title></polyline>')
         for (a, b), (c, d) in zip(xy, xy[1:]):
             placer.line(a, b, c, d)
-        if name[:1] in "ωε":                  # the sense of a rotation: an arrowhead at the arc's end, its name
+        if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
             head, box, _ = _arrowhead(xy[-3], xy[-1], 2.5)
             out.append(head)
             placer.block(box)
