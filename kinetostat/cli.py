@@ -854,8 +854,7 @@ def cmd_plans(args) -> int:
             written += sheet.write(out)
     except OSError as exc:
         raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
-    scales = ", ".join(str(s) for s in plans.scales.values())
-    _Out.write(f"{path.name} at phi = {plans.at:g} deg ({scales}): {len(written)} files -> {out}")
+    _Out.write(plans.summary(path.name, len(written), out, args.lang))
     return EXIT_OK
 
 
@@ -932,17 +931,7 @@ def cmd_variant(args) -> int:
         _Out.write(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
                    f"index -> {index}; {time.perf_counter() - t0:.1f} s")
         return EXIT_OK
-    v, k = jobs[0], keys[0]
-    spec = variants.TASKS[v.task]
-    lines = [f"seed 002, task {v.task} ({spec.title}), variant {v.code}: table {spec.table} columns "
-             + " ".join(f"{ch}={v.code[i]}" for ch, i in variants.LETTERS.items())]
-    lines += [f"  {r.letter}  {r.symbol:<22s} = {v.values[r.key]:g} {r.unit if r.unit != '1' else ''}".rstrip()
-              for r in spec.rows]
-    lines += [f"at phi1 = {k.phi1:g} deg: M_bal = {_fmt(k.M_bal, 'N m')}, largest reaction |{k.largest}| = "
-              f"{_fmt(k.R_max, 'N')}",
-              f"over the cycle: max |M_bal| = {_fmt(k.cycle_M_max, 'N m')}, max |R| = {_fmt(k.cycle_R_max, 'N')}",
-              f"model {v.name}.toml (assumptions in its header), worksheet, plans and cycle.csv: "
-              f"{len(k.files)} files -> {out}"]
+    lines = variants.summary(jobs[0], keys[0], out, args.lang)
     _Out.write("\n".join(lines))
     return EXIT_OK
 

@@ -608,6 +608,25 @@ def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
     return "\n".join(lines)
 
 
+def summary(v: Variant, k: KeySummary, out: str | Path, lang: str = "en") -> list[str]:
+    """What `kinetostat variant TASK CODE` prints, in `lang`: the code's columns, the rows'
+    values, M_зр and the largest reaction at phi1 and over the cycle, the files written."""
+    from .plans.i18n import num, text, unit
+    spec, L = TASKS[v.task], lettering_of(v.task)
+    title = spec.title if lang == "en" else TITLES[spec.task][lang == "ru"]
+    Nm, N = unit("N m", lang), unit("N", lang)
+    lines = [text("cli.variant", lang, task=v.task, title=title, code=v.code, table=spec.table)
+             + " " + " ".join(f"{ch}={v.code[i]}" for ch, i in LETTERS.items())]
+    lines += [f"  {r.letter}  {r.symbol:<22s} = {num(v.values[r.key], lang, 6)} {unit(r.unit, lang)}".rstrip()
+              for r in spec.rows]
+    lines += [text("cli.at", lang, phi=num(k.phi1, lang, 6), M=L.M_bal, M_value=f"{num(k.M_bal, lang, 5)} {Nm}",
+                   R=k.largest, R_value=f"{num(k.R_max, lang, 5)} {N}"),
+              text("cli.cycle", lang, M=L.M_bal, M_value=f"{num(k.cycle_M_max, lang, 5)} {Nm}",
+                   R_value=f"{num(k.cycle_R_max, lang, 5)} {N}"),
+              text("cli.files", lang, model=f"{v.name}.toml", n=len(k.files), out=out)]
+    return lines
+
+
 def lettering_of(task: int):
     """The lettering of task `task`'s variants (that of its bundled model)."""
     from .plans.lettering import lettering

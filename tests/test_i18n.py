@@ -91,6 +91,10 @@ def test_variant_key_and_index_print_no_english(lang, tmp_path):
     variants.write_index(tmp_path, [key], lang)
     assert _english(tmp_path) == {}
     assert "|M_зр|" in (tmp_path / "index.md").read_text(encoding="utf-8")
+    printed = "\n".join(variants.summary(v, key, tmp_path, lang))     # what `kinetostat variant` prints
+    words = re.sub(r"`[^`]*`|\S+\.toml|\S*_\S*|/\S+", "", printed)      # less file names and symbols (P_max)
+    assert not {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in words_en()}, printed
+    assert "M_зр = " in printed and "Н·м" in printed
 
 
 def test_english_is_found_where_it_is(ice, tmp_path):
@@ -135,6 +139,8 @@ def test_cli_defaults_to_the_texts_language(cli, tmp_path):
     assert "Velocity plan" in (tmp_path / "yoke" / "velocity.svg").read_text(encoding="utf-8")      # none stated: en
     r = cli("plans", "models/ice_crank_slider.toml", "--only", "velocity", "--lang", "ru", "--out", tmp_path / "ru")
     assert "План скоростей" in (tmp_path / "ru" / "velocity.svg").read_text(encoding="utf-8")
+    words = re.sub(r"\S+\.toml|\S*_\S*|/\S+", "", r.stdout)                # less file names and symbols
+    assert "файлов" in r.stdout and not {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in words_en()}
 
 
 @pytest.mark.parametrize("table, field", [

@@ -94,6 +94,13 @@ class Plans(Mapping):
     def rows(self) -> list[dict]:
         return [r for p in self._plans.values() for r in p.rows()]
 
+    def summary(self, name: str, n_files: int, out, lang: str = "en") -> str:
+        """One line for the command line in `lang`: the model, the angle, the scales, the files."""
+        from .draw import scale_text
+        from .i18n import num, text
+        scales = ", ".join(scale_text(s, lang) for s in self.scales.values())
+        return text("cli.plans", lang, name=name, phi=num(self.at, lang, 6), scales=scales, n=n_files, out=out)
+
     def segments_frame(self):
         """Every drawn segment as a pandas DataFrame with the columns of segments.csv."""
         import pandas as pd
