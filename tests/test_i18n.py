@@ -73,9 +73,14 @@ def ice():
     return kinetostat.load("ice_crank_slider")
 
 
+@pytest.fixture(scope="module")
+def ice_plans(ice):
+    return P.build(ice, at=30)
+
+
 @pytest.mark.parametrize("lang", ["uk", "ru"])
-def test_plans_and_worksheet_print_no_english(ice, lang, tmp_path):
-    plans = P.build(ice, at=30)
+def test_plans_and_worksheet_print_no_english(ice, ice_plans, lang, tmp_path):
+    plans = ice_plans
     plans.write(tmp_path, lang=lang)
     worksheet(ice, 30, mu_l=plans.scales["mu_l"].value, lang=lang).write(tmp_path)
     assert _english(tmp_path) == {}
@@ -97,18 +102,18 @@ def test_variant_key_and_index_print_no_english(lang, tmp_path):
     assert "M_зр = " in printed and "Н·м" in printed
 
 
-def test_english_is_found_where_it_is(ice, tmp_path):
+def test_english_is_found_where_it_is(ice_plans, tmp_path):
     """The check itself: an English sheet is caught."""
-    P.build(ice, at=30, only=["velocity"]).write(tmp_path, lang="en")
+    (tmp_path / "velocity.svg").write_text(P.draw.svg(ice_plans["velocity"], lang="en"), encoding="utf-8")
     assert "velocity.svg" in _english(tmp_path)
 
 
-def test_the_texts_names_agree_across_outputs(ice, tmp_path):
+def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path):
     """Seed 002 numbers the cylinder 4 and writes R43, R41, M_зр, F_зр, F_p: the sheets, the
     worksheet and cycle.csv's aliases say the same, and nothing says R03, R01 or M_bal."""
     L = lettering(ice)
     assert (L.frame, L.M_bal, L.F_bal, L.load("gas force")) == (4, "M_зр", "F_зр", "F_p")
-    plans = P.build(ice, at=30)
+    plans = ice_plans
     plans.write(tmp_path, lang="uk")
     sheets = {p.stem: _words(p) for p in tmp_path.glob("*.svg")}
     ws = worksheet(ice, 30, lang="uk")
@@ -125,8 +130,8 @@ def test_the_texts_names_agree_across_outputs(ice, tmp_path):
     assert frame.attrs["units"]["M_зр"] == "N m"
 
 
-def test_svg_sheets_parse_in_every_language(ice):
-    plan = P.build(ice, at=30, only=["velocity"])["velocity"]
+def test_svg_sheets_parse_in_every_language(ice_plans):
+    plan = ice_plans["velocity"]
     for lang in LANGS:
         ET.fromstring(P.draw.svg(plan, lang=lang).encode())
 
