@@ -162,7 +162,7 @@ def _result_line(plan: Plan, lang: str) -> list[str]:
         return []
     parts = []
     for r in plan.results:
-        part = f"{r.symbol} = {num(r.value, lang)} {unit(r.unit, lang)}".rstrip()
+        part = f"{r.symbol} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
         parts.append(part + (f" ({text(r.how, lang)})" if r.how else ""))
     return [f"{text('results', lang)}: " + "; ".join(parts)]
 
@@ -180,7 +180,7 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
             L = abs(plan.points[s.end] - plan.points[s.start])
             key = "out of scale" if tiny[s.name] == "out" else "negligible"
             mark = "*" if tiny[s.name] == "out" else ""
-            lines.append(f"{s.name}{mark} = {num(s.value, lang)} {unit(s.unit, lang)}: "
+            lines.append(f"{s.name}{mark} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
                          f"{text(key, lang, length=num(L, lang, decimals=2))}")
     if plan.kind == "lever":
         lines.append(text("arms natural", lang))
@@ -196,7 +196,7 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
         if s.kind not in ("vector", "arm") or not math.isfinite(s.value):
             continue
         L = num(plan.length_mm(s.name), lang, decimals=2)
-        value = f"{num(s.value, lang)} {unit(s.unit, lang)}".rstrip()
+        value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
         if sides:
             out.append(f"{text('segment', lang)} {s.start}{s.end} = {L} {mm} → {s.name} = {value}")
         else:
