@@ -904,8 +904,10 @@ def cmd_plans(args) -> int:
     from .errors import SingularPositionWarning
     from .plans import build
     from .plans.worksheet import worksheet
+    from .plans.lettering import lettering
     path = Path(args.model)
     mech = _load(path)
+    args.lang = args.lang or lettering(mech).language or "en"
     out = _writable_dir(args.out, "--out")
     only = [n for group in (args.only or []) for n in group] or None
     args.at, args.starting = _turn(args.at, "--at"), _turn(args.starting, "--starting")
@@ -925,12 +927,11 @@ def cmd_plans(args) -> int:
             written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])
     except (OSError, ValueError) as exc:
         raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
-    scales = ", ".join(str(s) for s in plans.scales.values())
     at_plan = [w for w in caught if issubclass(w.category, SingularPositionWarning)
                and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
-    _Out.write(f"{path.name} at phi = {plans.at:g} deg ({scales}): {len(written)} files -> {out}")
+    _Out.write(plans.summary(path.name, len(written), out, args.lang))
     return EXIT_OK
 
 
@@ -976,6 +977,7 @@ def cmd_variant(args) -> int:
             jobs = [(t, c) for t in tasks for c in variants.codes()]
     except ValueError as exc:
         raise CLIError(f"{exc} (see 'kinetostat variant --help')") from None
+    args.lang = args.lang or "uk"                   # seed 002's language (its models' [lettering])
     default = "seed002_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
     t0 = time.perf_counter()
@@ -997,7 +999,7 @@ def cmd_variant(args) -> int:
             bar.update()
         if args.all:
             try:
-                index = variants.write_index(out, keys)
+                index = variants.write_index(out, keys, args.lang)
             except OSError as exc:
                 raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
@@ -1006,17 +1008,7 @@ def cmd_variant(args) -> int:
         _Out.write(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
                    f"index -> {index}; {time.perf_counter() - t0:.1f} s")
         return EXIT_OK
-    v, k = jobs[0], keys[0]
-    spec = variants.TASKS[v.task]
-    lines = [f"seed 002, task {v.task} ({spec.title}), variant {v.code}: table {spec.table} columns "
-             + " ".join(f"{ch}={v.code[i]}" for ch, i in variants.LETTERS.items())]
-    lines += [f"  {r.letter}  {r.symbol:<22s} = {v.values[r.key]:g} {r.unit if r.unit != '1' else ''}".rstrip()
-              for r in spec.rows]
-    lines += [f"at phi1 = {k.phi1:g} deg: M_bal = {_fmt(k.M_bal, 'N m')}, largest reaction |{k.largest}| = "
-              f"{_fmt(k.R_max, 'N')}",
-              f"over the cycle: max |M_bal| = {_fmt(k.cycle_M_max, 'N m')}, max |R| = {_fmt(k.cycle_R_max, 'N')}",
-              f"model {v.name}.toml (assumptions in its header), worksheet, plans and cycle.csv: "
-              f"{len(k.files)} files -> {out}"]
+    lines = variants.summary(jobs[0], keys[0], out, args.lang)
     _Out.write("\n".join(lines))
     return EXIT_OK
 
@@ -1255,7 +1247,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "mu_a [m/(s^2 mm)], mu_F [N/mm], e.g. --scale mu_l=0.001 mu_v=0.2 mu_a=100 mu_F=50")
     pl.add_argument("--starting", metavar="DEG", type=_angle,
                     help="position 0 of the plan of positions (default: found, crank and rod in line)")
-    pl.add_argument("--lang", choices=("en", "uk"), default="en", help="language of the sheets (default en)")
+    pl.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
+                    help="language of the sheets and worksheet (default: the language of the model's text, "
+                         "[lettering] language, else en)")
     pl.add_argument("--only", metavar="PLANS", type=_plan_names, action="append",
                     help="draw only these plans, comma-separated: positions, velocity, acceleration")
     pl.add_argument("--out", metavar="DIR", required=True, help="output directory (created)")
@@ -1285,7 +1279,8 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--all", action="store_true", help="every code of TASK (or of every task), for a teacher")
     va.add_argument("--out", metavar="DIR", help="output directory (created; default ./task<T>_<CODE>, "
                                                  "with --all ./seed002_variants)")
-    va.add_argument("--lang", choices=("en", "uk"), default="en", help="language of the key (default en)")
+    va.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
+                    help="language of the key and the index (default uk: the language of seed 002)")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
     va.set_defaults(func=cmd_variant)
 

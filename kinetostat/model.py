@@ -307,6 +307,9 @@ class Mechanism:
     #: every field and parameter given as an expression: field path -> (expression, value)
     expressions: Mapping[str, tuple[str, float]] = field(default_factory=lambda: MappingProxyType({}))
     study: Study | None = None
+    #: `[lettering]`: the names the model's source text uses (frame, M_bal, F_bal, loads, name,
+    #: language), as given; read through `kinetostat.plans.lettering.lettering`
+    lettering: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     #: Structural analysis (mobility, Assur groups, structure formula), derived from the pairs
     #: when the mechanism is built; raises StructureError for what kinetostat does not analyse.
     structure: Structure = field(init=False, repr=False, compare=False)
@@ -643,7 +646,7 @@ LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
 GYRATION_SPANS, FORCE_SCALE = 100.0, 1e-4
 
 _TOP_KEYS = {"mechanism", "parameters", "drive", "frame", "link", "pair", "group", "load", "spring", "friction",
-             "published", "study"}
+             "published", "study", "lettering"}
 #: Most parameters of one file, and most values one parameter takes in a study.
 MAX_PARAMETERS, MAX_STUDY_VALUES = 1000, 50
 #: Most crank angles one `[[published]]` entry may list.
@@ -860,6 +863,45 @@ class _Reader:
             return None
         return x
 
+    def lettering(self, links: list[Link], loads: list[Load]) -> Mapping[str, Any]:
+        """`[lettering]`: the text's names (models/FORMAT.md), checked; frozen."""
+        t = self.data.get("lettering", {})
+        if not isinstance(t, dict):
+            self.err("lettering: expected a table")
+            return MappingProxyType({})
+        self.unknown_keys(t, {"frame", "M_bal", "F_bal", "loads", "name", "language"}, "lettering")
+        out: dict[str, Any] = {}
+        if "frame" in t:
+            k = t["frame"]
+            if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k <= 99 or (k and k < len(links)):
+                self.err(f"lettering.frame: expected the frame's number 0..99, not a moving link's "
+                         f"(1..{len(links) - 1}), got {k!r}")
+            else:
+                out["frame"] = k
+        for key in ("M_bal", "F_bal"):
+            x = self.string(t, key, "lettering", default=None)
+            if x is not None and not (0 < len(x) <= 16 and x.isprintable()):
+                self.err(f"lettering.{key}: expected a symbol of 1..16 printable characters, got {x!r}")
+            elif x is not None:
+                out[key] = x
+        x = self.string(t, "language", "lettering", choices=("en", "uk", "ru"), default=None)
+        if x is not None:
+            out["language"] = x
+        names = {ld.name for ld in loads}
+        for key, valid in (("loads", names), ("name", {"en", "uk", "ru"})):
+            tab = t.get(key, {})
+            if not isinstance(tab, dict) or not all(isinstance(v, str) and v.isprintable() for v in tab.values()):
+                self.err(f"lettering.{key}: expected a table of strings")
+                continue
+            bad = sorted(set(tab) - valid)
+            if bad:
+                self.err(f"lettering.{key}.{bad[0]}: no such {'load' if key == 'loads' else 'language'}. "
+                         f"Valid: {sorted(valid)}")
+                continue
+            if tab:
+                out[key] = MappingProxyType(dict(tab))
+        return MappingProxyType(out)
+
     def table_list(self, key: str) -> list:
         x = self.data.get(key, [])
         if not isinstance(x, list) or not all(isinstance(t, dict) for t in x):
@@ -905,6 +947,7 @@ class _Reader:
         friction = self.friction()
         published = self.published(links, pairs, drive)
         study = self.study(pairs)
+        lettering = self.lettering(links, loads_)
         if friction is not None and friction.radius is None:
             for p in pairs:
                 if p.kind == "R" and p.radius is None:
@@ -920,7 +963,7 @@ class _Reader:
                              springs=tuple(springs), drive=drive, friction=friction,
                              published=tuple(published), path=self.source,
                              parameters=MappingProxyType({n: v for n, v in self.values.items() if n != "g"}),
-                             expressions=MappingProxyType(self.expressions), study=study)
+                             expressions=MappingProxyType(self.expressions), study=study, lettering=lettering)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
         for path, msg in self.doubts(mech):

@@ -65,6 +65,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import re
 import textwrap
 from dataclasses import dataclass
 from functools import lru_cache
@@ -309,7 +310,30 @@ def _rod_inertia(G_rod: float, length: float) -> float:
     return G_rod / G * length ** 2 / 12
 
 
-def _model(task: int, v: Mapping[str, float], label: str, assumptions: list[str]) -> dict:
+#: Each task's title and the name of a variant in Ukrainian and Russian (the sheets' lettering).
+TITLES = {
+    1: ("Кривошипно-повзунний механізм двотактного ДВЗ водонасосної установки",
+        "Кривошипно-ползунный механизм двухтактного ДВС водонасосной установки"),
+    2: ("Двотактний ДВЗ з протилежними циліндрами транспортної силової установки",
+        "Двухтактный ДВС с противолежащими цилиндрами транспортной силовой установки"),
+    3: ("Одноступеневий повітряний компресор простої дії", "Одноступенчатый воздушный компрессор простого действия"),
+}
+_NAME = ("{title} (джерело 002, задача {task}, {label})", "{title} (источник 002, задача {task}, {label})")
+_LABEL = (("варіант {code}", "задані значення"), ("вариант {code}", "заданные значения"))
+
+
+def _lettering(task: int, code: str | None) -> dict:
+    """The variant's [lettering]: the bundled model's (frame, M_зр, F_зр, loads, language) and
+    the variant's name in Ukrainian and Russian."""
+    ref = dict(_bundled(TASKS[task].bundled).lettering)
+    names = {}
+    for lang, i in (("uk", 0), ("ru", 1)):
+        label = _LABEL[i][0].format(code=code) if code else _LABEL[i][1]
+        names[lang] = _NAME[i].format(title=TITLES[task][i], task=task, label=label)
+    return {k: (dict(x) if isinstance(x, Mapping) else x) for k, x in ref.items() if k != "name"} | {"name": names}
+
+
+def _model(task: int, v: Mapping[str, float], label: str, assumptions: list[str], code: str | None = None) -> dict:
     """The model dict of task `task` with table values `v`."""
     spec = TASKS[task]
     l_OA, length = v["l_OA"], v["ratio"] * v["l_OA"]
@@ -353,6 +377,7 @@ def _model(task: int, v: Mapping[str, float], label: str, assumptions: list[str]
         for key, items in part.items():
             model[key] += items
     model["link"].sort(key=lambda t: t["id"])
+    model["lettering"] = _lettering(task, code)
     return model
 
 
@@ -399,7 +424,7 @@ def build(task: int, v: Mapping[str, float], code: str | None = None, columns: M
               f"(lines 56-63): " if code else "Values given, not a code: ")
     chosen += ", ".join(f"{r.symbol} = {v[r.key]:g}{_unit(r)}" for r in spec.rows) + "."
     assumptions = [chosen] + ([_AMBIGUITY_G2] if task == 1 else []) + _ASSUMED[task] + _COMMON
-    model = _model(task, v, label, assumptions)
+    model = _model(task, v, label, assumptions, code)
     return Variant(task, code, MappingProxyType(dict(columns or {})), MappingProxyType(dict(v)), model,
                    _header(spec, v, code, columns, model, assumptions))
 
@@ -446,6 +471,11 @@ def _header(spec: TaskTable, v, code, cols, model, assumptions) -> tuple[str, ..
 
 # ============================================================================ TOML
 
+def _key(k: str) -> str:
+    """A TOML key: bare where it may be, else quoted."""
+    return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else json.dumps(k, ensure_ascii=False)
+
+
 def _value(x: Any) -> str:
     if isinstance(x, bool):
         return "true" if x else "false"
@@ -458,7 +488,7 @@ def _value(x: Any) -> str:
     if isinstance(x, (list, tuple)):
         return "[" + ", ".join(_value(y) for y in x) + "]"
     if isinstance(x, Mapping):
-        return "{ " + ", ".join(f"{k} = {_value(y)}" for k, y in x.items()) + " }"
+        return "{ " + ", ".join(f"{_key(k)} = {_value(y)}" for k, y in x.items()) + " }"
     raise TypeError(f"cannot write {type(x).__name__} to TOML")
 
 
@@ -466,14 +496,14 @@ def _body(path: str, table: Mapping, array: bool) -> list[str]:
     head = f"[[{path}]]" if array else f"[{path}]"
     lines, subs = ["", head], []
     for k, x in table.items():
-        if isinstance(x, Mapping) and k != "points":
+        if isinstance(x, Mapping) and k not in ("points", "loads", "name"):
             subs.append((k, x))
         elif isinstance(x, list) and x and all(isinstance(s, str) for s in x) and len(_value(x)) > 80:
             lines.append(f"{k} = [")
             lines += [f"    {_value(s)}," for s in x]
             lines.append("]")
         else:
-            lines.append(f"{k} = {_value(x)}")
+            lines.append(f"{_key(k)} = {_value(x)}")
     for k, x in subs:
         lines += _body(f"{path}.{k}", x, False)
     return lines
@@ -512,7 +542,11 @@ class KeySummary:
 
 
 def _largest(res, mech: Mechanism, n: int = 0) -> tuple[str, float]:
-    mags = {f"R({p.links[0]},{p.links[1]})": float(np.linalg.norm(res.forces.R[n, p.index])) for p in mech.pairs}
+    """The most loaded pair at angle n, named as the model's text names its reaction (R43), N."""
+    from .plans.lettering import lettering
+    frame = lettering(mech).frame
+    mags = {"R" + "".join(str(k or frame) for k in p.links): float(np.linalg.norm(res.forces.R[n, p.index]))
+            for p in mech.pairs}
     label = max(mags, key=mags.get)
     return label, mags[label]
 
@@ -521,11 +555,13 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
               steps: int = 360, root: str | Path | None = None) -> KeySummary:
     """Write the variant's model file `<name>.toml` and its answer key into `out_dir` (created): the
     worksheet (worksheet.md/html/csv/json) and the plans (SVG sheets, segments.csv) at the design
-    position, and with `cycle_csv` the analysis over the cycle (cycle.csv, `steps` positions).
-    The files are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside
-    `root` (default: itself), ValueError otherwise."""
+    position in `lang` ("en", "uk", "ru"), and with `cycle_csv` the analysis over the cycle
+    (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр). The files
+    are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
+    (default: itself), ValueError otherwise."""
     from .analysis import analyze
     from .plans import build as build_plans
+    from .plans.lettering import with_aliases
     from .plans.worksheet import worksheet
     from .tables import csv_text
     out = Path(out_dir)
@@ -539,7 +575,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
         files += plans.write(tmp, lang=lang) + sheet.write(tmp)
         if cycle_csv:
-            files.append(write_text(tmp / "cycle.csv", csv_text(res.to_frame())))
+            files.append(write_text(tmp / "cycle.csv", csv_text(with_aliases(res.to_frame(), mech))))
     files = [out / f.relative_to(tmp) for f in files]
     label, R = _largest(at, mech)
     R_cycle = max(float(np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))) for p in mech.pairs)
@@ -547,32 +583,59 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
                       float(np.nanmax(np.abs(res.balancing_moment))), R_cycle, tuple(files))
 
 
-def index_markdown(keys: list[KeySummary]) -> str:
-    """The teacher's index of answer keys: per task a table code -> phi1, M_bal and the largest
-    reaction at phi1, and the largest |M_bal| and |R| over the cycle; each code links to the
-    worksheet in its folder `<name>/` (`KeySummary.name`)."""
-    lines = ["# Seed 002: answer keys of the task variants", "",
-             "Each folder holds the variant's model (`task<T>_<CODE>.toml`, its header states the table's "
-             "columns and every assumption), its worksheet (`worksheet.md`, `.html`, `.csv`, `.json`) and "
-             "its plans (SVG sheets, `segments.csv`) at the design position phi1. R(i,j) is the force of "
-             "link i on link j; M_bal the moment the drive applies to the crank (about +z, N m).", ""]
+def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
+    """The teacher's index of answer keys in `lang` ("en", "uk", "ru"): per task a table code ->
+    phi1, M_зр and the largest reaction at phi1, and the largest |M_зр| and |R| over the cycle;
+    each code links to the worksheet in its folder `<name>/` (`KeySummary.name`)."""
+    from .plans.i18n import num, text, unit
+    M = lettering_of(1).M_bal
+    Nm, N, deg = unit("N m", lang), unit("N", lang), unit("deg", lang)
+    lines = [f"# {text('ix.title', lang)}", "", text("ix.intro", lang, M=M), ""]
     by_task: dict[str, list[KeySummary]] = {}
     for k in keys:
         by_task.setdefault(k.name.split("_")[0], []).append(k)
     for task, ks in by_task.items():
         spec = TASKS[int(task[4:])]
-        lines += [f"## Task {spec.task}: {spec.title} (table {spec.table})", "",
-                  "| code | phi1, deg | M_bal at phi1, N m | largest reaction at phi1, N | "
-                  "max abs M_bal over the cycle, N m | max R over the cycle, N |",
+        title = spec.title if lang == "en" else TITLES[spec.task][lang == "ru"]
+        cyc = text("ix.cycle", lang)
+        lines += [f"## {text('ix.task', lang, task=spec.task, title=title, table=spec.table)}", "",
+                  f"| {text('ix.code', lang)} | φ1, {deg} | {M} {text('ix.at', lang)}, {Nm} | "
+                  f"{text('ix.largest', lang)}, {N} | |{M}| {cyc}, {Nm} | |R| {cyc}, {N} |",
                   "|---|---:|---:|---|---:|---:|"]
         for k in ks:
             code = k.name.split("_", 1)[1]
-            lines.append(f"| [{code}]({k.name}/worksheet.md) | {k.phi1:g} | {k.M_bal:.2f} | "
-                         f"{k.largest} = {k.R_max:.1f} | {k.cycle_M_max:.2f} | {k.cycle_R_max:.1f} |")
+            lines.append(f"| [{code}]({k.name}/worksheet.md) | {num(k.phi1, lang, 6)} | "
+                         f"{num(k.M_bal, lang, decimals=2)} | {k.largest} = {num(k.R_max, lang, decimals=1)} | "
+                         f"{num(k.cycle_M_max, lang, decimals=2)} | {num(k.cycle_R_max, lang, decimals=1)} |")
         lines.append("")
     return "\n".join(lines)
 
 
-def write_index(out_dir: str | Path, keys: list[KeySummary]) -> Path:
-    """`index_markdown(keys)` into `out_dir/index.md`, atomically; returns its path."""
-    return write_text(Path(out_dir) / "index.md", index_markdown(keys))
+def summary(v: Variant, k: KeySummary, out: str | Path, lang: str = "en") -> list[str]:
+    """What `kinetostat variant TASK CODE` prints, in `lang`: the code's columns, the rows'
+    values, M_зр and the largest reaction at phi1 and over the cycle, the files written."""
+    from .plans.i18n import num, text, unit
+    spec, L = TASKS[v.task], lettering_of(v.task)
+    title = spec.title if lang == "en" else TITLES[spec.task][lang == "ru"]
+    Nm, N = unit("N m", lang), unit("N", lang)
+    lines = [text("cli.variant", lang, task=v.task, title=title, code=v.code, table=spec.table)
+             + " " + " ".join(f"{ch}={v.code[i]}" for ch, i in LETTERS.items())]
+    lines += [f"  {r.letter}  {r.symbol:<22s} = {num(v.values[r.key], lang, 6)} {unit(r.unit, lang)}".rstrip()
+              for r in spec.rows]
+    lines += [text("cli.at", lang, phi=num(k.phi1, lang, 6), M=L.M_bal, M_value=f"{num(k.M_bal, lang, 5)} {Nm}",
+                   R=k.largest, R_value=f"{num(k.R_max, lang, 5)} {N}"),
+              text("cli.cycle", lang, M=L.M_bal, M_value=f"{num(k.cycle_M_max, lang, 5)} {Nm}",
+                   R_value=f"{num(k.cycle_R_max, lang, 5)} {N}"),
+              text("cli.files", lang, model=f"{v.name}.toml", n=len(k.files), out=out)]
+    return lines
+
+
+def lettering_of(task: int):
+    """The lettering of task `task`'s variants (that of its bundled model)."""
+    from .plans.lettering import lettering
+    return lettering(_bundled(TASKS[task].bundled))
+
+
+def write_index(out_dir: str | Path, keys: list[KeySummary], lang: str = "en") -> Path:
+    """`index_markdown(keys, lang)` into `out_dir/index.md`, atomically; returns its path."""
+    return write_text(Path(out_dir) / "index.md", index_markdown(keys, lang))

@@ -11,6 +11,7 @@ import pytest
 import kinetostat
 from kinetostat.plans.core import Scale
 from kinetostat.plans.forces import crank_plan, default_mu_F, force_plans, group_plans, link_loads, reaction_name
+from kinetostat.plans.lettering import lettering
 from kinetostat.plans.lever import lever_check, lever_plan, pole_moment
 
 MODELS = sorted((Path(__file__).parent.parent / "models").glob("*.toml"))
@@ -59,7 +60,8 @@ def test_seed_002_polygon_order(ice):
     """R12t + G2 + F_i2 + G3 + F_i3 + F_p + R43 + R12n = 0, from the known R12t (seed 002)."""
     plan = _plans(*ice)["forces:2,3"]
     order = [s.name for s in plan.segments][:8]
-    assert order == ["R12t", "G2", "F_i2", "G3", "F_i3", "P3", "R43", "R12n"]
+    assert order == ["R12t", "G2", "F_i2", "G3", "F_i3", "F_p", "R43", "R12n"]    # the text's lettering
+    assert plan.equation == tuple(order)
 
 
 def _angles(mech):
@@ -131,9 +133,11 @@ def test_every_model(analysed, path, n):
             assert abs(total - expected) <= 1e-9 * max(abs(expected), largest * mu_F.value)
     # the lever: the loads' moment about the pole x mu_v / omega_1 = M_bal, and F'_bal cancels it
     lever = plans["lever"]
+    F_bal = lettering(mech).lever(lettering(mech).F_bal)       # F'_bal, or the text's F'_зр
+    assert lever.segments[-1].name == F_bal
     omega1 = res.omega(1)[0]
     terms = [abs(s.value) * lever.length_mm(f"h_{s.name.replace('_', '')}") for s in lever.segments
-             if s.unit == "N" and s.name != "F'_bal" and abs(s.value) > 0 and lever.points[s.start] != 0]
+             if s.unit == "N" and s.name != F_bal and abs(s.value) > 0 and lever.points[s.start] != 0]
     largest = max(terms + [abs(res.balancing_moment[0]) * abs(omega1) / MU_V.value])
     M = res.balancing_moment[0]
     assert abs(pole_moment(lever) - M * omega1 / MU_V.value) <= 1e-9 * largest
@@ -142,7 +146,7 @@ def test_every_model(analysed, path, n):
     crank = plans["crank"]
     if mech.drive.kind == "machine":
         F_bal = np.hypot(*res.balancing_force[0])
-        assert crank.segment("F_bal").value == pytest.approx(F_bal, rel=1e-9)
+        assert crank.segment(lettering(mech).F_bal).value == pytest.approx(F_bal, rel=1e-9)
         assert crank.segment("r_b").value == pytest.approx(mech.drive.gear.r_b, rel=1e-9)
         assert F_bal * mech.drive.gear.r_b == pytest.approx(abs(M), rel=1e-9)
     else:

@@ -140,7 +140,7 @@ def test_positions_plan_has_twelve_positions_design_and_paths(ice_plans):
 
 def test_svg_sheet(ice_plans, tmp_path):
     written = ice_plans.write(tmp_path, lang="uk")
-    assert {p.name for p in written} == {"positions.svg", "velocity.svg", "acceleration.svg", "group_2-3.svg",
+    assert {p.name for p in written} == {"mechanism.svg", "positions.svg", "velocity.svg", "acceleration.svg", "group_2-3.svg",
                                          "forces_2-3.svg", "crank.svg", "lever.svg", "segments.csv"}
     for p in written[:-1]:
         root = ET.parse(p).getroot()
@@ -185,8 +185,8 @@ def test_cli_plans(cli, tmp_path):
             "mu_F=50", "--lang", "uk", "--out", tmp_path / "all")
     assert r.returncode == 0, r.stderr
     assert {p.name for p in (tmp_path / "all").iterdir()} == {
-        "positions.svg", "velocity.svg", "acceleration.svg", "group_2-3.svg", "forces_2-3.svg", "crank.svg",
-        "lever.svg", "segments.csv", "worksheet.md", "worksheet.html", "worksheet.csv", "worksheet.json"}
+        "mechanism.svg", "positions.svg", "velocity.svg", "acceleration.svg", "group_2-3.svg", "forces_2-3.svg",
+        "crank.svg", "lever.svg", "segments.csv", "worksheet.md", "worksheet.html", "worksheet.csv", "worksheet.json"}
     with open(tmp_path / "all" / "segments.csv", newline="", encoding="utf-8") as f:
         rows = {(row["plan"], row["segment"]): row for row in csv.DictReader(f)}
     assert float(rows[("velocity", "p-b")]["length_mm"]) == pytest.approx(54.7, rel=0.015)

@@ -28,10 +28,13 @@ from .._io import write_text
 from ..tables import rounded, value
 from .._text import csv_cell
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
+from .draw import fits
 from .forces import crank_plan, force_plans, group_plans
+from .lettering import lettering
+from .mechanism import mechanism_plan
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
-from .scales import choose_scales
+from .scales import choose_scales, coarser
 
 __all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS",
            "choose_scales", "starting_position", "plan_file_name"]
@@ -39,14 +42,29 @@ __all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_CO
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
 #: Plan or list of Plans).
 BUILDERS: tuple[tuple[str, Callable], ...] = (
+    ("mechanism", mechanism_plan),
     ("positions", positions_plan),
     ("velocity", velocity_plan),
     ("acceleration", acceleration_plan),
-    ("groups", lambda mech, res, sc: group_plans(mech, res, sc["mu_l"])),
-    ("forces", lambda mech, res, sc: force_plans(mech, res, sc["mu_F"])),
-    ("crank", lambda mech, res, sc: crank_plan(mech, res, sc["mu_l"], sc["mu_F"])),
-    ("lever", lambda mech, res, sc: lever_plan(mech, res, sc["mu_v"])),
+    ("groups", lambda mech, res, sc: _fitted(lambda mu: group_plans(mech, res, mu), sc["mu_l"])),
+    ("forces", lambda mech, res, sc: _fitted(lambda mu: force_plans(mech, res, mu), sc["mu_F"])),
+    ("crank", lambda mech, res, sc: _fitted(lambda mu: crank_plan(mech, res, mu, None), sc["mu_l"])),
+    ("lever", lambda mech, res, sc: _fitted(lambda mu: lever_plan(mech, res, mu), sc["mu_v"])),
 )
+def _fitted(make: Callable, mu: Scale) -> list[Plan]:
+    """make(mu) -> a Plan or Plans, made again at the next coarser round scale while one of them
+    overflows its sheet (`draw.fits`: a group's reaction far out on its guide, a polygon longer than its
+    largest force, a lever whose forces reach beyond the velocity plan): the sheet states the
+    scale it is drawn at. A few tries at most; the last is kept."""
+    value = mu.value
+    for _ in range(4):
+        made = make(Scale(mu.symbol, value, mu.unit))
+        plans = list(made) if isinstance(made, (list, tuple)) else [made]
+        factor = max(fits(p) for p in plans)
+        if factor <= 1:
+            break
+        value = coarser(value, factor)
+    return plans
 
 
 class Plans(Mapping):
@@ -77,6 +95,13 @@ class Plans(Mapping):
     def rows(self) -> list[dict]:
         return [r for p in self._plans.values() for r in p.rows()]
 
+    def summary(self, name: str, n_files: int, out, lang: str = "en") -> str:
+        """One line for the command line in `lang`: the model, the angle, the scales, the files."""
+        from .draw import scale_text
+        from .i18n import num, text
+        scales = ", ".join(scale_text(s, lang) for s in self.scales.values())
+        return text("cli.plans", lang, name=name, phi=num(self.at, lang, 6), scales=scales, n=n_files, out=out)
+
     def segments_frame(self):
         """Every drawn segment as a pandas DataFrame with the columns of segments.csv."""
         import pandas as pd
@@ -93,15 +118,17 @@ class Plans(Mapping):
         return out.to_csv(index=False, lineterminator="\n")
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
-        """Write one SVG sheet per plan (`plan_file_name`) and segments.csv into `out_dir`
-        (created), each atomically; returns the paths written."""
+        """Write one SVG sheet per plan (`plan_file_name`) in `lang` ("en", "uk", "ru"; the
+        mechanism named as the model's lettering names it in `lang`) and segments.csv into
+        `out_dir` (created), each atomically; returns the paths written."""
         from .draw import svg
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
+        name = lettering(self.mech).name(lang, self.mech.name)
         for plan in self._plans.values():
             path = out / plan_file_name(plan)
-            write_text(path, svg(plan, lang=lang, mechanism=self.mech.name))
+            write_text(path, svg(plan, lang=lang, mechanism=name))
             written.append(path)
         write_text(out / "segments.csv", self.segments_csv())
         return written + [out / "segments.csv"]

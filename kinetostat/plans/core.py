@@ -10,11 +10,12 @@ May use: numpy and the standard library. Never matplotlib at import time, never 
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Mapping
 
-__all__ = ["Scale", "Segment", "Plan", "SEGMENT_COLUMNS"]
+__all__ = ["Scale", "Segment", "Result", "Plan", "SEGMENT_COLUMNS", "extent"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -56,6 +57,17 @@ class Segment:
 
 
 @dataclass(frozen=True)
+class Result:
+    """A result a sheet states beside its plan: `symbol` as the text letters it (M_зр, δ),
+    `value` SI in `unit`, and `how`: a key of the message catalogue (`i18n.MESSAGES`) saying how
+    it is obtained, or ""."""
+    symbol: str
+    value: float
+    unit: str
+    how: str = ""
+
+
+@dataclass(frozen=True)
 class Plan:
     """A plan of the method at one crank angle: points on the sheet (mm, x right, y up, the world's
     orientation unless the plan says otherwise, e.g. the lever turned by 90 deg), its segments,
@@ -69,11 +81,15 @@ class Plan:
     segments: tuple[Segment, ...]
     paths: Mapping[str, tuple[complex, ...]] = field(default_factory=dict)   # polylines (mm), e.g. paths of S
     notes: tuple[str, ...] = ()            # lines of text the sheet shows beside the plan (e.g. the branches)
+    results: tuple[Result, ...] = ()       # what the sheet finds (M_зр, δ), stated beside the plan
+    equation: tuple[str, ...] = ()         # a force plan's vector equation: its sides' names in the order drawn
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", MappingProxyType(dict(self.points)))
         object.__setattr__(self, "paths", MappingProxyType({k: tuple(v) for k, v in self.paths.items()}))
         object.__setattr__(self, "notes", tuple(self.notes))
+        object.__setattr__(self, "results", tuple(self.results))
+        object.__setattr__(self, "equation", tuple(self.equation))
 
     def length_mm(self, name: str) -> float:
         """Drawn length of the segment `name`, mm."""
@@ -98,7 +114,7 @@ class Plan:
         return out
 
     def figure(self, lang: str = "en", ax=None):
-        """The plan as a matplotlib Figure (equal aspect, mm axes); `lang` "en" or "uk"."""
+        """The plan as a matplotlib Figure (equal aspect, mm axes); `lang` "en", "uk" or "ru"."""
         from .draw import figure
         return figure(self, lang=lang, ax=ax)
 
@@ -110,3 +126,12 @@ class Plan:
     def __repr__(self) -> str:
         return (f"Plan({self.kind!r}, phi_deg={self.phi_deg:g}, {self.scale}, points={len(self.points)}, "
                 f"segments={len(self.segments)})")
+
+
+def extent(plan: Plan) -> tuple[float, float, float, float]:
+    """(x0, y0, x1, y1) of the plan's finite points and paths, mm."""
+    zs = [z for z in plan.points.values() if math.isfinite(z.real) and math.isfinite(z.imag)]
+    zs += [z for p in plan.paths.values() for z in p if math.isfinite(z.real) and math.isfinite(z.imag)]
+    if not zs:
+        return 0.0, 0.0, 0.0, 0.0
+    return min(z.real for z in zs), min(z.imag for z in zs), max(z.real for z in zs), max(z.imag for z in zs)

@@ -1,13 +1,19 @@
 """A plan drawn: an SVG sheet true to scale in millimetres (A3 landscape, 420 x 297 mm, as the
-appendix sheets of seed 002; the plan centred in the drawing area, a title block that states
-the plan's title and scale), and a matplotlib Figure for notebooks and the reports' PNGs.
+appendix sheets of seed 002: the plan in the drawing area, a title block that states the plan's
+title and its scales, and beside it the notes: legend, the results the sheet finds, a force
+plan's vector equation and every drawn segment with its length and value), and a matplotlib
+Figure for notebooks and the reports' PNGs.
 
-Labels in English or Ukrainian (`lang="en" | "uk"`): titles, the scale line, the legend and the
-table of segments; point letters stay as the texts letter them (digits drawn as subscripts, the
-acceleration pole `pi` as π). The SVG is written with the standard library; every text that
-comes from a model (names, notes) is escaped.
+Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
+results (vectors, the design position) thick, construction thin; a vector shorter than 1 mm at
+its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a polygon whose sides must
+close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
+clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
+no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
+text that comes from a model (names, notes) is escaped.
 
-May use: the standard library, `.core`, `kinetostat._text` (XML-safe text); matplotlib only inside `figure`.
+May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `kinetostat._text` (XML-safe
+text); matplotlib only inside `figure`.
 """
 from __future__ import annotations
 
@@ -15,95 +21,60 @@ import math
 import re
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 
-from .core import Plan, Segment
+from .core import Plan, Scale, Segment, extent
+from .i18n import LANGS, MESSAGES, check_lang, num, phrase, text, unit
+from .labels import (ASCENT, DESCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_box,
+                     text_width)
 
-__all__ = ["svg", "figure", "title_of", "scale_text", "LANGS", "SHEET_MM"]
+__all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM",
+           "ROOM_MM"]
 
-LANGS = ("en", "uk")
 #: The sheet: A3 landscape, mm.
 SHEET_MM = (420.0, 297.0)
 _FRAME = (20.0, 5.0, 415.0, 292.0)          # inner frame: left 20 mm (binding), 5 mm elsewhere
 _TITLE_BLOCK = (230.0, 247.0, 415.0, 292.0)  # bottom right, 185 x 45 mm
-_AREA = (25.0, 10.0, 410.0, 242.0)          # where the plan is centred
+_AREA = (25.0, 10.0, 410.0, 242.0)          # where the plan is centred (above the notes)
+#: Arrowhead: length and half-width, mm (drafting: 3-4 mm); shorter on a vector under 3 lengths.
+ARROW_MM = (3.5, 0.6)
+#: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM.
+TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
+_POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
+_LINE_STEP = 3.3                             # line spacing of the notes, mm
+_LEFT_NOTES_MM = 120.0                       # width of the notes beside a tall plan, mm
 
-_TITLES = {
-    "positions": ("Plan of positions", "План положень"),
-    "velocity": ("Velocity plan", "План швидкостей"),
-    "acceleration": ("Acceleration plan", "План прискорень"),
-    "group": ("Plan of group", "План групи"),
-    "forces": ("Force plan of group", "План сил групи"),
-    "crank": ("Plan of the initial link", "План початкової ланки"),
-    "lever": ("Zhukovsky's lever", "Важіль Жуковського"),
-}
-_WORDS = {
-    "angle": ("crank angle", "кут кривошипа"),
-    "scale": ("scale", "масштаб"),
-    "sheet": ("sheet A3, true to scale in mm", "аркуш А3, креслення в мм у масштабі"),
-    "segment": ("segment", "відрізок"),
-    "value": ("value", "значення"),
-    "more": ("more segments in segments.csv", "інші відрізки в segments.csv"),
-    "nofit": ("the plan does not fit the sheet at this scale", "план не вміщується на аркуші в цьому масштабі"),
-}
-_LEGENDS = {
-    "positions": (("bold: the design position; thin: positions 0-11 every 30 deg; curves: paths of the centres "
-                   "of mass", "жирно: розрахункове положення; тонко: положення 0-11 через 30°; криві: "
-                   "траєкторії центрів мас"),),
-    "velocity": (("p: pole; vectors p-x: absolute velocities; the others: relative velocities",
-                  "p: полюс; вектори p-x: абсолютні швидкості; інші: відносні швидкості"),),
-    "acceleration": (("π: pole; n: normal, n-x: tangential, k: Coriolis, k-x: relative parts",
-                      "π: полюс; n: нормальні, n-x: дотичні, k: коріолісові, k-x: відносні складові"),),
-}
-#: Phrases of the generated notes, in Ukrainian.
-_NOTE_UK = [("position 0 at phi =", "положення 0 при φ ="), ("(crank and rod in line), then every 30 deg",
-            "(кривошип і шатун на одній прямій), далі через 30°"), ("design position phi =", "розрахункове положення φ ="),
-            ("drawn with plain letters", "позначене літерами без індексу"), ("branch", "складання"),
-            ("drawn", "накреслено"), ("dashed to", "штрихом до"), ("the other branch", "інше складання"),
-            ("one assembly", "єдине складання"), ("does not assemble here", "тут не складається"),
-            ("looks the same here", "тут має той самий вигляд"), (" deg", "°")]
-_UNITS = {"m/mm": ("m/mm", "м/мм"), "m/(s mm)": ("m/(s·mm)", "м/(с·мм)"), "m/(s^2 mm)": ("m/(s²·mm)", "м/(с²·мм)"),
-          "N/mm": ("N/mm", "Н/мм"), "m/s": ("m/s", "м/с"), "m/s^2": ("m/s²", "м/с²"), "m": ("m", "м"),
-          "N": ("N", "Н"), "N m": ("N m", "Н·м"), "mm": ("mm", "мм"), "": ("", "")}
+#: Room a plan has on its sheet (width, height), mm: above notes of a few lines, or beside a
+#: column of notes at its left.
+ROOM_MM = ((380.0, 185.0), (262.0, 228.0))
+
+
+def fits(plan: Plan) -> float:
+    """By how much the plan exceeds the room of its sheet (ROOM_MM): <= 1 where it fits."""
+    x0, y0, x1, y1 = extent(plan)
+    return min(max((x1 - x0) / w, (y1 - y0) / h) for w, h in ROOM_MM)
+
+
+#: How each kind of segment is drawn: stroke width (mm), dash pattern, colour.
+_STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
+          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33")}
 
 
 def _lang(lang: str) -> int:
-    if lang not in LANGS:
-        raise ValueError(f"lang: expected one of {', '.join(LANGS)}, got {lang!r}")
-    return LANGS.index(lang)
-
-
-def _num(x: float, lang: str, fmt: str = ".4g") -> str:
-    s = format(x, fmt)
-    return s.replace(".", ",") if lang == "uk" else s
-
-
-def _unit(u: str, lang: str) -> str:
-    return _UNITS.get(u, (u, u))[_lang(lang)]
+    return check_lang(lang)
 
 
 def title_of(plan: Plan, lang: str = "en") -> str:
     """The plan's title in `lang`, with its crank angle."""
-    i = _lang(lang)
     base, _, rest = plan.kind.partition(":")
-    name = _TITLES[base][i] if base in _TITLES else plan.title
+    name = text(f"plan.{base}", lang) if f"plan.{base}" in MESSAGES else plan.title
     if rest:
         name += " " + rest.replace(",", "-")
-    return f"{name}, φ = {_num(plan.phi_deg, lang, 'g')}°"
+    return f"{name}, φ = {num(plan.phi_deg, lang, 6)}°"
 
 
-def scale_text(plan: Plan, lang: str = "en") -> str:
-    """The scale line, e.g. 'μ_v = 0.2 m/(s·mm)'."""
-    s = plan.scale
-    return f"{s.symbol.replace('mu_', 'μ_')} = {_num(s.value, lang, 'g')} {_unit(s.unit, lang)}"
-
-
-def _note(text: str, lang: str) -> str:
-    if lang == "uk":
-        for en, uk in _NOTE_UK:
-            text = text.replace(en, uk)
-    return text
-
-
-_LABEL = re.compile(r"^([^\d_']*)([\d_]*)('*)$")
+def scale_text(plan_or_scale, lang: str = "en") -> str:
+    """A scale line, e.g. 'μ_v = 0.2 m/(s·mm)' (of a Plan's scale, or of a Scale)."""
+    s = plan_or_scale.scale if isinstance(plan_or_scale, Plan) else plan_or_scale
+    return f"{s.symbol.replace('mu_', 'μ_')} = {num(s.value, lang, 6)} {unit(s.unit, lang)}"
 
 
 def labelled(name: str) -> bool:
@@ -112,26 +83,14 @@ def labelled(name: str) -> bool:
     return ":" not in name
 
 
-def _label_parts(name: str) -> tuple[str, str, str]:
-    """A point name as (letters, subscript, primes): 's2' -> ('s', '2', ''), 'S2_3' -> ('S', '2,3', ''),
-    'pi' -> ('π', '', ''), "B'" -> ('B', '', '′')."""
-    if name == "pi":
-        return "π", "", ""
-    m = _LABEL.match(name)
-    if not m or not m.group(1):
-        return name, "", ""
-    return m.group(1), m.group(2).strip("_").replace("_", ","), "′" * len(m.group(3))
+def segment_label(s: Segment, lang: str) -> str:
+    """A segment's name as the sheet letters it (a guide or a line of action in `lang`)."""
+    if s.name.startswith("guide "):
+        return f"{text('guide', lang)} {s.name[6:]}"
+    return text(s.name, lang) if s.name in MESSAGES else s.name
 
 
 # ----------------------------------------------------------------------------- geometry shared by both
-
-def _bbox(plan: Plan) -> tuple[float, float, float, float]:
-    zs = [z for z in plan.points.values() if _finite(z)] + [z for p in plan.paths.values() for z in p if _finite(z)]
-    if not zs:
-        return 0.0, 0.0, 0.0, 0.0
-    xs, ys = [z.real for z in zs], [z.imag for z in zs]
-    return min(xs), min(ys), max(xs), max(ys)
-
 
 def _finite(z: complex) -> bool:
     return math.isfinite(z.real) and math.isfinite(z.imag)
@@ -141,32 +100,192 @@ def _drawable(plan: Plan) -> list[Segment]:
     return [s for s in plan.segments if _finite(plan.points[s.start]) and _finite(plan.points[s.end])]
 
 
-_STYLE = {"vector": (0.35, "", "#000"), "link": (0.7, "", "#000"), "position": (0.18, "", "#555"),
-          "line": (0.2, "2,1.2", "#555"), "arm": (0.2, "4,1,1,1", "#a33")}
+#: How a path is drawn, by the first word of its name (mechanism sheet) or its first letter (ω, ε,
+#: a couple M):
+#: stroke width (mm), colour; any other path (paths of centres of mass, circles) thin and blue.
+_PATH_STYLE = {"pin": (0.35, "#000"), "block": (0.5, "#000"), "support": (0.35, "#000"), "hatch": (0.25, "#000"),
+               "com": (0.3, "#000"), "ω": (0.35, "#000"), "ε": (0.35, "#a33"), "M": (0.5, "#000")}
+
+
+def _numbered(plan: Plan, name: str) -> bool:
+    """Whether a point of the plan of positions is one of the numbered positions (A3, S2_3): its
+    name less the position's number is the design position's point (A, S2)."""
+    base = re.sub(r"_?\d+$", "", name)
+    return base != name and base in plan.points
+
+
+def _polygon_sides(plan: Plan) -> list[Segment]:
+    """A force plan's sides in the order drawn (its vector equation), else []."""
+    names = set(plan.equation)
+    return [s for s in plan.segments if s.name in names]
 
 
 # ----------------------------------------------------------------------------- SVG
 
-def _svg_label(x: float, y: float, name: str, size: float) -> str:
-    head, sub, primes = _label_parts(name)
-    out = f'<text x="{x:.3f}" y="{y:.3f}" font-size="{size:.2f}">{escape(head)}'
-    if sub:
-        out += f'<tspan font-size="{0.7 * size:.2f}" dy="{0.3 * size:.2f}">{escape(sub)}</tspan>'
-    if primes:
-        out += f'<tspan dy="{-0.3 * size if sub else 0:.2f}">{primes}</tspan>'
-    return out + "</text>"
+def _t(x: float, y: float, s: str, size: float, anchor: str = "start", weight: str = "normal",
+       ident: str = "", cls: str = "note") -> str:
+    attrs = f' id="{ident}"' if ident else ""
+    return (f'<text class="{cls}"{attrs} x="{x:.2f}" y="{y:.2f}" font-size="{size:.2f}" text-anchor="{anchor}" '
+            f'font-weight="{weight}">{escape(s)}</text>')
 
 
-def _svg_text(x: float, y: float, text: str, size: float, anchor: str = "start", weight: str = "normal") -> str:
-    return (f'<text x="{x:.3f}" y="{y:.3f}" font-size="{size:.2f}" text-anchor="{anchor}" '
-            f'font-weight="{weight}">{escape(text)}</text>')
+def _wrap(s: str, size: float, width: float) -> list[str]:
+    """`s` broken at spaces into lines no wider than `width` mm at `size` (a longer word alone)."""
+    out, line = [], ""
+    for word in s.split(" "):
+        trial = f"{line} {word}" if line else word
+        if line and text_width(trial, size) > width:
+            out.append(line)
+            line = word
+        else:
+            line = trial
+    return out + [line] if line else out
+
+
+def _fit(s: str, size: float, width: float, least: float = MIN_TEXT_MM) -> float:
+    """The font size, at most `size` and at least `least`, at which `s` fits `width` mm."""
+    return max(least, min(size, size * width / max(text_width(s, size), 1e-9)))
+
+
+def _tiny(plan: Plan) -> dict[str, str]:
+    """Vectors under TINY_MM at their scale: name -> how drawn ("out" of scale at MIN_DRAWN_MM: a
+    load at a scale of its own; "negligible": a polygon's side or a plan's vector, not laid off)."""
+    how = {}
+    for s in _drawable(plan):
+        if s.kind == "vector" and abs(plan.points[s.end] - plan.points[s.start]) < TINY_MM:
+            out = s.scale is not None and abs(plan.points[s.end] - plan.points[s.start]) > 0
+            how[s.name] = "out" if out else "negligible"
+    return how
+
+
+def _result_line(plan: Plan, lang: str) -> list[str]:
+    if not plan.results:
+        return []
+    parts = []
+    for r in plan.results:
+        part = f"{r.symbol} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
+        parts.append(part + (f" ({text(r.how, lang)})" if r.how else ""))
+    return [f"{text('results', lang)}: " + "; ".join(parts)]
+
+
+def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
+    """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors."""
+    base = plan.kind.partition(":")[0]
+    lines = [text(f"legend.{base}", lang)] if f"legend.{base}" in MESSAGES else []
+    lines += [phrase(n, lang) for n in plan.notes]
+    lines += _result_line(plan, lang)
+    if plan.equation:
+        lines.append(f"{text('equation', lang)}: " + " + ".join(plan.equation) + " = 0")
+    for s in _drawable(plan):
+        if s.name in tiny:
+            L = abs(plan.points[s.end] - plan.points[s.start])
+            key = "out of scale" if tiny[s.name] == "out" else "negligible"
+            mark = "*" if tiny[s.name] == "out" else ""
+            lines.append(f"{s.name}{mark} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
+                         f"{text(key, lang, length=num(L, lang, decimals=2))}")
+    if plan.kind == "lever":
+        lines.append(text("arms natural", lang))
+    return lines
+
+
+def _table_rows(plan: Plan, lang: str) -> list[str]:
+    """Every vector and arm drawn: its length and what it stands for."""
+    mm = unit("mm", lang)
+    sides = plan.kind.startswith("forces:")
+    out = []
+    for s in plan.segments:
+        if s.kind not in ("vector", "arm") or not math.isfinite(s.value):
+            continue
+        L = num(plan.length_mm(s.name), lang, decimals=2)
+        value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
+        if sides:
+            out.append(f"{text('segment', lang)} {s.start}{s.end} = {L} {mm} → {s.name} = {value}")
+        else:
+            out.append(f"{s.name}: {L} {mm} → {value}")
+    return out
+
+
+def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool,
+                 nofit: bool = False) -> tuple[list[str], tuple[float, float, float, float]]:
+    """SVG of the notes and the drawing area they leave: below the plan (bottom left, from the
+    frame's bottom up, beside the title block) or, for a tall plan, in a column at its left."""
+    x0 = _FRAME[0] + 3
+    width = _LEFT_NOTES_MM if left else _TITLE_BLOCK[0] - 3 - x0
+    lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
+    if nofit:
+        lines.append(text("nofit", lang))
+    rows = [w for r in _table_rows(plan, lang) for w in (_wrap(r, _NOTE_MM, width) if left else [r])]
+    col_w = max((text_width(r, _NOTE_MM) for r in rows), default=0.0) + 4.0
+    cols = 1 if left or not rows else max(1, int(width // col_w))
+    per_col = -(-len(rows) // cols) if rows else 0
+    height = _LINE_STEP * (len(lines) + per_col)
+    top = _AREA[1] if left else _FRAME[3] - 1.5 - height
+    out = ['<g id="notes">']
+    y = top + ASCENT * _NOTE_MM
+    for line in lines:
+        out.append(_t(x0, y, line, _NOTE_MM))
+        y += _LINE_STEP
+    for k, r in enumerate(rows):
+        out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
+    out.append("</g>")
+    if left:
+        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None
+    return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0))
+
+
+def _layout(plan: Plan, lang: str, tiny: dict[str, str]) -> tuple[list[str], tuple[float, float, float, float]]:
+    """The notes and the drawing area: notes below where the plan fits above them, else in a
+    column at its left where it fits beside them, else below with a note that it does not fit
+    (fitting: with MIN_DRAWN_MM to spare on every side, for a vector drawn out of scale)."""
+    x0, y0, x1, y1 = extent(plan)
+    for left in (False, True):
+        notes, area = _notes_block(plan, lang, tiny, left)
+        if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
+                and y1 - y0 + 2 * MIN_DRAWN_MM <= area[3] - area[1]:      # room for a vector drawn out of scale
+            return notes, area
+    return _notes_block(plan, lang, tiny, False, nofit=True)
+
+
+def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
+    x0, y0, x1, y1 = _TITLE_BLOCK
+    w = x1 - x0 - 6
+    title = title_of(plan, lang)
+    scales = [plan.scale] + list(dict.fromkeys(s.scale for s in plan.segments
+                                               if s.scale is not None and s.scale.symbol.startswith("mu_")))
+    sc = f"{text('scale' if len(scales) == 1 else 'scales', lang)}: " + "; ".join(scale_text(s, lang) for s in scales)
+    angle = f"{text('angle', lang)} φ = {num(plan.phi_deg, lang, 6)}°"
+    return [f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
+            f'stroke="#000" stroke-width="0.5"/>',
+            f'<line x1="{x0}" y1="{y0 + 12}" x2="{x1}" y2="{y0 + 12}" stroke="#000" stroke-width="0.25"/>',
+            f'<line x1="{x0}" y1="{y0 + 24}" x2="{x1}" y2="{y0 + 24}" stroke="#000" stroke-width="0.25"/>',
+            _t(x0 + 3, y0 + 8, title, _fit(title, 5.0, w), weight="bold", cls="title"),
+            _t(x0 + 3, y0 + 19.5, sc, _fit(sc, 4.5, w), ident="scale", cls="title"),
+            _t(x0 + 3, y0 + 30, mechanism, _fit(mechanism, 3.0, w), ident="mechanism", cls="title"),
+            _t(x0 + 3, y0 + 36, angle, 3.0, cls="title"),
+            _t(x0 + 3, y0 + 42, text("sheet", lang), MIN_TEXT_MM, cls="title"),
+            "</g>"]
+
+
+def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float) -> tuple[str, tuple, tuple]:
+    """A filled arrowhead with its tip at b pointing from a: (svg path, its box, the line's new end)."""
+    L = math.hypot(b[0] - a[0], b[1] - a[1])
+    ux, uy = (b[0] - a[0]) / L, (b[1] - a[1]) / L
+    h = min(ARROW_MM[0], max(0.3 * L, 0.8), length)
+    hw = max(0.3, ARROW_MM[1] * h / ARROW_MM[0] * 1.0)
+    bx, by = b[0] - ux * h, b[1] - uy * h
+    pts = [(b[0], b[1]), (bx - uy * hw, by + ux * hw), (bx + uy * hw, by - ux * hw)]
+    d = "M" + " L".join(f"{x:.3f},{y:.3f}" for x, y in pts) + " z"
+    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
+    return (f'<path class="arrowhead" d="{d}" fill="#000"/>', (min(xs), min(ys), max(xs), max(ys)),
+            (b[0] - ux * 0.6 * h, b[1] - uy * 0.6 * h))
 
 
 def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
     """The plan on an A3 landscape sheet, true to scale (1 user unit = 1 mm), as SVG text."""
     _lang(lang)
-    x0, y0, x1, y1 = _bbox(plan)
-    ax0, ay0, ax1, ay1 = _AREA
+    tiny = _tiny(plan)
+    x0, y0, x1, y1 = extent(plan)
+    notes, (ax0, ay0, ax1, ay1) = _layout(plan, lang, tiny)
     tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
 
     def P(z: complex) -> tuple[float, float]:
@@ -177,95 +296,89 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
            f'<svg xmlns="http://www.w3.org/2000/svg" width="{W:g}mm" height="{H:g}mm" viewBox="0 0 {W:g} {H:g}" '
            f'font-family="DejaVu Sans, Arial, sans-serif">',
            f'<title>{escape(title_of(plan, lang))}, {escape(scale_text(plan, lang))}</title>',
-           '<defs><marker id="arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="9" markerHeight="9" '
-           'markerUnits="userSpaceOnUse" orient="auto"><path d="M0,2 L10,5 L0,8 z" fill="#000"/></marker></defs>',
            f'<rect x="0" y="0" width="{W:g}" height="{H:g}" fill="#fff"/>',
            f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
            f'fill="none" stroke="#000" stroke-width="0.7"/>',
            '<g id="plan" stroke-linecap="round">']
+    placer = Placer((ax0 - 4.0, _FRAME[1] + 1, _FRAME[2] - 1, min(ay1 + 4.0, _TITLE_BLOCK[1]) - 0.5))
+    placer.block(_TITLE_BLOCK)
+    named: list[tuple[str, tuple[float, float], tuple[float, float] | None]] = []   # (label, anchor, along)
     for name, path in plan.paths.items():
-        pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in (P(z) for z in path if _finite(z)))
-        out.append(f'<polyline points="{pts}" fill="none" stroke="#1f5fa8" stroke-width="0.25">'
-                   f'<title>{escape(name)}</title></polyline>')
+        xy = [P(z) for z in path if _finite(z)]
+        if len(xy) < 2:
+            continue
+        width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
+        pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in xy)
+        out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="{width}">'
+                   f'<title>{escape(text(name, lang) if name in MESSAGES else name)}</title></polyline>')
+        for (a, b), (c, d) in zip(xy, xy[1:]):
+            placer.line(a, b, c, d)
+        if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
+            head, box, _ = _arrowhead(xy[-3], xy[-1], 2.5)
+            out.append(head)
+            placer.block(box)
+            named.append((name, xy[len(xy) // 2], None))
+    sides = {s.name for s in _polygon_sides(plan)} or None        # a polygon: every side and chord named
     for s in _drawable(plan):
-        (a, b), (c, d) = P(plan.points[s.start]), P(plan.points[s.end])
+        a, b = P(plan.points[s.start]), P(plan.points[s.end])
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
-        if s.kind == "vector" and math.hypot(c - a, d - b) < 0.05:
-            continue                       # a zero vector: its two points coincide
+        L = math.hypot(b[0] - a[0], b[1] - a[1])
+        label = segment_label(s, lang)
+        if s.name in tiny:
+            if tiny[s.name] == "negligible":
+                named.append((label, a, None))
+                continue
+            b = (a[0] + (b[0] - a[0]) / L * MIN_DRAWN_MM, a[1] + (b[1] - a[1]) / L * MIN_DRAWN_MM)
+            L, label = MIN_DRAWN_MM, label + "*"
+        end = b
+        if s.kind == "vector":
+            head, box, end = _arrowhead(a, b, L)
+            placer.block(box)
+        else:
+            placer.block((b[0] - 0.5, b[1] - 0.5, b[0] + 0.5, b[1] + 0.5))      # a line's end
         attrs = f' stroke-dasharray="{dash}"' if dash else ""
-        attrs += ' marker-end="url(#arrow)"' if s.kind == "vector" else ""
-        out.append(f'<line x1="{a:.3f}" y1="{b:.3f}" x2="{c:.3f}" y2="{d:.3f}" stroke="{colour}" '
-                   f'stroke-width="{width}"{attrs}><title>{escape(s.name)}</title></line>')
-        if not labelled(s.end):            # a load or an arm ends at a construction point: letter the segment
-            out.append(_svg_text(c + 1.0, d - 1.0, s.name, 2.8))
+        out.append(f'<line x1="{a[0]:.3f}" y1="{a[1]:.3f}" x2="{end[0]:.3f}" y2="{end[1]:.3f}" stroke="{colour}" '
+                   f'stroke-width="{width}"{attrs}><title>{escape(label)}</title></line>')
+        if s.kind == "vector":
+            out.append(head)
+        placer.line(a[0], a[1], b[0], b[1])
+        if not labelled(s.end) or (sides is not None and s.kind == "vector") or s.kind == "arm":
+            named.append((label, a, b))
     small = plan.kind == "positions"
+    dots = []
     for name, z in plan.points.items():
         if not _finite(z) or not labelled(name):
             continue
         a, b = P(z)
-        numbered = small and bool(re.search(r"\d$", name)) and name not in _frame_like(plan)
-        size = 2.2 if numbered else 3.5
-        out.append(f'<circle cx="{a:.3f}" cy="{b:.3f}" r="{0.35 if numbered else 0.6}" fill="#000"/>')
-        out.append(_svg_label(a + 0.8, b - 0.8, name, size))
+        numbered = small and _numbered(plan, name)
+        r = 0.4 if numbered else 0.6
+        out.append(f'<circle cx="{a:.3f}" cy="{b:.3f}" r="{r}" fill="#000"/>')
+        placer.block((a - r, b - r, a + r, b + r))
+        dots.append((numbered, name, a, b))
+    labels = []
+    for numbered in (False, True):        # the design position's letters first, then the numbered ones
+        group = [(n, a, b) for k, n, a, b in dots if k == numbered]
+        for name, a, b in merge_coincident(group):
+            pl = placer.place(name, _NUMBERED_MM if numbered else _POINT_MM, a, b)
+            labels.append(label_svg(pl.x, pl.y, pl.name, pl.size))
+            if pl.leader:
+                labels.append(_leader(pl.leader))
+    for name, a, along in named:
+        pl = placer.place(name, _NAME_MM, a[0], a[1], along)
+        labels.append(label_svg(pl.x, pl.y, pl.name, pl.size, cls="name"))
+        if pl.leader:
+            labels.append(_leader(pl.leader))
+    out += labels
     out.append("</g>")
-    out += _svg_title_block(plan, lang, mechanism)
-    out += _svg_notes(plan, lang, fits=(x1 - x0 <= ax1 - ax0 and y1 - y0 <= ay1 - ay0))
+    out += _title_block(plan, lang, mechanism)
+    out += notes
     out.append("</svg>")
     return "\n".join(out) + "\n"
 
 
-def _frame_like(plan: Plan) -> set[str]:
-    """Names of points that are the same in every position (the frame's), from the link segments."""
-    return {n for n in plan.points if not any(n in (s.start, s.end) for s in plan.segments if s.kind == "position")}
-
-
-def _svg_title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
-    i = _lang(lang)
-    x0, y0, x1, y1 = _TITLE_BLOCK
-    out = [f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
-           f'stroke="#000" stroke-width="0.5"/>',
-           f'<line x1="{x0}" y1="{y0 + 12}" x2="{x1}" y2="{y0 + 12}" stroke="#000" stroke-width="0.25"/>',
-           f'<line x1="{x0}" y1="{y0 + 24}" x2="{x1}" y2="{y0 + 24}" stroke="#000" stroke-width="0.25"/>',
-           _svg_text(x0 + 3, y0 + 8, title_of(plan, lang), 5, weight="bold"),
-           f'<text id="scale" x="{x0 + 3:.1f}" y="{y0 + 20:.1f}" font-size="4.5">{escape(_WORDS["scale"][i])}: '
-           f'{escape(scale_text(plan, lang))}</text>',
-           _svg_text(x0 + 3, y0 + 30, _clip(mechanism, 70), 3),
-           _svg_text(x0 + 3, y0 + 36, f"{_WORDS['angle'][i]} φ = {_num(plan.phi_deg, lang, 'g')}°", 3),
-           _svg_text(x0 + 3, y0 + 42, _WORDS["sheet"][i], 2.5),
-           "</g>"]
-    return out
-
-
-def _clip(text: str, n: int) -> str:
-    return text if len(text) <= n else text[:n - 1] + "…"
-
-
-def _svg_notes(plan: Plan, lang: str, fits: bool) -> list[str]:
-    """Legend, notes and (for vector plans) the table of segments, bottom left of the sheet."""
-    i = _lang(lang)
-    x, y = _FRAME[0] + 3, _TITLE_BLOCK[1] + 4
-    lines = [legend[i] for legend in _LEGENDS.get(plan.kind.partition(":")[0], ())]
-    lines += [_note(n, lang) for n in plan.notes]
-    if not fits:
-        lines.append(_WORDS["nofit"][i])
-    out = ['<g id="notes">']
-    for k, text in enumerate(lines[:4]):
-        out.append(_svg_text(x, y + 3.2 * k, _clip(text, 120), 2.4))
-    rows = [s for s in plan.segments if s.kind in ("vector", "arm") and math.isfinite(s.value)]
-    if rows:
-        top = y + 3.2 * min(len(lines), 4) + 1
-        per_col, col_w = max(1, int((_FRAME[3] - top - 1) // 3)), 70.0
-        cols = max(1, int((_TITLE_BLOCK[0] - x - 2) // col_w))
-        shown = rows[:per_col * cols]
-        for k, s in enumerate(shown):
-            cx, cy = x + col_w * (k // per_col), top + 3 + 3 * (k % per_col)
-            text = (f"{s.name}: {_num(plan.length_mm(s.name), lang, '.2f')} {_unit('mm', lang)} → "
-                    f"{_num(s.value, lang)} {_unit(s.unit, lang)}")
-            out.append(_svg_text(cx, cy, _clip(text, 44), 2.3))
-        if len(rows) > len(shown):
-            out.append(_svg_text(x + col_w * (cols - 1), _FRAME[3] - 1, _WORDS["more"][i], 2.0))
-    out.append("</g>")
-    return out
+def _leader(seg: tuple[float, float, float, float]) -> str:
+    a, b, c, d = seg
+    return f'<line class="leader" x1="{a:.2f}" y1="{b:.2f}" x2="{c:.2f}" y2="{d:.2f}" stroke="#777" stroke-width="0.13"/>'
 
 
 # ----------------------------------------------------------------------------- matplotlib
@@ -273,7 +386,7 @@ def _svg_notes(plan: Plan, lang: str, fits: bool) -> list[str]:
 def _tex(name: str) -> str:
     """A point name as mathtext (letters with a subscript), or as it is where it is anything
     else: `figure` then draws it with mathtext off (a model's point may be named anything)."""
-    head, sub, primes = _label_parts(name)
+    head, sub, primes = label_parts(name)
     if not re.fullmatch(r"[A-Za-zπ]+", head):
         return name
     head = r"\pi" if head == "π" else re.sub(r"([\\{}_^$#%&~])", r"\\\1", head)
@@ -286,7 +399,7 @@ def figure(plan: Plan, lang: str = "en", ax=None):
     _lang(lang)
     if ax is None:
         from matplotlib.figure import Figure
-        x0, y0, x1, y1 = _bbox(plan)
+        x0, y0, x1, y1 = extent(plan)
         w, h = max(x1 - x0, 1.0), max(y1 - y0, 1.0)
         height = min(max(8.0 * h / w, 3.0), 10.0) + 0.8
         fig = Figure(figsize=(8.0, height), layout=None)     # a fixed layout: margins in inches
@@ -311,18 +424,17 @@ def figure(plan: Plan, lang: str = "en", ax=None):
             ax.annotate(s.name, (b.real, b.imag), xytext=(3, -9), textcoords="offset points", fontsize=8,
                         color=colour)
     small = plan.kind == "positions"
-    frame = _frame_like(plan) if small else set()
     for name, z in plan.points.items():
         if not _finite(z) or not labelled(name):
             continue
-        numbered = small and bool(re.search(r"\d$", name)) and name not in frame
+        numbered = small and _numbered(plan, name)
         ax.plot([z.real], [z.imag], "o", color="k", ms=1.5 if numbered else 3)
         label = _tex(name)
         ax.annotate(label, (z.real, z.imag), xytext=(3, 3), textcoords="offset points", parse_math=label != name,
                     fontsize=6 if numbered else 10)
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel(_unit("mm", lang))
-    ax.set_ylabel(_unit("mm", lang))
+    ax.set_xlabel(unit("mm", lang))
+    ax.set_ylabel(unit("mm", lang))
     ax.set_title(f"{title_of(plan, lang)}\n{scale_text(plan, lang)}", fontsize=10)
     ax.grid(True, lw=0.3, alpha=0.5)
     return fig

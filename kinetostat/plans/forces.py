@@ -22,7 +22,6 @@ May use: numpy, the solver's public results (`Analysis`, `Mechanism`), `kinetost
 from __future__ import annotations
 
 import math
-import re
 import string
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -30,7 +29,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..applied import applied_moment, point_forces
-from .core import Plan, Scale, Segment
+from .core import Plan, Result, Scale, Segment
+from .lettering import lettering
 from .scales import round_scale
 
 if TYPE_CHECKING:
@@ -63,17 +63,9 @@ class Couple:
 # -- lettering
 
 def frame_number(mech: "Mechanism") -> int:
-    """The number the texts give the frame: 0 (seed 000) unless a published reaction of the model
-    letters it otherwise (seed 002's ICE: R43 for the pair (0, 3), the frame is 4)."""
-    for p in mech.published:
-        if p.quantity == "reaction" and p.pair is not None and 0 in p.pair:
-            m = re.fullmatch(r"R_?(\d)(\d)", p.symbol)
-            if m:
-                digits = tuple(int(d) for d in m.groups())
-                side = p.pair.index(0)
-                if digits[1 - side] == p.pair[1 - side]:
-                    return digits[side]
-    return 0
+    """The number the texts give the frame: 0 (seed 000) unless the model's lettering or a
+    published reaction letters it otherwise (seed 002's ICE: R43 for the pair (0, 3), the frame is 4)."""
+    return lettering(mech).frame
 
 
 def _label(mech: "Mechanism", k: int) -> int:
@@ -129,12 +121,15 @@ def _world(res: "Analysis", k: int, name: str) -> complex:
 
 
 def _applied(mech: "Mechanism", res: "Analysis", k: int) -> list[Load]:
-    """The model's force loads and spring forces on link k at angle 0 of `res`."""
-    out = [Load("", k, complex(f.X[0]), complex(f.force[0]), f.point)
+    """The model's force loads and spring forces on link k at angle 0 of `res`, named as the
+    model's lettering names them (F_p), else P<k> (P<k>a, P<k>b, ... when there are several)."""
+    out = [Load(f.name, k, complex(f.X[0]), complex(f.force[0]), f.point)
            for f in point_forces(mech, res.kin) if f.link == k]
+    L = lettering(mech)
     if len(out) == 1:
-        return [Load(f"P{k}", k, out[0].point, out[0].force, out[0].at)]
-    return [Load(f"P{k}{string.ascii_lowercase[n]}", k, ld.point, ld.force, ld.at) for n, ld in enumerate(out)]
+        return [Load(L.load(out[0].name, f"P{k}"), k, out[0].point, out[0].force, out[0].at)]
+    return [Load(L.load(ld.name, f"P{k}{string.ascii_lowercase[n]}"), k, ld.point, ld.force, ld.at)
+            for n, ld in enumerate(out)]
 
 
 def link_loads(mech: "Mechanism", res: "Analysis", k: int) -> list[Load]:
@@ -267,9 +262,9 @@ def _link_drawing(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: l
         if p.kind == "P" and k in p.links:
             X = _world(res, p.links[1], p.point) / mu_l.value
             d = complex(*p.direction) * complex(res.kin.rot[0, p.links[0]])
-            pts[f"guide {p.label}:from"], pts[f"guide {p.label}:to"] = X - 40 * d, X + 40 * d
-            segs.append(Segment(f"guide {p.label}", f"guide {p.label}:from", f"guide {p.label}:to",
-                                float("nan"), "", "line"))
+            name = f"guide P({_label(mech, p.links[0])},{_label(mech, p.links[1])})"     # the text's numbers
+            pts[f"{name}:from"], pts[f"{name}:to"] = X - 40 * d, X + 40 * d
+            segs.append(Segment(name, f"{name}:from", f"{name}:to", float("nan"), "", "line"))
 
 
 # -- the plans
@@ -411,20 +406,28 @@ def force_plans(mech: "Mechanism", res: "Analysis", mu_F) -> list[Plan]:
         segs.append(Segment(reaction_name(mech, k, j), _vertex(end_j), X, abs(internal), "N"))
         plans.append(Plan(f"forces:{_group_label(g)}", f"Force plan of group {_group_label(g)} ({g.kind}): "
                           + " + ".join(name for name, _ in seq) + " = 0", mu_F, float(res.phi_deg[0]),
-                          pts, tuple(segs)))
+                          pts, tuple(segs), equation=tuple(name for name, _ in seq)))
     return plans
 
 
-def crank_plan(mech: "Mechanism", res: "Analysis", mu_l, mu_F) -> Plan:
+#: The longest force on the plan of the initial link when it takes a force scale of its own, mm.
+CRANK_FORCE_MM = 80.0
+
+
+def crank_plan(mech: "Mechanism", res: "Analysis", mu_l, mu_F=None) -> Plan:
     """The initial link at mu_l with its loads drawn at mu_F (seed 002 fig. 1.11, seed 000
     sec. 7): the reactions of the groups on it (R21 at A, ...), its own weight and inertia, the
     frame's reaction at the pivot (R01; R41 for seed 002's ICE), the arms h_.. of its moment
     equation about the pivot, and the balancing load: an engine's couple M_bal (an arc, its
     value M_bal = sum of the arms' moments); a working machine's gear mesh (pitch circles of
-    wheel and pinion, pitch point P, line of action at alpha_w, F_bal at P and its arm r_b)."""
+    wheel and pinion, pitch point P, line of action at alpha_w, F_bal at P and its arm r_b).
+    mu_F None: a round force scale of its own, the largest reaction at most CRANK_FORCE_MM."""
     _single(res)
-    mu_l, mu_F = _scale(mu_l, "mu_l", "m/mm"), _scale(mu_F, "mu_F", "N/mm")
-    dr = mech.drive
+    mu_l = _scale(mu_l, "mu_l", "m/mm")
+    if mu_F is None:
+        mu_F = force_scale(np.hypot(*res.forces.R[0].T), CRANK_FORCE_MM)
+    mu_F = _scale(mu_F, "mu_F", "N/mm")
+    dr, L = mech.drive, lettering(mech)
     pts: dict[str, complex] = {}
     segs: list[Segment] = []
     paths: dict[str, tuple[complex, ...]] = {}
@@ -453,16 +456,20 @@ def crank_plan(mech: "Mechanism", res: "Analysis", mu_l, mu_F) -> Plan:
         pts["P"] = P / mu_l.value
         pts["line of action:from"], pts["line of action:to"] = pts["P"] - 40 * line, pts["P"] + 40 * line
         segs.append(Segment("line of action", "line of action:from", "line of action:to", float("nan"), "", "line"))
-        _arrow(segs, pts, "F_bal", P, F_bal, mu_l, mu_F)
+        _arrow(segs, pts, L.F_bal, P, F_bal, mu_l, mu_F)
         foot = _foot(P, line, O)
         pts["r_b:foot"] = foot / mu_l.value
         segs.append(Segment("r_b", dr.pivot, "r_b:foot", abs(foot - O), "m", "arm"))
-        title = (f"Initial link: gear mesh alpha_w = {gear.alpha_w_deg:g} deg, F_bal = {abs(F_bal):.6g} N, "
-                 f"r_b = {gear.r_b * 1e3:.6g} mm, M_bal = F_bal r_b = {M_bal:.6g} N m")
+        title = (f"Initial link: gear mesh alpha_w = {gear.alpha_w_deg:g} deg, {L.F_bal} = {abs(F_bal):.6g} N, "
+                 f"r_b = {gear.r_b * 1e3:.6g} mm, {L.M_bal} = {L.F_bal} r_b = {M_bal:.6g} N m")
+        results = (Result(L.F_bal, abs(F_bal), "N"), Result("r_b", gear.r_b, "m"),
+                   Result(L.M_bal, M_bal, "N m", "M = F r_b"))
     else:
-        paths["M_bal"] = _couple_path(O / mu_l.value, M_bal, 10.0)
-        title = f"Initial link: balancing couple M_bal = {M_bal:.6g} N m"
-    return Plan("crank", f"{title}; forces drawn at {mu_F}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths)
+        paths[L.M_bal] = _couple_path(O / mu_l.value, M_bal, 10.0)
+        title = f"Initial link: balancing couple {L.M_bal} = {M_bal:.6g} N m"
+        results = (Result(L.M_bal, M_bal, "N m", "M = sum"),)
+    return Plan("crank", f"{title}; forces drawn at {mu_F}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths,
+                results=results)
 
 
 def _line_of_action(gear, M: float) -> complex:

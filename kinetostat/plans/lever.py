@@ -19,14 +19,20 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .core import Plan, Scale, Segment
+from .core import Plan, Result, Scale, Segment
 from .forces import _scale, _single, arm_name, force_scale, link_couples, link_loads
+from .lettering import lettering
 
 if TYPE_CHECKING:
     from ..analysis import Analysis
     from ..model import Mechanism
 
-__all__ = ["lever_plan", "lever_check", "pole_moment"]
+__all__ = ["lever_plan", "lever_check", "pole_moment", "NATURAL", "TOLERANCE_PCT"]
+
+#: The arms on the lever are measured on the drawing, in mm at natural size (seed 002: h_Fi2 = 37.67 mm).
+NATURAL = Scale("natural", 0.001, "m/mm")
+#: The texts' rule: the two balancing moments may differ by 5 % (seed 002, line 468).
+TOLERANCE_PCT = 5.0
 
 
 def _couple_ends(mech: "Mechanism", k: int) -> list[tuple[str, tuple[float, float]]]:
@@ -62,9 +68,11 @@ def lever_plan(mech: "Mechanism", res: "Analysis", mu_v) -> Plan:
     """Zhukovsky's lever at mu_v: pole p, the image of every point of the moving links (turned by
     90 deg counter-clockwise), the vectors p-x and the links' images (a-b, values in m/s), every
     force at its like point (its value in N, drawn at a round force scale of its own; couples as
-    two forces "M_i2/l (a)", "M_i2/l (b)"), the arms h_.. about the pole (value: arm x mu_v, the
-    velocity of the point across the force, m/s), and the balancing force F'_bal at the crank
-    pin's image, across p-a, whose moment about the pole cancels the loads'."""
+    two forces "M_i2/l (a)", "M_i2/l (b)"), the arms h_.. about the pole (value: the arm's
+    drawn length, m at natural size: `NATURAL`), and the balancing force F'_bal (the model's
+    lettering: F'_зр) at the crank pin's image, across p-a, whose moment about the pole cancels
+    the loads'. Its results: F'_bal, M'_bal, M_bal by the force plans and their difference δ
+    against the texts' 5 % (TOLERANCE_PCT)."""
     _single(res)
     mu_v = _scale(mu_v, "mu_v", "m/(s mm)")
     pts: dict[str, complex] = {"p": 0j}
@@ -96,22 +104,30 @@ def lever_plan(mech: "Mechanism", res: "Analysis", mu_v) -> Plan:
     crank_pin = _image(mech, res, mech.drive.link, mech.drive.point, mu_v, pts)
     pa = pts[crank_pin]
     F_bal = _across(pa, -total)
-    forces.append(("F'_bal", crank_pin, F_bal))
+    L = lettering(mech)
+    F_name = L.lever(L.F_bal)
+    forces.append((F_name, crank_pin, F_bal))
     mu_F = force_scale([F for _, _, F in forces])
     for name, at, F in forces:
         start = f"{name}:from"
         pts[start], pts[f"{name}:to"] = pts[at], pts[at] + F / mu_F.value
         segs.append(Segment(name, start, f"{name}:to", abs(F), "N", "vector", mu_F))
-        if name != "F'_bal" and abs(F) > 0 and abs(pts[at]) > 0:
+        if name != F_name and abs(F) > 0 and abs(pts[at]) > 0:
             u = F / abs(F)
             foot = pts[at] - (pts[at] * u.conjugate()).real * u
             pts[f"{arm_name(name)}:foot"] = foot
-            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", abs(foot) * mu_v.value, "m/s", "arm"))
+            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", abs(foot) * NATURAL.value, "m", "arm",
+                                NATURAL))
     omega1 = float(res.omega(mech.drive.link)[0])
     M_lever = float(total) * mu_v.value / omega1
-    return Plan("lever", f"Zhukovsky's lever (velocity plan turned by 90 deg ccw): F'_bal = {abs(F_bal):.6g} N "
-                f"at {crank_pin}, M_bal = {M_lever:.6g} N m; forces drawn at {mu_F}",
-                mu_v, float(res.phi_deg[0]), pts, tuple(segs))
+    M_forces = float(res.balancing_moment[0])
+    delta = (M_lever - M_forces) / M_lever * 100 if M_lever else 0.0
+    results = (Result(F_name, abs(F_bal), "N", "by lever"), Result(L.lever(L.M_bal), M_lever, "N m", "by lever"),
+               Result(L.M_bal, M_forces, "N m", "by force plans"),
+               Result("δ", delta, "%", "within 5" if abs(delta) <= TOLERANCE_PCT else "beyond 5"))
+    return Plan("lever", f"Zhukovsky's lever (velocity plan turned by 90 deg ccw): {F_name} = {abs(F_bal):.6g} N "
+                f"at {crank_pin}, {L.lever(L.M_bal)} = {M_lever:.6g} N m; forces drawn at {mu_F}",
+                mu_v, float(res.phi_deg[0]), pts, tuple(segs), results=results)
 
 
 def _moment(r: complex, F: complex) -> float:
@@ -126,9 +142,12 @@ def _across(pa: complex, moment: float) -> complex:
     return moment / abs(pa) * 1j * pa / abs(pa)
 
 
-def pole_moment(plan: Plan, without: tuple[str, ...] = ("F'_bal",)) -> float:
+def pole_moment(plan: Plan, without: tuple[str, ...] | None = None) -> float:
     """Sum of the moments about the pole p of the lever's forces (segments in N), N mm, read off
-    the plan's own points: each force along its drawn segment, at its start."""
+    the plan's own points: each force along its drawn segment, at its start; `without` the
+    forces left out (default: the balancing force, the last one drawn)."""
+    if without is None:
+        without = tuple(s.name for s in plan.segments if s.unit == "N")[-1:]
     total = 0.0
     for s in plan.segments:
         if s.unit == "N" and s.name not in without:
@@ -152,5 +171,5 @@ def lever_check(mech: "Mechanism", res: "Analysis", mu_v=0.2) -> dict:
     link = mech.links[mech.drive.link]
     l_OA = float(np.hypot(*np.subtract(link.points[mech.drive.point], link.points[mech.drive.pivot])))
     return {"phi_deg": float(res.phi_deg[0]), "M_bal_forces": M_forces, "M_bal_lever": M_lever,
-            "F_bal_lever": float(plan.segment("F'_bal").value), "l_OA": l_OA,
+            "F_bal_lever": float([s for s in plan.segments if s.unit == "N"][-1].value), "l_OA": l_OA,
             "difference_pct": (M_lever - M_forces) / M_lever * 100 if M_lever else 0.0}

@@ -25,7 +25,7 @@ import numpy as np
 
 from .core import Scale
 
-__all__ = ["choose_scales", "round_scale", "check_given", "SCALE_UNITS", "ROUND_MANTISSAS", "FIT_MM"]
+__all__ = ["choose_scales", "round_scale", "coarser", "check_given", "SCALE_UNITS", "ROUND_MANTISSAS", "FIT_MM"]
 
 #: Unit of each scale, per millimetre drawn.
 SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F": "N/mm"}
@@ -64,6 +64,14 @@ def round_scale(reference: float, lo_mm: float, hi_mm: float, extent: tuple[floa
             return c
     k = max(extent[0] / fit_mm[0], extent[1] / fit_mm[1])     # beyond the candidates: next round value
     return min(m * 10.0 ** math.ceil(math.log10(k) - math.log10(m)) for m in ROUND_MANTISSAS)
+
+
+def coarser(value: float, factor: float) -> float:
+    """The smallest round scale at least `value` x `factor` (a drawing `factor` times too large
+    made to fit)."""
+    want = value * factor * (1 - 1e-12)
+    k = math.floor(math.log10(want))
+    return min(m * 10.0 ** e for e in (k, k + 1) for m in ROUND_MANTISSAS if m * 10.0 ** e >= want)
 
 
 def check_given(given: Mapping[str, float] | None) -> dict[str, float]:

@@ -26,34 +26,14 @@ from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
 from ..tables import value
+from .i18n import check_lang, num, phrase, text, unit
+from .lettering import lettering
 from .scales import choose_scales
 
 __all__ = ["Row", "Worksheet", "worksheet", "COLUMNS"]
 
 #: Columns of the worksheet's table (CSV, JSON, frame).
 COLUMNS = ("section", "key", "symbol", "value", "unit", "direction", "note")
-
-_WORDS = {
-    "en": {"kinematics": "Kinematics", "accelerations": "Accelerations", "inertia": "Inertia and loads",
-           "reactions": "Reactions", "crank": "The initial link and Zhukovsky's lever",
-           "cw": "clockwise", "ccw": "counter-clockwise", "angle": "at {:.2f} deg to x",
-           "title": "Worksheet: {name}, phi = {phi:g} deg", "scale": "scale mu_l = {:g} m/mm",
-           "accuracy": "**Accuracy:** near a singular position: about {:.1f} significant digits left at this angle "
-                       "(fewer than {}); the last digits of the values below are not reliable",
-           "head": ("Symbol", "Value", "Unit", "Sense / direction", "How obtained"),
-           "group": "group {}"},
-    "uk": {"kinematics": "Кінематика: швидкості", "accelerations": "Кінематика: прискорення",
-           "inertia": "Сили інерції та навантаження", "reactions": "Реакції в кінематичних парах",
-           "crank": "Початкова ланка і важіль Жуковського",
-           "cw": "за годинниковою стрілкою", "ccw": "проти годинникової стрілки",
-           "angle": "під кутом {:.2f} град до осі x",
-           "title": "Розрахунковий лист: {name}, φ = {phi:g} град", "scale": "масштаб μ_l = {:g} м/мм",
-           "accuracy": "**Точність:** поблизу особливого положення: лишилося близько {:.1f} значущих цифр "
-                       "(менше ніж {}); останні цифри значень нижче ненадійні",
-           "head": ("Позначення", "Значення", "Одиниця", "Напрямок", "Як отримано"),
-           "group": "група {}"},
-}
-
 
 @dataclass(frozen=True)
 class Row:
@@ -98,9 +78,12 @@ class Worksheet:
 
     # -- outputs
     def records(self) -> list[dict]:
-        w = _WORDS[self.lang]
-        return [{"section": w[r.section], "key": r.key, "symbol": r.symbol, "value": r.value, "unit": r.unit,
-                 "direction": _direction(r.direction, w), "note": r.note} for r in self.rows]
+        """The rows in the worksheet's language: sections, units, senses and notes translated
+        (`i18n`); values stay numbers."""
+        lang = self.lang
+        return [{"section": text(f"ws.{r.section}", lang), "key": r.key, "symbol": r.symbol, "value": r.value,
+                 "unit": unit(r.unit, lang), "direction": _direction(r.direction, lang),
+                 "note": phrase(r.note, lang)} for r in self.rows]
 
     def frame(self):
         """The rows as a pandas DataFrame (columns COLUMNS)."""
@@ -110,18 +93,20 @@ class Worksheet:
         return df
 
     def markdown(self) -> str:
-        """The worksheet as Markdown: a title, then one table per section."""
-        w = _WORDS[self.lang]
-        out = [f"# {w['title'].format(name=markdown_text(self.mechanism), phi=self.phi_deg)}", "",
-               w["scale"].format(self.mu_l)]
+        """The worksheet as Markdown: a title, then one table per section (numbers as the
+        worksheet's language writes them); near a singular position, the digits left."""
+        lang = self.lang
+        out = [f"# {text('ws.title', lang, name=markdown_text(self.mechanism), phi=num(self.phi_deg, lang, 6))}", "",
+               f"{text('scale', lang)} μ_l = {num(self.mu_l, lang, 6)} {unit('m/mm', lang)}"]
         if self.digits < DIGITS_WARN:
-            out += ["", w["accuracy"].format(self.digits, DIGITS_WARN)]
+            out += ["", text("ws.accuracy", lang, digits=num(self.digits, lang, 2), min=DIGITS_WARN)]
         section = None
+        head = [text(f"ws.head.{c}", lang) for c in ("symbol", "value", "unit", "direction", "note")]
         for rec in self.records():
             if rec["section"] != section:
                 section = rec["section"]
-                out += ["", f"## {section}", "", "| " + " | ".join(w["head"]) + " |", "|---|---:|---|---|---|"]
-            cells = (rec["symbol"], _number(rec["value"]), rec["unit"], rec["direction"], rec["note"])
+                out += ["", f"## {section}", "", "| " + " | ".join(head) + " |", "|---|---:|---|---|---|"]
+            cells = (rec["symbol"], num(rec["value"], lang, 6), rec["unit"], rec["direction"], rec["note"])
             out.append("| " + " | ".join(markdown_text(str(c)) for c in cells) + " |")
         return "\n".join(out) + "\n"
 
@@ -156,15 +141,11 @@ class Worksheet:
         return paths
 
 
-def _number(x: float) -> str:
-    return "n/a" if not math.isfinite(x) else f"{x:.6g}"
-
-
-def _direction(d: str, w: dict) -> str:
+def _direction(d: str, lang: str) -> str:
     if d in ("cw", "ccw"):
-        return w[d]
+        return text(f"ws.{d}", lang)
     if d.startswith("angle:"):
-        return w["angle"].format(float(d[6:]))
+        return text("ws.angle", lang, angle=num(float(d[6:]), lang, decimals=2))
     return d
 
 
@@ -184,6 +165,15 @@ class _Sheet:
     def __init__(self, res: Analysis, mu_l: float):
         self.res, self.mech, self.mu_l, self.rows = res, res.mech, mu_l, []
         self.seen: set[str] = set()
+        self.L = lettering(res.mech)
+
+    def n(self, k: int) -> int:
+        """Link k's number as the model's text letters it (the frame: 4 for seed 002's ICE)."""
+        return k or self.L.frame
+
+    def R(self, i: int, j: int) -> str:
+        """R<i><j> with the frame lettered as the model's text letters it (R43 for seed 002's ICE)."""
+        return f"R{self.n(i)}{self.n(j)}"
 
     def add(self, section, key, symbol, value, unit, direction="", note=""):
         self.rows.append(Row(section, key, symbol, float(value), unit, direction, note))
@@ -234,8 +224,9 @@ class _Sheet:
             for p in (pj, pin, pk):
                 if p.kind == "P":
                     vr = res.slide_velocity(*p.links)[0]
-                    sym = f"V_rel({p.links[0]},{p.links[1]})"
-                    self.add("kinematics", sym, sym, abs(vr), "m/s", "", f"along the guide of link {p.links[0]}")
+                    key, sym = f"V_rel({p.links[0]},{p.links[1]})", f"V_rel({self.n(p.links[0])},{p.links[1]})"
+                    self.add("kinematics", key, sym, abs(vr), "m/s", "",
+                             f"along the guide of link {self.n(p.links[0])}")
                     accel.append(("cor", p, vr))
             accel.append(("eps", (j, k), None))
         self.accelerations(accel)
@@ -301,8 +292,8 @@ class _Sheet:
                 self.add("inertia", f"z_{k}", f"z{k}", il.h[0] / self.mu_l, "mm", "", f"h{k} / μ_l")
         for n, ld in enumerate(m.loads):
             mag = load_magnitude(m, res.kin, ld)[0]
-            unit = "N m" if ld.kind == "moment" else "N"
-            self.add("inertia", f"load_{n}", ld.name, abs(mag), unit, "",
+            u = "N m" if ld.kind == "moment" else "N"
+            self.add("inertia", f"load_{n}", self.L.load(ld.name), abs(mag), u, "",
                      "read from its diagram" if ld.table is not None else "given")
 
     # ---- reactions
@@ -318,54 +309,57 @@ class _Sheet:
                     e = r / l
                     t = np.array([-e[1], e[0]])
                     arm = l / self.mu_l
-                    self.add("reactions", f"Rt_{other}_{link}", f"R^τ_{other}{link}", abs(R @ t), "N",
+                    self.add("reactions", f"Rt_{other}_{link}", f"R^τ_{self.R(other, link)[1:]}", abs(R @ t), "N",
                              _angle(np.sign(R @ t) * t), f"Σ M_{pin.point} = 0 of link {link}, arm {outer.point}{pin.point} = {arm:.4g} mm")
             for link, outer, other in ((j, pj, a), (k, pk, c)):
                 if outer.kind == "R" and pin.kind == "R":
                     R = res.reaction(other, link)[0]
                     r = res.position(pin.point)[0] - res.position(outer.point)[0]
                     e = r / np.hypot(*r)
-                    self.add("reactions", f"Rn_{other}_{link}", f"R^n_{other}{link}", abs(R @ e), "N",
+                    self.add("reactions", f"Rn_{other}_{link}", f"R^n_{self.R(other, link)[1:]}", abs(R @ e), "N",
                              _angle(np.sign(R @ e) * e), "force plan of the group")
             for link, other in ((j, a), (k, c)):
-                self.vector("reactions", f"R_{other}_{link}", f"R{other}{link}", res.reaction(other, link)[0], "N",
+                self.vector("reactions", f"R_{other}_{link}", self.R(other, link), res.reaction(other, link)[0], "N",
                             "force plan of the group")
-            self.vector("reactions", f"R_{k}_{j}", f"R{k}{j}", res.reaction(k, j)[0], "N",
+            self.vector("reactions", f"R_{k}_{j}", self.R(k, j), res.reaction(k, j)[0], "N",
                         f"force plan of link {j}")
             for p in (pj, pin, pk):
                 if p.kind == "P":
                     x = res.reaction_offset(*p.links)[0]
-                    self.add("reactions", f"x_{p.links[0]}_{p.links[1]}", f"x{p.links[0]}{p.links[1]}", x, "m", "",
+                    self.add("reactions", f"x_{p.links[0]}_{p.links[1]}", "x" + self.R(*p.links)[1:], x, "m", "",
                              f"Σ M_{p.point} = 0 of link {p.links[1]}")
 
     # ---- crank and lever
     def crank(self) -> None:
-        res, m, d = self.res, self.mech, self.mech.drive
+        res, m, d, L = self.res, self.mech, self.mech.drive, self.L
         O = res.position(d.pivot)[0]
         for p in m.pairs:
             if d.link in p.links and 0 not in p.links:
                 other = p.links[0] if p.links[1] == d.link else p.links[1]
                 R = res.reaction(other, d.link)[0]
                 X = res.position(p.point)[0]
-                self.vector("crank", f"R_{other}_{d.link}", f"R{other}{d.link}", R, "N", f"= -R{d.link}{other}")
+                self.vector("crank", f"R_{other}_{d.link}", self.R(other, d.link), R, "N",
+                            f"= -{self.R(d.link, other)}")
                 r = X - O
                 arm = abs(r[0] * R[1] - r[1] * R[0]) / np.hypot(*R) / self.mu_l
-                self.add("crank", f"h_R{other}{d.link}", f"h_R{other}{d.link}", arm, "mm", "",
+                self.add("crank", f"h_R{other}{d.link}", f"h_{self.R(other, d.link)}", arm, "mm", "",
                          "arm about the crank axis, on the crank's plan")
         M = res.balancing_moment[0]
-        self.add("crank", "M_bal", "M_bal", M, "N m", _sense(M), "Σ M_O = 0 of the crank (signed about +z)")
+        self.add("crank", "M_bal", L.M_bal, M, "N m", _sense(M), "Σ M_O = 0 of the crank (signed about +z)")
         if d.kind == "machine":
             F = res.balancing_force[0]
-            self.vector("crank", "F_bal", "F_bal", F, "N", "F21 h / r_b, at the pitch point on the line of action")
+            self.vector("crank", "F_bal", L.F_bal, F, "N", "F21 h / r_b, at the pitch point on the line of action")
             self.add("crank", "r_b", "r_b", d.gear.r_b, "m", "", "r_w cos α_w")
         R01 = res.reaction(0, d.link)[0]
-        self.vector("crank", f"R_0_{d.link}", f"R0{d.link}", R01, "N", "force plan of the crank")
+        self.vector("crank", f"R_0_{d.link}", self.R(0, d.link), R01, "N", "force plan of the crank")
         l1 = math.dist(*(m.links[d.link].points[n] for n in (d.pivot, d.point)))
         ML = res.lever_moment[0]
-        self.add("crank", "F_bal_lever", "F'_bal", abs(ML) / l1, "N", "", f"at {d.point}, ⟂ p{d.point.lower()}: Σ M_p = 0 on the lever")
-        self.add("crank", "M_bal_lever", "M'_bal", ML, "N m", _sense(ML), f"F'_bal l_{d.pivot}{d.point}")
+        F1, M1 = L.lever(L.F_bal), L.lever(L.M_bal)
+        self.add("crank", "F_bal_lever", F1, abs(ML) / l1, "N", "",
+                 f"at point {d.point}, ⟂ p{d.point.lower()}: Σ M_p = 0 on the lever")
+        self.add("crank", "M_bal_lever", M1, ML, "N m", _sense(ML), f"{F1} l_{d.pivot}{d.point}")
         self.add("crank", "delta_pct", "δ", (ML - M) / ML * 100 if ML else math.nan, "%", "",
-                 "(M'_bal - M_bal) / M'_bal 100 %")
+                 f"({M1} - {L.M_bal}) / {M1} 100 %")
 
 
 def _point_of(res: Analysis, k: int, name: str) -> np.ndarray:
@@ -381,9 +375,10 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
     """The worksheet of `mech` at crank angle `at` (deg; default the model's design position).
 
     mu_l: the scale of the plan of positions, m/mm, for the arms and z in mm (default: the
-    crank drawn 30-35 mm at a round scale, as seed 002 chooses it). lang: "en" or "uk"."""
-    if lang not in _WORDS:
-        raise ValueError(f"lang: expected one of {sorted(_WORDS)}, got {lang!r}")
+    crank drawn 30-35 mm at a round scale, as seed 002 chooses it). lang: "en", "uk" or "ru"
+    (the mechanism named as its lettering names it in that language). Symbols as the model's
+    lettering writes them (R43, M_зр)."""
+    check_lang(lang)
     if at is None:
         at = mech.drive.design_deg
     if mu_l is not None and not (isinstance(mu_l, (int, float)) and math.isfinite(mu_l) and mu_l > 0):
@@ -396,4 +391,5 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
     sheet.loads()
     sheet.reactions()
     sheet.crank()
-    return Worksheet(mech.name, float(at), float(mu_l), tuple(sheet.rows), lang, float(res.digits[0]))
+    return Worksheet(lettering(mech).name(lang, mech.name), float(at), float(mu_l), tuple(sheet.rows), lang,
+                     float(res.digits[0]))

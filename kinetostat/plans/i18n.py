@@ -1,0 +1,253 @@
+"""The message catalogue of the sheets, the worksheet, the answer keys and their index: every word
+they print, in English, Ukrainian and Russian (the seeds are Ukrainian and Russian), and the
+numbers and units as each language writes them (decimal comma in uk and ru, Н·м, рад/с²).
+
+    >>> from kinetostat.plans.i18n import num, text, unit
+    >>> num(3185.2, "uk"), num(2.852e-17, "en"), unit("N m", "ru"), text("scale", "uk")
+    ('3185', '0', 'Н·м', 'масштаб')
+
+`MESSAGES[key] = (en, uk, ru)`; `text(key, lang, **fields)` formats one. `PHRASES` translates the
+generated English notes of the plans (branches, positions) phrase by phrase; `words_en()` is the
+English side the tests look for in uk and ru output.
+
+May use: the standard library and numpy only.
+"""
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+__all__ = ["LANGS", "MESSAGES", "PHRASES", "UNITS", "check_lang", "text", "num", "unit", "phrase", "words_en",
+           "ZERO"]
+
+LANGS = ("en", "uk", "ru")
+#: A magnitude below this (SI) is printed as 0: the solver's rounding noise, never a value.
+ZERO = 1e-9
+
+MESSAGES: dict[str, tuple[str, str, str]] = {
+    # plan titles
+    "plan.positions": ("Plan of positions", "План положень", "План положений"),
+    "plan.velocity": ("Velocity plan", "План швидкостей", "План скоростей"),
+    "plan.acceleration": ("Acceleration plan", "План прискорень", "План ускорений"),
+    "plan.group": ("Plan of group", "План групи", "План группы"),
+    "plan.forces": ("Force plan of group", "План сил групи", "План сил группы"),
+    "plan.crank": ("Plan of the initial link", "План початкової ланки", "План начального звена"),
+    "plan.lever": ("Zhukovsky's lever", "Важіль Жуковського", "Рычаг Жуковского"),
+    "plan.mechanism": ("Mechanism at the design position", "Механізм у розрахунковому положенні",
+                       "Механизм в расчётном положении"),
+    # title block and notes
+    "angle": ("crank angle", "кут кривошипа", "угол кривошипа"),
+    "scale": ("scale", "масштаб", "масштаб"),
+    "scales": ("scales", "масштаби", "масштабы"),
+    "forces at": ("forces at", "сили в масштабі", "силы в масштабе"),
+    "sheet": ("sheet A3, true to scale in mm", "аркуш А3, креслення в мм у масштабі",
+              "лист А3, чертёж в мм в масштабе"),
+    "segment": ("segment", "відрізок", "отрезок"),
+    "results": ("Results", "Результати", "Результаты"),
+    "equation": ("Vector equation, in the order drawn", "Векторне рівняння в порядку побудови",
+                 "Векторное уравнение в порядке построения"),
+    "nofit": ("the plan does not fit the sheet at this scale", "план не вміщується на аркуші в цьому масштабі",
+              "план не помещается на листе в этом масштабе"),
+    "out of scale": ("drawn out of scale ({length} mm at the scale)", "показано поза масштабом ({length} мм у масштабі)",
+                     "показано вне масштаба ({length} мм в масштабе)"),
+    "negligible": ("negligible: {length} mm at the scale, not laid off",
+                   "нехтовно мала: {length} мм у масштабі, не відкладається",
+                   "пренебрежимо мала: {length} мм в масштабе, не откладывается"),
+    "arms natural": ("arms h measured on the drawing, mm", "плечі h виміряно на кресленні, мм",
+                     "плечи h измерены на чертеже, мм"),
+    "within 5": ("within the texts' 5 %", "у межах допустимих 5 %", "в пределах допустимых 5 %"),
+    "beyond 5": ("beyond the texts' 5 %", "перевищує допустимі 5 %", "превышает допустимые 5 %"),
+    "by force plans": ("by the force plans", "за планами сил", "по планам сил"),
+    "by lever": ("by Zhukovsky's lever", "за важелем Жуковського", "по рычагу Жуковского"),
+    "couple": ("couple of forces at the ends of the link", "пара сил на кінцях ланки", "пара сил на концах звена"),
+    "pole": ("pole", "полюс", "полюс"),
+    "M = sum": ("sum of the moments about the crank's axis is zero", "з рівняння моментів відносно осі кривошипа",
+                "из уравнения моментов относительно оси кривошипа"),
+    "M = F r_b": ("balancing force times the base radius", "зрівноважувальна сила на радіус основного кола",
+                  "уравновешивающая сила на радиус основной окружности"),
+    "legend.positions": ("bold: the design position; thin: positions 0-11 every 30°; curves: paths of the centres "
+                         "of mass", "жирно: розрахункове положення; тонко: положення 0-11 через 30°; криві: "
+                         "траєкторії центрів мас", "жирно: расчётное положение; тонко: положения 0-11 через 30°; "
+                         "кривые: траектории центров масс"),
+    "legend.velocity": ("p: pole; vectors p-x: absolute velocities; the others: relative velocities",
+                        "p: полюс; вектори p-x: абсолютні швидкості; інші: відносні швидкості",
+                        "p: полюс; векторы p-x: абсолютные скорости; остальные: относительные скорости"),
+    "legend.acceleration": ("π: pole; n: normal, n-x: tangential, k: Coriolis, k-x: relative parts",
+                            "π: полюс; n: нормальні, n-x: дотичні, k: коріолісові, k-x: відносні складові",
+                            "π: полюс; n: нормальные, n-x: касательные, k: кориолисовы, k-x: относительные "
+                            "составляющие"),
+    "legend.mechanism": ("ω: angular velocity, ε: angular acceleration (senses); S: centres of mass",
+                         "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
+                         "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
+    "guide": ("guide", "напрямна", "направляющая"),
+    "line of action": ("line of action", "лінія зачеплення", "линия зацепления"),
+    "pitch circle of the wheel": ("pitch circle of the wheel", "початкове коло колеса",
+                                  "начальная окружность колеса"),
+    "pitch circle of the pinion": ("pitch circle of the pinion", "початкове коло шестерні",
+                                   "начальная окружность шестерни"),
+    "mm": ("mm", "мм", "мм"),
+    # the index of the answer keys
+    "ix.title": ("Seed 002: answer keys of the task variants", "Джерело 002: відповіді до варіантів завдань",
+                 "Источник 002: ответы к вариантам заданий"),
+    "ix.intro": ("Each folder holds the variant's model (`task<T>_<CODE>.toml`, its header states the table's "
+                 "columns and every assumption), its worksheet (`worksheet.md`, `.html`, `.csv`, `.json`) and its "
+                 "plans (`SVG` sheets, `segments.csv`) at the design position φ1. R(i,j) is the force of link i on "
+                 "link j; {M} the moment the drive applies to the crank (about +z, N·m).",
+                 "Кожна тека містить модель варіанта (`task<T>_<CODE>.toml`, у заголовку — стовпці таблиці та всі "
+                 "припущення), розрахунковий лист (`worksheet.md`, `.html`, `.csv`, `.json`) і плани (аркуші `SVG`, "
+                 "`segments.csv`) у розрахунковому положенні φ1. R(i,j) — сила дії ланки i на ланку j; {M} — "
+                 "момент, який привод прикладає до кривошипа (відносно осі +z, Н·м).",
+                 "Каждая папка содержит модель варианта (`task<T>_<CODE>.toml`, в заголовке — столбцы таблицы и все "
+                 "допущения), расчётный лист (`worksheet.md`, `.html`, `.csv`, `.json`) и планы (листы `SVG`, "
+                 "`segments.csv`) в расчётном положении φ1. R(i,j) — сила действия звена i на звено j; {M} — "
+                 "момент, который привод прикладывает к кривошипу (относительно оси +z, Н·м)."),
+    "ix.task": ("Task {task}: {title} (table {table})", "Задача {task}: {title} (таблиця {table})",
+                "Задача {task}: {title} (таблица {table})"),
+    "ix.code": ("code", "код", "код"),
+    "ix.at": ("at φ1", "при φ1", "при φ1"),
+    "ix.largest": ("largest reaction at φ1", "найбільша реакція при φ1", "наибольшая реакция при φ1"),
+    "ix.cycle": ("max over the cycle", "найбільше за цикл", "наибольшее за цикл"),
+    # the command line
+    "cli.plans": ("{name} at φ = {phi}° ({scales}): {n} files -> {out}", "{name}, φ = {phi}° ({scales}): {n} файлів -> {out}",
+                  "{name}, φ = {phi}° ({scales}): {n} файлов -> {out}"),
+    "cli.variant": ("seed 002, task {task} ({title}), variant {code}: table {table} columns",
+                    "джерело 002, задача {task} ({title}), варіант {code}: стовпці таблиці {table}",
+                    "источник 002, задача {task} ({title}), вариант {code}: столбцы таблицы {table}"),
+    "cli.at": ("at φ1 = {phi}°: {M} = {M_value}, largest reaction |{R}| = {R_value}",
+               "при φ1 = {phi}°: {M} = {M_value}, найбільша реакція |{R}| = {R_value}",
+               "при φ1 = {phi}°: {M} = {M_value}, наибольшая реакция |{R}| = {R_value}"),
+    "cli.cycle": ("over the cycle: max |{M}| = {M_value}, max |R| = {R_value}",
+                  "за цикл: найбільше |{M}| = {M_value}, найбільше |R| = {R_value}",
+                  "за цикл: наибольшее |{M}| = {M_value}, наибольшее |R| = {R_value}"),
+    "cli.files": ("model {model} (assumptions in its header), worksheet, plans and `cycle.csv`: {n} files -> {out}",
+                  "модель {model} (припущення в її заголовку), розрахунковий лист, плани і `cycle.csv`: {n} файлів -> {out}",
+                  "модель {model} (допущения в её заголовке), расчётный лист, планы и `cycle.csv`: {n} файлов -> {out}"),
+    # the worksheet
+    "ws.title": ("Worksheet: {name}, φ = {phi}°", "Розрахунковий лист: {name}, φ = {phi}°",
+                 "Расчётный лист: {name}, φ = {phi}°"),
+    "ws.kinematics": ("Kinematics: velocities", "Кінематика: швидкості", "Кинематика: скорости"),
+    "ws.accelerations": ("Kinematics: accelerations", "Кінематика: прискорення", "Кинематика: ускорения"),
+    "ws.inertia": ("Inertia forces and loads", "Сили інерції та навантаження", "Силы инерции и нагрузки"),
+    "ws.reactions": ("Reactions in the kinematic pairs", "Реакції в кінематичних парах",
+                     "Реакции в кинематических парах"),
+    "ws.crank": ("The initial link and Zhukovsky's lever", "Початкова ланка і важіль Жуковського",
+                 "Начальное звено и рычаг Жуковского"),
+    "ws.cw": ("clockwise", "за годинниковою стрілкою", "по часовой стрелке"),
+    "ws.ccw": ("counter-clockwise", "проти годинникової стрілки", "против часовой стрелки"),
+    "ws.angle": ("at {angle}° to x", "під кутом {angle}° до осі x", "под углом {angle}° к оси x"),
+    "ws.accuracy": ("**Accuracy:** near a singular position: about {digits} significant digits left at this "
+                    "angle (fewer than {min}); the last digits of the values below are not reliable",
+                    "**Точність:** поблизу особливого положення: лишилося близько {digits} значущих цифр "
+                    "(менше ніж {min}); останні цифри значень нижче ненадійні",
+                    "**Точность:** вблизи особого положения: осталось около {digits} значащих цифр "
+                    "(меньше чем {min}); последние цифры значений ниже ненадёжны"),
+    "ws.head.symbol": ("Symbol", "Позначення", "Обозначение"),
+    "ws.head.value": ("Value", "Значення", "Значение"),
+    "ws.head.unit": ("Unit", "Одиниця", "Единица"),
+    "ws.head.direction": ("Sense / direction", "Напрямок", "Направление"),
+    "ws.head.note": ("How obtained", "Як отримано", "Как получено"),
+    "degrees": ("deg", "град", "град"),
+}
+
+#: The English phrases of the generated notes (positions, branches) and their translations,
+#: longest first where one contains another.
+PHRASES: tuple[tuple[str, str, str], ...] = (
+    ("(crank and rod in line), then every 30 deg", "(кривошип і шатун на одній прямій), далі через 30°",
+     "(кривошип и шатун на одной прямой), далее через 30°"),
+    ("drawn with plain letters", "позначене літерами без індексу", "обозначено буквами без индекса"),
+    ("design position phi =", "розрахункове положення φ =", "расчётное положение φ ="),
+    ("position 0 at phi =", "положення 0 при φ =", "положение 0 при φ ="),
+    ("(the other branch does not assemble here)", "(інше складання тут неможливе)", "(другая сборка здесь невозможна)"),
+    ("(the other branch looks the same here)", "(інше складання тут має той самий вигляд)",
+     "(другая сборка здесь выглядит так же)"),
+    (": the other branch", ": інше складання", ": другая сборка"),
+    ("arm about the crank axis, on the crank's plan", "плече відносно осі кривошипа, на плані кривошипа",
+     "плечо относительно оси кривошипа, на плане кривошипа"),
+    ("of the crank (signed about +z)", "для кривошипа (знак відносно осі +z)", "для кривошипа (знак относительно оси +z)"),
+    ("at the pitch point on the line of action", "у полюсі зачеплення на лінії зачеплення",
+     "в полюсе зацепления на линии зацепления"),
+    ("force plan of the crank", "план сил кривошипа", "план сил кривошипа"),
+    ("force plan of the group", "план сил групи", "план сил группы"),
+    ("force plan of link", "план сил ланки", "план сил звена"),
+    ("on the lever", "на важелі", "на рычаге"),
+    ("along the guide of link", "уздовж напрямної ланки", "вдоль направляющей звена"),
+    ("along the guide", "уздовж напрямної", "вдоль направляющей"),
+    ("read from its diagram", "за діаграмою", "по диаграмме"),
+    ("given", "задано", "задано"),
+    (", against", ", протилежно", ", противоположно"),
+    ("of link", "ланки", "звена"),
+    (", arm", ", плече", ", плечо"),
+    (" mm", " мм", " мм"),
+    ("at point", "у точці", "в точке"),
+    ("dashed to", "штрихом до", "штрихом до"),
+    ("one assembly", "єдине складання", "единственная сборка"),
+    ("branch", "складання", "сборка"),
+    ("drawn", "накреслено", "начерчено"),
+    (" deg", "°", "°"),
+)
+
+#: Units as each language writes them.
+UNITS: dict[str, tuple[str, str, str]] = {
+    "m/mm": ("m/mm", "м/мм", "м/мм"), "m/(s mm)": ("m/(s·mm)", "м/(с·мм)", "м/(с·мм)"),
+    "m/(s^2 mm)": ("m/(s²·mm)", "м/(с²·мм)", "м/(с²·мм)"), "N/mm": ("N/mm", "Н/мм", "Н/мм"),
+    "m/s": ("m/s", "м/с", "м/с"), "m/s^2": ("m/s²", "м/с²", "м/с²"), "m": ("m", "м", "м"), "mm": ("mm", "мм", "мм"),
+    "N": ("N", "Н", "Н"), "N m": ("N·m", "Н·м", "Н·м"), "rad/s": ("rad/s", "рад/с", "рад/с"),
+    "rad/s^2": ("rad/s²", "рад/с²", "рад/с²"), "kg": ("kg", "кг", "кг"), "kg m^2": ("kg·m²", "кг·м²", "кг·м²"),
+    "rpm": ("rpm", "об/хв", "об/мин"), "Pa": ("Pa", "Па", "Па"), "MPa": ("MPa", "МПа", "МПа"), "%": ("%", "%", "%"),
+    "deg": ("°", "°", "°"), "W": ("W", "Вт", "Вт"), "J": ("J", "Дж", "Дж"), "1": ("", "", ""), "": ("", "", ""),
+}
+
+
+def check_lang(lang: str) -> int:
+    """Index of `lang` in LANGS (ValueError naming the choices otherwise)."""
+    if lang not in LANGS:
+        raise ValueError(f"lang: expected one of {', '.join(LANGS)}, got {lang!r}")
+    return LANGS.index(lang)
+
+
+def text(key: str, lang: str, **fields) -> str:
+    """Message `key` in `lang`, its {fields} filled."""
+    s = MESSAGES[key][check_lang(lang)]
+    return s.format(**fields) if fields else s
+
+
+def unit(u: str, lang: str) -> str:
+    """A unit as `lang` writes it (an unknown unit as given)."""
+    return UNITS[u][check_lang(lang)] if u in UNITS else u
+
+
+def num(x: float, lang: str, digits: int = 4, decimals: int | None = None) -> str:
+    """x with `digits` significant digits (or `decimals` after the point), never in e-notation,
+    trailing zeros dropped, the decimal comma in uk and ru; |x| < ZERO is 0; NaN is '—'."""
+    x = float(x)
+    if not math.isfinite(x):
+        return "—"
+    if abs(x) < ZERO:
+        return "0"
+    if decimals is not None:
+        s = f"{x:.{decimals}f}"
+    else:
+        s = np.format_float_positional(x, precision=digits, unique=False, fractional=False, trim="-")
+    s = s.rstrip(".")
+    if s in ("-0", "0"):
+        return "0"
+    return s.replace(".", ",") if check_lang(lang) else s
+
+
+def phrase(note: str, lang: str) -> str:
+    """A generated English note in `lang`, phrase by phrase (PHRASES); its numbers as `lang` writes them."""
+    i = check_lang(lang)
+    if not i:
+        return note
+    for p in PHRASES:
+        note = note.replace(p[0], p[i])
+    return re.sub(r"(?<=\d)\.(?=\d)", ",", note)
+
+
+def words_en() -> set[str]:
+    """The English words (3 letters or more) of the catalogue's English side, less its {fields}
+    and `file names`: none may appear in uk or ru output."""
+    texts = [m[0] for m in MESSAGES.values()] + [p[0] for p in PHRASES]
+    return {w.lower() for t in texts for w in re.findall(r"[A-Za-z]{3,}", re.sub(r"\{[^}]*\}|`[^`]*`", "", t))}

@@ -1,0 +1,234 @@
+"""Lettering on a sheet: the size of a text as the browser sets it (DejaVu Sans), the SVG of a
+point's letter with its subscript, and a placer that puts each label beside its point or vector
+where it overprints no other label, arrowhead, point or line end, as a draughtsman would.
+
+Sheet coordinates: mm, x right, y down (SVG user units). A box is (x0, y0, x1, y1).
+
+The placer is greedy: labels in the order given (points first, then names of vectors), each at
+the candidate position of least cost (distance from its anchor, lines crossed) among those that
+overlap nothing placed before; far from its anchor a label gets a thin leader line. Coincident
+points are lettered once, "B1 ≡ B11" (`merge_coincident`).
+
+May use: numpy, the standard library.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from xml.sax.saxutils import escape
+
+import numpy as np
+
+__all__ = ["text_width", "text_box", "label_parts", "label_svg", "label_width", "Placer", "Placed",
+           "merge_coincident", "MIN_TEXT_MM", "ASCENT", "DESCENT"]
+
+#: Smallest text on a sheet, mm (the texts' standard lettering: 2.5 mm and up).
+MIN_TEXT_MM = 2.5
+#: DejaVu Sans ascent and descent, em: the box getBBox gives a text.
+ASCENT, DESCENT = 0.93, 0.24
+_NARROW = set("iljtfrI.,:;'′|!()[] -")
+_WIDE = set("mwMWЖШЩЮжшщюΣ≡→")
+
+
+def text_width(s: str, size: float) -> float:
+    """Advance width of `s` at font size `size` (mm), DejaVu Sans, slightly generous."""
+    w = 0.0
+    for ch in s:
+        if ch in _NARROW:
+            w += 0.36
+        elif ch in _WIDE:
+            w += 0.98
+        elif ch.isupper():
+            w += 0.76
+        else:
+            w += 0.65
+    return w * size
+
+
+def text_box(x: float, y: float, s: str, size: float, anchor: str = "start") -> tuple[float, float, float, float]:
+    """Box of a one-line text at baseline (x, y)."""
+    w = text_width(s, size)
+    x0 = x - (w if anchor == "end" else w / 2 if anchor == "middle" else 0.0)
+    return x0, y - ASCENT * size, x0 + w, y + DESCENT * size
+
+
+_LABEL = re.compile(r"^([^\d_']*)([\d_]*)('*)$")
+
+
+def label_parts(name: str) -> tuple[str, str, str]:
+    """A point name as (letters, subscript, primes): 's2' -> ('s', '2', ''), 'S2_3' -> ('S', '2,3', ''),
+    'pi' -> ('π', '', ''), "B'" -> ('B', '', '′'); 'R12t' -> ('R', '12', 't') is not split this
+    way: a name with letters after its digits is written as it is; 'F_i2' -> ('F', 'i2', '')."""
+    if name == "pi":
+        return "π", "", ""
+    m = _LABEL.match(name)
+    if (not m or not m.group(1)) and "_" in name.strip("_"):
+        head, _, sub = name.partition("_")
+        return head, sub, ""
+    if not m or not m.group(1):
+        return name, "", ""
+    return m.group(1), m.group(2).strip("_").replace("_", ","), "′" * len(m.group(3))
+
+
+def _sub(size: float) -> float:
+    return max(MIN_TEXT_MM, 0.75 * size)
+
+
+def label_width(name: str, size: float) -> float:
+    """Width of a lettered name (several names joined by ' ≡ ' allowed)."""
+    w = 0.0
+    for k, part in enumerate(name.split(" ≡ ")):
+        head, sub, primes = label_parts(part)
+        w += text_width(head, size) + text_width(sub, _sub(size)) + text_width(primes, size)
+        if k:
+            w += text_width(" ≡ ", size)
+    return w
+
+
+def label_height(name: str, size: float) -> tuple[float, float]:
+    """(above, below) the baseline of a lettered name, mm."""
+    below = DESCENT * size
+    if any(label_parts(p)[1] for p in name.split(" ≡ ")):
+        below = max(below, 0.3 * size + DESCENT * _sub(size))
+    return ASCENT * size, below
+
+
+def label_svg(x: float, y: float, name: str, size: float, cls: str = "label") -> str:
+    """A lettered name at baseline (x, y): letters, subscript (a smaller tspan below), primes;
+    coincident names joined by ' ≡ '."""
+    out = [f'<text class="{cls}" x="{x:.2f}" y="{y:.2f}" font-size="{size:.2f}">']
+    low = 0.0                                     # how far below the baseline the last tspan sits
+    for k, part in enumerate(name.split(" ≡ ")):
+        head, sub, primes = label_parts(part)
+        for piece, dy, small in (((" ≡ " if k else ""), -low, False), (head, 0.0, False),
+                                 (sub, 0.3 * size, True), (primes, -0.3 * size if sub else 0.0, False)):
+            if not piece:
+                continue
+            attrs = f' font-size="{_sub(size):.2f}"' if small else ""
+            attrs += f' dy="{dy:.2f}"' if dy else ""
+            out.append(f"<tspan{attrs}>{escape(piece)}</tspan>")
+            low += dy
+    return "".join(out) + "</text>"
+
+
+def merge_coincident(points: list[tuple[str, float, float]], tol: float = 0.5) -> list[tuple[str, float, float]]:
+    """Points (name, x, y) within `tol` mm of one another lettered once: 'B1 ≡ B11' (names in
+    the order given), at the first point."""
+    out: list[list] = []
+    for name, x, y in points:
+        for group in out:
+            if math.hypot(group[1] - x, group[2] - y) <= tol:
+                group[0].append(name)
+                break
+        else:
+            out.append([[name], x, y])
+    return [(" ≡ ".join(names), x, y) for names, x, y in out]
+
+
+@dataclass(frozen=True)
+class Placed:
+    """A placed label: baseline start (x, y), its box, and a leader from its anchor if far."""
+    name: str
+    x: float
+    y: float
+    size: float
+    box: tuple[float, float, float, float]
+    leader: tuple[float, float, float, float] | None
+
+
+class Placer:
+    """Places labels inside `bounds` (a box) so that none overlaps another, an obstacle box
+    (arrowheads, points, line ends, the title block) or leaves the bounds; lines (soft
+    obstacles) are crossed as little as may be."""
+
+    PAD = 0.35        # clearance between a label and anything else, mm
+
+    def __init__(self, bounds: tuple[float, float, float, float]):
+        self.bounds = bounds
+        self._boxes: list[tuple[float, float, float, float]] = []
+        self._samples: list[np.ndarray] = []
+        self.placed: list[Placed] = []
+
+    def block(self, box) -> None:
+        """A hard obstacle: nothing is placed over it."""
+        self._boxes.append(tuple(float(v) for v in box))
+
+    def line(self, x0: float, y0: float, x1: float, y1: float) -> None:
+        """A soft obstacle: a drawn line, sampled every 0.7 mm."""
+        n = max(2, int(math.hypot(x1 - x0, y1 - y0) / 0.7) + 1)
+        t = np.linspace(0.0, 1.0, n)
+        self._samples.append(np.column_stack([x0 + t * (x1 - x0), y0 + t * (y1 - y0)]))
+
+    def _cost(self, boxes: np.ndarray, base: np.ndarray) -> np.ndarray:
+        """Cost of candidate boxes (K, 4): inf where one overlaps a hard obstacle or leaves the bounds."""
+        p = self.PAD
+        bx0, by0, bx1, by1 = self.bounds
+        bad = (boxes[:, 0] < bx0) | (boxes[:, 1] < by0) | (boxes[:, 2] > bx1) | (boxes[:, 3] > by1)
+        if self._boxes:
+            ob = np.asarray(self._boxes)
+            hit = ((boxes[:, None, 0] < ob[None, :, 2] + p) & (boxes[:, None, 2] > ob[None, :, 0] - p)
+                   & (boxes[:, None, 1] < ob[None, :, 3] + p) & (boxes[:, None, 3] > ob[None, :, 1] - p))
+            bad |= hit.any(axis=1)
+        cost = base.astype(float).copy()
+        if self._samples:
+            s = np.concatenate(self._samples)
+            lo, hi = boxes[:, :2].min(axis=0) - 1, boxes[:, 2:].max(axis=0) + 1
+            s = s[(s[:, 0] > lo[0]) & (s[:, 0] < hi[0]) & (s[:, 1] > lo[1]) & (s[:, 1] < hi[1])]
+            if len(s):
+                inside = ((s[None, :, 0] > boxes[:, None, 0]) & (s[None, :, 0] < boxes[:, None, 2])
+                          & (s[None, :, 1] > boxes[:, None, 1]) & (s[None, :, 1] < boxes[:, None, 3]))
+                cost += 0.6 * inside.sum(axis=1)
+        cost[bad] = np.inf
+        return cost
+
+    def _boxes_at(self, centres: np.ndarray, w: float, up: float, down: float) -> np.ndarray:
+        """Boxes of a label whose box centre is at each of `centres` (K, 2)."""
+        h = up + down
+        return np.column_stack([centres[:, 0] - w / 2, centres[:, 1] - h / 2,
+                                centres[:, 0] + w / 2, centres[:, 1] + h / 2])
+
+    def place(self, name: str, size: float, ax: float, ay: float,
+              along: tuple[float, float] | None = None) -> Placed:
+        """Place `name` beside point (ax, ay), or beside the segment from (ax, ay) to `along`."""
+        w = label_width(name, size)
+        up, down = label_height(name, size)
+        half = np.array([w / 2, (up + down) / 2])
+        cands, base = [], []
+        angles = np.radians(np.arange(0, 360, 22.5) + 45.0)
+        dirs = np.column_stack([np.cos(angles), -np.sin(angles)])
+        if along is not None:
+            d = np.array([along[0] - ax, along[1] - ay])
+            L = float(np.hypot(*d))
+            if L > 1e-9:
+                u = d / L
+                nrm = np.array([-u[1], u[0]])
+                for t in (0.5, 0.38, 0.62, 0.25, 0.75, 0.15, 0.85):
+                    for side in (1.0, -1.0):
+                        for r in (0.6, 1.5, 3.0):
+                            c = np.array([ax, ay]) + t * d + side * nrm * (r + abs(nrm) @ half)
+                            cands.append(c)
+                            base.append(r + 6.0 * abs(t - 0.5) * min(L, 20.0) / 20.0)
+            mid = (ax + along[0]) / 2, (ay + along[1]) / 2
+            ax, ay = mid
+        for r in (0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0):
+            for dv in dirs:
+                cands.append(np.array([ax, ay]) + dv * (r + np.abs(dv) @ half))
+                base.append(1.2 * r + (0.3 if dv[1] > 0 else 0.0) + (2.0 if along is not None else 0.0))
+        cands_a = np.asarray(cands)
+        boxes = self._boxes_at(cands_a, w, up, down)
+        cost = self._cost(boxes, np.asarray(base))
+        k = int(np.argmin(cost))
+        if not np.isfinite(cost[k]):
+            k = 0                                   # nowhere free: the nearest place (the test tells)
+        x0, y0, x1, y1 = boxes[k]
+        box = (float(x0), float(y0), float(x1), float(y1))
+        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+        leader = None
+        if math.hypot(cx - ax, cy - ay) - float(np.abs(dirs).max(axis=0) @ half) > 6.0:
+            qx, qy = min(max(ax, x0), x1), min(max(ay, y0), y1)
+            leader = (ax, ay, float(qx), float(qy))
+        pl = Placed(name, float(x0), float(y0 + up), size, box, leader)
+        self.placed.append(pl)
+        self._boxes.append(box)
+        return pl

@@ -1,0 +1,98 @@
+"""A model's lettering: the names its source text gives (the model file's `[lettering]` table,
+models/FORMAT.md), with the project's defaults where the model gives none. Every output that
+names the frame, the balancing moment or force, or a load (sheets, worksheet, answer key,
+cycle.csv aliases) asks here, so that all of them say what the text says.
+
+    >>> import kinetostat
+    >>> L = lettering(kinetostat.load("ice_crank_slider"))
+    >>> L.frame, L.M_bal, L.F_bal, L.load("gas force"), L.language
+    (4, 'M_зр', 'F_зр', 'F_p', 'uk')
+
+May use: the model (`kinetostat.model`), the standard library.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Mapping
+
+if TYPE_CHECKING:
+    from ..model import Mechanism
+
+__all__ = ["Lettering", "lettering", "with_aliases", "DEFAULT"]
+
+
+@dataclass(frozen=True)
+class Lettering:
+    """The names a model's text uses: `frame` the frame's number (seed 002's ICE: 4, so R43,
+    R41), `M_bal`, `F_bal` the balancing moment's and force's symbols (M_зр, F_зр), `loads` load
+    name -> symbol (gas force -> F_p), `names` language -> the mechanism's name in it, `language`
+    the text's language ("" where the model does not state it)."""
+    frame: int = 0
+    M_bal: str = "M_bal"
+    F_bal: str = "F_bal"
+    loads: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    names: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    language: str = ""
+
+    def load(self, name: str, default: str | None = None) -> str:
+        """The symbol of the model's load `name` (`default`, else the name, where none is given)."""
+        return self.loads.get(name, name if default is None else default)
+
+    def lever(self, symbol: str) -> str:
+        """The lever's symbol of a balancing quantity: a prime after its letter (M'_зр, F'_bal)."""
+        head, sep, tail = symbol.partition("_")
+        return f"{head}'{sep}{tail}"
+
+    def name(self, lang: str, default: str) -> str:
+        """The mechanism's name in `lang` (its own name where the model gives none in `lang`)."""
+        return self.names.get(lang, default)
+
+
+DEFAULT = Lettering()
+
+
+def _published_frame(mech: "Mechanism") -> int:
+    """The frame's number a published reaction letters (R43 for the pair (0, 3): 4), else 0."""
+    for p in mech.published:
+        if p.quantity == "reaction" and p.pair is not None and 0 in p.pair:
+            m = re.fullmatch(r"R_?(\d)(\d)", p.symbol)
+            if m:
+                digits = tuple(int(d) for d in m.groups())
+                side = p.pair.index(0)
+                if digits[1 - side] == p.pair[1 - side]:
+                    return digits[side]
+    return 0
+
+
+def lettering(mech: "Mechanism") -> Lettering:
+    """The lettering of `mech`: its `[lettering]` table, the frame's number from a published
+    reaction where the table gives none, the defaults otherwise."""
+    given = dict(getattr(mech, "lettering", None) or {})
+    return Lettering(frame=int(given.get("frame", _published_frame(mech))),
+                     M_bal=str(given.get("M_bal", DEFAULT.M_bal)), F_bal=str(given.get("F_bal", DEFAULT.F_bal)),
+                     loads=MappingProxyType(dict(given.get("loads", {}))),
+                     names=MappingProxyType(dict(given.get("name", {}))),
+                     language=str(given.get("language", "")))
+
+
+def with_aliases(df, mech: "Mechanism"):
+    """The analysis frame `df` (`Analysis.to_frame`) with the text's names added as copies of
+    their columns, after them: R_4_3 for R_0_3 where the frame is lettered 4 (and Rx_, Ry_,
+    angle_R_, x_ likewise), M_зр for M_bal, M'_зр for M_lever, F_зр for F_bal. Units carried."""
+    L = lettering(mech)
+    units = dict(df.attrs.get("units", {}))
+    alias: dict[str, str] = {}
+    if L.frame:
+        for col in df.columns:
+            m = re.fullmatch(r"(Rx|Ry|R|angle_R|x|m|vs|as)_(\d+)_(\d+)", col)
+            if m and "0" in m.group(2, 3):
+                i, j = (L.frame if g == "0" else g for g in m.group(2, 3))
+                alias[f"{m.group(1)}_{i}_{j}"] = col
+    for symbol, col in ((L.M_bal, "M_bal"), (L.lever(L.M_bal), "M_lever"), (L.F_bal, "F_bal")):
+        if symbol != col and col in df.columns and symbol not in df.columns:
+            alias[symbol] = col
+    out = df.assign(**{a: df[c] for a, c in alias.items()})
+    out.attrs.update(df.attrs, units=units | {a: units.get(c, "") for a, c in alias.items()})
+    return out

@@ -1,0 +1,75 @@
+"""Sheets in a real browser: Debian's headless Chromium driven by Playwright measures every text's
+and arrowhead's box (getBBox, in the SVG's millimetres) and reports the overlaps a reader would
+see. Used by tests/test_sheet_layout.py; as a script (`python tests/sheet_browser.py OUT file.svg
+...`) it writes PNG screenshots of sheets.
+
+May use: playwright, the standard library.
+"""
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--no-first-run"]
+
+#: Boxes of every text and arrowhead, in SVG user units (mm: the sheets use no transforms), with their text.
+_MEASURE = """() => {
+  const out = [];
+  for (const el of document.querySelectorAll('text, path.arrowhead')) {
+    const b = el.getBBox();
+    out.push({tag: el.tagName === 'text' ? 'text' : 'arrow', text: el.textContent,
+              box: [b.x, b.y, b.x + b.width, b.y + b.height]});
+  }
+  return out;
+}"""
+
+
+def launch(playwright):
+    """Debian's chromium, headless (None where it is not installed)."""
+    exe = shutil.which("chromium") or shutil.which("chromium-browser")
+    if exe is None:
+        return None
+    return playwright.chromium.launch(executable_path=exe, args=ARGS)
+
+
+def measure(page, svg_text: str) -> list[dict]:
+    """Boxes (x0, y0, x1, y1, mm) of every text and arrowhead of an SVG sheet."""
+    page.set_content(svg_text.split("?>", 1)[-1])
+    return page.evaluate(_MEASURE)
+
+
+def _overlap(a, b, tol: float) -> bool:
+    return a[0] < b[2] - tol and b[0] < a[2] - tol and a[1] < b[3] - tol and b[1] < a[3] - tol
+
+
+def overlaps(items: list[dict], tol: float = 0.05) -> list[str]:
+    """Pairs of texts that overlap, and texts under an arrowhead (by more than `tol` mm)."""
+    texts = [i for i in items if i["tag"] == "text" and i["text"].strip()]
+    arrows = [i for i in items if i["tag"] == "arrow"]
+    bad = []
+    for n, a in enumerate(texts):
+        for b in texts[n + 1:]:
+            if _overlap(a["box"], b["box"], tol):
+                bad.append(f"text {a['text']!r} over text {b['text']!r}")
+        for b in arrows:
+            if _overlap(a["box"], b["box"], tol):
+                bad.append(f"text {a['text']!r} under an arrowhead at {[round(v, 1) for v in b['box']]}")
+    return bad
+
+
+def screenshots(out: Path, files: list[Path]) -> None:
+    from playwright.sync_api import sync_playwright
+    out.mkdir(parents=True, exist_ok=True)
+    with sync_playwright() as p:
+        browser = launch(p)
+        page = browser.new_page(viewport={"width": 1590, "height": 1125}, device_scale_factor=1.5)
+        for f in files:
+            page.goto(f.resolve().as_uri())
+            page.screenshot(path=str(out / f"{f.parent.name}__{f.stem}.png"), timeout=20000)
+        browser.close()
+
+
+if __name__ == "__main__":
+    screenshots(Path(sys.argv[1]), [Path(f) for f in sys.argv[2:]])
