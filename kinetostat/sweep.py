@@ -364,7 +364,7 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFram
     table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "worst_digits", "warned_deg",
                                    "error"])
     table["worst_digits"] = table["worst_digits"].astype(float)
-    table["warned_deg"] = table["warned_deg"].fillna("").astype(str)
+    table["warned_deg"] = table["warned_deg"].astype(object).fillna("").astype(str)
     table[peaks] = table[peaks].astype(float)
     table["n_singular"] = table["n_singular"].astype("Int64")
     for text in ("singular_deg", "error"):          # every design failed: a column of NaN, no text

@@ -158,7 +158,7 @@ def test_the_cli_tells_the_user_which_angle_it_took(cli, tmp_path):
     assert r.stderr == ("kinetostat: warning: --at: angles outside [0, 360) deg taken modulo 360 (the same crank "
                         "position): 400 -> 40, -1e-17 -> 0\n")
     r = cli("plans", "ice_crank_slider", "--at", "390", "--only", "positions", "--out", tmp_path)
-    assert r.returncode == 0 and "at phi = 30 deg" in r.stdout
+    assert r.returncode == 0 and "φ = 30°" in r.stdout
     assert "--at: angles outside [0, 360) deg taken modulo 360 (the same crank position): 390 -> 30" in r.stderr
 
 

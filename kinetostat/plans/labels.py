@@ -9,16 +9,17 @@ the candidate position of least cost (distance from its anchor, lines crossed) a
 overlap nothing placed before; far from its anchor a label gets a thin leader line. Coincident
 points are lettered once, "B1 ≡ B11" (`merge_coincident`).
 
-May use: numpy, the standard library.
+May use: numpy, the standard library, `kinetostat._text` (XML-safe text).
 """
 from __future__ import annotations
 
 import math
 import re
 from dataclasses import dataclass
-from xml.sax.saxutils import escape
 
 import numpy as np
+
+from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 
 __all__ = ["text_width", "text_box", "label_parts", "label_svg", "label_width", "Placer", "Placed",
            "merge_coincident", "MIN_TEXT_MM", "ASCENT", "DESCENT"]

@@ -99,7 +99,8 @@ class Worksheet:
         out = [f"# {text('ws.title', lang, name=markdown_text(self.mechanism), phi=num(self.phi_deg, lang, 6))}", "",
                f"{text('scale', lang)} μ_l = {num(self.mu_l, lang, 6)} {unit('m/mm', lang)}"]
         if self.digits < DIGITS_WARN:
-            out += ["", text("ws.accuracy", lang, digits=num(self.digits, lang, 2), min=DIGITS_WARN)]
+            out += ["", text("ws.accuracy", lang, digits=f"{self.digits:.1f}".replace(".", "." if lang == "en" else ","),
+                                   min=DIGITS_WARN)]
         section = None
         head = [text(f"ws.head.{c}", lang) for c in ("symbol", "value", "unit", "direction", "note")]
         for rec in self.records():
