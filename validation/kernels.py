@@ -36,7 +36,6 @@ mujoco, pinocchio, numba, numpy; gcc on the PATH for the MuJoCo kernel.
 from __future__ import annotations
 
 import functools
-import hashlib
 import math
 import os
 import re

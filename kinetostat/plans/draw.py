@@ -19,12 +19,11 @@ from __future__ import annotations
 
 import math
 import re
-from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 
-from .core import Plan, Scale, Segment, extent
+from .._text import xml_escape as escape     # also control characters, which XML cannot hold
+from .core import Plan, Segment, extent
 from .i18n import LANGS, MESSAGES, check_lang, num, phrase, text, unit
-from .labels import (ASCENT, DESCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_box,
-                     text_width)
+from .labels import ASCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_width
 
 __all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM",
            "ROOM_MM"]
