@@ -22,7 +22,6 @@ Generated inputs (huge files, deep nesting, bad analyze options) are built in th
 from __future__ import annotations
 
 import math
-import subprocess
 import sys
 import tomllib
 import warnings

@@ -10,7 +10,6 @@ from pathlib import Path
 
 import pytest
 
-import kinetostat
 from conftest import FOUR_BAR, ROOT
 
 ICE = ROOT / "models" / "ice_crank_slider.toml"

@@ -11,8 +11,6 @@ import shlex
 import subprocess
 import sys
 
-import pytest
-
 from conftest import ROOT
 from kinetostat.cli import build_parser
 
