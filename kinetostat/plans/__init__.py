@@ -24,7 +24,7 @@ from types import MappingProxyType
 from typing import Callable, Iterable
 
 from .._io import write_text
-from ..tables import rounded, value
+from ..tables import FLOAT_FORMAT, by_unit, rounded
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .forces import crank_plan, force_plans, group_plans
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
@@ -82,12 +82,12 @@ class Plans(Mapping):
 
     def segments_csv(self) -> str:
         """segments.csv, plain numbers: the drawing's coordinates and lengths to 12 significant
-        digits of their column's largest value (`kinetostat.tables.rounded`), each value (of
-        mixed units) to 12 significant digits."""
+        digits of their largest |value| (all in mm; `kinetostat.tables.rounded`), each value to
+        12 significant digits of the largest |value| of its unit (`kinetostat.tables.by_unit`)."""
         df = self.segments_frame()
-        out = rounded(df)
-        out["value"] = [value(x) for x in df["value"]]
-        return out.to_csv(index=False, lineterminator="\n")
+        out = rounded(df, units={c: "mm" for c in df.columns if c.endswith("_mm")})
+        out["value"] = by_unit(df["value"], df["unit"])
+        return out.to_csv(index=False, lineterminator="\n", float_format=FLOAT_FORMAT)
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
         """Write one SVG sheet per plan (`plan_file_name`) and segments.csv into `out_dir`

@@ -23,7 +23,7 @@ from ..analysis import Analysis, analyze
 from ..applied import load_magnitude
 from .._io import write_text
 from ..model import Mechanism
-from ..tables import value
+from ..tables import FLOAT_FORMAT, by_unit, plain
 from .scales import choose_scales
 
 __all__ = ["Row", "Worksheet", "worksheet", "COLUMNS"]
@@ -121,16 +121,17 @@ class Worksheet:
         return MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
 
     def to_csv(self, path: str | Path) -> None:
-        """Write the rows as CSV, values to 12 significant digits (atomic: a temporary file in the
-        same folder, then replaced)."""
+        """Write the rows as CSV, each value to 12 significant digits of the largest |value| of its
+        unit (`kinetostat.tables.by_unit`; atomic: a temporary file in the same folder, then replaced)."""
         df = self.frame()
-        df["value"] = [value(x) for x in df["value"]]       # 12 significant digits (`kinetostat.tables`)
-        write_text(path, df.to_csv(index=False))
+        df["value"] = by_unit(df["value"], df["unit"])
+        write_text(path, df.to_csv(index=False, float_format=FLOAT_FORMAT))
 
     def to_json(self, path: str | Path) -> None:
-        """Write the rows as a JSON list of objects, NaN as null (atomic)."""
-        recs = [{k: (None if not math.isfinite(v) else value(v)) if isinstance(v, float) else v for k, v in r.items()}
-                for r in self.records()]
+        """Write the rows as a JSON list of objects, values as in `to_csv`, NaN as null (atomic)."""
+        recs = self.records()
+        values = by_unit([r["value"] for r in recs], [r["unit"] for r in recs])
+        recs = [{**r, "value": plain(v)} for r, v in zip(recs, values)]
         doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l, "rows": recs}
         write_text(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")
 
