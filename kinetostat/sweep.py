@@ -15,7 +15,7 @@ A design whose mechanism does not load, build or assemble keeps its row: NaN pea
 reason in the `error` column (the sweep goes on). Warnings (singular positions, doubts about a
 model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular.
 
-May use: model, analysis, errors, examples; pandas (imported when a sweep runs, so that
+May use: model, analysis, errors, examples, units; pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
 Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
 `kinetostat.report`.
@@ -35,6 +35,7 @@ import numpy as np
 from .analysis import Analysis, analyze, crank_angles
 from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
+from .units import parameter_units
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -45,8 +46,6 @@ __all__ = ["Sweep", "sweep", "CHUNK", "LOCAL_SCHEDULERS"]
 CHUNK = 32
 #: The `scheduler` names of Dask's local schedulers; any other string is a `distributed` address.
 LOCAL_SCHEDULERS = ("threads", "processes")
-#: The unit `attrs["units"]` gives a design's parameter: the one its model file uses.
-PARAMETER_UNIT = "model's unit"
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,7 +105,7 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     if full:
         frames = [a for _, a in results if a is not None and len(a)]
         angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=names)
-        angles.attrs.update(mechanism=base.name, units=_units(frames, names))
+        angles.attrs.update(mechanism=base.name, units=_units(frames, _parameter_units(base, names)))
     return Sweep(table, angles, tuple(len(v) for v in values), phi_deg)
 
 
@@ -143,7 +142,7 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
     if not full:
         return pd.DataFrame(rows), None
     angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=list(designs[0]))
-    angles.attrs["units"] = _units(frames, list(designs[0]))
+    angles.attrs["units"] = _units(frames, {})
     return pd.DataFrame(rows), angles
 
 
@@ -196,11 +195,12 @@ def _reason(exc: Exception) -> str:
 
 
 def _with_design(df: pd.DataFrame, design: Mapping[str, float]) -> pd.DataFrame:
-    """`df` (one analysis's cycle table) led by the design's parameters as columns."""
+    """`df` (one analysis's cycle table) led by the design's parameters as columns (units: the
+    table's; `sweep` adds the parameters')."""
     import pandas as pd
     lead = pd.DataFrame({name: np.full(len(df), value) for name, value in design.items()})
     out = pd.concat([lead, df], axis=1)
-    out.attrs["units"] = _units([df], list(design))
+    out.attrs["units"] = _units([df], {})
     return out
 
 
@@ -331,14 +331,20 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFram
     for text in ("singular_deg", "error"):          # every design failed: a column of NaN, no text
         table[text] = table[text].astype(object).fillna("").astype(str)
     table.attrs.update(mechanism=base.name, units={
-        **dict.fromkeys(names, PARAMETER_UNIT), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
+        **_parameter_units(base, names), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
         "n_singular": "1", "singular_deg": "deg", "error": "text"})
     return table
 
 
-def _units(frames: list[pd.DataFrame], names: list[str]) -> dict[str, str]:
-    """The units of the columns of `frames`, led by the parameters `names`."""
-    units = dict.fromkeys(names, PARAMETER_UNIT)
+def _parameter_units(base: Mechanism, names: list[str]) -> dict[str, str]:
+    """The unit of each swept parameter (`kinetostat.units.parameter_units`; g in m/s^2)."""
+    stated = {**parameter_units(base), "g": "m/s^2"}
+    return {name: stated[name] for name in names}
+
+
+def _units(frames: list[pd.DataFrame], params: Mapping[str, str]) -> dict[str, str]:
+    """The units of the columns of `frames`, led by the parameters' `params` (name -> unit)."""
+    units = dict(params)
     for f in frames:
-        units.update(f.attrs.get("units", {}))
+        units.update({k: u for k, u in f.attrs.get("units", {}).items() if k not in params})
     return units

@@ -237,7 +237,7 @@ def test_reports_cite_their_sources_and_show_no_seed_or_line_number(ice_report):
 
 
 def test_every_parameter_shows_its_unit():
-    from kinetostat.report.writer import parameter_units
+    from kinetostat.report.writer import parameter_units      # the report's spelling of kinetostat.units
     for path in MODELS:
         units = parameter_units(kinetostat.load(path))
         assert "not stated" not in units.values(), (path.stem, units)
