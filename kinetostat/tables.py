@@ -60,10 +60,19 @@ def _peak(col: np.ndarray) -> float:
 
 def _column_rounded(col: np.ndarray, scale: float) -> np.ndarray:
     """`col` rounded to the decimal of `DIGITS` significant digits of `scale` (> 0), each value the
-    double nearest its decimal (exact decimal rounding, half to even); NaN and inf kept, -0 as 0."""
+    double nearest its decimal; NaN and inf kept, -0 as 0. The step 10^e: an integer number of
+    steps times or over the exact power 10^|e| (|e| <= 22), one correctly rounded operation;
+    beyond, exact decimal rounding (`Decimal.quantize`)."""
     if not (math.isfinite(scale) and scale > 0.0):
         return col + 0.0
-    step = Decimal(1).scaleb(math.floor(math.log10(scale)) - DIGITS + 1)
+    e = math.floor(math.log10(scale)) - DIGITS + 1
+    if -22 <= e <= 0:
+        f = float(10 ** -e)
+        return np.rint(col * f) / f + 0.0
+    if 0 < e <= 22:
+        f = float(10 ** e)
+        return np.rint(col / f) * f + 0.0
+    step = Decimal(1).scaleb(e)
     return np.array([float(Decimal(x).quantize(step)) if math.isfinite(x) else x for x in col.tolist()],
                     dtype=float) + 0.0
 

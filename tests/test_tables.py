@@ -38,6 +38,7 @@ def test_a_column_of_rounding_noise_prints_0():
     assert tables.csv_text(df) == "x_A [m],x_B [m],F [N],M [N m]\n0.12,0,9.52e-24,0.33333333333\n-0.05,0,0,2\n"
     assert tables.json_document(df)["rows"][0] == {"x_A": 0.12, "x_B": 0.0, "F": 9.52e-24, "M": 0.33333333333}
     assert tables.by_unit([0.12, 3e-17, 1 / 3], ["m", "m", "N"]) == [0.12, 0.0, 0.333333333333]
+    assert tables.by_unit([1.23456789012345e14, 5.0, -4.4e-12], ["Pa", "Pa", "m"]) == [1.23456789012e14, 0.0, -4.4e-12]
 
 
 def _digits(cell: str) -> int:
