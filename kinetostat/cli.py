@@ -1136,7 +1136,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="kinetostat",
                 description="Kinetostatic analysis of planar linkages (graphical-analytic method, computed "
                             "exactly over the crank cycle) and its cross-validation against physics engines.",
-                epilog="Exit codes: 0 ok; 1 validation failed; 2 bad input or options. "
+                epilog="Exit codes: 0 ok; 1 validate: a check failed (report: a model's report not made); 2 bad input or options; 3 validate: "
+                       "nothing failed but a model was not checked (or a route named with --engines is not "
+                       "installed); 130 interrupted (Ctrl-C). "
                        "Bundled models ship inside the package ('kinetostat examples' lists them); "
                        "$KINETOSTAT_MODELS names another folder of *.toml models to use instead.")
     p.add_argument("--version", action="version", version=f"kinetostat {__version__}")
@@ -1291,7 +1293,10 @@ def build_parser() -> argparse.ArgumentParser:
                                     "the cycle) for every pair, peak_M_bal (max |M_bal|), for a working machine "
                                     "peak_F_bal, n_singular and singular_deg (its singular crank angles), and "
                                     "error (why a design did not load or assemble; its peaks are then empty). "
-                                    "The chunks of designs run in this process, or over Dask with --scheduler.")
+                                    "The chunks of designs run in this process, or over Dask with --scheduler. "
+                                    "Exit codes: 0 the table written, also when some designs failed (their rows "
+                                    "keep the reason in 'error', and the summary counts them); 2 bad input; "
+                                    "130 interrupted (Ctrl-C).")
     sw.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
     sw.add_argument("--param", metavar="NAME=VALUES", type=_param, action="append", required=True,
                     help="a parameter of the model's [parameters] (or g) and its values: a range start:stop:step "

@@ -17,7 +17,7 @@ model) are not printed: the table's `n_singular` and `singular_deg` say where a 
 (values NaN), `warned_deg` and `worst_digits` where its values are kept with fewer than
 DIGITS_WARN digits and the fewest digits there.
 
-May use: model, analysis, errors, examples; pandas (imported when a sweep runs, so that
+May use: model, analysis, errors, examples, units; pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
 Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
 `kinetostat.report`.
@@ -38,6 +38,7 @@ import numpy as np
 from .analysis import Analysis, analyze, crank_angles
 from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
+from .units import parameter_units
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -52,8 +53,6 @@ LOCAL_SCHEDULERS = ("threads", "processes")
 MAX_DESIGNS = 1_000_000
 #: Seconds to wait for a distributed scheduler to answer, and for its first worker.
 CONNECT_TIMEOUT = 10.0
-#: The unit `attrs["units"]` gives a design's parameter: the one its model file uses.
-PARAMETER_UNIT = "model's unit"
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,7 +116,7 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     if full:
         frames = [a for _, a in results if a is not None and len(a)]
         angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=names)
-        angles.attrs.update(mechanism=base.name, units=_units(frames, names))
+        angles.attrs.update(mechanism=base.name, units=_units(frames, _parameter_units(base, names)))
     return Sweep(table, angles, tuple(len(v) for v in values), phi_deg)
 
 
@@ -155,7 +154,7 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
     if not full:
         return pd.DataFrame(rows), None
     angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=list(designs[0]))
-    angles.attrs["units"] = _units(frames, list(designs[0]))
+    angles.attrs["units"] = _units(frames, {})
     return pd.DataFrame(rows), angles
 
 
@@ -215,11 +214,12 @@ def _reason(exc: Exception) -> str:
 
 
 def _with_design(df: pd.DataFrame, design: Mapping[str, float]) -> pd.DataFrame:
-    """`df` (one analysis's cycle table) led by the design's parameters as columns."""
+    """`df` (one analysis's cycle table) led by the design's parameters as columns (units: the
+    table's; `sweep` adds the parameters')."""
     import pandas as pd
     lead = pd.DataFrame({name: np.full(len(df), value) for name, value in design.items()})
     out = pd.concat([lead, df], axis=1)
-    out.attrs["units"] = _units([df], list(design))
+    out.attrs["units"] = _units([df], {})
     return out
 
 
@@ -370,14 +370,20 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFram
     for text in ("singular_deg", "error"):          # every design failed: a column of NaN, no text
         table[text] = table[text].astype(object).fillna("").astype(str)
     table.attrs.update(mechanism=base.name, units={
-        **dict.fromkeys(names, PARAMETER_UNIT), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
+        **_parameter_units(base, names), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
         "n_singular": "1", "singular_deg": "deg", "worst_digits": "1", "warned_deg": "deg", "error": "text"})
     return table
 
 
-def _units(frames: list[pd.DataFrame], names: list[str]) -> dict[str, str]:
-    """The units of the columns of `frames`, led by the parameters `names`."""
-    units = dict.fromkeys(names, PARAMETER_UNIT)
+def _parameter_units(base: Mechanism, names: list[str]) -> dict[str, str]:
+    """The unit of each swept parameter (`kinetostat.units.parameter_units`; g in m/s^2)."""
+    stated = {**parameter_units(base), "g": "m/s^2"}
+    return {name: stated[name] for name in names}
+
+
+def _units(frames: list[pd.DataFrame], params: Mapping[str, str]) -> dict[str, str]:
+    """The units of the columns of `frames`, led by the parameters' `params` (name -> unit)."""
+    units = dict(params)
     for f in frames:
-        units.update(f.attrs.get("units", {}))
+        units.update({k: u for k, u in f.attrs.get("units", {}).items() if k not in params})
     return units

@@ -8,10 +8,12 @@ to the digits that mean something.
 - JSON: `{"mechanism", "units", "frame", "rows": [one object per row]}`, NaN as null.
 - Parquet: the full binary values, `attrs` (units, frame, mechanism) in the file's pandas metadata.
 
-Text formats round each float column to `DIGITS` significant digits of the column's largest
-|value| (`rounded`): the solver's accuracy is relative to a quantity's peak (about 1e-15), so
-digits below 1e-12 of the peak are rounding noise that differs between machines (a last-ulp
-difference, or a value that is 0 within rounding printed as 3e-17).
+Text formats round each float column to `DIGITS` significant digits of its unit's scale, the
+largest |value| among all the table's columns of that unit (`rounded`; a column with no unit:
+its own largest |value|): the solver's accuracy is relative to a quantity's peak (about 1e-15),
+so digits below 1e-12 of the peak are rounding noise that differs between machines (a last-ulp
+difference, or a value that is 0 within rounding printed as 3e-17, which prints 0). A rounded
+value is the double nearest its decimal, so it prints with at most `DIGITS` significant digits.
 
 May use: numpy, the standard library; pandas is passed in (never imported here).
 """
@@ -21,19 +23,22 @@ import io
 import json
 import math
 import re
-from typing import IO, Any
+from decimal import Decimal
+from typing import IO, Any, Iterable
 
 import numpy as np
 
-__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "value", "error", "header", "write_csv", "csv_text", "plain",
+__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "by_unit", "value", "error", "header", "write_csv", "csv_text", "plain",
            "json_document", "write_json", "write_parquet", "read_csv"]
 
-#: Significant digits of a value in a text output, counted on its column's largest |value|.
+#: Significant digits of a value in a text output, counted on its unit's largest |value|.
 DIGITS = 12
 #: Significant digits of an error (a difference between two routes, a relative error).
 ERROR_DIGITS = 3
 #: Units that are no unit: a column of text (no bracket in a CSV header).
 _NO_UNIT = ("text", "")
+#: The text of a float in a CSV: `DIGITS` significant digits at most (pandas' `float_format`).
+FLOAT_FORMAT = f"%.{DIGITS}g"
 _HEADER = re.compile(r"^(?P<name>.*?) \[(?P<unit>[^\[\]]*)\]$")
 
 
@@ -48,25 +53,55 @@ def error(x: float) -> float:
     return value(x, ERROR_DIGITS)
 
 
-def _column_rounded(col: np.ndarray) -> np.ndarray:
+def _peak(col: np.ndarray) -> float:
     finite = np.abs(col[np.isfinite(col)])
-    peak = float(finite.max()) if finite.size else 0.0
-    decimals = DIGITS - 1 - math.floor(math.log10(peak)) if peak > 0.0 else 0
-    if decimals > 290:                       # a column of subnormal-sized values: 10**decimals overflows
+    return float(finite.max()) if finite.size else 0.0
+
+
+def _column_rounded(col: np.ndarray, scale: float) -> np.ndarray:
+    """`col` rounded to the decimal of `DIGITS` significant digits of `scale` (> 0), each value the
+    double nearest its decimal; NaN and inf kept, -0 as 0. The step 10^e: an integer number of
+    steps times or over the exact power 10^|e| (|e| <= 22), one correctly rounded operation;
+    beyond, exact decimal rounding (`Decimal.quantize`)."""
+    if not (math.isfinite(scale) and scale > 0.0):
         return col + 0.0
-    if decimals < 0:                         # peak >= 1e12: np.round would multiply by 10**-decimals, inexactly
-        q = 10.0 ** -decimals
-        return np.array([float(f"{round(x / q):.0f}e{-decimals}") if math.isfinite(x) else x for x in col]) + 0.0
-    return np.round(col, decimals) + 0.0     # + 0.0: -0.0 as 0.0
+    e = math.floor(math.log10(scale)) - DIGITS + 1
+    if -22 <= e <= 0:
+        f = float(10 ** -e)
+        return np.rint(col * f) / f + 0.0
+    if 0 < e <= 22:
+        f = float(10 ** e)
+        return np.rint(col / f) * f + 0.0
+    step = Decimal(1).scaleb(e)
+    return np.array([float(Decimal(x).quantize(step)) if math.isfinite(x) else x for x in col.tolist()],
+                    dtype=float) + 0.0
 
 
-def rounded(df):
-    """A copy of `df` with every float column rounded to `DIGITS` significant digits of its
-    largest |value| (NaN kept); `attrs` kept."""
+def by_unit(values: Iterable[float], units: Iterable[str]) -> list[float]:
+    """Each of `values` rounded to `DIGITS` significant digits of the largest |value| of its unit
+    (the matching item of `units`) among `values`: a table of mixed units in one column."""
+    x, u = np.asarray(list(values), dtype=float), np.asarray(list(units), dtype=object)
+    out = x + 0.0
+    for unit in set(u.tolist()):
+        sel = u == unit
+        out[sel] = _column_rounded(x[sel], _peak(x[sel]))
+    return out.tolist()
+
+
+def rounded(df, units: dict[str, str] | None = None):
+    """A copy of `df` with every float column rounded to `DIGITS` significant digits of its unit's
+    scale: the largest |value| among the float columns of the same unit (`units`, default
+    `attrs["units"]`; a column with no unit: its own largest |value|). NaN kept; `attrs` kept."""
+    units = df.attrs.get("units", {}) if units is None else units
+    floats = [name for name in df.columns if df[name].dtype.kind == "f"]
+    cols = {name: df[name].to_numpy(dtype=float) for name in floats}
+    scale: dict[str, float] = {}
+    for name in floats:
+        key = units.get(name) or ("column", name)
+        scale[key] = max(scale.get(key, 0.0), _peak(cols[name]))
     out = df.copy()
-    for name in out.columns:
-        if out[name].dtype.kind == "f":
-            out[name] = _column_rounded(out[name].to_numpy(dtype=float))
+    for name in floats:
+        out[name] = _column_rounded(cols[name], scale[units.get(name) or ("column", name)])
     out.attrs = dict(df.attrs)
     return out
 
@@ -79,7 +114,7 @@ def header(df) -> list[str]:
 
 def write_csv(df, f: IO[str]) -> None:
     """`df` as CSV into the open text file `f`: units in the header, values `rounded`."""
-    rounded(df).to_csv(f, index=False, header=header(df), lineterminator="\n")
+    rounded(df).to_csv(f, index=False, header=header(df), lineterminator="\n", float_format=FLOAT_FORMAT)
 
 
 def csv_text(df) -> str:

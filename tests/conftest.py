@@ -100,6 +100,11 @@ def cli(capsys, monkeypatch):
 
 @pytest.fixture
 def sketched_plots(monkeypatch):
+    """`sketch_plots` for one test."""
+    sketch_plots(monkeypatch)
+
+
+def sketch_plots(monkeypatch: pytest.MonkeyPatch) -> None:
     """A report's plots and plan pictures each written as a 1-pixel PNG under its own name
     (atomically, as the real ones): for tests of what a report does with its folders, files
     and tables, at a tenth of the time. test_report and the injection tests draw them."""

@@ -1,5 +1,6 @@
 """The benchmark's kernel timers do the real work (the driving moment of the engines' exact
-routes) and the flop counter counts what a kernel computes."""
+routes) and the flop counter counts what a kernel computes. Their times are not asserted (the
+benchmark prints them)."""
 from __future__ import annotations
 
 import math
@@ -25,7 +26,6 @@ def scene(request):
 def _same_moment(k: kernels.KernelTiming, M: np.ndarray) -> None:
     assert np.isfinite(k.M_drive).sum() == np.isfinite(M).sum() > 0
     np.testing.assert_allclose(k.M_drive, M, rtol=0, atol=1e-12 * np.nanmax(np.abs(M)))
-    assert k.seconds_per_angle > 0
 
 
 def test_mujoco_kernel_gives_the_exact_routes_moment(scene):
@@ -36,7 +36,6 @@ def test_mujoco_kernel_gives_the_exact_routes_moment(scene):
 def test_pinocchio_kernel_gives_the_exact_routes_moment(scene):
     k = kernels.pinocchio_kernel(scene, repeat=1)
     _same_moment(k, engine_pinocchio.solve(scene).M_drive)
-    assert 0 < k.overhead_per_angle < k.seconds_per_angle
 
 
 @numba.njit

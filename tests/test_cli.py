@@ -57,6 +57,10 @@ def test_help_of_every_command(cli):
         assert "usage: kinetostat " + cmd in h.stdout
     assert "--junit" in cli("validate", "--help").stdout
     assert "--at" in cli("analyze", "--help").stdout
+    flat = " ".join(top.stdout.split())
+    assert "3 validate: nothing failed but a model was not checked" in flat and "130 interrupted" in flat
+    sweep = " ".join(cli("sweep", "--help").stdout.split())
+    assert "Exit codes: 0 the table written, also when some designs failed" in sweep
 
 
 def test_console_script_entry_point():

@@ -2,6 +2,8 @@
 and the comparison with the seeds' published values."""
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import multiprocessing
 import os
@@ -15,7 +17,8 @@ import pytest
 
 import kinetostat
 import kinetostat.report
-from conftest import FOUR_BAR, MODELS, ROOT
+from conftest import FOUR_BAR, MODELS, ROOT, sketch_plots
+from kinetostat import cli
 from kinetostat.report import published_rows, run_validation, write_index, write_report
 from kinetostat.report.document import Doc
 from kinetostat.tables import read_csv
@@ -29,40 +32,50 @@ PNGS = ["mechanism.png", "balancing_moment.png", "reactions.png", "errors.png", 
 
 def _report(out: Path, *args: str) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if k != "KINETOSTAT_MODELS"}
-    r = subprocess.run([sys.executable, "-m", "kinetostat", "report", str(ICE), str(SHAPER), "--out", str(out),
-                        "--steps", "36", "--engines", "pinocchio", "mujoco", "--no-progress", *args],
+    r = subprocess.run([sys.executable, "-m", "kinetostat", "report", *REPORT_ARGS, "--out", str(out), *args],
                        capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     return r
 
 
+REPORT_ARGS = (str(ICE), str(SHAPER), "--steps", "36", "--engines", "pinocchio", "mujoco", "--no-progress")
+
+
 @pytest.fixture(scope="module")
 def ice_report(tmp_path_factory) -> Path:
-    """Two reports written by two worker processes into a folder holding a stale report of an
-    earlier run."""
-    parallel = tmp_path_factory.mktemp("parallel")
-    stale = parallel / "stale_model"
+    """Two reports written by `kinetostat report` in this process (plots sketched,
+    `sketch_plots`; the real plots and worker processes: -m slow) into a folder holding a stale
+    report of an earlier run."""
+    folder = tmp_path_factory.mktemp("report")
+    stale = folder / "stale_model"
     stale.mkdir()
     (stale / "summary.json").write_text(json.dumps(dict(stem="stale_model", name="stale", formula="x",
                                                         passed=True, checks=1, routes={}, published=None)))
-    r = _report(parallel, "--jobs", "2")
-    assert "ice_crank_slider" in r.stdout and "slotted_link_shaper" in r.stdout and "PASS" in r.stdout
-    return parallel
+    out = io.StringIO()
+    with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out):
+        sketch_plots(mp)
+        assert cli.main(["report", *REPORT_ARGS, "--out", str(folder), "--jobs", "1"]) == 0
+    assert "ice_crank_slider" in out.getvalue() and "slotted_link_shaper" in out.getvalue() and "PASS" in out.getvalue()
+    return folder
 
 
 @pytest.mark.slow
-def test_reruns_are_byte_identical_and_jobs_do_not_matter(ice_report, tmp_path):
-    """No date, run time or process-dependent byte in any file: a second run (here in one process
-    instead of two workers) reproduces every file exactly."""
-    serial = tmp_path / "serial"
+def test_reruns_are_byte_identical_and_jobs_do_not_matter(tmp_path):
+    """No date, run time or process-dependent byte in any file: a run in one process reproduces
+    every file of a run by two worker processes exactly, the real PNG plots included."""
+    parallel, serial = tmp_path / "parallel", tmp_path / "serial"
+    _report(parallel, "--jobs", "2")
     _report(serial, "--jobs", "1")
     files = sorted(p.relative_to(serial) for p in serial.rglob("*") if p.is_file())
     for f in files:
-        assert (ice_report / f).read_bytes() == (serial / f).read_bytes(), f
+        assert (parallel / f).read_bytes() == (serial / f).read_bytes(), f
     plans = {m: len(kinetostat.plans.build(kinetostat.load(p))) for m, p in (("ice", ICE), ("shaper", SHAPER))}
     # the index; ice: 5 png, md, html, csv, json, an svg per plan, segments.csv, worksheet.csv; the shaper + 1 png
     assert len(files) == 2 + (9 + plans["ice"] + 2) + (10 + plans["shaper"] + 2)
+    for png in PNGS:
+        data = (serial / "ice_crank_slider" / png).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000, png
 
 
 def test_a_rerun_writes_the_same_text_files(tmp_path, sketched_plots):
@@ -83,8 +96,7 @@ def test_report_files(ice_report):
     for name in ["index.md", "index.html", "cycle.csv", "summary.json", *PNGS]:
         assert (d / name).is_file(), name
     for png in PNGS:
-        data = (d / png).read_bytes()
-        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000, png
+        assert (d / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", png     # sketched; real ones: -m slow
     cycle = read_csv(d / "cycle.csv")
     assert len(cycle) == 36 and {"phi_deg", "M_bal", "M_lever", "R_0_1"} <= set(cycle.columns)
     assert cycle.attrs["units"]["R_0_1"] == "N" and cycle.attrs["units"]["M_bal"] == "N m"
@@ -237,7 +249,7 @@ def test_reports_cite_their_sources_and_show_no_seed_or_line_number(ice_report):
 
 
 def test_every_parameter_shows_its_unit():
-    from kinetostat.report.writer import parameter_units
+    from kinetostat.report.writer import parameter_units      # the report's spelling of kinetostat.units
     for path in MODELS:
         units = parameter_units(kinetostat.load(path))
         assert "not stated" not in units.values(), (path.stem, units)

@@ -96,7 +96,8 @@ def test_full_keeps_every_angle_with_the_design_first():
     assert len(a) == 24 and list(a.columns[:2]) == ["r", "phi_deg"]
     res = kinetostat.analyze(kinetostat.load(CHAIN, parameters={"r": 0.08}), steps=12)
     np.testing.assert_array_equal(a.loc[a["r"] == 0.08, "R_0_1"], np.linalg.norm(res.reaction(0, 1), axis=-1))
-    assert a.attrs["units"]["R_0_1"] == "N" and a.attrs["units"]["r"] == "model's unit"
+    assert a.attrs["units"]["R_0_1"] == "N" and a.attrs["units"]["r"] == "m"
+    assert sw.table.attrs["units"]["r"] == "m"          # the model file's comment: "# crank length O1A, m"
 
 
 class _Bar:

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import io
 import json
+import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 import kinetostat
 from kinetostat import tables
@@ -24,7 +27,43 @@ def test_a_last_ulp_difference_and_rounding_noise_print_the_same():
     y[2] = -5e-17                                      # a zero within rounding, other sign
     units = {"R": "N"}
     a, b = tables.csv_text(_frame({"R": x}, units)), tables.csv_text(_frame({"R": y}, units))
-    assert a == b == "R [N]\n2862.81234568\n-1234.5\n0.0\n0.3\n"     # 12 digits of the column's peak
+    assert a == b == "R [N]\n2862.81234568\n-1234.5\n0\n0.3\n"     # 12 digits of the column's peak
+
+
+def test_a_column_of_rounding_noise_prints_0():
+    """The scale is the unit's, shared by its columns: a column that is noise alone prints 0, in
+    every text format, and no cell has more than 12 significant digits (np.round's 1e-18 artifacts)."""
+    df = _frame({"x_A": [0.12, -0.05], "x_B": [-3.4694469519500004e-18, 2e-17], "F": [9.520000000000001e-24, 0.0],
+                 "M": [1 / 3, 2.0]}, {"x_A": "m", "x_B": "m", "F": "N", "M": "N m"})
+    assert tables.csv_text(df) == "x_A [m],x_B [m],F [N],M [N m]\n0.12,0,9.52e-24,0.33333333333\n-0.05,0,0,2\n"
+    assert tables.json_document(df)["rows"][0] == {"x_A": 0.12, "x_B": 0.0, "F": 9.52e-24, "M": 0.33333333333}
+    assert tables.by_unit([0.12, 3e-17, 1 / 3], ["m", "m", "N"]) == [0.12, 0.0, 0.333333333333]
+    assert tables.by_unit([1.23456789012345e14, 5.0, -4.4e-12], ["Pa", "Pa", "m"]) == [1.23456789012e14, 0.0, -4.4e-12]
+
+
+def _digits(cell: str) -> int:
+    """Significant digits of a CSV number cell (0 for text)."""
+    m = re.fullmatch(r"-?(\d+)(?:\.(\d+))?(?:e[-+]?\d+)?", cell)
+    return len((m[1] + (m[2] or "")).lstrip("0")) if m else 0
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in (Path(kinetostat.__file__).parents[1] / "models").glob("*.toml")))
+def test_the_bundled_models_cycle_csv_prints_no_noise(name):
+    """Every cell of a bundled model's cycle CSV has at most 12 significant digits, and a nonzero
+    cell is at least 1e-12 of its unit's largest |value| (a value 0 within rounding prints 0)."""
+    df = kinetostat.analyze(kinetostat.load(name), steps=72).to_frame()
+    text = tables.csv_text(df).splitlines()
+    units = df.attrs["units"]
+    peak: dict[str, float] = {}
+    for c in df.columns:
+        if df[c].dtype.kind == "f":
+            v = np.abs(df[c].to_numpy(dtype=float))
+            peak[units[c]] = max(peak.get(units[c], 0.0), float(v[np.isfinite(v)].max(initial=0.0)))
+    for line in text[1:]:
+        for c, cell in zip(df.columns, line.split(",")):
+            assert _digits(cell) <= 12, (c, cell)
+            if df[c].dtype.kind == "f" and cell not in ("", "inf", "-inf"):
+                assert float(cell) == 0.0 or abs(float(cell)) >= 0.99e-12 * peak[units[c]], (c, cell)
 
 
 def test_units_in_the_header_and_read_back():

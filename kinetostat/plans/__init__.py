@@ -25,8 +25,8 @@ from types import MappingProxyType
 from typing import Callable, Iterable
 
 from .._io import write_text
-from ..tables import rounded, value
 from .._text import csv_cell
+from ..tables import FLOAT_FORMAT, by_unit, rounded
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
 from .draw import fits
 from .forces import crank_plan, force_plans, group_plans
@@ -109,13 +109,13 @@ class Plans(Mapping):
 
     def segments_csv(self) -> str:
         """segments.csv, plain numbers: the drawing's coordinates and lengths to 12 significant
-        digits of their column's largest value (`kinetostat.tables.rounded`), each value (of
-        mixed units) to 12 significant digits; no text cell a spreadsheet reads as a formula."""
+        digits of their largest |value| (all in mm; `kinetostat.tables.rounded`), each value to
+        12 significant digits of the largest |value| of its unit (`kinetostat.tables.by_unit`); no text cell a spreadsheet reads as a formula."""
         df = self.segments_frame()
-        out = rounded(df)
-        out["value"] = [value(x) for x in df["value"]]
+        out = rounded(df, units={c: "mm" for c in df.columns if c.endswith("_mm")})
+        out["value"] = by_unit(df["value"], df["unit"])
         out = out.map(csv_cell)                               # no text cell read as a formula
-        return out.to_csv(index=False, lineterminator="\n")
+        return out.to_csv(index=False, lineterminator="\n", float_format=FLOAT_FORMAT)
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
         """Write one SVG sheet per plan (`plan_file_name`) in `lang` ("en", "uk", "ru"; the

@@ -25,7 +25,7 @@ from ..kinematics import DIGITS_WARN
 from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
-from ..tables import value
+from ..tables import FLOAT_FORMAT, by_unit, plain
 from .i18n import check_lang, num, phrase, text, unit
 from .lettering import lettering
 from .scales import choose_scales
@@ -117,16 +117,17 @@ class Worksheet:
         return MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
 
     def to_csv(self, path: str | Path) -> None:
-        """Write the rows as CSV, values to 12 significant digits, no cell read as a formula
-        (atomic: a temporary file in the same folder, then replaced)."""
+        """Write the rows as CSV, each value to 12 significant digits of the largest |value| of its
+        unit (`kinetostat.tables.by_unit`), no cell read as a formula (atomic: a temporary file in the same folder, then replaced)."""
         df = self.frame()
-        df["value"] = [value(x) for x in df["value"]]       # 12 significant digits (`kinetostat.tables`)
-        write_text(path, df.map(csv_cell).to_csv(index=False))
+        df["value"] = by_unit(df["value"], df["unit"])
+        write_text(path, df.map(csv_cell).to_csv(index=False, float_format=FLOAT_FORMAT))
 
     def to_json(self, path: str | Path) -> None:
-        """Write the rows as a JSON list of objects, NaN as null (atomic)."""
-        recs = [{k: (None if not math.isfinite(v) else value(v)) if isinstance(v, float) else v for k, v in r.items()}
-                for r in self.records()]
+        """Write the rows as a JSON list of objects, values as in `to_csv`, NaN as null (atomic)."""
+        recs = self.records()
+        values = by_unit([r["value"] for r in recs], [r["unit"] for r in recs])
+        recs = [{**r, "value": plain(v)} for r, v in zip(recs, values)]
         doc = {"mechanism": self.mechanism, "phi_deg": self.phi_deg, "mu_l": self.mu_l,
                "digits": round(self.digits, 1), "rows": recs}
         write_text(path, json.dumps(doc, ensure_ascii=False, indent=1, allow_nan=False) + "\n")

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import warnings
 from pathlib import Path
 from typing import Any, Sequence
@@ -20,6 +19,7 @@ from ..model import Mechanism
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from ..sweep import sweep
+from .. import units as model_units
 from ..tables import error, plain, write_csv
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc, slug
 from .plots import (_pair_name, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
@@ -55,44 +55,13 @@ def _vec(v) -> str:
     return "(" + ", ".join(f"{c:.6g}" for c in v) + ")"
 
 
-#: Unit of a model field by its last name (models/FORMAT.md: SI throughout); points are in m.
-_FIELD_UNITS = {"mass": "kg", "I_S": "kg m²", "rpm": "rpm", "omega": "rad/s", "eps": "rad/s²", "module": "m",
-                "z_wheel": "1", "z_pinion": "1", "scale": "N", "stiffness": "N/m", "free_length": "m", "radius": "m",
-                "f": "1", "value": "N or N m"}
-#: Units a model file's comment may state for a parameter ("r = 0.080  # crank length, m").
-_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", "Pa", "m^2", "rad/s",
-                 "rad/s^2", "deg", "m/s^2", "s", "1"}
-
-
 def _unit_text(unit: str) -> str:
     return unit.replace("^2", "²").replace("^3", "³")
 
 
-def _field_unit(path: str) -> str | None:
-    """The unit of a model field given by its path ("link[id=2].mass"), None where unknown."""
-    if ".points." in path or path.startswith("frame."):
-        return "m"
-    return _FIELD_UNITS.get(re.sub(r"\[[^\]]*\]$", "", path).rsplit(".", 1)[-1])
-
-
 def parameter_units(m: Mechanism) -> dict[str, str]:
-    """The unit of each of the model's [parameters]: that of a field given as the parameter's name
-    alone, else the one the model file's comment on the parameter states ("# crank length, m"; a
-    ratio "l_AB / l_OA" is 1), else "not stated"."""
-    text = Path(m.path).read_text(encoding="utf-8") if m.path and Path(m.path).is_file() else ""
-    out = {}
-    for name in m.parameters:
-        unit = next((u for path, (expr, _) in m.expressions.items()
-                     if not path.startswith("parameters.") and expr.strip() == name
-                     and (u := _field_unit(path)) is not None), None)
-        said = re.search(rf"^[ \t]*{re.escape(name)}[ \t]*=[^#\n]*#([^\n]*)", text, re.M)
-        if unit is None and said:
-            comment = re.sub(r"\([^)]*\)", "", said[1])
-            unit = next((t.strip() for t in re.split(r"[,:;]", comment) if t.strip() in _STATED_UNITS), None)
-            if unit is None and re.match(r"\s*\w+ / \w+", comment):
-                unit = "1"
-        out[name] = _unit_text(unit) if unit else "not stated"
-    return out
+    """Each [parameter]'s unit (`kinetostat.units.parameter_units`) as the report prints it."""
+    return {name: _unit_text(u) for name, u in model_units.parameter_units(m).items()}
 
 
 def _parameters_section(doc: Doc, m: Mechanism) -> None:
@@ -108,7 +77,7 @@ def _parameters_section(doc: Doc, m: Mechanism) -> None:
     if fields:
         doc.h(3, "Numbers from expressions")
         doc.table(["field", "expression", "value", "unit"],
-                  [[esc(path), esc(text), f"{v:.10g}", _field_unit(path) or "not stated"] for path, (text, v) in fields],
+                  [[esc(path), esc(text), f"{v:.10g}", _unit_text(model_units.field_unit(path) or model_units.NOT_STATED)] for path, (text, v) in fields],
                   "llrl")
 
 
