@@ -552,12 +552,12 @@ def _largest(res, mech: Mechanism, n: int = 0) -> tuple[str, float]:
 
 
 def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool = True,
-              steps: int = 360, root: str | Path | None = None) -> KeySummary:
+              steps: int = 360, root: str | Path | None = None, teacher_pack: bool = True) -> KeySummary:
     """Write the variant's model file `<name>.toml` and its answer key into `out_dir` (created): the
     worksheet (worksheet.md/html/csv/json) and the plans (SVG sheets, segments.csv) at the design
     position in `lang` ("en", "uk", "ru"), and with `cycle_csv` the analysis over the cycle
-    (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр), and the
-    teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML). The files
+    (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр), and with
+    `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
     from .analysis import analyze
@@ -573,10 +573,10 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     res = analyze(mech, steps=steps)
     plans = build_plans(mech, at=phi1)
     sheet = worksheet(mech, phi1, mu_l=plans.scales["mu_l"].value, lang=lang)
-    teacher = pack(v, lang, plans=plans)
+    teacher = pack(v, lang, plans=plans) if teacher_pack else None
     with unit(out, root) as tmp:
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
-        files += plans.write(tmp, lang=lang) + sheet.write(tmp) + teacher.write(tmp)
+        files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
         if cycle_csv:
             files.append(write_text(tmp / "cycle.csv", csv_text(with_aliases(res.to_frame(), mech))))
     files = [out / f.relative_to(tmp) for f in files]
@@ -610,7 +610,7 @@ def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
             lines.append(f"| [{code}]({k.name}/worksheet.md) | {num(k.phi1, lang, 6)} | "
                          f"{num(k.M_bal, lang, decimals=2)} | {k.largest} = {num(k.R_max, lang, decimals=1)} | "
                          f"{num(k.cycle_M_max, lang, decimals=2)} | {num(k.cycle_R_max, lang, decimals=1)} | "
-                         f"[sheet.pdf]({k.name}/sheet.pdf) [key.pdf]({k.name}/key.pdf) |")
+                         + " ".join(f"[{f.name}]({k.name}/{f.name})" for f in k.files if f.suffix == ".pdf") + " |")
         lines.append("")
     return "\n".join(lines)
 

@@ -261,9 +261,9 @@ def _rc():
         log.setLevel(level)
 
 
-def _wrap(s: str, width_mm: float, size: float, bold: bool = False) -> list[str]:
-    """`s` in lines of about `width_mm` at `size` pt (DejaVu Sans: about 0.56 em a character, bold 0.63)."""
-    chars = max(int(width_mm / ((0.63 if bold else 0.56) * size * _PT)), 4)
+def _wrap(s: str, width_mm: float, size: float) -> list[str]:
+    """`s` in lines of about `width_mm` at `size` pt (DejaVu Sans: about 0.57 em a character)."""
+    chars = max(int(width_mm / (0.57 * size * _PT)), 4)
     return textwrap.wrap(s, chars, break_long_words=True) or [""]
 
 
@@ -305,13 +305,13 @@ class _Flow:
     def line(self, x0: float, y0: float, x1: float, y1: float, lw: float = 0.5) -> None:
         self.lines.append(((x0, y0, x1, y1), lw))
 
-    def paragraph(self, s: str, size: float, weight: str = "normal", after: float = 2.0) -> None:
+    def paragraph(self, s: str, size: float, after: float = 2.0) -> None:
         lh = size * _PT * 1.35
-        lines = _wrap(s, self.width, size, weight == "bold")
+        lines = _wrap(s, self.width, size)
         self.room(lh * min(len(lines), 3))
         for ln in lines:
             self.room(lh)
-            self.text(self.x0, self.y, ln, size, weight=weight)
+            self.text(self.x0, self.y, ln, size)
             self.y += lh
         self.y += after
 
@@ -320,7 +320,7 @@ class _Flow:
         widths = [w * self.width for w in t.widths]
 
         def draw(row, bold=False, blank=()):
-            wrapped = [_wrap(c, w - 2 * pad, size, bold) for c, w in zip(row, widths)]
+            wrapped = [_wrap(c, w - 2 * pad, size) for c, w in zip(row, widths)]
             h = max(len(c) for c in wrapped) * lh + 2 * pad + (2.5 if blank else 0)
             if self.room(h) and not bold:
                 draw(t.head, bold=True)
@@ -329,7 +329,7 @@ class _Flow:
                 for k, ln in enumerate(lines):
                     right = i in t.numeric and not bold
                     self.text(x + (w - pad if right else pad), self.y + pad + k * lh, ln, size,
-                              ha="right" if right else "left", weight="bold" if bold else "normal")
+                              ha="right" if right else "left")
                 self.line(x, self.y, x, self.y + h)
                 x += w
             self.line(x, self.y, x, self.y + h)
@@ -367,10 +367,10 @@ def _pdf(blocks, title: str) -> bytes:
         flow = _Flow(pdf)
         for kind, x in blocks:
             if kind == "h1":
-                flow.paragraph(x, 13, "bold", 3)
+                flow.paragraph(x, 13, after=3)
             elif kind == "h2":
                 flow.room(20)
-                flow.paragraph(x, 10.5, "bold", 1.5)
+                flow.paragraph(x, 10.5, after=1.5)
             elif kind == "p":
                 flow.paragraph(x, 9)
             elif kind == "table":
@@ -399,7 +399,7 @@ def _plans_pdf(plans, lang: str, title: str) -> bytes:
         fig = Figure(figsize=(W / 25.4, H / 25.4))
         for x0, y0, x1, y1 in ((20, 5, 415, 5), (20, 292, 415, 292), (20, 5, 20, 292), (415, 5, 415, 292)):
             fig.add_artist(_line(W, H, x0, y0, x1, y1))
-        fig.text(25 / W, 1 - 9 / H, title, fontsize=11, weight="bold", va="top")
+        fig.text(25 / W, 1 - 9 / H, title, fontsize=11, va="top")
         cw, ch = (410 - 25) / cols, (262 - 14) / rows
         for n, kind in enumerate(kinds):
             c, r = n % cols, n // cols
