@@ -978,6 +978,11 @@ def cmd_variant(args) -> int:
     except ValueError as exc:
         raise CLIError(f"{exc} (see 'kinetostat variant --help')") from None
     args.lang = args.lang or "uk"                   # seed 002's language (its models' [lettering])
+    import importlib.util
+    teacher_pack = not args.no_pack and importlib.util.find_spec("matplotlib") is not None
+    if not (args.no_pack or teacher_pack):          # a plain install: the keys, and a word on the pack
+        _Out.write("no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf): its PDFs need matplotlib: "
+                   "pip install 'kinetostat[reports]'", err=True)
     default = "seed002_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
     t0 = time.perf_counter()
@@ -991,7 +996,7 @@ def cmd_variant(args) -> int:
                 warnings.simplefilter("ignore")
                 try:
                     keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
-                                                   cycle_csv=not args.all, root=out, teacher_pack=not args.no_pack))
+                                                   cycle_csv=not args.all, root=out, teacher_pack=teacher_pack))
                 except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:

@@ -156,3 +156,14 @@ def test_the_crank_lands_at_30_to_35_mm(task, code, want):
     mech = v.mechanism()
     sc = choose_scales(mech, kinetostat.analyze(mech, phi_deg=[v.values["phi1"]]))
     assert v.values["l_OA"] / sc["mu_l"].value == pytest.approx(want)
+
+
+def test_a_plain_install_writes_the_key_and_says_why_no_pack(cli, tmp_path, monkeypatch):
+    """Without matplotlib (no extra `reports`) the key is written, the pack left out with one line."""
+    import importlib.util
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else find_spec(name, *a))
+    run = cli("variant", "3", "479", "--out", tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "pip install 'kinetostat[reports]'" in run.stderr and (tmp_path / "worksheet.html").is_file()
+    assert not (tmp_path / "key.pdf").exists()
