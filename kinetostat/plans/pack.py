@@ -38,9 +38,9 @@ import numpy as np
 
 from .._io import write_bytes, write_text
 from .draw import segment_label, title_of
-from .i18n import check_lang, num, phrase, text, unit
+from .i18n import check_lang, num, text, unit
 from .lettering import lettering
-from .worksheet import Worksheet, _direction, html_document, worksheet
+from .worksheet import CSS, Worksheet, html_document, worksheet
 
 __all__ = ["Pack", "pack", "BAND", "BAND_DRAWS", "PACK_FILES"]
 
@@ -80,7 +80,6 @@ class Pack:
     sheet: tuple[tuple[str, Any], ...]
     key: tuple[tuple[str, Any], ...]
     plans: Any
-    mechanism: str
     answers: frozenset[str]
     bands: Mapping[str, tuple[float, float]]
 
@@ -105,7 +104,7 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
     """The pack of variant `v` (`variants.Variant`) in `lang` at its design position; `plans`: its
     plans when built already (`kinetostat.plans.build`); `draws`: Monte Carlo draws of the bands."""
     from . import build
-    from .drawing_error import Scales, draws_forces, simulate
+    from .drawing_error import Scales, simulate
     from ..variants import TASKS, TITLES, LETTERS
     check_lang(lang)
     mech = v.mechanism()
@@ -124,23 +123,13 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
                   text("ws.head.value", lang), text("ws.head.unit", lang)),
                  tuple((r.letter, text(f"row.{r.key}", lang), r.symbol, num(v.values[r.key], lang, 6),
                         unit(r.unit, lang)) for r in spec.rows), (0.07, 0.5, 0.18, 0.13, 0.12), frozenset({3}))
-    head = [("h1", title), ("p", text("pack.statement", lang, M=L.M_bal)), ("p", text("pack.assume", lang)),
-            ("h2", text("pack.data", lang, table=spec.table)), ("table", data)]
+    sheet = [("h1", title), ("p", text("pack.statement", lang, M=L.M_bal)), ("p", text("pack.assume", lang)),
+             ("h2", text("pack.data", lang, table=spec.table)), ("table", data)]
     if v.code:
-        head.append(("p", "  ".join(f"{ch} = {v.code[i]}" for ch, i in LETTERS.items())))
-    sheet = head[:]
-    key = [("h1", f"{text('pack.key', lang)}. {title}")]
+        sheet.append(("p", "  ".join(f"{ch} = {v.code[i]}" for ch, i in LETTERS.items())))
+    key = [("h1", f"{text('pack.key', lang)}. {title}")]          # scales, values and bands, δ, segments
     answers: set[str] = set()
-    # the key: scales, values with bands, δ, segments
-    rows = []
-    for s in sc.values():
-        ref = _REFERENCE.get(s.symbol)
-        drawn_mm = f"{ref} = {num(_reference_mm(mech, ws, s), lang, 3)} {unit('mm', lang)}" if ref else ""
-        rows.append((_mu(s.symbol), num(s.value, lang, 6), unit(s.unit, lang), drawn_mm))
-        answers.add(num(s.value, lang, 6))
-    key += [("h2", text("pack.scales", lang)),
-            ("table", Table((text("ws.head.symbol", lang), text("ws.head.value", lang), text("ws.head.unit", lang),
-                             text("pack.drawn", lang)), tuple(rows), (0.15, 0.2, 0.25, 0.4), frozenset({1})))]
+    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
     sheet.append(("h2", text("pack.fill", lang)))
     recs = ws.records()
     for section in dict.fromkeys(r.section for r in ws.rows):
@@ -171,32 +160,43 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
         key.append(("p", text("pack.delta", lang, M=L.M_bal, ML=L.lever(L.M_bal),
                               delta=num(ws.value("delta_pct"), lang, 2, decimals=2),
                               lo=num(lo, lang, decimals=2), hi=num(hi, lang, decimals=2))))
-    seg_rows = []
+    key += [("h2", text("pack.segments", lang)), ("table", _segments_table(plans, lang, answers))]
+    sheet.append(("area", (text("pack.area", lang), (title, *(f"{text(k, lang)}: " for k in
+                                                               ("pack.student", "pack.group", "pack.checked"))))))
+    given = {num(v.values[r.key], lang, 6) for r in spec.rows}
+    answers = {a for a in answers if a not in given and a not in ("0", "—")}
+    return Pack(v.name, lang, title, tuple(sheet), tuple(key), plans, frozenset(answers), bands)
+
+
+def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> Table:
+    """μ_l, μ_v, μ_a, μ_F: value, unit and the reference each draws (OA, pa, πa in mm); the
+    values printed added to `answers`."""
+    rows = []
+    for s in scales.values():
+        ref = _REFERENCE.get(s.symbol)
+        drawn_mm = f"{ref} = {num(_reference_mm(mech, ws, s), lang, 3)} {unit('mm', lang)}" if ref else ""
+        rows.append(("μ_" + s.symbol.split("_", 1)[1], num(s.value, lang, 6), unit(s.unit, lang), drawn_mm))
+        answers.add(num(s.value, lang, 6))
+    return Table((text("ws.head.symbol", lang), text("ws.head.value", lang), text("ws.head.unit", lang),
+                  text("pack.drawn", lang)), tuple(rows), (0.15, 0.2, 0.25, 0.4), frozenset({1}))
+
+
+def _segments_table(plans, lang: str, answers: set[str]) -> Table:
+    """Every segment a student lays off or measures (vectors, links, arms; not the other
+    positions or the construction lines): its plan, name, length in mm and the value it stands
+    for; the lengths printed added to `answers`."""
+    rows = []
     for kind in plans:
         plan = plans[kind]
         for s in plan.segments:
-            if s.kind in ("position", "line"):
-                continue
             length = plan.length_mm(s.name)
-            if not math.isfinite(length):
+            if s.kind in ("position", "line") or not math.isfinite(length):
                 continue
             value = "" if not math.isfinite(s.value) else f"{num(s.value, lang, 4)} {unit(s.unit, lang)}".strip()
-            seg_rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), value))
+            rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), value))
             answers.add(num(length, lang, decimals=1))
-    key += [("h2", text("pack.segments", lang)),
-            ("table", Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang),
-                             text("ws.head.value", lang)), tuple(seg_rows), (0.4, 0.2, 0.18, 0.22),
-                            frozenset({2, 3})))]
-    sheet.append(("area", (text("pack.area", lang), (title, f"{text('pack.student', lang)}: ", f"{text('pack.group', lang)}: ",
-                           f"{text('pack.checked', lang)}: "))))
-    given = {num(v.values[r.key], lang, 6) for r in spec.rows}
-    answers = {a for a in answers if a not in given and a not in ("0", "—")}
-    return Pack(v.name, lang, title, tuple(sheet), tuple(key), plans, L.name(lang, mech.name),
-                frozenset(answers), bands)
-
-
-def _mu(symbol: str) -> str:
-    return "μ_" + symbol.split("_", 1)[1]
+    return Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang),
+                  text("ws.head.value", lang)), tuple(rows), (0.4, 0.2, 0.18, 0.22), frozenset({2, 3}))
 
 
 def _reference_mm(mech, ws: Worksheet, scale) -> float:
@@ -237,7 +237,6 @@ def _plans_html(plans, lang: str, title: str) -> str:
     from . import plan_file_name
     imgs = "\n".join(f'<figure><img src="{escape(plan_file_name(plans[k]))}" alt="{escape(title_of(plans[k], lang))}">'
                      f"<figcaption>{escape(title_of(plans[k], lang))}</figcaption></figure>" for k in plans)
-    from .worksheet import CSS
     return html_document(title, f"<h1>{escape(title)}</h1>\n<div class=\"plans\">\n{imgs}\n</div>\n", lang,
                          CSS + "@media print{@page{size:A3 landscape}}\n")
 
@@ -357,13 +356,21 @@ class _Flow:
                 self.line(230, y - 1.5, 415, y - 1.5, 0.3)
 
 
-def _pdf(blocks, title: str) -> bytes:
-    """The blocks as PDF (A4 portrait, the drawing area on A3 landscape)."""
+@contextmanager
+def _pdf_pages(title: str):
+    """A PDF written into a buffer (`PdfPages`, metadata `title`) in the PDFs' settings (`_rc`):
+    yields (pages, buffer)."""
     import io
 
     from matplotlib.backends.backend_pdf import PdfPages
     buf = io.BytesIO()
     with _rc(), PdfPages(buf, metadata={"Title": title, "Creator": "kinetostat"}) as pdf:
+        yield pdf, buf
+
+
+def _pdf(blocks, title: str) -> bytes:
+    """The blocks as PDF (A4 portrait, the drawing area on A3 landscape)."""
+    with _pdf_pages(title) as (pdf, buf):
         flow = _Flow(pdf)
         for kind, x in blocks:
             if kind == "h1":
@@ -384,21 +391,18 @@ def _pdf(blocks, title: str) -> bytes:
 def _plans_pdf(plans, lang: str, title: str) -> bytes:
     """All the plans on one A3 landscape sheet: a grid of the plans' Figures inside the frame, the
     title and the scales in the title block."""
-    import io
-
-    from matplotlib.backends.backend_pdf import PdfPages
     from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
 
     from .draw import scale_text
-    buf = io.BytesIO()
     kinds = list(plans)
     cols = 4 if len(kinds) > 6 else 3
     rows = math.ceil(len(kinds) / cols)
     W, H = A3
-    with _rc(), PdfPages(buf, metadata={"Title": title, "Creator": "kinetostat"}) as pdf:
+    with _pdf_pages(title) as (pdf, buf):
         fig = Figure(figsize=(W / 25.4, H / 25.4))
-        for x0, y0, x1, y1 in ((20, 5, 415, 5), (20, 292, 415, 292), (20, 5, 20, 292), (415, 5, 415, 292)):
-            fig.add_artist(_line(W, H, x0, y0, x1, y1))
+        x0, y0, x1, y1 = (20 / W, 1 - 5 / H, 415 / W, 1 - 292 / H)                # the frame
+        fig.add_artist(Line2D([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], lw=1.0, color="k"))
         fig.text(25 / W, 1 - 9 / H, title, fontsize=11, va="top")
         cw, ch = (410 - 25) / cols, (262 - 14) / rows
         for n, kind in enumerate(kinds):
@@ -417,7 +421,3 @@ def _plans_pdf(plans, lang: str, title: str) -> bytes:
         pdf.savefig(fig)
     return buf.getvalue()
 
-
-def _line(W: float, H: float, x0: float, y0: float, x1: float, y1: float):
-    from matplotlib.lines import Line2D
-    return Line2D([x0 / W, x1 / W], [1 - y0 / H, 1 - y1 / H], lw=1.0, color="k")
