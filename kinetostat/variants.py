@@ -603,7 +603,8 @@ def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
         cyc = text("ix.cycle", lang)
         lines += [f"## {text('ix.task', lang, task=spec.task, title=title, table=spec.table)}", "",
                   f"| {text('ix.code', lang)} | φ1, {deg} | {M} {text('ix.at', lang)}, {Nm} | "
-                  f"{text('ix.largest', lang)}, {N} | |{M}| {cyc}, {Nm} | |R| {cyc}, {N} | {text('pack.files', lang)} |",
+                  f"{text('ix.largest', lang)}, {N} | \\|{M}\\| {cyc}, {Nm} | \\|R\\| {cyc}, {N} | "   # \| : a bar in a cell
+                  f"{text('pack.files', lang)} |",
                   "|---|---:|---:|---|---:|---:|---|"]
         for k in ks:
             code = k.name.split("_", 1)[1]
