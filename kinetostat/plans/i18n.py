@@ -201,14 +201,19 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                        "длина отложена или измерена с погрешностью до ±{mm} мм, каждое направление до ±{deg}°); "
                        "ответ в этих границах точен настолько, насколько позволяет тщательный чертёж."),
     "pack.delta": ("δ = ({ML} - {M}) / {ML} · 100 %: the balancing moment by Zhukovsky's lever against that by "
-                   "the force plans; the texts accept a drawing whose |δ| does not exceed 5 %. Exact: δ = {delta} %; "
-                   "careful drawings: {lo}...{hi} %.",
+                   "the force plans; the texts accept a drawing whose |δ| does not exceed 5 %. Exact: δ = {delta} %.",
                    "δ = ({ML} - {M}) / {ML} · 100 %: зрівноважувальний момент за важелем Жуковського проти "
-                   "моменту за планами сил; допустима розбіжність |δ| не більше 5 %. Точно: δ = {delta} %; "
-                   "ретельні креслення: {lo}...{hi} %.",
+                   "моменту за планами сил; допустима розбіжність |δ| не більше 5 %. Точно: δ = {delta} %.",
                    "δ = ({ML} - {M}) / {ML} · 100 %: уравновешивающий момент по рычагу Жуковского против "
-                   "момента по планам сил; допустимое расхождение |δ| не более 5 %. Точно: δ = {delta} %; "
-                   "тщательные чертежи: {lo}...{hi} %."),
+                   "момента по планам сил; допустимое расхождение |δ| не более 5 %. Точно: δ = {delta} %."),
+    "pack.delta_band": ("Careful drawings: δ = {lo} … {hi} %.", "Ретельні креслення: δ = {lo} … {hi} %.",
+                        "Тщательные чертежи: δ = {lo} … {hi} %."),
+    "pack.band_partial": ("The drawing-error study draws the force plans of mechanisms of one group only: here "
+                          "the reactions and {M} have no band.",
+                          "Дослідження похибки креслення будує плани сил лише механізмів з однієї групи: тут "
+                          "реакції та {M} без меж.",
+                          "Исследование погрешности чертежа строит планы сил только механизмов из одной группы: "
+                          "здесь реакции и {M} без границ."),
     "pack.scales": ("Scales", "Масштаби", "Масштабы"),
     "pack.drawn": ("drawn", "відрізок", "отрезок"),
     "pack.segments": ("Segments a student measures, mm", "Відрізки, які вимірює студент, мм",

@@ -115,7 +115,7 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
     L = lettering(mech)
     spec = TASKS[v.task]
     title = text("pack.task", lang, task=v.task, code=v.code or "—",
-                 title=spec.title if lang == "en" else TITLES[v.task][lang == "ru"])
+                 title=spec.title[0].upper() + spec.title[1:] if lang == "en" else TITLES[v.task][lang == "ru"])
     drawn = simulate(mech, at=phi1, n=draws, seed=0,
                      scales=Scales(*(sc[k].value for k in ("mu_l", "mu_v", "mu_a", "mu_F"))))
     bands = {k: tuple(float(x) for x in np.percentile(s, BAND)) for k, s in drawn.samples.items()}
@@ -155,11 +155,13 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
                                 (0.14, 0.15, 0.12, 0.3, 0.29), frozenset({1, 4})))]
     key.append(("p", text("pack.band_note", lang, lo=num(BAND[0], lang), hi=num(BAND[1], lang), n=draws,
                           mm=num(drawn.length_mm, lang), deg=num(drawn.angle_deg, lang))))
-    if "delta_pct" in bands:
-        lo, hi = bands["delta_pct"]
-        key.append(("p", text("pack.delta", lang, M=L.M_bal, ML=L.lever(L.M_bal),
-                              delta=num(ws.value("delta_pct"), lang, 2, decimals=2),
-                              lo=num(lo, lang, decimals=2), hi=num(hi, lang, decimals=2))))
+    if not drawn.forces_drawn:
+        key.append(("p", text("pack.band_partial", lang, M=L.M_bal)))
+    delta = text("pack.delta", lang, M=L.M_bal, ML=L.lever(L.M_bal), delta=num(ws.value("delta_pct"), lang, decimals=2))
+    if "delta_pct" in bands:            # the study draws the force plans of one-group mechanisms only
+        lo, hi = (num(x, lang, decimals=2) for x in bands["delta_pct"])
+        delta += " " + text("pack.delta_band", lang, lo=lo, hi=hi)
+    key.append(("p", delta))
     key += [("h2", text("pack.segments", lang)), ("table", _segments_table(plans, lang, answers))]
     sheet.append(("area", (text("pack.area", lang), (title, *(f"{text(k, lang)}: " for k in
                                                                ("pack.student", "pack.group", "pack.checked"))))))
