@@ -978,6 +978,11 @@ def cmd_variant(args) -> int:
     except ValueError as exc:
         raise CLIError(f"{exc} (see 'kinetostat variant --help')") from None
     args.lang = args.lang or "uk"                   # seed 002's language (its models' [lettering])
+    import importlib.util
+    teacher_pack = not args.no_pack and importlib.util.find_spec("matplotlib") is not None
+    if not (args.no_pack or teacher_pack):          # a plain install: the keys, and a word on the pack
+        _Out.write("no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf): its PDFs need matplotlib: "
+                   "pip install 'kinetostat[reports]'", err=True)
     default = "seed002_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
     t0 = time.perf_counter()
@@ -991,7 +996,7 @@ def cmd_variant(args) -> int:
                 warnings.simplefilter("ignore")
                 try:
                     keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
-                                                   cycle_csv=not args.all, root=out))
+                                                   cycle_csv=not args.all, root=out, teacher_pack=teacher_pack))
                 except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:
@@ -1272,10 +1277,12 @@ def build_parser() -> argparse.ArgumentParser:
                                     "labelled а б в г д е), run it, and write into DIR the model file "
                                     "task<T>_<CODE>.toml (its header states the columns and every assumption the "
                                     "text leaves open), its answer key at the design position phi1 (worksheet.md/"
-                                    "html/csv/json and the plans' SVG sheets with segments.csv) and cycle.csv. "
+                                    "html/csv/json and the plans' SVG sheets with segments.csv), cycle.csv and the teacher's "
+                                    "pack (the student's sheet.pdf, the answer key key.pdf with the bands of a careful "
+                                    "drawing, all plans on one A3 sheet plans_a3.pdf, and their HTML). "
                                     "--all writes the keys of every code (of TASK, or of all three tasks) into "
-                                    "DIR/task<T>_<CODE>/ (no cycle.csv) with DIR/index.md, code -> M_bal and the "
-                                    "largest reaction.")
+                                    "DIR/task<T>_<CODE>/ (no cycle.csv) with DIR/index.md and index.html, code -> M_bal, "
+                                    "the largest reaction and the pack.")
     va.add_argument("task", metavar="TASK", nargs="?", help="task of seed 002: 1, 2 or 3 (with --all: default all)")
     va.add_argument("code", metavar="CODE", nargs="?", help="three-digit variant 000..999, e.g. 479")
     va.add_argument("--all", action="store_true", help="every code of TASK (or of every task), for a teacher")
@@ -1283,6 +1290,8 @@ def build_parser() -> argparse.ArgumentParser:
                                                  "with --all ./seed002_variants)")
     va.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
                     help="language of the key and the index (default uk: the language of seed 002)")
+    va.add_argument("--no-pack", action="store_true", help="no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf "
+                                                           "and their HTML): the keys only, about 4 s faster a code")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
     va.set_defaults(func=cmd_variant)
 

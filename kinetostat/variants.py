@@ -552,16 +552,18 @@ def _largest(res, mech: Mechanism, n: int = 0) -> tuple[str, float]:
 
 
 def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool = True,
-              steps: int = 360, root: str | Path | None = None) -> KeySummary:
+              steps: int = 360, root: str | Path | None = None, teacher_pack: bool = True) -> KeySummary:
     """Write the variant's model file `<name>.toml` and its answer key into `out_dir` (created): the
     worksheet (worksheet.md/html/csv/json) and the plans (SVG sheets, segments.csv) at the design
     position in `lang` ("en", "uk", "ru"), and with `cycle_csv` the analysis over the cycle
-    (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр). The files
+    (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр), and with
+    `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
     from .analysis import analyze
     from .plans import build as build_plans
     from .plans.lettering import with_aliases
+    from .plans.pack import pack
     from .plans.worksheet import worksheet
     from .tables import csv_text
     out = Path(out_dir)
@@ -571,9 +573,10 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     res = analyze(mech, steps=steps)
     plans = build_plans(mech, at=phi1)
     sheet = worksheet(mech, phi1, mu_l=plans.scales["mu_l"].value, lang=lang)
+    teacher = pack(v, lang, plans=plans) if teacher_pack else None
     with unit(out, root) as tmp:
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
-        files += plans.write(tmp, lang=lang) + sheet.write(tmp)
+        files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
         if cycle_csv:
             files.append(write_text(tmp / "cycle.csv", csv_text(with_aliases(res.to_frame(), mech))))
     files = [out / f.relative_to(tmp) for f in files]
@@ -600,13 +603,15 @@ def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
         cyc = text("ix.cycle", lang)
         lines += [f"## {text('ix.task', lang, task=spec.task, title=title, table=spec.table)}", "",
                   f"| {text('ix.code', lang)} | φ1, {deg} | {M} {text('ix.at', lang)}, {Nm} | "
-                  f"{text('ix.largest', lang)}, {N} | |{M}| {cyc}, {Nm} | |R| {cyc}, {N} |",
-                  "|---|---:|---:|---|---:|---:|"]
+                  f"{text('ix.largest', lang)}, {N} | \\|{M}\\| {cyc}, {Nm} | \\|R\\| {cyc}, {N} | "   # \| : a bar in a cell
+                  f"{text('pack.files', lang)} |",
+                  "|---|---:|---:|---|---:|---:|---|"]
         for k in ks:
             code = k.name.split("_", 1)[1]
             lines.append(f"| [{code}]({k.name}/worksheet.md) | {num(k.phi1, lang, 6)} | "
                          f"{num(k.M_bal, lang, decimals=2)} | {k.largest} = {num(k.R_max, lang, decimals=1)} | "
-                         f"{num(k.cycle_M_max, lang, decimals=2)} | {num(k.cycle_R_max, lang, decimals=1)} |")
+                         f"{num(k.cycle_M_max, lang, decimals=2)} | {num(k.cycle_R_max, lang, decimals=1)} | "
+                         + " ".join(f"[{f.name}]({k.name}/{f.name})" for f in k.files if f.suffix == ".pdf") + " |")
         lines.append("")
     return "\n".join(lines)
 
@@ -637,5 +642,13 @@ def lettering_of(task: int):
 
 
 def write_index(out_dir: str | Path, keys: list[KeySummary], lang: str = "en") -> Path:
-    """`index_markdown(keys, lang)` into `out_dir/index.md`, atomically; returns its path."""
-    return write_text(Path(out_dir) / "index.md", index_markdown(keys, lang))
+    """`index_markdown(keys, lang)` into `out_dir/index.md` and as a standalone page into
+    `out_dir/index.html` (links to the worksheets' HTML), each atomically; returns the Markdown's path."""
+    from markdown_it import MarkdownIt
+
+    from .plans.i18n import text
+    from .plans.worksheet import html_document
+    md = index_markdown(keys, lang)
+    body = MarkdownIt("commonmark", {"html": False}).enable("table").render(md.replace("/worksheet.md)", "/worksheet.html)"))
+    write_text(Path(out_dir) / "index.html", html_document(text("ix.title", lang), body, lang))
+    return write_text(Path(out_dir) / "index.md", md)

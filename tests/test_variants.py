@@ -57,7 +57,7 @@ def test_tables_have_ten_columns_and_the_texts_letters():
 # ----------------------------------------------------------------------------- task 1, code 479
 
 def test_variant_1_479_by_the_command_equals_the_hand_written_model(cli, tmp_path):
-    run = cli("variant", "1", "479", "--out", tmp_path)
+    run = cli("variant", "1", "479", "--out", tmp_path, "--no-pack")      # the pack: test_pack
     assert run.returncode == 0, run.stderr
     assert "а=4 б=7 в=9 г=4 д=7 е=9" in run.stdout
     for name in ("task1_479.toml", "worksheet.md", "worksheet.html", "worksheet.csv", "worksheet.json",
@@ -141,7 +141,7 @@ def test_every_code_builds_and_runs(task):
 
 def test_all_writes_one_key_per_code_and_an_index(cli, tmp_path, monkeypatch):
     monkeypatch.setattr(variants, "codes", lambda: ["000", "479", "999"])
-    run = cli("variant", "3", "--all", "--out", tmp_path, "--no-progress")
+    run = cli("variant", "3", "--all", "--out", tmp_path, "--no-progress", "--no-pack")
     assert run.returncode == 0, run.stderr
     index = (tmp_path / "index.md").read_text()
     for code in ("000", "479", "999"):

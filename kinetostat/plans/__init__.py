@@ -67,6 +67,14 @@ def _fitted(make: Callable, mu: Scale) -> list[Plan]:
     return plans
 
 
+def _positions(mech, res, sc, starting_deg: float | None) -> Plan:
+    """The plan of positions at mu_l; where the other branch's dashed mark alone would run off the
+    sheet (a slider's other branch below the crank), the mark left out and noted (the scale rule
+    keeps the crank at the length the text asks)."""
+    plan = positions_plan(mech, res, sc, starting_deg=starting_deg)
+    return plan if fits(plan) <= 1 else positions_plan(mech, res, sc, starting_deg=starting_deg, other_branch=False)
+
+
 class Plans(Mapping):
     """The plans of one mechanism at one crank angle: a frozen mapping kind -> Plan (kinds as in
     the `plan` column of segments.csv), with the scales they are drawn at."""
@@ -167,7 +175,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
                          "size to draw; the statics is in the tables (reactions, balancing moment)")
     sc = choose_scales(mech, res, scales)
     steps = dict(BUILDERS)
-    steps["positions"] = partial(positions_plan, starting_deg=starting_deg)
+    steps["positions"] = partial(_positions, starting_deg=starting_deg)
     plans: list[Plan] = []
     for name in names:
         if name in chosen:

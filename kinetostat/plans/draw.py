@@ -420,7 +420,7 @@ def figure(plan: Plan, lang: str = "en", ax=None):
             ax.plot([a.real, b.real], [a.imag, b.imag], color=colour, lw=width * 3,
                     ls=(0, tuple(float(v) * 2 for v in dash.split(","))) if dash else "-")
         if not labelled(s.end):            # a load or an arm ends at a construction point: letter the segment
-            ax.annotate(s.name, (b.real, b.imag), xytext=(3, -9), textcoords="offset points", fontsize=8,
+            ax.annotate(segment_label(s, lang), (b.real, b.imag), xytext=(3, -9), textcoords="offset points", fontsize=8,
                         color=colour)
     small = plan.kind == "positions"
     for name, z in plan.points.items():

@@ -121,9 +121,12 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "cli.cycle": ("over the cycle: max |{M}| = {M_value}, max |R| = {R_value}",
                   "за цикл: найбільше |{M}| = {M_value}, найбільше |R| = {R_value}",
                   "за цикл: наибольшее |{M}| = {M_value}, наибольшее |R| = {R_value}"),
-    "cli.files": ("model {model} (assumptions in its header), worksheet, plans and `cycle.csv`: {n} files -> {out}",
-                  "модель {model} (припущення в її заголовку), розрахунковий лист, плани і `cycle.csv`: {n} файлів -> {out}",
-                  "модель {model} (допущения в её заголовке), расчётный лист, планы и `cycle.csv`: {n} файлов -> {out}"),
+    "cli.files": ("model {model} (assumptions in its header), worksheet, plans, `cycle.csv`, the student's sheet "
+                  "`sheet.pdf`, the answer key `key.pdf` and the A3 sheet `plans_a3.pdf`: {n} files -> {out}",
+                  "модель {model} (припущення в її заголовку), розрахунковий лист, плани, `cycle.csv`, аркуш "
+                  "завдання `sheet.pdf`, ключ відповідей `key.pdf` і аркуш А3 `plans_a3.pdf`: {n} файлів -> {out}",
+                  "модель {model} (допущения в её заголовке), расчётный лист, планы, `cycle.csv`, лист задания "
+                  "`sheet.pdf`, ключ ответов `key.pdf` и лист А3 `plans_a3.pdf`: {n} файлов -> {out}"),
     # the worksheet
     "ws.title": ("Worksheet: {name}, φ = {phi}°", "Розрахунковий лист: {name}, φ = {phi}°",
                  "Расчётный лист: {name}, φ = {phi}°"),
@@ -149,6 +152,92 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "ws.head.direction": ("Sense / direction", "Напрямок", "Направление"),
     "ws.head.note": ("How obtained", "Як отримано", "Как получено"),
     "degrees": ("deg", "град", "град"),
+    # the teacher's pack (`pack`): the student's sheet, the answer key, the A3 sheet of plans
+    "pack.sheet": ("Student's sheet", "Аркуш завдання студента", "Лист задания студента"),
+    "pack.key": ("Answer key", "Ключ відповідей", "Ключ ответов"),
+    "pack.a3": ("Plans of the mechanism", "Плани механізму", "Планы механизма"),
+    "pack.task": ("Task {task}. {title}. Variant {code}", "Завдання {task}. {title}. Варіант {code}",
+                  "Задание {task}. {title}. Вариант {code}"),
+    "pack.statement": ("By the graphical-analytic method, at the design position φ1 of the crank determine: the "
+                       "velocities and accelerations of the points and links (plans of positions, velocities and "
+                       "accelerations), the inertia forces and moments, the reactions in the kinematic pairs (force "
+                       "plans of the groups) and the balancing moment {M} (force plan of the initial link); check "
+                       "{M} by Zhukovsky's lever and find the difference δ, which must not exceed 5 %.",
+                       "Графоаналітичним методом у розрахунковому положенні кривошипа φ1 визначити: швидкості та "
+                       "прискорення точок і ланок (плани положень, швидкостей і прискорень), сили та моменти сил "
+                       "інерції, реакції в кінематичних парах (плани сил груп) і зрівноважувальний момент {M} (план "
+                       "сил початкової ланки); перевірити {M} важелем Жуковського і знайти розбіжність δ, яка не "
+                       "повинна перевищувати 5 %.",
+                       "Графоаналитическим методом в расчётном положении кривошипа φ1 определить: скорости и "
+                       "ускорения точек и звеньев (планы положений, скоростей и ускорений), силы и моменты сил "
+                       "инерции, реакции в кинематических парах (планы сил групп) и уравновешивающий момент {M} (план "
+                       "сил начального звена); проверить {M} рычагом Жуковского и найти расхождение δ, которое не "
+                       "должно превышать 5 %."),
+    "pack.assume": ("The crank turns clockwise at constant speed; φ1 is measured from top dead centre; friction "
+                    "is neglected; g = 9.81 m/s².",
+                    "Кривошип обертається за годинниковою стрілкою зі сталою швидкістю; φ1 відлічується від верхньої "
+                    "мертвої точки; тертям знехтувати; g = 9,81 м/с².",
+                    "Кривошип вращается по часовой стрелке с постоянной скоростью; φ1 отсчитывается от верхней "
+                    "мёртвой точки; трением пренебречь; g = 9,81 м/с²."),
+    "pack.data": ("Initial data (table {table}, the code's columns)", "Початкові дані (таблиця {table}, стовпці за "
+                  "кодом)", "Исходные данные (таблица {table}, столбцы по коду)"),
+    "pack.letter": ("Row", "Рядок", "Строка"),
+    "pack.parameter": ("Parameter", "Параметр", "Параметр"),
+    "pack.fill": ("Fill in from your plans", "Заповнити за своїми планами", "Заполнить по своим планам"),
+    "pack.area": ("Drawing area: plans of positions, velocities, accelerations and forces, Zhukovsky's lever",
+                  "Поле креслення: плани положень, швидкостей, прискорень і сил, важіль Жуковського",
+                  "Поле чертежа: планы положений, скоростей, ускорений и сил, рычаг Жуковского"),
+    "pack.student": ("Student", "Студент", "Студент"),
+    "pack.group": ("Group", "Група", "Группа"),
+    "pack.checked": ("Checked", "Перевірив", "Проверил"),
+    "pack.band": ("Band of a careful drawing", "Межі ретельного креслення", "Границы тщательного чертежа"),
+    "pack.band_note": ("Band: {lo}-{hi} % of {n} simulated careful drawings at these scales (every length laid off "
+                       "or read wrong by up to ±{mm} mm, every direction by up to ±{deg}°); a drawn answer inside "
+                       "the band is as good as a careful drawing gets.",
+                       "Межі: {lo}-{hi} % з {n} змодельованих ретельних креслень у цих масштабах (кожна довжина "
+                       "відкладена або виміряна з похибкою до ±{mm} мм, кожен напрямок до ±{deg}°); відповідь у "
+                       "цих межах точна настільки, наскільки дозволяє ретельне креслення.",
+                       "Границы: {lo}-{hi} % из {n} смоделированных тщательных чертежей в этих масштабах (каждая "
+                       "длина отложена или измерена с погрешностью до ±{mm} мм, каждое направление до ±{deg}°); "
+                       "ответ в этих границах точен настолько, насколько позволяет тщательный чертёж."),
+    "pack.delta": ("δ = ({ML} - {M}) / {ML} · 100 %: the balancing moment by Zhukovsky's lever against that by "
+                   "the force plans; the texts accept a drawing whose |δ| does not exceed 5 %. Exact: δ = {delta} %.",
+                   "δ = ({ML} - {M}) / {ML} · 100 %: зрівноважувальний момент за важелем Жуковського проти "
+                   "моменту за планами сил; допустима розбіжність |δ| не більше 5 %. Точно: δ = {delta} %.",
+                   "δ = ({ML} - {M}) / {ML} · 100 %: уравновешивающий момент по рычагу Жуковского против "
+                   "момента по планам сил; допустимое расхождение |δ| не более 5 %. Точно: δ = {delta} %."),
+    "pack.delta_band": ("Careful drawings: δ = {lo} … {hi} %.", "Ретельні креслення: δ = {lo} … {hi} %.",
+                        "Тщательные чертежи: δ = {lo} … {hi} %."),
+    "pack.band_partial": ("The drawing-error study draws the force plans of mechanisms of one group only: here "
+                          "the reactions and {M} have no band.",
+                          "Дослідження похибки креслення будує плани сил лише механізмів з однієї групи: тут "
+                          "реакції та {M} без меж.",
+                          "Исследование погрешности чертежа строит планы сил только механизмов из одной группы: "
+                          "здесь реакции и {M} без границ."),
+    "pack.scales": ("Scales", "Масштаби", "Масштабы"),
+    "pack.drawn": ("drawn", "відрізок", "отрезок"),
+    "pack.segments": ("Segments a student measures, mm", "Відрізки, які вимірює студент, мм",
+                      "Отрезки, которые измеряет студент, мм"),
+    "pack.plan": ("Plan", "План", "План"),
+    "pack.length": ("Length, mm", "Довжина, мм", "Длина, мм"),
+    "pack.values": ("Values", "Значення", "Значения"),
+    "pack.files": ("Sheet and key", "Завдання і ключ", "Задание и ключ"),
+    # the rows of seed 002's tables 1.1-1.3, as the text words them
+    "row.n1": ("Crank speed", "Частота обертання кривошипа", "Частота вращения кривошипа"),
+    "row.l_OA": ("Crank length", "Довжина кривошипа", "Длина кривошипа"),
+    "row.phi1": ("Design position of the mechanism", "Координата розрахункового положення механізму",
+                 "Координата расчётного положения механизма"),
+    "row.ratio": ("Ratio of the link lengths", "Співвідношення довжин ланок", "Соотношение длин звеньев"),
+    "row.s_ratio": ("Position of the rod's centre of mass", "Положення центра мас шатуна",
+                    "Положение центра масс шатуна"),
+    "row.d": ("Cylinder diameter", "Діаметр циліндра", "Диаметр цилиндра"),
+    "row.p_max": ("Maximum cylinder pressure", "Максимальний тиск у циліндрі", "Максимальное давление в цилиндре"),
+    "row.G3": ("Piston weight", "Вага поршня", "Вес поршня"),
+    "row.G2": ("Rod weight", "Вага шатуна", "Вес шатуна"),
+    "row.I_S2": ("Rod moment of inertia about its centre of mass", "Момент інерції шатуна відносно центра мас",
+                 "Момент инерции шатуна относительно центра масс"),
+    "row.G_piston": ("Weight of the pistons", "Вага поршнів", "Вес поршней"),
+    "row.G_rod": ("Weight of the rods", "Вага шатунів", "Вес шатунов"),
 }
 
 #: The English phrases of the generated notes (positions, branches) and their translations,
@@ -162,6 +251,8 @@ PHRASES: tuple[tuple[str, str, str], ...] = (
     ("(the other branch does not assemble here)", "(інше складання тут неможливе)", "(другая сборка здесь невозможна)"),
     ("(the other branch looks the same here)", "(інше складання тут має той самий вигляд)",
      "(другая сборка здесь выглядит так же)"),
+    ("(the other branch", "(інше складання", "(другая сборка"),
+    ("off the sheet at this scale)", "поза аркушем у цьому масштабі)", "вне листа в этом масштабе)"),
     (": the other branch", ": інше складання", ": другая сборка"),
     ("arm about the crank axis, on the crank's plan", "плече відносно осі кривошипа, на плані кривошипа",
      "плечо относительно оси кривошипа, на плане кривошипа"),

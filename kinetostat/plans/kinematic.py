@@ -348,9 +348,9 @@ def _draw_position(mech, res, idx: int, label: int | None, mu: float, points: di
                                     abs(zb - za) * mu, "m", "link" if label is None else "position"))
 
 
-def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list) -> list[str]:
+def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list, dashed: bool = True) -> list[str]:
     """Mark each group's assembly branch: a note, and the other branch's inner joint drawn dashed
-    (primed name) where it lies elsewhere."""
+    (primed name) where it lies elsewhere (with `dashed` False only noted: it runs off the sheet)."""
     from ..analysis import analyze
     from ..errors import AssemblyError
     notes = []
@@ -372,6 +372,9 @@ def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list) -> 
             notes.append(text + " (the other branch looks the same here)")
             continue
         qp = f"{q}'"
+        if not dashed:
+            notes.append(text + f" (the other branch {qp} off the sheet at this scale)")
+            continue
         points[qp] = zq / mu
         for p in (g.pairs[0], g.pairs[2]):
             n = p.point if p.kind == "R" else None
@@ -381,11 +384,12 @@ def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list) -> 
     return notes
 
 
-def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | None = None) -> Plan:
+def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | None = None,
+                   other_branch: bool = True) -> Plan:
     """The plan of positions (seed 002 fig. 1.5): 12 positions every 30 deg in the drive's sense
     from the starting position (found by `starting_position` unless given), the design position
     of `res` (plain names), the paths of every centre of mass and the assembly branch of each
-    group (notes; the other branch dashed): all at mu_l. Link segments' values are the exact
+    group (notes; the other branch dashed, unless `other_branch` is False): all at mu_l. Link segments' values are the exact
     distances between their points, m."""
     from ..analysis import analyze
     at = float(res.phi_deg[0])
@@ -401,7 +405,7 @@ def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | No
     _draw_position(mech, res, 0, None, mu.value, points, segs)
     notes = [f"position 0 at phi = {start:.6g} deg (crank and rod in line), then every 30 deg; "
              f"design position phi = {at:g} deg drawn with plain letters"]
-    notes += _branch_marks(mech, at, res, mu.value, points, segs)
+    notes += _branch_marks(mech, at, res, mu.value, points, segs, other_branch)
     cycle = analyze(mech, phi_deg=np.arange(PATH_STEPS + 1) * 360.0 / PATH_STEPS)
     paths = {link.com: tuple(_z(cycle, link.com) / mu.value) for link in mech.links[1:]
              if link.com and link.com not in mech.links[0].points}

@@ -2,8 +2,11 @@
 
 The rule (seed 002 sec. 1.2.2): a reference quantity is drawn at a recommended length and the
 scale is its value over that length, rounded to a value an engineer can multiply by in the head.
-Here a round scale is m x 10^k with the mantissa m one of ROUND_MANTISSAS = (1, 2, 2.5, 4, 5);
-of the round scales, the one whose drawn reference length is nearest the recommended range (in
+Here a round scale is m x 10^k with the mantissa m one of ROUND_MANTISSAS = (1, 2, 2.5, 4, 5)
+(the reduction and enlargement scales of GOST 2.302); the plan of positions may also take the
+reductions 1:1.5 and 1:7.5 (GOST 2.302's 1:15 and 1:75, LENGTH_MANTISSAS), so that the crank
+lands in 30..35 mm as the text asks (l_OA = 0.048 m: 32 mm at 0.0015 m/mm, where 1 and 2 give
+48 and 24 mm); of the round scales, the one whose drawn reference length is nearest the recommended range (in
 ratio; ties go to the larger drawing) is taken, then made coarser step by step while the plan
 would not fit the drawing area of an A3 sheet (FIT_MM).
 
@@ -25,12 +28,15 @@ import numpy as np
 
 from .core import Scale
 
-__all__ = ["choose_scales", "round_scale", "coarser", "check_given", "SCALE_UNITS", "ROUND_MANTISSAS", "FIT_MM"]
+__all__ = ["choose_scales", "round_scale", "coarser", "check_given", "SCALE_UNITS", "ROUND_MANTISSAS", "LENGTH_MANTISSAS",
+           "FIT_MM"]
 
 #: Unit of each scale, per millimetre drawn.
 SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F": "N/mm"}
 #: Mantissas of a round scale.
 ROUND_MANTISSAS = (1.0, 2.0, 2.5, 4.0, 5.0)
+#: Mantissas of the plan of positions' scale mu_l: ROUND_MANTISSAS and GOST 2.302's 1:15 and 1:75.
+LENGTH_MANTISSAS = (1.0, 1.5, 2.0, 2.5, 4.0, 5.0, 7.5)
 #: Recommended drawn length of each scale's reference quantity, mm.
 TARGET_MM = {"mu_l": (30.0, 35.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (100.0, 200.0)}
 #: Drawing area of an A3 landscape sheet a plan must fit (width, height), mm: inside the frame,
@@ -38,21 +44,21 @@ TARGET_MM = {"mu_l": (30.0, 35.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "
 FIT_MM = (380.0, 220.0)
 
 
-def _round_candidates(value: float) -> list[float]:
+def _round_candidates(value: float, mantissas: tuple[float, ...] = ROUND_MANTISSAS) -> list[float]:
     """Round scales around `value`, ascending."""
     k0 = math.floor(math.log10(value))
-    return sorted(m * 10.0 ** k for k in range(k0 - 2, k0 + 3) for m in ROUND_MANTISSAS)
+    return sorted(m * 10.0 ** k for k in range(k0 - 2, k0 + 3) for m in mantissas)
 
 
 def round_scale(reference: float, lo_mm: float, hi_mm: float, extent: tuple[float, float] = (0.0, 0.0),
-                fit_mm: tuple[float, float] = FIT_MM) -> float:
-    """The round scale (SI per mm) that draws `reference` (SI) nearest [lo_mm, hi_mm] and the
-    plan's extent (width, height, SI) within `fit_mm`."""
+                fit_mm: tuple[float, float] = FIT_MM, mantissas: tuple[float, ...] = ROUND_MANTISSAS) -> float:
+    """The round scale (SI per mm, a mantissa of `mantissas` x 10^k) that draws `reference` (SI)
+    nearest [lo_mm, hi_mm] and the plan's extent (width, height, SI) within `fit_mm`."""
     if not (reference > 0 and math.isfinite(reference)):
         reference = max(extent)
         if not (reference > 0 and math.isfinite(reference)):
             return 1.0                # nothing to draw: any scale will do
-    cands = _round_candidates(reference / hi_mm)
+    cands = _round_candidates(reference / hi_mm, mantissas)
 
     def miss(c: float) -> float:      # how far the drawn length lies outside [lo, hi], in log ratio
         length = reference / c
@@ -121,6 +127,7 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
             value = given[key]
         else:
             ref, ext = reference[key]
-            value = round_scale(ref, *TARGET_MM[key], extent=ext)
+            value = round_scale(ref, *TARGET_MM[key], extent=ext,
+                                mantissas=LENGTH_MANTISSAS if key == "mu_l" else ROUND_MANTISSAS)
         out[key] = Scale(key, value, unit)
     return out

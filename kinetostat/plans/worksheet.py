@@ -30,7 +30,7 @@ from .i18n import check_lang, num, phrase, text, unit
 from .lettering import lettering
 from .scales import choose_scales
 
-__all__ = ["Row", "Worksheet", "worksheet", "COLUMNS"]
+__all__ = ["Row", "Worksheet", "worksheet", "COLUMNS", "CSS", "html_document"]
 
 #: Columns of the worksheet's table (CSV, JSON, frame).
 COLUMNS = ("section", "key", "symbol", "value", "unit", "direction", "note")
@@ -112,9 +112,12 @@ class Worksheet:
         return "\n".join(out) + "\n"
 
     def html(self) -> str:
-        """The Markdown rendered to HTML (CommonMark with tables; raw HTML is not passed through)."""
+        """A standalone HTML page (`html_document`): the Markdown rendered (CommonMark with tables;
+        raw HTML is not passed through)."""
         from markdown_it import MarkdownIt
-        return MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
+        body = MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
+        return html_document(text("ws.title", self.lang, name=self.mechanism, phi=num(self.phi_deg, self.lang, 6)),
+                             body, self.lang)
 
     def to_csv(self, path: str | Path) -> None:
         """Write the rows as CSV, each value to 12 significant digits of the largest |value| of its
@@ -141,6 +144,34 @@ class Worksheet:
         self.to_csv(paths[2])
         self.to_json(paths[3])
         return paths
+
+
+#: The style of every HTML page of the worksheet and the teacher's pack: screen and print (A4).
+CSS = """body{font-family:"DejaVu Sans",Arial,sans-serif;font-size:11pt;line-height:1.35;margin:1.5em auto;
+max-width:60em;padding:0 1em;color:#111}
+h1{font-size:1.4em}h2{font-size:1.15em;margin-top:1.4em}
+table{border-collapse:collapse;margin:.5em 0;width:100%}
+th,td{border:1px solid #888;padding:.2em .45em;vertical-align:top}th{background:#eee;text-align:left}
+td.num{text-align:right;white-space:nowrap}td.blank{min-width:6em;height:1.4em}
+.area{border:1px solid #000;height:24cm;margin-top:1em;position:relative}
+.titleblock{position:absolute;right:0;bottom:0;border-left:1px solid #000;border-top:1px solid #000;
+padding:.3em .6em;width:40%}
+.plans{display:grid;grid-template-columns:repeat(3,1fr);gap:.5em}.plans img{width:100%;border:1px solid #ccc}
+@media (max-width:800px){table{display:block;overflow-x:auto}.plans{grid-template-columns:1fr}}
+@media print{body{margin:0;max-width:none;font-size:10pt}h2{break-after:avoid}tr{break-inside:avoid}
+.area{break-before:page;height:26cm}a{color:inherit;text-decoration:none}}
+@page{size:A4;margin:12mm 10mm 12mm 20mm}
+"""
+
+
+def html_document(title: str, body: str, lang: str, css: str = CSS) -> str:
+    """A standalone HTML5 page in `lang`: UTF-8, `title` (escaped), the style `css` (screen and
+    print), `body` (HTML, as given)."""
+    from html import escape
+    check_lang(lang)
+    return (f'<!DOCTYPE html>\n<html lang="{lang}">\n<head>\n<meta charset="utf-8">\n'
+            f'<meta name="viewport" content="width=device-width, initial-scale=1">\n<title>{escape(title)}</title>\n'
+            f"<style>\n{css}</style>\n</head>\n<body>\n{body}</body>\n</html>\n")
 
 
 def _direction(d: str, lang: str) -> str:

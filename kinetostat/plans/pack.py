@@ -1,0 +1,425 @@
+"""The teacher's pack of a seed 002 variant (issue 21): the student's sheet, the answer key and one
+A3 sheet with all the plans, as PDF and as standalone HTML.
+
+    >>> from kinetostat import variants
+    >>> from kinetostat.plans.pack import pack
+    >>> p = pack(variants.variant(1, "479"), lang="uk")
+    >>> paths = p.write("out/task1_479")                            # doctest: +SKIP
+
+- `sheet.pdf` / `sheet.html`: the task in the text's words, the variant's data (table 1.1-1.3 rows
+  with their letters), the worksheet's tables with their values left blank, and an A3 drawing
+  area with a title block. No answer: no value, scale or length the key gives.
+- `key.pdf` / `key.html`: every worksheet value with its unit and sense, and the band a careful
+  drawing lands in (the 5-95 % range of `drawing_error.simulate`, BAND_DRAWS draws, seeded); the
+  scales μ_l, μ_v, μ_a, μ_F with the reference length each draws; δ with the texts' 5 % rule; every
+  segment a student measures on the plans, in mm at the plans' scales.
+- `plans_a3.pdf` / `plans.html`: the plans side by side on one A3 landscape sheet (seed 002,
+  appendix B puts the results on A3).
+
+Both documents are one list of blocks (headings, paragraphs, tables, the drawing area), rendered
+twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figure library; TrueType
+DejaVu Sans embedded as Type 42 with its Unicode map, so pdftotext reads the Cyrillic back) and to
+HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
+
+May use: the solver (`analysis`), `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
+`kinetostat._io`; matplotlib inside the PDF writers only. Never the harness.
+"""
+from __future__ import annotations
+
+import math
+import textwrap
+from contextlib import contextmanager
+from dataclasses import dataclass
+from html import escape
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from .._io import write_bytes, write_text
+from .draw import segment_label, title_of
+from .i18n import check_lang, num, text, unit
+from .lettering import lettering
+from .worksheet import CSS, Worksheet, html_document, worksheet
+
+__all__ = ["Pack", "pack", "BAND", "BAND_DRAWS", "PACK_FILES"]
+
+#: The band of a careful drawing: these percentiles of the simulated drawings, %.
+BAND = (5.0, 95.0)
+#: Monte Carlo draws of the band (`drawing_error.simulate`, seed 0): enough for 5-95 % to 2 digits.
+BAND_DRAWS = 400
+#: The files `Pack.write` writes.
+PACK_FILES = ("sheet.pdf", "key.pdf", "plans_a3.pdf", "sheet.html", "key.html", "plans.html")
+#: Reference length each scale draws (the texts' rule, `scales`): symbol -> the segment it draws.
+_REFERENCE = {"mu_l": "OA", "mu_v": "pa", "mu_a": "πa"}
+
+A4, A3 = (210.0, 297.0), (420.0, 297.0)
+_MARGIN = (20.0, 10.0, 12.0, 12.0)        # left (binding), right, top, bottom, mm
+_PT = 25.4 / 72.0                          # mm per point
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table block: header cells, rows of cells, column widths (fractions of the text width),
+    the columns of numbers (right-aligned) and the blank columns (to fill in by hand)."""
+    head: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+    widths: tuple[float, ...]
+    numeric: frozenset[int] = frozenset()
+    blank: frozenset[int] = frozenset()
+
+
+@dataclass(frozen=True)
+class Pack:
+    """The pack of one variant in `lang`: the blocks of the sheet and of the key (("h1"|"h2"|"p",
+    text), ("table", Table), ("area", title-block lines)), the plans, the numbers of the key as
+    printed (`answers`) and the bands (worksheet key -> (low, high), SI)."""
+    name: str
+    lang: str
+    title: str
+    sheet: tuple[tuple[str, Any], ...]
+    key: tuple[tuple[str, Any], ...]
+    plans: Any
+    answers: frozenset[str]
+    bands: Mapping[str, tuple[float, float]]
+
+    def write(self, out_dir: str | Path) -> list[Path]:
+        """PACK_FILES into `out_dir`, each atomically; returns the paths."""
+        out = Path(out_dir)
+        sheet_t, key_t = f"{text('pack.sheet', self.lang)}: {self.title}", f"{text('pack.key', self.lang)}: {self.title}"
+        out.mkdir(parents=True, exist_ok=True)
+        paths = [out / f for f in PACK_FILES]
+        write_bytes(paths[0], _pdf(self.sheet, sheet_t))
+        write_bytes(paths[1], _pdf(self.key, key_t))
+        write_bytes(paths[2], _plans_pdf(self.plans, self.lang, f"{text('pack.a3', self.lang)}: {self.title}"))
+        write_text(paths[3], html_document(sheet_t, _html(self.sheet), self.lang))
+        write_text(paths[4], html_document(key_t, _html(self.key), self.lang))
+        write_text(paths[5], _plans_html(self.plans, self.lang, f"{text('pack.a3', self.lang)}: {self.title}"))
+        return paths
+
+
+# ============================================================================ content
+
+def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
+    """The pack of variant `v` (`variants.Variant`) in `lang` at its design position; `plans`: its
+    plans when built already (`kinetostat.plans.build`); `draws`: Monte Carlo draws of the bands."""
+    from . import build
+    from .drawing_error import Scales, simulate
+    from ..variants import TASKS, TITLES, LETTERS
+    check_lang(lang)
+    mech = v.mechanism()
+    phi1 = float(v.values["phi1"])
+    plans = plans or build(mech, at=phi1)
+    sc = plans.scales
+    ws = worksheet(mech, phi1, mu_l=sc["mu_l"].value, lang=lang)
+    L = lettering(mech)
+    spec = TASKS[v.task]
+    title = text("pack.task", lang, task=v.task, code=v.code or "—",
+                 title=spec.title[0].upper() + spec.title[1:] if lang == "en" else TITLES[v.task][lang == "ru"])
+    drawn = simulate(mech, at=phi1, n=draws, seed=0,
+                     scales=Scales(*(sc[k].value for k in ("mu_l", "mu_v", "mu_a", "mu_F"))))
+    bands = {k: tuple(float(x) for x in np.percentile(s, BAND)) for k, s in drawn.samples.items()}
+    data = Table((text("pack.letter", lang), text("pack.parameter", lang), text("ws.head.symbol", lang),
+                  text("ws.head.value", lang), text("ws.head.unit", lang)),
+                 tuple((r.letter, text(f"row.{r.key}", lang), r.symbol, num(v.values[r.key], lang, 6),
+                        unit(r.unit, lang)) for r in spec.rows), (0.07, 0.5, 0.18, 0.13, 0.12), frozenset({3}))
+    sheet = [("h1", title), ("p", text("pack.statement", lang, M=L.M_bal)), ("p", text("pack.assume", lang)),
+             ("h2", text("pack.data", lang, table=spec.table)), ("table", data)]
+    if v.code:
+        sheet.append(("p", "  ".join(f"{ch} = {v.code[i]}" for ch, i in LETTERS.items())))
+    key = [("h1", f"{text('pack.key', lang)}. {title}")]          # scales, values and bands, δ, segments
+    answers: set[str] = set()
+    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
+    sheet.append(("h2", text("pack.fill", lang)))
+    recs = ws.records()
+    for section in dict.fromkeys(r.section for r in ws.rows):
+        idx = [i for i, r in enumerate(ws.rows) if r.section == section]
+        sheet.append(("h2", recs[idx[0]]["section"]))
+        sheet.append(("table", Table((text("ws.head.symbol", lang), text("ws.head.value", lang),
+                                      text("ws.head.unit", lang), text("ws.head.direction", lang)),
+                                     tuple((ws.rows[i].symbol, "", recs[i]["unit"], "") for i in idx),
+                                     (0.2, 0.25, 0.2, 0.35), blank=frozenset({1, 3}))))
+        krows = []
+        for i in idx:
+            r = ws.rows[i]
+            value = num(r.value, lang, 4)
+            lo_hi = bands.get(r.key)
+            band = f"{num(lo_hi[0], lang, 3)} … {num(lo_hi[1], lang, 3)}" if lo_hi else ""
+            krows.append((r.symbol, value, recs[i]["unit"], recs[i]["direction"], band))
+            answers.add(value)
+            if lo_hi:
+                answers.update(num(x, lang, 3) for x in lo_hi)
+        key += [("h2", recs[idx[0]]["section"]),
+                ("table", Table((text("ws.head.symbol", lang), text("ws.head.value", lang), text("ws.head.unit", lang),
+                                 text("ws.head.direction", lang), text("pack.band", lang)), tuple(krows),
+                                (0.14, 0.15, 0.12, 0.3, 0.29), frozenset({1, 4})))]
+    key.append(("p", text("pack.band_note", lang, lo=num(BAND[0], lang), hi=num(BAND[1], lang), n=draws,
+                          mm=num(drawn.length_mm, lang), deg=num(drawn.angle_deg, lang))))
+    if not drawn.forces_drawn:
+        key.append(("p", text("pack.band_partial", lang, M=L.M_bal)))
+    delta = text("pack.delta", lang, M=L.M_bal, ML=L.lever(L.M_bal), delta=num(ws.value("delta_pct"), lang, decimals=2))
+    if "delta_pct" in bands:            # the study draws the force plans of one-group mechanisms only
+        lo, hi = (num(x, lang, decimals=2) for x in bands["delta_pct"])
+        delta += " " + text("pack.delta_band", lang, lo=lo, hi=hi)
+    key.append(("p", delta))
+    key += [("h2", text("pack.segments", lang)), ("table", _segments_table(plans, lang, answers))]
+    sheet.append(("area", (text("pack.area", lang), (title, *(f"{text(k, lang)}: " for k in
+                                                               ("pack.student", "pack.group", "pack.checked"))))))
+    given = {num(v.values[r.key], lang, 6) for r in spec.rows}
+    answers = {a for a in answers if a not in given and a not in ("0", "—")}
+    return Pack(v.name, lang, title, tuple(sheet), tuple(key), plans, frozenset(answers), bands)
+
+
+def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> Table:
+    """μ_l, μ_v, μ_a, μ_F: value, unit and the reference each draws (OA, pa, πa in mm); the
+    values printed added to `answers`."""
+    rows = []
+    for s in scales.values():
+        ref = _REFERENCE.get(s.symbol)
+        drawn_mm = f"{ref} = {num(_reference_mm(mech, ws, s), lang, 3)} {unit('mm', lang)}" if ref else ""
+        rows.append(("μ_" + s.symbol.split("_", 1)[1], num(s.value, lang, 6), unit(s.unit, lang), drawn_mm))
+        answers.add(num(s.value, lang, 6))
+    return Table((text("ws.head.symbol", lang), text("ws.head.value", lang), text("ws.head.unit", lang),
+                  text("pack.drawn", lang)), tuple(rows), (0.15, 0.2, 0.25, 0.4), frozenset({1}))
+
+
+def _segments_table(plans, lang: str, answers: set[str]) -> Table:
+    """Every segment a student lays off or measures (vectors, links, arms; not the other
+    positions or the construction lines): its plan, name, length in mm and the value it stands
+    for; the lengths printed added to `answers`."""
+    rows = []
+    for kind in plans:
+        plan = plans[kind]
+        for s in plan.segments:
+            length = plan.length_mm(s.name)
+            if s.kind in ("position", "line") or not math.isfinite(length):
+                continue
+            value = "" if not math.isfinite(s.value) else f"{num(s.value, lang, 4)} {unit(s.unit, lang)}".strip()
+            rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), value))
+            answers.add(num(length, lang, decimals=1))
+    return Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang),
+                  text("ws.head.value", lang)), tuple(rows), (0.4, 0.2, 0.18, 0.22), frozenset({2, 3}))
+
+
+def _reference_mm(mech, ws: Worksheet, scale) -> float:
+    """The drawn length (mm) of the reference quantity of `scale` (the crank OA, pa, πa)."""
+    d = mech.drive
+    points = mech.links[d.link].points
+    value = {"mu_l": math.dist(points[d.pivot], points[d.point]), "mu_v": ws.value(f"V_{d.point}"),
+             "mu_a": ws.value(f"a_{d.point}")}[scale.symbol]
+    return value / scale.value
+
+
+# ============================================================================ HTML
+
+def _html(blocks) -> str:
+    """The blocks as the body of an HTML page (every text escaped)."""
+    out = []
+    for kind, x in blocks:
+        if kind in ("h1", "h2", "p"):
+            out.append(f"<{kind}>{escape(x)}</{kind}>")
+        elif kind == "table":
+            out.append("<table>\n<tr>" + "".join(f"<th>{escape(h)}</th>" for h in x.head) + "</tr>")
+            for row in x.rows:
+                cells = []
+                for i, c in enumerate(row):
+                    cls = ' class="blank"' if i in x.blank else ' class="num"' if i in x.numeric else ""
+                    cells.append(f"<td{cls}>{escape(c)}</td>")
+                out.append("<tr>" + "".join(cells) + "</tr>")
+            out.append("</table>")
+        else:                                   # the drawing area with its title block
+            out.append(f'<div class="area">{escape(x[0])}<div class="titleblock">' + "<br>".join(escape(s) for s in x[1])
+                       + "</div></div>")
+    return "\n".join(out) + "\n"
+
+
+def _plans_html(plans, lang: str, title: str) -> str:
+    """The plans' SVG sheets (written beside it by `Plans.write`) side by side on one page, A3
+    landscape in print."""
+    from . import plan_file_name
+    imgs = "\n".join(f'<figure><img src="{escape(plan_file_name(plans[k]))}" alt="{escape(title_of(plans[k], lang))}">'
+                     f"<figcaption>{escape(title_of(plans[k], lang))}</figcaption></figure>" for k in plans)
+    return html_document(title, f"<h1>{escape(title)}</h1>\n<div class=\"plans\">\n{imgs}\n</div>\n", lang,
+                         CSS + "@media print{@page{size:A3 landscape}}\n")
+
+
+# ============================================================================ PDF
+
+@contextmanager
+def _rc():
+    """matplotlib's settings of the PDFs (TrueType fonts, DejaVu Sans, no mathtext), and fontTools'
+    note on DejaVu's font timestamps, which every subset prints, kept quiet meanwhile."""
+    import logging
+
+    import matplotlib
+    log = logging.getLogger("fontTools.ttLib.tables._h_e_a_d")
+    level = log.level
+    log.setLevel(logging.ERROR)
+    try:
+        with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": "DejaVu Sans", "text.parse_math": False}):
+            yield
+    finally:
+        log.setLevel(level)
+
+
+def _wrap(s: str, width_mm: float, size: float) -> list[str]:
+    """`s` in lines of about `width_mm` at `size` pt (DejaVu Sans: about 0.57 em a character)."""
+    chars = max(int(width_mm / (0.57 * size * _PT)), 4)
+    return textwrap.wrap(s, chars, break_long_words=True) or [""]
+
+
+class _Flow:
+    """Blocks laid out top to bottom on A4 portrait pages (mm from the top left)."""
+
+    def __init__(self, pdf):
+        self.pdf, self.fig, self.y, self.lines = pdf, None, 0.0, []
+        self.x0, self.width = _MARGIN[0], A4[0] - _MARGIN[0] - _MARGIN[1]
+
+    def page(self, size=A4) -> None:
+        from matplotlib.figure import Figure
+        self.close()
+        self.fig, self.size, self.y = Figure(figsize=(size[0] / 25.4, size[1] / 25.4)), size, _MARGIN[2]
+        self.lines: list = []
+
+    def close(self) -> None:
+        """The page's lines as one collection, the page saved."""
+        if self.fig is not None:
+            from matplotlib.collections import LineCollection
+            W, H = self.size
+            for lw in sorted(set(w for _, w in self.lines)):
+                segs = [[(x0 / W, 1 - y0 / H), (x1 / W, 1 - y1 / H)] for (x0, y0, x1, y1), w in self.lines if w == lw]
+                self.fig.add_artist(LineCollection(segs, lw=lw, color="k", transform=self.fig.transFigure))
+            self.pdf.savefig(self.fig)
+            self.fig, self.lines = None, []
+
+    def room(self, h: float) -> bool:
+        """A new page unless `h` mm fit below; True when a page was started."""
+        if self.fig is None or self.size != A4 or self.y + h > A4[1] - _MARGIN[3]:
+            self.page()
+            return True
+        return False
+
+    def text(self, x: float, y: float, s: str, size: float, **kw) -> None:
+        W, H = self.size
+        self.fig.text(x / W, 1 - y / H, s, fontsize=size, va="top", **kw)
+
+    def line(self, x0: float, y0: float, x1: float, y1: float, lw: float = 0.5) -> None:
+        self.lines.append(((x0, y0, x1, y1), lw))
+
+    def paragraph(self, s: str, size: float, after: float = 2.0) -> None:
+        lh = size * _PT * 1.35
+        lines = _wrap(s, self.width, size)
+        self.room(lh * min(len(lines), 3))
+        for ln in lines:
+            self.room(lh)
+            self.text(self.x0, self.y, ln, size)
+            self.y += lh
+        self.y += after
+
+    def table(self, t: Table, size: float = 8.0) -> None:
+        lh, pad = size * _PT * 1.3, 1.0
+        widths = [w * self.width for w in t.widths]
+
+        def draw(row, bold=False, blank=()):
+            wrapped = [_wrap(c, w - 2 * pad, size) for c, w in zip(row, widths)]
+            h = max(len(c) for c in wrapped) * lh + 2 * pad + (2.5 if blank else 0)
+            if self.room(h) and not bold:
+                draw(t.head, bold=True)
+            x = self.x0
+            for i, (lines, w) in enumerate(zip(wrapped, widths)):
+                for k, ln in enumerate(lines):
+                    right = i in t.numeric and not bold
+                    self.text(x + (w - pad if right else pad), self.y + pad + k * lh, ln, size,
+                              ha="right" if right else "left")
+                self.line(x, self.y, x, self.y + h)
+                x += w
+            self.line(x, self.y, x, self.y + h)
+            self.line(self.x0, self.y, x, self.y)
+            self.line(self.x0, self.y + h, x, self.y + h)
+            self.y += h
+
+        draw(t.head, bold=True)
+        for row in t.rows:
+            draw(row, blank=t.blank)
+        self.y += 3.0
+
+    def area(self, text_area: str, lines) -> None:
+        """An A3 landscape page: the frame, the drawing area (`text_area` at its top left), the
+        title block (bottom right: `lines`)."""
+        self.page(A3)
+        self.line(20, 5, 415, 5, 1.0), self.line(20, 292, 415, 292, 1.0)
+        self.line(20, 5, 20, 292, 1.0), self.line(415, 5, 415, 292, 1.0)
+        self.line(230, 247, 415, 247, 1.0), self.line(230, 247, 230, 292, 1.0)
+        self.text(25, 7, text_area, 8)
+        for k, s in enumerate(lines):             # the title (two lines), then rows of 10 mm to fill in
+            y = 249 if k == 0 else 250 + 10 * k + 1
+            self.text(233, y, "\n".join(_wrap(s, 178, 9)), 9)
+            if k:
+                self.line(230, y - 1.5, 415, y - 1.5, 0.3)
+
+
+@contextmanager
+def _pdf_pages(title: str):
+    """A PDF written into a buffer (`PdfPages`, metadata `title`) in the PDFs' settings (`_rc`):
+    yields (pages, buffer)."""
+    import io
+
+    from matplotlib.backends.backend_pdf import PdfPages
+    buf = io.BytesIO()
+    with _rc(), PdfPages(buf, metadata={"Title": title, "Creator": "kinetostat"}) as pdf:
+        yield pdf, buf
+
+
+def _pdf(blocks, title: str) -> bytes:
+    """The blocks as PDF (A4 portrait, the drawing area on A3 landscape)."""
+    with _pdf_pages(title) as (pdf, buf):
+        flow = _Flow(pdf)
+        for kind, x in blocks:
+            if kind == "h1":
+                flow.paragraph(x, 13, after=3)
+            elif kind == "h2":
+                flow.room(20)
+                flow.paragraph(x, 10.5, after=1.5)
+            elif kind == "p":
+                flow.paragraph(x, 9)
+            elif kind == "table":
+                flow.table(x)
+            else:
+                flow.area(*x)
+        flow.close()
+    return buf.getvalue()
+
+
+def _plans_pdf(plans, lang: str, title: str) -> bytes:
+    """All the plans on one A3 landscape sheet: a grid of the plans' Figures inside the frame, the
+    title and the scales in the title block."""
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    from .draw import scale_text
+    kinds = list(plans)
+    cols = 4 if len(kinds) > 6 else 3
+    rows = math.ceil(len(kinds) / cols)
+    W, H = A3
+    with _pdf_pages(title) as (pdf, buf):
+        fig = Figure(figsize=(W / 25.4, H / 25.4))
+        x0, y0, x1, y1 = (20 / W, 1 - 5 / H, 415 / W, 1 - 292 / H)                # the frame
+        fig.add_artist(Line2D([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], lw=1.0, color="k"))
+        fig.text(25 / W, 1 - 9 / H, title, fontsize=11, va="top")
+        cw, ch = (410 - 25) / cols, (262 - 14) / rows
+        for n, kind in enumerate(kinds):
+            c, r = n % cols, n // cols
+            x, y = 25 + c * cw + 10, 14 + r * ch + 9
+            ax = fig.add_axes(((x) / W, 1 - (y + ch - 17) / H, (cw - 14) / W, (ch - 17) / H))
+            plans[kind].figure(lang, ax=ax)
+            ax.title.set_fontsize(7)
+            ax.tick_params(labelsize=5)
+            ax.xaxis.label.set_fontsize(6), ax.yaxis.label.set_fontsize(6)
+            for t in ax.texts:
+                t.set_fontsize(min(t.get_fontsize(), 6))
+        scales = ", ".join(scale_text(s, lang) for s in plans.scales.values())
+        fig.text(25 / W, 1 - 270 / H, "\n".join(_wrap(f"{text('scales', lang)}: {scales}", 200, 8)), fontsize=8,
+                 va="top")
+        pdf.savefig(fig)
+    return buf.getvalue()
+

@@ -1,0 +1,170 @@
+"""The teacher's pack (`kinetostat.plans.pack`, `kinetostat variant`): the student's sheet and the
+answer key as PDFs that pdftotext reads back in the key's language, the key holding the balancing
+moment, the four scales, the segments and a band per value, the sheet holding none of the key's
+numbers; the A3 sheet of plans; standalone HTML and the --all index. The scale rule's crank at
+30..35 mm as seed 002 sec. 1.2.2 asks."""
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import warnings
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat import variants
+from kinetostat.plans import pack as P
+from kinetostat.plans.drawing_error import simulate
+from kinetostat.plans.i18n import num, words_en
+from kinetostat.plans.scales import choose_scales
+
+needs_poppler = pytest.mark.skipif(shutil.which("pdftotext") is None, reason="poppler's pdftotext not installed")
+NUMBER = re.compile(r"(?<![\w.,])-?\d+(?:[.,]\d+)?(?![\w]|[.,]\d)")
+
+
+def pdftext(path) -> str:
+    return subprocess.run(["pdftotext", "-enc", "UTF-8", str(path), "-"], capture_output=True, text=True,
+                          check=True).stdout
+
+
+def english(text: str) -> set[str]:
+    """The catalogue's English words in `text`, less the symbols' subscripts (P_max)."""
+    words = re.findall(r"[A-Za-z]{3,}", re.sub(r"_\w+|<[^>]+>", " ", text))
+    return {w for w in words if w.lower() in words_en()}
+
+
+@pytest.fixture(scope="module")
+def uk_479(tmp_path_factory):
+    """`kinetostat variant 1 479 --lang uk --out K`, as a teacher types it."""
+    from kinetostat.cli import main
+    out = tmp_path_factory.mktemp("K")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["variant", "1", "479", "--lang", "uk", "--out", str(out)]) == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def pack_uk():
+    return P.pack(variants.variant(1, "479"), lang="uk")
+
+
+def test_the_command_writes_the_pack(uk_479):
+    for name in P.PACK_FILES:
+        assert (uk_479 / name).stat().st_size > 0, name
+    assert (uk_479 / "sheet.pdf").read_bytes().startswith(b"%PDF") and (uk_479 / "key.pdf").read_bytes()[:4] == b"%PDF"
+
+
+@needs_poppler
+def test_the_pdfs_read_back_in_ukrainian(uk_479):
+    sheet, key = pdftext(uk_479 / "sheet.pdf"), pdftext(uk_479 / "key.pdf")
+    a3 = pdftext(uk_479 / "plans_a3.pdf")
+    for t in (sheet, key, a3):
+        assert english(t) == set()
+    assert "Кривошипно-повзунний механізм двотактного ДВЗ" in key.replace("\n", " ")
+    assert "Частота обертання кривошипа" in sheet and "Вага шатуна" in sheet        # table 1.1's rows
+    assert "План швидкостей" in a3 and "Важіль Жуковського" in a3
+
+
+@needs_poppler
+def test_the_key_holds_the_answers_and_their_bands(uk_479):
+    key = pdftext(uk_479 / "key.pdf")
+    flat = re.sub(r"\s+", " ", key)
+    mech = variants.variant(1, "479").mechanism()
+    M = kinetostat.analyze(mech, phi_deg=[150.0]).balancing_moment[0]
+    assert "M_зр" in key and num(M, "uk", 4) in key                                   # 99,6 N m, exact solver
+    for mu, value in (("μ_l", "0,0015"), ("μ_v", "0,25"), ("μ_a", "100"), ("μ_F", "40")):
+        assert re.search(rf"{mu} {value} ", flat), mu
+    assert "OA = 32 мм" in flat                                                        # the crank at 30..35 mm
+    # the polygon's sides at mu_F = 40 N/mm: R12 = 7009 N is 175,2 mm
+    assert re.search(r"R12 175,2 7009 Н", flat)
+    # a band per drawn value: the 5-95 % of the seeded study, printed
+    sol = simulate(mech, at=150.0, n=P.BAND_DRAWS, seed=0)
+    lo, hi = np.percentile(sol.samples["M_bal"], P.BAND)
+    assert lo < M < hi and hi - lo < 0.1 * M
+    assert f"{num(lo, 'uk', 3)} … {num(hi, 'uk', 3)}" in key
+    assert "|δ| не більше 5 %" in flat
+
+
+@needs_poppler
+def test_the_sheet_holds_no_answer(uk_479, pack_uk):
+    sheet = pdftext(uk_479 / "sheet.pdf")
+    found = set(NUMBER.findall(sheet))
+    assert "4200" in found and "0,048" in found                                       # the data are there
+    assert len(pack_uk.answers) > 100
+    assert found & pack_uk.answers == set()
+    assert "M_зр" in sheet and "R12" in sheet                                         # the tables to fill in
+
+
+@needs_poppler
+@pytest.mark.parametrize("lang, words", [
+    ("ru", ("Ключ ответов", "Границы тщательного чертежа", "Частота вращения кривошипа")),
+    pytest.param("en", ("Answer key", "Band of a careful drawing", "Crank speed"), marks=pytest.mark.slow)])
+def test_the_same_in_russian_and_english(lang, words, tmp_path):
+    p = P.pack(variants.variant(1, "479"), lang=lang)
+    for name, blocks in (("sheet", p.sheet), ("key", p.key)):                        # as Pack.write renders them
+        (tmp_path / f"{name}.pdf").write_bytes(P._pdf(blocks, name))
+    sheet, key = pdftext(tmp_path / "sheet.pdf"), pdftext(tmp_path / "key.pdf")
+    both = re.sub(r"\s+", " ", sheet + key)
+    for w in words:
+        assert w in both, w
+    if lang != "en":
+        assert english(sheet + key) == set()
+    assert set(NUMBER.findall(sheet)) & p.answers == set()
+
+
+def test_html_pages_stand_alone(uk_479):
+    tmp_path = uk_479
+    for name in ("sheet.html", "key.html", "plans.html", "worksheet.html"):
+        page = (tmp_path / name).read_text(encoding="utf-8")
+        assert page.startswith("<!DOCTYPE html>") and '<meta charset="utf-8">' in page and "@media print" in page
+        assert '<html lang="uk">' in page and english(re.sub(r"(?s)<style>.*?</style>", "", page)) == set()
+    assert '<div class="area">' in (tmp_path / "sheet.html").read_text(encoding="utf-8")
+    assert 'src="velocity.svg"' in (tmp_path / "plans.html").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("lang", ["en", "ru"])
+def test_the_blocks_in_each_language(lang):
+    """The sheet and key, as their blocks (what both the PDF and the HTML print): every text in `lang`."""
+    p = P.pack(variants.variant(3, "479"), lang=lang, draws=50)
+    texts = [x for kind, x in p.sheet + p.key if kind in ("h1", "h2", "p")]
+    texts += [c for kind, x in p.sheet + p.key if kind == "table" for row in (x.head,) + x.rows for c in row]
+    assert (english(" ".join(texts)) == set()) is (lang != "en")
+    assert not any(c for kind, x in p.sheet if kind == "table" for row in x.rows for i, c in enumerate(row)
+                   if i in x.blank)                                                    # left blank to fill in
+
+
+def test_all_writes_an_html_index_of_the_packs(cli, tmp_path, monkeypatch):
+    monkeypatch.setattr(variants, "codes", lambda: ["479"])
+    for name in ("_pdf", "_plans_pdf"):                       # the PDFs: the tests above; here the index
+        monkeypatch.setattr(P, name, lambda *a: b"%PDF-1.4 drawn above\n")
+    run = cli("variant", "3", "--all", "--out", tmp_path, "--no-progress", "--lang", "ru")
+    assert run.returncode == 0, run.stderr
+    page = (tmp_path / "index.html").read_text(encoding="utf-8")
+    assert page.startswith("<!DOCTYPE html>") and '<meta charset="utf-8">' in page
+    assert 'href="task3_479/key.pdf"' in page and 'href="task3_479/sheet.pdf"' in page
+    assert 'href="task3_479/worksheet.html"' in page
+    assert len(re.findall(r"<th[ >]", page)) == 7 and "<td>|М_зр| " not in page and "|M_зр| наибольшее за цикл" in page   # one table
+    assert (tmp_path / "task3_479" / "key.pdf").stat().st_size > 0
+
+
+@pytest.mark.parametrize("task, code, want", [(1, "479", 32.0), (1, "000", 34.0), (3, "479", 32.0), (2, "111", 33.0)])
+def test_the_crank_lands_at_30_to_35_mm(task, code, want):
+    """Seed 002 sec. 1.2.2: OA drawn 30..35 mm; 1/479 (l_OA = 0.048 m) drew 24 mm at 0.002 m/mm."""
+    v = variants.variant(task, code)
+    mech = v.mechanism()
+    sc = choose_scales(mech, kinetostat.analyze(mech, phi_deg=[v.values["phi1"]]))
+    assert v.values["l_OA"] / sc["mu_l"].value == pytest.approx(want)
+
+
+def test_a_plain_install_writes_the_key_and_says_why_no_pack(cli, tmp_path, monkeypatch):
+    """Without matplotlib (no extra `reports`) the key is written, the pack left out with one line."""
+    import importlib.util
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else find_spec(name, *a))
+    run = cli("variant", "3", "479", "--out", tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "pip install 'kinetostat[reports]'" in run.stderr and (tmp_path / "worksheet.html").is_file()
+    assert not (tmp_path / "key.pdf").exists()
