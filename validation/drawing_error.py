@@ -9,7 +9,7 @@ and reports/drawing_error.png (fixed seed, fixed layout, no timestamps: the same
 
 `python -m kinetostat_validation.drawing_error`
 
-May use: kinetostat.plans, matplotlib.
+May use: kinetostat.plans, kinetostat.report.sources (the works cited), matplotlib.
 """
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ import numpy as np
 
 import kinetostat
 from kinetostat.plans.drawing_error import DrawnSolution, default_scales, simulate
+from kinetostat.report.sources import cited
 
 __all__ = ["PUBLISHED", "main", "study"]
 
@@ -86,7 +87,7 @@ def write_plot(r: dict, path: Path) -> None:
     ax[0, 0].axvline(0, color="k", lw=0.6)
     ax[0, 0].set_yticks(y, [p[1] for p in PUBLISHED if p[0] != "delta_pct"])
     ax[0, 0].set_xlabel("deviation from the exact value, %")
-    ax[0, 0].set_title("seed 002 ICE at 30 deg: 95 % of drawn values (bar), text's value (dot)")
+    ax[0, 0].set_title("ICE of Logvinenko, Nadtoka 2021 at 30 deg: 95 % of drawn values (bar), text's value (dot)")
     bins = np.linspace(-6, 6, 121)
     for p in PRECISIONS:
         ax[0, 1].hist(r["precision"][p].samples["delta_pct"], bins=bins, histtype="step", label=f"±{p:g} mm, ±{p:g} deg")
@@ -130,7 +131,7 @@ def write_report(r: dict, md: Path, png: Path) -> None:
          "Every act of the drawing is wrong by an independent error, uniform in its interval: a vector laid off "
          "at its scale by ±0.25 mm in length and ±0.25 deg in direction; a line drawn ⟂ or ∥ to a link or a guide "
          "by ±0.25 deg; every length or arm read off the sheet by ±0.25 mm; a like point found by similarity by "
-         "±0.25 mm along its segment. The constructions are the texts' (seed 002 sec. 1.2, seed 000 secs. 6-8): "
+         "±0.25 mm along its segment. The constructions are the texts' (Logvinenko, Nadtoka 2021, sec. 1.2; Kiriienko 2019, secs. 6-8): "
          "pa drawn, b where the line ⟂ AB through a meets the line ∥ the guide through p; a^n_BA laid off from the "
          "ω2 read off the plan, b where the line ⟂ AB through n2 meets the guide line through π; F_i and M_i from the "
          "read accelerations; R^τ from the moment equation with the arms read off the group plan; the force polygon "
@@ -139,9 +140,9 @@ def write_report(r: dict, md: Path, png: Path) -> None:
          "read, the inertia moment as a couple on ab, F'_bal at a. Weights are drawn (the text leaves them out of "
          "its polygon as small). The load diagram's reading (the gas force) and the plan of positions are taken "
          "as exact.", "",
-         f"Scales, as seed 002 chooses them (and as it prints them): μ_l = {sc.mu_l:g} m/mm, μ_v = {sc.mu_v:g} "
+         f"Scales, as Logvinenko, Nadtoka 2021 choose them (and as it prints them): μ_l = {sc.mu_l:g} m/mm, μ_v = {sc.mu_v:g} "
          f"m/(s mm), μ_a = {sc.mu_a:g} m/(s² mm), μ_F = {sc.mu_F:g} N/mm. {N} drawn solutions per case.", "",
-         "## Seed 002's example at 30 deg: the text's values against the spread of a careful drawing", "",
+         "## The worked example of Logvinenko, Nadtoka 2021 at 30 deg: the text's values against the spread of a careful drawing", "",
          "±0.25 mm, ±0.25 deg. **spread** = σ of the drawn values relative to the exact one; **95 %** = the 2.5 "
          "and 97.5 % points of the drawn values; **text at** = the percentile of the drawn values where the "
          "text's published value falls (50 = the middle; below 2.5 or above 97.5: outside what a careful "
@@ -166,8 +167,8 @@ def write_report(r: dict, md: Path, png: Path) -> None:
     unsafe = {p: [f"{a:g}" for a, c in zip(ANGLES, cyc[p]) if c["q95"] > 5.0] for p in PRECISIONS}
     L += ["", f"Outside the central 95 % of careful drawings: {', '.join(outside) or 'none'}.", "",
           "## The 5 % rule between the two balancing moments", "",
-          "The texts accept a drawn solution when δ = |M_bal − M'_bal| / M'_bal ≤ 5 % (seed 000 sec. 8.2, seed "
-          "002 sec. 1.2.3). The exact solver gives δ = 0 (to rounding): δ of a drawing is the drawing's error "
+          "The texts accept a drawn solution when δ = |M_bal − M'_bal| / M'_bal ≤ 5 % (Kiriienko 2019, sec. 8.2; "
+          "Logvinenko, Nadtoka 2021, sec. 1.2.3). The exact solver gives δ = 0 (to rounding): δ of a drawing is the drawing's error "
           "alone, since the two routes share the velocity and acceleration plans but not the force plans. The "
           "rule is *safe* when a careful drawing passes it (P(δ > 5 %) small) and *useful* when a wrong solution "
           "would fail it.", "",
@@ -189,7 +190,7 @@ def write_report(r: dict, md: Path, png: Path) -> None:
     lin = [r["precision"][0.5].samples[k].std() / r["precision"][0.25].samples[k].std()
            for k in sol.samples if r["precision"][0.25].samples[k].std() > 0]
     L += ["", "## Findings", "",
-          f"- A careful drawing of seed 002's example (±0.25 mm, ±0.25 deg) reads velocities to σ ≈ "
+          f"- A careful drawing of the worked example of Logvinenko, Nadtoka 2021 (±0.25 mm, ±0.25 deg) reads velocities to σ ≈ "
           f"{sol.samples['V_B'].std() / sol.exact['V_B'] * 100:.2g} % (V_B) and accelerations to "
           f"{sol.samples['a_B'].std() / sol.exact['a_B'] * 100:.2g} % (a_B); ε2 to "
           f"{sol.samples['eps_2'].std() / sol.exact['eps_2'] * 100:.2g} %, R12 to "
@@ -218,7 +219,7 @@ def write_report(r: dict, md: Path, png: Path) -> None:
           f"half the size (scales × 2) takes the 95th percentile of δ from {r['scale'][1.0]['q95']:.2g} % to "
           f"{r['scale'][2.0]['q95']:.2g} %, one twice the size to {r['scale'][0.5]['q95']:.2g} % (the errors of "
           f"direction do not shrink with a larger drawing).",
-          f"- The chain-unit four-bar (RRR, seed 004) at its design position {fb.phi_deg:g} deg with its default "
+          f"- The chain-unit four-bar (RRR, Potapov 2024) at its design position {fb.phi_deg:g} deg with its default "
           f"scales (μ_v = {r['four_bar_scales'].mu_v:g}, μ_a = {r['four_bar_scales'].mu_a:g}, μ_F = "
           f"{r['four_bar_scales'].mu_F:g}): the rocker almost stops (V_B = {fb.exact['V_B']:.3g} m/s, drawn "
           f"{fb.exact['V_B'] / r['four_bar_scales'].mu_v:.2g} mm long), so V_B and ω3 read off the plan carry "
@@ -243,6 +244,7 @@ def write_report(r: dict, md: Path, png: Path) -> None:
           "accelerations and forces, the group plans, the crank and the lever are drawn with error.",
           "- Errors are independent and uniform; a real student's errors are correlated (one set square, one "
           "habit) and sometimes gross (a wrong direction): those are not modelled.", ""]
+    L += ["## Sources", ""] + [f"- **{w.key}**: {w.reference}" for w in cited(L)] + [""]
     md.write_text("\n".join(L), encoding="utf-8")
 
 

@@ -5,7 +5,7 @@ Every act of the drawing carries an error: a vector laid off at a scale has its 
 up to ±`length_mm` and its direction by up to ±`angle_deg`; a line drawn in a known direction
 (⟂ AB, ∥ the guide) has its direction wrong by up to ±`angle_deg`; a length or an arm read off
 the sheet is wrong by up to ±`length_mm` (each error uniform in its interval, independent).
-The constructions are those of seed 002 sec. 1.2 and seed 000 secs. 6-8, all reduced to one
+The constructions are those of Logvinenko, Nadtoka 2021 (sec. 1.2) and Kiriienko 2019 (secs. 6-8), all reduced to one
 operation: a point found as the intersection of two lines through known points with known
 directions (`_Drafter.meet`), evaluated for all samples at once (numpy arrays of shape (n,)).
 
@@ -18,7 +18,7 @@ Zhukovsky's lever (the velocity plan again, arms of the turned loads about the p
 
 Kinematics and inertia loads: groups RRR, RRP with its guide on the frame, and RPR (anything
 else raises NotImplementedError naming it). Force plans, crank and lever: mechanisms of one
-group, RRR or RRP with its guide on the frame (seed 002's ICE, the compressor, the chain-unit
+group, RRR or RRP with its guide on the frame (Logvinenko and Nadtoka's ICE, the compressor, the chain-unit
 four-bar); for the others `simulate` draws the kinematics and the inertia loads only.
 
 May use: the solver (`analysis`, `applied`), `plans.worksheet`, numpy. Never matplotlib.
@@ -52,7 +52,7 @@ class Scales:
 
 
 def default_scales(mech: Mechanism, at: float | None = None) -> Scales:
-    """The scales the plans are drawn at (`scales.choose_scales`: as seed 002 chooses them)."""
+    """The scales the plans are drawn at (`scales.choose_scales`: as Logvinenko, Nadtoka 2021 choose them)."""
     res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at])
     sc = choose_scales(mech, res)
     return Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, sc["mu_F"].value)
