@@ -133,3 +133,35 @@ def test_text_sizes_and_numbers(ice_plans, lang):
             assert re.search(r"\d,\d", words), kind
         else:
             assert not re.search(r"\d,\d", re.sub(r"\b\d,\d\b", "", words)), kind     # 'group 2,3' aside
+
+
+def _on(z: complex, a: complex, b: complex) -> bool:
+    """Whether z lies on the segment a-b (within 1e-6 mm)."""
+    t = ((z - a) * (b - a).conjugate()).real / max(abs(b - a) ** 2, 1e-30)
+    return -1e-9 <= t <= 1 + 1e-9 and abs(a + t * (b - a) - z) < 1e-6
+
+
+@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+def test_mechanism_sheet_draws_every_link(path):
+    """Seed 002 fig. 1.6: every link drawn through all its points (a slotted link along its slot to
+    every block in it, a ram through B, S5 and T), each guide lettered once."""
+    mech = kinetostat.load(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plan = P.build(mech, only=["mechanism"])["mechanism"]
+    pts = plan.points
+    lines = [(pts[s.start], pts[s.end]) for s in plan.segments if s.kind == "link"]
+    for k in range(1, mech.n_links):
+        own = [pts[n] for n in mech.links[k].points]
+        carried = [pts[p.point] for p in mech.pairs if p.kind == "P" and p.links[0] == k
+                   and p.guide in mech.links[k].points]        # a slider's point on the slot of link k
+        if len(own) + len(carried) < 2:
+            continue                                  # a block on its pin: drawn as a block
+        for z in own + carried:
+            assert any(_on(z, a, b) for a, b in lines), (path.stem, k, z)
+    guides = [s.name for s in plan.segments if s.name.startswith("guide ")]
+    assert len(guides) == len(set(guides)), (path.stem, guides)
+    names = ["".join(t.itertext()) for t in ET.fromstring(svg(plan).encode()).iter(f"{_NS}text")
+             if t.get("class") == "name"]
+    for g in guides:
+        assert names.count(g) == 1, (path.stem, g, names)

@@ -341,7 +341,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         if s.kind == "vector":
             out.append(head)
         placer.line(a[0], a[1], b[0], b[1])
-        if not labelled(s.end) or (sides is not None and s.kind == "vector") or s.kind == "arm":
+        if s.kind != "link" and (not labelled(s.end) or (sides is not None and s.kind == "vector") or s.kind == "arm"):
             named.append((label, a, b))
     small = plan.kind == "positions"
     dots = []
