@@ -8,6 +8,7 @@ Also without a browser: no text under 2.5 mm, no e-notation or float noise in th
 """
 from __future__ import annotations
 
+import math
 import random
 import re
 import warnings
@@ -165,3 +166,20 @@ def test_mechanism_sheet_draws_every_link(path):
              if t.get("class") == "name"]
     for g in guides:
         assert names.count(g) == 1, (path.stem, g, names)
+
+
+_HEAD = re.compile(r'<path class="arrowhead( arc)?" d="M([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) z"')
+
+
+def test_arc_arrowheads_are_drafting_size(ice_plans):
+    """The senses of ω and ε and the couples M_i: every arc's head at least 2.5 mm long (a drafting
+    arrowhead), never scaled down to the arc's short last chord."""
+    mech, plans = ice_plans
+    n = 0
+    for kind in ("mechanism", "group:2,3", "crank"):
+        for arc, *xy in _HEAD.findall(svg(plans[kind], lang="uk")):
+            tx, ty, ax, ay, bx, by = map(float, xy)
+            if arc:
+                assert math.hypot(tx - (ax + bx) / 2, ty - (ay + by) / 2) >= 2.5, kind
+                n += 1
+    assert n >= 4

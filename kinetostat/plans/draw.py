@@ -25,7 +25,7 @@ from .core import Plan, Segment, extent
 from .i18n import LANGS, MESSAGES, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_width
 
-__all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM",
+__all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
 
 #: The sheet: A3 landscape, mm.
@@ -35,6 +35,8 @@ _TITLE_BLOCK = (230.0, 247.0, 415.0, 292.0)  # bottom right, 185 x 45 mm
 _AREA = (25.0, 10.0, 410.0, 242.0)          # where the plan is centred (above the notes)
 #: Arrowhead: length and half-width, mm (drafting: 3-4 mm); shorter on a vector under 3 lengths.
 ARROW_MM = (3.5, 0.6)
+#: Arrowhead on an arc (the sense of ω, ε, a couple M), mm: drafting size whatever the arc's chord.
+ARC_HEAD_MM = 2.8
 #: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM.
 TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
 _POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
@@ -265,17 +267,19 @@ def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
             "</g>"]
 
 
-def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float) -> tuple[str, tuple, tuple]:
-    """A filled arrowhead with its tip at b pointing from a: (svg path, its box, the line's new end)."""
+def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float,
+               arc: bool = False) -> tuple[str, tuple, tuple]:
+    """A filled arrowhead with its tip at b pointing from a: (svg path, its box, the line's new end);
+    on an arc (a sense, a couple) ARC_HEAD_MM long whatever the chord a-b."""
     L = math.hypot(b[0] - a[0], b[1] - a[1])
     ux, uy = (b[0] - a[0]) / L, (b[1] - a[1]) / L
-    h = min(ARROW_MM[0], max(0.3 * L, 0.8), length)
+    h = ARC_HEAD_MM if arc else min(ARROW_MM[0], max(0.3 * L, 0.8), length)
     hw = max(0.3, ARROW_MM[1] * h / ARROW_MM[0] * 1.0)
     bx, by = b[0] - ux * h, b[1] - uy * h
     pts = [(b[0], b[1]), (bx - uy * hw, by + ux * hw), (bx + uy * hw, by - ux * hw)]
     d = "M" + " L".join(f"{x:.3f},{y:.3f}" for x, y in pts) + " z"
     xs, ys = [p[0] for p in pts], [p[1] for p in pts]
-    return (f'<path class="arrowhead" d="{d}" fill="#000"/>', (min(xs), min(ys), max(xs), max(ys)),
+    return (f'<path class="arrowhead{" arc" if arc else ""}" d="{d}" fill="#000"/>', (min(xs), min(ys), max(xs), max(ys)),
             (b[0] - ux * 0.6 * h, b[1] - uy * 0.6 * h))
 
 
@@ -313,7 +317,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         for (a, b), (c, d) in zip(xy, xy[1:]):
             placer.line(a, b, c, d)
         if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
-            head, box, _ = _arrowhead(xy[-3], xy[-1], 2.5)
+            head, box, _ = _arrowhead(xy[-2], xy[-1], ARC_HEAD_MM, arc=True)
             out.append(head)
             placer.block(box)
             named.append((name, xy[len(xy) // 2], None))
