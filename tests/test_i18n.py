@@ -108,9 +108,9 @@ def test_english_is_found_where_it_is(ice_plans, tmp_path):
     assert "velocity.svg" in _english(tmp_path)
 
 
-def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path):
+def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path, sketched_plots):
     """Seed 002 numbers the cylinder 4 and writes R43, R41, M_зр, F_зр, F_p: the sheets, the
-    worksheet and cycle.csv's aliases say the same, and nothing says R03, R01 or M_bal."""
+    worksheet, the report and cycle.csv's aliases say the same, and nothing says R03, R01 or M_bal."""
     L = lettering(ice)
     assert (L.frame, L.M_bal, L.F_bal, L.load("gas force")) == (4, "M_зр", "F_зр", "F_p")
     plans = ice_plans
@@ -122,7 +122,12 @@ def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path):
     assert "R43" in sheets["group_2-3"] and "R43" in sheets["forces_2-3"] and "F_p" in sheets["forces_2-3"]
     assert "R41" in sheets["crank"] and "M_зр" in sheets["crank"]
     assert "M'_зр" in sheets["lever"] and "F'_зр" in sheets["lever"]
-    for name, words in list(sheets.items()) + [("worksheet", ws.markdown())]:
+    from kinetostat.report import run_validation, write_report
+    write_report(run_validation(ice, [], steps=12), tmp_path / "report")
+    (report,) = [f.read_text(encoding="utf-8") for f in (tmp_path / "report").glob("*/index.md")]
+    assert re.search(r"^\| M\\?_зр \|", report, re.M) and "| R43 slider B" in report and "| R41 at O |" in report
+    assert re.search(r"^\| R43 \| \\\|R43\\\|", report, re.M) and "| M_зр (lever) |" in report.replace("\\_", "_")
+    for name, words in list(sheets.items()) + [("worksheet", ws.markdown()), ("report", report)]:
         assert not re.search(r"\bR0\d|\bR\d0\b|M_bal|F_bal|\bP3\b", words), name
     assert plans["forces:2,3"].segment("R43").value == pytest.approx(ws.value("R_0_3"), rel=1e-12)
     frame = with_aliases(kinetostat.analyze(ice, steps=12).to_frame(), ice)
