@@ -53,16 +53,27 @@ def _words(path) -> str:
     names (`code` spans, link targets)."""
     raw = path.read_text(encoding="utf-8")
     if path.suffix in (".svg", ".html"):
+        raw = re.sub(r'</tspan><tspan[^>]*dy="[^"]*">', "_", raw)     # a lettered subscript: h_Fp, as written
         raw = re.sub(r"<[^>]+>", " ", raw)
     return re.sub(r"`[^`]*`|\]\([^)]*\)", " ", raw)
 
 
+#: A Latin word standing alone (not part of a symbol such as R43, h_G2, a^Cor, P(3,4), x_B) ...
+_LATIN = re.compile(r"(?<![\w^'’\\])[A-Za-z]{2,}(?![\w^'’(\\])")
+#: ... that is a letter name and not English: the Assur groups' kinds (RRP), a segment (ab, pa), cos.
+_SYMBOLS = re.compile(r"[RP]{3}|[A-Z]{2}|[a-z]{2}|sin|cos|tan")
+
+
 def _english(folder, skip: tuple[str, ...] = ()) -> dict[str, set[str]]:
+    """English in a folder's outputs: a word of the catalogue's English side, or any other Latin
+    word that is not a symbol or a letter name."""
     english = words_en()
     out = {}
     for path in sorted(folder.iterdir()):
         if path.suffix in (".svg", ".md", ".html") and path.name not in skip:
-            found = {w for w in re.findall(r"[A-Za-z]{3,}", _words(path)) if w.lower() in english}
+            words = _words(path)
+            found = {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in english}
+            found |= {w for w in _LATIN.findall(words) if not _SYMBOLS.fullmatch(w)}
             if found:
                 out[path.name] = found
     return out

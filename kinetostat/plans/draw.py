@@ -312,8 +312,9 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
             continue
         width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
         pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in xy)
+        tip = text(name, lang) if name in MESSAGES else name if name[:1] in "ωεM" else ""   # no English tooltip
         out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="{width}">'
-                   f'<title>{escape(text(name, lang) if name in MESSAGES else name)}</title></polyline>')
+                   + (f'<title>{escape(tip)}</title>' if tip else "") + '</polyline>')
         for (a, b), (c, d) in zip(xy, xy[1:]):
             placer.line(a, b, c, d)
         if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
