@@ -183,3 +183,16 @@ def test_arc_arrowheads_are_drafting_size(ice_plans):
                 assert math.hypot(tx - (ax + bx) / 2, ty - (ay + by) / 2) >= 2.5, kind
                 n += 1
     assert n >= 4
+
+
+_LINE = re.compile(r'<line x1="([-0-9.]+)" y1="([-0-9.]+)" x2="([-0-9.]+)" y2="([-0-9.]+)"[^>]*><title>([^<]*)</title>')
+
+
+def test_a_tiny_vector_is_drawn_beside_a_collinear_load(ice_plans):
+    """The ICE's G3, drawn out of scale from B along F_p, lies 1.5-2 mm beside F_p, not under it."""
+    mech, plans = ice_plans
+    lines = {t: tuple(map(float, xy)) for *xy, t in _LINE.findall(svg(plans["group:2,3"], lang="uk"))}
+    g, f = lines["G3*"], lines["F_p"]
+    ux, uy = f[2] - f[0], f[3] - f[1]
+    off = abs((g[0] - f[0]) * uy - (g[1] - f[1]) * ux) / math.hypot(ux, uy)     # G3*'s start off F_p's line
+    assert 1.5 <= off <= 2.0

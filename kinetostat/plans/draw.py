@@ -39,6 +39,8 @@ ARROW_MM = (3.5, 0.6)
 ARC_HEAD_MM = 2.8
 #: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM.
 TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
+#: A vector drawn out of scale along another vector from the same point is drawn this far beside it, mm.
+SIDE_MM = 1.8
 _POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
 _LINE_STEP = 3.3                             # line spacing of the notes, mm
 _LEFT_NOTES_MM = 120.0                       # width of the notes beside a tall plan, mm
@@ -157,6 +159,21 @@ def _tiny(plan: Plan) -> dict[str, str]:
             out = s.scale is not None and abs(plan.points[s.end] - plan.points[s.start]) > 0
             how[s.name] = "out" if out else "negligible"
     return how
+
+
+def _collinear(plan: Plan, s: Segment, tiny: dict[str, str]) -> bool:
+    """Whether a vector drawn out of scale would lie on another vector of the plan: one from the
+    same point (within 0.5 mm) in the same direction (within 5 degrees)."""
+    a = plan.points[s.start]
+    d = plan.points[s.end] - a
+    for o in _drawable(plan):
+        if o.kind != "vector" or o.name == s.name or o.name in tiny:
+            continue
+        e = plan.points[o.end] - plan.points[o.start]
+        turn = e * d.conjugate()
+        if abs(plan.points[o.start] - a) < 0.5 and abs(e) > 0 and abs(math.atan2(turn.imag, turn.real)) < math.radians(5.0):
+            return True
+    return False
 
 
 def _result_line(plan: Plan, lang: str) -> list[str]:
@@ -334,6 +351,9 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
                 continue
             b = (a[0] + (b[0] - a[0]) / L * MIN_DRAWN_MM, a[1] + (b[1] - a[1]) / L * MIN_DRAWN_MM)
             L, label = MIN_DRAWN_MM, label + "*"
+            if _collinear(plan, s, tiny):              # beside the load it would hide under (G3* along F_p)
+                nx, ny = -(b[1] - a[1]) / L * SIDE_MM, (b[0] - a[0]) / L * SIDE_MM
+                a, b = (a[0] + nx, a[1] + ny), (b[0] + nx, b[1] + ny)
         end = b
         if s.kind == "vector":
             head, box, end = _arrowhead(a, b, L)
