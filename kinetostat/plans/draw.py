@@ -218,6 +218,8 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
         value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
         if sides:
             out.append(f"{text('segment', lang)} {s.start}{s.end} = {L} {mm} → {s.name} = {value}")
+        elif s.unit == "mm":                      # a length kept as drawn (the lever's arms): once
+            out.append(f"{s.name} = {L} {mm}")
         else:
             out.append(f"{s.name}: {L} {mm} → {value}")
     return out
