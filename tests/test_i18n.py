@@ -53,8 +53,8 @@ def _words(path) -> str:
     names (`code` spans, link targets)."""
     raw = path.read_text(encoding="utf-8")
     if path.suffix in (".svg", ".html"):
-        raw = re.sub(r'</tspan><tspan[^>]*dy="[^"]*">', "_", raw)     # a lettered subscript: h_Fp, as written
-        raw = re.sub(r"<[^>]+>", " ", raw)
+        raw = re.sub(r'(</tspan>)?<tspan[^>]*dy="\d[^"]*">', "_", raw)     # a lettered subscript: h_Fp, as written
+        raw = re.sub(r"<[^>]+>", " ", re.sub(r"</?tspan[^>]*>", "", raw))
     return re.sub(r"`[^`]*`|\]\([^)]*\)", " ", raw)
 
 

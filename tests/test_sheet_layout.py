@@ -196,3 +196,16 @@ def test_a_tiny_vector_is_drawn_beside_a_collinear_load(ice_plans):
     ux, uy = f[2] - f[0], f[3] - f[1]
     off = abs((g[0] - f[0]) * uy - (g[1] - f[1]) * ux) / math.hypot(ux, uy)     # G3*'s start off F_p's line
     assert 1.5 <= off <= 2.0
+
+
+def test_notes_letter_names_as_the_drawing(ice_plans):
+    """The notes write πa, F with subscript i2, h with subscript Fi2 (as the drawing letters them),
+    never the raw 'pi-a', 'F_i2', 'h_Fi2'; the lever's arms stay in mm (seed 002: h_Fi2 = 37.67 mm)."""
+    mech, plans = ice_plans
+    for kind in ("acceleration", "group:2,3", "forces:2,3", "lever", "crank"):
+        notes = svg(plans[kind], lang="uk").split('<g id="notes">')[1]
+        words = re.sub(r"<[^>]+>", "", notes)
+        assert "_" not in words and "pi-" not in words, (kind, words)
+    notes = svg(plans["lever"], lang="uk").split('<g id="notes">')[1]
+    assert re.search(r'>h<tspan dy="0\.50">Fi2</tspan><tspan dy="-0\.50"> = 37,\d\d мм</tspan>', notes), notes
+    assert "πa" in svg(plans["acceleration"], lang="uk")
