@@ -129,7 +129,8 @@ def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path, sketched
     sheets = {p.stem: _words(p) for p in tmp_path.glob("*.svg")}
     ws = worksheet(ice, 30, lang="uk")
     symbols = {r.symbol for r in ws.rows}
-    assert {"R43", "R41", "R12", "R32", "R21", "M_зр", "F'_зр", "M'_зр", "F_p"} <= symbols
+    assert {"R43", "R41", "R12", "R32", "R21", "R12t", "R12n", "a^r(4,3)", "M_зр", "F'_зр", "M'_зр", "F_p"} <= symbols
+    assert {"R12t", "R12n"} <= {s.name for s in plans["group:2,3"].segments}          # one way, as the sheets
     assert "R43" in sheets["group_2-3"] and "R43" in sheets["forces_2-3"] and "F_p" in sheets["forces_2-3"]
     assert "R41" in sheets["crank"] and "M_зр" in sheets["crank"]
     assert "M'_зр" in sheets["lever"] and "F'_зр" in sheets["lever"]
