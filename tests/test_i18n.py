@@ -40,6 +40,16 @@ def test_numbers(x, lang, want):
     assert num(x, lang) == want
 
 
+@pytest.mark.parametrize("n, uk, ru, en", [
+    (1, "1 файл", "1 файл", "1 file"), (2, "2 файли", "2 файла", "2 files"), (4, "4 файли", "4 файла", "4 files"),
+    (5, "5 файлів", "5 файлов", "5 files"), (11, "11 файлів", "11 файлов", "11 files"),
+    (12, "12 файлів", "12 файлов", "12 files"), (21, "21 файл", "21 файл", "21 files"),
+    (22, "22 файли", "22 файла", "22 files"), (111, "111 файлів", "111 файлов", "111 files")])
+def test_plural_forms(n, uk, ru, en):
+    for lang, want in (("uk", uk), ("ru", ru), ("en", en)):
+        assert f" {want} -> " in text("cli.plans", lang, name="x", phi="30", scales="", n=n, out="o"), (lang, n)
+
+
 def test_decimals_and_units():
     assert num(63.7, "uk", decimals=2) == "63,70" and unit("N m", "uk") == "Н·м" and unit("rad/s^2", "ru") == "рад/с²"
     assert phrase("position 0 at phi = 218.9 deg", "uk") == "положення 0 при φ = 218,9°"
@@ -162,7 +172,7 @@ def test_cli_defaults_to_the_texts_language(cli, tmp_path):
     r = cli("plans", "models/ice_crank_slider.toml", "--only", "velocity", "--lang", "ru", "--out", tmp_path / "ru")
     assert "План скоростей" in (tmp_path / "ru" / "velocity.svg").read_text(encoding="utf-8")
     words = re.sub(r"\S+\.toml|\S*_\S*|/\S+", "", r.stdout)                # less file names and symbols
-    assert "файлов" in r.stdout and not {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in words_en()}
+    assert re.search(r"\b2 файла\b", r.stdout) and not {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in words_en()}
 
 
 @pytest.mark.parametrize("table, field", [
