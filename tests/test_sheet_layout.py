@@ -209,3 +209,19 @@ def test_notes_letter_names_as_the_drawing(ice_plans):
     notes = svg(plans["lever"], lang="uk").split('<g id="notes">')[1]
     assert re.search(r'>h<tspan dy="0\.50">Fi2</tspan><tspan dy="-0\.50"> = 37,\d\d мм</tspan>', notes), notes
     assert "πa" in svg(plans["acceleration"], lang="uk")
+
+
+def test_the_overlap_check_finds_a_planted_overlap(page, ice_plans):
+    """Negative control: a label planted on another label, and one under an arrowhead, are reported."""
+    mech, plans = ice_plans
+    sheet = svg(plans["group:2,3"], lang="uk")
+    assert _check(page, {"clean": sheet}) > 10
+    label = re.search(r'<text class="label" x="([-0-9.]+)" y="([-0-9.]+)"', sheet)
+    head = re.search(r'<path class="arrowhead" d="M([-0-9.]+),([-0-9.]+) ', sheet)
+    planted = sheet.replace('<g id="title-block">',
+                            f'<text x="{label.group(1)}" y="{label.group(2)}" font-size="3">QQ</text>'
+                            f'<text x="{float(head.group(1)) - 1:.2f}" y="{float(head.group(2)) + 1:.2f}" '
+                            f'font-size="3">WW</text><g id="title-block">', 1)
+    bad = sheet_browser.overlaps(sheet_browser.measure(page, planted))
+    assert any("'QQ' over text" in b or "over text 'QQ'" in b for b in bad), bad
+    assert any("'WW' under an arrowhead" in b for b in bad), bad
