@@ -284,6 +284,6 @@ def test_report_without_engines(tmp_path):
     r = cli("report", ICE, "--engines", "none", "--steps", 36, "--out", tmp_path, "--no-progress", hide=True)
     assert r.returncode == 0, r.stdout + r.stderr
     md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
-    assert "## Against the published values" in md and "| M_bal (lever) |" in md
-    assert "| reference | M_drive |" in md and "| reference | mpmath |" not in md
+    assert "## Against the published values" in md and r"| M\_зр (lever) |" in md      # the text's lettering
+    assert r"| reference | M\_зр |" in md and "| reference | mpmath |" not in md
     assert "## The mechanism at φ = 30°" in md

@@ -40,6 +40,16 @@ def test_numbers(x, lang, want):
     assert num(x, lang) == want
 
 
+@pytest.mark.parametrize("n, uk, ru, en", [
+    (1, "1 файл", "1 файл", "1 file"), (2, "2 файли", "2 файла", "2 files"), (4, "4 файли", "4 файла", "4 files"),
+    (5, "5 файлів", "5 файлов", "5 files"), (11, "11 файлів", "11 файлов", "11 files"),
+    (12, "12 файлів", "12 файлов", "12 files"), (21, "21 файл", "21 файл", "21 files"),
+    (22, "22 файли", "22 файла", "22 files"), (111, "111 файлів", "111 файлов", "111 files")])
+def test_plural_forms(n, uk, ru, en):
+    for lang, want in (("uk", uk), ("ru", ru), ("en", en)):
+        assert f" {want} -> " in text("cli.plans", lang, name="x", phi="30", scales="", n=n, out="o"), (lang, n)
+
+
 def test_decimals_and_units():
     assert num(63.7, "uk", decimals=2) == "63,70" and unit("N m", "uk") == "Н·м" and unit("rad/s^2", "ru") == "рад/с²"
     assert phrase("position 0 at phi = 218.9 deg", "uk") == "положення 0 при φ = 218,9°"
@@ -53,16 +63,28 @@ def _words(path) -> str:
     names (`code` spans, link targets)."""
     raw = path.read_text(encoding="utf-8")
     if path.suffix in (".svg", ".html"):
-        raw = re.sub(r"<[^>]+>", " ", re.sub(r"(?s)<style>.*?</style>|<code>[^<]*</code>", " ", raw))  # CSS, file names
+        raw = re.sub(r"(?s)<style>.*?</style>|<code>[^<]*</code>", " ", raw)      # CSS, file names
+        raw = re.sub(r'(</tspan>)?<tspan[^>]*dy="\d[^"]*">', "_", raw)     # a lettered subscript: h_Fp, as written
+        raw = re.sub(r"<[^>]+>", " ", re.sub(r"</?tspan[^>]*>", "", raw))
     return re.sub(r"`[^`]*`|\]\([^)]*\)", " ", raw)
 
 
+#: A Latin word standing alone (not part of a symbol such as R43, h_G2, a^Cor, P(3,4), x_B) ...
+_LATIN = re.compile(r"(?<![\w^'’\\])[A-Za-z]{2,}(?![\w^'’(\\])")
+#: ... that is a letter name and not English: the Assur groups' kinds (RRP), a segment (ab, pa), cos.
+_SYMBOLS = re.compile(r"[RP]{3}|[A-Z]{2}|[a-z]{2}|sin|cos|tan")
+
+
 def _english(folder, skip: tuple[str, ...] = ()) -> dict[str, set[str]]:
+    """English in a folder's outputs: a word of the catalogue's English side, or any other Latin
+    word that is not a symbol or a letter name."""
     english = words_en()
     out = {}
     for path in sorted(folder.iterdir()):
         if path.suffix in (".svg", ".md", ".html") and path.name not in skip:
-            found = {w for w in re.findall(r"[A-Za-z]{3,}", _words(path)) if w.lower() in english}
+            words = _words(path)
+            found = {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in english}
+            found |= {w for w in _LATIN.findall(words) if not _SYMBOLS.fullmatch(w)}
             if found:
                 out[path.name] = found
     return out
@@ -108,9 +130,9 @@ def test_english_is_found_where_it_is(ice_plans, tmp_path):
     assert "velocity.svg" in _english(tmp_path)
 
 
-def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path):
+def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path, sketched_plots):
     """Seed 002 numbers the cylinder 4 and writes R43, R41, M_зр, F_зр, F_p: the sheets, the
-    worksheet and cycle.csv's aliases say the same, and nothing says R03, R01 or M_bal."""
+    worksheet, the report and cycle.csv's aliases say the same, and nothing says R03, R01 or M_bal."""
     L = lettering(ice)
     assert (L.frame, L.M_bal, L.F_bal, L.load("gas force")) == (4, "M_зр", "F_зр", "F_p")
     plans = ice_plans
@@ -118,11 +140,17 @@ def test_the_texts_names_agree_across_outputs(ice, ice_plans, tmp_path):
     sheets = {p.stem: _words(p) for p in tmp_path.glob("*.svg")}
     ws = worksheet(ice, 30, lang="uk")
     symbols = {r.symbol for r in ws.rows}
-    assert {"R43", "R41", "R12", "R32", "R21", "M_зр", "F'_зр", "M'_зр", "F_p"} <= symbols
+    assert {"R43", "R41", "R12", "R32", "R21", "R12t", "R12n", "a^r(4,3)", "M_зр", "F'_зр", "M'_зр", "F_p"} <= symbols
+    assert {"R12t", "R12n"} <= {s.name for s in plans["group:2,3"].segments}          # one way, as the sheets
     assert "R43" in sheets["group_2-3"] and "R43" in sheets["forces_2-3"] and "F_p" in sheets["forces_2-3"]
     assert "R41" in sheets["crank"] and "M_зр" in sheets["crank"]
     assert "M'_зр" in sheets["lever"] and "F'_зр" in sheets["lever"]
-    for name, words in list(sheets.items()) + [("worksheet", ws.markdown())]:
+    from kinetostat.report import run_validation, write_report
+    write_report(run_validation(ice, [], steps=12), tmp_path / "report")
+    (report,) = [f.read_text(encoding="utf-8") for f in (tmp_path / "report").glob("*/index.md")]
+    assert re.search(r"^\| M\\?_зр \|", report, re.M) and "| R43 slider B" in report and "| R41 at O |" in report
+    assert re.search(r"^\| R43 \| \\\|R43\\\|", report, re.M) and "| M_зр (lever) |" in report.replace("\\_", "_")
+    for name, words in list(sheets.items()) + [("worksheet", ws.markdown()), ("report", report)]:
         assert not re.search(r"\bR0\d|\bR\d0\b|M_bal|F_bal|\bP3\b", words), name
     assert plans["forces:2,3"].segment("R43").value == pytest.approx(ws.value("R_0_3"), rel=1e-12)
     frame = with_aliases(kinetostat.analyze(ice, steps=12).to_frame(), ice)
@@ -145,7 +173,7 @@ def test_cli_defaults_to_the_texts_language(cli, tmp_path):
     r = cli("plans", "models/ice_crank_slider.toml", "--only", "velocity", "--lang", "ru", "--out", tmp_path / "ru")
     assert "План скоростей" in (tmp_path / "ru" / "velocity.svg").read_text(encoding="utf-8")
     words = re.sub(r"\S+\.toml|\S*_\S*|/\S+", "", r.stdout)                # less file names and symbols
-    assert "файлов" in r.stdout and not {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in words_en()}
+    assert re.search(r"\b2 файла\b", r.stdout) and not {w for w in re.findall(r"[A-Za-z]{3,}", words) if w.lower() in words_en()}
 
 
 @pytest.mark.parametrize("table, field", [

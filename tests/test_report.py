@@ -151,10 +151,11 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     assert mech.name in md and mech.source in md and "g** = 9.81" in md
     assert "| id | name | mass, kg | I_S, kg m² |" in md and "| P(0,3) | prismatic |" in md
     assert "3·3 − 2·4 − 0 = **1**" in md and "`I(0,1) <- II(2,3)`" in md
-    # the error table: every route x quantity with the angle of its maximum, its tolerance and verdict
+    # the error table: every route x quantity (named as the text: M_зр, R43) with the angle of its maximum,
+    # its tolerance and verdict
     assert ("| route | quantity | max abs error | at φ, deg | peak relative, 1 | tolerance, 1 | RMS relative, 1 |"
             in md)
-    rows = re.findall(r"^\| (pinocchio|mujoco) \| (M_drive|R\(\d,\d\)) \| (.*?) \| (.*?) \| (.*?) \| 1e-09 \|"
+    rows = re.findall(r"^\| (pinocchio|mujoco) \| (M\\_зр|R\d\d) \| (.*?) \| (.*?) \| (.*?) \| 1e-09 \|"
                       r".*\| \*\*PASS\*\* \|$", md, re.M)
     assert len(rows) == 10
     # exact routes agree to rounding: shown as such, never as a meaningless "8.0452e-14 N"
@@ -163,7 +164,7 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     assert "| route | kind | tolerance (peak-relative, 1) | why this tolerance |" in md
     # the seed's published values, with the difference in %
     assert "## Against the published values" in md
-    for symbol, value in [("V_B", "10.94"), ("R32", "6481"), ("M_bal (lever)", "102.97")]:
+    for symbol, value in [("V_B", "10.94"), ("R32", "6481"), (r"M\_зр (lever)", "102.97")]:
         assert re.search(rf"^\| {re.escape(symbol)} \|.*\| {value} \|.*%", md, re.M), symbol
     # images linked next to the markdown; an engine has no balancing force section
     for png in PNGS:
@@ -178,7 +179,7 @@ def test_machine_report_shows_the_balancing_force(ice_report):
     res = kinetostat.analyze(kinetostat.load(SHAPER), steps=36)
     F = np.linalg.norm(res.balancing_force, axis=-1)
     i = int(np.argmax(F))
-    assert f"| \\|F_bal\\| | {F[i]:.5g} | {res.phi_deg[i]:.4g} |" in md
+    assert f"| \\|F\\_зр\\| | {F[i]:.5g} | {res.phi_deg[i]:.4g} |" in md          # the text's F_зр
     assert (d / "balancing_force.png").read_bytes()[:4] == b"\x89PNG"
 
 
@@ -270,7 +271,7 @@ def test_report_of_a_model_without_published_values(tmp_path, sketched_plots):
     summary = write_report(run, tmp_path / "out")
     md = (tmp_path / "out" / "four_bar" / "index.md").read_text()
     assert summary["passed"] and summary["published"] is None
-    assert "published values" not in md and "| pinocchio | R(0,3) |" in md
+    assert "published values" not in md and "| pinocchio | R03 |" in md
     write_index(tmp_path / "out", [summary])
     assert "[four_bar](four_bar/index.md)" in (tmp_path / "out" / "index.md").read_text()
 

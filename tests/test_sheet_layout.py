@@ -8,6 +8,7 @@ Also without a browser: no text under 2.5 mm, no e-notation or float noise in th
 """
 from __future__ import annotations
 
+import math
 import random
 import re
 import warnings
@@ -133,3 +134,94 @@ def test_text_sizes_and_numbers(ice_plans, lang):
             assert re.search(r"\d,\d", words), kind
         else:
             assert not re.search(r"\d,\d", re.sub(r"\b\d,\d\b", "", words)), kind     # 'group 2,3' aside
+
+
+def _on(z: complex, a: complex, b: complex) -> bool:
+    """Whether z lies on the segment a-b (within 1e-6 mm)."""
+    t = ((z - a) * (b - a).conjugate()).real / max(abs(b - a) ** 2, 1e-30)
+    return -1e-9 <= t <= 1 + 1e-9 and abs(a + t * (b - a) - z) < 1e-6
+
+
+@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+def test_mechanism_sheet_draws_every_link(path):
+    """Seed 002 fig. 1.6: every link drawn through all its points (a slotted link along its slot to
+    every block in it, a ram through B, S5 and T), each guide lettered once."""
+    mech = kinetostat.load(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plan = P.build(mech, only=["mechanism"])["mechanism"]
+    pts = plan.points
+    lines = [(pts[s.start], pts[s.end]) for s in plan.segments if s.kind == "link"]
+    for k in range(1, mech.n_links):
+        own = [pts[n] for n in mech.links[k].points]
+        carried = [pts[p.point] for p in mech.pairs if p.kind == "P" and p.links[0] == k
+                   and p.guide in mech.links[k].points]        # a slider's point on the slot of link k
+        if len(own) + len(carried) < 2:
+            continue                                  # a block on its pin: drawn as a block
+        for z in own + carried:
+            assert any(_on(z, a, b) for a, b in lines), (path.stem, k, z)
+    guides = [s.name for s in plan.segments if s.name.startswith("guide ")]
+    assert len(guides) == len(set(guides)), (path.stem, guides)
+    names = ["".join(t.itertext()) for t in ET.fromstring(svg(plan).encode()).iter(f"{_NS}text")
+             if t.get("class") == "name"]
+    for g in guides:
+        assert names.count(g) == 1, (path.stem, g, names)
+
+
+_HEAD = re.compile(r'<path class="arrowhead( arc)?" d="M([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) z"')
+
+
+def test_arc_arrowheads_are_drafting_size(ice_plans):
+    """The senses of ω and ε and the couples M_i: every arc's head at least 2.5 mm long (a drafting
+    arrowhead), never scaled down to the arc's short last chord."""
+    mech, plans = ice_plans
+    n = 0
+    for kind in ("mechanism", "group:2,3", "crank"):
+        for arc, *xy in _HEAD.findall(svg(plans[kind], lang="uk")):
+            tx, ty, ax, ay, bx, by = map(float, xy)
+            if arc:
+                assert math.hypot(tx - (ax + bx) / 2, ty - (ay + by) / 2) >= 2.5, kind
+                n += 1
+    assert n >= 4
+
+
+_LINE = re.compile(r'<line x1="([-0-9.]+)" y1="([-0-9.]+)" x2="([-0-9.]+)" y2="([-0-9.]+)"[^>]*><title>([^<]*)</title>')
+
+
+def test_a_tiny_vector_is_drawn_beside_a_collinear_load(ice_plans):
+    """The ICE's G3, drawn out of scale from B along F_p, lies 1.5-2 mm beside F_p, not under it."""
+    mech, plans = ice_plans
+    lines = {t: tuple(map(float, xy)) for *xy, t in _LINE.findall(svg(plans["group:2,3"], lang="uk"))}
+    g, f = lines["G3*"], lines["F_p"]
+    ux, uy = f[2] - f[0], f[3] - f[1]
+    off = abs((g[0] - f[0]) * uy - (g[1] - f[1]) * ux) / math.hypot(ux, uy)     # G3*'s start off F_p's line
+    assert 1.5 <= off <= 2.0
+
+
+def test_notes_letter_names_as_the_drawing(ice_plans):
+    """The notes write πa, F with subscript i2, h with subscript Fi2 (as the drawing letters them),
+    never the raw 'pi-a', 'F_i2', 'h_Fi2'; the lever's arms stay in mm (seed 002: h_Fi2 = 37.67 mm)."""
+    mech, plans = ice_plans
+    for kind in ("acceleration", "group:2,3", "forces:2,3", "lever", "crank"):
+        notes = svg(plans[kind], lang="uk").split('<g id="notes">')[1]
+        words = re.sub(r"<[^>]+>", "", notes)
+        assert "_" not in words and "pi-" not in words, (kind, words)
+    notes = svg(plans["lever"], lang="uk").split('<g id="notes">')[1]
+    assert re.search(r'>h<tspan dy="0\.50">Fi2</tspan><tspan dy="-0\.50"> = 37,\d\d мм</tspan>', notes), notes
+    assert "πa" in svg(plans["acceleration"], lang="uk")
+
+
+def test_the_overlap_check_finds_a_planted_overlap(page, ice_plans):
+    """Negative control: a label planted on another label, and one under an arrowhead, are reported."""
+    mech, plans = ice_plans
+    sheet = svg(plans["group:2,3"], lang="uk")
+    assert _check(page, {"clean": sheet}) > 10
+    label = re.search(r'<text class="label" x="([-0-9.]+)" y="([-0-9.]+)"', sheet)
+    head = re.search(r'<path class="arrowhead" d="M([-0-9.]+),([-0-9.]+) ', sheet)
+    planted = sheet.replace('<g id="title-block">',
+                            f'<text x="{label.group(1)}" y="{label.group(2)}" font-size="3">QQ</text>'
+                            f'<text x="{float(head.group(1)) - 1:.2f}" y="{float(head.group(2)) + 1:.2f}" '
+                            f'font-size="3">WW</text><g id="title-block">', 1)
+    bad = sheet_browser.overlaps(sheet_browser.measure(page, planted))
+    assert any("'QQ' over text" in b or "over text 'QQ'" in b for b in bad), bad
+    assert any("'WW' under an arrowhead" in b for b in bad), bad

@@ -25,7 +25,7 @@ from .core import Plan, Segment, extent
 from .i18n import LANGS, MESSAGES, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_width
 
-__all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM",
+__all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
 
 #: The sheet: A3 landscape, mm.
@@ -35,10 +35,14 @@ _TITLE_BLOCK = (230.0, 247.0, 415.0, 292.0)  # bottom right, 185 x 45 mm
 _AREA = (25.0, 10.0, 410.0, 242.0)          # where the plan is centred (above the notes)
 #: Arrowhead: length and half-width, mm (drafting: 3-4 mm); shorter on a vector under 3 lengths.
 ARROW_MM = (3.5, 0.6)
+#: Arrowhead on an arc (the sense of ω, ε, a couple M), mm: drafting size whatever the arc's chord.
+ARC_HEAD_MM = 2.8
 #: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM.
 TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
+#: A vector drawn out of scale along another vector from the same point is drawn this far beside it, mm.
+SIDE_MM = 1.8
 _POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
-_LINE_STEP = 3.3                             # line spacing of the notes, mm
+_LINE_STEP = 3.6                             # line spacing of the notes, mm (room for a subscript)
 _LEFT_NOTES_MM = 120.0                       # width of the notes beside a tall plan, mm
 
 #: Room a plan has on its sheet (width, height), mm: above notes of a few lines, or beside a
@@ -121,11 +125,45 @@ def _polygon_sides(plan: Plan) -> list[Segment]:
 
 # ----------------------------------------------------------------------------- SVG
 
+def _n(name: str) -> str:
+    """A name in a note, marked to be lettered as the drawing letters it (πa, F with subscript i2;
+    of 'M_i2/l (a)' its first word)."""
+    head, sep, tail = name.partition(" ")
+    return f"\x01{head}\x02{sep}{tail}"
+
+
+_NAMED = re.compile("\x01([^\x02]*)\x02")
+
+
+def _runs(name: str) -> list[tuple[str, bool]]:
+    """A name as (text, subscript?) runs, by `label_parts`; a segment 'pi-a' as its points' letters: πa."""
+    parts = name.split("-") if re.fullmatch(r"[^-\s]+-[^-\s]+", name) else [name]
+    return [(t, k == 1) for part in parts for k, t in enumerate(label_parts(part)) if t]
+
+
+def _plain(s: str) -> str:
+    """A note as read, without the names' marks (for its width)."""
+    return _NAMED.sub(lambda m: "".join(t for t, _ in _runs(m.group(1))), s)
+
+
+def _rich(s: str, size: float) -> str:
+    """A note's SVG content: text escaped, marked names with their subscripts lowered 0.2 of the size
+    (the same size: no note text under 2.5 mm)."""
+    out, low = [], 0.0
+    for k, piece in enumerate(_NAMED.split(s)):
+        runs = _runs(piece) if k % 2 else [(piece, False)]
+        for t, sub in runs:
+            dy = (0.2 * size if sub else 0.0) - low
+            out.append(f'<tspan dy="{dy:.2f}">{escape(t)}</tspan>' if dy else escape(t))
+            low += dy
+    return "".join(out)
+
+
 def _t(x: float, y: float, s: str, size: float, anchor: str = "start", weight: str = "normal",
        ident: str = "", cls: str = "note") -> str:
     attrs = f' id="{ident}"' if ident else ""
     return (f'<text class="{cls}"{attrs} x="{x:.2f}" y="{y:.2f}" font-size="{size:.2f}" text-anchor="{anchor}" '
-            f'font-weight="{weight}">{escape(s)}</text>')
+            f'font-weight="{weight}">{_rich(s, size)}</text>')
 
 
 def _wrap(s: str, size: float, width: float) -> list[str]:
@@ -133,7 +171,7 @@ def _wrap(s: str, size: float, width: float) -> list[str]:
     out, line = [], ""
     for word in s.split(" "):
         trial = f"{line} {word}" if line else word
-        if line and text_width(trial, size) > width:
+        if line and text_width(_plain(trial), size) > width:
             out.append(line)
             line = word
         else:
@@ -143,7 +181,7 @@ def _wrap(s: str, size: float, width: float) -> list[str]:
 
 def _fit(s: str, size: float, width: float, least: float = MIN_TEXT_MM) -> float:
     """The font size, at most `size` and at least `least`, at which `s` fits `width` mm."""
-    return max(least, min(size, size * width / max(text_width(s, size), 1e-9)))
+    return max(least, min(size, size * width / max(text_width(_plain(s), size), 1e-9)))
 
 
 def _tiny(plan: Plan) -> dict[str, str]:
@@ -157,12 +195,27 @@ def _tiny(plan: Plan) -> dict[str, str]:
     return how
 
 
+def _collinear(plan: Plan, s: Segment, tiny: dict[str, str]) -> bool:
+    """Whether a vector drawn out of scale would lie on another vector of the plan: one from the
+    same point (within 0.5 mm) in the same direction (within 5 degrees)."""
+    a = plan.points[s.start]
+    d = plan.points[s.end] - a
+    for o in _drawable(plan):
+        if o.kind != "vector" or o.name == s.name or o.name in tiny:
+            continue
+        e = plan.points[o.end] - plan.points[o.start]
+        turn = e * d.conjugate()
+        if abs(plan.points[o.start] - a) < 0.5 and abs(e) > 0 and abs(math.atan2(turn.imag, turn.real)) < math.radians(5.0):
+            return True
+    return False
+
+
 def _result_line(plan: Plan, lang: str) -> list[str]:
     if not plan.results:
         return []
     parts = []
     for r in plan.results:
-        part = f"{r.symbol} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
+        part = f"{_n(r.symbol)} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
         parts.append(part + (f" ({text(r.how, lang)})" if r.how else ""))
     return [f"{text('results', lang)}: " + "; ".join(parts)]
 
@@ -174,13 +227,13 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
     lines += [phrase(n, lang) for n in plan.notes]
     lines += _result_line(plan, lang)
     if plan.equation:
-        lines.append(f"{text('equation', lang)}: " + " + ".join(plan.equation) + " = 0")
+        lines.append(f"{text('equation', lang)}: " + " + ".join(map(_n, plan.equation)) + " = 0")
     for s in _drawable(plan):
         if s.name in tiny:
             L = abs(plan.points[s.end] - plan.points[s.start])
             key = "out of scale" if tiny[s.name] == "out" else "negligible"
             mark = "*" if tiny[s.name] == "out" else ""
-            lines.append(f"{s.name}{mark} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
+            lines.append(f"{_n(s.name)}{mark} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
                          f"{text(key, lang, length=num(L, lang, decimals=2))}")
     if plan.kind == "lever":
         lines.append(text("arms natural", lang))
@@ -198,9 +251,11 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
         L = num(plan.length_mm(s.name), lang, decimals=2)
         value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
         if sides:
-            out.append(f"{text('segment', lang)} {s.start}{s.end} = {L} {mm} → {s.name} = {value}")
+            out.append(f"{text('segment', lang)} {_n(s.start + '-' + s.end)} = {L} {mm} → {_n(s.name)} = {value}")
+        elif s.unit == "mm":                      # a length kept as drawn (the lever's arms): once
+            out.append(f"{_n(s.name)} = {L} {mm}")
         else:
-            out.append(f"{s.name}: {L} {mm} → {value}")
+            out.append(f"{_n(s.name)}: {L} {mm} → {value}")
     return out
 
 
@@ -214,7 +269,7 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool,
     if nofit:
         lines.append(text("nofit", lang))
     rows = [w for r in _table_rows(plan, lang) for w in (_wrap(r, _NOTE_MM, width) if left else [r])]
-    col_w = max((text_width(r, _NOTE_MM) for r in rows), default=0.0) + 4.0
+    col_w = max((text_width(_plain(r), _NOTE_MM) for r in rows), default=0.0) + 4.0
     cols = 1 if left or not rows else max(1, int(width // col_w))
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
@@ -265,17 +320,19 @@ def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
             "</g>"]
 
 
-def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float) -> tuple[str, tuple, tuple]:
-    """A filled arrowhead with its tip at b pointing from a: (svg path, its box, the line's new end)."""
+def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float,
+               arc: bool = False) -> tuple[str, tuple, tuple]:
+    """A filled arrowhead with its tip at b pointing from a: (svg path, its box, the line's new end);
+    on an arc (a sense, a couple) ARC_HEAD_MM long whatever the chord a-b."""
     L = math.hypot(b[0] - a[0], b[1] - a[1])
     ux, uy = (b[0] - a[0]) / L, (b[1] - a[1]) / L
-    h = min(ARROW_MM[0], max(0.3 * L, 0.8), length)
+    h = ARC_HEAD_MM if arc else min(ARROW_MM[0], max(0.3 * L, 0.8), length)
     hw = max(0.3, ARROW_MM[1] * h / ARROW_MM[0] * 1.0)
     bx, by = b[0] - ux * h, b[1] - uy * h
     pts = [(b[0], b[1]), (bx - uy * hw, by + ux * hw), (bx + uy * hw, by - ux * hw)]
     d = "M" + " L".join(f"{x:.3f},{y:.3f}" for x, y in pts) + " z"
     xs, ys = [p[0] for p in pts], [p[1] for p in pts]
-    return (f'<path class="arrowhead" d="{d}" fill="#000"/>', (min(xs), min(ys), max(xs), max(ys)),
+    return (f'<path class="arrowhead{" arc" if arc else ""}" d="{d}" fill="#000"/>', (min(xs), min(ys), max(xs), max(ys)),
             (b[0] - ux * 0.6 * h, b[1] - uy * 0.6 * h))
 
 
@@ -308,12 +365,13 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
             continue
         width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
         pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in xy)
+        tip = text(name, lang) if name in MESSAGES else name if name[:1] in "ωεM" else ""   # no English tooltip
         out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="{width}">'
-                   f'<title>{escape(text(name, lang) if name in MESSAGES else name)}</title></polyline>')
+                   + (f'<title>{escape(tip)}</title>' if tip else "") + '</polyline>')
         for (a, b), (c, d) in zip(xy, xy[1:]):
             placer.line(a, b, c, d)
         if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
-            head, box, _ = _arrowhead(xy[-3], xy[-1], 2.5)
+            head, box, _ = _arrowhead(xy[-2], xy[-1], ARC_HEAD_MM, arc=True)
             out.append(head)
             placer.block(box)
             named.append((name, xy[len(xy) // 2], None))
@@ -329,6 +387,9 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
                 continue
             b = (a[0] + (b[0] - a[0]) / L * MIN_DRAWN_MM, a[1] + (b[1] - a[1]) / L * MIN_DRAWN_MM)
             L, label = MIN_DRAWN_MM, label + "*"
+            if _collinear(plan, s, tiny):              # beside the load it would hide under (G3* along F_p)
+                nx, ny = -(b[1] - a[1]) / L * SIDE_MM, (b[0] - a[0]) / L * SIDE_MM
+                a, b = (a[0] + nx, a[1] + ny), (b[0] + nx, b[1] + ny)
         end = b
         if s.kind == "vector":
             head, box, end = _arrowhead(a, b, L)
@@ -341,7 +402,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         if s.kind == "vector":
             out.append(head)
         placer.line(a[0], a[1], b[0], b[1])
-        if not labelled(s.end) or (sides is not None and s.kind == "vector") or s.kind == "arm":
+        if s.kind != "link" and (not labelled(s.end) or (sides is not None and s.kind == "vector") or s.kind == "arm"):
             named.append((label, a, b))
     small = plan.kind == "positions"
     dots = []

@@ -19,7 +19,7 @@ import re
 
 import numpy as np
 
-__all__ = ["LANGS", "MESSAGES", "PHRASES", "UNITS", "check_lang", "text", "num", "unit", "phrase", "words_en",
+__all__ = ["LANGS", "MESSAGES", "PHRASES", "UNITS", "check_lang", "text", "plural", "PLURALS", "num", "unit", "phrase", "words_en",
            "ZERO"]
 
 LANGS = ("en", "uk", "ru")
@@ -298,9 +298,27 @@ def check_lang(lang: str) -> int:
     return LANGS.index(lang)
 
 
+#: Nouns counted by a message's {n}, by the form the catalogue writes: (one, few, many).
+PLURALS = {"files": ("file", "files", "files"), "файлів": ("файл", "файли", "файлів"),
+           "файлов": ("файл", "файла", "файлов")}
+
+
+def plural(n: int, lang: str) -> int:
+    """Which form (0 one, 1 few, 2 many) `lang` gives a noun counted n: en 1 file, 2 files; uk/ru
+    1, 21 файл; 2-4, 22 файли/файла; 5-20, 11-14 файлів/файлов."""
+    if check_lang(lang) == 0:
+        return 0 if n == 1 else 2
+    if n % 10 == 1 and n % 100 != 11:
+        return 0
+    return 1 if 2 <= n % 10 <= 4 and not 12 <= n % 100 <= 14 else 2
+
+
 def text(key: str, lang: str, **fields) -> str:
-    """Message `key` in `lang`, its {fields} filled."""
+    """Message `key` in `lang`, its {fields} filled; a noun after an integer {n} in its plural form."""
     s = MESSAGES[key][check_lang(lang)]
+    n = fields.get("n")
+    if isinstance(n, int) and not isinstance(n, bool):
+        s = re.sub(r"\{n\} (\w+)", lambda m: "{n} " + PLURALS.get(m.group(1), (m.group(1),) * 3)[plural(n, lang)], s)
     return s.format(**fields) if fields else s
 
 

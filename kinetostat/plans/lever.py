@@ -29,8 +29,8 @@ if TYPE_CHECKING:
 
 __all__ = ["lever_plan", "lever_check", "pole_moment", "NATURAL", "TOLERANCE_PCT"]
 
-#: The arms on the lever are measured on the drawing, in mm at natural size (seed 002: h_Fi2 = 37.67 mm).
-NATURAL = Scale("natural", 0.001, "m/mm")
+#: The arms on the lever are measured on the drawing and kept in mm (seed 002: h_Fi2 = 37.67 mm).
+NATURAL = Scale("natural", 1.0, "mm/mm")
 #: The texts' rule: the two balancing moments may differ by 5 % (seed 002, line 468).
 TOLERANCE_PCT = 5.0
 
@@ -69,7 +69,7 @@ def lever_plan(mech: "Mechanism", res: "Analysis", mu_v) -> Plan:
     90 deg counter-clockwise), the vectors p-x and the links' images (a-b, values in m/s), every
     force at its like point (its value in N, drawn at a round force scale of its own; couples as
     two forces "M_i2/l (a)", "M_i2/l (b)"), the arms h_.. about the pole (value: the arm's
-    drawn length, m at natural size: `NATURAL`), and the balancing force F'_bal (the model's
+    drawn length in mm, as the texts keep it: `NATURAL`), and the balancing force F'_bal (the model's
     lettering: F'_зр) at the crank pin's image, across p-a, whose moment about the pole cancels
     the loads'. Its results: F'_bal, M'_bal, M_bal by the force plans and their difference δ
     against the texts' 5 % (TOLERANCE_PCT)."""
@@ -116,7 +116,7 @@ def lever_plan(mech: "Mechanism", res: "Analysis", mu_v) -> Plan:
             u = F / abs(F)
             foot = pts[at] - (pts[at] * u.conjugate()).real * u
             pts[f"{arm_name(name)}:foot"] = foot
-            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", abs(foot) * NATURAL.value, "m", "arm",
+            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", abs(foot) * NATURAL.value, "mm", "arm",
                                 NATURAL))
     omega1 = float(res.omega(mech.drive.link)[0])
     M_lever = float(total) * mu_v.value / omega1

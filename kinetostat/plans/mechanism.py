@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .core import Plan, Scale
+from .core import Plan, Scale, Segment
 from .forces import _link_drawing, _world
 
 __all__ = ["mechanism_plan", "PIN_MM", "BLOCK_MM", "ARC_MM"]
@@ -43,6 +43,33 @@ def _arc(c: complex, r: float, sense: float) -> tuple[complex, ...]:
     return tuple(c + r * np.exp(1j * (np.radians(150.0) + sense * t)))
 
 
+def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
+    """Link k drawn through all its points: along each slot it carries, from end to end of what
+    runs in it (O2-S3 on to B), and every point not on a drawn line joined to the nearest drawn
+    point (B-S5-T of a ram)."""
+    drawn = {n for s in segs if s.kind == "link" for n in (s.start, s.end)} & set(mech.links[k].points)
+    for p in mech.pairs:
+        if p.kind != "P" or p.links[0] != k or p.guide not in mech.links[k].points:
+            continue
+        G = pts[p.guide]
+        d = complex(*p.direction) * complex(res.kin.rot[0, k])
+        on = {n: ((pts[n] - G) * d.conjugate()).real for n in mech.links[k].points}
+        on[p.point] = ((_world(res, p.links[1], p.point) / mu.value - G) * d.conjugate()).real
+        lo, hi = min(on.values()), max(on.values())
+        name = f"slot {k} {p.point}"
+        pts[f"{name}:from"], pts[f"{name}:to"] = G + lo * d, G + hi * d
+        segs.append(Segment(name, f"{name}:from", f"{name}:to", (hi - lo) * mu.value, "m", "link"))
+        drawn |= {n for n in mech.links[k].points if abs(((pts[n] - G) * d.conjugate()).imag) < 1e-6}
+    rest = [n for n in mech.links[k].points if n not in drawn]
+    if not drawn and rest:
+        drawn.add(rest.pop(0))
+    while rest:                                   # the nearest point not yet drawn, joined to the drawing
+        a, b = min(((a, b) for a in rest for b in drawn), key=lambda ab: abs(pts[ab[0]] - pts[ab[1]]))
+        segs.append(Segment(f"{b}{a}", b, a, abs(pts[a] - pts[b]) * mu.value, "m", "link"))
+        drawn.add(a)
+        rest.remove(a)
+
+
 def mechanism_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     """The mechanism at the analysis's angle at mu_l: links, frame supports and guides hatched,
     pins and blocks, centres of mass, and the arcs of ω_k and ε_k of every turning link."""
@@ -53,6 +80,8 @@ def mechanism_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     paths: dict[str, tuple[complex, ...]] = {}
     for k in range(1, mech.n_links):
         _link_drawing(mech, res, k, pts, segs, mu)
+        _link_lines(mech, res, k, pts, segs, mu)
+    segs = list({s.name: s for s in segs}.values())        # a guide drawn by both its links: once
     for p in mech.pairs:
         if p.kind == "R":
             owner = next(k for k in p.links[::-1] if k and p.point in mech.links[k].points)

@@ -287,11 +287,11 @@ class _Sheet:
                 if wg:
                     dvec = res.velocity(p.point)[0] - _point_of(res, p.links[0], p.point)
                     cor = 2 * wg * np.array([-dvec[1], dvec[0]])
-                    sym = f"a^Cor({p.links[0]},{p.links[1]})"
+                    sym = f"a^Cor({self.n(p.links[0])},{self.n(p.links[1])})"
                     self.vector("accelerations", f"aCor_{p.links[0]}_{p.links[1]}", sym, cor, "m/s^2",
                                 f"2 ω{p.links[0]} V_rel")
                 ar = res.slide_acceleration(*p.links)[0]
-                sym = f"a^r({p.links[0]},{p.links[1]})"
+                sym = f"a^r({self.n(p.links[0])},{self.n(p.links[1])})"
                 self.add("accelerations", f"ar_{p.links[0]}_{p.links[1]}", sym, abs(ar), "m/s^2", "", "along the guide")
             elif what == "eps":
                 for k in a:
@@ -342,14 +342,14 @@ class _Sheet:
                     e = r / l
                     t = np.array([-e[1], e[0]])
                     arm = l / self.mu_l
-                    self.add("reactions", f"Rt_{other}_{link}", f"R^τ_{self.R(other, link)[1:]}", abs(R @ t), "N",
+                    self.add("reactions", f"Rt_{other}_{link}", f"{self.R(other, link)}t", abs(R @ t), "N",
                              _angle(np.sign(R @ t) * t), f"Σ M_{pin.point} = 0 of link {link}, arm {outer.point}{pin.point} = {arm:.4g} mm")
             for link, outer, other in ((j, pj, a), (k, pk, c)):
                 if outer.kind == "R" and pin.kind == "R":
                     R = res.reaction(other, link)[0]
                     r = res.position(pin.point)[0] - res.position(outer.point)[0]
                     e = r / np.hypot(*r)
-                    self.add("reactions", f"Rn_{other}_{link}", f"R^n_{self.R(other, link)[1:]}", abs(R @ e), "N",
+                    self.add("reactions", f"Rn_{other}_{link}", f"{self.R(other, link)}n", abs(R @ e), "N",
                              _angle(np.sign(R @ e) * e), "force plan of the group")
             for link, other in ((j, a), (k, c)):
                 self.vector("reactions", f"R_{other}_{link}", self.R(other, link), res.reaction(other, link)[0], "N",

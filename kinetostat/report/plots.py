@@ -4,11 +4,16 @@ beyond `plain_text`'s settings while the figures are made).
 Every text of a figure is plain text: a model's name or a point's name is never parsed as a
 mathtext formula or given to LaTeX (`plain_text`).
 
-May use: numpy, matplotlib, the solver's results, the runs room and `kinetostat._io` (atomic writes).
+Names as the model's text letters them (`plans.lettering`: R43 for the ICE's R(0,3), M_зр): every
+quantity a figure or a table shows goes through `quantity_name`.
+
+May use: numpy, matplotlib, the solver's results, the runs room, `kinetostat._io` (atomic writes)
+and the plans' lettering (`plans.lettering`, `plans.forces.reaction_name`).
 """
 from __future__ import annotations
 
 import math
+import re
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator
@@ -18,6 +23,8 @@ import numpy as np
 from .._io import atomic
 from ..analysis import Analysis
 from ..model import Mechanism
+from ..plans.forces import reaction_name
+from ..plans.lettering import lettering
 from .runs import ModelRun, quantities
 
 
@@ -137,7 +144,16 @@ def _phi_axis(ax, label: bool = True, step: int = 60):
 def _pair_name(mech: Mechanism, p) -> str:
     i, j = p.links
     where = f"at {p.point}" if p.kind == "R" else f"slider {p.point} on guide {p.guide}"
-    return f"R({i},{j}) {where}"
+    return f"{reaction_name(mech, i, j)} {where}"
+
+
+def quantity_name(mech: Mechanism, q: str) -> str:
+    """A quantity (or a phrase naming quantities) as the model's text names them: R(0,3) -> R43
+    (the frame lettered 4), M_drive and M_bal -> M_зр, F_bal -> F_зр; other words as they are."""
+    L = lettering(mech)
+    q = re.sub(r"R\((\d+),(\d+)\)", lambda m: reaction_name(mech, int(m.group(1)), int(m.group(2))), q)
+    q = re.sub(r"\bM_(bal|drive)\b", lambda _: L.M_bal, q)
+    return re.sub(r"\bF_bal\b", lambda _: L.F_bal, q)
 
 
 def _link_name(mech: Mechanism, k: int) -> str:
@@ -357,7 +373,7 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
         col, ls = _style(route, n)
         ax.plot(*_closed(er.phi_deg, er.M_drive), **_line(er, res, col, ls, 1.6), label=f"{route} ({er.route})")
     ax.axhline(0, color="0.3", lw=0.6)
-    ax.set_ylabel("balancing moment on the crank M_bal, N·m")
+    ax.set_ylabel(f"balancing moment on the crank {quantity_name(m, 'M_bal')}, N·m")
     kind = "moment of the drive on the crank about +z"
     ax.set_title(f"{m.name}\nbalancing moment ({kind}) over the cycle", fontsize=10, y=1.0)
     ax.legend(fontsize=8, loc="best")
@@ -438,7 +454,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
             ax.text(0.5, 0.5, "no differences to draw\n(no engine results, or exactly equal)",
                     transform=ax.transAxes, ha="center", va="center", fontsize=8, color="0.4")
             ax.set_yscale("log")
-        title = "M_drive: balancing moment" if q == "M_drive" else \
+        title = f"{quantity_name(m, q)}: balancing moment" if q == "M_drive" else \
             _pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
         ax.set_title(_wrap(title), fontsize=9, y=1.0)
         _log_ticks(ax)
@@ -511,9 +527,9 @@ def plot_balancing_force(res: Analysis, path: Path) -> Path:
     ax = fig.subplots()
     F = res.balancing_force
     phi = res.phi_deg
-    ax.plot(*_closed(phi, np.linalg.norm(F, axis=-1)), color="black", lw=2.4, label="|F_bal|")
-    ax.plot(*_closed(phi, F[:, 0]), color="tab:blue", lw=1.4, ls="--", label="F_bal,x")
-    ax.plot(*_closed(phi, F[:, 1]), color="tab:orange", lw=1.4, ls=(0, (2, 2)), label="F_bal,y")
+    ax.plot(*_closed(phi, np.linalg.norm(F, axis=-1)), color="black", lw=2.4, label=quantity_name(m, "|F_bal|"))
+    ax.plot(*_closed(phi, F[:, 0]), color="tab:blue", lw=1.4, ls="--", label=quantity_name(m, "F_bal,x"))
+    ax.plot(*_closed(phi, F[:, 1]), color="tab:orange", lw=1.4, ls=(0, (2, 2)), label=quantity_name(m, "F_bal,y"))
     ax.axhline(0, color="0.3", lw=0.6)
     ax.set_ylabel("balancing force, N")
     ax.set_title(f"{m.name}\nbalancing force of the pinion on the crank's wheel (pitch point, line of action)",

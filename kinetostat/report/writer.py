@@ -22,7 +22,7 @@ from ..sweep import sweep
 from .. import units as model_units
 from ..tables import error, plain, write_csv
 from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc, slug
-from .plots import (_pair_name, plain_text, plot_balancing_force, plot_errors, plot_hodographs,
+from .plots import (_pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
 from .runs import ModelRun, trust
@@ -229,7 +229,7 @@ def _angles(c: PublishedCheck) -> str:
     return f"{c.entry.reduce.replace('_', ' ')} over {listed} ({len(a)} positions)"
 
 
-def _published_section(doc: Doc, published: Sequence[PublishedCheck]) -> None:
+def _published_section(doc: Doc, m: Mechanism, published: Sequence[PublishedCheck]) -> None:
     """The sources' published numbers beside the exact ones (nothing if the model has none)."""
     if not published:
         return
@@ -243,7 +243,7 @@ def _published_section(doc: Doc, published: Sequence[PublishedCheck]) -> None:
         e = c.entry
         diff = f"{c.difference:+.3g}°" if c.by_angle else f"{100 * c.difference:+.3f} %"
         tol = f"±{e.tolerance:g}°" if c.by_angle else f"±{100 * e.tolerance:g} %"
-        rows.append([esc(e.symbol), esc(e.meaning), _angles(c), f"{e.value:g}", f"{c.exact:.6g}", esc(e.unit), diff, tol,
+        rows.append([esc(quantity_name(m, e.symbol)), esc(quantity_name(m, e.meaning)), _angles(c), f"{e.value:g}", f"{c.exact:.6g}", esc(e.unit), diff, tol,
                      "yes" if c.passed else "**NO**"])
     doc.table(["quantity", "meaning", "φ", "published", "kinetostat (exact)", "unit", "difference", "accepted",
                "within"], rows, "lllrrlrrl")
@@ -313,16 +313,16 @@ def _extremes(values: np.ndarray, phi: np.ndarray) -> list[str]:
 def _balancing_force_section(doc: Doc, res, image: Path) -> None:
     """Working machine: the force of the pinion on the crank's wheel, plot and extremes."""
     doc.h(2, "Balancing force")
-    F = res.balancing_force
+    F, m = res.balancing_force, res.mech
     doc.p("The unknown of a working machine: the force of the pinion on the crank's wheel at the pitch point, "
-          "along the line of action of the mesh (world frame); M_bal above is its moment about the crank's "
-          "pivot.")
+          f"along the line of action of the mesh (world frame); {esc(quantity_name(m, 'M_bal'))} above is its moment "
+          "about the crank's pivot.")
     doc.img(image, "Balancing force over the cycle: magnitude and world components, N")
     phi = res.phi_deg
     doc.table(["quantity", "max, N", "at φ, deg", "min, N", "at φ, deg"],
-              [["|F_bal|", *_extremes(np.linalg.norm(F, axis=-1), phi)],
-               ["F_bal,x", *_extremes(F[:, 0], phi)],
-               ["F_bal,y", *_extremes(F[:, 1], phi)]], "lrrrr")
+              [[esc(quantity_name(m, "|F_bal|")), *_extremes(np.linalg.norm(F, axis=-1), phi)],
+               [esc(quantity_name(m, "F_bal,x")), *_extremes(F[:, 0], phi)],
+               [esc(quantity_name(m, "F_bal,y")), *_extremes(F[:, 1], phi)]], "lrrrr")
 
 
 def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
@@ -348,8 +348,9 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
         x, peak = worst(a, b)
         return [quantity, route, _err(x, peak, unit), _rel(x / peak) if peak > 0 and math.isfinite(x) else "n/a"]
 
-    rows = [row("M_bal", "Zhukovsky's lever", res.lever_moment, res.balancing_moment, "N·m"),
-            row("M_bal", "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
+    M = esc(quantity_name(m, "M_bal"))
+    rows = [row(M, "Zhukovsky's lever", res.lever_moment, res.balancing_moment, "N·m"),
+            row(M, "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
     rows += [row(esc(_pair_name(m, p)), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
              for p in m.pairs]
     doc.table(["quantity", "route against group by group", "max |difference|", "peak relative, 1"], rows, "llrr")
@@ -358,7 +359,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
 def _error_rows(run: ModelRun) -> list[list[str]]:
     rows = []
     for r in run.rows:
-        rows.append([r.route, esc(r.quantity), _err(r.max_abs, r.peak, r.unit),
+        rows.append([r.route, esc(quantity_name(run.mech, r.quantity)), _err(r.max_abs, r.peak, r.unit),
                      f"{r.phi_deg_max:.4g}" if math.isfinite(r.phi_deg_max) and not _is_rounding(r.peak_relative)
                      else "-",
                      _rel(r.peak_relative), f"{r.tolerance:.0e}", _rel(r.rms_relative),
@@ -442,12 +443,13 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
           f"{_err(lever, peak_m, 'N·m')}.")
     doc.img(images["moment"], "Balancing moment on the crank over the cycle, N·m")
     doc.table(["quantity", "max, N·m", "at φ, deg", "min, N·m", "at φ, deg"],
-              [["M_bal", *_extremes(res.balancing_moment, res.phi_deg)]], "lrrrr")
+              [[esc(quantity_name(m, "M_bal")), *_extremes(res.balancing_moment, res.phi_deg)]], "lrrrr")
     if machine:
         _balancing_force_section(doc, res, images["force"])
 
     doc.h(2, "Reactions")
-    doc.p("Magnitude of every pair's reaction R(i,j) (force of link i on link j), kinetostat and each "
+    doc.p("Magnitude of every pair's reaction R_ij (force of link i on link j; the frame lettered as the model's "
+          "text letters it), kinetostat and each "
           "engine route overlaid.")
     doc.img(images["reactions"], "Reaction magnitudes over the cycle, N")
     doc.table(["pair", "max |R|, N", "at φ, deg", "min |R|, N", "at φ, deg"],
@@ -484,7 +486,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
           "over the cycle, as Potapov 2024 draws them; grey rays every 30° of φ; the red dot marks the maximum.")
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
-    _published_section(doc, published)
+    _published_section(doc, m, published)
     plan_files = _plans_section(doc, m, d)
 
     sing = int(np.sum(res.singular))
