@@ -905,6 +905,7 @@ def cmd_plans(args) -> int:
     from .plans import build
     from .plans.worksheet import worksheet
     from .plans.lettering import lettering
+    from .plans.scales import ScaleError
     path = Path(args.model)
     mech = _load(path)
     args.lang = args.lang or lettering(mech).language or "en"
@@ -916,12 +917,10 @@ def cmd_plans(args) -> int:
             warnings.simplefilter("always")
             plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
+    except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
+        raise CLIError(f"--scale {exc}") from None
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
-    huge = [r for r in plans.rows() if not all(map(math.isfinite, (r["x0_mm"], r["y0_mm"], r["x1_mm"], r["y1_mm"])))]
-    if huge:                              # a scale so small that a segment's end is beyond any float
-        raise CLIError(f"--scale: the {huge[0]['plan']} plan's segment {huge[0]['segment']} would end beyond "
-                       f"1e308 mm at {huge[0]['scale']}; use a larger scale")
     try:
         with unit(out) as tmp:                # swapped in as a set: never new sheets beside an old worksheet
             written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])

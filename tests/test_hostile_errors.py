@@ -175,14 +175,39 @@ def test_a_pressure_in_mpa_is_warned():
 
 @pytest.mark.parametrize("scale, message", [
     ("mu_F=5e-324", "mu_F must be a positive number in N/mm (at least 2.23e-308)"),
-    ("mu_F=1e-307", "segment R12t would end beyond 1e308 mm at mu_F = 1e-307 N/mm"),
+    ("mu_F=1e-307", "--scale mu_F=1e-307 N/mm would draw the forces plan beyond 1e308 mm across"),
+    # a ZeroDivisionError (the frame's hatching at 1e19 mm), a 383 GiB and a 1.2 GiB allocation (the
+    # labels' samples along a link), a 181 GiB one, "Maximum allowed size exceeded": the ICE's
+    # positions span 0.182 m, the crank pin's velocity 17 m/s
+    ("mu_l=1e-20", "--scale mu_l=1e-20 m/mm would draw the mechanism plan 1.82e+19 mm across (at most 100000 mm)"),
+    ("mu_l=1e-12", "--scale mu_l=1e-12 m/mm would draw the mechanism plan 1.82e+11 mm across"),
+    ("mu_l=1e-9", "--scale mu_l=1e-09 m/mm would draw the mechanism plan 1.82e+08 mm across"),
+    ("mu_v=1e-9", "--scale mu_v=1e-09 m/(s mm) would draw the velocity plan 1.7e+10 mm across"),
+    ("mu_v=1e-300", "--scale mu_v=1e-300 m/(s mm) would draw the velocity plan 1.7e+301 mm across"),
 ])
-def test_a_scale_that_draws_inf_is_refused(scale, message, tmp_path, cli):
+def test_a_scale_that_draws_beyond_a_sheet_is_refused(scale, message, tmp_path, cli):
     out = tmp_path / "plans"
     p = cli("plans", ROOT / "models" / "ice_crank_slider.toml", "--scale", scale, "--out", out)
     _one_line_exit_2(p)
     assert message in p.stderr
     assert not out.exists() or not list(out.iterdir())
+
+
+def test_the_drawings_loops_are_bounded_by_a_sheet():
+    """What a plan near MAX_EXTENT_MM draws: the frame's hatching and the labels' samples along a
+    line are capped (counted), whatever the length handed to them; a zero-length stretch is no error."""
+    from kinetostat.plans.labels import Placer
+    from kinetostat.plans.mechanism import _hatch
+    paths: dict = {}
+    _hatch(0j, 1e12 + 0j, 1j, "h", paths)
+    assert len(paths) == 1 + 50                         # the line and its strokes every 2 mm over 100 mm
+    paths.clear()
+    _hatch(1e19 + 0j, 1e19 + 0j, 1j, "h", paths)       # both ends one float at 1e19 mm
+    assert len(paths) == 1
+    placer = Placer((0.0, 0.0, 420.0, 297.0))
+    placer.line(0.0, 0.0, 1e12, 0.0)
+    placer.line(0.0, 0.0, 7.0, 0.0)
+    assert [len(s) for s in placer._samples] == [10_000, 11]
 
 
 # ============================================================================ 8. accuracy near singular positions
