@@ -30,10 +30,10 @@ import time
 import warnings
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Callable, Iterator, Sequence
+from typing import IO, Callable, Iterable, Iterator, Sequence
 
 from ._io import atomic, is_stream, unique_names, unit
-from ._text import visible
+from ._text import one_line, visible
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -42,10 +42,13 @@ __all__ = ["main", "build_parser", "exit_code", "bundled_models", "CLIError"]
 
 
 class CLIError(Exception):
-    """A problem with the command's input or options: one message, exit code `code`."""
+    """A problem with the command's input or options: one message, exit code `code`. The message
+    is one line (its newlines and control characters written as "\\n" etc.: no forged
+    "kinetostat: error:" line from a name or a path), or the given `lines`, each made one line."""
 
-    def __init__(self, message: str, code: int = EXIT_USAGE):
-        super().__init__(message)
+    def __init__(self, message: str = "", code: int = EXIT_USAGE, lines: Sequence[str] = ()):
+        self.lines = tuple(one_line(s) for s in (lines or [message]))
+        super().__init__("\n".join(self.lines))
         self.code = code
 
 
@@ -71,9 +74,15 @@ class _Out:
             raise CLIError(f"cannot write to {'stderr' if err else 'stdout'}: {exc.strerror or exc}") from None
 
 
-def _error(msg: str) -> None:
+def _lines(lines: Iterable[str]) -> str:
+    """Lines for stdout, each made one line: a name's newline prints as "\\n", never a forged line."""
+    return "\n".join(map(one_line, lines))
+
+
+def _error(msg: str | CLIError) -> None:
+    """The error line (a CLIError's lines, each made one line already)."""
     try:
-        _Out.write(f"kinetostat: error: {msg}", err=True)
+        _Out.write(f"kinetostat: error: {msg if isinstance(msg, CLIError) else one_line(msg)}", err=True)
     except (CLIError, OSError):          # stderr itself cannot be written: the exit code says it
         pass
 
@@ -162,7 +171,7 @@ def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bo
 
 
 def _warn(msg: str) -> None:
-    _Out.write(f"kinetostat: warning: {msg}", err=True)
+    _Out.write(f"kinetostat: warning: {one_line(msg)}", err=True)
 
 
 def _showwarning(message, category, filename, lineno, file=None, line=None):
@@ -260,11 +269,11 @@ def bundled_models() -> list[Path]:
     return files
 
 
-def _model_error_text(exc) -> str:
+def _model_error_lines(exc) -> list[str]:
     """A ModelError as the CLI prints it: the file, then each problem led by its line."""
     if len(exc.located) == 1:
-        return f"{exc.source}: {exc.located[0]}"
-    return f"{exc.source}: {len(exc.located)} problems:\n" + "\n".join(f"  - {p}" for p in exc.located)
+        return [f"{exc.source}: {exc.located[0]}"]
+    return [f"{exc.source}: {len(exc.located)} problems:"] + [f"  - {p}" for p in exc.located]
 
 
 def _load(path: str | Path):
@@ -281,7 +290,7 @@ def _load(path: str | Path):
     try:
         return load(p)
     except ModelError as exc:
-        raise CLIError(_model_error_text(exc)) from None
+        raise CLIError(lines=_model_error_lines(exc)) from None
     except StructureError as exc:
         msg = str(exc)
         raise CLIError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
@@ -366,7 +375,7 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
         except AssemblyError as exc:
             raise CLIError(f"{path}: {exc}") from None
         except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
-            raise CLIError(_model_error_text(exc)) from None
+            raise CLIError(lines=_model_error_lines(exc)) from None
     seen = set()
     for w in caught:
         text = str(w.message).splitlines()[0]
@@ -437,14 +446,14 @@ def _prepare(paths: Sequence[str | Path], steps: int):
             mech = _load(path)
             res, secs = _analyze(mech, Path(path), steps=steps)
         except CLIError as exc:
-            problems.append(str(exc))
+            problems.append(exc)
             continue
         jobs.append((Path(path), mech, res, secs))
     if problems:
         for p in problems[:-1]:
             _error(p)
-        raise CLIError(problems[-1] + (f"\n(nothing run: {len(problems)} of {len(paths)} models have errors)"
-                                       if len(paths) > 1 else ""))
+        raise CLIError(lines=problems[-1].lines + ((f"(nothing run: {len(problems)} of {len(paths)} models have "
+                                                    f"errors)",) if len(paths) > 1 else ()))
     return jobs
 
 
@@ -546,7 +555,7 @@ def cmd_analyze(args) -> int:
             lines.append(f"table: {len(df)} rows x {len(df.columns)} columns -> {out}")
     else:
         lines.append("(the full table: --out FILE.csv | FILE.parquet | FILE.json)")
-    _Out.write("\n".join(lines), err=(out == "-"))
+    _Out.write(_lines(lines), err=(out == "-"))
     return EXIT_OK
 
 
@@ -580,7 +589,7 @@ def cmd_structure(args) -> int:
     if m.expressions:
         lines.append("numbers from expressions:")
         lines += [f"  {path} = {text} = {v:.10g}" for path, (text, v) in m.expressions.items()]
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -644,7 +653,7 @@ def validation_table(run) -> str:
     lines.append(_coverage(run))
     lines.append(f"  => {verdict}: {n} checks ({len(run.published)} published values), {f} failed, "
                  f"{len(run.skipped)} route(s) skipped, {len(run.errors)} with errors")
-    return "\n".join(lines)
+    return _lines(lines)
 
 
 def cmd_validate(args) -> int:
@@ -861,7 +870,7 @@ def cmd_export(args) -> int:
     except AssemblyError as exc:
         raise CLIError(f"{path}: {exc}") from None
     except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
-        raise CLIError(_model_error_text(exc)) from None
+        raise CLIError(lines=_model_error_lines(exc)) from None
     if args.output is None or args.output == "-":
         _Out.write(text.rstrip("\n"))
         return EXIT_OK
@@ -955,7 +964,7 @@ def cmd_examples(args) -> int:
     for path in bundled_models():
         m = _load(path)
         lines.append(f"  {path.stem:<24s} {m.structure.formula:<34s} {m.source or m.name}")
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -1008,7 +1017,7 @@ def cmd_variant(args) -> int:
                    f"index -> {index}; {time.perf_counter() - t0:.1f} s")
         return EXIT_OK
     lines = variants.summary(jobs[0], keys[0], out, args.lang)
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -1123,7 +1132,7 @@ def cmd_sweep(args) -> int:
         from .kinematics import DIGITS_WARN
         lines.append(f"{len(warned)} design(s) keep values with fewer than {DIGITS_WARN} significant digits near a "
                      f"singular position, down to {warned.min():.1f} (columns worst_digits, warned_deg)")
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -1332,7 +1341,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             sys.stdout.flush()           # stdout on a full disk fails here, not at the interpreter's exit
             return code
         except CLIError as exc:
-            _error(str(exc))
+            _error(exc)
             return exc.code
         except KeyboardInterrupt:
             _error("interrupted")
