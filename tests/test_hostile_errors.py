@@ -274,6 +274,8 @@ def test_did_you_mean_work_is_bounded(monkeypatch):
     (("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01], " + "N" * 10_000 + " = [0.2, 0.0] }"),
      "link[id=3].points: a point name of 10000 characters ('NNNNNNNNNNNNNNNNNNNN'...), at most 200"),
     (('name = "resisting moment"', 'name = "' + "N" * 10_000 + '"'), "load[0].name: 10000 characters, at most 200"),
+    # the mechanism's own name (it titles every sheet and page): 100,000 characters took `report` 24.5 s
+    (('name = "test four-bar"', 'name = "' + "N" * 100_000 + '"'), "mechanism.name: 100000 characters, at most 200"),
 ])
 def test_a_name_of_10000_characters_is_refused_before_any_plot(edit, message, tmp_path, cli):
     """A point named with 10,000 characters made a report take two minutes (its labels); names
