@@ -8,6 +8,7 @@ May use: the standard library, numpy, errors, expressions, planar, structure, ex
 from __future__ import annotations
 
 import functools
+import keyword
 import math
 import re
 import stat
@@ -745,6 +746,9 @@ class _Reader:
             elif unicodedata.normalize("NFKC", name) != name:
                 self.err(f"parameters.{name}: {_code_points(name)} reads as {_code_points(unicodedata.normalize('NFKC', name))} "
                          f"in expressions (Unicode NFKC, as Python folds names); write it so")
+            elif keyword.iskeyword(name):
+                self.err(f"parameters.{name}: {name!r} is a Python keyword, which an expression reads as itself, "
+                         f"never as this parameter; choose another name")
             elif not name.isidentifier() or name.startswith("__"):
                 self.err(f"parameters.{name}: a parameter's name is a Python-style identifier (letters, digits, _)")
         for name, x in self.overrides.items():
