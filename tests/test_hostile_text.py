@@ -89,11 +89,13 @@ def test_no_csv_cell_is_a_formula(tmp_path, cli):
 
 def test_worksheet_markdown_carries_no_tag_from_a_name(tmp_path, cli):
     out = tmp_path / "plans"
-    p = cli("plans", _model(tmp_path, name="<script>alert(1)</script> [x](javascript:alert(2)) a|b"), "--out", out)
+    p = cli("plans", _model(tmp_path, name="<script>alert(1)</script> [x](javascript:alert(2)) a|b __bold__ _em_"),
+            "--out", out)
     assert p.returncode == 0, p.stderr
     md = (out / "worksheet.md").read_text(encoding="utf-8")
     assert "<script" not in md and "&lt;script>alert(1)&lt;/script>" in md
     assert "\\[x\\](javascript:alert(2))" in md and "a\\|b" in md
+    assert "\\_\\_bold\\_\\_ \\_em\\_" in md                   # no emphasis from underscores
     assert "<script" not in (out / "worksheet.html").read_text(encoding="utf-8")
 
 
