@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import os
 import signal
+import socket
 import subprocess
 import sys
 import tracemalloc
+import warnings
 
 import numpy as np
 import pytest
@@ -88,9 +90,22 @@ def test_a_scheduler_with_no_worker_stops_with_a_message(monkeypatch):
     distributed = pytest.importorskip("distributed")
     sweep_module = sys.modules["kinetostat.sweep"]
     monkeypatch.setattr(sweep_module, "CONNECT_TIMEOUT", 0.5)
-    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
-        with pytest.raises(ConnectionError, match="no worker joined it within 0.5 s"):
-            kinetostat.sweep("ice_crank_slider", {"g": [9.8]}, steps=4, scheduler=cluster.scheduler_address)
+    busy = socket.socket()              # the dashboard's default port taken (by this test, or already by another)
+    try:
+        busy.bind(("", 8787))
+    except OSError:
+        pass
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            # no dashboard; the scheduler's HTTP routes on a free port, not 8787 ("Port 8787 is already in use")
+            with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None,
+                                          scheduler_kwargs={"dashboard_address": ":0"}) as cluster:
+                with pytest.raises(ConnectionError, match="no worker joined it within 0.5 s"):
+                    kinetostat.sweep("ice_crank_slider", {"g": [9.8]}, steps=4, scheduler=cluster.scheduler_address)
+    finally:
+        busy.close()
+    assert not [str(w.message) for w in caught if "already in use" in str(w.message)]
 
 
 SITE = '''
