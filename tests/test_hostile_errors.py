@@ -2,6 +2,8 @@
 error line (exit 2 from the command line, 130 for Ctrl-C) and bounded work, shown by counting."""
 from __future__ import annotations
 
+import csv
+import io
 import os
 import signal
 import socket
@@ -259,9 +261,19 @@ def test_plans_and_worksheet_at_a_warned_angle_state_the_accuracy(tmp_path, cli)
     assert "kinetostat: warning:" in p.stderr and "phi = [179] deg" in p.stderr and "8.0 to 8.0" in p.stderr
     assert "about 8.0 significant digits left at this angle" in (out / "worksheet.md").read_text(encoding="utf-8")
     assert '"digits": 8.0' in (out / "worksheet.json").read_text(encoding="utf-8")
+    line = "Accuracy: near a singular position: about 8.0 significant digits left at this angle (fewer than 10)"
+    sheets = sorted(out.glob("*.svg"))
+    assert len(sheets) == 8 and all(line in q.read_text(encoding="utf-8") for q in sheets)     # every sheet says it
+    rows = list(csv.DictReader(io.StringIO((out / "worksheet.csv").read_text(encoding="utf-8"))))
+    assert (rows[0]["section"], rows[0]["key"], float(rows[0]["value"])) == ("Accuracy", "digits", 8.0)
+    assert rows[0]["note"].startswith("near a singular position: about 8.0 significant digits left")
     calm = tmp_path / "calm"
     assert cli("plans", TOGGLE, "--at", "90", "--out", calm).returncode == 0
-    assert "Accuracy" not in (calm / "worksheet.md").read_text(encoding="utf-8")
+    assert not any("Accuracy" in q.read_text(encoding="utf-8") for q in [*calm.glob("*.svg"), *calm.glob("worksheet.*")])
+    uk = tmp_path / "uk"
+    assert cli("plans", TOGGLE, "--at", "179", "--lang", "uk", "--only", "velocity", "--out", uk).returncode == 0
+    assert "Точність: поблизу особливого положення: лишилося близько 8,0 значущих цифр" in (
+        uk / "velocity.svg").read_text(encoding="utf-8")
 
 
 def test_did_you_mean_work_is_bounded(monkeypatch):

@@ -19,6 +19,7 @@ pandas only inside `Plans.segments_frame` and `Plans.segments_csv`; never the ha
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
@@ -26,6 +27,7 @@ from typing import Callable, Iterable
 
 from .._io import write_text
 from .._text import csv_cell
+from ..kinematics import DIGITS_WARN
 from ..tables import FLOAT_FORMAT, by_unit, rounded
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment, extent
 from .draw import fits
@@ -174,6 +176,8 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
         if name in chosen:
             made = steps[name](mech, res, sc)
             plans.extend(made if isinstance(made, (list, tuple)) else [made])
+    if res.digits[0] < DIGITS_WARN:                 # each sheet states the accuracy at this angle
+        plans = [replace(p, accuracy=(float(res.digits[0]), DIGITS_WARN)) for p in plans]
     for p in plans:
         x0, y0, x1, y1 = extent(p)
         ends = [r[c] for r in p.rows() for c in ("x0_mm", "y0_mm", "x1_mm", "y1_mm")]
