@@ -707,7 +707,7 @@ def cmd_validate(args) -> int:
         from .report import junit_xml
         tree = junit_xml(runs)
         _save(junit, "--junit", lambda f: tree.write(f, encoding="utf-8", xml_declaration=True), binary=True)
-        _Out.write(f"JUnit XML -> {junit}")
+        _Out.write(one_line(f"JUnit XML -> {junit}"))
     return code
 
 
@@ -737,7 +737,7 @@ def _write_validation_json(runs, code: int, dest) -> None:
         _Out.write(text.rstrip("\n"))
         return
     _save(dest, "--json", lambda f: f.write(text))
-    _Out.write(f"JSON -> {dest}")
+    _Out.write(one_line(f"JSON -> {dest}"))
 
 
 # ============================================================================ report
@@ -839,8 +839,8 @@ def cmd_report(args) -> int:
             n_fail += not s["passed"]
             status = "PASS" if s["passed"] and s["checked"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
-            _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
-                       f"  -> {out / s['stem'] / 'index.html'}")
+            _Out.write(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
+                                f"  -> {out / s['stem'] / 'index.html'}"))
         index = out / "index.md"
         keep = n_err and index.exists()     # a model without a report: the earlier index is not lost
         if not keep:
@@ -850,11 +850,11 @@ def cmd_report(args) -> int:
                 raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
         _close(bar)
-    _Out.write(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
-               + (f", {n_err} without a report (errors above)" if n_err else "")
-               + (f"; the earlier index {index} stays as it was" if keep else
-                  f"; index -> {index} and {index.with_suffix('.html')}")
-               + f"; {time.perf_counter() - t0:.1f} s")
+    _Out.write(one_line(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
+                        + (f", {n_err} without a report (errors above)" if n_err else "")
+                        + (f"; the earlier index {index} stays as it was" if keep else
+                           f"; index -> {index} and {index.with_suffix('.html')}")
+                        + f"; {time.perf_counter() - t0:.1f} s"))
     return EXIT_FAIL if n_err else EXIT_OK
 
 
@@ -875,7 +875,7 @@ def cmd_export(args) -> int:
         _Out.write(text.rstrip("\n"))
         return EXIT_OK
     _save(args.output, "-o", lambda f: f.write(text))
-    _Out.write(f"{args.format.upper()} of {path.name} -> {args.output}")
+    _Out.write(one_line(f"{args.format.upper()} of {path.name} -> {args.output}"))
     return EXIT_OK
 
 
@@ -939,7 +939,7 @@ def cmd_plans(args) -> int:
                and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
-    _Out.write(plans.summary(path.name, len(written), out, args.lang))
+    _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))
     return EXIT_OK
 
 
@@ -957,7 +957,7 @@ def cmd_examples(args) -> int:
                            f"(--force replaces them)") from None
         except OSError as exc:
             raise CLIError(f"cannot write --copy {args.copy}: {exc.strerror or exc}") from None
-        _Out.write(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}")
+        _Out.write(one_line(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}"))
         return EXIT_OK
     lines = [f"bundled models in {examples.models_dir()} (by name: kinetostat.load(NAME); "
              f"copies: kinetostat examples --copy DIR):"]
@@ -1013,8 +1013,8 @@ def cmd_variant(args) -> int:
     finally:
         _close(bar)
     if args.all:
-        _Out.write(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
-                   f"index -> {index}; {time.perf_counter() - t0:.1f} s")
+        _Out.write(one_line(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
+                            f"index -> {index}; {time.perf_counter() - t0:.1f} s"))
         return EXIT_OK
     lines = variants.summary(jobs[0], keys[0], out, args.lang)
     _Out.write(_lines(lines))

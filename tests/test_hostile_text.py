@@ -163,3 +163,10 @@ def test_a_model_files_problem_list_keeps_one_line_per_problem(tmp_path, cli):
     lines = p.stderr.splitlines()
     assert p.returncode == 2 and lines[0].startswith("kinetostat: error:") and lines[0].endswith("2 problems:"), p.stderr
     assert len(lines) == 3 and all(line.startswith("  - ") for line in lines[1:]) and "x\\ny" in p.stderr
+
+
+def test_a_newline_in_an_output_path_prints_one_line_on_stdout(tmp_path, cli):
+    out = tmp_path / "m\nkinetostat: error: forged.xml"
+    p = cli("export", ICE, "--mjcf", "-o", out)
+    assert p.returncode == 0 and out.exists(), p.stderr
+    assert p.stdout.count("\n") == 1 and "m\\nkinetostat: error: forged.xml" in p.stdout, p.stdout
