@@ -32,7 +32,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Callable, Iterable, Iterator, Sequence
 
-from ._io import atomic, is_stream, unique_names, unit
+from ._io import _sigint_deferred, atomic, is_stream, unique_names, unit
 from ._text import one_line, visible
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
@@ -398,8 +398,8 @@ def _writable_file(path: str, option: str) -> Path:
             raise CLIError(f"cannot write {option} {p}: it is a directory")
         if len(os.fsencode(p.name)) > os.pathconf(p.parent, "PC_NAME_MAX"):
             raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
-        with tempfile.NamedTemporaryFile(dir=p.parent, prefix=".kinetostat-probe-"):
-            pass
+        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p.parent, prefix=".kinetostat-probe-"):
+            pass                         # Ctrl-C held back till the probe is gone: none left behind
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
     return p
@@ -409,7 +409,7 @@ def _writable_dir(path: str, option: str) -> Path:
     p = Path(path)
     try:
         p.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=p, prefix=".kinetostat-probe-"):
+        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p, prefix=".kinetostat-probe-"):
             pass
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None

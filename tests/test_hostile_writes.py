@@ -225,3 +225,21 @@ def test_a_set_is_swapped_in_whole(tmp_path):
         assert (out / "a.csv").read_text() == "old a\n"          # nothing seen before the end
     assert _files(out) == {"a.csv": b"new a\n", "b.csv": b"new b\n", "mine.txt": b"mine\n"}
     assert outside.read_text() == "outside\n" and not (out / "b.csv").is_symlink()
+
+
+def test_ctrl_c_as_an_output_is_probed_leaves_no_probe(tmp_path, cli, monkeypatch):
+    """Ctrl-C the moment the check that --out is writable has made its probe file (tempfile's
+    window between creating the file and guarding it): the command stops (exit 130) once the
+    probe is removed (a probe was once left beside the table)."""
+    import signal
+    import tempfile
+    real, made = tempfile._mkstemp_inner, []
+
+    def inner(*args, **kwargs):
+        fd, name = real(*args, **kwargs)
+        made.append(name)
+        os.kill(os.getpid(), signal.SIGINT)
+        return fd, name
+    monkeypatch.setattr(tempfile, "_mkstemp_inner", inner)
+    p = cli("analyze", ICE, "--steps", "4", "--out", tmp_path / "t.csv")
+    assert p.returncode == 130 and len(made) == 1 and list(tmp_path.iterdir()) == [], p.stderr
