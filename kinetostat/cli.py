@@ -9,10 +9,10 @@ route named with --engines whose engine is not installed; 130 interrupted (Ctrl-
 exits 0 once its table is written, also where designs failed (each keeps its row with the
 reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model file's
 problem list prints one line per problem) and never a traceback; warnings print one line each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
-disk leaves the previous file as it was; a device, FIFO or stdout named as an output is written
-as a stream, never replaced; the files of `plans`, `variant` and each model's `report` are
+disk leaves the previous file as it was; a device, FIFO, or the process's own stdout or stderr
+(also through a link, e.g. /dev/stderr) named as an output is written as a stream, never replaced; the files of `plans`, `variant` and each model's `report` are
 swapped in as a set (`kinetostat._io.unit`). Text from a model is printed with its control
-characters visible.
+characters visible, and every error, warning and summary line stays one line (a newline as \\n).
 
 May use: every room of the package, and the harness inside the commands that need it
 (imported there, so that `import kinetostat.cli` loads no engine).
