@@ -35,14 +35,48 @@ def _file_mode(path: Path) -> int:
         return 0o666 & ~umask
 
 
+#: A name that stands for a process's open file: /proc/PID/fd/N, /dev/fd/N, /dev/stdin|stdout|stderr.
+_STREAM_NAME = re.compile(r"/(proc/[^/]+/fd|dev/fd)/\d+|/dev/std(in|out|err)")
+
+
+def _names_a_stream(path: str | Path) -> bool:
+    """True where `path`, or a link on the way from it (at most 40 followed), is one of the
+    _STREAM_NAME names: a process's own stdout or stderr even where that is a regular file."""
+    p = os.path.abspath(path)
+    for _ in range(40):
+        p = os.path.join(os.path.realpath(os.path.dirname(p)), os.path.basename(p))   # its folder resolved
+        if _STREAM_NAME.fullmatch(p):
+            return True
+        try:
+            target = os.readlink(p)
+        except (OSError, ValueError):                 # not a link, or not there
+            return False
+        p = os.path.join(os.path.dirname(p), target)
+    return False
+
+
+def _is_std_file(st: os.stat_result) -> bool:
+    """True where `st` is the file this process's stdin, stdout or stderr is open on."""
+    for fd in (0, 1, 2):
+        try:
+            s = os.fstat(fd)
+        except OSError:
+            continue
+        if (s.st_dev, s.st_ino) == (st.st_dev, st.st_ino):
+            return True
+    return False
+
+
 def is_stream(path: str | Path) -> bool:
     """True where `path` (links followed) exists and is not a regular file or folder: a device
-    (/dev/null, /dev/stdout on a terminal or a pipe), a FIFO or a socket."""
+    (/dev/null, /dev/stdout on a terminal or a pipe), a FIFO or a socket; or where it is, or links
+    into, /proc/*/fd, /dev/fd or /dev/std* (e.g. /dev/stderr with stderr redirected to a file),
+    or is the very file stdin, stdout or stderr is open on: never replaced by a new file."""
     try:
-        mode = os.stat(path).st_mode
+        st = os.stat(path)
     except (OSError, ValueError):
         return False
-    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+    return not (stat.S_ISREG(st.st_mode) or stat.S_ISDIR(st.st_mode)) or _names_a_stream(path) or _is_std_file(st)
 
 
 _TEMPORARY_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
@@ -59,7 +93,7 @@ def atomic(path: str | Path, binary: bool = False, stream: bool = False) -> Iter
     old `path` as it was. Text is UTF-8; a name the file system cannot hold raises OSError.
 
     Only a regular file (or a link, which is replaced, never followed) is replaced. A device,
-    FIFO or socket at `path` (links followed) is written as a stream where `stream` (a path the
+    FIFO, socket or link to a process's own stream at `path` (`is_stream`) is written as a stream where `stream` (a path the
     user named, e.g. `-o /dev/null`), else refused (OSError) and left as it was.
     """
     path = Path(path)
@@ -135,8 +169,9 @@ def _moves(tmp: Path, folder: Path, root: Path) -> list[tuple[Path, Path]]:
             mode = os.lstat(dst).st_mode
         except FileNotFoundError:
             mode = None
-        if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISLNK(mode)):
-            raise OSError(22, "not a regular file (a device, FIFO, socket or folder); left as it is", str(dst))
+        if mode is not None and (not (stat.S_ISREG(mode) or stat.S_ISLNK(mode)) or is_stream(dst)):
+            raise OSError(22, "not a regular file (a device, FIFO, socket, folder or a stream's link); "
+                          "left as it is", str(dst))
         if mode is not None and stat.S_ISREG(mode):
             os.chmod(src, mode & 0o7777)        # the mode of the file it replaces
         moves.append((src, dst))

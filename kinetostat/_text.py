@@ -18,8 +18,9 @@ _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
 _CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 #: The first characters that make a spreadsheet read a cell as a formula (OWASP, CSV injection).
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r", "\n")
-#: Characters that make emphasis, code, links, table cells or strike-through in Markdown anywhere in a line.
-_MARKDOWN = re.compile(r"([\\`*\[\]|~])")
+#: Characters that make emphasis, code, links, table cells or strike-through in Markdown anywhere in a line;
+#: `_` where it can open or close emphasis (CommonMark: not between two letters or digits, as in V_BA).
+_MARKDOWN = re.compile(r"([\\`*\[\]|~]|(?<![^\W_])_|_(?![^\W_]))")
 
 
 def _escaped(m: re.Match) -> str:
@@ -59,8 +60,8 @@ def csv_cell(x: Any) -> Any:
 
 
 def markdown_text(s: str) -> str:
-    """`s` as literal text inside a Markdown line (a table cell, a heading): \\ ` * [ ] | ~
-    backslash-escaped, & < as entities (no tag, link, emphasis or extra cell from a name),
+    """`s` as literal text inside a Markdown line (a table cell, a heading): \\ ` * [ ] | ~ and
+    a `_` not inside a word backslash-escaped, & < as entities (no tag, link, emphasis or extra cell from a name),
     controls visible, one line."""
     s = _MARKDOWN.sub(r"\\\1", one_line(s))
     return s.replace("&", "&amp;").replace("<", "&lt;")

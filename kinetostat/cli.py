@@ -9,10 +9,10 @@ route named with --engines whose engine is not installed; 130 interrupted (Ctrl-
 exits 0 once its table is written, also where designs failed (each keeps its row with the
 reason in `error`). Expected problems print one `kinetostat: error: ...` line (a model file's
 problem list prints one line per problem) and never a traceback; warnings print one line each. Every output file is written atomically (`kinetostat._io.atomic`): an interrupt or a full
-disk leaves the previous file as it was; a device, FIFO or stdout named as an output is written
-as a stream, never replaced; the files of `plans`, `variant` and each model's `report` are
+disk leaves the previous file as it was; a device, FIFO, or the process's own stdout or stderr
+(also through a link, e.g. /dev/stderr) named as an output is written as a stream, never replaced; the files of `plans`, `variant` and each model's `report` are
 swapped in as a set (`kinetostat._io.unit`). Text from a model is printed with its control
-characters visible.
+characters visible, and every error, warning and summary line stays one line (a newline as \\n).
 
 May use: every room of the package, and the harness inside the commands that need it
 (imported there, so that `import kinetostat.cli` loads no engine).
@@ -30,10 +30,10 @@ import time
 import warnings
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO, Callable, Iterator, Sequence
+from typing import IO, Callable, Iterable, Iterator, Sequence
 
-from ._io import atomic, is_stream, unique_names, unit
-from ._text import visible
+from ._io import _sigint_deferred, atomic, is_stream, unique_names, unit
+from ._text import one_line, visible
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -42,10 +42,13 @@ __all__ = ["main", "build_parser", "exit_code", "bundled_models", "CLIError"]
 
 
 class CLIError(Exception):
-    """A problem with the command's input or options: one message, exit code `code`."""
+    """A problem with the command's input or options: one message, exit code `code`. The message
+    is one line (its newlines and control characters written as "\\n" etc.: no forged
+    "kinetostat: error:" line from a name or a path), or the given `lines`, each made one line."""
 
-    def __init__(self, message: str, code: int = EXIT_USAGE):
-        super().__init__(message)
+    def __init__(self, message: str = "", code: int = EXIT_USAGE, lines: Sequence[str] = ()):
+        self.lines = tuple(one_line(s) for s in (lines or [message]))
+        super().__init__("\n".join(self.lines))
         self.code = code
 
 
@@ -71,9 +74,15 @@ class _Out:
             raise CLIError(f"cannot write to {'stderr' if err else 'stdout'}: {exc.strerror or exc}") from None
 
 
-def _error(msg: str) -> None:
+def _lines(lines: Iterable[str]) -> str:
+    """Lines for stdout, each made one line: a name's newline prints as "\\n", never a forged line."""
+    return "\n".join(map(one_line, lines))
+
+
+def _error(msg: str | CLIError) -> None:
+    """The error line (a CLIError's lines, each made one line already)."""
     try:
-        _Out.write(f"kinetostat: error: {msg}", err=True)
+        _Out.write(f"kinetostat: error: {msg if isinstance(msg, CLIError) else one_line(msg)}", err=True)
     except (CLIError, OSError):          # stderr itself cannot be written: the exit code says it
         pass
 
@@ -162,7 +171,7 @@ def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bo
 
 
 def _warn(msg: str) -> None:
-    _Out.write(f"kinetostat: warning: {msg}", err=True)
+    _Out.write(f"kinetostat: warning: {one_line(msg)}", err=True)
 
 
 def _showwarning(message, category, filename, lineno, file=None, line=None):
@@ -260,11 +269,11 @@ def bundled_models() -> list[Path]:
     return files
 
 
-def _model_error_text(exc) -> str:
+def _model_error_lines(exc) -> list[str]:
     """A ModelError as the CLI prints it: the file, then each problem led by its line."""
     if len(exc.located) == 1:
-        return f"{exc.source}: {exc.located[0]}"
-    return f"{exc.source}: {len(exc.located)} problems:\n" + "\n".join(f"  - {p}" for p in exc.located)
+        return [f"{exc.source}: {exc.located[0]}"]
+    return [f"{exc.source}: {len(exc.located)} problems:"] + [f"  - {p}" for p in exc.located]
 
 
 def _load(path: str | Path):
@@ -281,7 +290,7 @@ def _load(path: str | Path):
     try:
         return load(p)
     except ModelError as exc:
-        raise CLIError(_model_error_text(exc)) from None
+        raise CLIError(lines=_model_error_lines(exc)) from None
     except StructureError as exc:
         msg = str(exc)
         raise CLIError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
@@ -366,7 +375,7 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
         except AssemblyError as exc:
             raise CLIError(f"{path}: {exc}") from None
         except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
-            raise CLIError(_model_error_text(exc)) from None
+            raise CLIError(lines=_model_error_lines(exc)) from None
     seen = set()
     for w in caught:
         text = str(w.message).splitlines()[0]
@@ -389,8 +398,8 @@ def _writable_file(path: str, option: str) -> Path:
             raise CLIError(f"cannot write {option} {p}: it is a directory")
         if len(os.fsencode(p.name)) > os.pathconf(p.parent, "PC_NAME_MAX"):
             raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
-        with tempfile.NamedTemporaryFile(dir=p.parent, prefix=".kinetostat-probe-"):
-            pass
+        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p.parent, prefix=".kinetostat-probe-"):
+            pass                         # Ctrl-C held back till the probe is gone: none left behind
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
     return p
@@ -400,7 +409,7 @@ def _writable_dir(path: str, option: str) -> Path:
     p = Path(path)
     try:
         p.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=p, prefix=".kinetostat-probe-"):
+        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p, prefix=".kinetostat-probe-"):
             pass
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
@@ -437,14 +446,14 @@ def _prepare(paths: Sequence[str | Path], steps: int):
             mech = _load(path)
             res, secs = _analyze(mech, Path(path), steps=steps)
         except CLIError as exc:
-            problems.append(str(exc))
+            problems.append(exc)
             continue
         jobs.append((Path(path), mech, res, secs))
     if problems:
         for p in problems[:-1]:
             _error(p)
-        raise CLIError(problems[-1] + (f"\n(nothing run: {len(problems)} of {len(paths)} models have errors)"
-                                       if len(paths) > 1 else ""))
+        raise CLIError(lines=problems[-1].lines + ((f"(nothing run: {len(problems)} of {len(paths)} models have "
+                                                    f"errors)",) if len(paths) > 1 else ()))
     return jobs
 
 
@@ -546,7 +555,7 @@ def cmd_analyze(args) -> int:
             lines.append(f"table: {len(df)} rows x {len(df.columns)} columns -> {out}")
     else:
         lines.append("(the full table: --out FILE.csv | FILE.parquet | FILE.json)")
-    _Out.write("\n".join(lines), err=(out == "-"))
+    _Out.write(_lines(lines), err=(out == "-"))
     return EXIT_OK
 
 
@@ -580,7 +589,7 @@ def cmd_structure(args) -> int:
     if m.expressions:
         lines.append("numbers from expressions:")
         lines += [f"  {path} = {text} = {v:.10g}" for path, (text, v) in m.expressions.items()]
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -644,7 +653,7 @@ def validation_table(run) -> str:
     lines.append(_coverage(run))
     lines.append(f"  => {verdict}: {n} checks ({len(run.published)} published values), {f} failed, "
                  f"{len(run.skipped)} route(s) skipped, {len(run.errors)} with errors")
-    return "\n".join(lines)
+    return _lines(lines)
 
 
 def cmd_validate(args) -> int:
@@ -698,7 +707,7 @@ def cmd_validate(args) -> int:
         from .report import junit_xml
         tree = junit_xml(runs)
         _save(junit, "--junit", lambda f: tree.write(f, encoding="utf-8", xml_declaration=True), binary=True)
-        _Out.write(f"JUnit XML -> {junit}")
+        _Out.write(one_line(f"JUnit XML -> {junit}"))
     return code
 
 
@@ -728,7 +737,7 @@ def _write_validation_json(runs, code: int, dest) -> None:
         _Out.write(text.rstrip("\n"))
         return
     _save(dest, "--json", lambda f: f.write(text))
-    _Out.write(f"JSON -> {dest}")
+    _Out.write(one_line(f"JSON -> {dest}"))
 
 
 # ============================================================================ report
@@ -830,8 +839,8 @@ def cmd_report(args) -> int:
             n_fail += not s["passed"]
             status = "PASS" if s["passed"] and s["checked"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
-            _Out.write(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
-                       f"  -> {out / s['stem'] / 'index.html'}")
+            _Out.write(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
+                                f"  -> {out / s['stem'] / 'index.html'}"))
         index = out / "index.md"
         keep = n_err and index.exists()     # a model without a report: the earlier index is not lost
         if not keep:
@@ -841,11 +850,11 @@ def cmd_report(args) -> int:
                 raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
         _close(bar)
-    _Out.write(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
-               + (f", {n_err} without a report (errors above)" if n_err else "")
-               + (f"; the earlier index {index} stays as it was" if keep else
-                  f"; index -> {index} and {index.with_suffix('.html')}")
-               + f"; {time.perf_counter() - t0:.1f} s")
+    _Out.write(one_line(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
+                        + (f", {n_err} without a report (errors above)" if n_err else "")
+                        + (f"; the earlier index {index} stays as it was" if keep else
+                           f"; index -> {index} and {index.with_suffix('.html')}")
+                        + f"; {time.perf_counter() - t0:.1f} s"))
     return EXIT_FAIL if n_err else EXIT_OK
 
 
@@ -861,12 +870,12 @@ def cmd_export(args) -> int:
     except AssemblyError as exc:
         raise CLIError(f"{path}: {exc}") from None
     except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
-        raise CLIError(_model_error_text(exc)) from None
+        raise CLIError(lines=_model_error_lines(exc)) from None
     if args.output is None or args.output == "-":
         _Out.write(text.rstrip("\n"))
         return EXIT_OK
     _save(args.output, "-o", lambda f: f.write(text))
-    _Out.write(f"{args.format.upper()} of {path.name} -> {args.output}")
+    _Out.write(one_line(f"{args.format.upper()} of {path.name} -> {args.output}"))
     return EXIT_OK
 
 
@@ -905,6 +914,7 @@ def cmd_plans(args) -> int:
     from .plans import build
     from .plans.worksheet import worksheet
     from .plans.lettering import lettering
+    from .plans.scales import ScaleError
     path = Path(args.model)
     mech = _load(path)
     args.lang = args.lang or lettering(mech).language or "en"
@@ -916,12 +926,10 @@ def cmd_plans(args) -> int:
             warnings.simplefilter("always")
             plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
+    except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
+        raise CLIError(f"--scale {exc}") from None
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
-    huge = [r for r in plans.rows() if not all(map(math.isfinite, (r["x0_mm"], r["y0_mm"], r["x1_mm"], r["y1_mm"])))]
-    if huge:                              # a scale so small that a segment's end is beyond any float
-        raise CLIError(f"--scale: the {huge[0]['plan']} plan's segment {huge[0]['segment']} would end beyond "
-                       f"1e308 mm at {huge[0]['scale']}; use a larger scale")
     try:
         with unit(out) as tmp:                # swapped in as a set: never new sheets beside an old worksheet
             written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])
@@ -931,7 +939,7 @@ def cmd_plans(args) -> int:
                and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
-    _Out.write(plans.summary(path.name, len(written), out, args.lang))
+    _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))
     return EXIT_OK
 
 
@@ -949,14 +957,14 @@ def cmd_examples(args) -> int:
                            f"(--force replaces them)") from None
         except OSError as exc:
             raise CLIError(f"cannot write --copy {args.copy}: {exc.strerror or exc}") from None
-        _Out.write(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}")
+        _Out.write(one_line(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}"))
         return EXIT_OK
     lines = [f"bundled models in {examples.models_dir()} (by name: kinetostat.load(NAME); "
              f"copies: kinetostat examples --copy DIR):"]
     for path in bundled_models():
         m = _load(path)
         lines.append(f"  {path.stem:<24s} {m.structure.formula:<34s} {m.source or m.name}")
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -1010,11 +1018,11 @@ def cmd_variant(args) -> int:
     finally:
         _close(bar)
     if args.all:
-        _Out.write(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
-                   f"index -> {index}; {time.perf_counter() - t0:.1f} s")
+        _Out.write(one_line(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
+                            f"index -> {index}; {time.perf_counter() - t0:.1f} s"))
         return EXIT_OK
     lines = variants.summary(jobs[0], keys[0], out, args.lang)
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -1129,7 +1137,7 @@ def cmd_sweep(args) -> int:
         from .kinematics import DIGITS_WARN
         lines.append(f"{len(warned)} design(s) keep values with fewer than {DIGITS_WARN} significant digits near a "
                      f"singular position, down to {warned.min():.1f} (columns worst_digits, warned_deg)")
-    _Out.write("\n".join(lines))
+    _Out.write(_lines(lines))
     return EXIT_OK
 
 
@@ -1342,7 +1350,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             sys.stdout.flush()           # stdout on a full disk fails here, not at the interpreter's exit
             return code
         except CLIError as exc:
-            _error(str(exc))
+            _error(exc)
             return exc.code
         except KeyboardInterrupt:
             _error("interrupted")

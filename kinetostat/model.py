@@ -8,6 +8,7 @@ May use: the standard library, numpy, errors, expressions, planar, structure, ex
 from __future__ import annotations
 
 import functools
+import keyword
 import math
 import re
 import stat
@@ -655,8 +656,8 @@ MAX_PUBLISHED_ANGLES = 3600
 
 #: Characters of an expression quoted in a message.
 MAX_SHOWN = 120
-#: Longest name of a point, link, body, load or spring (each labels plots and plans: 10,000
-#: characters took a report two minutes); the mechanism's own name is not limited.
+#: Longest name of the mechanism, a point, link, body, load or spring (each labels plots and plans:
+#: 10,000 characters took a report two minutes, a mechanism's name of 100,000 characters 24 s).
 MAX_NAME = 200
 #: Most problems listed for one file (the rest are counted): 300,000 unknown keys stay one short list.
 MAX_PROBLEMS = 100
@@ -745,6 +746,9 @@ class _Reader:
             elif unicodedata.normalize("NFKC", name) != name:
                 self.err(f"parameters.{name}: {_code_points(name)} reads as {_code_points(unicodedata.normalize('NFKC', name))} "
                          f"in expressions (Unicode NFKC, as Python folds names); write it so")
+            elif keyword.iskeyword(name):
+                self.err(f"parameters.{name}: {name!r} is a Python keyword, which an expression reads as itself, "
+                         f"never as this parameter; choose another name")
             elif not name.isidentifier() or name.startswith("__"):
                 self.err(f"parameters.{name}: a parameter's name is a Python-style identifier (letters, digits, _)")
         for name, x in self.overrides.items():
@@ -848,7 +852,7 @@ class _Reader:
         if choices and x not in choices:
             self.err(f"{where}.{key}: invalid value {x!r}{_suggest(x, choices)}. Valid values: {list(choices)}")
             return None
-        if key == "name" and where != "mechanism" and len(x) > MAX_NAME:
+        if key == "name" and len(x) > MAX_NAME:
             self.err(f"{where}.name: {len(x)} characters, at most {MAX_NAME} (it labels plots and plans)")
             return None
         return x

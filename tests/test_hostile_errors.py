@@ -2,11 +2,15 @@
 error line (exit 2 from the command line, 130 for Ctrl-C) and bounded work, shown by counting."""
 from __future__ import annotations
 
+import csv
+import io
 import os
 import signal
+import socket
 import subprocess
 import sys
 import tracemalloc
+import warnings
 
 import numpy as np
 import pytest
@@ -88,9 +92,22 @@ def test_a_scheduler_with_no_worker_stops_with_a_message(monkeypatch):
     distributed = pytest.importorskip("distributed")
     sweep_module = sys.modules["kinetostat.sweep"]
     monkeypatch.setattr(sweep_module, "CONNECT_TIMEOUT", 0.5)
-    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
-        with pytest.raises(ConnectionError, match="no worker joined it within 0.5 s"):
-            kinetostat.sweep("ice_crank_slider", {"g": [9.8]}, steps=4, scheduler=cluster.scheduler_address)
+    busy = socket.socket()              # the dashboard's default port taken (by this test, or already by another)
+    try:
+        busy.bind(("", 8787))
+    except OSError:
+        pass
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            # no dashboard; the scheduler's HTTP routes on a free port, not 8787 ("Port 8787 is already in use")
+            with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None,
+                                          scheduler_kwargs={"dashboard_address": ":0"}) as cluster:
+                with pytest.raises(ConnectionError, match="no worker joined it within 0.5 s"):
+                    kinetostat.sweep("ice_crank_slider", {"g": [9.8]}, steps=4, scheduler=cluster.scheduler_address)
+    finally:
+        busy.close()
+    assert not [str(w.message) for w in caught if "already in use" in str(w.message)]
 
 
 SITE = '''
@@ -175,14 +192,39 @@ def test_a_pressure_in_mpa_is_warned():
 
 @pytest.mark.parametrize("scale, message", [
     ("mu_F=5e-324", "mu_F must be a positive number in N/mm (at least 2.23e-308)"),
-    ("mu_F=1e-307", "segment R12t would end beyond 1e308 mm at mu_F = 1e-307 N/mm"),
+    ("mu_F=1e-307", "--scale mu_F=1e-307 N/mm would draw the forces plan beyond 1e308 mm across"),
+    # a ZeroDivisionError (the frame's hatching at 1e19 mm), a 383 GiB and a 1.2 GiB allocation (the
+    # labels' samples along a link), a 181 GiB one, "Maximum allowed size exceeded": the ICE's
+    # positions span 0.182 m, the crank pin's velocity 17 m/s
+    ("mu_l=1e-20", "--scale mu_l=1e-20 m/mm would draw the mechanism plan 1.82e+19 mm across (at most 100000 mm)"),
+    ("mu_l=1e-12", "--scale mu_l=1e-12 m/mm would draw the mechanism plan 1.82e+11 mm across"),
+    ("mu_l=1e-9", "--scale mu_l=1e-09 m/mm would draw the mechanism plan 1.82e+08 mm across"),
+    ("mu_v=1e-9", "--scale mu_v=1e-09 m/(s mm) would draw the velocity plan 1.7e+10 mm across"),
+    ("mu_v=1e-300", "--scale mu_v=1e-300 m/(s mm) would draw the velocity plan 1.7e+301 mm across"),
 ])
-def test_a_scale_that_draws_inf_is_refused(scale, message, tmp_path, cli):
+def test_a_scale_that_draws_beyond_a_sheet_is_refused(scale, message, tmp_path, cli):
     out = tmp_path / "plans"
     p = cli("plans", ROOT / "models" / "ice_crank_slider.toml", "--scale", scale, "--out", out)
     _one_line_exit_2(p)
     assert message in p.stderr
     assert not out.exists() or not list(out.iterdir())
+
+
+def test_the_drawings_loops_are_bounded_by_a_sheet():
+    """What a plan near MAX_EXTENT_MM draws: the frame's hatching and the labels' samples along a
+    line are capped (counted), whatever the length handed to them; a zero-length stretch is no error."""
+    from kinetostat.plans.labels import Placer
+    from kinetostat.plans.mechanism import _hatch
+    paths: dict = {}
+    _hatch(0j, 1e12 + 0j, 1j, "h", paths)
+    assert len(paths) == 1 + 50                         # the line and its strokes every 2 mm over 100 mm
+    paths.clear()
+    _hatch(1e19 + 0j, 1e19 + 0j, 1j, "h", paths)       # both ends one float at 1e19 mm
+    assert len(paths) == 1
+    placer = Placer((0.0, 0.0, 420.0, 297.0))
+    placer.line(0.0, 0.0, 1e12, 0.0)
+    placer.line(0.0, 0.0, 7.0, 0.0)
+    assert [len(s) for s in placer._samples] == [10_000, 11]
 
 
 # ============================================================================ 8. accuracy near singular positions
@@ -219,9 +261,19 @@ def test_plans_and_worksheet_at_a_warned_angle_state_the_accuracy(tmp_path, cli)
     assert "kinetostat: warning:" in p.stderr and "phi = [179] deg" in p.stderr and "8.0 to 8.0" in p.stderr
     assert "about 8.0 significant digits left at this angle" in (out / "worksheet.md").read_text(encoding="utf-8")
     assert '"digits": 8.0' in (out / "worksheet.json").read_text(encoding="utf-8")
+    line = "Accuracy: near a singular position: about 8.0 significant digits left at this angle (fewer than 10)"
+    sheets = sorted(out.glob("*.svg"))
+    assert len(sheets) == 8 and all(line in q.read_text(encoding="utf-8") for q in sheets)     # every sheet says it
+    rows = list(csv.DictReader(io.StringIO((out / "worksheet.csv").read_text(encoding="utf-8"))))
+    assert (rows[0]["section"], rows[0]["key"], float(rows[0]["value"])) == ("Accuracy", "digits", 8.0)
+    assert rows[0]["note"].startswith("near a singular position: about 8.0 significant digits left")
     calm = tmp_path / "calm"
     assert cli("plans", TOGGLE, "--at", "90", "--out", calm).returncode == 0
-    assert "Accuracy" not in (calm / "worksheet.md").read_text(encoding="utf-8")
+    assert not any("Accuracy" in q.read_text(encoding="utf-8") for q in [*calm.glob("*.svg"), *calm.glob("worksheet.*")])
+    uk = tmp_path / "uk"
+    assert cli("plans", TOGGLE, "--at", "179", "--lang", "uk", "--only", "velocity", "--out", uk).returncode == 0
+    assert "Точність: поблизу особливого положення: лишилося близько 8,0 значущих цифр" in (
+        uk / "velocity.svg").read_text(encoding="utf-8")
 
 
 def test_did_you_mean_work_is_bounded(monkeypatch):
@@ -249,6 +301,8 @@ def test_did_you_mean_work_is_bounded(monkeypatch):
     (("S3 = [0.12, -0.01] }", "S3 = [0.12, -0.01], " + "N" * 10_000 + " = [0.2, 0.0] }"),
      "link[id=3].points: a point name of 10000 characters ('NNNNNNNNNNNNNNNNNNNN'...), at most 200"),
     (('name = "resisting moment"', 'name = "' + "N" * 10_000 + '"'), "load[0].name: 10000 characters, at most 200"),
+    # the mechanism's own name (it titles every sheet and page): 100,000 characters took `report` 24.5 s
+    (('name = "test four-bar"', 'name = "' + "N" * 100_000 + '"'), "mechanism.name: 100000 characters, at most 200"),
 ])
 def test_a_name_of_10000_characters_is_refused_before_any_plot(edit, message, tmp_path, cli):
     """A point named with 10,000 characters made a report take two minutes (its labels); names

@@ -111,6 +111,10 @@ def test_a_sweep_over_g_changes_the_gravity_moment(tmp_path):
     # the variables of laws and characteristics shadowed the parameter silently
     ("omega = 3.0\n", "parameters.omega: 'omega' is the variable of a law of motion"),
     ("phi = 1.0\n", "parameters.phi: 'phi' is the variable of a law of motion"),
+    # Python keywords: an expression reads True, None, lambda as themselves, never as the parameter
+    ("True = 2.0\n", "parameters.True: 'True' is a Python keyword"),
+    ("None = 2.0\n", "parameters.None: 'None' is a Python keyword"),
+    ("lambda = 2.0\n", "parameters.lambda: 'lambda' is a Python keyword"),
 ])
 def test_look_alike_and_reserved_parameter_names_are_refused(params, message, tmp_path, cli):
     text = FOUR_BAR.replace("[drive]", "[parameters]\n" + params + "[drive]")

@@ -89,11 +89,13 @@ def test_no_csv_cell_is_a_formula(tmp_path, cli):
 
 def test_worksheet_markdown_carries_no_tag_from_a_name(tmp_path, cli):
     out = tmp_path / "plans"
-    p = cli("plans", _model(tmp_path, name="<script>alert(1)</script> [x](javascript:alert(2)) a|b"), "--out", out)
+    p = cli("plans", _model(tmp_path, name="<script>alert(1)</script> [x](javascript:alert(2)) a|b __bold__ _em_"),
+            "--out", out)
     assert p.returncode == 0, p.stderr
     md = (out / "worksheet.md").read_text(encoding="utf-8")
     assert "<script" not in md and "&lt;script>alert(1)&lt;/script>" in md
     assert "\\[x\\](javascript:alert(2))" in md and "a\\|b" in md
+    assert "\\_\\_bold\\_\\_ \\_em\\_" in md                   # no emphasis from underscores
     assert "<script" not in (out / "worksheet.html").read_text(encoding="utf-8")
 
 
@@ -122,3 +124,49 @@ def test_a_newline_in_an_expression_cannot_forge_an_error_line(tmp_path, cli):
     assert p.returncode == 2 and "Traceback" not in p.stderr
     assert p.stderr.count("kinetostat: error:") == 2 and p.stderr.count("\n") == 1, p.stderr   # one line
     assert '"1.5 +\\nkinetostat: error: none' in p.stderr
+
+
+FORGED = "a\\nkinetostat: error: forged"       # a TOML escape: a newline in the name
+
+
+@pytest.mark.parametrize("command", ["analyze", "structure", "sweep"])
+def test_a_newline_in_a_name_cannot_forge_a_line_on_stdout(command, tmp_path, cli):
+    model = _model(tmp_path, name=FORGED)
+    model.write_text(model.read_text(encoding="utf-8").replace("[drive]", "[parameters]\nm3 = 1.2\n[drive]"),
+                     encoding="utf-8")
+    more = {"analyze": ["--steps", "4"], "structure": [],
+            "sweep": ["--param", "m3=1.0,1.2", "--steps", "4", "--out", tmp_path / "s.csv", "--no-progress"]}
+    p = cli(command, model, *more[command])
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.splitlines()[0].startswith("a\\nkinetostat: error: forged   [")
+    assert not any(line.startswith("kinetostat:") for line in p.stdout.splitlines() + p.stderr.splitlines())
+
+
+@pytest.mark.parametrize("case", ["out", "model"])
+def test_a_newline_in_a_path_is_one_error_line(case, tmp_path, cli):
+    """An --out folder that cannot be made (under a file) and a missing model file, each named
+    with a newline: one "kinetostat: error:" line, the newline printed as \\n."""
+    (tmp_path / "file").write_text("x")
+    bad = f"{tmp_path}/file/x\nkinetostat: error: forged"
+    args = ["plans", ICE, "--out", bad] if case == "out" else ["analyze", f"{tmp_path}/no\nkinetostat: error: forged"]
+    p = cli(*args)
+    assert p.returncode == 2 and "Traceback" not in p.stderr
+    assert p.stderr.count("\n") == 1 and p.stderr.count("kinetostat: error:") == 2, p.stderr
+    assert "\\nkinetostat: error: forged" in p.stderr
+
+
+def test_a_model_files_problem_list_keeps_one_line_per_problem(tmp_path, cli):
+    model = tmp_path / "m.toml"
+    model.write_text(FOUR_BAR.replace("mass = 1.5", 'mass = "x\\ny"').replace("mass = 1.2", "mass = -1"),
+                     encoding="utf-8")
+    p = cli("analyze", model)
+    lines = p.stderr.splitlines()
+    assert p.returncode == 2 and lines[0].startswith("kinetostat: error:") and lines[0].endswith("2 problems:"), p.stderr
+    assert len(lines) == 3 and all(line.startswith("  - ") for line in lines[1:]) and "x\\ny" in p.stderr
+
+
+def test_a_newline_in_an_output_path_prints_one_line_on_stdout(tmp_path, cli):
+    out = tmp_path / "m\nkinetostat: error: forged.xml"
+    p = cli("export", ICE, "--mjcf", "-o", out)
+    assert p.returncode == 0 and out.exists(), p.stderr
+    assert p.stdout.count("\n") == 1 and "m\\nkinetostat: error: forged.xml" in p.stdout, p.stdout

@@ -56,6 +56,56 @@ def test_export_to_dev_stdout_prints_and_replaces_nothing(redirect, tmp_path):
     assert redirect == "pipe" or stat.S_ISREG(os.lstat(out).st_mode)
 
 
+@pytest.mark.skipif(not Path("/proc/self/fd/2").exists(), reason="no /proc")
+@pytest.mark.parametrize("target", ["link", "same file"])
+def test_export_to_a_link_to_its_own_stderr_writes_the_stream(target, tmp_path):
+    """`export -o /dev/stderr 2>log` replaced /dev/stderr (a link to /proc/self/fd/2, stderr a
+    regular file) by a file of its own, as root. Here a link made in tmp_path stands for it (never
+    /dev/stderr itself); `-o log 2>log` names stderr's file by its own name. Both keep the link or
+    the file (same inode) and write the MJCF into stderr's file."""
+    log = tmp_path / "log"
+    link = tmp_path / "stderr"
+    link.symlink_to("/proc/self/fd/2")
+    named = link if target == "link" else log
+    env = {k: v for k, v in os.environ.items() if k != "KINETOSTAT_MODELS"}
+    with open(log, "wb") as f:
+        inode = os.fstat(f.fileno()).st_ino
+        r = subprocess.run([sys.executable, "-m", "kinetostat", "export", str(ICE), "--mjcf", "-o", str(named)],
+                           stdout=subprocess.PIPE, stderr=f, cwd=ROOT, env=env, timeout=120)
+    assert r.returncode == 0, log.read_text()
+    assert os.readlink(link) == "/proc/self/fd/2" and os.lstat(log).st_ino == inode
+    assert b"<mujoco" in log.read_bytes() and b"</mujoco>" in log.read_bytes()
+    assert sorted(q.name for q in tmp_path.iterdir()) == ["log", "stderr"]      # no temporary file
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd/0").exists(), reason="no /proc")
+def test_the_library_never_replaces_a_link_into_proc_fd(tmp_path):
+    """A link (or a link to a link, or a path through a linked folder) into /proc/self/fd is a
+    stream: refused as a file to replace, appended to as a stream; the link stays."""
+    from kinetostat._io import atomic, is_stream, unit, write_text
+    log = tmp_path / "log"
+    log.write_text("old\n")
+    fd = os.open(log, os.O_WRONLY | os.O_APPEND)
+    try:
+        (tmp_path / "a").symlink_to(f"/proc/self/fd/{fd}")
+        (tmp_path / "b").symlink_to("a")
+        (tmp_path / "fds").symlink_to("/proc/self/fd")
+        for name in ("a", "b", f"fds/{fd}"):
+            assert is_stream(tmp_path / name), name
+            with pytest.raises(OSError, match="not a regular file"):
+                write_text(tmp_path / name, "new\n")
+        assert not is_stream(log) and not is_stream(tmp_path / "nothing")
+        with atomic(tmp_path / "b", stream=True) as f:
+            f.write("appended\n")
+        assert log.read_text() == "old\nappended\n"
+        with pytest.raises(OSError, match="stream's link"):
+            with unit(tmp_path) as tmp:
+                (tmp / "a").write_text("x")
+        assert os.readlink(tmp_path / "a") == f"/proc/self/fd/{fd}" and os.readlink(tmp_path / "b") == "a"
+    finally:
+        os.close(fd)
+
+
 def test_the_library_refuses_to_replace_a_fifo(tmp_path):
     from kinetostat._io import write_text
     fifo = tmp_path / "segments.csv"
@@ -175,3 +225,21 @@ def test_a_set_is_swapped_in_whole(tmp_path):
         assert (out / "a.csv").read_text() == "old a\n"          # nothing seen before the end
     assert _files(out) == {"a.csv": b"new a\n", "b.csv": b"new b\n", "mine.txt": b"mine\n"}
     assert outside.read_text() == "outside\n" and not (out / "b.csv").is_symlink()
+
+
+def test_ctrl_c_as_an_output_is_probed_leaves_no_probe(tmp_path, cli, monkeypatch):
+    """Ctrl-C the moment the check that --out is writable has made its probe file (tempfile's
+    window between creating the file and guarding it): the command stops (exit 130) once the
+    probe is removed (a probe was once left beside the table)."""
+    import signal
+    import tempfile
+    real, made = tempfile._mkstemp_inner, []
+
+    def inner(*args, **kwargs):
+        fd, name = real(*args, **kwargs)
+        made.append(name)
+        os.kill(os.getpid(), signal.SIGINT)
+        return fd, name
+    monkeypatch.setattr(tempfile, "_mkstemp_inner", inner)
+    p = cli("analyze", ICE, "--steps", "4", "--out", tmp_path / "t.csv")
+    assert p.returncode == 130 and len(made) == 1 and list(tmp_path.iterdir()) == [], p.stderr

@@ -19,6 +19,7 @@ pandas only inside `Plans.segments_frame` and `Plans.segments_csv`; never the ha
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
@@ -26,15 +27,16 @@ from typing import Callable, Iterable
 
 from .._io import write_text
 from .._text import csv_cell
+from ..kinematics import DIGITS_WARN
 from ..tables import FLOAT_FORMAT, by_unit, rounded
-from .core import SEGMENT_COLUMNS, Plan, Scale, Segment
+from .core import SEGMENT_COLUMNS, Plan, Scale, Segment, extent
 from .draw import fits
 from .forces import crank_plan, force_plans, group_plans
 from .lettering import lettering
 from .mechanism import mechanism_plan
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
-from .scales import choose_scales, coarser
+from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
 
 __all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS",
            "choose_scales", "starting_position", "plan_file_name"]
@@ -153,7 +155,8 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     `drive.design_deg`). `scales`: any of mu_l [m/mm], mu_v [m/(s mm)], mu_a [m/(s^2 mm)],
     mu_F [N/mm] (the others chosen by the texts' rule, `choose_scales`); `starting_deg`: position
     0 of the plan of positions (default: found, `starting_position`); `only`: names of BUILDERS
-    to draw (default all). ValueError for a bad angle, scale or name."""
+    to draw (default all). ValueError for a bad angle or name; ScaleError (a ValueError) for a
+    scale that would draw a plan beyond MAX_EXTENT_MM."""
     import math
 
     from ..analysis import analyze
@@ -181,4 +184,12 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
         if name in chosen:
             made = steps[name](mech, res, sc)
             plans.extend(made if isinstance(made, (list, tuple)) else [made])
+    if res.digits[0] < DIGITS_WARN:                 # each sheet states the accuracy at this angle
+        plans = [replace(p, accuracy=(float(res.digits[0]), DIGITS_WARN)) for p in plans]
+    for p in plans:
+        x0, y0, x1, y1 = extent(p)
+        ends = [r[c] for r in p.rows() for c in ("x0_mm", "y0_mm", "x1_mm", "y1_mm")]
+        if not (max(x1 - x0, y1 - y0) <= MAX_EXTENT_MM and all(map(math.isfinite, ends))):
+            raise ScaleError(f"{p.scale.symbol}={p.scale.value:g} {p.scale.unit} would draw the {p.kind} plan "
+                             f"beyond {MAX_EXTENT_MM:g} mm; use a larger scale")
     return Plans(mech, float(at), sc, plans)

@@ -83,6 +83,8 @@ class Plan:
     notes: tuple[str, ...] = ()            # lines of text the sheet shows beside the plan (e.g. the branches)
     results: tuple[Result, ...] = ()       # what the sheet finds (M_зр, δ), stated beside the plan
     equation: tuple[str, ...] = ()         # a force plan's vector equation: its sides' names in the order drawn
+    accuracy: tuple[float, int] | None = None   # near a singular position: (digits left, fewer than this);
+                                                # the sheet states it (i18n.accuracy)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", MappingProxyType(dict(self.points)))

@@ -22,7 +22,7 @@ import re
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 from .core import Plan, Segment, extent
-from .i18n import LANGS, MESSAGES, check_lang, num, phrase, text, unit
+from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_width
 
 __all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
@@ -224,7 +224,7 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
     """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors."""
     base = plan.kind.partition(":")[0]
     lines = [text(f"legend.{base}", lang)] if f"legend.{base}" in MESSAGES else []
-    lines += [phrase(n, lang) for n in plan.notes]
+    lines += [phrase(n, lang) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
     lines += _result_line(plan, lang)
     if plan.equation:
         lines.append(f"{text('equation', lang)}: " + " + ".join(map(_n, plan.equation)) + " = 0")

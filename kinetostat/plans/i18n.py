@@ -19,8 +19,8 @@ import re
 
 import numpy as np
 
-__all__ = ["LANGS", "MESSAGES", "PHRASES", "UNITS", "check_lang", "text", "plural", "PLURALS", "num", "unit", "phrase", "words_en",
-           "ZERO"]
+__all__ = ["LANGS", "MESSAGES", "PHRASES", "UNITS", "check_lang", "text", "plural", "PLURALS", "num", "unit", "phrase",
+           "words_en", "accuracy", "ZERO"]
 
 LANGS = ("en", "uk", "ru")
 #: A magnitude below this (SI) is printed as 0: the solver's rounding noise, never a value.
@@ -343,6 +343,13 @@ def num(x: float, lang: str, digits: int = 4, decimals: int | None = None) -> st
     if s in ("-0", "0"):
         return "0"
     return s.replace(".", ",") if check_lang(lang) else s
+
+
+def accuracy(digits: float, minimum: int, lang: str, markdown: bool = True) -> str:
+    """The accuracy line ('ws.accuracy') near a singular position: about `digits` significant digits
+    left (fewer than `minimum`), one decimal as `lang` writes it; Markdown's bold kept or dropped."""
+    line = text("ws.accuracy", lang, digits=f"{digits:.1f}".replace(".", "." if lang == "en" else ","), min=minimum)
+    return line if markdown else line.replace("**", "")
 
 
 def phrase(note: str, lang: str) -> str:

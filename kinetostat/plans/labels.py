@@ -157,7 +157,7 @@ class Placer:
 
     def line(self, x0: float, y0: float, x1: float, y1: float) -> None:
         """A soft obstacle: a drawn line, sampled every 0.7 mm."""
-        n = max(2, int(math.hypot(x1 - x0, y1 - y0) / 0.7) + 1)
+        n = int(min(max(2.0, math.hypot(x1 - x0, y1 - y0) / 0.7 + 1), 1e4))     # a sheet's length at most
         t = np.linspace(0.0, 1.0, n)
         self._samples.append(np.column_stack([x0 + t * (x1 - x0), y0 + t * (y1 - y0)]))
 

@@ -31,8 +31,8 @@ def _hatch(a: complex, b: complex, side: complex, name: str, paths: dict) -> Non
     """The frame's hatching: the line a-b and short strokes every 2 mm on its `side` (a unit)."""
     paths[f"{name}"] = (a, b)
     L = abs(b - a)
-    u = (b - a) / L
-    for n, t in enumerate(np.arange(1.0, L, 2.0)):
+    u = (b - a) / L if L else 1.0
+    for n, t in enumerate(np.arange(1.0, min(L, 100.0), 2.0)):      # a frame's stretch: at most 50 strokes
         p = a + t * u
         paths[f"{name} {n}"] = (p, p + 2.0 * side - 1.5 * u)
 

@@ -28,8 +28,8 @@ import numpy as np
 
 from .core import Scale
 
-__all__ = ["choose_scales", "round_scale", "coarser", "check_given", "SCALE_UNITS", "ROUND_MANTISSAS", "LENGTH_MANTISSAS",
-           "FIT_MM"]
+__all__ = ["choose_scales", "round_scale", "coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
+           "LENGTH_MANTISSAS", "FIT_MM", "MAX_EXTENT_MM", "PLAN_OF"]
 
 #: Unit of each scale, per millimetre drawn.
 SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F": "N/mm"}
@@ -42,6 +42,15 @@ TARGET_MM = {"mu_l": (30.0, 35.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "
 #: Drawing area of an A3 landscape sheet a plan must fit (width, height), mm: inside the frame,
 #: above the title block.
 FIT_MM = (380.0, 220.0)
+#: The largest extent a plan may have on its sheet, mm: a given scale that draws a plan larger is
+#: refused (a sheet 100 m long is a typing error, and its drawing would take unbounded memory).
+MAX_EXTENT_MM = 1e5
+#: The plan that each scale draws first (named when that scale is refused).
+PLAN_OF = {"mu_l": "mechanism", "mu_v": "velocity", "mu_a": "acceleration", "mu_F": "forces"}
+
+
+class ScaleError(ValueError):
+    """A given scale that cannot be drawn: the message names the scale and the plan."""
 
 
 def _round_candidates(value: float, mantissas: tuple[float, ...] = ROUND_MANTISSAS) -> list[float]:
@@ -125,6 +134,10 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
     for key, unit in SCALE_UNITS.items():
         if key in given:
             value = given[key]
+            size = max(reference[key][0], *reference[key][1]) / value
+            if not size <= MAX_EXTENT_MM:
+                raise ScaleError(f"{key}={value:g} {unit} would draw the {PLAN_OF[key]} plan "
+                                 f"{f'{size:.3g} mm' if size < math.inf else 'beyond 1e308 mm'} across (at most {MAX_EXTENT_MM:g} mm); use a larger scale")
         else:
             ref, ext = reference[key]
             value = round_scale(ref, *TARGET_MM[key], extent=ext,

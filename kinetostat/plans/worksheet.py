@@ -26,7 +26,7 @@ from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
 from ..tables import FLOAT_FORMAT, by_unit, plain
-from .i18n import check_lang, num, phrase, text, unit
+from .i18n import accuracy, check_lang, num, phrase, text, unit
 from .lettering import lettering
 from .scales import choose_scales
 
@@ -99,8 +99,7 @@ class Worksheet:
         out = [f"# {text('ws.title', lang, name=markdown_text(self.mechanism), phi=num(self.phi_deg, lang, 6))}", "",
                f"{text('scale', lang)} μ_l = {num(self.mu_l, lang, 6)} {unit('m/mm', lang)}"]
         if self.digits < DIGITS_WARN:
-            out += ["", text("ws.accuracy", lang, digits=f"{self.digits:.1f}".replace(".", "." if lang == "en" else ","),
-                                   min=DIGITS_WARN)]
+            out += ["", accuracy(self.digits, DIGITS_WARN, lang)]
         section = None
         head = [text(f"ws.head.{c}", lang) for c in ("symbol", "value", "unit", "direction", "note")]
         for rec in self.records():
@@ -121,9 +120,16 @@ class Worksheet:
 
     def to_csv(self, path: str | Path) -> None:
         """Write the rows as CSV, each value to 12 significant digits of the largest |value| of its
-        unit (`kinetostat.tables.by_unit`), no cell read as a formula (atomic: a temporary file in the same folder, then replaced)."""
+        unit (`kinetostat.tables.by_unit`), no cell read as a formula (atomic: a temporary file in the same folder, then replaced).
+        Near a singular position the first row states the accuracy (key "digits")."""
+        import pandas as pd
         df = self.frame()
         df["value"] = by_unit(df["value"], df["unit"])
+        if self.digits < DIGITS_WARN:          # the accuracy first: section "Accuracy", key "digits", the line as note
+            head, _, note = accuracy(self.digits, DIGITS_WARN, self.lang, markdown=False).partition(": ")
+            df = pd.concat([pd.DataFrame([{"section": head, "key": "digits", "symbol": "digits",
+                                           "value": round(self.digits, 1), "unit": "", "direction": "",
+                                           "note": note}]), df], ignore_index=True)
         write_text(path, df.map(csv_cell).to_csv(index=False, float_format=FLOAT_FORMAT))
 
     def to_json(self, path: str | Path) -> None:
