@@ -420,7 +420,7 @@ def _fill(buf: np.ndarray, x: float) -> None:
 @dataclass(frozen=True)
 class MachineRates:
     """One core's double-precision arithmetic throughput (flop/s) and memory write bandwidth
-    (bytes/s), measured here, best of the repeats; how they were measured."""
+    (bytes/s), measured here in this thread's CPU time, best of the repeats; how they were measured."""
     flops_per_second: float
     bytes_per_second: float
     note: str
@@ -428,7 +428,8 @@ class MachineRates:
 
 @functools.cache
 def machine_rates(repeat: int = 5, buffer_bytes: int = 256 * 2**20) -> MachineRates:
-    """Measure the machine once per process (see the module docstring): best of `repeat` runs."""
+    """Measure the machine once per process (see the module docstring): best of `repeat` runs,
+    each in this thread's CPU time (time.thread_time)."""
     import numba
     fma = numba.njit(fastmath=True)(_fma_chains)
     fill = numba.njit(_fill)
@@ -441,13 +442,16 @@ def machine_rates(repeat: int = 5, buffer_bytes: int = 256 * 2**20) -> MachineRa
     t_fill = min(_timed(lambda: fill(buf, 1.5)) for _ in range(repeat))
     return MachineRates(2 * _CHAINS * rounds / t_fma, buf.nbytes / t_fill,
                         f"numba {numba.__version__}: {_CHAINS} independent multiply-add chains (fastmath, FMA), "
-                        f"one core; a numba loop writing a reused {buffer_bytes / 2**20:.0f} MiB buffer")
+                        f"one core; a numba loop writing a reused {buffer_bytes / 2**20:.0f} MiB buffer; "
+                        f"thread CPU time, best of {repeat}")
 
 
 def _timed(fn) -> float:
-    t = time.perf_counter()
+    """CPU time of this thread running fn, s: the clock the kernels' rows are timed in, so the
+    share of the core that other processes take on a loaded machine counts in neither."""
+    t = time.thread_time()
     fn()
-    return time.perf_counter() - t
+    return time.thread_time() - t
 
 
 def machine_limit(flops_per_angle: float, bytes_per_angle: float, cores: int = 1,
