@@ -112,11 +112,11 @@ def study(models: list[Path], quick: bool) -> list[dict]:
 
 def throughput(mech: kinetostat.Mechanism) -> list[dict]:
     """The solver's full kinetostatic analysis on large batches of angles: the first call of each
-    size (fresh memory from the operating system) and the median of repeated calls, and the
-    size of the result per angle."""
+    size (after a warm-up of FAST_MIN angles that loads the compiled kernel: fresh memory from
+    the operating system) and the median of repeated calls, and the size of the result per angle."""
     out = []
     rng = np.random.default_rng(0)
-    kinetostat.analyze(mech, steps=8)       # the mechanism's one-off memos (dead centres, diagrams)
+    kinetostat.analyze(mech, steps=fast.FAST_MIN)   # memos (dead centres, diagrams), the compiled kernel loaded
     for n in (10**4, 10**5, 10**6):
         phi = rng.uniform(0.0, 360.0, n)
         t = time.perf_counter()
@@ -335,6 +335,52 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
     return dict(rates=rates, rows=rows, models=models, info=info, repeat=repeat)
 
 
+#: `kinetostat report` (8 bundled models, --jobs 2) at commit 7970a58, before the report's CSV
+#: rounding was rebuilt, measured on this machine (2 runs, load average 3.8-4.4): CPU s (user +
+#: sys, every process), wall s.
+MAIN_JOB_BEFORE = dict(commit="7970a58", cpu=(21.7, 22.5), wall=(28.3, 29.2), load="3.8-4.4")
+
+
+def main_job(runs: int = 3) -> dict:
+    """`kinetostat report` for every bundled model (--jobs 2, the default on 2 cores), `runs`
+    times in fresh processes into a temporary folder: CPU time of the command and its workers
+    (user + sys, from getrusage of the waited-for children) and wall time, s; the load before
+    and after."""
+    import resource
+    import subprocess
+    import sys
+    import tempfile
+    from .kernels import cpu_info
+    cpu, wall, load = [], [], [cpu_info()["load"]]
+    for _ in range(runs):
+        with tempfile.TemporaryDirectory(prefix="kinetostat-report-") as folder:
+            r0, w0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+            subprocess.run([sys.executable, "-m", "kinetostat", "report", "--jobs", "2", "--no-progress",
+                            "--out", folder], check=True, capture_output=True)
+            w, r1 = time.perf_counter() - w0, resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+        wall.append(w)
+        print(f"main job: kinetostat report, 8 models: {cpu[-1]:.1f} s CPU, {wall[-1]:.1f} s wall", flush=True)
+    load.append(cpu_info()["load"])
+    return dict(cpu=cpu, wall=wall, load=load)
+
+
+def main_job_lines(mj: dict) -> list[str]:
+    """The report's section on `kinetostat report` (`main_job`), with the recorded before."""
+    b = MAIN_JOB_BEFORE
+    return ["## The main job: `kinetostat report` for every bundled model", "",
+            f"`kinetostat report --jobs 2` (8 models: the solver, 5 engine routes, the 40-digit reference, "
+            f"plots, plans, HTML), in a fresh process per run; CPU = user + sys of the command and its two "
+            f"workers. Target: <= 10 s wall on this 2-core machine. Before: commit {b['commit']}, measured by "
+            f"hand on this machine at load average {b['load']}. After: this run, load average "
+            f"{mj['load'][0]} before and {mj['load'][1]} after.", "",
+            "| the main job | runs | CPU s min / median | wall s min / median |", "|---|---|---|---|",
+            f"| before ({b['commit']}) | {len(b['cpu'])} | {min(b['cpu']):.1f} / {statistics.median(b['cpu']):.1f} | "
+            f"{min(b['wall']):.1f} / {statistics.median(b['wall']):.1f} |",
+            f"| after (this run) | {len(mj['cpu'])} | {min(mj['cpu']):.1f} / {statistics.median(mj['cpu']):.1f} | "
+            f"{min(mj['wall']):.1f} / {statistics.median(mj['wall']):.1f} |"]
+
+
 def speed_lines(sp: dict) -> list[str]:
     """The report's section on the compiled path (`speed_study`)."""
     info, rates = sp["info"], sp["rates"]
@@ -511,12 +557,13 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
                      f"{r['positions_per_s']:.3g} |")
     lines += ["", "## Solver throughput on large batches (slotted-link shaper, full analysis)", "",
               f"The result holds every point, link and pair: {thr[-1]['bytes_per_angle'] / 1e3:.1f} kB per angle. "
-              "The first call of a size pays for fresh memory from the operating system; repeated calls "
-              "(median of 3, the previous result released) reuse it.", "",
+              f"A warm-up call of `fast.FAST_MIN` = {fast.FAST_MIN:,} angles loads (or compiles) the compiled "
+              "kernel first, so the first call of a size pays for fresh memory from the operating system "
+              "only; repeated calls (median of 3, the previous result released) reuse it.", "",
               "| angles | first call, s | repeated, s | angles/s (repeated) |", "|---|---|---|---|"]
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"])
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + main_job_lines(kernels["main_job"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -542,6 +589,7 @@ def main(argv: list[str] | None = None) -> None:
     print("\n".join(speed_lines(kern["speed"])))
     rows = study(models, args.quick)
     if not args.quick:
+        kern["main_job"] = main_job()
         write_report(rows, kin_rows, thr, kern, args.out)
         print(f"wrote {args.out / 'benchmark.md'}")
 
