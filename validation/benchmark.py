@@ -585,7 +585,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
         lines.append(f"| {model} | {s.seconds * 1e3:.3f} ms | {s.error:.1e} | {e.route} ({e.setting}) | "
                      f"{e.seconds * 1e3:.2f} ms | {e.error:.1e} | {e.seconds / s.seconds:.0f}x |")
     lines += ["", "## Every route and setting", "", "Exact routes: at least 20 runs and 1 s; simulations: 3 runs "
-              "(a pymunk cycle at 1000 iterations takes seconds). CPU: this process, all its threads.", "",
+              "(a run takes up to seconds). CPU: this process, all its threads.", "",
               "| model | route | setting | runs | CPU, ms min / median | wall, ms min / median | error |",
               "|---|---|---|---|---|---|---|"]
     for r in rows:
