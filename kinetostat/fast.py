@@ -21,7 +21,7 @@ flags the angle, below). The primitives agree with numpy's operators on finite v
 1e-154 < |z| < 1e154, where x^2 + y^2 neither overflows nor underflows; at the edges they differ:
 |z| and complex / complex overflow or underflow outside that range (|1e155| is inf,
 (1+1j)/(1e155+1e155j) is 0), |inf + nan j| is nan (numpy: inf), phase(inf + inf j) is nan
-(numpy: pi/4), (1+1j)/inf is nan (numpy: 0), and cis reduces its angle exactly only to
+(numpy: pi/4), (1+1j)/(inf+0j) is nan (numpy: 0), and cis reduces its angle exactly only to
 |th| ~ 1e6 rad. The generated module is written to a cache folder (`cache_dir`)
 under the hash of its source and compiled with numba's disk cache: compiled once per machine.
 
