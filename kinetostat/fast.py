@@ -17,7 +17,7 @@ index from 0, the guard a boolean value, each per-angle output stored at a compi
 one flat buffer (row-major: rows of angles), peaks as per-block maxima of squares. LLVM
 vectorises that inner loop (`vector_report` counts the packed instructions). No fast-math:
 every operation keeps IEEE semantics, so a NaN or inf that enters propagates (a non-finite peak
-flags the angle, below). The primitives agree with numpy's operators on finite values of
+flags the angle, below). The primitives agree with numpy's operators to rounding on finite values of
 1e-154 < |z| < 1e154, where x^2 + y^2 neither overflows nor underflows; at the edges they differ:
 |z| and complex / complex overflow or underflow outside that range (|1e155| is inf,
 (1+1j)/(1e155+1e155j) is 0), |inf + nan j| is nan (numpy: inf), phase(inf + inf j) is nan
