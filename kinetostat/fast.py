@@ -16,7 +16,13 @@ an outer loop over blocks of BLOCK angles (one design each), an inner loop with 
 index from 0, the guard a boolean value, each per-angle output stored at a compile-time row of
 one flat buffer (row-major: rows of angles), peaks as per-block maxima of squares. LLVM
 vectorises that inner loop (`vector_report` counts the packed instructions). No fast-math:
-NaN and inf behave as in numpy. The generated module is written to a cache folder (`cache_dir`)
+every operation keeps IEEE semantics, so a NaN or inf that enters propagates (a non-finite peak
+flags the angle, below). The primitives agree with numpy's operators to rounding on finite values of
+1e-154 < |z| < 1e154, where x^2 + y^2 neither overflows nor underflows; at the edges they differ:
+|z| and complex / complex overflow or underflow outside that range (|1e155| is inf,
+(1+1j)/(1e155+1e155j) is 0), |inf + nan j| is nan (numpy: inf), phase(inf + inf j) is nan
+(numpy: pi/4), (1+1j)/(inf+0j) is nan (numpy: 0), and cis reduces its angle exactly only to
+|th| ~ 1e6 rad. The generated module is written to a cache folder (`cache_dir`)
 under the hash of its source and compiled with numba's disk cache: compiled once per machine.
 
 Angles where a group's plan is ill-conditioned (cond > COND_CHECK), cannot be assembled, or

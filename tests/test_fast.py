@@ -73,7 +73,7 @@ def _peaks_agree(mech, phi_deg) -> None:
     ok = ~res.singular
     for got, want in [(pk.R[0], np.linalg.norm(res.forces.R[ok], axis=-1).max(axis=0)),
                       (pk.M_bal[0], np.abs(res.balancing_moment[ok]).max()),
-                      (pk.F_bal[0], np.linalg.norm(res.balancing_force[ok], axis=-1).max())]:
+                      (pk.F_bal[0], np.linalg.norm(res.forces.F_bal[ok], axis=-1).max())]:
         np.testing.assert_allclose(got, want, rtol=TOL, atol=TOL * np.max(want))
     np.testing.assert_array_equal(pk.singular_deg[0], res.phi_deg[res.singular])
 

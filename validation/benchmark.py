@@ -45,18 +45,31 @@ ANGLES = 360
 EXACT_SECONDS = 1.0     # an exact route is timed over at least 20 runs and at least this long
 
 
-def median_seconds(fn: Callable[[], object], repeat: int, min_seconds: float = 0.0) -> tuple[float, object]:
-    """Median wall time of `fn()` over at least `repeat` runs, and as many more as fill
-    `min_seconds` (a sub-millisecond route then gets hundreds: one stall of the machine cannot
-    move its median), after one warm-up, s, and its last result."""
+@dataclasses.dataclass(frozen=True)
+class Timing:
+    """Repeated runs of one call, s: CPU time (this process, all its threads) and wall time,
+    minimum and median, and the number of runs."""
+    cpu_min: float
+    cpu_median: float
+    wall_min: float
+    wall_median: float
+    runs: int
+
+
+def timed_runs(fn: Callable[[], object], repeat: int, min_seconds: float = 0.0) -> tuple[Timing, object]:
+    """CPU and wall time of `fn()` over at least `repeat` runs, and as many more as fill
+    `min_seconds` of wall time (a sub-millisecond route then gets hundreds: one stall of the
+    machine cannot move its median), after one warm-up, and its last result."""
     out = fn()
-    times: list[float] = []
-    while len(times) < repeat or sum(times) < min_seconds:
+    cpu: list[float] = []
+    wall: list[float] = []
+    while len(wall) < repeat or sum(wall) < min_seconds:
         out = None          # the last result is released first: a run reuses its memory, as in a loop
-        t = time.perf_counter()
+        c, w = time.process_time(), time.perf_counter()
         out = fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times), out
+        cpu.append(time.process_time() - c)
+        wall.append(time.perf_counter() - w)
+    return Timing(min(cpu), statistics.median(cpu), min(wall), statistics.median(wall), len(wall)), out
 
 
 def _solver_result(scene: Scene) -> EngineResult:
@@ -101,8 +114,10 @@ def study(models: list[Path], quick: bool) -> list[dict]:
         for route, setting, run in routes(quick):
             exact = route in ("kinetostat", "pinocchio", "mujoco")
             repeat = 3 if quick else (20 if exact else 3)
-            seconds, er = median_seconds(lambda: run(scene), repeat, EXACT_SECONDS if exact and not quick else 0.0)
-            rows.append(dict(model=path.stem, route=route, setting=setting, seconds=seconds,
+            t, er = timed_runs(lambda: run(scene), repeat, EXACT_SECONDS if exact and not quick else 0.0)
+            seconds = t.wall_median
+            rows.append(dict(model=path.stem, route=route, setting=setting, seconds=seconds, cpu_min=t.cpu_min,
+                             cpu_median=t.cpu_median, wall_min=t.wall_min, runs=t.runs,
                              error=worst_error(scene.res, M_ref, R_ref, er),
                              magnitudes_only=er.magnitudes_only))
             print(f"{path.stem:24s} {route:11s} {setting:28s} {seconds * 1e3:10.3f} ms  error {rows[-1]['error']:.2e}",
@@ -112,11 +127,11 @@ def study(models: list[Path], quick: bool) -> list[dict]:
 
 def throughput(mech: kinetostat.Mechanism) -> list[dict]:
     """The solver's full kinetostatic analysis on large batches of angles: the first call of each
-    size (fresh memory from the operating system) and the median of repeated calls, and the
-    size of the result per angle."""
+    size (after a warm-up of FAST_MIN angles that loads the compiled kernel: fresh memory from
+    the operating system) and the median of repeated calls, and the size of the result per angle."""
     out = []
     rng = np.random.default_rng(0)
-    kinetostat.analyze(mech, steps=8)       # the mechanism's one-off memos (dead centres, diagrams)
+    kinetostat.analyze(mech, steps=fast.FAST_MIN)   # memos (dead centres, diagrams), the compiled kernel loaded
     for n in (10**4, 10**5, 10**6):
         phi = rng.uniform(0.0, 360.0, n)
         t = time.perf_counter()
@@ -124,9 +139,9 @@ def throughput(mech: kinetostat.Mechanism) -> list[dict]:
         first = time.perf_counter() - t
         size = _nbytes(res) / n
         del res
-        seconds, _ = median_seconds(lambda: kinetostat.analyze(mech, phi_deg=phi), 3)
-        out.append(dict(angles=n, first_seconds=first, seconds=seconds, per_second=n / seconds,
-                        bytes_per_angle=size))
+        t, _ = timed_runs(lambda: kinetostat.analyze(mech, phi_deg=phi), 5)
+        out.append(dict(angles=n, first_seconds=first, seconds=t.wall_median, per_second=n / t.wall_median,
+                        cpu_min=t.cpu_min, cpu_median=t.cpu_median, wall_min=t.wall_min, bytes_per_angle=size))
     return out
 
 
@@ -155,8 +170,8 @@ def fast_path_rows(models: list[Path], fast: Callable[[kinetostat.Mechanism, int
                    sizes: tuple[int, ...] = (ANGLES, LARGE), repeat: int = 3) -> list[dict]:
     """The hook for a route of the solver: `fast(mech, N)` analyses N crank angles of `mech` and
     returns its result (a dataclass or a dict of arrays); each model and size gives a row with
-    the seconds per angle (median of `repeat` calls after one warm-up, the previous result
-    released), the result's bytes per angle, the flops per angle when `flops_per_angle` is
+    the seconds per angle (wall: median of `repeat` calls after one warm-up, the previous result
+    released; CPU: minimum and median), the result's bytes per angle, the flops per angle when `flops_per_angle` is
     given (e.g. `kernels.count_flops` of the route's per-angle body) and the machine's limit
     for them (bytes only without flops)."""
     from .kernels import machine_limit
@@ -167,10 +182,11 @@ def fast_path_rows(models: list[Path], fast: Callable[[kinetostat.Mechanism, int
         for n in sizes:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                seconds, res = median_seconds(lambda: fast(mech, n), repeat)
+                t, res = timed_runs(lambda: fast(mech, n), repeat)
             size = _nbytes(res) / n
             del res
-            rows.append(dict(model=path.stem, route=label, angles=n, seconds_per_angle=seconds / n,
+            rows.append(dict(model=path.stem, route=label, angles=n, seconds_per_angle=t.wall_median / n,
+                             cpu_min_per_angle=t.cpu_min / n, cpu_median_per_angle=t.cpu_median / n,
                              bytes_per_angle=size, flops_per_angle=flops,
                              limit=machine_limit(flops or 0.0, size)))
     return rows
@@ -189,7 +205,7 @@ def kernel_study(models: list[Path], quick: bool, extra_routes: tuple = (),
     fast path, each timed by `fast_path_rows` beside today's."""
     from .kernels import machine_rates, mujoco_kernel, pinocchio_kernel
     rates = machine_rates()
-    repeat = 1 if quick else 3
+    repeat = 1 if quick else 5
     solver = fast_path_rows(models, _analyze, "kinetostat.analyze", sizes=sizes, repeat=repeat)
     extra = [r for fast, label, flops in extra_routes
              for r in fast_path_rows(models, fast, label, flops, sizes=sizes, repeat=repeat)]
@@ -199,8 +215,10 @@ def kernel_study(models: list[Path], quick: bool, extra_routes: tuple = (),
         for kernel in (mujoco_kernel, pinocchio_kernel):
             k = kernel(scene, repeat=3 if quick else 11)
             engines.append(dict(model=path.stem, engine=k.engine, seconds_per_angle=k.seconds_per_angle,
-                                overhead_per_angle=k.overhead_per_angle, note=k.note))
-    return dict(rates=rates, solver=solver, engines=engines, extra=extra)
+                                overhead_per_angle=k.overhead_per_angle, note=k.note,
+                                cpu_min=k.cpu_min_per_angle, cpu_median=k.cpu_median_per_angle))
+    return dict(rates=rates, solver=solver, engines=engines, extra=extra, repeat=repeat,
+                engine_repeat=3 if quick else 11)
 
 
 SPEED_MODELS = ("chain_unit_four_bar", "furnace_loader_six_bar")
@@ -272,6 +290,14 @@ def _compile_times(model: str, kinds: tuple[str, ...] = ("peaks", "full")) -> di
     return times
 
 
+def _mujoco_cycle(scene: Scene) -> tuple[float, float]:
+    """MuJoCo's C loop over the scene's cycle once, timed by the program's own clocks: CPU and
+    wall seconds per ANGLES angles."""
+    from .kernels import mujoco_kernel
+    k = mujoco_kernel(scene, repeat=1)
+    return k.cpu_min_per_angle * ANGLES, k.seconds_per_angle * ANGLES
+
+
 def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: int = 2 * 10**5) -> dict:
     """The compiled path against today's scalar kernel (commit BEFORE), the numpy path and
     MuJoCo's compiled kernels, on the four-bar and the six-link furnace loader (loads: springs),
@@ -279,7 +305,7 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
     time and wall time; the flops per angle of the peaks kernel's vectorised loop and the bytes
     the full kernel writes, against this machine's rates; compile and cache-load times in fresh
     processes; the CPU and its load."""
-    from .kernels import cpu_info, machine_rates, mujoco_kernel
+    from .kernels import cpu_info, machine_rates
     rates = machine_rates()
     info = {"before": cpu_info()}
     before = _before_fast()
@@ -299,9 +325,8 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
         if before is not None and not fast._has_loads(mech):       # the scalar kernel took no loads: numpy path then
             routes[f"scalar kernel of {BEFORE}, peaks, 1 thread"] = (N, lambda m=mech: before.peaks([m], phi, threads=1))
         scene = build_scene(mech, steps=ANGLES)
-        mj: list[float] = []
-        routes["MuJoCo kernels (C loop, its own clock: wall)"] = (ANGLES, lambda s=scene: mj.append(
-            mujoco_kernel(s, repeat=1).seconds_per_angle))
+        mj: list[tuple[float, float]] = []
+        routes["MuJoCo kernels (C loop, its own clocks)"] = (ANGLES, lambda s=scene: mj.append(_mujoco_cycle(s)))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             for n, fn in routes.values():          # warm-up: compiled, loaded, memos filled
@@ -310,7 +335,7 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
             for _ in range(repeat):                # interleaved rounds
                 for label, (n, fn) in routes.items():
                     times[label].append(_timed(fn))
-        times["MuJoCo kernels (C loop, its own clock: wall)"] = [(s * ANGLES, s * ANGLES) for s in mj[1:]]
+        times["MuJoCo kernels (C loop, its own clocks)"] = mj[1:]
         compiled = _compile_times(name)
         flops = compiled.pop("flops")
         written = fast.bytes_per_angle(mech)
@@ -335,6 +360,52 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
     return dict(rates=rates, rows=rows, models=models, info=info, repeat=repeat)
 
 
+#: `kinetostat report` (8 bundled models, --jobs 2) at commit 7970a58, before the report's CSV
+#: rounding was rebuilt, measured on this machine (2 runs, load average 3.8-4.4): CPU s (user +
+#: sys, every process), wall s.
+MAIN_JOB_BEFORE = dict(commit="7970a58", cpu=(21.7, 22.5), wall=(28.3, 29.2), load="3.8-4.4")
+
+
+def main_job(runs: int = 3) -> dict:
+    """`kinetostat report` for every bundled model (--jobs 2, the default on 2 cores), `runs`
+    times in fresh processes into a temporary folder: CPU time of the command and its workers
+    (user + sys, from getrusage of the waited-for children) and wall time, s; the load before
+    and after."""
+    import resource
+    import subprocess
+    import sys
+    import tempfile
+    from .kernels import cpu_info
+    cpu, wall, load = [], [], [cpu_info()["load"]]
+    for _ in range(runs):
+        with tempfile.TemporaryDirectory(prefix="kinetostat-report-") as folder:
+            r0, w0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+            subprocess.run([sys.executable, "-m", "kinetostat", "report", "--jobs", "2", "--no-progress",
+                            "--out", folder], check=True, capture_output=True)
+            w, r1 = time.perf_counter() - w0, resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+        wall.append(w)
+        print(f"main job: kinetostat report, 8 models: {cpu[-1]:.1f} s CPU, {wall[-1]:.1f} s wall", flush=True)
+    load.append(cpu_info()["load"])
+    return dict(cpu=cpu, wall=wall, load=load)
+
+
+def main_job_lines(mj: dict) -> list[str]:
+    """The report's section on `kinetostat report` (`main_job`), with the recorded before."""
+    b = MAIN_JOB_BEFORE
+    return ["## The main job: `kinetostat report` for every bundled model", "",
+            f"`kinetostat report --jobs 2` (8 models: the solver, 5 engine routes, the 40-digit reference, "
+            f"plots, plans, HTML), in a fresh process per run; CPU = user + sys of the command and its two "
+            f"workers. Target: <= 10 s wall on this 2-core machine. Before: commit {b['commit']}, measured by "
+            f"hand on this machine at load average {b['load']}. After: this run, load average "
+            f"{mj['load'][0]} before and {mj['load'][1]} after.", "",
+            "| the main job | runs | CPU s min / median | wall s min / median |", "|---|---|---|---|",
+            f"| before ({b['commit']}) | {len(b['cpu'])} | {min(b['cpu']):.1f} / {statistics.median(b['cpu']):.1f} | "
+            f"{min(b['wall']):.1f} / {statistics.median(b['wall']):.1f} |",
+            f"| after (this run) | {len(mj['cpu'])} | {min(mj['cpu']):.1f} / {statistics.median(mj['cpu']):.1f} | "
+            f"{min(mj['wall']):.1f} / {statistics.median(mj['wall']):.1f} |"]
+
+
 def speed_lines(sp: dict) -> list[str]:
     """The report's section on the compiled path (`speed_study`)."""
     info, rates = sp["info"], sp["rates"]
@@ -352,7 +423,7 @@ def speed_lines(sp: dict) -> list[str]:
              "full kernel writes per angle over the write bandwidth for 'full'. M/s per core = angles / CPU time "
              "(minimum). The scalar kernel is `kinetostat/fast.py` of commit "
              f"{BEFORE}, loaded from git history and run in this same process; MuJoCo's kernels are the C loop of "
-             "`validation/kernels.py` (timed by its own clock, wall).", "",
+             "`validation/kernels.py` (timed by its own clocks: CLOCK_PROCESS_CPUTIME_ID and CLOCK_MONOTONIC).", "",
              "| model | route | angles | CPU ns/angle min / median | wall ns/angle min / median | M/s per core (CPU) | "
              "M/s (wall) | limit ns/angle | CPU / limit |", "|---|---|---|---|---|---|---|---|---|"]
     for r in sp["rows"]:
@@ -396,23 +467,28 @@ def kernel_lines(study: dict) -> list[str]:
              f"(`kinetostat.analyze`: the numpy path at 360 angles, the compiled full kernel from "
              f"{fast.FAST_MIN:,}), whose limit is their bytes; the peaks path is set against its flops in the "
              f"next section.", "",
-             "| model | route | angles | per angle, us | result, B/angle | flops/angle | machine limit, us | "
-             "/ MuJoCo kernel | / Pinocchio kernel | / machine limit |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "Per angle: CPU time (this process; MuJoCo's: its C program's CPU clock) minimum / median, and wall "
+             "time (median); the ratios are of CPU minima. The solver's rows: "
+             f"{study['repeat']} calls each; the engines' kernels: {study['engine_repeat']} runs.", "",
+             "| model | route | angles | CPU per angle, us min / median | wall, us median | result, B/angle | "
+             "flops/angle | machine limit, us | / MuJoCo kernel | / Pinocchio kernel | / machine limit |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for model in dict.fromkeys(r["model"] for r in study["solver"]):
         mj, pn = eng[(model, "mujoco")], eng[(model, "pinocchio")]
-        lines.append(f"| {model} | MuJoCo kernels (C loop) | {ANGLES} | {us(mj['seconds_per_angle'])} | | | | 1 | "
-                     f"{mj['seconds_per_angle'] / pn['seconds_per_angle']:.2g} | |")
-        lines.append(f"| {model} | Pinocchio kernels (Python loop [its own Python]) | {ANGLES} | "
+        lines.append(f"| {model} | MuJoCo kernels (C loop) | {ANGLES} | {us(mj['cpu_min'])} / {us(mj['cpu_median'])} | "
+                     f"{us(mj['seconds_per_angle'])} | | | | 1 | {mj['cpu_min'] / pn['cpu_min']:.2g} | |")
+        lines.append(f"| {model} | Pinocchio kernels (Python loop [its own Python, wall]) | {ANGLES} | "
+                     f"{us(pn['cpu_min'])} / {us(pn['cpu_median'])} | "
                      f"{us(pn['seconds_per_angle'])} [{us(pn['overhead_per_angle'])}] | | | | "
-                     f"{pn['seconds_per_angle'] / mj['seconds_per_angle']:.2g} | 1 | |")
+                     f"{pn['cpu_min'] / mj['cpu_min']:.2g} | 1 | |")
         for r in (r for r in study["solver"] + study["extra"] if r["model"] == model):
             flops = "-" if r["flops_per_angle"] is None else f"{r['flops_per_angle']:.0f}"
-            lines.append(f"| {model} | {r['route']} | {r['angles']:,} | {us(r['seconds_per_angle'])} | "
+            lines.append(f"| {model} | {r['route']} | {r['angles']:,} | {us(r['cpu_min_per_angle'])} / "
+                         f"{us(r['cpu_median_per_angle'])} | {us(r['seconds_per_angle'])} | "
                          f"{r['bytes_per_angle']:.0f} | {flops} | {r['limit'] * 1e6:.2g} | "
-                         f"{r['seconds_per_angle'] / mj['seconds_per_angle']:.2g} | "
-                         f"{r['seconds_per_angle'] / pn['seconds_per_angle']:.2g} | "
-                         f"{r['seconds_per_angle'] / r['limit']:.3g} |")
+                         f"{r['cpu_min_per_angle'] / mj['cpu_min']:.2g} | "
+                         f"{r['cpu_min_per_angle'] / pn['cpu_min']:.2g} | "
+                         f"{r['cpu_min_per_angle'] / r['limit']:.3g} |")
     return lines
 
 
@@ -426,12 +502,13 @@ def kinematics_table(models: list[Path]) -> list[dict]:
         mech = kinetostat.load(path)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            t_kin, _ = median_seconds(lambda: kinematics(mech, phi), 20)
-            t_all, _ = median_seconds(lambda: kinetostat.analyze(mech, steps=360), 20, EXACT_SECONDS)
-            t_one, _ = median_seconds(lambda: kinetostat.analyze(mech, steps=1), 20, EXACT_SECONDS)
-            t_batch, _ = median_seconds(lambda: kinematics(mech, batch), 3)
-        rows.append(dict(model=path.stem, kinematics_ms=t_kin * 1e3, analysis_ms=t_all * 1e3,
-                         single_ms=t_one * 1e3, positions_per_s=len(batch) / t_batch))
+            t_kin, _ = timed_runs(lambda: kinematics(mech, phi), 20)
+            t_all, _ = timed_runs(lambda: kinetostat.analyze(mech, steps=360), 20, EXACT_SECONDS)
+            t_one, _ = timed_runs(lambda: kinetostat.analyze(mech, steps=1), 20, EXACT_SECONDS)
+            t_batch, _ = timed_runs(lambda: kinematics(mech, batch), 5)
+        rows.append(dict(model=path.stem, kinematics_ms=t_kin.wall_median * 1e3, analysis_ms=t_all.wall_median * 1e3,
+                         analysis_cpu_ms=t_all.cpu_min * 1e3, single_ms=t_one.wall_median * 1e3,
+                         positions_per_s=len(batch) / t_batch.wall_median, positions_per_cpu_s=len(batch) / t_batch.cpu_min))
     return rows
 
 
@@ -453,6 +530,12 @@ def target_line(df, kin_rows: list[dict]) -> str:
             f"takes {min(k['single_ms'] for k in kin_rows):.2f}-{max(k['single_ms'] for k in kin_rows):.2f} ms: "
             f"numpy's per-operation overhead), while MuJoCo's exact route costs {min(mj):.0f}-{max(mj):.0f} us "
             f"per angle in this adapter.")
+
+
+def _machine_line(before: dict, after: dict) -> str:
+    return (f"**Machine**: {before['model']}, {before['cores']} cores; vector flags {before['vector_flags']}; "
+            f"numba compiles for `{before['llvm_target']}`. Load average (1, 5, 15 min) {before['load']} at the start "
+            f"of the run and {after['load']} at its end: the machine is shared, so read CPU time where it is given.")
 
 
 def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernels: dict, out: Path) -> None:
@@ -491,7 +574,8 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
              "simulations: 3 runs), error the "
              "worst peak-relative error over the driving moment and every reaction against the mpmath reference "
              "(`validation/reference.py`, 40 digits; pymunk: magnitudes). Regenerate with "
-             "`python -m kinetostat_validation.benchmark`.", "", "![time against error](benchmark.png)", "",
+             "`python -m kinetostat_validation.benchmark`.", "", _machine_line(*kernels["machine"]), "",
+             "![time against error](benchmark.png)", "",
              "## Solver against the fastest engine route (same run)", "", target_line(df, kin_rows), "",
              "| model | solver | its error | fastest engine route | its time | its error | speed-up |",
              "|---|---|---|---|---|---|---|"]
@@ -500,23 +584,32 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
         e = g[g.route != "kinetostat"].sort_values("seconds").iloc[0]
         lines.append(f"| {model} | {s.seconds * 1e3:.3f} ms | {s.error:.1e} | {e.route} ({e.setting}) | "
                      f"{e.seconds * 1e3:.2f} ms | {e.error:.1e} | {e.seconds / s.seconds:.0f}x |")
-    lines += ["", "## Every route and setting", "", "| model | route | setting | time, ms | error |", "|---|---|---|---|---|"]
+    lines += ["", "## Every route and setting", "", "Exact routes: at least 20 runs and 1 s; simulations: 3 runs "
+              "(a run takes up to seconds). CPU: this process, all its threads.", "",
+              "| model | route | setting | runs | CPU, ms min / median | wall, ms min / median | error |",
+              "|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r['model']} | {r['route']} | {r['setting']} | {r['seconds'] * 1e3:.3f} | {r['error']:.2e} |")
+        lines.append(f"| {r['model']} | {r['route']} | {r['setting']} | {r['runs']} | {r['cpu_min'] * 1e3:.3f} / "
+                     f"{r['cpu_median'] * 1e3:.3f} | {r['wall_min'] * 1e3:.3f} / {r['seconds'] * 1e3:.3f} | "
+                     f"{r['error']:.2e} |")
     lines += ["", "## Solver: a 360-angle cycle, and positions per second", "",
-              "| model | kinematics, ms | full analysis, ms | one angle, ms | positions/s (10^5 angles) |",
-              "|---|---|---|---|---|"]
+              "Wall: median of at least 20 runs (kinematics of 10^5 angles: 5); CPU: minimum.", "",
+              "| model | kinematics, ms wall | full analysis, ms CPU / wall | one angle, ms wall | "
+              "positions/s (10^5 angles) CPU / wall |", "|---|---|---|---|---|"]
     for r in kin_rows:
-        lines.append(f"| {r['model']} | {r['kinematics_ms']:.3f} | {r['analysis_ms']:.3f} | {r['single_ms']:.3f} | "
-                     f"{r['positions_per_s']:.3g} |")
+        lines.append(f"| {r['model']} | {r['kinematics_ms']:.3f} | {r['analysis_cpu_ms']:.3f} / {r['analysis_ms']:.3f} | "
+                     f"{r['single_ms']:.3f} | {r['positions_per_cpu_s']:.3g} / {r['positions_per_s']:.3g} |")
     lines += ["", "## Solver throughput on large batches (slotted-link shaper, full analysis)", "",
               f"The result holds every point, link and pair: {thr[-1]['bytes_per_angle'] / 1e3:.1f} kB per angle. "
-              "The first call of a size pays for fresh memory from the operating system; repeated calls "
-              "(median of 3, the previous result released) reuse it.", "",
-              "| angles | first call, s | repeated, s | angles/s (repeated) |", "|---|---|---|---|"]
+              f"A warm-up call of `fast.FAST_MIN` = {fast.FAST_MIN:,} angles loads (or compiles) the compiled "
+              "kernel first, so the first call of a size pays for fresh memory from the operating system "
+              "only; repeated calls (5, the previous result released) reuse it.", "",
+              "| angles | first call, s wall | repeated, s CPU min / median | repeated, s wall min / median | "
+              "angles/s (repeated, wall median) |", "|---|---|---|---|---|"]
     for r in thr:
-        lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"])
+        lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['cpu_min']:.3f} / {r['cpu_median']:.3f} | "
+                     f"{r['wall_min']:.3f} / {r['seconds']:.3f} | {r['per_second']:.3g} |")
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + main_job_lines(kernels["main_job"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -525,6 +618,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--quick", action="store_true", help="fewer repeats and settings; print only")
     ap.add_argument("--out", type=Path, default=ROOT / "reports", help="folder for benchmark.{md,csv,png}")
     args = ap.parse_args(argv)
+    from .kernels import cpu_info
+    machine = cpu_info()
     models = sorted((ROOT / "models").glob("*.toml"))
     kin_rows = kinematics_table(models)
     for r in kin_rows:
@@ -542,6 +637,8 @@ def main(argv: list[str] | None = None) -> None:
     print("\n".join(speed_lines(kern["speed"])))
     rows = study(models, args.quick)
     if not args.quick:
+        kern["main_job"] = main_job()
+        kern["machine"] = (machine, cpu_info())
         write_report(rows, kin_rows, thr, kern, args.out)
         print(f"wrote {args.out / 'benchmark.md'}")
 

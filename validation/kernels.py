@@ -57,14 +57,17 @@ __all__ = ["KernelTiming", "mujoco_kernel", "pinocchio_kernel", "MachineRates", 
 
 @dataclass(frozen=True)
 class KernelTiming:
-    """An engine kernel over the scene's regular angles: seconds per angle (median of the
-    repeats), the loop's own Python overhead per angle where the loop is Python (NaN for C), and
-    the driving moment it computed at every angle (NaN at singular angles), N m."""
+    """An engine kernel over the scene's regular angles: wall seconds per angle (median of the
+    repeats), the loop's own Python overhead per angle where the loop is Python (NaN for C), the
+    driving moment it computed at every angle (NaN at singular angles), N m, and the CPU seconds
+    per angle (this process' CPU clock), minimum and median of the repeats."""
     engine: str
     seconds_per_angle: float
     overhead_per_angle: float
     M_drive: np.ndarray
     note: str
+    cpu_min_per_angle: float
+    cpu_median_per_angle: float
 
 
 # ----------------------------------------------------------------------------- MuJoCo, in C
@@ -77,8 +80,8 @@ _MUJOCO_C = r"""
 #include <time.h>
 #include <mujoco/mujoco.h>
 
-static double now(void) {
-  struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec;
+static double now(clockid_t c) {
+  struct timespec t; clock_gettime(c, &t); return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
 /* solve A x = b in place (A n x n, row-major), partial pivoting; 0 if singular */
@@ -106,7 +109,7 @@ static int solve(double *A, double *b, int n) {
 
 /* argv: model.mjb states.bin N repeat crank_dof out.bin row0 row1 ...
    states.bin: qpos (N nq), qvel (N nv), qacc (N nv), xfrc (N nbody 6), doubles
-   out.bin: tau (N), then the seconds of each repeat */
+   out.bin: tau (N), then the wall seconds of each repeat, then its CPU seconds (this process) */
 int main(int argc, char **argv) {
   mjModel *m = mj_loadModel(argv[1], NULL);
   if (!m) { fprintf(stderr, "cannot load %s\n", argv[1]); return 2; }
@@ -122,11 +125,11 @@ int main(int argc, char **argv) {
   if (!f || fread(st, sizeof(double), len, f) != len) { fprintf(stderr, "cannot read states\n"); return 2; }
   fclose(f);
   double *qpos = st, *qvel = qpos + (size_t)N * nq, *qacc = qvel + (size_t)N * nv, *xfrc = qacc + (size_t)N * nv;
-  double *tau = malloc(sizeof(double) * N), *secs = malloc(sizeof(double) * repeat);
+  double *tau = malloc(sizeof(double) * N), *secs = malloc(sizeof(double) * 2 * repeat);
   double *rne = malloc(sizeof(double) * nv), *qfrc = malloc(sizeof(double) * nv);
   double *A = malloc(sizeof(double) * n * n), *x = malloc(sizeof(double) * n);
   for (int r = 0; r < repeat; r++) {
-    double t0 = now();
+    double t0 = now(CLOCK_MONOTONIC), c0 = now(CLOCK_PROCESS_CPUTIME_ID);
     for (int i = 0; i < N; i++) {
       mju_copy(d->qpos, qpos + (size_t)i * nq, nq);
       mju_copy(d->qvel, qvel + (size_t)i * nv, nv);
@@ -151,10 +154,11 @@ int main(int argc, char **argv) {
       mj_rnePostConstraint(m, d);
       tau[i] = x[0];
     }
-    secs[r] = now() - t0;
+    secs[r] = now(CLOCK_MONOTONIC) - t0;
+    secs[repeat + r] = now(CLOCK_PROCESS_CPUTIME_ID) - c0;
   }
   f = fopen(argv[6], "wb");
-  fwrite(tau, sizeof(double), N, f); fwrite(secs, sizeof(double), repeat, f); fclose(f);
+  fwrite(tau, sizeof(double), N, f); fwrite(secs, sizeof(double), 2 * repeat, f); fclose(f);
   mj_deleteData(d); mj_deleteModel(m);
   return 0;
 }
@@ -182,7 +186,8 @@ def _mujoco_program() -> Path:
 
 def mujoco_kernel(scene: Scene, repeat: int = 5) -> KernelTiming:
     """MuJoCo's compiled inverse dynamics, timed in C over the scene's regular angles (see the
-    module docstring): median over `repeat` runs of the loop, seconds per angle."""
+    module docstring): median over `repeat` runs of the loop, wall seconds per angle, and the
+    loop's CPU time (CLOCK_PROCESS_CPUTIME_ID of the C program), minimum and median."""
     import mujoco
     from . import engine_mujoco as em
     mm = em._compile(scene, em.EXACT_FLOOR, exact_masses=True)
@@ -204,8 +209,10 @@ def mujoco_kernel(scene: Scene, repeat: int = 5) -> KernelTiming:
         out = np.fromfile(tmp / "out.bin", dtype=np.float64)
     M_drive = np.full(len(ok), np.nan)
     M_drive[ok] = out[:N]
-    return KernelTiming("mujoco", statistics.median(out[N:]) / N, math.nan, M_drive,
-                        f"MuJoCo {mujoco.__version__}, C loop (gcc -O2) over {N} angles, median of {repeat}")
+    wall, cpu = out[N:N + repeat], out[N + repeat:]
+    return KernelTiming("mujoco", statistics.median(wall) / N, math.nan, M_drive,
+                        f"MuJoCo {mujoco.__version__}, C loop (gcc -O2) over {N} angles, {repeat} runs",
+                        min(cpu) / N, statistics.median(cpu) / N)
 
 
 # ----------------------------------------------------------------------------- Pinocchio, a Python loop
@@ -252,8 +259,9 @@ def _pin_closures(ps):
 
 def pinocchio_kernel(scene: Scene, repeat: int = 5) -> KernelTiming:
     """Pinocchio's compiled calls in a Python loop over the scene's regular angles (see the
-    module docstring): median over `repeat` runs, seconds per angle, and the same loop with
-    stubs for every engine and numpy call (the loop's own Python), seconds per angle."""
+    module docstring): median over `repeat` runs, wall seconds per angle, its CPU time (this
+    process) minimum and median, and the same loop with stubs for every engine and numpy call
+    (the loop's own Python), wall seconds per angle."""
     import pinocchio as pin
     from .engine_pinocchio import PinocchioScene
     ps = PinocchioScene(scene)
@@ -274,19 +282,19 @@ def pinocchio_kernel(scene: Scene, repeat: int = 5) -> KernelTiming:
     nothing = lambda *args: None
     stubs = (nothing, lambda *args: Jc, lambda *args: b, lambda *args: x)
 
-    def run(calls, calc_fns):
-        t = time.perf_counter()
+    def run(calls, calc_fns) -> tuple[float, float]:
+        t, c = time.perf_counter(), time.process_time()
         _pin_loop(calls, model, data, calc_fns, cmodels, cdatas, states, fexts, A, keep, tau)
-        return time.perf_counter() - t
+        return time.perf_counter() - t, time.process_time() - c
 
     run(real, calcs)
-    seconds = statistics.median(run(real, calcs) for _ in range(repeat)) / len(ok)
+    wall, cpu = zip(*(run(real, calcs) for _ in range(repeat)))
     M_drive = np.full(len(scene.phi_deg), np.nan)
     M_drive[ok] = tau
-    overhead = statistics.median(run(stubs, [nothing] * len(calcs)) for _ in range(repeat)) / len(ok)
-    return KernelTiming("pinocchio", seconds, overhead, M_drive,
+    overhead = statistics.median(run(stubs, [nothing] * len(calcs))[0] for _ in range(repeat)) / len(ok)
+    return KernelTiming("pinocchio", statistics.median(wall) / len(ok), overhead, M_drive,
                         f"pin {pin.__version__}, Python loop over {len(ok)} angles, {4 + len(calcs)} bound calls "
-                        f"per angle, median of {repeat}")
+                        f"per angle, {repeat} runs", min(cpu) / len(ok), statistics.median(cpu) / len(ok))
 
 
 # ----------------------------------------------------------------------------- flops of a compiled kernel
@@ -420,7 +428,7 @@ def _fill(buf: np.ndarray, x: float) -> None:
 @dataclass(frozen=True)
 class MachineRates:
     """One core's double-precision arithmetic throughput (flop/s) and memory write bandwidth
-    (bytes/s), measured here, best of the repeats; how they were measured."""
+    (bytes/s), measured here in this thread's CPU time, best of the repeats; how they were measured."""
     flops_per_second: float
     bytes_per_second: float
     note: str
@@ -428,7 +436,8 @@ class MachineRates:
 
 @functools.cache
 def machine_rates(repeat: int = 5, buffer_bytes: int = 256 * 2**20) -> MachineRates:
-    """Measure the machine once per process (see the module docstring): best of `repeat` runs."""
+    """Measure the machine once per process (see the module docstring): best of `repeat` runs,
+    each in this thread's CPU time (time.thread_time)."""
     import numba
     fma = numba.njit(fastmath=True)(_fma_chains)
     fill = numba.njit(_fill)
@@ -441,13 +450,16 @@ def machine_rates(repeat: int = 5, buffer_bytes: int = 256 * 2**20) -> MachineRa
     t_fill = min(_timed(lambda: fill(buf, 1.5)) for _ in range(repeat))
     return MachineRates(2 * _CHAINS * rounds / t_fma, buf.nbytes / t_fill,
                         f"numba {numba.__version__}: {_CHAINS} independent multiply-add chains (fastmath, FMA), "
-                        f"one core; a numba loop writing a reused {buffer_bytes / 2**20:.0f} MiB buffer")
+                        f"one core; a numba loop writing a reused {buffer_bytes / 2**20:.0f} MiB buffer; "
+                        f"thread CPU time, best of {repeat}")
 
 
 def _timed(fn) -> float:
-    t = time.perf_counter()
+    """CPU time of this thread running fn, s: the clock the kernels' rows are timed in, so the
+    share of the core that other processes take on a loaded machine counts in neither."""
+    t = time.thread_time()
     fn()
-    return time.perf_counter() - t
+    return time.thread_time() - t
 
 
 def machine_limit(flops_per_angle: float, bytes_per_angle: float, cores: int = 1,
