@@ -158,7 +158,7 @@ def test_all_writes_one_key_per_code_and_an_index(cli, tmp_path, monkeypatch):
 # ----------------------------------------------------------------------------- bad input
 
 @pytest.mark.parametrize("args, names", [
-    (["4", "479"], "TASK: unknown task '4'; seed 002 has tasks 1, 2, 3"),
+    (["4", "479"], "TASK: unknown task '4'; Logvinenko, Nadtoka 2021 has tasks 1, 2, 3"),
     (["0", "000"], "TASK: unknown task '0'"),
     (["one", "479"], "TASK: unknown task 'one'"),
     (["1", "47"], "CODE: '47' is not a variant of task 1: expected three digits 000..999"),

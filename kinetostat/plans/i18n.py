@@ -112,9 +112,9 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     # the command line
     "cli.plans": ("{name} at φ = {phi}° ({scales}): {n} files -> {out}", "{name}, φ = {phi}° ({scales}): {n} файлів -> {out}",
                   "{name}, φ = {phi}° ({scales}): {n} файлов -> {out}"),
-    "cli.variant": ("seed 002, task {task} ({title}), variant {code}: table {table} columns",
-                    "джерело 002, задача {task} ({title}), варіант {code}: стовпці таблиці {table}",
-                    "источник 002, задача {task} ({title}), вариант {code}: столбцы таблицы {table}"),
+    "cli.variant": ("Logvinenko, Nadtoka 2021, task {task} ({title}), variant {code}: table {table} columns",
+                    "Логвіненко, Надтока 2021, задача {task} ({title}), варіант {code}: стовпці таблиці {table}",
+                    "Логвиненко, Надтока 2021, задача {task} ({title}), вариант {code}: столбцы таблицы {table}"),
     "cli.at": ("at φ1 = {phi}°: {M} = {M_value}, largest reaction |{R}| = {R_value}",
                "при φ1 = {phi}°: {M} = {M_value}, найбільша реакція |{R}| = {R_value}",
                "при φ1 = {phi}°: {M} = {M_value}, наибольшая реакция |{R}| = {R_value}"),
