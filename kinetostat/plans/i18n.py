@@ -89,8 +89,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                                    "начальная окружность шестерни"),
     "mm": ("mm", "мм", "мм"),
     # the index of the answer keys
-    "ix.title": ("Seed 002: answer keys of the task variants", "Джерело 002: відповіді до варіантів завдань",
-                 "Источник 002: ответы к вариантам заданий"),
+    "ix.title": ("Logvinenko, Nadtoka 2021: answer keys of the task variants", "Логвіненко, Надтока 2021: відповіді до варіантів завдань",
+                 "Логвиненко, Надтока 2021: ответы к вариантам заданий"),
     "ix.intro": ("Each folder holds the variant's model (`task<T>_<CODE>.toml`, its header states the table's "
                  "columns and every assumption), its worksheet (`worksheet.md`, `.html`, `.csv`, `.json`) and its "
                  "plans (`SVG` sheets, `segments.csv`) at the design position φ1. R(i,j) is the force of link i on "
