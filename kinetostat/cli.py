@@ -991,7 +991,7 @@ def cmd_variant(args) -> int:
     if not (args.no_pack or teacher_pack):          # a plain install: the keys, and a word on the pack
         _Out.write("no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf): its PDFs need matplotlib: "
                    "pip install 'kinetostat[reports]'", err=True)
-    default = "seed002_variants" if args.all else jobs[0].name
+    default = "task_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
     t0 = time.perf_counter()
     keys = []
@@ -1278,8 +1278,8 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--force", action="store_true", help="with --copy: replace files already in DIR")
     e.set_defaults(func=cmd_examples)
 
-    va = sub.add_parser("variant", help="seed 002's task variants (tables 1.1-1.3): the model and its answer key",
-                        description="Build the model of seed 002's task TASK (1: ICE crank-slider, table 1.1; 2: "
+    va = sub.add_parser("variant", help="the task variants of Logvinenko, Nadtoka 2021 (tables 1.1-1.3): the model and its answer key",
+                        description="Build the model of task TASK of Logvinenko, Nadtoka 2021 (1: ICE crank-slider, table 1.1; 2: "
                                     "opposed-cylinder ICE, table 1.2; 3: air compressor, table 1.3) for the three-"
                                     "digit variant CODE (the digits, written twice, select the columns of the rows "
                                     "labelled а б в г д е), run it, and write into DIR the model file "
@@ -1291,13 +1291,13 @@ def build_parser() -> argparse.ArgumentParser:
                                     "--all writes the keys of every code (of TASK, or of all three tasks) into "
                                     "DIR/task<T>_<CODE>/ (no cycle.csv) with DIR/index.md and index.html, code -> M_bal, "
                                     "the largest reaction and the pack.")
-    va.add_argument("task", metavar="TASK", nargs="?", help="task of seed 002: 1, 2 or 3 (with --all: default all)")
+    va.add_argument("task", metavar="TASK", nargs="?", help="task of Logvinenko, Nadtoka 2021: 1, 2 or 3 (with --all: default all)")
     va.add_argument("code", metavar="CODE", nargs="?", help="three-digit variant 000..999, e.g. 479")
     va.add_argument("--all", action="store_true", help="every code of TASK (or of every task), for a teacher")
     va.add_argument("--out", metavar="DIR", help="output directory (created; default ./task<T>_<CODE>, "
-                                                 "with --all ./seed002_variants)")
+                                                 "with --all ./task_variants)")
     va.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
-                    help="language of the key and the index (default uk: the language of seed 002)")
+                    help="language of the key and the index (default uk: the language of Logvinenko, Nadtoka 2021)")
     va.add_argument("--no-pack", action="store_true", help="no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf "
                                                            "and their HTML): the keys only, about 4 s faster a code")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")

@@ -85,20 +85,20 @@ __all__ = ["TASKS", "Row", "TaskTable", "Variant", "KeySummary", "variant", "bui
 G = 9.81
 #: The letters of the code's digits (lines 56-63): letter -> position in the three-digit code.
 LETTERS = {"а": 0, "б": 1, "в": 2, "г": 0, "д": 1, "е": 2}
-SEED = "seed 002 (UkrDUZT course guide 'Technical mechanics', 2021, part 1)"
+#: The work the variants come from, by its citation (kinetostat.report.sources has the full reference).
+SEED = "Logvinenko, Nadtoka 2021"
 
 
 @dataclass(frozen=True)
 class Row:
     """One row of a variant table: its letter (а..е), an ASCII `key`, the text's symbol, meaning,
-    unit as printed, the values of columns 0..9, and the seed's lines of columns 0-4 and 5-9."""
+    unit as printed and the values of columns 0..9."""
     letter: str
     key: str
     symbol: str
     meaning: str
     unit: str
     values: tuple[float, ...]
-    lines: tuple[int, int]
 
 
 @dataclass(frozen=True)
@@ -107,69 +107,68 @@ class TaskTable:
     task: int
     table: str
     title: str
-    lines: str
     bundled: str            # the bundled model whose assumptions the task reuses
     rows: tuple[Row, ...]
 
 
-def _row(letter, key, symbol, meaning, unit, values, lines) -> Row:
+def _row(letter, key, symbol, meaning, unit, values) -> Row:
     values = tuple(float(x) for x in values)
     assert len(values) == 10 and letter in LETTERS, key
-    return Row(letter, key, symbol, meaning, unit, values, lines)
+    return Row(letter, key, symbol, meaning, unit, values)
 
 
 _PHI = (30, 60, 90, 120, 150) * 2
 _HALF = (0.5,) * 10
 
-#: The three tables as printed (lines of seed 002 in each row).
+#: The three tables as printed (Logvinenko, Nadtoka 2021, sec. 1.1).
 TASKS: Mapping[int, TaskTable] = MappingProxyType({
-    1: TaskTable(1, "1.1", "two-stroke ICE crank-slider of a water-pumping unit", "73-114", "ice_crank_slider", (
+    1: TaskTable(1, "1.1", "two-stroke ICE crank-slider of a water-pumping unit", "ice_crank_slider", (
         _row("а", "n1", "n_1", "crank speed", "rpm",
-             (4400, 4500, 4400, 4300, 4200, 4100, 4000, 4400, 4200, 4300), (88, 105)),
+             (4400, 4500, 4400, 4300, 4200, 4100, 4000, 4400, 4200, 4300)),
         _row("б", "l_OA", "l_OA", "crank length", "m",
-             (0.034, 0.036, 0.038, 0.04, 0.042, 0.044, 0.046, 0.048, 0.05, 0.052), (89, 106)),
-        _row("в", "phi1", "φ_1", "design position from TDC", "deg", _PHI, (90, 107)),
+             (0.034, 0.036, 0.038, 0.04, 0.042, 0.044, 0.046, 0.048, 0.05, 0.052)),
+        _row("в", "phi1", "φ_1", "design position from TDC", "deg", _PHI),
         _row("г", "ratio", "l_AB/l_OA", "rod to crank length", "1",
-             (3.5, 3.55, 3.6, 3.65, 3.7, 3.75, 3.8, 3.85, 3.9, 3.95), (96, 108)),
-        _row("д", "s_ratio", "l_AS2/l_AB", "rod centre of mass", "1", _HALF, (97, 109)),
-        _row("е", "d", "d", "cylinder diameter", "m", (0.070, 0.072, 0.074, 0.076, 0.078) * 2, (98, 110)),
-        _row("а", "p_max", "P_max", "maximum cylinder pressure", "MPa", (2.4, 2.5, 2.6, 2.7, 2.8) * 2, (99, 111)),
+             (3.5, 3.55, 3.6, 3.65, 3.7, 3.75, 3.8, 3.85, 3.9, 3.95)),
+        _row("д", "s_ratio", "l_AS2/l_AB", "rod centre of mass", "1", _HALF),
+        _row("е", "d", "d", "cylinder diameter", "m", (0.070, 0.072, 0.074, 0.076, 0.078) * 2),
+        _row("а", "p_max", "P_max", "maximum cylinder pressure", "MPa", (2.4, 2.5, 2.6, 2.7, 2.8) * 2),
         _row("б", "G3", "G_3", "piston weight", "N",
-             (3.6, 3.65, 3.7, 3.75, 3.8, 3.8, 3.75, 3.7, 3.65, 3.6), (100, 112)),
-        _row("б", "G2", "G_2", "rod weight", "N", (4.7, 4.75, 4.8, 4.85, 4.9) * 2, (101, 113)),
+             (3.6, 3.65, 3.7, 3.75, 3.8, 3.8, 3.75, 3.7, 3.65, 3.6)),
+        _row("б", "G2", "G_2", "rod weight", "N", (4.7, 4.75, 4.8, 4.85, 4.9) * 2),
         _row("в", "I_S2", "I_S2", "rod moment of inertia about S2", "kg m^2",
-             (0.0018, 0.0019, 0.002, 0.0021, 0.0022, 0.0023, 0.0018, 0.0019, 0.002, 0.0021), (102, 114)),
+             (0.0018, 0.0019, 0.002, 0.0021, 0.0022, 0.0023, 0.0018, 0.0019, 0.002, 0.0021)),
     )),
-    2: TaskTable(2, "1.2", "two-stroke opposed-cylinder ICE of a transport power unit", "116-150", "opposed_twin", (
+    2: TaskTable(2, "1.2", "two-stroke opposed-cylinder ICE of a transport power unit", "opposed_twin", (
         _row("а", "n1", "n_1", "crankshaft speed", "rpm",
-             (5000, 4500, 5100, 5200, 5000, 4500, 4400, 4800, 5000, 4400), (131, 142)),
+             (5000, 4500, 5100, 5200, 5000, 4500, 4400, 4800, 5000, 4400)),
         _row("б", "l_OA", "l_OA, l_OC", "crank throw length", "m",
-             (0.035, 0.033, 0.037, 0.039, 0.04, 0.042, 0.033, 0.038, 0.042, 0.038), (132, 143)),
+             (0.035, 0.033, 0.037, 0.039, 0.04, 0.042, 0.033, 0.038, 0.042, 0.038)),
         _row("в", "ratio", "l_AB/l_OA, l_CD/l_OC", "rod to crank length", "1",
-             (3.5, 3.55, 3.6, 3.65, 3.7, 3.75, 3.8, 3.85, 3.9, 3.95), (133, 144)),
-        _row("г", "s_ratio", "l_AS2/l_AB, l_CS4/l_CD", "rods' centres of mass", "1", _HALF, (134, 145)),
-        _row("д", "phi1", "φ_1", "design position from TDC of cylinder 3", "deg", _PHI, (135, 146)),
+             (3.5, 3.55, 3.6, 3.65, 3.7, 3.75, 3.8, 3.85, 3.9, 3.95)),
+        _row("г", "s_ratio", "l_AS2/l_AB, l_CS4/l_CD", "rods' centres of mass", "1", _HALF),
+        _row("д", "phi1", "φ_1", "design position from TDC of cylinder 3", "deg", _PHI),
         _row("е", "d", "d", "cylinder diameter", "m",
-             (0.075, 0.074, 0.072, 0.072, 0.078, 0.078, 0.078, 0.08, 0.07, 0.08), (136, 147)),
+             (0.075, 0.074, 0.072, 0.072, 0.078, 0.078, 0.078, 0.08, 0.07, 0.08)),
         _row("а", "p_max", "P_max", "maximum cylinder pressure", "MPa",
-             (3.2, 3.4, 3.2, 3.0, 2.8, 3.0, 3.2, 3.4, 3.2, 3.0), (137, 148)),
+             (3.2, 3.4, 3.2, 3.0, 2.8, 3.0, 3.2, 3.4, 3.2, 3.0)),
         _row("б", "G_piston", "G_3, G_5", "piston weight", "N",
-             (3.2, 3.6, 3.6, 3.2, 3.4, 3.6, 3.6, 3.4, 3.2, 3.4), (138, 149)),
+             (3.2, 3.6, 3.6, 3.2, 3.4, 3.6, 3.6, 3.4, 3.2, 3.4)),
         _row("в", "G_rod", "G_2, G_4", "rod weight", "N",
-             (4.6, 4.2, 4.6, 4.0, 4.6, 4.2, 4.0, 4.6, 4.0, 4.2), (139, 150)),
+             (4.6, 4.2, 4.6, 4.0, 4.6, 4.2, 4.0, 4.6, 4.0, 4.2)),
     )),
-    3: TaskTable(3, "1.3", "single-stage single-acting air compressor", "152-188", "compressor", (
-        _row("а", "n1", "n_1", "crank speed", "rpm", (380, 400, 375, 350, 325, 300, 325, 350, 375, 360), (169, 180)),
+    3: TaskTable(3, "1.3", "single-stage single-acting air compressor", "compressor", (
+        _row("а", "n1", "n_1", "crank speed", "rpm", (380, 400, 375, 350, 325, 300, 325, 350, 375, 360)),
         _row("б", "l_OA", "l_OA", "crank radius", "m",
-             (0.045, 0.05, 0.055, 0.06, 0.065, 0.07, 0.075, 0.08, 0.08, 0.09), (170, 181)),
+             (0.045, 0.05, 0.055, 0.06, 0.065, 0.07, 0.075, 0.08, 0.08, 0.09)),
         _row("в", "ratio", "l_AB/l_OA", "rod to crank length", "1",
-             (3.5, 3.55, 3.6, 3.65, 3.7, 3.75, 3.8, 3.85, 3.9, 3.95), (171, 182)),
-        _row("г", "G2", "G_2", "rod weight", "N", (50, 52, 54, 56, 58, 60, 62, 64, 66, 68), (172, 183)),
-        _row("д", "G3", "G_3", "piston weight", "N", (40, 42, 44, 46, 48, 50, 48, 46, 44, 42), (173, 184)),
-        _row("е", "s_ratio", "l_AS2/l_AB", "rod centre of mass", "1", _HALF, (174, 185)),
-        _row("а", "d", "d", "cylinder diameter", "m", (0.154,) * 10, (175, 186)),
-        _row("б", "p_max", "P_max", "maximum cylinder pressure (gauge)", "MPa", (0.2,) * 10, (176, 187)),
-        _row("в", "phi1", "φ_1", "design position from TDC", "deg", _PHI, (177, 188)),
+             (3.5, 3.55, 3.6, 3.65, 3.7, 3.75, 3.8, 3.85, 3.9, 3.95)),
+        _row("г", "G2", "G_2", "rod weight", "N", (50, 52, 54, 56, 58, 60, 62, 64, 66, 68)),
+        _row("д", "G3", "G_3", "piston weight", "N", (40, 42, 44, 46, 48, 50, 48, 46, 44, 42)),
+        _row("е", "s_ratio", "l_AS2/l_AB", "rod centre of mass", "1", _HALF),
+        _row("а", "d", "d", "cylinder diameter", "m", (0.154,) * 10),
+        _row("б", "p_max", "P_max", "maximum cylinder pressure (gauge)", "MPa", (0.2,) * 10),
+        _row("в", "phi1", "φ_1", "design position from TDC", "deg", _PHI),
     )),
 })
 
@@ -184,12 +183,12 @@ _AMBIGUITY_G2 = ("Table 1.1 labels both G3 and G2 with row 'б' and I_S2 with '�
                  "the sequence was written with it; the letters are the text's only selection rule).")
 _ASSUMED = {
     1: ["Cylinder above the crank shaft, slider axis vertical through O; crank angle from top dead centre "
-        "(line 82), crank turning clockwise (figure 1.1a not available; magnitudes are the same for either "
+        "(sec. 1.1), crank turning clockwise (figure 1.1a not available; magnitudes are the same for either "
         "sense by mirror symmetry). As the bundled ice_crank_slider.",
         "Crank mass not given: treated as balanced and massless (the worked example does not use it).",
         "Indicator diagram (figure 1.1b not available): the bundled ice_crank_slider's assumed two-stroke "
         "diagram p/p_max against crank angle (p = 0.8 p_max at 30 deg, as sec. 1.2 states; expansion "
-        "0-180 deg, driving in positions 0-6 and resisting in 6-12, line 77); the gas force acts on the "
+        "0-180 deg, driving in positions 0-6 and resisting in 6-12, sec. 1.1 task 1); the gas force acts on the "
         "piston crown towards the crank shaft (-y), pi/4 d^2 p."],
     2: ["Crankshaft with two throws 180 deg apart (A and C on opposite sides of O, boxer layout), cylinders "
         "horizontal on one axis through O: piston 3 to the right (+x), piston 5 to the left (-x); crank "
@@ -198,14 +197,14 @@ _ASSUMED = {
         "Indicator diagram (figure 1.2b not available): the bundled ice_crank_slider's assumed two-stroke "
         "diagram, one per cylinder, in phase (both pistons reach TDC together with 180-deg throws); gas "
         "force on each piston towards the crank shaft, pi/4 d^2 p.",
-        "Rod centroidal moments of inertia not in table 1.2: I_S = m l^2/12 (uniform bar, line 360), m = G/g.",
+        "Rod centroidal moments of inertia not in table 1.2: I_S = m l^2/12 (uniform bar, sec. 1.2.3), m = G/g.",
         "Crankshaft mass not given: treated as balanced and massless."],
     3: ["Vertical cylinder above the crank shaft, slider axis through O (suction on the downward stroke, "
-        "line 161); crank angle from top dead centre, crank turning clockwise (figure 1.3a not available). "
+        "sec. 1.1 task 3); crank angle from top dead centre, crank turning clockwise (figure 1.3a not available). "
         "As the bundled compressor.",
-        "Rod centroidal moment of inertia not in table 1.3: I_S2 = m l^2/12 (uniform bar, line 360), m = G/g.",
+        "Rod centroidal moment of inertia not in table 1.3: I_S2 = m l^2/12 (uniform bar, sec. 1.2.3), m = G/g.",
         "Reducer and crank wheel not specified: the bundled compressor's spur pair, wheel mass and inertia "
-        "(seed 000 sec. 7.2 estimate), the wheel carrying the crank pin; the pin radius of every column "
+        "(Kiriienko 2019 sec. 7.2 estimate), the wheel carrying the crank pin; the pin radius of every column "
         "(<= 0.09 m) lies inside the wheel.",
         "Pressure diagram (figure 1.3b not available): the bundled compressor's assumed diagram, gauge "
         "pressure / p_max against piston travel from TDC (clearance 5 %, polytropic n = 1.3, suction "
@@ -216,7 +215,7 @@ _COMMON = ["Every number not derived from the table is an assumption of the bund
            "items (models/<name>.toml, whose header gives the reasons); the table's values are used as "
            "printed (columns that break a pattern included).",
            "l_AB = (l_AB/l_OA) * l_OA exactly (not rounded as in the worked example); l_AS = (l_AS/l_AB) * l_AB.",
-           "Constant crank speed (eps = 0), no friction (the text ignores it, line 334), g = 9.81 (line 350); "
+           "Constant crank speed (eps = 0), no friction (the text ignores it, sec. 1.2.3), g = 9.81 (sec. 1.2.3); "
            "design position phi1 of the table."]
 
 
@@ -226,7 +225,7 @@ def check_task(task: Any, name: str = "task") -> int:
     """The task number 1, 2 or 3 (int or its digit as text); ValueError naming `name` otherwise."""
     text = str(task).strip()
     if isinstance(task, bool) or text not in {str(t) for t in TASKS}:
-        raise ValueError(f"{name}: unknown task {task!r}; seed 002 has tasks {', '.join(map(str, TASKS))}")
+        raise ValueError(f"{name}: unknown task {task!r}; Logvinenko, Nadtoka 2021 has tasks {', '.join(map(str, TASKS))}")
     return int(text)
 
 
@@ -236,7 +235,7 @@ def check_code(code: Any, task: int | None = None, name: str = "code") -> str:
     of = f" of task {task}" if task is not None else ""
     if not (isinstance(code, str) and len(code) == 3 and all(c in "0123456789" for c in code)):
         raise ValueError(f"{name}: {code!r} is not a variant{of}: expected three digits 000..999 "
-                         f"(e.g. '479', seed 002 lines 56-63)")
+                         f"(e.g. '479', as Logvinenko, Nadtoka 2021 numbers them in its introduction)")
     return code
 
 
@@ -266,7 +265,7 @@ def _bundled(name: str) -> Mechanism:
     try:
         return load(examples.path(name))
     except FileNotFoundError as exc:
-        raise FileNotFoundError(f"the seed 002 variants reuse the assumptions of the bundled model {name!r}: "
+        raise FileNotFoundError(f"the variants of Logvinenko, Nadtoka 2021 reuse the assumptions of the bundled model {name!r}: "
                                 f"{exc}") from None
 
 
@@ -367,8 +366,8 @@ def _model(task: int, v: Mapping[str, float], label: str, assumptions: list[str]
         parts = [_slider_crank(2, "A", "B", "S2", length, v["s_ratio"], v["G2"], _rod_inertia(v["G2"], length),
                                v["G3"], [0.0, 1.0], gas, "air pressure force")]
     model: dict[str, Any] = {
-        "mechanism": {"name": f"{spec.title} (seed 002, task {task}, {label})",
-                      "source": f"{SEED}, sec. 1.1 task {task}, table {spec.table} (lines {spec.lines})",
+        "mechanism": {"name": f"{spec.title} ({SEED}, task {task}, {label})",
+                      "source": f"{SEED}, sec. 1.1 task {task}, table {spec.table}",
                       "assumptions": assumptions, "g": G},
         "drive": drive, "frame": {"O": [0.0, 0.0]}, "link": [crank], "pair": [{"kind": "R", "links": [0, 1],
                                                                               "point": "O"}],
@@ -421,7 +420,7 @@ def build(task: int, v: Mapping[str, float], code: str | None = None, columns: M
         raise ValueError(f"values: task {task} needs {', '.join(missing)}")
     label = f"variant {code}" if code else "values given"
     chosen = (f"Variant {code}: rows а б в г д е take columns {' '.join(code * 2)} "
-              f"(lines 56-63): " if code else "Values given, not a code: ")
+              f"(the rule of the text's introduction): " if code else "Values given, not a code: ")
     chosen += ", ".join(f"{r.symbol} = {v[r.key]:g}{_unit(r)}" for r in spec.rows) + "."
     assumptions = [chosen] + ([_AMBIGUITY_G2] if task == 1 else []) + _ASSUMED[task] + _COMMON
     model = _model(task, v, label, assumptions, code)
@@ -442,18 +441,17 @@ def _unit(r: Row) -> str:
 
 def _header(spec: TaskTable, v, code, cols, model, assumptions) -> tuple[str, ...]:
     length = v["ratio"] * v["l_OA"]
-    lines = [f"Seed 002 (UkrDUZT, Technical mechanics, 2021, part 1), task {spec.task}: {spec.title};",
-             f"table {spec.table} (shared/seeds/002_*.txt, lines {spec.lines}).",
+    lines = [f"{SEED}, sec. 1.1, task {spec.task}: {spec.title}; table {spec.table}.",
              f"Written by `kinetostat variant {spec.task} {code}` (kinetostat.variants)." if code else
              "Written by kinetostat.variants.build from values given (not a code of the table).", ""]
     if code:
-        lines += [f"The code (lines 56-63): \"{code}\" written twice, \"{code * 2}\", with а б в г д е under the",
+        lines += [f"The code (the text's introduction): \"{code}\" written twice, \"{code * 2}\", with а б в г д е under the",
                   "digits; a row labelled with a letter takes the column of the digit under it:",
                   "  " + "  ".join(f"{ch}={code[i]}" for ch, i in LETTERS.items()), ""]
-    lines.append("Rows (letter, symbol = value [unit], column, seed line):")
+    lines.append("Rows (letter, symbol = value [unit], column):")
     for r in spec.rows:
         c = cols[r.key] if cols else None
-        where = f"column {c}, line {r.lines[c >= 5]}" if c is not None else "given"
+        where = f"column {c}" if c is not None else "given"
         lines.append(f"  {r.letter}  {r.symbol} = {v[r.key]:g}{_unit(r)}   ({r.meaning}; {where})")
     lines += ["", "Derived:",
               f"  l_AB = {v['ratio']:g} * {v['l_OA']:g} = {length:.12g} m;  l_AS = {v['s_ratio']:g} * l_AB "

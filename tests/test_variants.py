@@ -152,13 +152,13 @@ def test_all_writes_one_key_per_code_and_an_index(cli, tmp_path, monkeypatch):
                                phi_deg=[variants.values(3, code)["phi1"]]).balancing_moment[0]
         assert f"| [{code}](task3_{code}/worksheet.md) | " in index
         assert f"| {M:.2f} |".replace(".", ",") in index           # seed 002's language, its decimal comma
-    assert index.startswith("# Джерело 002")
+    assert index.startswith("# Логвіненко, Надтока 2021")
 
 
 # ----------------------------------------------------------------------------- bad input
 
 @pytest.mark.parametrize("args, names", [
-    (["4", "479"], "TASK: unknown task '4'; seed 002 has tasks 1, 2, 3"),
+    (["4", "479"], "TASK: unknown task '4'; Logvinenko, Nadtoka 2021 has tasks 1, 2, 3"),
     (["0", "000"], "TASK: unknown task '0'"),
     (["one", "479"], "TASK: unknown task 'one'"),
     (["1", "47"], "CODE: '47' is not a variant of task 1: expected three digits 000..999"),

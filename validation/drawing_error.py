@@ -197,7 +197,7 @@ def write_report(r: dict, md: Path, png: Path) -> None:
           f"{sol.samples['R_1_2'].std() / sol.exact['R_1_2'] * 100:.2g} %, the small R43 to "
           f"{sol.samples['R_0_3'].std() / sol.exact['R_0_3'] * 100:.2g} % (it is the short closing side of a "
           f"polygon of ~200 mm sides), M_bal to {abs(sol.samples['M_bal'].std() / sol.exact['M_bal']) * 100:.2g} %.",
-          f"- Seed 002's published values lie between percentiles {min(pcts):.0f} and {max(pcts):.0f} of "
+          f"- The published values of Logvinenko, Nadtoka 2021 lie between percentiles {min(pcts):.0f} and {max(pcts):.0f} of "
           f"careful drawings (outside the central 95 %: {', '.join(outside) or 'none'}): the text's numbers are "
           f"what a ±0.25 mm drawing gives, and its differences from the exact values (at most "
           f"{max(abs(x) for x in diffs):.2g} %, R12) are drawing error, not a different method.",

@@ -89,8 +89,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                                    "начальная окружность шестерни"),
     "mm": ("mm", "мм", "мм"),
     # the index of the answer keys
-    "ix.title": ("Seed 002: answer keys of the task variants", "Джерело 002: відповіді до варіантів завдань",
-                 "Источник 002: ответы к вариантам заданий"),
+    "ix.title": ("Logvinenko, Nadtoka 2021: answer keys of the task variants", "Логвіненко, Надтока 2021: відповіді до варіантів завдань",
+                 "Логвиненко, Надтока 2021: ответы к вариантам заданий"),
     "ix.intro": ("Each folder holds the variant's model (`task<T>_<CODE>.toml`, its header states the table's "
                  "columns and every assumption), its worksheet (`worksheet.md`, `.html`, `.csv`, `.json`) and its "
                  "plans (`SVG` sheets, `segments.csv`) at the design position φ1. R(i,j) is the force of link i on "
@@ -112,9 +112,9 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     # the command line
     "cli.plans": ("{name} at φ = {phi}° ({scales}): {n} files -> {out}", "{name}, φ = {phi}° ({scales}): {n} файлів -> {out}",
                   "{name}, φ = {phi}° ({scales}): {n} файлов -> {out}"),
-    "cli.variant": ("seed 002, task {task} ({title}), variant {code}: table {table} columns",
-                    "джерело 002, задача {task} ({title}), варіант {code}: стовпці таблиці {table}",
-                    "источник 002, задача {task} ({title}), вариант {code}: столбцы таблицы {table}"),
+    "cli.variant": ("Logvinenko, Nadtoka 2021, task {task} ({title}), variant {code}: table {table} columns",
+                    "Логвіненко, Надтока 2021, задача {task} ({title}), варіант {code}: стовпці таблиці {table}",
+                    "Логвиненко, Надтока 2021, задача {task} ({title}), вариант {code}: столбцы таблицы {table}"),
     "cli.at": ("at φ1 = {phi}°: {M} = {M_value}, largest reaction |{R}| = {R_value}",
                "при φ1 = {phi}°: {M} = {M_value}, найбільша реакція |{R}| = {R_value}",
                "при φ1 = {phi}°: {M} = {M_value}, наибольшая реакция |{R}| = {R_value}"),
