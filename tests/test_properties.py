@@ -332,6 +332,12 @@ def _assembled(data: dict, steps: int = 120):
     """The mechanism and its analysis over a cycle, or None if it does not assemble cleanly."""
     try:
         mech = kinetostat.from_dict(data)
+    except kinetostat.ModelWarning as exc:
+        # a drawn two-group chain may just pass the 20 m plausibility bound of a single linkage
+        # (the warning "drawn in millimetres?"): not a mechanism the strategies mean to draw
+        if "the largest link spans" in str(exc):
+            return None
+        raise
     except kinetostat.ModelError as exc:
         # the drawn extra points of a small slider may all fall on its pin, or within 1e-150 m of
         # it (hypothesis likes 0 and the tiniest floats): a degenerate link, refused as such

@@ -87,7 +87,9 @@ def test_a_design_that_does_not_assemble_keeps_its_row():
 def test_a_design_the_model_refuses_keeps_its_row():
     sw = kinetostat.sweep(CHAIN, {"m2": [7.791, -1.0]}, steps=4)
     assert sw.table["error"].iloc[0] == ""
-    assert sw.table["error"].iloc[1] == 'ModelError: line 155: link[id=2].mass: must be >= 0.0, got -1.0 (= "m2")'
+    line = 1 + next(n for n, text in enumerate(CHAIN.read_text(encoding="utf-8").splitlines())
+                    if text.startswith("mass = ") and "m2" in text)       # the line of link 2's mass
+    assert sw.table["error"].iloc[1] == f'ModelError: line {line}: link[id=2].mass: must be >= 0.0, got -1.0 (= "m2")'
 
 
 def test_full_keeps_every_angle_with_the_design_first():
