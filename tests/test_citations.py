@@ -14,8 +14,10 @@ from kinetostat import variants
 from kinetostat.report.sources import WORKS
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
-# "seed 002", "seeds/000_...", "line 360", "lines 120-130", "(l.131)"; not "line 27:" (an error message)
-SEED_REF = re.compile(r"\bseeds?[ /_]?0\d\d|\blines? \d+(?![\d:])|\bl\.\s?\d+", re.IGNORECASE)
+# "seed 002", "seeds/000_...", "line 360", "lines 120-130", "(l.131)", and the uk/ru "джерело 002",
+# "источник 002"; not "line 27:" (an error message)
+SEED_REF = re.compile(r"\bseeds?[ /_]?0\d\d|\blines? \d+(?![\d:])|\bl\.\s?\d+|(джерел|источник)\w* 0\d\d",
+                      re.IGNORECASE)
 
 
 def seed_refs(text: str) -> list[str]:
@@ -24,6 +26,7 @@ def seed_refs(text: str) -> list[str]:
 
 def test_the_pattern_finds_what_it_must_and_passes_error_messages():
     assert len(seed_refs("seed 002 (lines 116-150); Seed 000 line 947; (l.131); seeds/004_6.txt")) == 6
+    assert len(seed_refs("(приклад джерела 002, розд. 1.2); (источник 000, разд. 6.3)")) == 2
     assert seed_refs("`line 27: link[id=2].mass: must be >= 0.0`; Logvinenko, Nadtoka 2021, sec. 1.2.3") == []
 
 
