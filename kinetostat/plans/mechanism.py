@@ -64,7 +64,8 @@ def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
     if not drawn and rest:
         drawn.add(rest.pop(0))
     while rest:                                   # the nearest point not yet drawn, joined to the drawing
-        a, b = min(((a, b) for a in rest for b in drawn), key=lambda ab: abs(pts[ab[0]] - pts[ab[1]]))
+        a, b = min(((a, b) for a in rest for b in drawn),          # ties by name: the same sheet every run
+                   key=lambda ab: (abs(pts[ab[0]] - pts[ab[1]]), ab))
         segs.append(Segment(f"{b}{a}", b, a, abs(pts[a] - pts[b]) * mu.value, "m", "link"))
         drawn.add(a)
         rest.remove(a)
