@@ -219,3 +219,19 @@ def test_given_scales_are_checked():
         P.build(mech, scales={"mu_l": 0.0})
     with pytest.raises(ValueError, match="at"):
         P.build(mech, at=float("nan"))
+
+
+def test_the_sheets_do_not_depend_on_the_hash_seed(tmp_path):
+    """The furnace loader's S3 lies midway between B and O2 (a tie of the mechanism sheet's
+    nearest drawn point): two processes with other string hash seeds write the same files."""
+    import os
+    import subprocess
+    import sys
+    outs = []
+    for seed in ("1", "3"):          # on the old code these two drew S3 from O2 and from B
+        out = tmp_path / seed
+        subprocess.run([sys.executable, "-m", "kinetostat", "plans", str(ROOT / "models" / "furnace_loader_six_bar.toml"),
+                        "--only", "mechanism", "--lang", "en", "--out", str(out)], check=True, capture_output=True,
+                       env=dict(os.environ, PYTHONHASHSEED=seed), cwd=ROOT)
+        outs.append({p.name: p.read_bytes() for p in sorted(out.iterdir())})
+    assert outs[0] == outs[1] and "mechanism.svg" in outs[0]
