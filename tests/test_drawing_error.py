@@ -10,8 +10,9 @@ import kinetostat
 from kinetostat.plans.drawing_error import Scales, default_scales, draws_forces, simulate
 from kinetostat.plans.worksheet import worksheet
 
-DRAWN = ["ice_crank_slider", "chain_unit_four_bar", "compressor"]          # forces, crank and lever
-KINEMATICS_ONLY = ["furnace_loader_six_bar", "opposed_twin", "rotating_slotted_link"]   # RPR among them
+DRAWN = ["ice_crank_slider", "chain_unit_four_bar", "compressor",          # forces, crank and lever
+         "furnace_loader_six_bar", "opposed_twin"]                         # two groups, reactions carried
+KINEMATICS_ONLY = ["rotating_slotted_link"]                                # an RPR group
 
 
 @pytest.mark.parametrize("name", DRAWN + KINEMATICS_ONLY)
@@ -27,6 +28,25 @@ def test_zero_error_is_the_exact_solution(name):
         assert np.all(np.abs(s - exact) <= 1e-9 * scale), key
     if name in DRAWN:
         assert {"R_1_2", "M_bal", "M_bal_lever", "delta_pct"} <= set(sol.samples)
+        for g in mech.structure.groups:            # every group's polygon, every arm on the crank
+            (j, k), (a, c) = g.links, g.known
+            assert {f"R_{a}_{j}", f"R_{c}_{k}", f"R_{k}_{j}"} <= set(sol.samples), g.label
+            if a == mech.drive.link:
+                assert f"h_R{j}{a}" in sol.samples, g.label
+
+
+def test_two_groups_spread_about_the_exact_solution():
+    """Opposed twin (both groups on the crank) and the six-bar loader (R34 carried from the slider
+    group to the rocker): the drawn values centre on the exact ones, and M_bal, summed from the
+    reactions of both groups, spreads by a few per cent at most."""
+    for name, carried in (("opposed_twin", "R_1_4"), ("furnace_loader_six_bar", "R_3_4")):
+        sol = simulate(kinetostat.load(name), n=20000, seed=3)
+        for key in ("M_bal", "M_bal_lever", carried, "R_0_3" if name == "opposed_twin" else "R_1_2"):
+            s = sol.spread(key)
+            assert abs(s["mean"] - s["exact"]) < 4 * s["sd"] / np.sqrt(20000) + 1e-3 * abs(s["exact"]), (name, key)
+            assert s["sd"] > 0, (name, key)
+        assert sol.spread("M_bal")["sd"] < 0.05 * abs(sol.exact["M_bal"])
+        assert 2 < sol.percentile_of("M_bal", sol.exact["M_bal"]) < 98
 
 
 def test_spread_is_linear_in_a_small_precision():

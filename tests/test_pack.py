@@ -88,6 +88,26 @@ def test_the_key_holds_the_answers_and_their_bands(uk_479):
     assert "|δ| не більше 5 %" in flat
 
 
+def test_task_2_bands_both_groups_and_marks_a_value_outside_its_band():
+    """Task 2 (opposed twin, two groups on the crank): both groups' reactions, both arms on the
+    crank and M_зр have bands from the simulated drawings; R61 (4.2 N, a 0.04 mm closing side at
+    μ_F = 100 N/mm) is read longer by every careful drawing, and the key says so."""
+    v = variants.variant(2, "479")
+    p = P.pack(v, lang="uk", draws=400)
+    mech = v.mechanism()
+    res = kinetostat.analyze(mech, phi_deg=[float(v.values["phi1"])])
+    for key, exact in (("M_bal", res.balancing_moment[0]), ("R_1_2", np.hypot(*res.reaction(1, 2)[0])),
+                       ("R_1_4", np.hypot(*res.reaction(1, 4)[0])), ("R_3_2", np.hypot(*res.reaction(3, 2)[0])),
+                       ("R_5_4", np.hypot(*res.reaction(5, 4)[0]))):
+        lo, hi = p.bands[key]
+        assert lo < exact < hi and hi - lo < 0.05 * abs(exact), key
+    assert {"h_R21", "h_R41"} <= set(p.bands)
+    R01 = np.hypot(*res.reaction(0, 1)[0])
+    assert R01 < p.bands["R_0_1"][0]
+    notes = [b for kind, b in p.key if kind == "p"]
+    assert any(b.startswith("* Точне значення поза межами") for b in notes)
+
+
 @needs_poppler
 def test_the_sheet_holds_no_answer(uk_479, pack_uk):
     sheet = pdftext(uk_479 / "sheet.pdf")

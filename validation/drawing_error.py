@@ -31,6 +31,7 @@ SEED = 2026
 PRECISIONS = (0.1, 0.25, 0.5)          # mm and deg together: a reading of ±p mm, a direction of ±p deg
 SCALE_FACTORS = (0.5, 1.0, 2.0)        # the text's scales times this: 2 = a drawing half the size
 ANGLES = np.arange(0.0, 360.0, 30.0)
+TWO_GROUPS = ("opposed_twin", "furnace_loader_six_bar")   # the reactions carried from group to group
 
 #: Seed 002 sec. 1.2 at 30 deg: the worksheet key, the text's symbol, its published value.
 PUBLISHED = [("V_B", "V_B", 10.94), ("V_BA", "V_BA", 14.92), ("V_S2", "V_S2", 12.2), ("omega_2", "ω2", 135.6),
@@ -61,7 +62,8 @@ def study() -> dict:
     four_bar = kinetostat.load("chain_unit_four_bar")
     base = default_scales(ice, 30.0)
     out = {"ice": simulate(ice, 30.0, n=N, seed=SEED), "four_bar": simulate(four_bar, n=N, seed=SEED),
-           "scales": base, "four_bar_scales": default_scales(four_bar)}
+           "scales": base, "four_bar_scales": default_scales(four_bar),
+           "two_groups": [simulate(kinetostat.load(name), n=N, seed=SEED) for name in TWO_GROUPS]}
     out["precision"] = {p: simulate(ice, 30.0, n=N, length_mm=p, angle_deg=p, seed=SEED) for p in PRECISIONS}
     out["scale"] = {f: _rule(simulate(ice, 30.0, n=N, seed=SEED, scales=replace(
         base, mu_v=base.mu_v * f, mu_a=base.mu_a * f, mu_F=base.mu_F * f, mu_l=base.mu_l * f))) for f in SCALE_FACTORS}
@@ -120,6 +122,17 @@ def write_plot(r: dict, path: Path) -> None:
 
 def _g(x: float) -> str:
     return "n/a" if not math.isfinite(x) else f"{x:.5g}"
+
+
+def _spread_table(sol: DrawnSolution, keys) -> list[str]:
+    """Markdown rows: each value's exact value, σ, relative spread and central 95 % of the drawn values."""
+    L = ["| value | exact | σ | spread, % | 95 % of drawn values |", "|---|---:|---:|---:|---|"]
+    for key in keys:
+        s, e = _abs_if_signed(sol, key)
+        lo, hi = np.percentile(s, [2.5, 97.5])
+        rel = s.std() / abs(e) * 100 if e and key != "delta_pct" else float("nan")
+        L.append(f"| {key} | {_g(e)} | {_g(s.std())} | {_g(rel)} | {_g(lo)} .. {_g(hi)} |")
+    return L
 
 
 def write_report(r: dict, md: Path, png: Path) -> None:
@@ -228,18 +241,25 @@ def write_report(r: dict, md: Path, png: Path) -> None:
           f"{abs(fb.samples['M_bal'].std() / fb.exact['M_bal']) * 100:.2g} %, 95th percentile of δ "
           f"{np.percentile(np.abs(fb.samples['delta_pct']), 95):.2g} %.",
           "", "![drawing error](drawing_error.png)", "",
-          f"## The chain-unit four-bar (RRR) at {fb.phi_deg:g} deg, ±0.25 mm, ±0.25 deg", "",
-          "| value | exact | σ | spread, % | 95 % of drawn values |", "|---|---:|---:|---:|---|"]
-    for key in fb.samples:
-        s, e = _abs_if_signed(fb, key)
-        lo, hi = np.percentile(s, [2.5, 97.5])
-        rel = s.std() / abs(e) * 100 if e and key != "delta_pct" else float("nan")
-        L.append(f"| {key} | {_g(e)} | {_g(s.std())} | {_g(rel)} | {_g(lo)} .. {_g(hi)} |")
+          f"## The chain-unit four-bar (RRR) at {fb.phi_deg:g} deg, ±0.25 mm, ±0.25 deg", ""]
+    L += _spread_table(fb, fb.samples)
+    L += ["", "## Two groups: the reactions carried from group to group", "",
+          "With two Assur groups the last attached is drawn first; a reaction it takes from a link of the earlier "
+          "group (R34 of the loader's slider group on its rocker 3) is read off its polygon and laid off again, "
+          "reversed, as a load on the earlier group's plan, and a reaction on the crank (both rods of the opposed "
+          "twin) enters M_bal with its own arm read off the crank's plan. Each carried force adds the error of one "
+          "reading and one laying-off. The reactions, M_bal and δ, ±0.25 mm, ±0.25 deg, the default scales:", ""]
+    for sol in r["two_groups"]:
+        keys = [k for k in sol.samples if k.startswith(("R_", "Rt_", "Rn_", "h_R")) or k in ("M_bal", "M_bal_lever", "delta_pct")]
+        L += [f"### {sol.mechanism} at {sol.phi_deg:g} deg", "", f"Scales: μ_l = {sol.scales.mu_l:g} m/mm, μ_v = "
+              f"{sol.scales.mu_v:g} m/(s mm), μ_a = {sol.scales.mu_a:g} m/(s² mm), μ_F = {sol.scales.mu_F:g} N/mm; "
+              f"95th percentile of |δ| {np.percentile(np.abs(sol.samples['delta_pct']), 95):.2g} %.", ""]
+        L += _spread_table(sol, keys) + [""]
     L += ["", "## Limitations", "",
-          "- Force plans, crank and lever are drawn for mechanisms of one Assur group, RRR or RRP with its guide "
-          "on the frame (ICE, compressor, chain-unit four-bar); for two groups (the six-bar loader, the opposed "
-          "twin, the rotating slotted link) only the kinematics and inertia loads are drawn; groups RPP (Scotch "
-          "yoke) and PRP (slotted-link shaper), and RRP with a moving guide, are not drawn.",
+          "- Force plans, crank and lever are drawn for mechanisms whose groups, any number of them, are RRR or "
+          "RRP with its guide on the frame (ICE, compressor, chain-unit four-bar, opposed twin, six-bar loader); "
+          "for the rotating slotted link (an RPR group) only the kinematics and inertia loads are drawn; groups "
+          "RPP (Scotch yoke) and PRP (slotted-link shaper), and RRP with a moving guide, are not drawn.",
           "- The plan of positions and the load diagrams are taken as exact: only the plans of velocities, "
           "accelerations and forces, the group plans, the crank and the lever are drawn with error.",
           "- Errors are independent and uniform; a real student's errors are correlated (one set square, one "

@@ -12,14 +12,17 @@ directions (`_Drafter.meet`), evaluated for all samples at once (numpy arrays of
 What is drawn, in order: the velocity plan (pa, then per group the two lines whose
 intersection is the inner joint's point, like points by similarity), the acceleration plan (the
 normal components from the read angular velocities, the tangential lines, the intersection),
-the inertia loads from the read accelerations, the group plan (arms read for the moment
-equation of R^τ), the force polygon closed by two lines, the crank (the arm of R21) and
-Zhukovsky's lever (the velocity plan again, arms of the turned loads about the pole).
+the inertia loads from the read accelerations, then per group from the last attached to the
+first its plan (arms read for the moment equation of R^τ) and force polygon closed by two lines,
+a reaction on a link of an earlier group read and laid off there as a load, the crank (the arms
+of the reactions on it) and Zhukovsky's lever (the velocity plan again, arms of the turned loads
+about the pole).
 
 Kinematics and inertia loads: groups RRR, RRP with its guide on the frame, and RPR (anything
-else raises NotImplementedError naming it). Force plans, crank and lever: mechanisms of one
-group, RRR or RRP with its guide on the frame (Logvinenko and Nadtoka's ICE, the compressor, the chain-unit
-four-bar); for the others `simulate` draws the kinematics and the inertia loads only.
+else raises NotImplementedError naming it). Force plans, crank and lever: mechanisms whose groups
+are all RRR or RRP with its guide on the frame (Logvinenko and Nadtoka's ICE and opposed twin,
+the compressor, the chain-unit four-bar, the furnace loader); for the others `simulate` draws the
+kinematics and the inertia loads only.
 
 May use: the solver (`analysis`, `applied`), `plans.worksheet`, numpy. Never matplotlib.
 """
@@ -39,7 +42,7 @@ from .scales import choose_scales
 __all__ = ["Scales", "DrawnSolution", "default_scales", "draws_forces", "simulate", "SUPPORTED"]
 
 #: What `simulate` draws completely (forces included).
-SUPPORTED = "one Assur group, RRR or RRP with its guide on the frame"
+SUPPORTED = "Assur groups RRR, and RRP with its guide on the frame, any number"
 
 
 @dataclass(frozen=True)
@@ -296,6 +299,10 @@ class _Plans:
             Mi = -I_S[k] * self.eps[k]
             if I_S[k]:
                 self.put(f"M_i{k}", np.abs(Mi), "N m")
+                il = res.inertia(k)
+                if il.moment[0] and np.isfinite(il.h[0]):   # the arm of the shifted inertia force, computed
+                    self.put(f"h_{k}", np.abs(Mi) / Fi, "m")
+                    self.put(f"z_{k}", np.abs(Mi) / Fi / sc.mu_l, "mm")
             ext = _z(res.F_applied[0, k]) - G
             Mext = res.M_applied[0, k] - _cross(S - _z(res.kin.origin[0, k]), G)
             if abs(ext) > 1e-12 * max(1.0, abs(_z(res.F_applied[0, k]))):
@@ -305,16 +312,18 @@ class _Plans:
             forces[k], couples[k] = fl, Mi + Mext
         return forces, couples
 
-    def group_forces(self, forces, couples):
-        m, sc, dr, W = self.m, self.sc, self.dr, self.world
-        g = m.structure.groups[0]
+    def group_forces(self, g, loads, couples) -> list[tuple[int, int, np.ndarray, complex]]:
+        """Group g's plan and force polygon under `loads` (link -> [(force N (n,) complex, world
+        point)]) and `couples` (link -> N m (n,)); the reactions it takes from its known links:
+        [(known link, group link, R_known_link drawn (n,) complex mm, world point)]."""
+        sc, dr, W = self.sc, self.dr, self.world
         (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
         B = W[pin.point]
 
         def tangential(link, X):           # Σ M_B = 0 of the link: R^τ along i (B - X)/|BX|
             l = abs(B - X)
             tot = couples[link] / sc.mu_l
-            for F, Y in forces[link]:
+            for F, Y in loads[link]:
                 tot = tot + np.abs(F) * dr.arm((Y - B) / sc.mu_l, _unit(F))
             return tot / (l / sc.mu_l), 1j * (B - X) / l
 
@@ -322,40 +331,74 @@ class _Plans:
         self.put(f"Rt_{a}_{j}", np.abs(Rt_j), "N")
         pts = [np.zeros(dr.n, complex)]
         pts.append(pts[-1] + dr.draw(Rt_j * t_j / sc.mu_F))
-        for F, _ in forces[j]:
+        for F, _ in loads[j]:
             pts.append(pts[-1] + dr.draw(F / sc.mu_F))
         end_j = pts[-1]
-        for F, _ in forces[k]:
+        for F, _ in loads[k]:
             pts.append(pts[-1] + dr.draw(F / sc.mu_F))
         end_k = pts[-1]
         if g.kind == "RRR":
             Rt_k, t_k = tangential(k, W[pk.point])
+            self.put(f"Rt_{c}_{k}", np.abs(Rt_k), "N")
             pts.append(pts[-1] + dr.draw(Rt_k * t_k / sc.mu_F))
             last = (W[pk.point] - B) / abs(W[pk.point] - B)
         else:
             last = 1j * complex(*pk.direction)
         K = dr.meet(pts[0], dr.turn((B - W[pj.point]) / abs(B - W[pj.point])), pts[-1], dr.turn(last))
-        R_aj = pts[1] - K
+        R_aj, R_ck = pts[1] - K, K - end_k
         self.put(f"R_{a}_{j}", dr.read(R_aj) * sc.mu_F, "N")
-        self.put(f"R_{c}_{k}", dr.read(K - end_k) * sc.mu_F, "N")
+        self.put(f"R_{c}_{k}", dr.read(R_ck) * sc.mu_F, "N")
         self.put(f"R_{k}_{j}", dr.read(K - end_j) * sc.mu_F, "N")
-        return R_aj
+        self.put(f"Rn_{a}_{j}", dr.read(pts[0] - K) * sc.mu_F, "N")        # the polygon's closing sides
+        if g.kind == "RRR":
+            self.put(f"Rn_{c}_{k}", dr.read(K - pts[-1]) * sc.mu_F, "N")
+        return [(a, j, R_aj, W[pj.point]), (c, k, R_ck, W[pk.point])]
 
-    def crank(self, R12, forces, couples) -> np.ndarray:
+    def forces_of_groups(self, forces, couples) -> list[tuple[int, np.ndarray, complex]]:
+        """The groups' plans from the last attached to the first (Kiriienko 2019, sec. 7): each
+        reaction a group takes from a moving link other than the crank is read, carried over with
+        its drawn direction and laid off as a load of that link in the earlier group. Returns the
+        reactions on the crank: [(group link, R_crank_link drawn (n,) complex mm, world point)]."""
+        d, dr, sc = self.m.drive, self.dr, self.sc
+        carried: dict[int, list] = {}
+        on_crank = []
+        for g in reversed(self.m.structure.groups):
+            loads = {k: forces[k] + carried.get(k, []) for k in g.links}
+            for known, link, R, X in self.group_forces(g, loads, couples):
+                if known == d.link:
+                    on_crank.append((link, R, X))
+                elif known != 0:
+                    F = self.out[f"R_{known}_{link}"] * dr.turn(-_unit(R))
+                    carried.setdefault(known, []).append((F, X))
+        return on_crank
+
+    def crank(self, on_crank, forces, couples) -> np.ndarray:
         m, sc, dr, W = self.m, self.sc, self.dr, self.world
         d = m.drive
-        O, A = W[d.pivot], W[d.point]
-        other = m.structure.groups[0].links[0]
-        R21 = self.out[f"R_{d.link}_{other}"]
-        u21 = dr.turn(-_unit(R12))
-        h = dr.arm((A - O) / sc.mu_l, u21)
-        self.put(f"h_R{other}{d.link}", np.abs(h), "mm")
-        M = R21 * h * sc.mu_l + couples[d.link]
+        O = W[d.pivot]
+        M = couples[d.link]
+        polygon = []                               # the crank's force polygon, closed by R01
+        for other, R, X in on_crank:               # R_{other, crank} = -R_{crank, other}: its arm about O
+            u = dr.turn(-_unit(R))
+            h = dr.arm((X - O) / sc.mu_l, u)
+            self.put(f"h_R{other}{d.link}", np.abs(h), "mm")
+            R_read = self.out[f"R_{d.link}_{other}"]
+            self.put(f"R_{other}_{d.link}", R_read, "N")
+            M = M + R_read * h * sc.mu_l
+            polygon.append(R_read * u)
         for F, Y in forces[d.link]:
             M = M + np.abs(F) * dr.arm((Y - O) / sc.mu_l, _unit(F)) * sc.mu_l
+            polygon.append(F)
         self.put("M_bal", -M, "N m")
         if d.kind == "machine":
             self.put("F_bal", np.abs(M) / (dr.read(d.gear.r_b / sc.mu_l) * sc.mu_l), "N")
+            M_exact, F_exact = self.res.balancing_moment[0], _z(self.res.balancing_force[0])
+            if M_exact:                            # F_bal on its line of action, in proportion to M_bal
+                polygon.append(-M / M_exact * abs(F_exact) * dr.turn(F_exact / abs(F_exact)))
+        end = np.zeros(dr.n, complex)
+        for F in polygon:
+            end = end + dr.draw(F / sc.mu_F)
+        self.put(f"R_0_{d.link}", dr.read(end) * sc.mu_F, "N")
         return -M
 
     def lever(self, forces, couples) -> np.ndarray:
@@ -401,8 +444,7 @@ def _velocity_of(res: Analysis, k: int, X: complex) -> np.ndarray:
 
 def draws_forces(mech: Mechanism) -> bool:
     """Whether `simulate` draws the force plans, the crank and the lever of `mech` (SUPPORTED)."""
-    groups = mech.structure.groups
-    return len(groups) == 1 and (groups[0].kind == "RRR" or (groups[0].kind == "RRP" and groups[0].known[1] == 0))
+    return all(g.kind == "RRR" or (g.kind == "RRP" and g.known[1] == 0) for g in mech.structure.groups)
 
 
 def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length_mm: float = 0.25,
@@ -425,8 +467,7 @@ def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length
     forces, couples = pl.loads()
     drawn = draws_forces(mech)
     if drawn:
-        R12 = pl.group_forces(forces, couples)
-        M = pl.crank(R12, forces, couples)
+        M = pl.crank(pl.forces_of_groups(forces, couples), forces, couples)
         ML = pl.lever(forces, couples)
         pl.put("delta_pct", (ML - M) / ML * 100.0, "%")
     ws = worksheet(mech, at=at, mu_l=sc.mu_l)

@@ -206,14 +206,20 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                    "моменту за планами сил; допустима розбіжність |δ| не більше 5 %. Точно: δ = {delta} %.",
                    "δ = ({ML} - {M}) / {ML} · 100 %: уравновешивающий момент по рычагу Жуковского против "
                    "момента по планам сил; допустимое расхождение |δ| не более 5 %. Точно: δ = {delta} %."),
+    "pack.band_outside": ("* The exact value lies outside the band: its segment is shorter than the drawing's own "
+                          "error, so a careful drawing reads it too long; mark it by the band.",
+                          "* Точне значення поза межами: його відрізок коротший за похибку самого креслення, тож "
+                          "ретельне креслення дає його завеликим; оцінюйте за межами.",
+                          "* Точное значение вне границ: его отрезок короче погрешности самого чертежа, поэтому "
+                          "тщательный чертёж даёт его завышенным; оценивайте по границам."),
     "pack.delta_band": ("Careful drawings: δ = {lo} … {hi} %.", "Ретельні креслення: δ = {lo} … {hi} %.",
                         "Тщательные чертежи: δ = {lo} … {hi} %."),
-    "pack.band_partial": ("The drawing-error study draws the force plans of mechanisms of one group only: here "
-                          "the reactions and {M} have no band.",
-                          "Дослідження похибки креслення будує плани сил лише механізмів з однієї групи: тут "
-                          "реакції та {M} без меж.",
-                          "Исследование погрешности чертежа строит планы сил только механизмов из одной группы: "
-                          "здесь реакции и {M} без границ."),
+    "pack.band_partial": ("The drawing-error study draws the force plans of groups {kinds} with the guide on "
+                          "the frame only: here the reactions and {M} have no band.",
+                          "Дослідження похибки креслення будує плани сил лише груп {kinds} з напрямною на "
+                          "стояку: тут реакції та {M} без меж.",
+                          "Исследование погрешности чертежа строит планы сил только групп {kinds} с "
+                          "направляющей на стойке: здесь реакции и {M} без границ."),
     "pack.scales": ("Scales", "Масштаби", "Масштабы"),
     "pack.drawn": ("drawn", "відрізок", "отрезок"),
     "pack.segments": ("Segments a student measures, mm", "Відрізки, які вимірює студент, мм",

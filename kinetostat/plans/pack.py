@@ -132,6 +132,7 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
     key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
     sheet.append(("h2", text("pack.fill", lang)))
     recs = ws.records()
+    outside = False                     # an exact value beyond its band (a segment shorter than the error)
     for section in dict.fromkeys(r.section for r in ws.rows):
         idx = [i for i, r in enumerate(ws.rows) if r.section == section]
         sheet.append(("h2", recs[idx[0]]["section"]))
@@ -145,6 +146,9 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
             value = num(r.value, lang, 4)
             lo_hi = bands.get(r.key)
             band = f"{num(lo_hi[0], lang, 3)} … {num(lo_hi[1], lang, 3)}" if lo_hi else ""
+            if lo_hi and not lo_hi[0] <= r.value <= lo_hi[1]:
+                band += " *"
+                outside = True
             krows.append((r.symbol, value, recs[i]["unit"], recs[i]["direction"], band))
             answers.add(value)
             if lo_hi:
@@ -155,10 +159,12 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
                                 (0.14, 0.15, 0.12, 0.3, 0.29), frozenset({1, 4})))]
     key.append(("p", text("pack.band_note", lang, lo=num(BAND[0], lang), hi=num(BAND[1], lang), n=draws,
                           mm=num(drawn.length_mm, lang), deg=num(drawn.angle_deg, lang))))
+    if outside:
+        key.append(("p", text("pack.band_outside", lang)))
     if not drawn.forces_drawn:
-        key.append(("p", text("pack.band_partial", lang, M=L.M_bal)))
+        key.append(("p", text("pack.band_partial", lang, M=L.M_bal, kinds="RRR, RRP")))
     delta = text("pack.delta", lang, M=L.M_bal, ML=L.lever(L.M_bal), delta=num(ws.value("delta_pct"), lang, decimals=2))
-    if "delta_pct" in bands:            # the study draws the force plans of one-group mechanisms only
+    if "delta_pct" in bands:            # the study draws the force plans of RRR and RRP (frame guide) groups only
         lo, hi = (num(x, lang, decimals=2) for x in bands["delta_pct"])
         delta += " " + text("pack.delta_band", lang, lo=lo, hi=hi)
     key.append(("p", delta))
