@@ -159,7 +159,11 @@ def simulate(scene: Scene, steps_per_rev: int = 720, iterations: int = 50,
     its = int(iterations)
     run = 0.0
     for attempt in range(MAX_DOUBLINGS + 1):
-        cycles = [_cycle(p, its) for p in preps]
+        cycles = []
+        for p in preps:          # the coarse level first: where it fails, the fine one is not run
+            cycles.append(_cycle(p, its))
+            if cycles[-1].bad.any() and attempt < MAX_DOUBLINGS:
+                break
         build += sum(c.build_seconds for c in cycles)
         run += sum(c.run_seconds for c in cycles)
         failed = [c for c in cycles if c.bad.any()]
@@ -410,26 +414,29 @@ def _simulate(prep: _Prep, iterations: int, K: float, M_first: np.ndarray | None
     build = time.perf_counter() - t0
     t0 = time.perf_counter()
     crank = dr.link
+    jj = 2 * (np.arange(steps) + 1)                   # the angle the positions reach in each step
+    F_all, T_all = np.zeros((steps, L, 2)), np.zeros((steps, L))
+    for i, lk in enumerate(prep.links):               # the loads of every step, before the steps
+        F, T = prep.F_ext[jj, lk], prep.M_ext[jj, lk]
+        if lk in prep.comp_F:
+            F = F + prep.comp_F[lk][jj]
+        if lk in prep.comp_T:
+            T = T + prep.comp_T[lk][jj]
+        if lk == crank:
+            T = T + K
+            if M_first is not None:
+                f = np.array([prep.mesh_force(float(M)) for M in M_first[:steps]])
+                r = prep.pitch - np.array([prep.pose(lk, j)[0] for j in jj])
+                M_mesh[:] = r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0]
+                F = F + f
+                T = T + M_mesh
+        F_all[:, i], T_all[:, i] = F, T
+    forces, torques = (F_all * f_u).tolist(), (T_all * f_u).tolist()
+    order = [bodies[lk] for lk in prep.links]
     for k in range(steps):
-        j = 2 * (k + 1)                               # the angle the positions reach in this step
-        for lk in prep.links:
-            F = prep.F_ext[j, lk]
-            T = prep.M_ext[j, lk]
-            if lk in prep.comp_F:
-                F = F + prep.comp_F[lk][j]
-            if lk in prep.comp_T:
-                T = T + prep.comp_T[lk][j]
-            if lk == crank:
-                T = T + K
-                if M_first is not None:
-                    f = prep.mesh_force(float(M_first[k]))
-                    r = prep.pitch - prep.pose(lk, j)[0]
-                    M_mesh[k] = r[0] * f[1] - r[1] * f[0]
-                    F = F + f
-                    T = T + M_mesh[k]
-            body = bodies[lk]
-            body.force = (float(F[0]) * f_u, float(F[1]) * f_u)
-            body.torque = float(T) * f_u
+        for body, F, T in zip(order, forces[k], torques[k]):
+            body.force = (F[0], F[1])
+            body.torque = T
         space.step(1.0)
         for i, c in enumerate(pair_c):
             imp[k, i] = c.impulse
