@@ -149,6 +149,7 @@ class Placer:
         self.bounds = bounds
         self._boxes: list[tuple[float, float, float, float]] = []
         self._samples: list[np.ndarray] = []
+        self._all_samples: np.ndarray | None = None    # their concatenation, made once per change
         self.placed: list[Placed] = []
 
     def block(self, box) -> None:
@@ -160,9 +161,13 @@ class Placer:
         n = int(min(max(2.0, math.hypot(x1 - x0, y1 - y0) / 0.7 + 1), 1e4))     # a sheet's length at most
         t = np.linspace(0.0, 1.0, n)
         self._samples.append(np.column_stack([x0 + t * (x1 - x0), y0 + t * (y1 - y0)]))
+        self._all_samples = None
 
-    def _cost(self, boxes: np.ndarray, base: np.ndarray) -> np.ndarray:
-        """Cost of candidate boxes (K, 4): inf where one overlaps a hard obstacle or leaves the bounds."""
+    def _best(self, boxes: np.ndarray, base: np.ndarray) -> int:
+        """Index of the candidate box (K, 4) of least cost: `base` plus 0.6 per line sample inside
+        it; inf where it overlaps a hard obstacle or leaves the bounds; the first of equal costs;
+        0 where none is free. The samples are counted in batches in order of `base`, until the
+        next base exceeds the best cost found (a count only adds): the same choice as counting all."""
         p = self.PAD
         bx0, by0, bx1, by1 = self.bounds
         bad = (boxes[:, 0] < bx0) | (boxes[:, 1] < by0) | (boxes[:, 2] > bx1) | (boxes[:, 3] > by1)
@@ -171,17 +176,29 @@ class Placer:
             hit = ((boxes[:, None, 0] < ob[None, :, 2] + p) & (boxes[:, None, 2] > ob[None, :, 0] - p)
                    & (boxes[:, None, 1] < ob[None, :, 3] + p) & (boxes[:, None, 3] > ob[None, :, 1] - p))
             bad |= hit.any(axis=1)
-        cost = base.astype(float).copy()
-        if self._samples:
-            s = np.concatenate(self._samples)
-            lo, hi = boxes[:, :2].min(axis=0) - 1, boxes[:, 2:].max(axis=0) + 1
-            s = s[(s[:, 0] > lo[0]) & (s[:, 0] < hi[0]) & (s[:, 1] > lo[1]) & (s[:, 1] < hi[1])]
-            if len(s):
-                inside = ((s[None, :, 0] > boxes[:, None, 0]) & (s[None, :, 0] < boxes[:, None, 2])
-                          & (s[None, :, 1] > boxes[:, None, 1]) & (s[None, :, 1] < boxes[:, None, 3]))
-                cost += 0.6 * inside.sum(axis=1)
-        cost[bad] = np.inf
-        return cost
+        cost = np.where(bad, np.inf, base.astype(float))
+        if self._samples and self._all_samples is None:
+            self._all_samples = np.concatenate(self._samples)
+        order = np.lexsort((np.arange(len(cost)), cost))
+        best, k_best = np.inf, 0
+        for start in range(0, len(order), 32):
+            idx = order[start:start + 32]
+            if not (np.isfinite(cost[idx[0]]) and cost[idx[0]] <= best):
+                break
+            c = cost[idx]
+            if self._samples:
+                b = boxes[idx]
+                lo, hi = b[:, :2].min(axis=0) - 1, b[:, 2:].max(axis=0) + 1
+                s = self._all_samples
+                s = s[(s[:, 0] > lo[0]) & (s[:, 0] < hi[0]) & (s[:, 1] > lo[1]) & (s[:, 1] < hi[1])]
+                if len(s):
+                    inside = ((s[None, :, 0] > b[:, None, 0]) & (s[None, :, 0] < b[:, None, 2])
+                              & (s[None, :, 1] > b[:, None, 1]) & (s[None, :, 1] < b[:, None, 3]))
+                    c = c + 0.6 * inside.sum(axis=1)
+            for k, ck in zip(idx.tolist(), c.tolist()):
+                if ck < best or (ck == best and k < k_best):
+                    best, k_best = ck, k
+        return k_best
 
     def _boxes_at(self, centres: np.ndarray, w: float, up: float, down: float) -> np.ndarray:
         """Boxes of a label whose box centre is at each of `centres` (K, 2)."""
@@ -195,7 +212,8 @@ class Placer:
         w = label_width(name, size)
         up, down = label_height(name, size)
         half = np.array([w / 2, (up + down) / 2])
-        cands, base = [], []
+        A = np.array([ax, ay])
+        cands, base = [], []                        # blocks of candidate centres (K, 2) and costs (K,)
         angles = np.radians(np.arange(0, 360, 22.5) + 45.0)
         dirs = np.column_stack([np.cos(angles), -np.sin(angles)])
         if along is not None:
@@ -204,24 +222,19 @@ class Placer:
             if L > 1e-9:
                 u = d / L
                 nrm = np.array([-u[1], u[0]])
-                for t in (0.5, 0.38, 0.62, 0.25, 0.75, 0.15, 0.85):
-                    for side in (1.0, -1.0):
-                        for r in (0.6, 1.5, 3.0):
-                            c = np.array([ax, ay]) + t * d + side * nrm * (r + abs(nrm) @ half)
-                            cands.append(c)
-                            base.append(r + 6.0 * abs(t - 0.5) * min(L, 20.0) / 20.0)
-            mid = (ax + along[0]) / 2, (ay + along[1]) / 2
-            ax, ay = mid
-        for r in (0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0):
-            for dv in dirs:
-                cands.append(np.array([ax, ay]) + dv * (r + np.abs(dv) @ half))
-                base.append(1.2 * r + (0.3 if dv[1] > 0 else 0.0) + (2.0 if along is not None else 0.0))
-        cands_a = np.asarray(cands)
+                T, S, R = (g.reshape(-1, 1) for g in np.meshgrid(
+                    (0.5, 0.38, 0.62, 0.25, 0.75, 0.15, 0.85), (1.0, -1.0), (0.6, 1.5, 3.0), indexing="ij"))
+                cands.append(A + T * d + S * nrm * (R + abs(nrm) @ half))
+                base.append(R[:, 0] + 6.0 * np.abs(T[:, 0] - 0.5) * min(L, 20.0) / 20.0)
+            ax, ay = (ax + along[0]) / 2, (ay + along[1]) / 2
+            A = np.array([ax, ay])
+        R = np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0])[:, None, None]
+        cands.append((A + dirs * (R + (np.abs(dirs) @ half)[:, None])).reshape(-1, 2))
+        base.append((1.2 * R[:, :, 0] + np.where(dirs[:, 1] > 0, 0.3, 0.0)
+                     + (2.0 if along is not None else 0.0)).reshape(-1))
+        cands_a = np.concatenate(cands)
         boxes = self._boxes_at(cands_a, w, up, down)
-        cost = self._cost(boxes, np.asarray(base))
-        k = int(np.argmin(cost))
-        if not np.isfinite(cost[k]):
-            k = 0                                   # nowhere free: the nearest place (the test tells)
+        k = self._best(boxes, np.concatenate(base))    # nowhere free: 0, the nearest place (the test tells)
         x0, y0, x1, y1 = boxes[k]
         box = (float(x0), float(y0), float(x1), float(y1))
         cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
