@@ -93,6 +93,8 @@ def rounded(df, units: dict[str, str] | None = None):
     scale: the largest |value| among the float columns of the same unit (`units`, default
     `attrs["units"]`; a column with no unit: its own largest |value|). NaN kept; `attrs` kept."""
     units = df.attrs.get("units", {}) if units is None else units
+    attrs, df = dict(df.attrs), df.copy(deep=False)
+    df.attrs = {}              # pandas deep-copies `attrs` into every column `items` hands out
     cols = {name: col.to_numpy(dtype=float) for name, col in df.items() if col.dtype.kind == "f"}
     scale: dict[str, float] = {}
     for name in cols:
@@ -102,7 +104,7 @@ def rounded(df, units: dict[str, str] | None = None):
     # setting each column back, cost most of a report's CSV writing
     out = type(df)({name: _column_rounded(cols[name], scale[units.get(name) or ("column", name)])
                     if name in cols else col for name, col in df.items()}, index=df.index)
-    out.attrs = dict(df.attrs)
+    out.attrs = attrs
     return out
 
 
