@@ -780,11 +780,18 @@ def _worker_init() -> None:
     signal.signal(signal.SIGINT, end)
 
 
-def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int):
+def _report_cost(mech) -> int:
+    """A model's rough share of the report's time, to start the longest first: the work grows
+    with the pairs, and the simulations run twice for a machine (its mesh force from a first run)."""
+    return len(mech.pairs) * (2 if mech.drive.kind == "machine" else 1)
+
+
+def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int,
+                    costs: Sequence[int] = ()):
     """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
     them in a process pool (only paths and names cross to the workers, so any start method
-    works), 1 in this process. Ctrl-C cancels the models not started and raises
-    KeyboardInterrupt here."""
+    works), the largest `costs` first, 1 in this process. Ctrl-C cancels the models not started
+    and raises KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
         for n, p in enumerate(paths):
             yield n, _report_job(str(p), engines, steps, str(out), folders[n])
@@ -792,8 +799,8 @@ def _report_results(paths: list[Path], folders: list[str], engines: list[str], s
     from concurrent.futures import ProcessPoolExecutor, as_completed
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
     try:
-        futures = {pool.submit(_report_job, str(p), engines, steps, str(out), folders[n]): n
-                   for n, p in enumerate(paths)}
+        first = sorted(range(len(paths)), key=lambda n: -costs[n] if costs else 0)
+        futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n]): n for n in first}
         for f in as_completed(futures):
             try:
                 r = f.result()
@@ -824,7 +831,8 @@ def cmd_report(args) -> int:
     n_fail, n_err = 0, 0
     bar = _progress(len(order), "report", not args.no_progress)
     try:
-        for n, r in _report_results(order, folders, engines, args.steps, out, args.jobs or os.cpu_count() or 1):
+        for n, r in _report_results(order, folders, engines, args.steps, out, args.jobs or os.cpu_count() or 1,
+                                    [_report_cost(mech) for _, mech, *_ in prepared]):
             _checkpoint()
             path = order[n]
             bar.update()
