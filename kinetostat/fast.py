@@ -29,7 +29,8 @@ Angles where a group's plan is ill-conditioned (cond > COND_CHECK), cannot be as
 give a non-finite peak, are flagged by the kernel and solved again by the numpy path with its
 accuracy guard. Loads other than gravity and inertia (tables, diagrams, springs, dampers, laws
 of motion) are evaluated by `applied.applied_wrenches` per chunk of CHUNK angles, on the motion
-a first pass of the full kernel wrote, and read by the second pass (or the peaks kernel).
+a first pass of the motion kernel (the kinematics only) wrote, and read by the full or the
+peaks kernel.
 
 May use: numpy, numba, program, groups, kinematics, kinetostatics, applied, analysis (results),
 model and structure (for type hints).
@@ -167,6 +168,8 @@ _KERNELS: dict[tuple, Any] = {}
 #: are filled by numpy after the kernel).
 REAL = ("th", "w", "e", "vs", "as", "cond", "M_app", "M_i", "normal", "m", "M_bal", "lever", "friction", "error")
 COMPLEX = ("rot", "O", "V", "A", "F_app", "F_i", "R", "F_bal")
+#: The arrays the "motion" kernel writes: the kinematics and the groups' condition numbers.
+MOTION = ("th", "w", "e", "vs", "as", "cond", "rot", "O", "V", "A")
 
 
 def _has_loads(mech: "Mechanism") -> bool:
@@ -310,7 +313,9 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     (X's rows, or zero where X is empty) are copied into T; after it, "full" copies every array
     of the result (a complex one interleaved) into the flat buffer S (rows of n angles);
     "peaks" keeps per block the largest |R| of each pair, |M_bal| and |F_bal| (PK) from the
-    squares in T. Both flag in FL the angles the exact guard must see."""
+    squares in T; "motion" runs the kinematics program only and copies its arrays (MOTION), the
+    first pass of a mechanism whose loads depend on the motion. All flag in FL the angles the
+    exact guard must see."""
     from .kinematics import COND_CHECK
     motion, statics = _motion(mech), statics_program(mech)
     v = Identifiers().__getitem__
@@ -334,7 +339,7 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     pro = [f"{v(n)} = C[d, {j}]" + (".real" if real else "") for j, (n, real) in enumerate(zip(lay.consts, lay.real))]
     fixed = set(lay.consts)               # hoisted: the steps that read constants only
     hoisted, moving = [], []
-    for st in motion.steps + statics.steps:
+    for st in motion.steps + (() if kind == "motion" else statics.steps):
         if st.fn != "check" and all(not isinstance(a, str) or a in fixed for a in st.args):
             fixed.update(st.out)
             hoisted.append(st)
@@ -347,7 +352,7 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     body += code(Program(tuple(st for st in moving if st in in_motion), (), motion.outputs), v, check)
     body += [f"ok &= {v(f'cond{n}')} <= {COND_CHECK!r}" for n in range(lay.G)]
     first = {name: r for name, r, _ in lay.rows}
-    for k in range(1, L):
+    for k in range(1, L if kind != "motion" else 1):
         body.append(f"r{k}, Fi{k}, Mi{k} = inertia({v(f'A{k}')}, {v(f'w{k}')}, {v(f'e{k}')}, {v(f'rot{k}')}, "
                     f"{v(f'com{k}')}, {v(f'mass{k}')}, {v(f'I_S{k}')})")
         f, g, h = t(), t(), t()       # the loads besides gravity: X's rows, or zero
@@ -361,7 +366,8 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     if kind == "full":       # Zhukovsky's lever, before the groups change the known wrenches
         pw = " + ".join(f"power({v(f'F{k}')}, {v(f'M{k}')}, {v(f'V{k}')}, {v(f'w{k}')})" for k in range(1, L))
         body.append(f"lever = -({pw}) / {v('w1')}")
-    body += code(Program(tuple(st for st in moving if st not in in_motion), (), statics.outputs), v, check)
+    if kind != "motion":
+        body += code(Program(tuple(st for st in moving if st not in in_motion), (), statics.outputs), v, check)
     if kind == "peaks":
         sq = [f"square({v(f'R{p}')}.real) + square({v(f'R{p}')}.imag)" for p in range(P)] + [f"square({v('M_bal')})"]
         sq += [f"square({v('F_bal')}.real) + square({v('F_bal')}.imag)"] if lay.machine else []
@@ -377,6 +383,8 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
                 post.append(f"PK[b, {q}] = 0.0")
     else:
         for (name, col), val in _value_map(lay, v).items():
+            if kind == "motion" and name not in MOTION:
+                continue
             if name in COMPLEX:
                 re_, im = t(), t()
                 body += [f"T[{re_} + j] = {val}.real", f"T[{im} + j] = {val}.imag"]
@@ -430,7 +438,7 @@ def _load(text: str) -> Any:
 
 
 def kernel(mech: "Mechanism", kind: str):
-    """The compiled kernel of `mech`'s structure for `kind` ("full" or "peaks") and its layout:
+    """The compiled kernel of `mech`'s structure for `kind` ("full", "peaks" or "motion") and its layout:
     generated once per structure (designs enter through C; structures whose programs differ
     only in names share one), loaded from the cache folder where an earlier process compiled it."""
     lay = _layout(mech)
@@ -543,7 +551,7 @@ def _loads(mech: "Mechanism", phi: np.ndarray, r: dict[str, np.ndarray]) -> np.n
 
 def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | None) -> tuple[dict, np.ndarray]:
     """Run the full kernel over the angles `phi` (rad) into `buf`; where `mech` has loads besides
-    gravity, per chunk of CHUNK angles: the kernel (its motion), the loads, the kernel with them.
+    gravity, per chunk of CHUNK angles: the motion kernel, the loads, the full kernel with them.
     The views and the flags."""
     lay = _layout(mech)
     N = len(phi)
@@ -556,7 +564,7 @@ def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | No
     X = np.empty((3 * (lay.L - 1), N))
     for a in range(0, N, CHUNK):
         span = (a, min(a + CHUNK, N))
-        _run([mech], phi, "full", S=buf, span=span, FL=FL, threads=threads)
+        _run([mech], phi, "motion", S=buf, span=span, FL=FL, threads=threads)
         X[:, span[0]:span[1]] = _loads(mech, phi[span[0]:span[1]], {k: x[span[0]:span[1]] for k, x in r.items()})
         _run([mech], phi, "full", X, S=buf, span=span, FL=FL, threads=threads)
     return r, FL
@@ -648,7 +656,7 @@ class Peaks:
 
 def _loaded_peaks(mech: "Mechanism", phi: np.ndarray, threads: int | None) -> tuple[np.ndarray, np.ndarray]:
     """Peaks per block and flags of one design with loads besides gravity: per chunk of CHUNK
-    angles, the full kernel (its motion) into a reused buffer, the loads, the peaks kernel."""
+    angles, the motion kernel into a reused buffer, the loads, the peaks kernel."""
     lay = _layout(mech)
     N = len(phi)
     FL, PK, buf = np.zeros((1, N), bool), [], None
@@ -659,7 +667,7 @@ def _loaded_peaks(mech: "Mechanism", phi: np.ndarray, threads: int | None) -> tu
             buf = buffer(mech, n)
         r = _views(lay, buf, n)
         r["rot"][:, 0] = 1.0
-        fl, _, _ = _run([mech], part, "full", S=buf, threads=threads)
+        fl, _, _ = _run([mech], part, "motion", S=buf, threads=threads)
         fl2, pk, _ = _run([mech], part, "peaks", _loads(mech, part, r), threads=threads)
         FL[0, a:a + n] = fl[0] | fl2[0]
         PK.append(pk)

@@ -222,6 +222,7 @@ def test_the_kernel_vectorises(tmp_path, monkeypatch):
     the full kernel does as well as the peaks one). A kernel loaded from the cache keeps no
     assembly, so this compiles both afresh in an empty cache (about 15 s of CPU: slow)."""
     monkeypatch.setenv(fast.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(fast, "_KERNELS", {})     # not the kernels this process loaded before
     m = kinetostat.load("chain_unit_four_bar")
     for kind in ("peaks", "full"):
         fast.kernel(m, kind)[0](*_args(m, kind))
