@@ -194,8 +194,10 @@ def _angle(v: np.ndarray) -> str:
     return f"angle:{math.degrees(math.atan2(v[1], v[0])):.6f}"
 
 
-def _sense(x: float) -> str:
-    return "ccw" if x > 0 else "cw" if x < 0 else ""
+def _sense(x: float, scale: float = 0.0) -> str:
+    """The sense of rotation of x, none where |x| is rounding of `scale` (an ω that is zero but
+    for 1e-15 of the crank's has no sense to read)."""
+    return "" if abs(x) <= 1e-12 * scale else "ccw" if x > 0 else "cw"
 
 
 class _Sheet:
@@ -257,7 +259,7 @@ class _Sheet:
                 self.velocity_rows([com] if com else [])
                 wk = res.omega(link)[0]
                 if not (wk == 0 and res.eps(link)[0] == 0):      # a translating link has no ω
-                    self.add("kinematics", f"omega_{link}", f"ω{link}", abs(wk), "rad/s", _sense(wk),
+                    self.add("kinematics", f"omega_{link}", f"ω{link}", abs(wk), "rad/s", _sense(wk, abs(w1)),
                              f"V_{pin.point}{outer.point} / l_{outer.point}{pin.point}" if outer.kind == pin.kind == "R" else "")
                 accel += [("a", name, None) for name in pts]
             for p in (pj, pin, pk):
@@ -273,7 +275,7 @@ class _Sheet:
     def accelerations(self, steps) -> None:
         res, d = self.res, self.mech.drive
         done: set = set()
-        e1 = res.eps(d.link)[0]
+        e1, w1 = res.eps(d.link)[0], res.omega(d.link)[0]
         for what, a, b in steps:
             if what == "a" and a not in done:
                 done.add(a)
@@ -307,7 +309,7 @@ class _Sheet:
                     ek = res.eps(k)[0]
                     if ek == 0 and res.omega(k)[0] == 0:
                         continue
-                    self.add("accelerations", f"eps_{k}", f"ε{k}", abs(ek), "rad/s^2", _sense(ek), "a^τ / l")
+                    self.add("accelerations", f"eps_{k}", f"ε{k}", abs(ek), "rad/s^2", _sense(ek, w1 * w1 + abs(e1)), "a^τ / l")
         if e1:
             self.add("accelerations", f"eps_{d.link}", f"ε{d.link}", abs(e1), "rad/s^2", _sense(e1), "given")
 
