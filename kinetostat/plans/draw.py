@@ -321,9 +321,9 @@ def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
 
 
 def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float,
-               arc: bool = False) -> tuple[str, tuple, tuple]:
-    """A filled arrowhead with its tip at b pointing from a: (svg path, its box, the line's new end);
-    on an arc (a sense, a couple) ARC_HEAD_MM long whatever the chord a-b."""
+               arc: bool = False, colour: str = "#000") -> tuple[str, tuple, tuple]:
+    """An arrowhead filled with its line's `colour`, its tip at b pointing from a: (svg path, its
+    box, the line's new end); on an arc (a sense, a couple) ARC_HEAD_MM long whatever the chord a-b."""
     L = math.hypot(b[0] - a[0], b[1] - a[1])
     ux, uy = (b[0] - a[0]) / L, (b[1] - a[1]) / L
     h = ARC_HEAD_MM if arc else min(ARROW_MM[0], max(0.3 * L, 0.8), length)
@@ -332,7 +332,7 @@ def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float,
     pts = [(b[0], b[1]), (bx - uy * hw, by + ux * hw), (bx + uy * hw, by - ux * hw)]
     d = "M" + " L".join(f"{x:.3f},{y:.3f}" for x, y in pts) + " z"
     xs, ys = [p[0] for p in pts], [p[1] for p in pts]
-    return (f'<path class="arrowhead{" arc" if arc else ""}" d="{d}" fill="#000"/>', (min(xs), min(ys), max(xs), max(ys)),
+    return (f'<path class="arrowhead{" arc" if arc else ""}" d="{d}" fill="{colour}"/>', (min(xs), min(ys), max(xs), max(ys)),
             (b[0] - ux * 0.6 * h, b[1] - uy * 0.6 * h))
 
 
@@ -371,7 +371,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         for (a, b), (c, d) in zip(xy, xy[1:]):
             placer.line(a, b, c, d)
         if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
-            head, box, _ = _arrowhead(xy[-2], xy[-1], ARC_HEAD_MM, arc=True)
+            head, box, _ = _arrowhead(xy[-2], xy[-1], ARC_HEAD_MM, arc=True, colour=colour)
             out.append(head)
             placer.block(box)
             named.append((name, xy[len(xy) // 2], None))
@@ -392,7 +392,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
                 a, b = (a[0] + nx, a[1] + ny), (b[0] + nx, b[1] + ny)
         end = b
         if s.kind == "vector":
-            head, box, end = _arrowhead(a, b, L)
+            head, box, end = _arrowhead(a, b, L, colour=colour)
             placer.block(box)
         else:
             placer.block((b[0] - 0.5, b[1] - 0.5, b[0] + 0.5, b[1] + 0.5))      # a line's end
