@@ -346,7 +346,7 @@ _SAMPLE_STEPS = 4
 def _check_memory(mech, steps: int) -> None:
     """Refuse `steps` before anything is allocated where the result's arrays (measured per crank
     position on a few positions of this model) would not fit in the memory available now."""
-    from .analysis import analyze
+    from .solve import analyze
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -363,7 +363,7 @@ def _check_memory(mech, steps: int) -> None:
 def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
     """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each;
     `steps` that would not fit in memory are refused before anything is allocated."""
-    from .analysis import analyze
+    from .solve import analyze
     from .errors import AssemblyError, ModelError
     if phi_deg is None:
         _check_memory(mech, steps)
@@ -748,7 +748,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
     from .report import run_validation, write_report
     t0 = time.perf_counter()
     try:
-        from .analysis import analyze
+        from .solve import analyze
         mech = _load(path)
         with warnings.catch_warnings():       # the main process printed the analysis' warnings
             warnings.simplefilter("ignore")

@@ -35,7 +35,8 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 import numpy as np
 
-from .analysis import Analysis, analyze, crank_angles
+from .analysis import Analysis, crank_angles
+from .solve import analyze
 from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
 from .units import parameter_units

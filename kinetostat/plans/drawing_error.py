@@ -35,7 +35,8 @@ from typing import Mapping
 
 import numpy as np
 
-from ..analysis import Analysis, analyze
+from ..analysis import Analysis
+from ..solve import analyze
 from ..model import Mechanism
 from .scales import choose_scales
 

@@ -113,7 +113,7 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
     """Scales mu_l, mu_v, mu_a, mu_F for the plans of `res` (an Analysis at one crank angle):
     the given ones as given, the others by the texts' rule (module docstring). `cycle`: an
     Analysis over the cycle whose positions the plan of positions must fit (default: 72 steps)."""
-    from ..analysis import analyze
+    from ..solve import analyze
     given = check_given(given)
     d = mech.drive
     crank = mech.links[d.link].points

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis import Analysis, analyze
+from ..analysis import Analysis
+from ..solve import analyze
 from ..applied import load_magnitude
 from ..kinematics import DIGITS_WARN
 from .._io import write_text

@@ -10,7 +10,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..analysis import Analysis, analyze
+from ..analysis import Analysis
+from ..solve import analyze
 from ..model import Mechanism, Published
 
 
