@@ -57,7 +57,7 @@ all 1000 of each task are distinct models.
 9. Design position: phi1 of the table, from top dead centre (line 82; task 2: of cylinder 3) in
    the crank's sense; the key (worksheet, plans) is drawn there.
 
-May use: the solver (`model`, `analysis`), `kinetostat.plans` (the key's plans and worksheet),
+May use: the solver (`model`, `solve`), `kinetostat.plans` (the key's plans and worksheet),
 `examples` (the bundled models' assumptions), `_io`, `tables`; never the harness, the engines or `report`.
 """
 from __future__ import annotations

@@ -12,7 +12,7 @@
 (`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
 there and only when a figure is drawn).
 
-May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`, `tables`;
+May use: numpy, the solver (`kinetostat.solve`, `kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`, `tables`;
 pandas only inside `Plans.segments_frame` and `Plans.segments_csv`; never the harness or
 `kinetostat.report`.
 """

@@ -15,7 +15,7 @@ crank pin `a1` in a slotted-link group, the guide's point `b3` when the guide is
 `k2`, ... when a plan has several. The plan of positions names each position's points with the
 position number (`A3`, `S2_3` where the name ends in a digit) and the design position's plain.
 
-May use: numpy, `kinetostat.analysis` (the exact results: never re-solved here), `.core`.
+May use: numpy, `kinetostat.solve` (the exact results: never re-solved here), `.core`.
 """
 from __future__ import annotations
 

@@ -21,8 +21,9 @@ twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figur
 DejaVu Sans embedded as Type 42 with its Unicode map, so pdftotext reads the Cyrillic back) and to
 HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
-May use: the solver (`analysis`), `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
-`kinetostat._io`; matplotlib inside the PDF writers only. Never the harness.
+May use: `build` of this package, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
+`kinetostat._io`; matplotlib inside the PDF writers only. Never the harness, nor `kinetostat.variants` (the variant
+is passed in and says its task, title and letters).
 """
 from __future__ import annotations
 

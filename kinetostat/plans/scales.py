@@ -17,7 +17,7 @@ would not fit the drawing area of an A3 sheet (FIT_MM).
           drawn 100..200 mm: the texts give the force plan a sheet of its own (seed 002 draws
           its 9651 N gas force 193 mm long at mu_F = 50 N/mm).
 
-May use: numpy, `kinetostat.analysis` (the exact results), `.core`.
+May use: numpy, `kinetostat.solve` (the exact results), `.core`.
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """The sources' published values of a model (its `[[published]]` tables), set beside the exact ones.
 
-May use: numpy, the solver (analysis, model). Never matplotlib, the harness or the engines.
+May use: numpy, the solver (solve, analysis, model). Never matplotlib, the harness or the engines.
 """
 from __future__ import annotations
 
