@@ -28,7 +28,8 @@ if _sys.argv[:1] == ["-m"] or _os.path.basename(_sys.argv[0] if _sys.argv else "
     _signal.signal(_signal.SIGINT, _interrupted_while_starting)
 
 from . import examples, plans, variants   # after the handler: these imports take most of the start
-from .analysis import Analysis, InertiaLoad, analyze
+from .analysis import Analysis, InertiaLoad
+from .solve import analyze
 from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning, SingularPositionWarning,
                      StructureError)
 from .kinematics import COND_CHECK, COND_MAX, DIGITS_MIN, DIGITS_WARN

@@ -1,6 +1,7 @@
-"""`analyze(mech, phi_deg)`: the whole kinetostatic analysis as one frozen result object.
+"""The whole kinetostatic analysis as one frozen result object (`Analysis`), and the numpy path
+that computes it (`exact`); `kinetostat.solve.analyze` chooses between it and the compiled path.
 
-May use: model, groups, kinematics, kinetostatics, applied, planar, fast; pandas only inside `to_frame`.
+May use: model, groups, kinematics, kinetostatics, applied, planar; pandas only inside `to_frame`.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from .applied import applied_moment, applied_wrenches, com_motion, load_magnitud
 from .planar import as_xy, as_z, dot_z
 from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "analyze", "exact", "crank_angles", "FRAME_NOTE", "deviation",
+__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "crank_angles", "FRAME_NOTE", "deviation",
            "force_deviation"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
@@ -435,22 +436,6 @@ def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
         raise ValueError(f"phi_deg: expected finite crank angles of shape (N,), got shape {phi_deg.shape}")
     phi_deg.flags.writeable = False
     return phi_deg
-
-
-def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
-    """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
-    or at `steps` equal steps over a full revolution when `phi_deg` is None.
-
-    From fast.FAST_MIN angles on it runs the compiled kernel (`fast.analyze_fast`), below them
-    the numpy path (`exact`): the same results to rounding (tests/test_fast.py)."""
-    if not isinstance(mech, Mechanism):
-        raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
-                        f"read a model file with kinetostat.load(path)")
-    phi_deg = crank_angles(phi_deg, steps)
-    from . import fast
-    if len(phi_deg) >= fast.FAST_MIN and fast.available():
-        return fast.analyze_fast(mech, phi_deg)
-    return exact(mech, phi_deg)
 
 
 def exact(mech: Mechanism, phi_deg: np.ndarray) -> Analysis:

@@ -32,8 +32,8 @@ of motion) are evaluated by `applied.applied_wrenches` per chunk of CHUNK angles
 a first pass of the motion kernel (the kinematics only) wrote, and read by the full or the
 peaks kernel.
 
-May use: numpy, numba, program, groups, kinematics, kinetostatics, applied, analysis (results),
-model and structure (for type hints).
+May use: numpy, numba, program, groups, kinematics, kinetostatics, applied, planar, analysis (the
+result and the numpy path), model and structure (for type hints).
 """
 from __future__ import annotations
 
@@ -54,10 +54,14 @@ from typing import TYPE_CHECKING, Any, Iterator, Sequence
 import numpy as np
 
 from . import groups
+from .analysis import Analysis, _read_only, exact
+from .applied import applied_wrenches
+from .kinematics import COND_CHECK, DIGITS_WARN, Kinematics, a_priori_error
+from .kinetostatics import Forces, friction_power, lever_moment
+from .planar import as_xy
 from .program import Identifiers, Program, code, constants, free_names, motion_program, statics_program
 
 if TYPE_CHECKING:
-    from .analysis import Analysis
     from .model import Mechanism
 
 __all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "CHUNK", "BLOCK", "available",
@@ -316,7 +320,6 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     squares in T; "motion" runs the kinematics program only and copies its arrays (MOTION), the
     first pass of a mechanism whose loads depend on the motion. All flag in FL the angles the
     exact guard must see."""
-    from .kinematics import COND_CHECK
     motion, statics = _motion(mech), statics_program(mech)
     v = Identifiers().__getitem__
     L, P = lay.L, lay.P
@@ -530,7 +533,6 @@ _NO_LOADS = np.zeros((0, 1))
 
 
 def _kinematics(mech: "Mechanism", phi: np.ndarray, r: dict[str, np.ndarray], error: np.ndarray):
-    from .kinematics import Kinematics
     return Kinematics(phi, r["th"], r["rot"], r["O"], r["V"], r["A"], r["w"], r["e"], r["vs"], r["as"],
                       r["cond"], np.zeros(len(phi), bool), error)
 
@@ -538,7 +540,6 @@ def _kinematics(mech: "Mechanism", phi: np.ndarray, r: dict[str, np.ndarray], er
 def _loads(mech: "Mechanism", phi: np.ndarray, r: dict[str, np.ndarray]) -> np.ndarray:
     """The loads on `mech` besides gravity at the motion in the views `r` (angles phi, rad), as
     the kernel reads them: (3 (L - 1), N) rows F_x, F_y, M of each moving link about its origin."""
-    from .applied import applied_wrenches
     kin = _kinematics(mech, phi, r, r["error"][:, 0])
     arm = mech.inertia_arrays[2] * kin.rot
     F, M = applied_wrenches(mech, kin, arm)
@@ -572,10 +573,6 @@ def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | No
 
 def _analysis(mech: "Mechanism", phi_deg: np.ndarray, buf: np.ndarray, threads: int | None) -> "Analysis":
     """The Analysis of `mech` at `phi_deg` (deg) whose arrays are views of the flat buffer `buf`."""
-    from .analysis import Analysis, _read_only, exact
-    from .kinematics import a_priori_error
-    from .kinetostatics import Forces, friction_power
-    from .planar import as_xy
     phi = np.radians(phi_deg)
     N = len(phi)
     r, FL = _fill(mech, phi, buf, threads)
@@ -586,7 +583,6 @@ def _analysis(mech: "Mechanism", phi_deg: np.ndarray, buf: np.ndarray, threads: 
                    Forces(xy(r["R"]), r["normal"], r["m"], r["M_bal"][:, 0], xy(r["F_bal"])[:, 0]),
                    r["lever"][:, 0], r["friction"])
     if (r["w"][:, 1] == 0).any():     # at standstill the lever needs the plan at unit speed
-        from .kinetostatics import lever_moment
         F_all = r["F_app"] + r["F_i"]
         M_all = r["M_app"] + r["M_i"] + groups.cross(mech.inertia_arrays[2] * kin.rot, r["F_i"])
         res.lever_moment[:] = lever_moment(mech, kin, F_all, M_all)
@@ -680,7 +676,6 @@ def peaks(mechs: Sequence["Mechanism"], phi_deg: np.ndarray, threads: int | None
     (one call for the designs without loads; per design and chunk with them); the angles the
     guard must see are solved by the numpy path, and excluded where they are singular. Designs
     at standstill go through the numpy path whole."""
-    from .analysis import exact
     phi_deg = np.asarray(phi_deg, float)
     phi = np.radians(phi_deg)
     D = len(mechs)
@@ -720,6 +715,5 @@ def peaks(mechs: Sequence["Mechanism"], phi_deg: np.ndarray, threads: int | None
 def warned_band(res) -> tuple[np.ndarray, float]:
     """The angles (deg) whose values `res` keeps with fewer than DIGITS_WARN digits, and the fewest
     digits there (NaN where there is none)."""
-    from .kinematics import DIGITS_WARN
     low = ~res.singular & (res.digits < DIGITS_WARN)
     return res.phi_deg[low], float(res.digits[low].min()) if low.any() else np.nan

@@ -12,7 +12,7 @@ with every input (each point of the linkage, the crank angle) moved by PERTURB_U
 the change is the error estimate (`Kinematics.error`). Fewer than DIGITS_WARN digits left: a
 SingularPositionWarning names the angles and the digits; fewer than DIGITS_MIN: NaN.
 
-May use: program, planar, errors (model and structure for type hints only).
+May use: program, sizes, planar, errors (model and structure for type hints only).
 """
 from __future__ import annotations
 
@@ -25,8 +25,9 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 
 from .errors import SingularPositionWarning, singular_message
-from .planar import as_xy, diameter
+from .planar import as_xy
 from .program import constants, motion_program, run
+from .sizes import group_scales, kinematic_size
 
 if TYPE_CHECKING:
     from .model import Mechanism
@@ -221,40 +222,6 @@ def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Ki
                       stack("V", L, 0.0, c), stack("A", L, 0.0, c), stack("w", L, 0.0, f), stack("e", L, 0.0, f),
                       stack("vs", len(mech.pairs), 0.0, f, 0), stack("as", len(mech.pairs), 0.0, f, 0),
                       stack("cond", G, 0.0, f, 0), xp.zeros(lead + (N,), dtype=xp.bool), xp.zeros(lead + (N,), dtype=f))
-
-
-# -- length scales: only the points of the pairs (the joints) count; a point that carries a load,
-# a centre of mass, or no pair at all plays no part in a group's geometry.
-def _joint_extents(mech: "Mechanism") -> list[float]:
-    """Per link: the largest distance between two of its joint points (points of its pairs), m."""
-    if "joint_extents" not in mech._derived:
-        joints: list[set[str]] = [set() for _ in mech.links]
-        for p in mech.pairs:
-            if p.kind == "R":
-                joints[p.links[0]].add(p.point)
-                joints[p.links[1]].add(p.point)
-            else:
-                joints[p.links[0]].add(p.guide)
-                joints[p.links[1]].add(p.point)
-        mech._derived["joint_extents"] = [diameter(pts[a] for a in names)
-                                          for pts, names in zip(mech.points_z, joints)]
-    return mech._derived["joint_extents"]
-
-
-def kinematic_size(mech: "Mechanism") -> float:
-    """The linkage's length scale for the accuracy measure: the largest distance between two
-    joint points of one moving link, m (mech.size if no link has two)."""
-    return max(_joint_extents(mech)[1:], default=0.0) or mech.size
-
-
-def group_scales(mech: "Mechanism") -> list[float]:
-    """Per Assur group, its length scale for the condition number, m: the largest distance
-    between two joint points of one of its links or of the moving links it is attached to."""
-    if "group_scales" not in mech._derived:
-        ext = _joint_extents(mech)
-        mech._derived["group_scales"] = [max((ext[k] for k in (*g.links, *g.known) if k), default=0.0)
-                                         or kinematic_size(mech) for g in mech.structure.groups]
-    return mech._derived["group_scales"]
 
 
 # -- the accuracy estimate and the guard

@@ -11,7 +11,7 @@ scales: `constants`) enter as the environment it runs in. The same program runs
 - on scalars inside a compiled loop over designs and angles (`kinetostat.fast` generates it
   from `code`, over groups' source with its compiled primitives).
 
-May use: numpy, groups, errors (model and structure for type hints only).
+May use: numpy, groups, sizes, errors (model and structure for type hints only).
 """
 from __future__ import annotations
 
@@ -23,6 +23,7 @@ import numpy as np
 
 from . import groups
 from .errors import AssemblyError
+from .sizes import group_scales
 
 if TYPE_CHECKING:
     from .model import Mechanism, Pair
@@ -62,7 +63,6 @@ def constants(mech: "Mechanism", points: tuple[Mapping[str, complex], ...] | Non
     (L<n>, m), the drive, the masses (mass<k>, I_S<k>, com<k> the local centre of mass), g,
     and the gear. `points`: the local points (default the
     model's; the accuracy check passes them perturbed); `scales`: the group scales."""
-    from .kinematics import group_scales
     pts = mech.points_z if points is None else points
     c: dict[str, Any] = {}
     for k, link_pts in enumerate(pts):

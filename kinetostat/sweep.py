@@ -17,7 +17,7 @@ model) are not printed: the table's `n_singular` and `singular_deg` say where a 
 (values NaN), `warned_deg` and `worst_digits` where its values are kept with fewer than
 DIGITS_WARN digits and the fewest digits there.
 
-May use: model, analysis, errors, examples, units; pandas (imported when a sweep runs, so that
+May use: model, analysis, solve, fast, errors, examples, units; pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
 Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
 `kinetostat.report`.
@@ -35,7 +35,8 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 import numpy as np
 
-from .analysis import Analysis, analyze, crank_angles
+from .analysis import Analysis, crank_angles
+from .solve import analyze
 from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
 from .units import parameter_units

@@ -23,7 +23,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ._io import atomic
-from .analysis import analyze
+from .solve import analyze
 from .model import Mechanism, load
 
 __all__ = ["check_cycle", "cycle_table", "ColumnDiff", "CycleMismatch", "obtained_path"]

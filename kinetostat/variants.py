@@ -57,7 +57,7 @@ all 1000 of each task are distinct models.
 9. Design position: phi1 of the table, from top dead centre (line 82; task 2: of cylinder 3) in
    the crank's sense; the key (worksheet, plans) is drawn there.
 
-May use: the solver (`model`, `analysis`), `kinetostat.plans` (the key's plans and worksheet),
+May use: the solver (`model`, `solve`), `kinetostat.plans` (the key's plans and worksheet),
 `examples` (the bundled models' assumptions), `_io`, `tables`; never the harness, the engines or `report`.
 """
 from __future__ import annotations
@@ -321,6 +321,11 @@ _NAME = ("{title} (Логвіненко, Надтока 2021, задача {task
 _LABEL = (("варіант {code}", "задані значення"), ("вариант {code}", "заданные значения"))
 
 
+def task_title(task: int, lang: str = "en") -> str:
+    """Task `task`'s title in `lang` ("en", "uk", "ru")."""
+    return TASKS[task].title if lang == "en" else TITLES[task][lang == "ru"]
+
+
 def _lettering(task: int, code: str | None) -> dict:
     """The variant's [lettering]: the bundled model's (frame, M_зр, F_зр, loads, language) and
     the variant's name in Ukrainian and Russian."""
@@ -400,6 +405,20 @@ class Variant:
     def name(self) -> str:
         """`task<T>_<CODE>`: the stem of its file and folder."""
         return f"task{self.task}_{self.code or 'custom'}"
+
+    @property
+    def spec(self) -> TaskTable:
+        """The task's table of the text (`TASKS[task]`)."""
+        return TASKS[self.task]
+
+    @property
+    def letters(self) -> dict[str, str]:
+        """The code's digit under each letter of the text (а, б, в, г, д, е); empty without a code."""
+        return {ch: self.code[i] for ch, i in LETTERS.items()} if self.code else {}
+
+    def title(self, lang: str = "en") -> str:
+        """The task's title in `lang` ("en", "uk", "ru")."""
+        return task_title(self.task, lang)
 
     def mechanism(self) -> Mechanism:
         return from_dict(self._model, source=self.name)
@@ -558,7 +577,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
-    from .analysis import analyze
+    from .solve import analyze
     from .plans import build as build_plans
     from .plans.lettering import with_aliases
     from .plans.pack import pack
@@ -597,7 +616,7 @@ def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
         by_task.setdefault(k.name.split("_")[0], []).append(k)
     for task, ks in by_task.items():
         spec = TASKS[int(task[4:])]
-        title = spec.title if lang == "en" else TITLES[spec.task][lang == "ru"]
+        title = task_title(spec.task, lang)
         cyc = text("ix.cycle", lang)
         lines += [f"## {text('ix.task', lang, task=spec.task, title=title, table=spec.table)}", "",
                   f"| {text('ix.code', lang)} | φ1, {deg} | {M} {text('ix.at', lang)}, {Nm} | "
@@ -619,10 +638,10 @@ def summary(v: Variant, k: KeySummary, out: str | Path, lang: str = "en") -> lis
     values, M_зр and the largest reaction at phi1 and over the cycle, the files written."""
     from .plans.i18n import num, text, unit
     spec, L = TASKS[v.task], lettering_of(v.task)
-    title = spec.title if lang == "en" else TITLES[spec.task][lang == "ru"]
+    title = v.title(lang)
     Nm, N = unit("N m", lang), unit("N", lang)
     lines = [text("cli.variant", lang, task=v.task, title=title, code=v.code, table=spec.table)
-             + " " + " ".join(f"{ch}={v.code[i]}" for ch, i in LETTERS.items())]
+             + " " + " ".join(f"{ch}={d}" for ch, d in v.letters.items())]
     lines += [f"  {r.letter}  {r.symbol:<22s} = {num(v.values[r.key], lang, 6)} {unit(r.unit, lang)}".rstrip()
               for r in spec.rows]
     lines += [text("cli.at", lang, phi=num(k.phi1, lang, 6), M=L.M_bal, M_value=f"{num(k.M_bal, lang, 5)} {Nm}",

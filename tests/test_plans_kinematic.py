@@ -174,7 +174,7 @@ def test_figures_render(path, tmp_path):
     assert {"positions", "velocity", "acceleration", "crank", "lever"} <= set(plans)
     assert any(k.startswith("forces:") for k in plans) and any(k.startswith("group:") for k in plans)
     for plan in plans.values():
-        fig = plan.figure(lang="uk")
+        fig = P.figure(plan, lang="uk")
         FigureCanvasAgg(fig).print_png(tmp_path / "plan.png")
         assert (tmp_path / "plan.png").stat().st_size > 5000
         ET.fromstring(P.draw.svg(plan, lang="en", mechanism=mech.name))

@@ -194,7 +194,7 @@ def test_report_html_is_markdown_it_rendering(ice_report):
     for plan in plans.values():
         name = "plan_" + kinetostat.plans.plan_file_name(plan)
         assert f'<a href="{name}"><img' in html
-        assert (d / name).read_text() == plan.svg(mechanism=kinetostat.load(ICE).name)
+        assert (d / name).read_text() == kinetostat.plans.svg(plan, mechanism=kinetostat.load(ICE).name)
     assert not re.search(r'src="(?!data:)', html)
     assert '<div class="scroll"><table>' in html and 'class="pass"' in html
     assert 'href="../index.html"' in html and 'href="cycle.csv"' in html

@@ -5,14 +5,14 @@
     >>> plans = kinetostat.plans.build(mech, at=30)
     >>> round(plans["velocity"].length_mm("p-b"), 1)        # seed 002: pb = 54.7 mm at mu_v = 0.2
     54.7
-    >>> fig = plans["acceleration"].figure(lang="uk")       # a matplotlib Figure (notebooks)
+    >>> fig = kinetostat.plans.figure(plans["acceleration"], lang="uk")   # a matplotlib Figure
     >>> plans.write("out", lang="en")                       # one SVG sheet per plan + segments.csv
 
 `build` -> `Plans`, a frozen mapping kind -> `Plan` (`core`); scales by the texts' rule or given
 (`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
 there and only when a figure is drawn).
 
-May use: numpy, the solver (`kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`, `tables`;
+May use: numpy, the solver (`kinetostat.solve`, `kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`, `tables`;
 pandas only inside `Plans.segments_frame` and `Plans.segments_csv`; never the harness or
 `kinetostat.report`.
 """
@@ -30,7 +30,7 @@ from .._text import csv_cell
 from ..kinematics import DIGITS_WARN
 from ..tables import FLOAT_FORMAT, by_unit, rounded
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment, extent
-from .draw import fits
+from .draw import figure, fits, svg
 from .forces import crank_plan, force_plans, group_plans
 from .lettering import lettering
 from .mechanism import mechanism_plan
@@ -38,7 +38,7 @@ from .kinematic import acceleration_plan, positions_plan, starting_position, vel
 from .lever import lever_plan
 from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
 
-__all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS",
+__all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS", "svg", "figure",
            "choose_scales", "starting_position", "plan_file_name"]
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
@@ -131,7 +131,6 @@ class Plans(Mapping):
         """Write one SVG sheet per plan (`plan_file_name`) in `lang` ("en", "uk", "ru"; the
         mechanism named as the model's lettering names it in `lang`) and segments.csv into
         `out_dir` (created), each atomically; returns the paths written."""
-        from .draw import svg
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
@@ -159,7 +158,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     scale that would draw a plan beyond MAX_EXTENT_MM."""
     import math
 
-    from ..analysis import analyze
+    from ..solve import analyze
     if at is None:
         at = getattr(mech.drive, "design_deg", 30.0)
     if isinstance(at, bool) or not isinstance(at, (int, float)) or not math.isfinite(at):

@@ -3,7 +3,7 @@ sheet, lettered segments, and the scale that turns a drawn length into the quant
 
 Every plan of the method (positions, velocity, acceleration, a group's plan and force plan, the
 initial link, Zhukovsky's lever) is a `Plan`: data first, drawn later (SVG sheets, matplotlib
-figures) by other rooms of this package. A segment's drawn length times the plan's scale is the
+figures) by `draw`, which this module never imports. A segment's drawn length times the plan's scale is the
 magnitude of the quantity it stands for (`Segment.value`, SI).
 
 May use: numpy and the standard library. Never matplotlib at import time, never the harness.
@@ -114,16 +114,6 @@ class Plan:
                         "length_mm": abs(b - a), "value": s.value, "unit": s.unit,
                         "scale": str(s.scale or self.scale)})
         return out
-
-    def figure(self, lang: str = "en", ax=None):
-        """The plan as a matplotlib Figure (equal aspect, mm axes); `lang` "en", "uk" or "ru"."""
-        from .draw import figure
-        return figure(self, lang=lang, ax=ax)
-
-    def svg(self, lang: str = "en", mechanism: str = "") -> str:
-        """The plan as an SVG sheet (A3 landscape, true to scale in mm)."""
-        from .draw import svg
-        return svg(self, lang=lang, mechanism=mechanism)
 
     def __repr__(self) -> str:
         return (f"Plan({self.kind!r}, phi_deg={self.phi_deg:g}, {self.scale}, points={len(self.points)}, "

@@ -24,7 +24,7 @@ are all RRR or RRP with its guide on the frame (Logvinenko and Nadtoka's ICE and
 the compressor, the chain-unit four-bar, the furnace loader); for the others `simulate` draws the
 kinematics and the inertia loads only.
 
-May use: the solver (`analysis`, `applied`), `plans.worksheet`, numpy. Never matplotlib.
+May use: the solver (`solve`, `analysis`, `applied`), `plans.worksheet`, numpy. Never matplotlib.
 """
 from __future__ import annotations
 
@@ -35,7 +35,8 @@ from typing import Mapping
 
 import numpy as np
 
-from ..analysis import Analysis, analyze
+from ..analysis import Analysis
+from ..solve import analyze
 from ..model import Mechanism
 from .scales import choose_scales
 

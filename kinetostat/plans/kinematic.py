@@ -15,7 +15,7 @@ crank pin `a1` in a slotted-link group, the guide's point `b3` when the guide is
 `k2`, ... when a plan has several. The plan of positions names each position's points with the
 position number (`A3`, `S2_3` where the name ends in a digit) and the design position's plain.
 
-May use: numpy, `kinetostat.analysis` (the exact results: never re-solved here), `.core`.
+May use: numpy, `kinetostat.solve` (the exact results: never re-solved here), `.core`.
 """
 from __future__ import annotations
 
@@ -273,7 +273,7 @@ def starting_position(mech, steps: int = 720) -> float:
     in deg in [0, 360): the first dead centre of the first group driven by a link turning about
     a frame pin that has one (module docstring of `_dead_centre_functions`), found by a scan of
     `steps` angles and bisection to ~1e-13 deg. 0 (the model's reference) when there is none."""
-    from ..analysis import analyze
+    from ..solve import analyze
     phi = np.arange(steps) * 360.0 / steps
     cyc = analyze(mech, phi_deg=phi)
     for f in _dead_centre_functions(mech):
@@ -351,7 +351,7 @@ def _draw_position(mech, res, idx: int, label: int | None, mu: float, points: di
 def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list, dashed: bool = True) -> list[str]:
     """Mark each group's assembly branch: a note, and the other branch's inner joint drawn dashed
     (primed name) where it lies elsewhere (with `dashed` False only noted: it runs off the sheet)."""
-    from ..analysis import analyze
+    from ..solve import analyze
     from ..errors import AssemblyError
     notes = []
     for g in mech.structure.groups:
@@ -391,7 +391,7 @@ def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | No
     of `res` (plain names), the paths of every centre of mass and the assembly branch of each
     group (notes; the other branch dashed, unless `other_branch` is False): all at mu_l. Link segments' values are the exact
     distances between their points, m."""
-    from ..analysis import analyze
+    from ..solve import analyze
     at = float(res.phi_deg[0])
     mu = scales["mu_l"]
     start = starting_position(mech) if starting_deg is None else float(starting_deg)

@@ -21,8 +21,9 @@ twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figur
 DejaVu Sans embedded as Type 42 with its Unicode map, so pdftotext reads the Cyrillic back) and to
 HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
-May use: the solver (`analysis`), `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
-`kinetostat._io`; matplotlib inside the PDF writers only. Never the harness.
+May use: `build` of this package, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
+`kinetostat._io`; matplotlib inside the PDF writers only. Never the harness, nor `kinetostat.variants` (the variant
+is passed in and says its task, title and letters).
 """
 from __future__ import annotations
 
@@ -105,7 +106,6 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
     plans when built already (`kinetostat.plans.build`); `draws`: Monte Carlo draws of the bands."""
     from . import build
     from .drawing_error import Scales, simulate
-    from ..variants import TASKS, TITLES, LETTERS
     check_lang(lang)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
@@ -113,9 +113,9 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
     sc = plans.scales
     ws = worksheet(mech, phi1, mu_l=sc["mu_l"].value, lang=lang)
     L = lettering(mech)
-    spec = TASKS[v.task]
+    spec, name = v.spec, v.title(lang)
     title = text("pack.task", lang, task=v.task, code=v.code or "—",
-                 title=spec.title[0].upper() + spec.title[1:] if lang == "en" else TITLES[v.task][lang == "ru"])
+                 title=name[0].upper() + name[1:] if lang == "en" else name)
     drawn = simulate(mech, at=phi1, n=draws, seed=0,
                      scales=Scales(*(sc[k].value for k in ("mu_l", "mu_v", "mu_a", "mu_F"))))
     bands = {k: tuple(float(x) for x in np.percentile(s, BAND)) for k, s in drawn.samples.items()}
@@ -126,7 +126,7 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
     sheet = [("h1", title), ("p", text("pack.statement", lang, M=L.M_bal)), ("p", text("pack.assume", lang)),
              ("h2", text("pack.data", lang, table=spec.table)), ("table", data)]
     if v.code:
-        sheet.append(("p", "  ".join(f"{ch} = {v.code[i]}" for ch, i in LETTERS.items())))
+        sheet.append(("p", "  ".join(f"{ch} = {d}" for ch, d in v.letters.items())))
     key = [("h1", f"{text('pack.key', lang)}. {title}")]          # scales, values and bands, δ, segments
     answers: set[str] = set()
     key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
@@ -402,7 +402,7 @@ def _plans_pdf(plans, lang: str, title: str) -> bytes:
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
-    from .draw import scale_text
+    from .draw import figure, scale_text
     kinds = list(plans)
     cols = 4 if len(kinds) > 6 else 3
     rows = math.ceil(len(kinds) / cols)
@@ -417,7 +417,7 @@ def _plans_pdf(plans, lang: str, title: str) -> bytes:
             c, r = n % cols, n // cols
             x, y = 25 + c * cw + 10, 14 + r * ch + 9
             ax = fig.add_axes(((x) / W, 1 - (y + ch - 17) / H, (cw - 14) / W, (ch - 17) / H))
-            plans[kind].figure(lang, ax=ax)
+            figure(plans[kind], lang, ax=ax)
             ax.title.set_fontsize(7)
             ax.tick_params(labelsize=5)
             ax.xaxis.label.set_fontsize(6), ax.yaxis.label.set_fontsize(6)

@@ -17,7 +17,7 @@ would not fit the drawing area of an A3 sheet (FIT_MM).
           drawn 100..200 mm: the texts give the force plan a sheet of its own (seed 002 draws
           its 9651 N gas force 193 mm long at mu_F = 50 N/mm).
 
-May use: numpy, `kinetostat.analysis` (the exact results), `.core`.
+May use: numpy, `kinetostat.solve` (the exact results), `.core`.
 """
 from __future__ import annotations
 
@@ -113,7 +113,7 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
     """Scales mu_l, mu_v, mu_a, mu_F for the plans of `res` (an Analysis at one crank angle):
     the given ones as given, the others by the texts' rule (module docstring). `cycle`: an
     Analysis over the cycle whose positions the plan of positions must fit (default: 72 steps)."""
-    from ..analysis import analyze
+    from ..solve import analyze
     given = check_given(given)
     d = mech.drive
     crank = mech.links[d.link].points

@@ -7,7 +7,7 @@ accelerations), the inertia loads and the applied loads, the reactions group by 
 last group attached back to the crank, the crank, Zhukovsky's lever and the difference of the two
 balancing moments. Outputs: Markdown, HTML, a pandas frame, CSV and JSON (written atomically).
 
-May use: the solver (`analysis`, `applied`, `model`), `_io`, `_text` (safe cells), numpy; pandas and markdown-it-py inside the
+May use: the solver (`solve`, `analysis`, `applied`, `model`), `_io`, `_text` (safe cells), numpy; pandas and markdown-it-py inside the
 output methods only. Never matplotlib, never the harness.
 """
 from __future__ import annotations
@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis import Analysis, analyze
+from ..analysis import Analysis
+from ..solve import analyze
 from ..applied import load_magnitude
 from ..kinematics import DIGITS_WARN
 from .._io import write_text

@@ -1,6 +1,6 @@
 """The sources' published values of a model (its `[[published]]` tables), set beside the exact ones.
 
-May use: numpy, the solver (analysis, model). Never matplotlib, the harness or the engines.
+May use: numpy, the solver (solve, analysis, model). Never matplotlib, the harness or the engines.
 """
 from __future__ import annotations
 
@@ -10,7 +10,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..analysis import Analysis, analyze
+from ..analysis import Analysis
+from ..solve import analyze
 from ..model import Mechanism, Published
 
 

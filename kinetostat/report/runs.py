@@ -15,7 +15,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .._io import safe_name
-from ..analysis import Analysis, analyze
+from ..analysis import Analysis
+from ..solve import analyze
 from ..model import Mechanism
 from .published import PublishedCheck, published_rows
 

@@ -14,7 +14,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
-from ..analysis import analyze
+from ..solve import analyze
 from ..model import Mechanism
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
@@ -252,7 +252,7 @@ def _published_section(doc: Doc, m: Mechanism, published: Sequence[PublishedChec
 def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
     """The plans of the graphical method at the model's design position (`kinetostat.plans`),
     one picture each, with their segments.csv and the worksheet beside them; returns the files."""
-    from ..plans import build, plan_file_name
+    from ..plans import build, plan_file_name, svg
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
     doc.h(2, PLANS_HEADING)
@@ -274,7 +274,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
     files = []
     for plan in plans.values():
         path = d / ("plan_" + plan_file_name(plan, ".svg"))
-        write_text(path, plan.svg(mechanism=m.name))
+        write_text(path, svg(plan, mechanism=m.name))
         doc.img(path, f"{esc(plan.title)}, {plan.scale}", link=True)
         files.append(path)
     write_text(d / "segments.csv", plans.segments_csv())

@@ -1,0 +1,180 @@
+"""The commands on one model: `analyze` (summary, worksheet, full table), `structure`, `export`
+(MJCF, URDF), and `examples` (the bundled models listed or copied).
+
+May use: `.common`, the solver, `kinetostat.plans.worksheet`; the harness inside `cmd_export`.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from .._text import one_line
+from .common import CLIError, EXIT_OK, TABLE_SUFFIXES, _Out, _analyze, _fmt, _lines, _load, _model_error_lines, _parquet_engine, _save, _turn, _writable_file, bundled_models
+
+
+def _summary(res, path: Path) -> list[str]:
+    import numpy as np
+    m = res.mech
+    s = m.structure
+    phi = res.phi_deg
+    lines = [f"{m.name}   [{path}]",
+             f"structure: {s.formula}   (W = 3*{s.n} - 2*{s.p5} - {s.p4} = {s.W})",
+             f"{len(phi)} crank position(s), phi = {phi.min():g} .. {phi.max():g} deg; "
+             f"omega1 = {m.drive.omega:.6g} rad/s ({m.drive.omega * 30 / math.pi:.6g} rpm, "
+             f"{'ccw' if m.drive.sense > 0 else 'cw'})"]
+    lines.append("peak reactions |R(i,j)| (force of link i on link j):")
+    for p in m.pairs:
+        mag = np.linalg.norm(res.forces.R[:, p.index], axis=-1)
+        where = f"at {p.point}" if p.kind == "R" else f"guide {p.guide}"
+        name = f"R({p.links[0]},{p.links[1]}) {where}"
+        if np.any(np.isfinite(mag)):
+            i = int(np.nanargmax(mag))
+            lines.append(f"  {name:<22s} {_fmt(mag[i], 'N'):>14s}  at phi = {phi[i]:g} deg")
+        else:
+            lines.append(f"  {name:<22s} {'n/a':>14s}")
+    M = res.balancing_moment
+    if np.any(np.isfinite(M)):
+        i, j = int(np.nanargmin(M)), int(np.nanargmax(M))
+        lines.append(f"balancing moment M_bal: {_fmt(M[i], 'N m')} (phi = {phi[i]:g} deg) .. "
+                     f"{_fmt(M[j], 'N m')} (phi = {phi[j]:g} deg)")
+    if m.drive.kind == "machine":
+        F = np.linalg.norm(res.balancing_force, axis=-1)
+        if np.any(np.isfinite(F)):
+            lines.append(f"balancing force |F_bal| on the gear mesh: {_fmt(np.nanmin(F), 'N')} .. {_fmt(np.nanmax(F), 'N')}")
+    d = res.lever_discrepancy
+    if np.any(np.isfinite(d)):
+        k = int(np.nanargmax(np.abs(d)))
+        lines.append(f"lever discrepancy max |M_lever - M_bal|: {abs(d[k]):.3g} N m (phi = {phi[k]:g} deg)")
+    n_sing = int(np.sum(res.singular))
+    if n_sing:
+        lines.append(f"singular positions: {n_sing} (their values are NaN)")
+    if len(phi) <= 12:
+        head = f"  {'phi, deg':>9s} {'M_bal, N m':>12s} " + " ".join(
+            f"{'|R(%d,%d)|, N' % p.links:>13s}" for p in m.pairs)
+        lines += ["values:", head]
+        for n in range(len(phi)):
+            lines.append(f"  {phi[n]:9.4g} {M[n]:12.6g} " + " ".join(
+                f"{np.linalg.norm(res.forces.R[n, p.index]):13.6g}" for p in m.pairs))
+    return lines
+
+
+def _worksheet_lines(mech, phi: float) -> list[str]:
+    """The worksheet's kinematic and inertia values at one position, as a student compares them."""
+    import warnings
+
+    from ..plans.worksheet import worksheet
+    with warnings.catch_warnings():          # the analysis above has warned already
+        warnings.simplefilter("ignore")
+        ws = worksheet(mech, at=phi)
+    lines = [f"worksheet at phi = {phi:g} deg (kinematics, inertia and loads; mu_l = {ws.mu_l:g} m/mm):"]
+    for r in ws.rows:
+        if r.section in ("kinematics", "accelerations", "inertia"):
+            sense = r.direction if r.direction in ("cw", "ccw") else ""
+            lines.append(f"  {r.symbol:<14s} {_fmt(r.value, r.unit):>18s}  {sense}".rstrip())
+    return lines
+
+
+def cmd_analyze(args) -> int:
+    out = args.out
+    if out is not None and out != "-":
+        suffix = Path(out).suffix.lower()
+        if suffix not in TABLE_SUFFIXES:
+            raise CLIError(f"--out {out}: unknown table format {suffix or '(no suffix)'!r}; "
+                           f"use one of {', '.join(TABLE_SUFFIXES)} (or '-' for CSV on stdout)")
+        if suffix == ".parquet":
+            _parquet_engine(f"--out {out}", ".csv / .json")
+        _writable_file(out, "--out")
+    path = Path(args.model)
+    mech = _load(path)
+    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps)
+    lines = _summary(res, path)
+    if len(res.phi_deg) == 1:
+        lines += _worksheet_lines(mech, float(res.phi_deg[0]))
+    if out is not None:
+        from .. import tables
+        df = res.to_frame()
+        if out == "-":
+            _Out.write(tables.csv_text(df).rstrip("\n"))
+        else:
+            suffix = Path(out).suffix.lower()
+            write = {".csv": tables.write_csv, ".json": tables.write_json}.get(suffix, tables.write_parquet)
+            _save(out, "--out", lambda f: write(df, f), binary=suffix == ".parquet")
+            lines.append(f"table: {len(df)} rows x {len(df.columns)} columns -> {out}")
+    else:
+        lines.append("(the full table: --out FILE.csv | FILE.parquet | FILE.json)")
+    _Out.write(_lines(lines), err=(out == "-"))
+    return EXIT_OK
+
+
+def cmd_structure(args) -> int:
+    from ..structure import GROUP_KINDS
+    path = Path(args.model)
+    m = _load(path)
+    s = m.structure
+    pairs = ", ".join(f"{p.label} at {p.point}" if p.kind == "R" else f"{p.label} guide {p.guide}" for p in m.pairs)
+    crank = next(p for p in m.pairs if set(p.links) == {0, 1})
+    lines = [f"{m.name}   [{path}]",
+             f"moving links n = {s.n}: " + ", ".join(f"{k.id} {k.name}" for k in m.links[1:]),
+             f"lower pairs p5 = {s.p5}: {pairs}",
+             f"higher pairs p4 = {s.p4}",
+             f"mobility (Chebyshev): W = 3n - 2p5 - p4 = 3*{s.n} - 2*{s.p5} - {s.p4} = {s.W}",
+             f"initial mechanism I(0,1): crank 1 on the frame at {crank.point} ({crank.label})",
+             "Assur groups, in order of attachment:"]
+    for g in s.groups:
+        outer_j, inner, outer_k = g.pairs
+        lines.append(f"  {g.label}  {g.kind} (kind {GROUP_KINDS[g.kind]})  links {g.links[0]}, {g.links[1]}; "
+                     f"outer pairs {outer_j.label}, {outer_k.label} (to links {g.known[0]}, {g.known[1]}), "
+                     f"inner {inner.label}; branch {g.branch:+d}")
+    if not s.groups:
+        lines.append("  none")
+    lines.append(f"structure formula: {s.formula}")
+    lines.append(f"class {s.mechanism_class}, order {s.order}")
+    if m.parameters:
+        lines.append("parameters: " + ", ".join(f"{n} = {v:.10g}" for n, v in m.parameters.items()))
+    if m.expressions:
+        lines.append("numbers from expressions:")
+        lines += [f"  {path} = {text} = {v:.10g}" for path, (text, v) in m.expressions.items()]
+    _Out.write(_lines(lines))
+    return EXIT_OK
+
+
+def cmd_export(args) -> int:
+    from ..errors import AssemblyError, ModelError
+    path = Path(args.model)
+    mech = _load(path)
+    from kinetostat_validation.export import to_mjcf, to_urdf
+    try:
+        text = to_mjcf(mech) if args.format == "mjcf" else to_urdf(mech)
+    except AssemblyError as exc:
+        raise CLIError(f"{path}: {exc}") from None
+    except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
+        raise CLIError(lines=_model_error_lines(exc)) from None
+    if args.output is None or args.output == "-":
+        _Out.write(text.rstrip("\n"))
+        return EXIT_OK
+    _save(args.output, "-o", lambda f: f.write(text))
+    _Out.write(one_line(f"{args.format.upper()} of {path.name} -> {args.output}"))
+    return EXIT_OK
+
+
+def cmd_examples(args) -> int:
+    from .. import examples
+    if args.force and args.copy is None:
+        raise CLIError("--force only goes with --copy DIR (it replaces files already in DIR)")
+    if args.copy is not None:
+        try:
+            written = examples.copy(args.copy, overwrite=args.force)
+        except FileExistsError as exc:
+            raise CLIError(f"--copy {args.copy}: {exc.filename} {exc.strerror}; nothing copied "
+                           f"(--force replaces them)") from None
+        except OSError as exc:
+            raise CLIError(f"cannot write --copy {args.copy}: {exc.strerror or exc}") from None
+        _Out.write(one_line(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}"))
+        return EXIT_OK
+    lines = [f"bundled models in {examples.models_dir()} (by name: kinetostat.load(NAME); "
+             f"copies: kinetostat examples --copy DIR):"]
+    for path in bundled_models():
+        m = _load(path)
+        lines.append(f"  {path.stem:<24s} {m.structure.formula:<34s} {m.source or m.name}")
+    _Out.write(_lines(lines))
+    return EXIT_OK

@@ -1,0 +1,457 @@
+"""What every command shares: exit codes, CLIError, output that does not break a progress bar,
+interrupts, atomic saving (`_save`), warnings as one line, progress bars, the argument types,
+loading a model (`_load`), the analysis with its memory check (`_analyze`), writable outputs,
+the engine routes (`_engines`) and the models prepared for them (`_prepare`).
+
+May use: every room of the solver; the harness only inside `_engines`.
+"""
+from __future__ import annotations
+
+import argparse
+import errno
+import math
+import os
+import signal
+import sys
+import tempfile
+import time
+import warnings
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Callable, IO, Iterable, Iterator, Sequence
+
+from .._io import _sigint_deferred, atomic, is_stream
+from .._text import one_line, visible
+
+
+EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+
+
+TABLE_SUFFIXES = (".csv", ".parquet", ".json")
+
+
+class CLIError(Exception):
+    """A problem with the command's input or options: one message, exit code `code`. The message
+    is one line (its newlines and control characters written as "\\n" etc.: no forged
+    "kinetostat: error:" line from a name or a path), or the given `lines`, each made one line."""
+
+    def __init__(self, message: str = "", code: int = EXIT_USAGE, lines: Sequence[str] = ()):
+        self.lines = tuple(one_line(s) for s in (lines or [message]))
+        super().__init__("\n".join(self.lines))
+        self.code = code
+
+
+class _Out:
+    """stderr/stdout writers that do not break an active progress bar."""
+    bar = None
+
+    @classmethod
+    def write(cls, text: str, err: bool = False) -> None:
+        stream = sys.stderr if err else sys.stdout
+        text = visible(text)             # a name's ESC [2J or OSC 52 printed as text, never acted on
+        try:
+            if cls.bar is not None:
+                from tqdm import tqdm
+                tqdm.write(text, file=stream)
+            else:
+                print(text, file=stream)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:           # stdout on a full disk: one error line, not a traceback
+            raise CLIError(f"cannot write to {'stderr' if err else 'stdout'}: {exc.strerror or exc}") from None
+
+
+def _lines(lines: Iterable[str]) -> str:
+    """Lines for stdout, each made one line: a name's newline prints as "\\n", never a forged line."""
+    return "\n".join(map(one_line, lines))
+
+
+def _error(msg: str | CLIError) -> None:
+    """The error line (a CLIError's lines, each made one line already)."""
+    try:
+        _Out.write(f"kinetostat: error: {msg if isinstance(msg, CLIError) else one_line(msg)}", err=True)
+    except (CLIError, OSError):          # stderr itself cannot be written: the exit code says it
+        pass
+
+
+def _readable_streams() -> None:
+    """stdout and stderr write what their encoding cannot hold (a non-ASCII model name under
+    LC_ALL=C or PYTHONIOENCODING=latin-1, a non-UTF-8 file name) as backslash escapes."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):
+            pass
+
+
+def _quiet_stdout() -> None:
+    """After stdout failed (a closed pipe, a full disk): what is still buffered goes to
+    /dev/null, so that the interpreter's own flush at exit does not fail again."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (AttributeError, ValueError, OSError):
+        pass
+
+
+class _Interrupt:
+    """Ctrl-C while a command runs. The handler records it before it raises KeyboardInterrupt:
+    an interrupt that lands in a garbage-collection callback or a __del__ is swallowed there
+    ("Exception ignored in ..."), and the next `_checkpoint` raises it again."""
+    seen = False
+
+
+def _on_sigint(signum, frame) -> None:
+    _Interrupt.seen = True
+    raise KeyboardInterrupt
+
+
+def _checkpoint() -> None:
+    """Raise KeyboardInterrupt if Ctrl-C was pressed, also if its first raise was swallowed."""
+    if _Interrupt.seen:
+        raise KeyboardInterrupt
+
+
+@contextmanager
+def _interrupts() -> Iterator[None]:
+    """`_on_sigint` as the SIGINT handler while a command runs (main thread only), then the old one."""
+    _Interrupt.seen = False
+    try:
+        old = signal.signal(signal.SIGINT, _on_sigint)
+    except ValueError:                   # not the main thread: leave the handler as it is
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def _is_stdout(path: str | Path) -> bool:
+    """`path` is '-' or names this process's stdout (/dev/stdout, /proc/self/fd/1, the file it goes to)."""
+    if str(path) == "-":
+        return True
+    try:
+        return os.path.samestat(os.stat(path), os.fstat(sys.stdout.fileno()))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bool = False) -> None:
+    """`write(file)` into `path` atomically (`kinetostat._io.atomic`); '-' or stdout itself gets the
+    data through sys.stdout, a device or FIFO as a stream (never replaced by a file). A failure is
+    a CLIError naming `option`, and the old file stays as it was."""
+    if _is_stdout(path):
+        import io
+        buf = io.BytesIO() if binary else io.StringIO()
+        write(buf)
+        sys.stdout.flush()
+        (sys.stdout.buffer if binary else sys.stdout).write(buf.getvalue())
+        sys.stdout.flush()
+        return
+    try:
+        with atomic(path, binary=binary, stream=True) as f:
+            write(f)
+    except OSError as exc:
+        raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
+
+
+def _warn(msg: str) -> None:
+    _Out.write(f"kinetostat: warning: {one_line(msg)}", err=True)
+
+
+def _showwarning(message, category, filename, lineno, file=None, line=None):
+    text = str(message).splitlines()[0] if str(message) else category.__name__
+    _warn(text if issubclass(category, UserWarning) else f"{category.__name__}: {text}")
+
+
+class _NoBar:
+    def update(self, n: int = 1): ...
+    def set_postfix_str(self, s: str = ""): ...
+    def close(self): ...
+
+
+def _progress(total: int, desc: str, enabled: bool):
+    """A tqdm bar on stderr when stderr is a terminal (and tqdm is installed), else a no-op."""
+    if not enabled or not sys.stderr.isatty():
+        return _NoBar()
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return _NoBar()
+    bar = tqdm(total=total, desc=desc, unit="step", file=sys.stderr, delay=0.3, leave=False, dynamic_ncols=True)
+    _Out.bar = bar
+    return bar
+
+
+def _close(bar) -> None:
+    bar.close()
+    _Out.bar = None
+
+
+def _angle(text: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid crank angle {text!r}: expected a number of degrees, "
+                                         f"e.g. --at 0 30 45.5") from None
+    if not math.isfinite(x):
+        raise argparse.ArgumentTypeError(f"invalid crank angle {text!r}: expected a finite number of degrees")
+    return x
+
+
+def _turn(deg, option: str):
+    """Typed crank angle(s) (a float, a list, or None) in [0, 360): one outside is the same crank
+    position as the angle modulo 360 and is taken so, with a warning line naming it."""
+    if deg is None:
+        return None
+    many = isinstance(deg, list)
+    given = deg if many else [deg]
+    taken = [x % 360.0 if x % 360.0 != 360.0 else 0.0 for x in given]      # -1e-20 % 360 rounds to 360
+    moved = [f"{a:g} -> {b:g}" for a, b in zip(given, taken) if a != b]
+    if moved:
+        _warn(f"{option}: angles outside [0, 360) deg taken modulo 360 (the same crank position): {', '.join(moved)}")
+    return taken if many else taken[0]
+
+
+def _positive(what: str, example: str):
+    """An argparse type: a positive integer, or an error naming `what` with an example."""
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            n = 0
+        if n < 1:
+            raise argparse.ArgumentTypeError(f"invalid {what} {text!r}: expected a positive integer, e.g. {example}")
+        return n
+    return parse
+
+
+_steps = _positive("number of positions", "--steps 360")
+
+
+_jobs = _positive("number of jobs", "--jobs 4")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises CLIError (one line, exit 2) instead of printing usage and exiting."""
+
+    def error(self, message: str):
+        raise CLIError(f"{message} (see '{self.prog} --help')")
+
+
+def bundled_models() -> list[Path]:
+    from ..examples import models_dir
+    d = models_dir()
+    if not d.is_dir():
+        raise CLIError(f"no bundled models: {d} is not a directory "
+                       f"(give MODEL files, or set KINETOSTAT_MODELS to a directory of *.toml models)")
+    files = sorted(d.glob("*.toml"))
+    if not files:
+        raise CLIError(f"no bundled models: no *.toml file in {d} "
+                       f"(give MODEL files, or set KINETOSTAT_MODELS to a directory of *.toml models)")
+    return files
+
+
+def _model_error_lines(exc) -> list[str]:
+    """A ModelError as the CLI prints it: the file, then each problem led by its line."""
+    if len(exc.located) == 1:
+        return [f"{exc.source}: {exc.located[0]}"]
+    return [f"{exc.source}: {len(exc.located)} problems:"] + [f"  - {p}" for p in exc.located]
+
+
+def _load(path: str | Path):
+    """Load a model file, or a bundled model by name; every expected fault becomes a CLIError
+    naming the file."""
+    from ..errors import ModelError, StructureError
+    from ..examples import resolve
+    from ..model import load
+    p = resolve(path)
+    if not p.exists():
+        raise CLIError(f"model file not found: {p}")
+    if p.is_dir():
+        raise CLIError(f"model file expected, got a directory: {p}")
+    try:
+        return load(p)
+    except ModelError as exc:
+        raise CLIError(lines=_model_error_lines(exc)) from None
+    except StructureError as exc:
+        msg = str(exc)
+        raise CLIError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
+
+
+def _size(n: float) -> str:
+    """A number of bytes for people: "1.3 kB", "8.1 TB", "1.3e+23 bytes" beyond yottabytes."""
+    for unit in ("bytes", "kB", "MB", "GB", "TB", "PB", "EB", "ZB", "YB"):
+        if n < 999.5:
+            return f"{n:.3g} {unit}"
+        n /= 1000
+    return f"{n * 1e24:.3g} bytes"
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available now (Linux: MemAvailable; else free physical pages), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def _result_bytes(x, seen: set[int] | None = None) -> int:
+    """Bytes of the numpy arrays an analysis result holds (the mechanism itself not counted)."""
+    import numpy as np
+    from ..model import Mechanism
+    seen = set() if seen is None else seen
+    if id(x) in seen or isinstance(x, (Mechanism, str, bytes, int, float, type(None))):
+        return 0
+    seen.add(id(x))
+    if isinstance(x, np.ndarray):
+        return x.nbytes
+    if isinstance(x, dict):
+        return sum(_result_bytes(v, seen) for v in x.values())
+    if isinstance(x, (list, tuple)):
+        return sum(_result_bytes(v, seen) for v in x)
+    fields = getattr(x, "__dict__", None)
+    return sum(_result_bytes(v, seen) for v in fields.values()) if fields else 0
+
+
+#: `--steps` is refused where the result alone would need more than the memory available now.
+#: The bytes per crank position are measured on this many positions of the model.
+_SAMPLE_STEPS = 4
+
+
+def _check_memory(mech, steps: int) -> None:
+    """Refuse `steps` before anything is allocated where the result's arrays (measured per crank
+    position on a few positions of this model) would not fit in the memory available now."""
+    from ..solve import analyze
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            per_angle = _result_bytes(analyze(mech, steps=_SAMPLE_STEPS)) / _SAMPLE_STEPS
+        except Exception:                # noqa: BLE001 -- the real analysis reports the fault
+            return
+    need, free = steps * per_angle, _available_memory()
+    if free is not None and need > free:
+        raise CLIError(f"--steps {steps}: the result alone would need {_size(need)} of memory "
+                       f"({_size(per_angle)} per crank position for this model), and {_size(free)} is "
+                       f"available; use fewer steps (at most about {int(free // per_angle):,})")
+
+
+def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
+    """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each;
+    `steps` that would not fit in memory are refused before anything is allocated."""
+    from ..solve import analyze
+    from ..errors import AssemblyError, ModelError
+    if phi_deg is None:
+        _check_memory(mech, steps)
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            res = analyze(mech, phi_deg=phi_deg, steps=steps)
+        except AssemblyError as exc:
+            raise CLIError(f"{path}: {exc}") from None
+        except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
+            raise CLIError(lines=_model_error_lines(exc)) from None
+    seen = set()
+    for w in caught:
+        text = str(w.message).splitlines()[0]
+        if text not in seen:
+            seen.add(text)
+            _warn(f"{Path(path).name}: {text}")
+    return res, time.perf_counter() - t0
+
+
+def _writable_file(path: str, option: str) -> Path:
+    """Check that `path` can be written now (so that a long run does not fail at its end): its
+    folder takes a temporary file, and the name itself is one the file system can hold."""
+    p = Path(path)
+    if _is_stdout(p) or is_stream(p):    # written as a stream (`_save`)
+        if str(p) != "-" and not os.access(p, os.W_OK):
+            raise CLIError(f"cannot write {option} {p}: permission denied")
+        return p
+    try:
+        if p.is_dir():
+            raise CLIError(f"cannot write {option} {p}: it is a directory")
+        if len(os.fsencode(p.name)) > os.pathconf(p.parent, "PC_NAME_MAX"):
+            raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
+        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p.parent, prefix=".kinetostat-probe-"):
+            pass                         # Ctrl-C held back till the probe is gone: none left behind
+    except OSError as exc:
+        raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
+    return p
+
+
+def _writable_dir(path: str, option: str) -> Path:
+    p = Path(path)
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p, prefix=".kinetostat-probe-"):
+            pass
+    except OSError as exc:
+        raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
+    return p
+
+
+#: `--engines none`: no physics engine, only the 40-digit reference route (and the published values).
+NO_ENGINE = "none"
+
+
+def _engines(names: Sequence[str] | None) -> list[str]:
+    """The routes of `--engines` (default: every route); `none` alone means the reference route only."""
+    from kinetostat_validation.compare import ROUTES
+    if names is None:
+        return list(ROUTES)
+    if NO_ENGINE in names:
+        if len(names) > 1:
+            raise CLIError(f"--engines {NO_ENGINE} stands alone (it means no engine: the reference route and the "
+                           f"published values only), got {' '.join(names)}")
+        return ["reference"]
+    unknown = [n for n in names if n not in ROUTES]
+    if unknown:
+        hint = " (put MODEL files before --engines)" if any(n.endswith(".toml") for n in unknown) else ""
+        raise CLIError(f"unknown engine route(s) {', '.join(unknown)}{hint}. "
+                       f"Valid names: {', '.join(ROUTES)}, {NO_ENGINE}")
+    return list(dict.fromkeys(names))
+
+
+def _prepare(paths: Sequence[str | Path], steps: int):
+    """Load and analyse every model before any engine runs: input errors stop the command."""
+    jobs, problems = [], []
+    for path in paths:
+        try:
+            mech = _load(path)
+            res, secs = _analyze(mech, Path(path), steps=steps)
+        except CLIError as exc:
+            problems.append(exc)
+            continue
+        jobs.append((Path(path), mech, res, secs))
+    if problems:
+        for p in problems[:-1]:
+            _error(p)
+        raise CLIError(lines=problems[-1].lines + ((f"(nothing run: {len(problems)} of {len(paths)} models have "
+                                                    f"errors)",) if len(paths) > 1 else ()))
+    return jobs
+
+
+def _fmt(x: float, unit: str = "") -> str:
+    if not math.isfinite(x):
+        return "n/a"
+    return f"{x:.5g}{' ' + unit if unit else ''}"
+
+
+
+def _parquet_engine(option: str, instead: str) -> None:
+    """CLIError naming `option` where no Parquet engine (pyarrow, fastparquet) is installed."""
+    import importlib.util
+    if importlib.util.find_spec("pyarrow") is None and importlib.util.find_spec("fastparquet") is None:
+        raise CLIError(f"{option}: writing .parquet needs pyarrow (pip install 'kinetostat[sweep]' or pyarrow); "
+                       f"or write {instead}")

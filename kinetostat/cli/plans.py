@@ -1,0 +1,135 @@
+"""The teaching commands: `plans` (the SVG sheets of the graphical method) and `variant` (the task
+variants of Logvinenko, Nadtoka 2021 and their answer keys).
+
+May use: `.common`, the solver, `kinetostat.plans`, `kinetostat.variants`.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+import warnings
+from pathlib import Path
+
+from .._io import unit
+from .._text import one_line
+from .common import CLIError, EXIT_OK, _Out, _checkpoint, _close, _lines, _load, _progress, _turn, _warn, _writable_dir
+
+
+def _scale_item(text: str) -> tuple[str, float]:
+    from ..plans.scales import SCALE_UNITS
+    key, eq, value = text.partition("=")
+    if not eq or key not in SCALE_UNITS:
+        raise argparse.ArgumentTypeError(f"invalid --scale {text!r}: expected KEY=VALUE with KEY one of "
+                                         f"{', '.join(SCALE_UNITS)}, e.g. --scale mu_l=0.001 mu_v=0.2")
+    try:
+        x = float(value)
+    except ValueError:
+        x = math.nan
+    if not (math.isfinite(x) and x >= sys.float_info.min):      # a subnormal scale divides to inf
+        raise argparse.ArgumentTypeError(f"invalid --scale {text!r}: {key} must be a positive number "
+                                         f"in {SCALE_UNITS[key]} (at least {sys.float_info.min:.3g})")
+    return key, x
+
+
+def _plan_names(text: str) -> list[str]:
+    from ..plans import BUILDERS
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    valid = [n for n, _ in BUILDERS]
+    bad = [n for n in names if n not in valid]
+    if bad or not names:
+        raise argparse.ArgumentTypeError(f"invalid --only {text!r}: expected plan names from {', '.join(valid)}, "
+                                         f"comma-separated")
+    return names
+
+
+def cmd_plans(args) -> int:
+    import numpy as np
+    from ..errors import SingularPositionWarning
+    from ..plans import build
+    from ..plans.worksheet import worksheet
+    from ..plans.lettering import lettering
+    from ..plans.scales import ScaleError
+    path = Path(args.model)
+    mech = _load(path)
+    args.lang = args.lang or lettering(mech).language or "en"
+    out = _writable_dir(args.out, "--out")
+    only = [n for group in (args.only or []) for n in group] or None
+    args.at, args.starting = _turn(args.at, "--at"), _turn(args.starting, "--starting")
+    try:
+        with warnings.catch_warnings(record=True) as caught:     # the accuracy at this angle: said below
+            warnings.simplefilter("always")
+            plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
+            sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
+    except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
+        raise CLIError(f"--scale {exc}") from None
+    except ValueError as exc:
+        raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
+    try:
+        with unit(out) as tmp:                # swapped in as a set: never new sheets beside an old worksheet
+            written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])
+    except (OSError, ValueError) as exc:
+        raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
+    at_plan = [w for w in caught if issubclass(w.category, SingularPositionWarning)
+               and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
+    for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
+        _warn(f"{path.name}: {text}")
+    _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))
+    return EXIT_OK
+
+
+def cmd_variant(args) -> int:
+    from .. import variants
+    from ..errors import AssemblyError, ModelError
+    try:
+        tasks = list(variants.TASKS) if args.task is None else [variants.check_task(args.task, "TASK")]
+        if args.all and args.code is not None:
+            raise CLIError(f"CODE {args.code!r}: not with --all (--all writes every code of the task)")
+        if not args.all:
+            if args.task is None or args.code is None:
+                raise CLIError("TASK and CODE are required (e.g. 'kinetostat variant 1 479'), or --all")
+            jobs = [variants.variant(tasks[0], variants.check_code(args.code, tasks[0], "CODE"))]
+        else:
+            jobs = [(t, c) for t in tasks for c in variants.codes()]
+    except ValueError as exc:
+        raise CLIError(f"{exc} (see 'kinetostat variant --help')") from None
+    args.lang = args.lang or "uk"                   # seed 002's language (its models' [lettering])
+    import importlib.util
+    teacher_pack = not args.no_pack and importlib.util.find_spec("matplotlib") is not None
+    if not (args.no_pack or teacher_pack):          # a plain install: the keys, and a word on the pack
+        _Out.write("no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf): its PDFs need matplotlib: "
+                   "pip install 'kinetostat[reports]'", err=True)
+    default = "task_variants" if args.all else jobs[0].name
+    out = _writable_dir(args.out or default, "--out")
+    t0 = time.perf_counter()
+    keys = []
+    bar = _progress(len(jobs), "variants", args.all and not args.no_progress)
+    try:
+        for job in jobs:
+            _checkpoint()
+            v = job if not args.all else variants.variant(*job)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:
+                    keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
+                                                   cycle_csv=not args.all, root=out, teacher_pack=teacher_pack))
+                except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
+                    raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
+                except OSError as exc:
+                    raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
+            bar.update()
+        if args.all:
+            try:
+                index = variants.write_index(out, keys, args.lang)
+            except OSError as exc:
+                raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
+    finally:
+        _close(bar)
+    if args.all:
+        _Out.write(one_line(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
+                            f"index -> {index}; {time.perf_counter() - t0:.1f} s"))
+        return EXIT_OK
+    lines = variants.summary(jobs[0], keys[0], out, args.lang)
+    _Out.write(_lines(lines))
+    return EXIT_OK

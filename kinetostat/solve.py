@@ -1,0 +1,27 @@
+"""`analyze(mech, phi_deg)`: the whole kinetostatic analysis, by the path that suits the work: the
+numpy path (`analysis.exact`) below `fast.FAST_MIN` angles, the compiled kernel (`fast`) from them on.
+
+May use: model, analysis, fast.
+"""
+from __future__ import annotations
+
+from . import fast
+from .analysis import Analysis, crank_angles, exact
+from .model import Mechanism
+
+__all__ = ["analyze"]
+
+
+def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
+    """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
+    or at `steps` equal steps over a full revolution when `phi_deg` is None.
+
+    From fast.FAST_MIN angles on it runs the compiled kernel (`fast.analyze_fast`), below them
+    the numpy path (`exact`): the same results to rounding (tests/test_fast.py)."""
+    if not isinstance(mech, Mechanism):
+        raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
+                        f"read a model file with kinetostat.load(path)")
+    phi_deg = crank_angles(phi_deg, steps)
+    if len(phi_deg) >= fast.FAST_MIN and fast.available():
+        return fast.analyze_fast(mech, phi_deg)
+    return exact(mech, phi_deg)

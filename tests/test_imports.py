@@ -1,0 +1,169 @@
+"""The house's imports against its map: no module of the package or of the harness imports,
+directly or through others, a module that imports it back (module-level and function-level
+imports alike, relative and absolute, type-checking ones too), and no room imports a room of a
+higher layer or one its line in the README's "How it works" does not name. The layers and the
+rooms are read from the README (one source of truth), so the map stays true."""
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+
+PACKAGES = {"kinetostat": ROOT / "kinetostat", "kinetostat_validation": ROOT / "validation"}
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+HARNESS_USERS = {"report", "cli"}        # the only rooms that may import the harness (README)
+
+
+def _modules() -> dict[str, tuple[Path, bool]]:
+    """Every module of the package and of the harness: dotted name -> (file, is a package)."""
+    mods = {}
+    for top, folder in PACKAGES.items():
+        for path in sorted(folder.rglob("*.py")):
+            parts = [top, *path.relative_to(folder).with_suffix("").parts]
+            package = parts[-1] == "__init__"
+            mods[".".join(parts[:-1] if package else parts)] = (path, package)
+    return mods
+
+
+MODULES = _modules()
+
+
+def _target(name: str) -> str | None:
+    """The module that an imported dotted name lives in (a name imported from a module: that module)."""
+    while name and name not in MODULES:
+        name = name.rpartition(".")[0]
+    return name or None
+
+
+def _imports(module: str) -> dict[str, int]:
+    """The modules `module` imports anywhere in its source (-> the line of the first import)."""
+    path, package = MODULES[module]
+    here = module if package else module.rpartition(".")[0]
+    out: dict[str, int] = {}
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = here.split(".")[: len(here.split(".")) - node.level + 1]
+                origin = ".".join(base + ([node.module] if node.module else []))
+            else:
+                origin = node.module or ""
+            names = [f"{origin}.{a.name}" if f"{origin}.{a.name}" in MODULES else origin for a in node.names]
+        else:
+            continue
+        for name in names:
+            target = _target(name)
+            if target and target != module:
+                out.setdefault(target, node.lineno)
+    return out
+
+
+GRAPH = {m: _imports(m) for m in MODULES}
+
+
+def _cycle() -> list[str] | None:
+    """One import circle of GRAPH (its modules in order, the first repeated at the end), or None."""
+    state: dict[str, int] = {}            # 1 on the current path, 2 done
+    path: list[str] = []
+
+    def visit(m: str) -> list[str] | None:
+        state[m] = 1
+        path.append(m)
+        for t in sorted(GRAPH[m]):
+            if state.get(t) == 1:
+                return path[path.index(t):] + [t]
+            if t not in state and (found := visit(t)):
+                return found
+        path.pop()
+        state[m] = 2
+        return None
+    for m in sorted(GRAPH):
+        if m not in state and (found := visit(m)):
+            return found
+    return None
+
+
+def _room(module: str) -> str:
+    """The README's name of the room a package module belongs to: `plans` for kinetostat.plans.draw,
+    `__init__` for the package itself."""
+    parts = module.split(".")
+    return "__init__" if len(parts) == 1 else parts[1]
+
+
+def _layers() -> dict[str, int]:
+    """room -> its layer (0 the lowest), from the README's picture of the layers."""
+    block = re.search(r"<!-- layers:.*?-->\n```text\n(.*?)\n```", README, flags=re.S)
+    assert block, "README: the picture of the layers (<!-- layers: ... --> and a text block) is missing"
+    rows = block.group(1).splitlines()[::-1]
+    layer = {}
+    for n, row in enumerate(rows):
+        rooms = re.split(r"\s{2,}", row.strip())[1]
+        for room in rooms.split(", "):
+            assert room not in layer, f"README: room {room} stands in two layers"
+            layer[room] = n
+    return layer
+
+
+def _uses() -> dict[str, set[str]]:
+    """room -> the rooms its line in the README's list says it uses."""
+    out = {}
+    for name, text in re.findall(r"^- `([\w]+)/?` — (.*?)(?=^- `|^\n)", README, flags=re.S | re.M):
+        said = re.search(r"Uses: (.*?)\.\s*$", " ".join(text.split()))
+        if said:
+            out[name] = set() if said.group(1) == "none" else set(said.group(1).split(", "))
+    return out
+
+
+LAYERS = _layers()
+USES = _uses()
+PACKAGE_MODULES = sorted(m for m in MODULES if m.split(".")[0] == "kinetostat")
+
+
+def test_no_import_circles():
+    cycle = _cycle()
+    assert cycle is None, "import circle: " + " -> ".join(
+        f"{a} (line {GRAPH[a][b]})" for a, b in zip(cycle, cycle[1:])) + f" -> {cycle[-1]}"
+
+
+def test_the_walk_sees_relative_absolute_and_deferred_imports():
+    # the circles this test was written against, each kind of import once: they must be seen
+    assert "kinetostat.program" in GRAPH["kinetostat.kinematics"]              # from .program import
+    assert "kinetostat.solve" in GRAPH["kinetostat.plans.kinematic"]           # inside a function, ..solve
+    assert "kinetostat.plans.worksheet" in GRAPH["kinetostat.cli.analyze"]     # deferred, ..plans.worksheet
+    assert "kinetostat.units" in GRAPH["kinetostat.report.writer"]             # from .. import units
+    assert "kinetostat.analysis" in GRAPH["kinetostat_validation.stability"]   # absolute
+    GRAPH["kinetostat.analysis"]["kinetostat.solve"] = 0                       # a circle, made up
+    try:
+        cycle = _cycle()
+        assert cycle[0] == cycle[-1] and set(cycle) == {"kinetostat.analysis", "kinetostat.solve"}
+    finally:
+        del GRAPH["kinetostat.analysis"]["kinetostat.solve"]
+
+
+@pytest.mark.parametrize("module", PACKAGE_MODULES)
+def test_a_room_uses_only_its_layer_and_those_below_and_what_its_line_names(module):
+    room = _room(module)
+    assert room in LAYERS, f"{module}: room {room} is on no layer of the README's picture (How it works)"
+    assert room in USES, f"{module}: room {room} has no line with 'Uses: ...' in the README's list (How it works)"
+    for target, line in GRAPH[module].items():
+        if target.split(".")[0] != "kinetostat":
+            assert room in HARNESS_USERS, f"{module}, line {line}: imports the harness {target}"
+            continue
+        other = _room(target)
+        if other == room:
+            continue
+        assert LAYERS[other] <= LAYERS[room], (f"{module}, line {line}: imports {target}, of the layer above "
+                                               f"(README: {other} stands above {room})")
+        assert other in USES[room], f"{module}, line {line}: imports {target}; the README's line of {room} does not name {other}"
+
+
+def test_the_map_names_only_rooms_that_exist():
+    rooms = {_room(m) for m in PACKAGE_MODULES}
+    assert set(LAYERS) == rooms, (set(LAYERS) - rooms, rooms - set(LAYERS))
+    assert set(USES) == rooms, (set(USES) - rooms, rooms - set(USES))
+    assert all(used <= rooms for used in USES.values())
