@@ -953,6 +953,11 @@ def cmd_plans(args) -> int:
 
 # ============================================================================ examples
 
+def cmd_schema(args) -> int:
+    from .model.describe import print_schema
+    return print_schema(sys.stdout)
+
+
 def cmd_examples(args) -> int:
     from . import examples
     if args.force and args.copy is None:
@@ -1285,6 +1290,12 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--copy", metavar="DIR", help="copy every bundled model and FORMAT.md into DIR (created)")
     e.add_argument("--force", action="store_true", help="with --copy: replace files already in DIR")
     e.set_defaults(func=cmd_examples)
+
+    sc = sub.add_parser("schema", help="print the JSON Schema of the model format, for TOML editors",
+                        description="Print the JSON Schema (draft-07) of the model file format. A model file that "
+                                    "names it in its first line (#:schema ./model.schema.json) is completed and "
+                                    "checked as it is typed by TOML editors (Even Better TOML, taplo).")
+    sc.set_defaults(func=cmd_schema)
 
     va = sub.add_parser("variant", help="the task variants of Logvinenko, Nadtoka 2021 (tables 1.1-1.3): the model and its answer key",
                         description="Build the model of task TASK of Logvinenko, Nadtoka 2021 (1: ICE crank-slider, table 1.1; 2: "
