@@ -2,7 +2,7 @@
 contradiction is an error), and what loads but looks like a mistake (a ModelWarning). Each is
 a function yielding its messages; the reader records them.
 
-May use: the standard library, limits, mechanism.
+May use: the standard library, limits, parts, mechanism.
 """
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ from types import MappingProxyType
 from typing import Iterator, Mapping
 
 from .limits import FASTEST_PIN, FORCE_SCALE, GYRATION_SPANS, LARGEST_LINK
-from .mechanism import Friction, Link, Mechanism, Pair, Vec, _span
+from .mechanism import Mechanism, _span
+from .parts import Friction, Link, Pair, Vec
 
 
 def check_pairs(links: list[Link], pairs: list[Pair], coincident: Mapping[int, str],

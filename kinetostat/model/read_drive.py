@@ -1,7 +1,7 @@
 """The reader's section for the drive: the crank, its speed or law of motion, the gear mesh of
 a working machine.
 
-May use: the standard library, numpy, limits, laws, mechanism, schema.
+May use: the standard library, numpy, limits, laws, parts, mechanism, schema.
 """
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ import numpy as np
 
 from .laws import _mentions_phi
 from .limits import MAX_SHOWN, MAX_VALUE, MIN_GEAR
-from .mechanism import Drive, Gear, Link, Pair, SpeedLaw, _span
+from .mechanism import _span
+from .parts import Drive, Gear, Link, Pair, SpeedLaw
 from .schema import DRIVE, GEAR, OMEGA_TABLE
 
 

@@ -1,7 +1,7 @@
 """The reader's sections for the mechanism's body: the links (and their bodies), the pairs, the
 groups' branches.
 
-May use: the standard library, limits, mechanism, schema, checks.
+May use: the standard library, limits, parts, mechanism, schema, checks, core (its name suggestions).
 """
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ from typing import Mapping
 from .checks import check_pairs, turned_slider
 from .core import _suggest
 from .limits import MAX_VALUE, MIN_LENGTH
-from .mechanism import Body, Link, Pair, Vec, _span, combine
+from .mechanism import _span
+from .parts import Body, Link, Pair, Vec, combine
 from .schema import BODY, GROUP, LINK, PAIR
 
 

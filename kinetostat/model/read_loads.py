@@ -1,7 +1,7 @@
 """The reader's sections for what acts on the mechanism: loads (forces, moments, dampers, their
 diagrams and characteristics), springs, friction.
 
-May use: the standard library, numpy, limits, mechanism, schema.
+May use: the standard library, numpy, limits, parts, schema.
 """
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .limits import MAX_SHOWN
-from .mechanism import Characteristic, Friction, Link, Load, Pair, Spring, Table
+from .parts import Characteristic, Friction, Link, Load, Pair, Spring, Table
 from .schema import CHARACTERISTIC, FRICTION, LOAD, LOAD_TABLE, SPRING
 
 

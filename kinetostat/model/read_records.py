@@ -1,7 +1,7 @@
 """The reader's sections for what the model records beside the mechanism: the sources' published
 values, a parameter study, the text's lettering.
 
-May use: the standard library, limits, mechanism, schema.
+May use: the standard library, limits, parts, schema, core (its name suggestions).
 """
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Any, Mapping
 
 from .core import _suggest
 from .limits import MAX_PUBLISHED_ANGLES, MAX_STUDY_VALUES, MAX_VALUE, _finite
-from .mechanism import PUBLISHED_UNITS, Drive, Link, Load, Pair, Published, Study
+from .parts import PUBLISHED_UNITS, Drive, Link, Load, Pair, Published, Study
 from .schema import LETTERING, PUBLISHED, REQUIRED, STUDY
 
 

@@ -17,11 +17,12 @@ from .mechanism import Mechanism
 from .read_drive import DriveReading
 from .read_links import LinkReading
 from .read_loads import LoadReading
+from .read_parameters import ParameterReading
 from .read_records import RecordReading
 from .schema import MECHANISM, MODEL
 
 
-class _Reader(ReaderCore, LinkReading, DriveReading, LoadReading, RecordReading):
+class _Reader(ReaderCore, ParameterReading, LinkReading, DriveReading, LoadReading, RecordReading):
     """Reads the raw TOML structure, collecting every problem instead of stopping at the first."""
 
     def mechanism(self) -> Mechanism:

@@ -10,7 +10,7 @@ A small table of our own rather than pydantic or msgspec: the reader keeps its o
 (field paths such as `link[id=2].mass`, the file's line, "did you mean", every problem at once,
 no follow-on errors), which those libraries would have to be bent to give; the table is data.
 
-May use: the standard library, limits, mechanism (PUBLISHED_UNITS).
+May use: the standard library, limits, parts (PUBLISHED_UNITS).
 """
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 from .limits import MAX_NAME, MAX_PARAMETERS, MAX_POINTS, MAX_PUBLISHED_ANGLES
-from .mechanism import PUBLISHED_UNITS
+from .parts import PUBLISHED_UNITS
 
 #: The default of a field that must be given.
 REQUIRED = "required"
