@@ -100,3 +100,27 @@ def test_cli_schema_prints_the_shipped_schema(cli):
     r = cli("schema")
     assert r.returncode == 0 and r.stderr == "" and r.stdout == describe.SCHEMA_FILE.read_text(encoding="utf-8")
     assert "model file format" in cli("schema", "--help").stdout
+
+
+def test_a_spring_end_refuses_an_unknown_key(validate):
+    """A spring's end { link, point } is a table of the schema like any other: a near miss is
+    named, by the reader and by the JSON Schema (before, the reader ignored it)."""
+    text = four_bar(append='\n[[spring]]\na = { link = 0, point = "O" }\nb = { link = 2, ponit = "B" }\n'
+                           'stiffness = 500.0\nfree_length = 0.1\n')
+    with pytest.raises(ModelError) as e:
+        kinetostat.loads(text)
+    assert e.value.problems == ["spring[0].b.ponit: unknown field (did you mean 'point'?). Valid fields: ['link', 'point']"]
+    with pytest.raises(fastjsonschema.JsonSchemaValueException) as j:
+        validate(tomllib.loads(text))
+    assert _reader_path(tomllib.loads(text), j.value) in ("spring[0].b.ponit", "spring[0].b.point")
+
+
+def test_a_missing_point_name_is_missing_and_not_reported_after_its_misspelling():
+    """A point name not given reads "missing", and not at all after the misspelt key it follows
+    from (before: "link 1 has no point None" beside the unknown field)."""
+    with pytest.raises(ModelError) as e:
+        kinetostat.loads(four_bar(('point = "A"', 'pont = "A"')))
+    assert [p.partition(":")[0] for p in e.value.problems] == ["drive.pont"]
+    with pytest.raises(ModelError) as e:
+        kinetostat.loads(four_bar(('point = "A"\n', '')))
+    assert "drive.point: missing (a point of link 1 is required). Valid names: ['A', 'O', 'S1']" in e.value.problems

@@ -202,7 +202,10 @@ class ReaderCore:
 
     def point_ok(self, links: list[Link], lid: int, name: Any, where: str, why: str = "") -> bool:
         if not isinstance(name, str) or name not in links[lid].points:
-            if (lid, None) not in self.points_unread and (lid, name) not in self.points_unread:
+            if name is None:            # (after a misspelt key, err leaves this out)
+                self.err(f"{where}: missing (a point of link {lid} is required){why}. "
+                         f"Valid names: {sorted(links[lid].points)}")
+            elif (lid, None) not in self.points_unread and (lid, name) not in self.points_unread:
                 self.err(f"{where}: link {lid} has no point {name!r}{_suggest(name, links[lid].points)}{why}. "
                          f"Valid names: {sorted(links[lid].points)}")
             return False

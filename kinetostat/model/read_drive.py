@@ -148,8 +148,8 @@ class DriveReading:
         module = self.read(GEAR, t, "module", w)
         z1, z2 = self.read(GEAR, t, "z_pinion", w), self.read(GEAR, t, "z_wheel", w)
         for key, z in (("z_pinion", z1), ("z_wheel", z2)):
-            if z is not None and z < 5:
-                self.err(f"{w}.{key}: a gear needs at least 5 teeth, got {z}")
+            if z is not None and z < GEAR[key].minimum:
+                self.err(f"{w}.{key}: a gear needs at least {GEAR[key].minimum} teeth, got {z}")
         corr = self.read(GEAR, t, "correction", w)
         if corr == "unequal" and "alpha_w_deg" not in t:
             self.err(f"{w}.alpha_w_deg: required for an unequal correction (25-26 deg typically)")

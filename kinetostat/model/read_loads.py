@@ -11,7 +11,7 @@ import numpy as np
 
 from .limits import MAX_SHOWN
 from .parts import Characteristic, Friction, Link, Load, Pair, Spring, Table
-from .schema import CHARACTERISTIC, FRICTION, LOAD, LOAD_TABLE, SPRING
+from .schema import CHARACTERISTIC, FRICTION, LOAD, LOAD_TABLE, SPRING, SPRING_END
 
 
 class LoadReading:
@@ -167,6 +167,7 @@ class LoadReading:
                 if not isinstance(end, dict):
                     self.err(f"{where}.{e}: expected {{ link = i, point = 'P' }}")
                     continue
+                self.unknown_keys(end, SPRING_END.keys(), f"{where}.{e}")
                 if self.link_ok(links, end.get("link"), f"{where}.{e}.link") and \
                         self.point_ok(links, end["link"], end.get("point"), f"{where}.{e}.point"):
                     ends.append((end["link"], end["point"]))

@@ -135,9 +135,10 @@ class RecordReading:
             self.err(f"study.pair: expected [i, j] of a kinematic pair (R(i, j), force of link i on link j), "
                      f"got {pair!r:.60}. Pairs: {[list(p.links) for p in pairs]}")
             return None
-        steps = t.get("steps", 36)
-        if not (isinstance(steps, int) and not isinstance(steps, bool) and 1 <= steps <= 3600):
-            self.err(f"study.steps: expected an integer 1..3600 (crank angles per cycle), got {steps!r}")
+        f = STUDY["steps"]
+        steps = t.get("steps", f.default)
+        if not (isinstance(steps, int) and not isinstance(steps, bool) and f.minimum <= steps <= f.maximum):
+            self.err(f"study.steps: expected an integer {f.minimum}..{f.maximum} (crank angles per cycle), got {steps!r}")
             return None
         if not isinstance(v, dict) or len(vary) != len(v):
             return None
@@ -153,8 +154,9 @@ class RecordReading:
         out: dict[str, Any] = {}
         if "frame" in t:
             k = t["frame"]
-            if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k <= 99 or (k and k < len(links)):
-                self.err(f"lettering.frame: expected the frame's number 0..99, not a moving link's "
+            f = LETTERING["frame"]
+            if not isinstance(k, int) or isinstance(k, bool) or not f.minimum <= k <= f.maximum or (k and k < len(links)):
+                self.err(f"lettering.frame: expected the frame's number {f.minimum}..{f.maximum}, not a moving link's "
                          f"(1..{len(links) - 1}), got {k!r}")
             else:
                 out["frame"] = k

@@ -76,8 +76,8 @@ def _name(doc: str, default: str) -> Field:
 
 GEAR = Section("drive.gear", "The last gear pair of a working machine (drive.kind = \"machine\"; Kiriienko 2019, sec. 7.1).", (
     _num("module", "module of the gear pair", "m", default=REQUIRED, positive=True),
-    Field("z_pinion", "integer", "teeth of the driving pinion (at least 5)", default=REQUIRED, minimum=5, expression=True),
-    Field("z_wheel", "integer", "teeth of the wheel on the crank shaft (at least 5)", default=REQUIRED, minimum=5, expression=True),
+    Field("z_pinion", "integer", "teeth of the driving pinion", default=REQUIRED, minimum=5, expression=True),
+    Field("z_wheel", "integer", "teeth of the wheel on the crank shaft", default=REQUIRED, minimum=5, expression=True),
     Field("correction", "string", "profile correction; \"unequal\" needs alpha_w_deg and y", default="none",
           choices=("none", "equal", "unequal")),
     _num("alpha_w_deg", "pressure angle of the mesh, below 45 deg", "deg", default=20.0, positive=True),
