@@ -56,8 +56,11 @@ class Section:
     fields: tuple[Field, ...]
     array: bool = False
 
+    def __post_init__(self):
+        object.__setattr__(self, "_by_name", {f.name: f for f in self.fields})
+
     def __getitem__(self, key: str) -> Field:
-        return next(f for f in self.fields if f.name == key)
+        return self._by_name[key]
 
     def keys(self, **given: Any) -> set[str]:
         """Names of the fields this table may hold, given the values of its discriminating fields
