@@ -72,13 +72,13 @@ def test_the_readmes_python_runs_in_a_fresh_interpreter():
 
 def _shell_commands() -> list[list[str]]:
     """Every command line of the README's bash blocks and inline spans that runs kinetostat or
-    `python -m`: comments dropped, `.venv/bin/` and `&&` chains split."""
+    `python -m`: comments and output redirections (`> FILE`) dropped, `.venv/bin/` and `&&` chains split."""
     lines = [ln.split("  #")[0].split(" # ")[0] for b in _blocks("bash") for ln in b.splitlines()]
     lines += [s for s in _inline() if s.startswith(("kinetostat ", "python -m "))]
     out = []
     for line in lines:
         for part in line.split("&&"):
-            words = shlex.split(part.replace(".venv/bin/", ""))
+            words = shlex.split(part.replace(".venv/bin/", "").split(" > ")[0])
             if words and words[0] in ("kinetostat", "python", "python3"):
                 out.append(words)
     return out

@@ -1,11 +1,13 @@
 """The commands on one model: `analyze` (summary, worksheet, full table), `structure`, `export`
-(MJCF, URDF), and `examples` (the bundled models listed or copied).
+(MJCF, URDF), `examples` (the bundled models listed or copied) and `schema` (the JSON Schema of
+the model format).
 
 May use: `.common`, the solver, `kinetostat.plans.worksheet`; the harness inside `cmd_export`.
 """
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 from .._text import one_line
@@ -155,6 +157,11 @@ def cmd_export(args) -> int:
     _save(args.output, "-o", lambda f: f.write(text))
     _Out.write(one_line(f"{args.format.upper()} of {path.name} -> {args.output}"))
     return EXIT_OK
+
+
+def cmd_schema(args) -> int:
+    from ..model.describe import print_schema
+    return print_schema(sys.stdout)
 
 
 def cmd_examples(args) -> int:

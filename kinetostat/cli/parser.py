@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import argparse
 
-from .analyze import cmd_analyze, cmd_examples, cmd_export, cmd_structure
+from .analyze import cmd_analyze, cmd_examples, cmd_export, cmd_schema, cmd_structure
 from .common import _Parser, _angle, _jobs, _positive, _steps
 from .plans import _plan_names, _scale_item, cmd_plans, cmd_variant
 from .report import cmd_report
@@ -149,6 +149,12 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--copy", metavar="DIR", help="copy every bundled model and FORMAT.md into DIR (created)")
     e.add_argument("--force", action="store_true", help="with --copy: replace files already in DIR")
     e.set_defaults(func=cmd_examples)
+
+    sc = sub.add_parser("schema", help="print the JSON Schema of the model format, for TOML editors",
+                        description="Print the JSON Schema (draft-07) of the model file format. A model file that "
+                                    "names it in its first line (#:schema ./model.schema.json) is completed and "
+                                    "checked as it is typed by TOML editors (Even Better TOML, taplo).")
+    sc.set_defaults(func=cmd_schema)
 
     va = sub.add_parser("variant", help="the task variants of Logvinenko, Nadtoka 2021 (tables 1.1-1.3): the model and its answer key",
                         description="Build the model of task TASK of Logvinenko, Nadtoka 2021 (1: ICE crank-slider, table 1.1; 2: "

@@ -1,0 +1,26 @@
+"""The mechanism model: a model file (TOML), described once by `schema`, read and checked by
+`reader` into the immutable `Mechanism` of `mechanism`.
+
+Rooms: parts (the frozen parts a Mechanism is made of), mechanism (the Mechanism), laws
+(splines, parsed expressions of laws), limits (sizes, ranges, thresholds), schema (every table
+and field of the format), describe (the schema as JSON Schema and as the field tables of
+models/FORMAT.md), source (file -> text -> data), lines (where keys sit), core (the reader's
+machinery), read_* (its sections), checks (the cross-field checks and plausibility warnings),
+reader (the sections put together).
+
+May use: its rooms.
+"""
+from __future__ import annotations
+
+from .core import _suggest
+from .laws import _periodic_spline, _spline_at
+from .limits import (FASTEST_PIN, LAW_VARIABLES, MAX_FILE_BYTES, MAX_NAME, MAX_PARAMETERS, MAX_POINTS,
+                     MAX_PROBLEMS, MAX_VALUE)
+from .lines import _Lines
+from .mechanism import Mechanism, _abbreviate
+from .parts import (PUBLISHED_UNITS, Body, Characteristic, Drive, Friction, Gear, Link, Load, Pair, Published, SpeedLaw,
+                    Spring, Study, Table, combine)
+from .source import _read_text, from_dict, load, loads
+
+__all__ = ["Link", "Body", "Pair", "Table", "Load", "Characteristic", "SpeedLaw", "combine", "Spring", "Gear", "Drive",
+           "Friction", "Published", "Study", "Mechanism", "PUBLISHED_UNITS", "load", "loads", "from_dict"]

@@ -1,0 +1,207 @@
+"""The schema of the model format (`schema`) told to people and to editors: the JSON Schema
+(draft-07, which Even Better TOML / taplo reads) shipped as `model.schema.json`, and the field
+tables of models/FORMAT.md. Both are generated from the one table; tests fail when they are stale.
+
+    python -m kinetostat.model.describe              # print the JSON Schema
+    python -m kinetostat.model.describe --write      # rewrite model.schema.json and FORMAT.md's tables
+
+May use: the standard library, limits, schema.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any, TextIO
+
+from .limits import MAX_STUDY_VALUES, MAX_VALUE
+from .schema import MODEL, REQUIRED, Field, Section, sections
+
+#: The JSON Schema shipped in the wheel (package data), as `json_schema()` writes it.
+SCHEMA_FILE = Path(__file__).with_name("model.schema.json")
+#: The file format's reference, whose field tables sit between these markers.
+FORMAT_MD = Path(__file__).resolve().parents[2] / "models" / "FORMAT.md"
+BEGIN, END = "<!-- fields: begin (generated from kinetostat/model/schema.py; do not edit) -->", "<!-- fields: end -->"
+
+_EXPRESSION = {"type": "string", "description": "an expression over [parameters], e.g. \"3.05 * l_OA\""}
+
+
+def json_schema() -> dict:
+    """The JSON Schema (draft-07) of a model file read as TOML: every table and field, with its
+    title and description (what editors show), type, range, default and allowed keys."""
+    out = {"$schema": "http://json-schema.org/draft-07/schema#", "$id": "urn:kinetostat:model-format",
+           "title": "kinetostat model", **_section(MODEL)}
+    out["definitions"] = {s.name: _section(s) for s in sections()[1:]}
+    return out
+
+
+def _section(s: Section) -> dict:
+    out: dict[str, Any] = {"type": "object", "description": s.doc,
+                           "properties": {f.name: _field(f) for f in s.fields}, "additionalProperties": False}
+    required = [f.name for f in s.fields if f.default == REQUIRED and f.when is None]
+    if required:
+        out["required"] = required
+    conditions = []
+    for f in s.fields:
+        if f.when is not None:
+            key, values = f.when
+            test: dict[str, Any] = {"properties": {key: {"enum": list(values)}}}
+            if s[key].default not in values:
+                test["required"] = [key]
+            conditions.append({"if": test, "else": {"properties": {f.name: False}},
+                               **({"then": {"required": [f.name]}} if f.default == REQUIRED else {})})
+    if conditions:
+        out["allOf"] = conditions
+    return out
+
+
+def _number(f: Field, integer: bool = False) -> dict:
+    out: dict[str, Any] = {"type": "integer" if integer else "number"}
+    if f.choices:
+        out["enum"] = list(f.choices)
+    if f.positive:
+        out["exclusiveMinimum"] = 0
+    out["minimum"] = f.minimum if f.minimum is not None else -MAX_VALUE
+    out["maximum"] = f.maximum if f.maximum is not None else MAX_VALUE
+    return {"anyOf": [out, _EXPRESSION]} if f.expression else out
+
+
+def _field(f: Field) -> dict:
+    number = {"anyOf": [{"type": "number", "minimum": -MAX_VALUE, "maximum": MAX_VALUE}, _EXPRESSION]}
+    vector = {"type": "array", "items": number, "minItems": 2, "maxItems": 2}
+    link = {"type": "integer", "minimum": f.minimum or 0}
+    if f.maximum is not None:
+        link["maximum"] = f.maximum
+    kinds: dict[str, Any] = {
+        "number": lambda: _number(f), "integer": lambda: _number(f, integer=True),
+        "string": lambda: {"type": "string", **({"enum": list(f.choices)} if f.choices else {}),
+                           **({"maxLength": f.max_length} if f.max_length else {})},
+        "strings": lambda: {"type": "array", "items": {"type": "string"}},
+        "vector": lambda: vector, "direction": lambda: vector,
+        "series": lambda: {"type": "array", "items": number, "minItems": 2},
+        "points": lambda: {"type": "object", "additionalProperties": vector, "minProperties": 1,
+                           "maxProperties": f.max_length},
+        "point": lambda: {"type": "string"},
+        "link": lambda: link,
+        "links": lambda: {"type": "array", "items": {"type": "integer", "minimum": 0}, "minItems": 2, "maxItems": 2},
+        "angles": lambda: {"anyOf": [number, {"type": "array", "items": number, "minItems": 1,
+                                              "maxItems": f.max_length}]},
+        "com": lambda: {"anyOf": [{"type": "string", "description": "a point of the link"}, vector]},
+        "load_direction": lambda: {"anyOf": [vector, {"enum": ["against_velocity", "against_omega"]}]},
+        "characteristic": lambda: {"anyOf": [_ref(f.section), {"type": "string", "description":
+                                                                "an expression of omega (rad/s)"}]},
+        "map": lambda: _map(f),
+        "table": lambda: _ref(f.section),
+        "tables": lambda: {"type": "array", "items": {"$ref": f"#/definitions/{f.section.name}"}},
+    }
+    out = {"title": f.name + (f" ({f.unit})" if f.unit else ""), "description": _describe(f), **kinds[f.type]()}
+    if f.default not in (None, REQUIRED) and not (isinstance(f.default, str) and "<" in f.default):
+        out["default"] = list(f.default) if isinstance(f.default, tuple) else f.default
+    return out
+
+
+def _map(f: Field) -> dict:
+    items = {"number": {"anyOf": [{"type": "number"}, _EXPRESSION]},
+             "numbers": {"type": "array", "items": {"type": "number"}, "minItems": 1, "maxItems": MAX_STUDY_VALUES},
+             "string": {"type": "string"}}[f.items]
+    out: dict[str, Any] = {"type": "object", "additionalProperties": items}
+    if f.max_length:
+        out["maxProperties"] = f.max_length
+    if f.default == REQUIRED:
+        out["minProperties"] = 1
+    return out
+
+
+def _ref(s: Section | None) -> dict:
+    """The section's definition, referred to (inside allOf: a $ref's siblings, the field's title
+    and description, would be ignored in draft-07)."""
+    assert s is not None
+    return {"allOf": [{"$ref": f"#/definitions/{s.name}"}]}
+
+
+def _describe(f: Field, unit: bool = True) -> str:
+    """The field's description as an editor shows it: its line, its unit, when it is allowed."""
+    out = f.doc[0].upper() + f.doc[1:].removesuffix(".")
+    if f.unit and unit:
+        out += f"; {f.unit}"
+    if f.when is not None:
+        out += f" (only with {f.when[0]} = {' or '.join(map(str, f.when[1]))})"
+    if f.default == REQUIRED:
+        out += ". Required"
+    return out + "."
+
+
+# ----------------------------------------------------------------------------- models/FORMAT.md
+
+_TYPES = {"number": "number", "integer": "integer", "string": "string", "strings": "list of strings",
+          "vector": "[x, y]", "direction": "[x, y], nonzero", "series": "list of >= 2 numbers",
+          "points": "table of name = [x, y]", "point": "point name", "link": "link id", "links": "[i, j]",
+          "angles": "number or list", "com": "point name or [x, y]",
+          "load_direction": "[x, y] or string", "characteristic": "table or expression", "map": "table of names",
+          "table": "table", "tables": "array of tables"}
+
+
+def field_tables() -> str:
+    """The field tables of models/FORMAT.md (Markdown), one per table of the format."""
+    out = []
+    for s in sections():
+        head = "Top level" if s is MODEL else (f"`[[{s.name}]]`" if s.array else f"`[{s.name}]`")
+        out += [f"#### {head}", "", s.doc.replace("|", "\\|"), "", "| field | type | unit | range | default | expression | description |",
+                "|---|---|---|---|---|---|---|"]
+        for f in s.fields:
+            kind = _TYPES[f.type] + (": " + ", ".join(f"`{json.dumps(c)}`" for c in f.choices) if f.choices else "")
+            default = "required" if f.default == REQUIRED else "" if f.default is None else (
+                f"`{list(f.default)}`" if isinstance(f.default, tuple) else f"`{json.dumps(f.default, ensure_ascii=False)}`")
+            doc = _describe(f, unit=False).removesuffix(". Required.").removesuffix(".")
+            cells = (f"`{f.name}`", kind, f.unit, _range(f), default, "yes" if f.expression else "", doc)
+            out.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+        out.append("")
+    return "\n".join(out).rstrip() + "\n"
+
+
+def _range(f: Field) -> str:
+    if f.positive:
+        return "> 0"
+    if f.minimum is not None and f.maximum is not None:
+        return f"{f.minimum:g}" + (f"..{f.maximum:g}" if f.maximum != f.minimum else "")
+    if f.minimum is not None:
+        return f">= {f.minimum:g}"
+    if f.max_length is not None:
+        return f"at most {f.max_length}" + (" characters" if f.type == "string" else "")
+    return ""
+
+
+def format_md(text: str) -> str:
+    """`text` (models/FORMAT.md) with its field tables replaced by those of the schema."""
+    head, _, rest = text.partition(BEGIN)
+    _, _, tail = rest.partition(END)
+    if not rest or not tail:
+        raise ValueError(f"models/FORMAT.md has no markers {BEGIN} ... {END}")
+    return f"{head}{BEGIN}\n{field_tables()}{END}{tail}"
+
+
+def schema_text() -> str:
+    """The JSON Schema as the shipped file holds it."""
+    return json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"
+
+
+def print_schema(out: TextIO) -> int:
+    """Write the JSON Schema of the model format to `out`; the exit code (0)."""
+    out.write(schema_text())
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if args == ["--write"]:
+        SCHEMA_FILE.write_text(schema_text(), encoding="utf-8")
+        FORMAT_MD.write_text(format_md(FORMAT_MD.read_text(encoding="utf-8")), encoding="utf-8")
+        return 0
+    if args:
+        print(__doc__.split("\n\n")[1], file=sys.stderr)
+        return 2
+    return print_schema(sys.stdout)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,81 @@
+"""What laws of motion and motor characteristics evaluate: parsed expressions, kept, and the
+periodic cubic spline through a table of omega(phi).
+
+May use: the standard library, numpy, expressions.
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from ..expressions import ExpressionError, parse as parse_expression
+
+def _mentions_phi(text: str) -> bool:
+    """Whether a drive's `omega` string is a law of motion (an expression of `phi`) rather than
+    a constant speed written over the model's parameters (`"n1 * pi / 30"`)."""
+    try:
+        return "phi" in _expression(text).names
+    except ExpressionError:
+        return True                  # not a valid expression: the law's reader says why
+
+
+#: A checked expression, parsed once (laws of motion and characteristics are evaluated per call).
+_expression = functools.lru_cache(maxsize=256)(parse_expression)
+
+
+@functools.lru_cache(maxsize=64)
+def _periodic_spline(x_deg: tuple, y: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Knots x (rad, increasing, within one period 2 pi; a last knot at x[0] + 2 pi repeats the
+    first and is dropped), values y and second derivatives m of the periodic cubic spline
+    through the points (x_deg, deg; y)."""
+    x, y = np.radians(x_deg), np.asarray(y, float)
+    if np.isclose(x[-1] - x[0], 2 * np.pi, rtol=0, atol=1e-12):
+        x, y = x[:-1], y[:-1]
+    n = len(x)
+    h = np.diff(np.append(x, x[0] + 2 * np.pi))           # h[i] = x[i+1] - x[i], cyclically
+    slope = (np.roll(y, -1) - y) / h
+    r = 6 * (slope - np.roll(slope, 1))
+    if n < 3:                                             # both neighbours are one knot
+        return x, y, np.linalg.solve(np.diag(2 * (np.roll(h, 1) + h)) + np.diag(h.sum() * np.ones(n - 1), 1)
+                                     + np.diag(h.sum() * np.ones(n - 1), -1), r)
+    return x, y, _cyclic_tridiagonal(np.roll(h, 1), 2 * (np.roll(h, 1) + h), h, r)
+
+
+def _cyclic_tridiagonal(sub: np.ndarray, diag: np.ndarray, sup: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """x of A x = r, A tridiagonal with corners (n >= 3): A[i, i-1] = sub[i], A[i, i] = diag[i],
+    A[i, i+1] = sup[i], indices cyclic (sub[0] = A[0, n-1], sup[n-1] = A[n-1, 0]). The Thomas
+    algorithm with the Sherman-Morrison correction for the corners: O(n) work and memory."""
+    n = len(diag)
+    beta, alpha, gamma = float(sub[0]), float(sup[-1]), -float(diag[0])
+    b = [float(v) for v in diag]
+    b[0] -= gamma
+    b[-1] -= alpha * beta / gamma
+    a, c, d = [float(v) for v in sub], [float(v) for v in sup], [float(v) for v in r]
+    u = [gamma] + [0.0] * (n - 2) + [alpha]
+    cp, xp, zp = [0.0] * n, [0.0] * n, [0.0] * n       # forward sweep for r and u together
+    cp[0], xp[0], zp[0] = c[0] / b[0], d[0] / b[0], u[0] / b[0]
+    for i in range(1, n):
+        m = b[i] - a[i] * cp[i - 1]
+        cp[i] = c[i] / m
+        xp[i] = (d[i] - a[i] * xp[i - 1]) / m
+        zp[i] = (u[i] - a[i] * zp[i - 1]) / m
+    for i in range(n - 2, -1, -1):
+        xp[i] -= cp[i] * xp[i + 1]
+        zp[i] -= cp[i] * zp[i + 1]
+    x, z = np.array(xp), np.array(zp)
+    return x - z * (x[0] + beta * x[-1] / gamma) / (1 + z[0] + beta * z[-1] / gamma)
+
+
+def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Value and first derivative of the periodic cubic spline (x, y, m) at `phi` (rad)."""
+    xe, ye, me = np.append(x, x[0] + 2 * np.pi), np.append(y, y[0]), np.append(m, m[0])
+    t = x[0] + np.mod(phi - x[0], 2 * np.pi)
+    i = np.clip(np.searchsorted(xe, t, side="right") - 1, 0, len(x) - 1)
+    h = xe[i + 1] - xe[i]
+    a, b = xe[i + 1] - t, t - xe[i]
+    ca, cb = ye[i] / h - me[i] * h / 6, ye[i + 1] / h - me[i + 1] * h / 6
+    # the same cubic, written so that it is exact at a knot (a table's 0 stays 0, never -1e-21)
+    value = ye[i] * (a / h) + ye[i + 1] * (b / h) + (me[i] * a * (a * a - h * h) + me[i + 1] * b * (b * b - h * h)) / (6 * h)
+    slope = (-me[i] * a**2 + me[i + 1] * b**2) / (2 * h) - ca + cb
+    return value, slope

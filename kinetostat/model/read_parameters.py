@@ -1,0 +1,94 @@
+"""The reader's section for `[parameters]` and the expressions that read them: each parameter
+evaluated (overrides applied, in any order), and each numeric field given as an expression
+evaluated over them, its problems named by field and parameter.
+
+May use: the standard library, expressions, limits.
+"""
+from __future__ import annotations
+
+import keyword
+import unicodedata
+from typing import Any, Mapping
+
+from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse as parse_expression
+from ..expressions import resolve as resolve_parameters
+from .core import _suggest
+from .limits import LAW_VARIABLES, MAX_PARAMETERS, MAX_SHOWN
+
+
+def _code_points(name: str) -> str:
+    """A name with the code points that are not ASCII named: 'µ' -> "'µ' (U+00B5 MICRO SIGN)"."""
+    odd = [f"U+{ord(c):04X} {unicodedata.name(c, '?')}" for c in dict.fromkeys(name) if ord(c) > 127]
+    return f"{name!r}" + (f" ({', '.join(odd[:4])}{', ...' if len(odd) > 4 else ''})" if odd else "")
+
+
+class ParameterReading:
+    """The reader's section for parameters and expressions: a part of `reader._Reader`, using
+    the getters of `core.ReaderCore`."""
+
+    def read_parameters(self, head: Mapping) -> None:
+        """Evaluate `[parameters]` (with the overrides) and g (mechanism.g, which expressions read
+        as `g`), in any order, into self.values; problems are recorded against each parameter."""
+        t = self.data.get("parameters", {})
+        if not isinstance(t, dict):
+            self.err("parameters: expected a table of named numbers and expressions")
+            t = {}
+        if len(t) > MAX_PARAMETERS:
+            self.err(f"parameters: {len(t)} parameters, at most {MAX_PARAMETERS}")
+            t = {}
+        raw = dict(t)
+        for name in raw:
+            if name == "g":
+                self.err("parameters.g: g is mechanism.g (m/s^2), which expressions read as g: give it there")
+            elif name in FUNCTIONS or name in CONSTANTS:
+                self.err(f"parameters.{name}: {name!r} is the name of a function or constant of expressions")
+            elif name in LAW_VARIABLES:
+                self.err(f"parameters.{name}: {name!r} is the variable of a law of motion omega(phi) or of a "
+                         f"characteristic M(omega), which would hide this parameter there; choose another name")
+            elif unicodedata.normalize("NFKC", name) != name:
+                self.err(f"parameters.{name}: {_code_points(name)} reads as {_code_points(unicodedata.normalize('NFKC', name))} "
+                         f"in expressions (Unicode NFKC, as Python folds names); write it so")
+            elif keyword.iskeyword(name):
+                self.err(f"parameters.{name}: {name!r} is a Python keyword, which an expression reads as itself, "
+                         f"never as this parameter; choose another name")
+            elif not name.isidentifier() or name.startswith("__"):
+                self.err(f"parameters.{name}: a parameter's name is a Python-style identifier (letters, digits, _)")
+        for name, x in self.overrides.items():
+            if name != "g" and name not in raw:
+                self.err(f"parameters: cannot override {name!r}: the model has no such parameter"
+                         f"{_suggest(name, [*raw, 'g'])}. Parameters: {sorted(raw)}")
+            elif name != "g":
+                raw[name] = x
+        raw = {n: x for n, x in raw.items() if n != "g"}
+        if "g" in head or "g" in self.overrides:
+            raw["g"] = self.overrides.get("g", head.get("g"))
+        values, problems = resolve_parameters(raw)
+        for name, msg in problems.items():
+            if name != "g":             # mechanism.g reports its own problem when read
+                self.err(f"parameters.{name}: {msg}")
+        self.values, self.failed = values, set(problems)
+        for name, x in raw.items():
+            if isinstance(x, str) and name in values:
+                self.expressions["mechanism.g" if name == "g" else f"parameters.{name}"] = (x, values[name])
+
+    def scalar(self, x: Any, path: str) -> Any:
+        """`x` itself, or the value of the expression `x` (a string) over the parameters; None
+        after recording a problem (naming `path` and the parameter that fails)."""
+        if path == "mechanism.g" and "g" in self.values:      # also a number that an override of g replaces
+            return self.values["g"]
+        if not isinstance(x, str):
+            return x
+        try:
+            e = parse_expression(x)
+            bad = sorted(n for n in e.names if n in self.failed)
+            if bad:
+                raise ExpressionError(f"reads {', '.join(map(repr, bad))}, which has an error (see "
+                                      f"{', '.join('mechanism.g' if n == 'g' else f'parameters.{n}' for n in bad)})")
+            value = e(self.values)
+        except ExpressionError as exc:
+            self.err(f'{path}: expression "{x:.{MAX_SHOWN}}": {exc}')
+            return None
+        self.expressions[path] = (x, value)
+        return value
+
+    # -- typed getters: each returns None after recording a problem

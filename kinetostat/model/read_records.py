@@ -1,0 +1,185 @@
+"""The reader's sections for what the model records beside the mechanism: the sources' published
+values, a parameter study, the text's lettering.
+
+May use: the standard library, limits, parts, schema, core (its name suggestions).
+"""
+from __future__ import annotations
+
+from types import MappingProxyType
+from typing import Any, Mapping
+
+from .core import _suggest
+from .limits import MAX_PUBLISHED_ANGLES, MAX_STUDY_VALUES, MAX_VALUE, _finite
+from .parts import PUBLISHED_UNITS, Drive, Link, Load, Pair, Published, Study
+from .schema import LETTERING, PUBLISHED, REQUIRED, STUDY
+
+
+class RecordReading:
+    """The reader's sections for published values, study, lettering: a part of `reader._Reader`, using the getters of
+    `core.ReaderCore`."""
+
+    def published(self, links: list[Link], pairs: list[Pair], drive: Drive | None) -> list[Published]:
+        out: list[Published] = []
+        first: dict[str, int] = {}
+        for n, t in enumerate(self.table_list("published")):
+            entry = self.published_entry(t, f"published[{n}]", links, pairs, drive)
+            if entry is None:
+                continue
+            if entry.symbol in first:
+                self.err(f"published[{n}].symbol: {entry.symbol!r} is already used by published[{first[entry.symbol]}]")
+                continue
+            first[entry.symbol] = n
+            out.append(entry)
+        return out
+
+    def published_entry(self, t: Mapping, where: str, links: list[Link], pairs: list[Pair],
+                        drive: Drive | None) -> Published | None:
+        quantity = self.read(PUBLISHED, t, "quantity", where)
+        allowed = PUBLISHED.keys(quantity=quantity)
+        needs = allowed - PUBLISHED.keys()        # the quantity's own fields
+        self.unknown_keys(t, allowed, where)
+        n_problems = len(self.problems)
+        symbol, source, meaning, accuracy, value = (
+            self.read(PUBLISHED, t, key, where) for key in ("symbol", "source", "meaning", "accuracy", "value"))
+        angles = self.published_angles(t.get("angle"), f"{where}.angle")
+        reduce = self.read(PUBLISHED, t, "reduce", where)
+        if isinstance(t.get("angle"), list) and reduce is None and "reduce" not in t:
+            self.err(f"{where}.reduce: missing: a list of angles needs reduce = 'min', 'max' or 'angle_of_max'")
+        elif reduce is not None and not isinstance(t.get("angle"), list):
+            self.err(f"{where}.reduce: only with a list of angles (angle = [...])")
+        by_angle = reduce == "angle_of_max"
+        tol_key, other = ("tolerance_deg", "tolerance") if by_angle else ("tolerance", "tolerance_deg")
+        if other in t:
+            self.err(f"{where}.{other}: " + ("the angle of the maximum takes tolerance_deg (deg)" if by_angle
+                                             else "only reduce = 'angle_of_max' takes tolerance_deg; "
+                                                  "give tolerance (relative, e.g. 0.01 for 1 %)"))
+        tolerance = self.read(PUBLISHED, t, tol_key, where, default=REQUIRED)
+        unit = "deg" if by_angle else PUBLISHED_UNITS.get(quantity)
+        if "unit" in t and unit is not None and t["unit"] != unit:
+            self.err(f"{where}.unit: {quantity if not by_angle else 'angle_of_max'} is in {unit!r}, "
+                     f"got {t['unit']!r}")
+        point = relative_to = link = pair = None
+        if "point" in needs:
+            point = self.published_point(t, "point", where, links, required=True)
+            relative_to = self.published_point(t, "relative_to", where, links, required=False)
+        elif "link" in needs:
+            link = t.get("link")
+            self.link_ok(links, link, f"{where}.link", first=1)
+        elif "pair" in needs:
+            pair = t.get("pair")
+            if not (isinstance(pair, list) and len(pair) == 2
+                    and all(isinstance(x, int) and not isinstance(x, bool) for x in pair)):
+                self.err(f"{where}.pair: expected two link ids [i, j] (R(i, j), force of i on j), got {pair!r}")
+            elif not any(set(p.links) == set(pair) and pair[0] != pair[1] for p in pairs):
+                self.err(f"{where}.pair: no kinematic pair joins links {pair!r}. "
+                         f"Pairs: {[list(p.links) for p in pairs]}")
+            else:
+                pair = (pair[0], pair[1])
+        if quantity == "balancing_force" and drive is not None and drive.kind != "machine":
+            self.err(f"{where}.quantity: a balancing force needs drive.kind = 'machine' (an engine has a moment)")
+        if len(self.problems) > n_problems or None in (symbol, source, quantity, value, angles, tolerance):
+            return None
+        return Published(symbol, quantity, value, unit, angles, reduce, tolerance, source, meaning, accuracy,
+                         point, relative_to, link, pair)
+
+    def published_angles(self, x: Any, where: str) -> tuple[float, ...] | None:
+        items = [self.scalar(a, f"{where}[{i}]") for i, a in enumerate(x)] if isinstance(x, list) \
+            else [self.scalar(x, where)]
+        if None in items and x is not None:
+            return None
+        if x is None or not items or len(items) > MAX_PUBLISHED_ANGLES or \
+                not all(_finite(a) and abs(a) <= MAX_VALUE for a in items):
+            self.err(f"{where}: " + ("missing (a crank angle in deg, or a list of them)" if x is None else
+                                     f"expected a finite number of deg or a list of 1..{MAX_PUBLISHED_ANGLES} "
+                                     f"of them, got {x!r}"[:200]))
+            return None
+        return tuple(float(a) for a in items)
+
+    def published_point(self, t: Mapping, key: str, where: str, links: list[Link], *, required: bool) -> str | None:
+        name = t.get(key)
+        if name is None and not required:
+            return None
+        if not isinstance(name, str) or not any(name in link.points for link in links):
+            known = sorted({p for link in links for p in link.points})
+            self.err(f"{where}.{key}: " + (f"missing (a point name is required). Valid names: {known}" if name is None
+                                           else f"unknown point {name!r}. Valid names: {known}"))
+            return None
+        return name
+
+    def study(self, pairs: list[Pair]) -> Study | None:
+        """[study]: vary = { name = [values], ... } (one or two parameters), pair = [i, j], steps."""
+        t = self.data.get("study")
+        if t is None:
+            return None
+        if not isinstance(t, dict):
+            self.err("study: expected a table")
+            return None
+        self.unknown_keys(t, STUDY.keys(), "study")
+        title = self.read(STUDY, t, "title", "study")
+        vary, v = [], t.get("vary")
+        if not (isinstance(v, dict) and 1 <= len(v) <= 2):
+            self.err(f"study.vary: expected a table of one or two parameters and their values, "
+                     f"e.g. {{ r = [0.05, 0.08], n_k = [60, 120] }}, got {v!r:.80}")
+        else:
+            for name, xs in v.items():
+                if name not in self.values or name == "g":
+                    self.err(f"study.vary.{name}: not a parameter of the model{_suggest(name, self.values)}. "
+                             f"Parameters: {sorted(n for n in self.values if n != 'g')}")
+                elif not (isinstance(xs, list) and 1 <= len(xs) <= MAX_STUDY_VALUES and all(_finite(x) for x in xs)):
+                    self.err(f"study.vary.{name}: expected a list of 1..{MAX_STUDY_VALUES} finite numbers")
+                else:
+                    vary.append((name, tuple(float(x) for x in xs)))
+        pair = t.get("pair")
+        if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(i, int) for i in pair)
+                and any(set(p.links) == set(pair) and pair[0] != pair[1] for p in pairs)):
+            self.err(f"study.pair: expected [i, j] of a kinematic pair (R(i, j), force of link i on link j), "
+                     f"got {pair!r:.60}. Pairs: {[list(p.links) for p in pairs]}")
+            return None
+        f = STUDY["steps"]
+        steps = t.get("steps", f.default)
+        if not (isinstance(steps, int) and not isinstance(steps, bool) and f.minimum <= steps <= f.maximum):
+            self.err(f"study.steps: expected an integer {f.minimum}..{f.maximum} (crank angles per cycle), got {steps!r}")
+            return None
+        if not isinstance(v, dict) or len(vary) != len(v):
+            return None
+        return Study(title, tuple(vary), (pair[0], pair[1]), steps)
+
+    def lettering(self, links: list[Link], loads: list[Load]) -> Mapping[str, Any]:
+        """`[lettering]`: the text's names (models/FORMAT.md), checked; frozen."""
+        t = self.data.get("lettering", {})
+        if not isinstance(t, dict):
+            self.err("lettering: expected a table")
+            return MappingProxyType({})
+        self.unknown_keys(t, LETTERING.keys(), "lettering")
+        out: dict[str, Any] = {}
+        if "frame" in t:
+            k = t["frame"]
+            f = LETTERING["frame"]
+            if not isinstance(k, int) or isinstance(k, bool) or not f.minimum <= k <= f.maximum or (k and k < len(links)):
+                self.err(f"lettering.frame: expected the frame's number {f.minimum}..{f.maximum}, not a moving link's "
+                         f"(1..{len(links) - 1}), got {k!r}")
+            else:
+                out["frame"] = k
+        for key in ("M_bal", "F_bal"):
+            x = self.string(t, key, "lettering", default=None)
+            if x is not None and not (0 < len(x) <= 16 and x.isprintable()):
+                self.err(f"lettering.{key}: expected a symbol of 1..16 printable characters, got {x!r}")
+            elif x is not None:
+                out[key] = x
+        x = self.read(LETTERING, t, "language", "lettering")
+        if x is not None:
+            out["language"] = x
+        names = {ld.name for ld in loads}
+        for key, valid in (("loads", names), ("name", {"en", "uk", "ru"})):
+            tab = t.get(key, {})
+            if not isinstance(tab, dict) or not all(isinstance(v, str) and v.isprintable() for v in tab.values()):
+                self.err(f"lettering.{key}: expected a table of strings")
+                continue
+            bad = sorted(set(tab) - valid)
+            if bad:
+                self.err(f"lettering.{key}.{bad[0]}: no such {'load' if key == 'loads' else 'language'}. "
+                         f"Valid: {sorted(valid)}")
+                continue
+            if tab:
+                out[key] = MappingProxyType(dict(tab))
+        return MappingProxyType(out)
