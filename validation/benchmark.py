@@ -363,7 +363,7 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
 #: `kinetostat report` (8 bundled models, --jobs 2) at commit 7970a58, before the report's CSV
 #: rounding was rebuilt, measured on this machine (2 runs, load average 3.8-4.4): CPU s (user +
 #: sys, every process), wall s.
-MAIN_JOB_BEFORE = dict(commit="7970a58", cpu=(21.7, 22.5), wall=(28.3, 29.2), load="3.8-4.4")
+MAIN_JOB_BEFORE = dict(commit="4f33869", cpu=(20.8, 20.1), wall=(11.8, 11.4), load="0.9-1.3")
 
 
 def main_job(runs: int = 3) -> dict:
