@@ -52,6 +52,64 @@ def test_senses_by_the_texts_rule(ice_sheet):
     assert ice_sheet.row("omega_1").direction == "cw"                     # the model's crank turns clockwise
 
 
+def test_every_value_is_analyze_exactly(mech):
+    at = getattr(mech.drive, "design_deg", 30.0)
+    ws = worksheet(mech, at=at)
+    res = kinetostat.analyze(mech, phi_deg=[at])
+    expect = {"M_bal": res.balancing_moment[0], "M_bal_lever": res.lever_moment[0]}
+    for p in mech.pairs:
+        i, j = p.links
+        expect[f"R_{i}_{j}"] = np.hypot(*res.reaction(i, j)[0])
+    for k in range(1, mech.n_links):
+        expect[f"omega_{k}"] = abs(res.omega(k)[0])
+        expect[f"eps_{k}"] = abs(res.eps(k)[0])
+        if mech.links[k].mass:
+            expect[f"F_i{k}"] = np.hypot(*res.F_i[0, k])
+    for name in mech.point_names:
+        expect[f"V_{name}"] = np.hypot(*res.velocity(name)[0])
+        expect[f"a_{name}"] = np.hypot(*res.acceleration(name)[0])
+    checked = 0
+    for r in ws.rows:
+        if r.key in expect:
+            assert r.value == pytest.approx(expect[r.key], rel=1e-12, abs=1e-12 * max(1.0, abs(expect[r.key])))
+            checked += 1
+        assert math.isfinite(r.value), r.key
+    assert checked >= 8
+
+
+def test_outputs(ice_sheet, tmp_path):
+    md = ice_sheet.markdown()
+    assert "| V_BA | 14.8925 | m/s |" in md
+    html = ice_sheet.html()
+    assert "<table>" in html and "<td>V_BA</td>" in html
+    df = ice_sheet.frame()
+    assert list(df.columns) == ["section", "key", "symbol", "value", "unit", "direction", "note"]
+    ice_sheet.to_csv(tmp_path / "w.csv")
+    ice_sheet.to_json(tmp_path / "w.json")
+    doc = json.loads((tmp_path / "w.json").read_text(encoding="utf-8"))
+    assert doc["rows"][0]["key"] == "omega_1" and len(doc["rows"]) == len(ice_sheet.rows)
+    assert (tmp_path / "w.csv").read_text(encoding="utf-8").splitlines()[0] == "section,key,symbol,value,unit,direction,note"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w.csv", "w.json"]     # no temporary left
+    uk = worksheet(kinetostat.load("ice_crank_slider"), lang="uk")
+    assert "за годинниковою стрілкою" in uk.markdown() and "Реакції" in uk.markdown()
+
+
+def test_bad_options():
+    mech = kinetostat.load("ice_crank_slider")
+    with pytest.raises(ValueError, match="lang"):
+        worksheet(mech, lang="fr")
+    with pytest.raises(ValueError, match="mu_l"):
+        worksheet(mech, mu_l=-1.0)
+
+
+def test_analyze_at_prints_the_worksheet(cli):
+    r = cli("analyze", "models/ice_crank_slider.toml", "--at", 30)
+    assert r.returncode == 0
+    assert "V_BA" in r.stdout and "14.893 m/s" in r.stdout and "ε2" in r.stdout and "F_i2" in r.stdout
+    r = cli("analyze", "models/ice_crank_slider.toml", "--at", 30, 60)
+    assert "worksheet" not in r.stdout
+
+
 def test_a_rod_at_rest_has_no_sense():
     """Task 2 of Logvinenko, Nadtoka 2021, variant 479, at phi = 90 deg: the rods translate,
     omega_2 is zero but for rounding (8e-15 rad/s, its sign rounding's), and the worksheet gives
