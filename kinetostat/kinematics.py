@@ -12,7 +12,7 @@ with every input (each point of the linkage, the crank angle) moved by PERTURB_U
 the change is the error estimate (`Kinematics.error`). Fewer than DIGITS_WARN digits left: a
 SingularPositionWarning names the angles and the digits; fewer than DIGITS_MIN: NaN.
 
-May use: program, planar, errors (model and structure for type hints only).
+May use: program, triad, planar, errors (model and structure for type hints only).
 """
 from __future__ import annotations
 
@@ -27,6 +27,7 @@ import numpy as np
 from .errors import SingularPositionWarning, singular_message
 from .planar import as_xy, diameter
 from .program import constants, motion_program, run
+from .triad import stations
 
 if TYPE_CHECKING:
     from .model import Mechanism
@@ -195,10 +196,16 @@ def _perturbed_points(mech: "Mechanism", draw: int) -> list[dict[str, complex]]:
 def _solve(mech: "Mechanism", phi: np.ndarray, locals_: tuple[Mapping[str, complex], ...],
            unit_speed: bool = False) -> Kinematics:
     """The motion program of `mech` run over the angles `phi` with the local points `locals_`."""
+    N = phi.shape[-1]
+    if any(g.klass == 3 for g in mech.structure.groups):      # a triad's continuation: its stations too
+        phi = stations(phi, math.radians(mech.drive.design_deg))
     w, e = (1.0, 0.0) if unit_speed else mech.drive.speed(phi)      # the constants, or per angle by the law
     env = dict(mech.memo(("constants", id(locals_)), lambda: constants(mech, locals_)))
     env.update(phi=phi, w_in=w, e_in=e)
-    return assemble(mech, phi, run(motion_program(mech), env))
+    env = run(motion_program(mech), env)
+    if phi.shape[-1] != N:
+        env = {k: v[..., :N] if isinstance(v, np.ndarray) and v.shape[-1:] == phi.shape else v for k, v in env.items()}
+    return assemble(mech, phi[:N], env)
 
 
 def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Kinematics:
