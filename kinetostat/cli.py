@@ -562,7 +562,6 @@ def cmd_analyze(args) -> int:
 # ============================================================================ structure
 
 def cmd_structure(args) -> int:
-    from .structure import GROUP_KINDS
     path = Path(args.model)
     m = _load(path)
     s = m.structure
@@ -575,15 +574,14 @@ def cmd_structure(args) -> int:
              f"mobility (Chebyshev): W = 3n - 2p5 - p4 = 3*{s.n} - 2*{s.p5} - {s.p4} = {s.W}",
              f"initial mechanism I(0,1): crank 1 on the frame at {crank.point} ({crank.label})",
              "Assur groups, in order of attachment:"]
-    for g in s.groups:
-        outer_j, inner, outer_k = g.pairs
-        lines.append(f"  {g.label}  {g.kind} (kind {GROUP_KINDS[g.kind]})  links {g.links[0]}, {g.links[1]}; "
-                     f"outer pairs {outer_j.label}, {outer_k.label} (to links {g.known[0]}, {g.known[1]}), "
-                     f"inner {inner.label}; branch {g.branch:+d}")
+    lines += [f"  {g.describe()}" for g in s.groups]
     if not s.groups:
         lines.append("  none")
     lines.append(f"structure formula: {s.formula}")
     lines.append(f"class {s.mechanism_class}, order {s.order}")
+    if args.modes:
+        from .kinematics import assembly_modes
+        lines += ["assembly modes at the design position:"] + [x for am in assembly_modes(m) for x in am.lines()]
     if m.parameters:
         lines.append("parameters: " + ", ".join(f"{n} = {v:.10g}" for n, v in m.parameters.items()))
     if m.expressions:
@@ -1186,6 +1184,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Structural analysis of MODEL: mobility W by Chebyshev's formula with its "
                                    "arithmetic, the Assur groups with their kinds, the structure formula.")
     s.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
+    s.add_argument("--modes", action="store_true", help="list every assembly mode of each triad at the design position")
     s.set_defaults(func=cmd_structure)
 
     e = sub.add_parser("export", help="write a model as MJCF (MuJoCo) or URDF for physics engines",

@@ -60,6 +60,13 @@ class AssurGroup:
         return f"II({self.links[0]},{self.links[1]})" if self.links[0] < self.links[1] \
             else f"II({self.links[1]},{self.links[0]})"
 
+    def describe(self) -> str:
+        """One line for the structure listing: links, outer and inner pairs, branch."""
+        outer_j, inner, outer_k = self.pairs
+        return (f"{self.label}  {self.kind} ({self.vid})  links {self.links[0]}, {self.links[1]}; "
+                f"outer pairs {outer_j.label}, {outer_k.label} (to links {self.known[0]}, {self.known[1]}), "
+                f"inner {inner.label}; branch {self.branch:+d}")
+
     def __repr__(self) -> str:
         pairs = ", ".join(f"{p.kind}({p.links[0]},{p.links[1]})" for p in self.pairs)
         return f"AssurGroup({self.label} {self.kind}, pairs=[{pairs}], known={self.known}, branch={self.branch:+d})"
@@ -87,6 +94,13 @@ class Triad:
     @property
     def label(self) -> str:
         return "III(" + ",".join(map(str, sorted(self.links))) + ")"
+
+    def describe(self) -> str:
+        """One line for the structure listing: base, leashes with their outer and inner pairs."""
+        leashes = "; ".join(f"leash {i + 1} link {self.links[1 + i]}: outer {self.pairs[2 * i].label} (to link "
+                            f"{self.known[i]}), inner {self.pairs[2 * i + 1].label}" for i in range(3))
+        return (f"{self.label}  class III, order 3 (III3, outer pairs {self.kind})  base link {self.links[0]}; "
+                f"{leashes}; mode: as drawn at the design position")
 
     def __repr__(self) -> str:
         pairs = ", ".join(f"{p.kind}({p.links[0]},{p.links[1]})" for p in self.pairs)

@@ -26,7 +26,7 @@ from .groups import cis, cross, dot, magnitude, over, solve2
 
 __all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
-           "rr_tangential", "iii3_polygon", "iii3_positions", "positions", "misses", "stations", "Positions", "BLOCK", "MAX_ITER",
+           "rr_tangential", "iii3_polygon", "iii3_positions", "positions", "misses", "stations", "modes", "MODE_SAMPLES", "Positions", "BLOCK", "MAX_ITER",
            "STATION", "CLOSURE_TOL", "EQUATIONS"]
 
 #: Continuation: angles within BLOCK (rad) of the last solved one are solved together, from the
@@ -38,6 +38,8 @@ STATION = np.radians(3.0)
 MAX_ITER = 40
 #: The largest miss of a leash accepted as closed, in rounding units of the group's size.
 CLOSURE_TOL = 1e3
+#: Trial positions of leash 1 per turn (or along a slider's line) in the search for the modes.
+MODE_SAMPLES = 3600
 _EPS = np.finfo(float).eps
 
 
@@ -187,10 +189,11 @@ def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple
     linear extrapolation of the last two solved poses, and Newton runs on the block's angles
     at once. P and c as `misses` reads them, arrays over phi (or constants)."""
     phi = np.asarray(phi, float)
-    N = phi.shape[-1]
-    P = tuple(np.broadcast_to(p, (N,)) for p in P)
-    c = tuple(np.broadcast_to(v, (N,)) for v in c)
-    u = np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi          # along the path, in [-pi, pi)
+    u, first, back = np.unique(np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi, return_index=True,
+                               return_inverse=True)           # along the path, in [-pi, pi); each angle once
+    phi, N = phi[first], len(first)
+    P = tuple(np.broadcast_to(p, back.shape)[first] for p in P)
+    c = tuple(np.broadcast_to(v, back.shape)[first] for v in c)
     O, rot = np.empty(N, complex), np.empty(N, complex)
     its, res = np.zeros(N, int), np.zeros(N)
     at = lambda idx, arrs: tuple(a[idx] for a in arrs)
@@ -213,7 +216,7 @@ def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple
             last = [last[-1], (u[idx[-1]], O[idx[-1]], rot[idx[-1]])] if len(idx) == 1 else \
                 [(u[idx[-2]], O[idx[-2]], rot[idx[-2]]), (u[idx[-1]], O[idx[-1]], rot[idx[-1]])]
             start += len(idx)
-    return Positions(O, rot, its, res)
+    return Positions(O[back], rot[back], its[back], res[back])
 
 
 def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L):
@@ -233,3 +236,42 @@ def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3,
 EQUATIONS = ("leash_rr", "leash_slider", "special_point", "special_solve", "iii3_newton", "iii3_velocity",
              "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion", "rr_tangential",
              "iii3_polygon", "iii3_positions")
+
+
+def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[complex, complex]]:
+    """Every assembly mode (base pose O, e^{i theta}) at one position of the known joints (P, c
+    scalars as `misses` reads them), by the texts' method of false positions: leash 1 is set at
+    MODE_SAMPLES trial positions (a two-pin leash turned round its outer pin; a slider's pin
+    moved along its line over +-4 L), the base turned about it until leash 2 closes (two ways,
+    as a dyad closes), and the miss of leash 3 read; each change of sign of the miss is refined
+    by Newton on the whole group. Modes that coincide to 1e-9 L are one."""
+    t = np.linspace(0.0, 2 * np.pi, MODE_SAMPLES + 1)
+    X1 = P[0] + c[0] * cis(t) if kinds[0] == "R" else P[0] + 1j * c[0] * (4 * L) * (t / np.pi - 1.0)
+    r12 = x[1] - x[0]
+    rho = abs(r12)
+    found: list[tuple[complex, complex]] = []
+    for sign in (1.0, -1.0):
+        if kinds[1] == "R":         # C on the circle (X1, rho) and on the circle (A2, l2)
+            d = P[1] - X1
+            dd = np.abs(d)
+            along = (rho**2 - c[1]**2 + dd**2) / (2 * dd)
+            C = X1 + d / dd * (along + 1j * sign * np.sqrt(np.maximum(rho**2 - along**2, 0.0)))
+            ok = rho**2 - along**2 >= 0
+        else:                       # C on the circle (X1, rho) and on the line (K2, normal n2)
+            foot = X1 - dot(X1 - P[1], c[1]) * c[1]
+            h2 = rho**2 - np.abs(foot - X1)**2
+            C = foot + sign * 1j * c[1] * np.sqrt(np.maximum(h2, 0.0))
+            ok = h2 >= 0
+        rot = (C - X1) / r12
+        O = X1 - x[0] * rot
+        f3 = misses(kinds, O, rot, x, P, c)[2][2]
+        f3 = np.where(ok, f3, np.nan)
+        at = np.flatnonzero((f3[:-1] * f3[1:] <= 0) & np.isfinite(f3[:-1] * f3[1:]))
+        if not len(at):
+            continue
+        Os, rots, _, res = _newton(kinds, O[at], rot[at], x, tuple(np.full(len(at), p) for p in P),
+                                   tuple(np.full(len(at), v) for v in c), L)
+        for O_, rot_ in zip(Os[res <= CLOSURE_TOL * _EPS * L], rots[res <= CLOSURE_TOL * _EPS * L]):
+            if all(abs(O_ - Ok) + L * abs(rot_ - rk) > 1e-9 * L for Ok, rk in found):
+                found.append((complex(O_), complex(rot_)))
+    return found
