@@ -154,7 +154,6 @@ def kinematics(mech: "Mechanism", phi: np.ndarray, unit_speed: bool = False) -> 
         if len(checked):
             nominal = kin.take(checked)
             error[checked] = np.max([kinematic_deviation(mech, nominal, t) for t in trials], axis=0)
-    _check_modes(mech)
     return guard(mech, kin, error)
 
 
@@ -226,11 +225,11 @@ def _check_modes(mech: "Mechanism") -> None:
                     f"group {am.group}: the base link's points do not draw the group assembled at the design position "
                     f"(design_deg = {mech.drive.design_deg:g}; the pins miss the nearest mode by {am.drawn_miss:.3g} m); "
                     f"that mode is solved: give the triad's points in world coordinates at the design position"),
-                    stacklevel=4)
+                    stacklevel=5)
             if am.separation < MODES_CLOSE:
                 warnings.warn(ModelWarning(
                     f"group {am.group}: another assembly mode is within {am.separation:.3g} of the group's size at the "
-                    f"design position (kinetostat structure MODEL --modes lists them)"), stacklevel=4)
+                    f"design position (kinetostat structure MODEL --modes lists them)"), stacklevel=5)
         return True
     mech.memo("modes checked", check)
 
@@ -241,6 +240,7 @@ def solve_checked(mech: "Mechanism", phi: np.ndarray,
     angles where some group's cond exceeds COND_CHECK, and the kinematics at those angles solved
     again on inputs moved by PERTURB_ULPS ulps (one per sign pattern). Call under np.errstate
     as `kinematics` does."""
+    _check_modes(mech)
     kin = _solve(mech, phi, mech.points_z, unit_speed)
     checked = np.flatnonzero(~(kin.cond <= COND_CHECK).all(axis=1))       # NaN cond: checked
     trials = []

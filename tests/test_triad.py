@@ -1,0 +1,133 @@
+"""The class-III group III3 (a triad, Artobolevsky 1988): positions by Newton with continuation,
+velocities, accelerations and reactions at Assur's special point S, checked against independent
+formulations (the mechanism's constraint Jacobian; the group's full linear system of 12
+equilibrium equations), the assembly modes, and the refusals of the paths that do not take it."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import kinetostat
+from conftest import ROOT
+from kinetostat import fast, program
+from kinetostat.applied import applied_wrenches, com_motion, inertia_loads
+from kinetostat.kinematics import assembly_modes, kinematics
+from kinetostat.program import constants, motion_program
+from kinetostat.virtual_work import constraint_jacobian
+
+MODELS = ("triad_six_bar", "triad_slider")
+PHI = np.arange(0.0, 360.0, 15.0)
+
+
+@pytest.fixture(scope="module", params=MODELS)
+def mech(request):
+    return kinetostat.load(ROOT / "models" / f"{request.param}.toml")
+
+
+def test_structure_names_the_class_and_the_triad(mech):
+    s = mech.structure
+    assert s.formula == "I(0,1) <- III(2,3,4,5)" and (s.mechanism_class, s.order) == (3, 3)
+    g = s.groups[0]
+    assert (g.links, g.known) == ((3, 2, 4, 5), (1, 0, 0))
+    assert "class 3, order 3" in str(s)
+
+
+def test_special_point_velocities_equal_the_jacobians(mech):
+    """v_S from the 2x2 solve at S, omega from leash 3's arm: the same as J qd = (0, ..., 1), the
+    whole mechanism's constraint Jacobian (two rows per pair) solved at unit crank speed."""
+    kin = kinematics(mech, np.radians(PHI), unit_speed=True)
+    J = constraint_jacobian(mech, kin)
+    rhs = np.zeros(J.shape[:2])
+    rhs[:, -1] = 1.0
+    qd = np.linalg.solve(J, rhs[..., None])[..., 0].reshape(len(PHI), -1, 3)
+    mine = np.stack([kin.v_z.real, kin.v_z.imag, kin.omega], axis=-1)[:, 1:]
+    assert np.max(np.abs(mine - qd)) <= 1e-14 * np.max(np.abs(qd))
+
+
+def test_group_order_reactions_equal_the_groups_full_linear_system(mech):
+    """The reactions found in the texts' order (R^tau by each leash's moment, R^n of leash 3 by
+    the group's moment about S, the polygon, the leashes' polygons) against the 12 x 12 system of
+    the group's four links (force and moment balance), solved by LU."""
+    res = kinetostatic = kinetostat.analyze(mech, phi_deg=PHI)
+    kin = kinetostatic.kin
+    r, aS = com_motion(mech, kin)
+    F, M = applied_wrenches(mech, kin, r)
+    F_i, M_i = inertia_loads(mech, kin, aS)
+    F, M = F + F_i, M + M_i + (np.conj(r) * F_i).imag
+    g = mech.structure.groups[0]
+    links = list(g.links)
+    pairs = [p for p in mech.pairs if set(p.links) & set(links)]
+    assert len(pairs) == 6
+    pts = mech.points_z
+    for n in range(len(PHI)):
+        A = np.zeros((12, 12))
+        b = np.zeros(12)
+        for e, k in enumerate(links):
+            b[3 * e:3 * e + 3] = -F[n, k].real, -F[n, k].imag, -M[n, k]
+        for c, p in enumerate(pairs):
+            X = kin.origin_z[n, p.links[1]] + pts[p.links[1]][p.point] * kin.rot[n, p.links[1]]
+            if p.kind == "R":
+                cols = ((1.0, 0j + 1.0, 0.0), (1.0, 1j, 0.0))      # unit force along x, along y
+            else:
+                nrm = 1j * complex(*p.direction) * kin.rot[n, p.links[0]]
+                cols = ((1.0, nrm, 0.0), (1.0, 0j, 1.0))          # normal force; couple
+            for q, (_, f, couple) in enumerate(cols):
+                for k, s in ((p.links[1], 1.0), (p.links[0], -1.0)):
+                    if k in links:
+                        e = links.index(k)
+                        arm = X - kin.origin_z[n, k]
+                        A[3 * e:3 * e + 3, 2 * c + q] += s * np.array(
+                            [f.real, f.imag, (np.conj(arm) * f).imag + couple])
+        x = np.linalg.solve(A, b)
+        for c, p in enumerate(pairs):
+            got = res.forces.R[n, p.index] if p.kind == "R" else \
+                np.array([res.forces.normal[n, p.index], res.forces.m[n, p.index]])
+            scale = np.max(np.abs(res.forces.R[n]))
+            assert np.max(np.abs(got - x[2 * c:2 * c + 2])) <= 1e-12 * scale, (PHI[n], p.label)
+
+
+def test_newton_converges_to_rounding_in_few_steps(mech):
+    """The continuation's Newton: every leash closed to a few ulps of the group's size, within
+    six steps from each block's start (the counts are the program's outputs)."""
+    env = dict(constants(mech))
+    env.update(phi=np.radians(np.arange(0.0, 360.0, 1.0)), w_in=1.0, e_in=0.0)
+    out = program.run(motion_program(mech), env)
+    L = max(kinetostat.kinematics.group_scales(mech))
+    assert np.max(out["res0"]) <= 8 * np.finfo(float).eps * L
+    assert 1 <= np.max(out["it0"]) <= 6
+
+
+def test_the_result_does_not_depend_on_the_angles_asked(mech):
+    a = kinetostat.analyze(mech, phi_deg=[200.0])
+    b = kinetostat.analyze(mech, phi_deg=np.arange(0.0, 360.0, 10.0))
+    assert np.allclose(a.forces.R[0], b.forces.R[20], rtol=0, atol=1e-12 * np.abs(b.forces.R).max())
+
+
+def test_the_modes_at_the_design_position_are_listed_and_the_drawn_one_chosen(mech):
+    (am,) = assembly_modes(mech)
+    assert len(am.O) >= 2 and am.chosen == 0 and am.drawn_miss <= 1e-12
+    assert abs(am.O[0]) < 1e-12 and abs(am.rot[0] - 1) < 1e-12      # the drawing: the base's frame is the world's
+    assert am.separation > kinetostat.kinematics.MODES_CLOSE
+    assert "<- solved (drawn by the model)" in am.lines()[0]
+
+
+def test_a_drawing_off_the_assembly_is_warned_and_its_nearest_mode_solved():
+    text = (ROOT / "models" / "triad_six_bar.toml").read_text()
+    moved = kinetostat.loads(text.replace("B = [0.70, 0.0], C = [0.50, 0.30], D = [0.90, 0.30], S3",
+                                          "B = [0.70, 0.0], C = [0.50, 0.30], D = [0.90, 0.31], S3"))
+    with pytest.warns(kinetostat.ModelWarning, match=r"III\(2,3,4,5\): the base link's points do not draw"):
+        res = kinetostat.analyze(moved, phi_deg=[0.0, 90.0])
+    (am,) = assembly_modes(moved)
+    assert 1e-3 < am.drawn_miss < 0.02 and np.isfinite(res.balancing_moment).all()
+
+
+def test_the_compiled_path_and_the_array_api_refuse_a_triad_by_name(mech):
+    assert "III(2,3,4,5)" in fast.refusal(mech)
+    with pytest.raises(NotImplementedError, match=r"class-III groups \(III\(2,3,4,5\)\)"):
+        fast.analyze_fast(mech, np.arange(0.0, 360.0, 30.0))
+    pytest.importorskip("array_api_strict")
+    import array_api_strict as xp
+    from kinetostat import arrays
+    with pytest.raises(NotImplementedError, match=r"class-III group \(III\(2,3,4,5\)\)"):
+        arrays.solve(kinetostat.loads((ROOT / "models" / "triad_six_bar.toml").read_text().split("[[load]]")[0]),
+                     xp.asarray([0.0, 1.0]))
