@@ -26,16 +26,19 @@ from .groups import cis, cross, dot, magnitude, over, solve2
 
 __all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
-           "rr_tangential", "iii3_polygon", "iii3_positions", "positions", "misses", "stations", "modes", "MODE_SAMPLES", "Positions", "BLOCK", "MAX_ITER",
+           "rr_tangential", "iii3_polygon", "iii3_positions", "positions", "misses", "stations", "modes", "MODE_SAMPLES", "Positions", "BLOCK", "MAX_ITER", "RETRIES",
            "STATION", "CLOSURE_TOL", "EQUATIONS"]
 
 #: Continuation: angles within BLOCK (rad) of the last solved one are solved together, from the
 #: linear extrapolation of the last two solutions.
-BLOCK = np.radians(15.0)
+BLOCK = np.radians(6.0)
 #: Extra crank angles (rad apart) solved with the asked ones, so that no continuation step is longer.
 STATION = np.radians(3.0)
 #: Newton steps per block at most.
 MAX_ITER = 40
+#: Angles of a block that do not close are solved again from the nearest closed angle before
+#: them, at most this many times.
+RETRIES = 3
 #: The largest miss of a leash accepted as closed, in rounding units of the group's size.
 CLOSURE_TOL = 1e3
 #: Trial positions of leash 1 per turn (or along a slider's line) in the search for the modes.
@@ -187,7 +190,7 @@ def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple
     along the crank's path from the design angle phi0 where the pose is near (O0, rot0), both
     ways round (to +-pi). The angles are taken in blocks of BLOCK: each block starts from the
     linear extrapolation of the last two solved poses, and Newton runs on the block's angles
-    at once. P and c as `misses` reads them, arrays over phi (or constants)."""
+    at once; an angle that does not close is solved again from the nearest closed one before it. P and c as `misses` reads them, arrays over phi (or constants)."""
     phi = np.asarray(phi, float)
     u, first, back = np.unique(np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi, return_index=True,
                                return_inverse=True)           # along the path, in [-pi, pi); each angle once
@@ -213,6 +216,15 @@ def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple
             th2 = np.angle(r2)
             Og, thg = O2 + t * (O2 - O1), th2 + t * np.angle(r2 / r1)
             O[idx], rot[idx], its[idx], res[idx] = _newton(kinds, Og, np.exp(1j * thg), x, at(idx, P), at(idx, c), L)
+            for _ in range(RETRIES):        # a miss: again from the nearest closed angle before it
+                ok = res[idx] <= CLOSURE_TOL * _EPS * L
+                prev = np.maximum.accumulate(np.where(ok, np.arange(len(idx)), -1))
+                redo = np.flatnonzero(~ok & (prev >= 0))
+                if not len(redo):
+                    break
+                j, src = idx[redo], idx[prev[redo]]
+                O[j], rot[j], more, res[j] = _newton(kinds, O[src], rot[src], x, at(j, P), at(j, c), L)
+                its[j] += more
             last = [last[-1], (u[idx[-1]], O[idx[-1]], rot[idx[-1]])] if len(idx) == 1 else \
                 [(u[idx[-2]], O[idx[-2]], rot[idx[-2]]), (u[idx[-1]], O[idx[-1]], rot[idx[-1]])]
             start += len(idx)
