@@ -159,3 +159,28 @@ def test_a_crank_that_brushes_the_triads_singular_position_is_flagged_and_its_ac
     err = np.max(np.linalg.norm(res.forces.R[:2] - ref.R, axis=-1), axis=1) / \
         np.max(np.linalg.norm(ref.R, axis=-1), axis=1)
     assert (err <= res.error[:2]).all() and err[1] > 1e-12      # the lost digits are real, and bounded
+
+
+@pytest.mark.parametrize("route", ["pinocchio", "mujoco", "reference"])
+def test_the_exact_routes_agree_on_a_sample_of_the_cycle(mech, route):
+    """Kinematics, reactions and M_bal of the group route against an engine or the 40-digit
+    reference at 24 angles (the whole cycle, with the simulations too, runs in test_compare's
+    gate under -m slow): within 1e-9 of each quantity's peak (measured: 4e-15)."""
+    from kinetostat_validation import compare as cmp
+    if cmp.available(route):
+        pytest.skip(cmp.available(route))
+    c = cmp.compare(mech, engines=(route,), steps=24)
+    assert not c.failed and c.rows
+    worst = max(r.peak_relative for r in c.rows)
+    assert worst <= 1e-9 and all(r.passed for r in c.rows)
+
+
+def test_virtual_work_and_the_lever_agree_over_the_cycle(mech):
+    from kinetostat.virtual_work import virtual_work
+    res = kinetostat.analyze(mech)
+    vw = virtual_work(mech)
+    peak = np.max(np.abs(res.balancing_moment))
+    assert np.max(np.abs(vw.balancing_moment - res.balancing_moment)) <= 1e-12 * peak
+    assert np.max(np.abs(res.lever_discrepancy)) <= 1e-12 * peak
+    R = np.abs(res.forces.R).max()
+    assert np.max(np.abs(vw.forces.R - res.forces.R)) <= 1e-12 * R
