@@ -27,7 +27,7 @@ import numpy as np
 from .errors import ModelWarning, SingularPositionWarning, singular_message
 from .planar import as_xy, diameter
 from .program import constants, motion_program, run
-from .triad import modes, stations
+from .triad import modes, special_point, stations
 
 if TYPE_CHECKING:
     from .model import Mechanism
@@ -35,7 +35,7 @@ if TYPE_CHECKING:
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
            "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes",
-           "MODES_CLOSE"]
+           "MODES_CLOSE", "special_point_z"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
@@ -208,6 +208,21 @@ def assembly_modes(mech: "Mechanism") -> tuple[AssemblyModes, ...]:
                                      float(np.abs(solved - np.array(x)).max()), min(others, default=math.inf)))
         return tuple(out)
     return mech.memo("assembly modes", make)
+
+
+def special_point_z(mech: "Mechanism", kin: Kinematics, g) -> np.ndarray:
+    """(N,) complex, m: Assur's special point S of triad g, where the axes of its leashes 1 and
+    2 meet (a two-pin leash's axis: outer pin -> inner pin; a slider's: the guide's normal through
+    its pin)."""
+    pts, X, u = mech.points_z, [], []
+    for ell, outer, inner, a in g.sides[:2]:
+        X.append(kin.position_z(ell, _xy(pts[ell][inner.point])))
+        if outer.kind == "R":
+            r = X[-1] - kin.position_z(ell, _xy(pts[ell][outer.point]))
+            u.append(r / np.abs(r))
+        else:
+            u.append(1j * complex(*outer.direction) * kin.rot[:, a])
+    return special_point(X[0], u[0], X[1], u[1])[0]
 
 
 def _xy(z: complex) -> tuple[float, float]:

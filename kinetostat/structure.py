@@ -56,6 +56,12 @@ class AssurGroup:
         return f"kind {GROUP_KINDS[self.kind]}"
 
     @property
+    def sides(self) -> tuple[tuple[int, KinematicPair, KinematicPair, int], ...]:
+        """(link, its outer pair, the inner pair, the known link) of j and of k."""
+        return ((self.links[0], self.pairs[0], self.pairs[1], self.known[0]),
+                (self.links[1], self.pairs[2], self.pairs[1], self.known[1]))
+
+    @property
     def label(self) -> str:
         return f"II({self.links[0]},{self.links[1]})" if self.links[0] < self.links[1] \
             else f"II({self.links[1]},{self.links[0]})"
@@ -90,6 +96,11 @@ class Triad:
     @property
     def vid(self) -> str:
         return f"III3 {self.kind}"
+
+    @property
+    def sides(self) -> tuple[tuple[int, KinematicPair, KinematicPair, int], ...]:
+        """(leash, its outer pair, its inner pair on the base, the known link) of each leash."""
+        return tuple((self.links[1 + i], self.pairs[2 * i], self.pairs[2 * i + 1], self.known[i]) for i in range(3))
 
     @property
     def label(self) -> str:

@@ -189,7 +189,8 @@ def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple
     """The base link's pose at the crank angles phi (rad, (N,)) by Newton with continuation
     along the crank's path from the design angle phi0 where the pose is near (O0, rot0), both
     ways round (to +-pi). The angles are taken in blocks of BLOCK: each block starts from the
-    linear extrapolation of the last two solved poses, and Newton runs on the block's angles
+    linear extrapolation of two solved poses (the last, and the farthest from it of the block's
+    first and the previous block's last), and Newton runs on the block's angles
     at once; an angle that does not close is solved again from the nearest closed one before it. P and c as `misses` reads them, arrays over phi (or constants)."""
     phi = np.asarray(phi, float)
     u, first, back = np.unique(np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi, return_index=True,
@@ -225,8 +226,9 @@ def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple
                 j, src = idx[redo], idx[prev[redo]]
                 O[j], rot[j], more, res[j] = _newton(kinds, O[src], rot[src], x, at(j, P), at(j, c), L)
                 its[j] += more
-            last = [last[-1], (u[idx[-1]], O[idx[-1]], rot[idx[-1]])] if len(idx) == 1 else \
-                [(u[idx[-2]], O[idx[-2]], rot[idx[-2]]), (u[idx[-1]], O[idx[-1]], rot[idx[-1]])]
+            new = (u[idx[-1]], O[idx[-1]], rot[idx[-1]])      # extrapolate from the two farthest apart
+            first = (u[idx[0]], O[idx[0]], rot[idx[0]])
+            last = [max(last[-1], first, key=lambda e: abs(e[0] - new[0])), new]
             start += len(idx)
     return Positions(O[back], rot[back], its[back], res[back])
 
