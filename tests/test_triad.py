@@ -190,3 +190,37 @@ def test_virtual_work_and_the_lever_agree_over_the_cycle(mech):
     assert np.max(np.abs(res.lever_discrepancy)) <= 1e-12 * peak
     R = np.abs(res.forces.R).max()
     assert np.max(np.abs(vw.forces.R - res.forces.R)) <= 1e-12 * R
+
+
+def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
+    """Velocity plan: s with v_S (from the outer pins of leashes 1 and 2); the group plan: S and
+    the arms about it; the force polygon closes with R..n of leashes 1 and 2, and every reaction
+    on it (outer, as chords over their parts, and inner, from each leash's polygon) is analyze's
+    vector."""
+    from kinetostat.kinematics import special_point_z
+    from kinetostat.plans import forces, kinematic
+    from kinetostat.plans.scales import choose_scales
+    res = kinetostat.analyze(mech, phi_deg=[60.0])
+    g = mech.structure.groups[0]
+    sc = choose_scales(mech, res)
+    v = kinematic.velocity_plan(mech, res, sc)
+    S = special_point_z(mech, res.kin, g)[0]
+    b = g.links[0]
+    local = (S - res.kin.origin_z[0, b]) / res.kin.rot[0, b]
+    vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
+    assert abs(v.points["s"] * sc["mu_v"].value - vS) <= 1e-12 * abs(vS)
+    assert {s.name for s in v.segments} >= {"a-s", "p-s"}
+    (gp,) = forces.group_plans(mech, res, sc["mu_l"])
+    assert abs(gp.points["S"] * sc["mu_l"].value - S) <= 1e-12
+    assert any(s.name.endswith("(S)") for s in gp.segments)
+    mu_F = forces.default_mu_F(mech, res)
+    (fp,) = forces.force_plans(mech, res, mu_F)
+    eq = fp.equation
+    assert eq[-2:] == ("R12n", "R04n") and eq[0] == "R04t"
+    n = len(eq)
+    sides = [fp.points[s.end] - fp.points[s.start] for s in fp.segments[:n]]
+    assert abs(sum(sides)) <= 1e-12 * max(map(abs, sides))
+    for i, j in [(1, 2), (0, 4), (3, 2), (3, 4), (3, 5)] + ([(0, 5)] if g.kind == "RRR" else []):
+        s = fp.segment(forces.reaction_name(mech, i, j))
+        drawn = (fp.points[s.end] - fp.points[s.start]) * mu_F.value
+        assert abs(drawn - complex(*res.reaction(i, j)[0])) <= 1e-9 * abs(drawn)
