@@ -293,16 +293,28 @@ def _perturbed_points(mech: "Mechanism", draw: int) -> list[dict[str, complex]]:
 def _solve(mech: "Mechanism", phi: np.ndarray, locals_: tuple[Mapping[str, complex], ...],
            unit_speed: bool = False) -> Kinematics:
     """The motion program of `mech` run over the angles `phi` with the local points `locals_`."""
-    N = phi.shape[-1]
-    if any(g.klass == 3 for g in mech.structure.groups):      # a triad's continuation: its stations too
-        phi = stations(phi, math.radians(mech.drive.design_deg))
     w, e = (1.0, 0.0) if unit_speed else mech.drive.speed(phi)      # the constants, or per angle by the law
     env = dict(mech.memo(("constants", id(locals_)), lambda: constants(mech, locals_)))
-    env.update(phi=phi, w_in=w, e_in=e)
-    env = run(motion_program(mech), env)
-    if phi.shape[-1] != N:
-        env = {k: v[..., :N] if isinstance(v, np.ndarray) and v.shape[-1:] == phi.shape else v for k, v in env.items()}
-    return assemble(mech, phi[:N], env)
+    env.update(_tracks(mech), phi=phi, w_in=w, e_in=e)
+    return assemble(mech, phi, run(motion_program(mech), env))
+
+
+def _tracks(mech: "Mechanism") -> dict[str, tuple]:
+    """Each triad's track (memoised per mechanism): its base link's poses at the continuation's
+    stations round the cycle, solved once by continuation from the design position; the angles
+    asked later start from it (`triad.iii3_positions`)."""
+    def make() -> dict[str, tuple]:
+        triads = [n for n, g in enumerate(mech.structure.groups) if g.klass == 3]
+        if not triads:
+            return {}
+        phi0 = math.radians(mech.drive.design_deg)
+        phi = stations(phi0)
+        env = dict(constants(mech), phi=phi, w_in=1.0, e_in=0.0)
+        run(motion_program(mech), env)
+        u = phi - phi0
+        return {f"track{n}": (u, env[f"O{g}"], env[f"rot{g}"]) for n in triads
+                for g in [mech.structure.groups[n].links[0]]}
+    return mech.memo("triad tracks", make)
 
 
 def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Kinematics:

@@ -60,7 +60,8 @@ def constants(mech: "Mechanism", points: tuple[Mapping[str, complex], ...] | Non
     """The base constants the programs of `mech` read: every local point (x<k>_<name>, complex),
     every guide direction (d<p>, complex unit) and its angle (alpha<p>), the group scales
     (L<n>, m), the drive, the masses (mass<k>, I_S<k>, com<k> the local centre of mass), g,
-    and the gear. `points`: the local points (default the
+    the gear, the design angle phi_design (rad) and each triad's track<n> (None: the program
+    runs its continuation). `points`: the local points (default the
     model's; the accuracy check passes them perturbed); `scales`: the group scales."""
     from .kinematics import group_scales
     pts = mech.points_z if points is None else points
@@ -81,6 +82,9 @@ def constants(mech: "Mechanism", points: tuple[Mapping[str, complex], ...] | Non
         c[f"mass{k}"], c[f"I_S{k}"], c[f"com{k}"] = float(mass[k]), float(I_S[k]), complex(com[k])
     c["g"] = float(mech.g)
     c["phi_design"] = float(np.radians(dr.design_deg))
+    for n, grp in enumerate(mech.structure.groups):
+        if grp.klass == 3:
+            c[f"track{n}"] = None        # a triad's poses at the stations (`kinematics` sets them)
     if dr.kind == "machine":
         g = dr.gear
         c["gear_e"], c["gear_alpha"], c["gear_rb"] = complex(*g.centre_direction), float(np.radians(g.alpha_w_deg)), g.r_b
@@ -296,7 +300,7 @@ class _Motion(_Build):
         O, rot, closure, _, _ = self.call(
             "iii3_positions", "phi", "phi_design", *(float(m[0] == "P") for m in leash),
             *(_x(b, g.pairs[2 * i + 1].point) for i in range(3)), *(m[1] for m in leash), *(m[2] for m in leash),
-            f"L{n}", out=(self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
+            f"L{n}", f"track{n}", out=(self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
         self.steps.append(Step("check", (closure, 0.0), (), g.label, "the three leashes do not close"))
         u = []
         for i, m in enumerate(leash):

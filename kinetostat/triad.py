@@ -9,9 +9,10 @@ primitives of `groups`, in the same elementwise style:
   plans, the reactions) is x . u1 = r1, x . u2 = r2 for a vector x at S (a 2x2 solve) and one
   division by h3 = (X3 - S) x u3, the arm of leash 3's axis about S. h3 = 0 (three axes through
   one point) is the group's singular position;
-- the positions by Newton with continuation from the design position, all the angles of a block
-  at once (`positions`, numpy only: it reads the whole angle axis, so the compiled path and the
-  Array API path refuse triads by name).
+- the positions by Newton with continuation from the design position over the stations round
+  the cycle, all the angles of a block at once (`positions`, once per mechanism: the track), then
+  at the angles asked all at once from the track (`iii3_positions`; numpy only: it reads the
+  whole angle axis, so the compiled path and the Array API path refuse triads by name).
 
 May use: numpy, groups.
 """
@@ -32,7 +33,7 @@ __all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "iii3_n
 #: Continuation: angles within BLOCK (rad) of the last solved one are solved together, from the
 #: linear extrapolation of the last two solutions.
 BLOCK = np.radians(6.0)
-#: Extra crank angles (rad apart) solved with the asked ones, so that no continuation step is longer.
+#: The continuation's stations (rad apart) round the cycle: the track every angle starts from.
 STATION = np.radians(3.0)
 #: Newton steps per block at most.
 MAX_ITER = 40
@@ -140,11 +141,11 @@ def iii3_polygon(S, X3, u1, u2, u3, det, T1, T2, T3, P1, P2, P3, m1, m2, m3, F, 
     return n1, n2, n3
 
 
-def stations(phi: np.ndarray, phi0: float) -> np.ndarray:
-    """phi (rad, (N,)) followed by the design angle phi0 and the angles STATION apart from it
-    round the cycle: solved with phi, they keep every continuation step short."""
+def stations(phi0: float) -> np.ndarray:
+    """The design angle phi0 and the angles STATION apart from it round the cycle (rad), in
+    the order of u = phi - phi0 from -pi to pi: the continuation's track."""
     k = np.arange(-int(np.pi / STATION), int(np.pi / STATION) + 1)
-    return np.concatenate([phi, phi0 + STATION * k])
+    return phi0 + STATION * k
 
 
 # -- the positions over the angles: Newton with continuation (numpy)
@@ -233,16 +234,28 @@ def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple
     return Positions(O[back], rot[back], its[back], res[back])
 
 
-def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L):
-    """The program's step (`positions` over the angle axis, the design pose being the base
-    link's local frame, the model's points drawn in world coordinates): O, e^{i theta}, the
-    closure (0, or -1 where a leash misses by more than CLOSURE_TOL rounding units of L: the
-    group cannot be assembled there), the Newton steps and the largest miss (m). slider<i>: 1.0
-    where leash i is a slider, else 0.0."""
+def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L, track):
+    """The program's step: the base link's pose O, e^{i theta}, the closure (0, or -1 where a
+    leash misses by more than CLOSURE_TOL rounding units of L: the group cannot be assembled
+    there), the Newton steps and the largest miss (m). slider<i>: 1.0 where leash i is a
+    slider, else 0.0. `track`: None, or the poses (u, O, rot) solved at the stations (`stations`
+    with no angle asked; u = phi - phi0 in [-pi, pi), sorted): None runs the continuation from
+    the design pose (the base link's local frame: the model's points drawn in world
+    coordinates); a track gives every angle its start, interpolated between the stations
+    around it, and Newton runs on all the angles at once."""
     kinds = "".join("P" if s else "R" for s in (slider1, slider2, slider3))
-    pos = positions(kinds, phi, phi0, 0j, 1 + 0j, (x1, x2, x3), (P1, P2, P3), (c1, c2, c3), L)
-    return pos.O, pos.rot, np.where(pos.residual <= CLOSURE_TOL * _EPS * L, 0.0, -1.0), \
-        pos.iterations.astype(float), pos.residual
+    if track is None:
+        pos = positions(kinds, phi, phi0, 0j, 1 + 0j, (x1, x2, x3), (P1, P2, P3), (c1, c2, c3), L)
+        O, rot, its, res = pos.O, pos.rot, pos.iterations, pos.residual
+    else:
+        tu, tO, trot = track
+        u = np.mod(np.asarray(phi, float) - phi0 + np.pi, 2 * np.pi) - np.pi
+        th = np.unwrap(np.angle(trot))
+        O, rot, its, res = _newton(kinds, np.interp(u, tu, tO.real) + 1j * np.interp(u, tu, tO.imag),
+                                   np.exp(1j * np.interp(u, tu, th)), (x1, x2, x3),
+                                   tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3)),
+                                   tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3)), L)
+    return O, rot, np.where(res <= CLOSURE_TOL * _EPS * L, 0.0, -1.0), its.astype(float), res
 
 
 #: The names a program may call (`program.bind` binds them with `groups`'); all but
