@@ -224,3 +224,10 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
         s = fp.segment(forces.reaction_name(mech, i, j))
         drawn = (fp.points[s.end] - fp.points[s.start]) * mu_F.value
         assert abs(drawn - complex(*res.reaction(i, j)[0])) <= 1e-9 * abs(drawn)
+
+
+def test_the_drawing_error_simulation_refuses_a_triad_by_name(mech):
+    from kinetostat.plans import drawing_error
+    assert not drawing_error.draws_forces(mech)
+    with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind III3 R.. is not drawn"):
+        drawing_error.simulate(mech, n=10)
