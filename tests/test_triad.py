@@ -229,5 +229,5 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
 def test_the_drawing_error_simulation_refuses_a_triad_by_name(mech):
     from kinetostat.plans import drawing_error
     assert not drawing_error.draws_forces(mech)
-    with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind III3 R.. is not drawn"):
+    with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind R.. \(III3 R..\) is not drawn"):
         drawing_error.simulate(mech, n=10)

@@ -188,7 +188,7 @@ class _Plans:
 
     @staticmethod
     def _unsupported(g) -> None:
-        raise NotImplementedError(f"drawing error: group {g.label} of kind {g.vid} is not drawn "
+        raise NotImplementedError(f"drawing error: group {g.label} of kind {g.kind} ({g.vid}) is not drawn "
                                   f"(kinematics: the dyads RRR, RRP with its guide on the frame, RPR)")
 
     def _link_plan(self, P: str, B: str, pP, b, scale: float, key: str, unit: str):
