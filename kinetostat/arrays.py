@@ -37,6 +37,10 @@ def solve(mech: "Mechanism", phi: Any) -> Mapping[str, Any]:
                                   f"({', '.join(ld.name for ld in mech.loads) or 'springs'}); use kinetostat.analyze")
     if mech.drive.law is not None:
         raise NotImplementedError("kinetostat.arrays.solve: a law of motion (drive omega(phi)); use kinetostat.analyze")
+    triads = [g.label for g in mech.structure.groups if g.klass == 3]
+    if triads:
+        raise NotImplementedError(f"kinetostat.arrays.solve: a class-III group ({', '.join(triads)}): its positions "
+                                  f"are a continuation over the angle axis in numpy; use kinetostat.analyze")
     dev = device(phi)
     env = dict(mech.memo(("xp constants", id(xp), str(dev)), lambda: {
         n: xp.asarray(v, dtype=xp.complex128 if isinstance(v, complex) else xp.float64, device=dev)

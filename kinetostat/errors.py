@@ -50,7 +50,7 @@ class ModelWarning(UserWarning):
 
 
 class StructureError(ValueError):
-    """The linkage is not a mobility-1 chain of class-II Assur groups on a crank."""
+    """The linkage is not a mobility-1 chain of class-II Assur groups and triads III3 on a crank."""
 
 
 def _angle_list(phi_deg: np.ndarray, limit: int = 12) -> str:

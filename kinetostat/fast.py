@@ -9,6 +9,8 @@ per angle, the kinematics, the loads, the reactions of every group and the balan
   each a view of one buffer reused from chunk to chunk (valid until the next is asked for).
 - `peaks(mechs, phi_deg)`: what a sweep keeps of each design: the largest |R| of every pair,
   |M_bal| and |F_bal| over the cycle, and the angles that need the exact guard.
+- `refusal(mech)`: why a mechanism is not taken (a class-III group), None where it is; the
+  three above raise NotImplementedError with it, and `analyze` and the sweeps use the numpy path.
 
 The kernel: the five primitives of `groups` (|z|, complex / real, complex / complex, e^{i th},
 atan2) bound to branch-free versions (sincos and atan by polynomials, divisions part by part);
@@ -234,12 +236,23 @@ def _constants(mech: "Mechanism") -> dict[str, Any]:
         **constants(mech), **{f"branch{n}": float(b) for n, b in enumerate(_branches(mech))}})
 
 
+def refusal(mech: "Mechanism") -> str | None:
+    """Why the compiled path does not take `mech`, None where it does: a class-III group (its
+    positions are a continuation over the angle axis, not a closed form per angle)."""
+    triads = [g.label for g in mech.structure.groups if g.klass == 3]
+    return (f"the compiled path does not take class-III groups ({', '.join(triads)}): a triad's positions "
+            f"are a continuation over the angle axis; the numpy path (kinetostat.analyze) solves it") if triads else None
+
+
 def _layout(mech: "Mechanism") -> _Layout:
     """The layout of `mech`'s kernels and buffer (memoised per mechanism)."""
     return mech.memo(("fast layout", _branches(mech)), lambda: _make_layout(mech))
 
 
 def _make_layout(mech: "Mechanism") -> _Layout:
+    why = refusal(mech)
+    if why:
+        raise NotImplementedError(f"{mech.name}: {why}")
     motion, statics = _motion(mech), statics_program(mech)
     base = _constants(mech)
     consts = tuple(dict.fromkeys(n for n in free_names(motion) + free_names(statics) if n in base)) + tuple(

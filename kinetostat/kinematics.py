@@ -12,7 +12,7 @@ with every input (each point of the linkage, the crank angle) moved by PERTURB_U
 the change is the error estimate (`Kinematics.error`). Fewer than DIGITS_WARN digits left: a
 SingularPositionWarning names the angles and the digits; fewer than DIGITS_MIN: NaN.
 
-May use: program, sizes, planar, errors (model and structure for type hints only).
+May use: program, sizes, triad, planar, errors (model and structure for type hints only).
 """
 from __future__ import annotations
 
@@ -24,17 +24,19 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from .errors import SingularPositionWarning, singular_message
+from .errors import ModelWarning, SingularPositionWarning, singular_message
 from .planar import as_xy
 from .program import constants, motion_program, run
 from .sizes import group_scales, kinematic_size
+from .triad import modes, special_point, stations
 
 if TYPE_CHECKING:
     from .model import Mechanism
 
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
-           "a_priori_error", "relative_change", "digits", "assemble"]
+           "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes",
+           "MODES_CLOSE", "special_point_z"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
@@ -55,6 +57,9 @@ DIGITS_MIN = 6
 #: Size of the input perturbation of the accuracy check, in units of the double-precision
 #: rounding of each input; two solves with independent signs per input.
 PERTURB_ULPS = 4
+#: Two assembly modes of a triad closer than this (the largest move of an inner pin, in units of
+#: the group's size) at the design position: a ModelWarning.
+MODES_CLOSE = 0.05
 _EPS = np.finfo(float).eps
 _TINY = np.finfo(float).tiny
 
@@ -153,12 +158,105 @@ def kinematics(mech: "Mechanism", phi: np.ndarray, unit_speed: bool = False) -> 
     return guard(mech, kin, error)
 
 
+@dataclass(frozen=True)
+class AssemblyModes:
+    """The assembly modes of a triad at the design position (the texts' method of false
+    positions, `triad.modes`): the base link's pose in each, the one solved (the mode the
+    model's points draw), and how far the nearest other mode is."""
+    group: str
+    O: tuple[complex, ...]       # base link's local origin per mode, m (world, complex)
+    rot: tuple[complex, ...]     # its e^{i theta} per mode
+    chosen: int                  # index of the mode solved
+    drawn_miss: float            # how far the model's drawing is from the chosen mode (inner pins), m
+    separation: float            # nearest other mode: largest move of an inner pin / group size (inf: none)
+
+    def lines(self) -> list[str]:
+        """One line per mode, the chosen one marked."""
+        return [f"  {self.group} mode {i + 1}: base origin ({round(O.real, 9) + 0.0:.6g}, {round(O.imag, 9) + 0.0:.6g}) m, theta "
+                f"{round(math.degrees(math.atan2(r.imag, r.real)), 7) + 0.0:.6g} deg" + ("   <- solved (drawn by the model)" if
+                                                                          i == self.chosen else "")
+                for i, (O, r) in enumerate(zip(self.O, self.rot))]
+
+
+def assembly_modes(mech: "Mechanism") -> tuple[AssemblyModes, ...]:
+    """Per triad of `mech` (memoised), its assembly modes at the design position (drive.design_deg)."""
+    def make() -> tuple[AssemblyModes, ...]:
+        triads = [(n, g) for n, g in enumerate(mech.structure.groups) if g.klass == 3]
+        if not triads:
+            return ()
+        kin = _solve(mech, np.radians([mech.drive.design_deg]), mech.points_z)
+        pts, out = mech.points_z, []
+        for n, g in triads:
+            b, L = g.links[0], group_scales(mech)[n]
+            x, P, c = [], [], []
+            for i in range(3):
+                po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
+                x.append(pts[b][pi.point])
+                if po.kind == "R":
+                    P.append(complex(kin.position_z(a, _xy(pts[a][po.point]))[0]))
+                    c.append(abs(pts[ell][pi.point] - pts[ell][po.point]))
+                else:                   # the guide line through the pin as solved, its normal
+                    P.append(complex(kin.position_z(ell, _xy(pts[ell][pi.point]))[0]))
+                    c.append(complex(1j * kin.rot[0, a] * complex(*po.direction)))
+            found = modes("".join(g.pairs[2 * i].kind for i in range(3)), tuple(x), tuple(P), tuple(c), L)
+            pins = lambda O, r: np.array([O + xi * r for xi in x])
+            solved = pins(kin.origin_z[0, b], kin.rot[0, b])
+            apart = [float(np.abs(pins(O, r) - solved).max()) for O, r in found]
+            chosen = int(np.argmin(apart))
+            others = [float(np.abs(pins(O, r) - pins(*found[chosen])).max()) / L
+                      for i, (O, r) in enumerate(found) if i != chosen]
+            out.append(AssemblyModes(g.label, tuple(O for O, _ in found), tuple(r for _, r in found), chosen,
+                                     float(np.abs(solved - np.array(x)).max()), min(others, default=math.inf)))
+        return tuple(out)
+    return mech.memo("assembly modes", make)
+
+
+def special_point_z(mech: "Mechanism", kin: Kinematics, g) -> np.ndarray:
+    """(N,) complex, m: Assur's special point S of triad g, where the axes of its leashes 1 and
+    2 meet (a two-pin leash's axis: outer pin -> inner pin; a slider's: the guide's normal through
+    its pin)."""
+    pts, X, u = mech.points_z, [], []
+    for ell, outer, inner, a in g.sides[:2]:
+        X.append(kin.position_z(ell, _xy(pts[ell][inner.point])))
+        if outer.kind == "R":
+            r = X[-1] - kin.position_z(ell, _xy(pts[ell][outer.point]))
+            u.append(r / np.abs(r))
+        else:
+            u.append(1j * complex(*outer.direction) * kin.rot[:, a])
+    return special_point(X[0], u[0], X[1], u[1])[0]
+
+
+def _xy(z: complex) -> tuple[float, float]:
+    return z.real, z.imag
+
+
+def _check_modes(mech: "Mechanism") -> None:
+    """Warn (once per mechanism) where a triad's model does not draw it assembled at the design
+    position, or where another mode is closer than MODES_CLOSE."""
+    def check() -> bool:
+        for am in assembly_modes(mech):
+            L = group_scales(mech)[[g.label for g in mech.structure.groups].index(am.group)]
+            if am.drawn_miss > 1e-6 * L:
+                warnings.warn(ModelWarning(
+                    f"group {am.group}: the base link's points do not draw the group assembled at the design position "
+                    f"(design_deg = {mech.drive.design_deg:g}; the pins miss the nearest mode by {am.drawn_miss:.3g} m); "
+                    f"that mode is solved: give the triad's points in world coordinates at the design position"),
+                    stacklevel=5)
+            if am.separation < MODES_CLOSE:
+                warnings.warn(ModelWarning(
+                    f"group {am.group}: another assembly mode is within {am.separation:.3g} of the group's size at the "
+                    f"design position (kinetostat structure MODEL --modes lists them)"), stacklevel=5)
+        return True
+    mech.memo("modes checked", check)
+
+
 def solve_checked(mech: "Mechanism", phi: np.ndarray,
                   unit_speed: bool = False) -> tuple[Kinematics, np.ndarray, list[Kinematics]]:
     """The kinematics at `phi` (unguarded: nothing NaN yet, `error` not set), the indices of the
     angles where some group's cond exceeds COND_CHECK, and the kinematics at those angles solved
     again on inputs moved by PERTURB_ULPS ulps (one per sign pattern). Call under np.errstate
     as `kinematics` does."""
+    _check_modes(mech)
     kin = _solve(mech, phi, mech.points_z, unit_speed)
     checked = np.flatnonzero(~(kin.cond <= COND_CHECK).all(axis=1))       # NaN cond: checked
     trials = []
@@ -198,8 +296,26 @@ def _solve(mech: "Mechanism", phi: np.ndarray, locals_: tuple[Mapping[str, compl
     """The motion program of `mech` run over the angles `phi` with the local points `locals_`."""
     w, e = (1.0, 0.0) if unit_speed else mech.drive.speed(phi)      # the constants, or per angle by the law
     env = dict(mech.memo(("constants", id(locals_)), lambda: constants(mech, locals_)))
-    env.update(phi=phi, w_in=w, e_in=e)
+    env.update(_tracks(mech), phi=phi, w_in=w, e_in=e)
     return assemble(mech, phi, run(motion_program(mech), env))
+
+
+def _tracks(mech: "Mechanism") -> dict[str, tuple]:
+    """Each triad's track (memoised per mechanism): its base link's poses at the continuation's
+    stations round the cycle, solved once by continuation from the design position; the angles
+    asked later start from it (`triad.iii3_positions`)."""
+    def make() -> dict[str, tuple]:
+        triads = [n for n, g in enumerate(mech.structure.groups) if g.klass == 3]
+        if not triads:
+            return {}
+        phi0 = math.radians(mech.drive.design_deg)
+        phi = stations(phi0)
+        env = dict(constants(mech), phi=phi, w_in=1.0, e_in=0.0)
+        run(motion_program(mech), env)
+        u = phi - phi0
+        return {f"track{n}": (u, env[f"O{g}"], env[f"rot{g}"]) for n in triads
+                for g in [mech.structure.groups[n].links[0]]}
+    return mech.memo("triad tracks", make)
 
 
 def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Kinematics:

@@ -11,7 +11,7 @@ scales: `constants`) enter as the environment it runs in. The same program runs
 - on scalars inside a compiled loop over designs and angles (`kinetostat.fast` generates it
   from `code`, over groups' source with its compiled primitives).
 
-May use: numpy, groups, sizes, errors (model and structure for type hints only).
+May use: numpy, groups, triad, sizes, errors (model and structure for type hints only).
 """
 from __future__ import annotations
 
@@ -21,13 +21,13 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple
 
 import numpy as np
 
-from . import groups
+from . import groups, triad
 from .errors import AssemblyError
 from .sizes import group_scales
 
 if TYPE_CHECKING:
     from .model import Mechanism, Pair
-    from .structure import AssurGroup
+    from .structure import AssurGroup, Triad
 
 __all__ = ["Step", "Program", "motion_program", "statics_program", "constants", "run", "bind",
            "code", "free_names", "compiled", "Identifiers", "REACH_TOL"]
@@ -61,7 +61,8 @@ def constants(mech: "Mechanism", points: tuple[Mapping[str, complex], ...] | Non
     """The base constants the programs of `mech` read: every local point (x<k>_<name>, complex),
     every guide direction (d<p>, complex unit) and its angle (alpha<p>), the group scales
     (L<n>, m), the drive, the masses (mass<k>, I_S<k>, com<k> the local centre of mass), g,
-    and the gear. `points`: the local points (default the
+    the gear, the design angle phi_design (rad) and each triad's track<n> (None: the program
+    runs its continuation). `points`: the local points (default the
     model's; the accuracy check passes them perturbed); `scales`: the group scales."""
     pts = mech.points_z if points is None else points
     c: dict[str, Any] = {}
@@ -80,6 +81,10 @@ def constants(mech: "Mechanism", points: tuple[Mapping[str, complex], ...] | Non
     for k in range(1, mech.n_links):
         c[f"mass{k}"], c[f"I_S{k}"], c[f"com{k}"] = float(mass[k]), float(I_S[k]), complex(com[k])
     c["g"] = float(mech.g)
+    c["phi_design"] = float(np.radians(dr.design_deg))
+    for n, grp in enumerate(mech.structure.groups):
+        if grp.klass == 3:
+            c[f"track{n}"] = None        # a triad's poses at the stations (`kinematics` sets them)
     if dr.kind == "machine":
         g = dr.gear
         c["gear_e"], c["gear_alpha"], c["gear_rb"] = complex(*g.centre_direction), float(np.radians(g.alpha_w_deg)), g.r_b
@@ -278,6 +283,60 @@ class _Motion(_Build):
         self.slide(pk, k, v2, a2)
         self.conditioning(n, frob, det)
 
+    def iii3(self, n: int, g: "Triad") -> None:
+        """III3: the base link's pose by Newton with continuation (`triad.iii3_positions`), then
+        the plans at Assur's special point S (axes of leashes 1 and 2) as 2x2 solves."""
+        b = g.links[0]
+        X, leash = [], []
+        for i in range(3):
+            po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
+            if po.kind == "R":
+                A, VA, AA = self.point(a, po.point)
+                leash.append(("R", A, self.length(ell, pi.point, po.point), VA, AA))
+            else:
+                d = self.guide(po, a, self.frame_of(a)[1])
+                K = self.call("off_line", self.position(a, self.anchor(po, a)), self.offset(po, ell, pi.point), d)
+                leash.append(("P", K, self.call("times", d, 1j), d))
+        O, rot, closure, _, _ = self.call(
+            "iii3_positions", "phi", "phi_design", *(float(m[0] == "P") for m in leash),
+            *(_x(b, g.pairs[2 * i + 1].point) for i in range(3)), *(m[1] for m in leash), *(m[2] for m in leash),
+            f"L{n}", f"track{n}", out=(self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
+        self.steps.append(Step("check", (closure, 0.0), (), g.label, "the three leashes do not close"))
+        u = []
+        for i, m in enumerate(leash):
+            X.append(self.call("place", O, rot, _x(b, g.pairs[2 * i + 1].point)))
+            u.append(self.call("leash_rr" if m[0] == "R" else "leash_slider", X[i], m[1], m[2], out=2)[0])
+        S, det = self.call("special_point", X[0], u[0], X[1], u[1], out=2)
+        ref = [m[3] if m[0] == "R" else self.at(g.known[i], X[i])[0] for i, m in enumerate(leash)]
+        vS, w, h3 = self.call("iii3_velocity", S, X[2], *u, det, *ref, out=3)
+        VX = [self.call("motion_at", S, vS, 0.0, w, 0.0, Xi, out=2)[0] for Xi in X]
+        normal = [self.leash_motion(g, i, m, X[i], VX[i], 0.0)[2] for i, m in enumerate(leash)]
+        acc = [m[4] if m[0] == "R" else self.at(g.known[i], X[i])[1] for i, m in enumerate(leash)]
+        aS, e = self.call("iii3_acceleration", S, *X, *u, det, h3, w, *acc, *normal, out=2)
+        th = self.call("phase", rot)
+        self.set_link(b, th, rot, S, self.call("local_of", S, O, rot), w, vS, e, aS)
+        for i, m in enumerate(leash):
+            po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
+            AX = self.call("motion_at", S, vS, aS, w, e, X[i], out=2)[1]
+            w_l, e_l, _ = self.leash_motion(g, i, m, X[i], VX[i], AX)
+            if m[0] == "R":
+                self.set_link(ell, *self.aligned(ell, po.point, pi.point, self.call("sub", X[i], m[1])), m[1],
+                              _x(ell, po.point), w_l, m[3], e_l, m[4])
+            else:
+                wa, ea = (f"w{a}", f"e{a}") if a else (0.0, 0.0)
+                self.set_link(ell, *self.turned(po, ell, *self.frame_of(a)), X[i], _x(ell, pi.point), wa, VX[i], ea, AX)
+                self.slide(po, ell, w_l, e_l)
+        self.steps.append(Step("iii3_condition", (*u, det, h3, f"L{n}"), (f"cond{n}",)))
+
+    def leash_motion(self, g: "Triad", i: int, m: tuple, X, VX, AX) -> tuple:
+        """Leash i's (omega, eps, normal term), a slider's (v_r, a_r, Coriolis term), given the
+        motion VX, AX of its inner pin X."""
+        if m[0] == "R":
+            return self.call("rr_leash_motion", X, m[1], VX, m[3], AX, m[4], out=3)
+        a = g.known[i]
+        VXa, AXa = self.at(a, X)
+        return self.call("slider_leash_motion", m[3], VX, VXa, AX, AXa, f"w{a}" if a else 0.0, out=3)
+
     def frame_of(self, k: int) -> tuple:
         """Angle and e^{i theta} of link k (the frame's are constants)."""
         return (f"th{k}", f"rot{k}") if k else (0.0, 1.0 + 0j)
@@ -285,6 +344,11 @@ class _Motion(_Build):
     def motion_or_rest(self, k: int) -> tuple:
         """O, V, A, w, e of link k; the frame's at rest."""
         return self.motion(k) if k else (0.0,) * 5
+
+
+def _solver(g: "AssurGroup | Triad") -> str:
+    """The builder's method for group g: its kind's name, iii3 for a triad."""
+    return "iii3" if g.klass == 3 else g.kind.lower()
 
 
 def motion_program(mech: "Mechanism") -> Program:
@@ -299,10 +363,11 @@ def motion_program(mech: "Mechanism") -> Program:
         b.set_link(1, th1, rot1, _x(0, dr.pivot), _x(1, dr.pivot), b.call("scaled", "w_in", "sense"), 0.0,
                    b.call("scaled", "e_in", "sense"), 0.0)
         for n, g in enumerate(mech.structure.groups):
-            getattr(b, g.kind.lower())(n, g)
+            getattr(b, _solver(g))(n, g)
         L, G = mech.n_links, len(mech.structure.groups)
         outputs = tuple(f"{s}{k}" for s in ("th", "rot", "O", "V", "A", "w", "e") for k in range(1, L)) + \
-            tuple(f"{s}{p}" for s in ("vs", "as") for p in sorted(b.slides)) + tuple(f"cond{n}" for n in range(G))
+            tuple(f"{s}{p}" for s in ("vs", "as") for p in sorted(b.slides)) + tuple(f"cond{n}" for n in range(G)) + \
+            tuple(f"{s}{n}" for n, g in enumerate(mech.structure.groups) if g.klass == 3 for s in ("it", "res"))
         return Program(tuple(b.steps), ("phi", "w_in", "e_in"), outputs)
     # keyed by the branches too: a Mechanism copied with other branches (dataclasses.replace) shares the memo
     return mech.memo(("motion_program", tuple(g.branch for g in mech.structure.groups)), make)
@@ -397,6 +462,42 @@ class _Statics(_Build):
         self.carry(a, f_aj, B, m_aj)
         self.carry(c, f_ck, B, m_ck)
 
+    def iii3(self, g: "Triad") -> None:
+        """III3 in the texts' order: R^tau of each leash from its moment about its inner pin; R^n
+        of leash 3 from the group's moment about S; R^n of leashes 1, 2 from the group's force
+        polygon; the inner reactions from each leash's polygon."""
+        b = g.links[0]
+        X, u, T, P, m, lengths = [], [], [], [], [], []
+        for i in range(3):
+            po, pi, ell = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i]
+            X.append(self.at(b, pi.point))
+            if po.kind == "R":
+                P.append(self.at(ell, po.point))
+                lengths.append(self.length(ell, pi.point, po.point))
+                u.append(self.call("leash_rr", X[i], P[i], lengths[i], out=2)[0])
+                T.append(self.call("rr_tangential", u[i], self.moment(ell, X[i]), lengths[i]))
+                m.append(0.0)
+            else:
+                P.append(X[i])
+                u.append(self.normal(po))
+                T.append(0j)
+                m.append(self.call("scaled", self.moment(ell, X[i]), -1.0))
+        S, det = self.call("special_point", X[0], u[0], X[1], u[1], out=2)
+        F, MS = f"F{b}", self.moment(b, S)
+        for ell in g.links[1:]:
+            F, MS = self.call("add", F, f"F{ell}"), self.call("add", MS, self.moment(ell, S))
+        N = self.call("iii3_polygon", S, X[2], *u, det, *T, *P, *m, F, MS, out=3)
+        for i in range(3):
+            po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
+            if po.kind == "R":
+                R = self.call("add", T[i], self.call("times", N[i], u[i]))
+                self.revolute(po, a, R)
+                self.carry(a, R, P[i])
+            else:
+                R = self.prismatic(po, a, N[i], u[i], m[i], X[i])
+                self.carry(a, R, X[i], m[i])
+            self.revolute(pi, ell, self.call("add", f"F{ell}", R))
+
     def rpp(self, g: "AssurGroup") -> None:
         (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
         P, n_in, nc = self.at(j, pj.point), self.normal(pin), self.normal(pk)
@@ -418,7 +519,7 @@ def statics_program(mech: "Mechanism") -> Program:
     def make() -> Program:
         b = _Statics(mech)
         for g in reversed(mech.structure.groups):
-            getattr(b, g.kind.lower())(g)
+            getattr(b, _solver(g))(g)
         dr = mech.drive
         b.steps.append(Step("scaled", (b.moment(1, b.at(1, dr.pivot)), -1.0), ("M_bal",)))
         if dr.kind == "machine":
@@ -447,14 +548,15 @@ def bind(xp: Any) -> types.SimpleNamespace:
     are numpy's. (The compiled path, `kinetostat.fast`, compiles groups' source with its own.)"""
     key = id(xp)
     if key not in _BOUND:
+        names = {**{n: groups for n in groups.__all__}, **{n: triad for n in triad.EQUATIONS}}
         if xp is np:
-            _BOUND[key] = types.SimpleNamespace(**{n: getattr(groups, n) for n in groups.__all__})
+            _BOUND[key] = types.SimpleNamespace(**{n: getattr(m, n) for n, m in names.items()})
         else:
             env = dict(vars(groups), xp=xp)
-            for n in groups.__all__:
-                f = getattr(groups, n)
+            for n, m in names.items():
+                f = getattr(m, n)
                 env[n] = types.FunctionType(f.__code__, env, n, f.__defaults__, f.__closure__)
-            _BOUND[key] = types.SimpleNamespace(**{n: env[n] for n in groups.__all__})
+            _BOUND[key] = types.SimpleNamespace(**{n: env[n] for n in names})
     return _BOUND[key]
 
 

@@ -1,5 +1,6 @@
 """`analyze(mech, phi_deg)`: the whole kinetostatic analysis, by the path that suits the work: the
-numpy path (`analysis.exact`) below `fast.FAST_MIN` angles, the compiled kernel (`fast`) from them on.
+numpy path (`analysis.exact`) below `fast.FAST_MIN` angles (and for what the kernel refuses), the
+compiled kernel (`fast`) from them on.
 
 May use: model, analysis, fast.
 """
@@ -17,11 +18,12 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
     or at `steps` equal steps over a full revolution when `phi_deg` is None.
 
     From fast.FAST_MIN angles on it runs the compiled kernel (`fast.analyze_fast`), below them
-    the numpy path (`exact`): the same results to rounding (tests/test_fast.py)."""
+    the numpy path (`exact`): the same results to rounding (tests/test_fast.py). A mechanism the
+    kernel does not take (`fast.refusal`: a class-III group) goes the numpy path at any count."""
     if not isinstance(mech, Mechanism):
         raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
                         f"read a model file with kinetostat.load(path)")
     phi_deg = crank_angles(phi_deg, steps)
-    if len(phi_deg) >= fast.FAST_MIN and fast.available():
+    if len(phi_deg) >= fast.FAST_MIN and fast.available() and fast.refusal(mech) is None:
         return fast.analyze_fast(mech, phi_deg)
     return exact(mech, phi_deg)

@@ -1,5 +1,6 @@
 """Structural analysis (seed 000 sec. 5, seed 002 sec. 1.2.1): mobility by Chebyshev and the
-decomposition into the initial mechanism I(0,1) and class-II Assur groups.
+decomposition into the initial mechanism I(0,1), class-II Assur groups (dyads) and the
+simplest class-III group III3 (a triad: a ternary base link and three leashes; Artobolevsky).
 
 Works on the model's data only (the number of links, the pairs, the assembly branches): it
 imports nothing of `model`, which calls `analyse_structure` when it builds a Mechanism. May
@@ -16,7 +17,7 @@ from typing import Protocol
 
 from .errors import StructureError
 
-__all__ = ["AssurGroup", "Structure", "analyse_structure", "GROUP_KINDS", "KinematicPair"]
+__all__ = ["AssurGroup", "Triad", "Structure", "analyse_structure", "GROUP_KINDS", "KinematicPair"]
 
 # The five kinds of class-II groups, numbered as the texts number them ("вид").
 GROUP_KINDS = {"RRR": 1, "RRP": 2, "RPR": 3, "PRP": 4, "RPP": 5}
@@ -47,15 +48,74 @@ class AssurGroup:
     pairs: tuple[KinematicPair, KinematicPair, KinematicPair]   # the model's Pair objects
     known: tuple[int, int]
     branch: int
+    klass = 2     # the group's class (Assur-Artobolevsky)
+
+    @property
+    def vid(self) -> str:
+        """The kind's number as the texts give it ("вид")."""
+        return f"kind {GROUP_KINDS[self.kind]}"
+
+    @property
+    def sides(self) -> tuple[tuple[int, KinematicPair, KinematicPair, int], ...]:
+        """(link, its outer pair, the inner pair, the known link) of j and of k."""
+        return ((self.links[0], self.pairs[0], self.pairs[1], self.known[0]),
+                (self.links[1], self.pairs[2], self.pairs[1], self.known[1]))
 
     @property
     def label(self) -> str:
         return f"II({self.links[0]},{self.links[1]})" if self.links[0] < self.links[1] \
             else f"II({self.links[1]},{self.links[0]})"
 
+    def describe(self) -> str:
+        """One line for the structure listing: links, outer and inner pairs, branch."""
+        outer_j, inner, outer_k = self.pairs
+        return (f"{self.label}  {self.kind} ({self.vid})  links {self.links[0]}, {self.links[1]}; "
+                f"outer pairs {outer_j.label}, {outer_k.label} (to links {self.known[0]}, {self.known[1]}), "
+                f"inner {inner.label}; branch {self.branch:+d}")
+
     def __repr__(self) -> str:
         pairs = ", ".join(f"{p.kind}({p.links[0]},{p.links[1]})" for p in self.pairs)
         return f"AssurGroup({self.label} {self.kind}, pairs=[{pairs}], known={self.known}, branch={self.branch:+d})"
+
+
+@dataclass(frozen=True)
+class Triad:
+    """The class-III, order-3 Assur group III3 of the base link `links[0]` and the leashes
+    `links[1:]`: leash i joins the base at its inner pair `pairs[2i + 1]` (revolute) and the
+    link `known[i]`, already attached, at its outer pair `pairs[2i]` (revolute, or prismatic with
+    the guide on the known link: a slider). `kind` reads the outer pairs, e.g. "RRR" or "RRP".
+    Assur's special point S is where the axes of leashes 1 and 2 meet; leash 3 is the third.
+    The assembly mode is the one the model's points draw at the design position (no branch)."""
+    kind: str
+    links: tuple[int, int, int, int]
+    pairs: tuple[KinematicPair, ...]
+    known: tuple[int, int, int]
+    branch: int = 0
+    klass = 3
+
+    @property
+    def vid(self) -> str:
+        return f"III3 {self.kind}"
+
+    @property
+    def sides(self) -> tuple[tuple[int, KinematicPair, KinematicPair, int], ...]:
+        """(leash, its outer pair, its inner pair on the base, the known link) of each leash."""
+        return tuple((self.links[1 + i], self.pairs[2 * i], self.pairs[2 * i + 1], self.known[i]) for i in range(3))
+
+    @property
+    def label(self) -> str:
+        return "III(" + ",".join(map(str, sorted(self.links))) + ")"
+
+    def describe(self) -> str:
+        """One line for the structure listing: base, leashes with their outer and inner pairs."""
+        leashes = "; ".join(f"leash {i + 1} link {self.links[1 + i]}: outer {self.pairs[2 * i].label} (to link "
+                            f"{self.known[i]}), inner {self.pairs[2 * i + 1].label}" for i in range(3))
+        return (f"{self.label}  class III, order 3 (III3, outer pairs {self.kind})  base link {self.links[0]}; "
+                f"{leashes}; mode: as drawn at the design position")
+
+    def __repr__(self) -> str:
+        pairs = ", ".join(f"{p.kind}({p.links[0]},{p.links[1]})" for p in self.pairs)
+        return f"Triad({self.label} base {self.links[0]}, pairs=[{pairs}], known={self.known})"
 
 
 @dataclass(frozen=True)
@@ -64,7 +124,7 @@ class Structure:
     n: int
     p5: int
     p4: int
-    groups: tuple[AssurGroup, ...]
+    groups: tuple[AssurGroup | Triad, ...]
 
     @property
     def W(self) -> int:
@@ -77,17 +137,19 @@ class Structure:
 
     @property
     def mechanism_class(self) -> int:
-        return 2 if self.groups else 1
+        """The highest class of its groups (1: the initial mechanism alone)."""
+        return max((g.klass for g in self.groups), default=1)
 
     @property
     def order(self) -> int:
-        return 2 if self.groups else 1
+        """The highest order of its groups (a dyad 2, a triad III3 3)."""
+        return max((g.klass for g in self.groups), default=1)
 
     def __repr__(self) -> str:
         return f"Structure(W={self.W}, formula={self.formula!r}, kinds={[g.kind for g in self.groups]})"
 
     def __str__(self) -> str:
-        kinds = ", ".join(f"{g.label} {g.kind} (kind {GROUP_KINDS[g.kind]})" for g in self.groups)
+        kinds = ", ".join(f"{g.label} {g.kind} ({g.vid})" for g in self.groups)
         return (f"W = 3*{self.n} - 2*{self.p5} - {self.p4} = {self.W}; {self.formula}; "
                 f"class {self.mechanism_class}, order {self.order}; groups: {kinds or 'none'}")
 
@@ -95,8 +157,8 @@ class Structure:
 def analyse_structure(n_links: int, pairs: Sequence[KinematicPair],
                       branches: Mapping[frozenset, int]) -> Structure:
     """Mobility and Assur-group decomposition of `n_links` links (frame included) joined by
-    `pairs`, each group of kinds RRR, RRP, RPR on its assembly branch `branches[{j, k}]` (+1 or
-    -1). Raises StructureError for what is unsupported."""
+    `pairs`: dyads, each of kinds RRR, RRP, RPR on its assembly branch `branches[{j, k}]` (+1 or
+    -1), and triads III3. Raises StructureError for what is unsupported (class IV and higher)."""
     n = n_links - 1
     s = Structure(n, len(pairs), 0, ())
     if s.W != 1:
@@ -106,12 +168,13 @@ def analyse_structure(n_links: int, pairs: Sequence[KinematicPair],
     if len(crank_frame) != 1 or crank_frame[0].kind != "R":
         raise StructureError("the crank (link 1) must be joined to the frame by exactly one revolute pair")
 
-    groups = _dyads(n_links, pairs, branches)
+    groups = _groups(n_links, pairs, branches)
     remaining = set(range(2, n_links)).difference(*(g.links for g in groups))
     if remaining:
         raise StructureError(
-            f"links {sorted(remaining)} do not split into class-II Assur groups (dyads); "
-            f"a class-III or higher group (e.g. a triad) is not supported by kinetostat")
+            f"links {sorted(remaining)} do not split into class-II Assur groups (dyads) and class-III "
+            f"triads III3; a group of class IV or higher, or another class-III group, is not supported "
+            f"by kinetostat")
     unused = set(branches) - {frozenset(g.links) for g in groups}
     if unused:
         raise StructureError(f"group: branch given for {[sorted(u) for u in unused]}, "
@@ -120,10 +183,11 @@ def analyse_structure(n_links: int, pairs: Sequence[KinematicPair],
     return Structure(n, len(pairs), 0, tuple(groups))
 
 
-def _dyads(n_links: int, pairs: Sequence[KinematicPair], branches: Mapping[frozenset, int]) -> list[AssurGroup]:
+def _groups(n_links: int, pairs: Sequence[KinematicPair],
+            branches: Mapping[frozenset, int]) -> list[AssurGroup | Triad]:
     """The groups in the order of attachment: each time, of the links not yet attached, the
-    first (j, k), j < k, joined to each other by one pair and each to the attached links by one
-    pair. Stops where no such dyad is left. Work O(pairs x log links): per link its pairs to the
+    first dyad (j, k), j < k, joined to each other by one pair and each to the attached links by one
+    pair; where no dyad is left, the first triad (`_triad`). Stops where neither is left. Work O(pairs x log links): per link its pairs to the
     attached links, kept as links attach; a heap of the dyads that may be next."""
     at: list[list[KinematicPair]] = [[] for _ in range(n_links)]
     between: dict[frozenset, int] = {}
@@ -151,15 +215,49 @@ def _dyads(n_links: int, pairs: Sequence[KinematicPair], branches: Mapping[froze
                             heapq.heappush(heap, (min(y, z), max(y, z)))
 
     attach(0, 1)
-    groups: list[AssurGroup] = []
-    while heap:
-        j, k = heapq.heappop(heap)
-        if j in known or k in known or len(out[j]) != 1 or len(out[k]) != 1:
-            continue                                 # attached since, or joined twice
-        inner = next(p for p in at[j] if other(p, j) == k)
-        groups.append(_orient(branches, j, k, out[j][0], inner, out[k][0]))
-        attach(j, k)
-    return groups
+    groups: list[AssurGroup | Triad] = []
+    while True:
+        while heap:
+            j, k = heapq.heappop(heap)
+            if j in known or k in known or len(out[j]) != 1 or len(out[k]) != 1:
+                continue                             # attached since, or joined twice
+            inner = next(p for p in at[j] if other(p, j) == k)
+            groups.append(_orient(branches, j, k, out[j][0], inner, out[k][0]))
+            attach(j, k)
+        triad = _triad(n_links, at, known, out)
+        if triad is None:
+            return groups
+        groups.append(triad)
+        attach(*triad.links)
+
+
+def _triad(n_links: int, at: Sequence[Sequence[KinematicPair]], known: set[int],
+           out: Sequence[Sequence[KinematicPair]]) -> Triad | None:
+    """The first triad III3 among the links not attached: a base link with exactly three pairs,
+    none to an attached link, each to a leash that has exactly two pairs, one of them to an
+    attached link. Raises StructureError for a triad whose pairs the solver does not take."""
+    for b in range(2, n_links):
+        if b in known or out[b] or len(at[b]) != 3:
+            continue
+        leashes = [(set(p.links) - {b}).pop() for p in at[b]]
+        if len(set(leashes)) != 3 or any(x in known or len(at[x]) != 2 or len(out[x]) != 1 for x in leashes):
+            continue
+        order = sorted(range(3), key=lambda i: leashes[i])
+        pairs: list[KinematicPair] = []
+        for i in order:
+            x, inner, outer = leashes[i], at[b][i], out[leashes[i]][0]
+            label = "III(" + ",".join(map(str, sorted([b, *leashes]))) + ")"
+            if inner.kind != "R" or (outer.kind == "P" and outer.links[1] != x):
+                raise StructureError(
+                    f"triad {label}: leash {x} joins the base {b} by a {inner.kind} pair and link "
+                    f"{(set(outer.links) - {x}).pop()} by a {outer.kind} pair; kinetostat takes leashes "
+                    f"with a revolute inner pair and a revolute outer pair, or a slider (outer P pair, "
+                    f"the guide on the attached link)")
+            pairs += [outer, inner]
+        ls = tuple(leashes[i] for i in order)
+        return Triad("".join(pairs[2 * i].kind for i in range(3)), (b, *ls), tuple(pairs),
+                     tuple((set(pairs[2 * i].links) - {ls[i]}).pop() for i in range(3)))
+    return None
 
 
 def _orient(branches: Mapping[frozenset, int], j: int, k: int, pj: KinematicPair, pin: KinematicPair,

@@ -136,11 +136,12 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
         for design in designs:
             try:
                 mech = loads(text, source, parameters=design)
-                res = None if compiled else analyze(mech, phi_deg=phi_deg)
+                kernel = compiled and fast.refusal(mech) is None     # a triad: the numpy path
+                res = None if kernel else analyze(mech, phi_deg=phi_deg)
             except (ModelError, StructureError, AssemblyError) as exc:
                 rows.append({**design, "error": _reason(exc)})
                 continue
-            if compiled:
+            if kernel:
                 rows.append({**design, "error": ""})
                 built.append((len(rows) - 1, mech))
                 continue

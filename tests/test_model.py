@@ -87,9 +87,9 @@ def test_linkage_that_cannot_be_assembled_names_the_angles():
                               "at phi = [0, 30, 330] deg")
 
 
-def test_class_three_group_is_refused():
-    # W = 1, but links 2..5 form a class-III group: ternary link 3 (B, D, E) with three dyad legs
-    text = """
+def _linkage(links: dict[int, str], pins: list[tuple[int, int, str]]) -> str:
+    """A crank-driven model: frame O, F, G, the links' points (id -> TOML inline table), revolute pairs."""
+    head = """
 [mechanism]
 g = 9.81
 [drive]
@@ -102,27 +102,29 @@ rpm = 60.0
 O = [0.0, 0.0]
 F = [0.5, 0.3]
 G = [0.5, -0.3]
-[[link]]
-id = 1
-points = { O = [0.0, 0.0], A = [0.1, 0.0] }
-[[link]]
-id = 2
-points = { A = [0.0, 0.0], B = [0.3, 0.0] }
-[[link]]
-id = 3
-points = { B = [0.0, 0.0], D = [0.1, 0.1], E = [0.1, -0.1] }
-[[link]]
-id = 4
-points = { D = [0.0, 0.0], F = [0.2, 0.0] }
-[[link]]
-id = 5
-points = { E = [0.0, 0.0], G = [0.2, 0.0] }
-""" + "".join(f'[[pair]]\nkind = "R"\nlinks = [{i}, {j}]\npoint = "{p}"\n'
-              for i, j, p in [(0, 1, "O"), (1, 2, "A"), (2, 3, "B"), (3, 4, "D"), (4, 0, "F"),
-                              (3, 5, "E"), (5, 0, "G")])
+"""
+    return head + "".join(f"[[link]]\nid = {k}\npoints = {pts}\n" for k, pts in links.items()) + "".join(
+        f'[[pair]]\nkind = "R"\nlinks = [{i}, {j}]\npoint = "{p}"\n' for i, j, p in pins)
+
+
+def test_class_three_group_is_recognised_and_class_four_refused():
+    # W = 1, links 2..5 form the class-III group III3: ternary link 3 (B, D, E) with three leashes
+    crank = "{ O = [0.0, 0.0], A = [0.1, 0.0] }"
+    three = _linkage({1: crank, 2: "{ A = [0.0, 0.0], B = [0.3, 0.0] }",
+                      3: "{ B = [0.0, 0.0], D = [0.1, 0.1], E = [0.1, -0.1] }",
+                      4: "{ D = [0.0, 0.0], F = [0.2, 0.0] }", 5: "{ E = [0.0, 0.0], G = [0.2, 0.0] }"},
+                     [(0, 1, "O"), (1, 2, "A"), (2, 3, "B"), (3, 4, "D"), (4, 0, "F"), (3, 5, "E"), (5, 0, "G")])
+    s = kinetostat.loads(three).structure
+    assert (s.formula, s.mechanism_class, s.order) == ("I(0,1) <- III(2,3,4,5)", 3, 3)
+    assert s.groups[0].links == (3, 2, 4, 5) and s.groups[0].known == (1, 0, 0)
+    # the class-IV group of four links: the closed contour 2-3-4-5 with outer pairs on 2 and 4
+    four = _linkage({1: crank, 2: "{ A = [0.0, 0.0], B = [0.3, 0.0], D = [0.1, -0.1] }",
+                     3: "{ B = [0.0, 0.0], C = [0.2, 0.0] }", 4: "{ C = [0.0, 0.0], F = [0.2, 0.0], H = [0.1, -0.1] }",
+                     5: "{ D = [0.0, 0.0], H = [0.2, 0.0] }"},
+                    [(0, 1, "O"), (1, 2, "A"), (2, 3, "B"), (3, 4, "C"), (4, 0, "F"), (4, 5, "H"), (5, 2, "D")])
     with pytest.raises(StructureError, match=r"links \[2, 3, 4, 5\] do not split into class-II Assur groups"
-                                             r"(.*)class-III"):
-        kinetostat.loads(text)
+                                             r" \(dyads\) and class-III triads III3; a group of class IV or higher"):
+        kinetostat.loads(four)
 
 
 def test_wrong_mobility_is_refused():

@@ -101,6 +101,8 @@ def test_every_model(analysed, path, n):
                 assert plan.length_mm(s.name) * scale == pytest.approx(abs(s.value), rel=1e-9, abs=1e-12 * scale), \
                     (plan.kind, s.name)
     for g in mech.structure.groups:
+        if g.klass == 3:               # a triad's plans: tests/test_triad.py
+            continue
         j, k = g.links
         label = f"{min(j, k)},{max(j, k)}"
         plan = plans[f"forces:{label}"]

@@ -15,6 +15,8 @@ EXPECTED = {
     "rotating_slotted_link": ("I(0,1) <- II(2,3) <- II(4,5)", ["RPR", "RRP"], 5, 7),
     "furnace_loader_six_bar": ("I(0,1) <- II(2,3) <- II(4,5)", ["RRR", "RRP"], 5, 7),
     "scotch_yoke": ("I(0,1) <- II(2,3)", ["RPP"], 3, 4),
+    "triad_six_bar": ("I(0,1) <- III(2,3,4,5)", ["RRR"], 5, 7),
+    "triad_slider": ("I(0,1) <- III(2,3,4,5)", ["RRP"], 5, 7),
 }
 
 
@@ -29,7 +31,8 @@ def test_structure_formula(stem):
     assert s.formula == formula
     assert [g.kind for g in s.groups] == kinds
     assert (s.n, s.p5, s.p4, s.W) == (n, p5, 0, 1)       # Chebyshev: W = 3n - 2p5 - p4 = 1
-    assert (s.mechanism_class, s.order) == (2, 2)
+    klass = 3 if formula.count("III") else 2
+    assert (s.mechanism_class, s.order) == (klass, klass)
 
 
 def test_seed_002_structure_text():

@@ -13,7 +13,9 @@ group-by-group closed forms:
   solver's kinematics: it picks the assembly branch) and is iterated in extended precision to
   a residual below 1e-35 of the mechanism's size. The branch of every RRR/RRP/RPR group is then
   re-derived from the converged positions by the definitions of models/FORMAT.md and checked
-  against the model's `branch`, so a solver on the wrong branch cannot pass unnoticed.
+  against the model's `branch`, so a solver on the wrong branch cannot pass unnoticed. A
+  triad (III3) has no branch sign: its assembly mode is the one Newton converges to from the
+  solver's positions (the mode the model's points draw is checked by the solver's own tests).
 - **Velocities and accelerations**: linear solves J qd = (drive row), J qdd = -(J-dot qd)
   (the quadratic velocity terms written out for both pair kinds) in mpmath.
 - **Kinetostatics**: one global Newton-Euler system, 3 equations per moving link (force x, y
@@ -354,8 +356,8 @@ def _solve(A: list[list], b: list) -> list:
 def _branch_check(m: _Model, q, phi_deg: float) -> None:
     """Re-derive each group's branch from the converged positions (models/FORMAT.md)."""
     for g in m.mech.structure.groups:
-        if g.kind not in ("RRR", "RRP", "RPR"):
-            continue
+        if g.klass == 3 or g.kind not in ("RRR", "RRP", "RPR"):
+            continue                 # a triad's mode has no branch sign: Newton keeps the solver's
         pj, pin, pk = g.pairs
         j, k = g.links
         if g.kind == "RRR":

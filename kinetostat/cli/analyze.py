@@ -109,7 +109,6 @@ def cmd_analyze(args) -> int:
 
 
 def cmd_structure(args) -> int:
-    from ..structure import GROUP_KINDS
     path = Path(args.model)
     m = _load(path)
     s = m.structure
@@ -122,15 +121,14 @@ def cmd_structure(args) -> int:
              f"mobility (Chebyshev): W = 3n - 2p5 - p4 = 3*{s.n} - 2*{s.p5} - {s.p4} = {s.W}",
              f"initial mechanism I(0,1): crank 1 on the frame at {crank.point} ({crank.label})",
              "Assur groups, in order of attachment:"]
-    for g in s.groups:
-        outer_j, inner, outer_k = g.pairs
-        lines.append(f"  {g.label}  {g.kind} (kind {GROUP_KINDS[g.kind]})  links {g.links[0]}, {g.links[1]}; "
-                     f"outer pairs {outer_j.label}, {outer_k.label} (to links {g.known[0]}, {g.known[1]}), "
-                     f"inner {inner.label}; branch {g.branch:+d}")
+    lines += [f"  {g.describe()}" for g in s.groups]
     if not s.groups:
         lines.append("  none")
     lines.append(f"structure formula: {s.formula}")
     lines.append(f"class {s.mechanism_class}, order {s.order}")
+    if args.modes:
+        from ..kinematics import assembly_modes
+        lines += ["assembly modes at the design position:"] + [x for am in assembly_modes(m) for x in am.lines()]
     if m.parameters:
         lines.append("parameters: " + ", ".join(f"{n} = {v:.10g}" for n, v in m.parameters.items()))
     if m.expressions:

@@ -50,6 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Structural analysis of MODEL: mobility W by Chebyshev's formula with its "
                                    "arithmetic, the Assur groups with their kinds, the structure formula.")
     s.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
+    s.add_argument("--modes", action="store_true", help="list every assembly mode of each triad at the design position")
     s.set_defaults(func=cmd_structure)
 
     e = sub.add_parser("export", help="write a model as MJCF (MuJoCo) or URDF for physics engines",

@@ -178,7 +178,8 @@ class _Plans:
         self.eps = {d.link: zero + res.eps(d.link)[0]}
         self.pa = a_v
         for g in m.structure.groups:
-            {"RRR": self._rrr, "RRP": self._rrp, "RPR": self._rpr}.get(g.kind, self._unsupported)(g)
+            {"RRR": self._rrr, "RRP": self._rrp, "RPR": self._rpr}.get(g.kind if g.klass == 2 else "",
+                                                                        self._unsupported)(g)
         for k in range(1, m.n_links):
             com = m.links[k].com
             if com and f"V_{com}" not in self.out:
@@ -188,8 +189,8 @@ class _Plans:
 
     @staticmethod
     def _unsupported(g) -> None:
-        raise NotImplementedError(f"drawing error: group {g.label} of kind {g.kind} is not drawn "
-                                  f"(kinematics: RRR, RRP with its guide on the frame, RPR)")
+        raise NotImplementedError(f"drawing error: group {g.label} of kind {g.kind} ({g.vid}) is not drawn "
+                                  f"(kinematics: the dyads RRR, RRP with its guide on the frame, RPR)")
 
     def _link_plan(self, P: str, B: str, pP, b, scale: float, key: str, unit: str):
         """Link PB: the relative value (V_BP or a^τ_BP) read off the plan, and it over l_PB (ω or ε)."""
@@ -445,7 +446,8 @@ def _velocity_of(res: Analysis, k: int, X: complex) -> np.ndarray:
 
 def draws_forces(mech: Mechanism) -> bool:
     """Whether `simulate` draws the force plans, the crank and the lever of `mech` (SUPPORTED)."""
-    return all(g.kind == "RRR" or (g.kind == "RRP" and g.known[1] == 0) for g in mech.structure.groups)
+    return all(g.klass == 2 and (g.kind == "RRR" or (g.kind == "RRP" and g.known[1] == 0))
+               for g in mech.structure.groups)
 
 
 def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length_mm: float = 0.25,

@@ -183,7 +183,7 @@ def _later(mech: "Mechanism", g: "AssurGroup") -> set[int]:
 
 
 def _group_label(g: "AssurGroup") -> str:
-    return f"{g.links[0]},{g.links[1]}" if g.links[0] < g.links[1] else f"{g.links[1]},{g.links[0]}"
+    return ",".join(map(str, sorted(g.links)))
 
 
 # -- the reactions of a group, as the texts split them
@@ -280,6 +280,9 @@ def group_plans(mech: "Mechanism", res: "Analysis", mu_l) -> list[Plan]:
     mu_l = _scale(mu_l, "mu_l", "m/mm")
     plans = []
     for g in mech.structure.groups:
+        if g.klass == 3:
+            plans.append(_triad_group_plan(mech, res, g, mu_l))
+            continue
         j, k = g.links
         later = _later(mech, g)
         loads = {x: link_loads(mech, res, x) + _carried(mech, res, x, later) for x in (j, k)}
@@ -288,16 +291,7 @@ def group_plans(mech: "Mechanism", res: "Analysis", mu_l) -> list[Plan]:
         pts: dict[str, complex] = {}
         segs: list[Segment] = []
         paths: dict[str, tuple[complex, ...]] = {}
-        for x in (j, k):
-            _link_drawing(mech, res, x, pts, segs, mu_l)
-        for x in (j, k):
-            for ld in loads[x]:
-                _arrow(segs, pts, ld.name, ld.point, ld.force, mu_l, mu_F)
-            for c in link_couples(mech, res, x):
-                link = mech.links[x]
-                S = _world(res, x, link.com) if link.com else complex(res.kin.origin_z[0, x])
-                paths[c.name] = _couple_path(S / mu_l.value, c.moment, 8.0)
-            _resultant(mech, res, x, pts, segs, mu_l, mu_F)
+        _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_F)
         for o in outer:
             w = o.whole
             if o.normal is None:
@@ -317,6 +311,105 @@ def group_plans(mech: "Mechanism", res: "Analysis", mu_l) -> list[Plan]:
         plans.append(Plan(f"group:{_group_label(g)}", f"Group {_group_label(g)} ({g.kind}): loads and reactions; "
                           f"forces drawn at {mu_F}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths))
     return plans
+
+
+def _links_and_loads(mech: "Mechanism", res: "Analysis", loads: dict[int, list[Load]], pts: dict, segs: list,
+                     paths: dict, mu_l: Scale, mu_F: Scale) -> None:
+    """The links of a group (the keys of `loads`) at mu_l, their loads at mu_F, the inertia
+    moments as arcs and the single inertia resultants."""
+    for x in loads:
+        _link_drawing(mech, res, x, pts, segs, mu_l)
+    for x in loads:
+        for ld in loads[x]:
+            _arrow(segs, pts, ld.name, ld.point, ld.force, mu_l, mu_F)
+        for c in link_couples(mech, res, x):
+            link = mech.links[x]
+            S = _world(res, x, link.com) if link.com else complex(res.kin.origin_z[0, x])
+            paths[c.name] = _couple_path(S / mu_l.value, c.moment, 8.0)
+        _resultant(mech, res, x, pts, segs, mu_l, mu_F)
+
+
+def _leash_parts(mech: "Mechanism", res: "Analysis", side) -> _Parts:
+    """The reaction of the known link on a triad's leash: a two-pin leash's split along its axis
+    (outer pin -> inner pin) and across it; a slider's normal force whole."""
+    ell, outer, inner, known = side
+    whole = _reaction_load(mech, res, known, ell)
+    if outer.kind != "R":
+        return _Parts(whole)
+    u = _world(res, ell, inner.point) - _world(res, ell, outer.point)
+    u /= abs(u)
+    n = (whole.force * u.conjugate()).real * u
+    return _Parts(whole, n, whole.force - n)
+
+
+def _special_point(mech: "Mechanism", res: "Analysis", g) -> tuple[str, complex]:
+    """The name on the plans and the world position (m) of a triad's special point S."""
+    from ..kinematics import special_point_z
+    return ("S" if "S" not in mech.point_names else "S*"), complex(special_point_z(mech, res.kin, g)[0])
+
+
+def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale) -> Plan:
+    """A triad's plan (Artobolevsky 1988): its four links with their loads and the carried
+    reactions; each leash's outer reaction (a two-pin leash's split into R..n along its axis and
+    R..t across it; a slider's normal force at its offset x); the axes of leashes 1 and 2 drawn
+    through Assur's special point S; the arms of each leash's moment equation about its inner pin
+    (R..t) and of the group's about S (R..n of leash 3, marked (S))."""
+    later = _later(mech, g)
+    loads = {x: link_loads(mech, res, x) + _carried(mech, res, x, later) for x in g.links}
+    parts = [_leash_parts(mech, res, side) for side in g.sides]
+    mu_F = force_scale([ld.force for x in g.links for ld in loads[x]] + [o.whole.force for o in parts])
+    pts: dict[str, complex] = {}
+    segs: list[Segment] = []
+    paths: dict[str, tuple[complex, ...]] = {}
+    _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_F)
+    S_name, S = _special_point(mech, res, g)
+    pts[S_name] = S / mu_l.value
+    for (ell, outer, inner, _), o in zip(g.sides, parts):
+        w = o.whole
+        if o.normal is None:
+            _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_F)
+            _offset(mech, res, outer, ell, pts, segs, mu_l)
+        else:
+            _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_F)
+            _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_F)
+            X = _world(res, ell, inner.point)
+            for ld in loads[ell]:
+                if abs(ld.force) > 0 and abs(ld.point - X) > 1e-12 * mech.size:
+                    _arm(segs, pts, arm_name(ld.name), X, inner.point, ld.point, ld.force, mu_l)
+    for ell, _, inner, _ in g.sides[:2]:
+        segs.append(Segment(f"axis {inner.point}{S_name}", inner.point, S_name, abs(_world(res, ell, inner.point) - S),
+                            "m", "line"))
+    for x in g.links:
+        for ld in loads[x]:
+            if abs(ld.force) > 0 and abs(ld.point - S) > 1e-12 * mech.size:
+                _arm(segs, pts, f"{arm_name(ld.name)}({S_name})", S, S_name, ld.point, ld.force, mu_l)
+    return Plan(f"group:{_group_label(g)}", f"Group {g.label} (III3, Assur's point {S_name}): loads and reactions; "
+                f"forces drawn at {mu_F}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths)
+
+
+def _triad_polygon(mech: "Mechanism", res: "Analysis", g) -> tuple[list[tuple[str, complex]], list, list]:
+    """A triad's vector equation in an order that keeps each leash's forces together: R..t of
+    leash 2, its loads, the base's loads, R..n and R..t of leash 3 (R..n known from the group's
+    moment about S), its loads, leash 1's loads, its R..t, and the unknowns R..n of leashes 1 and
+    2 closing the polygon. Also, per leash, the indices of its first and last forces (its inner
+    reaction closes its own polygon from the one to the other) and of its two reaction parts."""
+    later = _later(mech, g)
+    parts = [_leash_parts(mech, res, side) for side in g.sides]
+    loads = lambda x: [(ld.name, ld.force) for ld in link_loads(mech, res, x) + _carried(mech, res, x, later)]
+    t = lambda o: [] if o.normal is None else [(f"{o.whole.name}t", o.tangential)]
+    n = lambda o: [(o.whole.name, o.whole.force)] if o.normal is None else [(f"{o.whole.name}n", o.normal)]
+    (l1, l2, l3), (o1, o2, o3) = [s[0] for s in g.sides], parts
+    blocks = [t(o2) + loads(l2), loads(g.links[0]), n(o3) + t(o3) + loads(l3), loads(l1) + t(o1) + n(o1), n(o2)]
+    seq = [f for b in blocks for f in b]
+    at = [0]
+    for b in blocks:
+        at.append(at[-1] + len(b))
+    # leash -> (first, one past its last) in the cyclic order: leash 2 wraps round
+    spans = [(at[3], at[4]), (at[4], at[5] + len(t(o2) + loads(l2))), (at[2], at[3])]
+    whole = [(at[4] - len(t(o1) + n(o1)), at[4]) if o1.normal is not None else None,
+             (at[4], at[5] + len(t(o2))) if o2.normal is not None else None,
+             (at[2], at[2] + 2) if o3.normal is not None else None]
+    return seq, spans, whole
 
 
 def _resultant(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: list, mu_l: Scale, mu_F: Scale) -> None:
@@ -386,15 +479,12 @@ def force_plans(mech: "Mechanism", res: "Analysis", mu_F) -> list[Plan]:
     mu_F = _scale(mu_F, "mu_F", "N/mm")
     plans = []
     for g in mech.structure.groups:
+        if g.klass == 3:
+            plans.append(_triad_force_plan(mech, res, g, mu_F))
+            continue
         j, k = g.links
         seq, end_j, start_j = _polygon(mech, res, g)
-        pts = {_vertex(0): 0j}
-        segs = []
-        for n, (name, F) in enumerate(seq):
-            a, b = _vertex(n), _vertex((n + 1) % len(seq))
-            if b not in pts:
-                pts[b] = pts[a] + F / mu_F.value
-            segs.append(Segment(name, a, b, abs(F), "N"))
+        pts, segs = _closed_polygon(seq, mu_F)
         oj, ok = _outer(mech, res, g, 0), _outer(mech, res, g, 1)
         X = _vertex(start_j)
         if oj.normal is not None:     # whole pin reactions as chords: R = R^n + R^tau
@@ -408,6 +498,39 @@ def force_plans(mech: "Mechanism", res: "Analysis", mu_F) -> list[Plan]:
                           + " + ".join(name for name, _ in seq) + " = 0", mu_F, float(res.phi_deg[0]),
                           pts, tuple(segs), equation=tuple(name for name, _ in seq)))
     return plans
+
+
+def _closed_polygon(seq: list[tuple[str, complex]], mu_F: Scale) -> tuple[dict, list]:
+    """The polygon of `seq` at mu_F: vertices a, b, c, ... from the start of the first force,
+    the last force ending at the first vertex."""
+    pts = {_vertex(0): 0j}
+    segs = []
+    for n, (name, F) in enumerate(seq):
+        a, b = _vertex(n), _vertex((n + 1) % len(seq))
+        if b not in pts:
+            pts[b] = pts[a] + F / mu_F.value
+        segs.append(Segment(name, a, b, abs(F), "N"))
+    return pts, segs
+
+
+def _triad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Plan:
+    """A triad's force plan: its polygon (`_triad_polygon`) closed by R..n of leashes 1 and 2,
+    the whole reaction of each two-pin leash as a chord over its two parts, and each leash's
+    inner reaction (of the base on it) from its own polygon: the chord from the end of its
+    forces back to their start."""
+    seq, spans, whole = _triad_polygon(mech, res, g)
+    pts, segs = _closed_polygon(seq, mu_F)
+    m = len(seq)
+    for (ell, _, _, known), w in zip(g.sides, whole):
+        if w is not None:
+            segs.append(Segment(reaction_name(mech, known, ell), _vertex(w[0] % m), _vertex(w[1] % m),
+                                float(np.hypot(*res.reaction(known, ell)[0])), "N"))
+    for (ell, _, _, _), (a, b) in zip(g.sides, spans):
+        segs.append(Segment(reaction_name(mech, g.links[0], ell), _vertex(b % m), _vertex(a % m),
+                            float(np.hypot(*res.reaction(g.links[0], ell)[0])), "N"))
+    return Plan(f"forces:{_group_label(g)}", f"Force plan of group {g.label} (III3): "
+                + " + ".join(name for name, _ in seq) + " = 0", mu_F, float(res.phi_deg[0]),
+                pts, tuple(segs), equation=tuple(name for name, _ in seq))
 
 
 #: The longest force on the plan of the initial link when it takes a force scale of its own, mm.

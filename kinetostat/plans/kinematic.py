@@ -150,7 +150,8 @@ def _rel(a: str, b: str, value: float, unit: str) -> Segment:
 def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     """The velocity plan (seed 002 fig. 1.7): pole p, p-x for every point, the relative
     velocities of each floating link's joints (a-b), the sliding velocities of blocks on moving
-    guides (a1-a3), like points by similarity (s2 on ab): all at mu_v."""
+    guides (a1-a3), like points by similarity (s2 on ab), and a triad's special point s (v_S
+    from the outer pins of leashes 1 and 2, a-s, e-s): all at mu_v."""
     at = _at(res)
     mu = scales["mu_v"]
     pts = plan_point_names(mech, res)
@@ -161,12 +162,35 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
         segs += [_rel(a, b, abs(mo[b][1] - mo[a][1]), "m/s") for i, a in enumerate(joints) for b in joints[i + 1:]]
     for s in _slidings(mech):
         segs.append(_rel(s.start, s.end, abs(res.kin.v_slide[0, s.pair.index]), "m/s"))
+    for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
+        vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
+        points[name] = vS / mu.value
+        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, abs(vS - (mo[r][1] if r else 0j)), "m/s") for r in refs]
     return Plan("velocity", f"Velocity plan at phi = {at:g} deg", mu, at, points, tuple(segs))
+
+
+def _special(mech, res, pts: dict) -> list[tuple[str, int, complex, list[str]]]:
+    """Per triad: the plan name of Assur's special point S (a point of the base link), the base,
+    S's local coordinates on it, and the plan names of the references of leashes 1 and 2 (their
+    outer pins; "" for a point of the frame, at the pole)."""
+    from ..kinematics import special_point_z
+    out = []
+    for n, g in enumerate(g for g in mech.structure.groups if g.klass == 3):
+        name = "s" if n == 0 else f"s{n + 1}'"
+        name = name if name not in pts else f"{name}'"
+        b = g.links[0]
+        S = complex(special_point_z(mech, res.kin, g)[0])
+        local = (S - res.kin.origin_z[0, b]) / res.kin.rot[0, b]
+        refs = [_name_of(mech, o.point) if o.kind == "R" else "" for _, o, _, _ in g.sides[:2]]
+        out.append((name, b, local, refs))
+    return out
 
 
 def _normals(mech, g):
     """(link, reference point, point) whose relative acceleration the group's plan splits into
-    normal and tangential parts, by the group's kind."""
+    normal and tangential parts, by the group's kind (a triad: each two-pin leash)."""
+    if g.klass == 3:
+        return [(ell, o.point, i.point) for ell, o, i, _ in g.sides if o.kind == "R"]
     p0, p1, p2 = g.pairs
     j, k = g.links
     if g.kind == "RRR":
@@ -226,6 +250,10 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
         else:
             segs.append(_rel(s.start, s.end, abs(a_r), unit))
     segs += [Segment(f"pi-{n}", "pi", n, abs(m[2]), unit) for n, m in mo.items()]
+    for name, b, local, refs in _special(mech, res, pts):        # a_S, a point of the base
+        aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
+        points[name] = aS / mu.value
+        segs.append(Segment(f"pi-{name}", "pi", name, abs(aS), unit))
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
     return Plan("acceleration", f"Acceleration plan at phi = {at:g} deg", mu, at, points, tuple(segs))
@@ -242,6 +270,8 @@ def _dead_centre_functions(mech):
                   for p in mech.pairs if p.kind == "R" and 0 in p.links}
     out = []
     for g in mech.structure.groups:
+        if g.klass == 3:            # a triad's leash: no dead centre of the texts' starting position
+            continue
         drv = g.known[0]
         p0, p1, _ = g.pairs
         if drv not in frame_pins or p0.kind != "R":
@@ -356,6 +386,11 @@ def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list, das
     notes = []
     for g in mech.structure.groups:
         key = frozenset(g.links)
+        if g.klass == 3:
+            from ..kinematics import assembly_modes
+            count = next(len(am.O) for am in assembly_modes(mech) if am.group == g.label)
+            notes.append(f"{g.label} III3: the mode the model draws at the design position ({count} modes there)")
+            continue
         if key not in mech.branches:
             notes.append(f"{g.label} {g.kind}: one assembly")
             continue

@@ -22,7 +22,7 @@ import numpy as np
 from ..analysis import Analysis
 from ..solve import analyze
 from ..applied import load_magnitude
-from ..kinematics import DIGITS_WARN
+from ..kinematics import DIGITS_WARN, special_point_z
 from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
@@ -247,9 +247,10 @@ class _Sheet:
                     f"ω{d.link} l_{d.pivot}{d.point}")
         accel = [("a", d.point, None)]
         for g in m.structure.groups:
-            (pj, pin, pk), (j, k) = g.pairs, g.links
-            for link, outer in ((j, pj), (k, pk)):
-                pts = self.link_points(link, (pj, pin, pk))
+            if g.klass == 3:
+                accel += self.special_point(g)
+            for link, outer, pin, _ in g.sides:
+                pts = self.link_points(link, g.pairs)
                 com = self.mech.links[link].com
                 self.velocity_rows([n for n in pts if n != com])
                 if outer.kind == "R" and pin.kind == "R":
@@ -263,15 +264,43 @@ class _Sheet:
                     self.add("kinematics", f"omega_{link}", f"ω{link}", abs(wk), "rad/s", _sense(wk, abs(w1)),
                              f"V_{pin.point}{outer.point} / l_{outer.point}{pin.point}" if outer.kind == pin.kind == "R" else "")
                 accel += [("a", name, None) for name in pts]
-            for p in (pj, pin, pk):
+            for p in dict.fromkeys(g.pairs):
                 if p.kind == "P":
                     vr = res.slide_velocity(*p.links)[0]
                     key, sym = f"V_rel({p.links[0]},{p.links[1]})", f"V_rel({self.n(p.links[0])},{p.links[1]})"
                     self.add("kinematics", key, sym, abs(vr), "m/s", "",
                              f"along the guide of link {self.n(p.links[0])}")
                     accel.append(("cor", p, vr))
-            accel.append(("eps", (j, k), None))
+            accel.append(("eps", g.links, None))
         self.accelerations(accel)
+
+    def special_point(self, g) -> list:
+        """A triad's base link first, by Assur's special point S (the axes of leashes 1 and 2):
+        V_S and a_S from 2x2 solves, then its pins, omega and eps from leash 3. Returns the
+        acceleration steps of the base."""
+        res, b = self.res, g.links[0]
+        kin = res.kin
+        S = special_point_z(self.mech, kin, g)[0]
+        loc = (S - kin.origin_z[0, b]) / kin.rot[0, b]
+        V, A = (complex(z[0]) for z in kin.point_z(b, (loc.real, loc.imag))[1:])
+        axes = " and ".join(f"{o.point}{i.point}" if o.kind == "R" else f"⟂ guide at {i.point}"
+                            for _, o, i, _ in g.sides[:2])
+        self.vector("kinematics", "V_S", "V_S", np.array([V.real, V.imag]), "m/s", f"ps μ_v; S on the axes {axes}")
+        pts = self.link_points(b, g.pairs)
+        self.velocity_rows(pts)
+        wb = res.omega(b)[0]
+        self.add("kinematics", f"omega_{b}", f"ω{b}", abs(wb), "rad/s", _sense(wb),
+                 f"leash {g.sides[2][0]}'s axis, arm h_S = {abs(self._arm3(g, S)):.4g} m")
+        self.vector("accelerations", "a_S", "a_S", np.array([A.real, A.imag]), "m/s^2", "πs μ_a")
+        return [("a", name, None) for name in pts]
+
+    def _arm3(self, g, S: complex) -> float:
+        """The arm of leash 3's axis about S, m."""
+        ell, outer, inner, a = g.sides[2]
+        X = complex(*self.res.position(inner.point)[0])
+        u = X - complex(*self.res.position(outer.point)[0]) if outer.kind == "R" else \
+            1j * complex(*outer.direction) * self.res.kin.rot[0, a]
+        return float(((X - S).conjugate() * u).imag / abs(u))
 
     def accelerations(self, steps) -> None:
         res, d = self.res, self.mech.drive
@@ -342,8 +371,7 @@ class _Sheet:
     def reactions(self) -> None:
         res, m = self.res, self.mech
         for g in reversed(m.structure.groups):
-            (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known
-            for link, outer, other in ((j, pj, a), (k, pk, c)):
+            for link, outer, pin, other in g.sides:
                 if outer.kind == "R" and pin.kind == "R":
                     R = res.reaction(other, link)[0]
                     r = res.position(pin.point)[0] - res.position(outer.point)[0]
@@ -353,19 +381,27 @@ class _Sheet:
                     arm = l / self.mu_l
                     self.add("reactions", f"Rt_{other}_{link}", f"{self.R(other, link)}t", abs(R @ t), "N",
                              _angle(np.sign(R @ t) * t), f"Σ M_{pin.point} = 0 of link {link}, arm {outer.point}{pin.point} = {arm:.4g} mm")
-            for link, outer, other in ((j, pj, a), (k, pk, c)):
+            for n, (link, outer, pin, other) in enumerate(g.sides):
                 if outer.kind == "R" and pin.kind == "R":
                     R = res.reaction(other, link)[0]
                     r = res.position(pin.point)[0] - res.position(outer.point)[0]
                     e = r / np.hypot(*r)
                     self.add("reactions", f"Rn_{other}_{link}", f"{self.R(other, link)}n", abs(R @ e), "N",
-                             _angle(np.sign(R @ e) * e), "force plan of the group")
-            for link, other in ((j, a), (k, c)):
+                             _angle(np.sign(R @ e) * e), "Σ M_S = 0 of the group" if (g.klass, n) == (3, 2)
+                             else "force plan of the group")
+            for link, _, _, other in g.sides:
                 self.vector("reactions", f"R_{other}_{link}", self.R(other, link), res.reaction(other, link)[0], "N",
                             "force plan of the group")
-            self.vector("reactions", f"R_{k}_{j}", self.R(k, j), res.reaction(k, j)[0], "N",
-                        f"force plan of link {j}")
-            for p in (pj, pin, pk):
+            if g.klass == 3:
+                b = g.links[0]
+                for link, _, _, _ in g.sides:
+                    self.vector("reactions", f"R_{link}_{b}", self.R(link, b), res.reaction(link, b)[0], "N",
+                                f"force plan of link {link}")
+            else:
+                j, k = g.links
+                self.vector("reactions", f"R_{k}_{j}", self.R(k, j), res.reaction(k, j)[0], "N",
+                            f"force plan of link {j}")
+            for p in dict.fromkeys(g.pairs):
                 if p.kind == "P":
                     x = res.reaction_offset(*p.links)[0]
                     self.add("reactions", f"x_{p.links[0]}_{p.links[1]}", "x" + self.R(*p.links)[1:], x, "m", "",
