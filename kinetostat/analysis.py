@@ -4,6 +4,7 @@ May use: model, groups, kinematics, kinetostatics, applied, planar, fast; pandas
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, fields, replace
 from types import MappingProxyType
 from typing import Mapping, NamedTuple
@@ -13,9 +14,10 @@ import numpy as np
 from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation, kinematic_size, kinematics,
                          relative_change, solve_checked)
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from . import groups
+from . import friction as _friction, groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, dot_z
+from .errors import SelfLockingWarning, self_locking_message
 from .model import Mechanism, _abbreviate
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "analyze", "exact", "crank_angles", "FRAME_NOTE", "deviation",
@@ -70,8 +72,11 @@ class Analysis:
     F_i: np.ndarray         # (N, L, 2) inertia main vectors (at the centres of mass), N
     M_i: np.ndarray         # (N, L) inertia main moments, N m
     forces: Forces
-    lever_moment: np.ndarray      # (N,) balancing moment by Zhukovsky's lever, N m
-    friction_power: np.ndarray    # (N, n_pairs) power lost in each pair, W
+    lever_moment: np.ndarray      # (N,) balancing moment by Zhukovsky's lever, N m (with friction in
+                                  #   the reactions: the friction loads applied on the lever too)
+    friction_power: np.ndarray    # (N, n_pairs) power lost in each pair, W (>= 0)
+    friction: _friction.FrictionSolution | None = None   # friction in the reactions (None: the first
+                                  #   approximation or no friction; `friction_method` says which)
 
     def __repr__(self) -> str:
         phi = self.phi_deg
@@ -192,7 +197,8 @@ class Analysis:
         return Analysis(self.mech, self.phi_deg[idx], self.kin.take(idx), self.F_applied[idx],
                         self.M_applied[idx], self.F_i[idx], self.M_i[idx],
                         type(f)(f.R[idx], f.normal[idx], f.m[idx], f.M_bal[idx], f.F_bal[idx]),
-                        self.lever_moment[idx], self.friction_power[idx])
+                        self.lever_moment[idx], self.friction_power[idx],
+                        None if self.friction is None else self.friction.take(idx))
 
     def inertia(self, k: int) -> InertiaLoad:
         """Inertia force, moment, offset h and a point of the single resultant of link k."""
@@ -274,7 +280,72 @@ class Analysis:
         """(n_pairs,) energy lost in each pair over one revolution, J: the integral of its power
         over the crank angle (`_cycle_integral`). Needs the angles of a uniform full cycle, as
         `analyze(mech, steps=N)` gives."""
-        return self._cycle_integral(friction_power(self.mech, self._unit_motion(), self.forces.R), "friction_energy")
+        return self._cycle_integral(self._friction_power(self._unit_motion()), "friction_energy")
+
+    def _friction_power(self, kin: Kinematics) -> np.ndarray:
+        """(N, n_pairs) power lost in each pair at the motion `kin` (the same angles), W: from the
+        friction loads of the exact solution, or seed 003's formulas on the frictionless reactions."""
+        if self.friction is None:
+            return friction_power(self.mech, kin, self.forces.R)
+        return -self.friction.load * _friction.relative_rate(self.mech, kin)[0]
+
+    @property
+    def friction_method(self) -> str:
+        """"reactions" (friction in the reactions, exact), "first" (seed 003's first approximation:
+        frictionless reactions and M_bal, friction power from them) or "none" (no [friction])."""
+        return "none" if self.mech.friction is None else "first" if self.friction is None else "reactions"
+
+    @property
+    def balancing_moment_frictionless(self) -> np.ndarray:
+        """(N,) balancing moment without friction, N m about +z."""
+        return self.balancing_moment if self.friction is None else self.friction.M_bal_frictionless
+
+    @property
+    def balancing_moment_with_friction(self) -> np.ndarray:
+        """(N,) balancing moment with friction, N m about +z: the exact one with friction in the
+        reactions; in the first approximation M_bal + (total friction power) / omega_1 (the drive
+        supplies the losses on top, seed 003), M_bal where the crank stands still."""
+        if self.friction is not None or self.mech.friction is None:
+            return self.balancing_moment
+        w = self.kin.omega[:, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(w != 0, self.balancing_moment + self.friction_power_total / w, self.balancing_moment)
+
+    def _turn(self) -> np.ndarray:
+        """(N,) sign of the crank's rotation (the drive's sense where it stands still)."""
+        w = np.sign(self.kin.omega[:, 1])
+        return np.where(w != 0, w, self.mech.drive.sense)
+
+    @property
+    def efficiency(self) -> np.ndarray:
+        """(N,) instantaneous efficiency eta(phi), 1: M0 / Mf where the drive works against the
+        loads (M0 omega_1 >= 0), Mf / M0 where the loads drive the crank (an engine's expansion
+        stroke), M0 and Mf the balancing moments without and with friction
+        (`balancing_moment_with_friction`: the first approximation's where friction is not in the
+        reactions; 1 without friction). NaN where both moments are below 1e-12 x the largest
+        reaction x size (a dead centre: undefined) and where no equilibrium was found."""
+        R = np.linalg.norm(self.forces.R, axis=-1).max(axis=1, initial=0.0)
+        return _friction.efficiency(self.balancing_moment_frictionless, self.balancing_moment_with_friction,
+                                    self._turn(), 1e-12 * R * self.mech.size)
+
+    @property
+    def self_locking(self) -> np.ndarray:
+        """(N,) bool: eta <= 0 (the loads cannot drive the crank through friction; the drive must
+        help where they would), or no equilibrium found with friction in the reactions (M_bal NaN
+        there, with a SelfLockingWarning naming the angles)."""
+        unsolved = np.zeros(len(self.phi_deg), bool) if self.friction is None else ~self.friction.solved
+        with np.errstate(invalid="ignore"):
+            return unsolved | (self.efficiency <= 0)
+
+    def cycle_efficiency(self) -> float:
+        """Efficiency over one revolution, 1: the same rule as `efficiency` over the works of the
+        balancing moment without (W0) and with (Wf) friction: W0 / Wf where the drive does work
+        on the loads over the cycle (W0 > 0), Wf / W0 where the loads drive it (an engine).
+        Needs a uniform full cycle of angles (NaN if any angle has no equilibrium)."""
+        w1 = self._unit_motion().omega[:, 1]
+        W0, Wf = self._cycle_integral(np.stack([self.balancing_moment_frictionless * w1,
+                                                self.balancing_moment_with_friction * w1], -1), "cycle_efficiency")
+        return float(W0 / Wf if W0 > 0 else Wf / W0)
 
     def _unit_motion(self) -> Kinematics:
         """The motion at the same angles at unit crank speed (d phi/dt = 1 rad/s): its velocities
@@ -303,9 +374,10 @@ class Analysis:
         per applied force or moment (loads of one name summed); "spring NAME" (both ends);
         "damper NAME" (both links: -(energy dissipated)); "balancing moment" (M_bal omega_1; for
         a working machine the pinion's force, the same power); with friction "friction R(i,j)" per
-        pair, the energy lost (negative). The balancing moment is frictionless: every entry but
-        friction sums to 0 (to rounding) at any speed law, and the friction entries are what the
-        drive must supply on top (seed 003)."""
+        pair, the energy lost (negative). With friction in the reactions every entry sums to 0 (to
+        rounding); in the first approximation the balancing moment is frictionless: every entry
+        but friction sums to 0 at any speed law, and the friction entries are what the drive must
+        supply on top (seed 003)."""
         m, kin, u = self.mech, self.kin, self._unit_motion()
         per_radian: dict[str, np.ndarray] = {}
 
@@ -332,7 +404,7 @@ class Analysis:
             add(f"{f.source} {f.name}", dot_z(f.force, v))
         add("balancing moment", self.balancing_moment * u.omega[:, 1])
         if m.friction is not None:
-            lost = friction_power(m, u, self.forces.R)
+            lost = self._friction_power(u)
             for p in m.pairs:
                 add(f"friction {p.label}", -lost[:, p.index])
         names = list(per_radian)
@@ -437,35 +509,58 @@ def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
     return phi_deg
 
 
-def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
+def analyze(mech: Mechanism, phi_deg=None, steps: int = 360, friction: str | None = None) -> Analysis:
     """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
     or at `steps` equal steps over a full revolution when `phi_deg` is None.
 
+    `friction` (a model with [friction] only; the default is the model's `friction.method`, else
+    "first"): "first" is seed 003's first approximation (frictionless reactions and M_bal, the
+    friction power from them); "reactions" solves the reactions with friction exactly
+    (`kinetostat.friction`), group by group, on the numpy path at any number of angles.
+
     From fast.FAST_MIN angles on it runs the compiled kernel (`fast.analyze_fast`), below them
-    the numpy path (`exact`): the same results to rounding (tests/test_fast.py)."""
+    the numpy path (`exact`): the same results to rounding (tests/test_fast.py). The compiled
+    kernel does not solve friction in the reactions: friction="reactions" takes the numpy path."""
     if not isinstance(mech, Mechanism):
         raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
                         f"read a model file with kinetostat.load(path)")
     phi_deg = crank_angles(phi_deg, steps)
+    method = friction_method(mech, friction)
     from . import fast
-    if len(phi_deg) >= fast.FAST_MIN and fast.available():
+    if method != "reactions" and len(phi_deg) >= fast.FAST_MIN and fast.available():
         return fast.analyze_fast(mech, phi_deg)
-    return exact(mech, phi_deg)
+    return exact(mech, phi_deg, method)
 
 
-def exact(mech: Mechanism, phi_deg: np.ndarray) -> Analysis:
+def friction_method(mech: Mechanism, friction: str | None) -> str:
+    """The friction method `analyze` takes: `friction`, else the model's, else "first";
+    ValueError naming the argument if it is not one of friction.METHODS."""
+    method = friction if friction is not None else mech.friction.method if mech.friction is not None else "first"
+    if method not in _friction.METHODS:
+        raise ValueError(f"friction: expected one of {list(_friction.METHODS)}, got {friction!r}")
+    return method
+
+
+def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Analysis:
     """`analyze` by the numpy path at the crank angles `phi_deg` (deg, (N,)), with the accuracy
-    guard: where a group's cond exceeds COND_CHECK the error is measured by perturbed re-solves."""
+    guard: where a group's cond exceeds COND_CHECK the error is measured by perturbed re-solves.
+    `friction`: "first" or "reactions" (see `analyze`); a SelfLockingWarning names the angles
+    where friction in the reactions leaves no equilibrium."""
+    reactions = friction == "reactions" and mech.friction is not None
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # NaN only at angles marked singular
         kin, checked, trials = solve_checked(mech, np.radians(phi_deg))
-        res = _kinetostatics(mech, phi_deg, kin)
+        res = _kinetostatics(mech, phi_deg, kin, reactions)
         error = a_priori_error(kin.cond)
         if len(checked):
             nominal = res.take(checked)
-            error[checked] = np.max([deviation(nominal, _kinetostatics(mech, phi_deg[checked], t))
+            error[checked] = np.max([deviation(nominal, _kinetostatics(mech, phi_deg[checked], t, reactions))
                                      for t in trials], axis=0)
         kin = guard(mech, kin, error)
-        return _kinetostatics(mech, phi_deg, kin) if kin.singular.any() else _read_only(replace(res, kin=kin))
+        res = _kinetostatics(mech, phi_deg, kin, reactions) if kin.singular.any() else replace(res, kin=kin)
+    if res.friction is not None and not (res.friction.solved | kin.singular).all():
+        bad = phi_deg[~(res.friction.solved | kin.singular)]
+        warnings.warn(SelfLockingWarning(self_locking_message(bad), bad), stacklevel=3)
+    return _read_only(res)
 
 
 def force_deviation(a: Analysis, b: Analysis) -> np.ndarray:
@@ -484,21 +579,27 @@ def deviation(a: Analysis, b: Analysis) -> np.ndarray:
     return np.maximum(kinematic_deviation(a.mech, a.kin, b.kin), force_deviation(a, b))
 
 
-def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics) -> Analysis:
+def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics, reactions: bool = False) -> Analysis:
+    """The forces at the motion `kin`; `reactions`: with friction in the reactions."""
     mass, I_S, com = mech.inertia_arrays
     r, F_i, M_i = groups.inertia(kin.a_z, kin.omega, kin.eps, kin.rot, com, mass, I_S)
     F_app, M_app = applied_wrenches(mech, kin, r)
     F_all, M_all = groups.wrench(F_app, M_app, F_i, M_i, r)
     frc = forces(mech, kin, F_all, M_all)
-    lever = lever_moment(mech, kin, F_all, M_all)
+    if not reactions:
+        return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc,
+                                   lever_moment(mech, kin, F_all, M_all), friction_power(mech, kin, frc.R)))
+    with np.errstate(all="ignore"):
+        frc, sol = _friction.solve(mech, kin, F_all, M_all, frc.M_bal)
+    lever = lever_moment(mech, kin, F_all + sol.F, M_all + sol.M)
     return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
-                               friction_power(mech, kin, frc.R)))
+                               -sol.load * _friction.relative_rate(mech, kin)[0], sol))
 
 
 def _read_only(res: Analysis) -> Analysis:
     """`res` with every array it holds (its own, its Kinematics' and Forces') read-only: a
     frozen result whose numbers no caller can change in place."""
-    for part in (res, res.kin, res.forces):
+    for part in (res, res.kin, res.forces) + (() if res.friction is None else (res.friction,)):
         for f in fields(part):
             value = getattr(part, f.name)
             if isinstance(value, np.ndarray):

@@ -246,6 +246,7 @@ class Drive:
 class Friction:
     f: float                   # reduced friction coefficient
     radius: float | None       # default journal radius, m
+    method: str = "first"      # analyze's default: "first" (seed 003's first approximation) or "reactions"
 
 
 #: What a `[[published]]` entry may measure -> the SI unit of its magnitude.
@@ -1648,10 +1649,13 @@ class _Reader:
         if not isinstance(t, dict):
             self.err("friction: expected a table")
             return None
-        self.unknown_keys(t, {"f", "radius"}, "friction")
+        self.unknown_keys(t, {"f", "radius", "method"}, "friction")
         f = self.number(t, "f", "friction", minimum=0.0)
         r = self.number(t, "radius", "friction", default=None, positive=True)
-        return None if f is None else Friction(f, r)
+        method = t.get("method", "first")
+        if method not in ("first", "reactions"):
+            self.err(f"friction.method: expected 'first' or 'reactions', got {method!r}")
+        return None if f is None else Friction(f, r, method)
 
     def published(self, links: list[Link], pairs: list[Pair], drive: Drive | None) -> list[Published]:
         out: list[Published] = []
