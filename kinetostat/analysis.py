@@ -337,6 +337,37 @@ class Analysis:
         with np.errstate(invalid="ignore"):
             return unsolved | (self.efficiency <= 0)
 
+    def self_locking_zones(self, tol_deg: float = 1e-9) -> np.ndarray:
+        """(n_zones, 2) start and end of each run of self-locking angles, deg, start < end (a zone
+        across 0 starts below 0 on a full cycle), its edges found to `tol_deg` by bisection on the
+        crank angle between the angles of this result (re-solved at the same friction method).
+        On a uniform full cycle the angles wrap around; a zone narrower than the step between
+        two angles of the result can be missed."""
+        phi, lock = np.asarray(self.phi_deg, float), self.self_locking
+        cyclic = len(phi) > 1 and np.allclose(np.diff(phi), 360.0 / len(phi), rtol=0, atol=1e-9)
+        nxt = np.arange(1, len(phi) + 1) % len(phi) if cyclic else np.arange(1, len(phi))
+        lo = phi[:len(nxt)]
+        hi = np.where(nxt > np.arange(len(nxt)), phi[nxt], phi[nxt] + 360.0)
+        cut = np.flatnonzero(lock[:len(nxt)] != lock[nxt])
+        lo, hi, rising = lo[cut], hi[cut], ~lock[cut]
+        method = "reactions" if self.friction is not None else "first"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SelfLockingWarning)
+            while len(lo) and (hi - lo).max() > tol_deg:
+                mid = 0.5 * (lo + hi)
+                at = exact(self.mech, mid, method).self_locking
+                left = at == ~rising                # mid on the side of lo
+                lo, hi = np.where(left, mid, lo), np.where(left, hi, mid)
+        edge = 0.5 * (lo + hi)
+        starts, ends = list(edge[rising]), list(edge[~rising])
+        if lock[0] and not cyclic:
+            starts.insert(0, phi[0])
+        if lock[-1] and not cyclic:
+            ends.append(phi[-1])
+        if cyclic and starts and ends and ends[0] < starts[0]:
+            starts = [starts[-1] - 360.0] + starts[:-1]
+        return np.array(list(zip(starts, ends)), float).reshape(-1, 2)
+
     def cycle_efficiency(self) -> float:
         """Efficiency over one revolution, 1: the same rule as `efficiency` over the works of the
         balancing moment without (W0) and with (Wf) friction: W0 / Wf where the drive does work

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .kinetostatics import Forces, packed, statics_environment
-from .planar import cross_z
+from .planar import as_xy, cross_z
 from .program import Program, run, statics_program
 
 if TYPE_CHECKING:
@@ -181,6 +181,9 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
             for k in names:
                 env[k] = np.where(failed, np.nan, env[k])
     frc = packed(mech, env, N)
+    for p in mech.pairs:                     # a guide's reaction leans: its friction force joins the normal one
+        if p.kind == "P":
+            frc.R[:, p.index] += as_xy(load[:, p.index] * d[p.index])
     if not solved.all():
         frc = Forces(*(np.where(solved.reshape((N,) + (1,) * (a.ndim - 1)), a, np.nan)
                        for a in (frc.R, frc.normal, frc.m, frc.M_bal, frc.F_bal)))
