@@ -457,8 +457,11 @@ class Analysis:
         about the slider point), vs_i_j [m/s] and as_i_j [m/s^2] (sliding velocity and
         acceleration); Fax_k [N] for every two-pin link (axial force, tension positive, the mean of
         its two ends: `axial_force`); M_bal, M_lever [N m]; for a working machine F_balx, F_baly, F_bal [N]; with
-        friction Pfr_i_j per pair and Pfr_total [W]; cond_<group> [1] per Assur group; singular
-        [bool].
+        friction Pfr_i_j per pair and Pfr_total [W], eta [1] (`efficiency`), self_locking [bool],
+        and with friction in the reactions Ffr_i_j per pair (friction moment on link j [N m] in
+        a revolute pair, friction force on the slider along the guide [N] in a prismatic one) and
+        M_bal_0 [N m] (the frictionless balancing moment); cond_<group> [1] per Assur group;
+        singular [bool].
 
         `df.attrs["units"]` maps every column to its unit ("1": dimensionless, "bool": a flag);
         `df.attrs["frame"]` states the frame and sign conventions; `df.attrs["mechanism"]` the
@@ -513,6 +516,12 @@ class Analysis:
         if m.friction is not None:
             put("W", **{f"Pfr_{p.links[0]}_{p.links[1]}": self.friction_power[:, p.index] for p in m.pairs})
             put("W", Pfr_total=self.friction_power_total)
+            if self.friction is not None:
+                for p in m.pairs:
+                    put("N m" if p.kind == "R" else "N", **{f"Ffr_{p.links[0]}_{p.links[1]}": self.friction.load[:, p.index]})
+                put("N m", M_bal_0=self.balancing_moment_frictionless)
+            put("1", eta=self.efficiency)
+            put("bool", self_locking=self.self_locking)
         put("1", **{f"cond_{g.label}": self.cond[:, n] for n, g in enumerate(m.structure.groups)})
         put("bool", singular=self.singular)
         df = pd.DataFrame(cols)
