@@ -360,7 +360,7 @@ def _check_memory(mech, steps: int) -> None:
                        f"available; use fewer steps (at most about {int(free // per_angle):,})")
 
 
-def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
+def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | None = None):
     """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each;
     `steps` that would not fit in memory are refused before anything is allocated."""
     from .analysis import analyze
@@ -371,7 +371,7 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            res = analyze(mech, phi_deg=phi_deg, steps=steps)
+            res = analyze(mech, phi_deg=phi_deg, steps=steps, friction=friction)
         except AssemblyError as exc:
             raise CLIError(f"{path}: {exc}") from None
         except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
@@ -498,6 +498,11 @@ def _summary(res, path: Path) -> list[str]:
     if np.any(np.isfinite(d)):
         k = int(np.nanargmax(np.abs(d)))
         lines.append(f"lever discrepancy max |M_lever - M_bal|: {abs(d[k]):.3g} N m (phi = {phi[k]:g} deg)")
+    if m.friction is not None:
+        lock = res.self_locking
+        eta = res.efficiency[~lock & np.isfinite(res.efficiency)]
+        lines.append(f"friction ({res.friction_method}): self-locking at {int(lock.sum())} of {len(phi)} positions"
+                     + (f", eta {eta.min():.4g} .. {eta.max():.4g} elsewhere" if len(eta) else ""))
     n_sing = int(np.sum(res.singular))
     if n_sing:
         lines.append(f"singular positions: {n_sing} (their values are NaN)")
@@ -539,7 +544,7 @@ def cmd_analyze(args) -> int:
         _writable_file(out, "--out")
     path = Path(args.model)
     mech = _load(path)
-    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps)
+    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps, friction=args.friction)
     lines = _summary(res, path)
     if len(res.phi_deg) == 1:
         lines += _worksheet_lines(mech, float(res.phi_deg[0]))
@@ -1177,6 +1182,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="crank angles in degrees (model's reference and sense), e.g. --at 0 30 90")
     g.add_argument("--steps", metavar="N", type=_steps, default=360,
                    help="N equal steps over a revolution (default 360)")
+    a.add_argument("--friction", choices=["first", "reactions"], default=None,
+                   help="a model with [friction]: 'first' (seed 003's first approximation) or 'reactions' "
+                        "(friction in the reactions, exact); default: the model's friction.method, else first")
     a.add_argument("--out", metavar="FILE",
                    help="write the full table: FILE.csv, FILE.parquet (needs pyarrow) or FILE.json "
                         "(records); '-' writes CSV to stdout and the summary to stderr")

@@ -200,7 +200,9 @@ def efficiency(M0: np.ndarray, Mf: np.ndarray, turn: np.ndarray, tol: np.ndarray
     """(N,) instantaneous efficiency from the balancing moments without (M0) and with (Mf)
     friction, N m; `turn` the sign of the crank's rotation (+-1): M0/Mf where the drive works
     against the loads (M0 turn >= 0), Mf/M0 where the loads drive the crank (M0 turn < 0); NaN
-    where both moments are below `tol` (a dead centre: undefined)."""
+    where both moments are below `tol` (a dead centre: undefined); M0 below `tol` alone counts as
+    0 (eta = 0: the drive works against friction only)."""
+    M0 = np.where(np.abs(M0) <= tol, 0.0, M0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        eta = np.where(M0 * turn >= 0, M0 / Mf, Mf / M0)
+        eta = np.where(M0 * turn >= 0, M0 / Mf, Mf / M0) + 0.0      # + 0.0: no -0
     return np.where((np.abs(M0) <= tol) & (np.abs(Mf) <= tol), np.nan, eta)
