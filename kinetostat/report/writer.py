@@ -371,7 +371,7 @@ def _friction_section(doc: Doc, m: Mechanism, res) -> None:
     M = esc(quantity_name(m, "M_bal"))
     doc.h(2, "Friction in the reactions")
     doc.p("The course text on friction computes the losses *in the first approximation*: the frictionless reactions "
-          "go into f·r·|R|·|ω_rel| (revolute) and f·|R|·|v_rel| (prismatic), M_bal stays frictionless (the columns "
+          f"go into f·r·|R|·|ω_rel| (revolute) and f·|R|·|v_rel| (prismatic), {M} stays frictionless (the columns "
           "Pfr of cycle.csv, and every route above). The exact solution puts the friction into the reactions: a "
           "friction moment f·r·|R| against the relative rotation in each revolute pair (the reaction tangent to the "
           "friction circle ρ = f·r), a friction force f·|N| against the sliding in each prismatic pair (the reaction "
@@ -403,9 +403,9 @@ def _friction_section(doc: Doc, m: Mechanism, res) -> None:
         W = ex.work()
         doc.ul([f"Zhukovsky's lever with the friction loads applied against group by group: max |difference| "
                 f"{_err(float(np.max(np.abs(ex.lever_discrepancy[ok]))), peak, 'N·m')}",
-                "power balance, (M_bal − M_bal,0)·ω₁ against the sum of the pairs' friction powers: max |difference| "
+                f"power balance, ({M} − {M},0)·ω₁ against the sum of the pairs' friction powers: max |difference| "
                 f"{_err(float(np.max(np.abs(dP[ok]))), float(np.nanmax(ex.friction_power_total)), 'W')}",
-                f"work over the cycle, all loads, M_bal and friction: sum {_fmt(sum(W.values()))} J "
+                f"work over the cycle, all loads, {M} and friction: sum {_fmt(sum(W.values()))} J "
                 f"(of {_fmt(sum(abs(v) for v in W.values()))} J moved)" if len(W) else "work: n/a"])
 
 
