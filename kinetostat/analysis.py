@@ -287,7 +287,7 @@ class Analysis:
         friction loads of the exact solution, or seed 003's formulas on the frictionless reactions."""
         if self.friction is None:
             return friction_power(self.mech, kin, self.forces.R)
-        return -self.friction.load * _friction.relative_rate(self.mech, kin)[0]
+        return _friction.power(self.mech, kin, self.friction.load)
 
     @property
     def friction_method(self) -> str:
@@ -633,7 +633,7 @@ def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics, reacti
         frc, sol = _friction.solve(mech, kin, F_all, M_all, frc.M_bal)
     lever = lever_moment(mech, kin, F_all + sol.F, M_all + sol.M)
     return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
-                               -sol.load * _friction.relative_rate(mech, kin)[0], sol))
+                               _friction.power(mech, kin, sol.load), sol))
 
 
 def _read_only(res: Analysis) -> Analysis:

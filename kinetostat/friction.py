@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Mechanism
 
-__all__ = ["FrictionSolution", "solve", "relative_rate", "motion_sense", "efficiency", "METHODS", "RATE_TOL", "MAX_PASSES"]
+__all__ = ["FrictionSolution", "solve", "power", "relative_rate", "motion_sense", "efficiency", "METHODS", "RATE_TOL", "MAX_PASSES"]
 
 #: analyze(friction=...): seed 003's first approximation, or friction in the reactions.
 METHODS = ("first", "reactions")
@@ -92,6 +92,13 @@ def relative_rate(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.
     revolute = np.array([p.kind == "R" for p in mech.pairs])
     return (np.where(revolute, kin.omega[:, j] - kin.omega[:, i], kin.v_slide),
             np.where(revolute, kin.eps[:, j] - kin.eps[:, i], kin.a_slide))
+
+
+def power(mech: "Mechanism", kin: "Kinematics", load: np.ndarray) -> np.ndarray:
+    """(N, n_pairs) power lost in each pair, W: friction load (`FrictionSolution.load`) times the
+    relative motion at the motion `kin`; |load x rate| (the two have opposite signs wherever the
+    motion is more than rounding; at rest it is 0 to rounding, never a negative rounding)."""
+    return np.abs(load * relative_rate(mech, kin)[0])
 
 
 def motion_sense(mech: "Mechanism", kin: "Kinematics") -> np.ndarray:
