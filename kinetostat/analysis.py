@@ -567,7 +567,7 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360, friction: str | Non
     phi_deg = crank_angles(phi_deg, steps)
     method = friction_method(mech, friction)
     from . import fast
-    if method != "reactions" and len(phi_deg) >= fast.FAST_MIN and fast.available():
+    if (method != "reactions" or mech.friction is None) and len(phi_deg) >= fast.FAST_MIN and fast.available():
         return fast.analyze_fast(mech, phi_deg)
     return exact(mech, phi_deg, method)
 

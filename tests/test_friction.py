@@ -242,7 +242,10 @@ def test_random_mechanisms_with_friction(kind, size):
         ref = reference_full(mech, at[ok], friction=True)      # where the passes found an equilibrium
         assert np.abs(ref.M_bal - res.balancing_moment[ok]).max() <= ROUNDING * F.max() * length
         assert np.abs(ref.R - res.forces.R[ok]).max() <= ROUNDING * F.max()
+        checked.append(int(res.friction.passes.max()))
+    checked: list[int] = []
     check()
+    assert len(checked) == size, checked          # every example reached the reference
 
 
 def test_worksheet_names_the_friction_terms(ice):
