@@ -331,9 +331,11 @@ class Analysis:
     @property
     def self_locking(self) -> np.ndarray:
         """(N,) bool: eta <= 0 (the loads cannot drive the crank through friction; the drive must
-        help where they would), or no equilibrium found with friction in the reactions (M_bal NaN
-        there, with a SelfLockingWarning naming the angles)."""
-        unsolved = np.zeros(len(self.phi_deg), bool) if self.friction is None else ~self.friction.solved
+        help where they would), or, with friction in the reactions, a pair wedges (the friction
+        passes do not contract: M_bal is the equilibrium Newton's method finds there) or no
+        equilibrium is found (M_bal NaN, with a SelfLockingWarning naming the angles)."""
+        unsolved = np.zeros(len(self.phi_deg), bool) if self.friction is None else \
+            ~self.friction.solved | self.friction.wedged
         with np.errstate(invalid="ignore"):
             return unsolved | (self.efficiency <= 0)
 

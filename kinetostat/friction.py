@@ -15,7 +15,11 @@ The friction loads are loads like any other: each group's own statics steps (the
 of `program.statics_program`, marked by its `stages`) run again with the friction loads of the
 group's pairs added to its links' known wrenches, the loads recomputed from the new reactions,
 until the reactions stop changing (fixed-point passes from the frictionless solution, the
-texts' successive approximation carried to rounding). Groups go in the order of the frictionless
+texts' successive approximation carried to rounding). Where MAX_PASSES passes do not converge,
+Newton's method on the stage's friction loads looks for the equilibrium (from the frictionless
+loads). Where a stage's friction gain (`_gain`: reactions with no other load, in equilibrium
+with their own friction, grow by this factor per pass) is 1 or more, a pair wedges: the angle
+is self-locking, and an equilibrium found there need not be the only one. Groups go in the order of the frictionless
 solution (last attached first), then the initial link; each stage's passes converge before the
 next stage starts. Vectorised over the angles.
 
@@ -48,8 +52,12 @@ __all__ = ["FrictionSolution", "solve", "power", "relative_rate", "motion_sense"
 METHODS = ("first", "reactions")
 #: A relative velocity below this fraction of the crank's (angular; x size for a slider) is zero.
 RATE_TOL = 1e-12
-#: Most fixed-point passes per stage; an angle not converged by then has no equilibrium found.
-MAX_PASSES = 200
+#: Most fixed-point passes per stage; an angle not converged by then goes to Newton's method.
+MAX_PASSES = 60
+#: Most Newton steps on a stage's friction loads; an angle not converged by then has no equilibrium found.
+NEWTON_STEPS = 40
+#: Power-iteration steps for a stage's friction gain (`_gain`).
+GAIN_STEPS = 40
 #: Converged: the largest change of a stage's reactions in one pass below this x its largest reaction.
 PASS_TOL = 1e-14
 #: ... or the change stopped decreasing below this x the largest reaction (the rounding floor).
@@ -66,8 +74,12 @@ class FrictionSolution:
     F: np.ndarray         # (N, L) complex: all friction forces on each link, N, world
     M: np.ndarray         # (N, L) their moment about each link's local origin, N m
     passes: np.ndarray    # (N, n_groups + 1) int: fixed-point passes of each stage (groups in the
-                          #   order solved, then the initial link); 0 where singular or unsolved
-    solved: np.ndarray    # (N,) bool: every stage converged (False: no equilibrium found, NaN forces)
+                          #   order solved, then the initial link); above MAX_PASSES: MAX_PASSES +
+                          #   the Newton steps that found the equilibrium; 0 where singular or unsolved
+    solved: np.ndarray    # (N,) bool: an equilibrium found at every stage (False: NaN forces)
+    wedged: np.ndarray    # (N,) bool: at some stage a pair wedges: with no other load, the friction
+                          #   loads call for reactions whose friction is at least as large (`_gain`
+                          #   >= 1): self-locking; the equilibrium found there need not be the only one
 
     def __repr__(self) -> str:
         return f"FrictionSolution(positions={len(self.solved)}, passes<={int(self.passes.max(initial=0))})"
@@ -142,7 +154,7 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
     F_fr, M_fr = np.zeros((N, L), complex), np.zeros((N, L))
     bounds = prog.stages + (len(prog.steps),)
     passes = np.zeros((N, len(prog.stages)), int)
-    solved = np.ones(N, bool)
+    solved, wedged = np.ones(N, bool), np.zeros(N, bool)
     names = [f"{s}{k}" for s in "FM" for k in range(1, L)]
     for st in range(len(prog.stages)):
         segment = mech.memo(("friction_stage", st), lambda: _segment(prog, bounds[st], bounds[st + 1]))
@@ -156,19 +168,29 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
         def friction(R: np.ndarray) -> np.ndarray:
             return -coef[[p.index for p in pairs]] * np.abs(R) * sense[:, [p.index for p in pairs]]
 
-        run(segment, env)
-        R = reactions()
-        done = ~np.isfinite(R).all(axis=1) | ~solved       # singular there, or an earlier stage unsolved
-        q, last = friction(R), np.full(N, np.inf)
-        for count in range(1, MAX_PASSES + 1):
-            env.update(keep)
+        def apply(q: np.ndarray, base: dict = keep) -> np.ndarray:
+            """Run the stage with the friction loads q (N, n) on its links, added to the known
+            wrenches `base`; its reactions."""
+            env.update(base)
             dF, dM = np.zeros((N, L), complex), np.zeros((N, L))
             for c, p in enumerate(pairs):
                 _wrench(env, p, q[:, c], d.get(p.index), S.get(p.index), dF, dM)
             for k in range(1, L):
-                env[f"F{k}"], env[f"M{k}"] = keep[f"F{k}"] + dF[:, k], keep[f"M{k}"] + dM[:, k]
+                env[f"F{k}"], env[f"M{k}"] = base[f"F{k}"] + dF[:, k], base[f"M{k}"] + dM[:, k]
             run(segment, env)
-            R_new = reactions()
+            wrench[:] = dF, dM
+            return reactions()
+
+        wrench: list = [None, None]
+        run(segment, env)
+        R = reactions()
+        done = ~np.isfinite(R).all(axis=1) | ~solved       # singular there, or an earlier stage unsolved
+        q0 = q = friction(R)
+        wedged |= ~done & (_gain(lambda q: friction(apply(q, {k: 0.0 * keep[k] for k in names})),
+                                 -sense[:, [p.index for p in pairs]]) >= 1.0)
+        last = np.full(N, np.inf)
+        for count in range(1, MAX_PASSES + 1):
+            R_new = apply(q)
             change = np.abs(R_new - R).max(axis=1)
             scale = np.abs(R_new).max(axis=1)
             now = ~done & ((change <= PASS_TOL * scale) | ((change >= last) & (change <= FLOOR_TOL * scale)))
@@ -178,6 +200,11 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
             if done.all():
                 break
             q = friction(R)
+        if not done.all():                 # the passes do not converge there: Newton on the friction loads
+            applied, R, newton = _newton(apply, friction, np.where(done[:, None], applied, q0), ~done)
+            passes[newton > 0, st] = MAX_PASSES + newton[newton > 0]
+            done |= newton > 0
+        dF, dM = wrench
         failed = ~done
         for c, p in enumerate(pairs):
             load[:, p.index] = applied[:, c]
@@ -194,7 +221,52 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
     if not solved.all():
         frc = Forces(*(np.where(solved.reshape((N,) + (1,) * (a.ndim - 1)), a, np.nan)
                        for a in (frc.R, frc.normal, frc.m, frc.M_bal, frc.F_bal)))
-    return frc, FrictionSolution(np.asarray(M_bal_frictionless, float), load, F_fr, M_fr, passes, solved)
+    return frc, FrictionSolution(np.asarray(M_bal_frictionless, float), load, F_fr, M_fr, passes, solved, wedged)
+
+
+def _gain(T, q: np.ndarray) -> np.ndarray:
+    """(N,) the growth factor of the friction loads through a stage with no other load: the
+    friction loads T(q) that the reactions to the loads q (N, n) call for, |T^k q|^(1/k) for
+    large k, by power iteration (T is positively homogeneous of degree 1). At least 1: a pair
+    wedges (reactions with no load in equilibrium with their own friction: self-locking)."""
+    gain = np.zeros(len(q))
+    size = np.abs(q).max(axis=1)
+    for _ in range(GAIN_STEPS):
+        q = np.where(size[:, None] > 0, q / np.where(size > 0, size, 1.0)[:, None], 0.0)
+        q = T(q)
+        size = np.abs(q).max(axis=1)
+        gain = np.nan_to_num(size, nan=np.inf)
+    return gain
+
+
+def _newton(apply, friction, q: np.ndarray, todo: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Newton's method on a stage's friction loads q (N, n) at the angles `todo`: the root of
+    H(q) = friction(apply(q)) - q, its Jacobian by forward differences (n + 1 stage runs a step,
+    over all angles at once; the other angles keep their q). Returns the loads, the reactions
+    apply gives with them, and the steps each angle took (0: no root found: H not below
+    PASS_TOL of the loads within NEWTON_STEPS)."""
+    N, n = q.shape
+    steps = np.zeros(N, int)
+    for k in range(1, NEWTON_STEPS + 1):
+        R = apply(q)
+        H = friction(R) - q
+        size = np.abs(q).max(axis=1) + np.abs(friction(R)).max(axis=1)
+        ok = todo & (np.abs(H).max(axis=1) <= PASS_TOL * size) & np.isfinite(H).all(axis=1)
+        steps[ok] = k
+        todo = todo & ~ok
+        if not todo.any():
+            break
+        J = np.empty((N, n, n))
+        for c in range(n):
+            h = 1e-7 * (np.abs(q[:, c]) + 1e-3 * size) + 1e-300
+            dq = q.copy()
+            dq[:, c] += h
+            J[:, :, c] = (friction(apply(dq)) - dq - H) / h[:, None]
+        with np.errstate(all="ignore"):
+            step = np.linalg.solve(np.where(todo[:, None, None], J, np.eye(n)), np.where(todo[:, None], -H, 0.0)[..., None])
+        q = np.where(todo[:, None], q + step[..., 0], q)
+    R = apply(q)
+    return q, R, steps
 
 
 def _segment(prog: Program, start: int, stop: int) -> Program:

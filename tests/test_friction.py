@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 import kinetostat
 from conftest import EVERY_KIND, sampled
 from kinetostat.errors import SelfLockingWarning
-from kinetostat.friction import MAX_PASSES, RATE_TOL, relative_rate
+from kinetostat.friction import MAX_PASSES, NEWTON_STEPS, RATE_TOL, relative_rate
 from test_properties import KINDS, _SETTINGS, valid
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -73,7 +73,7 @@ def check_identities(mech, phi) -> None:
     w1 = res.omega(1)
     # the power balance: what friction takes, the drive gives on top
     dP = (res.balancing_moment - first.balancing_moment) * w1
-    assert np.abs(dP - res.friction_power.sum(axis=1))[ok].max() <= ROUNDING * (F * size * np.abs(w1)).max()
+    assert np.abs(dP - res.friction_power.sum(axis=1))[ok].max() <= ROUNDING * (F * size * np.abs(w1))[ok].max()
     # every contact dissipates: friction load x relative motion <= 0 (where the motion is more
     # than rounding: at rest the friction is the one of the motion just before)
     rate = relative_rate(mech, res.kin)[0]
@@ -88,7 +88,7 @@ def check_identities(mech, phi) -> None:
     # Zhukovsky's lever with the friction loads applied gives the same M_bal
     assert np.abs(res.lever_discrepancy)[ok].max() <= ROUNDING * F.max() * size
     # the passes are counted and bounded
-    assert (res.friction.passes[ok] >= 1).all() and res.friction.passes.max() <= MAX_PASSES
+    assert (res.friction.passes[ok] >= 1).all() and res.friction.passes.max() <= MAX_PASSES + NEWTON_STEPS
 
 
 # ----------------------------------------------------------------------------- the ICE worked example
@@ -213,11 +213,11 @@ def test_bundled_models_with_friction(path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SelfLockingWarning)
         res = kinetostat.analyze(mech, phi, friction="reactions")
-    ref = reference_full(mech, phi, res=res, friction=True)
-    ok = res.friction.solved
+    ok = res.friction.solved & ~res.friction.wedged
+    ref = reference_full(mech, phi[ok], friction=True)
     F, size = scales(res)
-    assert np.abs(ref.M_bal - res.balancing_moment)[ok].max() <= ROUNDING * F.max() * size
-    assert np.abs(ref.R - res.forces.R)[ok].max() <= ROUNDING * F.max()
+    assert np.abs(ref.M_bal - res.balancing_moment[ok]).max() <= ROUNDING * F.max() * size
+    assert np.abs(ref.R - res.forces.R[ok]).max() <= ROUNDING * F.max()
 
 
 @pytest.mark.parametrize("size", [QUICK, pytest.param(FULL, marks=pytest.mark.slow)], ids=["quick", "full"])
@@ -236,10 +236,10 @@ def test_random_mechanisms_with_friction(kind, size):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SelfLockingWarning)
             res = kinetostat.analyze(mech, at, friction="reactions")
-        ok = res.friction.solved & ~res.singular
+        ok = res.friction.solved & ~res.friction.wedged & ~res.singular    # a wedged pair: not unique
         F, length = scales(res)
         assume(ok.any() and F.max() > 0)
-        ref = reference_full(mech, at[ok], friction=True)      # where the passes found an equilibrium
+        ref = reference_full(mech, at[ok], friction=True)      # where the passes found the equilibrium
         assert np.abs(ref.M_bal - res.balancing_moment[ok]).max() <= ROUNDING * F.max() * length
         assert np.abs(ref.R - res.forces.R[ok]).max() <= ROUNDING * F.max()
         checked.append(int(res.friction.passes.max()))
