@@ -100,10 +100,10 @@ def singular_message(group: str, phi_deg: np.ndarray, cond: np.ndarray, digits: 
 
 
 class SelfLockingWarning(UserWarning):
-    """With friction in the reactions, no equilibrium was found at some crank angles (the
-    fixed-point passes of a group diverge: the friction loads grow faster than the reactions they
-    come from, a wedged mechanism that no finite drive moves). `phi_deg` lists them; the forces
-    and M_bal there are NaN."""
+    """With friction in the reactions, no equilibrium was found at some crank angles (neither
+    the fixed-point passes of a group nor Newton's method on its friction loads converge: a
+    wedged mechanism that no finite drive moves). `phi_deg` lists them; the forces and M_bal
+    there are NaN."""
 
     def __init__(self, message: str, phi_deg=()):
         super().__init__(message)
@@ -113,5 +113,6 @@ class SelfLockingWarning(UserWarning):
 def self_locking_message(phi_deg: np.ndarray) -> str:
     """The warning's text for the angles where friction leaves no equilibrium."""
     return (f"no equilibrium with friction in the reactions at phi = {_angle_list(np.round(phi_deg, 9))}: "
-            f"the friction passes do not converge (self-locking: no finite drive moves the mechanism); "
+            f"neither the friction passes nor Newton's method find one (self-locking: no finite drive moves "
+            f"the mechanism); "
             f"M_bal and the reactions there are NaN")
