@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 import numpy as np
 
-from .analysis import Analysis, analyze, crank_angles
+from .analysis import Analysis, analyze, crank_angles, friction_method
 from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
 from .units import parameter_units
@@ -135,11 +135,12 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
         for design in designs:
             try:
                 mech = loads(text, source, parameters=design)
-                res = None if compiled else analyze(mech, phi_deg=phi_deg)
+                kernel = compiled and friction_method(mech, None) != "reactions"   # the kernel has no friction
+                res = None if kernel else analyze(mech, phi_deg=phi_deg)
             except (ModelError, StructureError, AssemblyError) as exc:
                 rows.append({**design, "error": _reason(exc)})
                 continue
-            if compiled:
+            if kernel:
                 rows.append({**design, "error": ""})
                 built.append((len(rows) - 1, mech))
                 continue

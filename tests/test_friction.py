@@ -269,3 +269,20 @@ def test_worksheet_names_the_friction_terms(ice):
     assert ws.value("M_bal_friction") == res.balancing_moment[0] and ws.value("eta") == res.efficiency[0]
     assert "## Friction in the reactions" in ws.markdown()
     assert not worksheet(kinetostat.load(MODELS / "scotch_yoke.toml")).section("friction")
+
+
+def test_a_sweep_of_a_model_with_friction_in_the_reactions_solves_it(tmp_path):
+    """A model whose friction.method is "reactions": a sweep large enough for the compiled kernel
+    (which has no friction) takes the numpy path, and its peaks are the frictional ones."""
+    text = ICE.read_text().replace("radius = 0.012\n", 'radius = 0.012\nmethod = "reactions"\n', 1)
+    mech = tmp_path / "ice.toml"
+    mech.write_text(text)
+    phi = np.linspace(0.0, 360.0, 5001)[:-1]
+    from kinetostat.fast import FAST_MIN
+    from kinetostat.sweep import sweep
+    assert 2 * len(phi) >= FAST_MIN
+    table = sweep(mech, {"n1": [4500.0, 3000.0]}, phi_deg=phi).table
+    for n1, row in zip([4500.0, 3000.0], table.itertuples()):
+        res = kinetostat.analyze(kinetostat.load(mech, parameters={"n1": n1}), phi)
+        assert res.friction_method == "reactions"
+        assert row.peak_M_bal == pytest.approx(np.max(np.abs(res.balancing_moment)), rel=1e-12)
