@@ -286,3 +286,20 @@ def test_a_sweep_of_a_model_with_friction_in_the_reactions_solves_it(tmp_path):
         res = kinetostat.analyze(kinetostat.load(mech, parameters={"n1": n1}), phi)
         assert res.friction_method == "reactions"
         assert row.peak_M_bal == pytest.approx(np.max(np.abs(res.balancing_moment)), rel=1e-12)
+
+
+def test_the_engines_plans_and_worksheet_keep_the_frictionless_method(tmp_path):
+    """A model whose default is friction in the reactions: the engine routes (frictionless joints)
+    are compared with the first approximation's reactions, and the plans of the graphical method
+    and the worksheet's reactions stay frictionless; only analyze's own default changes."""
+    from kinetostat.plans.worksheet import worksheet
+    from kinetostat_validation.scene import build_scene
+    text = ICE.read_text().replace("radius = 0.012\n", 'radius = 0.012\nmethod = "reactions"\n', 1)
+    mech = kinetostat.loads(text, source=str(ICE))
+    first = kinetostat.analyze(mech, [30.0], friction="first")
+    assert kinetostat.analyze(mech, [30.0]).friction_method == "reactions"
+    assert build_scene(mech, phi_deg=[30.0]).res.friction_method == "first"
+    ws = worksheet(mech, 30.0)
+    assert ws.value("M_bal") == first.balancing_moment[0] != ws.value("M_bal_friction")
+    plans = kinetostat.plans.build(mech, only=["crank"])
+    assert plans["crank"].results[0].value == pytest.approx(first.balancing_moment[0], rel=1e-12)

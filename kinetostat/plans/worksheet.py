@@ -458,7 +458,7 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
         at = mech.drive.design_deg
     if mu_l is not None and not (isinstance(mu_l, (int, float)) and math.isfinite(mu_l) and mu_l > 0):
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
-    res = analyze(mech, phi_deg=[float(at)])
+    res = analyze(mech, phi_deg=[float(at)], friction="first")     # the graphical method; friction: its own section
     if mu_l is None:
         mu_l = choose_scales(mech, res)["mu_l"].value
     sheet = _Sheet(res, float(mu_l))
