@@ -1,6 +1,7 @@
 """`analyze(mech, phi_deg)`: the whole kinetostatic analysis as one frozen result object.
 
-May use: model, groups, kinematics, kinetostatics, applied, planar, fast; pandas only inside `to_frame`.
+May use: model, groups, kinematics, kinetostatics, applied, planar, friction, errors, fast; pandas only
+inside `to_frame`.
 """
 from __future__ import annotations
 

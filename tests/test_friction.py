@@ -303,3 +303,14 @@ def test_the_engines_plans_and_worksheet_keep_the_frictionless_method(tmp_path):
     assert ws.value("M_bal") == first.balancing_moment[0] != ws.value("M_bal_friction")
     plans = kinetostat.plans.build(mech, only=["crank"])
     assert plans["crank"].results[0].value == pytest.approx(first.balancing_moment[0], rel=1e-12)
+
+
+def test_cli_analyze_with_friction_in_the_reactions(capsys):
+    from kinetostat import cli
+    assert cli.main(["analyze", "ice_crank_slider", "--at", "0", "30", "--friction", "reactions"]) == 0
+    out = capsys.readouterr().out
+    res = kinetostat.analyze(kinetostat.load(ICE), [0.0, 30.0], friction="reactions")
+    assert "friction (reactions): self-locking at 1 of 2 positions, eta 0.9395 .. 0.9395 elsewhere" in out
+    assert f"{res.balancing_moment[1]:12.6g}" in out
+    assert cli.main(["analyze", "ice_crank_slider", "--at", "30"]) == 0
+    assert "friction (first): self-locking at 0 of 1 positions, eta 0.9379" in capsys.readouterr().out
