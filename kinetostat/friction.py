@@ -235,7 +235,9 @@ def _gain(T, q: np.ndarray) -> np.ndarray:
         q = np.where(size[:, None] > 0, q / np.where(size > 0, size, 1.0)[:, None], 0.0)
         q = T(q)
         size = np.abs(q).max(axis=1)
-        gain = np.nan_to_num(size, nan=np.inf)
+        gain, last = np.nan_to_num(size, nan=np.inf), gain
+        if np.all(np.abs(gain - last) <= 1e-9 * np.maximum(gain, 1.0)):     # settled (inf - inf: not)
+            break
     return gain
 
 
