@@ -1,10 +1,12 @@
 """The whole kinetostatic analysis as one frozen result object (`Analysis`), and the numpy path
 that computes it (`exact`); `kinetostat.solve.analyze` chooses between it and the compiled path.
 
-May use: model, groups, kinematics, kinetostatics, applied, planar; pandas only inside `to_frame`.
+May use: model, groups, kinematics, kinetostatics, applied, planar, friction, errors; pandas only inside
+`to_frame`.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, fields, replace
 from types import MappingProxyType
 from typing import Mapping, NamedTuple
@@ -14,12 +16,13 @@ import numpy as np
 from .kinematics import (Kinematics, a_priori_error, guard, kinematic_deviation, kinematic_size, kinematics,
                          relative_change, solve_checked)
 from .kinetostatics import Forces, forces, friction_power, lever_moment
-from . import groups
+from . import friction as _friction, groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, dot_z
+from .errors import SelfLockingWarning, self_locking_message
 from .model import Mechanism, _abbreviate
 
-__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "crank_angles", "FRAME_NOTE", "deviation",
+__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "deviation",
            "force_deviation"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
@@ -71,8 +74,11 @@ class Analysis:
     F_i: np.ndarray         # (N, L, 2) inertia main vectors (at the centres of mass), N
     M_i: np.ndarray         # (N, L) inertia main moments, N m
     forces: Forces
-    lever_moment: np.ndarray      # (N,) balancing moment by Zhukovsky's lever, N m
-    friction_power: np.ndarray    # (N, n_pairs) power lost in each pair, W
+    lever_moment: np.ndarray      # (N,) balancing moment by Zhukovsky's lever, N m (with friction in
+                                  #   the reactions: the friction loads applied on the lever too)
+    friction_power: np.ndarray    # (N, n_pairs) power lost in each pair, W (>= 0)
+    friction: _friction.FrictionSolution | None = None   # friction in the reactions (None: the first
+                                  #   approximation or no friction; `friction_method` says which)
 
     def __repr__(self) -> str:
         phi = self.phi_deg
@@ -193,7 +199,8 @@ class Analysis:
         return Analysis(self.mech, self.phi_deg[idx], self.kin.take(idx), self.F_applied[idx],
                         self.M_applied[idx], self.F_i[idx], self.M_i[idx],
                         type(f)(f.R[idx], f.normal[idx], f.m[idx], f.M_bal[idx], f.F_bal[idx]),
-                        self.lever_moment[idx], self.friction_power[idx])
+                        self.lever_moment[idx], self.friction_power[idx],
+                        None if self.friction is None else self.friction.take(idx))
 
     def inertia(self, k: int) -> InertiaLoad:
         """Inertia force, moment, offset h and a point of the single resultant of link k."""
@@ -275,7 +282,105 @@ class Analysis:
         """(n_pairs,) energy lost in each pair over one revolution, J: the integral of its power
         over the crank angle (`_cycle_integral`). Needs the angles of a uniform full cycle, as
         `analyze(mech, steps=N)` gives."""
-        return self._cycle_integral(friction_power(self.mech, self._unit_motion(), self.forces.R), "friction_energy")
+        return self._cycle_integral(self._friction_power(self._unit_motion()), "friction_energy")
+
+    def _friction_power(self, kin: Kinematics) -> np.ndarray:
+        """(N, n_pairs) power lost in each pair at the motion `kin` (the same angles), W: from the
+        friction loads of the exact solution, or seed 003's formulas on the frictionless reactions."""
+        if self.friction is None:
+            return friction_power(self.mech, kin, self.forces.R)
+        return _friction.power(self.mech, kin, self.friction.load)
+
+    @property
+    def friction_method(self) -> str:
+        """"reactions" (friction in the reactions, exact), "first" (seed 003's first approximation:
+        frictionless reactions and M_bal, friction power from them) or "none" (no [friction])."""
+        return "none" if self.mech.friction is None else "first" if self.friction is None else "reactions"
+
+    @property
+    def balancing_moment_frictionless(self) -> np.ndarray:
+        """(N,) balancing moment without friction, N m about +z."""
+        return self.balancing_moment if self.friction is None else self.friction.M_bal_frictionless
+
+    @property
+    def balancing_moment_with_friction(self) -> np.ndarray:
+        """(N,) balancing moment with friction, N m about +z: the exact one with friction in the
+        reactions; in the first approximation M_bal + (total friction power) / omega_1 (the drive
+        supplies the losses on top, seed 003), M_bal where the crank stands still."""
+        if self.friction is not None or self.mech.friction is None:
+            return self.balancing_moment
+        w = self.kin.omega[:, 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(w != 0, self.balancing_moment + self.friction_power_total / w, self.balancing_moment)
+
+    def _turn(self) -> np.ndarray:
+        """(N,) sign of the crank's rotation (the drive's sense where it stands still)."""
+        w = np.sign(self.kin.omega[:, 1])
+        return np.where(w != 0, w, self.mech.drive.sense)
+
+    @property
+    def efficiency(self) -> np.ndarray:
+        """(N,) instantaneous efficiency eta(phi), 1: M0 / Mf where the drive works against the
+        loads (M0 omega_1 >= 0), Mf / M0 where the loads drive the crank (an engine's expansion
+        stroke), M0 and Mf the balancing moments without and with friction
+        (`balancing_moment_with_friction`: the first approximation's where friction is not in the
+        reactions; 1 without friction). NaN where both moments are below 1e-12 x the largest
+        reaction x size (a dead centre: undefined) and where no equilibrium was found."""
+        R = np.linalg.norm(self.forces.R, axis=-1).max(axis=1, initial=0.0)
+        return _friction.efficiency(self.balancing_moment_frictionless, self.balancing_moment_with_friction,
+                                    self._turn(), 1e-12 * R * self.mech.size)
+
+    @property
+    def self_locking(self) -> np.ndarray:
+        """(N,) bool: eta <= 0 (the loads cannot drive the crank through friction; the drive must
+        help where they would), or, with friction in the reactions, a pair wedges (the friction
+        passes do not contract: M_bal is the equilibrium Newton's method finds there) or no
+        equilibrium is found (M_bal NaN, with a SelfLockingWarning naming the angles)."""
+        unsolved = np.zeros(len(self.phi_deg), bool) if self.friction is None else \
+            ~self.friction.solved | self.friction.wedged
+        with np.errstate(invalid="ignore"):
+            return unsolved | (self.efficiency <= 0)
+
+    def self_locking_zones(self, tol_deg: float = 1e-9) -> np.ndarray:
+        """(n_zones, 2) start and end of each run of self-locking angles, deg, start < end (a zone
+        across 0 starts below 0 on a full cycle), its edges found to `tol_deg` by bisection on the
+        crank angle between the angles of this result (re-solved at the same friction method).
+        On a uniform full cycle the angles wrap around; a zone narrower than the step between
+        two angles of the result can be missed."""
+        phi, lock = np.asarray(self.phi_deg, float), self.self_locking
+        cyclic = len(phi) > 1 and np.allclose(np.diff(phi), 360.0 / len(phi), rtol=0, atol=1e-9)
+        nxt = np.arange(1, len(phi) + 1) % len(phi) if cyclic else np.arange(1, len(phi))
+        lo = phi[:len(nxt)]
+        hi = np.where(nxt > np.arange(len(nxt)), phi[nxt], phi[nxt] + 360.0)
+        cut = np.flatnonzero(lock[:len(nxt)] != lock[nxt])
+        lo, hi, rising = lo[cut], hi[cut], ~lock[cut]
+        method = "reactions" if self.friction is not None else "first"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SelfLockingWarning)
+            while len(lo) and (hi - lo).max() > tol_deg:
+                mid = 0.5 * (lo + hi)
+                at = exact(self.mech, mid, method).self_locking
+                left = at == ~rising                # mid on the side of lo
+                lo, hi = np.where(left, mid, lo), np.where(left, hi, mid)
+        edge = 0.5 * (lo + hi)
+        starts, ends = list(edge[rising]), list(edge[~rising])
+        if lock[0] and not cyclic:
+            starts.insert(0, phi[0])
+        if lock[-1] and not cyclic:
+            ends.append(phi[-1])
+        if cyclic and starts and ends and ends[0] < starts[0]:
+            starts = [starts[-1] - 360.0] + starts[:-1]
+        return np.array(list(zip(starts, ends)), float).reshape(-1, 2)
+
+    def cycle_efficiency(self) -> float:
+        """Efficiency over one revolution, 1: the same rule as `efficiency` over the works of the
+        balancing moment without (W0) and with (Wf) friction: W0 / Wf where the drive does work
+        on the loads over the cycle (W0 > 0), Wf / W0 where the loads drive it (an engine).
+        Needs a uniform full cycle of angles (NaN if any angle has no equilibrium)."""
+        w1 = self._unit_motion().omega[:, 1]
+        W0, Wf = self._cycle_integral(np.stack([self.balancing_moment_frictionless * w1,
+                                                self.balancing_moment_with_friction * w1], -1), "cycle_efficiency")
+        return float(W0 / Wf if W0 > 0 else Wf / W0)
 
     def _unit_motion(self) -> Kinematics:
         """The motion at the same angles at unit crank speed (d phi/dt = 1 rad/s): its velocities
@@ -304,9 +409,10 @@ class Analysis:
         per applied force or moment (loads of one name summed); "spring NAME" (both ends);
         "damper NAME" (both links: -(energy dissipated)); "balancing moment" (M_bal omega_1; for
         a working machine the pinion's force, the same power); with friction "friction R(i,j)" per
-        pair, the energy lost (negative). The balancing moment is frictionless: every entry but
-        friction sums to 0 (to rounding) at any speed law, and the friction entries are what the
-        drive must supply on top (seed 003)."""
+        pair, the energy lost (negative). With friction in the reactions every entry sums to 0 (to
+        rounding); in the first approximation the balancing moment is frictionless: every entry
+        but friction sums to 0 at any speed law, and the friction entries are what the drive must
+        supply on top (seed 003)."""
         m, kin, u = self.mech, self.kin, self._unit_motion()
         per_radian: dict[str, np.ndarray] = {}
 
@@ -333,7 +439,7 @@ class Analysis:
             add(f"{f.source} {f.name}", dot_z(f.force, v))
         add("balancing moment", self.balancing_moment * u.omega[:, 1])
         if m.friction is not None:
-            lost = friction_power(m, u, self.forces.R)
+            lost = self._friction_power(u)
             for p in m.pairs:
                 add(f"friction {p.label}", -lost[:, p.index])
         names = list(per_radian)
@@ -355,8 +461,11 @@ class Analysis:
         about the slider point), vs_i_j [m/s] and as_i_j [m/s^2] (sliding velocity and
         acceleration); Fax_k [N] for every two-pin link (axial force, tension positive, the mean of
         its two ends: `axial_force`); M_bal, M_lever [N m]; for a working machine F_balx, F_baly, F_bal [N]; with
-        friction Pfr_i_j per pair and Pfr_total [W]; cond_<group> [1] per Assur group; singular
-        [bool].
+        friction Pfr_i_j per pair and Pfr_total [W], eta [1] (`efficiency`), self_locking [bool],
+        and with friction in the reactions Ffr_i_j per pair (friction moment on link j [N m] in
+        a revolute pair, friction force on the slider along the guide [N] in a prismatic one) and
+        M_bal_0 [N m] (the frictionless balancing moment); cond_<group> [1] per Assur group;
+        singular [bool].
 
         `df.attrs["units"]` maps every column to its unit ("1": dimensionless, "bool": a flag);
         `df.attrs["frame"]` states the frame and sign conventions; `df.attrs["mechanism"]` the
@@ -411,6 +520,12 @@ class Analysis:
         if m.friction is not None:
             put("W", **{f"Pfr_{p.links[0]}_{p.links[1]}": self.friction_power[:, p.index] for p in m.pairs})
             put("W", Pfr_total=self.friction_power_total)
+            if self.friction is not None:
+                for p in m.pairs:
+                    put("N m" if p.kind == "R" else "N", **{f"Ffr_{p.links[0]}_{p.links[1]}": self.friction.load[:, p.index]})
+                put("N m", M_bal_0=self.balancing_moment_frictionless)
+            put("1", eta=self.efficiency)
+            put("bool", self_locking=self.self_locking)
         put("1", **{f"cond_{g.label}": self.cond[:, n] for n, g in enumerate(m.structure.groups)})
         put("bool", singular=self.singular)
         df = pd.DataFrame(cols)
@@ -438,19 +553,35 @@ def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:
     return phi_deg
 
 
-def exact(mech: Mechanism, phi_deg: np.ndarray) -> Analysis:
+def friction_method(mech: Mechanism, friction: str | None) -> str:
+    """The friction method `analyze` takes: `friction`, else the model's, else "first";
+    ValueError naming the argument if it is not one of friction.METHODS."""
+    method = friction if friction is not None else mech.friction.method if mech.friction is not None else "first"
+    if method not in _friction.METHODS:
+        raise ValueError(f"friction: expected one of {list(_friction.METHODS)}, got {friction!r}")
+    return method
+
+
+def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Analysis:
     """`analyze` by the numpy path at the crank angles `phi_deg` (deg, (N,)), with the accuracy
-    guard: where a group's cond exceeds COND_CHECK the error is measured by perturbed re-solves."""
+    guard: where a group's cond exceeds COND_CHECK the error is measured by perturbed re-solves.
+    `friction`: "first" or "reactions" (see `analyze`); a SelfLockingWarning names the angles
+    where friction in the reactions leaves no equilibrium."""
+    reactions = friction == "reactions" and mech.friction is not None
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # NaN only at angles marked singular
         kin, checked, trials = solve_checked(mech, np.radians(phi_deg))
-        res = _kinetostatics(mech, phi_deg, kin)
+        res = _kinetostatics(mech, phi_deg, kin, reactions)
         error = a_priori_error(kin.cond)
         if len(checked):
             nominal = res.take(checked)
-            error[checked] = np.max([deviation(nominal, _kinetostatics(mech, phi_deg[checked], t))
+            error[checked] = np.max([deviation(nominal, _kinetostatics(mech, phi_deg[checked], t, reactions))
                                      for t in trials], axis=0)
         kin = guard(mech, kin, error)
-        return _kinetostatics(mech, phi_deg, kin) if kin.singular.any() else _read_only(replace(res, kin=kin))
+        res = _kinetostatics(mech, phi_deg, kin, reactions) if kin.singular.any() else replace(res, kin=kin)
+    if res.friction is not None and not (res.friction.solved | kin.singular).all():
+        bad = phi_deg[~(res.friction.solved | kin.singular)]
+        warnings.warn(SelfLockingWarning(self_locking_message(bad), bad), stacklevel=3)
+    return _read_only(res)
 
 
 def force_deviation(a: Analysis, b: Analysis) -> np.ndarray:
@@ -469,21 +600,27 @@ def deviation(a: Analysis, b: Analysis) -> np.ndarray:
     return np.maximum(kinematic_deviation(a.mech, a.kin, b.kin), force_deviation(a, b))
 
 
-def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics) -> Analysis:
+def _kinetostatics(mech: Mechanism, phi_deg: np.ndarray, kin: Kinematics, reactions: bool = False) -> Analysis:
+    """The forces at the motion `kin`; `reactions`: with friction in the reactions."""
     mass, I_S, com = mech.inertia_arrays
     r, F_i, M_i = groups.inertia(kin.a_z, kin.omega, kin.eps, kin.rot, com, mass, I_S)
     F_app, M_app = applied_wrenches(mech, kin, r)
     F_all, M_all = groups.wrench(F_app, M_app, F_i, M_i, r)
     frc = forces(mech, kin, F_all, M_all)
-    lever = lever_moment(mech, kin, F_all, M_all)
+    if not reactions:
+        return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc,
+                                   lever_moment(mech, kin, F_all, M_all), friction_power(mech, kin, frc.R)))
+    with np.errstate(all="ignore"):
+        frc, sol = _friction.solve(mech, kin, F_all, M_all, frc.M_bal)
+    lever = lever_moment(mech, kin, F_all + sol.F, M_all + sol.M)
     return _read_only(Analysis(mech, phi_deg, kin, as_xy(F_app), M_app, as_xy(F_i), M_i, frc, lever,
-                               friction_power(mech, kin, frc.R)))
+                               _friction.power(mech, kin, sol.load), sol))
 
 
 def _read_only(res: Analysis) -> Analysis:
     """`res` with every array it holds (its own, its Kinematics' and Forces') read-only: a
     frozen result whose numbers no caller can change in place."""
-    for part in (res, res.kin, res.forces):
+    for part in (res, res.kin, res.forces) + (() if res.friction is None else (res.friction,)):
         for f in fields(part):
             value = getattr(part, f.name)
             if isinstance(value, np.ndarray):

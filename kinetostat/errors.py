@@ -97,3 +97,22 @@ def singular_message(group: str, phi_deg: np.ndarray, cond: np.ndarray, digits: 
     return (f"group {group} is near a singular position at phi = {_angle_list(np.round(phi_deg, 9))}; "
             f"condition number up to {np.max(cond):.3g}; estimated significant digits left "
             f"{np.min(digits):.1f} to {np.max(digits):.1f} ({what})")
+
+
+class SelfLockingWarning(UserWarning):
+    """With friction in the reactions, no equilibrium was found at some crank angles (neither
+    the fixed-point passes of a group nor Newton's method on its friction loads converge: a
+    wedged mechanism that no finite drive moves). `phi_deg` lists them; the forces and M_bal
+    there are NaN."""
+
+    def __init__(self, message: str, phi_deg=()):
+        super().__init__(message)
+        self.phi_deg = np.round(np.asarray(phi_deg, dtype=float), 9)     # undo rad->deg rounding
+
+
+def self_locking_message(phi_deg: np.ndarray) -> str:
+    """The warning's text for the angles where friction leaves no equilibrium."""
+    return (f"no equilibrium with friction in the reactions at phi = {_angle_list(np.round(phi_deg, 9))}: "
+            f"neither the friction passes nor Newton's method find one (self-locking: no finite drive moves "
+            f"the mechanism); "
+            f"M_bal and the reactions there are NaN")

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Gear, Mechanism
 
-__all__ = ["Forces", "forces", "gear_force", "lever_moment", "friction_power"]
+__all__ = ["Forces", "forces", "statics_environment", "packed", "gear_force", "lever_moment", "friction_power"]
 
 
 @dataclass(frozen=True)
@@ -59,11 +59,23 @@ def forces(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -
     M per link (applied + inertia, about each link's local origin). Call under
     np.errstate(divide="ignore", invalid="ignore"), as `analyze` does: at angles the kinematics
     marked singular the divisions give NaN, by design."""
+    env = statics_environment(mech, kin, F, M)
+    run(statics_program(mech), env)
+    return packed(mech, env, len(kin.phi))
+
+
+def statics_environment(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray) -> dict:
+    """The environment the statics program runs in: the design's constants, the motion (rot<k>,
+    O<k>) and the known wrenches (F<k>, M<k>) of every moving link."""
     env = dict(mech.memo(("constants", id(mech.points_z)), lambda: constants(mech)))
     for k in range(1, mech.n_links):
         env.update({f"rot{k}": kin.rot[:, k], f"O{k}": kin.origin_z[:, k], f"F{k}": F[:, k], f"M{k}": M[:, k]})
-    run(statics_program(mech), env)
-    N, n = len(kin.phi), len(mech.pairs)
+    return env
+
+
+def packed(mech: "Mechanism", env: dict, N: int) -> Forces:
+    """The statics program's outputs in `env` as Forces at N angles."""
+    n = len(mech.pairs)
     R = np.empty((N, n), complex)
     normal, m = np.zeros((2, N, n))
     for p in mech.pairs:

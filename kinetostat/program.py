@@ -53,6 +53,8 @@ class Program:
     steps: tuple[Step, ...]
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
+    stages: tuple[int, ...] = ()     # statics: the index of the first step of each group (in the
+                                     # order solved) and of the initial link
 
 
 # ----------------------------------------------------------------------------- the numbers of one design
@@ -518,8 +520,11 @@ def statics_program(mech: "Mechanism") -> Program:
     origin); outputs R<p> for every pair, N<p>, m<p> for the prismatic ones, M_bal and F_bal."""
     def make() -> Program:
         b = _Statics(mech)
+        stages = []
         for g in reversed(mech.structure.groups):
+            stages.append(len(b.steps))
             getattr(b, _solver(g))(g)
+        stages.append(len(b.steps))
         dr = mech.drive
         b.steps.append(Step("scaled", (b.moment(1, b.at(1, dr.pivot)), -1.0), ("M_bal",)))
         if dr.kind == "machine":
@@ -532,7 +537,7 @@ def statics_program(mech: "Mechanism") -> Program:
         inputs = tuple(f"{s}{k}" for s in ("rot", "O", "F", "M") for k in range(1, L))
         outputs = tuple(f"R{p.index}" for p in mech.pairs) + \
             tuple(f"{s}{p}" for s in ("N", "m") for p in sorted(b.prismatic_pairs)) + ("M_bal", "F_bal")
-        return Program(tuple(b.steps), inputs, outputs)
+        return Program(tuple(b.steps), inputs, outputs, tuple(stages))
     return mech.memo("statics_program", make)
 
 

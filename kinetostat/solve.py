@@ -7,23 +7,31 @@ May use: model, analysis, fast.
 from __future__ import annotations
 
 from . import fast
-from .analysis import Analysis, crank_angles, exact
+from .analysis import Analysis, crank_angles, exact, friction_method
 from .model import Mechanism
 
 __all__ = ["analyze"]
 
 
-def analyze(mech: Mechanism, phi_deg=None, steps: int = 360) -> Analysis:
+def analyze(mech: Mechanism, phi_deg=None, steps: int = 360, friction: str | None = None) -> Analysis:
     """Kinematic and kinetostatic analysis of `mech` at crank angles `phi_deg` (deg, array-like),
     or at `steps` equal steps over a full revolution when `phi_deg` is None.
 
+    `friction` (a model with [friction] only; the default is the model's `friction.method`, else
+    "first"): "first" is the first approximation of the TMM course text on friction (frictionless
+    reactions and M_bal, the friction power from them); "reactions" solves the reactions with
+    friction exactly (`kinetostat.friction`), group by group, on the numpy path at any number of angles.
+
     From fast.FAST_MIN angles on it runs the compiled kernel (`fast.analyze_fast`), below them
     the numpy path (`exact`): the same results to rounding (tests/test_fast.py). A mechanism the
-    kernel does not take (`fast.refusal`: a class-III group) goes the numpy path at any count."""
+    kernel does not take (`fast.refusal`: a class-III group) and friction="reactions" (the kernel
+    has no friction in the reactions) go the numpy path at any count."""
     if not isinstance(mech, Mechanism):
         raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
                         f"read a model file with kinetostat.load(path)")
     phi_deg = crank_angles(phi_deg, steps)
-    if len(phi_deg) >= fast.FAST_MIN and fast.available() and fast.refusal(mech) is None:
+    method = friction_method(mech, friction)
+    if ((method != "reactions" or mech.friction is None) and len(phi_deg) >= fast.FAST_MIN and fast.available()
+            and fast.refusal(mech) is None):
         return fast.analyze_fast(mech, phi_deg)
-    return exact(mech, phi_deg)
+    return exact(mech, phi_deg, method)

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 import numpy as np
 
-from .analysis import Analysis, crank_angles
+from .analysis import Analysis, crank_angles, friction_method
 from .solve import analyze
 from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
@@ -136,7 +136,8 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
         for design in designs:
             try:
                 mech = loads(text, source, parameters=design)
-                kernel = compiled and fast.refusal(mech) is None     # a triad: the numpy path
+                kernel = (compiled and fast.refusal(mech) is None          # a triad: the numpy path
+                          and friction_method(mech, None) != "reactions")   # the kernel has no friction
                 res = None if kernel else analyze(mech, phi_deg=phi_deg)
             except (ModelError, StructureError, AssemblyError) as exc:
                 rows.append({**design, "error": _reason(exc)})

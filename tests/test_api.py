@@ -98,6 +98,7 @@ UNIT_OF_PREFIX = {   # column family -> unit, written out here independently of 
     "Rx": "N", "Ry": "N", "R": "N", "m": "N m", "vs": "m/s", "as": "m/s^2", "M_bal": "N m",
     "M_lever": "N m", "F_balx": "N", "F_baly": "N", "F_bal": "N", "Pfr": "W", "Pfr_total": "W",
     "cond": "1", "singular": "bool", "xK": "m", "yK": "m", "lSK": "m", "angle": "deg", "Fax": "N",
+    "eta": "1", "self_locking": "bool", "M_bal_0": "N m",
 }
 
 

@@ -346,3 +346,21 @@ def test_rounding_is_shown_as_such():
     assert _err(8.0452e-14, 1200.0, "N") == "≈ 0 (rounding)"
     assert _err(8.0452e-14, 0.1, "N") == "8.05e-14 N"         # 8e-13 of a 0.1 N peak: a real number
     assert _rel(1.1e-15) == "rounding" and _rel(3e-13) == "3.00e-13"
+
+
+def test_report_shows_friction_in_the_reactions_beside_the_first_approximation(ice_report):
+    """The ICE has [friction]: its M_bal at the design position with friction in the reactions and
+    in the first approximation (numbers from analyze), the self-locking zone near top dead centre
+    with its edges, and the checks; the shaper (no friction) has no such section."""
+    md = (ice_report / "ice_crank_slider" / "index.md").read_text()
+    mech = kinetostat.load(ICE)
+    exact = kinetostat.analyze(mech, [30.0], friction="reactions")
+    first = kinetostat.analyze(mech, [30.0], friction="first")
+    row = re.search(r"^\| M\\_зр at φ = 30°, N·m \| (\S+) \| (\S+) \| (\S+) \|$", md, re.M)
+    assert row and [float(x) for x in row.groups()] == pytest.approx(
+        [first.balancing_moment[0], first.balancing_moment_with_friction[0], exact.balancing_moment[0]], rel=1e-3)
+    assert "| quantity | frictionless | first approximation | friction in the reactions |" in md
+    zone = re.search(r"edges to 1e-9° by bisection on the crank angle: 0\.000000000° to (1\.\d{9})°", md)
+    assert zone and 1.0 < float(zone.group(1)) < 2.0
+    assert "their joint friction is a constant limit torque" in md and "≈ 0 (rounding)" in md
+    assert "## Friction in the reactions" not in (ice_report / "slotted_link_shaper" / "index.md").read_text()

@@ -298,8 +298,8 @@ def compare(mech: Mechanism, engines=tuple(ROUTES), steps: int = 360, res: Analy
         raise ValueError(f"unknown engine route(s) {unknown}. Valid names: {list(ROUTES)}")
     tol = TOLERANCES if tolerances is None else tolerances
     t0 = time.perf_counter()
-    if res is None:
-        res = analyze(mech, steps=steps)
+    if res is None:                       # the engines have no f r |R| friction: the first approximation
+        res = analyze(mech, steps=steps, friction="first")
     solver_seconds = time.perf_counter() - t0
     scene = build_scene(mech, res=res)
     rows, results, skipped, failed = [], {}, {}, {}

@@ -63,6 +63,7 @@ from mpmath import mp, mpf
 
 from kinetostat import Analysis, Mechanism, analyze
 from kinetostat.applied import load_magnitude
+from kinetostat.friction import RATE_TOL
 
 from .scene import EngineResult, Scene
 
@@ -419,8 +420,75 @@ def _applied(m: _Model, q, qd, phi_index: int, mags: dict, wrench_F, wrench_M, S
                 wrench_M[k] += _cross(_sub(X, S[k]), f)
 
 
-def _statics(m: _Model, q, qd, qdd, phi_index: int, mags: dict, s_gear: int):
-    """The global Newton-Euler system at one state; returns the unknown vector (a list)."""
+def _friction_signs(m: _Model, q, qd, qdd) -> list:
+    """Per pair: the sign of the motion of pair.links[1] relative to links[0] (omega_j - omega_i;
+    the sliding velocity along the guide), computed here from the reference's own velocities;
+    where it is below RATE_TOL x the crank's (x size for a slider), minus the sign of its rate
+    (the motion just before: kinetostat.friction's convention), 0 at standstill."""
+    out = []
+    for entry in m.pairs:
+        p = entry[1]
+        i, j = p.links
+        if entry[0] == "R":
+            rate, acc, tol = m.w(qd, j) - m.w(qd, i), m.w(qdd, j) - m.w(qdd, i), RATE_TOL
+        else:
+            dw, _ = m.guide(q, entry)
+            X = m.X(q, j, p.point)
+            wi, ei = m.w(qd, i), m.w(qdd, i)
+            if i:
+                c = m.col(i)
+                r = _sub(X, (q[c], q[c + 1]))
+                Vi = _add((qd[c], qd[c + 1]), _mul(wi, _r90(r)))
+                Ai = _add(_add((qdd[c], qdd[c + 1]), _mul(ei, _r90(r))), _mul(-wi ** 2, r))
+            else:
+                Vi = Ai = (mpf(0), mpf(0))
+            v_rel = _sub(m.V(q, qd, j, p.point), Vi)
+            a_rel = _sub(_sub(m.A(q, qd, qdd, j, p.point), Ai), _mul(2 * wi, _r90(v_rel)))
+            rate, acc, tol = _dot(dw, v_rel), _dot(dw, a_rel), RATE_TOL * m.size
+        crank = abs(m.w(qd, 1))
+        out.append(mp.sign(rate) if abs(rate) > tol * crank else (-mp.sign(acc) if crank else 0))
+    return out
+
+
+def _friction_terms(m: _Model, q, x, S, signs, coef, row) -> tuple[list, list]:
+    """The friction loads of every pair as the left-hand side Phi(x) of the Newton-Euler rows
+    (added like the reactions' own terms) and their Jacobian dPhi/dx (lists)."""
+    n = m.n
+    phi, J = [mpf(0)] * n, _zeros(n)
+    for u, entry in enumerate(m.pairs):
+        p, c, s = entry[1], 2 * u, signs[u]
+        i, j = p.links
+        if not s:
+            continue
+        if entry[0] == "R":
+            mag = mp.sqrt(x[c] ** 2 + x[c + 1] ** 2)
+            grad = {c: x[c] / mag, c + 1: x[c + 1] / mag} if mag else {}
+            for k, sgn in ((j, 1), (i, -1)):
+                if k:
+                    r = row(k) + 2
+                    phi[r] += -sgn * coef[u] * s * mag
+                    for col, g in grad.items():
+                        J[r][col] += -sgn * coef[u] * s * g
+        else:
+            dw, _ = m.guide(q, entry)
+            X = m.X(q, j, p.point)
+            mag, g = abs(x[c]), mp.sign(x[c])
+            for k, sgn in ((j, 1), (i, -1)):
+                if k:
+                    r = row(k)
+                    unit = _mul(-sgn * coef[u] * s, dw)          # d(force on k) / d|N|
+                    arm = _cross(_sub(X, S[k]), unit)
+                    for dr, val in ((0, unit[0]), (1, unit[1]), (2, arm)):
+                        phi[r + dr] += val * mag
+                        J[r + dr][c] += val * g
+    return phi, J
+
+
+def _statics(m: _Model, q, qd, qdd, phi_index: int, mags: dict, s_gear: int, friction: bool = False):
+    """The global Newton-Euler system at one state; returns the unknown vector (a list). With
+    `friction`: the friction loads of every pair (kinetostat.friction's laws) are unknowns'
+    functions, and the whole nonlinear system is solved at once by Newton's method from the
+    frictionless solution, to a residual below 1e-30 of the largest load."""
     mech = m.mech
     L = m.L
     n = m.n
@@ -480,19 +548,39 @@ def _statics(m: _Model, q, qd, qdd, phi_index: int, mags: dict, s_gear: int):
         A[0][last], A[1][last] = u_dir
         A[2][last] = _cross(_sub(Pp, S[1]), u_dir)
     x = _solve(A, b)
+    if friction and m.mech.friction is not None:
+        fr = m.mech.friction
+        coef = [mpf(fr.f) * (mpf(e[1].radius if e[1].radius is not None else fr.radius) if e[0] == "R" else 1)
+                for e in m.pairs]
+        signs = _friction_signs(m, q, qd, qdd)
+        scale = max(abs(v) for v in b) + max(abs(v) for v in x)
+        for _ in range(60):
+            phi, J = _friction_terms(m, q, x, S, signs, coef, row)
+            res = [sum(a * xi for a, xi in zip(Ar, x)) + f - bi for Ar, f, bi in zip(A, phi, b)]
+            if max(abs(v) for v in res) <= mpf(10) ** (10 - mp.dps) * scale:
+                break
+            dx = _solve([[a + jj for a, jj in zip(Ar, Jr)] for Ar, Jr in zip(A, J)], res)
+            x = [xi - d for xi, d in zip(x, dx)]
+        else:
+            raise ArithmeticError("reference: Newton on the frictional equilibrium did not converge")
+        along = [-coef[u] * signs[u] * abs(x[2 * u]) for u in range(len(m.pairs))]
+    else:
+        along = [mpf(0)] * len(m.pairs)
     F_bal = (mpf(0), mpf(0))
     if mech.drive.kind == "engine":
         M_bal = x[last]
     else:
         F_bal = _mul(x[last], u_dir)
         M_bal = _cross(_mul(m.r_w, m.e), F_bal)
-    return x, M_bal, F_bal
+    return x, M_bal, F_bal, along
 
 
 def reference_full(mech: Mechanism, phi_deg, res: Analysis | None = None, dps: int = DPS,
-                   check_branch: bool = True, angle: str = "decimal") -> Reference:
+                   check_branch: bool = True, angle: str = "decimal", friction: bool = False) -> Reference:
     """The reference at crank angles `phi_deg` (deg). `res`: the solver's answer at the same
-    angles (its positions are the Newton start; computed if not given).
+    angles (its positions are the Newton start; computed if not given). `friction`: with the
+    model's friction in the reactions, the whole mechanism's equilibrium at once by Newton
+    (a prismatic pair's R then includes its friction force along the guide).
 
     `angle`: "decimal" (default) takes each angle as the exact number of degrees it is (90.0 is
     pi/2 exactly); "double" takes the double-precision radians the solver itself works with,
@@ -560,9 +648,9 @@ def reference_full(mech: Mechanism, phi_deg, res: Analysis | None = None, dps: i
                 rhs = [-x for x in Q]
                 rhs[0] = m.sense * m.eps1
                 qdd = _solve(J, rhs)
-                x, M_bal, F_bal = _statics(m, q, qd, qdd, a, mags, 1)
+                x, M_bal, F_bal, along = _statics(m, q, qd, qdd, a, mags, 1, friction)
                 if mech.drive.kind == "machine" and x[m.n - 1] < 0:
-                    x, M_bal, F_bal = _statics(m, q, qd, qdd, a, mags, -1)
+                    x, M_bal, F_bal, along = _statics(m, q, qd, qdd, a, mags, -1, friction)
             except ZeroDivisionError:           # exactly singular position
                 out["omega"][a] = out["eps"][a] = np.nan
                 out["v_origin"][a] = out["a_origin"][a] = np.nan
@@ -578,8 +666,9 @@ def reference_full(mech: Mechanism, phi_deg, res: Analysis | None = None, dps: i
                 if entry[0] == "R":
                     out["R"][a, u] = float(x[2 * u]), float(x[2 * u + 1])
                 else:
-                    _, nn = m.guide(q, entry)
-                    out["R"][a, u] = float(x[2 * u] * nn[0]), float(x[2 * u] * nn[1])
+                    dw, nn = m.guide(q, entry)
+                    t = along[u]
+                    out["R"][a, u] = float(x[2 * u] * nn[0] + t * dw[0]), float(x[2 * u] * nn[1] + t * dw[1])
                     out["couple"][a, u] = float(x[2 * u + 1])
     return Reference(phi_deg=phi_deg, **out)
 

@@ -47,6 +47,11 @@ def _summary(res, path: Path) -> list[str]:
     if np.any(np.isfinite(d)):
         k = int(np.nanargmax(np.abs(d)))
         lines.append(f"lever discrepancy max |M_lever - M_bal|: {abs(d[k]):.3g} N m (phi = {phi[k]:g} deg)")
+    if m.friction is not None:
+        lock = res.self_locking
+        eta = res.efficiency[~lock & np.isfinite(res.efficiency)]
+        lines.append(f"friction ({res.friction_method}): self-locking at {int(lock.sum())} of {len(phi)} positions"
+                     + (f", eta {eta.min():.4g} .. {eta.max():.4g} elsewhere" if len(eta) else ""))
     n_sing = int(np.sum(res.singular))
     if n_sing:
         lines.append(f"singular positions: {n_sing} (their values are NaN)")
@@ -88,7 +93,7 @@ def cmd_analyze(args) -> int:
         _writable_file(out, "--out")
     path = Path(args.model)
     mech = _load(path)
-    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps)
+    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps, friction=args.friction)
     lines = _summary(res, path)
     if len(res.phi_deg) == 1:
         lines += _worksheet_lines(mech, float(res.phi_deg[0]))

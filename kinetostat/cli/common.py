@@ -345,7 +345,7 @@ def _check_memory(mech, steps: int) -> None:
                        f"available; use fewer steps (at most about {int(free // per_angle):,})")
 
 
-def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
+def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | None = None):
     """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each;
     `steps` that would not fit in memory are refused before anything is allocated."""
     from ..solve import analyze
@@ -356,7 +356,7 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            res = analyze(mech, phi_deg=phi_deg, steps=steps)
+            res = analyze(mech, phi_deg=phi_deg, steps=steps, friction=friction)
         except AssemblyError as exc:
             raise CLIError(f"{path}: {exc}") from None
         except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)

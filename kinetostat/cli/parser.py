@@ -41,6 +41,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="crank angles in degrees (model's reference and sense), e.g. --at 0 30 90")
     g.add_argument("--steps", metavar="N", type=_steps, default=360,
                    help="N equal steps over a revolution (default 360)")
+    a.add_argument("--friction", choices=["first", "reactions"], default=None,
+                   help="a model with [friction]: 'first' (the first approximation: frictionless reactions) or "
+                        "'reactions' (friction in the reactions, exact); default: the model's friction.method, else first")
     a.add_argument("--out", metavar="FILE",
                    help="write the full table: FILE.csv, FILE.parquet (needs pyarrow) or FILE.json "
                         "(records); '-' writes CSV to stdout and the summary to stderr")

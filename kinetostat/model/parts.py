@@ -233,6 +233,7 @@ class Drive:
 class Friction:
     f: float                   # reduced friction coefficient
     radius: float | None       # default journal radius, m
+    method: str = "first"      # analyze's default: "first" (the first approximation) or "reactions"
 
 
 #: What a `[[published]]` entry may measure -> the SI unit of its magnitude.

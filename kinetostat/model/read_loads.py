@@ -190,4 +190,5 @@ class LoadReading:
         self.unknown_keys(t, FRICTION.keys(), "friction")
         f = self.read(FRICTION, t, "f", "friction")
         r = self.read(FRICTION, t, "radius", "friction")
-        return None if f is None else Friction(f, r)
+        method = self.read(FRICTION, t, "method", "friction")
+        return None if f is None else Friction(f, r, method)

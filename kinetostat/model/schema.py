@@ -205,6 +205,8 @@ SPRING = Section("spring", "A linear spring between two points; force = stiffnes
 FRICTION = Section("friction", "Friction in the pairs (TMM course text on friction).", (
     _num("f", "reduced friction coefficient", default=REQUIRED, minimum=0.0),
     _num("radius", "default journal radius of revolute pairs", "m", positive=True),
+    Field("method", "string", "analyze's default: 'first' (the first approximation: frictionless reactions) or "
+          "'reactions' (friction in the reactions, solved exactly)", default="first", choices=("first", "reactions")),
 ))
 
 _AT_POINT, _OF_LINK = ("velocity", "acceleration"), ("omega", "eps", "inertia_force", "inertia_moment")

@@ -168,7 +168,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     unknown = [n for n in chosen if n not in names]
     if unknown:
         raise ValueError(f"unknown plan {unknown[0]!r}: expected one of {', '.join(names)}")
-    res = analyze(mech, phi_deg=[float(at)])
+    res = analyze(mech, phi_deg=[float(at)], friction="first")     # the graphical method: frictionless reactions
     if res.singular[0]:
         raise ValueError(f"at {at:g} deg the mechanism is at a singular position "
                          f"(cond {res.cond[0].max():.3g}): velocities and accelerations undefined")

@@ -57,7 +57,7 @@ class Scales:
 
 def default_scales(mech: Mechanism, at: float | None = None) -> Scales:
     """The scales the plans are drawn at (`scales.choose_scales`: as Logvinenko, Nadtoka 2021 choose them)."""
-    res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at])
+    res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at], friction="first")   # drawn: frictionless
     sc = choose_scales(mech, res)
     return Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, sc["mu_F"].value)
 
@@ -463,7 +463,7 @@ def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length
             raise ValueError(f"{name}: expected a finite precision >= 0, got {v!r}")
     at = mech.drive.design_deg if at is None else float(at)
     sc = scales or default_scales(mech, at)
-    res = analyze(mech, phi_deg=[at])
+    res = analyze(mech, phi_deg=[at], friction="first")
     dr = _Drafter(int(n), float(length_mm), float(angle_deg), seed)
     pl = _Plans(res, sc, dr)
     pl.kinematics()

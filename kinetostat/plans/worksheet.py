@@ -13,6 +13,7 @@ output methods only. Never matplotlib, never the harness.
 from __future__ import annotations
 
 import json
+import warnings
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +23,7 @@ import numpy as np
 from ..analysis import Analysis
 from ..solve import analyze
 from ..applied import load_magnitude
+from ..errors import SelfLockingWarning
 from ..kinematics import DIGITS_WARN, special_point_z
 from .._io import write_text
 from .._text import csv_cell, markdown_text
@@ -440,6 +442,40 @@ class _Sheet:
                  f"({M1} - {L.M_bal}) / {M1} 100 %")
 
 
+    # ---- friction
+    def friction(self, at: float) -> None:
+        """The friction terms (a model with [friction]): per pair the friction circle rho = f r and
+        the friction moment f r |R|, or the friction angle arctg f and force f |N|, from the
+        exact solution with friction in the reactions; M_bal with friction, the first
+        approximation's and eta."""
+        m, L = self.mech, self.L
+        if m.friction is None:
+            return
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SelfLockingWarning)
+            ex = analyze(m, phi_deg=[at], friction="reactions")
+        f = m.friction.f
+        for p in m.pairs:
+            i, j = p.links
+            R, q = self.R(i, j), ex.friction.load[0, p.index]
+            if p.kind == "R":
+                r = p.radius if p.radius is not None else m.friction.radius
+                self.add("friction", f"rho_{i}_{j}", f"ρ{R[1:]}", f * r, "m", "", "f r")
+                self.add("friction", f"Mf_{i}_{j}", f"M_f{R[1:]}", abs(q), "N m", _sense(q),
+                         f"f r |{R}|, against the relative rotation")
+            else:
+                self.add("friction", f"phi_f_{i}_{j}", f"φ_f{R[1:]}", math.degrees(math.atan(f)), "deg", "", "tan φ_f = f")
+                self.add("friction", f"Ff_{i}_{j}", f"F_f{R[1:]}", abs(q), "N", "",
+                         f"f |N{R[1:]}|, along the guide, against the sliding")
+        M0, M1, Mf = (ex.balancing_moment_frictionless[0], analyze(m, phi_deg=[at], friction="first")
+                      .balancing_moment_with_friction[0], ex.balancing_moment[0])
+        self.add("friction", "M_bal_first", f"{L.M_bal} + P_f/ω1", M1, "N m", _sense(M1), "first approximation")
+        self.add("friction", "M_bal_friction", f"{L.M_bal},f", Mf, "N m", _sense(Mf),
+                 f"friction in the reactions, {int(ex.friction.passes[0].max())} passes")
+        self.add("friction", "eta", "η", ex.efficiency[0], "1", "",
+                 f"{L.M_bal} / {L.M_bal},f" if M0 * ex.omega(1)[0] >= 0 else f"{L.M_bal},f / {L.M_bal}")
+
+
 def _point_of(res: Analysis, k: int, name: str) -> np.ndarray:
     """Velocity (2,) of the point of link k at the current position of point `name`."""
     X = res.position(name)[0]
@@ -461,7 +497,7 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
         at = mech.drive.design_deg
     if mu_l is not None and not (isinstance(mu_l, (int, float)) and math.isfinite(mu_l) and mu_l > 0):
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
-    res = analyze(mech, phi_deg=[float(at)])
+    res = analyze(mech, phi_deg=[float(at)], friction="first")     # the graphical method; friction: its own section
     if mu_l is None:
         mu_l = choose_scales(mech, res)["mu_l"].value
     sheet = _Sheet(res, float(mu_l))
@@ -469,5 +505,6 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
     sheet.loads()
     sheet.reactions()
     sheet.crank()
+    sheet.friction(float(at))
     return Worksheet(lettering(mech).name(lang, mech.name), float(at), float(mu_l), tuple(sheet.rows), lang,
                      float(res.digits[0]))

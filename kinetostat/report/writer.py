@@ -21,7 +21,7 @@ from ..structure import GROUP_KINDS
 from ..sweep import sweep
 from .. import units as model_units
 from ..tables import error, plain, write_csv
-from .document import ROUNDING, Doc, _err, _is_rounding, _rel, esc, slug
+from .document import ROUNDING, Doc, _err, _fmt, _is_rounding, _rel, esc, slug
 from .plots import (_pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
@@ -360,6 +360,59 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
     doc.table(["quantity", "route against group by group", "max |difference|", "peak relative, 1"], rows, "llrr")
 
 
+def _friction_section(doc: Doc, m: Mechanism, res) -> None:
+    """With [friction]: the exact solution with friction in the reactions beside the first
+    approximation of the course text (`res`, the cycle the engines checked): M_bal at the design
+    position, the energy lost per pair, the efficiency, the self-locking zones, the checks."""
+    if m.friction is None or not len(res.phi_deg):
+        return
+    from ..errors import SelfLockingWarning
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SelfLockingWarning)
+        ex = analyze(m, phi_deg=res.phi_deg, friction="reactions")
+        at = analyze(m, phi_deg=[m.drive.design_deg], friction="reactions")
+        first = analyze(m, phi_deg=[m.drive.design_deg], friction="first")
+    M = esc(quantity_name(m, "M_bal"))
+    doc.h(2, "Friction in the reactions")
+    doc.p("The course text on friction computes the losses *in the first approximation*: the frictionless reactions "
+          f"go into f·r·|R|·|ω_rel| (revolute) and f·|R|·|v_rel| (prismatic), {M} stays frictionless (the columns "
+          "Pfr of cycle.csv, and every route above). The exact solution puts the friction into the reactions: a "
+          "friction moment f·r·|R| against the relative rotation in each revolute pair (the reaction tangent to the "
+          "friction circle ρ = f·r), a friction force f·|N| against the sliding in each prismatic pair (the reaction "
+          "leaning by arctg f), each group solved again with these loads until its reactions stop changing "
+          f"(at most {int(ex.friction.passes.max(initial=0))} passes per group here). Where a pair's relative motion "
+          "is zero its friction is that of the motion just before. The physics engines cannot check this: their joint "
+          "friction is a constant limit torque, not f·r·|R|.")
+    phi0 = m.drive.design_deg
+    rows = [[f"{M} at φ = {phi0:g}°, N·m", _fmt(at.balancing_moment_frictionless[0]),
+             _fmt(first.balancing_moment_with_friction[0]), _fmt(at.balancing_moment[0])],
+            [f"η at φ = {phi0:g}°, 1", "1", _fmt(first.efficiency[0]), _fmt(at.efficiency[0])]]
+    try:
+        lost0, lost = res.friction_energy(), ex.friction_energy()
+        rows.append(["cycle efficiency, 1", "1", _fmt(res.cycle_efficiency()), _fmt(ex.cycle_efficiency())])
+        rows += [[f"energy lost in {esc(_pair_name(m, p))} per cycle, J", "0", _fmt(lost0[p.index]), _fmt(lost[p.index])]
+                 for p in m.pairs]
+    except ValueError:                  # not a uniform full cycle: no cycle integrals
+        pass
+    doc.table(["quantity", "frictionless", "first approximation", "friction in the reactions"], rows, "lrrr")
+    zones = ex.self_locking_zones()
+    doc.p("Self-locking (η ≤ 0: the loads cannot drive the crank through friction, or no equilibrium exists), "
+          "edges to 1e-9° by bisection on the crank angle: "
+          + ("; ".join(f"{round(a, 9) + 0.0:.9f}° to {round(b, 9) + 0.0:.9f}°" for a, b in zones) if len(zones) else "none")
+          + f" (first approximation: {'; '.join(f'{round(a, 6) + 0.0:.6f}° to {round(b, 6) + 0.0:.6f}°' for a, b in res.self_locking_zones()) or 'none'}).")
+    ok = ex.friction.solved & np.isfinite(ex.balancing_moment)
+    if ok.any():
+        peak = np.nanmax(np.abs(ex.balancing_moment))
+        dP = (ex.balancing_moment - ex.balancing_moment_frictionless) * ex.omega(1) - ex.friction_power_total
+        W = ex.work()
+        doc.ul([f"Zhukovsky's lever with the friction loads applied against group by group: max |difference| "
+                f"{_err(float(np.max(np.abs(ex.lever_discrepancy[ok]))), peak, 'N·m')}",
+                f"power balance, ({M} − {M},0)·ω₁ against the sum of the pairs' friction powers: max |difference| "
+                f"{_err(float(np.max(np.abs(dP[ok]))), float(np.nanmax(ex.friction_power_total)), 'W')}",
+                f"work over the cycle, all loads, {M} and friction: sum {_fmt(sum(W.values()))} J "
+                f"(of {_fmt(sum(abs(v) for v in W.values()))} J moved)" if len(W) else "work: n/a"])
+
+
 def _error_rows(run: ModelRun) -> list[list[str]]:
     rows = []
     for r in run.rows:
@@ -461,6 +514,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
                for p in m.pairs], "lrrrr")
 
     _three_routes_section(doc, m, res)
+    _friction_section(doc, m, res)
     _study_section(doc, m)
 
     doc.h(2, "Errors against the engines")
