@@ -198,6 +198,20 @@ def test_a_tiny_vector_is_drawn_beside_a_collinear_load(ice_plans):
     assert 1.5 <= off <= 2.0
 
 
+def test_a_dead_centre_notes_its_zero_loads_negligible():
+    """At the ICE's dead centre (0 deg) R12t, the arms h_G2 and the lever's p-b are rounding noise
+    (1e-16..1e-14 mm): each sheet is drawn (before, a zero vector 'drawn out of scale' divided by
+    its length 0) and notes them negligible instead of drawing them in a direction they lack."""
+    mech = kinetostat.load("ice_crank_slider")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plans = P.build(mech, at=0.0)
+    group, lever = svg(plans["group:2,3"]), svg(plans["lever"])
+    assert plans["group:2,3"].length_mm("R12t") < 1e-9 and plans["lever"].length_mm("p-b") < 1e-9
+    assert "R12t*" not in group and "negligible" in group.split('<g id="notes">')[1]
+    assert "negligible" in lever.split('<g id="notes">')[1]
+
+
 def test_notes_letter_names_as_the_drawing(ice_plans):
     """The notes write πa, F with subscript i2, h with subscript Fi2 (as the drawing letters them),
     never the raw 'pi-a', 'F_i2', 'h_Fi2'; the lever's arms stay in mm (seed 002: h_Fi2 = 37.67 mm)."""

@@ -39,6 +39,9 @@ ARROW_MM = (3.5, 0.6)
 ARC_HEAD_MM = 2.8
 #: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM.
 TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
+#: A vector shorter than this (mm) is rounding noise of a zero (a load's arm at a dead centre): it
+#: has no direction to draw it out of scale in, and is noted as negligible.
+ZERO_MM = 1e-9
 #: A vector drawn out of scale along another vector from the same point is drawn this far beside it, mm.
 SIDE_MM = 1.8
 _POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
@@ -190,7 +193,7 @@ def _tiny(plan: Plan) -> dict[str, str]:
     how = {}
     for s in _drawable(plan):
         if s.kind == "vector" and abs(plan.points[s.end] - plan.points[s.start]) < TINY_MM:
-            out = s.scale is not None and abs(plan.points[s.end] - plan.points[s.start]) > 0
+            out = s.scale is not None and abs(plan.points[s.end] - plan.points[s.start]) > ZERO_MM
             how[s.name] = "out" if out else "negligible"
     return how
 
