@@ -919,7 +919,7 @@ def _plan_names(text: str) -> list[str]:
 def cmd_plans(args) -> int:
     import numpy as np
     from .errors import SingularPositionWarning
-    from .plans import build
+    from .plans import build, cycle_scales
     from .plans.worksheet import worksheet
     from .plans.lettering import lettering
     from .plans.scales import ScaleError
@@ -932,7 +932,9 @@ def cmd_plans(args) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:     # the accuracy at this angle: said below
             warnings.simplefilter("always")
-            plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
+            fixed = cycle_scales(mech) if args.cycle_scales else None          # the page's scales
+            plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only,
+                          fixed=fixed)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
         raise CLIError(f"--scale {exc}") from None
@@ -948,6 +950,20 @@ def cmd_plans(args) -> int:
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
     _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))
+    return EXIT_OK
+
+
+def cmd_page(args) -> int:
+    from .plans.lettering import lettering
+    from .plans.page import write_page
+    mech = _load(Path(args.model))
+    out = _writable_file(args.out, "--out")
+    try:
+        path = write_page(mech, out, lang=args.lang or lettering(mech).language or "en", student=args.student,
+                          at=_turn(args.at, "--at"))
+    except ValueError as exc:
+        raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
+    _Out.write(one_line(f"{Path(args.model).name}: page -> {path} ({_size(path.stat().st_size)})"))
     return EXIT_OK
 
 
@@ -1276,7 +1292,21 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--only", metavar="PLANS", type=_plan_names, action="append",
                     help="draw only these plans, comma-separated: positions, velocity, acceleration")
     pl.add_argument("--out", metavar="DIR", required=True, help="output directory (created)")
+    pl.add_argument("--cycle-scales", action="store_true",
+                    help="every plan at the scales of the interactive page (`kinetostat page`): chosen once for "
+                         "the whole cycle (--scale is then not used)")
     pl.set_defaults(func=cmd_plans)
+
+    pg = sub.add_parser("page", help="the interactive page of a mechanism: one offline HTML file, an angle slider "
+                                     "over every plan", description="Write one self-contained HTML file (no network): "
+                        "MODEL's plans at every degree and the design position at scales fixed for the cycle, the "
+                        "values table, the force plans step by step, a check of measured lengths (README: the page).")
+    pg.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
+    pg.add_argument("--lang", choices=("en", "uk", "ru"), default=None, help="language (default: the model's, else en)")
+    pg.add_argument("--student", action="store_true", help="the student's page: data, empty tables, the grid; no answer")
+    pg.add_argument("--at", metavar="DEG", type=_angle, help="angle of the check (default: the design position)")
+    pg.add_argument("--out", metavar="FILE", required=True, help="the HTML file to write")
+    pg.set_defaults(func=cmd_page)
 
     e = sub.add_parser("examples", help="list the bundled models, or copy them (with FORMAT.md) into a folder",
                        description="List the bundled models (the seeds' worked cases shipped inside the package, "
