@@ -742,7 +742,7 @@ def _write_validation_json(runs, code: int, dest) -> None:
 
 # ============================================================================ report
 
-def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str) -> dict:
+def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = False) -> dict:
     """One model's report: load, analyse, run the routes, write `out/<folder>/`. Returns
     {"summary", "warnings", "seconds"} or {"error"} (one line); raises only KeyboardInterrupt."""
     from .report import run_validation, write_report
@@ -758,7 +758,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
-            summary = write_report(run, tmp, folder)
+            summary = write_report(run, tmp, folder, page=page)
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
@@ -787,20 +787,20 @@ def _report_cost(mech) -> int:
 
 
 def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int,
-                    costs: Sequence[int] = ()):
+                    costs: Sequence[int] = (), page: bool = False):
     """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
     them in a process pool (only paths and names cross to the workers, so any start method
     works), the largest `costs` first, 1 in this process. Ctrl-C cancels the models not started
     and raises KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
         for n, p in enumerate(paths):
-            yield n, _report_job(str(p), engines, steps, str(out), folders[n])
+            yield n, _report_job(str(p), engines, steps, str(out), folders[n], page)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
     try:
         first = sorted(range(len(paths)), key=lambda n: -costs[n] if costs else 0)
-        futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n]): n for n in first}
+        futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n], page): n for n in first}
         for f in as_completed(futures):
             try:
                 r = f.result()
@@ -832,7 +832,7 @@ def cmd_report(args) -> int:
     bar = _progress(len(order), "report", not args.no_progress)
     try:
         for n, r in _report_results(order, folders, engines, args.steps, out, args.jobs or os.cpu_count() or 1,
-                                    [_report_cost(mech) for _, mech, *_ in prepared]):
+                                    [_report_cost(mech) for _, mech, *_ in prepared], args.page):
             _checkpoint()
             path = order[n]
             bar.update()
@@ -1028,7 +1028,8 @@ def cmd_variant(args) -> int:
                 warnings.simplefilter("ignore")
                 try:
                     keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
-                                                   cycle_csv=not args.all, root=out, teacher_pack=teacher_pack))
+                                                   cycle_csv=not args.all, root=out, teacher_pack=teacher_pack,
+                                                   page=args.page))
                 except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:
@@ -1269,6 +1270,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="models reported in parallel by N worker processes (default: the number of cores; "
                         "1: in this process)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--page", action="store_true", help="also each model's interactive page (page.html, linked; "
+                                                       "about 40 s a model)")
     r.set_defaults(func=cmd_report)
 
     pl = sub.add_parser("plans", help="draw the plans of the graphical method (SVG sheets, segments.csv)",
@@ -1339,6 +1342,8 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--no-pack", action="store_true", help="no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf "
                                                            "and their HTML): the keys only, about 4 s faster a code")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
+    va.add_argument("--page", action="store_true", help="also the variant's interactive page (page.html, linked from "
+                                                        "the index; about 40 s a code)")
     va.set_defaults(func=cmd_variant)
 
     sw = sub.add_parser("sweep", help="analyse every combination of some parameters' values: a row of peaks per design",

@@ -232,3 +232,19 @@ def test_whole_page_against_plans_cycle_scales(browser, tmp_path, cli):
         _slide(pg, at)
         _compare(_segments(pg), want, f"{at} deg")
     pg.close()
+
+
+@pytest.mark.slow
+def test_report_and_variant_link_their_pages(tmp_path, cli):
+    """`report --page` writes page.html beside the report and links it; `variant 1 479 --page`
+    writes the variant's page with its check at phi1."""
+    r = cli("report", "ice_crank_slider", "--engines", "none", "--steps", "36", "--page", "--out", str(tmp_path / "r"),
+            "--no-progress")
+    assert r.returncode == 0, r.stderr
+    folder = next(p for p in (tmp_path / "r").iterdir() if p.is_dir())
+    assert (folder / "page.html").stat().st_size > 100_000
+    assert "](page.html)" in (folder / "index.md").read_text(encoding="utf-8")
+    v = cli("variant", "1", "479", "--page", "--no-pack", "--out", str(tmp_path / "v"))
+    assert v.returncode == 0, v.stderr
+    html = (tmp_path / "v" / "page.html").read_text(encoding="utf-8")
+    assert '"at": 150.0' in html or '"at": 150' in html

@@ -165,7 +165,7 @@
     out.dataset.segment = s.segment || "";
     out.dataset.path = s.path || "";
     out.textContent = `${step + 1}/${meta.steps.length}`;
-    const len = el && el.dataset.lengthMm !== undefined ? ` — ${local(+el.dataset.lengthMm, 4)} mm` : "";
+    const len = el && el.dataset.lengthMm !== undefined ? ` — ${local(+el.dataset.lengthMm, 4)} ${D.mm}` : "";
     $("equation").textContent = s.eq + len;
   }
   const slider = $("phi");

@@ -311,8 +311,8 @@ def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
     inertia, the applied forces at this angle (symbol, value, unit)."""
     from .forces import _applied
     d = mech.drive
-    rows = [("φ", num(float(res.phi_deg[0]), lang, 6), "°"), ("ω1", num(abs(d.omega), lang, 6), unit("1/s", lang)),
-            ("ε1", num(d.eps, lang, 6), unit("1/s^2", lang)), ("g", num(mech.g, lang, 6), unit("m/s^2", lang))]
+    rows = [("φ", num(float(res.phi_deg[0]), lang, 6), "°"), ("ω1", num(abs(d.omega), lang, 6), unit("rad/s", lang)),
+            ("ε1", num(d.eps, lang, 6), unit("rad/s^2", lang)), ("g", num(mech.g, lang, 6), unit("m/s^2", lang))]
     for k, link in enumerate(mech.links):
         if k == 0:
             continue
@@ -402,8 +402,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
             items.append({"plan": kind, "segment": s.name, "title": title_of(plan, lang).split(",")[0],
                           "label": segment_label(s, lang), "exact": plan.length_mm(s.name),
                           "band": list(lo_hi) if lo_hi else None})
-    results = [(r.symbol, r.value) for kind in ("crank", "lever") if kind in check for r in check[kind].results
-               if r.unit == "N m"]
+    results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
+                    for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
     blobs["check"] = base64.b64encode(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(),
                                                              9, mtime=0))).decode("ascii")
     res = kinetostat.analyze(mech, phi_deg=[at])
@@ -427,8 +427,10 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
           data_rows, items, results) -> str:
     from .draw import scale_text
     title = f"{name}: {_ui('student' if student else 'key', lang)}"
-    scales = "; ".join(dict.fromkeys(scale_text(s, lang) for s in [*fixed.base.values(), *fixed.plan.values(),
-                                                                      *fixed.forces_on.values()]))
+    scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
+                       + [f"{_plan_name(k, lang)}: {scale_text(s, lang)}" for k, s in fixed.plan.items()
+                          if s != fixed.base[s.symbol]]
+                       + [f"{_plan_name(k, lang)} (F): {scale_text(s, lang)}" for k, s in fixed.forces_on.items()])
     head = "".join(f"<th>{escape(h)}</th>" for h in ("", "", ""))
     data_table = "".join(f'<tr><td>{escape(s)}</td><td class="num">{escape(v)}</td><td>{escape(u)}</td></tr>'
                          for s, v, u in data_rows)
@@ -449,7 +451,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     if student:
         body = (f'<section id="data"><h2>{escape(_ui("data", lang))}</h2><p>{escape(_ui("scales", lang))}: {escape(scales)}</p>'
                 f'<table><tr>{head}</tr>{data_table}</table></section>'
-                f'<section id="sheets"><h2>{escape(_ui("sheet", lang))}</h2><div class="sheet">{_grid_sheet(title, lang)}</div></section>'
+                f'<section id="grid"><h2>{escape(_ui("sheet", lang))}</h2><div class="sheet">{_grid_sheet(title, lang)}</div></section>'
                 + check)
     else:
         body = (f'<section id="controls"><label for="phi">{escape(_ui("phi", lang))}: <output id="phi-value"></output>°</label> '
@@ -472,6 +474,12 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
             f'<title>{escape(title)}</title><style>{_CSS}</style></head><body>'
             f'<h1>{escape(title)}</h1>{body}{blob_tags}'
             f'<script id="page-data" type="application/json">{payload}</script><script>{script}</script></body></html>\n')
+
+
+def _plan_name(kind: str, lang: str) -> str:
+    """A plan kind as its sheet's title names it, without the angle (group:2,3 -> Plan of group 2-3)."""
+    base, _, rest = kind.partition(":")
+    return text(f"plan.{base}", lang) + (" " + rest.replace(",", "-") if rest else "")
 
 
 def _grid_sheet(title: str, lang: str) -> str:
@@ -513,7 +521,7 @@ td.num{text-align:right;font-variant-numeric:tabular-nums}
 .verdict.ok{color:#176317}.verdict.bad{color:#b01515}
 @media print{
   @page{size:A3 landscape;margin:0}
-  body{margin:0}h1,#controls,#values,#data,#check,.hint,#status{display:none}
+  body{margin:0}h1,h2,#controls,#values,#data,#check,.hint,#status{display:none}
   #sheets{display:block}.sheet{border:0;margin:0;page-break-after:always;break-after:page}
   .sheet svg{width:420mm;height:297mm;max-width:none}
 }
