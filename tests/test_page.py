@@ -63,7 +63,10 @@ def _open(browser, path, requests=None):
     if requests is not None:
         pg.on("request", lambda r: requests.append(r.url))
     pg.goto(path.as_uri())
-    pg.wait_for_selector("body[data-ready]", timeout=20000)
+    try:
+        pg.wait_for_selector("body[data-ready]", state="attached", timeout=20000)
+    except Exception as exc:                        # noqa: BLE001 - say why: the script's errors
+        raise AssertionError(f"the page did not get ready: {errors or exc}") from None
     assert not errors, errors
     return pg
 
@@ -173,28 +176,37 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(browser, ice):
     pg.close()
 
 
+def _bar_mm(pdf) -> tuple[tuple[float, float], dict[str, float], int]:
+    """(page size in pt, the bar's labels 0, 50, 100 -> their centres' y in mm, the number of
+    pages) of a PDF's first page (pdftotext -bbox); the bar's labels are the words left of 20 mm."""
+    box = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+    first = box.split("</page>")[0]
+    size = re.search(r'<page width="([\d.]+)" height="([\d.]+)"', first)
+    words = re.findall(r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="([\d.]+)">([^<]*)</word>', first)
+    x_bar = min(float(w[0]) for w in words if w[4] == "100")
+    y = {w[4]: (float(w[1]) + float(w[3])) / 2 * 25.4 / 72 for w in words
+         if abs(float(w[0]) - x_bar) < 20 and w[4] in ("0", "50", "100")}
+    return (float(size[1]), float(size[2])), y, box.count("<page ")
+
+
 def test_print_scale_bar_measures_100_mm(browser, ice, tmp_path):
-    """Printed to PDF, each sheet is an A3 landscape page and its 100 mm bar's ticks 0 and 100
+    """Printed to PDF, each sheet is a page at true scale, A3 landscape (the whole sheet) or, with
+    A4 chosen, A4 landscape (the 297 x 210 mm around the plan): the 100 mm bar's labels 0 and 100
     lie 100 mm apart (pdftotext -bbox: the labels' centres)."""
     if shutil.which("pdftotext") is None:
         pytest.skip("no pdftotext (apt-get install poppler-utils)")
     mech, fixed, key, _ = ice
     pg = _open(browser, key)
-    pdf = tmp_path / "key.pdf"
-    pg.pdf(path=str(pdf), prefer_css_page_size=True, print_background=True)
+    for paper, (w, h) in (("A3", (420, 297)), ("A4", (297, 210))):
+        pg.select_option("#paper", paper)
+        pdf = tmp_path / f"{paper}.pdf"
+        pg.pdf(path=str(pdf), prefer_css_page_size=True, print_background=True)
+        size, y, pages = _bar_mm(pdf)
+        assert size == pytest.approx((w / 25.4 * 72, h / 25.4 * 72), abs=1.0), paper   # Chromium: whole px
+        assert y["100"] - y["0"] == pytest.approx(100.0, abs=0.2), paper
+        assert y["50"] - y["0"] == pytest.approx(50.0, abs=0.2), paper
+        assert pages == len(_build(mech, 30.0, fixed)), paper
     pg.close()
-    box = subprocess.run(["pdftotext", "-bbox", "-f", "1", "-l", "1", str(pdf), "-"], capture_output=True,
-                         text=True, check=True).stdout
-    size = re.search(r'<page width="([\d.]+)" height="([\d.]+)"', box)
-    assert (float(size[1]), float(size[2])) == pytest.approx((420 / 25.4 * 72, 297 / 25.4 * 72), abs=1.0)  # Chromium: whole px
-    words = [(w[4], (float(w[0]) + float(w[2])) / 2, (float(w[1]) + float(w[3])) / 2) for w in
-             re.findall(r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="([\d.]+)">([^<]*)</word>', box)]
-    margin = [w for w in words if w[1] < 20 / 25.4 * 72]            # the binding margin: the bar only
-    y = {t: yc for t, _, yc in margin}
-    assert (y["100"] - y["0"]) * 25.4 / 72 == pytest.approx(100.0, abs=0.2)
-    assert (y["50"] - y["0"]) * 25.4 / 72 == pytest.approx(50.0, abs=0.2)
-    assert len(re.findall(r"<page ", subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], capture_output=True,
-                                                    text=True, check=True).stdout)) == len(_build(mech, 30.0, fixed))
 
 
 def test_the_page_makes_no_request(browser, ice):

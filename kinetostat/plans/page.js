@@ -151,8 +151,29 @@
       cells[c].textContent = local(v, 4);
     });
     $("phi-value").textContent = local(D.frames[f], 6);
+    paper();
     highlight();
   }
+  function paper() {                              // A4 landscape: the 297 x 210 mm around the plan
+    const a4 = $("paper").value === "A4";
+    document.documentElement.dataset.paper = $("paper").value;
+    $("page-size").textContent = `@page{size:${a4 ? "A4" : "A3"} landscape;margin:0}`;
+    boxes.forEach((box) => {
+      const svg = box.querySelector("svg"), plan = svg && svg.querySelector("#plan");
+      if (!plan) return;
+      const bar = svg.querySelector("#scalebar");
+      if (!a4) {
+        svg.setAttribute("viewBox", "0 0 420 297"); svg.setAttribute("width", "420mm"); svg.setAttribute("height", "297mm");
+        bar.removeAttribute("transform"); delete box.dataset.a4; return;
+      }
+      const b = plan.getBBox(), clamp = (x, hi) => Math.min(Math.max(x, 0), hi);
+      const x0 = clamp(b.x + b.width / 2 - 148.5, 123), y0 = clamp(b.y + b.height / 2 - 105, 87);
+      svg.setAttribute("viewBox", `${x0} ${y0} 297 210`); svg.setAttribute("width", "297mm"); svg.setAttribute("height", "210mm");
+      bar.setAttribute("transform", `translate(${x0 - 8} ${y0 - 30})`);   // the bar 8 mm in, 10 mm down
+      if (b.width > 280 || b.height > 195) box.dataset.a4 = D.ui.a4_cut; else delete box.dataset.a4;
+    });
+  }
+  $("paper").addEventListener("change", paper);
   function highlight() {
     document.querySelectorAll(".hl").forEach((el) => el.classList.remove("hl"));
     const out = $("step");

@@ -91,9 +91,14 @@ _UI = {
               "Ваш лист (A3, в натуральную величину; печатайте)"),
     "student": ("Student's page: no answers", "Сторінка студента: без відповідей", "Страница студента: без ответов"),
     "key": ("Key: every plan and value", "Ключ: усі плани і значення", "Ключ: все планы и значения"),
-    "print": ("Print: each sheet at true scale on A3 landscape (the 100 mm bar measures 100 mm).",
-              "Друк: кожен аркуш у натуральну величину на A3 альбомно (відрізок 100 мм має 100 мм).",
-              "Печать: каждый лист в натуральную величину на A3 альбомно (отрезок 100 мм имеет 100 мм)."),
+    "print": ("Print: each sheet at true scale, landscape, on the paper chosen (A4: the plan's part of the "
+              "sheet; the 100 mm bar measures 100 mm).",
+              "Друк: кожен аркуш у натуральну величину, альбомно, на вибраному папері (A4: частина аркуша з "
+              "планом; відрізок 100 мм має 100 мм).",
+              "Печать: каждый лист в натуральную величину, альбомно, на выбранной бумаге (A4: часть листа с "
+              "планом; отрезок 100 мм имеет 100 мм)."),
+    "paper": ("Paper", "Папір", "Бумага"),
+    "a4_cut": ("larger than A4: print it on A3", "більший за A4: друкуйте на A3", "больше A4: печатайте на A3"),
     "singular": ("a singular position: no plans at this angle", "особливе положення: планів немає",
                  "особое положение: планов нет"),
     "tau": ("{R} from ΣM_{P}(link {k}) = 0", "{R} з ΣM_{P}(ланка {k}) = 0", "{R} из ΣM_{P}(звено {k}) = 0"),
@@ -359,7 +364,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
     bands = _bands(mech, check, fixed, at)
     data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": frames,
-                  "tol": TOLERANCE_PCT, "ui": {k: _ui(k, lang) for k in ("in_band", "out_band", "singular")},
+                  "tol": TOLERANCE_PCT, "ui": {k: _ui(k, lang) for k in ("in_band", "out_band", "singular", "a4_cut")},
                   "rule_ok": _ui("rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": _ui("rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang)}
@@ -459,7 +464,8 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                 f'<button id="design" type="button">{escape(_ui("design", lang))} ({num(data["design"], lang, 6)}°)</button> '
                 f'<button id="prev" type="button">{escape(_ui("prev", lang))}</button> '
                 f'<button id="next" type="button">{escape(_ui("next", lang))}</button> '
-                f'<output id="step"></output><p id="equation"></p><p class="hint">{escape(_ui("print", lang))}</p>'
+                f'<output id="step"></output> <label>{escape(_ui("paper", lang))}: <select id="paper"><option>A3</option>'
+                f'<option>A4</option></select></label><p id="equation"></p><p class="hint">{escape(_ui("print", lang))}</p>'
                 f'<p>{escape(_ui("scales", lang))}: {escape(scales)}</p></section>'
                 f'<section id="sheets"><p id="status">{escape(_ui("loading", lang))}</p></section>'
                 f'<section id="values"><h2>{escape(_ui("values", lang))}</h2><table id="value-table"></table></section>'
@@ -471,7 +477,8 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
             f'<meta http-equiv="Content-Security-Policy" content="default-src \'none\'; style-src \'unsafe-inline\'; '
             f'script-src \'unsafe-inline\'; img-src data:">'
-            f'<title>{escape(title)}</title><style>{_CSS}</style></head><body>'
+            f'<title>{escape(title)}</title><style>{_CSS}</style><style id="page-size">@page{{size:A3 landscape;margin:0}}</style>'
+            f'</head><body>'
             f'<h1>{escape(title)}</h1>{body}{blob_tags}'
             f'<script id="page-data" type="application/json">{payload}</script><script>{script}</script></body></html>\n')
 
@@ -518,12 +525,13 @@ td.num{text-align:right;font-variant-numeric:tabular-nums}
 #sheets{display:grid;grid-template-columns:repeat(auto-fill,minmax(620px,1fr));gap:.6em}
 .sheet{border:1px solid #ddd}.sheet svg{display:block;width:100%;height:auto;max-width:1260px}
 .hl{stroke:#d01c1c !important;stroke-width:1.2 !important}
+.sheet[data-a4]::before{content:attr(data-a4);color:#b01515}
 .verdict.ok{color:#176317}.verdict.bad{color:#b01515}
 @media print{
-  @page{size:A3 landscape;margin:0}
   body{margin:0}h1,h2,#controls,#values,#data,#check,.hint,#status{display:none}
   #sheets{display:block}.sheet{border:0;margin:0;page-break-after:always;break-after:page}
   .sheet svg{width:420mm;height:297mm;max-width:none}
+  [data-paper="A4"] .sheet svg{width:297mm;height:210mm}.sheet::before{display:none}
 }
 """
 
