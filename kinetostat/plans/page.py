@@ -56,73 +56,6 @@ _NUM = re.compile(r"(-?)(\d+)(?:([.,])(\d+))?")
 _NOTES = re.compile(r'<g id="notes">.*?</g>\n?', re.S)
 _LENGTH = re.compile(r'data-length-mm="([^"]*)"')
 
-#: The page's words: key -> (en, uk, ru).
-_UI = {
-    "phi": ("Crank angle φ", "Кут кривошипа φ", "Угол кривошипа φ"),
-    "design": ("Design position", "Розрахункове положення", "Расчётное положение"),
-    "next": ("Next step", "Наступний крок", "Следующий шаг"),
-    "prev": ("Previous step", "Попередній крок", "Предыдущий шаг"),
-    "values": ("Values at this angle", "Значення в цьому положенні", "Значения в этом положении"),
-    "check": ("Check your drawing", "Перевірка креслення", "Проверка чертежа"),
-    "check_note": ("Type the lengths you measured on your plans (mm) at φ = {phi}°: the deviation from the "
-                   "exact length, and whether it lies in the band a careful drawing lands in (the 5-95 % "
-                   "band of the drawing-error study; — where the study has none); the two balancing "
-                   "moments by the texts' {tol} % rule.",
-                   "Введіть довжини, виміряні на ваших планах (мм) при φ = {phi}°: відхилення від точної "
-                   "довжини і чи лежить воно в смузі, куди потрапляє ретельне креслення (5-95 % "
-                   "дослідження похибки креслення; — де його немає); два зрівноважувальні моменти за "
-                   "правилом {tol} % методички.",
-                   "Введите длины, измеренные на ваших планах (мм) при φ = {phi}°: отклонение от точной "
-                   "длины и лежит ли оно в полосе, куда попадает тщательный чертёж (5-95 % исследования "
-                   "погрешности чертежа; — где его нет); два уравновешивающих момента по правилу {tol} % "
-                   "методички."),
-    "plan": ("Plan", "План", "План"),
-    "segment": ("Segment", "Відрізок", "Отрезок"),
-    "measured": ("Measured", "Виміряно", "Измерено"),
-    "exact": ("Exact", "Точно", "Точно"),
-    "band": ("Band", "Смуга", "Полоса"),
-    "verdict": ("Verdict", "Висновок", "Вывод"),
-    "in_band": ("in the band", "у смузі", "в полосе"),
-    "out_band": ("outside the band", "поза смугою", "вне полосы"),
-    "rule_ok": ("within {tol} %", "в межах {tol} %", "в пределах {tol} %"),
-    "rule_bad": ("beyond {tol} %", "понад {tol} %", "больше {tol} %"),
-    "data": ("Data", "Вихідні дані", "Исходные данные"),
-    "sheet": ("Your sheet (A3, true scale; print it)", "Ваш аркуш (A3, у натуральну величину; друкуйте)",
-              "Ваш лист (A3, в натуральную величину; печатайте)"),
-    "student": ("Student's page: no answers", "Сторінка студента: без відповідей", "Страница студента: без ответов"),
-    "key": ("Key: every plan and value", "Ключ: усі плани і значення", "Ключ: все планы и значения"),
-    "print": ("Print: each sheet at true scale, landscape, on the paper chosen (A4: the plan's part of the "
-              "sheet; the 100 mm bar measures 100 mm).",
-              "Друк: кожен аркуш у натуральну величину, альбомно, на вибраному папері (A4: частина аркуша з "
-              "планом; відрізок 100 мм має 100 мм).",
-              "Печать: каждый лист в натуральную величину, альбомно, на выбранной бумаге (A4: часть листа с "
-              "планом; отрезок 100 мм имеет 100 мм)."),
-    "paper": ("Paper", "Папір", "Бумага"),
-    "a4_cut": ("larger than A4: print it on A3", "більший за A4: друкуйте на A3", "больше A4: печатайте на A3"),
-    "singular": ("a singular position: no plans at this angle", "особливе положення: планів немає",
-                 "особое положение: планов нет"),
-    "tau": ("{R} from ΣM_{P}(link {k}) = 0", "{R} з ΣM_{P}(ланка {k}) = 0", "{R} из ΣM_{P}(звено {k}) = 0"),
-    "side": ("polygon: {sum} (side {n} of {m})", "многокутник: {sum} (сторона {n} з {m})",
-             "многоугольник: {sum} (сторона {n} из {m})"),
-    "inner": ("inner reaction {R}: ΣF(link {k}) = 0", "внутрішня реакція {R}: ΣF(ланка {k}) = 0",
-              "внутренняя реакция {R}: ΣF(звено {k}) = 0"),
-    "crank": ("initial link: {F}", "початкова ланка: {F}", "начальное звено: {F}"),
-    "M_crank": ("{M} = Σ F·h about {O} (initial link)", "{M} = Σ F·h відносно {O} (початкова ланка)",
-                "{M} = Σ F·h относительно {O} (начальное звено)"),
-    "lever": ("Zhukovsky's lever: {F}", "важіль Жуковського: {F}", "рычаг Жуковского: {F}"),
-    "M_lever": ("{M}' from the lever, δ against {tol} %", "{M}' з важеля, δ проти {tol} %",
-                "{M}' с рычага, δ против {tol} %"),
-    "scales": ("Scales (fixed for the whole cycle)", "Масштаби (сталі для всього циклу)",
-               "Масштабы (постоянные для всего цикла)"),
-    "loading": ("decoding…", "розпакування…", "распаковка…"),
-}
-
-
-def _ui(key: str, lang: str, **kw) -> str:
-    s = _UI[key][check_lang(lang)]
-    return s.format(**kw) if kw else s
-
-
 # ============================================================================ the numbers, small
 
 @dataclass(frozen=True)
@@ -257,27 +190,27 @@ def _steps(mech, plans, lang: str) -> list[dict]:
         taus = [n for n in forces.equation if n.startswith("R") and n.endswith("t")]
         for (links, point), R in zip(_moment_equations(g), taus):
             out.append({"plan": f"group:{label}", "segment": R,
-                        "eq": _ui("tau", lang, R=R, P=point, k=",".join(map(str, links)))})
+                        "eq": text("page.tau", lang, R=R, P=point, k=",".join(map(str, links)))})
         m = len(forces.equation)
         for n, name in enumerate(forces.equation):
             out.append({"plan": f"forces:{label}", "segment": name,
-                        "eq": _ui("side", lang, sum=" + ".join(forces.equation[:n + 1]) + (" = 0" if n + 1 == m else " + …"),
+                        "eq": text("page.side", lang, sum=" + ".join(forces.equation[:n + 1]) + (" = 0" if n + 1 == m else " + …"),
                                   n=n + 1, m=m)})
         j, k = g.links
         inner = reaction_name(mech, k, j)
-        out.append({"plan": f"forces:{label}", "segment": inner, "eq": _ui("inner", lang, R=inner, k=j)})
+        out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=j)})
     crank = plans.get("crank")
     if crank is not None:
         for s in crank.segments:
             if s.kind == "vector":
-                out.append({"plan": "crank", "segment": s.name, "eq": _ui("crank", lang, F=s.name)})
-        out.append({"plan": "crank", "path": L.M_bal, "eq": _ui("M_crank", lang, M=L.M_bal, O=mech.drive.pivot)})
+                out.append({"plan": "crank", "segment": s.name, "eq": text("page.crank", lang, F=s.name)})
+        out.append({"plan": "crank", "path": L.M_bal, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot)})
     lever = plans.get("lever")
     if lever is not None:
         for s in lever.segments:
             if s.kind == "vector" and s.scale is not None:
-                out.append({"plan": "lever", "segment": s.name, "eq": _ui("lever", lang, F=s.name)})
-        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": _ui("M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang))})
+                out.append({"plan": "lever", "segment": s.name, "eq": text("page.lever", lang, F=s.name)})
+        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang))})
     return out
 
 
@@ -364,9 +297,9 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
     bands = _bands(mech, check, fixed, at)
     data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": frames,
-                  "tol": TOLERANCE_PCT, "ui": {k: _ui(k, lang) for k in ("in_band", "out_band", "singular", "a4_cut")},
-                  "rule_ok": _ui("rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
-                  "rule_bad": _ui("rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
+                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut")},
+                  "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
+                  "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang)}
     blobs: dict[str, str] = {}
     if not student:
@@ -431,7 +364,7 @@ def _obscure(data: bytes) -> bytes:
 def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
           data_rows, items, results) -> str:
     from .draw import scale_text
-    title = f"{name}: {_ui('student' if student else 'key', lang)}"
+    title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
     scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
                        + [f"{_plan_name(k, lang)}: {scale_text(s, lang)}" for k, s in fixed.plan.items()
                           if s != fixed.base[s.symbol]]
@@ -450,26 +383,26 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                           f'<td><input type="text" inputmode="decimal" class="moment" data-symbol="{escape(symbol)}" '
                           f'size="7"></td><td class="exact num"></td><td></td><td class="verdict"></td></tr>')
     phi = num(data["at"], lang, 6)
-    check = (f'<section id="check"><h2>{escape(_ui("check", lang))}</h2><p>{escape(_ui("check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
-             f'<table><tr>' + "".join(f"<th>{escape(_ui(k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
+    check = (f'<section id="check"><h2>{escape(text("page.check", lang))}</h2><p>{escape(text("page.check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
+             f'<table><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
              + "</tr>" + "".join(check_rows) + "</table></section>")
     if student:
-        body = (f'<section id="data"><h2>{escape(_ui("data", lang))}</h2><p>{escape(_ui("scales", lang))}: {escape(scales)}</p>'
+        body = (f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><p>{escape(text("page.scales", lang))}: {escape(scales)}</p>'
                 f'<table><tr>{head}</tr>{data_table}</table></section>'
-                f'<section id="grid"><h2>{escape(_ui("sheet", lang))}</h2><div class="sheet">{_grid_sheet(title, lang)}</div></section>'
+                f'<section id="grid"><h2>{escape(text("page.sheet", lang))}</h2><div class="sheet">{_grid_sheet(title, lang)}</div></section>'
                 + check)
     else:
-        body = (f'<section id="controls"><label for="phi">{escape(_ui("phi", lang))}: <output id="phi-value"></output>°</label> '
+        body = (f'<section id="controls"><label for="phi">{escape(text("page.phi", lang))}: <output id="phi-value"></output>°</label> '
                 f'<input type="range" id="phi" min="0" max="359" step="1" value="0"> '
-                f'<button id="design" type="button">{escape(_ui("design", lang))} ({num(data["design"], lang, 6)}°)</button> '
-                f'<button id="prev" type="button">{escape(_ui("prev", lang))}</button> '
-                f'<button id="next" type="button">{escape(_ui("next", lang))}</button> '
-                f'<output id="step"></output> <label>{escape(_ui("paper", lang))}: <select id="paper"><option>A3</option>'
-                f'<option>A4</option></select></label><p id="equation"></p><p class="hint">{escape(_ui("print", lang))}</p>'
-                f'<p>{escape(_ui("scales", lang))}: {escape(scales)}</p></section>'
-                f'<section id="sheets"><p id="status">{escape(_ui("loading", lang))}</p></section>'
-                f'<section id="values"><h2>{escape(_ui("values", lang))}</h2><table id="value-table"></table></section>'
-                f'<section id="data"><h2>{escape(_ui("data", lang))}</h2><table>{data_table}</table></section>'
+                f'<button id="design" type="button">{escape(text("page.design", lang))} ({num(data["design"], lang, 6)}°)</button> '
+                f'<button id="prev" type="button">{escape(text("page.prev", lang))}</button> '
+                f'<button id="next" type="button">{escape(text("page.next", lang))}</button> '
+                f'<output id="step"></output> <label>{escape(text("page.paper", lang))}: <select id="paper"><option>A3</option>'
+                f'<option>A4</option></select></label><p id="equation"></p><p class="hint">{escape(text("page.print", lang))}</p>'
+                f'<p>{escape(text("page.scales", lang))}: {escape(scales)}</p></section>'
+                f'<section id="sheets"><p id="status">{escape(text("page.loading", lang))}</p></section>'
+                f'<section id="values"><h2>{escape(text("page.values", lang))}</h2><table id="value-table"></table></section>'
+                f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><table>{data_table}</table></section>'
                 + check)
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
     payload = json.dumps(data, ensure_ascii=False).replace("</", "<\\/")
