@@ -20,10 +20,11 @@ import pytest
 import kinetostat
 import kinetostat.plans as P
 from kinetostat.plans.i18n import num
-from kinetostat.plans.page import page as make_page
+from kinetostat.plans.page import _steps, page as make_page
 from kinetostat.plans.worksheet import worksheet
 
 import sheet_browser
+from conftest import MODELS, sampled
 
 ANGLES = (0.0, 30.0, 150.0)
 
@@ -216,6 +217,24 @@ def test_the_page_makes_no_request(browser, ice):
         assert requests == [path.as_uri()], requests
         pg.close()
     assert "default-src 'none'" in key.read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("path", sampled(MODELS))
+def test_every_step_names_a_drawn_vector(path):
+    """Each step of "Next step" lights a segment (or a couple's arc) its plan draws, every group's
+    polygon side once in the order of its equation, the groups from the last attached."""
+    mech = kinetostat.load(path)
+    plans = _build(mech, None, None)
+    steps = _steps(mech, plans, "en")
+    for s in steps:
+        plan = plans[s["plan"]]
+        assert (s["path"] in plan.paths) if "path" in s else any(x.name == s["segment"] for x in plan.segments), s
+    for g in mech.structure.groups:
+        label = f"{min(g.links)},{max(g.links)}"
+        sides = [s["segment"] for s in steps if s["plan"] == f"forces:{label}"]
+        assert sides[:-1] == list(plans[f"forces:{label}"].equation)
+    groups = list(dict.fromkeys(s["plan"].split(":")[1] for s in steps if s["plan"].startswith("forces:")))
+    assert groups == [f"{min(g.links)},{max(g.links)}" for g in reversed(mech.structure.groups)]
 
 
 @pytest.mark.slow

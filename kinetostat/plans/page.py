@@ -204,11 +204,12 @@ def _steps(mech, plans, lang: str) -> list[dict]:
         for s in crank.segments:
             if s.kind == "vector":
                 out.append({"plan": "crank", "segment": s.name, "eq": text("page.crank", lang, F=s.name)})
-        out.append({"plan": "crank", "path": L.M_bal, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot)})
+        where = {"path": L.M_bal} if L.M_bal in crank.paths else {"segment": "r_b"}     # an engine's couple; a gear's arm
+        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot)})
     lever = plans.get("lever")
     if lever is not None:
         for s in lever.segments:
-            if s.kind == "vector" and s.scale is not None:
+            if s.kind == "vector" and s.scale is not None and s.name != L.lever(L.F_bal):
                 out.append({"plan": "lever", "segment": s.name, "eq": text("page.lever", lang, F=s.name)})
         out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang))})
     return out
@@ -218,15 +219,18 @@ def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, 
     """The band (mm) a careful drawing of each segment lands in (5-95 % of `drawing_error.simulate`
     at the page's scales), for the segments whose value is a value of the worksheet (matched by
     value and unit: the study reads the worksheet's values), each band that value's band at the
-    segment's scale."""
+    segment's scale; none where the study does not draw the mechanism's groups (PRP, RPP)."""
     from .drawing_error import Scales, simulate
     from .pack import BAND, BAND_DRAWS
     sc = fixed.base
     mu_F = next((s.value for k, s in fixed.plan.items() if k.startswith("forces:")), sc["mu_F"].value)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        drawn = simulate(mech, at=at, n=BAND_DRAWS, seed=0,
-                         scales=Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, mu_F))
+        try:
+            drawn = simulate(mech, at=at, n=BAND_DRAWS, seed=0,
+                             scales=Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, mu_F))
+        except NotImplementedError:            # a group kind the study does not draw: no bands
+            return {}
     by_value = []
     for key, samples in drawn.samples.items():
         lo, hi = np.percentile(np.abs(samples), BAND)
