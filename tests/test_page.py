@@ -2,7 +2,7 @@
 (tests/sheet_browser.py; a fresh profile per launch). The slider's sheets carry every segment's
 length as segments.csv has it; "Next step" follows seed 002's order of the force analysis; the
 student's page holds no answer and judges typed lengths; the print's 100 mm bar measures 100 mm
-in the PDF; the page makes no request. By default the ICE (seed 002) on a page of three angles;
+in the PDF; the pages make no request. By default the ICE (seed 002) on a page of three angles;
 with `-m slow` the whole page of `kinetostat page` against `kinetostat plans --cycle-scales`.
 """
 from __future__ import annotations
@@ -100,9 +100,11 @@ def _compare(got: dict, want: dict, where: str) -> None:
 
 def test_slider_draws_every_segment_as_segments_csv(browser, ice):
     """At 30, 0 and 150 deg and the design position every segment's data-length-mm equals
-    segments.csv of the plans at the page's scales to 1e-9 mm, and the values table follows."""
+    segments.csv of the plans at the page's scales to 1e-9 mm, and the values table follows; the
+    page, loaded, slid and stepped, asks for nothing but itself (its CSP forbids the rest)."""
     mech, fixed, key, _ = ice
-    pg = _open(browser, key)
+    requests: list[str] = []
+    pg = _open(browser, key, requests)
     for at in (30.0, 0.0, 150.0):
         _slide(pg, at)
         plans = _build(mech, at, fixed)
@@ -114,6 +116,10 @@ def test_slider_draws_every_segment_as_segments_csv(browser, ice):
     pg.click("#design")
     _compare(_segments(pg), _csv(_build(mech, mech.drive.design_deg, fixed)), "design position")
     assert pg.text_content("#phi-value") == "30"
+    pg.click("#next")
+    pg.select_option("#paper", "A4")
+    assert requests == [key.as_uri()], requests
+    assert "default-src 'none'" in key.read_text(encoding="utf-8")
     pg.close()
 
 
@@ -142,7 +148,8 @@ def test_next_step_follows_the_texts_order(browser, ice):
 
 def test_student_page_holds_no_answer_and_judges_typed_lengths(browser, ice):
     """The student's page: no plan, no data-length-mm, none of the key's lengths or values in the
-    file; typed lengths get their verdict against the band, the two M_зр against the 5 % rule."""
+    file; typed lengths get their verdict against the band, the two M_зр against the 5 % rule; no
+    request but the page itself."""
     mech, fixed, _, student = ice
     html = student.read_text(encoding="utf-8")
     plans = _build(mech, 30.0, fixed)
@@ -152,7 +159,8 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(browser, ice):
                if s.kind == "vector" and plans[k].length_mm(s.name) > 1}
     answers |= {num(r.value, "uk", 4) for r in ws.rows if r.section != "kinematics" and abs(r.value) > 1}
     answers = {a for a in answers if "," in a}              # with decimals: not a bare small integer
-    pg = _open(browser, student)
+    requests: list[str] = []
+    pg = _open(browser, student, requests)
     shown = pg.text_content("body")
     assert not [a for a in answers if re.search(rf"(?<![\d,]){re.escape(a)}(?!\d)", html + shown)]
     assert pg.eval_on_selector_all("td.exact", "es => es.every(e => e.textContent === '')")
@@ -168,6 +176,7 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(browser, ice):
     sel = 'input.moment[data-symbol="M_зр"]'
     assert verdict(sel, f"{M * 1.04:.2f}") == "ok"
     assert verdict(sel, f"{M * 0.94:.2f}") == "bad"
+    assert requests == [student.as_uri()], requests
     pg.close()
 
 
@@ -202,21 +211,6 @@ def test_print_scale_bar_measures_100_mm(browser, ice, tmp_path):
         assert y["50"] - y["0"] == pytest.approx(50.0, abs=0.2), paper
         assert pages == len(_build(mech, 30.0, fixed)), paper
     pg.close()
-
-
-def test_the_page_makes_no_request(browser, ice):
-    """Loaded, slid and stepped, the page asks for nothing but itself (and its CSP forbids the rest)."""
-    _, _, key, student = ice
-    for path in (key, student):
-        requests: list[str] = []
-        pg = _open(browser, path, requests)
-        if path == key:
-            _slide(pg, 150)
-            pg.click("#next")
-        pg.wait_for_timeout(50)
-        assert requests == [path.as_uri()], requests
-        pg.close()
-    assert "default-src 'none'" in key.read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize("path", sampled(MODELS))
