@@ -267,3 +267,9 @@ def test_report_and_variant_link_their_pages(tmp_path, cli):
     assert v.returncode == 0, v.stderr
     html = (tmp_path / "v" / "page.html").read_text(encoding="utf-8")
     assert '"at": 150.0' in html or '"at": 150' in html
+
+
+def test_page_command_refuses_a_folder_as_out(cli, tmp_path):
+    """`kinetostat page` checks --out before the minute of work: a folder is one line, exit 2."""
+    r = cli("page", "ice_crank_slider", "--out", str(tmp_path))
+    assert r.returncode == 2 and r.stderr.strip() == f"kinetostat: error: cannot write --out {tmp_path}: it is a directory"
