@@ -30,13 +30,6 @@ ANGLES = (0.0, 30.0, 150.0)
 
 
 @pytest.fixture(scope="module")
-def browser():
-    """One headless Chromium for the module (skipped where Chromium or Playwright is missing)."""
-    with sheet_browser.chromium() as b:
-        yield b
-
-
-@pytest.fixture(scope="module")
 def ice(tmp_path_factory):
     """The ICE, its cycle scales (sampled every 30 deg: quick), its key page at ANGLES and its
     student's page, written to files."""
@@ -49,8 +42,8 @@ def ice(tmp_path_factory):
     return mech, fixed, key, student
 
 
-def _open(browser, path, requests=None):
-    pg = browser.new_page(viewport={"width": 1300, "height": 900})
+def _open(chromium, path, requests=None):
+    pg = chromium.new_page(viewport={"width": 1300, "height": 900})
     errors = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
     if requests is not None:
@@ -98,13 +91,13 @@ def _compare(got: dict, want: dict, where: str) -> None:
     assert not bad, (where, bad)
 
 
-def test_slider_draws_every_segment_as_segments_csv(browser, ice):
+def test_slider_draws_every_segment_as_segments_csv(chromium, ice):
     """At 30, 0 and 150 deg and the design position every segment's data-length-mm equals
     segments.csv of the plans at the page's scales to 1e-9 mm, and the values table follows; the
     page, loaded, slid and stepped, asks for nothing but itself (its CSP forbids the rest)."""
     mech, fixed, key, _ = ice
     requests: list[str] = []
-    pg = _open(browser, key, requests)
+    pg = _open(chromium, key, requests)
     for at in (30.0, 0.0, 150.0):
         _slide(pg, at)
         plans = _build(mech, at, fixed)
@@ -123,12 +116,12 @@ def test_slider_draws_every_segment_as_segments_csv(browser, ice):
     pg.close()
 
 
-def test_next_step_follows_the_texts_order(browser, ice):
+def test_next_step_follows_the_texts_order(chromium, ice):
     """Seed 002 (fig. 1.10): R12t from ΣM_B of the rod, then the polygon R12t + G2 + F_i2 + G3 +
     F_i3 + F_p + R43 + R12n = 0 in that order, then the inner reaction R32, then the crank (R21 and
     M_зр), then the lever; one vector highlighted at a time, on the plan it belongs to."""
     mech, fixed, key, _ = ice
-    pg = _open(browser, key)
+    pg = _open(chromium, key)
     _slide(pg, 30)
     steps = pg.evaluate("""n => [...Array(n)].map(() => {
         document.getElementById('next').click();
@@ -146,7 +139,7 @@ def test_next_step_follows_the_texts_order(browser, ice):
     pg.close()
 
 
-def test_student_page_holds_no_answer_and_judges_typed_lengths(browser, ice):
+def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
     """The student's page: no plan, no data-length-mm, none of the key's lengths or values in the
     file; typed lengths get their verdict against the band, the two M_зр against the 5 % rule; no
     request but the page itself."""
@@ -160,7 +153,7 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(browser, ice):
     answers |= {num(r.value, "uk", 4) for r in ws.rows if r.section != "kinematics" and abs(r.value) > 1}
     answers = {a for a in answers if "," in a}              # with decimals: not a bare small integer
     requests: list[str] = []
-    pg = _open(browser, student, requests)
+    pg = _open(chromium, student, requests)
     shown = pg.text_content("body")
     assert not [a for a in answers if re.search(rf"(?<![\d,]){re.escape(a)}(?!\d)", html + shown)]
     assert pg.eval_on_selector_all("td.exact", "es => es.every(e => e.textContent === '')")
@@ -193,14 +186,14 @@ def _bar_mm(pdf) -> tuple[tuple[float, float], dict[str, float], int]:
     return (float(size[1]), float(size[2])), y, box.count("<page ")
 
 
-def test_print_scale_bar_measures_100_mm(browser, ice, tmp_path):
+def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
     """Printed to PDF, each sheet is a page at true scale, A3 landscape (the whole sheet) or, with
     A4 chosen, A4 landscape (the 297 x 210 mm around the plan): the 100 mm bar's labels 0 and 100
     lie 100 mm apart (pdftotext -bbox: the labels' centres)."""
     if shutil.which("pdftotext") is None:
         pytest.skip("no pdftotext (apt-get install poppler-utils)")
     mech, fixed, key, _ = ice
-    pg = _open(browser, key)
+    pg = _open(chromium, key)
     for paper, (w, h) in (("A3", (420, 297)), ("A4", (297, 210))):
         pg.select_option("#paper", paper)
         pdf = tmp_path / f"{paper}.pdf"
@@ -232,7 +225,7 @@ def test_every_step_names_a_drawn_vector(path):
 
 
 @pytest.mark.slow
-def test_whole_page_against_plans_cycle_scales(browser, tmp_path, cli):
+def test_whole_page_against_plans_cycle_scales(chromium, tmp_path, cli):
     """`kinetostat page ice_crank_slider --lang uk`: 360 angles and the design position, under
     600 kB; at 0, 30, 90, 150, 270 and 359 deg every segment as `kinetostat plans --at A
     --cycle-scales` writes it in segments.csv."""
@@ -240,7 +233,7 @@ def test_whole_page_against_plans_cycle_scales(browser, tmp_path, cli):
     run = cli("page", "ice_crank_slider", "--lang", "uk", "--out", str(out))
     assert run.returncode == 0, run.stderr
     assert out.stat().st_size < 600_000
-    pg = _open(browser, out)
+    pg = _open(chromium, out)
     for at in (0, 30, 90, 150, 270, 359):
         d = tmp_path / f"plans_{at}"
         assert cli("plans", "ice_crank_slider", "--at", str(at), "--cycle-scales", "--out", str(d)).returncode == 0

@@ -27,10 +27,9 @@ from conftest import MODELS
 
 
 @pytest.fixture(scope="session")
-def page():
+def page(chromium):
     """One headless Chromium page for the session (skipped where Chromium or Playwright is missing)."""
-    with sheet_browser.chromium() as browser:
-        yield browser.new_page()
+    return chromium.new_page()
 
 
 def _sheets(mech, at: float | None, lang: str, plans=None) -> dict[str, str]:
