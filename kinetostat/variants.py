@@ -569,12 +569,14 @@ def _largest(res, mech: Mechanism, n: int = 0) -> tuple[str, float]:
 
 
 def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool = True,
-              steps: int = 360, root: str | Path | None = None, teacher_pack: bool = True) -> KeySummary:
+              steps: int = 360, root: str | Path | None = None, teacher_pack: bool = True,
+              page: bool = False) -> KeySummary:
     """Write the variant's model file `<name>.toml` and its answer key into `out_dir` (created): the
     worksheet (worksheet.md/html/csv/json) and the plans (SVG sheets, segments.csv) at the design
     position in `lang` ("en", "uk", "ru"), and with `cycle_csv` the analysis over the cycle
     (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр), and with
-    `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML). The files
+    `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML), and with
+    `page` the interactive page (page.html, `plans.page`: the key mode, the check at phi1). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
     from .solve import analyze
@@ -596,6 +598,9 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
         files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
         if cycle_csv:
             files.append(write_text(tmp / "cycle.csv", csv_text(with_aliases(res.to_frame(), mech))))
+        if page:
+            from .plans.page import write_page
+            files.append(write_page(mech, tmp / "page.html", lang=lang, at=phi1))
     files = [out / f.relative_to(tmp) for f in files]
     label, R = _largest(at, mech)
     R_cycle = max(float(np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))) for p in mech.pairs)
@@ -628,7 +633,8 @@ def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
             lines.append(f"| [{code}]({k.name}/worksheet.md) | {num(k.phi1, lang, 6)} | "
                          f"{num(k.M_bal, lang, decimals=2)} | {k.largest} = {num(k.R_max, lang, decimals=1)} | "
                          f"{num(k.cycle_M_max, lang, decimals=2)} | {num(k.cycle_R_max, lang, decimals=1)} | "
-                         + " ".join(f"[{f.name}]({k.name}/{f.name})" for f in k.files if f.suffix == ".pdf") + " |")
+                         + " ".join(f"[{f.name}]({k.name}/{f.name})" for f in k.files
+                                    if f.suffix == ".pdf" or f.name == "page.html") + " |")
         lines.append("")
     return "\n".join(lines)
 

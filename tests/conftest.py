@@ -48,6 +48,15 @@ def kernel_cache() -> Path:
     return fast.cache_dir()
 
 
+@pytest.fixture(scope="session")
+def chromium():
+    """Headless Chromium for the session's browser tests (`sheet_browser.chromium`: skipped,
+    saying why, where it cannot be had): one per process, as Playwright's sync API allows."""
+    import sheet_browser
+    with sheet_browser.chromium() as browser:
+        yield browser
+
+
 @pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])
 def model_path(request) -> Path:
     return request.param

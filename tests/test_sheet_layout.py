@@ -27,18 +27,9 @@ from conftest import MODELS
 
 
 @pytest.fixture(scope="session")
-def page():
+def page(chromium):
     """One headless Chromium page for the session (skipped where Chromium or Playwright is missing)."""
-    sync = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed (pip install playwright)")
-    with sync.sync_playwright() as p:
-        try:
-            browser = sheet_browser.launch(p)
-        except Exception as exc:                    # noqa: BLE001 - any launch failure: no browser here
-            pytest.skip(f"Chromium does not start: {exc}")
-        if browser is None:
-            pytest.skip("no chromium on PATH (apt-get install chromium)")
-        yield browser.new_page()
-        browser.close()
+    return chromium.new_page()
 
 
 def _sheets(mech, at: float | None, lang: str, plans=None) -> dict[str, str]:
@@ -196,6 +187,20 @@ def test_a_tiny_vector_is_drawn_beside_a_collinear_load(ice_plans):
     ux, uy = f[2] - f[0], f[3] - f[1]
     off = abs((g[0] - f[0]) * uy - (g[1] - f[1]) * ux) / math.hypot(ux, uy)     # G3*'s start off F_p's line
     assert 1.5 <= off <= 2.0
+
+
+def test_a_dead_centre_notes_its_zero_loads_negligible():
+    """At the ICE's dead centre (0 deg) R12t, the arms h_G2 and the lever's p-b are rounding noise
+    (1e-16..1e-14 mm): each sheet is drawn (before, a zero vector 'drawn out of scale' divided by
+    its length 0) and notes them negligible instead of drawing them in a direction they lack."""
+    mech = kinetostat.load("ice_crank_slider")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plans = P.build(mech, at=0.0)
+    group, lever = svg(plans["group:2,3"]), svg(plans["lever"])
+    assert plans["group:2,3"].length_mm("R12t") < 1e-9 and plans["lever"].length_mm("p-b") < 1e-9
+    assert "R12t*" not in group and "negligible" in group.split('<g id="notes">')[1]
+    assert "negligible" in lever.split('<g id="notes">')[1]
 
 
 def test_notes_letter_names_as_the_drawing(ice_plans):

@@ -9,7 +9,7 @@ import argparse
 
 from .analyze import cmd_analyze, cmd_examples, cmd_export, cmd_schema, cmd_structure
 from .common import _Parser, _angle, _jobs, _positive, _steps
-from .plans import _plan_names, _scale_item, cmd_plans, cmd_variant
+from .plans import _plan_names, _scale_item, cmd_page, cmd_plans, cmd_variant
 from .report import cmd_report
 from .sweep import _param, cmd_sweep
 from .validate import cmd_validate
@@ -121,6 +121,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="models reported in parallel by N worker processes (default: the number of cores; "
                         "1: in this process)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--page", action="store_true", help="also each model's interactive page (page.html, linked; "
+                                                       "about 40 s a model)")
     r.set_defaults(func=cmd_report)
 
     pl = sub.add_parser("plans", help="draw the plans of the graphical method (SVG sheets, segments.csv)",
@@ -144,7 +146,21 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--only", metavar="PLANS", type=_plan_names, action="append",
                     help="draw only these plans, comma-separated: positions, velocity, acceleration")
     pl.add_argument("--out", metavar="DIR", required=True, help="output directory (created)")
+    pl.add_argument("--cycle-scales", action="store_true",
+                    help="every plan at the scales of the interactive page (`kinetostat page`): chosen once for "
+                         "the whole cycle (--scale is then not used)")
     pl.set_defaults(func=cmd_plans)
+
+    pg = sub.add_parser("page", help="the interactive page of a mechanism: one offline HTML file, an angle slider "
+                                     "over every plan", description="Write one self-contained HTML file (no network): "
+                        "MODEL's plans at every degree and the design position at scales fixed for the cycle, the "
+                        "values table, the force plans step by step, a check of measured lengths (README: the page).")
+    pg.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
+    pg.add_argument("--lang", choices=("en", "uk", "ru"), default=None, help="language (default: the model's, else en)")
+    pg.add_argument("--student", action="store_true", help="the student's page: data, empty tables, the grid; no answer")
+    pg.add_argument("--at", metavar="DEG", type=_angle, help="angle of the check (default: the design position)")
+    pg.add_argument("--out", metavar="FILE", required=True, help="the HTML file to write")
+    pg.set_defaults(func=cmd_page)
 
     e = sub.add_parser("examples", help="list the bundled models, or copy them (with FORMAT.md) into a folder",
                        description="List the bundled models (the seeds' worked cases shipped inside the package, "
@@ -183,6 +199,8 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--no-pack", action="store_true", help="no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf "
                                                            "and their HTML): the keys only, about 4 s faster a code")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
+    va.add_argument("--page", action="store_true", help="also the variant's interactive page (page.html, linked from "
+                                                        "the index; about 40 s a code)")
     va.set_defaults(func=cmd_variant)
 
     sw = sub.add_parser("sweep", help="analyse every combination of some parameters' values: a row of peaks per design",

@@ -1,5 +1,6 @@
-"""The teaching commands: `plans` (the SVG sheets of the graphical method) and `variant` (the task
-variants of Logvinenko, Nadtoka 2021 and their answer keys).
+"""The teaching commands: `plans` (the SVG sheets of the graphical method), `page` (the interactive
+page of a mechanism) and `variant` (the task variants of Logvinenko, Nadtoka 2021 and their answer
+keys).
 
 May use: `.common`, the solver, `kinetostat.plans`, `kinetostat.variants`.
 """
@@ -14,7 +15,8 @@ from pathlib import Path
 
 from .._io import unit
 from .._text import one_line
-from .common import CLIError, EXIT_OK, _Out, _checkpoint, _close, _lines, _load, _progress, _turn, _warn, _writable_dir
+from .common import (CLIError, EXIT_OK, _Out, _checkpoint, _close, _lines, _load, _progress, _size, _turn, _warn,
+                     _writable_dir, _writable_file)
 
 
 def _scale_item(text: str) -> tuple[str, float]:
@@ -47,7 +49,7 @@ def _plan_names(text: str) -> list[str]:
 def cmd_plans(args) -> int:
     import numpy as np
     from ..errors import SingularPositionWarning
-    from ..plans import build
+    from ..plans import build, cycle_scales
     from ..plans.worksheet import worksheet
     from ..plans.lettering import lettering
     from ..plans.scales import ScaleError
@@ -60,7 +62,9 @@ def cmd_plans(args) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:     # the accuracy at this angle: said below
             warnings.simplefilter("always")
-            plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only)
+            fixed = cycle_scales(mech) if args.cycle_scales else None          # the page's scales
+            plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only,
+                          fixed=fixed)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
     except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
         raise CLIError(f"--scale {exc}") from None
@@ -76,6 +80,20 @@ def cmd_plans(args) -> int:
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
     _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))
+    return EXIT_OK
+
+
+def cmd_page(args) -> int:
+    from ..plans.lettering import lettering
+    from ..plans.page import write_page
+    mech = _load(Path(args.model))
+    out = _writable_file(args.out, "--out")
+    try:
+        path = write_page(mech, out, lang=args.lang or lettering(mech).language or "en", student=args.student,
+                          at=_turn(args.at, "--at"))
+    except ValueError as exc:
+        raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
+    _Out.write(one_line(f"{Path(args.model).name}: page -> {path} ({_size(path.stat().st_size)})"))
     return EXIT_OK
 
 
@@ -113,7 +131,8 @@ def cmd_variant(args) -> int:
                 warnings.simplefilter("ignore")
                 try:
                     keys.append(variants.write_key(v, out / v.name if args.all else out, lang=args.lang,
-                                                   cycle_csv=not args.all, root=out, teacher_pack=teacher_pack))
+                                                   cycle_csv=not args.all, root=out, teacher_pack=teacher_pack,
+                                                   page=args.page))
                 except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:

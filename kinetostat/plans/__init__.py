@@ -19,7 +19,7 @@ pandas only inside `Plans.segments_frame` and `Plans.segments_csv`; never the ha
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
@@ -39,7 +39,7 @@ from .lever import lever_plan
 from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
 
 __all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS", "svg", "figure",
-           "choose_scales", "starting_position", "plan_file_name"]
+           "choose_scales", "starting_position", "plan_file_name", "CycleScales", "cycle_scales"]
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
 #: Plan or list of Plans).
@@ -67,6 +67,68 @@ def _fitted(make: Callable, mu: Scale) -> list[Plan]:
             break
         value = coarser(value, factor)
     return plans
+
+
+@dataclass(frozen=True)
+class CycleScales:
+    """Every scale of every plan, fixed for the whole cycle (`cycle_scales`): so that a plan's vectors
+    grow and shrink with the crank angle as a student's would at one scale. `base`: mu_l, mu_v, mu_a,
+    mu_F; `plan`: the scale each plan kind is drawn at (group:2,3, forces:2,3, crank, lever);
+    `forces_on`: the force scale of the loads drawn on a group plan, the crank, the lever."""
+    base: Mapping[str, Scale]
+    plan: Mapping[str, Scale]
+    forces_on: Mapping[str, Scale]
+
+    def builders(self) -> dict[str, Callable]:
+        """BUILDERS' steps that draw at these scales."""
+        group = {k.partition(":")[2]: s for k, s in self.forces_on.items() if k.startswith("group:")}
+        kind = {k.partition(":")[0]: s for k, s in self.plan.items()}
+        return {"groups": lambda mech, res, sc: group_plans(mech, res, kind["group"], group),
+                "forces": lambda mech, res, sc: force_plans(mech, res, kind["forces"]),
+                "crank": lambda mech, res, sc: crank_plan(mech, res, self.plan["crank"], self.forces_on["crank"]),
+                "lever": lambda mech, res, sc: lever_plan(mech, res, self.plan["lever"], self.forces_on["lever"])}
+
+
+def cycle_scales(mech, step_deg: float = 5.0) -> CycleScales:
+    """The scales of `mech`'s plans fixed for the cycle: each the coarsest the texts' rule (and the
+    fitting of each plan to its sheet) chooses at the angles 0, step_deg, ... and the design
+    position, so that every plan fits its sheet at every angle (a peak between two angles 5 deg
+    apart exceeds the sampled one by under 0.4 % of a cosine; the round scales leave more room).
+    Singular positions are left out."""
+    import warnings
+
+    import numpy as np
+    base: dict[str, Scale] = {}
+    plan: dict[str, Scale] = {}
+    forces_on: dict[str, Scale] = {}
+
+    def coarsest(into: dict, key: str, s: Scale) -> None:
+        if key not in into or s.value > into[key].value:
+            into[key] = s
+    angles = [*np.arange(0.0, 360.0, step_deg), float(getattr(mech.drive, "design_deg", 30.0))]
+    start = starting_position(mech)             # the plan of positions' position 0: found once
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for at in angles:
+            try:
+                p = build(mech, at=float(at), starting_deg=start)
+            except ValueError:                     # a singular position: no plans there
+                continue
+            for key, s in p.scales.items():
+                coarsest(base, key, s)
+            for kind, pl in p.items():
+                if kind.partition(":")[0] in ("group", "forces", "crank", "lever"):
+                    coarsest(plan, kind, pl.scale)
+                    for s in pl.segments:
+                        if s.scale is not None and s.scale.symbol == "mu_F":
+                            coarsest(forces_on, kind, s.scale)
+    if not base:
+        raise ValueError(f"{mech.name}: no crank angle where the plans can be drawn")
+    group = max((s for k, s in plan.items() if k.startswith("group:")), key=lambda s: s.value, default=None)
+    forces = max((s for k, s in plan.items() if k.startswith("forces:")), key=lambda s: s.value, default=None)
+    plan.update({k: group for k in plan if k.startswith("group:")})      # one mu_l for the group plans,
+    plan.update({k: forces for k in plan if k.startswith("forces:")})    # one mu_F for the polygons, as build
+    return CycleScales(MappingProxyType(base), MappingProxyType(plan), MappingProxyType(forces_on))
 
 
 def _positions(mech, res, sc, starting_deg: float | None) -> Plan:
@@ -149,13 +211,15 @@ def plan_file_name(plan: Plan, suffix: str = ".svg") -> str:
 
 
 def build(mech, at: float | None = None, scales: Mapping[str, float] | None = None,
-          starting_deg: float | None = None, only: Iterable[str] | None = None) -> Plans:
+          starting_deg: float | None = None, only: Iterable[str] | None = None,
+          fixed: CycleScales | None = None) -> Plans:
     """The plans of `mech` at crank angle `at` (deg; default: the model's design position
     `drive.design_deg`). `scales`: any of mu_l [m/mm], mu_v [m/(s mm)], mu_a [m/(s^2 mm)],
     mu_F [N/mm] (the others chosen by the texts' rule, `choose_scales`); `starting_deg`: position
     0 of the plan of positions (default: found, `starting_position`); `only`: names of BUILDERS
-    to draw (default all). ValueError for a bad angle or name; ScaleError (a ValueError) for a
-    scale that would draw a plan beyond MAX_EXTENT_MM."""
+    to draw (default all); `fixed`: every plan at these scales (`cycle_scales`; `scales` then
+    unused). ValueError for a bad angle or name; ScaleError (a ValueError) for a scale that would
+    draw a plan beyond MAX_EXTENT_MM."""
     import math
 
     from ..solve import analyze
@@ -175,8 +239,8 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     if res.omega(1)[0] == 0:
         raise ValueError("the crank stands still (omega_1 = 0): the velocity and acceleration plans have no "
                          "size to draw; the statics is in the tables (reactions, balancing moment)")
-    sc = choose_scales(mech, res, scales)
-    steps = dict(BUILDERS)
+    sc = dict(fixed.base) if fixed is not None else choose_scales(mech, res, scales)
+    steps = dict(BUILDERS) | (fixed.builders() if fixed is not None else {})
     steps["positions"] = partial(_positions, starting_deg=starting_deg)
     plans: list[Plan] = []
     for name in names:

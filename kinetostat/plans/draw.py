@@ -39,6 +39,9 @@ ARROW_MM = (3.5, 0.6)
 ARC_HEAD_MM = 2.8
 #: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM.
 TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
+#: A vector shorter than this (mm) is rounding noise of a zero (a load's arm at a dead centre): it
+#: has no direction to draw it out of scale in, and is noted as negligible.
+ZERO_MM = 1e-9
 #: A vector drawn out of scale along another vector from the same point is drawn this far beside it, mm.
 SIDE_MM = 1.8
 _POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
@@ -190,7 +193,7 @@ def _tiny(plan: Plan) -> dict[str, str]:
     how = {}
     for s in _drawable(plan):
         if s.kind == "vector" and abs(plan.points[s.end] - plan.points[s.start]) < TINY_MM:
-            out = s.scale is not None and abs(plan.points[s.end] - plan.points[s.start]) > 0
+            out = s.scale is not None and abs(plan.points[s.end] - plan.points[s.start]) > ZERO_MM
             how[s.name] = "out" if out else "negligible"
     return how
 
@@ -336,8 +339,11 @@ def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float,
             (b[0] - ux * 0.6 * h, b[1] - uy * 0.6 * h))
 
 
-def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
-    """The plan on an A3 landscape sheet, true to scale (1 user unit = 1 mm), as SVG text."""
+def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = False) -> str:
+    """The plan on an A3 landscape sheet, true to scale (1 user unit = 1 mm), as SVG text.
+    `contract`: every segment's element carries data-plan, data-segment and data-length-mm (its
+    length at the scale, as in segments.csv; a negligible vector, not drawn, an empty <g>): the
+    interactive page's contract (`page`)."""
     _lang(lang)
     tiny = _tiny(plan)
     x0, y0, x1, y1 = extent(plan)
@@ -366,7 +372,8 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
         pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in xy)
         tip = text(name, lang) if name in MESSAGES else name if name[:1] in "ωεM" else ""   # no English tooltip
-        out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="{width}">'
+        ident = f' data-plan="{escape(plan.kind)}" data-path="{escape(name)}"' if contract else ""
+        out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="{width}"{ident}>'
                    + (f'<title>{escape(tip)}</title>' if tip else "") + '</polyline>')
         for (a, b), (c, d) in zip(xy, xy[1:]):
             placer.line(a, b, c, d)
@@ -381,9 +388,13 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
         L = math.hypot(b[0] - a[0], b[1] - a[1])
         label = segment_label(s, lang)
+        data = (f' data-plan="{escape(plan.kind)}" data-segment="{escape(s.name)}" '
+                f'data-length-mm="{float(abs(plan.points[s.end] - plan.points[s.start]))!r}"') if contract else ""
         if s.name in tiny:
             if tiny[s.name] == "negligible":
                 named.append((label, a, None))
+                if contract:
+                    out.append(f'<g class="negligible"{data}/>')
                 continue
             b = (a[0] + (b[0] - a[0]) / L * MIN_DRAWN_MM, a[1] + (b[1] - a[1]) / L * MIN_DRAWN_MM)
             L, label = MIN_DRAWN_MM, label + "*"
@@ -398,7 +409,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "") -> str:
             placer.block((b[0] - 0.5, b[1] - 0.5, b[0] + 0.5, b[1] + 0.5))      # a line's end
         attrs = f' stroke-dasharray="{dash}"' if dash else ""
         out.append(f'<line x1="{a[0]:.3f}" y1="{a[1]:.3f}" x2="{end[0]:.3f}" y2="{end[1]:.3f}" stroke="{colour}" '
-                   f'stroke-width="{width}"{attrs}><title>{escape(label)}</title></line>')
+                   f'stroke-width="{width}"{attrs}{data}><title>{escape(label)}</title></line>')
         if s.kind == "vector":
             out.append(head)
         placer.line(a[0], a[1], b[0], b[1])

@@ -269,36 +269,38 @@ def _link_drawing(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: l
 
 # -- the plans
 
-def group_plans(mech: "Mechanism", res: "Analysis", mu_l) -> list[Plan]:
+def group_plans(mech: "Mechanism", res: "Analysis", mu_l, mu_F: dict[str, Scale] | None = None) -> list[Plan]:
     """The plan of every Assur group at mu_l (seed 002 fig. 1.9, seed 000 figs. 6.1-6.3): the
     group's links, every load at its point (weights, inertia main vectors F_i at S with their
     moments M_i as arcs, and the single resultant F_i(h) at z = h/mu_l from S), the carried
     reactions, the unknown reactions (pins of RRR, RRP split into R..n along and R..t across the
     link; prismatic normal forces at their offset x, with the arm x_..), and the arms h_.. of
-    the moment equations. Forces are drawn at a round force scale of their own."""
+    the moment equations. Forces are drawn at a round force scale of their own: `mu_F[label]` (label
+    "2,3" of group:2,3) where given, else chosen at this angle."""
     _single(res)
     mu_l = _scale(mu_l, "mu_l", "m/mm")
     plans = []
     for g in mech.structure.groups:
         if g.klass == 3:
-            plans.append(_triad_group_plan(mech, res, g, mu_l))
+            plans.append(_triad_group_plan(mech, res, g, mu_l, (mu_F or {}).get(_group_label(g))))
             continue
         j, k = g.links
         later = _later(mech, g)
         loads = {x: link_loads(mech, res, x) + _carried(mech, res, x, later) for x in (j, k)}
         outer = [_outer(mech, res, g, 0), _outer(mech, res, g, 1)]
-        mu_F = force_scale([ld.force for x in (j, k) for ld in loads[x]] + [o.whole.force for o in outer])
+        mu_g = (mu_F or {}).get(_group_label(g)) or force_scale([ld.force for x in (j, k) for ld in loads[x]]
+                                                                + [o.whole.force for o in outer])
         pts: dict[str, complex] = {}
         segs: list[Segment] = []
         paths: dict[str, tuple[complex, ...]] = {}
-        _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_F)
+        _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_g)
         for o in outer:
             w = o.whole
             if o.normal is None:
-                _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_F)
+                _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_g)
             else:
-                _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_F)
-                _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_F)
+                _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_g)
+                _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_g)
         for p, on in ((g.pairs[0], j), (g.pairs[1], j), (g.pairs[2], k)):
             if p.kind == "P":
                 _offset(mech, res, p, on, pts, segs, mu_l)
@@ -309,7 +311,7 @@ def group_plans(mech: "Mechanism", res: "Analysis", mu_l) -> list[Plan]:
                     if abs(ld.force) > 0 and abs(ld.point - M) > 1e-12 * mech.size:
                         _arm(segs, pts, arm_name(ld.name), M, M_name, ld.point, ld.force, mu_l)
         plans.append(Plan(f"group:{_group_label(g)}", f"Group {_group_label(g)} ({g.kind}): loads and reactions; "
-                          f"forces drawn at {mu_F}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths))
+                          f"forces drawn at {mu_g}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths))
     return plans
 
 
@@ -348,7 +350,7 @@ def _special_point(mech: "Mechanism", res: "Analysis", g) -> tuple[str, complex]
     return ("S" if "S" not in mech.point_names else "S*"), complex(special_point_z(mech, res.kin, g)[0])
 
 
-def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale) -> Plan:
+def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: Scale | None = None) -> Plan:
     """A triad's plan (Artobolevsky 1988): its four links with their loads and the carried
     reactions; each leash's outer reaction (a two-pin leash's split into R..n along its axis and
     R..t across it; a slider's normal force at its offset x); the axes of leashes 1 and 2 drawn
@@ -357,7 +359,7 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale) -> Pla
     later = _later(mech, g)
     loads = {x: link_loads(mech, res, x) + _carried(mech, res, x, later) for x in g.links}
     parts = [_leash_parts(mech, res, side) for side in g.sides]
-    mu_F = force_scale([ld.force for x in g.links for ld in loads[x]] + [o.whole.force for o in parts])
+    mu_F = mu_F or force_scale([ld.force for x in g.links for ld in loads[x]] + [o.whole.force for o in parts])
     pts: dict[str, complex] = {}
     segs: list[Segment] = []
     paths: dict[str, tuple[complex, ...]] = {}

@@ -245,6 +245,64 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                  "Момент инерции шатуна относительно центра масс"),
     "row.G_piston": ("Weight of the pistons", "Вага поршнів", "Вес поршней"),
     "row.G_rod": ("Weight of the rods", "Вага шатунів", "Вес шатунов"),
+    # the interactive page (`page`)
+    "page.phi": ("Crank angle φ", "Кут кривошипа φ", "Угол кривошипа φ"),
+    "page.design": ("Design position", "Розрахункове положення", "Расчётное положение"),
+    "page.next": ("Next step", "Наступний крок", "Следующий шаг"),
+    "page.prev": ("Previous step", "Попередній крок", "Предыдущий шаг"),
+    "page.values": ("Values at this angle", "Значення в цьому положенні", "Значения в этом положении"),
+    "page.check": ("Check your drawing", "Перевірка креслення", "Проверка чертежа"),
+    "page.check_note": ("Type the lengths you measured on your plans (mm) at φ = {phi}°: the deviation from the "
+                   "exact length, and whether it lies in the band a careful drawing lands in (the 5-95 % "
+                   "band of the drawing-error study; — where the study has none); the two balancing "
+                   "moments by the texts' {tol} % rule.",
+                   "Введіть довжини, виміряні на ваших планах (мм) при φ = {phi}°: відхилення від точної "
+                   "довжини і чи лежить воно в смузі, куди потрапляє ретельне креслення (5-95 % "
+                   "дослідження похибки креслення; — де його немає); два зрівноважувальні моменти за "
+                   "правилом {tol} % методички.",
+                   "Введите длины, измеренные на ваших планах (мм) при φ = {phi}°: отклонение от точной "
+                   "длины и лежит ли оно в полосе, куда попадает тщательный чертёж (5-95 % исследования "
+                   "погрешности чертежа; — где его нет); два уравновешивающих момента по правилу {tol} % "
+                   "методички."),
+    "page.plan": ("Plan", "План", "План"),
+    "page.segment": ("Segment", "Відрізок", "Отрезок"),
+    "page.measured": ("Measured", "Виміряно", "Измерено"),
+    "page.exact": ("Exact", "Точно", "Точно"),
+    "page.band": ("Band", "Смуга", "Полоса"),
+    "page.verdict": ("Verdict", "Висновок", "Вывод"),
+    "page.in_band": ("in the band", "у смузі", "в полосе"),
+    "page.out_band": ("outside the band", "поза смугою", "вне полосы"),
+    "page.rule_ok": ("within {tol} %", "в межах {tol} %", "в пределах {tol} %"),
+    "page.rule_bad": ("beyond {tol} %", "понад {tol} %", "больше {tol} %"),
+    "page.data": ("Data", "Вихідні дані", "Исходные данные"),
+    "page.sheet": ("Your sheet (A3, true scale; print it)", "Ваш аркуш (A3, у натуральну величину; друкуйте)",
+              "Ваш лист (A3, в натуральную величину; печатайте)"),
+    "page.student": ("Student's page: no answers", "Сторінка студента: без відповідей", "Страница студента: без ответов"),
+    "page.key": ("Key: every plan and value", "Ключ: усі плани і значення", "Ключ: все планы и значения"),
+    "page.print": ("Print: each sheet at true scale, landscape, on the paper chosen (A4: the plan's part of the "
+              "sheet; the 100 mm bar measures 100 mm).",
+              "Друк: кожен аркуш у натуральну величину, альбомно, на вибраному папері (A4: частина аркуша з "
+              "планом; відрізок 100 мм має 100 мм).",
+              "Печать: каждый лист в натуральную величину, альбомно, на выбранной бумаге (A4: часть листа с "
+              "планом; отрезок 100 мм имеет 100 мм)."),
+    "page.paper": ("Paper", "Папір", "Бумага"),
+    "page.a4_cut": ("larger than A4: print it on A3", "більший за A4: друкуйте на A3", "больше A4: печатайте на A3"),
+    "page.singular": ("a singular position: no plans at this angle", "особливе положення: планів немає",
+                 "особое положение: планов нет"),
+    "page.tau": ("{R} from ΣM_{P}(link {k}) = 0", "{R} з ΣM_{P}(ланка {k}) = 0", "{R} из ΣM_{P}(звено {k}) = 0"),
+    "page.side": ("polygon: {sum} (side {n} of {m})", "многокутник: {sum} (сторона {n} з {m})",
+             "многоугольник: {sum} (сторона {n} из {m})"),
+    "page.inner": ("inner reaction {R}: ΣF(link {k}) = 0", "внутрішня реакція {R}: ΣF(ланка {k}) = 0",
+              "внутренняя реакция {R}: ΣF(звено {k}) = 0"),
+    "page.crank": ("initial link: {F}", "початкова ланка: {F}", "начальное звено: {F}"),
+    "page.M_crank": ("{M} = Σ F·h about {O} (initial link)", "{M} = Σ F·h відносно {O} (початкова ланка)",
+                "{M} = Σ F·h относительно {O} (начальное звено)"),
+    "page.lever": ("Zhukovsky's lever: {F}", "важіль Жуковського: {F}", "рычаг Жуковского: {F}"),
+    "page.M_lever": ("{M}' from the lever, δ against {tol} %", "{M}' з важеля, δ проти {tol} %",
+                "{M}' с рычага, δ против {tol} %"),
+    "page.scales": ("Scales (fixed for the whole cycle)", "Масштаби (сталі для всього циклу)",
+               "Масштабы (постоянные для всего цикла)"),
+    "page.loading": ("decoding…", "розпакування…", "распаковка…"),
 }
 
 #: The English phrases of the generated notes (positions, branches) and their translations,

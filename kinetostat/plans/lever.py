@@ -64,7 +64,7 @@ def _image(mech: "Mechanism", res: "Analysis", k: int, name: str, mu_v: Scale, p
     return key
 
 
-def lever_plan(mech: "Mechanism", res: "Analysis", mu_v) -> Plan:
+def lever_plan(mech: "Mechanism", res: "Analysis", mu_v, mu_F: Scale | None = None) -> Plan:
     """Zhukovsky's lever at mu_v: pole p, the image of every point of the moving links (turned by
     90 deg counter-clockwise), the vectors p-x and the links' images (a-b, values in m/s), every
     force at its like point (its value in N, drawn at a round force scale of its own; couples as
@@ -72,7 +72,7 @@ def lever_plan(mech: "Mechanism", res: "Analysis", mu_v) -> Plan:
     drawn length in mm, as the texts keep it: `NATURAL`), and the balancing force F'_bal (the model's
     lettering: F'_зр) at the crank pin's image, across p-a, whose moment about the pole cancels
     the loads'. Its results: F'_bal, M'_bal, M_bal by the force plans and their difference δ
-    against the texts' 5 % (TOLERANCE_PCT)."""
+    against the texts' 5 % (TOLERANCE_PCT). `mu_F`: the forces' scale (default: chosen at this angle)."""
     _single(res)
     mu_v = _scale(mu_v, "mu_v", "m/(s mm)")
     pts: dict[str, complex] = {"p": 0j}
@@ -107,7 +107,7 @@ def lever_plan(mech: "Mechanism", res: "Analysis", mu_v) -> Plan:
     L = lettering(mech)
     F_name = L.lever(L.F_bal)
     forces.append((F_name, crank_pin, F_bal))
-    mu_F = force_scale([F for _, _, F in forces])
+    mu_F = mu_F or force_scale([F for _, _, F in forces])
     for name, at, F in forces:
         start = f"{name}:from"
         pts[start], pts[f"{name}:to"] = pts[at], pts[at] + F / mu_F.value

@@ -253,9 +253,10 @@ def _published_section(doc: Doc, m: Mechanism, published: Sequence[PublishedChec
                "within"], rows, "lllrrlrrl")
 
 
-def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
+def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False) -> list[Path]:
     """The plans of the graphical method at the model's design position (`kinetostat.plans`),
-    one picture each, with their segments.csv and the worksheet beside them; returns the files."""
+    one picture each, with their segments.csv and the worksheet beside them, and with `page` the
+    interactive page (`plans.page`, page.html) linked; returns the files."""
     from ..plans import build, plan_file_name, svg
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
@@ -276,6 +277,11 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path) -> list[Path]:
             "with its length and the quantity it stands for: [segments.csv](segments.csv); every value the "
             "texts write down at this position: [worksheet.csv](worksheet.csv).")
     files = []
+    if page:
+        from ..plans.page import write_page
+        files.append(write_page(m, d / "page.html"))
+        doc.p("[The interactive page](page.html): every plan at every degree of the crank at scales fixed for "
+              "the cycle, the values, the force plans step by step, a check of measured lengths (one offline file).")
     for plan in plans.values():
         path = d / ("plan_" + plan_file_name(plan, ".svg"))
         write_text(path, svg(plan, mechanism=m.name))
@@ -435,12 +441,13 @@ def _tolerance(run: ModelRun, route: str):
     return run.tolerances.get(route) or TOLERANCES.get(route)
 
 
-def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[str, Any]:
+def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool = False) -> dict[str, Any]:
     """Write `out/<folder>/` for one model (default folder: `run.stem`); returns the summary
     also saved as summary.json.
 
     `folder` is a name of ASCII letters, digits, '_' and '-' (`kinetostat._io.safe_name`), and
-    the folder must resolve to a place inside `out` (ValueError otherwise). Every file is
+    the folder must resolve to a place inside `out` (ValueError otherwise); `page`: also the
+    model's interactive page, page.html, linked from the plans' section. Every file is
     written atomically: an interrupted or failed run leaves each earlier file as it was. Every
     file depends only on the model, the routes and the steps (and the libraries' versions): no
     dates and no run times, so a rerun reproduces them byte for byte. Run times are printed by
@@ -545,7 +552,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None) -> dict[st
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
     _published_section(doc, m, published)
-    plan_files = _plans_section(doc, m, d)
+    plan_files = _plans_section(doc, m, d, page)
 
     sing = int(np.sum(res.singular))
     if run.warnings or sing:

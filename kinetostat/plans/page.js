@@ -1,0 +1,205 @@
+// The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes the
+// sheets and values stored as templates and second differences (gzip, base64), builds the sheet
+// of the angle chosen, steps through the force plans, checks typed lengths. No network, no library.
+"use strict";
+(async () => {
+  const D = JSON.parse(document.getElementById("page-data").textContent);
+  const $ = (id) => document.getElementById(id);
+
+  async function bytes(id, xor) {
+    const bin = Uint8Array.from(atob($("blob-" + id).textContent), (c) => c.charCodeAt(0));
+    if (xor) {                                   // page.py's _obscure: xorshift32, seed 27
+      let x = 27;
+      for (let i = 0; i < bin.length; i++) {
+        x ^= x << 13; x >>>= 0; x ^= x >>> 17; x ^= x << 5; x >>>= 0;
+        bin[i] ^= x & 255;
+      }
+    }
+    const stream = new Blob([bin]).stream().pipeThrough(new DecompressionStream("gzip"));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+  function varints(b) {                          // zigzag LEB128, exact below 2^53
+    const out = [];
+    let v = 0, m = 1;
+    for (let i = 0; i < b.length; i++) {
+      v += (b[i] & 127) * m;
+      if (b[i] & 128) { m *= 128; } else { out.push(v % 2 ? -(v + 1) / 2 : v / 2); v = 0; m = 1; }
+    }
+    return out;
+  }
+  function fmt(n, f) {                            // a number as the sheet wrote it
+    if (f === "") return String(n);
+    if (f === "L") return String(n / 1e10);       // page.py LENGTH_Q = 1e-10 mm
+    const d = +f.slice(1);
+    const s = String(Math.abs(n)).padStart(d + 1, "0");
+    return (n < 0 ? "-" : "") + s.slice(0, s.length - d) + f[0] + s.slice(s.length - d);
+  }
+  function local(x, digits) {                     // `digits` significant digits, as i18n.num writes them
+    if (!isFinite(x)) return "—";
+    if (Math.abs(x) < 1e-9) return "0";            // i18n.ZERO
+    if (Math.abs(x) >= 10 ** digits) return String(Math.round(x));
+    const places = Math.min(20, Math.max(0, digits - 1 - Math.floor(Math.log10(Math.abs(x)))));
+    let s = x.toFixed(places);
+    if (s.includes(".")) s = s.replace(/0+$/, "").replace(/\.$/, "");
+    return (s === "-0" ? "0" : s).replace(".", D.decimal);
+  }
+
+  // ------------------------------------------------------------------ the check of typed lengths
+  const check = JSON.parse(new TextDecoder().decode(await bytes("check", true)));
+  function parse(s) { const x = parseFloat(s.replace(",", ".")); return s.trim() === "" ? NaN : x; }
+  function verdict(tr, typed, exact, band, rule) {
+    const cell = tr.querySelector(".verdict");
+    if (!isFinite(typed)) { cell.textContent = ""; cell.className = "verdict"; delete cell.dataset.verdict; return; }
+    const dev = typed - exact, pct = 100 * dev / exact;
+    let ok, word;
+    if (rule) { ok = Math.abs(pct) <= D.tol; word = ok ? D.rule_ok : D.rule_bad; }
+    else if (band) { ok = band[0] <= typed && typed <= band[1]; word = D.ui[ok ? "in_band" : "out_band"]; }
+    else { ok = null; word = ""; }
+    cell.dataset.verdict = ok === null ? "none" : ok ? "ok" : "bad";
+    cell.className = "verdict" + (ok === null ? "" : ok ? " ok" : " bad");
+    cell.textContent = (dev >= 0 ? "+" : "") + local(dev, 3) + (rule ? "" : " " + D.mm) + " (" + (pct >= 0 ? "+" : "")
+      + local(pct, 2) + " %)" + (word ? " — " + word : "");
+  }
+  document.querySelectorAll("tr[data-item]").forEach((tr) => {
+    const it = check.items[+tr.dataset.item];
+    if (!D.student) {
+      tr.querySelector(".exact").textContent = local(it.exact, 4);
+      tr.querySelector(".band").textContent = it.band ? local(it.band[0], 3) + " … " + local(it.band[1], 3) : "—";
+    } else if (!it.band) {
+      tr.querySelector(".band").textContent = "—";
+    }
+    tr.querySelector("input").addEventListener("input", (e) => verdict(tr, parse(e.target.value), it.exact, it.band, false));
+  });
+  document.querySelectorAll("tr[data-moment]").forEach((tr) => {
+    const exact = Math.abs(check.M[+tr.dataset.moment][1]);
+    if (!D.student) tr.querySelector(".exact").textContent = local(exact, 4);
+    tr.querySelector("input").addEventListener("input", (e) => verdict(tr, Math.abs(parse(e.target.value)), exact, null, true));
+  });
+  if (D.student) { document.body.dataset.ready = "1"; return; }
+
+  // ------------------------------------------------------------------ the sheets of every angle
+  const meta = JSON.parse(new TextDecoder().decode(await bytes("meta")));
+  const kinds = [];
+  for (let k = 0; k < meta.kinds.length; k++) {
+    const K = meta.kinds[k], nums = varints(await bytes("k" + k)), frames = K.frames.map(() => null);
+    let p = 0;
+    K.templates.forEach((t, tid) => {              // template by template, slot by slot: page.py encode
+      const fs = [];
+      K.frames.forEach((x, f) => { if (x === tid) fs.push(f); });
+      const n = (t.length - 1) / 2;
+      fs.forEach((f) => { frames[f] = new Array(n); });
+      for (let i = 0; i < n; i++) {
+        let a = 0, b = 0;                          // the slot's two values before
+        fs.forEach((f, j) => {
+          const d = nums[p++], v = j >= 2 ? d + 2 * b - a : j === 1 ? d + b : d;
+          a = b; b = v;
+          frames[f][i] = v;
+        });
+      }
+    });
+    kinds.push({kind: K.kind, templates: K.templates, tids: K.frames, frames});
+  }
+  const rows = D.rows, ncol = rows.length, nf = D.frames.length;
+  const vals = varints(await bytes("values"));
+  const values = D.frames.map(() => new Array(ncol));
+  for (let c = 0; c < ncol; c++) {                 // column by column: page.py _columns
+    let a = 0, b = 0;
+    const e = D.exps[c];
+    for (let f = 0; f < nf; f++) {
+      const d = vals[nf * ncol + c * nf + f], n = f >= 2 ? d + 2 * b - a : f === 1 ? d + b : d;
+      a = b; b = n;
+      values[f][c] = vals[c * nf + f] ? NaN : e < 0 ? n / 10 ** -e : n * 10 ** e;
+    }
+  }
+
+  const sheets = $("sheets");
+  sheets.textContent = "";
+  const boxes = kinds.map((K) => {
+    const div = document.createElement("div");
+    div.className = "sheet"; div.dataset.kind = K.kind;
+    sheets.appendChild(div);
+    return div;
+  });
+  const table = $("value-table");
+  let section = null;
+  const cells = rows.map((r) => {
+    if (r.section !== section) {
+      section = r.section;
+      const th = table.insertRow().appendChild(document.createElement("th"));
+      th.colSpan = 3; th.textContent = section;
+    }
+    const tr = table.insertRow();
+    tr.insertCell().textContent = r.symbol;
+    const td = tr.insertCell();
+    td.className = "num"; td.dataset.symbol = r.symbol;
+    tr.insertCell().textContent = r.unit;
+    return td;
+  });
+
+  let frame = 0, step = -1;
+  function render(f) {
+    frame = f;
+    kinds.forEach((K, k) => {
+      const a = K.frames[f];
+      if (!a) { boxes[k].textContent = D.ui.singular; return; }
+      const t = K.templates[K.tids[f]], out = [t[0]];
+      for (let i = 0; i < a.length; i++) out.push(fmt(a[i], t[2 * i + 1]), t[2 * i + 2]);
+      boxes[k].innerHTML = out.join("").replace(/<\/svg>\s*$/, D.scalebar + "</svg>");
+    });
+    values[f].forEach((v, c) => {
+      cells[c].dataset.value = isFinite(v) ? String(v) : "";
+      cells[c].textContent = local(v, 4);
+    });
+    $("phi-value").textContent = local(D.frames[f], 6);
+    paper();
+    highlight();
+  }
+  function paper() {                              // A4 landscape: the 297 x 210 mm around the plan
+    const a4 = $("paper").value === "A4";
+    document.documentElement.dataset.paper = $("paper").value;
+    $("page-size").textContent = `@page{size:${a4 ? "A4" : "A3"} landscape;margin:0}`;
+    boxes.forEach((box) => {
+      const svg = box.querySelector("svg"), plan = svg && svg.querySelector("#plan");
+      if (!plan) return;
+      const bar = svg.querySelector("#scalebar");
+      if (!a4) {
+        svg.setAttribute("viewBox", "0 0 420 297"); svg.setAttribute("width", "420mm"); svg.setAttribute("height", "297mm");
+        bar.removeAttribute("transform"); delete box.dataset.a4; return;
+      }
+      const b = plan.getBBox(), clamp = (x, hi) => Math.min(Math.max(x, 0), hi);
+      const x0 = clamp(b.x + b.width / 2 - 148.5, 123), y0 = clamp(b.y + b.height / 2 - 105, 87);
+      svg.setAttribute("viewBox", `${x0} ${y0} 297 210`); svg.setAttribute("width", "297mm"); svg.setAttribute("height", "210mm");
+      bar.setAttribute("transform", `translate(${x0 - 8} ${y0 - 30})`);   // the bar 8 mm in, 10 mm down
+      if (b.width > 280 || b.height > 195) box.dataset.a4 = D.ui.a4_cut; else delete box.dataset.a4;
+    });
+  }
+  $("paper").addEventListener("change", paper);
+  function highlight() {
+    document.querySelectorAll(".hl").forEach((el) => el.classList.remove("hl"));
+    const out = $("step");
+    if (step < 0) { out.textContent = ""; $("equation").textContent = ""; return; }
+    const s = meta.steps[step];
+    const sel = `svg [data-plan="${s.plan}"]` + (s.segment ? `[data-segment="${CSS.escape(s.segment)}"]` : `[data-path="${CSS.escape(s.path)}"]`);
+    const el = document.querySelector(sel);
+    if (el) { el.classList.add("hl"); el.scrollIntoView({block: "center", behavior: "instant"}); }
+    out.dataset.plan = s.plan;
+    out.dataset.segment = s.segment || "";
+    out.dataset.path = s.path || "";
+    out.textContent = `${step + 1}/${meta.steps.length}`;
+    const len = el && el.dataset.lengthMm !== undefined ? ` — ${local(+el.dataset.lengthMm, 4)} ${D.mm}` : "";
+    $("equation").textContent = s.eq + len;
+  }
+  const slider = $("phi");
+  function frameOf(deg) {                        // the frame of the nearest angle on the slider
+    let best = 0;
+    for (let f = 0; f < nf - 1; f++) if (Math.abs(D.frames[f] - deg) < Math.abs(D.frames[best] - deg)) best = f;
+    return best;
+  }
+  slider.addEventListener("input", () => render(frameOf(+slider.value)));
+  $("design").addEventListener("click", () => { slider.value = Math.round(D.design) % 360; render(nf - 1); });
+  $("next").addEventListener("click", () => { step = (step + 1) % meta.steps.length; highlight(); });
+  $("prev").addEventListener("click", () => { step = step <= 0 ? meta.steps.length - 1 : step - 1; highlight(); });
+  slider.value = Math.round(D.design) % 360;
+  render(nf - 1);
+  document.body.dataset.ready = "1";
+})();

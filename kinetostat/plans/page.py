@@ -1,0 +1,480 @@
+"""The interactive page of a mechanism (issue 27): one self-contained, offline HTML file with an
+angle slider over every plan, the force plans stepped through in the texts' order, a check of a
+student's measured lengths, and print at true scale.
+
+    >>> import kinetostat
+    >>> from kinetostat.plans.page import page
+    >>> html = page(kinetostat.load("ice_crank_slider"), lang="uk")      # doctest: +SKIP
+
+Key mode (default): the sheets of `kinetostat plans` (`draw.svg`, the same lettering and label
+placement) at every whole degree and the design position, every scale fixed for the whole cycle
+(`cycle_scales`), without the sheets' notes (the page's tables take their place); the worksheet's
+values; "Next step". Student mode (`student=True`): no answer in the page: the data, the empty
+tables, an A3 sheet with a millimetre grid at true scale, and the check of typed lengths.
+
+Small: the sheets of all angles are cut into templates (the markup, a few per plan) and numbers;
+the numbers of each template slot are stored as second differences over the angle (the drawing's
+coordinates at 0.01 mm, each segment's length and each value to 12 significant digits), as
+zigzag varints, gzip-compressed and base64-encoded; the page's script (vanilla JavaScript, the
+browser's own DecompressionStream) decodes them once and builds the sheet of the angle chosen.
+The page contract (the README): `<input type="range" id="phi">`; every segment's element
+`data-plan`, `data-segment`, `data-length-mm` as in segments.csv; every value cell `data-symbol`,
+`data-value`.
+
+May use: the plans (`build`, `cycle_scales`, `draw`, `forces`, `worksheet`, `drawing_error`,
+`i18n`, `lettering`), the solver, numpy, the standard library. Never matplotlib, never the harness.
+"""
+from __future__ import annotations
+
+import base64
+import gzip
+import json
+import math
+import re
+import warnings
+from dataclasses import dataclass
+from html import escape
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from .._io import write_text
+from .draw import segment_label, svg, title_of
+from .i18n import check_lang, num, text, unit
+
+__all__ = ["page", "write_page", "encode", "PAGE_ANGLES", "TOLERANCE_PCT"]
+
+#: The angles of the slider, deg (the design position is one more frame).
+PAGE_ANGLES = tuple(float(a) for a in range(360))
+#: The texts' rule for the two balancing moments (crank and lever), %.
+TOLERANCE_PCT = 5.0
+#: Resolution of a segment's length in the page, mm (its data-length-mm): 12 significant digits
+#: of a 100 mm segment, as segments.csv.
+LENGTH_Q = 1e-10
+_NUM = re.compile(r"(-?)(\d+)(?:([.,])(\d+))?")
+_NOTES = re.compile(r'<g id="notes">.*?</g>\n?', re.S)
+_LENGTH = re.compile(r'data-length-mm="([^"]*)"')
+
+# ============================================================================ the numbers, small
+
+@dataclass(frozen=True)
+class Encoded:
+    """Sheets cut into templates and numbers (`encode`): `templates[t]` alternates literal text and
+    a number's format ("" integer, ".2" two decimals after a point, ",1" after a comma, "L" a
+    length at LENGTH_Q); `frames[f]` the template of each frame (-1: none); `data` the numbers."""
+    templates: tuple[tuple[str, ...], ...]
+    frames: tuple[int, ...]
+    data: bytes
+
+
+def _split(sheet: str) -> tuple[tuple[str, ...], list[int]]:
+    """A sheet as (template, numbers): coordinates with 3 decimals rounded to 2 (0.01 mm, finer than
+    print), data-length-mm as integers of LENGTH_Q."""
+    parts: list[str] = []
+    nums: list[int] = []
+    pieces = _LENGTH.split(sheet)
+    for k, piece in enumerate(pieces):
+        if k % 2:
+            parts[-1] += 'data-length-mm="'
+            parts.append("L")
+            nums.append(round(float(piece) / LENGTH_Q))
+            parts.append('"')
+            continue
+        last = 0
+        for m in _NUM.finditer(piece):
+            sign, whole, sep, frac = m.groups()
+            if len(whole) > 1 and whole[0] == "0":        # a zero-padded number: kept as text
+                continue
+            lit = piece[last:m.start()]
+            if len(parts) % 2:
+                parts[-1] += lit
+            else:
+                parts.append(lit)
+            last = m.end()
+            d = len(frac) if frac else 0
+            n = int(whole + (frac or ""))
+            if d == 3 and sep == ".":                    # 0.001 mm -> 0.01 mm
+                n, d = (n + 5) // 10, 2
+            parts.append(f"{sep or ''}{d}" if d else "")
+            nums.append(-n if sign else n)
+        lit = piece[last:]
+        if len(parts) % 2:
+            parts[-1] += lit
+        else:
+            parts.append(lit)
+    return tuple(parts), nums
+
+
+def _varints(values: np.ndarray) -> bytes:
+    """Zigzag LEB128 varints of int64 values (|v| < 2^53)."""
+    z = np.where(values >= 0, 2 * values, -2 * values - 1).astype(np.uint64)
+    out = bytearray()
+    for v in z.tolist():
+        while v >= 128:
+            out.append((v & 127) | 128)
+            v >>= 7
+        out.append(v)
+    return bytes(out)
+
+
+def _second_differences(a: np.ndarray) -> np.ndarray:
+    """Second differences of int64 rows along axis 0 (the first row as it is, the second as its
+    first difference): a smooth function of the angle becomes a few small numbers."""
+    d = a.copy()
+    d[1:] -= a[:-1]
+    d[2:] -= a[1:-1] - a[:-2]
+    return d
+
+
+def encode(sheets: list[str | None]) -> Encoded:
+    """Sheets of one plan at successive angles (None: not drawn there) as templates and, template
+    by template, slot by slot, the second differences of the slot's numbers over the frames that
+    use that template."""
+    templates: dict[tuple[str, ...], int] = {}
+    frames: list[int] = []
+    rows: dict[int, list[list[int]]] = {}
+    for sheet in sheets:
+        if sheet is None:
+            frames.append(-1)
+            continue
+        t, nums = _split(sheet)
+        tid = templates.setdefault(t, len(templates))
+        frames.append(tid)
+        rows.setdefault(tid, []).append(nums)
+    data = b"".join(_varints(_second_differences(np.array(rows[t], dtype=np.int64)).T.ravel())
+                    for t in range(len(templates)))
+    return Encoded(tuple(templates), tuple(frames), data)
+
+
+def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
+    """Columns of values over frames (NaN: none): each column's exponent e (12 significant digits
+    of its largest |value|), and column by column the NaN mask (1: none), then column by column the
+    second differences over the frames of round(v / 10^e) (NaN as 0)."""
+    exps = []
+    for col in values.T:
+        top = np.nanmax(np.abs(col)) if np.isfinite(col).any() else 0.0
+        exps.append(int(math.floor(math.log10(top))) - 11 if top > 0 else 0)
+    scaled = np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)
+    d = _second_differences(np.rint(scaled).astype(np.int64))
+    mask = (~np.isfinite(values)).astype(np.int64)
+    return exps, _varints(np.concatenate([mask.T.ravel(), d.T.ravel()]))
+
+
+def _b64gz(data: bytes) -> str:
+    return base64.b64encode(gzip.compress(data, 9, mtime=0)).decode("ascii")
+
+
+# ============================================================================ what the page holds
+
+def _sheets_of(plans, lang: str, name: str) -> dict[str, str]:
+    """The page's sheets of one angle: `draw.svg` with the contract, without the notes (the page's
+    tables hold them) and the XML declaration."""
+    return {kind: _NOTES.sub("", svg(p, lang=lang, mechanism=name, contract=True)).split("?>", 1)[-1].lstrip()
+            for kind, p in plans.items()}
+
+
+def _steps(mech, plans, lang: str) -> list[dict]:
+    """The force analysis in the texts' order, one vector a step: per Assur group from the last
+    attached, R^τ from ΣM about the inner joint, the polygon's sides in the order drawn, the inner
+    reaction; then the initial link's loads and M_bal; then the lever's loads and M'_bal."""
+    from .forces import _group_label, _moment_equations, reaction_name
+    from .lettering import lettering
+    L = lettering(mech)
+    out = []
+    for g in reversed(mech.structure.groups):
+        label = _group_label(g)
+        forces = plans.get(f"forces:{label}")
+        if forces is None:
+            continue
+        taus = [n for n in forces.equation if n.startswith("R") and n.endswith("t")]
+        for (links, point), R in zip(_moment_equations(g), taus):
+            out.append({"plan": f"group:{label}", "segment": R,
+                        "eq": text("page.tau", lang, R=R, P=point, k=",".join(map(str, links)))})
+        m = len(forces.equation)
+        for n, name in enumerate(forces.equation):
+            out.append({"plan": f"forces:{label}", "segment": name,
+                        "eq": text("page.side", lang, sum=" + ".join(forces.equation[:n + 1]) + (" = 0" if n + 1 == m else " + …"),
+                                  n=n + 1, m=m)})
+        j, k = g.links
+        inner = reaction_name(mech, k, j)
+        out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=j)})
+    crank = plans.get("crank")
+    if crank is not None:
+        for s in crank.segments:
+            if s.kind == "vector":
+                out.append({"plan": "crank", "segment": s.name, "eq": text("page.crank", lang, F=s.name)})
+        where = {"path": L.M_bal} if L.M_bal in crank.paths else {"segment": "r_b"}     # an engine's couple; a gear's arm
+        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot)})
+    lever = plans.get("lever")
+    if lever is not None:
+        for s in lever.segments:
+            if s.kind == "vector" and s.scale is not None and s.name != L.lever(L.F_bal):
+                out.append({"plan": "lever", "segment": s.name, "eq": text("page.lever", lang, F=s.name)})
+        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang))})
+    return out
+
+
+def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, float]]:
+    """The band (mm) a careful drawing of each segment lands in (5-95 % of `drawing_error.simulate`
+    at the page's scales), for the segments whose value is a value of the worksheet (matched by
+    value and unit: the study reads the worksheet's values), each band that value's band at the
+    segment's scale; none where the study does not draw the mechanism's groups (PRP, RPP)."""
+    from .drawing_error import Scales, simulate
+    from .pack import BAND, BAND_DRAWS
+    sc = fixed.base
+    mu_F = next((s.value for k, s in fixed.plan.items() if k.startswith("forces:")), sc["mu_F"].value)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            drawn = simulate(mech, at=at, n=BAND_DRAWS, seed=0,
+                             scales=Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, mu_F))
+        except NotImplementedError:            # a group kind the study does not draw: no bands
+            return {}
+    by_value = []
+    for key, samples in drawn.samples.items():
+        lo, hi = np.percentile(np.abs(samples), BAND)
+        by_value.append((abs(drawn.exact[key]), drawn.units.get(key, ""), float(lo), float(hi)))
+    out = {}
+    for kind, plan in plans.items():
+        for s in plan.segments:
+            if s.kind != "vector" or not math.isfinite(s.value) or s.value == 0:
+                continue
+            scale = (s.scale or plan.scale).value
+            for v, u, lo, hi in by_value:
+                if u == s.unit and math.isclose(v, abs(s.value), rel_tol=1e-9):
+                    out[(kind, s.name)] = (lo / scale, hi / scale)
+                    break
+    return out
+
+
+def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
+    """The data a student starts from: ω1, ε1, g, each moving link's lengths, mass and moment of
+    inertia, the applied forces at this angle (symbol, value, unit)."""
+    from .forces import _applied
+    d = mech.drive
+    rows = [("φ", num(float(res.phi_deg[0]), lang, 6), "°"), ("ω1", num(abs(d.omega), lang, 6), unit("rad/s", lang)),
+            ("ε1", num(d.eps, lang, 6), unit("rad/s^2", lang)), ("g", num(mech.g, lang, 6), unit("m/s^2", lang))]
+    for k, link in enumerate(mech.links):
+        if k == 0:
+            continue
+        names = list(link.points)
+        for a, b in zip(names, names[1:]):
+            rows.append((f"l_{a}{b}", num(math.dist(link.points[a], link.points[b]), lang, 6), unit("m", lang)))
+        if link.mass:
+            rows.append((f"m{k}", num(link.mass, lang, 6), unit("kg", lang)))
+        if link.I_S:
+            rows.append((f"I_S{k}", num(link.I_S, lang, 6), unit("kg m^2", lang)))
+        for ld in _applied(mech, res, k):
+            rows.append((ld.name, num(abs(ld.force), lang, 6), unit("N", lang)))
+    return rows
+
+
+# ============================================================================ the page
+
+def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
+         angles=PAGE_ANGLES, fixed=None) -> str:
+    """The interactive page of `mech` in `lang` (module docstring). `at`: the angle of the check
+    (and of a student's page; default the design position); `angles`: the slider's frames (deg);
+    `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
+    from ..solve import analyze
+    from . import build, cycle_scales, starting_position
+    from .lettering import lettering
+    from .worksheet import worksheet
+    check_lang(lang)
+    design = float(getattr(mech.drive, "design_deg", 30.0))
+    at = design if at is None else float(at)
+    fixed = fixed or cycle_scales(mech)
+    start = starting_position(mech)
+    name = lettering(mech).name(lang, mech.name)
+    frames = [at] if student else [*map(float, angles), design]
+
+    def plans_at(a: float):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                return build(mech, at=a, starting_deg=start, fixed=fixed)
+            except ValueError:                     # a singular position
+                return None
+    check = plans_at(at)
+    if check is None:
+        raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
+    bands = _bands(mech, check, fixed, at)
+    data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": frames,
+                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut")},
+                  "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
+                  "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
+                  "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang)}
+    blobs: dict[str, str] = {}
+    if not student:
+        per_kind: dict[str, list] = {k: [] for k in check}
+        values, rows = [], None
+        for a in frames:
+            plans = check if a == at else plans_at(a)
+            sheets = _sheets_of(plans, lang, name) if plans is not None else {}
+            for kind in per_kind:
+                per_kind[kind].append(sheets.get(kind))
+            if plans is not None:
+                ws = worksheet(mech, a, mu_l=fixed.base["mu_l"].value, lang=lang)
+                rows = rows or ws.records()
+                got = {r.key: r.value for r in ws.rows}
+                values.append([got.get(r["key"], math.nan) for r in rows])
+            else:
+                values.append(None)
+        width = len(rows)
+        table = np.array([v if v is not None else [math.nan] * width for v in values], dtype=float)
+        exps, vbytes = _columns(table)
+        kinds = []
+        for kind, sheets in per_kind.items():
+            enc = encode(sheets)
+            kinds.append({"kind": kind, "templates": enc.templates, "frames": enc.frames})
+            blobs[f"k{len(kinds) - 1}"] = _b64gz(enc.data)
+        blobs["values"] = _b64gz(vbytes)
+        data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "unit": r["unit"],
+                                        "section": r["section"]} for r in rows], exps=exps,
+                    steps=_steps(mech, check, lang))
+        blobs["meta"] = _b64gz(json.dumps({"kinds": data.pop("kinds"), "steps": data.pop("steps")},
+                                          ensure_ascii=False).encode())
+    items = []
+    for kind, plan in check.items():
+        for s in plan.segments:
+            if s.kind in ("position", "line") or not math.isfinite(plan.length_mm(s.name)):
+                continue
+            lo_hi = bands.get((kind, s.name))
+            items.append({"plan": kind, "segment": s.name, "title": title_of(plan, lang).split(",")[0],
+                          "label": segment_label(s, lang), "exact": plan.length_mm(s.name),
+                          "band": list(lo_hi) if lo_hi else None})
+    results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
+                    for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
+    blobs["check"] = base64.b64encode(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(),
+                                                             9, mtime=0))).decode("ascii")
+    res = analyze(mech, phi_deg=[at])
+    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results)
+
+
+def _obscure(data: bytes) -> bytes:
+    """`data` XORed with the xorshift32 keystream of seed 27 (the page's script undoes it): the
+    check's answers, which a page that works offline must hold, kept from a glance at the file
+    (not from a determined reader)."""
+    out, x = bytearray(len(data)), 27
+    for i, b in enumerate(data):
+        x ^= (x << 13) & 0xFFFFFFFF
+        x ^= x >> 17
+        x ^= (x << 5) & 0xFFFFFFFF
+        out[i] = b ^ (x & 255)
+    return bytes(out)
+
+
+def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
+          data_rows, items, results) -> str:
+    from .draw import scale_text
+    title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
+    scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
+                       + [f"{_plan_name(k, lang)}: {scale_text(s, lang)}" for k, s in fixed.plan.items()
+                          if s != fixed.base[s.symbol]]
+                       + [f"{_plan_name(k, lang)} (F): {scale_text(s, lang)}" for k, s in fixed.forces_on.items()])
+    head = "".join(f"<th>{escape(h)}</th>" for h in ("", "", ""))
+    data_table = "".join(f'<tr><td>{escape(s)}</td><td class="num">{escape(v)}</td><td>{escape(u)}</td></tr>'
+                         for s, v, u in data_rows)
+    check_rows = []
+    for n, it in enumerate(items):
+        check_rows.append(f'<tr data-item="{n}"><td>{escape(it["title"])}</td><td>{escape(it["label"])}</td>'
+                          f'<td><input type="text" inputmode="decimal" class="measured" data-plan="{escape(it["plan"])}" '
+                          f'data-segment="{escape(it["segment"])}" size="7"></td>'
+                          f'<td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
+    for n, (symbol, _) in enumerate(results):
+        check_rows.append(f'<tr data-moment="{n}"><td></td><td>{escape(symbol)}, {escape(unit("N m", lang))}</td>'
+                          f'<td><input type="text" inputmode="decimal" class="moment" data-symbol="{escape(symbol)}" '
+                          f'size="7"></td><td class="exact num"></td><td></td><td class="verdict"></td></tr>')
+    phi = num(data["at"], lang, 6)
+    check = (f'<section id="check"><h2>{escape(text("page.check", lang))}</h2><p>{escape(text("page.check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
+             f'<table><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
+             + "</tr>" + "".join(check_rows) + "</table></section>")
+    if student:
+        body = (f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><p>{escape(text("page.scales", lang))}: {escape(scales)}</p>'
+                f'<table><tr>{head}</tr>{data_table}</table></section>'
+                f'<section id="grid"><h2>{escape(text("page.sheet", lang))}</h2><div class="sheet">{_grid_sheet(title, lang)}</div></section>'
+                + check)
+    else:
+        body = (f'<section id="controls"><label for="phi">{escape(text("page.phi", lang))}: <output id="phi-value"></output>°</label> '
+                f'<input type="range" id="phi" min="0" max="359" step="1" value="0"> '
+                f'<button id="design" type="button">{escape(text("page.design", lang))} ({num(data["design"], lang, 6)}°)</button> '
+                f'<button id="prev" type="button">{escape(text("page.prev", lang))}</button> '
+                f'<button id="next" type="button">{escape(text("page.next", lang))}</button> '
+                f'<output id="step"></output> <label>{escape(text("page.paper", lang))}: <select id="paper"><option>A3</option>'
+                f'<option>A4</option></select></label><p id="equation"></p><p class="hint">{escape(text("page.print", lang))}</p>'
+                f'<p>{escape(text("page.scales", lang))}: {escape(scales)}</p></section>'
+                f'<section id="sheets"><p id="status">{escape(text("page.loading", lang))}</p></section>'
+                f'<section id="values"><h2>{escape(text("page.values", lang))}</h2><table id="value-table"></table></section>'
+                f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><table>{data_table}</table></section>'
+                + check)
+    script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
+    payload = json.dumps(data, ensure_ascii=False).replace("</", "<\\/")
+    blob_tags = "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
+    return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
+            f'<meta http-equiv="Content-Security-Policy" content="default-src \'none\'; style-src \'unsafe-inline\'; '
+            f'script-src \'unsafe-inline\'; img-src data:">'
+            f'<title>{escape(title)}</title><style>{_CSS}</style><style id="page-size">@page{{size:A3 landscape;margin:0}}</style>'
+            f'</head><body>'
+            f'<h1>{escape(title)}</h1>{body}{blob_tags}'
+            f'<script id="page-data" type="application/json">{payload}</script><script>{script}</script></body></html>\n')
+
+
+def _plan_name(kind: str, lang: str) -> str:
+    """A plan kind as its sheet's title names it, without the angle (group:2,3 -> Plan of group 2-3)."""
+    base, _, rest = kind.partition(":")
+    return text(f"plan.{base}", lang) + (" " + rest.replace(",", "-") if rest else "")
+
+
+def _grid_sheet(title: str, lang: str) -> str:
+    """An empty A3 sheet at true scale: frame, a millimetre grid (1, 5 and 10 mm lines), the title
+    block and the 100 mm scale bar."""
+    return ('<svg xmlns="http://www.w3.org/2000/svg" width="420mm" height="297mm" viewBox="0 0 420 297" '
+            'font-family="DejaVu Sans, Arial, sans-serif"><defs>'
+            '<pattern id="mm" width="10" height="10" patternUnits="userSpaceOnUse">'
+            '<path d="M1 0V10M2 0V10M3 0V10M4 0V10M6 0V10M7 0V10M8 0V10M9 0V10M0 1H10M0 2H10M0 3H10M0 4H10M0 6H10M0 7H10M0 8H10M0 9H10" '
+            'stroke="#e9b8a8" stroke-width="0.05"/><path d="M5 0V10M0 5H10" stroke="#d99580" stroke-width="0.1"/>'
+            '<path d="M0 0V10M0 0H10" stroke="#c0603f" stroke-width="0.2"/></pattern></defs>'
+            '<rect width="420" height="297" fill="#fff"/>'
+            '<rect x="20" y="5" width="395" height="287" fill="url(#mm)" stroke="#000" stroke-width="0.7"/>'
+            '<rect x="230" y="247" width="185" height="45" fill="#fff" stroke="#000" stroke-width="0.5"/>'
+            f'<text x="233" y="255" font-size="4">{escape(title)}</text>{scale_bar(lang)}</svg>')
+
+
+def scale_bar(lang: str) -> str:
+    """A 100 mm scale bar in the sheet's binding margin (x 16 mm, y 40-140 mm, 1 unit = 1 mm), ticks
+    every 10 mm, lettered 0, 50 and 100 at its ticks: printed at true scale it measures 100 mm."""
+    ticks = "".join(f"M{16 - (2 if k % 5 == 0 else 1)} {40 + 10 * k}H16" for k in range(11))
+    labels = "".join(f'<text x="13" y="{40 + 10 * k + 0.9}" font-size="2.5" text-anchor="end">{10 * k}</text>'
+                     for k in (0, 5, 10))
+    return (f'<g id="scalebar"><path d="M16 40V140{ticks}" stroke="#000" stroke-width="0.3" fill="none"/>{labels}'
+            f'<text x="13" y="145" font-size="2.5" text-anchor="end">{escape(unit("mm", lang))}</text></g>')
+
+
+_CSS = """
+body{font-family:"DejaVu Sans",Arial,sans-serif;margin:1em;color:#111}
+h1{font-size:1.3em}h2{font-size:1.1em}
+table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:2px 6px;font-size:.9em}
+td.num{text-align:right;font-variant-numeric:tabular-nums}
+#controls{position:sticky;top:0;background:#fff;padding:.4em 0;border-bottom:1px solid #ccc;z-index:2}
+#phi{width:40em;max-width:90vw;vertical-align:middle}
+#equation{font-size:1.05em;min-height:1.3em;margin:.3em 0}.hint{color:#555;font-size:.85em;margin:.2em 0}
+#sheets{display:grid;grid-template-columns:repeat(auto-fill,minmax(620px,1fr));gap:.6em}
+.sheet{border:1px solid #ddd}.sheet svg{display:block;width:100%;height:auto;max-width:1260px}
+.hl{stroke:#d01c1c !important;stroke-width:1.2 !important}
+.sheet[data-a4]::before{content:attr(data-a4);color:#b01515}
+.verdict.ok{color:#176317}.verdict.bad{color:#b01515}
+@media print{
+  body{margin:0}h1,h2,#controls,#values,#data,#check,.hint,#status{display:none}
+  #sheets{display:block}.sheet{border:0;margin:0;page-break-after:always;break-after:page}
+  .sheet svg{width:420mm;height:297mm;max-width:none}
+  [data-paper="A4"] .sheet svg{width:297mm;height:210mm}.sheet::before{display:none}
+}
+"""
+
+
+def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None) -> Path:
+    """The page of `mech` (`page`) written to `out` atomically; returns its path."""
+    path = Path(out)
+    write_text(path, page(mech, lang=lang, student=student, at=at))
+    return path

@@ -1,0 +1,268 @@
+"""The interactive page (issue 27) in a real browser: Debian's headless Chromium driven by Playwright
+(tests/sheet_browser.py; a fresh profile per launch). The slider's sheets carry every segment's
+length as segments.csv has it; "Next step" follows seed 002's order of the force analysis; the
+student's page holds no answer and judges typed lengths; the print's 100 mm bar measures 100 mm
+in the PDF; the pages make no request. By default the ICE (seed 002) on a page of three angles;
+with `-m slow` the whole page of `kinetostat page` against `kinetostat plans --cycle-scales`.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+import shutil
+import subprocess
+import warnings
+
+import pytest
+
+import kinetostat
+import kinetostat.plans as P
+from kinetostat.plans.i18n import num
+from kinetostat.plans.page import _steps, page as make_page
+from kinetostat.plans.worksheet import worksheet
+
+import sheet_browser
+from conftest import MODELS, sampled
+
+ANGLES = (0.0, 30.0, 150.0)
+
+
+@pytest.fixture(scope="module")
+def ice(tmp_path_factory):
+    """The ICE, its cycle scales (sampled every 30 deg: quick), its key page at ANGLES and its
+    student's page, written to files."""
+    mech = kinetostat.load("ice_crank_slider")
+    fixed = P.cycle_scales(mech, step_deg=30.0)
+    d = tmp_path_factory.mktemp("page")
+    key, student = d / "key.html", d / "student.html"
+    key.write_text(make_page(mech, lang="uk", angles=ANGLES, fixed=fixed), encoding="utf-8")
+    student.write_text(make_page(mech, lang="uk", student=True, fixed=fixed), encoding="utf-8")
+    return mech, fixed, key, student
+
+
+def _open(chromium, path, requests=None):
+    pg = chromium.new_page(viewport={"width": 1300, "height": 900})
+    errors = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    if requests is not None:
+        pg.on("request", lambda r: requests.append(r.url))
+    pg.goto(path.as_uri())
+    try:
+        pg.wait_for_selector("body[data-ready]", state="attached", timeout=20000)
+    except Exception as exc:                        # noqa: BLE001 - say why: the script's errors
+        raise AssertionError(f"the page did not get ready: {errors or exc}") from None
+    assert not errors, errors
+    return pg
+
+
+def _slide(pg, deg: float) -> None:
+    pg.evaluate("d => { const s = document.getElementById('phi'); s.value = d; s.dispatchEvent(new Event('input')); }", deg)
+
+
+def _segments(pg) -> dict[tuple[str, str], float]:
+    rows = pg.evaluate("() => [...document.querySelectorAll('svg [data-plan][data-segment]')]"
+                       ".map(e => [e.dataset.plan, e.dataset.segment, e.dataset.lengthMm])")
+    out = {(p, s): float(x) for p, s, x in rows}
+    assert len(out) == len(rows), "a segment drawn twice"
+    return out
+
+
+def _csv(plans) -> dict[tuple[str, str], float]:
+    """segments.csv as `kinetostat plans` writes it: (plan, segment) -> length_mm of each segment
+    with finite ends (drawn)."""
+    out = {}
+    for r in csv.DictReader(io.StringIO(plans.segments_csv())):
+        if all(math.isfinite(float(r[c] or "nan")) for c in ("x0_mm", "y0_mm", "x1_mm", "y1_mm")):
+            out[(r["plan"], r["segment"])] = float(r["length_mm"])
+    return out
+
+
+def _build(mech, at, fixed):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return P.build(mech, at=at, fixed=fixed)
+
+
+def _compare(got: dict, want: dict, where: str) -> None:
+    assert set(got) == set(want), (where, set(got) ^ set(want))
+    bad = {k: (got[k], want[k]) for k in want if abs(got[k] - want[k]) > 1e-9}
+    assert not bad, (where, bad)
+
+
+def test_slider_draws_every_segment_as_segments_csv(chromium, ice):
+    """At 30, 0 and 150 deg and the design position every segment's data-length-mm equals
+    segments.csv of the plans at the page's scales to 1e-9 mm, and the values table follows; the
+    page, loaded, slid and stepped, asks for nothing but itself (its CSP forbids the rest)."""
+    mech, fixed, key, _ = ice
+    requests: list[str] = []
+    pg = _open(chromium, key, requests)
+    for at in (30.0, 0.0, 150.0):
+        _slide(pg, at)
+        plans = _build(mech, at, fixed)
+        _compare(_segments(pg), _csv(plans), f"{at:g} deg")
+        assert len(plans["velocity"].segments) <= len(_segments(pg))
+        cell = pg.get_attribute('td[data-symbol="V_B"]', "data-value")
+        ws = worksheet(mech, at, mu_l=fixed.base["mu_l"].value)
+        assert float(cell) == pytest.approx(ws.value("V_B"), rel=1e-11)
+    pg.click("#design")
+    _compare(_segments(pg), _csv(_build(mech, mech.drive.design_deg, fixed)), "design position")
+    assert pg.text_content("#phi-value") == "30"
+    pg.click("#next")
+    pg.select_option("#paper", "A4")
+    assert requests == [key.as_uri()], requests
+    assert "default-src 'none'" in key.read_text(encoding="utf-8")
+    pg.close()
+
+
+def test_next_step_follows_the_texts_order(chromium, ice):
+    """Seed 002 (fig. 1.10): R12t from ΣM_B of the rod, then the polygon R12t + G2 + F_i2 + G3 +
+    F_i3 + F_p + R43 + R12n = 0 in that order, then the inner reaction R32, then the crank (R21 and
+    M_зр), then the lever; one vector highlighted at a time, on the plan it belongs to."""
+    mech, fixed, key, _ = ice
+    pg = _open(chromium, key)
+    _slide(pg, 30)
+    steps = pg.evaluate("""n => [...Array(n)].map(() => {
+        document.getElementById('next').click();
+        const s = document.getElementById('step').dataset, key = e => [e.plan, e.segment || e.path];
+        return [key(s), [...document.querySelectorAll('.hl')].map(e => key(e.dataset)),
+                document.getElementById('equation').textContent];
+    })""", 14)
+    for step, lit, _ in steps:
+        assert lit == [step], (step, lit)            # one vector lit at a time: the step's
+    seen = [tuple(step) for step, _, _ in steps]
+    polygon = [("forces:2,3", n) for n in ("R12t", "G2", "F_i2", "G3", "F_i3", "F_p", "R43", "R12n")]
+    assert seen[:10] == [("group:2,3", "R12t"), *polygon, ("forces:2,3", "R32")]
+    assert seen[10] == ("crank", "R21") and ("crank", "M_зр") in seen[10:]
+    assert steps[0][2].startswith("R12t з ΣM_B(ланка 2) = 0") and "R32" in steps[9][2]
+    pg.close()
+
+
+def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
+    """The student's page: no plan, no data-length-mm, none of the key's lengths or values in the
+    file; typed lengths get their verdict against the band, the two M_зр against the 5 % rule; no
+    request but the page itself."""
+    mech, fixed, _, student = ice
+    html = student.read_text(encoding="utf-8")
+    plans = _build(mech, 30.0, fixed)
+    assert "data-length-mm" not in html and 'id="phi"' not in html
+    ws = worksheet(mech, 30.0, mu_l=fixed.base["mu_l"].value)
+    answers = {num(plans[k].length_mm(s.name), "uk", decimals=2) for k in plans for s in plans[k].segments
+               if s.kind == "vector" and plans[k].length_mm(s.name) > 1}
+    answers |= {num(r.value, "uk", 4) for r in ws.rows if r.section != "kinematics" and abs(r.value) > 1}
+    answers = {a for a in answers if "," in a}              # with decimals: not a bare small integer
+    requests: list[str] = []
+    pg = _open(chromium, student, requests)
+    shown = pg.text_content("body")
+    assert not [a for a in answers if re.search(rf"(?<![\d,]){re.escape(a)}(?!\d)", html + shown)]
+    assert pg.eval_on_selector_all("td.exact", "es => es.every(e => e.textContent === '')")
+
+    def verdict(selector: str, typed: str) -> str:
+        pg.fill(selector, typed)
+        return pg.eval_on_selector(selector, "e => e.closest('tr').querySelector('.verdict').dataset.verdict")
+    pb = plans["velocity"].length_mm("p-b")
+    sel = 'input[data-plan="velocity"][data-segment="p-b"]'
+    assert verdict(sel, num(pb, "uk", decimals=2)) == "ok"
+    assert verdict(sel, num(pb + 3.0, "uk", decimals=2)) == "bad"
+    M = abs(plans["crank"].results[0].value)
+    sel = 'input.moment[data-symbol="M_зр"]'
+    assert verdict(sel, f"{M * 1.04:.2f}") == "ok"
+    assert verdict(sel, f"{M * 0.94:.2f}") == "bad"
+    assert requests == [student.as_uri()], requests
+    pg.close()
+
+
+def _bar_mm(pdf) -> tuple[tuple[float, float], dict[str, float], int]:
+    """(page size in pt, the bar's labels 0, 50, 100 -> their centres' y in mm, the number of
+    pages) of a PDF's first page (pdftotext -bbox); the bar's labels are the words left of 20 mm."""
+    box = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+    first = box.split("</page>")[0]
+    size = re.search(r'<page width="([\d.]+)" height="([\d.]+)"', first)
+    words = re.findall(r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="([\d.]+)">([^<]*)</word>', first)
+    x_bar = min(float(w[0]) for w in words if w[4] == "100")
+    y = {w[4]: (float(w[1]) + float(w[3])) / 2 * 25.4 / 72 for w in words
+         if abs(float(w[0]) - x_bar) < 20 and w[4] in ("0", "50", "100")}
+    return (float(size[1]), float(size[2])), y, box.count("<page ")
+
+
+def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
+    """Printed to PDF, each sheet is a page at true scale, A3 landscape (the whole sheet) or, with
+    A4 chosen, A4 landscape (the 297 x 210 mm around the plan): the 100 mm bar's labels 0 and 100
+    lie 100 mm apart (pdftotext -bbox: the labels' centres)."""
+    if shutil.which("pdftotext") is None:
+        pytest.skip("no pdftotext (apt-get install poppler-utils)")
+    mech, fixed, key, _ = ice
+    pg = _open(chromium, key)
+    for paper, (w, h) in (("A3", (420, 297)), ("A4", (297, 210))):
+        pg.select_option("#paper", paper)
+        pdf = tmp_path / f"{paper}.pdf"
+        pg.pdf(path=str(pdf), prefer_css_page_size=True, print_background=True)
+        size, y, pages = _bar_mm(pdf)
+        assert size == pytest.approx((w / 25.4 * 72, h / 25.4 * 72), abs=1.0), paper   # Chromium: whole px
+        assert y["100"] - y["0"] == pytest.approx(100.0, abs=0.2), paper
+        assert y["50"] - y["0"] == pytest.approx(50.0, abs=0.2), paper
+        assert pages == len(_build(mech, 30.0, fixed)), paper
+    pg.close()
+
+
+@pytest.mark.parametrize("path", sampled(MODELS))
+def test_every_step_names_a_drawn_vector(path):
+    """Each step of "Next step" lights a segment (or a couple's arc) its plan draws, every group's
+    polygon side once in the order of its equation, the groups from the last attached."""
+    mech = kinetostat.load(path)
+    plans = _build(mech, None, None)
+    steps = _steps(mech, plans, "en")
+    for s in steps:
+        plan = plans[s["plan"]]
+        assert (s["path"] in plan.paths) if "path" in s else any(x.name == s["segment"] for x in plan.segments), s
+    for g in mech.structure.groups:
+        label = f"{min(g.links)},{max(g.links)}"
+        sides = [s["segment"] for s in steps if s["plan"] == f"forces:{label}"]
+        assert sides[:-1] == list(plans[f"forces:{label}"].equation)
+    groups = list(dict.fromkeys(s["plan"].split(":")[1] for s in steps if s["plan"].startswith("forces:")))
+    assert groups == [f"{min(g.links)},{max(g.links)}" for g in reversed(mech.structure.groups)]
+
+
+@pytest.mark.slow
+def test_whole_page_against_plans_cycle_scales(chromium, tmp_path, cli):
+    """`kinetostat page ice_crank_slider --lang uk`: 360 angles and the design position, under
+    600 kB; at 0, 30, 90, 150, 270 and 359 deg every segment as `kinetostat plans --at A
+    --cycle-scales` writes it in segments.csv."""
+    out = tmp_path / "ice.html"
+    run = cli("page", "ice_crank_slider", "--lang", "uk", "--out", str(out))
+    assert run.returncode == 0, run.stderr
+    assert out.stat().st_size < 600_000
+    pg = _open(chromium, out)
+    for at in (0, 30, 90, 150, 270, 359):
+        d = tmp_path / f"plans_{at}"
+        assert cli("plans", "ice_crank_slider", "--at", str(at), "--cycle-scales", "--out", str(d)).returncode == 0
+        want = {}
+        for r in csv.DictReader((d / "segments.csv").open(encoding="utf-8")):
+            if all(math.isfinite(float(r[c] or "nan")) for c in ("x0_mm", "y0_mm", "x1_mm", "y1_mm")):
+                want[(r["plan"], r["segment"])] = float(r["length_mm"])
+        _slide(pg, at)
+        _compare(_segments(pg), want, f"{at} deg")
+    pg.close()
+
+
+@pytest.mark.slow
+def test_report_and_variant_link_their_pages(tmp_path, cli):
+    """`report --page` writes page.html beside the report and links it; `variant 1 479 --page`
+    writes the variant's page with its check at phi1."""
+    r = cli("report", "ice_crank_slider", "--engines", "none", "--steps", "36", "--page", "--out", str(tmp_path / "r"),
+            "--no-progress")
+    assert r.returncode == 0, r.stderr
+    folder = next(p for p in (tmp_path / "r").iterdir() if p.is_dir())
+    assert (folder / "page.html").stat().st_size > 100_000
+    assert "](page.html)" in (folder / "index.md").read_text(encoding="utf-8")
+    v = cli("variant", "1", "479", "--page", "--no-pack", "--out", str(tmp_path / "v"))
+    assert v.returncode == 0, v.stderr
+    html = (tmp_path / "v" / "page.html").read_text(encoding="utf-8")
+    assert '"at": 150.0' in html or '"at": 150' in html
+
+
+def test_page_command_refuses_a_folder_as_out(cli, tmp_path):
+    """`kinetostat page` checks --out before the minute of work: a folder is one line, exit 2."""
+    r = cli("page", "ice_crank_slider", "--out", str(tmp_path))
+    assert r.returncode == 2 and r.stderr.strip() == f"kinetostat: error: cannot write --out {tmp_path}: it is a directory"
