@@ -19,7 +19,7 @@ SEED_002 = {"V_B": 10.94, "V_BA": 14.92, "V_S2": 12.2, "omega_2": 135.6, "a_A": 
 
 @pytest.fixture(scope="module")
 def ice_sheet():
-    return worksheet(kinetostat.load("ice_crank_slider"), at=30.0)
+    return worksheet(kinetostat.load("ice_crank_slider"), at=30.0, mu_l=0.001)     # the text's own OA = 36 mm
 
 
 @pytest.mark.parametrize("key", SEED_002)
@@ -32,7 +32,7 @@ def test_seed_002_order_and_scale(ice_sheet):
     text_order = ["V_A", "V_B", "V_BA", "V_S2", "omega_2", "a_A", "an_BA", "at_BA", "a_B", "a_S2", "eps_2",
                   "m_2", "F_i2", "M_i2", "Rt_1_2", "R_1_2", "R_0_3", "R_3_2", "M_bal", "F_bal_lever", "M_bal_lever"]
     assert [k for k in keys if k in text_order] == text_order
-    assert ice_sheet.mu_l == 0.001                       # seed 002: mu_l = 0.036 / 36
+    assert ice_sheet.mu_l == 0.001                       # seed 002: mu_l = 0.036 / 36, as given
     assert ice_sheet.value("Rt_1_2") == pytest.approx(1326.37, rel=0.005)
     assert ice_sheet.value("load_0") == pytest.approx(9650.97, rel=1e-6)     # F_p = 0.8 p_max pi d^2 / 4
     assert ice_sheet.value("h_R21") == pytest.approx(32.39, rel=0.005)       # the crank's arm, mm
