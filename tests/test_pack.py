@@ -188,3 +188,63 @@ def test_a_plain_install_writes_the_key_and_says_why_no_pack(cli, tmp_path, monk
     assert run.returncode == 0, run.stderr
     assert "pip install 'kinetostat[reports]'" in run.stderr and (tmp_path / "worksheet.html").is_file()
     assert not (tmp_path / "key.pdf").exists()
+
+
+def _measured(fig, artist_xy) -> np.ndarray:
+    """Points of an artist as they land on the page, mm from its top left (the transform the PDF uses)."""
+    px = artist_xy(fig)
+    return np.column_stack([px[:, 0], fig.bbox.height - px[:, 1]]) / fig.dpi * 25.4
+
+
+def _drawn(figs, gid: str) -> np.ndarray:
+    """The ends (a line) or vertices (an arrowhead) of the artist `gid` on its page, mm."""
+    for fig in figs:
+        ax = fig.axes[0]
+        for a in list(ax.lines) + list(ax.patches):
+            if a.get_gid() == gid:
+                xy = a.get_xydata() if hasattr(a, "get_xydata") else a.get_xy()
+                return _measured(fig, lambda f: ax.transData.transform(xy))
+    raise KeyError(gid)
+
+
+def test_the_a3_sheet_draws_every_plan_true_to_scale(pack_uk):
+    """Measured on the page as the PDF backend places it: OA is the key's 32 mm (l_OA / μ_l), a side
+    of the force polygon its segments.csv length, every vector of the crank plan drawn (line and
+    arrowhead, to its tip) at its length; panels apart and clear of the title block."""
+    from kinetostat.plans.a3 import AREA, TITLE_BLOCK, pages
+    plans = pack_uk.plans
+    figs, drawings, places = pages(plans, "uk", "t")
+    assert len(figs) == 1 + max(p.page for p in places) and len(figs) <= 2
+    oa = _drawn(figs, "mechanism/OA")
+    assert np.hypot(*(oa[1] - oa[0])) == pytest.approx(0.048 / 0.0015, abs=0.5)           # 32 mm, as the key
+    assert plans["mechanism"].length_mm("OA") == pytest.approx(32.0)
+    crank = plans["crank"]
+    vectors = [s for s in crank.segments if s.kind == "vector"]
+    assert {s.name for s in vectors} == {"R21", "R41"}
+    for s in vectors + [plans["forces:2,3"].segment("R12")]:
+        plan = crank if s in vectors else plans["forces:2,3"]
+        start = _drawn(figs, f"{plan.kind}/{s.name}")[0]
+        tip = _drawn(figs, f"{plan.kind}/{s.name}^")[0]
+        assert np.hypot(*(tip - start)) == pytest.approx(plan.length_mm(s.name), abs=0.5), s.name
+    boxes = []
+    for d, p in zip(drawings, places):
+        x0, y0, x1, y1 = d.box[0] + p.dx, d.box[1] + p.dy, d.box[2] + p.dx, d.box[3] + p.dy
+        assert AREA[0] <= x0 and x1 <= AREA[2] and AREA[1] <= y0 and y1 <= AREA[3], d.kind
+        assert x1 <= TITLE_BLOCK[0] or y1 <= TITLE_BLOCK[1], d.kind
+        for q, b in boxes:
+            assert q != p.page or x1 <= b[0] or b[2] <= x0 or y1 <= b[1] or b[3] <= y0, d.kind
+        boxes.append((p.page, (x0, y0, x1, y1)))
+
+
+@needs_poppler
+def test_the_a3_pdf_titles_each_plan_with_its_scales(uk_479):
+    """Each panel heads its plan with every scale it is drawn at: the force scales of the group,
+    crank and lever plans appear on the sheet."""
+    page = pdftext(uk_479 / "plans_a3.pdf")
+    plans = kinetostat.plans.build(variants.variant(1, "479").mechanism(), at=150.0)
+    from kinetostat.plans.draw import scale_text, scales_of
+    for kind in ("group:2,3", "crank", "lever"):
+        assert len(scales_of(plans[kind])) == 2, kind
+        for s in scales_of(plans[kind]):
+            assert scale_text(s, "uk") in page, (kind, scale_text(s, "uk"))
+    assert "1 мм плану = 1 мм" in page

@@ -13,15 +13,15 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
   drawing lands in (the 5-95 % range of `drawing_error.simulate`, BAND_DRAWS draws, seeded); the
   scales μ_l, μ_v, μ_a, μ_F with the reference length each draws; δ with the texts' 5 % rule; every
   segment a student measures on the plans, in mm at the plans' scales.
-- `plans_a3.pdf` / `plans.html`: the plans side by side on one A3 landscape sheet (seed 002,
-  appendix B puts the results on A3).
+- `plans_a3.pdf` / `plans.html`: the plans, each true to scale, on one A3 landscape sheet (seed
+  002, appendix B puts the results on A3), on a further sheet where they do not fit (`a3`).
 
 Both documents are one list of blocks (headings, paragraphs, tables, the drawing area), rendered
 twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figure library; TrueType
 DejaVu Sans embedded as Type 42 with its Unicode map, so pdftotext reads the Cyrillic back) and to
 HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
-May use: `build` of this package, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
+May use: `build` of this package, `.a3`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
 `kinetostat._io`; matplotlib inside the PDF writers only. Never the harness, nor `kinetostat.variants` (the variant
 is passed in and says its task, title and letters).
 """
@@ -397,35 +397,9 @@ def _pdf(blocks, title: str) -> bytes:
 
 
 def _plans_pdf(plans, lang: str, title: str) -> bytes:
-    """All the plans on one A3 landscape sheet: a grid of the plans' Figures inside the frame, the
-    title and the scales in the title block."""
-    from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
-
-    from .draw import figure, scale_text
-    kinds = list(plans)
-    cols = 4 if len(kinds) > 6 else 3
-    rows = math.ceil(len(kinds) / cols)
-    W, H = A3
+    """All the plans true to scale on A3 landscape sheets (`a3.pages`: one where they fit)."""
+    from .a3 import pages
     with _pdf_pages(title) as (pdf, buf):
-        fig = Figure(figsize=(W / 25.4, H / 25.4))
-        x0, y0, x1, y1 = (20 / W, 1 - 5 / H, 415 / W, 1 - 292 / H)                # the frame
-        fig.add_artist(Line2D([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], lw=1.0, color="k"))
-        fig.text(25 / W, 1 - 9 / H, title, fontsize=11, va="top")
-        cw, ch = (410 - 25) / cols, (262 - 14) / rows
-        for n, kind in enumerate(kinds):
-            c, r = n % cols, n // cols
-            x, y = 25 + c * cw + 10, 14 + r * ch + 9
-            ax = fig.add_axes(((x) / W, 1 - (y + ch - 17) / H, (cw - 14) / W, (ch - 17) / H))
-            figure(plans[kind], lang, ax=ax)
-            ax.title.set_fontsize(7)
-            ax.tick_params(labelsize=5)
-            ax.xaxis.label.set_fontsize(6), ax.yaxis.label.set_fontsize(6)
-            for t in ax.texts:
-                t.set_fontsize(min(t.get_fontsize(), 6))
-        scales = ", ".join(scale_text(s, lang) for s in plans.scales.values())
-        fig.text(25 / W, 1 - 270 / H, "\n".join(_wrap(f"{text('scales', lang)}: {scales}", 200, 8)), fontsize=8,
-                 va="top")
-        pdf.savefig(fig)
+        for fig in pages(plans, lang, title)[0]:
+            pdf.savefig(fig)
     return buf.getvalue()
-
