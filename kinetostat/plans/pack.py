@@ -11,8 +11,9 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
   area with a title block. No answer: no value, scale or length the key gives.
 - `key.pdf` / `key.html`: every worksheet value with its unit and sense, and the band a careful
   drawing lands in (the 5-95 % range of `drawing_error.simulate`, BAND_DRAWS draws, seeded); the
-  scales μ_l, μ_v, μ_a, μ_F with the reference length each draws; δ with the texts' 5 % rule; every
-  segment a student measures on the plans, in mm at the plans' scales.
+  scales μ_l, μ_v, μ_a, μ_F with the reference length each draws, and every scale each plan is
+  drawn at; δ with the texts' 5 % rule; every segment a student measures on the plans, in mm, with
+  the scale it is drawn at.
 - `plans_a3.pdf` / `plans.html`: the plans, each true to scale, on one A3 landscape sheet (seed
   002, appendix B puts the results on A3), on a further sheet where they do not fit (`a3`).
 
@@ -38,7 +39,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .._io import write_bytes, write_text
-from .draw import segment_label, title_of
+from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 from .lettering import lettering
 from .worksheet import CSS, Worksheet, html_document, worksheet
@@ -129,7 +130,8 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
         sheet.append(("p", "  ".join(f"{ch} = {d}" for ch, d in v.letters.items())))
     key = [("h1", f"{text('pack.key', lang)}. {title}")]          # scales, values and bands, δ, segments
     answers: set[str] = set()
-    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
+    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers)),
+            ("h2", text("pack.plan_scales", lang)), ("table", _plan_scales_table(plans, lang, answers))]
     sheet.append(("h2", text("pack.fill", lang)))
     recs = ws.records()
     outside = False                     # an exact value beyond its band (a segment shorter than the error)
@@ -189,10 +191,21 @@ def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> 
                   text("pack.drawn", lang)), tuple(rows), (0.15, 0.2, 0.25, 0.4), frozenset({1}))
 
 
+def _plan_scales_table(plans, lang: str, answers: set[str]) -> Table:
+    """Every scale each plan is drawn at (`draw.scales_of`: its own, and the force scale of the
+    loads on a group plan or the crank); the values printed added to `answers`."""
+    rows = []
+    for kind in plans:
+        scales = scales_of(plans[kind])
+        rows.append((title_of(plans[kind], lang), "; ".join(scale_text(s, lang) for s in scales)))
+        answers.update(num(s.value, lang, 6) for s in scales)
+    return Table((text("pack.plan", lang), text("scales", lang)), tuple(rows), (0.5, 0.5))
+
+
 def _segments_table(plans, lang: str, answers: set[str]) -> Table:
     """Every segment a student lays off or measures (vectors, links, arms; not the other
-    positions or the construction lines): its plan, name, length in mm and the value it stands
-    for; the lengths printed added to `answers`."""
+    positions or the construction lines): its plan, name, length in mm at the scale stated, and
+    the value it stands for; the lengths printed added to `answers`."""
     rows = []
     for kind in plans:
         plan = plans[kind]
@@ -201,10 +214,11 @@ def _segments_table(plans, lang: str, answers: set[str]) -> Table:
             if s.kind in ("position", "line") or not math.isfinite(length):
                 continue
             value = "" if not math.isfinite(s.value) else f"{num(s.value, lang, 4)} {unit(s.unit, lang)}".strip()
-            rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), value))
+            scale = scale_text(s.scale or plan.scale, lang) if s.unit != "mm" else ""    # an arm kept as drawn: none
+            rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), scale, value))
             answers.add(num(length, lang, decimals=1))
-    return Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang),
-                  text("ws.head.value", lang)), tuple(rows), (0.4, 0.2, 0.18, 0.22), frozenset({2, 3}))
+    return Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang), text("scale", lang),
+                  text("ws.head.value", lang)), tuple(rows), (0.3, 0.14, 0.12, 0.24, 0.2), frozenset({2, 4}))
 
 
 def _reference_mm(mech, ws: Worksheet, scale) -> float:
