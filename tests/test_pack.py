@@ -273,3 +273,31 @@ def test_the_key_states_each_plans_scales_and_its_arms_agree(task, code):
     assert float(h_value) == pytest.approx(float(h_segment[2]), abs=0.06)
     assert h_segment[3] == scale_text(mu_l, "en")
     assert float(h_segment[2]) == pytest.approx(p.plans["crank"].length_mm("h_R21"), abs=0.05)
+
+
+@needs_poppler
+def test_plans_html_prints_each_sheet_on_one_a3_page_at_true_size(uk_479, tmp_path):
+    """Chromium prints plans.html: one A3 landscape page per plan (was two mostly blank pages with
+    the sheets at a third of the width), the sheet filling it (its frame 20 mm from the left edge)."""
+    sync = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed")
+    import sheet_browser
+    with sync.sync_playwright() as p:
+        try:
+            browser = sheet_browser.launch(p)
+        except Exception as exc:                    # noqa: BLE001 - any launch failure: no browser here
+            pytest.skip(f"Chromium does not start: {exc}")
+        if browser is None:
+            pytest.skip("no chromium on PATH")
+        page = browser.new_page()
+        page.goto((uk_479 / "plans.html").as_uri())
+        page.pdf(path=str(tmp_path / "printed.pdf"), prefer_css_page_size=True)
+        browser.close()
+    info = subprocess.run(["pdfinfo", str(tmp_path / "printed.pdf")], capture_output=True, text=True, check=True).stdout
+    n_plans = (uk_479 / "plans.html").read_text(encoding="utf-8").count("<figure>")
+    assert n_plans == 8 and int(re.search(r"Pages:\s+(\d+)", info).group(1)) == n_plans
+    w, h = map(float, re.search(r"Page size:\s+([\d.]+) x ([\d.]+)", info).groups())
+    assert w == pytest.approx(420 / 25.4 * 72, abs=1.5) and h == pytest.approx(297 / 25.4 * 72, abs=1.5)
+    box = subprocess.run(["pdftotext", "-bbox", "-f", "1", "-l", "1", str(tmp_path / "printed.pdf"), "-"],
+                         capture_output=True, text=True, check=True).stdout
+    xs = [float(x) for x in re.findall(r'xMin="([\d.]+)"', box)]
+    assert xs and max(xs) > 300 / 25.4 * 72                   # the title block's words at the right, true size

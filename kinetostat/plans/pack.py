@@ -254,13 +254,24 @@ def _html(blocks) -> str:
 
 
 def _plans_html(plans, lang: str, title: str) -> str:
-    """The plans' SVG sheets (written beside it by `Plans.write`) side by side on one page, A3
-    landscape in print."""
+    """The plans' SVG sheets (written beside it by `Plans.write`) side by side on screen, each a
+    link to itself at full size; in print
+    each sheet one A3 landscape page at its true size (_PRINT_A3)."""
     from . import plan_file_name
-    imgs = "\n".join(f'<figure><img src="{escape(plan_file_name(plans[k]))}" alt="{escape(title_of(plans[k], lang))}">'
+    imgs = "\n".join(f'<figure><a href="{escape(plan_file_name(plans[k]))}"><img src="{escape(plan_file_name(plans[k]))}" '
+                     f'alt="{escape(title_of(plans[k], lang))}"></a>'
                      f"<figcaption>{escape(title_of(plans[k], lang))}</figcaption></figure>" for k in plans)
     return html_document(title, f"<h1>{escape(title)}</h1>\n<div class=\"plans\">\n{imgs}\n</div>\n", lang,
-                         CSS + "@media print{@page{size:A3 landscape}}\n")
+                         CSS + _PRINT_A3)
+
+
+#: Print: each plan's SVG sheet alone on an A3 landscape page at its true size (420 x 297 mm, no
+#: margin: the sheet has its own frame); the page's heading and captions are for the screen.
+_PRINT_A3 = """@page{size:420mm 297mm;margin:0}
+@media print{body{margin:0;padding:0;max-width:none}h1,figcaption{display:none}.plans{display:block}
+.plans figure{margin:0;break-after:page;break-inside:avoid}.plans figure:last-child{break-after:auto}
+.plans img{display:block;width:420mm;height:296.9mm;border:none}}
+"""
 
 
 # ============================================================================ PDF
