@@ -168,6 +168,7 @@ def test_all_writes_an_html_index_of_the_packs(cli, tmp_path, monkeypatch):
     assert 'href="task3_479/worksheet.html"' in page
     assert len(re.findall(r"<th[ >]", page)) == 7 and "<td>|М_зр| " not in page and "|M_зр| наибольшее за цикл" in page   # one table
     assert (tmp_path / "task3_479" / "key.pdf").stat().st_size > 0
+    assert re.search(r"Ключи ответов: 1 \(задания 3\) -> .*; оглавление -> .*index\.md; \d+,\d с", run.stdout)
 
 
 @pytest.mark.parametrize("task, code, want", [(1, "479", 32.0), (1, "000", 34.0), (3, "479", 32.0), (2, "111", 33.0)])
@@ -301,3 +302,11 @@ def test_plans_html_prints_each_sheet_on_one_a3_page_at_true_size(uk_479, tmp_pa
                          capture_output=True, text=True, check=True).stdout
     xs = [float(x) for x in re.findall(r'xMin="([\d.]+)"', box)]
     assert xs and max(xs) > 300 / 25.4 * 72                   # the title block's words at the right, true size
+
+
+def test_a_zero_vector_has_no_direction():
+    """Task 2, 479 at 90 deg: V_BA is 0 (printed so); the key gives it no angle, a non-zero vector keeps its own."""
+    v = variants.variant(2, "479")
+    rec = {r["key"]: r for r in P.worksheet(v.mechanism(), float(v.values["phi1"]), lang="uk").records()}
+    assert num(rec["V_BA"]["value"], "uk") == "0" and rec["V_BA"]["direction"] == ""
+    assert rec["V_B"]["value"] > 1 and rec["V_B"]["direction"].startswith("під кутом")

@@ -103,7 +103,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                  "допущения), расчётный лист (`worksheet.md`, `.html`, `.csv`, `.json`) и планы (листы `SVG`, "
                  "`segments.csv`) в расчётном положении φ1. R(i,j) — сила действия звена i на звено j; {M} — "
                  "момент, который привод прикладывает к кривошипу (относительно оси +z, Н·м)."),
-    "ix.task": ("Task {task}: {title} (table {table})", "Задача {task}: {title} (таблиця {table})",
+    "ix.task": ("Task {task}: {title} (table {table})", "Завдання {task}: {title} (таблиця {table})",
                 "Задача {task}: {title} (таблица {table})"),
     "ix.code": ("code", "код", "код"),
     "ix.at": ("at φ1", "при φ1", "при φ1"),
@@ -112,6 +112,9 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     # the command line
     "cli.plans": ("{name} at φ = {phi}° ({scales}): {n} files -> {out}", "{name}, φ = {phi}° ({scales}): {n} файлів -> {out}",
                   "{name}, φ = {phi}° ({scales}): {n} файлов -> {out}"),
+    "cli.all": ("Answer keys: {keys} (tasks {tasks}) -> {out}/`task<T>_<CODE>`/; index -> {index}; {s} s",
+                "Ключі відповідей: {keys} (завдання {tasks}) -> {out}/`task<T>_<CODE>`/; зміст -> {index}; {s} с",
+                "Ключи ответов: {keys} (задания {tasks}) -> {out}/`task<T>_<CODE>`/; оглавление -> {index}; {s} с"),
     "cli.variant": ("Logvinenko, Nadtoka 2021, task {task} ({title}), variant {code}: table {table} columns",
                     "Логвіненко, Надтока 2021, задача {task} ({title}), варіант {code}: стовпці таблиці {table}",
                     "Логвиненко, Надтока 2021, задача {task} ({title}), вариант {code}: столбцы таблицы {table}"),
