@@ -310,3 +310,16 @@ def test_a_zero_vector_has_no_direction():
     rec = {r["key"]: r for r in P.worksheet(v.mechanism(), float(v.values["phi1"]), lang="uk").records()}
     assert num(rec["V_BA"]["value"], "uk") == "0" and rec["V_BA"]["direction"] == ""
     assert rec["V_B"]["value"] > 1 and rec["V_B"]["direction"].startswith("під кутом")
+
+
+def test_the_figure_of_a_plan_holds_every_vector(pack_uk):
+    """`draw.figure` (notebooks, the reports' PNGs): the crank plan's R21 and R41, drawn as arrows
+    that count for no limits, lie inside the axes' limits (they fell outside and were not drawn)."""
+    from kinetostat.plans.draw import figure
+    plan = pack_uk.plans["crank"]
+    ax = figure(plan, "uk").axes[0]
+    (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
+    for s in plan.segments:
+        for z in (plan.points[s.start], plan.points[s.end]):
+            assert x0 <= z.real <= x1 and y0 <= z.imag <= y1, s.name
+    assert len([t for t in ax.texts if t.arrow_patch is not None]) == 2          # R21, R41

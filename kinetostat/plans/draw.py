@@ -498,6 +498,10 @@ def figure(plan: Plan, lang: str = "en", ax=None):
         label = _tex(name)
         ax.annotate(label, (z.real, z.imag), xytext=(3, 3), textcoords="offset points", parse_math=label != name,
                     fontsize=6 if numbered else 10)
+    ends = [(z.real, z.imag) for s in _drawable(plan) for z in (plan.points[s.start], plan.points[s.end])]
+    if ends:                            # an arrow (annotate) counts for no limits: its ends do
+        ax.update_datalim(ends)
+        ax.autoscale_view()
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(unit("mm", lang))
     ax.set_ylabel(unit("mm", lang))
