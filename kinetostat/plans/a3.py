@@ -5,8 +5,9 @@ drawing = 1 mm on paper, at the scales its heading states), as seed 002 (Logvine
 Each plan is drawn exactly as its own SVG sheet draws it (`draw.svg`: its lines, arrowheads,
 points and every label where `labels.Placer` put it clear of the others): the `plan` group of
 that sheet is read back (`drawing`) and redrawn by matplotlib's PDF backend in millimetres. The
-plans' extents (drawing, labels and a two-line heading: title, then every scale the plan is drawn
-at) are shelf-packed, tallest first, inside the frame and clear of the title block (`layout`);
+plans' extents (drawing, labels and a heading: title, then every scale the plan is drawn at) are
+shelf-packed (first fit, tallest first, columns within a shelf) inside the frame, clear of the
+title block (`layout`);
 what does not fit goes onto a further A3 sheet, never drawn smaller, and the title block says so.
 
 May use: the standard library, `.draw`, `.i18n`, `.labels`; matplotlib inside `pages` only.
@@ -20,7 +21,7 @@ from dataclasses import dataclass
 from .draw import SHEET_MM, scale_text, scales_of, svg, title_of
 from .i18n import text
 
-__all__ = ["Drawing", "Placement", "drawing", "layout", "pages", "AREA", "TITLE_BLOCK", "HEADING_MM"]
+__all__ = ["Drawing", "Placement", "drawing", "layout", "pages", "AREA", "TITLE_BLOCK", "MIN_HEADING_MM"]
 
 _NS = "{http://www.w3.org/2000/svg}"
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
@@ -28,8 +29,10 @@ _NS = "{http://www.w3.org/2000/svg}"
 AREA = (24.0, 13.0, 411.0, 288.0)
 #: The title block, bottom right (as `draw`'s sheets), mm.
 TITLE_BLOCK = (230.0, 247.0, 415.0, 292.0)
-#: A plan's heading above its drawing: its title (3.5 mm) and its scales (3 mm), mm.
-HEADING_MM, _GAP = 9.0, 4.0
+#: A plan's heading above its drawing (its title, 3.5 mm, then its scales, 3 mm) is broken into
+#: lines no wider than the drawing, or than this where the drawing is narrower, mm.
+MIN_HEADING_MM = 50.0
+_GAP = 4.0                                  # between two drawings, mm
 _PT = 72.0 / 25.4                           # points per mm
 
 
@@ -130,8 +133,27 @@ def drawing(plan, lang: str) -> Drawing:
                    tuple(polylines), tuple(polygons), tuple(dots), tuple(texts), box)
 
 
-def _heading_width(d: Drawing) -> float:
-    return max(_width(d.heading[0], 3.5, "bold"), _width(d.heading[1], 3.0))
+def _heading(d: Drawing) -> list[tuple[str, float, str]]:
+    """The heading's lines (text, size mm, weight): the title, then the scales, broken between
+    scales to the drawing's width (at least MIN_HEADING_MM)."""
+    width = max(d.box[2] - d.box[0], MIN_HEADING_MM)
+    out = [(ln, 3.5, "bold") for ln in _lines(d.heading[0], 3.5, width, "bold")]
+    line = ""
+    for part in d.heading[1].split("; "):
+        trial = f"{line}; {part}" if line else part
+        if line and _width(trial, 3.0) > width:
+            out.append((line + ";", 3.0, "normal"))
+            line = part
+        else:
+            line = trial
+    return out + [(line, 3.0, "normal")]
+
+
+def _size(d: Drawing) -> tuple[float, float, float]:
+    """(width, height, heading's height) of a drawing with its heading, mm."""
+    head = _heading(d)
+    top = sum(1.3 * size for _, size, _ in head) + 1.0
+    return max(d.box[2] - d.box[0], *(_width(t, size, wt) for t, size, wt in head)), d.box[3] - d.box[1] + top, top
 
 
 def _fits(x0: float, y0: float, w: float, h: float) -> bool:
@@ -141,28 +163,45 @@ def _fits(x0: float, y0: float, w: float, h: float) -> bool:
 
 
 def layout(drawings: list[Drawing]) -> list[Placement]:
-    """Shelf packing of the drawings (heading above each) into AREA, tallest first, clear of the
-    title block: each on the first page whose open shelf, or a new shelf below it, has room; else
-    on a new page (a further A3 sheet)."""
-    order = sorted(range(len(drawings)), key=lambda i: -(drawings[i].box[3] - drawings[i].box[1]))
+    """Shelf packing, first fit by decreasing height, of the drawings (heading above each) into
+    AREA, clear of the title block. A shelf is as tall as its first (tallest) drawing and holds
+    columns side by side; a drawing goes under the last in a column of a shelf where it fits
+    (width and height), else into a new column of a shelf with room beside, else onto a new shelf
+    below the last of the first page with room, else onto a new page (a further A3 sheet)."""
+    sizes = [_size(d) for d in drawings]
+    order = sorted(range(len(drawings)), key=lambda i: -sizes[i][1])
     out: dict[int, Placement] = {}
-    shelves: list[list[float]] = []                   # per page: [x, y, height] of its open shelf
+    shelves: list[dict] = []          # page, y, height, x (where a new column goes), columns [[x, width, next y]]
+    bottoms: list[float] = []         # per page: where its next shelf would start
     for i in order:
+        w, h, top = sizes[i]
+        spot = None
+        for sh in shelves:            # under a column
+            for col in sh["columns"]:
+                last = col is sh["columns"][-1]       # the last column may widen into the room beside it
+                if (w <= col[1] or last) and col[2] + h <= sh["y"] + sh["height"] and _fits(col[0], col[2], w, h):
+                    spot = (sh["page"], col[0], col[2])
+                    col[1], col[2] = max(col[1], w), col[2] + h + _GAP
+                    sh["x"] = max(sh["x"], col[0] + w + _GAP)
+                    break
+            if spot:
+                break
+        if spot is None:              # a new column beside, or a new shelf, or a new page
+            sh = next((sh for sh in shelves if h <= sh["height"] and _fits(sh["x"], sh["y"], w, h)), None)
+            if sh is None:
+                page = next((k for k, y in enumerate(bottoms) if _fits(AREA[0], y, w, h)), None)
+                if page is None:
+                    bottoms.append(AREA[1])
+                    page = len(bottoms) - 1
+                sh = {"page": page, "y": bottoms[page], "height": h, "x": AREA[0], "columns": []}
+                shelves.append(sh)
+                bottoms[page] += h + _GAP
+            spot = (sh["page"], sh["x"], sh["y"])
+            sh["columns"].append([sh["x"], w, sh["y"] + h + _GAP])
+            sh["x"] += w + _GAP
+        page, x, y = spot
         d = drawings[i]
-        w = max(d.box[2] - d.box[0], _heading_width(d))
-        h = d.box[3] - d.box[1] + HEADING_MM
-        for page, (x, y, shelf) in enumerate(shelves):
-            if _fits(x, y, w, h):
-                break
-            if _fits(AREA[0], y + shelf + _GAP, w, h):
-                shelves[page] = [AREA[0], y + shelf + _GAP, 0.0]
-                break
-        else:
-            shelves.append([AREA[0], AREA[1], 0.0])
-            page = len(shelves) - 1
-        x, y, shelf = shelves[page]
-        out[i] = Placement(d.kind, page, x - d.box[0], y + HEADING_MM - d.box[1])
-        shelves[page] = [x + w + _GAP, y, max(shelf, h)]
+        out[i] = Placement(d.kind, page, x - d.box[0], y + top - d.box[1])
     return [out[i] for i in range(len(drawings))]
 
 
@@ -203,9 +242,10 @@ def pages(plans, lang: str, title: str):
         ax = figs[p.page][1]
         X = lambda x: x + p.dx                                         # noqa: E731
         Y = lambda y: y + p.dy                                         # noqa: E731
-        ax.text(X(d.box[0]), Y(d.box[1]) - HEADING_MM + 3.3, d.heading[0], fontsize=3.5 * _PT, va="baseline",
-                weight="bold")
-        ax.text(X(d.box[0]), Y(d.box[1]) - HEADING_MM + 7.3, d.heading[1], fontsize=3.0 * _PT, va="baseline")
+        y = Y(d.box[1]) - _size(d)[2]
+        for line, size, weight in _heading(d):
+            y += 1.3 * size
+            ax.text(X(d.box[0]), y - 0.3 * size, line, fontsize=size * _PT, va="baseline", weight=weight)
         for pts, width, colour in d.polylines:
             ax.plot([X(a) for a, _ in pts], [Y(b) for _, b in pts], color=colour, lw=width * _PT,
                     solid_capstyle="round")
