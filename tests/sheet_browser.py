@@ -3,12 +3,13 @@ and arrowhead's box (getBBox, in the SVG's millimetres) and reports the overlaps
 see. Used by tests/test_sheet_layout.py; as a script (`python tests/sheet_browser.py OUT file.svg
 ...`) it writes PNG screenshots of sheets.
 
-May use: playwright, the standard library.
+May use: playwright, pytest (`browser_page`), the standard library.
 """
 from __future__ import annotations
 
 import shutil
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
@@ -32,6 +33,23 @@ def launch(playwright):
     if exe is None:
         return None
     return playwright.chromium.launch(executable_path=exe, args=ARGS)
+
+
+@contextmanager
+def browser_page():
+    """A page of headless Chromium for a test (the test skipped where Playwright or Chromium is
+    missing or does not start); closed after."""
+    import pytest
+    sync = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed (pip install playwright)")
+    with sync.sync_playwright() as p:
+        try:
+            browser = launch(p)
+        except Exception as exc:                    # noqa: BLE001 - any launch failure: no browser here
+            pytest.skip(f"Chromium does not start: {exc}")
+        if browser is None:
+            pytest.skip("no chromium on PATH (apt-get install chromium)")
+        yield browser.new_page()
+        browser.close()
 
 
 def measure(page, svg_text: str) -> list[dict]:

@@ -280,19 +280,10 @@ def test_the_key_states_each_plans_scales_and_its_arms_agree(task, code):
 def test_plans_html_prints_each_sheet_on_one_a3_page_at_true_size(uk_479, tmp_path):
     """Chromium prints plans.html: one A3 landscape page per plan (was two mostly blank pages with
     the sheets at a third of the width), the sheet filling it (its frame 20 mm from the left edge)."""
-    sync = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed")
     import sheet_browser
-    with sync.sync_playwright() as p:
-        try:
-            browser = sheet_browser.launch(p)
-        except Exception as exc:                    # noqa: BLE001 - any launch failure: no browser here
-            pytest.skip(f"Chromium does not start: {exc}")
-        if browser is None:
-            pytest.skip("no chromium on PATH")
-        page = browser.new_page()
+    with sheet_browser.browser_page() as page:
         page.goto((uk_479 / "plans.html").as_uri())
         page.pdf(path=str(tmp_path / "printed.pdf"), prefer_css_page_size=True)
-        browser.close()
     info = subprocess.run(["pdfinfo", str(tmp_path / "printed.pdf")], capture_output=True, text=True, check=True).stdout
     n_plans = (uk_479 / "plans.html").read_text(encoding="utf-8").count("<figure>")
     assert n_plans == 8 and int(re.search(r"Pages:\s+(\d+)", info).group(1)) == n_plans

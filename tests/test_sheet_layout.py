@@ -29,16 +29,8 @@ from conftest import MODELS
 @pytest.fixture(scope="session")
 def page():
     """One headless Chromium page for the session (skipped where Chromium or Playwright is missing)."""
-    sync = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed (pip install playwright)")
-    with sync.sync_playwright() as p:
-        try:
-            browser = sheet_browser.launch(p)
-        except Exception as exc:                    # noqa: BLE001 - any launch failure: no browser here
-            pytest.skip(f"Chromium does not start: {exc}")
-        if browser is None:
-            pytest.skip("no chromium on PATH (apt-get install chromium)")
-        yield browser.new_page()
-        browser.close()
+    with sheet_browser.browser_page() as page:
+        yield page
 
 
 def _sheets(mech, at: float | None, lang: str, plans=None) -> dict[str, str]:
