@@ -98,6 +98,11 @@ def test_every_drawn_value_has_samples(name):
     keys = {r.key for r in worksheet(mech, mu_l=sol.scales.mu_l).rows}
     drawn = {k for k in keys if k.startswith(("an_", "V_rel(", "ar_"))}
     assert drawn and drawn <= set(sol.samples)
+    if name == "opposed_twin":                  # the crank's second pin C, read by similarity
+        assert {"V_C", "a_C"} <= set(sol.samples)
+    if sol.forces_drawn:                        # sliders loaded through their pin: x = 0 exactly
+        offsets = {k for k in keys if k.startswith("x_")}
+        assert offsets and offsets <= set(sol.samples) and all(not np.any(sol.samples[k]) for k in offsets)
 
 
 def test_a_length_read_is_never_below_zero():

@@ -185,6 +185,10 @@ class _Plans:
                 self.put(f"V_{com}", dr.read(self.like(self.v, k, com)) * sc.mu_v, "m/s")
             if com and f"a_{com}" not in self.out:
                 self.put(f"a_{com}", dr.read(self.like(self.a, k, com)) * sc.mu_a, "m/s^2")
+        for name in m.links[d.link].points:      # the crank's other points (C of a twin): by similarity
+            if name not in (d.pivot, d.point) and f"V_{name}" not in self.out:
+                self.put(f"V_{name}", dr.read(self.like(self.v, d.link, name)) * sc.mu_v, "m/s")
+                self.put(f"a_{name}", dr.read(self.like(self.a, d.link, name)) * sc.mu_a, "m/s^2")
 
     @staticmethod
     def _unsupported(g) -> None:
@@ -358,6 +362,10 @@ class _Plans:
         self.put(f"Rn_{a}_{j}", dr.read(pts[0] - K) * sc.mu_F, "N")        # the polygon's closing sides
         if g.kind == "RRR":
             self.put(f"Rn_{c}_{k}", dr.read(K - pts[-1]) * sc.mu_F, "N")
+        elif all(abs(Y - B) <= 1e-9 * abs(B - W[pj.point]) for _, Y in loads[k]) and not np.any(couples[k]):
+            # Σ M_B = 0 of the slider with every load through B: its frame reaction's offset x is 0,
+            # with no arm to read (other sliders: not drawn here)
+            self.put(f"x_{pk.links[0]}_{pk.links[1]}", np.zeros(dr.n), "m")
         return [(a, j, R_aj, W[pj.point]), (c, k, R_ck, W[pk.point])]
 
     def forces_of_groups(self, forces, couples) -> list[tuple[int, np.ndarray, complex]]:

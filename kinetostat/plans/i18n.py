@@ -227,6 +227,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "pack.a3_true": ("Every plan true to scale: 1 mm drawn is 1 mm on this A3 sheet, at the scales above it",
                      "Кожен план у натуральну величину креслення: 1 мм плану = 1 мм на цьому аркуші А3, у масштабах над ним",
                      "Каждый план в натуральную величину чертежа: 1 мм плана = 1 мм на этом листе А3, в масштабах над ним"),
+    "pack.no_band": ("— (from the data, not the plans)", "— (з даних, не з планів)", "— (из данных, не по планам)"),
     "pack.plan_scales": ("Scales of each plan", "Масштаби кожного плану", "Масштабы каждого плана"),
     "pack.a3_page": ("Sheet {k} of {n}", "Аркуш {k} з {n}", "Лист {k} из {n}"),
     "pack.a3_more": ("The plans at their scales do not fit one A3 sheet: {n} sheets, none drawn smaller",

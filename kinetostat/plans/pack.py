@@ -147,7 +147,7 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
             r = ws.rows[i]
             value = num(r.value, lang, 4)
             lo_hi = bands.get(r.key)
-            band = f"{num(lo_hi[0], lang, 3)} … {num(lo_hi[1], lang, 3)}" if lo_hi else ""
+            band = f"{num(lo_hi[0], lang, 3)} … {num(lo_hi[1], lang, 3)}" if lo_hi else text("pack.no_band", lang)
             if lo_hi and not lo_hi[0] <= r.value <= lo_hi[1]:
                 band += " *"
                 outside = True
