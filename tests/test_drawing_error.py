@@ -69,7 +69,8 @@ def test_reproducible_with_a_fixed_seed():
 
 
 def test_seed_002_scales_and_spread():
-    """Seed 002's own scales are the default choice; the published V_B lies inside the spread."""
+    """Seed 002's own scales are the default choice (mu_l: OA 36 mm at 0.001, as the worked example);
+    the published V_B lies inside the spread."""
     mech = kinetostat.load("ice_crank_slider")
     assert default_scales(mech) == Scales(0.001, 0.2, 100.0, 50.0)
     sol = simulate(mech, n=20000, seed=0)
@@ -86,3 +87,33 @@ def test_unsupported_and_bad_input():
         simulate(mech, length_mm=-1)
     with pytest.raises(ValueError, match="n:"):
         simulate(mech, n=0)
+
+
+@pytest.mark.parametrize("name", ["ice_crank_slider", "rotating_slotted_link", "opposed_twin"])
+def test_every_drawn_value_has_samples(name):
+    """a^n of each link's relative acceleration (the plan's a-n side), and on a sliding pair V_rel
+    and a^r, have samples wherever the worksheet lists them (the test above: equal to it at no error)."""
+    mech = kinetostat.load(name)
+    sol = simulate(mech, n=4)
+    keys = {r.key for r in worksheet(mech, mu_l=sol.scales.mu_l).rows}
+    drawn = {k for k in keys if k.startswith(("an_", "V_rel(", "ar_"))}
+    assert drawn and drawn <= set(sol.samples)
+    if name == "opposed_twin":                  # the crank's second pin C, read by similarity
+        assert {"V_C", "a_C"} <= set(sol.samples)
+    if sol.forces_drawn:                        # sliders loaded through their pin: x = 0 exactly
+        offsets = {k for k in keys if k.startswith("x_")}
+        assert offsets and offsets <= set(sol.samples) and all(not np.any(sol.samples[k]) for k in offsets)
+
+
+def test_a_length_read_is_never_below_zero():
+    """Task 2, code 479 at 90 deg: V_BA is 0 exactly; read off the sheet with +-0.25 mm it is at least 0
+    (the band 0 ... x holds the exact 0), and ω2 = V_BA / l_AB likewise."""
+    from kinetostat import variants
+    v = variants.variant(2, "479")
+    mech = v.mechanism()
+    sol = simulate(mech, at=float(v.values["phi1"]), n=2000, seed=0)
+    for key in ("V_BA", "omega_2"):
+        assert abs(sol.exact[key]) < 1e-9, key
+        s = sol.samples[key]
+        assert s.min() == 0.0 and (s == 0).mean() > 0.05, key         # the reads below 0 clipped (15 % of V_BA)
+        assert np.percentile(s, 5.0) == 0.0 <= sol.exact[key] + 1e-12

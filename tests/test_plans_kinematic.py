@@ -33,10 +33,11 @@ def test_seed_002_lengths(ice_plans, plan, segment, text_mm):
 
 
 def test_seed_002_scales_chosen_by_the_rule():
-    """The texts' rule (OA 30-35 mm, pa and pi-a 70-90 mm, round values) lands on seed 002's
-    own mu_l = 0.001, mu_v = 0.2, mu_a = 100."""
+    """The texts' rule (pa and pi-a 70-90 mm, round values) lands on seed 002's own mu_v = 0.2,
+    mu_a = 100, and OA taken about 30-35 mm its mu_l = 0.001 (OA = 36 mm, as the worked example)."""
     plans = P.build(kinetostat.load(ROOT / "models" / "ice_crank_slider.toml"), at=30)
     assert {k: plans.scales[k].value for k in ("mu_l", "mu_v", "mu_a")} == {"mu_l": 0.001, "mu_v": 0.2, "mu_a": 100.0}
+    assert plans["mechanism"].length_mm("OA") == pytest.approx(36.0)
 
 
 def _exact_values(mech, res, plans):

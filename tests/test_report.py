@@ -228,11 +228,14 @@ def test_index_links_the_studies_in_its_folder(tmp_path, ice_report):
     summary = json.loads((ice_report / "ice_crank_slider" / "summary.json").read_text())
     write_index(tmp_path, [summary])
     assert "## Studies" not in (tmp_path / "index.md").read_text()
-    (tmp_path / "stability.md").write_text("# study\n")
+    (tmp_path / "stability.md").write_text("# study\n\nWritten by validation/stability.py.\n\n| a | b |\n|---|---:|\n| x | 1 |\n")
     write_index(tmp_path, [summary])
     md = (tmp_path / "index.md").read_text()
-    assert "## Studies" in md and "](stability.md)" in md and "drawing_error.md" not in md
-    assert 'href="stability.md"' in (tmp_path / "index.html").read_text()     # a study stays Markdown
+    assert "## Studies" in md and "](stability.html)" in md and "](stability.md)" in md and "drawing_error" not in md
+    assert 'href="stability.html"' in (tmp_path / "index.html").read_text()   # the study's HTML, as the reports
+    page = (tmp_path / "stability.html").read_text()
+    assert page.startswith("<!DOCTYPE html>") and '<h1 id="study">study</h1>' in page and "<table>" in page
+    assert page.index("kinetostat_validation") < page.index("Written by validation/stability.py")   # said where it is
 
 
 def test_reports_cite_their_sources_and_show_no_seed_or_line_number(ice_report):

@@ -146,8 +146,9 @@ def cmd_variant(args) -> int:
     finally:
         _close(bar)
     if args.all:
-        _Out.write(one_line(f"{len(keys)} answer keys (tasks {', '.join(map(str, tasks))}) -> {out}/task<T>_<CODE>/; "
-                            f"index -> {index}; {time.perf_counter() - t0:.1f} s"))
+        from ..plans.i18n import num, text
+        _Out.write(one_line(text("cli.all", args.lang, keys=len(keys), tasks=", ".join(map(str, tasks)), out=out,
+                                 index=index, s=num(time.perf_counter() - t0, args.lang, decimals=1))))
         return EXIT_OK
     lines = variants.summary(jobs[0], keys[0], out, args.lang)
     _Out.write(_lines(lines))

@@ -31,7 +31,7 @@ from ..kinematics import DIGITS_WARN
 from ..tables import FLOAT_FORMAT, by_unit, rounded
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment, extent
 from .draw import figure, fits, svg
-from .forces import crank_plan, force_plans, group_plans
+from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
 from .lettering import lettering
 from .mechanism import mechanism_plan
 from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
@@ -50,9 +50,17 @@ BUILDERS: tuple[tuple[str, Callable], ...] = (
     ("acceleration", acceleration_plan),
     ("groups", lambda mech, res, sc: _fitted(lambda mu: group_plans(mech, res, mu), sc["mu_l"])),
     ("forces", lambda mech, res, sc: _fitted(lambda mu: force_plans(mech, res, mu), sc["mu_F"])),
-    ("crank", lambda mech, res, sc: _fitted(lambda mu: crank_plan(mech, res, mu, None), sc["mu_l"])),
+    ("crank", lambda mech, res, sc: _crank(mech, res, sc)),
     ("lever", lambda mech, res, sc: _fitted(lambda mu: lever_plan(mech, res, mu), sc["mu_v"])),
 )
+def _crank(mech, res, sc) -> list[Plan]:
+    """The initial link at the plans' mu_l (its arms in mm as the worksheet gives them), its forces
+    at a mu_F of its own (`forces.crank_plan`'s), made coarser while the plan overflows its sheet."""
+    import numpy as np
+    mu_F = force_scale(np.hypot(*res.forces.R[0].T), CRANK_FORCE_MM)
+    return _fitted(lambda mu: crank_plan(mech, res, sc["mu_l"], mu), mu_F)
+
+
 def _fitted(make: Callable, mu: Scale) -> list[Plan]:
     """make(mu) -> a Plan or Plans, made again at the next coarser round scale while one of them
     overflows its sheet (`draw.fits`: a group's reaction far out on its guide, a polygon longer than its

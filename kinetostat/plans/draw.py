@@ -25,7 +25,7 @@ from .core import Plan, Segment, extent
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_width
 
-__all__ = ["svg", "figure", "title_of", "scale_text", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
+__all__ = ["svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
 
 #: The sheet: A3 landscape, mm.
@@ -81,6 +81,13 @@ def scale_text(plan_or_scale, lang: str = "en") -> str:
     """A scale line, e.g. 'μ_v = 0.2 m/(s·mm)' (of a Plan's scale, or of a Scale)."""
     s = plan_or_scale.scale if isinstance(plan_or_scale, Plan) else plan_or_scale
     return f"{s.symbol.replace('mu_', 'μ_')} = {num(s.value, lang, 6)} {unit(s.unit, lang)}"
+
+
+def scales_of(plan: Plan) -> list:
+    """Every scale the plan is drawn at: its own, then those of its segments drawn at another
+    (the loads on a group plan, at a force scale)."""
+    return [plan.scale] + list(dict.fromkeys(s.scale for s in plan.segments
+                                             if s.scale is not None and s.scale.symbol.startswith("mu_")))
 
 
 def labelled(name: str) -> bool:
@@ -307,8 +314,7 @@ def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
     x0, y0, x1, y1 = _TITLE_BLOCK
     w = x1 - x0 - 6
     title = title_of(plan, lang)
-    scales = [plan.scale] + list(dict.fromkeys(s.scale for s in plan.segments
-                                               if s.scale is not None and s.scale.symbol.startswith("mu_")))
+    scales = scales_of(plan)
     sc = f"{text('scale' if len(scales) == 1 else 'scales', lang)}: " + "; ".join(scale_text(s, lang) for s in scales)
     angle = f"{text('angle', lang)} φ = {num(plan.phi_deg, lang, 6)}°"
     return [f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
@@ -503,6 +509,10 @@ def figure(plan: Plan, lang: str = "en", ax=None):
         label = _tex(name)
         ax.annotate(label, (z.real, z.imag), xytext=(3, 3), textcoords="offset points", parse_math=label != name,
                     fontsize=6 if numbered else 10)
+    ends = [(z.real, z.imag) for s in _drawable(plan) for z in (plan.points[s.start], plan.points[s.end])]
+    if ends:                            # an arrow (annotate) counts for no limits: its ends do
+        ax.update_datalim(ends)
+        ax.autoscale_view()
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(unit("mm", lang))
     ax.set_ylabel(unit("mm", lang))

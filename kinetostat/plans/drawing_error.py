@@ -119,8 +119,8 @@ class _Drafter:
         return np.where(mag > 0, (mag + self._err(self.dl)) * self.turn(_unit(v)), 0.0)
 
     def read(self, z) -> np.ndarray:
-        """A length read off the sheet, mm."""
-        return np.abs(z) + self._err(self.dl)
+        """A length read off the sheet, mm: never below 0 (a length is no less than none)."""
+        return np.maximum(np.abs(z) + self._err(self.dl), 0.0)
 
     def arm(self, r, u) -> np.ndarray:
         """Signed arm (mm) about a point of a line through r (mm from the point) along unit u
@@ -186,6 +186,10 @@ class _Plans:
                 self.put(f"V_{com}", dr.read(self.like(self.v, k, com)) * sc.mu_v, "m/s")
             if com and f"a_{com}" not in self.out:
                 self.put(f"a_{com}", dr.read(self.like(self.a, k, com)) * sc.mu_a, "m/s^2")
+        for name in m.links[d.link].points:      # the crank's other points (C of a twin): by similarity
+            if name not in (d.pivot, d.point) and f"V_{name}" not in self.out:
+                self.put(f"V_{name}", dr.read(self.like(self.v, d.link, name)) * sc.mu_v, "m/s")
+                self.put(f"a_{name}", dr.read(self.like(self.a, d.link, name)) * sc.mu_a, "m/s^2")
 
     @staticmethod
     def _unsupported(g) -> None:
@@ -199,8 +203,10 @@ class _Plans:
         return rel / abs(self.world[B] - self.world[P])
 
     def _normal(self, reg, a: int, k: int, P: str, B: str):
-        """n_k: the end of a^n_BP (link k, ω_k as read) laid off from the plan point of P (on link a)."""
+        """n_k: the end of a^n_BP (link k, ω_k as read) laid off from the plan point of P (on link a);
+        a^n_BP = ω_k² l_PB as computed from the read ω_k."""
         W = self.world
+        self.put(f"an_{B}{P}", np.abs(self.omega[k]) ** 2 * abs(W[B] - W[P]), "m/s^2")
         return self.at(reg, a, W[P]) + self.dr.draw(-self.omega[k] ** 2 * (W[B] - W[P]) / self.sc.mu_a)
 
     def _rrr(self, g) -> None:
@@ -239,6 +245,7 @@ class _Plans:
         zero = np.zeros(dr.n, complex)
         b = dr.meet(pP, dr.turn(1j * (W[B] - W[P])), zero, dr.turn(guide))
         self.put(f"V_{B}", dr.read(b) * sc.mu_v, "m/s")
+        self.put(f"V_rel({pk.links[0]},{pk.links[1]})", self.out[f"V_{B}"], "m/s")    # on a guide of the frame: V_B
         w = np.sign(res.omega(j)[0]) * self._link_plan(P, B, pP, b, sc.mu_v, "V", "m/s")
         self.omega[j] = w
         self.put(f"omega_{j}", np.abs(w), "rad/s")
@@ -246,6 +253,7 @@ class _Plans:
         nP = self._normal(self.a, a, j, P, B)
         ab = dr.meet(nP, dr.turn(1j * (W[B] - W[P])), zero, dr.turn(guide))
         self.put(f"a_{B}", dr.read(ab) * sc.mu_a, "m/s^2")
+        self.put(f"ar_{pk.links[0]}_{pk.links[1]}", self.out[f"a_{B}"], "m/s^2")        # a^r = a_B likewise
         e = self._link_plan(P, B, nP, ab, sc.mu_a, "at", "m/s^2")
         self.put(f"eps_{j}", e, "rad/s^2")
         self.eps[j], self.eps[k] = np.sign(res.eps(j)[0]) * e, zero
@@ -267,7 +275,7 @@ class _Plans:
         vr = dr.read(pP - pk_) * sc.mu_v
         self.omega[j] = self.omega[k] = w
         self.put(f"omega_{k}", np.abs(w), "rad/s")
-        self.put(f"V_rel_{pin.links[0]}_{pin.links[1]}", vr, "m/s")
+        self.put(f"V_rel({pin.links[0]},{pin.links[1]})", vr, "m/s")
         aP, aQ = self.at(self.a, a, W[P]), self.at(self.a, c, W[Q])
         nQ = aQ + dr.draw(-w ** 2 * (W[P] - W[Q]) / sc.mu_a)
         sign_vr = np.sign((guide * np.conj(dvec)).real) if abs(guide) else 1.0
@@ -279,6 +287,7 @@ class _Plans:
         f_v, f_a = (pk_ - pQ) / (W[P] - W[Q]), (ak - aQ) / (W[P] - W[Q])
         self.v[k], self.a[k] = (W[Q], pQ, f_v), (W[Q], aQ, f_a)
         self.v[j], self.a[j] = (W[P], pP, f_v), (W[P], aP, f_a)
+        self.put(f"ar_{pin.links[0]}_{pin.links[1]}", dr.read(aP - cor - ak) * sc.mu_a, "m/s^2")   # a^r: its side
 
     # ---- loads, group plan, force polygon, crank, lever
     def loads(self):
@@ -354,6 +363,10 @@ class _Plans:
         self.put(f"Rn_{a}_{j}", dr.read(pts[0] - K) * sc.mu_F, "N")        # the polygon's closing sides
         if g.kind == "RRR":
             self.put(f"Rn_{c}_{k}", dr.read(K - pts[-1]) * sc.mu_F, "N")
+        elif all(abs(Y - B) <= 1e-9 * abs(B - W[pj.point]) for _, Y in loads[k]) and not np.any(couples[k]):
+            # Σ M_B = 0 of the slider with every load through B: its frame reaction's offset x is 0,
+            # with no arm to read (other sliders: not drawn here)
+            self.put(f"x_{pk.links[0]}_{pk.links[1]}", np.zeros(dr.n), "m")
         return [(a, j, R_aj, W[pj.point]), (c, k, R_ck, W[pk.point])]
 
     def forces_of_groups(self, forces, couples) -> list[tuple[int, np.ndarray, complex]]:

@@ -103,7 +103,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                  "допущения), расчётный лист (`worksheet.md`, `.html`, `.csv`, `.json`) и планы (листы `SVG`, "
                  "`segments.csv`) в расчётном положении φ1. R(i,j) — сила действия звена i на звено j; {M} — "
                  "момент, который привод прикладывает к кривошипу (относительно оси +z, Н·м)."),
-    "ix.task": ("Task {task}: {title} (table {table})", "Задача {task}: {title} (таблиця {table})",
+    "ix.task": ("Task {task}: {title} (table {table})", "Завдання {task}: {title} (таблиця {table})",
                 "Задача {task}: {title} (таблица {table})"),
     "ix.code": ("code", "код", "код"),
     "ix.at": ("at φ1", "при φ1", "при φ1"),
@@ -112,6 +112,9 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     # the command line
     "cli.plans": ("{name} at φ = {phi}° ({scales}): {n} files -> {out}", "{name}, φ = {phi}° ({scales}): {n} файлів -> {out}",
                   "{name}, φ = {phi}° ({scales}): {n} файлов -> {out}"),
+    "cli.all": ("Answer keys: {keys} (tasks {tasks}) -> {out}/`task<T>_<CODE>`/; index -> {index}; {s} s",
+                "Ключі відповідей: {keys} (завдання {tasks}) -> {out}/`task<T>_<CODE>`/; зміст -> {index}; {s} с",
+                "Ключи ответов: {keys} (задания {tasks}) -> {out}/`task<T>_<CODE>`/; оглавление -> {index}; {s} с"),
     "cli.variant": ("Logvinenko, Nadtoka 2021, task {task} ({title}), variant {code}: table {table} columns",
                     "Логвіненко, Надтока 2021, задача {task} ({title}), варіант {code}: стовпці таблиці {table}",
                     "Логвиненко, Надтока 2021, задача {task} ({title}), вариант {code}: столбцы таблицы {table}"),
@@ -222,6 +225,15 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                           "Исследование погрешности чертежа строит планы сил только групп {kinds} с "
                           "направляющей на стойке: здесь реакции и {M} без границ."),
     "pack.scales": ("Scales", "Масштаби", "Масштабы"),
+    "pack.a3_true": ("Every plan true to scale: 1 mm drawn is 1 mm on this A3 sheet, at the scales above it",
+                     "Кожен план у натуральну величину креслення: 1 мм плану = 1 мм на цьому аркуші А3, у масштабах над ним",
+                     "Каждый план в натуральную величину чертежа: 1 мм плана = 1 мм на этом листе А3, в масштабах над ним"),
+    "pack.no_band": ("— (from the data, not the plans)", "— (з даних, не з планів)", "— (из данных, не по планам)"),
+    "pack.plan_scales": ("Scales of each plan", "Масштаби кожного плану", "Масштабы каждого плана"),
+    "pack.a3_page": ("Sheet {k} of {n}", "Аркуш {k} з {n}", "Лист {k} из {n}"),
+    "pack.a3_more": ("The plans at their scales do not fit one A3 sheet: {n} sheets, none drawn smaller",
+                     "Плани у своїх масштабах не вміщуються на одному аркуші А3: {n} аркуші, жоден не зменшено",
+                     "Планы в своих масштабах не помещаются на одном листе А3: {n} листа, ни один не уменьшен"),
     "pack.drawn": ("drawn", "відрізок", "отрезок"),
     "pack.segments": ("Segments a student measures, mm", "Відрізки, які вимірює студент, мм",
                       "Отрезки, которые измеряет студент, мм"),

@@ -11,17 +11,18 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
   area with a title block. No answer: no value, scale or length the key gives.
 - `key.pdf` / `key.html`: every worksheet value with its unit and sense, and the band a careful
   drawing lands in (the 5-95 % range of `drawing_error.simulate`, BAND_DRAWS draws, seeded); the
-  scales μ_l, μ_v, μ_a, μ_F with the reference length each draws; δ with the texts' 5 % rule; every
-  segment a student measures on the plans, in mm at the plans' scales.
-- `plans_a3.pdf` / `plans.html`: the plans side by side on one A3 landscape sheet (seed 002,
-  appendix B puts the results on A3).
+  scales μ_l, μ_v, μ_a, μ_F with the reference length each draws, and every scale each plan is
+  drawn at; δ with the texts' 5 % rule; every segment a student measures on the plans, in mm, with
+  the scale it is drawn at.
+- `plans_a3.pdf` / `plans.html`: the plans, each true to scale, on one A3 landscape sheet (seed
+  002, appendix B puts the results on A3), on a further sheet where they do not fit (`a3`).
 
 Both documents are one list of blocks (headings, paragraphs, tables, the drawing area), rendered
 twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figure library; TrueType
 DejaVu Sans embedded as Type 42 with its Unicode map, so pdftotext reads the Cyrillic back) and to
 HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
-May use: `build` of this package, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
+May use: `build` of this package, `.a3`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
 `kinetostat._io`; matplotlib inside the PDF writers only. Never the harness, nor `kinetostat.variants` (the variant
 is passed in and says its task, title and letters).
 """
@@ -38,7 +39,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .._io import write_bytes, write_text
-from .draw import segment_label, title_of
+from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 from .lettering import lettering
 from .worksheet import CSS, Worksheet, html_document, worksheet
@@ -129,7 +130,8 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
         sheet.append(("p", "  ".join(f"{ch} = {d}" for ch, d in v.letters.items())))
     key = [("h1", f"{text('pack.key', lang)}. {title}")]          # scales, values and bands, δ, segments
     answers: set[str] = set()
-    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
+    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers)),
+            ("h2", text("pack.plan_scales", lang)), ("table", _plan_scales_table(plans, lang, answers))]
     sheet.append(("h2", text("pack.fill", lang)))
     recs = ws.records()
     outside = False                     # an exact value beyond its band (a segment shorter than the error)
@@ -145,7 +147,7 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
             r = ws.rows[i]
             value = num(r.value, lang, 4)
             lo_hi = bands.get(r.key)
-            band = f"{num(lo_hi[0], lang, 3)} … {num(lo_hi[1], lang, 3)}" if lo_hi else ""
+            band = f"{num(lo_hi[0], lang, 3)} … {num(lo_hi[1], lang, 3)}" if lo_hi else text("pack.no_band", lang)
             if lo_hi and not lo_hi[0] <= r.value <= lo_hi[1]:
                 band += " *"
                 outside = True
@@ -189,10 +191,21 @@ def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> 
                   text("pack.drawn", lang)), tuple(rows), (0.15, 0.2, 0.25, 0.4), frozenset({1}))
 
 
+def _plan_scales_table(plans, lang: str, answers: set[str]) -> Table:
+    """Every scale each plan is drawn at (`draw.scales_of`: its own, and the force scale of the
+    loads on a group plan or the crank); the values printed added to `answers`."""
+    rows = []
+    for kind in plans:
+        scales = scales_of(plans[kind])
+        rows.append((title_of(plans[kind], lang), "; ".join(scale_text(s, lang) for s in scales)))
+        answers.update(num(s.value, lang, 6) for s in scales)
+    return Table((text("pack.plan", lang), text("scales", lang)), tuple(rows), (0.5, 0.5))
+
+
 def _segments_table(plans, lang: str, answers: set[str]) -> Table:
     """Every segment a student lays off or measures (vectors, links, arms; not the other
-    positions or the construction lines): its plan, name, length in mm and the value it stands
-    for; the lengths printed added to `answers`."""
+    positions or the construction lines): its plan, name, length in mm at the scale stated, and
+    the value it stands for; the lengths printed added to `answers`."""
     rows = []
     for kind in plans:
         plan = plans[kind]
@@ -201,10 +214,11 @@ def _segments_table(plans, lang: str, answers: set[str]) -> Table:
             if s.kind in ("position", "line") or not math.isfinite(length):
                 continue
             value = "" if not math.isfinite(s.value) else f"{num(s.value, lang, 4)} {unit(s.unit, lang)}".strip()
-            rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), value))
+            scale = scale_text(s.scale or plan.scale, lang) if s.unit != "mm" else ""    # an arm kept as drawn: none
+            rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), scale, value))
             answers.add(num(length, lang, decimals=1))
-    return Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang),
-                  text("ws.head.value", lang)), tuple(rows), (0.4, 0.2, 0.18, 0.22), frozenset({2, 3}))
+    return Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang), text("scale", lang),
+                  text("ws.head.value", lang)), tuple(rows), (0.3, 0.14, 0.12, 0.24, 0.2), frozenset({2, 4}))
 
 
 def _reference_mm(mech, ws: Worksheet, scale) -> float:
@@ -240,13 +254,24 @@ def _html(blocks) -> str:
 
 
 def _plans_html(plans, lang: str, title: str) -> str:
-    """The plans' SVG sheets (written beside it by `Plans.write`) side by side on one page, A3
-    landscape in print."""
+    """The plans' SVG sheets (written beside it by `Plans.write`) side by side on screen, each a
+    link to itself at full size; in print
+    each sheet one A3 landscape page at its true size (_PRINT_A3)."""
     from . import plan_file_name
-    imgs = "\n".join(f'<figure><img src="{escape(plan_file_name(plans[k]))}" alt="{escape(title_of(plans[k], lang))}">'
+    imgs = "\n".join(f'<figure><a href="{escape(plan_file_name(plans[k]))}"><img src="{escape(plan_file_name(plans[k]))}" '
+                     f'alt="{escape(title_of(plans[k], lang))}"></a>'
                      f"<figcaption>{escape(title_of(plans[k], lang))}</figcaption></figure>" for k in plans)
     return html_document(title, f"<h1>{escape(title)}</h1>\n<div class=\"plans\">\n{imgs}\n</div>\n", lang,
-                         CSS + "@media print{@page{size:A3 landscape}}\n")
+                         CSS + _PRINT_A3)
+
+
+#: Print: each plan's SVG sheet alone on an A3 landscape page at its true size (420 x 297 mm, no
+#: margin: the sheet has its own frame); the page's heading and captions are for the screen.
+_PRINT_A3 = """@page{size:420mm 297mm;margin:0}
+@media print{body{margin:0;padding:0;max-width:none}h1,figcaption{display:none}.plans{display:block}
+.plans figure{margin:0;break-after:page;break-inside:avoid}.plans figure:last-child{break-after:auto}
+.plans img{display:block;width:420mm;height:296.9mm;border:none}}
+"""
 
 
 # ============================================================================ PDF
@@ -397,35 +422,9 @@ def _pdf(blocks, title: str) -> bytes:
 
 
 def _plans_pdf(plans, lang: str, title: str) -> bytes:
-    """All the plans on one A3 landscape sheet: a grid of the plans' Figures inside the frame, the
-    title and the scales in the title block."""
-    from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
-
-    from .draw import figure, scale_text
-    kinds = list(plans)
-    cols = 4 if len(kinds) > 6 else 3
-    rows = math.ceil(len(kinds) / cols)
-    W, H = A3
+    """All the plans true to scale on A3 landscape sheets (`a3.pages`: one where they fit)."""
+    from .a3 import pages
     with _pdf_pages(title) as (pdf, buf):
-        fig = Figure(figsize=(W / 25.4, H / 25.4))
-        x0, y0, x1, y1 = (20 / W, 1 - 5 / H, 415 / W, 1 - 292 / H)                # the frame
-        fig.add_artist(Line2D([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], lw=1.0, color="k"))
-        fig.text(25 / W, 1 - 9 / H, title, fontsize=11, va="top")
-        cw, ch = (410 - 25) / cols, (262 - 14) / rows
-        for n, kind in enumerate(kinds):
-            c, r = n % cols, n // cols
-            x, y = 25 + c * cw + 10, 14 + r * ch + 9
-            ax = fig.add_axes(((x) / W, 1 - (y + ch - 17) / H, (cw - 14) / W, (ch - 17) / H))
-            figure(plans[kind], lang, ax=ax)
-            ax.title.set_fontsize(7)
-            ax.tick_params(labelsize=5)
-            ax.xaxis.label.set_fontsize(6), ax.yaxis.label.set_fontsize(6)
-            for t in ax.texts:
-                t.set_fontsize(min(t.get_fontsize(), 6))
-        scales = ", ".join(scale_text(s, lang) for s in plans.scales.values())
-        fig.text(25 / W, 1 - 270 / H, "\n".join(_wrap(f"{text('scales', lang)}: {scales}", 200, 8)), fontsize=8,
-                 va="top")
-        pdf.savefig(fig)
+        for fig in pages(plans, lang, title)[0]:
+            pdf.savefig(fig)
     return buf.getvalue()
-

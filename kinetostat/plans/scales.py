@@ -3,14 +3,19 @@
 The rule (seed 002 sec. 1.2.2): a reference quantity is drawn at a recommended length and the
 scale is its value over that length, rounded to a value an engineer can multiply by in the head.
 Here a round scale is m x 10^k with the mantissa m one of ROUND_MANTISSAS = (1, 2, 2.5, 4, 5)
-(the reduction and enlargement scales of GOST 2.302); the plan of positions may also take the
-reductions 1:1.5 and 1:7.5 (GOST 2.302's 1:15 and 1:75, LENGTH_MANTISSAS), so that the crank
-lands in 30..35 mm as the text asks (l_OA = 0.048 m: 32 mm at 0.0015 m/mm, where 1 and 2 give
-48 and 24 mm); of the round scales, the one whose drawn reference length is nearest the recommended range (in
-ratio; ties go to the larger drawing) is taken, then made coarser step by step while the plan
-would not fit the drawing area of an A3 sheet (FIT_MM).
+(the reduction and enlargement scales of GOST 2.302); of the round scales, the one whose drawn
+reference length is nearest the recommended range (in ratio; ties go to the larger drawing) is
+taken, then made coarser step by step while the plan would not fit the drawing area of an A3
+sheet (FIT_MM).
 
-    mu_l: the crank O-A drawn 30..35 mm (seed 002 draws 36 mm at mu_l = 0.001 m/mm);
+The plan of positions follows the text's own words (sec. 1.2.2): "the crank's length OA is taken
+(30..35 mm recommended); then mu_l = l_OA / OA", and its worked example takes OA = 36 mm for the
+round mu_l = 0.001. So OA is chosen "about 30..35 mm", 30..36 mm (the example's own practice), and
+mu_l follows from it, as round as that allows (`length_scale`): a GOST 2.302 value
+(LENGTH_MANTISSAS, with 1:15 and 1:75) where one lands OA in the range, else two significant
+digits (l_OA = 0.036 m: 0.001 m/mm, OA = 36 mm, as the example).
+
+    mu_l: the crank O-A drawn 30..36 mm;
     mu_v: the crank pin's velocity p-a drawn 70..90 mm (seed 002: 85 mm, mu_v = 0.2);
     mu_a: the crank pin's acceleration pi-a drawn 70..90 mm (seed 002: 79.94 mm, mu_a = 100);
     mu_F: the largest force at that angle (a reaction, an applied load or an inertia force)
@@ -28,7 +33,7 @@ import numpy as np
 
 from .core import Scale
 
-__all__ = ["choose_scales", "round_scale", "coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
+__all__ = ["choose_scales", "round_scale", "length_scale", "coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
            "LENGTH_MANTISSAS", "FIT_MM", "MAX_EXTENT_MM", "PLAN_OF"]
 
 #: Unit of each scale, per millimetre drawn.
@@ -38,7 +43,7 @@ ROUND_MANTISSAS = (1.0, 2.0, 2.5, 4.0, 5.0)
 #: Mantissas of the plan of positions' scale mu_l: ROUND_MANTISSAS and GOST 2.302's 1:15 and 1:75.
 LENGTH_MANTISSAS = (1.0, 1.5, 2.0, 2.5, 4.0, 5.0, 7.5)
 #: Recommended drawn length of each scale's reference quantity, mm.
-TARGET_MM = {"mu_l": (30.0, 35.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (100.0, 200.0)}
+TARGET_MM = {"mu_l": (30.0, 36.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (100.0, 200.0)}
 #: Drawing area of an A3 landscape sheet a plan must fit (width, height), mm: inside the frame,
 #: above the title block.
 FIT_MM = (380.0, 220.0)
@@ -79,6 +84,29 @@ def round_scale(reference: float, lo_mm: float, hi_mm: float, extent: tuple[floa
             return c
     k = max(extent[0] / fit_mm[0], extent[1] / fit_mm[1])     # beyond the candidates: next round value
     return min(m * 10.0 ** math.ceil(math.log10(k) - math.log10(m)) for m in ROUND_MANTISSAS)
+
+
+def length_scale(l_oa: float, lo_mm: float = TARGET_MM["mu_l"][0], hi_mm: float = TARGET_MM["mu_l"][1]) -> float:
+    """mu_l (m/mm) of a crank `l_oa` m long drawn OA in [lo_mm, hi_mm] (seed 002 sec. 1.2.2: mu_l =
+    l_OA / OA): of the scales in that range, a LENGTH_MANTISSAS value first, then the one of
+    fewest significant digits; among equals, the one drawing OA nearest the range's middle.
+    Two digits always land in it when hi/lo > 1.1 (their steps are at most 10 %)."""
+    lo, hi = l_oa / hi_mm, l_oa / lo_mm                     # the scales that draw OA in range
+    best = None
+    for digits in (1, 2, 3):
+        for e in {math.floor(math.log10(lo)), math.floor(math.log10(hi))}:       # the decades it spans
+            exp = e - digits + 1
+            for n in range(math.ceil(lo / 10.0 ** exp), math.floor(hi / 10.0 ** exp) + 1):
+                c = float(f"{n}e{exp}")                                      # exact in decimal
+                if not lo <= c <= hi:
+                    continue
+                m = c / 10.0 ** math.floor(math.log10(c))
+                rank = (0 if any(math.isclose(m, g) for g in LENGTH_MANTISSAS) else digits,
+                        abs(l_oa / c - (lo_mm + hi_mm) / 2))
+                best = min(best or (rank, c), (rank, c))
+        if best is not None and digits >= 2:          # GOST's 1.5, 2.5, 7.5 have two digits
+            return best[1]
+    return best[1] if best else l_oa / ((lo_mm + hi_mm) / 2)
 
 
 def coarser(value: float, factor: float) -> float:
@@ -138,9 +166,14 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
             if not size <= MAX_EXTENT_MM:
                 raise ScaleError(f"{key}={value:g} {unit} would draw the {PLAN_OF[key]} plan "
                                  f"{f'{size:.3g} mm' if size < math.inf else 'beyond 1e308 mm'} across (at most {MAX_EXTENT_MM:g} mm); use a larger scale")
+        elif key == "mu_l" and l_oa > 0:
+            value = length_scale(l_oa)
+            ext = reference[key][1]
+            factor = max(ext[0] / value / FIT_MM[0], ext[1] / value / FIT_MM[1])
+            if factor > 1:                   # the positions would not fit the sheet: coarser
+                value = coarser(value, factor)
         else:
             ref, ext = reference[key]
-            value = round_scale(ref, *TARGET_MM[key], extent=ext,
-                                mantissas=LENGTH_MANTISSAS if key == "mu_l" else ROUND_MANTISSAS)
+            value = round_scale(ref, *TARGET_MM[key], extent=ext)
         out[key] = Scale(key, value, unit)
     return out

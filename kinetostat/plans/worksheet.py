@@ -29,7 +29,7 @@ from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
 from ..tables import FLOAT_FORMAT, by_unit, plain
-from .i18n import accuracy, check_lang, num, phrase, text, unit
+from .i18n import ZERO, accuracy, check_lang, num, phrase, text, unit
 from .lettering import lettering
 from .scales import choose_scales
 
@@ -223,7 +223,9 @@ class _Sheet:
         self.rows.append(Row(section, key, symbol, float(value), unit, direction, note))
 
     def vector(self, section, key, symbol, v: np.ndarray, unit, note=""):
-        self.add(section, key, symbol, np.hypot(*v), unit, _angle(v), note)
+        """A vector's magnitude and angle; one printed as 0 (below i18n.ZERO) has no direction."""
+        size = np.hypot(*v)
+        self.add(section, key, symbol, size, unit, _angle(v) if size >= ZERO else "", note)
 
     # ---- kinematics
     def link_points(self, k: int, pairs) -> list[str]:

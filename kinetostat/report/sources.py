@@ -31,15 +31,17 @@ WORKS: tuple[Work, ...] = (
     Work("Potapov 2024",
          "Потапов В. А. Исследование сил взаимодействия звеньев приводного механизма цепного агрегата "
          "[Potapov V. A. Investigation of the interaction forces of the links of a chain unit's drive "
-         "mechanism]. Барановичский государственный университет, journal paper received 19.09.2024."),
+         "mechanism]. Journal article (УДК 531.8), Барановичский государственный университет; received by the "
+         "editors 19.09.2024. The pages available do not name the journal; the author's earlier paper on this "
+         "mechanism appeared in «Вестник БарГУ. Серия „Технические науки“» (2022, № 2)."),
     Work("Artobolevsky 1988",
          "Артоболевский И. И. Теория механизмов и машин: учебник для втузов. 4-е изд. [Artobolevsky I. I. "
          "Theory of mechanisms and machines: a textbook]. Москва: Наука, 1988. 640 с. (the class-III group "
          "III3: its structure, Assur's special points, its positions, plans and force analysis)."),
     Work("TMM course text on friction",
-         "A course text in Russian on the theory of machines and mechanisms, pp. 81–82: the order of the "
-         "force analysis with friction in the pairs («Отделяют от механизма структурные группы...»). Its "
-         "author, title and year are not on the pages available."),
+         "Anonymous course page (Russian), undated: a text on the theory of machines and mechanisms, pp. 81–82, "
+         "the order of the force analysis with friction in the pairs («Отделяют от механизма структурные "
+         "группы...»). The pages available name no author, title, publisher or year."),
 )
 
 

@@ -36,6 +36,22 @@ PLANS_HEADING = "Plans of the graphical method"
 STUDIES = (("stability.md", "Stability: the solver's accuracy near singular positions"),
            ("drawing_error.md", "Drawing error: the spread of a careful drawing of the plans"),
            ("benchmark.md", "Benchmark: speed of the solver and the engines"))
+#: Said at the top of a study's HTML that names files of the validation/ folder.
+REPO_NOTE = ("*Paths `validation/...` name files of the project's source repository; an installed kinetostat "
+             "holds them as the module `kinetostat_validation` (e.g. `python -m kinetostat_validation.stability`).*")
+
+
+def study_page(out: Path, name: str, title: str) -> str:
+    """The study `out/name` (Markdown) rendered beside it as HTML, as the reports are (`Doc.html`:
+    the same Markdown, images embedded), with REPO_NOTE under its title where it names a path of
+    validation/; returns the HTML file's name."""
+    md = (Path(out) / name).read_text(encoding="utf-8")
+    if "validation/" in md:
+        head, sep, rest = md.partition("\n")
+        md = f"{head}{sep}\n{REPO_NOTE}\n{rest}" if head.startswith("#") else f"{REPO_NOTE}\n\n{md}"
+    page = Path(name).with_suffix(".html").name
+    write_text(Path(out) / page, Doc(title).html(out, md))
+    return page
 
 
 def _versions() -> str:
@@ -610,7 +626,8 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
     """`out/index.md` and `out/index.html` over the reports of this run (`summaries`, as
     `write_report` returns them, in the order given); other folders in `out` are not listed. The
     verdicts come first, in a table narrow enough for a page 800 px wide; the errors route by route
-    in a second table; then the studies found in `out` and the sources the reports cite."""
+    in a second table; then the studies found in `out` (each rendered to HTML beside it,
+    `study_page`) and the sources the reports cite."""
     out = Path(out)
     sums = list(summaries)
     routes: list[str] = []
@@ -655,7 +672,7 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
     studies = [(name, title) for name, title in STUDIES if (out / name).is_file()]
     if studies:
         doc.h(2, "Studies")
-        doc.ul([f"[{title}]({name})" for name, title in studies])
+        doc.ul([f"[{title}]({study_page(out, name, title)}) (Markdown: [{name}]({name}))" for name, title in studies])
     keys = {k for s in sums for k in s.get("sources", ())}
     if keys:
         doc.h(2, "Sources")
