@@ -219,3 +219,18 @@ def test_the_map_names_only_rooms_that_exist():
     assert set(LAYERS) == rooms, (set(LAYERS) - rooms, rooms - set(LAYERS))
     assert set(USES) == rooms, (set(USES) - rooms, rooms - set(USES))
     assert all(used <= rooms for used in USES.values())
+
+
+def test_the_model_package_keeps_the_names_of_the_module_it_replaced():
+    """`kinetostat.model` was one module (to c9e783d); the names users and tests imported from it
+    import from the package, the same objects as where they live now."""
+    import kinetostat
+    import kinetostat.model as model
+    from kinetostat.model import limits, parts
+    from kinetostat.structure import Structure
+    assert (model.ModelError, model.ModelWarning, model.ModelFileNotFound, model.StructureError) == (
+        kinetostat.ModelError, kinetostat.ModelWarning, kinetostat.errors.ModelFileNotFound, kinetostat.StructureError)
+    assert model.Structure is Structure and model.Vec is parts.Vec
+    for name in ("MAX_KEY", "MAX_KEY_MEMORY", "MAX_FILE_BYTES", "MAX_VALUE", "MAX_POINTS", "MIN_LENGTH", "MIN_GEAR",
+                 "MAX_PUBLISHED_ANGLES", "MAX_SHOWN", "MAX_NAME", "MAX_PROBLEMS", "MAX_PARAMETERS", "LAW_VARIABLES"):
+        assert getattr(model, name) is getattr(limits, name), name
