@@ -94,6 +94,24 @@ def test_reader_takes_its_ranges_and_choices_from_the_schema(monkeypatch, sectio
         fastjsonschema.compile(describe.json_schema())(tomllib.loads(text))
 
 
+def test_reader_takes_its_orders_and_groups_from_the_schema(monkeypatch):
+    """A series the table calls increasing, and a group of which the table wants exactly one,
+    are checked as the table says (the group by the JSON Schema too)."""
+    text = four_bar(("value = -4.0", "table = { phi_deg = [0.0, 360.0], value = [2.0, 2.0] }"))
+    kinetostat.loads(text)
+    _patch(monkeypatch, schema.LOAD_TABLE, "value", increasing=True)
+    with pytest.raises(ModelError) as e:
+        kinetostat.loads(text)
+    assert e.value.problems == ["load[0].table.value: the values must increase strictly, got 2.0 after 2.0"]
+    monkeypatch.setitem(schema.DRIVE.__dict__, "one_of", (schema.OneOf(("rpm", "eps"), hint="a test"),))
+    with pytest.raises(ModelError) as e:
+        kinetostat.loads(four_bar())
+    assert e.value.problems == ["drive: give exactly one of rpm or eps (a test)"]
+    with pytest.raises(fastjsonschema.JsonSchemaValueException) as j:
+        fastjsonschema.compile(describe.json_schema())(tomllib.loads(four_bar()))
+    assert _reader_path(tomllib.loads(four_bar()), j.value) == "drive"
+
+
 @pytest.mark.parametrize("path", MODELS, ids=lambda p: p.stem)
 def test_json_schema_accepts_every_bundled_model(path: Path, validate):
     validate(tomllib.loads(path.read_text(encoding="utf-8")))

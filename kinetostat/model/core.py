@@ -12,7 +12,7 @@ import sys
 from typing import Any, Mapping
 
 from ..expressions import ExpressionError, parse as parse_expression, shown_number, suggest
-from .limits import MAX_NAME, MAX_POINTS, MAX_PROBLEMS, MAX_SHOWN, MAX_VALUE, _finite, _subnormal
+from .limits import MAX_NAME, MAX_PROBLEMS, MAX_SHOWN, MAX_VALUE, _finite, _subnormal
 from .lines import _Lines
 from .parts import Link, Pair, Vec
 from .schema import REQUIRED, Field, Section
@@ -140,13 +140,21 @@ class ReaderCore:
         field without default is not given)."""
         f = section[key]
         d = default.get("default", f.default)
-        path = f"{where}.{key}"
+        path = f"{where}.{key}" if where else key
         if key not in tab:
-            if d == REQUIRED:
+            if d == REQUIRED and f.type == "table" and not where:
+                self.err(f"{path}: missing table [{key}]")
+            elif d == REQUIRED and f.type == "table":
+                self.err(f"{path}: missing (a table {{ {', '.join(g.name for g in f.section.fields)} }} is required)")
+            elif d == REQUIRED:
                 self.err(f"{path}: missing ({_WANTED[f.type]} is required)")
-                return None
-            return d
+            return None if d == REQUIRED else d
         x = tab[key]
+        if f.type == "table":
+            if not isinstance(x, dict):
+                self.err(f"{path}: expected a table {{ {', '.join(g.name for g in f.section.fields)} }}")
+                return None
+            return x
         if f.type == "number":
             return self.number(f, x, path)
         if f.type in ("integer", "link"):
@@ -233,9 +241,12 @@ class ReaderCore:
         return tuple(x)
 
     def link_ids(self, f: Field, x: Any, path: str) -> list[int] | None:
-        """[i, j]: two link ids (whether they are links, and joined, the caller asks)."""
+        """[i, j]: two different link ids (whether they are links, and joined, the caller asks)."""
         if not (isinstance(x, list) and len(x) == 2 and all(isinstance(i, int) and not isinstance(i, bool) for i in x)):
             self.err(f"{path}: expected two link ids [i, j], got {x!r:.80} ({f.doc})")
+            return None
+        if x[0] == x[1]:
+            self.err(f"{path}: {f.rule or 'expected two different link ids [i, j]'}, got {x} ({f.doc})")
             return None
         return [x[0], x[1]]
 
@@ -253,7 +264,7 @@ class ReaderCore:
 
     def series(self, f: Field, x: Any, path: str) -> tuple[float, ...] | None:
         """A list of at least two finite numbers (each may be an expression), each within the
-        field's range."""
+        field's range, strictly increasing if the field says so."""
         if isinstance(x, list):
             x = [self.scalar(v, f"{path}[{i}]") for i, v in enumerate(x)]
             if None in x:
@@ -264,6 +275,11 @@ class ReaderCore:
         bad = [v for v in x if not _in_range(f, v)]
         if bad:
             self.out_of_range(f, path, shown_number(bad[0]))
+            return None
+        down = [(a, b) for a, b in zip(x, x[1:]) if b <= a] if f.increasing else []
+        if down:
+            self.err(f"{path}: the values must increase strictly, got {shown_number(down[0][1])} after "
+                     f"{shown_number(down[0][0])}")
             return None
         return tuple(float(v) for v in x)
 
@@ -327,9 +343,24 @@ class ReaderCore:
             return False
         return True
 
+    def one_of(self, section: Section, tab: Mapping, where: str, **given: Any) -> bool:
+        """Is exactly one field of each of the section's `one_of` groups given (of the groups whose
+        condition holds, given the values of its discriminating fields)? Recorded if not."""
+        ok = True
+        for g in section.one_of:
+            if g.when is not None and given.get(g.when[0], section[g.when[0]].default) not in g.when[1]:
+                continue
+            if sum(name in tab for name in g.fields) != 1:
+                allowed = section.keys(**given)
+                names = [name for name in g.fields if name in allowed]
+                self.err(f"{where}: give exactly one of {', '.join(names[:-1])} or {names[-1]}"
+                         + (f" ({g.hint})" if g.hint else ""))
+                ok = False
+        return ok
+
     def joined(self, pairs: list[Pair], lk: list[int], path: str) -> bool:
         """Do the links `lk` = [i, j] share a kinematic pair? (Recorded if not.)"""
-        if lk[0] != lk[1] and any(set(p.links) == set(lk) for p in pairs):
+        if any(set(p.links) == set(lk) for p in pairs):
             return True
         self.err(f"{path}: no kinematic pair joins links {lk}. Pairs: {[list(p.links) for p in pairs]}")
         return False

@@ -104,7 +104,8 @@ def _field(f: Field) -> dict:
                            "maxProperties": f.max_length},
         "point": lambda: {"type": "string"},
         "link": lambda: link,
-        "links": lambda: {"type": "array", "items": {"type": "integer", "minimum": 0}, "minItems": 2, "maxItems": 2},
+        "links": lambda: {"type": "array", "items": {"type": "integer", "minimum": 0}, "minItems": 2, "maxItems": 2,
+                          "uniqueItems": True},
         "angles": lambda: {"anyOf": [number, {"type": "array", "items": number, "minItems": 1,
                                               "maxItems": f.max_length}]},
         "com": lambda: {"anyOf": [{"type": "string", "description": "a point of the link"}, vector]},
@@ -185,7 +186,12 @@ def field_tables() -> str:
 
 
 def _range(f: Field) -> str:
-    """The field's range as FORMAT.md shows it ("> 0, < 45", "0..360", "1..16 printable characters")."""
+    """The field's range as FORMAT.md shows it ("> 0, < 45", "0..360, increasing", "1..16 printable characters")."""
+    bounds = _bounds(f)
+    return f"{bounds}, increasing" if f.increasing and bounds else "increasing" if f.increasing else bounds
+
+
+def _bounds(f: Field) -> str:
     if f.type == "map" and f.printable:
         return "printable strings"
     if f.min_length or f.printable:

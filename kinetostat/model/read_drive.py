@@ -6,7 +6,6 @@ May use: the standard library, numpy, core, limits, laws, parts, mechanism, sche
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
@@ -15,16 +14,15 @@ from .laws import mentions_phi
 from .limits import MAX_SHOWN, MAX_VALUE, MIN_GEAR
 from .mechanism import extent
 from .parts import Drive, Gear, Link, Pair, SpeedLaw
-from .schema import DRIVE, GEAR, OMEGA_TABLE
+from .schema import DRIVE, GEAR, MODEL, OMEGA_TABLE
 
 
 class DriveReading(ReaderCore):
     """The reader's sections for the drive: a part of `reader._Reader`."""
 
     def drive(self, links: list[Link], pairs: list[Pair]) -> Drive | None:
-        t = self.data.get("drive")
-        if not isinstance(t, dict):
-            self.err("drive: missing table [drive]")
+        t = self.read(MODEL, self.data, "drive", "")
+        if t is None:
             return None
         w = "drive"
         self.unknown_keys(t, DRIVE.keys(kind="machine"), w)     # gear with another kind: its own message below
@@ -40,11 +38,10 @@ class DriveReading(ReaderCore):
         ref = self.read(DRIVE, t, "reference", w)
         sense = self.read(DRIVE, t, "sense", w)
         law = None
-        if sum(k in t for k in ("rpm", "omega", "omega_table")) != 1:
-            self.err("drive: give exactly one of rpm, omega (a number, or an expression of phi) or omega_table")
+        if not self.one_of(DRIVE, t, w):
             omega = None
         elif "omega_table" in t:
-            law = self.speed_table(t["omega_table"], "drive.omega_table")
+            law = self.speed_table(self.read(DRIVE, t, "omega_table", w), "drive.omega_table")
         elif isinstance(t.get("omega"), str) and mentions_phi(t["omega"]):
             law = self.speed_expression(t["omega"], "drive.omega")
         elif "rpm" in t:
@@ -61,7 +58,7 @@ class DriveReading(ReaderCore):
         kind = self.read(DRIVE, t, "kind", w)
         gear = None
         if kind == "machine":
-            gear = self.gear(t.get("gear"), max((extent(k.points.values()) for k in links[1:]), default=0.0))
+            gear = self.gear(t, max((extent(k.points.values()) for k in links[1:]), default=0.0))
         elif "gear" in t:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
         if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
@@ -69,14 +66,12 @@ class DriveReading(ReaderCore):
         return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law,
                      self.source)
 
-    def speed_table(self, t: Any, where: str) -> SpeedLaw | None:
-        """[drive.omega_table]: phi_deg and omega (rad/s) or rpm over one revolution."""
-        if not isinstance(t, dict):
-            self.err(f"{where}: expected a table {{ phi_deg = [...], omega = [...] }} (or rpm = [...])")
+    def speed_table(self, t: dict | None, where: str) -> SpeedLaw | None:
+        """[drive.omega_table] (None: reported): phi_deg and omega (rad/s) or rpm over one revolution."""
+        if t is None:
             return None
         self.unknown_keys(t, OMEGA_TABLE.keys(), where)
-        if ("omega" in t) == ("rpm" in t):
-            self.err(f"{where}: give exactly one of omega (rad/s) or rpm")
+        if not self.one_of(OMEGA_TABLE, t, where):
             return None
         xs = self.read(OMEGA_TABLE, t, "phi_deg", where)
         key = "omega" if "omega" in t else "rpm"
@@ -88,9 +83,7 @@ class DriveReading(ReaderCore):
             self.err(f"{where}.{key}: {len(vs)} values for {len(xs)} angles")
         if len(xs) < 3:
             self.err(f"{where}.phi_deg: a periodic spline needs at least 3 angles, got {len(xs)}")
-        if any(b <= a for a, b in zip(xs, xs[1:])):
-            self.err(f"{where}.phi_deg: the angles must increase strictly")
-        elif not xs[-1] - xs[0] <= 360:
+        if not xs[-1] - xs[0] <= 360:
             self.err(f"{where}.phi_deg: the angles must lie within one revolution (last - first <= 360)")
         elif xs[-1] - xs[0] == 360 and len(vs) == len(xs) and vs[0] != vs[-1]:
             self.err(f"{where}.{key}: the law is periodic, but its values at {xs[0]:g} and {xs[-1]:g} deg "
@@ -134,11 +127,15 @@ class DriveReading(ReaderCore):
             return float(w.max()), float(np.abs(w * dw).max())
         return None, None
 
-    def gear(self, t: Any, size: float) -> Gear | None:
-        """[drive.gear]; `size`: the largest link, m (the wheel must not be vanishingly small beside it)."""
+    def gear(self, drive: dict, size: float) -> Gear | None:
+        """[drive.gear] of the table [drive]; `size`: the largest link, m (the wheel must not be
+        vanishingly small beside it)."""
         w = "drive.gear"
-        if not isinstance(t, dict):
+        if "gear" not in drive:
             self.err(f"{w}: a working machine needs the table [drive.gear] (module, z_pinion, z_wheel, ...)")
+            return None
+        t = self.read(DRIVE, drive, "gear", "drive")
+        if t is None:
             return None
         self.unknown_keys(t, GEAR.keys(), w)
         module = self.read(GEAR, t, "module", w)

@@ -104,8 +104,7 @@ class LinkReading(ReaderCore):
         for n, b in enumerate(raw):
             w = f"{where}.body[{n}]"
             self.unknown_keys(b, BODY.keys(), w)
-            if ("mass" in b) == ("weight" in b):
-                self.err(f"{w}: give exactly one of mass or weight")
+            if not self.one_of(BODY, b, w):
                 continue
             mass = self.read(BODY, b, "mass", w)
             if "weight" in b:
@@ -133,9 +132,6 @@ class LinkReading(ReaderCore):
             self.unknown_keys(t, PAIR.keys(kind=kind), where)
             lk = self.read(PAIR, t, "links", where)
             if lk is None or not all(self.link_ok(links, x, f"{where}.links") for x in lk):
-                continue
-            if lk[0] == lk[1]:
-                self.err(f"{where}.links: a pair joins two different links, got {lk}")
                 continue
             radius = self.read(PAIR, t, "radius", where)
             if kind == "R":

@@ -2,18 +2,19 @@
 order) into the values that the fields' expressions read (`core.ReaderCore.scalar`), its
 problems named by parameter.
 
-May use: the standard library, expressions, core, limits.
+May use: the standard library, expressions, core, limits, schema.
 """
 from __future__ import annotations
 
 import keyword
 import unicodedata
-from typing import Any, Mapping
+from typing import Mapping
 
 from ..expressions import CONSTANTS, FUNCTIONS
 from ..expressions import resolve as resolve_parameters
 from .core import ReaderCore, _suggest
-from .limits import LAW_VARIABLES, MAX_PARAMETERS
+from .limits import LAW_VARIABLES
+from .schema import MODEL
 
 
 def _code_points(name: str) -> str:
@@ -32,8 +33,9 @@ class ParameterReading(ReaderCore):
         if not isinstance(t, dict):
             self.err("parameters: expected a table of named numbers and expressions")
             t = {}
-        if len(t) > MAX_PARAMETERS:
-            self.err(f"parameters: {len(t)} parameters, at most {MAX_PARAMETERS}")
+        most = MODEL["parameters"].max_length
+        if len(t) > most:
+            self.err(f"parameters: {len(t)} parameters, at most {most}")
             t = {}
         raw = dict(t)
         for name in raw:

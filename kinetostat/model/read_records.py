@@ -9,9 +9,9 @@ from types import MappingProxyType
 from typing import Any, Mapping
 
 from .core import ReaderCore, _rule, _suggest
-from .limits import MAX_PUBLISHED_ANGLES, MAX_STUDY_VALUES, MAX_VALUE, _finite
+from .limits import MAX_STUDY_VALUES, MAX_VALUE, _finite
 from .parts import PUBLISHED_UNITS, Drive, Link, Load, Pair, Published, Study
-from .schema import LETTERING, PUBLISHED, REQUIRED, STUDY
+from .schema import LETTERING, MODEL, PUBLISHED, REQUIRED, STUDY
 
 
 class RecordReading(ReaderCore):
@@ -80,11 +80,10 @@ class RecordReading(ReaderCore):
             else [self.scalar(x, where)]
         if None in items and x is not None:
             return None
-        if x is None or not items or len(items) > MAX_PUBLISHED_ANGLES or \
-                not all(_finite(a) and abs(a) <= MAX_VALUE for a in items):
+        most = PUBLISHED["angle"].max_length
+        if x is None or not items or len(items) > most or not all(_finite(a) and abs(a) <= MAX_VALUE for a in items):
             self.err(f"{where}: " + ("missing (a crank angle in deg, or a list of them)" if x is None else
-                                     f"expected a finite number of deg or a list of 1..{MAX_PUBLISHED_ANGLES} "
-                                     f"of them, got {x!r}"[:200]))
+                                     f"expected a finite number of deg or a list of 1..{most} of them, got {x!r}"[:200]))
             return None
         return tuple(float(a) for a in items)
 
@@ -101,17 +100,14 @@ class RecordReading(ReaderCore):
 
     def study(self, pairs: list[Pair]) -> Study | None:
         """[study]: vary = { name = [values], ... } (one or two parameters), pair = [i, j], steps."""
-        t = self.data.get("study")
+        t = self.read(MODEL, self.data, "study", "")
         if t is None:
-            return None
-        if not isinstance(t, dict):
-            self.err("study: expected a table")
             return None
         self.unknown_keys(t, STUDY.keys(), "study")
         title = self.read(STUDY, t, "title", "study")
-        vary, v = [], t.get("vary")
-        if not (isinstance(v, dict) and 1 <= len(v) <= 2):
-            self.err(f"study.vary: expected a table of one or two parameters and their values, "
+        vary, v, most = [], t.get("vary"), STUDY["vary"].max_length
+        if not (isinstance(v, dict) and 1 <= len(v) <= most):
+            self.err(f"study.vary: expected a table of 1..{most} parameters and their values, "
                      f"e.g. {{ r = [0.05, 0.08], n_k = [60, 120] }}, got {v!r:.80}")
         else:
             for name, xs in v.items():
@@ -132,9 +128,8 @@ class RecordReading(ReaderCore):
 
     def lettering(self, links: list[Link], loads: list[Load]) -> Mapping[str, Any]:
         """`[lettering]`: the text's names (models/FORMAT.md), checked; frozen."""
-        t = self.data.get("lettering", {})
-        if not isinstance(t, dict):
-            self.err("lettering: expected a table")
+        t = self.read(MODEL, self.data, "lettering", "")
+        if t is None:
             return MappingProxyType({})
         self.unknown_keys(t, LETTERING.keys(), "lettering")
         out: dict[str, Any] = {}

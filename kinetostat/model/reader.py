@@ -27,10 +27,7 @@ class _Reader(ParameterReading, LinkReading, DriveReading, LoadReading, RecordRe
     def mechanism(self) -> Mechanism:
         d = self.data
         self.unknown_keys(d, MODEL.keys(), "<top level>")
-        head = d.get("mechanism", {})
-        if not isinstance(head, dict):
-            self.err("mechanism: expected a table")
-            head = {}
+        head = (self.read(MODEL, d, "mechanism", "") if "mechanism" in d else {}) or {}   # missing: its fields say so
         self.unknown_keys(head, MECHANISM.keys(), "mechanism")
         self.read_parameters(head)
         name = self.read(MECHANISM, head, "name", "mechanism")

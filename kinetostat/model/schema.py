@@ -46,7 +46,8 @@ class Field:
     exclusive_maximum: float | None = None   # value < exclusive_maximum (as minimum)
     min_length: int = 0               # strings: fewest characters
     printable: bool = False           # strings (a map's too): printable characters only
-    rule: str = ""                    # the message when out of range or choices, "{minimum}" etc. filled
+    increasing: bool = False          # series: strictly increasing
+    rule: str = ""                    # the message when out of range or choices (links: the same id twice), "{minimum}" etc. filled
                                       # in from the field (default: the range, "must be >= 0.0")
     when: tuple[str, tuple] | None = None   # (field, values): allowed only when that field has one of them
     required_when: tuple[str, tuple] | None = None   # (field, values): required when that field has one of them
@@ -57,9 +58,10 @@ class Field:
 @dataclass(frozen=True)
 class OneOf:
     """Exactly one of `fields` is given (only when the field `when[0]` has one of the values
-    `when[1]`, if `when`)."""
+    `when[1]`, if `when`); `hint`: what the reader's message adds."""
     fields: tuple[str, ...]
     when: tuple[str, tuple] | None = None
+    hint: str = ""
 
 
 @dataclass(frozen=True)
@@ -117,10 +119,10 @@ GEAR = Section("drive.gear", "The last gear pair of a working machine (drive.kin
 ))
 
 OMEGA_TABLE = Section("drive.omega_table", "A law of motion omega(phi) as a table over one revolution (periodic cubic spline).", (
-    Field("phi_deg", "series", "crank angles, strictly increasing, within 360 deg", "deg", default=REQUIRED, expression=True),
+    Field("phi_deg", "series", "crank angles, within 360 deg", "deg", default=REQUIRED, expression=True, increasing=True),
     Field("omega", "series", "crank speeds (or rpm)", "rad/s", expression=True, minimum=0.0, rule=_SPEEDS),
     Field("rpm", "series", "crank speeds (or omega)", "rpm", expression=True, minimum=0.0, rule=_SPEEDS),
-), one_of=(OneOf(("omega", "rpm")),))
+), one_of=(OneOf(("omega", "rpm"), hint="omega in rad/s"),))
 
 DRIVE = Section("drive", "The initial link I(0,1): the crank, its angle's reference and sense, its speed.", (
     Field("link", "link", "the crank: always 1", default=1, minimum=1, maximum=1, rule="the crank must be link {minimum}"),
@@ -137,7 +139,7 @@ DRIVE = Section("drive", "The initial link I(0,1): the crank, its angle's refere
           default="engine", choices=("engine", "machine")),
     Field("gear", "table", "the gear mesh of a machine", default=REQUIRED, section=GEAR, when=("kind", ("machine",))),
     _num("design_deg", "the design position: crank angle of the mechanism's picture", "deg", default=30.0),
-), one_of=(OneOf(("rpm", "omega", "omega_table")),))
+), one_of=(OneOf(("rpm", "omega", "omega_table"), hint="omega: a number, or an expression of phi"),))
 
 MECHANISM = Section("mechanism", "What the model is and where its data come from.", (
     _name("free text, labels plots and plans", "unnamed"),
@@ -170,7 +172,8 @@ LINK = Section("link", "A moving link, one table each, numbered as in the text (
 
 PAIR = Section("pair", "A lower kinematic pair: revolute R or prismatic P.", (
     Field("kind", "string", "revolute or prismatic", default=REQUIRED, choices=("R", "P")),
-    Field("links", "links", "R: the two links; P: [guide link, slider link]", default=REQUIRED),
+    Field("links", "links", "R: the two links; P: [guide link, slider link]", default=REQUIRED,
+          rule="a pair joins two different links"),
     Field("point", "point", "R: a point of both links; P: a point of the slider on the guide line", default=REQUIRED),
     _num("radius", "journal radius, for friction losses", "m", positive=True),
     Field("guide", "point", "a point of the guide link on the guide line", default=REQUIRED, when=("kind", ("P",))),
@@ -187,9 +190,9 @@ GROUP = Section("group", "The assembly branch of an Assur group (RRR, RRP, RPR).
 
 LOAD_TABLE = Section("load.table", "A piecewise-linear load diagram; the load is scale * value.", (
     Field("phi_deg", "series", "argument: crank angle (or travel)", "deg", expression=True, minimum=0.0, maximum=360.0,
-          rule="angles must lie in [{minimum:g}, {maximum:g}]"),
+          increasing=True, rule="angles must lie in [{minimum:g}, {maximum:g}]"),
     Field("travel", "series", "argument: fraction of the stroke (or phi_deg)", expression=True, minimum=0.0,
-          maximum=1.0, rule="fractions of stroke must lie in [{minimum:g}, {maximum:g}]"),
+          maximum=1.0, increasing=True, rule="fractions of stroke must lie in [{minimum:g}, {maximum:g}]"),
     Field("value", "series", "the diagram's values (forward stroke for travel)", expression=True, default=REQUIRED),
     Field("value_return", "series", "travel only: values on the return stroke (default: value)", expression=True),
     _num("scale", "load per table unit", "N or N m", default=1.0),
@@ -198,7 +201,7 @@ LOAD_TABLE = Section("load.table", "A piecewise-linear load diagram; the load is
 ), one_of=(OneOf(("phi_deg", "travel")),))
 
 CHARACTERISTIC = Section("load.characteristic", "A motor's M(omega), in the drive's sense: a table (or an expression of omega).", (
-    Field("omega", "series", "speeds, strictly increasing", "rad/s", default=REQUIRED, expression=True),
+    Field("omega", "series", "speeds", "rad/s", default=REQUIRED, expression=True, increasing=True),
     Field("M", "series", "moments at those speeds", "N m", default=REQUIRED, expression=True),
 ))
 
