@@ -15,7 +15,7 @@ from ..expressions import ExpressionError, parse as parse_expression, shown_numb
 from .limits import MAX_NAME, MAX_PROBLEMS, MAX_SHOWN, MAX_VALUE, _finite, _subnormal
 from .lines import _Lines
 from .parts import Link, Pair, Vec
-from .schema import REQUIRED, Field, Section
+from .schema import MODEL, REQUIRED, Field, Section
 
 
 def _suggest(name: Any, valid) -> str:
@@ -153,6 +153,12 @@ class ReaderCore:
         if f.type == "table":
             if not isinstance(x, dict):
                 self.err(f"{path}: expected a table {{ {', '.join(g.name for g in f.section.fields)} }}")
+                return None
+            return x
+        if f.type == "tables":
+            if not (isinstance(x, list) and len(x) >= f.min_length and all(isinstance(t, dict) for t in x)):
+                self.err(f"{path}: expected an array of tables ([[{f.section.name}]]) with "
+                         f"{', '.join(g.name for g in f.section.fields)}")
                 return None
             return x
         if f.type == "number":
@@ -303,11 +309,8 @@ class ReaderCore:
         return (float(x[0]), float(x[1]))
 
     def table_list(self, key: str) -> list:
-        x = self.data.get(key, [])
-        if not isinstance(x, list) or not all(isinstance(t, dict) for t in x):
-            self.err(f"{key}: expected an array of tables ([[{key}]])")
-            return []
-        return x
+        """The array of tables `[[key]]` of the file (none: [])."""
+        return self.read(MODEL, self.data, key, "", default=[]) or []
 
     def unknown_keys(self, tab: Mapping, allowed: set[str], where: str) -> None:
         unused = sorted(allowed.difference(tab))

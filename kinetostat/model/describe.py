@@ -114,7 +114,8 @@ def _field(f: Field) -> dict:
                                                                 "an expression of omega (rad/s)"}]},
         "map": lambda: _map(f),
         "table": lambda: _ref(f.section),
-        "tables": lambda: {"type": "array", "items": {"$ref": f"#/definitions/{f.section.name}"}},
+        "tables": lambda: {"type": "array", "items": {"$ref": f"#/definitions/{f.section.name}"},
+                           **({"minItems": f.min_length} if f.min_length else {})},
     }
     out = {"title": f.name + (f" ({f.unit})" if f.unit else ""), "description": _describe(f), **kinds[f.type]()}
     if f.default not in (None, REQUIRED) and not (isinstance(f.default, str) and "<" in f.default):
@@ -194,6 +195,8 @@ def _range(f: Field) -> str:
 def _bounds(f: Field) -> str:
     if f.type == "map" and f.printable:
         return "printable strings"
+    if f.type == "tables" and f.min_length:
+        return f"at least {f.min_length}"
     if f.min_length or f.printable:
         return f"{f.min_length}..{f.max_length} printable characters"
     low = "> 0" if f.positive else None if f.minimum is None else f">= {f.minimum:g}"

@@ -93,12 +93,11 @@ class LinkReading(ReaderCore):
     def bodies(self, t: Mapping, where: str, pts: dict[str, Vec], g: float | None) -> tuple[Body, ...]:
         """[[link.body]]: each with mass (or weight), com (a point of the link or [x, y]) and
         I_S about its own centre (default 0, a point mass); () after recording a problem."""
-        raw = t["body"]
         for key in ("mass", "weight", "I_S"):
             if key in t:
                 self.err(f"{where}.{key}: a link given by bodies takes its {key} from them; remove it")
-        if not (isinstance(raw, list) and raw and all(isinstance(b, dict) for b in raw)):
-            self.err(f"{where}.body: expected an array of tables [[link.body]] (mass, com, I_S)")
+        raw = self.read(LINK, t, "body", where)
+        if raw is None:
             return ()
         n0, out = len(self.problems), []
         for n, b in enumerate(raw):

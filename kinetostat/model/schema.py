@@ -44,7 +44,7 @@ class Field:
     max_length: int | None = None     # strings: most characters; lists and tables: most items
     maximum: float | None = None      # value <= maximum (as minimum)
     exclusive_maximum: float | None = None   # value < exclusive_maximum (as minimum)
-    min_length: int = 0               # strings: fewest characters
+    min_length: int = 0               # strings: fewest characters; tables: fewest tables
     printable: bool = False           # strings (a map's too): printable characters only
     increasing: bool = False          # series: strictly increasing
     rule: str = ""                    # the message when out of range or choices (links: the same id twice), "{minimum}" etc. filled
@@ -167,7 +167,8 @@ LINK = Section("link", "A moving link, one table each, numbered as in the text (
     _num("weight", "weight, converted with g (or mass)", "N", minimum=0.0),
     _num("I_S", "moment of inertia about the centre of mass", "kg m^2", default=0.0, minimum=0.0),
     Field("com", "string", "the point that is the centre of mass (needed if mass > 0; with bodies: a new point)"),
-    Field("body", "tables", "the bodies the link is made of, instead of mass, weight and I_S", section=BODY),
+    Field("body", "tables", "the bodies the link is made of, instead of mass, weight and I_S", section=BODY,
+          min_length=1),
 ), array=True)
 
 PAIR = Section("pair", "A lower kinematic pair: revolute R or prismatic P.", (
