@@ -1,6 +1,9 @@
 """The reader's machinery: problems collected with their lines (each cause once, the rest counted),
-and the typed getters each field of the schema is read with (number, vector, string, integer,
-points, series, a link's id, a point of a link, unknown keys with "did you mean").
+expressions evaluated, and `ReaderCore.read`, which reads a field as its `schema.Field` says (type,
+range, choices, length, order, shape, default; the message from the field's `rule` or its range)
+through the typed getters (number, integer, string, strings, [i, j], series, vector, table, array
+of tables, table of names), beside the getters the schema cannot say alone (points, a link's id
+among the links, a point of a link, unknown keys with "did you mean", exactly one of a group).
 
 May use: the standard library, expressions, limits, lines, parts, schema.
 """
@@ -59,9 +62,9 @@ def _rule(f: Field) -> str:
 
 
 class ReaderCore:
-    """What every section of the reader uses: the problems collected (each once, with its line),
-    the state of what was read, and the typed getters that check a field as the schema
-    (`schema.Section`) describes it. Each getter returns None after recording a problem."""
+    """The base of every section of the reader (`read_*`): the problems collected (each once,
+    with its line), the state of what was read, and the typed getters that check a field as the
+    schema (`schema.Section`) describes it. Each getter returns None after recording a problem."""
 
     def __init__(self, data: Mapping[str, Any], source: str, text: str | None = None,
                  overrides: Mapping[str, Any] | None = None):
