@@ -106,10 +106,13 @@ def _field(f: Field) -> dict:
         "link": lambda: link,
         "links": lambda: {"type": "array", "items": {"type": "integer", "minimum": 0}, "minItems": 2, "maxItems": 2,
                           "uniqueItems": True},
-        "angles": lambda: {"anyOf": [number, {"type": "array", "items": number, "minItems": 1,
-                                              "maxItems": f.max_length}]},
-        "com": lambda: {"anyOf": [{"type": "string", "description": "a point of the link"}, vector]},
-        "load_direction": lambda: {"anyOf": [vector, {"enum": ["against_velocity", "against_omega"]}]},
+        # one schema of several types rather than anyOf: each keyword applies to its own type
+        # (minimum to numbers, items to arrays, pattern to strings), and an editor names it
+        "angles": lambda: {**number, "type": ["number", "string", "array"], "items": number, "minItems": 1,
+                           "maxItems": f.max_length},
+        "com": lambda: {**vector, "type": ["string", "array"]},
+        "load_direction": lambda: {**vector, "type": ["array", "string"],
+                                   "pattern": "^(against_velocity|against_omega)$"},
         "characteristic": lambda: {"anyOf": [_ref(f.section), {"type": "string", "description":
                                                                 "an expression of omega (rad/s)"}]},
         "map": lambda: _map(f),
