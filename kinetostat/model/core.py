@@ -42,11 +42,11 @@ def _in_range(f: Field, x: Any) -> bool:
             and (f.exclusive_maximum is None or x < f.exclusive_maximum))
 
 
-def _rule(f: Field) -> str:
-    """What a value outside the field's range or choices is told: the field's own `rule` (its
+def _rule(f: Field, rule: str = "") -> str:
+    """What a value outside the field's range or choices is told: `rule` or the field's own (its
     range filled in), else the range itself ("must be >= 0.0", "expected +1 or -1")."""
-    if f.rule:
-        return f.rule.format_map(vars(f))
+    if rule or f.rule:
+        return (rule or f.rule).format_map(vars(f))
     if f.choices:
         signed = any(isinstance(c, int) and c < 0 for c in f.choices)
         return "expected " + " or ".join(f"{c:+d}" if signed else repr(c) for c in f.choices)
@@ -183,8 +183,10 @@ class ReaderCore:
         raise TypeError(f"{section.name}.{key}: a {f.type} field has its own reader")
 
     def out_of_range(self, f: Field, path: str, shown: str) -> None:
-        """Record that the value `shown` of field `f` at `path` is outside its range or choices."""
-        self.err(f"{path}: {_rule(f)}, got {shown}")
+        """Record that the value `shown` of field `f` at `path` is outside its range or choices
+        (where the field's rule places it with "{value}", there; else after it)."""
+        rule = f.rule.replace("{value}", shown) if "{value}" in f.rule else ""
+        self.err(f"{path}: {_rule(f, rule)}" if rule else f"{path}: {_rule(f)}, got {shown}")
 
     def number(self, f: Field, x: Any, path: str) -> float | None:
         x0, x = x, self.scalar(x, path) if f.expression else x

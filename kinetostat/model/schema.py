@@ -47,8 +47,9 @@ class Field:
     min_length: int = 0               # strings: fewest characters; tables: fewest tables
     printable: bool = False           # strings (a map's too): printable characters only
     increasing: bool = False          # series: strictly increasing
-    rule: str = ""                    # the message when out of range or choices (links: the same id twice), "{minimum}" etc. filled
-                                      # in from the field (default: the range, "must be >= 0.0")
+    rule: str = ""                    # the message when out of range or choices (links: the same id twice), "{minimum}"
+                                      # etc. filled in from the field, "{value}" the value (else ", got" it follows);
+                                      # default: the range, "must be >= 0.0"
     when: tuple[str, tuple] | None = None   # (field, values): allowed only when that field has one of them
     required_when: tuple[str, tuple] | None = None   # (field, values): required when that field has one of them
     section: "Section | None" = None  # table, tables, characteristic: its table
@@ -251,7 +252,7 @@ PUBLISHED = Section("published", "A value the source prints for this model, chec
     Field("point", "point", "velocity, acceleration: the point", default=REQUIRED, when=("quantity", _AT_POINT)),
     Field("relative_to", "point", "velocity, acceleration: minus this point's", when=("quantity", _AT_POINT)),
     Field("link", "link", "omega, eps, inertia_force, inertia_moment: the moving link", default=REQUIRED, minimum=1,
-          when=("quantity", _OF_LINK), rule="expected a moving link (>= {minimum})"),
+          when=("quantity", _OF_LINK), rule="unknown moving link {value}: expected a link >= {minimum}"),
     Field("pair", "links", "reaction: R(i, j), force of link i on link j", default=REQUIRED,
           when=("quantity", ("reaction",))),
     Field("angle", "angles", "crank angle, or a list of them with reduce", "deg", default=REQUIRED, expression=True,
