@@ -1,5 +1,5 @@
-"""The command line: `kinetostat analyze | structure | plans | validate | report | export | examples | variant | sweep`
-(also `python -m kinetostat`).
+"""The command line, `kinetostat COMMAND`: analyze, structure, plans, validate, report, export, examples,
+variant, sweep, schema (also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance or a route that raised, or
 `report` could not make a model's report; 2 bad input or options (model file, structure,
@@ -16,8 +16,8 @@ characters visible, and every error, warning and summary line stays one line (a 
 
 The rooms: `common` (what every command shares: exit codes, errors, output, interrupts, atomic
 saving, progress, loading), one module per command or group of related commands (`analyze`:
-analyze, structure, export, examples; `validate`; `report`; `plans`: plans, variant; `sweep`),
-`parser` (the options of every command), and `main` here.
+analyze, structure, export, examples, schema; `validate`; `report`; `plans`: plans, variant;
+`sweep`), `parser` (the options of every command), and `main` here.
 
 May use: every room of the package, and the harness inside the commands that need it
 (imported there, so that `import kinetostat.cli` loads no engine).

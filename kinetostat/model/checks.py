@@ -11,7 +11,7 @@ from types import MappingProxyType
 from typing import Iterator, Mapping
 
 from .limits import FASTEST_PIN, FORCE_SCALE, GYRATION_SPANS, LARGEST_LINK
-from .mechanism import Mechanism, _span
+from .mechanism import Mechanism, extent
 from .parts import Friction, Link, Pair, Vec
 
 
@@ -85,14 +85,14 @@ def doubts(mech: Mechanism, group_tables: Mapping[frozenset, tuple[int, tuple]],
         yield "mechanism.g", (f"{mech.g:g} m/s^2 is far from the 9.81 of the texts (warned outside 1..100): "
                               f"is it in m/s^2? (0 switches gravity off)")
     for link in mech.links[1:]:
-        span = _span(link.points.values())
+        span = extent(link.points.values())
         if link.mass > 0 and span > 0 and math.sqrt(link.I_S / link.mass) > GYRATION_SPANS * span:
             yield f"link[id={link.id}].I_S", (
                 f"{link.I_S:.4g} kg m^2 gives a radius of gyration of {math.sqrt(link.I_S / link.mass):.4g} m, "
                 f"more than {GYRATION_SPANS:g} times the link's span {span:.4g} m: is it in kg m^2? "
                 f"(g mm^2 is 1e-9 kg m^2, kg mm^2 1e-6)")
     scale = FORCE_SCALE * max([mech.g * link.mass for link in mech.links]
-                              + [link.mass * _span(link.points.values()) * mech.drive.omega**2 for link in mech.links])
+                              + [link.mass * extent(link.points.values()) * mech.drive.omega**2 for link in mech.links])
     for n, ld in enumerate(mech.loads):
         if ld.kind == "force" and ld.table is not None and 0 < max(map(abs, ld.table.value)) * abs(ld.table.scale) < scale:
             peak = max(map(abs, ld.table.value)) * abs(ld.table.scale)

@@ -1,6 +1,9 @@
 """The reader's machinery: problems collected with their lines (each cause once, the rest counted),
-and the typed getters each field of the schema is read with (number, vector, string, integer,
-points, series, a link's id, a point of a link, unknown keys with "did you mean").
+expressions evaluated, and `ReaderCore.read`, which reads a field as its `schema.Field` says (type,
+range, choices, length, order, shape, default; the message from the field's `rule` or its range)
+through the typed getters (number, integer, string, strings, [i, j], series, vector, table, array
+of tables, table of names), beside the getters the schema cannot say alone (points, a link's id
+among the links, a point of a link, unknown keys with "did you mean", exactly one of a group).
 
 May use: the standard library, expressions, limits, lines, parts, schema.
 """
@@ -11,11 +14,11 @@ import re
 import sys
 from typing import Any, Mapping
 
-from ..expressions import shown_number, suggest
-from .limits import MAX_NAME, MAX_POINTS, MAX_PROBLEMS, MAX_SHOWN, MAX_VALUE, _finite, _subnormal
+from ..expressions import ExpressionError, parse as parse_expression, shown_number, suggest
+from .limits import MAX_NAME, MAX_PROBLEMS, MAX_SHOWN, MAX_VALUE, _finite, _subnormal
 from .lines import _Lines
-from .parts import Link, Vec
-from .schema import REQUIRED, Section
+from .parts import Link, Pair, Vec
+from .schema import MODEL, REQUIRED, Field, Section
 
 
 def _suggest(name: Any, valid) -> str:
@@ -24,11 +27,44 @@ def _suggest(name: Any, valid) -> str:
     return suggest(name, valid) if isinstance(name, str) else ""
 
 
+#: What a missing required field of each type is, in its message ("missing (a number is required)").
+_WANTED = {"number": "a number", "integer": "an integer", "link": "a link id", "string": "a string",
+           "strings": "a list of strings", "links": "two link ids [i, j]", "series": "a list of numbers",
+           "vector": "[x, y]", "direction": "a direction [x, y]", "map": "a table"}
+
+
+def _in_range(f: Field, x: Any) -> bool:
+    """Is `x` (a number, or a string's length and characters) within the field's range and choices?"""
+    if isinstance(x, str):
+        return f.min_length <= len(x) <= (f.max_length or len(x)) and (x.isprintable() or not f.printable)
+    return ((not f.choices or x in f.choices) and (f.minimum is None or x >= f.minimum)
+            and (f.maximum is None or x <= f.maximum) and not (f.positive and x <= 0)
+            and (f.exclusive_maximum is None or x < f.exclusive_maximum))
+
+
+def _rule(f: Field, rule: str = "") -> str:
+    """What a value outside the field's range or choices is told: `rule` or the field's own (its
+    range filled in), else the range itself ("must be >= 0.0", "expected +1 or -1")."""
+    if rule or f.rule:
+        return (rule or f.rule).format_map(vars(f))
+    if f.choices:
+        signed = any(isinstance(c, int) and c < 0 for c in f.choices)
+        return "expected " + " or ".join(f"{c:+d}" if signed else repr(c) for c in f.choices)
+    if f.type in ("integer", "link"):
+        lo, hi = f.minimum, f.maximum
+        span = f"{lo}..{hi}" if hi is not None and lo is not None else f">= {lo}" if lo is not None else f"<= {hi}"
+        return f"expected an integer {span} ({f.doc})"
+    if f.positive:
+        return "must be > 0"
+    bounds = [f">= {f.minimum}"] * (f.minimum is not None) + [f"<= {f.maximum}"] * (f.maximum is not None) \
+        + [f"< {f.exclusive_maximum}"] * (f.exclusive_maximum is not None)
+    return ("values " if f.type == "series" else "") + "must be " + " and ".join(bounds)
+
 
 class ReaderCore:
-    """What every section of the reader uses: the problems collected (each once, with its line),
-    the state of what was read, and the typed getters that check a field as the schema
-    (`schema.Section`) describes it. Each getter returns None after recording a problem."""
+    """The base of every section of the reader (`read_*`): the problems collected (each once,
+    with its line), the state of what was read, and the typed getters that check a field as the
+    schema (`schema.Section`) describes it. Each getter returns None after recording a problem."""
 
     def __init__(self, data: Mapping[str, Any], source: str, text: str | None = None,
                  overrides: Mapping[str, Any] | None = None):
@@ -77,50 +113,186 @@ class ReaderCore:
                 steps += (self.link_table.get(int(m[5]), -1) if m[4] else int(m[5]),)
         return self.where_lines.line(steps) if steps else None
 
-    # -- parameters and expressions
+    # -- the typed getters: a field read as its table (schema.Section) describes it
+
+    def scalar(self, x: Any, path: str) -> Any:
+        """`x` itself, or the value of the expression `x` (a string) over the parameters; None
+        after recording a problem (naming `path` and the parameter that fails)."""
+        if path == "mechanism.g" and "g" in self.values:      # also a number that an override of g replaces
+            return self.values["g"]
+        if not isinstance(x, str):
+            return x
+        try:
+            e = parse_expression(x)
+            bad = sorted(n for n in e.names if n in self.failed)
+            if bad:
+                raise ExpressionError(f"reads {', '.join(map(repr, bad))}, which has an error (see "
+                                      f"{', '.join('mechanism.g' if n == 'g' else f'parameters.{n}' for n in bad)})")
+            value = e(self.values)
+        except ExpressionError as exc:
+            self.err(f'{path}: expression "{x:.{MAX_SHOWN}}": {exc}')
+            return None
+        self.expressions[path] = (x, value)
+        return value
+
 
     def read(self, section: Section, tab: Mapping, key: str, where: str, **default: Any) -> Any:
         """Field `key` of the table `tab` (at `where`), checked as `section` describes it: its type,
-        range, choices and default (`default=...` gives a default that depends on the table,
-        such as a link's name)."""
+        range, choices, length, shape and default (`default=...` gives a default that depends on
+        the table, such as a link's name). None after recording a problem (or when an optional
+        field without default is not given)."""
         f = section[key]
         d = default.get("default", f.default)
+        path = f"{where}.{key}" if where else key
+        if key not in tab:
+            if d == REQUIRED and f.type == "table" and not where:
+                self.err(f"{path}: missing table [{key}]")
+            elif d == REQUIRED and f.type == "table":
+                self.err(f"{path}: missing (a table {{ {', '.join(g.name for g in f.section.fields)} }} is required)")
+            elif d == REQUIRED:
+                self.err(f"{path}: missing ({_WANTED[f.type]} is required)")
+            return None if d == REQUIRED else d
+        x = tab[key]
+        if f.type == "table":
+            if not isinstance(x, dict):
+                self.err(f"{path}: expected a table {{ {', '.join(g.name for g in f.section.fields)} }}")
+                return None
+            return x
+        if f.type == "tables":
+            if not (isinstance(x, list) and len(x) >= f.min_length and all(isinstance(t, dict) for t in x)):
+                self.err(f"{path}: expected an array of tables ([[{f.section.name}]]) with "
+                         f"{', '.join(g.name for g in f.section.fields)}")
+                return None
+            return x
         if f.type == "number":
-            return self.number(tab, key, where, default=d, minimum=f.minimum, positive=f.positive, divisor=f.divisor)
+            return self.number(f, x, path)
+        if f.type in ("integer", "link"):
+            return self.integer(f, x, path)
         if f.type == "string":
-            return self.string(tab, key, where, choices=f.choices or None, default=d, max_length=f.max_length)
-        if f.type == "integer":
-            return self.integer(tab, key, where)
+            return self.string(f, x, path)
+        if f.type == "strings":
+            return self.strings(f, x, path)
+        if f.type == "links":
+            return self.link_ids(f, x, path)
+        if f.type == "series":
+            return self.series(f, x, path)
+        if f.type in ("vector", "direction"):
+            return self.vec(x, path, unit=f.type == "direction")
+        if f.type == "map" and f.items == "string":
+            return self.names(f, x, path)
         raise TypeError(f"{section.name}.{key}: a {f.type} field has its own reader")
 
-    def number(self, tab: Mapping, key: str, where: str, *, default: Any = REQUIRED,
-               minimum: float | None = None, positive: bool = False, divisor: bool = False) -> float | None:
-        if key not in tab:
-            if default == REQUIRED:
-                self.err(f"{where}.{key}: missing (a number is required)")
-                return None
-            return default
-        x = self.scalar(tab[key], f"{where}.{key}")
+    def out_of_range(self, f: Field, path: str, shown: str) -> None:
+        """Record that the value `shown` of field `f` at `path` is outside its range or choices
+        (where the field's rule places it with "{value}", there; else after it)."""
+        rule = f.rule.replace("{value}", shown) if "{value}" in f.rule else ""
+        self.err(f"{path}: {_rule(f, rule)}" if rule else f"{path}: {_rule(f)}, got {shown}")
+
+    def number(self, f: Field, x: Any, path: str) -> float | None:
+        x0, x = x, self.scalar(x, path) if f.expression else x
+        if isinstance(x, str):
+            self.err(f"{path}: expected a number, got {x!r:.{MAX_SHOWN}}")
+            return None
         if x is None:
             return None
-        shown = shown_number(x) if not isinstance(tab[key], str) else f'{x!r} (= "{tab[key]:.{MAX_SHOWN}}")'
+        shown = shown_number(x) if not isinstance(x0, str) else f'{x!r} (= "{x0:.{MAX_SHOWN}}")'
         if not _finite(x):
-            self.err(f"{where}.{key}: expected a finite number, got {shown}")
+            self.err(f"{path}: expected a finite number, got {shown}")
             return None
         if abs(x) > MAX_VALUE:
-            self.err(f"{where}.{key}: {shown} is out of range (|value| <= {MAX_VALUE:g})")
+            self.err(f"{path}: {shown} is out of range (|value| <= {MAX_VALUE:g})")
             return None
-        if (positive or divisor) and _subnormal(x):
-            self.err(f"{where}.{key}: {shown} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
+        if (f.positive or f.divisor) and _subnormal(x):
+            self.err(f"{path}: {shown} is subnormal (0 < |value| < {sys.float_info.min:.3g}): it loses its "
                      f"digits, and its products turn into 0, NaN or inf; write 0 or the value meant")
             return None
-        if positive and x <= 0:
-            self.err(f"{where}.{key}: must be > 0, got {shown}")
-            return None
-        if minimum is not None and x < minimum:
-            self.err(f"{where}.{key}: must be >= {minimum}, got {shown}")
+        if not _in_range(f, x):
+            self.out_of_range(f, path, shown)
             return None
         return float(x)
+
+    def integer(self, f: Field, x: Any, path: str) -> int | None:
+        """An integer (or an expression giving a whole number) within the field's range or choices."""
+        given, x = x, self.scalar(x, path) if f.expression else x
+        if isinstance(x, float) and x.is_integer() and isinstance(given, str):
+            x = int(x)
+        if not isinstance(x, int) or isinstance(x, bool):
+            if x is not None:
+                one = f.choices or (f.minimum is not None and f.minimum == f.maximum)    # "+1 or -1", "link 1"
+                want = _rule(f) if one else "expected an integer"
+                self.err(f"{path}: {want}, got {x!r}" + (
+                    "" if not (isinstance(x, float) and x.is_integer()) else
+                    " (write it without a decimal point)" if want == "expected an integer"
+                    else " (an integer: write it without a decimal point)"))
+            return None
+        if not _in_range(f, x):
+            self.out_of_range(f, path, repr(x))
+            return None
+        return x
+
+    def string(self, f: Field, x: Any, path: str) -> str | None:
+        if not isinstance(x, str):
+            self.err(f"{path}: expected a string, got {x!r}")
+            return None
+        if f.choices and x not in f.choices:
+            self.err(f"{path}: invalid value {x!r}{_suggest(x, f.choices)}. Valid values: {list(f.choices)}")
+            return None
+        if f.max_length is not None and len(x) > f.max_length and not f.rule:
+            self.err(f"{path}: {len(x)} characters, at most {f.max_length} (it labels plots and plans)")
+            return None
+        if not _in_range(f, x):
+            self.out_of_range(f, path, repr(x))
+            return None
+        return x
+
+    def strings(self, f: Field, x: Any, path: str) -> tuple[str, ...] | None:
+        if not (isinstance(x, list) and all(isinstance(a, str) for a in x)):
+            self.err(f"{path}: expected a list of strings, got {x!r:.80}")
+            return None
+        return tuple(x)
+
+    def link_ids(self, f: Field, x: Any, path: str) -> list[int] | None:
+        """[i, j]: two different link ids (whether they are links, and joined, the caller asks)."""
+        if not (isinstance(x, list) and len(x) == 2 and all(isinstance(i, int) and not isinstance(i, bool) for i in x)):
+            self.err(f"{path}: expected two link ids [i, j], got {x!r:.80} ({f.doc})")
+            return None
+        if x[0] == x[1]:
+            self.err(f"{path}: {f.rule or 'expected two different link ids [i, j]'}, got {x} ({f.doc})")
+            return None
+        return [x[0], x[1]]
+
+    def names(self, f: Field, x: Any, path: str) -> dict[str, str] | None:
+        """A table of strings by name (its keys among the field's choices, if it has any)."""
+        if not (isinstance(x, dict) and all(isinstance(v, str) and (v.isprintable() or not f.printable)
+                                            for v in x.values())):
+            self.err(f"{path}: expected a table of {'printable ' if f.printable else ''}strings")
+            return None
+        bad = sorted(set(x) - set(f.choices)) if f.choices else []
+        if bad:
+            self.err(f"{path}.{bad[0]}: {_rule(f)}{_suggest(bad[0], f.choices)}. Valid: {sorted(f.choices)}")
+            return None
+        return dict(x)
+
+    def series(self, f: Field, x: Any, path: str) -> tuple[float, ...] | None:
+        """A list of at least two finite numbers (each may be an expression), each within the
+        field's range, strictly increasing if the field says so."""
+        if isinstance(x, list):
+            x = [self.scalar(v, f"{path}[{i}]") for i, v in enumerate(x)]
+            if None in x:
+                return None
+        if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) and abs(v) <= MAX_VALUE for v in x)):
+            self.err(f"{path}: expected a list of at least two finite numbers (|value| <= {MAX_VALUE:g})")
+            return None
+        bad = [v for v in x if not _in_range(f, v)]
+        if bad:
+            self.out_of_range(f, path, shown_number(bad[0]))
+            return None
+        down = [(a, b) for a, b in zip(x, x[1:]) if b <= a] if f.increasing else []
+        if down:
+            self.err(f"{path}: the values must increase strictly, got {shown_number(down[0][1])} after "
+                     f"{shown_number(down[0][0])}")
+            return None
+        return tuple(float(v) for v in x)
 
     def vec(self, x: Any, where: str, *, unit: bool = False) -> Vec | None:
         if isinstance(x, list) and len(x) == 2:
@@ -141,41 +313,9 @@ class ReaderCore:
             return (x[0] / n, x[1] / n)
         return (float(x[0]), float(x[1]))
 
-    def string(self, tab: Mapping, key: str, where: str, *, choices: tuple[str, ...] | None = None,
-               default: Any = REQUIRED, max_length: int | None = None) -> str | None:
-        if key not in tab:
-            if default == REQUIRED:
-                self.err(f"{where}.{key}: missing (a string is required)")
-                return None
-            return default
-        x = tab[key]
-        if not isinstance(x, str):
-            self.err(f"{where}.{key}: expected a string, got {x!r}")
-            return None
-        if choices and x not in choices:
-            self.err(f"{where}.{key}: invalid value {x!r}{_suggest(x, choices)}. Valid values: {list(choices)}")
-            return None
-        if max_length is not None and len(x) > max_length:
-            self.err(f"{where}.{key}: {len(x)} characters, at most {max_length} (it labels plots and plans)")
-            return None
-        return x
-
-    def integer(self, tab: Mapping, key: str, where: str) -> int | None:
-        x = self.scalar(tab.get(key), f"{where}.{key}")     # an expression must give a whole number
-        if isinstance(x, float) and x.is_integer() and isinstance(tab.get(key), str):
-            x = int(x)
-        if not isinstance(x, int) or isinstance(x, bool):
-            self.err(f"{where}.{key}: expected an integer, got {x!r}" if key in tab
-                     else f"{where}.{key}: missing (an integer is required)")
-            return None
-        return x
-
     def table_list(self, key: str) -> list:
-        x = self.data.get(key, [])
-        if not isinstance(x, list) or not all(isinstance(t, dict) for t in x):
-            self.err(f"{key}: expected an array of tables ([[{key}]])")
-            return []
-        return x
+        """The array of tables `[[key]]` of the file (none: [])."""
+        return self.read(MODEL, self.data, key, "", default=[]) or []
 
     def unknown_keys(self, tab: Mapping, allowed: set[str], where: str) -> None:
         unused = sorted(allowed.difference(tab))
@@ -211,11 +351,34 @@ class ReaderCore:
             return False
         return True
 
-    def points(self, raw: Any, where: str, lid: int | None = None) -> dict[str, Vec]:
-        """A table of named points; those that fail are recorded in points_unread for link `lid`."""
-        if not isinstance(raw, dict) or not raw or len(raw) > MAX_POINTS:
+    def one_of(self, section: Section, tab: Mapping, where: str, **given: Any) -> bool:
+        """Is exactly one field of each of the section's `one_of` groups given (of the groups whose
+        condition holds, given the values of its discriminating fields)? Recorded if not."""
+        ok = True
+        for g in section.one_of:
+            if g.when is not None and given.get(g.when[0], section[g.when[0]].default) not in g.when[1]:
+                continue
+            if sum(name in tab for name in g.fields) != 1:
+                allowed = section.keys(**given)
+                names = [name for name in g.fields if name in allowed]
+                self.err(f"{where}: give exactly one of {', '.join(names[:-1])} or {names[-1]}"
+                         + (f" ({g.hint})" if g.hint else ""))
+                ok = False
+        return ok
+
+    def joined(self, pairs: list[Pair], lk: list[int], path: str) -> bool:
+        """Do the links `lk` = [i, j] share a kinematic pair? (Recorded if not.)"""
+        if any(set(p.links) == set(lk) for p in pairs):
+            return True
+        self.err(f"{path}: no kinematic pair joins links {lk}. Pairs: {[list(p.links) for p in pairs]}")
+        return False
+
+    def points(self, f: Field, raw: Any, where: str, lid: int | None = None) -> dict[str, Vec]:
+        """A table of named points (at most the field's max_length); those that fail are recorded
+        in points_unread for link `lid`."""
+        if not isinstance(raw, dict) or not raw or len(raw) > f.max_length:
             self.err(f"{where}: {'missing: ' if raw is None else ''}expected a table of named points {{A = [x, y], ...}}"
-                     + (f", at most {MAX_POINTS} of them, got {len(raw)}" if raw and isinstance(raw, dict) else ""))
+                     + (f", at most {f.max_length} of them, got {len(raw)}" if raw and isinstance(raw, dict) else ""))
             self.points_unread.add((lid, None))
             return {}
         out = {}
@@ -231,13 +394,3 @@ class ReaderCore:
             else:
                 self.points_unread.add((lid, name))
         return out
-
-    def series(self, x: Any, where: str) -> tuple[float, ...] | None:
-        if isinstance(x, list):
-            x = [self.scalar(v, f"{where}[{i}]") for i, v in enumerate(x)]
-            if None in x:
-                return None
-        if not (isinstance(x, list) and len(x) >= 2 and all(_finite(v) and abs(v) <= MAX_VALUE for v in x)):
-            self.err(f"{where}: expected a list of at least two finite numbers (|value| <= {MAX_VALUE:g})")
-            return None
-        return tuple(float(v) for v in x)

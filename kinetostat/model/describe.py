@@ -23,9 +23,6 @@ SCHEMA_FILE = Path(__file__).with_name("model.schema.json")
 FORMAT_MD = Path(__file__).resolve().parents[2] / "models" / "FORMAT.md"
 BEGIN, END = "<!-- fields: begin (generated from kinetostat/model/schema.py; do not edit) -->", "<!-- fields: end -->"
 
-_EXPRESSION = {"type": "string", "description": "an expression over [parameters], e.g. \"3.05 * l_OA\""}
-
-
 def json_schema() -> dict:
     """The JSON Schema (draft-07) of a model file read as TOML: every table and field, with its
     title and description (what editors show), type, range, default and allowed keys."""
@@ -36,7 +33,7 @@ def json_schema() -> dict:
 
 
 def _section(s: Section) -> dict:
-    out: dict[str, Any] = {"type": "object", "description": s.doc,
+    out: dict[str, Any] = {"type": "object", "description": _doc(s),
                            "properties": {f.name: _field(f) for f in s.fields}, "additionalProperties": False}
     required = [f.name for f in s.fields if f.default == REQUIRED and f.when is None]
     if required:
@@ -44,30 +41,53 @@ def _section(s: Section) -> dict:
     conditions = []
     for f in s.fields:
         if f.when is not None:
-            key, values = f.when
-            test: dict[str, Any] = {"properties": {key: {"enum": list(values)}}}
-            if s[key].default not in values:
-                test["required"] = [key]
-            conditions.append({"if": test, "else": {"properties": {f.name: False}},
+            conditions.append({"if": _holds(s, f.when), "else": {"properties": {f.name: False}},
                                **({"then": {"required": [f.name]}} if f.default == REQUIRED else {})})
+        if f.required_when is not None:
+            conditions.append({"if": _holds(s, f.required_when), "then": {"required": [f.name]}})
+    for group in s.one_of:
+        one = {"oneOf": [{"required": [name]} for name in group.fields]}
+        conditions.append(one if group.when is None else {"if": _holds(s, group.when), "then": one})
     if conditions:
         out["allOf"] = conditions
     return out
 
 
+def _holds(s: Section, when: tuple[str, tuple]) -> dict:
+    """A JSON Schema that holds when the field `when[0]` of `s` has one of the values `when[1]`
+    (its default counts when it is not given)."""
+    key, values = when
+    test: dict[str, Any] = {"properties": {key: {"enum": list(values)}}}
+    if s[key].default not in values:
+        test["required"] = [key]
+    return test
+
+
+def _doc(s: Section) -> str:
+    """The table's line, with the groups of its fields of which exactly one is given."""
+    return s.doc + "".join(f" Exactly one of {', '.join(g.fields)}" + (
+        f" (with {g.when[0]} = {' or '.join(g.when[1])})" if g.when else "") + "." for g in s.one_of)
+
+
 def _number(f: Field, integer: bool = False) -> dict:
-    out: dict[str, Any] = {"type": "integer" if integer else "number"}
+    """A number (an integer) within the field's range, or an expression if the field takes one:
+    {"type": ["number", "string"], "minimum": ...} (minimum and maximum apply to numbers only),
+    so that an editor names the bound a number breaks."""
+    kind = "integer" if integer else "number"
+    out: dict[str, Any] = {"type": [kind, "string"] if f.expression else kind}
     if f.choices:
         out["enum"] = list(f.choices)
     if f.positive:
         out["exclusiveMinimum"] = 0
     out["minimum"] = f.minimum if f.minimum is not None else -MAX_VALUE
     out["maximum"] = f.maximum if f.maximum is not None else MAX_VALUE
-    return {"anyOf": [out, _EXPRESSION]} if f.expression else out
+    if f.exclusive_maximum is not None:
+        out["exclusiveMaximum"] = f.exclusive_maximum
+    return out
 
 
 def _field(f: Field) -> dict:
-    number = {"anyOf": [{"type": "number", "minimum": -MAX_VALUE, "maximum": MAX_VALUE}, _EXPRESSION]}
+    number = {"type": ["number", "string"], "minimum": -MAX_VALUE, "maximum": MAX_VALUE}
     vector = {"type": "array", "items": number, "minItems": 2, "maxItems": 2}
     link = {"type": "integer", "minimum": f.minimum or 0}
     if f.maximum is not None:
@@ -75,24 +95,30 @@ def _field(f: Field) -> dict:
     kinds: dict[str, Any] = {
         "number": lambda: _number(f), "integer": lambda: _number(f, integer=True),
         "string": lambda: {"type": "string", **({"enum": list(f.choices)} if f.choices else {}),
+                           **({"minLength": f.min_length} if f.min_length else {}),
                            **({"maxLength": f.max_length} if f.max_length else {})},
         "strings": lambda: {"type": "array", "items": {"type": "string"}},
         "vector": lambda: vector, "direction": lambda: vector,
-        "series": lambda: {"type": "array", "items": number, "minItems": 2},
+        "series": lambda: {"type": "array", "items": _number(f), "minItems": 2},
         "points": lambda: {"type": "object", "additionalProperties": vector, "minProperties": 1,
                            "maxProperties": f.max_length},
         "point": lambda: {"type": "string"},
         "link": lambda: link,
-        "links": lambda: {"type": "array", "items": {"type": "integer", "minimum": 0}, "minItems": 2, "maxItems": 2},
-        "angles": lambda: {"anyOf": [number, {"type": "array", "items": number, "minItems": 1,
-                                              "maxItems": f.max_length}]},
-        "com": lambda: {"anyOf": [{"type": "string", "description": "a point of the link"}, vector]},
-        "load_direction": lambda: {"anyOf": [vector, {"enum": ["against_velocity", "against_omega"]}]},
+        "links": lambda: {"type": "array", "items": {"type": "integer", "minimum": 0}, "minItems": 2, "maxItems": 2,
+                          "uniqueItems": True},
+        # one schema of several types rather than anyOf: each keyword applies to its own type
+        # (minimum to numbers, items to arrays, pattern to strings), and an editor names it
+        "angles": lambda: {**number, "type": ["number", "string", "array"], "items": number, "minItems": 1,
+                           "maxItems": f.max_length},
+        "com": lambda: {**vector, "type": ["string", "array"]},
+        "load_direction": lambda: {**vector, "type": ["array", "string"],
+                                   "pattern": "^(against_velocity|against_omega)$"},
         "characteristic": lambda: {"anyOf": [_ref(f.section), {"type": "string", "description":
                                                                 "an expression of omega (rad/s)"}]},
         "map": lambda: _map(f),
         "table": lambda: _ref(f.section),
-        "tables": lambda: {"type": "array", "items": {"$ref": f"#/definitions/{f.section.name}"}},
+        "tables": lambda: {"type": "array", "items": {"$ref": f"#/definitions/{f.section.name}"},
+                           **({"minItems": f.min_length} if f.min_length else {})},
     }
     out = {"title": f.name + (f" ({f.unit})" if f.unit else ""), "description": _describe(f), **kinds[f.type]()}
     if f.default not in (None, REQUIRED) and not (isinstance(f.default, str) and "<" in f.default):
@@ -101,10 +127,12 @@ def _field(f: Field) -> dict:
 
 
 def _map(f: Field) -> dict:
-    items = {"number": {"anyOf": [{"type": "number"}, _EXPRESSION]},
+    items = {"number": {"type": ["number", "string"]},
              "numbers": {"type": "array", "items": {"type": "number"}, "minItems": 1, "maxItems": MAX_STUDY_VALUES},
              "string": {"type": "string"}}[f.items]
     out: dict[str, Any] = {"type": "object", "additionalProperties": items}
+    if f.choices:
+        out["propertyNames"] = {"enum": list(f.choices)}
     if f.max_length:
         out["maxProperties"] = f.max_length
     if f.default == REQUIRED:
@@ -128,6 +156,8 @@ def _describe(f: Field, unit: bool = True) -> str:
         out += f" (only with {f.when[0]} = {' or '.join(map(str, f.when[1]))})"
     if f.default == REQUIRED:
         out += ". Required"
+    if f.required_when is not None:
+        out += f". Required with {f.required_when[0]} = {' or '.join(map(str, f.required_when[1]))}"
     return out + "."
 
 
@@ -146,7 +176,7 @@ def field_tables() -> str:
     out = []
     for s in sections():
         head = "Top level" if s is MODEL else (f"`[[{s.name}]]`" if s.array else f"`[{s.name}]`")
-        out += [f"#### {head}", "", s.doc.replace("|", "\\|"), "", "| field | type | unit | range | default | expression | description |",
+        out += [f"#### {head}", "", _doc(s).replace("|", "\\|"), "", "| field | type | unit | range | default | expression | description |",
                 "|---|---|---|---|---|---|---|"]
         for f in s.fields:
             kind = _TYPES[f.type] + (": " + ", ".join(f"`{json.dumps(c)}`" for c in f.choices) if f.choices else "")
@@ -160,12 +190,26 @@ def field_tables() -> str:
 
 
 def _range(f: Field) -> str:
-    if f.positive:
-        return "> 0"
+    """The field's range as FORMAT.md shows it ("> 0, < 45", "0..360, increasing", "1..16 printable characters")."""
+    bounds = _bounds(f)
+    return f"{bounds}, increasing" if f.increasing and bounds else "increasing" if f.increasing else bounds
+
+
+def _bounds(f: Field) -> str:
+    if f.type == "map" and f.printable:
+        return "printable strings"
+    if f.type == "tables" and f.min_length:
+        return f"at least {f.min_length}"
+    if f.min_length or f.printable:
+        return f"{f.min_length}..{f.max_length} printable characters"
+    low = "> 0" if f.positive else None if f.minimum is None else f">= {f.minimum:g}"
+    high = None if f.exclusive_maximum is None else f"< {f.exclusive_maximum:g}"
     if f.minimum is not None and f.maximum is not None:
         return f"{f.minimum:g}" + (f"..{f.maximum:g}" if f.maximum != f.minimum else "")
-    if f.minimum is not None:
-        return f">= {f.minimum:g}"
+    if f.maximum is not None:
+        high = f"<= {f.maximum:g}"
+    if low or high:
+        return ", ".join(b for b in (low, high) if b)
     if f.max_length is not None:
         return f"at most {f.max_length}" + (" characters" if f.type == "string" else "")
     return ""

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..expressions import ExpressionError, parse as parse_expression
 
-def _mentions_phi(text: str) -> bool:
+def mentions_phi(text: str) -> bool:
     """Whether a drive's `omega` string is a law of motion (an expression of `phi`) rather than
     a constant speed written over the model's parameters (`"n1 * pi / 30"`)."""
     try:

@@ -109,11 +109,11 @@ class Mechanism:
         return self.memo("size", self._largest_link)
 
     def _largest_link(self) -> float:
-        return max((_span(link.points.values()) for link in self.links[1:]), default=0.0) or 1.0
+        return max((extent(link.points.values()) for link in self.links[1:]), default=0.0) or 1.0
 
 
 
-def _span(points) -> float:
+def extent(points) -> float:
     """Largest distance between two of `points` ((x, y) pairs), m."""
     return diameter(complex(*xy) for xy in points)
 

@@ -1,36 +1,32 @@
 """The reader's section for the drive: the crank, its speed or law of motion, the gear mesh of
 a working machine.
 
-May use: the standard library, numpy, limits, laws, parts, mechanism, schema.
+May use: the standard library, numpy, core, limits, laws, parts, mechanism, schema.
 """
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
-from .laws import _mentions_phi
+from .core import ReaderCore
+from .laws import mentions_phi
 from .limits import MAX_SHOWN, MAX_VALUE, MIN_GEAR
-from .mechanism import _span
+from .mechanism import extent
 from .parts import Drive, Gear, Link, Pair, SpeedLaw
-from .schema import DRIVE, GEAR, OMEGA_TABLE
+from .schema import DRIVE, GEAR, MODEL, OMEGA_TABLE
 
 
-class DriveReading:
-    """The reader's sections for the drive: a part of `reader._Reader`, using the getters of
-    `core.ReaderCore`."""
+class DriveReading(ReaderCore):
+    """The reader's sections for the drive: a part of `reader._Reader`."""
 
     def drive(self, links: list[Link], pairs: list[Pair]) -> Drive | None:
-        t = self.data.get("drive")
-        if not isinstance(t, dict):
-            self.err("drive: missing table [drive]")
+        t = self.read(MODEL, self.data, "drive", "")
+        if t is None:
             return None
         w = "drive"
-        self.unknown_keys(t, DRIVE.keys(), w)
-        link = t.get("link", 1)
-        if link != 1:
-            self.err(f"drive.link: the crank must be link 1, got {link!r}")
+        self.unknown_keys(t, DRIVE.keys(kind="machine"), w)     # gear with another kind: its own message below
+        self.read(DRIVE, t, "link", w)
         pivot, point = t.get("pivot"), t.get("point")
         if len(links) > 1:
             if self.point_ok(links, 1, pivot, "drive.pivot") & self.point_ok(links, 1, point, "drive.point") \
@@ -39,15 +35,14 @@ class DriveReading:
                          f"(zero crank length: the crank angle has no direction)")
             if not any(p.kind == "R" and set(p.links) == {0, 1} and p.point == pivot for p in pairs):
                 self.err(f"drive.pivot: the crank needs a revolute pair with the frame at {pivot!r}")
-        ref = self.vec(t.get("reference"), "drive.reference", unit=True)
+        ref = self.read(DRIVE, t, "reference", w)
         sense = self.read(DRIVE, t, "sense", w)
         law = None
-        if sum(k in t for k in ("rpm", "omega", "omega_table")) != 1:
-            self.err("drive: give exactly one of rpm, omega (a number, or an expression of phi) or omega_table")
+        if not self.one_of(DRIVE, t, w):
             omega = None
         elif "omega_table" in t:
-            law = self.speed_table(t["omega_table"], "drive.omega_table")
-        elif isinstance(t.get("omega"), str) and _mentions_phi(t["omega"]):
+            law = self.speed_table(self.read(DRIVE, t, "omega_table", w), "drive.omega_table")
+        elif isinstance(t.get("omega"), str) and mentions_phi(t["omega"]):
             law = self.speed_expression(t["omega"], "drive.omega")
         elif "rpm" in t:
             rpm = self.read(DRIVE, t, "rpm", w)
@@ -57,13 +52,13 @@ class DriveReading:
         if law is not None and "eps" in t:
             self.err("drive.eps: a law of motion gives eps = omega d omega / d phi itself; remove eps")
         eps = self.read(DRIVE, t, "eps", w)
-        if "omega_table" in t or isinstance(t.get("omega"), str) and _mentions_phi(t["omega"]):
+        if "omega_table" in t or isinstance(t.get("omega"), str) and mentions_phi(t["omega"]):
             omega, eps = (None, None) if law is None else self.law_scales(law)
         design = self.read(DRIVE, t, "design_deg", w)
         kind = self.read(DRIVE, t, "kind", w)
         gear = None
         if kind == "machine":
-            gear = self.gear(t.get("gear"), max((_span(k.points.values()) for k in links[1:]), default=0.0))
+            gear = self.gear(t, max((extent(k.points.values()) for k in links[1:]), default=0.0))
         elif "gear" in t:
             self.err("drive.gear: only a working machine (drive.kind = 'machine') has a gear mesh")
         if None in (ref, sense, omega, eps, design) or (kind == "machine" and gear is None):
@@ -71,18 +66,16 @@ class DriveReading:
         return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law,
                      self.source)
 
-    def speed_table(self, t: Any, where: str) -> SpeedLaw | None:
-        """[drive.omega_table]: phi_deg and omega (rad/s) or rpm over one revolution."""
-        if not isinstance(t, dict):
-            self.err(f"{where}: expected a table {{ phi_deg = [...], omega = [...] }} (or rpm = [...])")
+    def speed_table(self, t: dict | None, where: str) -> SpeedLaw | None:
+        """[drive.omega_table] (None: reported): phi_deg and omega (rad/s) or rpm over one revolution."""
+        if t is None:
             return None
         self.unknown_keys(t, OMEGA_TABLE.keys(), where)
-        if ("omega" in t) == ("rpm" in t):
-            self.err(f"{where}: give exactly one of omega (rad/s) or rpm")
+        if not self.one_of(OMEGA_TABLE, t, where):
             return None
-        xs = self.series(t.get("phi_deg"), f"{where}.phi_deg")
+        xs = self.read(OMEGA_TABLE, t, "phi_deg", where)
         key = "omega" if "omega" in t else "rpm"
-        vs = self.series(t.get(key), f"{where}.{key}")
+        vs = self.read(OMEGA_TABLE, t, key, where)
         if xs is None or vs is None:
             return None
         n = len(self.problems)
@@ -90,15 +83,11 @@ class DriveReading:
             self.err(f"{where}.{key}: {len(vs)} values for {len(xs)} angles")
         if len(xs) < 3:
             self.err(f"{where}.phi_deg: a periodic spline needs at least 3 angles, got {len(xs)}")
-        if any(b <= a for a, b in zip(xs, xs[1:])):
-            self.err(f"{where}.phi_deg: the angles must increase strictly")
-        elif not xs[-1] - xs[0] <= 360:
+        if not xs[-1] - xs[0] <= 360:
             self.err(f"{where}.phi_deg: the angles must lie within one revolution (last - first <= 360)")
         elif xs[-1] - xs[0] == 360 and len(vs) == len(xs) and vs[0] != vs[-1]:
             self.err(f"{where}.{key}: the law is periodic, but its values at {xs[0]:g} and {xs[-1]:g} deg "
                      f"({vs[0]:g}, {vs[-1]:g}) differ")
-        if any(v < 0 for v in vs):
-            self.err(f"{where}.{key}: the crank turns in the drive's sense: speeds must be >= 0")
         if len(self.problems) > n:
             return None
         scale = 1.0 if key == "omega" else math.pi / 30
@@ -138,26 +127,25 @@ class DriveReading:
             return float(w.max()), float(np.abs(w * dw).max())
         return None, None
 
-    def gear(self, t: Any, size: float) -> Gear | None:
-        """[drive.gear]; `size`: the largest link, m (the wheel must not be vanishingly small beside it)."""
+    def gear(self, drive: dict, size: float) -> Gear | None:
+        """[drive.gear] of the table [drive]; `size`: the largest link, m (the wheel must not be
+        vanishingly small beside it)."""
         w = "drive.gear"
-        if not isinstance(t, dict):
+        if "gear" not in drive:
             self.err(f"{w}: a working machine needs the table [drive.gear] (module, z_pinion, z_wheel, ...)")
+            return None
+        t = self.read(DRIVE, drive, "gear", "drive")
+        if t is None:
             return None
         self.unknown_keys(t, GEAR.keys(), w)
         module = self.read(GEAR, t, "module", w)
         z1, z2 = self.read(GEAR, t, "z_pinion", w), self.read(GEAR, t, "z_wheel", w)
-        for key, z in (("z_pinion", z1), ("z_wheel", z2)):
-            if z is not None and z < GEAR[key].minimum:
-                self.err(f"{w}.{key}: a gear needs at least {GEAR[key].minimum} teeth, got {z}")
         corr = self.read(GEAR, t, "correction", w)
         if corr == "unequal" and "alpha_w_deg" not in t:
             self.err(f"{w}.alpha_w_deg: required for an unequal correction (25-26 deg typically)")
         alpha = self.read(GEAR, t, "alpha_w_deg", w)
-        if alpha is not None and alpha >= 45:
-            self.err(f"{w}.alpha_w_deg: pressure angle must be below 45 deg, got {alpha}")
         y = self.read(GEAR, t, "y", w)
-        cd = self.vec(t.get("centre_direction"), f"{w}.centre_direction", unit=True)
+        cd = self.read(GEAR, t, "centre_direction", w)
         if None in (module, z1, z2, corr, alpha, y, cd):
             return None
         gear = Gear(module, z1, z2, corr, alpha, y, cd)

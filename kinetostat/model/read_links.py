@@ -1,7 +1,7 @@
 """The reader's sections for the mechanism's body: the links (and their bodies), the pairs, the
 groups' branches.
 
-May use: the standard library, limits, parts, mechanism, schema, checks, core (its name suggestions).
+May use: the standard library, limits, parts, mechanism, schema, checks, core.
 """
 from __future__ import annotations
 
@@ -9,24 +9,23 @@ from types import MappingProxyType
 from typing import Mapping
 
 from .checks import check_pairs, turned_slider
-from .core import _suggest
+from .core import ReaderCore, _in_range, _suggest
 from .limits import MAX_VALUE, MIN_LENGTH
-from .mechanism import _span
+from .mechanism import extent
 from .parts import Body, Link, Pair, Vec, combine
-from .schema import BODY, GROUP, LINK, PAIR
+from .schema import BODY, GROUP, LINK, MODEL, PAIR
 
 
-class LinkReading:
-    """The reader's sections for links, their bodies, pairs, groups: a part of `reader._Reader`, using the getters of
-    `core.ReaderCore`."""
+class LinkReading(ReaderCore):
+    """The reader's sections for links, their bodies, pairs, groups: a part of `reader._Reader`."""
 
     def links(self, g: float | None) -> list[Link]:
-        frame = Link(0, "frame", MappingProxyType(self.points(self.data.get("frame"), "frame", 0)))
+        frame = Link(0, "frame", MappingProxyType(self.points(MODEL["frame"], self.data.get("frame"), "frame", 0)))
         raw = self.table_list("link")
         by_id: dict[int, Link] = {}
         for n, t in enumerate(raw):
             lid = t.get("id")
-            valid_id = isinstance(lid, int) and not isinstance(lid, bool) and lid > 0
+            valid_id = isinstance(lid, int) and not isinstance(lid, bool) and _in_range(LINK["id"], lid)
             # named by its id, as the texts number links; by its table's place only without one
             where = f"link[id={lid}]" if valid_id and lid not in by_id else f"[[link]] #{n + 1}"
             if valid_id and lid not in by_id:
@@ -35,14 +34,12 @@ class LinkReading:
             if valid_id and lid in by_id:
                 self.err(f"{where}.id: duplicate link id {lid} (link[id={lid}] is [[link]] "
                          f"#{self.link_table[lid] + 1})")
-            elif isinstance(lid, int) and not isinstance(lid, bool) and lid <= 0:
-                self.err(f"{where}.id: moving links are numbered from 1 (0 is the frame), got {lid}")
             elif not valid_id:
-                self.integer(t, "id", where)
+                self.read(LINK, t, "id", where)
             if not valid_id or lid in by_id:
                 self.ids_unknown = True
                 lid = None
-            pts = self.points(t.get("points"), f"{where}.points", lid)
+            pts = self.points(LINK["points"], t.get("points"), f"{where}.points", lid)
             bodies: tuple[Body, ...] = ()
             if "body" in t:
                 bodies = self.bodies(t, where, pts, g)
@@ -76,7 +73,7 @@ class LinkReading:
                 self.err(f"{where}.com: unknown point {com!r}{_suggest(com, pts)}. Valid names: {sorted(pts)}")
             if mass and com is None:
                 self.err(f"{where}.com: missing (a link with mass needs its centre-of-mass point)")
-            span = _span(pts.values()) if pts else None
+            span = extent(pts.values()) if pts else None
             if span == 0 and len(pts) >= 2:
                 self.coincident[lid if lid is not None else -n - 1] = where     # refused unless in a P pair
             elif span is not None and 0 < span < MIN_LENGTH:
@@ -96,19 +93,17 @@ class LinkReading:
     def bodies(self, t: Mapping, where: str, pts: dict[str, Vec], g: float | None) -> tuple[Body, ...]:
         """[[link.body]]: each with mass (or weight), com (a point of the link or [x, y]) and
         I_S about its own centre (default 0, a point mass); () after recording a problem."""
-        raw = t["body"]
         for key in ("mass", "weight", "I_S"):
             if key in t:
                 self.err(f"{where}.{key}: a link given by bodies takes its {key} from them; remove it")
-        if not (isinstance(raw, list) and raw and all(isinstance(b, dict) for b in raw)):
-            self.err(f"{where}.body: expected an array of tables [[link.body]] (mass, com, I_S)")
+        raw = self.read(LINK, t, "body", where)
+        if raw is None:
             return ()
         n0, out = len(self.problems), []
         for n, b in enumerate(raw):
             w = f"{where}.body[{n}]"
             self.unknown_keys(b, BODY.keys(), w)
-            if ("mass" in b) == ("weight" in b):
-                self.err(f"{w}: give exactly one of mass or weight")
+            if not self.one_of(BODY, b, w):
                 continue
             mass = self.read(BODY, b, "mass", w)
             if "weight" in b:
@@ -134,14 +129,8 @@ class LinkReading:
             where = f"pair[{n}]"
             kind = self.read(PAIR, t, "kind", where)
             self.unknown_keys(t, PAIR.keys(kind=kind), where)
-            lk = t.get("links")
-            if not (isinstance(lk, list) and len(lk) == 2):
-                self.err(f"{where}.links: expected two link ids [i, j], got {lk!r}")
-                continue
-            if not all(self.link_ok(links, x, f"{where}.links") for x in lk):
-                continue
-            if lk[0] == lk[1]:
-                self.err(f"{where}.links: a pair joins two different links, got {lk}")
+            lk = self.read(PAIR, t, "links", where)
+            if lk is None or not all(self.link_ok(links, x, f"{where}.links") for x in lk):
                 continue
             radius = self.read(PAIR, t, "radius", where)
             if kind == "R":
@@ -159,8 +148,8 @@ class LinkReading:
                 order = " (links = [guide link, slider link]: the {} is on link {})"
                 ok = self.point_ok(links, lk[1], pt, f"{where}.point", order.format("point", lk[1]))
                 ok &= self.point_ok(links, lk[0], gd, f"{where}.guide", order.format("guide point", lk[0]))
-                d = self.vec(t.get("direction"), f"{where}.direction", unit=True)
-                axis = self.vec(t["slider_axis"], f"{where}.slider_axis", unit=True) if "slider_axis" in t else None
+                d = self.read(PAIR, t, "direction", where)
+                axis = self.read(PAIR, t, "slider_axis", where) if "slider_axis" in t else None
                 if ok and d is not None and ("slider_axis" not in t or axis is not None):
                     if axis is not None:
                         self.slider_axes.add(len(out))
@@ -175,16 +164,11 @@ class LinkReading:
         for n, t in enumerate(self.table_list("group")):
             where = f"group[{n}]"
             self.unknown_keys(t, GROUP.keys(), where)
-            lk = t.get("links")
-            if not (isinstance(lk, list) and len(lk) == 2
-                    and all(self.link_ok(links, x, f"{where}.links") for x in lk)):
-                if not isinstance(lk, list) or len(lk) != 2:
-                    self.err(f"{where}.links: expected two link ids, got {lk!r}")
+            lk = self.read(GROUP, t, "links", where)
+            if lk is None or not all(self.link_ok(links, x, f"{where}.links") for x in lk):
                 continue
-            b = t.get("branch")
-            if not isinstance(b, int) or isinstance(b, bool) or b not in (1, -1):
-                self.err(f"{where}.branch: expected +1 or -1, got {b!r}"
-                         + (" (an integer: write it without a decimal point)" if isinstance(b, float) else ""))
+            b = self.read(GROUP, t, "branch", where)
+            if b is None:
                 continue
             key = frozenset(lk)
             if key in out and out[key] != b:

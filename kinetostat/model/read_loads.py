@@ -1,7 +1,7 @@
 """The reader's sections for what acts on the mechanism: loads (forces, moments, dampers, their
 diagrams and characteristics), springs, friction.
 
-May use: the standard library, numpy, limits, parts, schema.
+May use: the standard library, numpy, core, limits, parts, schema.
 """
 from __future__ import annotations
 
@@ -9,14 +9,14 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from .core import ReaderCore
 from .limits import MAX_SHOWN
 from .parts import Characteristic, Friction, Link, Load, Pair, Spring, Table
-from .schema import CHARACTERISTIC, FRICTION, LOAD, LOAD_TABLE, SPRING, SPRING_END
+from .schema import CHARACTERISTIC, FRICTION, LOAD, LOAD_TABLE, MODEL, SPRING, SPRING_END
 
 
-class LoadReading:
-    """The reader's sections for loads, springs, friction: a part of `reader._Reader`, using the getters of
-    `core.ReaderCore`."""
+class LoadReading(ReaderCore):
+    """The reader's sections for loads, springs, friction: a part of `reader._Reader`."""
 
     def loads(self, links: list[Link], pairs: list[Pair]) -> list[Load]:
         out = []
@@ -31,11 +31,8 @@ class LoadReading:
                     out.append(damper)
                 continue
             self.unknown_keys(t, LOAD.keys(kind=kind or "force"), where)
-            lid = t.get("link")
-            if not self.link_ok(links, lid, f"{where}.link"):
-                continue
-            if lid == 0:
-                self.err(f"{where}.link: loads on the frame do not enter the analysis")
+            lid = self.read(LOAD, t, "link", where)
+            if lid is None or not self.link_ok(links, lid, f"{where}.link"):
                 continue
             point, direction = None, None
             if kind == "force":
@@ -50,12 +47,10 @@ class LoadReading:
                 if raw not in (None, "against_omega"):
                     self.err(f"{where}.direction: a moment takes no direction or 'against_omega', got {raw!r}")
                 direction = raw
-            if sum(k in t for k in ("value", "table", "characteristic")) != 1:
-                self.err(f"{where}: give exactly one of value or table"
-                         + (" or characteristic" if kind == "moment" else ""))
+            if not self.one_of(LOAD, t, where, kind=kind or "force"):
                 continue
             value = self.read(LOAD, t, "value", where)
-            table = self.table(t["table"], f"{where}.table") if "table" in t else None
+            table = self.table(self.read(LOAD, t, "table", where), f"{where}.table") if "table" in t else None
             if "characteristic" in t:
                 if direction is not None:
                     self.err(f"{where}.direction: a characteristic M(omega) gives its own sign")
@@ -97,62 +92,48 @@ class LoadReading:
             self.err(f"{where}: expected {{ omega = [...], M = [...] }} (rad/s, N m) or an expression of omega")
             return None
         self.unknown_keys(t, CHARACTERISTIC.keys(), where)
-        ws, ms = self.series(t.get("omega"), f"{where}.omega"), self.series(t.get("M"), f"{where}.M")
+        ws, ms = self.read(CHARACTERISTIC, t, "omega", where), self.read(CHARACTERISTIC, t, "M", where)
         if ws is None or ms is None:
             return None
         if len(ws) != len(ms):
             self.err(f"{where}.M: {len(ms)} values for {len(ws)} speeds")
-        elif any(b <= a for a, b in zip(ws, ws[1:])):
-            self.err(f"{where}.omega: the speeds must increase strictly")
-        else:
-            return Characteristic(ws, ms)
-        return None
+            return None
+        return Characteristic(ws, ms)
 
     def damper(self, t: Mapping, where: str, name: str, links: list[Link], pairs: list[Pair]) -> Load | None:
         """A viscous damper on the pair `pair` = [i, j]: coefficient c >= 0."""
-        lk = t.get("pair")
+        lk = self.read(LOAD, t, "pair", where)
         c = self.read(LOAD, t, "c", where)
-        if not (isinstance(lk, list) and len(lk) == 2 and all(self.link_ok(links, x, f"{where}.pair") for x in lk)):
-            if not isinstance(lk, list) or len(lk) != 2:
-                self.err(f"{where}.pair: expected the two link ids [i, j] of a pair, got {lk!r}")
-            return None
-        if not any(set(p.links) == set(lk) for p in pairs):
-            self.err(f"{where}.pair: no kinematic pair joins links {lk}. Pairs: {[list(p.links) for p in pairs]}")
+        if lk is None or not all(self.link_ok(links, x, f"{where}.pair") for x in lk) \
+                or not self.joined(pairs, lk, f"{where}.pair"):
             return None
         if c is None:
             return None
         return Load(name, "damper", lk[1], None, None, c, None, None, (lk[0], lk[1]))
 
-    def table(self, t: Any, where: str) -> Table | None:
-        if not isinstance(t, dict):
-            self.err(f"{where}: expected a table")
+    def table(self, t: dict | None, where: str) -> Table | None:
+        """A load diagram [load.table] (None: reported)."""
+        if t is None:
             return None
         self.unknown_keys(t, LOAD_TABLE.keys(), where)
-        if ("phi_deg" in t) == ("travel" in t):
-            self.err(f"{where}: give exactly one argument, phi_deg or travel")
+        if not self.one_of(LOAD_TABLE, t, where):
             return None
         arg = "phi" if "phi_deg" in t else "travel"
-        xs = self.series(t.get("phi_deg" if arg == "phi" else "travel"), f"{where}.{'phi_deg' if arg == 'phi' else 'travel'}")
-        vs = self.series(t.get("value"), f"{where}.value")
-        vr = self.series(t["value_return"], f"{where}.value_return") if "value_return" in t else None
+        xs = self.read(LOAD_TABLE, t, "phi_deg" if arg == "phi" else "travel", where)
+        vs = self.read(LOAD_TABLE, t, "value", where)
+        vr = self.read(LOAD_TABLE, t, "value_return", where)
         scale = self.read(LOAD_TABLE, t, "scale", where)
         if xs is None or vs is None or scale is None:
             return None
-        if any(b <= a for a, b in zip(xs, xs[1:])):
-            self.err(f"{where}: the argument must increase strictly")
         for nm, v in (("value", vs), ("value_return", vr)):
             if v is not None and len(v) != len(xs):
                 self.err(f"{where}.{nm}: {len(v)} values for {len(xs)} arguments")
-        if arg == "phi" and (xs[0] < 0 or xs[-1] > 360):
-            self.err(f"{where}.phi_deg: angles must lie in [0, 360]")
-        elif arg == "phi" and xs[0] == 0 and xs[-1] == 360 and len(vs) == len(xs) and vs[0] != vs[-1]:
+        if arg == "phi" and xs[0] == 0 and xs[-1] == 360 and len(vs) == len(xs) and vs[0] != vs[-1]:
             self.err(f"{where}: a crank-angle diagram is periodic, but its value at 0 deg ({vs[0]:g}) "
                      f"and at 360 deg ({vs[-1]:g}) differ")
-        if arg == "travel" and (xs[0] < 0 or xs[-1] > 1):
-            self.err(f"{where}.travel: fractions of stroke must lie in [0, 1]")
         if arg == "phi" and ("value_return" in t or "axis" in t or "origin" in t):
             self.err(f"{where}: value_return, axis and origin belong to a travel table")
-        axis = self.vec(t["axis"], f"{where}.axis", unit=True) if "axis" in t else None
+        axis = self.read(LOAD_TABLE, t, "axis", where)
         origin = self.read(LOAD_TABLE, t, "origin", where)
         return Table(arg, xs, vs, vr, scale, axis, origin)
 
@@ -163,14 +144,14 @@ class LoadReading:
             self.unknown_keys(t, SPRING.keys(), where)
             ends = []
             for e in ("a", "b"):
-                end = t.get(e)
-                if not isinstance(end, dict):
-                    self.err(f"{where}.{e}: expected {{ link = i, point = 'P' }}")
+                end = self.read(SPRING, t, e, where)
+                if end is None:
                     continue
                 self.unknown_keys(end, SPRING_END.keys(), f"{where}.{e}")
-                if self.link_ok(links, end.get("link"), f"{where}.{e}.link") and \
-                        self.point_ok(links, end["link"], end.get("point"), f"{where}.{e}.point"):
-                    ends.append((end["link"], end["point"]))
+                lid = self.read(SPRING_END, end, "link", f"{where}.{e}")
+                if lid is not None and self.link_ok(links, lid, f"{where}.{e}.link") and \
+                        self.point_ok(links, lid, end.get("point"), f"{where}.{e}.point"):
+                    ends.append((lid, end["point"]))
             if len(ends) == 2 and ends[0][1] == ends[1][1]:
                 self.err(f"{where}: both ends are the point {ends[0][1]!r}: the spring has no length or direction")
                 ends = []
@@ -181,11 +162,8 @@ class LoadReading:
         return out
 
     def friction(self) -> Friction | None:
-        t = self.data.get("friction")
+        t = self.read(MODEL, self.data, "friction", "")
         if t is None:
-            return None
-        if not isinstance(t, dict):
-            self.err("friction: expected a table")
             return None
         self.unknown_keys(t, FRICTION.keys(), "friction")
         f = self.read(FRICTION, t, "f", "friction")

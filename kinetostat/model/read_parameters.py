@@ -1,19 +1,20 @@
-"""The reader's section for `[parameters]` and the expressions that read them: each parameter
-evaluated (overrides applied, in any order), and each numeric field given as an expression
-evaluated over them, its problems named by field and parameter.
+"""The reader's section for `[parameters]`: each parameter evaluated (overrides applied, in any
+order) into the values that the fields' expressions read (`core.ReaderCore.scalar`), its
+problems named by parameter.
 
-May use: the standard library, expressions, limits.
+May use: the standard library, expressions, core, limits, schema.
 """
 from __future__ import annotations
 
 import keyword
 import unicodedata
-from typing import Any, Mapping
+from typing import Mapping
 
-from ..expressions import CONSTANTS, FUNCTIONS, ExpressionError, parse as parse_expression
+from ..expressions import CONSTANTS, FUNCTIONS
 from ..expressions import resolve as resolve_parameters
-from .core import _suggest
-from .limits import LAW_VARIABLES, MAX_PARAMETERS, MAX_SHOWN
+from .core import ReaderCore, _suggest
+from .limits import LAW_VARIABLES
+from .schema import MODEL
 
 
 def _code_points(name: str) -> str:
@@ -22,9 +23,8 @@ def _code_points(name: str) -> str:
     return f"{name!r}" + (f" ({', '.join(odd[:4])}{', ...' if len(odd) > 4 else ''})" if odd else "")
 
 
-class ParameterReading:
-    """The reader's section for parameters and expressions: a part of `reader._Reader`, using
-    the getters of `core.ReaderCore`."""
+class ParameterReading(ReaderCore):
+    """The reader's section for parameters: a part of `reader._Reader`."""
 
     def read_parameters(self, head: Mapping) -> None:
         """Evaluate `[parameters]` (with the overrides) and g (mechanism.g, which expressions read
@@ -33,8 +33,9 @@ class ParameterReading:
         if not isinstance(t, dict):
             self.err("parameters: expected a table of named numbers and expressions")
             t = {}
-        if len(t) > MAX_PARAMETERS:
-            self.err(f"parameters: {len(t)} parameters, at most {MAX_PARAMETERS}")
+        most = MODEL["parameters"].max_length
+        if len(t) > most:
+            self.err(f"parameters: {len(t)} parameters, at most {most}")
             t = {}
         raw = dict(t)
         for name in raw:
@@ -70,25 +71,3 @@ class ParameterReading:
         for name, x in raw.items():
             if isinstance(x, str) and name in values:
                 self.expressions["mechanism.g" if name == "g" else f"parameters.{name}"] = (x, values[name])
-
-    def scalar(self, x: Any, path: str) -> Any:
-        """`x` itself, or the value of the expression `x` (a string) over the parameters; None
-        after recording a problem (naming `path` and the parameter that fails)."""
-        if path == "mechanism.g" and "g" in self.values:      # also a number that an override of g replaces
-            return self.values["g"]
-        if not isinstance(x, str):
-            return x
-        try:
-            e = parse_expression(x)
-            bad = sorted(n for n in e.names if n in self.failed)
-            if bad:
-                raise ExpressionError(f"reads {', '.join(map(repr, bad))}, which has an error (see "
-                                      f"{', '.join('mechanism.g' if n == 'g' else f'parameters.{n}' for n in bad)})")
-            value = e(self.values)
-        except ExpressionError as exc:
-            self.err(f'{path}: expression "{x:.{MAX_SHOWN}}": {exc}')
-            return None
-        self.expressions[path] = (x, value)
-        return value
-
-    # -- typed getters: each returns None after recording a problem

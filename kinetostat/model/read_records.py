@@ -1,22 +1,21 @@
 """The reader's sections for what the model records beside the mechanism: the sources' published
 values, a parameter study, the text's lettering.
 
-May use: the standard library, limits, parts, schema, core (its name suggestions).
+May use: the standard library, limits, parts, schema, core.
 """
 from __future__ import annotations
 
 from types import MappingProxyType
 from typing import Any, Mapping
 
-from .core import _suggest
-from .limits import MAX_PUBLISHED_ANGLES, MAX_STUDY_VALUES, MAX_VALUE, _finite
+from .core import ReaderCore, _rule, _suggest
+from .limits import MAX_STUDY_VALUES, MAX_VALUE, _finite
 from .parts import PUBLISHED_UNITS, Drive, Link, Load, Pair, Published, Study
-from .schema import LETTERING, PUBLISHED, REQUIRED, STUDY
+from .schema import LETTERING, MODEL, PUBLISHED, REQUIRED, STUDY
 
 
-class RecordReading:
-    """The reader's sections for published values, study, lettering: a part of `reader._Reader`, using the getters of
-    `core.ReaderCore`."""
+class RecordReading(ReaderCore):
+    """The reader's sections for published values, study, lettering: a part of `reader._Reader`."""
 
     def published(self, links: list[Link], pairs: list[Pair], drive: Drive | None) -> list[Published]:
         out: list[Published] = []
@@ -63,18 +62,12 @@ class RecordReading:
             point = self.published_point(t, "point", where, links, required=True)
             relative_to = self.published_point(t, "relative_to", where, links, required=False)
         elif "link" in needs:
-            link = t.get("link")
-            self.link_ok(links, link, f"{where}.link", first=1)
+            link = self.read(PUBLISHED, t, "link", where)
+            if link is not None:
+                self.link_ok(links, link, f"{where}.link")
         elif "pair" in needs:
-            pair = t.get("pair")
-            if not (isinstance(pair, list) and len(pair) == 2
-                    and all(isinstance(x, int) and not isinstance(x, bool) for x in pair)):
-                self.err(f"{where}.pair: expected two link ids [i, j] (R(i, j), force of i on j), got {pair!r}")
-            elif not any(set(p.links) == set(pair) and pair[0] != pair[1] for p in pairs):
-                self.err(f"{where}.pair: no kinematic pair joins links {pair!r}. "
-                         f"Pairs: {[list(p.links) for p in pairs]}")
-            else:
-                pair = (pair[0], pair[1])
+            pair = self.read(PUBLISHED, t, "pair", where)
+            pair = tuple(pair) if pair is not None and self.joined(pairs, pair, f"{where}.pair") else None
         if quantity == "balancing_force" and drive is not None and drive.kind != "machine":
             self.err(f"{where}.quantity: a balancing force needs drive.kind = 'machine' (an engine has a moment)")
         if len(self.problems) > n_problems or None in (symbol, source, quantity, value, angles, tolerance):
@@ -87,11 +80,10 @@ class RecordReading:
             else [self.scalar(x, where)]
         if None in items and x is not None:
             return None
-        if x is None or not items or len(items) > MAX_PUBLISHED_ANGLES or \
-                not all(_finite(a) and abs(a) <= MAX_VALUE for a in items):
+        most = PUBLISHED["angle"].max_length
+        if x is None or not items or len(items) > most or not all(_finite(a) and abs(a) <= MAX_VALUE for a in items):
             self.err(f"{where}: " + ("missing (a crank angle in deg, or a list of them)" if x is None else
-                                     f"expected a finite number of deg or a list of 1..{MAX_PUBLISHED_ANGLES} "
-                                     f"of them, got {x!r}"[:200]))
+                                     f"expected a finite number of deg or a list of 1..{most} of them, got {x!r}"[:200]))
             return None
         return tuple(float(a) for a in items)
 
@@ -108,17 +100,14 @@ class RecordReading:
 
     def study(self, pairs: list[Pair]) -> Study | None:
         """[study]: vary = { name = [values], ... } (one or two parameters), pair = [i, j], steps."""
-        t = self.data.get("study")
+        t = self.read(MODEL, self.data, "study", "")
         if t is None:
-            return None
-        if not isinstance(t, dict):
-            self.err("study: expected a table")
             return None
         self.unknown_keys(t, STUDY.keys(), "study")
         title = self.read(STUDY, t, "title", "study")
-        vary, v = [], t.get("vary")
-        if not (isinstance(v, dict) and 1 <= len(v) <= 2):
-            self.err(f"study.vary: expected a table of one or two parameters and their values, "
+        vary, v, most = [], t.get("vary"), STUDY["vary"].max_length
+        if not (isinstance(v, dict) and 1 <= len(v) <= most):
+            self.err(f"study.vary: expected a table of 1..{most} parameters and their values, "
                      f"e.g. {{ r = [0.05, 0.08], n_k = [60, 120] }}, got {v!r:.80}")
         else:
             for name, xs in v.items():
@@ -129,57 +118,32 @@ class RecordReading:
                     self.err(f"study.vary.{name}: expected a list of 1..{MAX_STUDY_VALUES} finite numbers")
                 else:
                     vary.append((name, tuple(float(x) for x in xs)))
-        pair = t.get("pair")
-        if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(i, int) for i in pair)
-                and any(set(p.links) == set(pair) and pair[0] != pair[1] for p in pairs)):
-            self.err(f"study.pair: expected [i, j] of a kinematic pair (R(i, j), force of link i on link j), "
-                     f"got {pair!r:.60}. Pairs: {[list(p.links) for p in pairs]}")
+        pair = self.read(STUDY, t, "pair", "study")
+        if pair is None or not self.joined(pairs, pair, "study.pair"):
             return None
-        f = STUDY["steps"]
-        steps = t.get("steps", f.default)
-        if not (isinstance(steps, int) and not isinstance(steps, bool) and f.minimum <= steps <= f.maximum):
-            self.err(f"study.steps: expected an integer {f.minimum}..{f.maximum} (crank angles per cycle), got {steps!r}")
-            return None
-        if not isinstance(v, dict) or len(vary) != len(v):
+        steps = self.read(STUDY, t, "steps", "study")
+        if steps is None or not isinstance(v, dict) or len(vary) != len(v):
             return None
         return Study(title, tuple(vary), (pair[0], pair[1]), steps)
 
     def lettering(self, links: list[Link], loads: list[Load]) -> Mapping[str, Any]:
         """`[lettering]`: the text's names (models/FORMAT.md), checked; frozen."""
-        t = self.data.get("lettering", {})
-        if not isinstance(t, dict):
-            self.err("lettering: expected a table")
+        t = self.read(MODEL, self.data, "lettering", "")
+        if t is None:
             return MappingProxyType({})
         self.unknown_keys(t, LETTERING.keys(), "lettering")
         out: dict[str, Any] = {}
-        if "frame" in t:
-            k = t["frame"]
-            f = LETTERING["frame"]
-            if not isinstance(k, int) or isinstance(k, bool) or not f.minimum <= k <= f.maximum or (k and k < len(links)):
-                self.err(f"lettering.frame: expected the frame's number {f.minimum}..{f.maximum}, not a moving link's "
-                         f"(1..{len(links) - 1}), got {k!r}")
-            else:
-                out["frame"] = k
-        for key in ("M_bal", "F_bal"):
-            x = self.string(t, key, "lettering", default=None)
-            if x is not None and not (0 < len(x) <= 16 and x.isprintable()):
-                self.err(f"lettering.{key}: expected a symbol of 1..16 printable characters, got {x!r}")
-            elif x is not None:
-                out[key] = x
-        x = self.read(LETTERING, t, "language", "lettering")
-        if x is not None:
-            out["language"] = x
-        names = {ld.name for ld in loads}
-        for key, valid in (("loads", names), ("name", {"en", "uk", "ru"})):
-            tab = t.get(key, {})
-            if not isinstance(tab, dict) or not all(isinstance(v, str) and v.isprintable() for v in tab.values()):
-                self.err(f"lettering.{key}: expected a table of strings")
-                continue
-            bad = sorted(set(tab) - valid)
+        k = self.read(LETTERING, t, "frame", "lettering", default=None)
+        if k and k < len(links):
+            self.err(f"lettering.frame: {_rule(LETTERING['frame'])}, not a moving link's (1..{len(links) - 1}), got {k!r}")
+        elif k is not None:
+            out["frame"] = k
+        for key in ("M_bal", "F_bal", "language", "name", "loads"):
+            x = self.read(LETTERING, t, key, "lettering", default=None)
+            bad = sorted(set(x) - {ld.name for ld in loads}) if key == "loads" and x else ()
             if bad:
-                self.err(f"lettering.{key}.{bad[0]}: no such {'load' if key == 'loads' else 'language'}. "
-                         f"Valid: {sorted(valid)}")
-                continue
-            if tab:
-                out[key] = MappingProxyType(dict(tab))
+                self.err(f"lettering.loads.{bad[0]}: no such load{_suggest(bad[0], [ld.name for ld in loads])}. "
+                         f"Valid: {sorted(ld.name for ld in loads)}")
+            elif x:
+                out[key] = MappingProxyType(x) if isinstance(x, dict) else x
         return MappingProxyType(out)

@@ -2,7 +2,7 @@
 an immutable Mechanism; every problem collected and reported at once, each with its field path
 and line, and what only follows from a problem already reported left out.
 
-May use: the standard library, errors, limits, mechanism, schema, checks, core, read_*.
+May use: the standard library, errors, limits, mechanism, schema, checks, read_*.
 """
 from __future__ import annotations
 
@@ -11,7 +11,6 @@ from types import MappingProxyType
 
 from ..errors import ModelError, ModelWarning, StructureError
 from .checks import doubts, missing_radii
-from .core import ReaderCore
 from .limits import MAX_PROBLEMS
 from .mechanism import Mechanism
 from .read_drive import DriveReading
@@ -22,24 +21,18 @@ from .read_records import RecordReading
 from .schema import MECHANISM, MODEL
 
 
-class _Reader(ReaderCore, ParameterReading, LinkReading, DriveReading, LoadReading, RecordReading):
+class _Reader(ParameterReading, LinkReading, DriveReading, LoadReading, RecordReading):
     """Reads the raw TOML structure, collecting every problem instead of stopping at the first."""
 
     def mechanism(self) -> Mechanism:
         d = self.data
         self.unknown_keys(d, MODEL.keys(), "<top level>")
-        head = d.get("mechanism", {})
-        if not isinstance(head, dict):
-            self.err("mechanism: expected a table")
-            head = {}
+        head = (self.read(MODEL, d, "mechanism", "") if "mechanism" in d else {}) or {}   # missing: its fields say so
         self.unknown_keys(head, MECHANISM.keys(), "mechanism")
         self.read_parameters(head)
         name = self.read(MECHANISM, head, "name", "mechanism")
         source = self.read(MECHANISM, head, "source", "mechanism")
-        assumptions = head.get("assumptions", [])
-        if not (isinstance(assumptions, list) and all(isinstance(a, str) for a in assumptions)):
-            self.err("mechanism.assumptions: expected a list of strings")
-            assumptions = []
+        assumptions = self.read(MECHANISM, head, "assumptions", "mechanism") or ()
         g = self.read(MECHANISM, head, "g", "mechanism")
 
         links = self.links(g)

@@ -36,25 +36,44 @@ class Field:
     doc: str
     unit: str = ""
     default: Any = None               # REQUIRED, None (optional, no default) or the value taken
-    minimum: float | None = None      # value >= minimum
+    minimum: float | None = None      # value >= minimum (numbers, integers, links, a series' items)
     positive: bool = False            # value > 0 (also refused subnormal)
     divisor: bool = False             # refused subnormal (0 < |x| < 2.2e-308): it divides or is squared
-    choices: tuple = ()
+    choices: tuple = ()               # strings, integers: the values allowed; map: the keys allowed
     expression: bool = False          # a string is an expression over [parameters]
     max_length: int | None = None     # strings: most characters; lists and tables: most items
-    maximum: float | None = None      # integers: value <= maximum
+    maximum: float | None = None      # value <= maximum (as minimum)
+    exclusive_maximum: float | None = None   # value < exclusive_maximum (as minimum)
+    min_length: int = 0               # strings: fewest characters; tables: fewest tables
+    printable: bool = False           # strings (a map's too): printable characters only
+    increasing: bool = False          # series: strictly increasing
+    rule: str = ""                    # the message when out of range or choices (links: the same id twice), "{minimum}"
+                                      # etc. filled in from the field, "{value}" the value (else ", got" it follows);
+                                      # default: the range, "must be >= 0.0"
     when: tuple[str, tuple] | None = None   # (field, values): allowed only when that field has one of them
+    required_when: tuple[str, tuple] | None = None   # (field, values): required when that field has one of them
     section: "Section | None" = None  # table, tables, characteristic: its table
     items: str = ""                   # map: "number", "numbers" (a list) or "string"
 
 
 @dataclass(frozen=True)
+class OneOf:
+    """Exactly one of `fields` is given (only when the field `when[0]` has one of the values
+    `when[1]`, if `when`); `hint`: what the reader's message adds."""
+    fields: tuple[str, ...]
+    when: tuple[str, tuple] | None = None
+    hint: str = ""
+
+
+@dataclass(frozen=True)
 class Section:
-    """A table (`array`: an array of tables `[[name]]`) of the model file."""
+    """A table (`array`: an array of tables `[[name]]`) of the model file; `one_of`: the groups of
+    its fields of which exactly one is given."""
     name: str
     doc: str
     fields: tuple[Field, ...]
     array: bool = False
+    one_of: tuple[OneOf, ...] = ()
 
     def __post_init__(self):
         object.__setattr__(self, "_by_name", {f.name: f for f in self.fields})
@@ -73,30 +92,41 @@ def _num(name: str, doc: str, unit: str = "", **kw) -> Field:
     return Field(name, "number", doc, unit, expression=True, **kw)
 
 
+_TEETH = "a gear needs at least {minimum} teeth"
+_SPEEDS = "the crank turns in the drive's sense: speeds must be >= {minimum:g}"
+_SYMBOL = dict(min_length=1, max_length=16, printable=True,
+               rule="expected a symbol of {min_length}..{max_length} printable characters")
+#: The languages of the outputs.
+LANGUAGES = ("en", "uk", "ru")
+
+
 def _name(doc: str, default: str) -> Field:
     return Field("name", "string", doc, default=default, max_length=MAX_NAME)
 
 
 GEAR = Section("drive.gear", "The last gear pair of a working machine (drive.kind = \"machine\"; Kiriienko 2019, sec. 7.1).", (
     _num("module", "module of the gear pair", "m", default=REQUIRED, positive=True),
-    Field("z_pinion", "integer", "teeth of the driving pinion", default=REQUIRED, minimum=5, expression=True),
-    Field("z_wheel", "integer", "teeth of the wheel on the crank shaft", default=REQUIRED, minimum=5, expression=True),
+    Field("z_pinion", "integer", "teeth of the driving pinion", default=REQUIRED, minimum=5, expression=True,
+          rule=_TEETH),
+    Field("z_wheel", "integer", "teeth of the wheel on the crank shaft", default=REQUIRED, minimum=5, expression=True,
+          rule=_TEETH),
     Field("correction", "string", "profile correction; \"unequal\" needs alpha_w_deg and y", default="none",
           choices=("none", "equal", "unequal")),
-    _num("alpha_w_deg", "pressure angle of the mesh, below 45 deg", "deg", default=20.0, positive=True),
+    _num("alpha_w_deg", "pressure angle of the mesh", "deg", default=20.0, positive=True, exclusive_maximum=45.0,
+         rule="pressure angle must be below {exclusive_maximum:g} deg"),
     _num("y", "pitch-line shift coefficient (unequal correction only)", default=0.0),
     Field("centre_direction", "direction", "world direction from the crank axis to the pinion axis", default=REQUIRED,
           expression=True),
 ))
 
 OMEGA_TABLE = Section("drive.omega_table", "A law of motion omega(phi) as a table over one revolution (periodic cubic spline).", (
-    Field("phi_deg", "series", "crank angles, strictly increasing, within 360 deg", "deg", default=REQUIRED, expression=True),
-    Field("omega", "series", "crank speeds, >= 0 (or rpm)", "rad/s", expression=True),
-    Field("rpm", "series", "crank speeds, >= 0 (or omega)", "rpm", expression=True),
-))
+    Field("phi_deg", "series", "crank angles, within 360 deg", "deg", default=REQUIRED, expression=True, increasing=True),
+    Field("omega", "series", "crank speeds (or rpm)", "rad/s", expression=True, minimum=0.0, rule=_SPEEDS),
+    Field("rpm", "series", "crank speeds (or omega)", "rpm", expression=True, minimum=0.0, rule=_SPEEDS),
+), one_of=(OneOf(("omega", "rpm"), hint="omega in rad/s"),))
 
 DRIVE = Section("drive", "The initial link I(0,1): the crank, its angle's reference and sense, its speed.", (
-    Field("link", "link", "the crank: always 1", default=1, minimum=1, maximum=1),
+    Field("link", "link", "the crank: always 1", default=1, minimum=1, maximum=1, rule="the crank must be link {minimum}"),
     Field("pivot", "point", "the crank's revolute pair with the frame", default=REQUIRED),
     Field("point", "point", "crank angle = direction of pivot -> point", default=REQUIRED),
     Field("reference", "direction", "world direction of phi = 0", default=REQUIRED, expression=True),
@@ -108,9 +138,9 @@ DRIVE = Section("drive", "The initial link I(0,1): the crank, its angle's refere
     _num("eps", "crank angular acceleration in sense (not with a law of motion)", "rad/s^2", default=0.0),
     Field("kind", "string", "\"engine\": balancing moment through a coupling; \"machine\": balancing force on a gear mesh",
           default="engine", choices=("engine", "machine")),
-    Field("gear", "table", "the gear mesh of a machine", section=GEAR),
+    Field("gear", "table", "the gear mesh of a machine", default=REQUIRED, section=GEAR, when=("kind", ("machine",))),
     _num("design_deg", "the design position: crank angle of the mechanism's picture", "deg", default=30.0),
-))
+), one_of=(OneOf(("rpm", "omega", "omega_table"), hint="omega: a number, or an expression of phi"),))
 
 MECHANISM = Section("mechanism", "What the model is and where its data come from.", (
     _name("free text, labels plots and plans", "unnamed"),
@@ -126,10 +156,11 @@ BODY = Section("link.body", "One of the bodies a link is made of; the link's mas
     _num("weight", "weight, converted with g (or mass)", "N", minimum=0.0),
     Field("com", "com", "its centre of mass: a point of the link, or local [x, y]", "m", default=REQUIRED, expression=True),
     _num("I_S", "moment of inertia about its own centre (0: a point mass)", "kg m^2", default=0.0, minimum=0.0),
-), array=True)
+), array=True, one_of=(OneOf(("mass", "weight")),))
 
 LINK = Section("link", "A moving link, one table each, numbered as in the text (1 = the crank).", (
-    Field("id", "integer", "the link's number: 1..n without gaps", default=REQUIRED, minimum=1),
+    Field("id", "integer", "the link's number: 1..n without gaps", default=REQUIRED, minimum=1,
+          rule="moving links are numbered from {minimum} (0 is the frame)"),
     _name("the link's name", "link <id>"),
     Field("points", "points", "named points in the link's local frame", "m", default=REQUIRED, expression=True,
           max_length=MAX_POINTS),
@@ -137,17 +168,19 @@ LINK = Section("link", "A moving link, one table each, numbered as in the text (
     _num("weight", "weight, converted with g (or mass)", "N", minimum=0.0),
     _num("I_S", "moment of inertia about the centre of mass", "kg m^2", default=0.0, minimum=0.0),
     Field("com", "string", "the point that is the centre of mass (needed if mass > 0; with bodies: a new point)"),
-    Field("body", "tables", "the bodies the link is made of, instead of mass, weight and I_S", section=BODY),
+    Field("body", "tables", "the bodies the link is made of, instead of mass, weight and I_S", section=BODY,
+          min_length=1),
 ), array=True)
 
 PAIR = Section("pair", "A lower kinematic pair: revolute R or prismatic P.", (
     Field("kind", "string", "revolute or prismatic", default=REQUIRED, choices=("R", "P")),
-    Field("links", "links", "R: the two links; P: [guide link, slider link]", default=REQUIRED),
+    Field("links", "links", "R: the two links; P: [guide link, slider link]", default=REQUIRED,
+          rule="a pair joins two different links"),
     Field("point", "point", "R: a point of both links; P: a point of the slider on the guide line", default=REQUIRED),
     _num("radius", "journal radius, for friction losses", "m", positive=True),
-    Field("guide", "point", "a point of the guide link on the guide line", when=("kind", ("P",))),
-    Field("direction", "direction", "guide direction in the guide link's local frame", expression=True,
-          when=("kind", ("P",))),
+    Field("guide", "point", "a point of the guide link on the guide line", default=REQUIRED, when=("kind", ("P",))),
+    Field("direction", "direction", "guide direction in the guide link's local frame", default=REQUIRED,
+          expression=True, when=("kind", ("P",))),
     Field("slider_axis", "direction", "the guide direction in the frame the slider's points are given in",
           default=(1.0, 0.0), expression=True, when=("kind", ("P",))),
 ), array=True)
@@ -158,17 +191,19 @@ GROUP = Section("group", "The assembly branch of an Assur group (RRR, RRP, RPR).
 ), array=True)
 
 LOAD_TABLE = Section("load.table", "A piecewise-linear load diagram; the load is scale * value.", (
-    Field("phi_deg", "series", "argument: crank angle, in [0, 360] (or travel)", "deg", expression=True),
-    Field("travel", "series", "argument: fraction of the stroke, in [0, 1] (or phi_deg)", expression=True),
+    Field("phi_deg", "series", "argument: crank angle (or travel)", "deg", expression=True, minimum=0.0, maximum=360.0,
+          increasing=True, rule="angles must lie in [{minimum:g}, {maximum:g}]"),
+    Field("travel", "series", "argument: fraction of the stroke (or phi_deg)", expression=True, minimum=0.0,
+          maximum=1.0, increasing=True, rule="fractions of stroke must lie in [{minimum:g}, {maximum:g}]"),
     Field("value", "series", "the diagram's values (forward stroke for travel)", expression=True, default=REQUIRED),
     Field("value_return", "series", "travel only: values on the return stroke (default: value)", expression=True),
     _num("scale", "load per table unit", "N or N m", default=1.0),
     Field("axis", "direction", "travel only: world axis of the stroke (default: the load's direction)", expression=True),
     Field("origin", "string", "travel only: the extreme the travel is measured from", default="max", choices=("max", "min")),
-))
+), one_of=(OneOf(("phi_deg", "travel")),))
 
 CHARACTERISTIC = Section("load.characteristic", "A motor's M(omega), in the drive's sense: a table (or an expression of omega).", (
-    Field("omega", "series", "speeds, strictly increasing", "rad/s", default=REQUIRED, expression=True),
+    Field("omega", "series", "speeds", "rad/s", default=REQUIRED, expression=True, increasing=True),
     Field("M", "series", "moments at those speeds", "N m", default=REQUIRED, expression=True),
 ))
 
@@ -176,10 +211,12 @@ _APPLIED = ("force", "moment")
 LOAD = Section("load", "An external force at a point, a moment on a link, or a viscous damper on a pair.", (
     _name("the load's name", "load <n>"),
     Field("kind", "string", "what the load is", default="force", choices=("force", "moment", "damper")),
-    Field("link", "link", "the loaded link (not the frame)", default=REQUIRED, minimum=1, when=("kind", _APPLIED)),
-    Field("point", "point", "force: its point of application", when=("kind", _APPLIED)),
+    Field("link", "link", "the loaded link (not the frame)", default=REQUIRED, minimum=1, when=("kind", _APPLIED),
+          rule="loads on the frame do not enter the analysis"),
+    Field("point", "point", "force: its point of application", when=("kind", _APPLIED),
+          required_when=("kind", ("force",))),
     Field("direction", "load_direction", "force: world direction or \"against_velocity\"; moment: \"against_omega\"",
-          expression=True, when=("kind", _APPLIED)),
+          expression=True, when=("kind", _APPLIED), required_when=("kind", ("force",))),
     _num("value", "constant value: N, or N m about +z (or table, characteristic)", "N or N m", when=("kind", _APPLIED)),
     Field("table", "table", "a load diagram (or value)", section=LOAD_TABLE, when=("kind", _APPLIED)),
     Field("characteristic", "characteristic", "moment: M(omega) of the link, a table or an expression of omega",
@@ -187,7 +224,7 @@ LOAD = Section("load", "An external force at a point, a moment on a link, or a v
     Field("pair", "links", "damper: the links of a pair (either order)", default=REQUIRED, when=("kind", ("damper",))),
     _num("c", "damper coefficient: N m s/rad (R) or N s/m (P)", "N m s/rad or N s/m", default=REQUIRED, minimum=0.0,
          when=("kind", ("damper",))),
-), array=True)
+), array=True, one_of=(OneOf(("value", "table", "characteristic"), when=("kind", _APPLIED)),))
 
 SPRING_END = Section("spring.a", "An end of a spring: a point of a link.", (
     Field("link", "link", "the link", default=REQUIRED),
@@ -214,11 +251,12 @@ PUBLISHED = Section("published", "A value the source prints for this model, chec
     Field("symbol", "string", "as the source names it (unique in the file)", default=REQUIRED),
     Field("meaning", "string", "what it is, in this project's terms", default=""),
     Field("quantity", "string", "what it measures (a magnitude)", default=REQUIRED, choices=tuple(PUBLISHED_UNITS)),
-    Field("point", "point", "velocity, acceleration: the point (required)", when=("quantity", _AT_POINT)),
+    Field("point", "point", "velocity, acceleration: the point", default=REQUIRED, when=("quantity", _AT_POINT)),
     Field("relative_to", "point", "velocity, acceleration: minus this point's", when=("quantity", _AT_POINT)),
-    Field("link", "link", "omega, eps, inertia_force, inertia_moment: the moving link (required)", minimum=1,
-          when=("quantity", _OF_LINK)),
-    Field("pair", "links", "reaction: R(i, j), force of link i on link j (required)", when=("quantity", ("reaction",))),
+    Field("link", "link", "omega, eps, inertia_force, inertia_moment: the moving link", default=REQUIRED, minimum=1,
+          when=("quantity", _OF_LINK), rule="unknown moving link {value}: expected a link >= {minimum}"),
+    Field("pair", "links", "reaction: R(i, j), force of link i on link j", default=REQUIRED,
+          when=("quantity", ("reaction",))),
     Field("angle", "angles", "crank angle, or a list of them with reduce", "deg", default=REQUIRED, expression=True,
           max_length=MAX_PUBLISHED_ANGLES),
     Field("reduce", "string", "over a list of angles: min, max, or the angle of the max", choices=("min", "max", "angle_of_max")),
@@ -239,12 +277,14 @@ STUDY = Section("study", "A parameter study: the largest |R(i,j)| over the cycle
 ))
 
 LETTERING = Section("lettering", "The names the model's source text uses, on every output.", (
-    Field("language", "string", "the text's language: outputs are written in it by default", choices=("en", "uk", "ru")),
-    Field("frame", "integer", "the frame's number in the text (no moving link's)", default=0, minimum=0, maximum=99),
-    Field("M_bal", "string", "the balancing moment's symbol, 1..16 printable characters", default="M_bal", max_length=16),
-    Field("F_bal", "string", "the balancing force's symbol, 1..16 printable characters", default="F_bal", max_length=16),
-    Field("loads", "map", "a load's symbol by its [[load]] name", items="string"),
-    Field("name", "map", "the mechanism's name by language (en, uk, ru)", items="string"),
+    Field("language", "string", "the text's language: outputs are written in it by default", choices=LANGUAGES),
+    Field("frame", "integer", "the frame's number in the text (no moving link's)", default=0, minimum=0, maximum=99,
+          rule="expected the frame's number {minimum}..{maximum}"),
+    Field("M_bal", "string", "the balancing moment's symbol", default="M_bal", **_SYMBOL),
+    Field("F_bal", "string", "the balancing force's symbol", default="F_bal", **_SYMBOL),
+    Field("loads", "map", "a load's symbol by its [[load]] name", items="string", printable=True),
+    Field("name", "map", "the mechanism's name by language", items="string", printable=True, choices=LANGUAGES,
+          rule="no such language"),
 ))
 
 MODEL = Section("<top level>", "A kinetostat mechanism model: one planar linkage with one degree of freedom, SI units.", (
