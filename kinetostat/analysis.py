@@ -318,28 +318,54 @@ class Analysis:
         w = np.sign(self.kin.omega[:, 1])
         return np.where(w != 0, w, self.mech.drive.sense)
 
+    def _eta(self) -> np.ndarray:
+        """(N,) eta by its rule everywhere (`friction.efficiency`), before the dead centres and the
+        wedged angles are made NaN: its sign decides self-locking."""
+        R = np.linalg.norm(self.forces.R, axis=-1).max(axis=1, initial=0.0)
+        return _friction.efficiency(self.balancing_moment_frictionless, self.balancing_moment_with_friction,
+                                    self._turn(), 1e-12 * R * self.mech.size)
+
     @property
     def efficiency(self) -> np.ndarray:
         """(N,) instantaneous efficiency eta(phi), 1: M0 / Mf where the drive works against the
         loads (M0 omega_1 >= 0), Mf / M0 where the loads drive the crank (an engine's expansion
         stroke), M0 and Mf the balancing moments without and with friction
         (`balancing_moment_with_friction`: the first approximation's where friction is not in the
-        reactions; 1 without friction). NaN where both moments are below 1e-12 x the largest
-        reaction x size (a dead centre: undefined) and where no equilibrium was found."""
-        R = np.linalg.norm(self.forces.R, axis=-1).max(axis=1, initial=0.0)
-        return _friction.efficiency(self.balancing_moment_frictionless, self.balancing_moment_with_friction,
-                                    self._turn(), 1e-12 * R * self.mech.size)
+        reactions; 1 without friction). Undefined (NaN) near a dead centre, where
+        |M0| <= friction.DEAD_CENTRE x |Mf - M0| (the frictionless moment below a tenth of the
+        moment friction takes: a ratio ruled by the vanishing M0, |eta| above about 10 or below
+        0.09)
+        or where both moments are rounding (below 1e-12 x the largest reaction x size); NaN where
+        no equilibrium was found and where a pair wedges (`self_locking_reason`)."""
+        eta = self._eta()
+        M0, Mf = self.balancing_moment_frictionless, self.balancing_moment_with_friction
+        with np.errstate(invalid="ignore"):
+            dead = np.abs(M0) <= _friction.DEAD_CENTRE * np.abs(Mf - M0)
+        if self.friction is not None:
+            dead |= self.friction.wedged | ~self.friction.solved
+        return np.where(dead, np.nan, eta)
 
     @property
     def self_locking(self) -> np.ndarray:
-        """(N,) bool: eta <= 0 (the loads cannot drive the crank through friction; the drive must
-        help where they would), or, with friction in the reactions, a pair wedges (the friction
-        passes do not contract: M_bal is the equilibrium Newton's method finds there) or no
-        equilibrium is found (M_bal NaN, with a SelfLockingWarning naming the angles)."""
-        unsolved = np.zeros(len(self.phi_deg), bool) if self.friction is None else \
-            ~self.friction.solved | self.friction.wedged
+        """(N,) bool: eta <= 0 by its rule (also where `efficiency` reports NaN near a dead
+        centre), or, with friction in the reactions, a pair wedges or no equilibrium is found
+        (`self_locking_reason` says which; a SelfLockingWarning names every such angle)."""
+        return self.self_locking_reason != ""
+
+    @property
+    def self_locking_reason(self) -> np.ndarray:
+        """(N,) str: why each angle is self-locking, "" where it is not. "no equilibrium": neither
+        the friction passes nor Newton's method find one (M_bal and the forces NaN); "wedged": a
+        pair's friction gain is >= 1 (`friction.FrictionSolution.wedged`), an equilibrium exists
+        but not a unique one (M_bal is the one reached from the frictionless solution, eta NaN);
+        "eta<=0": the loads cannot drive the crank through friction (M_bal the equilibrium, the
+        drive must help)."""
         with np.errstate(invalid="ignore"):
-            return unsolved | (self.efficiency <= 0)
+            why = np.where(self._eta() <= 0, "eta<=0", "")
+        if self.friction is not None:
+            why = np.where(self.friction.wedged, "wedged", why)
+            why = np.where(~self.friction.solved, "no equilibrium", why)
+        return np.where(self.singular, "", why).astype(object)
 
     def self_locking_zones(self, tol_deg: float = 1e-9) -> np.ndarray:
         """(n_zones, 2) start and end of each run of self-locking angles, deg, start < end (a zone
@@ -578,9 +604,10 @@ def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Anal
                                      for t in trials], axis=0)
         kin = guard(mech, kin, error)
         res = _kinetostatics(mech, phi_deg, kin, reactions) if kin.singular.any() else replace(res, kin=kin)
-    if res.friction is not None and not (res.friction.solved | kin.singular).all():
-        bad = phi_deg[~(res.friction.solved | kin.singular)]
-        warnings.warn(SelfLockingWarning(self_locking_message(bad), bad), stacklevel=3)
+    if res.friction is not None and res.self_locking.any():
+        why = res.self_locking_reason
+        warnings.warn(SelfLockingWarning(self_locking_message(phi_deg[why != ""], why[why != ""]),
+                                         phi_deg[why != ""], why[why != ""]), stacklevel=3)
     return _read_only(res)
 
 

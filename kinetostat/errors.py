@@ -100,19 +100,32 @@ def singular_message(group: str, phi_deg: np.ndarray, cond: np.ndarray, digits: 
 
 
 class SelfLockingWarning(UserWarning):
-    """With friction in the reactions, no equilibrium was found at some crank angles (neither
-    the fixed-point passes of a group nor Newton's method on its friction loads converge: a
-    wedged mechanism that no finite drive moves). `phi_deg` lists them; the forces and M_bal
-    there are NaN."""
+    """With friction in the reactions, the self-locking crank angles, each with its reason
+    (`Analysis.self_locking_reason`): "no equilibrium" (neither the friction passes nor Newton's
+    method find one: M_bal and the forces NaN), "wedged" (a pair's friction gain >= 1: an
+    equilibrium exists but is not the only one; M_bal is the one reached from the frictionless
+    solution, eta NaN) or "eta<=0" (the loads cannot drive the crank through friction: M_bal is
+    the equilibrium value, the drive must help). `phi_deg` lists the angles, `reasons` the
+    reason of each."""
 
-    def __init__(self, message: str, phi_deg=()):
+    def __init__(self, message: str, phi_deg=(), reasons=()):
         super().__init__(message)
         self.phi_deg = np.round(np.asarray(phi_deg, dtype=float), 9)     # undo rad->deg rounding
+        self.reasons = tuple(reasons)
 
 
-def self_locking_message(phi_deg: np.ndarray) -> str:
-    """The warning's text for the angles where friction leaves no equilibrium."""
-    return (f"no equilibrium with friction in the reactions at phi = {_angle_list(np.round(phi_deg, 9))}: "
-            f"neither the friction passes nor Newton's method find one (self-locking: no finite drive moves "
-            f"the mechanism); "
-            f"M_bal and the reactions there are NaN")
+#: What M_bal means at a self-locking angle of each reason (`SelfLockingWarning`).
+SELF_LOCKING_MEANING = {
+    "no equilibrium": "no finite drive moves the mechanism: M_bal and the reactions NaN",
+    "wedged": "a pair's friction gain >= 1, the equilibrium not unique: M_bal is the one reached from the "
+              "frictionless solution, eta NaN",
+    "eta<=0": "the loads cannot drive the crank through friction: M_bal is the equilibrium, the drive helps",
+}
+
+
+def self_locking_message(phi_deg: np.ndarray, reasons) -> str:
+    """The warning's one-line text: the self-locking angles grouped by reason, each with what M_bal means there."""
+    reasons = np.asarray(reasons, dtype=object)
+    parts = [f"{key} at phi = {_angle_list(np.round(np.asarray(phi_deg)[reasons == key], 9))} ({why})"
+             for key, why in SELF_LOCKING_MEANING.items() if (reasons == key).any()]
+    return f"self-locking with friction in the reactions at {len(reasons)} angle(s): " + "; ".join(parts)

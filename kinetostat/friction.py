@@ -46,7 +46,8 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Mechanism
 
-__all__ = ["FrictionSolution", "solve", "power", "relative_rate", "motion_sense", "efficiency", "METHODS", "RATE_TOL", "MAX_PASSES"]
+__all__ = ["FrictionSolution", "solve", "power", "relative_rate", "motion_sense", "efficiency", "METHODS", "RATE_TOL", "MAX_PASSES",
+           "DEAD_CENTRE"]
 
 #: analyze(friction=...): seed 003's first approximation, or friction in the reactions.
 METHODS = ("first", "reactions")
@@ -56,6 +57,8 @@ RATE_TOL = 1e-12
 MAX_PASSES = 60
 #: Most Newton steps on a stage's friction loads; an angle not converged by then has no equilibrium found.
 NEWTON_STEPS = 40
+#: eta is undefined (NaN) near a dead centre: where |M0| <= DEAD_CENTRE x |Mf - M0| (`Analysis.efficiency`).
+DEAD_CENTRE = 0.1
 #: Power-iteration steps for a stage's friction gain (`_gain`).
 GAIN_STEPS = 40
 #: Converged: the largest change of a stage's reactions in one pass below this x its largest reaction.

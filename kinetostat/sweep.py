@@ -37,7 +37,7 @@ import numpy as np
 
 from .analysis import Analysis, crank_angles, friction_method
 from .solve import analyze
-from .errors import AssemblyError, ModelError, ModelWarning, SingularPositionWarning, StructureError
+from .errors import AssemblyError, ModelError, ModelWarning, SelfLockingWarning, SingularPositionWarning, StructureError
 from .model import Mechanism, _read_text, _suggest, load, loads
 from .units import parameter_units
 
@@ -234,11 +234,11 @@ def _quiet() -> Iterator[None]:
     restores the filters around Dask's local threads."""
     if threading.current_thread() is threading.main_thread():
         with warnings.catch_warnings():
-            for category in (ModelWarning, SingularPositionWarning):
+            for category in (ModelWarning, SingularPositionWarning, SelfLockingWarning):
                 warnings.simplefilter("ignore", category)
             yield
     else:
-        for category in (ModelWarning, SingularPositionWarning):
+        for category in (ModelWarning, SingularPositionWarning, SelfLockingWarning):
             warnings.simplefilter("ignore", category)
         yield
 

@@ -60,12 +60,26 @@ def scales(res) -> tuple[np.ndarray, float]:
     return np.nan_to_num(R), res.mech.size
 
 
+def reactions(mech, phi=None, steps: int = 360, **kw):
+    """analyze(friction="reactions"), asserting that its SelfLockingWarning names exactly the
+    self-locking angles (none where there are none)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SelfLockingWarning)
+        res = kinetostat.analyze(mech, phi, steps=steps, friction="reactions", **kw)
+    lock = [w.message for w in caught if isinstance(w.message, SelfLockingWarning)]
+    assert len(lock) == int(res.self_locking.any())
+    if lock:
+        np.testing.assert_allclose(lock[0].phi_deg, np.round(res.phi_deg[res.self_locking], 9))
+    return res
+
+
 def check_identities(mech, phi) -> None:
     """Every identity of the module docstring that needs no reference, at the angles `phi`."""
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SelfLockingWarning)
+        warnings.simplefilter("ignore", SelfLockingWarning)       # random mechanisms: read from the result
+        warnings.simplefilter("ignore", kinetostat.SingularPositionWarning)
         res = kinetostat.analyze(mech, phi, friction="reactions")
-    first = kinetostat.analyze(mech, phi, friction="first")
+        first = kinetostat.analyze(mech, phi, friction="first")
     ok = res.friction.solved & ~res.singular
     F, size = scales(res)
     if not ok.any() or not F.max() > 0:
@@ -112,7 +126,7 @@ def test_zero_friction_gives_the_frictionless_result_bit_for_bit(ice):
 def test_ice_at_30_deg_agrees_with_the_40_digit_newton_solution(ice):
     from kinetostat_validation.reference import reference_full
     phi = np.array([0.0, 30.0, 90.0, 180.0, 1.0, 200.0, 300.0])
-    res = kinetostat.analyze(ice, phi, friction="reactions")
+    res = reactions(ice, phi)
     ref = reference_full(ice, phi, res=res, friction=True)
     F, size = scales(res)
     assert np.abs(ref.M_bal - res.balancing_moment).max() <= ROUNDING * F.max() * size
@@ -126,7 +140,7 @@ def test_ice_identities_over_the_cycle(ice):
 
 
 def test_ice_work_balances_to_rounding_with_friction_in_the_reactions(ice):
-    res = kinetostat.analyze(ice, steps=360, friction="reactions")
+    res = reactions(ice, steps=360)
     W = res.work()
     lost = sum(v for k, v in W.items() if k.startswith("friction"))
     assert lost < 0 and abs(sum(W.values())) <= 1e-12 * sum(abs(v) for v in W.values())
@@ -142,15 +156,15 @@ def test_ice_work_balances_to_rounding_with_friction_in_the_reactions(ice):
 
 
 def test_self_locking_zone_near_top_dead_centre_and_its_edges(ice):
-    res = kinetostat.analyze(ice, steps=360, friction="reactions")
+    res = reactions(ice, steps=360)
     zones = res.self_locking_zones()
     tdc = zones[np.argmin(np.abs(zones[:, 0]))]
     assert abs(tdc[0]) <= 1e-9 and 0.5 < tdc[1] < 5.0          # from the dead centre to where the gas wins
     lo, hi = tdc[1] - 1e-9, tdc[1] + 1e-9
-    r = kinetostat.analyze(ice, [lo, hi], friction="reactions")
+    r = reactions(ice, [lo, hi])
     assert r.self_locking.tolist() == [True, False]
     # inside the zone the equilibrium exists (a number, not NaN) and the drive must help the gas
-    inside = kinetostat.analyze(ice, [0.5 * tdc[1]], friction="reactions")
+    inside = reactions(ice, [0.5 * tdc[1]])
     assert inside.friction.solved.all() and inside.efficiency[0] < 0
     assert inside.balancing_moment[0] * inside.balancing_moment_frictionless[0] < 0
 
@@ -159,12 +173,12 @@ def test_zero_relative_motion_takes_the_side_the_motion_comes_from(ice):
     """At top dead centre the piston is at rest: its friction is the one just before (the crank
     turns towards increasing phi), not the one just after. Same for the rod-piston pin where
     omega_2 = 0."""
-    res = kinetostat.analyze(ice, steps=360, friction="reactions")
+    res = reactions(ice, steps=360)
     w2_zero = [np.degrees(np.arccos(0.0))]              # omega_2 = 0 where the crank is at 90 deg
     P, B = ice.pair_between(0, 3).index, ice.pair_between(2, 3).index
     for phi0, pair in ((0.0, P), (180.0, P), (w2_zero[0], B), (270.0, B)):
         d = 1e-7
-        r = kinetostat.analyze(ice, [phi0 - d, phi0, phi0 + d], friction="reactions")
+        r = reactions(ice, [phi0 - d, phi0, phi0 + d])
         before, at, after = r.friction.load[:, pair]
         rate = relative_rate(ice, r.kin)[0][:, pair]
         assert rate[0] * rate[2] < 0, "a sign change of the relative motion"
@@ -172,16 +186,52 @@ def test_zero_relative_motion_takes_the_side_the_motion_comes_from(ice):
         assert abs(at - before) < 1e-4 * abs(after - at)
 
 
-def test_no_equilibrium_is_nan_with_a_warning_naming_the_angles():
-    """A friction so large that the slider wedges: no finite drive moves the mechanism there."""
+def test_every_self_locking_angle_is_named_with_its_reason_and_never_a_silent_number():
+    """A friction so large (f = 3.5, r = 1 mm) that pairs wedge: the warning names every
+    self-locking angle with its reason. No equilibrium: M_bal NaN. Wedged (friction gain >= 1):
+    M_bal is an equilibrium (the lever and the power balance hold there to rounding) but not the
+    only one, so eta is NaN. eta <= 0: the equilibrium value, eta a number <= 0."""
     mech = with_friction(ICE, f=3.5, radius=0.001)
-    with pytest.warns(SelfLockingWarning, match=r"no equilibrium with friction in the reactions at phi = \[") as w:
+    with pytest.warns(SelfLockingWarning, match=r"self-locking with friction in the reactions at \d+ angle") as w:
         res = kinetostat.analyze(mech, steps=72, friction="reactions")
-    bad = ~res.friction.solved
-    assert bad.any() and not bad.all()
-    assert np.isnan(res.balancing_moment[bad]).all() and np.isfinite(res.balancing_moment[~bad]).all()
-    assert res.self_locking[bad].all() and np.isnan(res.efficiency[bad]).all()
-    np.testing.assert_allclose(w[0].message.phi_deg, res.phi_deg[bad])
+    msg = w[0].message
+    why = res.self_locking_reason
+    np.testing.assert_allclose(msg.phi_deg, res.phi_deg[res.self_locking])
+    assert list(msg.reasons) == list(why[res.self_locking])
+    for key in ("no equilibrium", "wedged", "eta<=0"):
+        assert (why == key).any() and f"{key} at phi = [" in str(msg)
+    none, wedged, eta0 = (why == "no equilibrium"), (why == "wedged"), (why == "eta<=0")
+    assert np.isnan(res.balancing_moment[none]).all() and np.isnan(res.efficiency[none | wedged]).all()
+    assert np.isfinite(res.balancing_moment[~none]).all() and (res.efficiency[eta0 & np.isfinite(res.efficiency)] <= 0).all()
+    assert np.isfinite(res.efficiency[~res.self_locking]).any()
+    # at a wedged angle M_bal is an equilibrium: Zhukovsky's lever with the friction loads and the
+    # power balance agree with it to rounding
+    F, size = scales(res)
+    w1 = res.omega(1)
+    assert np.abs(res.lever_discrepancy[wedged]).max() <= ROUNDING * F.max() * size
+    dP = (res.balancing_moment - res.balancing_moment_frictionless) * w1 - res.friction_power.sum(axis=1)
+    assert np.abs(dP[wedged]).max() <= ROUNDING * (F * size * np.abs(w1)).max()
+
+
+def test_eta_is_undefined_near_a_dead_centre_by_the_40_digit_moments(ice):
+    """eta is NaN exactly where |M0| <= DEAD_CENTRE |Mf - M0|, M0 and Mf taken from the 40-digit
+    reference (frictionless and frictional); a number elsewhere, with the sign of its rule. At
+    the dead centres and 1e-6 deg past them it is NaN (no longer 0 and -1.4e6); self-locking
+    still follows eta's sign there."""
+    from kinetostat.friction import DEAD_CENTRE
+    from kinetostat_validation.reference import reference_full
+    phi = np.array([0.0, 1e-6, 0.01, 0.3, 3.0, 20.0, 179.0, 179.9, 180.0, 180.1, 183.0, 359.9])
+    with pytest.warns(SelfLockingWarning):
+        res = kinetostat.analyze(ice, phi, friction="reactions")
+    M0 = reference_full(ice, phi, res=res).M_bal
+    Mf = reference_full(ice, phi, res=res, friction=True).M_bal
+    dead = np.abs(M0) <= DEAD_CENTRE * np.abs(Mf - M0)
+    assert dead[[0, 1, 2, 7, 8, 9, 11]].all() and not dead[[4, 5, 6]].any()
+    assert np.isnan(res.efficiency[dead]).all() and np.isfinite(res.efficiency[~dead]).all()
+    turn = np.sign(res.omega(1))
+    eta = np.where(M0 * turn >= 0, M0 / Mf, Mf / M0)
+    np.testing.assert_allclose(res.efficiency[~dead], eta[~dead], rtol=1e-9)
+    assert res.self_locking[[0, 1, 2]].all()                        # the drive must carry the crank past TDC
 
 
 def test_friction_method_is_an_argument_and_a_model_default(ice):
@@ -235,6 +285,7 @@ def test_random_mechanisms_with_friction(kind, size):
         at = phi[::4]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SelfLockingWarning)
+            warnings.simplefilter("ignore", kinetostat.SingularPositionWarning)
             res = kinetostat.analyze(mech, at, friction="reactions")
         ok = res.friction.solved & ~res.friction.wedged & ~res.singular    # a wedged pair: not unique
         F, length = scales(res)
@@ -283,7 +334,7 @@ def test_a_sweep_of_a_model_with_friction_in_the_reactions_solves_it(tmp_path):
     assert 2 * len(phi) >= FAST_MIN
     table = sweep(mech, {"n1": [4500.0, 3000.0]}, phi_deg=phi).table
     for n1, row in zip([4500.0, 3000.0], table.itertuples()):
-        res = kinetostat.analyze(kinetostat.load(mech, parameters={"n1": n1}), phi)
+        res = reactions(kinetostat.load(mech, parameters={"n1": n1}), phi)
         assert res.friction_method == "reactions"
         assert row.peak_M_bal == pytest.approx(np.max(np.abs(res.balancing_moment)), rel=1e-12)
 
@@ -297,7 +348,7 @@ def test_the_engines_plans_and_worksheet_keep_the_frictionless_method(tmp_path):
     text = ICE.read_text().replace("radius = 0.012\n", 'radius = 0.012\nmethod = "reactions"\n', 1)
     mech = kinetostat.loads(text, source=str(ICE))
     first = kinetostat.analyze(mech, [30.0], friction="first")
-    assert kinetostat.analyze(mech, [30.0]).friction_method == "reactions"
+    assert reactions(mech, [30.0]).friction_method == "reactions"
     assert build_scene(mech, phi_deg=[30.0]).res.friction_method == "first"
     ws = worksheet(mech, 30.0)
     assert ws.value("M_bal") == first.balancing_moment[0] != ws.value("M_bal_friction")

@@ -120,7 +120,7 @@ def tracked_points(mech: Mechanism) -> tuple[tuple[str, int], ...]:
 def build_scene(mech: Mechanism, phi_deg=None, steps: int = 360, res: Analysis | None = None) -> Scene:
     """The scene of `mech` with its exact motion at `phi_deg` (or `steps` angles over a cycle)."""
     res = res if res is not None else analyze(mech, phi_deg=phi_deg, steps=steps, friction="first")
-    ref = analyze(mech, phi_deg=[0.0])   # revolute joints' zero: the assembly at phi = 0, for every scene
+    ref = analyze(mech, phi_deg=[0.0], friction="first")   # revolute joints' zero: the assembly at phi = 0, for every scene
     parent = {0: None}
     order, joints, used = [], [], set()
     frontier = [0]

@@ -148,7 +148,7 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
     l_oa = math.dist(crank[d.pivot], crank[d.point])
     vA, aA = res.velocity(d.point)[0], res.acceleration(d.point)[0]
     if cycle is None:
-        cycle = analyze(mech, steps=72)
+        cycle = analyze(mech, steps=72, friction="first")      # positions only
     pos = np.concatenate([cycle.kin.point_z(k, p)[0] for k, link in enumerate(mech.links) if k
                           for p in link.points.values()] + [np.array([complex(*p) for p in mech.links[0].points.values()])])
     vel = np.array([0j] + [complex(*res.velocity(n)[0]) for n in mech.point_names])
