@@ -490,7 +490,8 @@ class Analysis:
         friction Pfr_i_j per pair and Pfr_total [W], eta [1] (`efficiency`), self_locking [bool],
         and with friction in the reactions Ffr_i_j per pair (friction moment on link j [N m] in
         a revolute pair, friction force on the slider along the guide [N] in a prismatic one) and
-        M_bal_0 [N m] (the frictionless balancing moment); cond_<group> [1] per Assur group;
+        M_bal_0 [N m] (the frictionless balancing moment) and passes [1] (the most friction passes
+        of a group at that angle, `FrictionSolution.passes`); cond_<group> [1] per Assur group;
         singular [bool].
 
         `df.attrs["units"]` maps every column to its unit ("1": dimensionless, "bool": a flag);
@@ -550,6 +551,7 @@ class Analysis:
                 for p in m.pairs:
                     put("N m" if p.kind == "R" else "N", **{f"Ffr_{p.links[0]}_{p.links[1]}": self.friction.load[:, p.index]})
                 put("N m", M_bal_0=self.balancing_moment_frictionless)
+                put("1", passes=self.friction.passes.max(axis=1))
             put("1", eta=self.efficiency)
             put("bool", self_locking=self.self_locking)
         put("1", **{f"cond_{g.label}": self.cond[:, n] for n, g in enumerate(m.structure.groups)})

@@ -80,7 +80,8 @@ class Sweep:
 
 
 def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: int = 360, phi_deg=None,
-          full: bool = False, scheduler: Any = None, chunk: int = CHUNK, progress: bool = False) -> Sweep:
+          full: bool = False, scheduler: Any = None, chunk: int = CHUNK, progress: bool = False,
+          friction: str | None = None) -> Sweep:
     """Analyse `model` (a file, a bundled model's name, or a Mechanism read from a file) for every
     combination of `params` (name -> values, array-like; the first parameter the slowest) at
     `steps` crank angles over a cycle, or at `phi_deg` (deg).
@@ -88,7 +89,10 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     `full`: also keep every angle's row (`Sweep.angles`). `scheduler`: None runs in this
     process (no Dask); "threads" or "processes": Dask's local schedulers; another string: the
     address of a `distributed` scheduler; or a `distributed.Client`. `chunk`: designs per task.
-    `progress`: a tqdm bar over the chunks on stderr.
+    `progress`: a tqdm bar over the chunks on stderr. `friction`: as `analyze` takes it (default:
+    the model's); with friction in the reactions each row also has `eta_cycle` (the cycle
+    efficiency, NaN unless the angles are a uniform full cycle) and `n_self_locking` (the count of
+    self-locking angles, `Analysis.self_locking`).
 
     ValueError names an unknown parameter, an empty or non-finite list of values, or a bad
     `chunk`; the model itself must load with its own parameters (ModelError otherwise);
@@ -111,8 +115,9 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     phi_deg = crank_angles(phi_deg, steps)
     designs = [dict(zip(names, d)) for d in itertools.product(*values)]
     parts = [designs[k:k + chunk] for k in range(0, len(designs), chunk)]
-    results = _run(parts, text, source, phi_deg, full, scheduler, progress)
-    table = _tidy(pd.concat([rows for rows, _ in results], ignore_index=True), names, base)
+    friction_method(base, friction)                 # ValueError for a bad method, before any design runs
+    results = _run(parts, text, source, phi_deg, full, scheduler, progress, friction)
+    table = _tidy(pd.concat([rows for rows, _ in results], ignore_index=True), names, base, friction)
     angles = None
     if full:
         frames = [a for _, a in results if a is not None and len(a)]
@@ -124,7 +129,7 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
 # ----------------------------------------------------------------------------- one chunk of designs
 
 def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.ndarray,
-           full: bool) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+           full: bool, friction: str | None = None) -> tuple[pd.DataFrame, pd.DataFrame | None]:
     """The rows of `designs` (each: parameter -> value) of the model `text`: one per design (its
     parameters, peaks, singular angles, error), and with `full` every angle's row (None without).
     A Dask task: plain, picklable arguments."""
@@ -137,8 +142,8 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
             try:
                 mech = loads(text, source, parameters=design)
                 kernel = (compiled and fast.refusal(mech) is None          # a triad: the numpy path
-                          and friction_method(mech, None) != "reactions")   # the kernel has no friction
-                res = None if kernel else analyze(mech, phi_deg=phi_deg)
+                          and friction_method(mech, friction) != "reactions")   # the kernel has no friction
+                res = None if kernel else analyze(mech, phi_deg=phi_deg, friction=friction)
             except (ModelError, StructureError, AssemblyError) as exc:
                 rows.append({**design, "error": _reason(exc)})
                 continue
@@ -149,7 +154,7 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
             sing = res.phi_deg[res.singular]
             rows.append({**design, **{name: _peak(column(res)) for name, column in _peak_columns(mech).items()},
                          "n_singular": len(sing), "singular_deg": " ".join(f"{x:g}" for x in sing),
-                         **_accuracy(*fast.warned_band(res)), "error": ""})
+                         **_accuracy(*fast.warned_band(res)), **_friction_columns(res), "error": ""})
             if full:
                 frames.append(_with_design(res.to_frame(), design))
         if built:       # the peaks of every design of the chunk in one call of the compiled kernel
@@ -185,6 +190,18 @@ def _peaks_into(rows: list[dict], built: list[tuple[int, Mechanism]], phi_deg: n
                        n_singular=len(sing), singular_deg=" ".join(f"{x:g}" for x in sing),
                        **_accuracy(pk.warned_deg[q], pk.worst_digits[q]))
         rows[n] = {**{k: v for k, v in rows[n].items() if k != "error"}, "error": rows[n]["error"]}
+
+
+def _friction_columns(res: Analysis) -> dict[str, Any]:
+    """With friction in the reactions: the cycle efficiency (NaN unless the angles are a uniform
+    full cycle) and the number of self-locking angles; nothing otherwise."""
+    if res.friction is None:
+        return {}
+    try:
+        eta = res.cycle_efficiency()
+    except ValueError:                   # not a uniform full cycle
+        eta = math.nan
+    return {"eta_cycle": eta, "n_self_locking": int(res.self_locking.sum())}
 
 
 def _accuracy(warned_deg: np.ndarray, worst: float) -> dict[str, Any]:
@@ -246,19 +263,19 @@ def _quiet() -> Iterator[None]:
 # ----------------------------------------------------------------------------- running the chunks
 
 def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: np.ndarray, full: bool,
-         scheduler: Any, progress: bool) -> list[tuple[pd.DataFrame, pd.DataFrame | None]]:
+         scheduler: Any, progress: bool, friction: str | None = None) -> list[tuple[pd.DataFrame, pd.DataFrame | None]]:
     """Every chunk's result, in the order of `parts`: in this process, or over Dask."""
     bar = _bar(len(parts), progress)
     try:
         if scheduler is None:
             out = []
             for part in parts:
-                out.append(_chunk(text, source, part, phi_deg, full))
+                out.append(_chunk(text, source, part, phi_deg, full, friction))
                 bar.update()
             return out
         import dask
         keys = [f"kinetostat-sweep-chunk-{k}" for k in range(len(parts))]
-        tasks = [dask.delayed(_chunk, pure=True)(text, source, part, phi_deg, full, dask_key_name=key)
+        tasks = [dask.delayed(_chunk, pure=True)(text, source, part, phi_deg, full, friction, dask_key_name=key)
                  for part, key in zip(parts, keys)]
         if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS:
             from dask.callbacks import Callback
@@ -361,11 +378,15 @@ def _values(name: str, x: Any) -> list[float]:
     return [float(a) for a in v]
 
 
-def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFrame:
+def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism, friction: str | None = None) -> pd.DataFrame:
     """The rows in the sweep's column order (NaN peaks for a failed design), with their units."""
     peaks = list(_peak_columns(base))
+    exact = base.friction is not None and friction_method(base, friction) == "reactions"
     table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "worst_digits", "warned_deg",
-                                   "error"])
+                                   *(["eta_cycle", "n_self_locking"] if exact else []), "error"])
+    if exact:
+        table["eta_cycle"] = table["eta_cycle"].astype(float)
+        table["n_self_locking"] = table["n_self_locking"].astype("Int64")
     table["worst_digits"] = table["worst_digits"].astype(float)
     table["warned_deg"] = table["warned_deg"].astype(object).fillna("").astype(str)
     table[peaks] = table[peaks].astype(float)
@@ -374,7 +395,8 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism) -> pd.DataFram
         table[text] = table[text].astype(object).fillna("").astype(str)
     table.attrs.update(mechanism=base.name, units={
         **_parameter_units(base, names), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
-        "n_singular": "1", "singular_deg": "deg", "worst_digits": "1", "warned_deg": "deg", "error": "text"})
+        "n_singular": "1", "singular_deg": "deg", "worst_digits": "1", "warned_deg": "deg", "error": "text",
+        **({"eta_cycle": "1", "n_self_locking": "1"} if exact else {})})
     return table
 
 

@@ -48,20 +48,63 @@ def _summary(res, path: Path) -> list[str]:
         k = int(np.nanargmax(np.abs(d)))
         lines.append(f"lever discrepancy max |M_lever - M_bal|: {abs(d[k]):.3g} N m (phi = {phi[k]:g} deg)")
     if m.friction is not None:
-        lock = res.self_locking
-        eta = res.efficiency[~lock & np.isfinite(res.efficiency)]
-        lines.append(f"friction ({res.friction_method}): self-locking at {int(lock.sum())} of {len(phi)} positions"
-                     + (f", eta {eta.min():.4g} .. {eta.max():.4g} elsewhere" if len(eta) else ""))
+        lines += _friction_lines(res)
     n_sing = int(np.sum(res.singular))
     if n_sing:
         lines.append(f"singular positions: {n_sing} (their values are NaN)")
     if len(phi) <= 12:
-        head = f"  {'phi, deg':>9s} {'M_bal, N m':>12s} " + " ".join(
-            f"{'|R(%d,%d)|, N' % p.links:>13s}" for p in m.pairs)
+        exact = res.friction is not None
+        head = f"  {'phi, deg':>9s} {'M_bal, N m':>12s} " + (f"{'M_bal,0, N m':>12s} {'eta':>8s} {'passes':>6s} " if exact else "") \
+            + " ".join(f"{'|R(%d,%d)|, N' % p.links:>13s}" for p in m.pairs)
         lines += ["values:", head]
         for n in range(len(phi)):
-            lines.append(f"  {phi[n]:9.4g} {M[n]:12.6g} " + " ".join(
+            extra = (f"{res.balancing_moment_frictionless[n]:12.6g} {res.efficiency[n]:8.4g} "
+                     f"{int(res.friction.passes[n].max()):6d} ") if exact else ""
+            lines.append(f"  {phi[n]:9.4g} {M[n]:12.6g} {extra}" + " ".join(
                 f"{np.linalg.norm(res.forces.R[n, p.index]):13.6g}" for p in m.pairs))
+    return lines
+
+
+def _friction_lines(res) -> list[str]:
+    """The summary's friction lines: the method, the self-locking angles by reason (on a uniform
+    full cycle the zones, edges to 1e-9 deg), eta elsewhere; with friction in the reactions the
+    frictionless and frictional peak M_bal, the passes, the friction power per pair and the
+    cycle efficiency (on a uniform full cycle)."""
+    import warnings
+
+    import numpy as np
+    from ..errors import SelfLockingWarning
+    from ..friction import MAX_PASSES
+    m, phi = res.mech, res.phi_deg
+    lock, why = res.self_locking, res.self_locking_reason
+    eta = res.efficiency[~lock & np.isfinite(res.efficiency)]
+    lines = [f"friction ({res.friction_method}): self-locking at {int(lock.sum())} of {len(phi)} positions"
+             + (f", eta {eta.min():.4g} .. {eta.max():.4g} elsewhere" if len(eta) else "")]
+    cycle = len(phi) > 1 and np.allclose(phi, phi[0] + np.arange(len(phi)) * 360.0 / len(phi), rtol=0, atol=1e-9)
+    if cycle and lock.any():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SelfLockingWarning)
+            zones = res.self_locking_zones()
+        lines.append("  self-locking zones: " + "; ".join(f"{round(a, 9) + 0.0:.9f} .. {round(b, 9) + 0.0:.9f} deg" for a, b in zones))
+    for key in dict.fromkeys(why[lock]):
+        at = phi[why == key]
+        lines.append(f"  {key}: {len(at)} position(s), phi = " + ", ".join(f"{x:g}" for x in at[:8])
+                     + (", ..." if len(at) > 8 else ""))
+    if res.friction is None:
+        return lines
+    M0, Mf = res.balancing_moment_frictionless, res.balancing_moment
+    if np.isfinite(Mf).any():
+        i, k = int(np.nanargmax(np.abs(M0))), int(np.nanargmax(np.abs(Mf)))
+        lines.append(f"  peak |M_bal| frictionless {_fmt(abs(M0[i]), 'N m')} (phi = {phi[i]:g} deg), "
+                     f"with friction {_fmt(abs(Mf[k]), 'N m')} (phi = {phi[k]:g} deg)")
+    p = res.friction.passes
+    lines.append(f"  passes per group: at most {int(p.max(initial=0))} (Newton's method at "
+                 f"{int((p > MAX_PASSES).any(axis=1).sum())} position(s))")
+    P = res.friction_power
+    lines.append("  peak friction power: " + ", ".join(
+        f"{q.label} {_fmt(float(np.nanmax(P[:, q.index])), 'W')}" for q in m.pairs if np.isfinite(P[:, q.index]).any()))
+    if cycle:
+        lines.append(f"  cycle efficiency: {res.cycle_efficiency():.6g}")
     return lines
 
 

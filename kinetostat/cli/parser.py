@@ -15,6 +15,13 @@ from .sweep import _param, cmd_sweep
 from .validate import cmd_validate
 
 
+def _friction_option(parser: argparse.ArgumentParser, default: str) -> None:
+    """--friction first|reactions, with what its default is for this command."""
+    parser.add_argument("--friction", choices=["first", "reactions"], default=None,
+                        help="a model with [friction]: 'first' (the first approximation: frictionless reactions) or "
+                             f"'reactions' (friction in the reactions, exact); {default}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .. import __version__
     from ..sweep import CHUNK
@@ -41,9 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="crank angles in degrees (model's reference and sense), e.g. --at 0 30 90")
     g.add_argument("--steps", metavar="N", type=_steps, default=360,
                    help="N equal steps over a revolution (default 360)")
-    a.add_argument("--friction", choices=["first", "reactions"], default=None,
-                   help="a model with [friction]: 'first' (the first approximation: frictionless reactions) or "
-                        "'reactions' (friction in the reactions, exact); default: the model's friction.method, else first")
+    _friction_option(a, "default: the model's friction.method, else first")
     a.add_argument("--out", metavar="FILE",
                    help="write the full table: FILE.csv, FILE.parquet (needs pyarrow) or FILE.json "
                         "(records); '-' writes CSV to stdout and the summary to stderr")
@@ -121,6 +126,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="models reported in parallel by N worker processes (default: the number of cores; "
                         "1: in this process)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _friction_option(r, "of the report's plans and worksheet (default first, the graphical method's; the friction "
+                        "section shows both either way)")
     r.add_argument("--page", action="store_true", help="also each model's interactive page (page.html, linked; "
                                                        "about 40 s a model)")
     r.set_defaults(func=cmd_report)
@@ -149,6 +156,9 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--cycle-scales", action="store_true",
                     help="every plan at the scales of the interactive page (`kinetostat page`): chosen once for "
                          "the whole cycle (--scale is then not used)")
+    _friction_option(pl, "default first (the graphical method's frictionless reactions); reactions draws each "
+                         "revolute pair's friction circle with its reaction tangent to it, the guides' reactions "
+                         "leaning by arctg f, the force polygons closed by them, and the worksheet's reactions with friction")
     pl.set_defaults(func=cmd_plans)
 
     pg = sub.add_parser("page", help="the interactive page of a mechanism: one offline HTML file, an angle slider "
@@ -232,6 +242,8 @@ def build_parser() -> argparse.ArgumentParser:
                          "distributed scheduler, e.g. tcp://10.0.0.5:8786 (default: in this process, no Dask)")
     sw.add_argument("--chunk", metavar="N", type=_positive("number of designs per task", "--chunk 32"), default=CHUNK,
                     help=f"designs per task (default {CHUNK})")
+    _friction_option(sw, "default: the model's friction.method, else first; reactions adds to each row the cycle "
+                         "efficiency eta_cycle and n_self_locking, the count of self-locking angles")
     sw.add_argument("--no-progress", action="store_true", help="no progress bar")
     sw.set_defaults(func=cmd_sweep)
     return p

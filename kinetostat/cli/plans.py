@@ -48,7 +48,7 @@ def _plan_names(text: str) -> list[str]:
 
 def cmd_plans(args) -> int:
     import numpy as np
-    from ..errors import SingularPositionWarning
+    from ..errors import SelfLockingWarning, SingularPositionWarning
     from ..plans import build, cycle_scales
     from ..plans.worksheet import worksheet
     from ..plans.lettering import lettering
@@ -64,8 +64,9 @@ def cmd_plans(args) -> int:
             warnings.simplefilter("always")
             fixed = cycle_scales(mech) if args.cycle_scales else None          # the page's scales
             plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only,
-                          fixed=fixed)
-            sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang)
+                          fixed=fixed, friction=args.friction or "first")
+            sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang,
+                                                friction=args.friction or "first")
     except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
         raise CLIError(f"--scale {exc}") from None
     except ValueError as exc:
@@ -77,6 +78,7 @@ def cmd_plans(args) -> int:
         raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
     at_plan = [w for w in caught if issubclass(w.category, SingularPositionWarning)
                and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
+    at_plan += [w for w in caught if issubclass(w.category, SelfLockingWarning)]
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
     _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))

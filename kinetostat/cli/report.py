@@ -16,7 +16,8 @@ from .._text import one_line
 from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, _Out, _checkpoint, _close, _engines, _error, _load, _prepare, _progress, _warn, _writable_dir, bundled_models
 
 
-def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = False) -> dict:
+def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = False,
+                friction: str = "first") -> dict:
     """One model's report: load, analyse, run the routes, write `out/<folder>/`. Returns
     {"summary", "warnings", "seconds"} or {"error"} (one line); raises only KeyboardInterrupt."""
     from ..report import run_validation, write_report
@@ -32,7 +33,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
-            summary = write_report(run, tmp, folder, page=page)
+            summary = write_report(run, tmp, folder, page=page, friction=friction)
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
@@ -61,20 +62,21 @@ def _report_cost(mech) -> int:
 
 
 def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int,
-                    costs: Sequence[int] = (), page: bool = False):
+                    costs: Sequence[int] = (), page: bool = False, friction: str = "first"):
     """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
     them in a process pool (only paths and names cross to the workers, so any start method
     works), the largest `costs` first, 1 in this process. Ctrl-C cancels the models not started
     and raises KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
         for n, p in enumerate(paths):
-            yield n, _report_job(str(p), engines, steps, str(out), folders[n], page)
+            yield n, _report_job(str(p), engines, steps, str(out), folders[n], page, friction)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
     try:
         first = sorted(range(len(paths)), key=lambda n: -costs[n] if costs else 0)
-        futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n], page): n for n in first}
+        futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n], page, friction): n
+                   for n in first}
         for f in as_completed(futures):
             try:
                 r = f.result()
@@ -106,7 +108,8 @@ def cmd_report(args) -> int:
     bar = _progress(len(order), "report", not args.no_progress)
     try:
         for n, r in _report_results(order, folders, engines, args.steps, out, args.jobs or os.cpu_count() or 1,
-                                    [_report_cost(mech) for _, mech, *_ in prepared], args.page):
+                                    [_report_cost(mech) for _, mech, *_ in prepared], args.page,
+                                    args.friction or "first"):
             _checkpoint()
             path = order[n]
             bar.update()

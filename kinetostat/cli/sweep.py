@@ -88,6 +88,7 @@ def cmd_sweep(args) -> int:
     t0 = time.perf_counter()
     try:
         sw = sweep(mech, dict(args.param), steps=args.steps, full=args.full, scheduler=args.scheduler,
+                   friction=args.friction,
                    chunk=args.chunk, progress=not args.no_progress and sys.stderr.isatty())
     except ValueError as exc:
         raise CLIError(f"--param: {str(exc).removeprefix('sweep: ')}") from None

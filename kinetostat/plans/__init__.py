@@ -220,14 +220,17 @@ def plan_file_name(plan: Plan, suffix: str = ".svg") -> str:
 
 def build(mech, at: float | None = None, scales: Mapping[str, float] | None = None,
           starting_deg: float | None = None, only: Iterable[str] | None = None,
-          fixed: CycleScales | None = None) -> Plans:
+          fixed: CycleScales | None = None, friction: str = "first") -> Plans:
     """The plans of `mech` at crank angle `at` (deg; default: the model's design position
     `drive.design_deg`). `scales`: any of mu_l [m/mm], mu_v [m/(s mm)], mu_a [m/(s^2 mm)],
     mu_F [N/mm] (the others chosen by the texts' rule, `choose_scales`); `starting_deg`: position
     0 of the plan of positions (default: found, `starting_position`); `only`: names of BUILDERS
     to draw (default all); `fixed`: every plan at these scales (`cycle_scales`; `scales` then
-    unused). ValueError for a bad angle or name; ScaleError (a ValueError) for a scale that would
-    draw a plan beyond MAX_EXTENT_MM."""
+    unused). `friction`: "first" (default: the frictionless reactions of the graphical method) or
+    "reactions" (a model with [friction]: the group plans, force polygons and crank plan with the
+    reactions with friction, each revolute pair's friction circle drawn, `forces`). ValueError for
+    a bad angle or name, or an angle with no equilibrium with friction; ScaleError (a ValueError)
+    for a scale that would draw a plan beyond MAX_EXTENT_MM."""
     import math
 
     from ..solve import analyze
@@ -240,7 +243,12 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     unknown = [n for n in chosen if n not in names]
     if unknown:
         raise ValueError(f"unknown plan {unknown[0]!r}: expected one of {', '.join(names)}")
-    res = analyze(mech, phi_deg=[float(at)], friction="first")     # the graphical method: frictionless reactions
+    if friction not in ("first", "reactions"):
+        raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
+    res = analyze(mech, phi_deg=[float(at)], friction=friction)    # default: the graphical method's frictionless reactions
+    if res.friction is not None and not res.friction.solved[0]:
+        raise ValueError(f"at {at:g} deg there is no equilibrium with friction in the reactions (self-locking): "
+                         f"no plans of the forces to draw")
     if res.singular[0]:
         raise ValueError(f"at {at:g} deg the mechanism is at a singular position "
                          f"(cond {res.cond[0].max():.3g}): velocities and accelerations undefined")

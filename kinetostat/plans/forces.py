@@ -13,6 +13,11 @@ pair's normal force from its slider point. The frame is lettered 0 as seed 000 l
 unless the model's `[[published]]` reactions letter it otherwise: seed 002 calls the ICE's
 cylinder link 4 (R43, R41), and the ICE model publishes R43 for the pair (0, 3).
 
+With friction in the reactions (`res.friction`), a revolute pair's reaction is drawn on its line
+tangent to the pair's friction circle rho = f r (drawn at mu_l, its radius a segment rho<ij>),
+a prismatic pair's reaction whole, leaning by arctg f from the normal; the force polygons close
+with these reactions.
+
 Forces on a group plan or the crank plan are drawn at a force scale of their own, stated on each
 segment (`Segment.scale`); arms, links and offsets at the plan's mu_l.
 
@@ -168,7 +173,76 @@ def _reaction_load(mech: "Mechanism", res: "Analysis", i: int, j: int, name: str
         x = res.reaction_offset(*p.links)[0]
         d = complex(*p.direction) * res.kin.rot[0, p.links[0]]
         X = X + (0.0 if math.isnan(x) else x) * d
+    else:
+        X = X + _friction_offset(res, p)
     return Load(name or reaction_name(mech, i, j), j, complex(X), complex(*res.reaction(i, j)[0]), p.point)
+
+
+#: A friction circle drawn under this radius (mm) gets an enlarged detail beside the plan, of
+#: about this radius (mm), this far (mm) right of the plan's points.
+DETAIL_MIN_MM, DETAIL_RADIUS_MM, DETAIL_GAP_MM = 1.0, 8.0, 20.0
+
+
+def _nice(x: float) -> float:
+    """The largest of 1, 2, 5 x 10^n not above x (at least 1)."""
+    e = 10.0 ** math.floor(math.log10(x)) if x >= 1 else 1.0
+    return max(m * e for m in (1.0, 2.0, 5.0) if m * e <= max(x, 1.0))
+
+
+def _friction_offset(res: "Analysis", p) -> complex:
+    """Revolute pair p with friction in the reactions (`res.friction`): where its reaction's line
+    touches the friction circle, from the pin, world m (0 without): the foot r with r x R = q,
+    q the friction moment on p.links[1], R the force of links[0] on it; |r| = f r_pin = rho."""
+    if res.friction is None:
+        return 0j
+    R, q = complex(*res.forces.R[0, p.index]), float(res.friction.load[0, p.index])
+    return -q * 1j * R / abs(R) ** 2 if abs(R) > 0 else 0j
+
+
+def _friction_circles(mech: "Mechanism", res: "Analysis", pairs, pts: dict, segs: list, paths: dict,
+                      mu_l: Scale) -> list[str]:
+    """With friction in the reactions: each revolute pair's friction circle rho = f r at its pin
+    (a path at mu_l) and the radius rho<ij> from the pin to where the reaction's line touches it
+    (a segment: value rho, m); each prismatic pair's friction angle. Returns the sheet's notes:
+    rho in mm, and where it is drawn under 1 mm, that it is drawn at true scale (too small to read);
+    the angle arctg f a guide's reaction leans by from its normal."""
+    if res.friction is None:
+        return []
+    notes = []
+    finite = [z for z in pts.values() if math.isfinite(z.real) and math.isfinite(z.imag)]
+    corner = complex(max(z.real for z in finite) + DETAIL_GAP_MM, max(z.imag for z in finite))
+    for p in dict.fromkeys(pairs):
+        name = reaction_name(mech, *p.links)[1:]
+        if p.kind == "R":
+            rho = mech.friction.f * (p.radius if p.radius is not None else mech.friction.radius)
+            pin = _world(res, p.links[1], p.point)
+            paths[f"friction circle ρ{name}"] = _circle(pin / mu_l.value, rho / mu_l.value)
+            touch = pin + _friction_offset(res, p)
+            pts[f"ρ{name}:pin"], pts[f"ρ{name}:touch"] = pin / mu_l.value, touch / mu_l.value
+            segs.append(Segment(f"ρ{name}", f"ρ{name}:pin", f"ρ{name}:touch", rho, "m", "arm"))
+            drawn = rho / mu_l.value
+            notes.append(f"friction circle ρ{name} = f r = {rho * 1e3:.4g} mm, drawn {drawn:.3g} mm: R{name} is tangent to it")
+            if drawn < DETAIL_MIN_MM:                # too small to read: an enlarged detail beside the plan
+                k = _nice(DETAIL_RADIUS_MM / drawn)
+                corner -= 3.4j * DETAIL_RADIUS_MM
+                C = corner + DETAIL_RADIUS_MM
+                R = complex(*res.forces.R[0, p.index])
+                u = _friction_offset(res, p)
+                t = C + k * u / mu_l.value
+                paths[f"detail ρ{name} x{k:g}"] = _circle(C, k * drawn)
+                pts[f"ρ{name} x{k:g}:pin"], pts[f"ρ{name} x{k:g}:touch"] = C, t
+                segs.append(Segment(f"ρ{name} x{k:g}", f"ρ{name} x{k:g}:pin", f"ρ{name} x{k:g}:touch", rho, "m", "arm",
+                                    Scale("mu_l", mu_l.value / k, "m/mm")))
+                if abs(R) > 0:
+                    e = R / abs(R)
+                    pts[f"R{name} x{k:g}:from"], pts[f"R{name} x{k:g}:to"] = t - 1.6 * DETAIL_RADIUS_MM * e, t + 1.6 * DETAIL_RADIUS_MM * e
+                    segs.append(Segment(f"R{name} x{k:g}", f"R{name} x{k:g}:from", f"R{name} x{k:g}:to",
+                                        float("nan"), "", "line"))
+                notes.append(f"detail ρ{name} x{k:g}: the friction circle enlarged {k:g} times, the line of R{name} tangent to it")
+        else:
+            notes.append(f"friction angle φ{name} = {math.degrees(math.atan(mech.friction.f)):.4g} deg (tan φ{name} = f): "
+                         f"R{name} leans from the normal to the guide")
+    return notes
 
 
 def _carried(mech: "Mechanism", res: "Analysis", k: int, solved: set[int]) -> list[Load]:
@@ -310,8 +384,10 @@ def group_plans(mech: "Mechanism", res: "Analysis", mu_l, mu_F: dict[str, Scale]
                 for ld in loads[x]:
                     if abs(ld.force) > 0 and abs(ld.point - M) > 1e-12 * mech.size:
                         _arm(segs, pts, arm_name(ld.name), M, M_name, ld.point, ld.force, mu_l)
-        plans.append(Plan(f"group:{_group_label(g)}", f"Group {_group_label(g)} ({g.kind}): loads and reactions; "
-                          f"forces drawn at {mu_g}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths))
+        notes = _friction_circles(mech, res, g.pairs, pts, segs, paths, mu_l)
+        plans.append(Plan(f"group:{_group_label(g)}", f"Group {_group_label(g)} ({g.kind}): loads and reactions"
+                          + (" with friction" if res.friction is not None else "") + f"; forces drawn at {mu_g}",
+                          mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths, notes=notes))
     return plans
 
 
@@ -567,7 +643,7 @@ def crank_plan(mech: "Mechanism", res: "Analysis", mu_l, mu_F=None) -> Plan:
     for c in link_couples(mech, res, 1):
         paths[c.name] = _couple_path(O / mu_l.value, c.moment, 6.0)
     R01 = _reaction_load(mech, res, 0, 1)
-    _arrow(segs, pts, R01.name, O, R01.force, mu_l, mu_F)
+    _arrow(segs, pts, R01.name, R01.point, R01.force, mu_l, mu_F)
     M_bal = float(res.balancing_moment[0])
     if dr.kind == "machine":
         gear = dr.gear
@@ -593,8 +669,9 @@ def crank_plan(mech: "Mechanism", res: "Analysis", mu_l, mu_F=None) -> Plan:
         paths[L.M_bal] = _couple_path(O / mu_l.value, M_bal, 10.0)
         title = f"Initial link: balancing couple {L.M_bal} = {M_bal:.6g} N m"
         results = (Result(L.M_bal, M_bal, "N m", "M = sum"),)
+    notes = _friction_circles(mech, res, [p for p in mech.pairs if dr.link in p.links], pts, segs, paths, mu_l)
     return Plan("crank", f"{title}; forces drawn at {mu_F}", mu_l, float(res.phi_deg[0]), pts, tuple(segs), paths,
-                results=results)
+                notes=notes, results=results)
 
 
 def _line_of_action(gear, M: float) -> complex:

@@ -453,24 +453,32 @@ class _Sheet:
         m, L = self.mech, self.L
         if m.friction is None:
             return
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SelfLockingWarning)
-            ex = analyze(m, phi_deg=[at], friction="reactions")
+        ex = self.res
+        if ex.friction is None:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", SelfLockingWarning)
+                ex = analyze(m, phi_deg=[at], friction="reactions")
         f = m.friction.f
         for p in m.pairs:
             i, j = p.links
             R, q = self.R(i, j), ex.friction.load[0, p.index]
+            Rf = R if ex is self.res else f"{R},f"
+            if ex is not self.res:         # the sheet's reactions are frictionless: the frictional ones beside them
+                self.add("friction", f"Rf_{i}_{j}", f"|{Rf}|", float(np.linalg.norm(ex.forces.R[0, p.index])), "N", "",
+                         "the reaction with friction in the reactions")
             if p.kind == "R":
                 r = p.radius if p.radius is not None else m.friction.radius
                 self.add("friction", f"rho_{i}_{j}", f"ρ{R[1:]}", f * r, "m", "", "f r")
                 self.add("friction", f"Mf_{i}_{j}", f"M_f{R[1:]}", abs(q), "N m", _sense(q),
-                         f"f r |{R}|, against the relative rotation")
+                         f"f r |{Rf}|, against the relative rotation")
             else:
                 self.add("friction", f"phi_f_{i}_{j}", f"φ_f{R[1:]}", math.degrees(math.atan(f)), "deg", "", "tan φ_f = f")
                 self.add("friction", f"Ff_{i}_{j}", f"F_f{R[1:]}", abs(q), "N", "",
                          f"f |N{R[1:]}|, along the guide, against the sliding")
         M0, M1, Mf = (ex.balancing_moment_frictionless[0], analyze(m, phi_deg=[at], friction="first")
                       .balancing_moment_with_friction[0], ex.balancing_moment[0])
+        if ex is self.res:             # the sheet's M_bal is the frictional one: the frictionless one beside it
+            self.add("friction", "M_bal_0", f"{L.M_bal},0", M0, "N m", _sense(M0), "frictionless")
         self.add("friction", "M_bal_first", f"{L.M_bal} + P_f/ω1", M1, "N m", _sense(M1), "first approximation")
         self.add("friction", "M_bal_friction", f"{L.M_bal},f", Mf, "N m", _sense(Mf),
                  f"friction in the reactions, {int(ex.friction.passes[0].max())} passes")
@@ -487,19 +495,27 @@ def _point_of(res: Analysis, k: int, name: str) -> np.ndarray:
     return res.kin.v_origin[0, k] + w * np.array([-r[1], r[0]])
 
 
-def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = None, lang: str = "en") -> Worksheet:
+def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = None, lang: str = "en",
+              friction: str = "first") -> Worksheet:
     """The worksheet of `mech` at crank angle `at` (deg; default the model's design position).
 
     mu_l: the scale of the plan of positions, m/mm, for the arms and z in mm (default: the
     crank drawn 30-35 mm at a round scale, as seed 002 chooses it). lang: "en", "uk" or "ru"
     (the mechanism named as its lettering names it in that language). Symbols as the model's
-    lettering writes them (R43, M_зр)."""
+    lettering writes them (R43, M_зр). friction: "first" (the graphical method's frictionless
+    reactions; a model with [friction] gets its friction section from the exact solution, its
+    reactions with friction |R..,f| written beside) or "reactions" (every reaction and M_bal of
+    the sheet with friction in the reactions, as `plans.build(..., friction="reactions")` draws them)."""
     check_lang(lang)
     if at is None:
         at = mech.drive.design_deg
     if mu_l is not None and not (isinstance(mu_l, (int, float)) and math.isfinite(mu_l) and mu_l > 0):
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
-    res = analyze(mech, phi_deg=[float(at)], friction="first")     # the graphical method; friction: its own section
+    if friction not in ("first", "reactions"):
+        raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SelfLockingWarning)       # the sheet's friction rows state eta
+        res = analyze(mech, phi_deg=[float(at)], friction=friction)   # default: the graphical method's, frictionless
     if mu_l is None:
         mu_l = choose_scales(mech, res)["mu_l"].value
     sheet = _Sheet(res, float(mu_l))

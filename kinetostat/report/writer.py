@@ -269,10 +269,11 @@ def _published_section(doc: Doc, m: Mechanism, published: Sequence[PublishedChec
                "within"], rows, "lllrrlrrl")
 
 
-def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False) -> list[Path]:
+def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction: str = "first") -> list[Path]:
     """The plans of the graphical method at the model's design position (`kinetostat.plans`),
     one picture each, with their segments.csv and the worksheet beside them, and with `page` the
-    interactive page (`plans.page`, page.html) linked; returns the files."""
+    interactive page (`plans.page`, page.html) linked; `friction`: the method they are drawn with
+    (`plans.build`); returns the files."""
     from ..plans import build, plan_file_name, svg
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
@@ -280,12 +281,14 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False) -> list[
     try:
         with warnings.catch_warnings():         # the cycle's warnings are reported below
             warnings.simplefilter("ignore")
-            plans = build(m)
-            sheet = worksheet(m, mu_l=plans.scales["mu_l"].value)
+            plans = build(m, friction=friction)
+            sheet = worksheet(m, mu_l=plans.scales["mu_l"].value, friction=friction)
     except ValueError as exc:
         doc.p(f"No plans at this position: {esc(str(exc))}")
         return []
-    doc.p(f"The plans at φ = {at:g}° as the course texts draw them, from the exact solution, at the scales "
+    doc.p(f"The plans at φ = {at:g}° as the course texts draw them, from the exact solution"
+          + (" with friction in the reactions (each revolute pair's friction circle drawn, its reaction tangent to it)"
+             if friction == "reactions" else "") + ", at the scales "
           + ", ".join(f"`{s}`" for s in plans.scales.values())
           + ": positions, velocities, accelerations, each Assur group with its loads and arms, the "
             "force polygons, the initial link and Zhukovsky's lever, each on an A3 sheet true to scale in mm "
@@ -457,13 +460,16 @@ def _tolerance(run: ModelRun, route: str):
     return run.tolerances.get(route) or TOLERANCES.get(route)
 
 
-def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool = False) -> dict[str, Any]:
+def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool = False,
+                 friction: str = "first") -> dict[str, Any]:
     """Write `out/<folder>/` for one model (default folder: `run.stem`); returns the summary
     also saved as summary.json.
 
     `folder` is a name of ASCII letters, digits, '_' and '-' (`kinetostat._io.safe_name`), and
     the folder must resolve to a place inside `out` (ValueError otherwise); `page`: also the
-    model's interactive page, page.html, linked from the plans' section. Every file is
+    model's interactive page, page.html, linked from the plans' section; `friction`: the method
+    of the plans and worksheet ("first": the graphical method's; "reactions": with friction in the
+    reactions, a model with [friction] only). Every file is
     written atomically: an interrupted or failed run leaves each earlier file as it was. Every
     file depends only on the model, the routes and the steps (and the libraries' versions): no
     dates and no run times, so a rerun reproduces them byte for byte. Run times are printed by
@@ -568,7 +574,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
     _published_section(doc, m, published)
-    plan_files = _plans_section(doc, m, d, page)
+    plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first")
 
     sing = int(np.sum(res.singular))
     if run.warnings or sing:
