@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, fields, replace
+from functools import cached_property
 from types import MappingProxyType
-from typing import Mapping, NamedTuple
+from typing import Callable, Mapping, NamedTuple
 
 import numpy as np
 
@@ -19,7 +20,8 @@ from .kinetostatics import Forces, forces, friction_power, lever_moment
 from . import friction as _friction, groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, dot_z
-from .errors import SelfLockingWarning, self_locking_message
+from .friction import relative_rate
+from .errors import SelfLockingWarning, SingularPositionWarning, self_locking_message
 from .model import Mechanism, _abbreviate
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "deviation",
@@ -32,6 +34,12 @@ FRAME_NOTE = ("SI units; world frame: x right, y up, gravity along -y; moments, 
               "from the model's drive.reference in the drive's sense; R_i_j, Rx_i_j, Ry_i_j: force exerted "
               "by link i on link j (R_j_i = -R_i_j); M_bal: moment the drive applies to the crank; inertia "
               "loads: main vector at the centre of mass and main moment; NaN where singular is True")
+
+
+#: Gauss-Legendre nodes per smooth piece of a cycle integral with friction (`Analysis._cycle_integral`).
+CYCLE_NODES = 24
+#: The sign changes of relative motion, found to this, deg (`Analysis._breakpoints`).
+BREAK_TOL_DEG = 1e-9
 
 
 class InertiaLoad(NamedTuple):
@@ -282,7 +290,7 @@ class Analysis:
         """(n_pairs,) energy lost in each pair over one revolution, J: the integral of its power
         over the crank angle (`_cycle_integral`). Needs the angles of a uniform full cycle, as
         `analyze(mech, steps=N)` gives."""
-        return self._cycle_integral(self._friction_power(self._unit_motion()), "friction_energy")
+        return self._cycle_integral(lambda r: r._friction_power(r._unit_motion()), "friction_energy")
 
     def _friction_power(self, kin: Kinematics) -> np.ndarray:
         """(N, n_pairs) power lost in each pair at the motion `kin` (the same angles), W: from the
@@ -403,9 +411,10 @@ class Analysis:
         balancing moment without (W0) and with (Wf) friction: W0 / Wf where the drive does work
         on the loads over the cycle (W0 > 0), Wf / W0 where the loads drive it (an engine).
         Needs a uniform full cycle of angles (NaN if any angle has no equilibrium)."""
-        w1 = self._unit_motion().omega[:, 1]
-        W0, Wf = self._cycle_integral(np.stack([self.balancing_moment_frictionless * w1,
-                                                self.balancing_moment_with_friction * w1], -1), "cycle_efficiency")
+        def drive(r: Analysis) -> np.ndarray:
+            w1 = r._unit_motion().omega[:, 1]
+            return np.stack([r.balancing_moment_frictionless * w1, r.balancing_moment_with_friction * w1], -1)
+        W0, Wf = self._cycle_integral(drive, "cycle_efficiency")
         return float(W0 / Wf if W0 > 0 else Wf / W0)
 
     def _unit_motion(self) -> Kinematics:
@@ -413,16 +422,74 @@ class Analysis:
         are d/d phi, so a load's power there is its work per radian of crank turn."""
         return kinematics(self.mech, np.radians(self.phi_deg), unit_speed=True)
 
-    def _cycle_integral(self, per_radian: np.ndarray, who: str) -> np.ndarray:
-        """Integral over one revolution of a work per radian of crank turn (N, ...) J/rad (a power
-        at unit crank speed), J: the mean over the uniform full cycle of angles times 2 pi (the
-        periodic trapezoid rule, spectrally accurate for a smooth periodic integrand). Over the
-        crank angle, not time: defined at any speed law, standstill included. ValueError naming
-        `who` otherwise."""
+    def _cycle_integral(self, integrand: Callable[["Analysis"], np.ndarray], who: str) -> np.ndarray:
+        """Integral over one revolution of a work per radian of crank turn, `integrand(res)` (N, ...)
+        J/rad of a result at N angles (a power at unit crank speed), J. Over the crank angle, not
+        time: defined at any speed law, standstill included. Needs this result's angles to be a
+        uniform full cycle (ValueError naming `who` otherwise).
+
+        Without [friction]: the periodic trapezoid rule on this result's angles (spectrally
+        accurate for a smooth periodic integrand). With [friction] the integrand jumps or kinks
+        where a pair's relative motion changes sign (the friction turns), and kinks at the knots
+        of a load's crank-angle table: it is integrated piecewise between these angles
+        (`_breakpoints`), CYCLE_NODES Gauss-Legendre nodes a piece, at which the mechanism is
+        solved again by the same method. Kinks it does not find (a travel table's knots, a
+        characteristic) leave the rule's algebraic error there."""
         phi = self.phi_deg
         if not np.allclose(phi, phi[0] + np.arange(len(phi)) * 360.0 / len(phi), rtol=0, atol=1e-9):
             raise ValueError(f"{who}: needs the angles of a uniform full cycle (analyze with steps=N)")
-        return per_radian.mean(axis=0) * 2 * np.pi
+        edges = self._breakpoints if self.mech.friction is not None else np.empty(0)
+        if not len(edges):
+            return integrand(self).mean(axis=0) * 2 * np.pi
+        x, w = np.polynomial.legendre.leggauss(CYCLE_NODES)
+        lo, hi = edges, np.append(edges[1:], edges[0] + 360.0)
+        nodes = (0.5 * (lo + hi)[:, None] + 0.5 * (hi - lo)[:, None] * x).ravel()
+        weights = (np.radians(0.5 * (hi - lo))[:, None] * w).ravel()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SelfLockingWarning)
+            warnings.simplefilter("ignore", SingularPositionWarning)
+            at = exact(self.mech, nodes, "reactions" if self.friction is not None else "first")
+        values = integrand(at)
+        return np.tensordot(weights, values, axes=(0, 0))
+
+    @cached_property
+    def _breakpoints(self) -> np.ndarray:
+        """(n,) sorted crank angles in [phi_0, phi_0 + 360), deg, where a cycle integrand with
+        friction is not smooth: each sign change of a pair's relative motion (the friction turns)
+        or of a prismatic pair's normal force (f |N| kinks) between two of this result's angles,
+        found by bisection to BREAK_TOL_DEG (re-solved by the same method; two changes between
+        the same two angles are missed), and each knot of a load's crank-angle table."""
+        m, phi0 = self.mech, float(self.phi_deg[0])
+        phi = np.asarray(self.phi_deg, float)
+        method = "reactions" if self.friction is not None else "first"
+
+        def signs(a: np.ndarray, c: np.ndarray) -> np.ndarray:
+            """(len(a),) the sign of column c (`s` below) at the angles a: a pair's relative motion
+            (kinematics only), or a prismatic pair's normal force (solved again)."""
+            out = np.sign(relative_rate(m, kinematics(m, np.radians(a), unit_speed=True))[0][np.arange(len(a)), c % n])
+            force = c >= n
+            if force.any():
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", SelfLockingWarning)
+                    warnings.simplefilter("ignore", SingularPositionWarning)
+                    out[force] = np.sign(exact(m, a[force], method).forces.normal[np.arange(force.sum()), c[force] - n])
+            return out
+        n = len(m.pairs)
+        s = np.sign(np.concatenate([relative_rate(m, self._unit_motion())[0],
+                                    np.where([p.kind == "P" for p in m.pairs], self.forces.normal, 0.0)], axis=1))
+        s_next = np.roll(s, -1, axis=0)
+        k, c = np.nonzero(s * s_next < 0)
+        lo, hi = phi[k], phi[k] + 360.0 / len(phi)
+        while len(lo) and (hi - lo).max() > BREAK_TOL_DEG:
+            mid = 0.5 * (lo + hi)
+            left = signs(mid, c) == s[k, c]
+            lo, hi = np.where(left, mid, lo), np.where(left, hi, mid)
+        k0, _ = np.nonzero((s == 0) & (np.roll(s, 1, axis=0) * s_next < 0))     # a zero at one of the angles
+        knots = [np.asarray(ld.table.x, float) for ld in m.loads if ld.table is not None and ld.table.argument == "phi"]
+        found = np.concatenate([0.5 * (lo + hi), phi[k0], *knots])
+        at = np.sort(phi0 + np.mod(found - phi0, 360.0))
+        keep = np.append(True, np.diff(at) > 1e-9) & (at < phi0 + 360.0 - 1e-9)   # one of two within 1e-9 deg
+        return at[keep] if len(at) else at
 
     def work(self) -> Mapping[str, float]:
         """Work of each load over one revolution, J (positive: the load drives the mechanism): the
@@ -439,6 +506,12 @@ class Analysis:
         rounding); in the first approximation the balancing moment is frictionless: every entry
         but friction sums to 0 at any speed law, and the friction entries are what the drive must
         supply on top (seed 003)."""
+        names = list(self._work_per_radian())
+        W = self._cycle_integral(lambda r: np.stack(list(r._work_per_radian().values()), axis=-1), "work")
+        return MappingProxyType(dict(zip(names, W.tolist())))
+
+    def _work_per_radian(self) -> dict[str, np.ndarray]:
+        """Each load's work per radian of crank turn at this result's angles (`work`), J/rad."""
         m, kin, u = self.mech, self.kin, self._unit_motion()
         per_radian: dict[str, np.ndarray] = {}
 
@@ -468,9 +541,7 @@ class Analysis:
             lost = self._friction_power(u)
             for p in m.pairs:
                 add(f"friction {p.label}", -lost[:, p.index])
-        names = list(per_radian)
-        W = self._cycle_integral(np.stack([per_radian[n] for n in names], axis=-1), "work")
-        return MappingProxyType(dict(zip(names, W.tolist())))
+        return per_radian
 
     # -- table
     def to_frame(self):

@@ -110,10 +110,14 @@ def relative_rate(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.
 
 
 def power(mech: "Mechanism", kin: "Kinematics", load: np.ndarray) -> np.ndarray:
-    """(N, n_pairs) power lost in each pair, W: friction load (`FrictionSolution.load`) times the
-    relative motion at the motion `kin`; |load x rate| (the two have opposite signs wherever the
-    motion is more than rounding; at rest it is 0 to rounding, never a negative rounding)."""
-    return np.abs(load * relative_rate(mech, kin)[0])
+    """(N, n_pairs) power lost in each pair, W: -(friction load (`FrictionSolution.load`) x the
+    relative motion) at the motion `kin`, signed: >= 0 wherever the friction opposes the motion
+    (a load along the motion would show as a negative loss); where the relative motion is below
+    RATE_TOL (at rest, `motion_sense`) |load x rate|, a rounding-sized loss, never negative."""
+    rate = relative_rate(mech, kin)[0]
+    revolute = np.array([p.kind == "R" for p in mech.pairs])
+    still = np.abs(rate) <= RATE_TOL * np.abs(kin.omega[:, 1:2]) * np.where(revolute, 1.0, mech.size)
+    return np.where(still, np.abs(load * rate), -load * rate)
 
 
 def motion_sense(mech: "Mechanism", kin: "Kinematics") -> np.ndarray:

@@ -93,6 +93,8 @@ def check_identities(mech, phi) -> None:
     rate = relative_rate(mech, res.kin)[0]
     moving = np.abs(rate) > RATE_TOL * np.abs(w1)[:, None] * np.where([p.kind == "R" for p in mech.pairs], 1, size)
     assert (res.friction.load * rate)[ok[:, None] & moving].max(initial=0.0) <= 0.0
+    # the reported losses are the signed -(load x rate), not a magnitude: >= 0 since each opposes its motion
+    np.testing.assert_array_equal(res.friction_power[ok[:, None] & moving], -(res.friction.load * rate)[ok[:, None] & moving])
     assert (res.friction_power[ok] >= 0).all()
     # the friction laws hold on the converged reactions: f r |R|, f |N|
     R = np.linalg.norm(res.forces.R, axis=-1)
@@ -121,6 +123,20 @@ def test_zero_friction_gives_the_frictionless_result_bit_for_bit(ice):
     assert np.array_equal(a.lever_moment, b.lever_moment) and np.array_equal(a.forces.normal, b.forces.normal)
     assert (b.friction.passes[:, 0] == 1).all() and not b.self_locking[np.abs(a.balancing_moment) > 1e-6].any()
     assert np.array_equal(b.efficiency[np.isfinite(b.efficiency)], np.ones(np.isfinite(b.efficiency).sum()))
+
+
+@pytest.mark.parametrize("path", sorted(MODELS.glob("*.toml")), ids=lambda p: p.stem)
+def test_zero_friction_is_bit_for_bit_on_every_bundled_model(path):
+    mech = with_friction(path, f=0.0)
+    phi = np.arange(0.0, 360.0, 45.0) + 0.5
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kinetostat.SingularPositionWarning)
+        a = kinetostat.analyze(mech, phi, friction="first")
+        b = reactions(mech, phi)
+    for x, y in ((a.forces.R, b.forces.R), (a.balancing_moment, b.balancing_moment), (a.lever_moment, b.lever_moment),
+                 (a.forces.normal, b.forces.normal), (a.forces.F_bal, b.forces.F_bal)):
+        np.testing.assert_array_equal(x, y)
+    assert np.abs(b.friction_power).max() == 0.0
 
 
 def test_ice_at_30_deg_agrees_with_the_40_digit_newton_solution(ice):
@@ -153,6 +169,37 @@ def test_ice_work_balances_to_rounding_with_friction_in_the_reactions(ice):
     eta = res.cycle_efficiency()
     assert eta == pytest.approx(-W["balancing moment"] / W["load gas force"], rel=1e-12)
     assert 0 < eta < 1
+
+
+def test_cycle_integrals_with_friction_are_converged_across_the_jumps(ice):
+    """With friction the integrands jump (M_bal where a relative motion turns) and kink (f |N|
+    where a normal force turns, the gas diagram's knots): integrated piecewise between them, the
+    cycle efficiency and the energies do not depend on the sampling (36 or 360 angles) nor on the
+    nodes a piece, and the plain trapezoid at 7200 angles (first order across the jumps) lies
+    within its own O(h) error of them; the trapezoid at 360 angles (the old rule, 0.5530683 and
+    7.9445 J) does not."""
+    import kinetostat.analysis as A
+    coarse, fine = reactions(ice, steps=36), reactions(ice, steps=360)
+    eta, E = fine.cycle_efficiency(), fine.friction_energy()
+    assert coarse.cycle_efficiency() == pytest.approx(eta, rel=1e-12)
+    np.testing.assert_allclose(coarse.friction_energy(), E, rtol=1e-11)
+    nodes = A.CYCLE_NODES
+    try:
+        A.CYCLE_NODES = 2 * nodes
+        assert reactions(ice, steps=360).cycle_efficiency() == pytest.approx(eta, rel=1e-12)
+    finally:
+        A.CYCLE_NODES = nodes
+
+    def trapezoid(N: int) -> tuple[float, float]:
+        r = reactions(ice, steps=N)
+        u = r._unit_motion()
+        W0, Wf = ((M * u.omega[:, 1]).mean() for M in (r.balancing_moment_frictionless, r.balancing_moment))
+        return Wf / W0, float(r._friction_power(u)[:, ice.pair_between(0, 3).index].mean() * 2 * np.pi)
+    (e1, E1), (e2, E2) = trapezoid(3600), trapezoid(7200)
+    assert abs(e2 - eta) <= 2 * abs(e2 - e1) and abs(E2 - E[ice.pair_between(0, 3).index]) <= 2 * abs(E2 - E1)
+    e360, E360 = trapezoid(360)
+    assert abs(e360 - eta) > 1e-5 and abs(E360 - E[ice.pair_between(0, 3).index]) > 1e-3
+    assert round(eta, 6) == 0.553036 and round(float(E[ice.pair_between(0, 3).index]), 4) == 7.9460
 
 
 def test_self_locking_zone_near_top_dead_centre_and_its_edges(ice):
@@ -320,6 +367,45 @@ def test_worksheet_names_the_friction_terms(ice):
     assert ws.value("M_bal_friction") == res.balancing_moment[0] and ws.value("eta") == res.efficiency[0]
     assert "## Friction in the reactions" in ws.markdown()
     assert not worksheet(kinetostat.load(MODELS / "scotch_yoke.toml")).section("friction")
+
+
+def test_plans_with_friction_draw_the_circles_and_the_tangent_reactions(ice):
+    """plans.build(friction="reactions"): each revolute reaction's drawn line passes at rho = f r
+    from its pin (measured on the sheet, x mu_l), on the side that gives the friction moment's
+    sense; the guide's reaction leans by arctg f from the normal; every force polygon closes with
+    the frictional reactions, whose drawn lengths are the 40-digit reference's |R|; the worksheet
+    at friction="reactions" writes the same reactions (R41 = 3122.02 N, M_f41 = f r R41)."""
+    from kinetostat.plans.worksheet import worksheet
+    from kinetostat_validation.reference import reference_full
+    plans = kinetostat.plans.build(ice, at=30.0, friction="reactions")
+    res = reactions(ice, [30.0])
+    ref = reference_full(ice, [30.0], res=res, friction=True)
+    f, r = ice.friction.f, ice.friction.radius
+    g, mu = plans["group:2,3"], plans["group:2,3"].scale.value
+    A = g.points["A"]
+    R12 = complex(*res.reaction(1, 2)[0])
+    X = g.points["R12n:from"]                        # the drawn line of R12 (R12n, R12t start on it)
+    arm = abs(((X - A) * (R12 / abs(R12)).conjugate()).imag) * mu
+    assert arm == pytest.approx(f * r, rel=1e-9) and g.length_mm("ρ12") * mu == pytest.approx(f * r, rel=1e-12)
+    q = res.friction.load[0, ice.pair_between(1, 2).index]
+    assert np.sign(((X - A).conjugate() * R12).imag) == np.sign(q) != 0          # r x R = q: its sense
+    assert any(k.startswith("friction circle ρ12") for k in g.paths) and any("detail ρ12" in n for n in g.notes)
+    N43, R43 = res.forces.normal[0, ice.pair_between(0, 3).index], res.reaction(0, 3)[0]
+    assert np.degrees(np.arccos(abs(N43) / np.linalg.norm(R43))) == pytest.approx(np.degrees(np.arctan(f)), rel=1e-9)
+    fp = plans["forces:2,3"]
+    drawn = {s.name: fp.length_mm(s.name) * fp.scale.value for s in fp.segments}
+    sides = [fp.points[fp.segment(n).end] - fp.points[fp.segment(n).start] for n in fp.equation]
+    assert abs(sum(sides)) <= 1e-9 * max(map(abs, sides))
+    assert drawn["R43"] == pytest.approx(np.linalg.norm(ref.R[0, ice.pair_between(0, 3).index]), rel=1e-9)
+    assert drawn["R12"] == pytest.approx(np.linalg.norm(ref.R[0, ice.pair_between(1, 2).index]), rel=1e-9)
+    frame = plans.segments_frame()
+    assert frame.loc[frame.segment == "R12", "value"].iloc[0] == pytest.approx(3122.018, rel=1e-6)
+    ws = worksheet(ice, 30.0, friction="reactions")
+    R41 = np.linalg.norm(ref.R[0, ice.pair_between(0, 1).index])
+    assert ws.value("R_0_1") == pytest.approx(R41, rel=1e-9) and R41 == pytest.approx(3122.02, abs=0.01)
+    assert ws.value("Mf_0_1") == pytest.approx(f * r * R41, rel=1e-9)
+    first = worksheet(ice, 30.0)                     # frictionless reactions, the frictional ones beside them
+    assert first.value("R_0_1") == pytest.approx(3184.85, abs=0.01) and first.value("Rf_0_1") == pytest.approx(R41, rel=1e-9)
 
 
 def test_a_sweep_of_a_model_with_friction_in_the_reactions_solves_it(tmp_path):
