@@ -87,6 +87,11 @@ class FrictionSolution:
     def __repr__(self) -> str:
         return f"FrictionSolution(positions={len(self.solved)}, passes<={int(self.passes.max(initial=0))})"
 
+    @property
+    def newton(self) -> np.ndarray:
+        """(N,) bool: Newton's method found the equilibrium at some stage (the passes did not converge)."""
+        return (self.passes > MAX_PASSES).any(axis=1)
+
     def take(self, idx) -> "FrictionSolution":
         """The solution at the angles `idx` only."""
         return FrictionSolution(*(getattr(self, f)[idx] for f in self.__dataclass_fields__))

@@ -74,7 +74,6 @@ def _friction_lines(res) -> list[str]:
 
     import numpy as np
     from ..errors import SelfLockingWarning
-    from ..friction import MAX_PASSES
     m, phi = res.mech, res.phi_deg
     lock, why = res.self_locking, res.self_locking_reason
     eta = res.efficiency[~lock & np.isfinite(res.efficiency)]
@@ -99,7 +98,7 @@ def _friction_lines(res) -> list[str]:
                      f"with friction {_fmt(abs(Mf[k]), 'N m')} (phi = {phi[k]:g} deg)")
     p = res.friction.passes
     lines.append(f"  passes per group: at most {int(p.max(initial=0))} (Newton's method at "
-                 f"{int((p > MAX_PASSES).any(axis=1).sum())} position(s))")
+                 f"{int(res.friction.newton.sum())} position(s))")
     P = res.friction_power
     lines.append("  peak friction power: " + ", ".join(
         f"{q.label} {_fmt(float(np.nanmax(P[:, q.index])), 'W')}" for q in m.pairs if np.isfinite(P[:, q.index]).any()))
