@@ -574,7 +574,8 @@ def force_plans(mech: "Mechanism", res: "Analysis", mu_F) -> list[Plan]:
         segs.append(Segment(reaction_name(mech, k, j), _vertex(end_j), X, abs(internal), "N"))
         plans.append(Plan(f"forces:{_group_label(g)}", f"Force plan of group {_group_label(g)} ({g.kind}): "
                           + " + ".join(name for name, _ in seq) + " = 0", mu_F, float(res.phi_deg[0]),
-                          pts, tuple(segs), equation=tuple(name for name, _ in seq)))
+                          pts, tuple(segs), equation=tuple(name for name, _ in seq),
+                          notes=("the reactions with friction in the reactions",) if res.friction is not None else ()))
     return plans
 
 

@@ -337,6 +337,7 @@ PHRASES: tuple[tuple[str, str, str], ...] = (
     ("at the pitch point on the line of action", "у полюсі зачеплення на лінії зачеплення",
      "в полюсе зацепления на линии зацепления"),
     ("force plan of the crank", "план сил кривошипа", "план сил кривошипа"),
+    ("the reactions with friction in the reactions", "реакції з тертям у реакціях", "реакции с трением в реакциях"),
     ("the reaction with friction in the reactions", "реакція з тертям у реакціях", "реакция с трением в реакциях"),
     (": the friction circle enlarged", ": коло тертя, збільшене в", ": круг трения, увеличенный в"),
     (" times, the line of", " разів, лінія", " раз, линия"),
