@@ -63,8 +63,8 @@ def constants(mech: "Mechanism", points: tuple[Mapping[str, complex], ...] | Non
     """The base constants the programs of `mech` read: every local point (x<k>_<name>, complex),
     every guide direction (d<p>, complex unit) and its angle (alpha<p>), the group scales
     (L<n>, m), the drive, the masses (mass<k>, I_S<k>, com<k> the local centre of mass), g,
-    the gear, the design angle phi_design (rad) and each triad's track<n> (None: the program
-    runs its continuation). `points`: the local points (default the
+    the gear, the design angle phi_design (rad) and each triad's track<n> (None here: a
+    `triad.Track` that `kinematics.tracks` sets). `points`: the local points (default the
     model's; the accuracy check passes them perturbed); `scales`: the group scales."""
     pts = mech.points_z if points is None else points
     c: dict[str, Any] = {}
@@ -299,11 +299,14 @@ class _Motion(_Build):
                 d = self.guide(po, a, self.frame_of(a)[1])
                 K = self.call("off_line", self.position(a, self.anchor(po, a)), self.offset(po, ell, pi.point), d)
                 leash.append(("P", K, self.call("times", d, 1j), d))
-        O, rot, closure, _, _ = self.call(
+        O, rot, closure, path, _, _ = self.call(
             "iii3_positions", "phi", "phi_design", *(float(m[0] == "P") for m in leash),
             *(_x(b, g.pairs[2 * i + 1].point) for i in range(3)), *(m[1] for m in leash), *(m[2] for m in leash),
-            f"L{n}", f"track{n}", out=(self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
-        self.steps.append(Step("check", (closure, 0.0), (), g.label, "the three leashes do not close"))
+            f"L{n}", f"track{n}", out=(self.tmp(), self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
+        self.steps.append(Step("check", (closure, 0.0), (), g.label, "the three leashes do not close in the mode "
+                               "drawn at the design position: the crank cannot reach these angles from there"))
+        self.steps.append(Step("check", (path, 0.0), (), g.label, "Newton left the mode's path: another assembly "
+                               "mode is near"))
         u = []
         for i, m in enumerate(leash):
             X.append(self.call("place", O, rot, _x(b, g.pairs[2 * i + 1].point)))

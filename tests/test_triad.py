@@ -88,8 +88,8 @@ def test_group_order_reactions_equal_the_groups_full_linear_system(mech):
 
 def test_newton_converges_to_rounding_in_few_steps(mech):
     """The continuation's Newton: every leash closed to a few ulps of the group's size, within
-    six steps from each block's start (the counts are the program's outputs)."""
-    env = dict(constants(mech))
+    six steps from the track's pose (the counts are the program's outputs)."""
+    env = dict(constants(mech), **kinetostat.kinematics.tracks(mech))
     env.update(phi=np.radians(np.arange(0.0, 360.0, 1.0)), w_in=1.0, e_in=0.0)
     out = program.run(motion_program(mech), env)
     L = max(kinetostat.kinematics.group_scales(mech))
@@ -231,3 +231,54 @@ def test_the_drawing_error_simulation_refuses_a_triad_by_name(mech):
     assert not drawing_error.draws_forces(mech)
     with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind R.. \(III3 R..\) is not drawn"):
         drawing_error.simulate(mech, n=10)
+
+
+def test_near_the_singular_position_the_mode_drawn_is_kept_on_a_fine_grid():
+    """Crank r = 0.1171 m (4.3e-5 m short of touching the fold): the path passes close to the
+    other mode near phi = 202 deg. On a 0.01 deg grid the base turns smoothly (the true rate is
+    below 0.0018 deg per 0.01 deg; the old block continuation jumped 1.6 deg at 202.14 deg and
+    followed the other mode to 240 deg), and the base's angle equals an independent continuation
+    (a 3x3 Newton on the three leashes' closure, finite-difference Jacobian, 0.01 deg steps from
+    the design position both ways: /tmp/t2_fine.py in the review's scratch) to 1e-9 deg."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kinetostat.ModelWarning)     # the base is drawn for r = 0.10
+        mech = _six_bar_with_crank(0.1171)
+        phi = np.arange(195.0, 245.0, 0.01)
+        kin = kinematics(mech, np.radians(phi))
+        th = np.degrees(np.unwrap(np.angle(kin.rot[:, 3])))
+        assert np.max(np.abs(np.diff(th))) <= 0.002 and np.max(kin.cond) < 90
+        at = kinematics(mech, np.radians([150.0, 202.14, 202.15, 240.0, 300.0]))
+    fine = [7.941273160, 12.561725178, 12.560127420, 6.568191905, 0.463113479]
+    assert np.max(np.abs(np.degrees(np.angle(at.rot[:, 3])) - fine)) <= 1e-8
+    tr = kinetostat.kinematics.tracks(mech)["track0"]
+    assert tr.full and tr.mismatch <= 1e-12 and tr.steps < 400     # the path closes over the turn
+
+
+def test_a_crank_stopped_by_a_fold_is_solved_where_it_turns_and_refused_by_name_beyond(tmp_path):
+    """Crank r = 0.125 m: the triad's fold stops the crank at 166.5 deg going up and 230.2 deg
+    going down (the group's condition number grows without bound there). Angles asked on the
+    path are solved (no error for angles nobody asked); one beyond names itself alone; the CLI
+    says so in one line, exit 2."""
+    import subprocess
+    import sys
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kinetostat.ModelWarning)
+        mech = _six_bar_with_crank(0.125)
+        res = kinetostat.analyze(mech, phi_deg=[60.0, 90.0, 300.0])
+        assert np.isfinite(res.balancing_moment).all()
+        tr = kinetostat.kinematics.tracks(mech)["track0"]
+        ends = np.degrees(tr.u[[0, -1]]) + 60.0
+        np.testing.assert_allclose(ends, [230.19 - 360.0, 166.51], atol=0.01)
+        with pytest.warns(kinetostat.SingularPositionWarning, match=r"phi = \[166.5, 230.2\] deg"):
+            near = kinematics(mech, np.radians([166.5, 230.2, 100.0]))
+        assert (near.cond[:2, 0] > 200).all() and near.cond[2, 0] < 10
+        with pytest.raises(kinetostat.AssemblyError, match=r"III\(2,3,4,5\).* at phi = \[180\] deg"):
+            kinetostat.analyze(mech, phi_deg=[60.0, 180.0])
+    bad = tmp_path / "far.toml"       # the frame pin F moved 2 m off: the crank no longer reaches 84 deg
+    bad.write_text((ROOT / "models" / "triad_six_bar.toml").read_text().replace("F = [0.95, 0.80]", "F = [2.95, 0.80]"))
+    for cmd in (["structure", str(bad), "--modes"], ["analyze", str(bad)]):
+        out = subprocess.run([sys.executable, "-m", "kinetostat", *cmd], capture_output=True, text=True)
+        assert (out.returncode, "Traceback" in out.stderr) == ((0, False) if cmd[0] == "structure" else (2, False))
+    assert out.stderr.strip().splitlines()[-1].startswith("kinetostat: error:") and "at phi = [84, 85" in out.stderr

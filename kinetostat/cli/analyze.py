@@ -132,8 +132,13 @@ def cmd_structure(args) -> int:
     lines.append(f"structure formula: {s.formula}")
     lines.append(f"class {s.mechanism_class}, order {s.order}")
     if args.modes:
+        from ..errors import AssemblyError
         from ..kinematics import assembly_modes
-        lines += ["assembly modes at the design position:"] + [x for am in assembly_modes(m) for x in am.lines()]
+        try:
+            found = assembly_modes(m)
+        except AssemblyError as exc:
+            raise CLIError(f"{path}: {exc}") from None
+        lines += ["assembly modes at the design position:"] + [x for am in found for x in am.lines()]
     if m.parameters:
         lines.append("parameters: " + ", ".join(f"{n} = {v:.10g}" for n, v in m.parameters.items()))
     if m.expressions:
