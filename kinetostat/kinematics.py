@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
            "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes",
-           "MODES_CLOSE", "special_point_z", "tracks"]
+           "MODES_CLOSE", "special_point_z", "special_sides", "tracks"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
@@ -212,18 +212,31 @@ def assembly_modes(mech: "Mechanism") -> tuple[AssemblyModes, ...]:
 
 
 def special_point_z(mech: "Mechanism", kin: Kinematics, g) -> np.ndarray:
-    """(N,) complex, m: Assur's special point S of triad g, where the axes of its leashes 1 and
-    2 meet (a two-pin leash's axis: outer pin -> inner pin; a slider's: the guide's normal through
-    its pin)."""
+    """(N,) complex, m: Assur's special point S of triad g as the solver takes it, where the two
+    leash axes meeting at the best angle cross (a two-pin leash's axis: outer pin -> inner pin;
+    a slider's: the guide's normal through its pin)."""
+    return _special(mech, kin, g)[0]
+
+
+def special_sides(mech: "Mechanism", kin: Kinematics, g, at: int = 0) -> tuple:
+    """Triad g's sides (`Triad.sides`) at angle index `at` in the solver's order there: the two
+    leashes whose axes meet in S, then the one whose arm about S closes the group."""
+    k = int(_special(mech, kin.take([at]), g)[1][0])
+    return tuple(g.sides[(k + i) % 3] for i in (1, 2, 0))
+
+
+def _special(mech: "Mechanism", kin: Kinematics, g) -> tuple[np.ndarray, np.ndarray]:
+    """S (complex, m) and k (`triad.special_point`), each (N,)."""
     pts, X, u = mech.points_z, [], []
-    for ell, outer, inner, a in g.sides[:2]:
+    for ell, outer, inner, a in g.sides:
         X.append(kin.position_z(ell, _xy(pts[ell][inner.point])))
         if outer.kind == "R":
             r = X[-1] - kin.position_z(ell, _xy(pts[ell][outer.point]))
             u.append(r / np.abs(r))
         else:
             u.append(1j * complex(*outer.direction) * kin.rot[:, a])
-    return special_point(X[0], u[0], X[1], u[1])[0]
+    S, _, k = special_point(X[0], u[0], X[1], u[1], X[2], u[2])
+    return S, k
 
 
 def _xy(z: complex) -> tuple[float, float]:

@@ -4,11 +4,12 @@ primitives of `groups`, in the same elementwise style:
 
 - a leash's axis u (unit) and its miss f: a two-pin leash A-X (u along A -> X, f = |AX| - l),
   or a slider whose pin X runs on a guide line (u the line's normal, f = (X - K) . u);
-- Assur's special point S, where the axes of leashes 1 and 2 meet, taken as a point of the base:
-  every linear solve of the group (a Newton step of the positions, the velocity and acceleration
-  plans, the reactions) is x . u1 = r1, x . u2 = r2 for a vector x at S (a 2x2 solve) and one
-  division by h3 = (X3 - S) x u3, the arm of leash 3's axis about S. h3 = 0 (three axes through
-  one point) is the group's singular position;
+- Assur's special point S, per angle where the two leash axes meeting at the best angle cross
+  (any two may define it), taken as a point of the base: every linear solve of the group (a
+  Newton step of the positions, the velocity and acceleration plans, the reactions) is
+  x . u_i = r_i for those two, a vector x at S (a 2x2 solve), and one division by h, the arm of
+  the third leash's axis about S. h = 0 (three axes through one point) is the group's singular
+  position;
 - the positions by Newton with continuation from the design position round the cycle, one
   angle per step with step control (`track`, once per mechanism: the mode's path, ending at a
   fold where the crank cannot pass), then at the angles asked all at once from the track
@@ -26,7 +27,7 @@ import numpy as xp
 
 from .groups import cis, cross, dot, magnitude, over, solve2
 
-__all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "iii3_newton", "iii3_velocity",
+__all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
            "rr_tangential", "iii3_polygon", "iii3_positions", "track", "Track", "pose_distance", "jacobian_det", "misses", "modes",
            "MODE_SAMPLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
@@ -64,50 +65,70 @@ def leash_slider(X, K, n):
     return n, dot(X - K, n)
 
 
-def special_point(X1, u1, X2, u2):
-    """Assur's special point S = the meeting point of the axes (X1, u1) and (X2, u2), and u1 x u2."""
-    det = cross(u1, u2)
-    return X1 + u1 * (cross(X2 - X1, u2) / det), det
+def _pick(k, a1, a2, a3):
+    """Leash values in the order (first, second, third) for the special point S of the leashes
+    other than k (0, 1, 2; cyclic: k = 2 takes 1, 2 then 3)."""
+    return (xp.where(k == 2.0, a1, xp.where(k == 0.0, a2, a3)), xp.where(k == 2.0, a2, xp.where(k == 0.0, a3, a1)),
+            xp.where(k == 2.0, a3, xp.where(k == 0.0, a1, a2)))
 
 
-def special_solve(u1, u2, u3, det, h3, r1, r2, r3):
-    """The group's linear solve at S: the vector x (at S) with x . u1 = r1, x . u2 = r2, and
-    y = (r3 - x . u3) / h3, the rate of turn that closes leash 3 (arm h3 about S)."""
-    x = r1 * u1 + 1j * u1 * ((r2 - r1 * dot(u1, u2)) / det)
-    return x, (r3 - dot(x, u3)) / h3
+def special_point(X1, u1, X2, u2, X3, u3):
+    """Assur's special point S, per angle where the two leash axes that meet at the best angle
+    (the largest |u_i x u_j|) cross, taken as a point of the base; then u_first x u_second, and k
+    (0., 1., 2.): the leash whose axis S is not on (its arm about S closes the group)."""
+    d12, d23, d31 = cross(u1, u2), cross(u2, u3), cross(u3, u1)
+    k = xp.where((abs(d12) >= abs(d23)) & (abs(d12) >= abs(d31)), 2.0, xp.where(abs(d23) >= abs(d31), 0.0, 1.0))
+    (Xa, Xb, _), (ua, ub, _) = _pick(k, X1, X2, X3), _pick(k, u1, u2, u3)
+    det = cross(ua, ub)
+    return Xa + ua * (cross(Xb - Xa, ub) / det), det, k
 
 
-def iii3_newton(O, rot, S, det, X3, u1, u2, u3, f1, f2, f3):
+def special_solve(u1, u2, u3, det, k, h, r1, r2, r3):
+    """The group's linear solve at S (`special_point`'s det, k): the vector x (at S) with
+    x . u_i = r_i for the two leashes through S, and y = (r_k - x . u_k) / h, the rate of turn
+    that closes the third (arm h about S)."""
+    (ua, ub, uc), (ra, rb, rc) = _pick(k, u1, u2, u3), _pick(k, r1, r2, r3)
+    x = ra * ua + 1j * ua * ((rb - ra * dot(ua, ub)) / det)
+    return x, (rc - dot(x, uc)) / h
+
+
+def third_arm(S, k, X1, X2, X3, u1, u2, u3):
+    """The arm about S of the axis of the leash not through it (0: the three axes meet in S)."""
+    return cross(_pick(k, X1, X2, X3)[2] - S, _pick(k, u1, u2, u3)[2])
+
+
+def iii3_newton(O, rot, S, det, k, X1, X2, X3, u1, u2, u3, f1, f2, f3):
     """One Newton step of the base link's pose (origin O, e^{i theta}): move S by dS and turn
     about it by dth so that each leash's miss f_i goes to zero to first order."""
-    h3 = cross(X3 - S, u3)
-    dS, dth = special_solve(u1, u2, u3, det, h3, -f1, -f2, -f3)
+    h = third_arm(S, k, X1, X2, X3, u1, u2, u3)
+    dS, dth = special_solve(u1, u2, u3, det, k, h, -f1, -f2, -f3)
     turn = cis(dth)
     return S + dS + (O - S) * turn, rot * turn, magnitude(dS) + abs(dth * magnitude(O - S))
 
 
-def iii3_velocity(S, X3, u1, u2, u3, det, V1, V2, V3):
-    """Velocity plan at S: v_S = v_1 + v_S1 (v_S1 _|_ u1) = v_2 + v_S2 (v_S2 _|_ u2), v_i the known
-    velocity of leash i's reference (its outer pin; a slider's guide point under X); then
-    (v_X3 - v_3) . u3 = 0 gives omega. Returns v_S, omega, h3."""
-    h3 = cross(X3 - S, u3)
-    vS, w = special_solve(u1, u2, u3, det, h3, dot(V1, u1), dot(V2, u2), dot(V3, u3))
-    return vS, w, h3
+def iii3_velocity(S, X1, X2, X3, u1, u2, u3, det, k, V1, V2, V3):
+    """Velocity plan at S: v_S = v_i + v_Si (v_Si _|_ u_i) for the two leashes through S, v_i the
+    known velocity of leash i's reference (its outer pin; a slider's guide point under X); then
+    (v_X - v_k) . u_k = 0 for the third gives omega. Returns v_S, omega, h (the third's arm)."""
+    h = third_arm(S, k, X1, X2, X3, u1, u2, u3)
+    vS, w = special_solve(u1, u2, u3, det, k, h, dot(V1, u1), dot(V2, u2), dot(V3, u3))
+    return vS, w, h
 
 
-def iii3_acceleration(S, X1, X2, X3, u1, u2, u3, det, h3, w, A1, A2, A3, c1, c2, c3):
+def iii3_acceleration(S, X1, X2, X3, u1, u2, u3, det, k, h, w, A1, A2, A3, c1, c2, c3):
     """Acceleration plan at S: a_Xi . u_i = a_i . u_i + c_i (c_i: a leash's normal or Coriolis
     term), a_Xi = a_S + (i eps - w^2)(X_i - S). Returns a_S, eps."""
     w2 = w * w
-    return special_solve(u1, u2, u3, det, h3, dot(A1, u1) + c1 + w2 * dot(X1 - S, u1),
+    return special_solve(u1, u2, u3, det, k, h, dot(A1, u1) + c1 + w2 * dot(X1 - S, u1),
                          dot(A2, u2) + c2 + w2 * dot(X2 - S, u2), dot(A3, u3) + c3 + w2 * dot(X3 - S, u3))
 
 
-def iii3_condition(u1, u2, u3, det, h3, L):
-    """Frobenius condition number of the group's system at S (rows u_i, arm h_i / L; h1 = h2 = 0):
-    inf where the three axes meet in one point (h3 = 0) or axes 1 and 2 are parallel."""
-    c = h3 / L
-    y1, y2 = solve2(u1, u2, det, u3)
+def iii3_condition(u1, u2, u3, det, k, h, L):
+    """Frobenius condition number of the group's system at S (rows u_i, arm about S / L; two
+    arms 0): inf only where the three axes meet in one point (h = 0) or are all parallel."""
+    ua, ub, uc = _pick(k, u1, u2, u3)
+    c = h / L
+    y1, y2 = solve2(ua, ub, det, uc)
     return xp.sqrt((3.0 + c * c) * (2.0 / (det * det) + (y1 * y1 + y2 * y2 + 1.0) / (c * c)))
 
 
@@ -134,18 +155,22 @@ def rr_tangential(u, MX, l):
     return 1j * u * (MX / l)
 
 
-def iii3_polygon(S, X3, u1, u2, u3, det, T1, T2, T3, P1, P2, P3, m1, m2, m3, F, MS):
+def iii3_polygon(S, X1, X2, X3, u1, u2, u3, det, k, T1, T2, T3, P1, P2, P3, m1, m2, m3, F, MS):
     """Reactions in the texts' order. T_i: leash i's R^tau (from its moment about its inner pin),
     acting at P_i (a slider: T = 0 and the couple m_i); F, MS: the group's known loads (sum of
-    forces; moment about S). R^n of leash 3 from the group's moment about S (R^n_1, R^n_2 pass
-    through S), then R^n_1, R^n_2 from the group's force polygon. Returns the magnitudes along u_i."""
-    h3 = cross(X3 - S, u3)
+    forces; moment about S). R^n of the leash off S (k) from the group's moment about S (the
+    other two pass through S), then theirs from the group's force polygon. Returns the
+    magnitudes along u_1, u_2, u_3."""
+    h = third_arm(S, k, X1, X2, X3, u1, u2, u3)
     M = MS + cross(P1 - S, T1) + cross(P2 - S, T2) + cross(P3 - S, T3) + m1 + m2 + m3
-    n3 = -M / h3
-    n1, n2 = solve2(u1, u2, det, -(F + T1 + T2 + T3 + n3 * u3))
-    return n1, n2, n3
+    nc = -M / h
+    ua, ub, uc = _pick(k, u1, u2, u3)
+    na, nb = solve2(ua, ub, det, -(F + T1 + T2 + T3 + nc * uc))
+    return (xp.where(k == 0.0, nc, xp.where(k == 2.0, na, nb)), xp.where(k == 1.0, nc, xp.where(k == 0.0, na, nb)),
+            xp.where(k == 2.0, nc, xp.where(k == 1.0, na, nb)))
 
 
+# -- the positions over the angles: Newton with continuation (numpy)
 def pose_distance(x: tuple, O1, rot1, O2, rot2):
     """The largest distance between the inner pins of two poses of the base (m)."""
     return np.max([np.abs(O1 - O2 + xi * (rot1 - rot2)) for xi in x], axis=0)
@@ -178,8 +203,8 @@ def _newton(kinds, O, rot, x, P, c, L):
     its = np.zeros(O.shape, int)
     for _ in range(MAX_ITER):
         (X1, u1, f1), (X2, u2, f2), (X3, u3, f3) = misses(kinds, O, rot, x, P, c)
-        S, det = special_point(X1, u1, X2, u2)
-        O_new, rot_new, step = iii3_newton(O, rot, S, det, X3, u1, u2, u3, f1, f2, f3)
+        S, det, k = special_point(X1, u1, X2, u2, X3, u3)
+        O_new, rot_new, step = iii3_newton(O, rot, S, det, k, X1, X2, X3, u1, u2, u3, f1, f2, f3)
         moving = ~(step <= 8 * _EPS * L) & ~(np.maximum(np.maximum(abs(f1), abs(f2)), abs(f3)) <= 2 * _EPS * L)
         its += moving
         O, rot = np.where(moving, O_new, O), np.where(moving, rot_new / np.abs(rot_new), rot)
@@ -296,7 +321,7 @@ def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3,
 
 #: The names a program may call (`program.bind` binds them with `groups`'); all but
 #: iii3_positions are elementwise.
-EQUATIONS = ("leash_rr", "leash_slider", "special_point", "special_solve", "iii3_newton", "iii3_velocity",
+EQUATIONS = ("leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
              "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion", "rr_tangential",
              "iii3_polygon", "iii3_positions")
 

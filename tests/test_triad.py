@@ -193,8 +193,9 @@ def test_virtual_work_and_the_lever_agree_over_the_cycle(mech):
 
 
 def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
-    """Velocity plan: s with v_S (from the outer pins of leashes 1 and 2); the group plan: S and
-    the arms about it; the force polygon closes with R..n of leashes 1 and 2, and every reaction
+    """Velocity plan: s with v_S (from the outer pins of the leashes through S, the two whose axes
+    meet at the best angle: 5 and 2 on the six-bar at 60 deg); the group plan: S and the arms
+    about it; the force polygon closes with R..n of those two, and every reaction
     on it (outer, as chords over their parts, and inner, from each leash's polygon) is analyze's
     vector."""
     from kinetostat.kinematics import special_point_z
@@ -216,7 +217,10 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
     mu_F = forces.default_mu_F(mech, res)
     (fp,) = forces.force_plans(mech, res, mu_F)
     eq = fp.equation
-    assert eq[-2:] == ("R12n", "R04n") and eq[0] == "R04t"
+    (l1, _, _, a1), (l2, _, _, a2), (l3, _, _, a3) = kinetostat.kinematics.special_sides(mech, res.kin, g)
+    assert {l1, l2, l3} == {2, 4, 5} and (l1, l2) == ((5, 2) if g.kind == "RRR" else (2, 4))   # S: best-met axes
+    name = lambda a, ell: forces.reaction_name(mech, a, ell)
+    assert eq[-2:] == (name(a1, l1) + "n", name(a2, l2) + "n") and eq[0] == name(a2, l2) + "t"
     n = len(eq)
     sides = [fp.points[s.end] - fp.points[s.start] for s in fp.segments[:n]]
     assert abs(sum(sides)) <= 1e-12 * max(map(abs, sides))
@@ -282,3 +286,40 @@ def test_a_crank_stopped_by_a_fold_is_solved_where_it_turns_and_refused_by_name_
         out = subprocess.run([sys.executable, "-m", "kinetostat", *cmd], capture_output=True, text=True)
         assert (out.returncode, "Traceback" in out.stderr) == ((0, False) if cmd[0] == "structure" else (2, False))
     assert out.stderr.strip().splitlines()[-1].startswith("kinetostat: error:") and "at phi = [84, 85" in out.stderr
+
+
+def _renumbered(text: str) -> str:
+    """The same mechanism with the leashes' links renumbered 2 -> 5, 4 -> 2, 5 -> 4 (the group's
+    leashes 1 and 2, the lowest ids, become the rocker E-C and the rod)."""
+    import re
+    new = {2: 5, 4: 2, 5: 4}
+    text = re.sub(r"^id = (\d+)", lambda g: f"id = {new.get(int(g[1]), int(g[1]))}", text, flags=re.M)
+    return re.sub(r"^links = \[(\d+), (\d+)\]",
+                  lambda g: f"links = [{new.get(int(g[1]), int(g[1]))}, {new.get(int(g[2]), int(g[2]))}]", text, flags=re.M)
+
+
+def test_any_two_leashes_define_s_so_the_numbering_does_not_matter():
+    """F moved so that the axes of the rocker E-C and of F-D are parallel at 60 deg (the
+    review's six_parF): renumbered, those are leashes 1 and 2 (S from them alone failed at 119
+    angles). S from the two axes meeting at the best angle: the renumbered mechanism gives the
+    same reactions and M_bal to rounding, no angle singular (cond <= 5.1: the three axes never
+    meet in one point), and the reactions still equal the constraint Jacobian's virtual work."""
+    from kinetostat.virtual_work import virtual_work
+    text = (ROOT / "models" / "triad_six_bar.toml").read_text().replace(
+        "F = [0.95, 0.80]", "F = [0.8497800941, 0.8132618385270001]")
+    a, b = kinetostat.loads(text), kinetostat.loads(_renumbered(text))
+    assert b.structure.groups[0].known == (0, 0, 1)
+    phi = np.arange(0.0, 360.0, 5.0)
+    with pytest.warns(kinetostat.ModelWarning, match="do not draw"):        # the base drawn for F as bundled
+        ra = kinetostat.analyze(a, phi_deg=phi)
+    with pytest.warns(kinetostat.ModelWarning, match="do not draw"):
+        rb = kinetostat.analyze(b, phi_deg=phi)
+    peak = np.max(np.abs(ra.balancing_moment))
+    assert np.max(np.abs(ra.balancing_moment - rb.balancing_moment)) <= 1e-12 * peak
+    Rmax = np.max(np.abs(ra.forces.R))
+    for i, j in [(1, 2), (0, 4), (0, 5), (2, 3), (3, 4), (3, 5)]:
+        jb, ib = {2: 5, 4: 2, 5: 4}.get(j, j), {2: 5, 4: 2, 5: 4}.get(i, i)
+        assert np.max(np.abs(ra.reaction(i, j) - rb.reaction(ib, jb))) <= 1e-12 * Rmax
+    assert not rb.singular.any() and np.max(rb.cond) < 5.1
+    vw = virtual_work(b, phi_deg=phi)
+    assert np.max(np.abs(vw.balancing_moment - rb.balancing_moment)) <= 1e-12 * peak

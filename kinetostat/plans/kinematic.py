@@ -171,9 +171,9 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
 
 def _special(mech, res, pts: dict) -> list[tuple[str, int, complex, list[str]]]:
     """Per triad: the plan name of Assur's special point S (a point of the base link), the base,
-    S's local coordinates on it, and the plan names of the references of leashes 1 and 2 (their
-    outer pins; "" for a point of the frame, at the pole)."""
-    from ..kinematics import special_point_z
+    S's local coordinates on it, and the plan names of the references of the two leashes through
+    S (their outer pins; "" for a point of the frame, at the pole)."""
+    from ..kinematics import special_point_z, special_sides
     out = []
     for n, g in enumerate(g for g in mech.structure.groups if g.klass == 3):
         name = "s" if n == 0 else f"s{n + 1}'"
@@ -181,7 +181,7 @@ def _special(mech, res, pts: dict) -> list[tuple[str, int, complex, list[str]]]:
         b = g.links[0]
         S = complex(special_point_z(mech, res.kin, g)[0])
         local = (S - res.kin.origin_z[0, b]) / res.kin.rot[0, b]
-        refs = [_name_of(mech, o.point) if o.kind == "R" else "" for _, o, _, _ in g.sides[:2]]
+        refs = [_name_of(mech, o.point) if o.kind == "R" else "" for _, o, _, _ in special_sides(mech, res.kin, g)[:2]]
         out.append((name, b, local, refs))
     return out
 
