@@ -326,39 +326,58 @@ EQUATIONS = ("leash_rr", "leash_slider", "special_point", "special_solve", "thir
              "iii3_polygon", "iii3_positions")
 
 
-def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[complex, complex]]:
-    """Every assembly mode (base pose O, e^{i theta}) at one position of the known joints (P, c
-    scalars as `misses` reads them), by the texts' method of false positions: leash 1 is set at
-    MODE_SAMPLES trial positions (a two-pin leash turned round its outer pin; a slider's pin
-    moved along its line over +-4 L), the base turned about it until leash 2 closes (two ways,
-    as a dyad closes), and the miss of leash 3 read; each change of sign of the miss is refined
-    by Newton on the whole group. Modes that coincide to 1e-9 L are one."""
-    t = np.linspace(0.0, 2 * np.pi, MODE_SAMPLES + 1)
+def _false_positions(kinds: str, x: tuple, P: tuple, c: tuple, L: float, t, sign: float):
+    """The method of false positions at the trial parameters t of leash 1 (a two-pin leash's
+    angle about its outer pin; a slider's pin along its line over +-4 L as t runs over 2 pi):
+    the base turned about leash 1's inner pin until leash 2 closes (on the side `sign`, as a
+    dyad closes), and the miss of leash 3 (NaN where leash 2 cannot close). Returns O, rot, f3."""
     X1 = P[0] + c[0] * cis(t) if kinds[0] == "R" else P[0] + 1j * c[0] * (4 * L) * (t / np.pi - 1.0)
     r12 = x[1] - x[0]
     rho = abs(r12)
+    if kinds[1] == "R":         # C on the circle (X1, rho) and on the circle (A2, l2)
+        d = P[1] - X1
+        dd = np.abs(d)
+        along = (rho**2 - c[1]**2 + dd**2) / (2 * dd)
+        C = X1 + d / dd * (along + 1j * sign * np.sqrt(np.maximum(rho**2 - along**2, 0.0)))
+        ok = rho**2 - along**2 >= 0
+    else:                       # C on the circle (X1, rho) and on the line (K2, normal n2)
+        foot = X1 - dot(X1 - P[1], c[1]) * c[1]
+        h2 = rho**2 - np.abs(foot - X1)**2
+        C = foot + sign * 1j * c[1] * np.sqrt(np.maximum(h2, 0.0))
+        ok = h2 >= 0
+    rot = (C - X1) / r12
+    O = X1 - x[0] * rot
+    return O, rot, np.where(ok, misses(kinds, O, rot, x, P, c)[2][2], np.nan)
+
+
+def _roots(f3) -> np.ndarray:
+    """Indices i where the sampled miss f3 changes sign between i and i + 1."""
+    return np.flatnonzero((f3[:-1] * f3[1:] <= 0) & np.isfinite(f3[:-1] * f3[1:]))
+
+
+def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[complex, complex]]:
+    """Every assembly mode (base pose O, e^{i theta}) at one position of the known joints (P, c
+    scalars as `misses` reads them), by the texts' method of false positions
+    (`_false_positions`) at MODE_SAMPLES trial positions of leash 1; each change of sign of the
+    miss is refined by Newton on the whole group. Two modes closer than the samples leave no
+    change of sign: round each local minimum of |miss| the interval of its two neighbours is
+    sampled MODE_SAMPLES times again and searched the same way. Modes that coincide to 1e-9 L
+    are one."""
+    t = np.linspace(0.0, 2 * np.pi, MODE_SAMPLES + 1)
     found: list[tuple[complex, complex]] = []
     for sign in (1.0, -1.0):
-        if kinds[1] == "R":         # C on the circle (X1, rho) and on the circle (A2, l2)
-            d = P[1] - X1
-            dd = np.abs(d)
-            along = (rho**2 - c[1]**2 + dd**2) / (2 * dd)
-            C = X1 + d / dd * (along + 1j * sign * np.sqrt(np.maximum(rho**2 - along**2, 0.0)))
-            ok = rho**2 - along**2 >= 0
-        else:                       # C on the circle (X1, rho) and on the line (K2, normal n2)
-            foot = X1 - dot(X1 - P[1], c[1]) * c[1]
-            h2 = rho**2 - np.abs(foot - X1)**2
-            C = foot + sign * 1j * c[1] * np.sqrt(np.maximum(h2, 0.0))
-            ok = h2 >= 0
-        rot = (C - X1) / r12
-        O = X1 - x[0] * rot
-        f3 = misses(kinds, O, rot, x, P, c)[2][2]
-        f3 = np.where(ok, f3, np.nan)
-        at = np.flatnonzero((f3[:-1] * f3[1:] <= 0) & np.isfinite(f3[:-1] * f3[1:]))
-        if not len(at):
+        O, rot, f3 = _false_positions(kinds, x, P, c, L, t, sign)
+        a = np.abs(f3)
+        low = np.flatnonzero((a[1:-1] < a[:-2]) & (a[1:-1] <= a[2:])) + 1
+        starts = [(O[_roots(f3)], rot[_roots(f3)])]
+        for i in low:
+            Of, rf, ff = _false_positions(kinds, x, P, c, L, np.linspace(t[i - 1], t[i + 1], MODE_SAMPLES + 1), sign)
+            starts.append((Of[_roots(ff)], rf[_roots(ff)]))
+        Os, rots = np.concatenate([s_[0] for s_ in starts]), np.concatenate([s_[1] for s_ in starts])
+        if not len(Os):
             continue
-        Os, rots, _, res = _newton(kinds, O[at], rot[at], x, tuple(np.full(len(at), p) for p in P),
-                                   tuple(np.full(len(at), v) for v in c), L)
+        Os, rots, _, res = _newton(kinds, Os, rots, x, tuple(np.full(len(Os), p) for p in P),
+                                   tuple(np.full(len(Os), v) for v in c), L)
         for O_, rot_ in zip(Os[res <= CLOSURE_TOL * _EPS * L], rots[res <= CLOSURE_TOL * _EPS * L]):
             if all(abs(O_ - Ok) + L * abs(rot_ - rk) > 1e-9 * L for Ok, rk in found):
                 found.append((complex(O_), complex(rot_)))

@@ -323,3 +323,29 @@ def test_any_two_leashes_define_s_so_the_numbering_does_not_matter():
     assert not rb.singular.any() and np.max(rb.cond) < 5.1
     vw = virtual_work(b, phi_deg=phi)
     assert np.max(np.abs(vw.balancing_moment - rb.balancing_moment)) <= 1e-12 * peak
+
+
+def test_two_modes_closer_than_the_samples_are_both_found_and_warned():
+    """The crank r = 0.11716309257991407 m with the design position at 198 deg, next to the
+    fold: two modes 0.125 deg apart in the base's angle (13.420 and 13.545 deg), both between
+    two of the 3600 trial positions of leash 1 (no change of sign of the miss there: one mode was
+    listed, separation inf, no warning). Each mode found closes the three leashes (their lengths
+    measured here from the model's points) to rounding, and the warning names the closeness."""
+    text = (ROOT / "models" / "triad_six_bar.toml").read_text().replace("design_deg = 60.0", "design_deg = 198.0")
+    mech = kinetostat.loads(text.replace('A = [0.10, 0.0] }\nmass = 2.0', 'A = [0.11716309257991407, 0.0] }\nmass = 2.0')
+                            .replace('points = { A = [0.10, 0.0], B', 'points = { A = [0.11716309257991407, 0.0], B'))
+    with pytest.warns(kinetostat.ModelWarning) as got:
+        (am,) = assembly_modes(mech)
+        kinetostat.kinematics.kinematics(mech, np.radians([198.0]))
+    assert any("another assembly mode is within 0.00319" in str(w.message) for w in got)
+    assert any(isinstance(w.message, kinetostat.SingularPositionWarning) for w in got)    # cond 670 there
+    th = np.degrees(np.angle(np.array(am.rot)))
+    np.testing.assert_allclose(np.sort(th), [13.4203, 13.5455], atol=1e-4)
+    assert 0.003 < am.separation < 0.0033
+    pts = mech.points_z
+    A = 0.11716309257991407 * np.exp(1j * np.radians(198.0))
+    for O, rot in zip(am.O, am.rot):
+        B, C, D = (O + pts[3][p] * rot for p in "BCD")
+        miss = [abs(B - A) - abs(pts[2]["B"] - pts[2]["A"]), abs(C - pts[0]["E"]) - abs(pts[4]["C"] - pts[4]["E"]),
+                abs(D - pts[0]["F"]) - abs(pts[5]["D"] - pts[5]["F"])]
+        assert np.max(np.abs(miss)) <= 1e-15
