@@ -87,6 +87,9 @@ class Kinematics:
                            #   digits left (velocities, accelerations etc. are NaN)
     error: np.ndarray      # (N,) estimated relative error (see `kinematic_deviation`): measured
                            #   where cond > COND_CHECK, A_PRIORI cond^3 elsewhere; inf where singular
+    residual: np.ndarray | None = None   # (N, n_groups) m: the largest miss of a triad's three
+                           #   leashes after its Newton (0 for a dyad, closed in closed form);
+                           #   None where the route does not give it (the compiled path)
 
     def __repr__(self) -> str:
         N, L = self.theta.shape
@@ -99,7 +102,7 @@ class Kinematics:
 
     def take(self, idx: np.ndarray) -> "Kinematics":
         """The same motion at the angles `idx` only."""
-        return Kinematics(*(getattr(self, f.name)[idx] for f in fields(self)))
+        return Kinematics(*(None if getattr(self, f.name) is None else getattr(self, f.name)[idx] for f in fields(self)))
 
     @property
     def origin(self) -> np.ndarray:
@@ -366,7 +369,8 @@ def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Ki
     return Kinematics(phi, stack("th", L, 0.0, f), stack("rot", L, 1.0, c), stack("O", L, 0.0, c),
                       stack("V", L, 0.0, c), stack("A", L, 0.0, c), stack("w", L, 0.0, f), stack("e", L, 0.0, f),
                       stack("vs", len(mech.pairs), 0.0, f, 0), stack("as", len(mech.pairs), 0.0, f, 0),
-                      stack("cond", G, 0.0, f, 0), xp.zeros(lead + (N,), dtype=xp.bool), xp.zeros(lead + (N,), dtype=f))
+                      stack("cond", G, 0.0, f, 0), xp.zeros(lead + (N,), dtype=xp.bool), xp.zeros(lead + (N,), dtype=f),
+                      stack("res", G, 0.0, f, 0))
 
 
 # -- the accuracy estimate and the guard

@@ -347,3 +347,21 @@ def test_two_modes_closer_than_the_samples_are_both_found_and_warned():
         miss = [abs(B - A) - abs(pts[2]["B"] - pts[2]["A"]), abs(C - pts[0]["E"]) - abs(pts[4]["C"] - pts[4]["E"]),
                 abs(D - pts[0]["F"]) - abs(pts[5]["D"] - pts[5]["F"])]
         assert np.max(np.abs(miss)) <= 1e-15
+
+
+def test_the_newton_residual_is_reported_per_angle_and_printed(cli):
+    """Kinematics.residual (N, groups), m: the triad's largest leash miss after its Newton, the
+    same as the misses measured here from the public positions (the three leashes' lengths);
+    `kinetostat analyze` prints the largest."""
+    mech = kinetostat.load(ROOT / "models" / "triad_six_bar.toml")
+    kin = kinematics(mech, np.radians(PHI))
+    pts, L = mech.points_z, kinetostat.kinematics.group_scales(mech)[0]
+    miss = []
+    for ell, outer, inner in [(2, "A", "B"), (4, "E", "C"), (5, "F", "D")]:
+        X = kin.position_z(3, (pts[3][inner].real, pts[3][inner].imag))
+        P = kin.position_z(ell, (pts[ell][outer].real, pts[ell][outer].imag))
+        miss.append(np.abs(np.abs(X - P) - abs(pts[ell][inner] - pts[ell][outer])))
+    assert kin.residual.shape == (len(PHI), 1) and np.max(kin.residual) <= 8 * np.finfo(float).eps * L
+    assert np.max(np.abs(kin.residual[:, 0] - np.max(miss, axis=0))) <= 4 * np.finfo(float).eps * L
+    out = cli("analyze", "triad_six_bar", "--steps", "12")
+    assert out.returncode == 0 and "triads' closure (Newton) residual: largest leash miss" in out.stdout

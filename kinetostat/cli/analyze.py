@@ -52,6 +52,12 @@ def _summary(res, path: Path) -> list[str]:
         eta = res.efficiency[~lock & np.isfinite(res.efficiency)]
         lines.append(f"friction ({res.friction_method}): self-locking at {int(lock.sum())} of {len(phi)} positions"
                      + (f", eta {eta.min():.4g} .. {eta.max():.4g} elsewhere" if len(eta) else ""))
+    triads = [n for n, g in enumerate(s.groups) if g.klass == 3]
+    if triads and res.kin.residual is not None:
+        r = res.kin.residual[:, triads].max(axis=1)
+        k = int(np.argmax(r))
+        lines.append(f"triads' closure (Newton) residual: largest leash miss {r[k]:.3g} m (phi = {phi[k]:g} deg; "
+                     f"{r[k] / m.size:.2g} of the linkage's size)")
     n_sing = int(np.sum(res.singular))
     if n_sing:
         lines.append(f"singular positions: {n_sing} (their values are NaN)")
