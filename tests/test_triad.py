@@ -365,3 +365,27 @@ def test_the_newton_residual_is_reported_per_angle_and_printed(cli):
     assert np.max(np.abs(kin.residual[:, 0] - np.max(miss, axis=0))) <= 4 * np.finfo(float).eps * L
     out = cli("analyze", "triad_six_bar", "--steps", "12")
     assert out.returncode == 0 and "triads' closure (Newton) residual: largest leash miss" in out.stdout
+
+
+def test_the_reference_refuses_positions_in_another_mode():
+    """The 40-digit reference's branch check covers triads: positions in the other assembly
+    mode (from `assembly_modes`, each leash laid between its pins) converge in 40 digits, but
+    the constraint Jacobian's determinant has the other sign than at the design position: a
+    BranchMismatch; the solver's own positions pass."""
+    from dataclasses import replace
+    from kinetostat_validation.reference import BranchMismatch, reference_full
+    mech = kinetostat.load(ROOT / "models" / "triad_six_bar.toml")
+    res = kinetostat.analyze(mech, phi_deg=[60.0])
+    assert np.isfinite(reference_full(mech, [60.0], res=res).M_bal).all()
+    (am,) = assembly_modes(mech)
+    O, rot = next((O, r) for i, (O, r) in enumerate(zip(am.O, am.rot)) if i != am.chosen)
+    pts, kin = mech.points_z, res.kin
+    oz, rz = kin.origin_z.copy(), kin.rot.copy()
+    oz[0, 3], rz[0, 3] = O, rot
+    for ell, outer, inner in [(2, "A", "B"), (4, "E", "C"), (5, "F", "D")]:
+        P, X = kin.position_z(ell, (pts[ell][outer].real, pts[ell][outer].imag))[0], O + pts[3][inner] * rot
+        rz[0, ell] = (X - P) / (pts[ell][inner] - pts[ell][outer])
+        oz[0, ell] = P - pts[ell][outer] * rz[0, ell]
+    other = replace(res, kin=replace(kin, origin_z=oz, rot=rz, theta=np.angle(rz)))
+    with pytest.raises(BranchMismatch, match="not in the mode continuous from the design position"):
+        reference_full(mech, [60.0], res=other)
