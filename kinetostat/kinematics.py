@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from .errors import ModelWarning, SingularPositionWarning, singular_message
+from .errors import AssemblyError, ModelWarning, SingularPositionWarning, singular_message
 from .planar import as_xy
 from .program import Program, Step, constants, motion_program, run
 from .sizes import group_scales, kinematic_size
@@ -335,7 +335,10 @@ def tracks(mech: "Mechanism") -> dict[str, Any]:
             head = Program(prog.steps[:at] + wanted, ("phi",), tuple(st.out[0] for st in wanted))
 
             def pins(phi, head=head, env={**env, **out}):
-                got = run(head, {**env, "phi": phi})
+                try:
+                    got = run(head, {**env, "phi": phi})
+                except AssemblyError:
+                    return None
                 vals = [np.broadcast_to(got[f"pin{n}_{i}"], phi.shape) for i in range(6)]
                 return tuple(vals[:3]), tuple(vals[3:])
             x = tuple(env[a] for a in args[5:8])

@@ -268,15 +268,13 @@ def track(kinds: str, pins, phi0: float, O0: complex, rot0: complex, x: tuple, L
     """The base link's path by Newton with continuation along the crank's path from the design
     angle phi0 (rad), where the pose is near (O0, rot0), both ways round (`_follow`) to +-pi;
     where one way ends at a fold, the other goes on (up to a whole turn in all).
-    `pins(phi)`: the known joints' (P, c) at the angles phi (rad, (n,)) as `misses` reads them;
-    it may raise AssemblyError (an earlier group does not close there: the path ends too)."""
-    from .errors import AssemblyError
-
+    `pins(phi)`: the known joints' (P, c) at the angles phi (rad, (n,)) as `misses` reads them,
+    or None where an earlier group does not close (the path ends there too)."""
     def solve(u, O, rot):
-        try:
-            P, c = pins(np.array([phi0 + u]))
-        except AssemblyError:
+        known = pins(np.array([phi0 + u]))
+        if known is None:
             return O, rot, MAX_ITER, np.inf, 0.0
+        P, c = known
         O, rot, its, res = _newton(kinds, np.array([O]), np.array([rot]), x, P, c, L)
         return O[0], rot[0], its[0], res[0], np.sign(jacobian_det(misses(kinds, O, rot, x, P, c), O))[0]
 
