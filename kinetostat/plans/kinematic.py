@@ -151,7 +151,7 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     """The velocity plan (seed 002 fig. 1.7): pole p, p-x for every point, the relative
     velocities of each floating link's joints (a-b), the sliding velocities of blocks on moving
     guides (a1-a3), like points by similarity (s2 on ab), and a triad's special point s (v_S
-    from the outer pins of leashes 1 and 2, a-s, e-s): all at mu_v."""
+    from the outer pins of the two leashes through S, e.g. a-s, e-s): all at mu_v."""
     at = _at(res)
     mu = scales["mu_v"]
     pts = plan_point_names(mech, res)
