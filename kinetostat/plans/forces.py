@@ -354,8 +354,8 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
     """A triad's plan (Artobolevsky 1988): its four links with their loads and the carried
     reactions; each leash's outer reaction (a two-pin leash's split into R..n along its axis and
     R..t across it; a slider's normal force at its offset x); the axes of the two leashes through
-    Assur's special point S drawn through it; the arms of each leash's moment equation about its inner pin
-    (R..t) and of the group's about S (R..n of leash 3, marked (S))."""
+    Assur's special point S drawn through it; the arms of each leash's moment equation about its
+    inner pin (R..t) and of the group's about S (R..n of the third leash, marked (S))."""
     later = _later(mech, g)
     loads = {x: link_loads(mech, res, x) + _carried(mech, res, x, later) for x in g.links}
     parts = [_leash_parts(mech, res, side) for side in g.sides]
