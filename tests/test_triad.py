@@ -211,6 +211,12 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
     vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
     assert abs(v.points["s"] * sc["mu_v"].value - vS) <= 1e-12 * abs(vS)
     assert {s.name for s in v.segments} >= {"a-s", "p-s"}
+    acc = kinematic.acceleration_plan(mech, res, sc)
+    aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
+    a_A = complex(res.kin.point_z(1, tuple(mech.links[1].points["A"]))[2][0])
+    seg = acc.segment("a-s")
+    assert abs(seg.value - abs(aS - a_A)) <= 1e-12 * abs(aS)                     # a_S = a_A + a_SA
+    assert abs(abs(acc.points["s"] - acc.points["a"]) * sc["mu_a"].value - seg.value) <= 1e-12 * abs(aS)
     (gp,) = forces.group_plans(mech, res, sc["mu_l"])
     assert abs(gp.points["S"] * sc["mu_l"].value - S) <= 1e-12
     assert any(s.name.endswith("(S)") for s in gp.segments)

@@ -208,7 +208,8 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     (normal and tangential parts when the crank accelerates); per group the normal `r-n<k>` and
     tangential `n<k>-q` parts of each turning link, the Coriolis `-k` and relative `k-` parts of
     a block on a moving guide; pi-x for every point, the relative accelerations of each floating
-    link's joints (a-b), like points by similarity: all at mu_a."""
+    link's joints (a-b), like points by similarity, and a triad's special point s with its
+    construction from the outer pins of the two leashes through S (e.g. a-s): all at mu_a."""
     at = _at(res)
     mu = scales["mu_a"]
     pts = plan_point_names(mech, res)
@@ -250,10 +251,11 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
         else:
             segs.append(_rel(s.start, s.end, abs(a_r), unit))
     segs += [Segment(f"pi-{n}", "pi", n, abs(m[2]), unit) for n, m in mo.items()]
-    for name, b, local, refs in _special(mech, res, pts):        # a_S, a point of the base
+    for name, b, local, refs in _special(mech, res, pts):        # a_S = a_1 + a_S1 = a_2 + a_S2
         aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
         points[name] = aS / mu.value
         segs.append(Segment(f"pi-{name}", "pi", name, abs(aS), unit))
+        segs += [Segment(f"{r}-{name}", r, name, abs(aS - mo[r][2]), unit) for r in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
     return Plan("acceleration", f"Acceleration plan at phi = {at:g} deg", mu, at, points, tuple(segs))
