@@ -24,11 +24,11 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from .errors import ModelWarning, SingularPositionWarning, singular_message
+from .errors import AssemblyError, ModelWarning, SingularPositionWarning, singular_message
 from .planar import as_xy
-from .program import constants, motion_program, run
+from .program import Program, Step, constants, motion_program, run
 from .sizes import group_scales, kinematic_size
-from .triad import modes, special_point, stations
+from .triad import PREDICT, modes, special_point, track
 
 if TYPE_CHECKING:
     from .model import Mechanism
@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
            "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes",
-           "MODES_CLOSE", "special_point_z"]
+           "MODES_CLOSE", "special_point_z", "special_sides", "tracks"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
@@ -87,6 +87,9 @@ class Kinematics:
                            #   digits left (velocities, accelerations etc. are NaN)
     error: np.ndarray      # (N,) estimated relative error (see `kinematic_deviation`): measured
                            #   where cond > COND_CHECK, A_PRIORI cond^3 elsewhere; inf where singular
+    residual: np.ndarray | None = None   # (N, n_groups) m: the largest miss of a triad's three
+                           #   leashes after its Newton (0 for a dyad, closed in closed form);
+                           #   None where the route does not give it (the compiled path)
 
     def __repr__(self) -> str:
         N, L = self.theta.shape
@@ -99,7 +102,7 @@ class Kinematics:
 
     def take(self, idx: np.ndarray) -> "Kinematics":
         """The same motion at the angles `idx` only."""
-        return Kinematics(*(getattr(self, f.name)[idx] for f in fields(self)))
+        return Kinematics(*(None if getattr(self, f.name) is None else getattr(self, f.name)[idx] for f in fields(self)))
 
     @property
     def origin(self) -> np.ndarray:
@@ -212,18 +215,31 @@ def assembly_modes(mech: "Mechanism") -> tuple[AssemblyModes, ...]:
 
 
 def special_point_z(mech: "Mechanism", kin: Kinematics, g) -> np.ndarray:
-    """(N,) complex, m: Assur's special point S of triad g, where the axes of its leashes 1 and
-    2 meet (a two-pin leash's axis: outer pin -> inner pin; a slider's: the guide's normal through
-    its pin)."""
+    """(N,) complex, m: Assur's special point S of triad g as the solver takes it, where the two
+    leash axes meeting at the best angle cross (a two-pin leash's axis: outer pin -> inner pin;
+    a slider's: the guide's normal through its pin)."""
+    return _special(mech, kin, g)[0]
+
+
+def special_sides(mech: "Mechanism", kin: Kinematics, g, at: int = 0) -> tuple:
+    """Triad g's sides (`Triad.sides`) at angle index `at` in the solver's order there: the two
+    leashes whose axes meet in S, then the one whose arm about S closes the group."""
+    k = int(_special(mech, kin.take([at]), g)[1][0])
+    return tuple(g.sides[(k + i) % 3] for i in (1, 2, 0))
+
+
+def _special(mech: "Mechanism", kin: Kinematics, g) -> tuple[np.ndarray, np.ndarray]:
+    """S (complex, m) and k (`triad.special_point`), each (N,)."""
     pts, X, u = mech.points_z, [], []
-    for ell, outer, inner, a in g.sides[:2]:
+    for ell, outer, inner, a in g.sides:
         X.append(kin.position_z(ell, _xy(pts[ell][inner.point])))
         if outer.kind == "R":
             r = X[-1] - kin.position_z(ell, _xy(pts[ell][outer.point]))
             u.append(r / np.abs(r))
         else:
             u.append(1j * complex(*outer.direction) * kin.rot[:, a])
-    return special_point(X[0], u[0], X[1], u[1])[0]
+    S, _, k = special_point(X[0], u[0], X[1], u[1], X[2], u[2])
+    return S, k
 
 
 def _xy(z: complex) -> tuple[float, float]:
@@ -296,25 +312,44 @@ def _solve(mech: "Mechanism", phi: np.ndarray, locals_: tuple[Mapping[str, compl
     """The motion program of `mech` run over the angles `phi` with the local points `locals_`."""
     w, e = (1.0, 0.0) if unit_speed else mech.drive.speed(phi)      # the constants, or per angle by the law
     env = dict(mech.memo(("constants", id(locals_)), lambda: constants(mech, locals_)))
-    env.update(_tracks(mech), phi=phi, w_in=w, e_in=e)
+    env.update(tracks(mech), phi=phi, w_in=w, e_in=e)
     return assemble(mech, phi, run(motion_program(mech), env))
 
 
-def _tracks(mech: "Mechanism") -> dict[str, tuple]:
-    """Each triad's track (memoised per mechanism): its base link's poses at the continuation's
-    stations round the cycle, solved once by continuation from the design position; the angles
-    asked later start from it (`triad.iii3_positions`)."""
-    def make() -> dict[str, tuple]:
-        triads = [n for n, g in enumerate(mech.structure.groups) if g.klass == 3]
-        if not triads:
-            return {}
+def tracks(mech: "Mechanism") -> dict[str, Any]:
+    """Each triad's track<n> (memoised per mechanism): its base link's path from the design
+    position (`triad.track`), the known joints at each step from the motion program's steps
+    before the group's (run on that one angle). A ModelWarning where the path does not close
+    over a turn (the two ways round meet in different poses)."""
+    def make() -> dict[str, Any]:
+        prog, out = motion_program(mech), {}
+        env = dict(constants(mech), w_in=1.0, e_in=0.0)
         phi0 = math.radians(mech.drive.design_deg)
-        phi = stations(phi0)
-        env = dict(constants(mech), phi=phi, w_in=1.0, e_in=0.0)
-        run(motion_program(mech), env)
-        u = phi - phi0
-        return {f"track{n}": (u, env[f"O{g}"], env[f"rot{g}"]) for n in triads
-                for g in [mech.structure.groups[n].links[0]]}
+        for n, g in enumerate(mech.structure.groups):
+            if g.klass != 3:
+                continue
+            at = next(i for i, st in enumerate(prog.steps) if st.fn == "iii3_positions" and f"it{n}" in st.out)
+            args = prog.steps[at].args
+            kinds = "".join("P" if s else "R" for s in args[2:5])
+            wanted = tuple(Step("same", (a,), (f"pin{n}_{i}",)) for i, a in enumerate(args[8:14]))
+            head = Program(prog.steps[:at] + wanted, ("phi",), tuple(st.out[0] for st in wanted))
+
+            def pins(phi, head=head, env={**env, **out}):
+                try:
+                    got = run(head, {**env, "phi": phi})
+                except AssemblyError:
+                    return None
+                vals = [np.broadcast_to(got[f"pin{n}_{i}"], phi.shape) for i in range(6)]
+                return tuple(vals[:3]), tuple(vals[3:])
+            x = tuple(env[a] for a in args[5:8])
+            out[f"track{n}"] = tr = track(kinds, pins, phi0, 0j, 1 + 0j, x, group_scales(mech)[n])
+            if tr.mismatch > PREDICT * group_scales(mech)[n]:
+                warnings.warn(ModelWarning(
+                    f"group {g.label}: the mode followed from the design position does not close over a turn: at "
+                    f"phi = {math.degrees(phi0 + math.pi) % 360:g} deg the paths both ways round differ by "
+                    f"{tr.mismatch:.3g} m (each angle is solved on the path within 180 deg of the design angle)"),
+                    stacklevel=6)
+        return out
     return mech.memo("triad tracks", make)
 
 
@@ -337,7 +372,8 @@ def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Ki
     return Kinematics(phi, stack("th", L, 0.0, f), stack("rot", L, 1.0, c), stack("O", L, 0.0, c),
                       stack("V", L, 0.0, c), stack("A", L, 0.0, c), stack("w", L, 0.0, f), stack("e", L, 0.0, f),
                       stack("vs", len(mech.pairs), 0.0, f, 0), stack("as", len(mech.pairs), 0.0, f, 0),
-                      stack("cond", G, 0.0, f, 0), xp.zeros(lead + (N,), dtype=xp.bool), xp.zeros(lead + (N,), dtype=f))
+                      stack("cond", G, 0.0, f, 0), xp.zeros(lead + (N,), dtype=xp.bool), xp.zeros(lead + (N,), dtype=f),
+                      stack("res", G, 0.0, f, 0))
 
 
 # -- the accuracy estimate and the guard

@@ -63,8 +63,8 @@ def constants(mech: "Mechanism", points: tuple[Mapping[str, complex], ...] | Non
     """The base constants the programs of `mech` read: every local point (x<k>_<name>, complex),
     every guide direction (d<p>, complex unit) and its angle (alpha<p>), the group scales
     (L<n>, m), the drive, the masses (mass<k>, I_S<k>, com<k> the local centre of mass), g,
-    the gear, the design angle phi_design (rad) and each triad's track<n> (None: the program
-    runs its continuation). `points`: the local points (default the
+    the gear, the design angle phi_design (rad) and each triad's track<n> (None here: a
+    `triad.Track` that `kinematics.tracks` sets). `points`: the local points (default the
     model's; the accuracy check passes them perturbed); `scales`: the group scales."""
     pts = mech.points_z if points is None else points
     c: dict[str, Any] = {}
@@ -287,7 +287,8 @@ class _Motion(_Build):
 
     def iii3(self, n: int, g: "Triad") -> None:
         """III3: the base link's pose by Newton with continuation (`triad.iii3_positions`), then
-        the plans at Assur's special point S (axes of leashes 1 and 2) as 2x2 solves."""
+        the plans at Assur's special point S (the two leash axes meeting at the best angle) as
+        2x2 solves."""
         b = g.links[0]
         X, leash = [], []
         for i in range(3):
@@ -299,22 +300,25 @@ class _Motion(_Build):
                 d = self.guide(po, a, self.frame_of(a)[1])
                 K = self.call("off_line", self.position(a, self.anchor(po, a)), self.offset(po, ell, pi.point), d)
                 leash.append(("P", K, self.call("times", d, 1j), d))
-        O, rot, closure, _, _ = self.call(
+        O, rot, closure, path, _, _ = self.call(
             "iii3_positions", "phi", "phi_design", *(float(m[0] == "P") for m in leash),
             *(_x(b, g.pairs[2 * i + 1].point) for i in range(3)), *(m[1] for m in leash), *(m[2] for m in leash),
-            f"L{n}", f"track{n}", out=(self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
-        self.steps.append(Step("check", (closure, 0.0), (), g.label, "the three leashes do not close"))
+            f"L{n}", f"track{n}", out=(self.tmp(), self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
+        self.steps.append(Step("check", (closure, 0.0), (), g.label, "the three leashes do not close in the mode "
+                               "drawn at the design position: the crank cannot reach these angles from there"))
+        self.steps.append(Step("check", (path, 0.0), (), g.label, "Newton left the mode's path: another assembly "
+                               "mode is near"))
         u = []
         for i, m in enumerate(leash):
             X.append(self.call("place", O, rot, _x(b, g.pairs[2 * i + 1].point)))
             u.append(self.call("leash_rr" if m[0] == "R" else "leash_slider", X[i], m[1], m[2], out=2)[0])
-        S, det = self.call("special_point", X[0], u[0], X[1], u[1], out=2)
+        S, det, k = self.call("special_point", X[0], u[0], X[1], u[1], X[2], u[2], out=3)
         ref = [m[3] if m[0] == "R" else self.at(g.known[i], X[i])[0] for i, m in enumerate(leash)]
-        vS, w, h3 = self.call("iii3_velocity", S, X[2], *u, det, *ref, out=3)
+        vS, w, h = self.call("iii3_velocity", S, *X, *u, det, k, *ref, out=3)
         VX = [self.call("motion_at", S, vS, 0.0, w, 0.0, Xi, out=2)[0] for Xi in X]
         normal = [self.leash_motion(g, i, m, X[i], VX[i], 0.0)[2] for i, m in enumerate(leash)]
         acc = [m[4] if m[0] == "R" else self.at(g.known[i], X[i])[1] for i, m in enumerate(leash)]
-        aS, e = self.call("iii3_acceleration", S, *X, *u, det, h3, w, *acc, *normal, out=2)
+        aS, e = self.call("iii3_acceleration", S, *X, *u, det, k, h, w, *acc, *normal, out=2)
         th = self.call("phase", rot)
         self.set_link(b, th, rot, S, self.call("local_of", S, O, rot), w, vS, e, aS)
         for i, m in enumerate(leash):
@@ -328,7 +332,7 @@ class _Motion(_Build):
                 wa, ea = (f"w{a}", f"e{a}") if a else (0.0, 0.0)
                 self.set_link(ell, *self.turned(po, ell, *self.frame_of(a)), X[i], _x(ell, pi.point), wa, VX[i], ea, AX)
                 self.slide(po, ell, w_l, e_l)
-        self.steps.append(Step("iii3_condition", (*u, det, h3, f"L{n}"), (f"cond{n}",)))
+        self.steps.append(Step("iii3_condition", (*u, det, k, h, f"L{n}"), (f"cond{n}",)))
 
     def leash_motion(self, g: "Triad", i: int, m: tuple, X, VX, AX) -> tuple:
         """Leash i's (omega, eps, normal term), a slider's (v_r, a_r, Coriolis term), given the
@@ -467,28 +471,28 @@ class _Statics(_Build):
     def iii3(self, g: "Triad") -> None:
         """III3 in the texts' order: R^tau of each leash from its moment about its inner pin; R^n
         of leash 3 from the group's moment about S; R^n of leashes 1, 2 from the group's force
-        polygon; the inner reactions from each leash's polygon."""
+        polygon; the inner reactions from each leash's polygon (S: `triad.special_point`)."""
         b = g.links[0]
-        X, u, T, P, m, lengths = [], [], [], [], [], []
+        X, u, T, P, m = [], [], [], [], []
         for i in range(3):
             po, pi, ell = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i]
             X.append(self.at(b, pi.point))
             if po.kind == "R":
                 P.append(self.at(ell, po.point))
-                lengths.append(self.length(ell, pi.point, po.point))
-                u.append(self.call("leash_rr", X[i], P[i], lengths[i], out=2)[0])
-                T.append(self.call("rr_tangential", u[i], self.moment(ell, X[i]), lengths[i]))
+                length = self.length(ell, pi.point, po.point)
+                u.append(self.call("leash_rr", X[i], P[i], length, out=2)[0])
+                T.append(self.call("rr_tangential", u[i], self.moment(ell, X[i]), length))
                 m.append(0.0)
             else:
                 P.append(X[i])
                 u.append(self.normal(po))
                 T.append(0j)
                 m.append(self.call("scaled", self.moment(ell, X[i]), -1.0))
-        S, det = self.call("special_point", X[0], u[0], X[1], u[1], out=2)
+        S, det, k = self.call("special_point", X[0], u[0], X[1], u[1], X[2], u[2], out=3)
         F, MS = f"F{b}", self.moment(b, S)
         for ell in g.links[1:]:
             F, MS = self.call("add", F, f"F{ell}"), self.call("add", MS, self.moment(ell, S))
-        N = self.call("iii3_polygon", S, X[2], *u, det, *T, *P, *m, F, MS, out=3)
+        N = self.call("iii3_polygon", S, *X, *u, det, k, *T, *P, *m, F, MS, out=3)
         for i in range(3):
             po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
             if po.kind == "R":

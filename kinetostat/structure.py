@@ -84,7 +84,8 @@ class Triad:
     `links[1:]`: leash i joins the base at its inner pair `pairs[2i + 1]` (revolute) and the
     link `known[i]`, already attached, at its outer pair `pairs[2i]` (revolute, or prismatic with
     the guide on the known link: a slider). `kind` reads the outer pairs, e.g. "RRR" or "RRP".
-    Assur's special point S is where the axes of leashes 1 and 2 meet; leash 3 is the third.
+    Assur's special point S is where two leash axes meet: per angle the two that meet at the
+    best angle (`triad.special_point`), any two may define it.
     The assembly mode is the one the model's points draw at the design position (no branch)."""
     kind: str
     links: tuple[int, int, int, int]

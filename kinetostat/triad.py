@@ -4,15 +4,17 @@ primitives of `groups`, in the same elementwise style:
 
 - a leash's axis u (unit) and its miss f: a two-pin leash A-X (u along A -> X, f = |AX| - l),
   or a slider whose pin X runs on a guide line (u the line's normal, f = (X - K) . u);
-- Assur's special point S, where the axes of leashes 1 and 2 meet, taken as a point of the base:
-  every linear solve of the group (a Newton step of the positions, the velocity and acceleration
-  plans, the reactions) is x . u1 = r1, x . u2 = r2 for a vector x at S (a 2x2 solve) and one
-  division by h3 = (X3 - S) x u3, the arm of leash 3's axis about S. h3 = 0 (three axes through
-  one point) is the group's singular position;
-- the positions by Newton with continuation from the design position over the stations round
-  the cycle, all the angles of a block at once (`positions`, once per mechanism: the track), then
-  at the angles asked all at once from the track (`iii3_positions`; numpy only: it reads the
-  whole angle axis, so the compiled path and the Array API path refuse triads by name).
+- Assur's special point S, per angle where the two leash axes meeting at the best angle cross
+  (any two may define it), taken as a point of the base: every linear solve of the group (a
+  Newton step of the positions, the velocity and acceleration plans, the reactions) is
+  x . u_i = r_i for those two, a vector x at S (a 2x2 solve), and one division by h, the arm of
+  the third leash's axis about S. h = 0 (three axes through one point) is the group's singular
+  position;
+- the positions by Newton with continuation from the design position round the cycle, one
+  angle per step with step control (`track`, once per mechanism: the mode's path, ending at a
+  fold where the crank cannot pass), then at the angles asked all at once from the track
+  (`iii3_positions`; numpy only: it reads the whole angle axis, so the compiled path and the
+  Array API path refuse triads by name), each checked to stay on the track's path.
 
 May use: numpy, groups.
 """
@@ -25,21 +27,25 @@ import numpy as xp
 
 from .groups import cis, cross, dot, magnitude, over, solve2
 
-__all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "iii3_newton", "iii3_velocity",
+__all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
-           "rr_tangential", "iii3_polygon", "iii3_positions", "positions", "misses", "stations", "modes", "MODE_SAMPLES", "Positions", "BLOCK", "MAX_ITER", "RETRIES",
-           "STATION", "CLOSURE_TOL", "EQUATIONS"]
+           "rr_tangential", "iii3_polygon", "iii3_positions", "track", "Track", "pose_distance", "jacobian_det", "misses", "modes",
+           "MODE_SAMPLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
 
-#: Continuation: angles within BLOCK (rad) of the last solved one are solved together, from the
-#: linear extrapolation of the last two solutions.
-BLOCK = np.radians(6.0)
-#: The continuation's stations (rad apart) round the cycle: the track every angle starts from.
+#: The continuation's longest step along the crank's path (rad).
 STATION = np.radians(3.0)
-#: Newton steps per block at most.
+#: Its shortest: where a step would have to be shorter, the group's path cannot be followed on
+#: (a fold: the crank cannot pass the group's dead position) and the track ends there.
+STEP_MIN = 1e-7
+#: A step is accepted where Newton closes in at most EASY steps, the closed pose is within
+#: PREDICT L of the one extrapolated from the last two (inner pins, L the group's size) and no
+#: inner pin moved more than MOVE L; else it is halved. An angle asked later, closed from the
+#: track's pose interpolated for it, must land within PREDICT L of it (else: off the path).
+EASY = 6
+PREDICT = 1e-3
+MOVE = 0.05
+#: Newton steps per solve at most.
 MAX_ITER = 40
-#: Angles of a block that do not close are solved again from the nearest closed angle before
-#: them, at most this many times.
-RETRIES = 3
 #: The largest miss of a leash accepted as closed, in rounding units of the group's size.
 CLOSURE_TOL = 1e3
 #: Trial positions of leash 1 per turn (or along a slider's line) in the search for the modes.
@@ -59,50 +65,70 @@ def leash_slider(X, K, n):
     return n, dot(X - K, n)
 
 
-def special_point(X1, u1, X2, u2):
-    """Assur's special point S = the meeting point of the axes (X1, u1) and (X2, u2), and u1 x u2."""
-    det = cross(u1, u2)
-    return X1 + u1 * (cross(X2 - X1, u2) / det), det
+def _pick(k, a1, a2, a3):
+    """Leash values in the order (first, second, third) for the special point S of the leashes
+    other than k (0, 1, 2; cyclic: k = 2 takes 1, 2 then 3)."""
+    return (xp.where(k == 2.0, a1, xp.where(k == 0.0, a2, a3)), xp.where(k == 2.0, a2, xp.where(k == 0.0, a3, a1)),
+            xp.where(k == 2.0, a3, xp.where(k == 0.0, a1, a2)))
 
 
-def special_solve(u1, u2, u3, det, h3, r1, r2, r3):
-    """The group's linear solve at S: the vector x (at S) with x . u1 = r1, x . u2 = r2, and
-    y = (r3 - x . u3) / h3, the rate of turn that closes leash 3 (arm h3 about S)."""
-    x = r1 * u1 + 1j * u1 * ((r2 - r1 * dot(u1, u2)) / det)
-    return x, (r3 - dot(x, u3)) / h3
+def special_point(X1, u1, X2, u2, X3, u3):
+    """Assur's special point S, per angle where the two leash axes that meet at the best angle
+    (the largest |u_i x u_j|) cross, taken as a point of the base; then u_first x u_second, and k
+    (0., 1., 2.): the leash whose axis S is not on (its arm about S closes the group)."""
+    d12, d23, d31 = cross(u1, u2), cross(u2, u3), cross(u3, u1)
+    k = xp.where((abs(d12) >= abs(d23)) & (abs(d12) >= abs(d31)), 2.0, xp.where(abs(d23) >= abs(d31), 0.0, 1.0))
+    (Xa, Xb, _), (ua, ub, _) = _pick(k, X1, X2, X3), _pick(k, u1, u2, u3)
+    det = cross(ua, ub)
+    return Xa + ua * (cross(Xb - Xa, ub) / det), det, k
 
 
-def iii3_newton(O, rot, S, det, X3, u1, u2, u3, f1, f2, f3):
+def special_solve(u1, u2, u3, det, k, h, r1, r2, r3):
+    """The group's linear solve at S (`special_point`'s det, k): the vector x (at S) with
+    x . u_i = r_i for the two leashes through S, and y = (r_k - x . u_k) / h, the rate of turn
+    that closes the third (arm h about S)."""
+    (ua, ub, uc), (ra, rb, rc) = _pick(k, u1, u2, u3), _pick(k, r1, r2, r3)
+    x = ra * ua + 1j * ua * ((rb - ra * dot(ua, ub)) / det)
+    return x, (rc - dot(x, uc)) / h
+
+
+def third_arm(S, k, X1, X2, X3, u1, u2, u3):
+    """The arm about S of the axis of the leash not through it (0: the three axes meet in S)."""
+    return cross(_pick(k, X1, X2, X3)[2] - S, _pick(k, u1, u2, u3)[2])
+
+
+def iii3_newton(O, rot, S, det, k, X1, X2, X3, u1, u2, u3, f1, f2, f3):
     """One Newton step of the base link's pose (origin O, e^{i theta}): move S by dS and turn
     about it by dth so that each leash's miss f_i goes to zero to first order."""
-    h3 = cross(X3 - S, u3)
-    dS, dth = special_solve(u1, u2, u3, det, h3, -f1, -f2, -f3)
+    h = third_arm(S, k, X1, X2, X3, u1, u2, u3)
+    dS, dth = special_solve(u1, u2, u3, det, k, h, -f1, -f2, -f3)
     turn = cis(dth)
     return S + dS + (O - S) * turn, rot * turn, magnitude(dS) + abs(dth * magnitude(O - S))
 
 
-def iii3_velocity(S, X3, u1, u2, u3, det, V1, V2, V3):
-    """Velocity plan at S: v_S = v_1 + v_S1 (v_S1 _|_ u1) = v_2 + v_S2 (v_S2 _|_ u2), v_i the known
-    velocity of leash i's reference (its outer pin; a slider's guide point under X); then
-    (v_X3 - v_3) . u3 = 0 gives omega. Returns v_S, omega, h3."""
-    h3 = cross(X3 - S, u3)
-    vS, w = special_solve(u1, u2, u3, det, h3, dot(V1, u1), dot(V2, u2), dot(V3, u3))
-    return vS, w, h3
+def iii3_velocity(S, X1, X2, X3, u1, u2, u3, det, k, V1, V2, V3):
+    """Velocity plan at S: v_S = v_i + v_Si (v_Si _|_ u_i) for the two leashes through S, v_i the
+    known velocity of leash i's reference (its outer pin; a slider's guide point under X); then
+    (v_X - v_k) . u_k = 0 for the third gives omega. Returns v_S, omega, h (the third's arm)."""
+    h = third_arm(S, k, X1, X2, X3, u1, u2, u3)
+    vS, w = special_solve(u1, u2, u3, det, k, h, dot(V1, u1), dot(V2, u2), dot(V3, u3))
+    return vS, w, h
 
 
-def iii3_acceleration(S, X1, X2, X3, u1, u2, u3, det, h3, w, A1, A2, A3, c1, c2, c3):
+def iii3_acceleration(S, X1, X2, X3, u1, u2, u3, det, k, h, w, A1, A2, A3, c1, c2, c3):
     """Acceleration plan at S: a_Xi . u_i = a_i . u_i + c_i (c_i: a leash's normal or Coriolis
     term), a_Xi = a_S + (i eps - w^2)(X_i - S). Returns a_S, eps."""
     w2 = w * w
-    return special_solve(u1, u2, u3, det, h3, dot(A1, u1) + c1 + w2 * dot(X1 - S, u1),
+    return special_solve(u1, u2, u3, det, k, h, dot(A1, u1) + c1 + w2 * dot(X1 - S, u1),
                          dot(A2, u2) + c2 + w2 * dot(X2 - S, u2), dot(A3, u3) + c3 + w2 * dot(X3 - S, u3))
 
 
-def iii3_condition(u1, u2, u3, det, h3, L):
-    """Frobenius condition number of the group's system at S (rows u_i, arm h_i / L; h1 = h2 = 0):
-    inf where the three axes meet in one point (h3 = 0) or axes 1 and 2 are parallel."""
-    c = h3 / L
-    y1, y2 = solve2(u1, u2, det, u3)
+def iii3_condition(u1, u2, u3, det, k, h, L):
+    """Frobenius condition number of the group's system at S (rows u_i, arm about S / L; two
+    arms 0): inf only where the three axes meet in one point (h = 0) or are all parallel."""
+    ua, ub, uc = _pick(k, u1, u2, u3)
+    c = h / L
+    y1, y2 = solve2(ua, ub, det, uc)
     return xp.sqrt((3.0 + c * c) * (2.0 / (det * det) + (y1 * y1 + y2 * y2 + 1.0) / (c * c)))
 
 
@@ -129,33 +155,25 @@ def rr_tangential(u, MX, l):
     return 1j * u * (MX / l)
 
 
-def iii3_polygon(S, X3, u1, u2, u3, det, T1, T2, T3, P1, P2, P3, m1, m2, m3, F, MS):
+def iii3_polygon(S, X1, X2, X3, u1, u2, u3, det, k, T1, T2, T3, P1, P2, P3, m1, m2, m3, F, MS):
     """Reactions in the texts' order. T_i: leash i's R^tau (from its moment about its inner pin),
     acting at P_i (a slider: T = 0 and the couple m_i); F, MS: the group's known loads (sum of
-    forces; moment about S). R^n of leash 3 from the group's moment about S (R^n_1, R^n_2 pass
-    through S), then R^n_1, R^n_2 from the group's force polygon. Returns the magnitudes along u_i."""
-    h3 = cross(X3 - S, u3)
+    forces; moment about S). R^n of the leash off S (k) from the group's moment about S (the
+    other two pass through S), then theirs from the group's force polygon. Returns the
+    magnitudes along u_1, u_2, u_3."""
+    h = third_arm(S, k, X1, X2, X3, u1, u2, u3)
     M = MS + cross(P1 - S, T1) + cross(P2 - S, T2) + cross(P3 - S, T3) + m1 + m2 + m3
-    n3 = -M / h3
-    n1, n2 = solve2(u1, u2, det, -(F + T1 + T2 + T3 + n3 * u3))
-    return n1, n2, n3
-
-
-def stations(phi0: float) -> np.ndarray:
-    """The design angle phi0 and the angles STATION apart from it round the cycle (rad), in
-    the order of u = phi - phi0 from -pi to pi: the continuation's track."""
-    k = np.arange(-int(np.pi / STATION), int(np.pi / STATION) + 1)
-    return phi0 + STATION * k
+    nc = -M / h
+    ua, ub, uc = _pick(k, u1, u2, u3)
+    na, nb = solve2(ua, ub, det, -(F + T1 + T2 + T3 + nc * uc))
+    return (xp.where(k == 0.0, nc, xp.where(k == 2.0, na, nb)), xp.where(k == 1.0, nc, xp.where(k == 0.0, na, nb)),
+            xp.where(k == 2.0, nc, xp.where(k == 1.0, na, nb)))
 
 
 # -- the positions over the angles: Newton with continuation (numpy)
-@dataclass(frozen=True)
-class Positions:
-    """The base link's pose at each angle, and how it was found."""
-    O: np.ndarray          # (N,) complex, m: the base link's local origin
-    rot: np.ndarray        # (N,) complex e^{i theta}
-    iterations: np.ndarray  # (N,) Newton steps taken at each angle (from its block's start)
-    residual: np.ndarray   # (N,) largest |miss| of the three leashes after the last step, m
+def pose_distance(x: tuple, O1, rot1, O2, rot2):
+    """The largest distance between the inner pins of two poses of the base (m)."""
+    return np.max([np.abs(O1 - O2 + xi * (rot1 - rot2)) for xi in x], axis=0)
 
 
 def misses(kinds: str, O, rot, x: tuple, P: tuple, c: tuple):
@@ -169,15 +187,25 @@ def misses(kinds: str, O, rot, x: tuple, P: tuple, c: tuple):
     return out
 
 
+def jacobian_det(leashes, O):
+    """The determinant of the group's Jacobian (rows u_i, (X_i - O) x u_i: the misses' rates
+    per move of the base's origin O and turn about it) from `misses`' (X_i, u_i, f_i): zero
+    where the three axes meet in one point, of one sign along a path that passes no fold."""
+    (X1, u1, _), (X2, u2, _), (X3, u3, _) = leashes
+    h = [cross(X - O, u) for X, u in ((X1, u1), (X2, u2), (X3, u3))]
+    return cross(u2, u3) * h[0] + cross(u3, u1) * h[1] + cross(u1, u2) * h[2]
+
+
 def _newton(kinds, O, rot, x, P, c, L):
-    """Newton on every angle at once until each step is below rounding (MAX_ITER at most);
+    """Newton on every angle at once until each step, or each leash's miss, is below rounding
+    (MAX_ITER at most; near a singular position the steps stay at rounding times its condition);
     the pose, the steps taken and the largest miss left."""
     its = np.zeros(O.shape, int)
     for _ in range(MAX_ITER):
         (X1, u1, f1), (X2, u2, f2), (X3, u3, f3) = misses(kinds, O, rot, x, P, c)
-        S, det = special_point(X1, u1, X2, u2)
-        O_new, rot_new, step = iii3_newton(O, rot, S, det, X3, u1, u2, u3, f1, f2, f3)
-        moving = ~(step <= 8 * _EPS * L)
+        S, det, k = special_point(X1, u1, X2, u2, X3, u3)
+        O_new, rot_new, step = iii3_newton(O, rot, S, det, k, X1, X2, X3, u1, u2, u3, f1, f2, f3)
+        moving = ~(step <= 8 * _EPS * L) & ~(np.maximum(np.maximum(abs(f1), abs(f2)), abs(f3)) <= 2 * _EPS * L)
         its += moving
         O, rot = np.where(moving, O_new, O), np.where(moving, rot_new / np.abs(rot_new), rot)
         if not moving.any():
@@ -185,119 +213,169 @@ def _newton(kinds, O, rot, x, P, c, L):
     return O, rot, its, np.max([np.abs(f) for _, _, f in misses(kinds, O, rot, x, P, c)], axis=0)
 
 
-def positions(kinds: str, phi, phi0: float, O0: complex, rot0: complex, x: tuple, P: tuple, c: tuple,
-              L: float) -> Positions:
-    """The base link's pose at the crank angles phi (rad, (N,)) by Newton with continuation
-    along the crank's path from the design angle phi0 where the pose is near (O0, rot0), both
-    ways round (to +-pi). The angles are taken in blocks of BLOCK: each block starts from the
-    linear extrapolation of two solved poses (the last, and the farthest from it of the block's
-    first and the previous block's last), and Newton runs on the block's angles
-    at once; an angle that does not close is solved again from the nearest closed one before it. P and c as `misses` reads them, arrays over phi (or constants)."""
-    phi = np.asarray(phi, float)
-    u, first, back = np.unique(np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi, return_index=True,
-                               return_inverse=True)           # along the path, in [-pi, pi); each angle once
-    phi, N = phi[first], len(first)
-    P = tuple(np.broadcast_to(p, back.shape)[first] for p in P)
-    c = tuple(np.broadcast_to(v, back.shape)[first] for v in c)
-    O, rot = np.empty(N, complex), np.empty(N, complex)
-    its, res = np.zeros(N, int), np.zeros(N)
-    at = lambda idx, arrs: tuple(a[idx] for a in arrs)
-    # the design pose itself: the mode the model's points draw (O0, rot0 refined)
-    seed = np.argmin(np.abs(u))
-    O_s, rot_s, _, _ = _newton(kinds, np.array([O0]), np.array([rot0]), x, at([seed], P), at([seed], c), L)
-    for side in (1.0, -1.0):
-        on = np.flatnonzero(side * u >= 0 if side > 0 else u < 0)
-        on = on[np.argsort(side * u[on], kind="stable")]
-        last = [(0.0 if abs(u[seed]) == 0 else u[seed], O_s[0], rot_s[0])]
-        start = 0
-        while start < len(on):
-            stop = start + np.searchsorted(side * u[on[start:]], side * last[-1][0] + BLOCK, side="right")
-            idx = on[start:max(stop, start + 1)]
-            (u1, O1, r1), (u2, O2, r2) = (last[-2] if len(last) > 1 else last[-1]), last[-1]
-            t = (u[idx] - u2) / (u2 - u1) if u2 != u1 else np.zeros(len(idx))
-            th2 = np.angle(r2)
-            Og, thg = O2 + t * (O2 - O1), th2 + t * np.angle(r2 / r1)
-            O[idx], rot[idx], its[idx], res[idx] = _newton(kinds, Og, np.exp(1j * thg), x, at(idx, P), at(idx, c), L)
-            for _ in range(RETRIES):        # a miss: again from the nearest closed angle before it
-                ok = res[idx] <= CLOSURE_TOL * _EPS * L
-                prev = np.maximum.accumulate(np.where(ok, np.arange(len(idx)), -1))
-                redo = np.flatnonzero(~ok & (prev >= 0))
-                if not len(redo):
-                    break
-                j, src = idx[redo], idx[prev[redo]]
-                O[j], rot[j], more, res[j] = _newton(kinds, O[src], rot[src], x, at(j, P), at(j, c), L)
-                its[j] += more
-            new = (u[idx[-1]], O[idx[-1]], rot[idx[-1]])      # extrapolate from the two farthest apart
-            first = (u[idx[0]], O[idx[0]], rot[idx[0]])
-            last = [max(last[-1], first, key=lambda e: abs(e[0] - new[0])), new]
-            start += len(idx)
-    return Positions(O[back], rot[back], its[back], res[back])
+@dataclass(frozen=True)
+class Track:
+    """A triad's path from the design position: the base link's pose at the continuation's
+    stations, u = phi - phi0 (rad) ascending, u[-1] - u[0] <= 2 pi."""
+    u: np.ndarray       # (M,) rad
+    O: np.ndarray       # (M,) complex, m: the base link's local origin
+    rot: np.ndarray     # (M,) complex e^{i theta}
+    steps: int          # Newton solves the continuation made (accepted or not)
+    mismatch: float     # m: where the path reaches +-pi from both sides, how far the two poses
+                        #   are apart (0 to rounding: the path closes over a turn); nan: a fold
+
+    @property
+    def full(self) -> bool:
+        """Whether the path covers a whole turn (the crank turns fully)."""
+        return bool(self.u[-1] - self.u[0] >= 2 * np.pi * (1 - 1e-12))
+
+    def start(self, u):
+        """At u (rad, any turn): the pose interpolated on the path, and whether u is on it."""
+        u = self.u[0] + np.mod(u - self.u[0], 2 * np.pi)
+        th = np.unwrap(np.angle(self.rot))
+        O = np.interp(u, self.u, self.O.real) + 1j * np.interp(u, self.u, self.O.imag)
+        return O, np.exp(1j * np.interp(u, self.u, th)), u <= self.u[-1]
+
+
+def _follow(solve, path: list, side: float, limit: float, sign: float, x: tuple, L: float, tol: float) -> int:
+    """Continue `path` ((|u|, O, rot) from the design pose) along side * u up to |u| = limit,
+    one angle per step: a step is accepted where Newton closes in at most EASY steps, within
+    PREDICT L of the pose extrapolated from the last two (and, past the first step, within 0.3
+    of the move from the last pose: the path's curvature resolved), no inner pin moving
+    more than MOVE L, and the group's Jacobian keeping its sign `sign` (a step over a fold or
+    past a near-crossing of two modes lands where it has the other); else halved, down to
+    STEP_MIN (a fold: the path ends). The solves made."""
+    h, count = STATION, 0
+    while path[-1][0] < limit * (1 - 1e-15) and h >= STEP_MIN:
+        u0, Oa, ra = path[-1]
+        h = min(h, limit - u0)
+        t = h / (u0 - path[-2][0]) if len(path) > 1 else 0.0
+        Ob, rb = path[-2][1:] if len(path) > 1 else (Oa, ra)
+        Op, rp = Oa + t * (Oa - Ob), ra * np.exp(1j * t * np.angle(ra / rb))
+        On, rn, its, res, sn = solve(side * (u0 + h), Op, rp)
+        count += 1
+        miss, move = pose_distance(x, On, rn, Op, rp), pose_distance(x, On, rn, Oa, ra)
+        if sn == sign and res <= tol and its <= EASY and miss <= PREDICT * L and move <= MOVE * L and \
+                (len(path) == 1 or miss <= 0.3 * move + 1e-6 * L):
+            path.append((u0 + h, On, rn))
+            h = min(2 * h, STATION) if miss <= PREDICT * L / 4 and (len(path) == 2 or miss <= 0.1 * move) else h
+        else:
+            h /= 2
+    return count
+
+
+def track(kinds: str, pins, phi0: float, O0: complex, rot0: complex, x: tuple, L: float) -> Track:
+    """The base link's path by Newton with continuation along the crank's path from the design
+    angle phi0 (rad), where the pose is near (O0, rot0), both ways round (`_follow`) to +-pi;
+    where one way ends at a fold, the other goes on (up to a whole turn in all).
+    `pins(phi)`: the known joints' (P, c) at the angles phi (rad, (n,)) as `misses` reads them,
+    or None where an earlier group does not close (the path ends there too)."""
+    def solve(u, O, rot):
+        known = pins(np.array([phi0 + u]))
+        if known is None:
+            return O, rot, MAX_ITER, np.inf, 0.0
+        P, c = known
+        O, rot, its, res = _newton(kinds, np.array([O]), np.array([rot]), x, P, c, L)
+        return O[0], rot[0], its[0], res[0], np.sign(jacobian_det(misses(kinds, O, rot, x, P, c), O))[0]
+
+    tol = CLOSURE_TOL * _EPS * L
+    O, rot, _, res, sign = solve(0.0, O0, rot0)
+    up, down = [(0.0, O, rot)], [(0.0, O, rot)]
+    count = 1
+    if res <= tol:
+        go = lambda path, side, limit: _follow(solve, path, side, limit, sign, x, L, tol)
+        count += go(up, 1.0, np.pi) + go(down, -1.0, np.pi)
+        if up[-1][0] < np.pi * (1 - 1e-15) <= down[-1][0]:
+            count += go(down, -1.0, 2 * np.pi - up[-1][0])
+        elif down[-1][0] < np.pi * (1 - 1e-15) <= up[-1][0]:
+            count += go(up, 1.0, 2 * np.pi - down[-1][0])
+    both = down[:0:-1] + up
+    u = np.array([-e[0] for e in down[:0:-1]] + [e[0] for e in up])
+    closes = abs(up[-1][0] - np.pi) < 1e-12 and abs(down[-1][0] - np.pi) < 1e-12
+    mismatch = float(pose_distance(x, up[-1][1], up[-1][2], down[-1][1], down[-1][2])) if closes else np.nan
+    return Track(u, np.array([e[1] for e in both]), np.array([e[2] for e in both]), count, mismatch)
 
 
 def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L, track):
-    """The program's step: the base link's pose O, e^{i theta}, the closure (0, or -1 where a
-    leash misses by more than CLOSURE_TOL rounding units of L: the group cannot be assembled
-    there), the Newton steps and the largest miss (m). slider<i>: 1.0 where leash i is a
-    slider, else 0.0. `track`: None, or the poses (u, O, rot) solved at the stations (`stations`
-    with no angle asked; u = phi - phi0 in [-pi, pi), sorted): None runs the continuation from
-    the design pose (the base link's local frame: the model's points drawn in world
-    coordinates); a track gives every angle its start, interpolated between the stations
-    around it, and Newton runs on all the angles at once."""
+    """The program's step: the base link's pose O, e^{i theta} at the crank angles phi (rad),
+    closed by Newton on all the angles at once from the `track` (a Track) interpolated at each;
+    then per angle the closure (0, or -1 where a leash misses by more than CLOSURE_TOL rounding
+    units of L, or the angle lies beyond the track's end: the mode drawn at the design position
+    cannot be assembled there), the path (0, or -1 where the closed pose lies more than PREDICT
+    L from the track's: Newton left the mode's path), the Newton steps and the largest miss (m).
+    slider<i>: 1.0 where leash i is a slider, else 0.0. Numpy only (it reads the whole angle
+    axis), so the compiled path and the Array API path refuse triads by name."""
     kinds = "".join("P" if s else "R" for s in (slider1, slider2, slider3))
-    if track is None:
-        pos = positions(kinds, phi, phi0, 0j, 1 + 0j, (x1, x2, x3), (P1, P2, P3), (c1, c2, c3), L)
-        O, rot, its, res = pos.O, pos.rot, pos.iterations, pos.residual
-    else:
-        tu, tO, trot = track
-        u = np.mod(np.asarray(phi, float) - phi0 + np.pi, 2 * np.pi) - np.pi
-        th = np.unwrap(np.angle(trot))
-        O, rot, its, res = _newton(kinds, np.interp(u, tu, tO.real) + 1j * np.interp(u, tu, tO.imag),
-                                   np.exp(1j * np.interp(u, tu, th)), (x1, x2, x3),
-                                   tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3)),
-                                   tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3)), L)
-    return O, rot, np.where(res <= CLOSURE_TOL * _EPS * L, 0.0, -1.0), its.astype(float), res
+    u = np.mod(np.asarray(phi, float) - phi0 + np.pi, 2 * np.pi) - np.pi
+    x = (x1, x2, x3)
+    O0, rot0, on = track.start(u)
+    O, rot, its, res = _newton(kinds, O0, rot0, x, tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3)),
+                               tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3)), L)
+    tol = CLOSURE_TOL * _EPS * L
+    closed = on & (res <= tol)
+    left = closed & ~(pose_distance(x, O, rot, O0, rot0) <= PREDICT * L)
+    return O, rot, np.where(closed, 0.0, -1.0), np.where(left, -1.0, 0.0), its.astype(float), res
 
 
 #: The names a program may call (`program.bind` binds them with `groups`'); all but
 #: iii3_positions are elementwise.
-EQUATIONS = ("leash_rr", "leash_slider", "special_point", "special_solve", "iii3_newton", "iii3_velocity",
+EQUATIONS = ("leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
              "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion", "rr_tangential",
              "iii3_polygon", "iii3_positions")
 
 
-def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[complex, complex]]:
-    """Every assembly mode (base pose O, e^{i theta}) at one position of the known joints (P, c
-    scalars as `misses` reads them), by the texts' method of false positions: leash 1 is set at
-    MODE_SAMPLES trial positions (a two-pin leash turned round its outer pin; a slider's pin
-    moved along its line over +-4 L), the base turned about it until leash 2 closes (two ways,
-    as a dyad closes), and the miss of leash 3 read; each change of sign of the miss is refined
-    by Newton on the whole group. Modes that coincide to 1e-9 L are one."""
-    t = np.linspace(0.0, 2 * np.pi, MODE_SAMPLES + 1)
+def _false_positions(kinds: str, x: tuple, P: tuple, c: tuple, L: float, t, sign: float):
+    """The method of false positions at the trial parameters t of leash 1 (a two-pin leash's
+    angle about its outer pin; a slider's pin along its line over +-4 L as t runs over 2 pi):
+    the base turned about leash 1's inner pin until leash 2 closes (on the side `sign`, as a
+    dyad closes), and the miss of leash 3 (NaN where leash 2 cannot close). Returns O, rot, f3."""
     X1 = P[0] + c[0] * cis(t) if kinds[0] == "R" else P[0] + 1j * c[0] * (4 * L) * (t / np.pi - 1.0)
     r12 = x[1] - x[0]
     rho = abs(r12)
+    if kinds[1] == "R":         # C on the circle (X1, rho) and on the circle (A2, l2)
+        d = P[1] - X1
+        dd = np.abs(d)
+        along = (rho**2 - c[1]**2 + dd**2) / (2 * dd)
+        C = X1 + d / dd * (along + 1j * sign * np.sqrt(np.maximum(rho**2 - along**2, 0.0)))
+        ok = rho**2 - along**2 >= 0
+    else:                       # C on the circle (X1, rho) and on the line (K2, normal n2)
+        foot = X1 - dot(X1 - P[1], c[1]) * c[1]
+        h2 = rho**2 - np.abs(foot - X1)**2
+        C = foot + sign * 1j * c[1] * np.sqrt(np.maximum(h2, 0.0))
+        ok = h2 >= 0
+    rot = (C - X1) / r12
+    O = X1 - x[0] * rot
+    return O, rot, np.where(ok, misses(kinds, O, rot, x, P, c)[2][2], np.nan)
+
+
+def _roots(f3) -> np.ndarray:
+    """Indices i where the sampled miss f3 changes sign between i and i + 1."""
+    return np.flatnonzero((f3[:-1] * f3[1:] <= 0) & np.isfinite(f3[:-1] * f3[1:]))
+
+
+def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[complex, complex]]:
+    """Every assembly mode (base pose O, e^{i theta}) at one position of the known joints (P, c
+    scalars as `misses` reads them), by the texts' method of false positions
+    (`_false_positions`) at MODE_SAMPLES trial positions of leash 1; each change of sign of the
+    miss is refined by Newton on the whole group. Two modes closer than the samples leave no
+    change of sign: round each local minimum of |miss| the interval of its two neighbours is
+    sampled MODE_SAMPLES times again and searched the same way. Modes that coincide to 1e-9 L
+    are one."""
+    t = np.linspace(0.0, 2 * np.pi, MODE_SAMPLES + 1)
     found: list[tuple[complex, complex]] = []
     for sign in (1.0, -1.0):
-        if kinds[1] == "R":         # C on the circle (X1, rho) and on the circle (A2, l2)
-            d = P[1] - X1
-            dd = np.abs(d)
-            along = (rho**2 - c[1]**2 + dd**2) / (2 * dd)
-            C = X1 + d / dd * (along + 1j * sign * np.sqrt(np.maximum(rho**2 - along**2, 0.0)))
-            ok = rho**2 - along**2 >= 0
-        else:                       # C on the circle (X1, rho) and on the line (K2, normal n2)
-            foot = X1 - dot(X1 - P[1], c[1]) * c[1]
-            h2 = rho**2 - np.abs(foot - X1)**2
-            C = foot + sign * 1j * c[1] * np.sqrt(np.maximum(h2, 0.0))
-            ok = h2 >= 0
-        rot = (C - X1) / r12
-        O = X1 - x[0] * rot
-        f3 = misses(kinds, O, rot, x, P, c)[2][2]
-        f3 = np.where(ok, f3, np.nan)
-        at = np.flatnonzero((f3[:-1] * f3[1:] <= 0) & np.isfinite(f3[:-1] * f3[1:]))
-        if not len(at):
+        O, rot, f3 = _false_positions(kinds, x, P, c, L, t, sign)
+        a = np.abs(f3)
+        low = np.flatnonzero((a[1:-1] < a[:-2]) & (a[1:-1] <= a[2:])) + 1
+        starts = [(O[_roots(f3)], rot[_roots(f3)])]
+        for i in low:
+            Of, rf, ff = _false_positions(kinds, x, P, c, L, np.linspace(t[i - 1], t[i + 1], MODE_SAMPLES + 1), sign)
+            starts.append((Of[_roots(ff)], rf[_roots(ff)]))
+        Os, rots = np.concatenate([s_[0] for s_ in starts]), np.concatenate([s_[1] for s_ in starts])
+        if not len(Os):
             continue
-        Os, rots, _, res = _newton(kinds, O[at], rot[at], x, tuple(np.full(len(at), p) for p in P),
-                                   tuple(np.full(len(at), v) for v in c), L)
+        Os, rots, _, res = _newton(kinds, Os, rots, x, tuple(np.full(len(Os), p) for p in P),
+                                   tuple(np.full(len(Os), v) for v in c), L)
         for O_, rot_ in zip(Os[res <= CLOSURE_TOL * _EPS * L], rots[res <= CLOSURE_TOL * _EPS * L]):
             if all(abs(O_ - Ok) + L * abs(rot_ - rk) > 1e-9 * L for Ok, rk in found):
                 found.append((complex(O_), complex(rot_)))

@@ -88,8 +88,8 @@ def test_group_order_reactions_equal_the_groups_full_linear_system(mech):
 
 def test_newton_converges_to_rounding_in_few_steps(mech):
     """The continuation's Newton: every leash closed to a few ulps of the group's size, within
-    six steps from each block's start (the counts are the program's outputs)."""
-    env = dict(constants(mech))
+    six steps from the track's pose (the counts are the program's outputs)."""
+    env = dict(constants(mech), **kinetostat.kinematics.tracks(mech))
     env.update(phi=np.radians(np.arange(0.0, 360.0, 1.0)), w_in=1.0, e_in=0.0)
     out = program.run(motion_program(mech), env)
     L = max(kinetostat.kinematics.group_scales(mech))
@@ -193,8 +193,9 @@ def test_virtual_work_and_the_lever_agree_over_the_cycle(mech):
 
 
 def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
-    """Velocity plan: s with v_S (from the outer pins of leashes 1 and 2); the group plan: S and
-    the arms about it; the force polygon closes with R..n of leashes 1 and 2, and every reaction
+    """Velocity plan: s with v_S (from the outer pins of the leashes through S, the two whose axes
+    meet at the best angle: 5 and 2 on the six-bar at 60 deg); the group plan: S and the arms
+    about it; the force polygon closes with R..n of those two, and every reaction
     on it (outer, as chords over their parts, and inner, from each leash's polygon) is analyze's
     vector."""
     from kinetostat.kinematics import special_point_z
@@ -210,13 +211,22 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
     vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
     assert abs(v.points["s"] * sc["mu_v"].value - vS) <= 1e-12 * abs(vS)
     assert {s.name for s in v.segments} >= {"a-s", "p-s"}
+    acc = kinematic.acceleration_plan(mech, res, sc)
+    aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
+    a_A = complex(res.kin.point_z(1, tuple(mech.links[1].points["A"]))[2][0])
+    seg = acc.segment("a-s")
+    assert abs(seg.value - abs(aS - a_A)) <= 1e-12 * abs(aS)                     # a_S = a_A + a_SA
+    assert abs(abs(acc.points["s"] - acc.points["a"]) * sc["mu_a"].value - seg.value) <= 1e-12 * abs(aS)
     (gp,) = forces.group_plans(mech, res, sc["mu_l"])
     assert abs(gp.points["S"] * sc["mu_l"].value - S) <= 1e-12
     assert any(s.name.endswith("(S)") for s in gp.segments)
     mu_F = forces.default_mu_F(mech, res)
     (fp,) = forces.force_plans(mech, res, mu_F)
     eq = fp.equation
-    assert eq[-2:] == ("R12n", "R04n") and eq[0] == "R04t"
+    (l1, _, _, a1), (l2, _, _, a2), (l3, _, _, a3) = kinetostat.kinematics.special_sides(mech, res.kin, g)
+    assert {l1, l2, l3} == {2, 4, 5} and (l1, l2) == ((5, 2) if g.kind == "RRR" else (2, 4))   # S: best-met axes
+    name = lambda a, ell: forces.reaction_name(mech, a, ell)
+    assert eq[-2:] == (name(a1, l1) + "n", name(a2, l2) + "n") and eq[0] == name(a2, l2) + "t"
     n = len(eq)
     sides = [fp.points[s.end] - fp.points[s.start] for s in fp.segments[:n]]
     assert abs(sum(sides)) <= 1e-12 * max(map(abs, sides))
@@ -231,3 +241,157 @@ def test_the_drawing_error_simulation_refuses_a_triad_by_name(mech):
     assert not drawing_error.draws_forces(mech)
     with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind R.. \(III3 R..\) is not drawn"):
         drawing_error.simulate(mech, n=10)
+
+
+def test_near_the_singular_position_the_mode_drawn_is_kept_on_a_fine_grid():
+    """Crank r = 0.1171 m (4.3e-5 m short of touching the fold): the path passes close to the
+    other mode near phi = 202 deg. On a 0.01 deg grid the base turns smoothly (the true rate is
+    below 0.0018 deg per 0.01 deg; the old block continuation jumped 1.6 deg at 202.14 deg and
+    followed the other mode to 240 deg), and the base's angle equals an independent continuation
+    (a 3x3 Newton on the three leashes' closure, finite-difference Jacobian, 0.01 deg steps from
+    the design position both ways: /tmp/t2_fine.py in the review's scratch) to 1e-9 deg."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kinetostat.ModelWarning)     # the base is drawn for r = 0.10
+        mech = _six_bar_with_crank(0.1171)
+        phi = np.arange(195.0, 245.0, 0.01)
+        kin = kinematics(mech, np.radians(phi))
+        th = np.degrees(np.unwrap(np.angle(kin.rot[:, 3])))
+        assert np.max(np.abs(np.diff(th))) <= 0.002 and np.max(kin.cond) < 90
+        at = kinematics(mech, np.radians([150.0, 202.14, 202.15, 240.0, 300.0]))
+    fine = [7.941273160, 12.561725178, 12.560127420, 6.568191905, 0.463113479]
+    assert np.max(np.abs(np.degrees(np.angle(at.rot[:, 3])) - fine)) <= 1e-8
+    tr = kinetostat.kinematics.tracks(mech)["track0"]
+    assert tr.full and tr.mismatch <= 1e-12 and tr.steps < 400     # the path closes over the turn
+
+
+def test_a_crank_stopped_by_a_fold_is_solved_where_it_turns_and_refused_by_name_beyond(tmp_path, cli):
+    """Crank r = 0.125 m: the triad's fold stops the crank at 166.5 deg going up and 230.2 deg
+    going down (the group's condition number grows without bound there). Angles asked on the
+    path are solved (no error for angles nobody asked); one beyond names itself alone; the CLI
+    says so in one line, exit 2."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kinetostat.ModelWarning)
+        mech = _six_bar_with_crank(0.125)
+        res = kinetostat.analyze(mech, phi_deg=[60.0, 90.0, 300.0])
+        assert np.isfinite(res.balancing_moment).all()
+        tr = kinetostat.kinematics.tracks(mech)["track0"]
+        ends = np.degrees(tr.u[[0, -1]]) + 60.0
+        np.testing.assert_allclose(ends, [230.19 - 360.0, 166.51], atol=0.01)
+        with pytest.warns(kinetostat.SingularPositionWarning, match=r"phi = \[166.5, 230.2\] deg"):
+            near = kinematics(mech, np.radians([166.5, 230.2, 100.0]))
+        assert (near.cond[:2, 0] > 200).all() and near.cond[2, 0] < 10
+        with pytest.raises(kinetostat.AssemblyError, match=r"III\(2,3,4,5\).* at phi = \[180\] deg"):
+            kinetostat.analyze(mech, phi_deg=[60.0, 180.0])
+    bad = tmp_path / "far.toml"       # the frame pin F moved 2 m off: the crank no longer reaches 84 deg
+    bad.write_text((ROOT / "models" / "triad_six_bar.toml").read_text().replace("F = [0.95, 0.80]", "F = [2.95, 0.80]"))
+    assert cli("structure", bad, "--modes").returncode == 0
+    out = cli("analyze", bad)
+    assert out.returncode == 2 and out.stderr.strip().splitlines()[-1].startswith("kinetostat: error:")
+    assert "at phi = [84, 85" in out.stderr
+
+
+def _renumbered(text: str) -> str:
+    """The same mechanism with the leashes' links renumbered 2 -> 5, 4 -> 2, 5 -> 4 (the group's
+    leashes 1 and 2, the lowest ids, become the rocker E-C and the rod)."""
+    import re
+    new = {2: 5, 4: 2, 5: 4}
+    text = re.sub(r"^id = (\d+)", lambda g: f"id = {new.get(int(g[1]), int(g[1]))}", text, flags=re.M)
+    return re.sub(r"^links = \[(\d+), (\d+)\]",
+                  lambda g: f"links = [{new.get(int(g[1]), int(g[1]))}, {new.get(int(g[2]), int(g[2]))}]", text, flags=re.M)
+
+
+def test_any_two_leashes_define_s_so_the_numbering_does_not_matter():
+    """F moved so that the axes of the rocker E-C and of F-D are parallel at 60 deg (the
+    review's six_parF): renumbered, those are leashes 1 and 2 (S from them alone failed at 119
+    angles). S from the two axes meeting at the best angle: the renumbered mechanism gives the
+    same reactions and M_bal to rounding, no angle singular (cond <= 5.1: the three axes never
+    meet in one point), and the reactions still equal the constraint Jacobian's virtual work."""
+    from kinetostat.virtual_work import virtual_work
+    text = (ROOT / "models" / "triad_six_bar.toml").read_text().replace(
+        "F = [0.95, 0.80]", "F = [0.8497800941, 0.8132618385270001]")
+    a, b = kinetostat.loads(text), kinetostat.loads(_renumbered(text))
+    assert b.structure.groups[0].known == (0, 0, 1)
+    phi = np.arange(0.0, 360.0, 5.0)
+    with pytest.warns(kinetostat.ModelWarning, match="do not draw"):        # the base drawn for F as bundled
+        ra = kinetostat.analyze(a, phi_deg=phi)
+    with pytest.warns(kinetostat.ModelWarning, match="do not draw"):
+        rb = kinetostat.analyze(b, phi_deg=phi)
+    peak = np.max(np.abs(ra.balancing_moment))
+    assert np.max(np.abs(ra.balancing_moment - rb.balancing_moment)) <= 1e-12 * peak
+    Rmax = np.max(np.abs(ra.forces.R))
+    for i, j in [(1, 2), (0, 4), (0, 5), (2, 3), (3, 4), (3, 5)]:
+        jb, ib = {2: 5, 4: 2, 5: 4}.get(j, j), {2: 5, 4: 2, 5: 4}.get(i, i)
+        assert np.max(np.abs(ra.reaction(i, j) - rb.reaction(ib, jb))) <= 1e-12 * Rmax
+    assert not rb.singular.any() and np.max(rb.cond) < 5.1
+    vw = virtual_work(b, phi_deg=phi)
+    assert np.max(np.abs(vw.balancing_moment - rb.balancing_moment)) <= 1e-12 * peak
+
+
+def test_two_modes_closer_than_the_samples_are_both_found_and_warned():
+    """The crank r = 0.11716309257991407 m with the design position at 198 deg, next to the
+    fold: two modes 0.125 deg apart in the base's angle (13.420 and 13.545 deg), both between
+    two of the 3600 trial positions of leash 1 (no change of sign of the miss there: one mode was
+    listed, separation inf, no warning). Each mode found closes the three leashes (their lengths
+    measured here from the model's points) to rounding, and the warning names the closeness."""
+    text = (ROOT / "models" / "triad_six_bar.toml").read_text().replace("design_deg = 60.0", "design_deg = 198.0")
+    mech = kinetostat.loads(text.replace('A = [0.10, 0.0] }\nmass = 2.0', 'A = [0.11716309257991407, 0.0] }\nmass = 2.0')
+                            .replace('points = { A = [0.10, 0.0], B', 'points = { A = [0.11716309257991407, 0.0], B'))
+    with pytest.warns(Warning) as got:                 # both asserted below
+        (am,) = assembly_modes(mech)
+        kinetostat.kinematics.kinematics(mech, np.radians([198.0]))
+    assert any("another assembly mode is within 0.00319" in str(w.message) for w in got)
+    assert any(isinstance(w.message, kinetostat.SingularPositionWarning) for w in got)    # cond 670 there
+    th = np.degrees(np.angle(np.array(am.rot)))
+    np.testing.assert_allclose(np.sort(th), [13.4203, 13.5455], atol=1e-4)
+    assert 0.003 < am.separation < 0.0033
+    pts = mech.points_z
+    A = 0.11716309257991407 * np.exp(1j * np.radians(198.0))
+    for O, rot in zip(am.O, am.rot):
+        B, C, D = (O + pts[3][p] * rot for p in "BCD")
+        miss = [abs(B - A) - abs(pts[2]["B"] - pts[2]["A"]), abs(C - pts[0]["E"]) - abs(pts[4]["C"] - pts[4]["E"]),
+                abs(D - pts[0]["F"]) - abs(pts[5]["D"] - pts[5]["F"])]
+        assert np.max(np.abs(miss)) <= 1e-15
+
+
+def test_the_newton_residual_is_reported_per_angle_and_printed(cli):
+    """Kinematics.residual (N, groups), m: the triad's largest leash miss after its Newton, the
+    same as the misses measured here from the public positions (the three leashes' lengths);
+    `kinetostat analyze` prints the largest."""
+    mech = kinetostat.load(ROOT / "models" / "triad_six_bar.toml")
+    kin = kinematics(mech, np.radians(PHI))
+    pts, L = mech.points_z, kinetostat.kinematics.group_scales(mech)[0]
+    miss = []
+    for ell, outer, inner in [(2, "A", "B"), (4, "E", "C"), (5, "F", "D")]:
+        X = kin.position_z(3, (pts[3][inner].real, pts[3][inner].imag))
+        P = kin.position_z(ell, (pts[ell][outer].real, pts[ell][outer].imag))
+        miss.append(np.abs(np.abs(X - P) - abs(pts[ell][inner] - pts[ell][outer])))
+    assert kin.residual.shape == (len(PHI), 1) and np.max(kin.residual) <= 8 * np.finfo(float).eps * L
+    assert np.max(np.abs(kin.residual[:, 0] - np.max(miss, axis=0))) <= 4 * np.finfo(float).eps * L
+    out = cli("analyze", "triad_six_bar", "--steps", "12")
+    assert out.returncode == 0 and "triads' closure (Newton) residual: largest leash miss" in out.stdout
+
+
+def test_the_reference_refuses_positions_in_another_mode():
+    """The 40-digit reference's branch check covers triads: positions in the other assembly
+    mode (from `assembly_modes`, each leash laid between its pins) converge in 40 digits, but
+    the constraint Jacobian's determinant has the other sign than at the design position: a
+    BranchMismatch; the solver's own positions pass."""
+    from dataclasses import replace
+    from kinetostat_validation.reference import BranchMismatch, reference_full
+    mech = kinetostat.load(ROOT / "models" / "triad_six_bar.toml")
+    res = kinetostat.analyze(mech, phi_deg=[60.0])
+    assert np.isfinite(reference_full(mech, [60.0], res=res).M_bal).all()
+    (am,) = assembly_modes(mech)
+    O, rot = next((O, r) for i, (O, r) in enumerate(zip(am.O, am.rot)) if i != am.chosen)
+    pts, kin = mech.points_z, res.kin
+    oz, rz = kin.origin_z.copy(), kin.rot.copy()
+    oz[0, 3], rz[0, 3] = O, rot
+    for ell, outer, inner in [(2, "A", "B"), (4, "E", "C"), (5, "F", "D")]:
+        P, X = kin.position_z(ell, (pts[ell][outer].real, pts[ell][outer].imag))[0], O + pts[3][inner] * rot
+        rz[0, ell] = (X - P) / (pts[ell][inner] - pts[ell][outer])
+        oz[0, ell] = P - pts[ell][outer] * rz[0, ell]
+    other = replace(res, kin=replace(kin, origin_z=oz, rot=rz, theta=np.angle(rz)))
+    with pytest.raises(BranchMismatch, match="not in the mode continuous from the design position"):
+        reference_full(mech, [60.0], res=other)

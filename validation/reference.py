@@ -354,11 +354,37 @@ def _solve(A: list[list], b: list) -> list:
     return list(mp.lu_solve(mp.matrix(A), mp.matrix(b)))
 
 
-def _branch_check(m: _Model, q, phi_deg: float) -> None:
-    """Re-derive each group's branch from the converged positions (models/FORMAT.md)."""
+def _orientation(m: _Model, q) -> int:
+    """The sign of the whole constraint Jacobian's determinant at q: constant along a path that
+    passes no singular position, so the mode continuous from the design position keeps it."""
+    return int(mp.sign(mp.det(mp.matrix(m.jacobian(q)))))
+
+
+def _design_orientation(m: _Model) -> int:
+    """`_orientation` at the design position, from the solver's pose there (the mode the
+    model's points draw; the group is far from singular there, so the double pose's sign is
+    the exact one)."""
+    mech = m.mech
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        kin = analyze(mech, phi_deg=[mech.drive.design_deg]).kin
+    q = [mpf(0)] * m.n
+    for k in range(1, m.L):
+        c = m.col(k)
+        q[c], q[c + 1], q[c + 2] = mpf(float(kin.origin[0, k, 0])), mpf(float(kin.origin[0, k, 1])), mpf(float(kin.theta[0, k]))
+    return _orientation(m, q)
+
+
+def _branch_check(m: _Model, q, phi_deg: float, design: int | None = None) -> None:
+    """Re-derive each group's branch from the converged positions (models/FORMAT.md); with a
+    triad, `design` (`_design_orientation`): the converged positions keep the design position's
+    orientation (a jump to a neighbouring mode, across a fold, flips it)."""
+    if design is not None and _orientation(m, q) != design:
+        raise BranchMismatch(f"phi = {phi_deg:.6g} deg: the solver's positions are not in the mode continuous from the "
+                             f"design position (the constraint Jacobian's determinant changed sign)")
     for g in m.mech.structure.groups:
         if g.klass == 3 or g.kind not in ("RRR", "RRP", "RPR"):
-            continue                 # a triad's mode has no branch sign: Newton keeps the solver's
+            continue                 # a triad: the orientation above
         pj, pin, pk = g.pairs
         j, k = g.links
         if g.kind == "RRR":
@@ -605,6 +631,7 @@ def reference_full(mech: Mechanism, phi_deg, res: Analysis | None = None, dps: i
     with mp.workdps(dps):
         m = _Model(mech)
         tol = mpf(10) ** (5 - dps) * m.size
+        design = _design_orientation(m) if check_branch and any(g.klass == 3 for g in mech.structure.groups) else None
         for a in range(N):
             if angle == "decimal":
                 phi = mp.radians(mpf(float(phi_deg[a])))
@@ -634,7 +661,7 @@ def reference_full(mech: Mechanism, phi_deg, res: Analysis | None = None, dps: i
                 out["theta"][a], out["origin"][a] = np.nan, np.nan
                 continue
             if check_branch:
-                _branch_check(m, q, float(phi_deg[a]))
+                _branch_check(m, q, float(phi_deg[a]), design)
             for k in range(1, L):
                 c = m.col(k)
                 out["theta"][a, k] = float(q[c + 2])

@@ -49,6 +49,12 @@ def _summary(res, path: Path) -> list[str]:
         lines.append(f"lever discrepancy max |M_lever - M_bal|: {abs(d[k]):.3g} N m (phi = {phi[k]:g} deg)")
     if m.friction is not None:
         lines += _friction_lines(res)
+    triads = [n for n, g in enumerate(s.groups) if g.klass == 3]
+    if triads and res.kin.residual is not None:
+        r = res.kin.residual[:, triads].max(axis=1)
+        k = int(np.argmax(r))
+        lines.append(f"triads' closure (Newton) residual: largest leash miss {r[k]:.3g} m (phi = {phi[k]:g} deg; "
+                     f"{r[k] / m.size:.2g} of the linkage's size)")
     n_sing = int(np.sum(res.singular))
     if n_sing:
         lines.append(f"singular positions: {n_sing} (their values are NaN)")
@@ -174,8 +180,13 @@ def cmd_structure(args) -> int:
     lines.append(f"structure formula: {s.formula}")
     lines.append(f"class {s.mechanism_class}, order {s.order}")
     if args.modes:
+        from ..errors import AssemblyError
         from ..kinematics import assembly_modes
-        lines += ["assembly modes at the design position:"] + [x for am in assembly_modes(m) for x in am.lines()]
+        try:
+            found = assembly_modes(m)
+        except AssemblyError as exc:
+            raise CLIError(f"{path}: {exc}") from None
+        lines += ["assembly modes at the design position:"] + [x for am in found for x in am.lines()]
     if m.parameters:
         lines.append("parameters: " + ", ".join(f"{n} = {v:.10g}" for n, v in m.parameters.items()))
     if m.expressions:

@@ -429,9 +429,9 @@ def _special_point(mech: "Mechanism", res: "Analysis", g) -> tuple[str, complex]
 def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: Scale | None = None) -> Plan:
     """A triad's plan (Artobolevsky 1988): its four links with their loads and the carried
     reactions; each leash's outer reaction (a two-pin leash's split into R..n along its axis and
-    R..t across it; a slider's normal force at its offset x); the axes of leashes 1 and 2 drawn
-    through Assur's special point S; the arms of each leash's moment equation about its inner pin
-    (R..t) and of the group's about S (R..n of leash 3, marked (S))."""
+    R..t across it; a slider's normal force at its offset x); the axes of the two leashes through
+    Assur's special point S drawn through it; the arms of each leash's moment equation about its
+    inner pin (R..t) and of the group's about S (R..n of the third leash, marked (S))."""
     later = _later(mech, g)
     loads = {x: link_loads(mech, res, x) + _carried(mech, res, x, later) for x in g.links}
     parts = [_leash_parts(mech, res, side) for side in g.sides]
@@ -454,7 +454,8 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
             for ld in loads[ell]:
                 if abs(ld.force) > 0 and abs(ld.point - X) > 1e-12 * mech.size:
                     _arm(segs, pts, arm_name(ld.name), X, inner.point, ld.point, ld.force, mu_l)
-    for ell, _, inner, _ in g.sides[:2]:
+    from ..kinematics import special_sides
+    for ell, _, inner, _ in special_sides(mech, res.kin, g)[:2]:
         segs.append(Segment(f"axis {inner.point}{S_name}", inner.point, S_name, abs(_world(res, ell, inner.point) - S),
                             "m", "line"))
     for x in g.links:
@@ -466,17 +467,20 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
 
 
 def _triad_polygon(mech: "Mechanism", res: "Analysis", g) -> tuple[list[tuple[str, complex]], list, list]:
-    """A triad's vector equation in an order that keeps each leash's forces together: R..t of
-    leash 2, its loads, the base's loads, R..n and R..t of leash 3 (R..n known from the group's
-    moment about S), its loads, leash 1's loads, its R..t, and the unknowns R..n of leashes 1 and
-    2 closing the polygon. Also, per leash, the indices of its first and last forces (its inner
+    """A triad's vector equation in an order that keeps each leash's forces together, leashes 1
+    and 2 those through S and 3 the third (`kinematics.special_sides`): R..t of leash 2, its
+    loads, the base's loads, R..n and R..t of leash 3 (R..n known from the group's moment about
+    S), its loads, leash 1's loads, its R..t, and the unknowns R..n of leashes 1 and 2 closing
+    the polygon. Also, per leash, the indices of its first and last forces (its inner
     reaction closes its own polygon from the one to the other) and of its two reaction parts."""
+    from ..kinematics import special_sides
     later = _later(mech, g)
-    parts = [_leash_parts(mech, res, side) for side in g.sides]
+    sides = special_sides(mech, res.kin, g)
+    parts = [_leash_parts(mech, res, side) for side in sides]
     loads = lambda x: [(ld.name, ld.force) for ld in link_loads(mech, res, x) + _carried(mech, res, x, later)]
     t = lambda o: [] if o.normal is None else [(f"{o.whole.name}t", o.tangential)]
     n = lambda o: [(o.whole.name, o.whole.force)] if o.normal is None else [(f"{o.whole.name}n", o.normal)]
-    (l1, l2, l3), (o1, o2, o3) = [s[0] for s in g.sides], parts
+    (l1, l2, l3), (o1, o2, o3) = [s[0] for s in sides], parts
     blocks = [t(o2) + loads(l2), loads(g.links[0]), n(o3) + t(o3) + loads(l3), loads(l1) + t(o1) + n(o1), n(o2)]
     seq = [f for b in blocks for f in b]
     at = [0]
@@ -593,18 +597,20 @@ def _closed_polygon(seq: list[tuple[str, complex]], mu_F: Scale) -> tuple[dict, 
 
 
 def _triad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Plan:
-    """A triad's force plan: its polygon (`_triad_polygon`) closed by R..n of leashes 1 and 2,
+    """A triad's force plan: its polygon (`_triad_polygon`) closed by R..n of the leashes through S,
     the whole reaction of each two-pin leash as a chord over its two parts, and each leash's
     inner reaction (of the base on it) from its own polygon: the chord from the end of its
     forces back to their start."""
+    from ..kinematics import special_sides
     seq, spans, whole = _triad_polygon(mech, res, g)
     pts, segs = _closed_polygon(seq, mu_F)
     m = len(seq)
-    for (ell, _, _, known), w in zip(g.sides, whole):
+    sides = special_sides(mech, res.kin, g)
+    for (ell, _, _, known), w in zip(sides, whole):
         if w is not None:
             segs.append(Segment(reaction_name(mech, known, ell), _vertex(w[0] % m), _vertex(w[1] % m),
                                 float(np.hypot(*res.reaction(known, ell)[0])), "N"))
-    for (ell, _, _, _), (a, b) in zip(g.sides, spans):
+    for (ell, _, _, _), (a, b) in zip(sides, spans):
         segs.append(Segment(reaction_name(mech, g.links[0], ell), _vertex(b % m), _vertex(a % m),
                             float(np.hypot(*res.reaction(g.links[0], ell)[0])), "N"))
     return Plan(f"forces:{_group_label(g)}", f"Force plan of group {g.label} (III3): "

@@ -151,7 +151,7 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     """The velocity plan (seed 002 fig. 1.7): pole p, p-x for every point, the relative
     velocities of each floating link's joints (a-b), the sliding velocities of blocks on moving
     guides (a1-a3), like points by similarity (s2 on ab), and a triad's special point s (v_S
-    from the outer pins of leashes 1 and 2, a-s, e-s): all at mu_v."""
+    from the outer pins of the two leashes through S, e.g. a-s, e-s): all at mu_v."""
     at = _at(res)
     mu = scales["mu_v"]
     pts = plan_point_names(mech, res)
@@ -171,9 +171,9 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
 
 def _special(mech, res, pts: dict) -> list[tuple[str, int, complex, list[str]]]:
     """Per triad: the plan name of Assur's special point S (a point of the base link), the base,
-    S's local coordinates on it, and the plan names of the references of leashes 1 and 2 (their
-    outer pins; "" for a point of the frame, at the pole)."""
-    from ..kinematics import special_point_z
+    S's local coordinates on it, and the plan names of the references of the two leashes through
+    S (their outer pins; "" for a point of the frame, at the pole)."""
+    from ..kinematics import special_point_z, special_sides
     out = []
     for n, g in enumerate(g for g in mech.structure.groups if g.klass == 3):
         name = "s" if n == 0 else f"s{n + 1}'"
@@ -181,7 +181,7 @@ def _special(mech, res, pts: dict) -> list[tuple[str, int, complex, list[str]]]:
         b = g.links[0]
         S = complex(special_point_z(mech, res.kin, g)[0])
         local = (S - res.kin.origin_z[0, b]) / res.kin.rot[0, b]
-        refs = [_name_of(mech, o.point) if o.kind == "R" else "" for _, o, _, _ in g.sides[:2]]
+        refs = [_name_of(mech, o.point) if o.kind == "R" else "" for _, o, _, _ in special_sides(mech, res.kin, g)[:2]]
         out.append((name, b, local, refs))
     return out
 
@@ -208,7 +208,8 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     (normal and tangential parts when the crank accelerates); per group the normal `r-n<k>` and
     tangential `n<k>-q` parts of each turning link, the Coriolis `-k` and relative `k-` parts of
     a block on a moving guide; pi-x for every point, the relative accelerations of each floating
-    link's joints (a-b), like points by similarity: all at mu_a."""
+    link's joints (a-b), like points by similarity, and a triad's special point s with its
+    construction from the outer pins of the two leashes through S (e.g. a-s): all at mu_a."""
     at = _at(res)
     mu = scales["mu_a"]
     pts = plan_point_names(mech, res)
@@ -250,10 +251,11 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
         else:
             segs.append(_rel(s.start, s.end, abs(a_r), unit))
     segs += [Segment(f"pi-{n}", "pi", n, abs(m[2]), unit) for n, m in mo.items()]
-    for name, b, local, refs in _special(mech, res, pts):        # a_S, a point of the base
+    for name, b, local, refs in _special(mech, res, pts):        # a_S = a_1 + a_S1 = a_2 + a_S2
         aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
         points[name] = aS / mu.value
         segs.append(Segment(f"pi-{name}", "pi", name, abs(aS), unit))
+        segs += [Segment(f"{r}-{name}", r, name, abs(aS - mo[r][2]), unit) for r in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
     return Plan("acceleration", f"Acceleration plan at phi = {at:g} deg", mu, at, points, tuple(segs))
