@@ -20,6 +20,7 @@ import pytest
 import kinetostat
 import kinetostat.plans as P
 from kinetostat.plans.i18n import num
+from kinetostat.plans.forces import _group_label
 from kinetostat.plans.page import _steps, page as make_page
 from kinetostat.plans.worksheet import worksheet
 
@@ -217,11 +218,31 @@ def test_every_step_names_a_drawn_vector(path):
         plan = plans[s["plan"]]
         assert (s["path"] in plan.paths) if "path" in s else any(x.name == s["segment"] for x in plan.segments), s
     for g in mech.structure.groups:
-        label = f"{min(g.links)},{max(g.links)}"
+        label = _group_label(g)
         sides = [s["segment"] for s in steps if s["plan"] == f"forces:{label}"]
-        assert sides[:-1] == list(plans[f"forces:{label}"].equation)
+        inner = 3 if g.klass == 3 else 1                 # a triad: the base's reaction on each leash
+        assert sides[:-inner] == list(plans[f"forces:{label}"].equation)
+        assert len(set(sides[-inner:])) == inner
     groups = list(dict.fromkeys(s["plan"].split(":")[1] for s in steps if s["plan"].startswith("forces:")))
-    assert groups == [f"{min(g.links)},{max(g.links)}" for g in reversed(mech.structure.groups)]
+    assert groups == [_group_label(g) for g in reversed(mech.structure.groups)]
+
+
+def test_triad_steps_follow_the_texts_order():
+    """A triad (Artobolevsky 1988, plans/forces.py): R^τ of each leash about its inner pin, then R^n
+    of leash 3 from the group's moment about Assur's point S, then the polygon in the order drawn,
+    then the base's reaction on each leash; every step a vector its plan draws."""
+    mech = kinetostat.load("triad_six_bar")
+    plans = _build(mech, None, None)
+    steps = _steps(mech, plans, "uk")
+    g = next(g for g in mech.structure.groups if g.klass == 3)
+    label = _group_label(g)
+    taus = [s for s in steps if s["plan"] == f"group:{label}"]
+    assert [s["segment"][-1] for s in taus] == ["t", "t", "t", "n"][:len(taus)] and len(taus) >= 2
+    assert "ΣM_S" in taus[-1]["eq"] or "ΣM_S*" in taus[-1]["eq"]
+    first = steps.index(taus[0])
+    assert steps[first + len(taus)]["plan"] == f"forces:{label}"
+    for s in steps:
+        assert any(x.name == s.get("segment") for x in plans[s["plan"]].segments) or s.get("path") in plans[s["plan"]].paths, s
 
 
 @pytest.mark.slow

@@ -176,29 +176,43 @@ def _sheets_of(plans, lang: str, name: str) -> dict[str, str]:
 
 def _steps(mech, plans, lang: str) -> list[dict]:
     """The force analysis in the texts' order, one vector a step: per Assur group from the last
-    attached, R^τ from ΣM about the inner joint, the polygon's sides in the order drawn, the inner
-    reaction; then the initial link's loads and M_bal; then the lever's loads and M'_bal."""
+    attached, the unknowns found from moment equations (a dyad's R^τ from ΣM about the inner
+    joint; a triad's R^τ of each leash about its inner pin, then R^n of leash 3 from the group's
+    moment about Assur's point S), the polygon's sides in the order drawn, the inner reactions;
+    then the initial link's loads and M_bal; then the lever's loads and M'_bal."""
     from .forces import _group_label, _moment_equations, reaction_name
     from .lettering import lettering
     L = lettering(mech)
     out = []
     for g in reversed(mech.structure.groups):
         label = _group_label(g)
-        forces = plans.get(f"forces:{label}")
+        forces, group = plans.get(f"forces:{label}"), plans.get(f"group:{label}")
         if forces is None:
             continue
-        taus = [n for n in forces.equation if n.startswith("R") and n.endswith("t")]
-        for (links, point), R in zip(_moment_equations(g), taus):
-            out.append({"plan": f"group:{label}", "segment": R,
-                        "eq": text("page.tau", lang, R=R, P=point, k=",".join(map(str, links)))})
+        drawn = {s.name for s in group.segments} if group is not None else set()
+        if g.klass == 3:
+            moments = [(f"{reaction_name(mech, known, ell)}t", inner.point, str(ell))
+                       for ell, _, inner, known in g.sides]
+            ell, _, _, known = g.sides[2]
+            S = "S" if "S" not in mech.point_names else "S*"
+            R3 = reaction_name(mech, known, ell)
+            moments.append((f"{R3}n" if f"{R3}n" in drawn else R3, S, label))
+            inners = [(reaction_name(mech, g.links[0], ell), ell) for ell, _, _, _ in g.sides]
+        else:
+            taus = [n for n in forces.equation if n.startswith("R") and n.endswith("t")]
+            moments = [(R, point, ",".join(map(str, links))) for (links, point), R in zip(_moment_equations(g), taus)]
+            j, k = g.links
+            inners = [(reaction_name(mech, k, j), j)]
+        for R, point, links in moments:
+            if R in drawn:
+                out.append({"plan": f"group:{label}", "segment": R, "eq": text("page.tau", lang, R=R, P=point, k=links)})
         m = len(forces.equation)
         for n, name in enumerate(forces.equation):
             out.append({"plan": f"forces:{label}", "segment": name,
                         "eq": text("page.side", lang, sum=" + ".join(forces.equation[:n + 1]) + (" = 0" if n + 1 == m else " + …"),
                                   n=n + 1, m=m)})
-        j, k = g.links
-        inner = reaction_name(mech, k, j)
-        out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=j)})
+        for inner, k in inners:
+            out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=k)})
     crank = plans.get("crank")
     if crank is not None:
         for s in crank.segments:
