@@ -166,10 +166,24 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
     sel = 'input[data-plan="velocity"][data-segment="p-b"]'
     assert verdict(sel, num(pb, "uk", decimals=2)) == "ok"
     assert verdict(sel, num(pb + 3.0, "uk", decimals=2)) == "bad"
-    M = abs(plans["crank"].results[0].value)
-    sel = 'input.moment[data-symbol="M_зр"]'
-    assert verdict(sel, f"{M * 1.04:.2f}") == "ok"
-    assert verdict(sel, f"{M * 0.94:.2f}") == "bad"
+    M = plans["crank"].results[0].value                    # seed 002: 103 N m, counter-clockwise
+    crank, lever = 'input.moment[data-symbol="M_зр"]', """input.moment[data-symbol="M'_зр"]"""
+
+    def moments(typed_crank: str, typed_lever: str) -> tuple[str, str, str, str]:
+        pg.fill(crank, typed_crank)
+        pg.fill(lever, typed_lever)
+        return tuple(pg.eval_on_selector_all("tr[data-moment] .verdict, #delta .verdict",
+                                             "es => es.map(e => e.dataset.verdict || '')")) + (pg.text_content("#delta .verdict"),)
+    assert moments(f"{M:.1f}", f"{M * 1.01:.1f}")[:3] == ("ok", "ok", "ok")
+    # the texts' rule is on the student's own two moments: 98 and 108 are each near 103, δ ≈ 9 %
+    assert moments("98", "108")[2] == "bad"
+    # the sense counts: a moment of the wrong sign is wrong whatever its size
+    assert moments(f"{-M:.1f}", f"{-M:.1f}")[:2] == ("bad", "bad")
+    # δ judged as shown, to 0.1 %: δ = (103,1 − 97,9)/103,1 = 5,0 % is within 5 %
+    v = moments("97,9", "103,1")
+    assert v[2] == "ok" and "+5,0 %" in v[3] and "в межах" in v[3], v
+    v = moments("97,8", "103,1")
+    assert v[2] == "bad" and "+5,1 %" in v[3], v
     assert requests == [student.as_uri()], requests
     pg.close()
 

@@ -267,15 +267,18 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "page.check_note": ("Type the lengths you measured on your plans (mm) at φ = {phi}°: the deviation from the "
                    "exact length, and whether it lies in the band a careful drawing lands in (the 5-95 % "
                    "band of the drawing-error study; — where the study has none); the two balancing "
-                   "moments by the texts' {tol} % rule.",
+                   "moments with their sign (+ counter-clockwise), each against its band and sense, and "
+                   "δ between your two by the texts' {tol} % rule.",
                    "Введіть довжини, виміряні на ваших планах (мм) при φ = {phi}°: відхилення від точної "
                    "довжини і чи лежить воно в смузі, куди потрапляє ретельне креслення (5-95 % "
-                   "дослідження похибки креслення; — де його немає); два зрівноважувальні моменти за "
-                   "правилом {tol} % методички.",
+                   "дослідження похибки креслення; — де його немає); два зрівноважувальні моменти зі "
+                   "знаком (+ проти годинникової стрілки), кожен проти своєї смуги і напряму, і δ між "
+                   "вашими двома за правилом {tol} % методички.",
                    "Введите длины, измеренные на ваших планах (мм) при φ = {phi}°: отклонение от точной "
                    "длины и лежит ли оно в полосе, куда попадает тщательный чертёж (5-95 % исследования "
-                   "погрешности чертежа; — где его нет); два уравновешивающих момента по правилу {tol} % "
-                   "методички."),
+                   "погрешности чертежа; — где его нет); два уравновешивающих момента со знаком (+ против "
+                   "часовой стрелки), каждый против своей полосы и направления, и δ между вашими двумя по "
+                   "правилу {tol} % методички."),
     "page.plan": ("Plan", "План", "План"),
     "page.segment": ("Segment", "Відрізок", "Отрезок"),
     "page.measured": ("Measured", "Виміряно", "Измерено"),
@@ -284,6 +287,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "page.verdict": ("Verdict", "Висновок", "Вывод"),
     "page.in_band": ("in the band", "у смузі", "в полосе"),
     "page.out_band": ("outside the band", "поза смугою", "вне полосы"),
+    "page.sense": ("the wrong sense (sign)", "не той напрям (знак)", "не то направление (знак)"),
+    "page.both": ("type both moments", "введіть обидва моменти", "введите оба момента"),
     "page.rule_ok": ("within {tol} %", "в межах {tol} %", "в пределах {tol} %"),
     "page.rule_bad": ("beyond {tol} %", "понад {tol} %", "больше {tol} %"),
     "page.data": ("Data", "Вихідні дані", "Исходные данные"),

@@ -47,33 +47,58 @@
   // ------------------------------------------------------------------ the check of typed lengths
   const check = JSON.parse(new TextDecoder().decode(await bytes("check", true)));
   function parse(s) { const x = parseFloat(s.replace(",", ".")); return s.trim() === "" ? NaN : x; }
-  function verdict(tr, typed, exact, band, rule) {
-    const cell = tr.querySelector(".verdict");
-    if (!isFinite(typed)) { cell.textContent = ""; cell.className = "verdict"; delete cell.dataset.verdict; return; }
-    const dev = typed - exact, pct = 100 * dev / exact;
-    let ok, word;
-    if (rule) { ok = Math.abs(pct) <= D.tol; word = ok ? D.rule_ok : D.rule_bad; }
-    else if (band) { ok = band[0] <= typed && typed <= band[1]; word = D.ui[ok ? "in_band" : "out_band"]; }
-    else { ok = null; word = ""; }
+  function pct1(x) { return (x >= 0 ? "+" : "−") + Math.abs(x).toFixed(1).replace(".", D.decimal) + " %"; }
+  function mark(cell, ok, text) {                 // a verdict cell: ok true/false, null (none), undefined (empty)
+    if (ok === undefined) { cell.textContent = ""; cell.className = "verdict"; delete cell.dataset.verdict; return; }
     cell.dataset.verdict = ok === null ? "none" : ok ? "ok" : "bad";
     cell.className = "verdict" + (ok === null ? "" : ok ? " ok" : " bad");
-    cell.textContent = (dev >= 0 ? "+" : "") + local(dev, 3) + (rule ? "" : " " + D.mm) + " (" + (pct >= 0 ? "+" : "")
-      + local(pct, 2) + " %)" + (word ? " — " + word : "");
+    cell.textContent = text;
   }
+  function dev(typed, exact, unit) {              // "+1,23 mm (+0,5 %)": the percentage to 0.1 %
+    const d = typed - exact;
+    return (d >= 0 ? "+" : "") + local(d, 3) + (unit ? " " + unit : "") + " (" + pct1(100 * d / exact) + ")";
+  }
+  function band(b) { return b ? local(b[0], 3) + " … " + local(b[1], 3) : "—"; }
   document.querySelectorAll("tr[data-item]").forEach((tr) => {
     const it = check.items[+tr.dataset.item];
     if (!D.student) {
       tr.querySelector(".exact").textContent = local(it.exact, 4);
-      tr.querySelector(".band").textContent = it.band ? local(it.band[0], 3) + " … " + local(it.band[1], 3) : "—";
+      tr.querySelector(".band").textContent = band(it.band);
     } else if (!it.band) {
       tr.querySelector(".band").textContent = "—";
     }
-    tr.querySelector("input").addEventListener("input", (e) => verdict(tr, parse(e.target.value), it.exact, it.band, false));
+    tr.querySelector("input").addEventListener("input", (e) => {
+      const typed = parse(e.target.value), cell = tr.querySelector(".verdict");
+      if (!isFinite(typed)) return mark(cell);
+      const ok = it.band ? it.band[0] <= typed && typed <= it.band[1] : null;
+      mark(cell, ok, dev(typed, it.exact, D.mm) + (ok === null ? "" : " — " + D.ui[ok ? "in_band" : "out_band"]));
+    });
   });
-  document.querySelectorAll("tr[data-moment]").forEach((tr) => {
-    const exact = Math.abs(check.M[+tr.dataset.moment][1]);
-    if (!D.student) tr.querySelector(".exact").textContent = local(exact, 4);
-    tr.querySelector("input").addEventListener("input", (e) => verdict(tr, Math.abs(parse(e.target.value)), exact, null, true));
+  // The two balancing moments (signed, N m): each against its band and sense; then the texts' rule
+  // on the student's own two, δ = (M' − M)/M' · 100 %, judged on δ as shown (0.1 %).
+  const moments = [...document.querySelectorAll("tr[data-moment]")];
+  function judgeMoments() {
+    const typed = moments.map((tr) => parse(tr.querySelector("input").value));
+    moments.forEach((tr, n) => {
+      const [, exact, b] = check.M[+tr.dataset.moment], x = typed[n], cell = tr.querySelector(".verdict");
+      if (!isFinite(x)) return mark(cell);
+      const sense = Math.sign(x) === Math.sign(exact), inBand = b ? b[0] <= x && x <= b[1] : null;
+      const ok = !sense ? false : inBand;
+      mark(cell, ok, dev(x, exact, "") + " — " + (!sense ? D.ui.sense : inBand === null ? "" : D.ui[inBand ? "in_band" : "out_band"]));
+    });
+    const row = $("delta");
+    if (!row) return;
+    const cell = row.querySelector(".verdict");
+    if (!typed.some(isFinite)) return mark(cell);
+    if (!typed.every(isFinite) || typed[1] === 0) return mark(cell, false, D.ui.both);
+    const delta = Math.round(1000 * (typed[1] - typed[0]) / typed[1]) / 10, ok = Math.abs(delta) <= D.tol;
+    row.dataset.delta = String(delta);
+    mark(cell, ok, "δ = " + pct1(delta) + " — " + (ok ? D.rule_ok : D.rule_bad));
+  }
+  moments.forEach((tr) => {
+    const [, exact, b] = check.M[+tr.dataset.moment];
+    if (!D.student) { tr.querySelector(".exact").textContent = local(exact, 4); tr.querySelector(".band").textContent = band(b); }
+    tr.querySelector("input").addEventListener("input", judgeMoments);
   });
   if (D.student) { document.body.dataset.ready = "1"; return; }
 

@@ -229,11 +229,12 @@ def _steps(mech, plans, lang: str) -> list[dict]:
     return out
 
 
-def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, float]]:
-    """The band (mm) a careful drawing of each segment lands in (5-95 % of `drawing_error.simulate`
-    at the page's scales), for the segments whose value is a value of the worksheet (matched by
-    value and unit: the study reads the worksheet's values), each band that value's band at the
-    segment's scale; none where the study does not draw the mechanism's groups (PRP, RPP)."""
+def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[float, float]], dict[str, tuple[float, float]]]:
+    """The bands a careful drawing lands in (5-95 % of `drawing_error.simulate` at the page's
+    scales): (1) of each segment (mm) whose value is a value of the worksheet (matched by value and
+    unit: the study reads the worksheet's values), that value's band at the segment's scale; (2) of
+    the two balancing moments, signed (N m): "M_bal" from the force plans, "M_bal_lever" from the
+    lever. None where the study does not draw the mechanism's groups (PRP, RPP, triads)."""
     from .drawing_error import Scales, simulate
     from .pack import BAND, BAND_DRAWS
     sc = fixed.base
@@ -244,7 +245,7 @@ def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, 
             drawn = simulate(mech, at=at, n=BAND_DRAWS, seed=0,
                              scales=Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, mu_F))
         except NotImplementedError:            # a group kind the study does not draw: no bands
-            return {}
+            return {}, {}
     by_value = []
     for key, samples in drawn.samples.items():
         lo, hi = np.percentile(np.abs(samples), BAND)
@@ -259,7 +260,9 @@ def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, 
                 if u == s.unit and math.isclose(v, abs(s.value), rel_tol=1e-9):
                     out[(kind, s.name)] = (lo / scale, hi / scale)
                     break
-    return out
+    moments = {k: tuple(float(x) for x in np.percentile(drawn.samples[k], BAND))
+               for k in ("M_bal", "M_bal_lever") if k in drawn.samples}
+    return out, moments
 
 
 def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
@@ -313,9 +316,9 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     check = plans_at(at)
     if check is None:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
-    bands = _bands(mech, check, fixed, at)
+    bands, moment_bands = _bands(mech, check, fixed, at)
     data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": frames,
-                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut")},
+                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")},
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang)}
@@ -360,6 +363,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                           "band": list(lo_hi) if lo_hi else None})
     results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
                     for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
+    results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
     blobs["check"] = base64.b64encode(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(),
                                                              9, mtime=0))).decode("ascii")
     res = analyze(mech, phi_deg=[at])
@@ -396,10 +400,14 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                           f'<td><input type="text" inputmode="decimal" class="measured" data-plan="{escape(it["plan"])}" '
                           f'data-segment="{escape(it["segment"])}" size="7"></td>'
                           f'<td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
-    for n, (symbol, _) in enumerate(results):
+    for n, (symbol, _, _) in enumerate(results):
         check_rows.append(f'<tr data-moment="{n}"><td></td><td>{escape(symbol)}, {escape(unit("N m", lang))}</td>'
                           f'<td><input type="text" inputmode="decimal" class="moment" data-symbol="{escape(symbol)}" '
-                          f'size="7"></td><td class="exact num"></td><td></td><td class="verdict"></td></tr>')
+                          f'size="7"></td><td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
+    if len(results) == 2:
+        check_rows.append(f'<tr id="delta"><td></td><td>δ = ({escape(results[1][0])} − {escape(results[0][0])}) / '
+                          f'{escape(results[1][0])} · 100 %</td><td></td><td></td><td class="num">|δ| ≤ '
+                          f'{num(TOLERANCE_PCT, lang)} %</td><td class="verdict"></td></tr>')
     phi = num(data["at"], lang, 6)
     check = (f'<section id="check"><h2>{escape(text("page.check", lang))}</h2><p>{escape(text("page.check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
              f'<table><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
