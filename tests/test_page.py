@@ -209,6 +209,12 @@ def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
         pytest.skip("no pdftotext (apt-get install poppler-utils)")
     mech, fixed, key, _ = ice
     pg = _open(chromium, key)
+    pg.click("#next")                                   # a step lit on screen, not in print
+    lit = "() => getComputedStyle(document.querySelector('.hl')).stroke"
+    assert pg.evaluate(lit) == "rgb(208, 28, 28)"
+    pg.emulate_media(media="print")
+    assert pg.evaluate(lit) != "rgb(208, 28, 28)"
+    pg.emulate_media(media="no-override")
     for paper, (w, h) in (("A3", (420, 297)), ("A4", (297, 210))):
         pg.select_option("#paper", paper)
         pdf = tmp_path / f"{paper}.pdf"
@@ -218,6 +224,11 @@ def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
         assert y["100"] - y["0"] == pytest.approx(100.0, abs=0.2), paper
         assert y["50"] - y["0"] == pytest.approx(50.0, abs=0.2), paper
         assert pages == len(_build(mech, 30.0, fixed)), paper
+        words = subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+        titled = [p for p in words.split("\f") if "φ = 30°" in p and "ДВЗ" in p]
+        assert len(titled) == pages, (paper, pages, len(titled))   # A3: the title block; A4: the line on top
+        if paper == "A4":                                   # the positions plan is taller than A4: said on it
+            assert sum("обрізаний" in p for p in titled) >= 1
     pg.close()
 
 

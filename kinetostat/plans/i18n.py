@@ -303,7 +303,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
               "Печать: каждый лист в натуральную величину, альбомно, на выбранной бумаге (A4: часть листа с "
               "планом; отрезок 100 мм имеет 100 мм)."),
     "page.paper": ("Paper", "Папір", "Бумага"),
-    "page.a4_cut": ("larger than A4: print it on A3", "більший за A4: друкуйте на A3", "больше A4: печатайте на A3"),
+    "page.a4_cut": ("the plan is larger than A4 and cut: print it on A3", "план більший за A4 і обрізаний: друкуйте на A3",
+               "план больше A4 и обрезан: печатайте на A3"),
     "page.singular": ("a singular position: no plans at this angle", "особливе положення: планів немає",
                  "особое положение: планов нет"),
     "page.tau": ("{R} from ΣM_{P}(link {k}) = 0", "{R} з ΣM_{P}(ланка {k}) = 0", "{R} из ΣM_{P}(звено {k}) = 0"),

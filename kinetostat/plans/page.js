@@ -186,7 +186,8 @@
     boxes.forEach((box) => {
       const svg = box.querySelector("svg"), plan = svg && svg.querySelector("#plan");
       if (!plan) return;
-      const bar = svg.querySelector("#scalebar");
+      const bar = svg.querySelector("#scalebar"), old = svg.querySelector("#a4-title");
+      if (old) old.remove();
       if (!a4) {
         svg.setAttribute("viewBox", "0 0 420 297"); svg.setAttribute("width", "420mm"); svg.setAttribute("height", "297mm");
         bar.removeAttribute("transform"); delete box.dataset.a4; return;
@@ -195,8 +196,29 @@
       const x0 = clamp(b.x + b.width / 2 - 148.5, 123), y0 = clamp(b.y + b.height / 2 - 105, 87);
       svg.setAttribute("viewBox", `${x0} ${y0} 297 210`); svg.setAttribute("width", "297mm"); svg.setAttribute("height", "210mm");
       bar.setAttribute("transform", `translate(${x0 - 8} ${y0 - 30})`);   // the bar 8 mm in, 10 mm down
-      if (b.width > 280 || b.height > 195) box.dataset.a4 = D.ui.a4_cut; else delete box.dataset.a4;
+      const cut = b.width > 280 || b.height > 195;
+      if (cut) box.dataset.a4 = D.ui.a4_cut; else delete box.dataset.a4;
+      svg.appendChild(a4Title(svg, x0, y0, cut));
     });
+  }
+  function a4Title(svg, x0, y0, cut) {           // A4 cuts the title block off: one line at the top instead
+    const NS = "http://www.w3.org/2000/svg", g = document.createElementNS(NS, "g"), t = document.createElementNS(NS, "text");
+    const mech = svg.querySelector("#mechanism"), title = svg.querySelector("title");
+    g.id = "a4-title";
+    t.setAttribute("x", x0 + 12); t.setAttribute("y", y0 + 6); t.setAttribute("font-size", "2.8");
+    t.textContent = (mech ? mech.textContent + " — " : "") + (title ? title.textContent : "");
+    if (cut) {                                   // a second line, red
+      const w = document.createElementNS(NS, "tspan");
+      w.setAttribute("fill", "#b01515"); w.setAttribute("x", x0 + 12); w.setAttribute("dy", "3.6");
+      w.textContent = D.ui.a4_cut;
+      t.appendChild(w);
+    }
+    const r = document.createElementNS(NS, "rect");
+    r.setAttribute("x", x0 + 11); r.setAttribute("y", y0 + 2); r.setAttribute("height", cut ? 9 : 5.5); r.setAttribute("fill", "#fff");
+    g.append(r, t);
+    svg.appendChild(g);
+    r.setAttribute("width", t.getComputedTextLength() + 2);
+    return g;
   }
   $("paper").addEventListener("change", paper);
   function highlight() {

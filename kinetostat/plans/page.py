@@ -483,7 +483,7 @@ td.num{text-align:right;font-variant-numeric:tabular-nums}
 #equation{font-size:1.05em;min-height:1.3em;margin:.3em 0}.hint{color:#555;font-size:.85em;margin:.2em 0}
 #sheets{display:grid;grid-template-columns:repeat(auto-fill,minmax(620px,1fr));gap:.6em}
 .sheet{border:1px solid #ddd}.sheet svg{display:block;width:100%;height:auto;max-width:1260px}
-.hl{stroke:#d01c1c !important;stroke-width:1.2 !important}
+@media screen{.hl{stroke:#d01c1c !important;stroke-width:1.2 !important}}
 .sheet[data-a4]::before{content:attr(data-a4);color:#b01515}
 .verdict.ok{color:#176317}.verdict.bad{color:#b01515}
 @media print{
