@@ -137,7 +137,37 @@ def test_next_step_follows_the_texts_order(chromium, ice):
     assert seen[:10] == [("group:2,3", "R12t"), *polygon, ("forces:2,3", "R32")]
     assert seen[10] == ("crank", "R21") and ("crank", "M_зр") in seen[10:]
     assert steps[0][2].startswith("R12t з ΣM_B(ланка 2) = 0") and "R32" in steps[9][2]
+    assert "G2" in steps[2][2] and "нехтовно мала" in steps[2][2]          # 0,049 mm: said, not an empty light
+    plans = _build(mech, 30.0, fixed)
+    crank_M = next(e for (plan, seg), _, e in steps if seg == "M_зр")
+    lever = pg.evaluate("""() => { for (let i = 0; i < 30; i++) { document.getElementById('next').click();
+        if (document.getElementById('step').dataset.segment === "F'_зр") return document.getElementById('equation').textContent; } }""")
+    couples = {"M_i2": float(kinetostat.analyze(mech, phi_deg=[30.0]).inertia(2).moment[0])}
+    for plan, eq in (("group:2,3", steps[0][2]), ("crank", crank_M), ("lever", lever)):
+        _balanced(plans[plan], eq, fixed.base["mu_l"].value, couples)
     pg.close()
+
+
+def _balanced(plan, eq: str, mu_l: float, couples: dict[str, float]) -> None:
+    """A moment equation as the page writes it ("±F·h ± M/μ_l … = 0", h in mm; the crank's "M_зр
+    + μ_l·(…) = 0") sums to zero with the forces and couples of the exact solution: the signs the
+    script read off the sheet are the moments' senses, the arms their lengths (4 digits)."""
+    body = eq.split(": ", 1)[1].split(" = 0")[0]
+    total, big = 0.0, 0.0
+    if body.startswith("M_зр + μ_l·("):
+        total = big = plan.results[0].value / mu_l                     # N mm
+        body = body[len("M_зр + μ_l·("):-1]
+    F = {s.name: s.value for s in plan.segments if s.kind == "vector"}
+    for sign, term in re.findall(r"(^−|^| [+−] )([^+−]+?)(?= [+−] |$)", body):
+        if term.endswith("/μ_l"):
+            value = abs(couples[term[:-4]]) / mu_l
+        else:
+            name, arm = term.rsplit("·", 1)
+            value = F[name] * float(arm.replace(",", "."))
+        value *= -1 if "−" in sign else 1
+        total += value
+        big = max(big, abs(value))
+    assert abs(total) < 2e-3 * big, (eq, total, big)
 
 
 def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):

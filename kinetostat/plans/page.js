@@ -233,8 +233,37 @@
     out.dataset.segment = s.segment || "";
     out.dataset.path = s.path || "";
     out.textContent = `${step + 1}/${meta.steps.length}`;
-    const len = el && el.dataset.lengthMm !== undefined ? ` — ${local(+el.dataset.lengthMm, 4)} ${D.mm}` : "";
-    $("equation").textContent = s.eq + len;
+    const mm = el && el.dataset.lengthMm !== undefined ? +el.dataset.lengthMm : NaN;
+    const len = isFinite(mm) ? ` — ${local(mm, 4)} ${D.mm}` + (mm < D.tiny ? `: ${D.ui.negligible}` : "") : "";
+    $("equation").textContent = s.eq + (s.moment ? ": " + momentText(s.plan, s.moment) : "") + len;
+  }
+  // A moment equation's terms at the angle shown (page.py _moment): each sign the moment's sense as
+  // drawn (+ counter-clockwise), each arm its length on the sheet (mm).
+  function ends(plan, name) {
+    const e = document.querySelector(`svg [data-plan="${plan}"][data-segment="${CSS.escape(name)}"]`);
+    return e && [e.x1.baseVal.value, e.y1.baseVal.value, e.x2.baseVal.value, e.y2.baseVal.value, +e.dataset.lengthMm];
+  }
+  function term(plan, force, arm, atEnd) {        // [sign, "F·h"] or null (no arm: no moment)
+    const F = ends(plan, force), h = ends(plan, arm);
+    if (!F || !h || !(h[4] > 1e-9)) return null;
+    const [mx, my, px, py] = atEnd ? [h[2], h[3], h[0], h[1]] : h;
+    const cross = (px - mx) * (F[3] - F[1]) - (py - my) * (F[2] - F[0]);     // the sheet's y runs down
+    return [cross > 0 ? -1 : 1, `${force}·${local(h[4], 4)}`];
+  }
+  function couple(plan, name) {
+    const e = document.querySelector(`svg [data-plan="${plan}"][data-path="${CSS.escape(name)}"]`);
+    if (!e) return null;
+    const p = e.getAttribute("points").trim().split(/\s+/).slice(0, 3).map((xy) => xy.split(",").map(Number));
+    const cross = (p[1][0] - p[0][0]) * (p[2][1] - p[1][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[1][0]);
+    return [cross > 0 ? -1 : 1, `${name}/μ_l`];
+  }
+  function momentText(plan, m) {
+    const parts = [];
+    if (m.unknown) { const u = term(plan, ...m.unknown); if (u) parts.push(u); }
+    m.terms.forEach((t) => { const x = term(plan, ...t); if (x) parts.push(x); });
+    m.couples.forEach((c) => { const x = couple(plan, c); if (x) parts.push(x); });
+    const sum = parts.map(([sg, t], i) => (sg < 0 ? (i ? " − " : "−") : i ? " + " : "") + t).join("") || "0";
+    return (m.M ? `${m.M} + μ_l·(${sum})` : sum) + " = 0 (h, l: " + D.mm + ")";
   }
   const slider = $("phi");
   function frameOf(deg) {                        // the frame of the nearest angle on the slider

@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import write_text
-from .draw import segment_label, svg, title_of
+from .draw import TINY_MM, segment_label, svg, title_of
 from .i18n import check_lang, num, text, unit
 
 __all__ = ["page", "write_page", "encode", "PAGE_ANGLES", "TOLERANCE_PCT"]
@@ -174,15 +174,40 @@ def _sheets_of(plans, lang: str, name: str) -> dict[str, str]:
             for kind, p in plans.items()}
 
 
+def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict:
+    """A moment equation about point M of `plan` as the page's script writes it at each angle
+    (page.js `momentText`): the unknown [segment, arm, M at the arm's end?] (R^τ with its link, the
+    lever's F'_bal with p-a), each force drawn with its arm h_.. about M ([force, arm, False]), each
+    couple's arc (M_i/μ_l); the script takes the signs and the arms (mm) from the sheet drawn."""
+    from .forces import arm_name
+    segs = {s.name: s for s in plan.segments}
+    terms = [[n, arm_name(n), False] for n in names if n in segs and arm_name(n) in segs]
+    out = {"terms": terms, "couples": [c for c in couples if c in plan.paths]}
+    if unknown is not None:
+        X = plan.points[segs[unknown].start]              # where the unknown acts: the arm is M to there
+        arm = next((x for x in plan.segments if x.kind in ("link", "vector") and x.name != unknown and M in (x.start, x.end)
+                    and abs(plan.points[x.end if x.start == M else x.start] - X) < 1e-6), None)
+        if arm is not None:
+            out["unknown"] = [unknown, arm.name, arm.end == M]
+    return out
+
+
 def _steps(mech, plans, lang: str) -> list[dict]:
     """The force analysis in the texts' order, one vector a step: per Assur group from the last
     attached, the unknowns found from moment equations (a dyad's R^τ from ΣM about the inner
-    joint; a triad's R^τ of each leash about its inner pin, then R^n of leash 3 from the group's
-    moment about Assur's point S), the polygon's sides in the order drawn, the inner reactions;
-    then the initial link's loads and M_bal; then the lever's loads and M'_bal."""
-    from .forces import _group_label, _moment_equations, reaction_name
+    joint, its terms R^τ·l + Σ±F·h ± M_i/μ_l = 0; a triad's R^τ of each leash about its inner pin,
+    then R^n of leash 3 from the group's moment about Assur's point S), the polygon's sides in the
+    order drawn, the inner reactions; then the initial link's loads and M_bal (M_bal + μ_l Σ±F·h =
+    0); then the lever's loads and F'_bal·pa + Σ±F·h = 0. A step with "moment" has its equation's
+    terms written by the page's script from the sheet of the angle shown."""
+    from ..solve import analyze
+    from .forces import _carried, _group_label, _later, _moment_equations, link_couples, link_loads, reaction_name
     from .lettering import lettering
     L = lettering(mech)
+    any_plan = next(iter(plans.values()))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = analyze(mech, phi_deg=[any_plan.phi_deg])
     out = []
     for g in reversed(mech.structure.groups):
         label = _group_label(g)
@@ -190,22 +215,30 @@ def _steps(mech, plans, lang: str) -> list[dict]:
         if forces is None:
             continue
         drawn = {s.name for s in group.segments} if group is not None else set()
+        later = _later(mech, g)
+        loads = {x: [ld.name for ld in link_loads(mech, res, x) + _carried(mech, res, x, later)] for x in g.links}
+        couples = {x: [c.name for c in link_couples(mech, res, x)] for x in g.links}
         if g.klass == 3:
-            moments = [(f"{reaction_name(mech, known, ell)}t", inner.point, str(ell))
+            moments = [(f"{reaction_name(mech, known, ell)}t", inner.point, str(ell), (ell,))
                        for ell, _, inner, known in g.sides]
             ell, _, _, known = g.sides[2]
             S = "S" if "S" not in mech.point_names else "S*"
             R3 = reaction_name(mech, known, ell)
-            moments.append((f"{R3}n" if f"{R3}n" in drawn else R3, S, label))
+            moments.append((f"{R3}n" if f"{R3}n" in drawn else R3, S, label, ()))
             inners = [(reaction_name(mech, g.links[0], ell), ell) for ell, _, _, _ in g.sides]
         else:
             taus = [n for n in forces.equation if n.startswith("R") and n.endswith("t")]
-            moments = [(R, point, ",".join(map(str, links))) for (links, point), R in zip(_moment_equations(g), taus)]
+            moments = [(R, point, ",".join(map(str, links)), links)
+                       for (links, point), R in zip(_moment_equations(g), taus)]
             j, k = g.links
             inners = [(reaction_name(mech, k, j), j)]
-        for R, point, links in moments:
+        for R, point, links, on in moments:
             if R in drawn:
-                out.append({"plan": f"group:{label}", "segment": R, "eq": text("page.tau", lang, R=R, P=point, k=links)})
+                step = {"plan": f"group:{label}", "segment": R, "eq": text("page.tau", lang, R=R, P=point, k=links)}
+                if on and R.endswith("t"):
+                    step["moment"] = _moment(group, point, [n for x in on for n in loads[x]],
+                                             [c for x in on for c in couples[x]], unknown=R)
+                out.append(step)
         m = len(forces.equation)
         for n, name in enumerate(forces.equation):
             out.append({"plan": f"forces:{label}", "segment": name,
@@ -215,17 +248,19 @@ def _steps(mech, plans, lang: str) -> list[dict]:
             out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=k)})
     crank = plans.get("crank")
     if crank is not None:
-        for s in crank.segments:
-            if s.kind == "vector":
-                out.append({"plan": "crank", "segment": s.name, "eq": text("page.crank", lang, F=s.name)})
+        vectors = [s.name for s in crank.segments if s.kind == "vector"]
+        for name in vectors:
+            out.append({"plan": "crank", "segment": name, "eq": text("page.crank", lang, F=name)})
         where = {"path": L.M_bal} if L.M_bal in crank.paths else {"segment": "r_b"}     # an engine's couple; a gear's arm
-        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot)})
+        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot),
+                    "moment": {**_moment(crank, mech.drive.pivot, vectors), "M": L.M_bal}})
     lever = plans.get("lever")
     if lever is not None:
-        for s in lever.segments:
-            if s.kind == "vector" and s.scale is not None and s.name != L.lever(L.F_bal):
-                out.append({"plan": "lever", "segment": s.name, "eq": text("page.lever", lang, F=s.name)})
-        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang))})
+        vectors = [s.name for s in lever.segments if s.kind == "vector" and s.scale is not None and s.name != L.lever(L.F_bal)]
+        for name in vectors:
+            out.append({"plan": "lever", "segment": name, "eq": text("page.lever", lang, F=name)})
+        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang)),
+                    "moment": _moment(lever, "p", vectors, unknown=L.lever(L.F_bal))})
     return out
 
 
@@ -318,7 +353,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
     bands, moment_bands = _bands(mech, check, fixed, at)
     data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": frames,
-                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")},
+                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
+                  | {"negligible": text("page.negligible", lang, tiny=num(TINY_MM, lang))}, "tiny": TINY_MM,
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang)}
