@@ -342,3 +342,17 @@ def test_page_command_refuses_a_folder_as_out(cli, tmp_path):
     """`kinetostat page` checks --out before the minute of work: a folder is one line, exit 2."""
     r = cli("page", "ice_crank_slider", "--out", str(tmp_path))
     assert r.returncode == 2 and r.stderr.strip() == f"kinetostat: error: cannot write --out {tmp_path}: it is a directory"
+
+
+def test_shaper_check_and_values_in_ukrainian():
+    """The shaper's slots and Coriolis accelerations in the page's tables come from the catalogue:
+    "паз ланки 3 (A)", a^к, not "slot 3 A", a^Cor (their data-segment, data-symbol stay)."""
+    from kinetostat.plans.draw import segment_label
+    from kinetostat.plans.page import _symbol
+    mech = kinetostat.load("slotted_link_shaper")
+    plans = _build(mech, 30.0, None)
+    labels = {segment_label(s, "uk") for k in plans for s in plans[k].segments}
+    assert {"паз ланки 3 (A)", "паз ланки 3 (B)"} <= labels and not [x for x in labels if "slot" in x]
+    shown = [_symbol(r.symbol, "uk") for r in worksheet(mech, 30.0, lang="uk").rows]
+    assert "a^к(3,2)" in shown and not [x for x in shown if "Cor" in x]
+    assert _symbol("a^Cor(3,2)", "en") == "a^Cor(3,2)"

@@ -82,6 +82,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                          "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
     "guide": ("guide", "напрямна", "направляющая"),
+    "slot": ("slot of link {k} ({P})", "паз ланки {k} ({P})", "паз звена {k} ({P})"),
+    "coriolis": ("Cor", "к", "к"),          # the superscript of the Coriolis acceleration: a^Cor, a^к
     "line of action": ("line of action", "лінія зачеплення", "линия зацепления"),
     "pitch circle of the wheel": ("pitch circle of the wheel", "початкове коло колеса",
                                   "начальная окружность колеса"),

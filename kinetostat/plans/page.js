@@ -154,7 +154,7 @@
       th.colSpan = 3; th.textContent = section;
     }
     const tr = table.insertRow();
-    tr.insertCell().textContent = r.symbol;
+    tr.insertCell().textContent = r.shown;
     const td = tr.insertCell();
     td.className = "num"; td.dataset.symbol = r.symbol;
     tr.insertCell().textContent = r.unit;

@@ -383,7 +383,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
             kinds.append({"kind": kind, "templates": enc.templates, "frames": enc.frames})
             blobs[f"k{len(kinds) - 1}"] = _b64gz(enc.data)
         blobs["values"] = _b64gz(vbytes)
-        data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "unit": r["unit"],
+        data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
                                         "section": r["section"]} for r in rows], exps=exps,
                     steps=_steps(mech, check, lang))
         blobs["meta"] = _b64gz(json.dumps({"kinds": data.pop("kinds"), "steps": data.pop("steps")},
@@ -404,6 +404,11 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                                                              9, mtime=0))).decode("ascii")
     res = analyze(mech, phi_deg=[at])
     return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results)
+
+
+def _symbol(symbol: str, lang: str) -> str:
+    """A worksheet's symbol as the page shows it in `lang` (a^Cor -> a^к); its data-symbol stays."""
+    return symbol.replace("^Cor", "^" + text("coriolis", lang))
 
 
 def _obscure(data: bytes) -> bytes:
