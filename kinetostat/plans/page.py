@@ -30,9 +30,13 @@ import base64
 import gzip
 import json
 import math
+import multiprocessing
+import os
 import re
 import warnings
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 from html import escape
 from importlib import resources
 from pathlib import Path
@@ -53,8 +57,12 @@ TOLERANCE_PCT = 5.0
 #: of a 100 mm segment, as segments.csv.
 LENGTH_Q = 1e-10
 _NUM = re.compile(r"(-?)(\d+)(?:([.,])(\d+))?")
+#: The attributes that place a drawing's elements (mm), and their decimals in the page.
+COORDINATES = frozenset({"x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "dx", "dy", "points", "d"})
+COORD_DECIMALS = 1
+_TAG = re.compile(r"(<[^>]*>)")
+_ATTR = re.compile(r'([\w:-]+)="([^"]*)"')
 _NOTES = re.compile(r'<g id="notes">.*?</g>\n?', re.S)
-_LENGTH = re.compile(r'data-length-mm="([^"]*)"')
 
 # ============================================================================ the numbers, small
 
@@ -69,40 +77,44 @@ class Encoded:
 
 
 def _split(sheet: str) -> tuple[tuple[str, ...], list[int]]:
-    """A sheet as (template, numbers): coordinates with 3 decimals rounded to 2 (0.01 mm, finer than
-    print), data-length-mm as integers of LENGTH_Q."""
-    parts: list[str] = []
+    """A sheet as (template, numbers): data-length-mm as integers of LENGTH_Q; a drawing's
+    coordinates (COORDINATES' attributes) rounded to COORD_DECIMALS (0.1 mm: finer than a ruler
+    reads); every other number (a stroke's width, a font's size, a number in a text) as written."""
+    parts: list[str] = [""]
     nums: list[int] = []
-    pieces = _LENGTH.split(sheet)
-    for k, piece in enumerate(pieces):
-        if k % 2:
-            parts[-1] += 'data-length-mm="'
-            parts.append("L")
-            nums.append(round(float(piece) / LENGTH_Q))
-            parts.append('"')
-            continue
+
+    def numbers(piece: str, places: int | None) -> None:
         last = 0
         for m in _NUM.finditer(piece):
             sign, whole, sep, frac = m.groups()
             if len(whole) > 1 and whole[0] == "0":        # a zero-padded number: kept as text
                 continue
-            lit = piece[last:m.start()]
-            if len(parts) % 2:
-                parts[-1] += lit
-            else:
-                parts.append(lit)
+            parts[-1] += piece[last:m.start()]
             last = m.end()
             d = len(frac) if frac else 0
             n = int(whole + (frac or ""))
-            if d == 3 and sep == ".":                    # 0.001 mm -> 0.01 mm
-                n, d = (n + 5) // 10, 2
-            parts.append(f"{sep or ''}{d}" if d else "")
+            if places is not None and d > places and sep == ".":     # "217,69": two integers of a list
+                n, d = (n + 5 * 10 ** (d - places - 1)) // 10 ** (d - places), places
+            parts.append(f"{sep or '.'}{d}" if d else "")
+            parts.append("")
             nums.append(-n if sign else n)
-        lit = piece[last:]
-        if len(parts) % 2:
-            parts[-1] += lit
-        else:
-            parts.append(lit)
+        parts[-1] += piece[last:]
+
+    for k, piece in enumerate(_TAG.split(sheet)):
+        if not k % 2:                                     # text between tags: as written
+            numbers(piece, None)
+            continue
+        last = 0
+        for m in _ATTR.finditer(piece):
+            name, value = m.groups()
+            parts[-1] += piece[last:m.start(2)]
+            last = m.end(2)
+            if name == "data-length-mm":
+                parts += ["L", ""]
+                nums.append(round(float(value) / LENGTH_Q))
+            else:
+                numbers(value, COORD_DECIMALS if name in COORDINATES else None)
+        parts[-1] += piece[last:]
     return tuple(parts), nums
 
 
@@ -131,14 +143,19 @@ def encode(sheets: list[str | None]) -> Encoded:
     """Sheets of one plan at successive angles (None: not drawn there) as templates and, template
     by template, slot by slot, the second differences of the slot's numbers over the frames that
     use that template."""
+    return _encode_split([None if s is None else _split(s) for s in sheets])
+
+
+def _encode_split(split: list[tuple[tuple[str, ...], list[int]] | None]) -> Encoded:
+    """`encode` of sheets already `_split`."""
     templates: dict[tuple[str, ...], int] = {}
     frames: list[int] = []
     rows: dict[int, list[list[int]]] = {}
-    for sheet in sheets:
-        if sheet is None:
+    for one in split:
+        if one is None:
             frames.append(-1)
             continue
-        t, nums = _split(sheet)
+        t, nums = one
         tid = templates.setdefault(t, len(templates))
         frames.append(tid)
         rows.setdefault(tid, []).append(nums)
@@ -190,6 +207,45 @@ def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict
         if arm is not None:
             out["unknown"] = [unknown, arm.name, arm.end == M]
     return out
+
+
+def _plans_at(mech, start: float, fixed, a: float):
+    """The plans at `a` deg at the page's scales; None at a singular position."""
+    from . import build
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            return build(mech, at=a, starting_deg=start, fixed=fixed)
+        except ValueError:                     # a singular position
+            return None
+
+
+def _frame(mech, start: float, fixed, lang: str, name: str, a: float) -> tuple[dict, dict | None, list | None]:
+    """One frame of the slider: each plan's sheet `_split` (kind -> (template, numbers)), the
+    worksheet's values (key -> value) and its records; ({}, None, None) at a singular position."""
+    from .worksheet import worksheet
+    plans = _plans_at(mech, start, fixed, a)
+    if plans is None:
+        return {}, None, None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ws = worksheet(mech, a, mu_l=fixed.base["mu_l"].value, lang=lang)
+    return ({k: _split(v) for k, v in _sheets_of(plans, lang, name).items()},
+            {r.key: r.value for r in ws.rows}, ws.records())
+
+
+#: Frames per page below which they are drawn in this process (a test's few angles).
+PARALLEL_FROM = 24
+
+
+def _map(fn, items: list) -> list:
+    """`fn` over `items` in order, on every core this process may use (forked workers) when there
+    are PARALLEL_FROM items or more, else here."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if cores < 2 or len(items) < PARALLEL_FROM or "fork" not in multiprocessing.get_all_start_methods():
+        return list(map(fn, items))
+    with ProcessPoolExecutor(min(cores, 8), mp_context=multiprocessing.get_context("fork")) as ex:
+        return list(ex.map(fn, items, chunksize=max(1, len(items) // (4 * min(cores, 8)))))
 
 
 def _steps(mech, plans, lang: str) -> list[dict]:
@@ -330,9 +386,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     (and of a student's page; default the design position); `angles`: the slider's frames (deg);
     `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
     from ..solve import analyze
-    from . import build, cycle_scales, starting_position
+    from . import cycle_scales, starting_position
     from .lettering import lettering
-    from .worksheet import worksheet
     check_lang(lang)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
@@ -341,13 +396,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     name = lettering(mech).name(lang, mech.name)
     frames = [at] if student else [*map(float, angles), design]
 
-    def plans_at(a: float):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                return build(mech, at=a, starting_deg=start, fixed=fixed)
-            except ValueError:                     # a singular position
-                return None
+    plans_at = partial(_plans_at, mech, start, fixed)
     check = plans_at(at)
     if check is None:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
@@ -362,15 +411,11 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     if not student:
         per_kind: dict[str, list] = {k: [] for k in check}
         values, rows = [], None
-        for a in frames:
-            plans = check if a == at else plans_at(a)
-            sheets = _sheets_of(plans, lang, name) if plans is not None else {}
+        for split, got, records in _map(partial(_frame, mech, start, fixed, lang, name), frames):
             for kind in per_kind:
-                per_kind[kind].append(sheets.get(kind))
-            if plans is not None:
-                ws = worksheet(mech, a, mu_l=fixed.base["mu_l"].value, lang=lang)
-                rows = rows or ws.records()
-                got = {r.key: r.value for r in ws.rows}
+                per_kind[kind].append(split.get(kind))
+            if got is not None:
+                rows = rows or records
                 values.append([got.get(r["key"], math.nan) for r in rows])
             else:
                 values.append(None)
@@ -379,7 +424,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         exps, vbytes = _columns(table)
         kinds = []
         for kind, sheets in per_kind.items():
-            enc = encode(sheets)
+            enc = _encode_split(sheets)
             kinds.append({"kind": kind, "templates": enc.templates, "frames": enc.frames})
             blobs[f"k{len(kinds) - 1}"] = _b64gz(enc.data)
         blobs["values"] = _b64gz(vbytes)
