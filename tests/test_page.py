@@ -356,3 +356,13 @@ def test_shaper_check_and_values_in_ukrainian():
     shown = [_symbol(r.symbol, "uk") for r in worksheet(mech, 30.0, lang="uk").rows]
     assert "a^к(3,2)" in shown and not [x for x in shown if "Cor" in x]
     assert _symbol("a^Cor(3,2)", "en") == "a^Cor(3,2)"
+
+
+def test_frames_drawn_in_workers_equal_those_drawn_here(ice, monkeypatch):
+    """The frames drawn by forked workers (`_map`, from PARALLEL_FROM frames) make the very page
+    drawn in this process."""
+    import kinetostat.plans.page as page_module
+    mech, fixed, _, _ = ice
+    here = make_page(mech, lang="uk", angles=(0.0, 150.0), fixed=fixed)
+    monkeypatch.setattr(page_module, "PARALLEL_FROM", 2)
+    assert make_page(mech, lang="uk", angles=(0.0, 150.0), fixed=fixed) == here

@@ -238,14 +238,27 @@ def _frame(mech, start: float, fixed, lang: str, name: str, a: float) -> tuple[d
 PARALLEL_FROM = 24
 
 
+_WORK = None                   # the function a forked worker applies (`_map`): inherited, not pickled
+
+
+def _work(item):
+    return _WORK(item)
+
+
 def _map(fn, items: list) -> list:
-    """`fn` over `items` in order, on every core this process may use (forked workers) when there
-    are PARALLEL_FROM items or more, else here."""
+    """`fn` over `items` in order, on every core this process may use (forked workers, which
+    inherit `fn` and what it holds: a mechanism is not picklable) when there are PARALLEL_FROM
+    items or more, else here."""
+    global _WORK
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     if cores < 2 or len(items) < PARALLEL_FROM or "fork" not in multiprocessing.get_all_start_methods():
         return list(map(fn, items))
-    with ProcessPoolExecutor(min(cores, 8), mp_context=multiprocessing.get_context("fork")) as ex:
-        return list(ex.map(fn, items, chunksize=max(1, len(items) // (4 * min(cores, 8)))))
+    _WORK, n = fn, min(cores, 8)
+    try:
+        with ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("fork")) as ex:
+            return list(ex.map(_work, items, chunksize=max(1, len(items) // (4 * n))))
+    finally:
+        _WORK = None
 
 
 def _steps(mech, plans, lang: str) -> list[dict]:
