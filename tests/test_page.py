@@ -214,6 +214,14 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
     assert v[2] == "ok" and "+5,0 %" in v[3] and "в межах" in v[3], v
     v = moments("97,8", "103,1")
     assert v[2] == "bad" and "+5,1 %" in v[3], v
+    # the worksheet's tables to fill in, as the teacher's pack: every value and sense blank
+    symbols = pg.eval_on_selector_all("#worksheet table.fill tr td:first-child", "es => es.map(e => e.textContent)")
+    assert {"V_B", "M_зр", "R12"} <= set(symbols), symbols
+    assert pg.eval_on_selector_all("#worksheet td.blank", "es => es.length > 0 && es.every(e => e.textContent === '')")
+    # the title block's lines stay inside it (x 230-415 mm)
+    right = pg.eval_on_selector_all("#grid svg text", "es => es.filter(e => +e.getAttribute('x') > 230)"
+                                    ".map(e => e.getBBox().x + e.getBBox().width)")
+    assert len(right) == 2 and max(right) < 415.0, right
     assert requests == [student.as_uri()], requests
     pg.close()
 

@@ -461,7 +461,25 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     blobs["check"] = base64.b64encode(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(),
                                                              9, mtime=0))).decode("ascii")
     res = analyze(mech, phi_deg=[at])
-    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results)
+    blank = _blank_tables(mech, at, fixed, lang) if student else ""
+    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results, blank)
+
+
+def _blank_tables(mech, at: float, fixed, lang: str) -> str:
+    """The worksheet's tables with their values and senses left blank, section by section
+    (velocities, accelerations, reactions, M_bal), as the teacher's pack has them (`pack`)."""
+    from .worksheet import worksheet
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ws = worksheet(mech, at, mu_l=fixed.base["mu_l"].value, lang=lang)
+    recs = ws.records()
+    head = "".join(f"<th>{escape(text(f'ws.head.{k}', lang))}</th>" for k in ("symbol", "value", "unit", "direction"))
+    out = [f'<section id="worksheet"><h2>{escape(text("pack.fill", lang))}</h2>']
+    for section in dict.fromkeys(r["section"] for r in recs):
+        rows = "".join(f'<tr><td>{escape(_symbol(r["symbol"], lang))}</td><td class="blank"></td>'
+                       f'<td>{escape(r["unit"])}</td><td class="blank"></td></tr>' for r in recs if r["section"] == section)
+        out.append(f'<h3>{escape(section)}</h3><table class="fill"><tr>{head}</tr>{rows}</table>')
+    return "".join(out) + "</section>"
 
 
 def _symbol(symbol: str, lang: str) -> str:
@@ -483,7 +501,7 @@ def _obscure(data: bytes) -> bytes:
 
 
 def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
-          data_rows, items, results) -> str:
+          data_rows, items, results, blank: str = "") -> str:
     from .draw import scale_text
     title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
     scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
@@ -514,7 +532,8 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     if student:
         body = (f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><p>{escape(text("page.scales", lang))}: {escape(scales)}</p>'
                 f'<table><tr>{head}</tr>{data_table}</table></section>'
-                f'<section id="grid"><h2>{escape(text("page.sheet", lang))}</h2><div class="sheet">{_grid_sheet(title, lang)}</div></section>'
+                + blank
+                + f'<section id="grid"><h2>{escape(text("page.sheet", lang))}</h2><div class="sheet">{_grid_sheet(name, title.removeprefix(name + ": "), lang)}</div></section>'
                 + check)
     else:
         body = (f'<section id="controls"><label for="phi">{escape(text("page.phi", lang))}: <output id="phi-value"></output>°</label> '
@@ -547,9 +566,14 @@ def _plan_name(kind: str, lang: str) -> str:
     return text(f"plan.{base}", lang) + (" " + rest.replace(",", "-") if rest else "")
 
 
-def _grid_sheet(title: str, lang: str) -> str:
+def _grid_sheet(name: str, what: str, lang: str) -> str:
     """An empty A3 sheet at true scale: frame, a millimetre grid (1, 5 and 10 mm lines), the title
-    block and the 100 mm scale bar."""
+    block (the mechanism's `name` and `what` the page is, each on a line of its own, in a size that
+    fits the block's 179 mm) and the 100 mm scale bar."""
+    from .labels import text_width
+    fit = lambda s, size: f"{max(1.8, min(size, size * 179.0 / max(text_width(s, size), 1e-9))):.2f}"
+    title = (f'<text x="233" y="256" font-size="{fit(name, 4.0)}">{escape(name)}</text>'
+             f'<text x="233" y="264" font-size="{fit(what, 3.5)}">{escape(what)}</text>')
     return ('<svg xmlns="http://www.w3.org/2000/svg" width="420mm" height="297mm" viewBox="0 0 420 297" '
             'font-family="DejaVu Sans, Arial, sans-serif"><defs>'
             '<pattern id="mm" width="10" height="10" patternUnits="userSpaceOnUse">'
@@ -559,7 +583,7 @@ def _grid_sheet(title: str, lang: str) -> str:
             '<rect width="420" height="297" fill="#fff"/>'
             '<rect x="20" y="5" width="395" height="287" fill="url(#mm)" stroke="#000" stroke-width="0.7"/>'
             '<rect x="230" y="247" width="185" height="45" fill="#fff" stroke="#000" stroke-width="0.5"/>'
-            f'<text x="233" y="255" font-size="4">{escape(title)}</text>{scale_bar(lang)}</svg>')
+            f'{title}{scale_bar(lang)}</svg>')
 
 
 def scale_bar(lang: str) -> str:
@@ -577,6 +601,7 @@ body{font-family:"DejaVu Sans",Arial,sans-serif;margin:1em;color:#111}
 h1{font-size:1.3em}h2{font-size:1.1em}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:2px 6px;font-size:.9em}
 td.num{text-align:right;font-variant-numeric:tabular-nums}
+table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2em}
 #controls{position:sticky;top:0;background:#fff;padding:.4em 0;border-bottom:1px solid #ccc;z-index:2}
 #phi{width:40em;max-width:90vw;vertical-align:middle}
 #equation{font-size:1.05em;min-height:1.3em;margin:.3em 0}.hint{color:#555;font-size:.85em;margin:.2em 0}
