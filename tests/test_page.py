@@ -301,7 +301,7 @@ def test_triad_steps_follow_the_texts_order():
     label = _group_label(g)
     taus = [s for s in steps if s["plan"] == f"group:{label}"]
     assert [s["segment"][-1] for s in taus] == ["t", "t", "t", "n"][:len(taus)] and len(taus) >= 2
-    assert "ΣM_S" in taus[-1]["eq"] or "ΣM_S*" in taus[-1]["eq"]
+    assert taus[-1]["eq"].startswith(f"{taus[-1]['segment']} з ΣM_S") and "(група 2,3,4,5)" in taus[-1]["eq"]
     first = steps.index(taus[0])
     assert steps[first + len(taus)]["plan"] == f"forces:{label}"
     for s in steps:

@@ -313,6 +313,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "page.singular": ("a singular position: no plans at this angle", "особливе положення: планів немає",
                  "особое положение: планов нет"),
     "page.tau": ("{R} from ΣM_{P}(link {k}) = 0", "{R} з ΣM_{P}(ланка {k}) = 0", "{R} из ΣM_{P}(звено {k}) = 0"),
+    "page.tau_S": ("{R} from ΣM_{P}(group {k}) = 0", "{R} з ΣM_{P}(група {k}) = 0", "{R} из ΣM_{P}(группа {k}) = 0"),
     "page.side": ("polygon: {sum} (side {n} of {m})", "многокутник: {sum} (сторона {n} з {m})",
              "многоугольник: {sum} (сторона {n} из {m})"),
     "page.inner": ("inner reaction {R}: ΣF(link {k}) = 0", "внутрішня реакція {R}: ΣF(ланка {k}) = 0",

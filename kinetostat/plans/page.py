@@ -303,7 +303,8 @@ def _steps(mech, plans, lang: str) -> list[dict]:
             inners = [(reaction_name(mech, k, j), j)]
         for R, point, links, on in moments:
             if R in drawn:
-                step = {"plan": f"group:{label}", "segment": R, "eq": text("page.tau", lang, R=R, P=point, k=links)}
+                key = "page.tau" if on else "page.tau_S"             # a link's moment; the triad's about S
+                step = {"plan": f"group:{label}", "segment": R, "eq": text(key, lang, R=R, P=point, k=links)}
                 if on and R.endswith("t"):
                     step["moment"] = _moment(group, point, [n for x in on for n in loads[x]],
                                              [c for x in on for c in couples[x]], unknown=R)
