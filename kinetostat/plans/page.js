@@ -107,21 +107,26 @@
   const kinds = [];
   for (let k = 0; k < meta.kinds.length; k++) {
     const K = meta.kinds[k], nums = varints(await bytes("k" + k)), frames = K.frames.map(() => null);
-    let p = 0;
-    K.templates.forEach((t, tid) => {              // template by template, slot by slot: page.py encode
-      const fs = [];
-      K.frames.forEach((x, f) => { if (x === tid) fs.push(f); });
-      const n = (t.length - 1) / 2;
-      fs.forEach((f) => { frames[f] = new Array(n); });
-      for (let i = 0; i < n; i++) {
-        let a = 0, b = 0;                          // the slot's two values before
-        fs.forEach((f, j) => {
-          const d = nums[p++], v = j >= 2 ? d + 2 * b - a : j === 1 ? d + b : d;
-          a = b; b = v;
-          frames[f][i] = v;
-        });
-      }
+    const slots = K.keys.map((deltas) => {      // template -> (series -> its slot): page.py _encode_split
+      const m = new Map();
+      let key = -1;
+      deltas.forEach((d, i) => { key += d; m.set(key, i); });
+      return m;
     });
+    K.frames.forEach((tid, f) => { if (tid >= 0) frames[f] = new Array(slots[tid].size); });
+    let nk = 0;
+    slots.forEach((m) => m.forEach((_, key) => { nk = Math.max(nk, key + 1); }));
+    let p = 0;
+    for (let key = 0; key < nk; key++) {           // series by series, the frames that have it in order
+      let a = 0, b = 0, j = 0;
+      K.frames.forEach((tid, f) => {
+        const i = tid < 0 ? undefined : slots[tid].get(key);
+        if (i === undefined) return;
+        const d = nums[p++], v = j >= 2 ? d + 2 * b - a : j === 1 ? d + b : d;
+        a = b; b = v; j++;
+        frames[f][i] = v;
+      });
+    }
     kinds.push({kind: K.kind, templates: K.templates, tids: K.frames, frames});
   }
   const rows = D.rows, ncol = rows.length, nf = D.frames.length;

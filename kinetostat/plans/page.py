@@ -70,10 +70,40 @@ _NOTES = re.compile(r'<g id="notes">.*?</g>\n?', re.S)
 class Encoded:
     """Sheets cut into templates and numbers (`encode`): `templates[t]` alternates literal text and
     a number's format ("" integer, ".2" two decimals after a point, ",1" after a comma, "L" a
-    length at LENGTH_Q); `frames[f]` the template of each frame (-1: none); `data` the numbers."""
+    length at LENGTH_Q); `keys[t]` the series of each of its slots (`_slot_keys`), as differences
+    from the slot before (the first from -1); `frames[f]` the template of each frame (-1: none);
+    `data` the numbers, series by series, each the second differences over the frames it is in."""
     templates: tuple[tuple[str, ...], ...]
+    keys: tuple[tuple[int, ...], ...]
     frames: tuple[int, ...]
     data: bytes
+
+
+_IDENT = re.compile(r'data-(?:segment|path)="([^"]*)"')
+
+
+def _slot_keys(template: tuple[str, ...]) -> list[tuple]:
+    """What each number of a template is, the same in every template that has it: the element it
+    is in (its data-segment or data-path; a label's text; else "after" the last element that had
+    one), the element's text up to the number, and how many slots before had that key. A label
+    or an arrowhead that comes or goes between angles then shifts no other series."""
+    s = "\x00".join(template[0::2])
+    out, seen, last = [], {}, ""
+    for m in re.finditer("\x00", s):
+        p = m.start()
+        a, b = s.rfind("<", 0, p), s.find(">", p)
+        tag = s[a:b]
+        ident = _IDENT.search(tag)
+        if ident:
+            who = last = ident.group(1)
+        elif tag.startswith("<text"):
+            who = last = "text:" + re.sub(r"<[^>]*>|\x00", "", s[b + 1:s.find("</text>", b)])
+        else:
+            who = ("after", last)
+        key = (who, s[a:p])
+        seen[key] = seen.get(key, -1) + 1
+        out.append((*key, seen[key]))
+    return out
 
 
 def _split(sheet: str) -> tuple[tuple[str, ...], list[int]]:
@@ -149,19 +179,25 @@ def encode(sheets: list[str | None]) -> Encoded:
 def _encode_split(split: list[tuple[tuple[str, ...], list[int]] | None]) -> Encoded:
     """`encode` of sheets already `_split`."""
     templates: dict[tuple[str, ...], int] = {}
+    keys: dict[tuple, int] = {}
+    slots: list[list[int]] = []
     frames: list[int] = []
-    rows: dict[int, list[list[int]]] = {}
+    series: dict[int, list[int]] = {}
     for one in split:
         if one is None:
             frames.append(-1)
             continue
         t, nums = one
-        tid = templates.setdefault(t, len(templates))
+        tid = templates.get(t)
+        if tid is None:
+            tid = templates[t] = len(templates)
+            slots.append([keys.setdefault(k, len(keys)) for k in _slot_keys(t)])
         frames.append(tid)
-        rows.setdefault(tid, []).append(nums)
-    data = b"".join(_varints(_second_differences(np.array(rows[t], dtype=np.int64)).T.ravel())
-                    for t in range(len(templates)))
-    return Encoded(tuple(templates), tuple(frames), data)
+        for k, v in zip(slots[tid], nums):
+            series.setdefault(k, []).append(v)
+    data = b"".join(_varints(_second_differences(np.array(series[k], dtype=np.int64))) for k in range(len(keys)))
+    deltas = tuple(tuple(np.diff([-1, *ks]).tolist()) for ks in slots)
+    return Encoded(tuple(templates), deltas, tuple(frames), data)
 
 
 def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
@@ -439,7 +475,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         kinds = []
         for kind, sheets in per_kind.items():
             enc = _encode_split(sheets)
-            kinds.append({"kind": kind, "templates": enc.templates, "frames": enc.frames})
+            kinds.append({"kind": kind, "templates": enc.templates, "keys": enc.keys, "frames": enc.frames})
             blobs[f"k{len(kinds) - 1}"] = _b64gz(enc.data)
         blobs["values"] = _b64gz(vbytes)
         data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
