@@ -374,3 +374,13 @@ def test_frames_drawn_in_workers_equal_those_drawn_here(ice, monkeypatch):
     here = make_page(mech, lang="uk", angles=(0.0, 150.0), fixed=fixed)
     monkeypatch.setattr(page_module, "PARALLEL_FROM", 2)
     assert make_page(mech, lang="uk", angles=(0.0, 150.0), fixed=fixed) == here
+
+
+def test_split_rounds_coordinates_only():
+    """The page keeps a drawing's coordinates to 0.1 mm and every other number as written: a
+    title's "0.001 m/mm" stays 0.001 (not 0.00), a stroke's 0.25 stays, data-length-mm exact."""
+    from kinetostat.plans.page import LENGTH_Q, _split
+    t, nums = _split('<line x1="12.345" stroke-width="0.25" data-length-mm="12.3456789012"/>'
+                     '<text x="1.26" y="7.00">μ_l = 0.001 m/mm</text>')
+    assert nums == [123, 25, round(12.3456789012 / LENGTH_Q), 13, 70, 1]
+    assert t[1::2] == (".1", ".2", "L", ".1", ".1", ".3")
