@@ -20,6 +20,7 @@ import pytest
 import kinetostat
 import kinetostat.plans as P
 from kinetostat.plans.i18n import num
+from kinetostat.plans.forces import _group_label
 from kinetostat.plans.page import _steps, page as make_page
 from kinetostat.plans.worksheet import worksheet
 
@@ -136,7 +137,37 @@ def test_next_step_follows_the_texts_order(chromium, ice):
     assert seen[:10] == [("group:2,3", "R12t"), *polygon, ("forces:2,3", "R32")]
     assert seen[10] == ("crank", "R21") and ("crank", "M_зр") in seen[10:]
     assert steps[0][2].startswith("R12t з ΣM_B(ланка 2) = 0") and "R32" in steps[9][2]
+    assert "G2" in steps[2][2] and "нехтовно мала" in steps[2][2]          # 0,049 mm: said, not an empty light
+    plans = _build(mech, 30.0, fixed)
+    crank_M = next(e for (plan, seg), _, e in steps if seg == "M_зр")
+    lever = pg.evaluate("""() => { for (let i = 0; i < 30; i++) { document.getElementById('next').click();
+        if (document.getElementById('step').dataset.segment === "F'_зр") return document.getElementById('equation').textContent; } }""")
+    couples = {"M_i2": float(kinetostat.analyze(mech, phi_deg=[30.0]).inertia(2).moment[0])}
+    for plan, eq in (("group:2,3", steps[0][2]), ("crank", crank_M), ("lever", lever)):
+        _balanced(plans[plan], eq, fixed.base["mu_l"].value, couples)
     pg.close()
+
+
+def _balanced(plan, eq: str, mu_l: float, couples: dict[str, float]) -> None:
+    """A moment equation as the page writes it ("±F·h ± M/μ_l … = 0", h in mm; the crank's "M_зр
+    + μ_l·(…) = 0") sums to zero with the forces and couples of the exact solution: the signs the
+    script read off the sheet are the moments' senses, the arms their lengths (4 digits)."""
+    body = eq.split(": ", 1)[1].split(" = 0")[0]
+    total, big = 0.0, 0.0
+    if body.startswith("M_зр + μ_l·("):
+        total = big = plan.results[0].value / mu_l                     # N mm
+        body = body[len("M_зр + μ_l·("):-1]
+    F = {s.name: s.value for s in plan.segments if s.kind == "vector"}
+    for sign, term in re.findall(r"(^−|^| [+−] )([^+−]+?)(?= [+−] |$)", body):
+        if term.endswith("/μ_l"):
+            value = abs(couples[term[:-4]]) / mu_l
+        else:
+            name, arm = term.rsplit("·", 1)
+            value = F[name] * float(arm.replace(",", "."))
+        value *= -1 if "−" in sign else 1
+        total += value
+        big = max(big, abs(value))
+    assert abs(total) < 2e-3 * big, (eq, total, big)
 
 
 def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
@@ -165,10 +196,32 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
     sel = 'input[data-plan="velocity"][data-segment="p-b"]'
     assert verdict(sel, num(pb, "uk", decimals=2)) == "ok"
     assert verdict(sel, num(pb + 3.0, "uk", decimals=2)) == "bad"
-    M = abs(plans["crank"].results[0].value)
-    sel = 'input.moment[data-symbol="M_зр"]'
-    assert verdict(sel, f"{M * 1.04:.2f}") == "ok"
-    assert verdict(sel, f"{M * 0.94:.2f}") == "bad"
+    M = plans["crank"].results[0].value                    # seed 002: 103 N m, counter-clockwise
+    crank, lever = 'input.moment[data-symbol="M_зр"]', """input.moment[data-symbol="M'_зр"]"""
+
+    def moments(typed_crank: str, typed_lever: str) -> tuple[str, str, str, str]:
+        pg.fill(crank, typed_crank)
+        pg.fill(lever, typed_lever)
+        return tuple(pg.eval_on_selector_all("tr[data-moment] .verdict, #delta .verdict",
+                                             "es => es.map(e => e.dataset.verdict || '')")) + (pg.text_content("#delta .verdict"),)
+    assert moments(f"{M:.1f}", f"{M * 1.01:.1f}")[:3] == ("ok", "ok", "ok")
+    # the texts' rule is on the student's own two moments: 98 and 108 are each near 103, δ ≈ 9 %
+    assert moments("98", "108")[2] == "bad"
+    # the sense counts: a moment of the wrong sign is wrong whatever its size
+    assert moments(f"{-M:.1f}", f"{-M:.1f}")[:2] == ("bad", "bad")
+    # δ judged as shown, to 0.1 %: δ = (103,1 − 97,9)/103,1 = 5,0 % is within 5 %
+    v = moments("97,9", "103,1")
+    assert v[2] == "ok" and "+5,0 %" in v[3] and "в межах" in v[3], v
+    v = moments("97,8", "103,1")
+    assert v[2] == "bad" and "+5,1 %" in v[3], v
+    # the worksheet's tables to fill in, as the teacher's pack: every value and sense blank
+    symbols = pg.eval_on_selector_all("#worksheet table.fill tr td:first-child", "es => es.map(e => e.textContent)")
+    assert {"V_B", "M_зр", "R12"} <= set(symbols), symbols
+    assert pg.eval_on_selector_all("#worksheet td.blank", "es => es.length > 0 && es.every(e => e.textContent === '')")
+    # the title block's lines stay inside it (x 230-415 mm)
+    right = pg.eval_on_selector_all("#grid svg text", "es => es.filter(e => +e.getAttribute('x') > 230)"
+                                    ".map(e => e.getBBox().x + e.getBBox().width)")
+    assert len(right) == 2 and max(right) < 415.0, right
     assert requests == [student.as_uri()], requests
     pg.close()
 
@@ -194,6 +247,12 @@ def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
         pytest.skip("no pdftotext (apt-get install poppler-utils)")
     mech, fixed, key, _ = ice
     pg = _open(chromium, key)
+    pg.click("#next")                                   # a step lit on screen, not in print
+    lit = "() => getComputedStyle(document.querySelector('.hl')).stroke"
+    assert pg.evaluate(lit) == "rgb(208, 28, 28)"
+    pg.emulate_media(media="print")
+    assert pg.evaluate(lit) != "rgb(208, 28, 28)"
+    pg.emulate_media(media="no-override")
     for paper, (w, h) in (("A3", (420, 297)), ("A4", (297, 210))):
         pg.select_option("#paper", paper)
         pdf = tmp_path / f"{paper}.pdf"
@@ -203,6 +262,11 @@ def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
         assert y["100"] - y["0"] == pytest.approx(100.0, abs=0.2), paper
         assert y["50"] - y["0"] == pytest.approx(50.0, abs=0.2), paper
         assert pages == len(_build(mech, 30.0, fixed)), paper
+        words = subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+        titled = [p for p in words.split("\f") if "φ = 30°" in p and "ДВЗ" in p]
+        assert len(titled) == pages, (paper, pages, len(titled))   # A3: the title block; A4: the line on top
+        if paper == "A4":                                   # the positions plan is taller than A4: said on it
+            assert sum("обрізаний" in p for p in titled) >= 1
     pg.close()
 
 
@@ -217,11 +281,31 @@ def test_every_step_names_a_drawn_vector(path):
         plan = plans[s["plan"]]
         assert (s["path"] in plan.paths) if "path" in s else any(x.name == s["segment"] for x in plan.segments), s
     for g in mech.structure.groups:
-        label = f"{min(g.links)},{max(g.links)}"
+        label = _group_label(g)
         sides = [s["segment"] for s in steps if s["plan"] == f"forces:{label}"]
-        assert sides[:-1] == list(plans[f"forces:{label}"].equation)
+        inner = 3 if g.klass == 3 else 1                 # a triad: the base's reaction on each leash
+        assert sides[:-inner] == list(plans[f"forces:{label}"].equation)
+        assert len(set(sides[-inner:])) == inner
     groups = list(dict.fromkeys(s["plan"].split(":")[1] for s in steps if s["plan"].startswith("forces:")))
-    assert groups == [f"{min(g.links)},{max(g.links)}" for g in reversed(mech.structure.groups)]
+    assert groups == [_group_label(g) for g in reversed(mech.structure.groups)]
+
+
+def test_triad_steps_follow_the_texts_order():
+    """A triad (Artobolevsky 1988, plans/forces.py): R^τ of each leash about its inner pin, then R^n
+    of leash 3 from the group's moment about Assur's point S, then the polygon in the order drawn,
+    then the base's reaction on each leash; every step a vector its plan draws."""
+    mech = kinetostat.load("triad_six_bar")
+    plans = _build(mech, None, None)
+    steps = _steps(mech, plans, "uk")
+    g = next(g for g in mech.structure.groups if g.klass == 3)
+    label = _group_label(g)
+    taus = [s for s in steps if s["plan"] == f"group:{label}"]
+    assert [s["segment"][-1] for s in taus] == ["t", "t", "t", "n"][:len(taus)] and len(taus) >= 2
+    assert taus[-1]["eq"].startswith(f"{taus[-1]['segment']} з ΣM_S") and "(група 2,3,4,5)" in taus[-1]["eq"]
+    first = steps.index(taus[0])
+    assert steps[first + len(taus)]["plan"] == f"forces:{label}"
+    for s in steps:
+        assert any(x.name == s.get("segment") for x in plans[s["plan"]].segments) or s.get("path") in plans[s["plan"]].paths, s
 
 
 @pytest.mark.slow
@@ -266,3 +350,37 @@ def test_page_command_refuses_a_folder_as_out(cli, tmp_path):
     """`kinetostat page` checks --out before the minute of work: a folder is one line, exit 2."""
     r = cli("page", "ice_crank_slider", "--out", str(tmp_path))
     assert r.returncode == 2 and r.stderr.strip() == f"kinetostat: error: cannot write --out {tmp_path}: it is a directory"
+
+
+def test_shaper_check_and_values_in_ukrainian():
+    """The shaper's slots and Coriolis accelerations in the page's tables come from the catalogue:
+    "паз ланки 3 (A)", a^к, not "slot 3 A", a^Cor (their data-segment, data-symbol stay)."""
+    from kinetostat.plans.draw import segment_label
+    from kinetostat.plans.page import _symbol
+    mech = kinetostat.load("slotted_link_shaper")
+    plans = _build(mech, 30.0, None)
+    labels = {segment_label(s, "uk") for k in plans for s in plans[k].segments}
+    assert {"паз ланки 3 (A)", "паз ланки 3 (B)"} <= labels and not [x for x in labels if "slot" in x]
+    shown = [_symbol(r.symbol, "uk") for r in worksheet(mech, 30.0, lang="uk").rows]
+    assert "a^к(3,2)" in shown and not [x for x in shown if "Cor" in x]
+    assert _symbol("a^Cor(3,2)", "en") == "a^Cor(3,2)"
+
+
+def test_frames_drawn_in_workers_equal_those_drawn_here(ice, monkeypatch):
+    """The frames drawn by forked workers (`_map`, from PARALLEL_FROM frames) make the very page
+    drawn in this process."""
+    import kinetostat.plans.page as page_module
+    mech, fixed, _, _ = ice
+    here = make_page(mech, lang="uk", angles=(0.0, 150.0), fixed=fixed)
+    monkeypatch.setattr(page_module, "PARALLEL_FROM", 2)
+    assert make_page(mech, lang="uk", angles=(0.0, 150.0), fixed=fixed) == here
+
+
+def test_split_rounds_coordinates_only():
+    """The page keeps a drawing's coordinates to 0.1 mm and every other number as written: a
+    title's "0.001 m/mm" stays 0.001 (not 0.00), a stroke's 0.25 stays, data-length-mm exact."""
+    from kinetostat.plans.page import LENGTH_Q, _split
+    t, nums = _split('<line x1="12.345" stroke-width="0.25" data-length-mm="12.3456789012"/>'
+                     '<text x="1.26" y="7.00">μ_l = 0.001 m/mm</text>')
+    assert nums == [123, 25, round(12.3456789012 / LENGTH_Q), 13, 70, 1]
+    assert t[1::2] == (".1", ".2", "L", ".1", ".1", ".3")

@@ -100,6 +100,9 @@ def segment_label(s: Segment, lang: str) -> str:
     """A segment's name as the sheet letters it (a guide or a line of action in `lang`)."""
     if s.name.startswith("guide "):
         return f"{text('guide', lang)} {s.name[6:]}"
+    if s.name.startswith("slot "):                  # mechanism.py: "slot <link> <point>"
+        k, P = s.name[5:].split(" ", 1)
+        return text("slot", lang, k=k, P=P)
     return text(s.name, lang) if s.name in MESSAGES else s.name
 
 

@@ -82,6 +82,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                          "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
     "guide": ("guide", "напрямна", "направляющая"),
+    "slot": ("slot of link {k} ({P})", "паз ланки {k} ({P})", "паз звена {k} ({P})"),
+    "coriolis": ("Cor", "к", "к"),          # the superscript of the Coriolis acceleration: a^Cor, a^к
     "line of action": ("line of action", "лінія зачеплення", "линия зацепления"),
     "pitch circle of the wheel": ("pitch circle of the wheel", "початкове коло колеса",
                                   "начальная окружность колеса"),
@@ -267,15 +269,18 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "page.check_note": ("Type the lengths you measured on your plans (mm) at φ = {phi}°: the deviation from the "
                    "exact length, and whether it lies in the band a careful drawing lands in (the 5-95 % "
                    "band of the drawing-error study; — where the study has none); the two balancing "
-                   "moments by the texts' {tol} % rule.",
+                   "moments with their sign (+ counter-clockwise), each against its band and sense, and "
+                   "δ between your two by the texts' {tol} % rule.",
                    "Введіть довжини, виміряні на ваших планах (мм) при φ = {phi}°: відхилення від точної "
                    "довжини і чи лежить воно в смузі, куди потрапляє ретельне креслення (5-95 % "
-                   "дослідження похибки креслення; — де його немає); два зрівноважувальні моменти за "
-                   "правилом {tol} % методички.",
+                   "дослідження похибки креслення; — де його немає); два зрівноважувальні моменти зі "
+                   "знаком (+ проти годинникової стрілки), кожен проти своєї смуги і напряму, і δ між "
+                   "вашими двома за правилом {tol} % методички.",
                    "Введите длины, измеренные на ваших планах (мм) при φ = {phi}°: отклонение от точной "
                    "длины и лежит ли оно в полосе, куда попадает тщательный чертёж (5-95 % исследования "
-                   "погрешности чертежа; — где его нет); два уравновешивающих момента по правилу {tol} % "
-                   "методички."),
+                   "погрешности чертежа; — где его нет); два уравновешивающих момента со знаком (+ против "
+                   "часовой стрелки), каждый против своей полосы и направления, и δ между вашими двумя по "
+                   "правилу {tol} % методички."),
     "page.plan": ("Plan", "План", "План"),
     "page.segment": ("Segment", "Відрізок", "Отрезок"),
     "page.measured": ("Measured", "Виміряно", "Измерено"),
@@ -284,6 +289,11 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "page.verdict": ("Verdict", "Висновок", "Вывод"),
     "page.in_band": ("in the band", "у смузі", "в полосе"),
     "page.out_band": ("outside the band", "поза смугою", "вне полосы"),
+    "page.negligible": ("under {tiny} mm at the plan's scale: negligible (not laid off, or drawn out of scale, marked *)",
+                   "менше {tiny} мм у масштабі плану: нехтовно мала (не відкладена або показана не в масштабі, з *)",
+                   "меньше {tiny} мм в масштабе плана: пренебрежимо мала (не отложена или показана не в масштабе, со *)"),
+    "page.sense": ("the wrong sense (sign)", "не той напрям (знак)", "не то направление (знак)"),
+    "page.both": ("type both moments", "введіть обидва моменти", "введите оба момента"),
     "page.rule_ok": ("within {tol} %", "в межах {tol} %", "в пределах {tol} %"),
     "page.rule_bad": ("beyond {tol} %", "понад {tol} %", "больше {tol} %"),
     "page.data": ("Data", "Вихідні дані", "Исходные данные"),
@@ -298,10 +308,12 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
               "Печать: каждый лист в натуральную величину, альбомно, на выбранной бумаге (A4: часть листа с "
               "планом; отрезок 100 мм имеет 100 мм)."),
     "page.paper": ("Paper", "Папір", "Бумага"),
-    "page.a4_cut": ("larger than A4: print it on A3", "більший за A4: друкуйте на A3", "больше A4: печатайте на A3"),
+    "page.a4_cut": ("the plan is larger than A4 and cut: print it on A3", "план більший за A4 і обрізаний: друкуйте на A3",
+               "план больше A4 и обрезан: печатайте на A3"),
     "page.singular": ("a singular position: no plans at this angle", "особливе положення: планів немає",
                  "особое положение: планов нет"),
     "page.tau": ("{R} from ΣM_{P}(link {k}) = 0", "{R} з ΣM_{P}(ланка {k}) = 0", "{R} из ΣM_{P}(звено {k}) = 0"),
+    "page.tau_S": ("{R} from ΣM_{P}(group {k}) = 0", "{R} з ΣM_{P}(група {k}) = 0", "{R} из ΣM_{P}(группа {k}) = 0"),
     "page.side": ("polygon: {sum} (side {n} of {m})", "многокутник: {sum} (сторона {n} з {m})",
              "многоугольник: {sum} (сторона {n} из {m})"),
     "page.inner": ("inner reaction {R}: ΣF(link {k}) = 0", "внутрішня реакція {R}: ΣF(ланка {k}) = 0",

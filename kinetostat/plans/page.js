@@ -47,33 +47,58 @@
   // ------------------------------------------------------------------ the check of typed lengths
   const check = JSON.parse(new TextDecoder().decode(await bytes("check", true)));
   function parse(s) { const x = parseFloat(s.replace(",", ".")); return s.trim() === "" ? NaN : x; }
-  function verdict(tr, typed, exact, band, rule) {
-    const cell = tr.querySelector(".verdict");
-    if (!isFinite(typed)) { cell.textContent = ""; cell.className = "verdict"; delete cell.dataset.verdict; return; }
-    const dev = typed - exact, pct = 100 * dev / exact;
-    let ok, word;
-    if (rule) { ok = Math.abs(pct) <= D.tol; word = ok ? D.rule_ok : D.rule_bad; }
-    else if (band) { ok = band[0] <= typed && typed <= band[1]; word = D.ui[ok ? "in_band" : "out_band"]; }
-    else { ok = null; word = ""; }
+  function pct1(x) { return (x >= 0 ? "+" : "−") + Math.abs(x).toFixed(1).replace(".", D.decimal) + " %"; }
+  function mark(cell, ok, text) {                 // a verdict cell: ok true/false, null (none), undefined (empty)
+    if (ok === undefined) { cell.textContent = ""; cell.className = "verdict"; delete cell.dataset.verdict; return; }
     cell.dataset.verdict = ok === null ? "none" : ok ? "ok" : "bad";
     cell.className = "verdict" + (ok === null ? "" : ok ? " ok" : " bad");
-    cell.textContent = (dev >= 0 ? "+" : "") + local(dev, 3) + (rule ? "" : " " + D.mm) + " (" + (pct >= 0 ? "+" : "")
-      + local(pct, 2) + " %)" + (word ? " — " + word : "");
+    cell.textContent = text;
   }
+  function dev(typed, exact, unit) {              // "+1,23 mm (+0,5 %)": the percentage to 0.1 %
+    const d = typed - exact;
+    return (d >= 0 ? "+" : "") + local(d, 3) + (unit ? " " + unit : "") + " (" + pct1(100 * d / exact) + ")";
+  }
+  function band(b) { return b ? local(b[0], 3) + " … " + local(b[1], 3) : "—"; }
   document.querySelectorAll("tr[data-item]").forEach((tr) => {
     const it = check.items[+tr.dataset.item];
     if (!D.student) {
       tr.querySelector(".exact").textContent = local(it.exact, 4);
-      tr.querySelector(".band").textContent = it.band ? local(it.band[0], 3) + " … " + local(it.band[1], 3) : "—";
+      tr.querySelector(".band").textContent = band(it.band);
     } else if (!it.band) {
       tr.querySelector(".band").textContent = "—";
     }
-    tr.querySelector("input").addEventListener("input", (e) => verdict(tr, parse(e.target.value), it.exact, it.band, false));
+    tr.querySelector("input").addEventListener("input", (e) => {
+      const typed = parse(e.target.value), cell = tr.querySelector(".verdict");
+      if (!isFinite(typed)) return mark(cell);
+      const ok = it.band ? it.band[0] <= typed && typed <= it.band[1] : null;
+      mark(cell, ok, dev(typed, it.exact, D.mm) + (ok === null ? "" : " — " + D.ui[ok ? "in_band" : "out_band"]));
+    });
   });
-  document.querySelectorAll("tr[data-moment]").forEach((tr) => {
-    const exact = Math.abs(check.M[+tr.dataset.moment][1]);
-    if (!D.student) tr.querySelector(".exact").textContent = local(exact, 4);
-    tr.querySelector("input").addEventListener("input", (e) => verdict(tr, Math.abs(parse(e.target.value)), exact, null, true));
+  // The two balancing moments (signed, N m): each against its band and sense; then the texts' rule
+  // on the student's own two, δ = (M' − M)/M' · 100 %, judged on δ as shown (0.1 %).
+  const moments = [...document.querySelectorAll("tr[data-moment]")];
+  function judgeMoments() {
+    const typed = moments.map((tr) => parse(tr.querySelector("input").value));
+    moments.forEach((tr, n) => {
+      const [, exact, b] = check.M[+tr.dataset.moment], x = typed[n], cell = tr.querySelector(".verdict");
+      if (!isFinite(x)) return mark(cell);
+      const sense = Math.sign(x) === Math.sign(exact), inBand = b ? b[0] <= x && x <= b[1] : null;
+      const ok = !sense ? false : inBand;
+      mark(cell, ok, dev(x, exact, "") + " — " + (!sense ? D.ui.sense : inBand === null ? "" : D.ui[inBand ? "in_band" : "out_band"]));
+    });
+    const row = $("delta");
+    if (!row) return;
+    const cell = row.querySelector(".verdict");
+    if (!typed.some(isFinite)) return mark(cell);
+    if (!typed.every(isFinite) || typed[1] === 0) return mark(cell, false, D.ui.both);
+    const delta = Math.round(1000 * (typed[1] - typed[0]) / typed[1]) / 10, ok = Math.abs(delta) <= D.tol;
+    row.dataset.delta = String(delta);
+    mark(cell, ok, "δ = " + pct1(delta) + " — " + (ok ? D.rule_ok : D.rule_bad));
+  }
+  moments.forEach((tr) => {
+    const [, exact, b] = check.M[+tr.dataset.moment];
+    if (!D.student) { tr.querySelector(".exact").textContent = local(exact, 4); tr.querySelector(".band").textContent = band(b); }
+    tr.querySelector("input").addEventListener("input", judgeMoments);
   });
   if (D.student) { document.body.dataset.ready = "1"; return; }
 
@@ -82,21 +107,26 @@
   const kinds = [];
   for (let k = 0; k < meta.kinds.length; k++) {
     const K = meta.kinds[k], nums = varints(await bytes("k" + k)), frames = K.frames.map(() => null);
-    let p = 0;
-    K.templates.forEach((t, tid) => {              // template by template, slot by slot: page.py encode
-      const fs = [];
-      K.frames.forEach((x, f) => { if (x === tid) fs.push(f); });
-      const n = (t.length - 1) / 2;
-      fs.forEach((f) => { frames[f] = new Array(n); });
-      for (let i = 0; i < n; i++) {
-        let a = 0, b = 0;                          // the slot's two values before
-        fs.forEach((f, j) => {
-          const d = nums[p++], v = j >= 2 ? d + 2 * b - a : j === 1 ? d + b : d;
-          a = b; b = v;
-          frames[f][i] = v;
-        });
-      }
+    const slots = K.keys.map((deltas) => {      // template -> (series -> its slot): page.py _encode_split
+      const m = new Map();
+      let key = -1;
+      deltas.forEach((d, i) => { key += d; m.set(key, i); });
+      return m;
     });
+    K.frames.forEach((tid, f) => { if (tid >= 0) frames[f] = new Array(slots[tid].size); });
+    let nk = 0;
+    slots.forEach((m) => m.forEach((_, key) => { nk = Math.max(nk, key + 1); }));
+    let p = 0;
+    for (let key = 0; key < nk; key++) {           // series by series, the frames that have it in order
+      let a = 0, b = 0, j = 0;
+      K.frames.forEach((tid, f) => {
+        const i = tid < 0 ? undefined : slots[tid].get(key);
+        if (i === undefined) return;
+        const d = nums[p++], v = j >= 2 ? d + 2 * b - a : j === 1 ? d + b : d;
+        a = b; b = v; j++;
+        frames[f][i] = v;
+      });
+    }
     kinds.push({kind: K.kind, templates: K.templates, tids: K.frames, frames});
   }
   const rows = D.rows, ncol = rows.length, nf = D.frames.length;
@@ -129,7 +159,7 @@
       th.colSpan = 3; th.textContent = section;
     }
     const tr = table.insertRow();
-    tr.insertCell().textContent = r.symbol;
+    tr.insertCell().textContent = r.shown;
     const td = tr.insertCell();
     td.className = "num"; td.dataset.symbol = r.symbol;
     tr.insertCell().textContent = r.unit;
@@ -161,7 +191,8 @@
     boxes.forEach((box) => {
       const svg = box.querySelector("svg"), plan = svg && svg.querySelector("#plan");
       if (!plan) return;
-      const bar = svg.querySelector("#scalebar");
+      const bar = svg.querySelector("#scalebar"), old = svg.querySelector("#a4-title");
+      if (old) old.remove();
       if (!a4) {
         svg.setAttribute("viewBox", "0 0 420 297"); svg.setAttribute("width", "420mm"); svg.setAttribute("height", "297mm");
         bar.removeAttribute("transform"); delete box.dataset.a4; return;
@@ -170,8 +201,29 @@
       const x0 = clamp(b.x + b.width / 2 - 148.5, 123), y0 = clamp(b.y + b.height / 2 - 105, 87);
       svg.setAttribute("viewBox", `${x0} ${y0} 297 210`); svg.setAttribute("width", "297mm"); svg.setAttribute("height", "210mm");
       bar.setAttribute("transform", `translate(${x0 - 8} ${y0 - 30})`);   // the bar 8 mm in, 10 mm down
-      if (b.width > 280 || b.height > 195) box.dataset.a4 = D.ui.a4_cut; else delete box.dataset.a4;
+      const cut = b.width > 280 || b.height > 195;
+      if (cut) box.dataset.a4 = D.ui.a4_cut; else delete box.dataset.a4;
+      svg.appendChild(a4Title(svg, x0, y0, cut));
     });
+  }
+  function a4Title(svg, x0, y0, cut) {           // A4 cuts the title block off: one line at the top instead
+    const NS = "http://www.w3.org/2000/svg", g = document.createElementNS(NS, "g"), t = document.createElementNS(NS, "text");
+    const mech = svg.querySelector("#mechanism"), title = svg.querySelector("title");
+    g.id = "a4-title";
+    t.setAttribute("x", x0 + 12); t.setAttribute("y", y0 + 6); t.setAttribute("font-size", "2.8");
+    t.textContent = (mech ? mech.textContent + " — " : "") + (title ? title.textContent : "");
+    if (cut) {                                   // a second line, red
+      const w = document.createElementNS(NS, "tspan");
+      w.setAttribute("fill", "#b01515"); w.setAttribute("x", x0 + 12); w.setAttribute("dy", "3.6");
+      w.textContent = D.ui.a4_cut;
+      t.appendChild(w);
+    }
+    const r = document.createElementNS(NS, "rect");
+    r.setAttribute("x", x0 + 11); r.setAttribute("y", y0 + 2); r.setAttribute("height", cut ? 9 : 5.5); r.setAttribute("fill", "#fff");
+    g.append(r, t);
+    svg.appendChild(g);
+    r.setAttribute("width", t.getComputedTextLength() + 2);
+    return g;
   }
   $("paper").addEventListener("change", paper);
   function highlight() {
@@ -186,8 +238,37 @@
     out.dataset.segment = s.segment || "";
     out.dataset.path = s.path || "";
     out.textContent = `${step + 1}/${meta.steps.length}`;
-    const len = el && el.dataset.lengthMm !== undefined ? ` — ${local(+el.dataset.lengthMm, 4)} ${D.mm}` : "";
-    $("equation").textContent = s.eq + len;
+    const mm = el && el.dataset.lengthMm !== undefined ? +el.dataset.lengthMm : NaN;
+    const len = isFinite(mm) ? ` — ${local(mm, 4)} ${D.mm}` + (mm < D.tiny ? `: ${D.ui.negligible}` : "") : "";
+    $("equation").textContent = s.eq + (s.moment ? ": " + momentText(s.plan, s.moment) : "") + len;
+  }
+  // A moment equation's terms at the angle shown (page.py _moment): each sign the moment's sense as
+  // drawn (+ counter-clockwise), each arm its length on the sheet (mm).
+  function ends(plan, name) {
+    const e = document.querySelector(`svg [data-plan="${plan}"][data-segment="${CSS.escape(name)}"]`);
+    return e && [e.x1.baseVal.value, e.y1.baseVal.value, e.x2.baseVal.value, e.y2.baseVal.value, +e.dataset.lengthMm];
+  }
+  function term(plan, force, arm, atEnd) {        // [sign, "F·h"] or null (no arm: no moment)
+    const F = ends(plan, force), h = ends(plan, arm);
+    if (!F || !h || !(h[4] > 1e-9)) return null;
+    const [mx, my, px, py] = atEnd ? [h[2], h[3], h[0], h[1]] : h;
+    const cross = (px - mx) * (F[3] - F[1]) - (py - my) * (F[2] - F[0]);     // the sheet's y runs down
+    return [cross > 0 ? -1 : 1, `${force}·${local(h[4], 4)}`];
+  }
+  function couple(plan, name) {
+    const e = document.querySelector(`svg [data-plan="${plan}"][data-path="${CSS.escape(name)}"]`);
+    if (!e) return null;
+    const p = e.getAttribute("points").trim().split(/\s+/).slice(0, 3).map((xy) => xy.split(",").map(Number));
+    const cross = (p[1][0] - p[0][0]) * (p[2][1] - p[1][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[1][0]);
+    return [cross > 0 ? -1 : 1, `${name}/μ_l`];
+  }
+  function momentText(plan, m) {
+    const parts = [];
+    if (m.unknown) { const u = term(plan, ...m.unknown); if (u) parts.push(u); }
+    m.terms.forEach((t) => { const x = term(plan, ...t); if (x) parts.push(x); });
+    m.couples.forEach((c) => { const x = couple(plan, c); if (x) parts.push(x); });
+    const sum = parts.map(([sg, t], i) => (sg < 0 ? (i ? " − " : "−") : i ? " + " : "") + t).join("") || "0";
+    return (m.M ? `${m.M} + μ_l·(${sum})` : sum) + " = 0 (h, l: " + D.mm + ")";
   }
   const slider = $("phi");
   function frameOf(deg) {                        // the frame of the nearest angle on the slider

@@ -30,9 +30,13 @@ import base64
 import gzip
 import json
 import math
+import multiprocessing
+import os
 import re
 import warnings
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 from html import escape
 from importlib import resources
 from pathlib import Path
@@ -40,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import write_text
-from .draw import segment_label, svg, title_of
+from .draw import TINY_MM, segment_label, svg, title_of
 from .i18n import check_lang, num, text, unit
 
 __all__ = ["page", "write_page", "encode", "PAGE_ANGLES", "TOLERANCE_PCT"]
@@ -53,8 +57,12 @@ TOLERANCE_PCT = 5.0
 #: of a 100 mm segment, as segments.csv.
 LENGTH_Q = 1e-10
 _NUM = re.compile(r"(-?)(\d+)(?:([.,])(\d+))?")
+#: The attributes that place a drawing's elements (mm), and their decimals in the page.
+COORDINATES = frozenset({"x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "dx", "dy", "points", "d"})
+COORD_DECIMALS = 1
+_TAG = re.compile(r"(<[^>]*>)")
+_ATTR = re.compile(r'([\w:-]+)="([^"]*)"')
 _NOTES = re.compile(r'<g id="notes">.*?</g>\n?', re.S)
-_LENGTH = re.compile(r'data-length-mm="([^"]*)"')
 
 # ============================================================================ the numbers, small
 
@@ -62,47 +70,81 @@ _LENGTH = re.compile(r'data-length-mm="([^"]*)"')
 class Encoded:
     """Sheets cut into templates and numbers (`encode`): `templates[t]` alternates literal text and
     a number's format ("" integer, ".2" two decimals after a point, ",1" after a comma, "L" a
-    length at LENGTH_Q); `frames[f]` the template of each frame (-1: none); `data` the numbers."""
+    length at LENGTH_Q); `keys[t]` the series of each of its slots (`_slot_keys`), as differences
+    from the slot before (the first from -1); `frames[f]` the template of each frame (-1: none);
+    `data` the numbers, series by series, each the second differences over the frames it is in."""
     templates: tuple[tuple[str, ...], ...]
+    keys: tuple[tuple[int, ...], ...]
     frames: tuple[int, ...]
     data: bytes
 
 
+_IDENT = re.compile(r'data-(?:segment|path)="([^"]*)"')
+
+
+def _slot_keys(template: tuple[str, ...]) -> list[tuple]:
+    """What each number of a template is, the same in every template that has it: the element it
+    is in (its data-segment or data-path; a label's text; else "after" the last element that had
+    one), the element's text up to the number, and how many slots before had that key. A label
+    or an arrowhead that comes or goes between angles then shifts no other series."""
+    s = "\x00".join(template[0::2])
+    out, seen, last = [], {}, ""
+    for m in re.finditer("\x00", s):
+        p = m.start()
+        a, b = s.rfind("<", 0, p), s.find(">", p)
+        tag = s[a:b]
+        ident = _IDENT.search(tag)
+        if ident:
+            who = last = ident.group(1)
+        elif tag.startswith("<text"):
+            who = last = "text:" + re.sub(r"<[^>]*>|\x00", "", s[b + 1:s.find("</text>", b)])
+        else:
+            who = ("after", last)
+        key = (who, s[a:p])
+        seen[key] = seen.get(key, -1) + 1
+        out.append((*key, seen[key]))
+    return out
+
+
 def _split(sheet: str) -> tuple[tuple[str, ...], list[int]]:
-    """A sheet as (template, numbers): coordinates with 3 decimals rounded to 2 (0.01 mm, finer than
-    print), data-length-mm as integers of LENGTH_Q."""
-    parts: list[str] = []
+    """A sheet as (template, numbers): data-length-mm as integers of LENGTH_Q; a drawing's
+    coordinates (COORDINATES' attributes) rounded to COORD_DECIMALS (0.1 mm: finer than a ruler
+    reads); every other number (a stroke's width, a font's size, a number in a text) as written."""
+    parts: list[str] = [""]
     nums: list[int] = []
-    pieces = _LENGTH.split(sheet)
-    for k, piece in enumerate(pieces):
-        if k % 2:
-            parts[-1] += 'data-length-mm="'
-            parts.append("L")
-            nums.append(round(float(piece) / LENGTH_Q))
-            parts.append('"')
-            continue
+
+    def numbers(piece: str, places: int | None) -> None:
         last = 0
         for m in _NUM.finditer(piece):
             sign, whole, sep, frac = m.groups()
             if len(whole) > 1 and whole[0] == "0":        # a zero-padded number: kept as text
                 continue
-            lit = piece[last:m.start()]
-            if len(parts) % 2:
-                parts[-1] += lit
-            else:
-                parts.append(lit)
+            parts[-1] += piece[last:m.start()]
             last = m.end()
             d = len(frac) if frac else 0
             n = int(whole + (frac or ""))
-            if d == 3 and sep == ".":                    # 0.001 mm -> 0.01 mm
-                n, d = (n + 5) // 10, 2
-            parts.append(f"{sep or ''}{d}" if d else "")
+            if places is not None and d > places and sep == ".":     # "217,69": two integers of a list
+                n, d = (n + 5 * 10 ** (d - places - 1)) // 10 ** (d - places), places
+            parts.append(f"{sep or '.'}{d}" if d else "")
+            parts.append("")
             nums.append(-n if sign else n)
-        lit = piece[last:]
-        if len(parts) % 2:
-            parts[-1] += lit
-        else:
-            parts.append(lit)
+        parts[-1] += piece[last:]
+
+    for k, piece in enumerate(_TAG.split(sheet)):
+        if not k % 2:                                     # text between tags: as written
+            numbers(piece, None)
+            continue
+        last = 0
+        for m in _ATTR.finditer(piece):
+            name, value = m.groups()
+            parts[-1] += piece[last:m.start(2)]
+            last = m.end(2)
+            if name == "data-length-mm":
+                parts += ["L", ""]
+                nums.append(round(float(value) / LENGTH_Q))
+            else:
+                numbers(value, COORD_DECIMALS if name in COORDINATES else None)
+        parts[-1] += piece[last:]
     return tuple(parts), nums
 
 
@@ -131,20 +173,31 @@ def encode(sheets: list[str | None]) -> Encoded:
     """Sheets of one plan at successive angles (None: not drawn there) as templates and, template
     by template, slot by slot, the second differences of the slot's numbers over the frames that
     use that template."""
+    return _encode_split([None if s is None else _split(s) for s in sheets])
+
+
+def _encode_split(split: list[tuple[tuple[str, ...], list[int]] | None]) -> Encoded:
+    """`encode` of sheets already `_split`."""
     templates: dict[tuple[str, ...], int] = {}
+    keys: dict[tuple, int] = {}
+    slots: list[list[int]] = []
     frames: list[int] = []
-    rows: dict[int, list[list[int]]] = {}
-    for sheet in sheets:
-        if sheet is None:
+    series: dict[int, list[int]] = {}
+    for one in split:
+        if one is None:
             frames.append(-1)
             continue
-        t, nums = _split(sheet)
-        tid = templates.setdefault(t, len(templates))
+        t, nums = one
+        tid = templates.get(t)
+        if tid is None:
+            tid = templates[t] = len(templates)
+            slots.append([keys.setdefault(k, len(keys)) for k in _slot_keys(t)])
         frames.append(tid)
-        rows.setdefault(tid, []).append(nums)
-    data = b"".join(_varints(_second_differences(np.array(rows[t], dtype=np.int64)).T.ravel())
-                    for t in range(len(templates)))
-    return Encoded(tuple(templates), tuple(frames), data)
+        for k, v in zip(slots[tid], nums):
+            series.setdefault(k, []).append(v)
+    data = b"".join(_varints(_second_differences(np.array(series[k], dtype=np.int64))) for k in range(len(keys)))
+    deltas = tuple(tuple(np.diff([-1, *ks]).tolist()) for ks in slots)
+    return Encoded(tuple(templates), deltas, tuple(frames), data)
 
 
 def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
@@ -174,52 +227,155 @@ def _sheets_of(plans, lang: str, name: str) -> dict[str, str]:
             for kind, p in plans.items()}
 
 
+def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict:
+    """A moment equation about point M of `plan` as the page's script writes it at each angle
+    (page.js `momentText`): the unknown [segment, arm, M at the arm's end?] (R^τ with its link, the
+    lever's F'_bal with p-a), each force drawn with its arm h_.. about M ([force, arm, False]), each
+    couple's arc (M_i/μ_l); the script takes the signs and the arms (mm) from the sheet drawn."""
+    from .forces import arm_name
+    segs = {s.name: s for s in plan.segments}
+    terms = [[n, arm_name(n), False] for n in names if n in segs and arm_name(n) in segs]
+    out = {"terms": terms, "couples": [c for c in couples if c in plan.paths]}
+    if unknown is not None:
+        X = plan.points[segs[unknown].start]              # where the unknown acts: the arm is M to there
+        arm = next((x for x in plan.segments if x.kind in ("link", "vector") and x.name != unknown and M in (x.start, x.end)
+                    and abs(plan.points[x.end if x.start == M else x.start] - X) < 1e-6), None)
+        if arm is not None:
+            out["unknown"] = [unknown, arm.name, arm.end == M]
+    return out
+
+
+def _plans_at(mech, start: float, fixed, a: float):
+    """The plans at `a` deg at the page's scales; None at a singular position."""
+    from . import build
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            return build(mech, at=a, starting_deg=start, fixed=fixed)
+        except ValueError:                     # a singular position
+            return None
+
+
+def _frame(mech, start: float, fixed, lang: str, name: str, a: float) -> tuple[dict, dict | None, list | None]:
+    """One frame of the slider: each plan's sheet `_split` (kind -> (template, numbers)), the
+    worksheet's values (key -> value) and its records; ({}, None, None) at a singular position."""
+    from .worksheet import worksheet
+    plans = _plans_at(mech, start, fixed, a)
+    if plans is None:
+        return {}, None, None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ws = worksheet(mech, a, mu_l=fixed.base["mu_l"].value, lang=lang)
+    return ({k: _split(v) for k, v in _sheets_of(plans, lang, name).items()},
+            {r.key: r.value for r in ws.rows}, ws.records())
+
+
+#: Frames per page below which they are drawn in this process (a test's few angles).
+PARALLEL_FROM = 24
+
+
+_WORK = None                   # the function a forked worker applies (`_map`): inherited, not pickled
+
+
+def _work(item):
+    return _WORK(item)
+
+
+def _map(fn, items: list) -> list:
+    """`fn` over `items` in order, on every core this process may use (forked workers, which
+    inherit `fn` and what it holds: a mechanism is not picklable) when there are PARALLEL_FROM
+    items or more, else here."""
+    global _WORK
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if cores < 2 or len(items) < PARALLEL_FROM or "fork" not in multiprocessing.get_all_start_methods():
+        return list(map(fn, items))
+    _WORK, n = fn, min(cores, 8)
+    try:
+        with ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("fork")) as ex:
+            return list(ex.map(_work, items, chunksize=max(1, len(items) // (4 * n))))
+    finally:
+        _WORK = None
+
+
 def _steps(mech, plans, lang: str) -> list[dict]:
     """The force analysis in the texts' order, one vector a step: per Assur group from the last
-    attached, R^τ from ΣM about the inner joint, the polygon's sides in the order drawn, the inner
-    reaction; then the initial link's loads and M_bal; then the lever's loads and M'_bal."""
-    from .forces import _group_label, _moment_equations, reaction_name
+    attached, the unknowns found from moment equations (a dyad's R^τ from ΣM about the inner
+    joint, its terms R^τ·l + Σ±F·h ± M_i/μ_l = 0; a triad's R^τ of each leash about its inner pin,
+    then R^n of leash 3 from the group's moment about Assur's point S), the polygon's sides in the
+    order drawn, the inner reactions; then the initial link's loads and M_bal (M_bal + μ_l Σ±F·h =
+    0); then the lever's loads and F'_bal·pa + Σ±F·h = 0. A step with "moment" has its equation's
+    terms written by the page's script from the sheet of the angle shown."""
+    from ..solve import analyze
+    from .forces import _carried, _group_label, _later, _moment_equations, link_couples, link_loads, reaction_name
     from .lettering import lettering
     L = lettering(mech)
+    any_plan = next(iter(plans.values()))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = analyze(mech, phi_deg=[any_plan.phi_deg])
     out = []
     for g in reversed(mech.structure.groups):
         label = _group_label(g)
-        forces = plans.get(f"forces:{label}")
+        forces, group = plans.get(f"forces:{label}"), plans.get(f"group:{label}")
         if forces is None:
             continue
-        taus = [n for n in forces.equation if n.startswith("R") and n.endswith("t")]
-        for (links, point), R in zip(_moment_equations(g), taus):
-            out.append({"plan": f"group:{label}", "segment": R,
-                        "eq": text("page.tau", lang, R=R, P=point, k=",".join(map(str, links)))})
+        drawn = {s.name for s in group.segments} if group is not None else set()
+        later = _later(mech, g)
+        loads = {x: [ld.name for ld in link_loads(mech, res, x) + _carried(mech, res, x, later)] for x in g.links}
+        couples = {x: [c.name for c in link_couples(mech, res, x)] for x in g.links}
+        if g.klass == 3:
+            moments = [(f"{reaction_name(mech, known, ell)}t", inner.point, str(ell), (ell,))
+                       for ell, _, inner, known in g.sides]
+            ell, _, _, known = g.sides[2]
+            S = "S" if "S" not in mech.point_names else "S*"
+            R3 = reaction_name(mech, known, ell)
+            moments.append((f"{R3}n" if f"{R3}n" in drawn else R3, S, label, ()))
+            inners = [(reaction_name(mech, g.links[0], ell), ell) for ell, _, _, _ in g.sides]
+        else:
+            taus = [n for n in forces.equation if n.startswith("R") and n.endswith("t")]
+            moments = [(R, point, ",".join(map(str, links)), links)
+                       for (links, point), R in zip(_moment_equations(g), taus)]
+            j, k = g.links
+            inners = [(reaction_name(mech, k, j), j)]
+        for R, point, links, on in moments:
+            if R in drawn:
+                key = "page.tau" if on else "page.tau_S"             # a link's moment; the triad's about S
+                step = {"plan": f"group:{label}", "segment": R, "eq": text(key, lang, R=R, P=point, k=links)}
+                if on and R.endswith("t"):
+                    step["moment"] = _moment(group, point, [n for x in on for n in loads[x]],
+                                             [c for x in on for c in couples[x]], unknown=R)
+                out.append(step)
         m = len(forces.equation)
         for n, name in enumerate(forces.equation):
             out.append({"plan": f"forces:{label}", "segment": name,
                         "eq": text("page.side", lang, sum=" + ".join(forces.equation[:n + 1]) + (" = 0" if n + 1 == m else " + …"),
                                   n=n + 1, m=m)})
-        j, k = g.links
-        inner = reaction_name(mech, k, j)
-        out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=j)})
+        for inner, k in inners:
+            out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=k)})
     crank = plans.get("crank")
     if crank is not None:
-        for s in crank.segments:
-            if s.kind == "vector":
-                out.append({"plan": "crank", "segment": s.name, "eq": text("page.crank", lang, F=s.name)})
+        vectors = [s.name for s in crank.segments if s.kind == "vector"]
+        for name in vectors:
+            out.append({"plan": "crank", "segment": name, "eq": text("page.crank", lang, F=name)})
         where = {"path": L.M_bal} if L.M_bal in crank.paths else {"segment": "r_b"}     # an engine's couple; a gear's arm
-        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot)})
+        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot),
+                    "moment": {**_moment(crank, mech.drive.pivot, vectors), "M": L.M_bal}})
     lever = plans.get("lever")
     if lever is not None:
-        for s in lever.segments:
-            if s.kind == "vector" and s.scale is not None and s.name != L.lever(L.F_bal):
-                out.append({"plan": "lever", "segment": s.name, "eq": text("page.lever", lang, F=s.name)})
-        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang))})
+        vectors = [s.name for s in lever.segments if s.kind == "vector" and s.scale is not None and s.name != L.lever(L.F_bal)]
+        for name in vectors:
+            out.append({"plan": "lever", "segment": name, "eq": text("page.lever", lang, F=name)})
+        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang)),
+                    "moment": _moment(lever, "p", vectors, unknown=L.lever(L.F_bal))})
     return out
 
 
-def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, float]]:
-    """The band (mm) a careful drawing of each segment lands in (5-95 % of `drawing_error.simulate`
-    at the page's scales), for the segments whose value is a value of the worksheet (matched by
-    value and unit: the study reads the worksheet's values), each band that value's band at the
-    segment's scale; none where the study does not draw the mechanism's groups (PRP, RPP)."""
+def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[float, float]], dict[str, tuple[float, float]]]:
+    """The bands a careful drawing lands in (5-95 % of `drawing_error.simulate` at the page's
+    scales): (1) of each segment (mm) whose value is a value of the worksheet (matched by value and
+    unit: the study reads the worksheet's values), that value's band at the segment's scale; (2) of
+    the two balancing moments, signed (N m): "M_bal" from the force plans, "M_bal_lever" from the
+    lever. None where the study does not draw the mechanism's groups (PRP, RPP, triads)."""
     from .drawing_error import Scales, simulate
     from .pack import BAND, BAND_DRAWS
     sc = fixed.base
@@ -230,7 +386,7 @@ def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, 
             drawn = simulate(mech, at=at, n=BAND_DRAWS, seed=0,
                              scales=Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, mu_F))
         except NotImplementedError:            # a group kind the study does not draw: no bands
-            return {}
+            return {}, {}
     by_value = []
     for key, samples in drawn.samples.items():
         lo, hi = np.percentile(np.abs(samples), BAND)
@@ -245,7 +401,9 @@ def _bands(mech, plans, fixed, at: float) -> dict[tuple[str, str], tuple[float, 
                 if u == s.unit and math.isclose(v, abs(s.value), rel_tol=1e-9):
                     out[(kind, s.name)] = (lo / scale, hi / scale)
                     break
-    return out
+    moments = {k: tuple(float(x) for x in np.percentile(drawn.samples[k], BAND))
+               for k in ("M_bal", "M_bal_lever") if k in drawn.samples}
+    return out, moments
 
 
 def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
@@ -278,9 +436,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     (and of a student's page; default the design position); `angles`: the slider's frames (deg);
     `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
     from ..solve import analyze
-    from . import build, cycle_scales, starting_position
+    from . import cycle_scales, starting_position
     from .lettering import lettering
-    from .worksheet import worksheet
     check_lang(lang)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
@@ -289,19 +446,14 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     name = lettering(mech).name(lang, mech.name)
     frames = [at] if student else [*map(float, angles), design]
 
-    def plans_at(a: float):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                return build(mech, at=a, starting_deg=start, fixed=fixed)
-            except ValueError:                     # a singular position
-                return None
+    plans_at = partial(_plans_at, mech, start, fixed)
     check = plans_at(at)
     if check is None:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
-    bands = _bands(mech, check, fixed, at)
+    bands, moment_bands = _bands(mech, check, fixed, at)
     data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": frames,
-                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut")},
+                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
+                  | {"negligible": text("page.negligible", lang, tiny=num(TINY_MM, lang))}, "tiny": TINY_MM,
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang)}
@@ -309,15 +461,11 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     if not student:
         per_kind: dict[str, list] = {k: [] for k in check}
         values, rows = [], None
-        for a in frames:
-            plans = check if a == at else plans_at(a)
-            sheets = _sheets_of(plans, lang, name) if plans is not None else {}
+        for split, got, records in _map(partial(_frame, mech, start, fixed, lang, name), frames):
             for kind in per_kind:
-                per_kind[kind].append(sheets.get(kind))
-            if plans is not None:
-                ws = worksheet(mech, a, mu_l=fixed.base["mu_l"].value, lang=lang)
-                rows = rows or ws.records()
-                got = {r.key: r.value for r in ws.rows}
+                per_kind[kind].append(split.get(kind))
+            if got is not None:
+                rows = rows or records
                 values.append([got.get(r["key"], math.nan) for r in rows])
             else:
                 values.append(None)
@@ -326,11 +474,11 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         exps, vbytes = _columns(table)
         kinds = []
         for kind, sheets in per_kind.items():
-            enc = encode(sheets)
-            kinds.append({"kind": kind, "templates": enc.templates, "frames": enc.frames})
+            enc = _encode_split(sheets)
+            kinds.append({"kind": kind, "templates": enc.templates, "keys": enc.keys, "frames": enc.frames})
             blobs[f"k{len(kinds) - 1}"] = _b64gz(enc.data)
         blobs["values"] = _b64gz(vbytes)
-        data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "unit": r["unit"],
+        data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
                                         "section": r["section"]} for r in rows], exps=exps,
                     steps=_steps(mech, check, lang))
         blobs["meta"] = _b64gz(json.dumps({"kinds": data.pop("kinds"), "steps": data.pop("steps")},
@@ -346,10 +494,34 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                           "band": list(lo_hi) if lo_hi else None})
     results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
                     for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
+    results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
     blobs["check"] = base64.b64encode(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(),
                                                              9, mtime=0))).decode("ascii")
     res = analyze(mech, phi_deg=[at])
-    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results)
+    blank = _blank_tables(mech, at, fixed, lang) if student else ""
+    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results, blank)
+
+
+def _blank_tables(mech, at: float, fixed, lang: str) -> str:
+    """The worksheet's tables with their values and senses left blank, section by section
+    (velocities, accelerations, reactions, M_bal), as the teacher's pack has them (`pack`)."""
+    from .worksheet import worksheet
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ws = worksheet(mech, at, mu_l=fixed.base["mu_l"].value, lang=lang)
+    recs = ws.records()
+    head = "".join(f"<th>{escape(text(f'ws.head.{k}', lang))}</th>" for k in ("symbol", "value", "unit", "direction"))
+    out = [f'<section id="worksheet"><h2>{escape(text("pack.fill", lang))}</h2>']
+    for section in dict.fromkeys(r["section"] for r in recs):
+        rows = "".join(f'<tr><td>{escape(_symbol(r["symbol"], lang))}</td><td class="blank"></td>'
+                       f'<td>{escape(r["unit"])}</td><td class="blank"></td></tr>' for r in recs if r["section"] == section)
+        out.append(f'<h3>{escape(section)}</h3><table class="fill"><tr>{head}</tr>{rows}</table>')
+    return "".join(out) + "</section>"
+
+
+def _symbol(symbol: str, lang: str) -> str:
+    """A worksheet's symbol as the page shows it in `lang` (a^Cor -> a^к); its data-symbol stays."""
+    return symbol.replace("^Cor", "^" + text("coriolis", lang))
 
 
 def _obscure(data: bytes) -> bytes:
@@ -366,7 +538,7 @@ def _obscure(data: bytes) -> bytes:
 
 
 def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
-          data_rows, items, results) -> str:
+          data_rows, items, results, blank: str = "") -> str:
     from .draw import scale_text
     title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
     scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
@@ -382,10 +554,14 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                           f'<td><input type="text" inputmode="decimal" class="measured" data-plan="{escape(it["plan"])}" '
                           f'data-segment="{escape(it["segment"])}" size="7"></td>'
                           f'<td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
-    for n, (symbol, _) in enumerate(results):
+    for n, (symbol, _, _) in enumerate(results):
         check_rows.append(f'<tr data-moment="{n}"><td></td><td>{escape(symbol)}, {escape(unit("N m", lang))}</td>'
                           f'<td><input type="text" inputmode="decimal" class="moment" data-symbol="{escape(symbol)}" '
-                          f'size="7"></td><td class="exact num"></td><td></td><td class="verdict"></td></tr>')
+                          f'size="7"></td><td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
+    if len(results) == 2:
+        check_rows.append(f'<tr id="delta"><td></td><td>δ = ({escape(results[1][0])} − {escape(results[0][0])}) / '
+                          f'{escape(results[1][0])} · 100 %</td><td></td><td></td><td class="num">|δ| ≤ '
+                          f'{num(TOLERANCE_PCT, lang)} %</td><td class="verdict"></td></tr>')
     phi = num(data["at"], lang, 6)
     check = (f'<section id="check"><h2>{escape(text("page.check", lang))}</h2><p>{escape(text("page.check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
              f'<table><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
@@ -393,7 +569,8 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     if student:
         body = (f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><p>{escape(text("page.scales", lang))}: {escape(scales)}</p>'
                 f'<table><tr>{head}</tr>{data_table}</table></section>'
-                f'<section id="grid"><h2>{escape(text("page.sheet", lang))}</h2><div class="sheet">{_grid_sheet(title, lang)}</div></section>'
+                + blank
+                + f'<section id="grid"><h2>{escape(text("page.sheet", lang))}</h2><div class="sheet">{_grid_sheet(name, title.removeprefix(name + ": "), lang)}</div></section>'
                 + check)
     else:
         body = (f'<section id="controls"><label for="phi">{escape(text("page.phi", lang))}: <output id="phi-value"></output>°</label> '
@@ -426,9 +603,14 @@ def _plan_name(kind: str, lang: str) -> str:
     return text(f"plan.{base}", lang) + (" " + rest.replace(",", "-") if rest else "")
 
 
-def _grid_sheet(title: str, lang: str) -> str:
+def _grid_sheet(name: str, what: str, lang: str) -> str:
     """An empty A3 sheet at true scale: frame, a millimetre grid (1, 5 and 10 mm lines), the title
-    block and the 100 mm scale bar."""
+    block (the mechanism's `name` and `what` the page is, each on a line of its own, in a size that
+    fits the block's 179 mm) and the 100 mm scale bar."""
+    from .labels import text_width
+    fit = lambda s, size: f"{max(1.8, min(size, size * 179.0 / max(text_width(s, size), 1e-9))):.2f}"
+    title = (f'<text x="233" y="256" font-size="{fit(name, 4.0)}">{escape(name)}</text>'
+             f'<text x="233" y="264" font-size="{fit(what, 3.5)}">{escape(what)}</text>')
     return ('<svg xmlns="http://www.w3.org/2000/svg" width="420mm" height="297mm" viewBox="0 0 420 297" '
             'font-family="DejaVu Sans, Arial, sans-serif"><defs>'
             '<pattern id="mm" width="10" height="10" patternUnits="userSpaceOnUse">'
@@ -438,7 +620,7 @@ def _grid_sheet(title: str, lang: str) -> str:
             '<rect width="420" height="297" fill="#fff"/>'
             '<rect x="20" y="5" width="395" height="287" fill="url(#mm)" stroke="#000" stroke-width="0.7"/>'
             '<rect x="230" y="247" width="185" height="45" fill="#fff" stroke="#000" stroke-width="0.5"/>'
-            f'<text x="233" y="255" font-size="4">{escape(title)}</text>{scale_bar(lang)}</svg>')
+            f'{title}{scale_bar(lang)}</svg>')
 
 
 def scale_bar(lang: str) -> str:
@@ -456,12 +638,13 @@ body{font-family:"DejaVu Sans",Arial,sans-serif;margin:1em;color:#111}
 h1{font-size:1.3em}h2{font-size:1.1em}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:2px 6px;font-size:.9em}
 td.num{text-align:right;font-variant-numeric:tabular-nums}
+table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2em}
 #controls{position:sticky;top:0;background:#fff;padding:.4em 0;border-bottom:1px solid #ccc;z-index:2}
 #phi{width:40em;max-width:90vw;vertical-align:middle}
 #equation{font-size:1.05em;min-height:1.3em;margin:.3em 0}.hint{color:#555;font-size:.85em;margin:.2em 0}
 #sheets{display:grid;grid-template-columns:repeat(auto-fill,minmax(620px,1fr));gap:.6em}
 .sheet{border:1px solid #ddd}.sheet svg{display:block;width:100%;height:auto;max-width:1260px}
-.hl{stroke:#d01c1c !important;stroke-width:1.2 !important}
+@media screen{.hl{stroke:#d01c1c !important;stroke-width:1.2 !important}}
 .sheet[data-a4]::before{content:attr(data-a4);color:#b01515}
 .verdict.ok{color:#176317}.verdict.bad{color:#b01515}
 @media print{
