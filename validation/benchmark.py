@@ -363,14 +363,21 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
 #: `kinetostat report` (8 bundled models, --jobs 2) at commit 7970a58, before the report's CSV
 #: rounding was rebuilt, measured on this machine (2 runs, load average 3.8-4.4): CPU s (user +
 #: sys, every process), wall s.
-MAIN_JOB_BEFORE = dict(commit="4f33869", cpu=(20.8, 20.1), wall=(11.8, 11.4), load="0.9-1.3")
+MAIN_JOB_BEFORE = dict(commit="4f33869", cpu=(20.8, 20.1), wall=(11.8, 11.4), load="0.9-1.3",
+                       models=("chain_unit_four_bar", "compressor", "furnace_loader_six_bar", "ice_crank_slider",
+                               "opposed_twin", "rotating_slotted_link", "scotch_yoke", "slotted_link_shaper"))
 
 
-def main_job(runs: int = 3) -> dict:
-    """`kinetostat report` for every bundled model (--jobs 2, the default on 2 cores), `runs`
-    times in fresh processes into a temporary folder: CPU time of the command and its workers
-    (user + sys, from getrusage of the waited-for children) and wall time, s; the load before
-    and after."""
+def _n_models() -> int:
+    """How many models `kinetostat report` runs: every bundled one."""
+    return len(list((ROOT / "models").glob("*.toml")))
+
+
+def main_job(runs: int = 3, models: tuple[str, ...] = ()) -> dict:
+    """`kinetostat report` for `models` (default every bundled model; --jobs 2, the default on 2
+    cores), `runs` times in fresh processes into a temporary folder: CPU time of the command and
+    its workers (user + sys, from getrusage of the waited-for children) and wall time, s; the
+    load before and after."""
     import resource
     import subprocess
     import sys
@@ -380,30 +387,34 @@ def main_job(runs: int = 3) -> dict:
     for _ in range(runs):
         with tempfile.TemporaryDirectory(prefix="kinetostat-report-") as folder:
             r0, w0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-            subprocess.run([sys.executable, "-m", "kinetostat", "report", "--jobs", "2", "--no-progress",
+            subprocess.run([sys.executable, "-m", "kinetostat", "report", *models, "--jobs", "2", "--no-progress",
                             "--out", folder], check=True, capture_output=True)
             w, r1 = time.perf_counter() - w0, resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
         wall.append(w)
-        print(f"main job: kinetostat report, 8 models: {cpu[-1]:.1f} s CPU, {wall[-1]:.1f} s wall", flush=True)
+        print(f"main job: kinetostat report, {len(models) or _n_models()} models: {cpu[-1]:.1f} s CPU, "
+              f"{wall[-1]:.1f} s wall", flush=True)
     load.append(cpu_info()["load"])
-    return dict(cpu=cpu, wall=wall, load=load)
+    return dict(cpu=cpu, wall=wall, load=load, n=len(models) or _n_models())
 
 
-def main_job_lines(mj: dict) -> list[str]:
-    """The report's section on `kinetostat report` (`main_job`), with the recorded before."""
+def main_job_lines(mj: dict, same: dict) -> list[str]:
+    """The report's section on `kinetostat report` (`main_job`: `mj` every bundled model, `same`
+    the models of the recorded before)."""
     b = MAIN_JOB_BEFORE
+    row = lambda name, r: (f"| {name} | {r['n']} | {len(r['cpu'])} | {min(r['cpu']):.1f} / {statistics.median(r['cpu']):.1f} | "
+                           f"{min(r['wall']):.1f} / {statistics.median(r['wall']):.1f} |")
     return ["## The main job: `kinetostat report` for every bundled model", "",
-            f"`kinetostat report --jobs 2` (8 models: the solver, 5 engine routes, the 40-digit reference, "
-            f"plots, plans, HTML), in a fresh process per run; CPU = user + sys of the command and its two "
-            f"workers. Target: <= 10 s wall on this 2-core machine. Before: commit {b['commit']}, measured by "
-            f"hand on this machine at load average {b['load']}. After: this run, load average "
-            f"{mj['load'][0]} before and {mj['load'][1]} after.", "",
-            "| the main job | runs | CPU s min / median | wall s min / median |", "|---|---|---|---|",
-            f"| before ({b['commit']}) | {len(b['cpu'])} | {min(b['cpu']):.1f} / {statistics.median(b['cpu']):.1f} | "
-            f"{min(b['wall']):.1f} / {statistics.median(b['wall']):.1f} |",
-            f"| after (this run) | {len(mj['cpu'])} | {min(mj['cpu']):.1f} / {statistics.median(mj['cpu']):.1f} | "
-            f"{min(mj['wall']):.1f} / {statistics.median(mj['wall']):.1f} |"]
+            "`kinetostat report --jobs 2` (per model: the solver, 5 engine routes, the 40-digit reference, "
+            "plots, plans, HTML), in a fresh process per run; CPU = user + sys of the command and its two "
+            f"workers. Target: <= 10 s wall on this 2-core machine for every bundled model. Before: commit "
+            f"{b['commit']}, its {len(b['models'])} models, measured by hand on this machine at load average "
+            f"{b['load']}. After: this run, on those {len(b['models'])} models and on every bundled model now "
+            f"({mj['n']}: the triads and the friction section came after); load average {mj['load'][0]} before "
+            f"and {mj['load'][1]} after.", "",
+            "| the main job | models | runs | CPU s min / median | wall s min / median |", "|---|---|---|---|---|",
+            row(f"before ({b['commit']})", dict(b, n=len(b["models"]))),
+            row("after (this run), the same models", same), row("after (this run), every bundled model", mj)]
 
 
 def speed_lines(sp: dict) -> list[str]:
@@ -609,7 +620,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['cpu_min']:.3f} / {r['cpu_median']:.3f} | "
                      f"{r['wall_min']:.3f} / {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + main_job_lines(kernels["main_job"])
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + main_job_lines(kernels["main_job"], kernels["main_job_same"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -638,6 +649,7 @@ def main(argv: list[str] | None = None) -> None:
     rows = study(models, args.quick)
     if not args.quick:
         kern["main_job"] = main_job()
+        kern["main_job_same"] = main_job(models=MAIN_JOB_BEFORE["models"])
         kern["machine"] = (machine, cpu_info())
         write_report(rows, kin_rows, thr, kern, args.out)
         print(f"wrote {args.out / 'benchmark.md'}")

@@ -133,7 +133,9 @@ def _log_ticks(ax) -> None:
     ax.yaxis.set_major_formatter(FuncFormatter(_decade))
 
 
-def _phi_axis(ax, label: bool = True, step: int = 60):
+def _phi_axis(ax, label: bool = True, step: int = 90):
+    """The crank-angle axis 0..360 deg, ticks every `step` (few ticks: each is five artists to
+    make and lay out, the largest share of a panel's drawing time)."""
     ax.set_xlim(0, 360)
     ax.set_xticks(range(0, 361, step))
     if label:
@@ -386,6 +388,7 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
 
 
 def plot_reactions(run: ModelRun, path: Path) -> Path:
+    from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     ncols = _legend_cols(1 + len(run.results), 5)
     fig, axes, cols = _panels(len(m.pairs), f"{m.name}\nreaction magnitudes over the cycle "
@@ -402,6 +405,7 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
         ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
         ax.set_ylabel("|R|, N")
         ax.set_ylim(bottom=0)
+        ax.yaxis.set_major_locator(MaxNLocator(4))
         _phi_axis(ax, label=n_ax + cols >= len(m.pairs))
     for ax in axes[len(m.pairs):]:
         ax.set_visible(False)
@@ -508,7 +512,8 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
             ax.annotate(f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", R[i], xytext=(6, -14), textcoords="offset points",
                         fontsize=7, color="tab:red")
         ax.set_aspect("equal", adjustable="datalim")
-        ax.xaxis.set_major_locator(MaxNLocator(5))      # room for "−4000" on a narrow panel
+        ax.xaxis.set_major_locator(MaxNLocator(4))      # room for "−4000" on a narrow panel
+        ax.yaxis.set_major_locator(MaxNLocator(5))
         ax.grid(True, alpha=0.3)
         ax.set_xlabel("R_x, N")
         ax.set_ylabel("R_y, N")
