@@ -1,6 +1,6 @@
 """All the plans of a variant on A3 landscape sheets, each TRUE TO SCALE (1 mm of the plan's
-drawing = 1 mm on paper, at the scales its heading states), as seed 002 (Logvinenko, Nadtoka
-2021, appendix B) puts them on one A3 sheet.
+drawing = 1 mm on paper, at the scales its heading states): seed 002 (Logvinenko, Nadtoka
+2021, appendix B) puts them on one A3 sheet; here a further sheet takes what does not fit.
 
 Each plan is drawn exactly as its own SVG sheet draws it (`draw.svg`: its lines, arrowheads,
 points and every label where `labels.Placer` put it clear of the others): the `plan` group of

@@ -14,8 +14,8 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
   scales μ_l, μ_v, μ_a, μ_F with the reference length each draws, and every scale each plan is
   drawn at; δ with the texts' 5 % rule; every segment a student measures on the plans, in mm, with
   the scale it is drawn at.
-- `plans_a3.pdf` / `plans.html`: the plans, each true to scale, on one A3 landscape sheet (seed
-  002, appendix B puts the results on A3), on a further sheet where they do not fit (`a3`).
+- `plans_a3.pdf` / `plans.html`: the plans, each true to scale, on A3 landscape sheets (seed
+  002, appendix B puts the results on one A3 sheet): a further sheet where they do not fit (`a3`).
 
 Both documents are one list of blocks (headings, paragraphs, tables, the drawing area), rendered
 twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figure library; TrueType
