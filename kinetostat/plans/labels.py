@@ -148,8 +148,8 @@ class Placer:
     def __init__(self, bounds: tuple[float, float, float, float]):
         self.bounds = bounds
         self._boxes: list[tuple[float, float, float, float]] = []
-        self._samples: list[np.ndarray] = []
-        self._all_samples: np.ndarray | None = None    # their concatenation, made once per change
+        self._lines: list[tuple[float, float, float, float]] = []
+        self._all_samples: np.ndarray | None = None    # the lines' samples, made once per change
         self.placed: list[Placed] = []
 
     def block(self, box) -> None:
@@ -157,11 +157,22 @@ class Placer:
         self._boxes.append(tuple(float(v) for v in box))
 
     def line(self, x0: float, y0: float, x1: float, y1: float) -> None:
-        """A soft obstacle: a drawn line, sampled every 0.7 mm."""
-        n = int(min(max(2.0, math.hypot(x1 - x0, y1 - y0) / 0.7 + 1), 1e4))     # a sheet's length at most
-        t = np.linspace(0.0, 1.0, n)
-        self._samples.append(np.column_stack([x0 + t * (x1 - x0), y0 + t * (y1 - y0)]))
+        """A soft obstacle: a drawn line, sampled every 0.7 mm (`_samples`)."""
+        self._lines.append((x0, y0, x1, y1))
         self._all_samples = None
+
+    def _samples(self) -> np.ndarray:
+        """Every line's samples (M, 2), all lines at once: n = 1 + length / 0.7 mm (2 at least, a
+        sheet's length at most) points from end to end, each line as np.linspace(0, 1, n) puts them."""
+        if self._all_samples is None:
+            x0, y0, x1, y1 = np.asarray(self._lines, float).reshape(-1, 4).T
+            n = np.minimum(np.maximum(2.0, np.hypot(x1 - x0, y1 - y0) / 0.7 + 1), 1e4).astype(int)
+            line = np.repeat(np.arange(len(n)), n)
+            k = np.arange(len(line)) - np.repeat(np.cumsum(n) - n, n)
+            t = k * np.repeat(1.0 / (n - 1), n)
+            t[np.cumsum(n) - 1] = 1.0
+            self._all_samples = np.column_stack([x0[line] + t * (x1 - x0)[line], y0[line] + t * (y1 - y0)[line]])
+        return self._all_samples
 
     def _best(self, boxes: np.ndarray, base: np.ndarray) -> int:
         """Index of the candidate box (K, 4) of least cost: `base` plus 0.6 per line sample inside
@@ -177,8 +188,6 @@ class Placer:
                    & (boxes[:, None, 1] < ob[None, :, 3] + p) & (boxes[:, None, 3] > ob[None, :, 1] - p))
             bad |= hit.any(axis=1)
         cost = np.where(bad, np.inf, base.astype(float))
-        if self._samples and self._all_samples is None:
-            self._all_samples = np.concatenate(self._samples)
         order = np.lexsort((np.arange(len(cost)), cost))
         best, k_best = np.inf, 0
         for start in range(0, len(order), 32):
@@ -186,10 +195,10 @@ class Placer:
             if not (np.isfinite(cost[idx[0]]) and cost[idx[0]] <= best):
                 break
             c = cost[idx]
-            if self._samples:
+            if self._lines:
                 b = boxes[idx]
                 lo, hi = b[:, :2].min(axis=0) - 1, b[:, 2:].max(axis=0) + 1
-                s = self._all_samples
+                s = self._samples()
                 s = s[(s[:, 0] > lo[0]) & (s[:, 0] < hi[0]) & (s[:, 1] > lo[1]) & (s[:, 1] < hi[1])]
                 if len(s):
                     inside = ((s[None, :, 0] > b[:, None, 0]) & (s[None, :, 0] < b[:, None, 2])
