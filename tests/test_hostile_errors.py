@@ -224,7 +224,9 @@ def test_the_drawings_loops_are_bounded_by_a_sheet():
     placer = Placer((0.0, 0.0, 420.0, 297.0))
     placer.line(0.0, 0.0, 1e12, 0.0)
     placer.line(0.0, 0.0, 7.0, 0.0)
-    assert [len(s) for s in placer._samples] == [10_000, 11]
+    s = placer._samples()
+    assert len(s) == 10_000 + 11                        # the first line capped, the second every 0.7 mm
+    assert s[[0, 9_999, 10_000, -1]].tolist() == [[0.0, 0.0], [1e12, 0.0], [0.0, 0.0], [7.0, 0.0]]
 
 
 # ============================================================================ 8. accuracy near singular positions
