@@ -35,7 +35,7 @@ if TYPE_CHECKING:
 
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
-           "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes",
+           "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes", "leash_axes",
            "MODES_CLOSE", "special_point_z", "special_sides", "tracks"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
@@ -221,21 +221,30 @@ def special_sides(mech: "Mechanism", kin: Kinematics, g, at: int = 0) -> tuple:
     return tuple(g.sides[(k + i) % 3] for i in (1, 2, 0))
 
 
-def _special(mech: "Mechanism", kin: Kinematics, g) -> tuple[np.ndarray, np.ndarray]:
-    """S (complex, m) and k (`triad.special_point`), each (N,)."""
-    pts, X, u = mech.points_z, [], []
+def leash_axes(mech: "Mechanism", kin: Kinematics, g) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per leash of triad g (`Triad.sides`' order) a point X of its axis and the axis' unit
+    direction u, each (N,) complex (m; 1): a two-pin leash's inner pin, outer -> inner; a
+    slider's inner pin, its guide's normal; a leash on an inner prismatic pair's outer pin, its
+    guide's normal."""
+    pts, out = mech.points_z, []
     for ell, outer, inner, a in g.sides:
         if inner.kind == "P":
-            X.append(kin.position_z(ell, _xy(pts[ell][outer.point])))
-            u.append(1j * complex(*inner.direction) * kin.rot[:, inner.links[0]])
+            out.append((kin.position_z(ell, _xy(pts[ell][outer.point])),
+                        1j * complex(*inner.direction) * kin.rot[:, inner.links[0]]))
             continue
-        X.append(kin.position_z(ell, _xy(pts[ell][inner.point])))
+        X = kin.position_z(ell, _xy(pts[ell][inner.point]))
         if outer.kind == "R":
-            r = X[-1] - kin.position_z(ell, _xy(pts[ell][outer.point]))
-            u.append(r / np.abs(r))
+            r = X - kin.position_z(ell, _xy(pts[ell][outer.point]))
+            out.append((X, r / np.abs(r)))
         else:
-            u.append(1j * complex(*outer.direction) * kin.rot[:, outer.links[0]])
-    S, _, k = special_point(X[0], u[0], X[1], u[1], X[2], u[2])
+            out.append((X, 1j * complex(*outer.direction) * kin.rot[:, outer.links[0]]))
+    return out
+
+
+def _special(mech: "Mechanism", kin: Kinematics, g) -> tuple[np.ndarray, np.ndarray]:
+    """S (complex, m) and k (`triad.special_point`), each (N,)."""
+    (X1, u1), (X2, u2), (X3, u3) = leash_axes(mech, kin, g)
+    S, _, k = special_point(X1, u1, X2, u2, X3, u3)
     return S, k
 
 

@@ -384,22 +384,23 @@ def _false_positions(kinds: str, x: tuple, P: tuple, c: tuple, L: float, t, sign
 
 def _roots(f3) -> np.ndarray:
     """Indices i where the sampled miss f3 changes sign between i and i + 1."""
-    return np.flatnonzero((f3[:-1] * f3[1:] <= 0) & np.isfinite(f3[:-1] * f3[1:]))
+    p = f3[:-1] * f3[1:]
+    return np.flatnonzero(np.where(np.isfinite(p), p, 1.0) <= 0)
 
 
 def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[complex, complex]]:
     """Every assembly mode (base pose O, e^{i theta}) at one position of the known joints (P, c
     scalars as `misses` reads them), by the texts' method of false positions
-    (`_false_positions`) at MODE_SAMPLES trial angles of the base; each change of sign of the
-    miss is refined by Newton on the whole group. Two modes closer than the samples leave no
-    change of sign: round each local minimum of |miss| the interval of its two neighbours is
+    (`_false_positions`) at MODE_SAMPLES trial angles of the base (half a step off 0, the angle
+    the model draws it at); each change of sign of the miss is refined by Newton on the whole
+    group. Two modes closer than the samples leave no change of sign: round each local minimum of |miss| the interval of its two neighbours is
     sampled MODE_SAMPLES times again and searched the same way. Modes that coincide to 1e-9 L
     are one."""
-    t = np.linspace(0.0, 2 * np.pi, MODE_SAMPLES + 1)
+    t = (np.arange(MODE_SAMPLES + 1) + 0.5) * (2 * np.pi / MODE_SAMPLES)   # the drawn mode, theta = 0, between two
     found: list[tuple[complex, complex]] = []
     for sign in (1.0, -1.0):
         O, rot, f3 = _false_positions(kinds, x, P, c, L, t, sign)
-        a = np.abs(f3)
+        a = np.where(np.isfinite(f3), np.abs(f3), np.inf)
         low = np.flatnonzero((a[1:-1] < a[:-2]) & (a[1:-1] <= a[2:])) + 1
         starts = [(O[_roots(f3)], rot[_roots(f3)])]
         for i in low:

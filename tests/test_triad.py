@@ -15,7 +15,7 @@ from kinetostat.kinematics import assembly_modes, kinematics
 from kinetostat.program import constants, motion_program
 from kinetostat.virtual_work import constraint_jacobian
 
-MODELS = ("triad_six_bar", "triad_slider")
+MODELS = ("triad_six_bar", "triad_slider", "triad_rocking_block")
 PHI = np.arange(0.0, 360.0, 15.0)
 
 
@@ -224,7 +224,8 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
     (fp,) = forces.force_plans(mech, res, mu_F)
     eq = fp.equation
     (l1, _, _, a1), (l2, _, _, a2), (l3, _, _, a3) = kinetostat.kinematics.special_sides(mech, res.kin, g)
-    assert {l1, l2, l3} == {2, 4, 5} and (l1, l2) == ((5, 2) if g.kind == "RRR" else (2, 4))   # S: best-met axes
+    best = {"RRR": (5, 2), "RRP": (2, 4)}[g.kind] if g.inner == "RRR" else (2, 4)     # S: the best-met axes
+    assert {l1, l2, l3} == {2, 4, 5} and (l1, l2) == best
     name = lambda a, ell: forces.reaction_name(mech, a, ell)
     assert eq[-2:] == (name(a1, l1) + "n", name(a2, l2) + "n") and eq[0] == name(a2, l2) + "t"
     n = len(eq)
@@ -239,7 +240,7 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
 def test_the_drawing_error_simulation_refuses_a_triad_by_name(mech):
     from kinetostat.plans import drawing_error
     assert not drawing_error.draws_forces(mech)
-    with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind R.. \(III3 R..\) is not drawn"):
+    with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind R.. \(III3 R..(, inner RRP)?\) is not drawn"):
         drawing_error.simulate(mech, n=10)
 
 
