@@ -247,6 +247,7 @@ class Track:
     steps: int          # Newton solves the continuation made (accepted or not)
     mismatch: float     # m: where the path reaches +-pi from both sides, how far the two poses
                         #   are apart (0 to rounding: the path closes over a turn); nan: a fold
+    sign: float = 0.0   # the sign of the group's Jacobian (`jacobian_det`) along the path
 
     @property
     def full(self) -> bool:
@@ -317,7 +318,7 @@ def track(kinds: str, pins, phi0: float, O0: complex, rot0: complex, x: tuple, L
     u = np.array([-e[0] for e in down[:0:-1]] + [e[0] for e in up])
     closes = abs(up[-1][0] - np.pi) < 1e-12 and abs(down[-1][0] - np.pi) < 1e-12
     mismatch = float(pose_distance(x, up[-1][1], up[-1][2], down[-1][1], down[-1][2])) if closes else np.nan
-    return Track(u, np.array([e[1] for e in both]), np.array([e[2] for e in both]), count, mismatch)
+    return Track(u, np.array([e[1] for e in both]), np.array([e[2] for e in both]), count, mismatch, float(sign))
 
 
 def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L, track):
@@ -326,7 +327,10 @@ def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c
     then per angle the closure (0, or -1 where a leash misses by more than CLOSURE_TOL rounding
     units of L, or the angle lies beyond the track's end: the mode drawn at the design position
     cannot be assembled there), the path (0, or -1 where the closed pose lies more than PREDICT
-    L from the track's: Newton left the mode's path), the Newton steps and the largest miss (m).
+    L from the track's, or where the group's Jacobian has the other sign than along the track:
+    Newton left the mode's path, however near the mode it landed in; one of the same sign
+    nearer than PREDICT L, three modes near a cusp, is not told apart), the Newton steps and
+    the largest miss (m).
     kind<i>: leash i's code (`LEASH_KINDS`); x, P, c as `misses` reads them. Numpy only (it
     reads the whole angle axis), so the compiled path and the Array API path refuse triads by
     name."""
@@ -334,11 +338,13 @@ def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c
     u = np.mod(np.asarray(phi, float) - phi0 + np.pi, 2 * np.pi) - np.pi
     x = (x1, x2, x3)
     O0, rot0, on = track.start(u)
-    O, rot, its, res = _newton(kinds, O0, rot0, x, tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3)),
-                               tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3)), L)
+    P = tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3))
+    c = tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3))
+    O, rot, its, res = _newton(kinds, O0, rot0, x, P, c, L)
     tol = CLOSURE_TOL * _EPS * L
     closed = on & (res <= tol)
-    left = closed & ~(pose_distance(x, O, rot, O0, rot0) <= PREDICT * L)
+    flipped = np.sign(jacobian_det(misses(kinds, O, rot, x, P, c), O)) != track.sign
+    left = closed & (~(pose_distance(x, O, rot, O0, rot0) <= PREDICT * L) | flipped)
     return O, rot, np.where(closed, 0.0, -1.0), np.where(left, -1.0, 0.0), its.astype(float), res
 
 
