@@ -177,8 +177,9 @@ def line_tangential(u, F):
 
 
 def iii3_polygon(S, X1, X2, X3, u1, u2, u3, det, k, T1, T2, T3, P1, P2, P3, m1, m2, m3, F, MS):
-    """Reactions in the texts' order. T_i: leash i's R^tau (from its moment about its inner pin),
-    acting at P_i (a slider: T = 0 and the couple m_i); F, MS: the group's known loads (sum of
+    """Reactions in the texts' order. T_i: leash i's R^tau (a two-pin leash's from its moment
+    about its inner pin, `rr_tangential`; on an inner prismatic pair from its forces along the
+    guide, `line_tangential`), acting at P_i (a slider: T = 0 and the couple m_i); F, MS: the group's known loads (sum of
     forces; moment about S). R^n of the leash off S (k) from the group's moment about S (the
     other two pass through S), then theirs from the group's force polygon. Returns the
     magnitudes along u_1, u_2, u_3."""
@@ -247,7 +248,7 @@ class Track:
     steps: int          # Newton solves the continuation made (accepted or not)
     mismatch: float     # m: where the path reaches +-pi from both sides, how far the two poses
                         #   are apart (0 to rounding: the path closes over a turn); nan: a fold
-    sign: float = 0.0   # the sign of the group's Jacobian (`jacobian_det`) along the path
+    sign: float         # the sign of the group's Jacobian (`jacobian_det`) along the path
 
     @property
     def full(self) -> bool:
