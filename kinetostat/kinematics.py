@@ -28,14 +28,14 @@ from .errors import AssemblyError, ModelWarning, SingularPositionWarning, singul
 from .planar import as_xy
 from .program import Program, Step, constants, motion_program, run
 from .sizes import group_scales, kinematic_size
-from .triad import PREDICT, modes, special_point, track
+from .triad import PREDICT, leash_kinds, modes, special_point, track
 
 if TYPE_CHECKING:
     from .model import Mechanism
 
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
-           "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes",
+           "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes", "leash_axes",
            "MODES_CLOSE", "special_point_z", "special_sides", "tracks"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
@@ -187,21 +187,13 @@ def assembly_modes(mech: "Mechanism") -> tuple[AssemblyModes, ...]:
         triads = [(n, g) for n, g in enumerate(mech.structure.groups) if g.klass == 3]
         if not triads:
             return ()
-        kin = _solve(mech, np.radians([mech.drive.design_deg]), mech.points_z)
-        pts, out = mech.points_z, []
+        phi0 = np.radians([mech.drive.design_deg])
+        kin, out = _solve(mech, phi0, mech.points_z), []
         for n, g in triads:
             b, L = g.links[0], group_scales(mech)[n]
-            x, P, c = [], [], []
-            for i in range(3):
-                po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
-                x.append(pts[b][pi.point])
-                if po.kind == "R":
-                    P.append(complex(kin.position_z(a, _xy(pts[a][po.point]))[0]))
-                    c.append(abs(pts[ell][pi.point] - pts[ell][po.point]))
-                else:                   # the guide line through the pin as solved, its normal
-                    P.append(complex(kin.position_z(ell, _xy(pts[ell][pi.point]))[0]))
-                    c.append(complex(1j * kin.rot[0, a] * complex(*po.direction)))
-            found = modes("".join(g.pairs[2 * i].kind for i in range(3)), tuple(x), tuple(P), tuple(c), L)
+            kinds, x, known = _known_joints(mech, n, {**constants(mech), **tracks(mech), "w_in": 1.0, "e_in": 0.0})
+            P, c = known(phi0)
+            found = modes(kinds, x, tuple(complex(v[0]) for v in P), tuple(complex(v[0]) for v in c), L)
             pins = lambda O, r: np.array([O + xi * r for xi in x])
             solved = pins(kin.origin_z[0, b], kin.rot[0, b])
             apart = [float(np.abs(pins(O, r) - solved).max()) for O, r in found]
@@ -217,7 +209,8 @@ def assembly_modes(mech: "Mechanism") -> tuple[AssemblyModes, ...]:
 def special_point_z(mech: "Mechanism", kin: Kinematics, g) -> np.ndarray:
     """(N,) complex, m: Assur's special point S of triad g as the solver takes it, where the two
     leash axes meeting at the best angle cross (a two-pin leash's axis: outer pin -> inner pin;
-    a slider's: the guide's normal through its pin)."""
+    a slider's: the guide's normal through its inner pin; a leash on an inner prismatic pair:
+    the guide's normal through its outer pin)."""
     return _special(mech, kin, g)[0]
 
 
@@ -228,17 +221,30 @@ def special_sides(mech: "Mechanism", kin: Kinematics, g, at: int = 0) -> tuple:
     return tuple(g.sides[(k + i) % 3] for i in (1, 2, 0))
 
 
+def leash_axes(mech: "Mechanism", kin: Kinematics, g) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per leash of triad g (`Triad.sides`' order) a point X of its axis and the axis' unit
+    direction u, each (N,) complex (m; 1): a two-pin leash's inner pin, outer -> inner; a
+    slider's inner pin, its guide's normal; a leash on an inner prismatic pair's outer pin, its
+    guide's normal."""
+    pts, out = mech.points_z, []
+    for ell, outer, inner, a in g.sides:
+        if inner.kind == "P":
+            out.append((kin.position_z(ell, _xy(pts[ell][outer.point])),
+                        1j * complex(*inner.direction) * kin.rot[:, inner.links[0]]))
+            continue
+        X = kin.position_z(ell, _xy(pts[ell][inner.point]))
+        if outer.kind == "R":
+            r = X - kin.position_z(ell, _xy(pts[ell][outer.point]))
+            out.append((X, r / np.abs(r)))
+        else:
+            out.append((X, 1j * complex(*outer.direction) * kin.rot[:, outer.links[0]]))
+    return out
+
+
 def _special(mech: "Mechanism", kin: Kinematics, g) -> tuple[np.ndarray, np.ndarray]:
     """S (complex, m) and k (`triad.special_point`), each (N,)."""
-    pts, X, u = mech.points_z, [], []
-    for ell, outer, inner, a in g.sides:
-        X.append(kin.position_z(ell, _xy(pts[ell][inner.point])))
-        if outer.kind == "R":
-            r = X[-1] - kin.position_z(ell, _xy(pts[ell][outer.point]))
-            u.append(r / np.abs(r))
-        else:
-            u.append(1j * complex(*outer.direction) * kin.rot[:, a])
-    S, _, k = special_point(X[0], u[0], X[1], u[1], X[2], u[2])
+    (X1, u1), (X2, u2), (X3, u3) = leash_axes(mech, kin, g)
+    S, _, k = special_point(X1, u1, X2, u2, X3, u3)
     return S, k
 
 
@@ -322,26 +328,13 @@ def tracks(mech: "Mechanism") -> dict[str, Any]:
     before the group's (run on that one angle). A ModelWarning where the path does not close
     over a turn (the two ways round meet in different poses)."""
     def make() -> dict[str, Any]:
-        prog, out = motion_program(mech), {}
+        out: dict[str, Any] = {}
         env = dict(constants(mech), w_in=1.0, e_in=0.0)
         phi0 = math.radians(mech.drive.design_deg)
         for n, g in enumerate(mech.structure.groups):
             if g.klass != 3:
                 continue
-            at = next(i for i, st in enumerate(prog.steps) if st.fn == "iii3_positions" and f"it{n}" in st.out)
-            args = prog.steps[at].args
-            kinds = "".join("P" if s else "R" for s in args[2:5])
-            wanted = tuple(Step("same", (a,), (f"pin{n}_{i}",)) for i, a in enumerate(args[8:14]))
-            head = Program(prog.steps[:at] + wanted, ("phi",), tuple(st.out[0] for st in wanted))
-
-            def pins(phi, head=head, env={**env, **out}):
-                try:
-                    got = run(head, {**env, "phi": phi})
-                except AssemblyError:
-                    return None
-                vals = [np.broadcast_to(got[f"pin{n}_{i}"], phi.shape) for i in range(6)]
-                return tuple(vals[:3]), tuple(vals[3:])
-            x = tuple(env[a] for a in args[5:8])
+            kinds, x, pins = _known_joints(mech, n, {**env, **out})
             out[f"track{n}"] = tr = track(kinds, pins, phi0, 0j, 1 + 0j, x, group_scales(mech)[n])
             if tr.mismatch > PREDICT * group_scales(mech)[n]:
                 warnings.warn(ModelWarning(
@@ -351,6 +344,30 @@ def tracks(mech: "Mechanism") -> dict[str, Any]:
                     stacklevel=6)
         return out
     return mech.memo("triad tracks", make)
+
+
+def _known_joints(mech: "Mechanism", n: int, env: Mapping[str, Any]) -> tuple[str, tuple, Any]:
+    """Triad n's leash kinds, its x as `triad.misses` reads them (constants: from the program's
+    steps that derive constants) and pins(phi): the known joints' (P, c) at the angles phi (rad,
+    (m,)) from the motion program's steps before the group's, run in `env` (None where an
+    earlier group does not close there)."""
+    prog = motion_program(mech)
+    at = next(i for i, st in enumerate(prog.steps) if st.fn == "iii3_positions" and f"it{n}" in st.out)
+    args = prog.steps[at].args
+    wanted = tuple(Step("same", (a,), (f"pin{n}_{i}",)) for i, a in enumerate(args[5:14]))
+    consts = tuple(st for st in prog.steps[:at] if all(o.startswith("c_") for o in st.out))
+    got = run(Program(consts + wanted[:3], (), tuple(st.out[0] for st in wanted[:3])), dict(env))
+    x = tuple(complex(got[f"pin{n}_{i}"]) for i in range(3))
+    head = Program(prog.steps[:at] + wanted[3:], ("phi",), tuple(st.out[0] for st in wanted[3:]))
+
+    def pins(phi):
+        try:
+            got = run(head, {**env, "phi": phi})
+        except AssemblyError:
+            return None
+        vals = [np.broadcast_to(got[f"pin{n}_{i}"], phi.shape) for i in range(3, 9)]
+        return tuple(vals[:3]), tuple(vals[3:])
+    return leash_kinds(args[2:5]), x, pins
 
 
 def assemble(mech: "Mechanism", phi, env: Mapping[str, Any], xp: Any = np) -> Kinematics:

@@ -288,21 +288,28 @@ class _Motion(_Build):
     def iii3(self, n: int, g: "Triad") -> None:
         """III3: the base link's pose by Newton with continuation (`triad.iii3_positions`), then
         the plans at Assur's special point S (the two leash axes meeting at the best angle) as
-        2x2 solves."""
+        2x2 solves. A leash (`triad.LEASH_KINDS`): (kind, x on the base, P, c as `triad.misses`
+        reads them, then the outer pin's velocity and acceleration; a slider's: its guide's world
+        direction)."""
         b = g.links[0]
         X, leash = [], []
         for i in range(3):
             po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
-            if po.kind == "R":
+            if po.kind == "R" and pi.kind == "R":
                 A, VA, AA = self.point(a, po.point)
-                leash.append(("R", A, self.length(ell, pi.point, po.point), VA, AA))
-            else:
+                leash.append(("R", _x(b, pi.point), A, self.length(ell, pi.point, po.point), VA, AA))
+            elif po.kind == "P":
                 d = self.guide(po, a, self.frame_of(a)[1])
                 K = self.call("off_line", self.position(a, self.anchor(po, a)), self.offset(po, ell, pi.point), d)
-                leash.append(("P", K, self.call("times", d, 1j), d))
+                leash.append(("P", _x(b, pi.point), K, self.call("times", d, 1j), d))
+            else:                # the base's line through A, at A's offset from the guide (local to the base)
+                A, VA, AA = self.point(a, po.point)
+                d = f"d{pi.index}" if b == pi.links[0] else 1.0
+                x = self.const("off_line", _x(b, self.anchor(pi, b)), self.offset(pi, ell, po.point), d)
+                leash.append(("L", x, A, self.const("times", d, 1j), VA, AA))
         O, rot, closure, path, _, _ = self.call(
-            "iii3_positions", "phi", "phi_design", *(float(m[0] == "P") for m in leash),
-            *(_x(b, g.pairs[2 * i + 1].point) for i in range(3)), *(m[1] for m in leash), *(m[2] for m in leash),
+            "iii3_positions", "phi", "phi_design", *(float(triad.LEASH_KINDS.index(m[0])) for m in leash),
+            *(m[1] for m in leash), *(m[2] for m in leash), *(m[3] for m in leash),
             f"L{n}", f"track{n}", out=(self.tmp(), self.tmp(), self.tmp(), self.tmp(), f"it{n}", f"res{n}"))
         self.steps.append(Step("check", (closure, 0.0), (), g.label, "the three leashes do not close in the mode "
                                "drawn at the design position: the crank cannot reach these angles from there"))
@@ -310,38 +317,51 @@ class _Motion(_Build):
                                "mode is near"))
         u = []
         for i, m in enumerate(leash):
-            X.append(self.call("place", O, rot, _x(b, g.pairs[2 * i + 1].point)))
-            u.append(self.call("leash_rr" if m[0] == "R" else "leash_slider", X[i], m[1], m[2], out=2)[0])
+            K = self.call("place", O, rot, m[1])
+            if m[0] == "L":           # the axis: the base's line's normal through the outer pin
+                X.append(m[2])
+                u.append(self.call("leash_slider", K, m[2], self.call("times", m[3], rot), out=2)[0])
+            else:
+                X.append(K)
+                u.append(self.call("leash_rr" if m[0] == "R" else "leash_slider", K, m[2], m[3], out=2)[0])
         S, det, k = self.call("special_point", X[0], u[0], X[1], u[1], X[2], u[2], out=3)
-        ref = [m[3] if m[0] == "R" else self.at(g.known[i], X[i])[0] for i, m in enumerate(leash)]
+        ref = [self.at(g.known[i], X[i])[0] if m[0] == "P" else m[4] for i, m in enumerate(leash)]
         vS, w, h = self.call("iii3_velocity", S, *X, *u, det, k, *ref, out=3)
         VX = [self.call("motion_at", S, vS, 0.0, w, 0.0, Xi, out=2)[0] for Xi in X]
-        normal = [self.leash_motion(g, i, m, X[i], VX[i], 0.0)[2] for i, m in enumerate(leash)]
-        acc = [m[4] if m[0] == "R" else self.at(g.known[i], X[i])[1] for i, m in enumerate(leash)]
+        normal = [self.leash_motion(g, i, m, X[i], u[i], VX[i], 0.0, w)[2] for i, m in enumerate(leash)]
+        acc = [self.at(g.known[i], X[i])[1] if m[0] == "P" else m[5] for i, m in enumerate(leash)]
         aS, e = self.call("iii3_acceleration", S, *X, *u, det, k, h, w, *acc, *normal, out=2)
         th = self.call("phase", rot)
         self.set_link(b, th, rot, S, self.call("local_of", S, O, rot), w, vS, e, aS)
         for i, m in enumerate(leash):
             po, pi, ell, a = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i], g.known[i]
             AX = self.call("motion_at", S, vS, aS, w, e, X[i], out=2)[1]
-            w_l, e_l, _ = self.leash_motion(g, i, m, X[i], VX[i], AX)
+            w_l, e_l, _ = self.leash_motion(g, i, m, X[i], u[i], VX[i], AX, w)
             if m[0] == "R":
-                self.set_link(ell, *self.aligned(ell, po.point, pi.point, self.call("sub", X[i], m[1])), m[1],
-                              _x(ell, po.point), w_l, m[3], e_l, m[4])
-            else:
+                self.set_link(ell, *self.aligned(ell, po.point, pi.point, self.call("sub", X[i], m[2])), m[2],
+                              _x(ell, po.point), w_l, m[4], e_l, m[5])
+            elif m[0] == "P":
                 wa, ea = (f"w{a}", f"e{a}") if a else (0.0, 0.0)
                 self.set_link(ell, *self.turned(po, ell, *self.frame_of(a)), X[i], _x(ell, pi.point), wa, VX[i], ea, AX)
                 self.slide(po, ell, w_l, e_l)
+            else:                     # turns with the base; its pin A moves with the known link
+                self.set_link(ell, *self.turned(pi, ell, th, rot), X[i], _x(ell, po.point), w, m[4], e, m[5])
+                self.slide(pi, ell, w_l, e_l)
         self.steps.append(Step("iii3_condition", (*u, det, k, h, f"L{n}"), (f"cond{n}",)))
 
-    def leash_motion(self, g: "Triad", i: int, m: tuple, X, VX, AX) -> tuple:
-        """Leash i's (omega, eps, normal term), a slider's (v_r, a_r, Coriolis term), given the
-        motion VX, AX of its inner pin X."""
+    def leash_motion(self, g: "Triad", i: int, m: tuple, X, u, VX, AX, w) -> tuple:
+        """Leash i's (omega, eps, normal term) given the motion VX, AX of the base's point at X
+        (its axis' point); a slider's (v_r, a_r, Coriolis term) on the known link's line; a
+        leash on an inner prismatic pair the same of its outer pin A (at X) on the base's line
+        (turning at w, the base's omega), the term taken to the base's side: -2 w v_r."""
         if m[0] == "R":
-            return self.call("rr_leash_motion", X, m[1], VX, m[3], AX, m[4], out=3)
-        a = g.known[i]
-        VXa, AXa = self.at(a, X)
-        return self.call("slider_leash_motion", m[3], VX, VXa, AX, AXa, f"w{a}" if a else 0.0, out=3)
+            return self.call("rr_leash_motion", X, m[2], VX, m[4], AX, m[5], out=3)
+        if m[0] == "P":
+            a = g.known[i]
+            VXa, AXa = self.at(a, X)
+            return self.call("slider_leash_motion", m[4], VX, VXa, AX, AXa, f"w{a}" if a else 0.0, out=3)
+        vr, ar, cor = self.call("slider_leash_motion", self.call("times", u, -1j), m[4], VX, m[5], AX, w, out=3)
+        return vr, ar, self.call("scaled", cor, -1.0)
 
     def frame_of(self, k: int) -> tuple:
         """Angle and e^{i theta} of link k (the frame's are constants)."""
@@ -469,13 +489,22 @@ class _Statics(_Build):
         self.carry(c, f_ck, B, m_ck)
 
     def iii3(self, g: "Triad") -> None:
-        """III3 in the texts' order: R^tau of each leash from its moment about its inner pin; R^n
+        """III3 in the texts' order: R^tau of each leash (a two-pin leash's from its moment about
+        its inner pin; on an inner prismatic pair, from its force balance along the guide); R^n
         of leash 3 from the group's moment about S; R^n of leashes 1, 2 from the group's force
-        polygon; the inner reactions from each leash's polygon (S: `triad.special_point`)."""
+        polygon; the inner reactions from each leash's polygon (S: `triad.special_point`), a
+        prismatic pair's acting where the leash's moment about its outer pin puts it."""
         b = g.links[0]
         X, u, T, P, m = [], [], [], [], []
         for i in range(3):
             po, pi, ell = g.pairs[2 * i], g.pairs[2 * i + 1], g.links[1 + i]
+            if pi.kind == "P":                 # the axis: the guide's normal through the outer pin
+                X.append(self.at(ell, po.point))
+                P.append(X[i])
+                u.append(self.normal(pi))
+                T.append(self.call("line_tangential", u[i], f"F{ell}"))
+                m.append(0.0)
+                continue
             X.append(self.at(b, pi.point))
             if po.kind == "R":
                 P.append(self.at(ell, po.point))
@@ -502,7 +531,11 @@ class _Statics(_Build):
             else:
                 R = self.prismatic(po, a, N[i], u[i], m[i], X[i])
                 self.carry(a, R, X[i], m[i])
-            self.revolute(pi, ell, self.call("add", f"F{ell}", R))
+            inner = self.call("add", f"F{ell}", R)         # the leash on the base
+            if pi.kind == "R":
+                self.revolute(pi, ell, inner)
+            else:
+                self.prismatic(pi, ell, self.call("dot", inner, u[i]), u[i], self.moment(ell, X[i]), X[i])
 
     def rpp(self, g: "AssurGroup") -> None:
         (pj, pin, pk), (j, k), (a, c) = g.pairs, g.links, g.known

@@ -81,9 +81,13 @@ class AssurGroup:
 @dataclass(frozen=True)
 class Triad:
     """The class-III, order-3 Assur group III3 of the base link `links[0]` and the leashes
-    `links[1:]`: leash i joins the base at its inner pair `pairs[2i + 1]` (revolute) and the
-    link `known[i]`, already attached, at its outer pair `pairs[2i]` (revolute, or prismatic with
-    the guide on the known link: a slider). `kind` reads the outer pairs, e.g. "RRR" or "RRP".
+    `links[1:]`: leash i joins the base at its inner pair `pairs[2i + 1]` and the link
+    `known[i]`, already attached, at its outer pair `pairs[2i]`. A leash's pairs: both revolute
+    (a two-pin leash); an outer prismatic pair, the guide on either link, and an inner revolute
+    (a slider: the inner pin runs on a line carried by the known link); or an outer revolute and
+    an inner prismatic, the guide on either link (the leash turns with the base: a line carried
+    by the base runs through the outer pin). `kind` reads the outer pairs, e.g. "RRR" or "RRP",
+    `inner` the inner pairs.
     Assur's special point S is where two leash axes meet: per angle the two that meet at the
     best angle (`triad.special_point`), any two may define it.
     The assembly mode is the one the model's points draw at the design position (no branch)."""
@@ -95,8 +99,13 @@ class Triad:
     klass = 3
 
     @property
+    def inner(self) -> str:
+        """The inner pairs' kinds, leash by leash, e.g. "RRR" or "RRP"."""
+        return "".join(self.pairs[2 * i + 1].kind for i in range(3))
+
+    @property
     def vid(self) -> str:
-        return f"III3 {self.kind}"
+        return f"III3 {self.kind}" + ("" if self.inner == "RRR" else f", inner {self.inner}")
 
     @property
     def sides(self) -> tuple[tuple[int, KinematicPair, KinematicPair, int], ...]:
@@ -111,7 +120,8 @@ class Triad:
         """One line for the structure listing: base, leashes with their outer and inner pairs."""
         leashes = "; ".join(f"leash {i + 1} link {self.links[1 + i]}: outer {self.pairs[2 * i].label} (to link "
                             f"{self.known[i]}), inner {self.pairs[2 * i + 1].label}" for i in range(3))
-        return (f"{self.label}  class III, order 3 (III3, outer pairs {self.kind})  base link {self.links[0]}; "
+        inner = "" if self.inner == "RRR" else f", inner pairs {self.inner}"
+        return (f"{self.label}  class III, order 3 (III3, outer pairs {self.kind}{inner})  base link {self.links[0]}; "
                 f"{leashes}; mode: as drawn at the design position")
 
     def __repr__(self) -> str:
@@ -236,7 +246,8 @@ def _triad(n_links: int, at: Sequence[Sequence[KinematicPair]], known: set[int],
            out: Sequence[Sequence[KinematicPair]]) -> Triad | None:
     """The first triad III3 among the links not attached: a base link with exactly three pairs,
     none to an attached link, each to a leash that has exactly two pairs, one of them to an
-    attached link. Raises StructureError for a triad whose pairs the solver does not take."""
+    attached link. Raises StructureError, naming the group, the leash and its pairs, for a leash
+    with two prismatic pairs (it only locks the base's angle to the known link's: no axis)."""
     for b in range(2, n_links):
         if b in known or out[b] or len(at[b]) != 3:
             continue
@@ -247,13 +258,13 @@ def _triad(n_links: int, at: Sequence[Sequence[KinematicPair]], known: set[int],
         pairs: list[KinematicPair] = []
         for i in order:
             x, inner, outer = leashes[i], at[b][i], out[leashes[i]][0]
-            label = "III(" + ",".join(map(str, sorted([b, *leashes]))) + ")"
-            if inner.kind != "R" or (outer.kind == "P" and outer.links[1] != x):
+            if inner.kind == "P" and outer.kind == "P":
+                label = "III(" + ",".join(map(str, sorted([b, *leashes]))) + ")"
                 raise StructureError(
-                    f"triad {label}: leash {x} joins the base {b} by a {inner.kind} pair and link "
-                    f"{(set(outer.links) - {x}).pop()} by a {outer.kind} pair; kinetostat takes leashes "
-                    f"with a revolute inner pair and a revolute outer pair, or a slider (outer P pair, "
-                    f"the guide on the attached link)")
+                    f"triad {label}: leash {x} joins the base {b} by the prismatic pair {inner.label} and link "
+                    f"{(set(outer.links) - {x}).pop()} by the prismatic pair {outer.label}; kinetostat takes a leash "
+                    f"with at most one prismatic pair (two lock the base's angle to the known link's, a group "
+                    f"the special point S does not solve)")
             pairs += [outer, inner]
         ls = tuple(leashes[i] for i in order)
         return Triad("".join(pairs[2 * i].kind for i in range(3)), (b, *ls), tuple(pairs),

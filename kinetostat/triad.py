@@ -2,8 +2,14 @@
 link with the inner joints X1, X2, X3 and three leashes to known joints. Written with the
 primitives of `groups`, in the same elementwise style:
 
-- a leash's axis u (unit) and its miss f: a two-pin leash A-X (u along A -> X, f = |AX| - l),
-  or a slider whose pin X runs on a guide line (u the line's normal, f = (X - K) . u);
+- a leash's axis u (unit) and its miss f, by the kind of its pairs (`LEASH_KINDS`): "R" a
+  two-pin leash A-X (u along A -> X, f = |AX| - l); "P" a slider, the inner pin X running on a
+  line carried by the known link (the outer pair prismatic, its guide on either link; u the
+  line's normal, f = (X - K) . u); "L" a leash on an inner prismatic pair (its guide on either
+  link): it turns with the base, so a line carried by the base runs through its outer pin A (u
+  the line's normal through A, f = (K - A) . u, K the line's point; the same `leash_slider`
+  with the roles of the pin and the line's point swapped). The reaction of a prismatic pair
+  is normal to its guide: each leash's unknown is its reaction's part along its axis;
 - Assur's special point S, per angle where the two leash axes meeting at the best angle cross
   (any two may define it), taken as a point of the base: every linear solve of the group (a
   Newton step of the positions, the velocity and acceleration plans, the reactions) is
@@ -27,9 +33,9 @@ import numpy as xp
 
 from .groups import cis, cross, dot, magnitude, over, solve2
 
-__all__ = ["leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
+__all__ = ["LEASH_KINDS", "leash_kinds", "leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
-           "rr_tangential", "iii3_polygon", "iii3_positions", "track", "Track", "pose_distance", "jacobian_det", "misses", "modes",
+           "rr_tangential", "line_tangential", "iii3_polygon", "iii3_positions", "track", "Track", "pose_distance", "jacobian_det", "misses", "modes",
            "MODE_SAMPLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
 
 #: The continuation's longest step along the crank's path (rad).
@@ -48,9 +54,17 @@ MOVE = 0.05
 MAX_ITER = 40
 #: The largest miss of a leash accepted as closed, in rounding units of the group's size.
 CLOSURE_TOL = 1e3
-#: Trial positions of leash 1 per turn (or along a slider's line) in the search for the modes.
+#: Trial angles of the base per turn in the search for the modes.
 MODE_SAMPLES = 3600
 _EPS = np.finfo(float).eps
+#: The kinds of leash by their code 0, 1, 2 (a program passes the code, a float): "R" two-pin,
+#: "P" a slider on a line of the known link, "L" a line of the base through the outer pin.
+LEASH_KINDS = "RPL"
+
+
+def leash_kinds(codes) -> str:
+    """The leashes' kinds ("R", "P", "L") from their codes (0., 1., 2.)."""
+    return "".join(LEASH_KINDS[int(c)] for c in codes)
 
 
 # -- elementwise equations (bound and rebound like `groups`)
@@ -155,9 +169,17 @@ def rr_tangential(u, MX, l):
     return 1j * u * (MX / l)
 
 
+def line_tangential(u, F):
+    """R^tau of a leash on an inner prismatic pair (the guide's normal u), on it at its outer
+    pin, from the leash's force balance along the guide (the base pushes only along u):
+    R^tau + F - (F . u) u = 0, F the leash's known loads."""
+    return dot(F, u) * u - F
+
+
 def iii3_polygon(S, X1, X2, X3, u1, u2, u3, det, k, T1, T2, T3, P1, P2, P3, m1, m2, m3, F, MS):
-    """Reactions in the texts' order. T_i: leash i's R^tau (from its moment about its inner pin),
-    acting at P_i (a slider: T = 0 and the couple m_i); F, MS: the group's known loads (sum of
+    """Reactions in the texts' order. T_i: leash i's R^tau (a two-pin leash's from its moment
+    about its inner pin, `rr_tangential`; on an inner prismatic pair from its forces along the
+    guide, `line_tangential`), acting at P_i (a slider: T = 0 and the couple m_i); F, MS: the group's known loads (sum of
     forces; moment about S). R^n of the leash off S (k) from the group's moment about S (the
     other two pass through S), then theirs from the group's force polygon. Returns the
     magnitudes along u_1, u_2, u_3."""
@@ -177,13 +199,16 @@ def pose_distance(x: tuple, O1, rot1, O2, rot2):
 
 
 def misses(kinds: str, O, rot, x: tuple, P: tuple, c: tuple):
-    """Per leash the world inner pin X_i, axis u_i and miss f_i at the pose (O, rot); kinds[i]
-    "R" (two-pin leash: P_i the outer pin, c_i the length) or "P" (slider: P_i a point of the
-    guide line, c_i its unit normal)."""
+    """Per leash a world point X_i of its axis (the inner pin; "L": the outer pin), its axis u_i
+    and miss f_i at the pose (O, rot); kinds[i] "R" (two-pin leash: x_i the inner pin, P_i the
+    outer pin, c_i the length), "P" (slider: x_i the inner pin, P_i a point of the guide line,
+    c_i its unit normal) or "L" (x_i a point of the base's line through the outer pin P_i, c_i
+    its unit normal in the base's frame)."""
     out = []
     for k, xi, Pi, ci in zip(kinds, x, P, c):
         X = O + xi * rot
-        out.append((X, *(leash_rr(X, Pi, ci) if k == "R" else leash_slider(X, Pi, ci))))
+        out.append((X, *leash_rr(X, Pi, ci)) if k == "R" else (X, *leash_slider(X, Pi, ci)) if k == "P" else
+                   (Pi, *leash_slider(X, Pi, ci * rot)))
     return out
 
 
@@ -223,6 +248,7 @@ class Track:
     steps: int          # Newton solves the continuation made (accepted or not)
     mismatch: float     # m: where the path reaches +-pi from both sides, how far the two poses
                         #   are apart (0 to rounding: the path closes over a turn); nan: a fold
+    sign: float         # the sign of the group's Jacobian (`jacobian_det`) along the path
 
     @property
     def full(self) -> bool:
@@ -293,27 +319,33 @@ def track(kinds: str, pins, phi0: float, O0: complex, rot0: complex, x: tuple, L
     u = np.array([-e[0] for e in down[:0:-1]] + [e[0] for e in up])
     closes = abs(up[-1][0] - np.pi) < 1e-12 and abs(down[-1][0] - np.pi) < 1e-12
     mismatch = float(pose_distance(x, up[-1][1], up[-1][2], down[-1][1], down[-1][2])) if closes else np.nan
-    return Track(u, np.array([e[1] for e in both]), np.array([e[2] for e in both]), count, mismatch)
+    return Track(u, np.array([e[1] for e in both]), np.array([e[2] for e in both]), count, mismatch, float(sign))
 
 
-def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L, track):
+def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L, track):
     """The program's step: the base link's pose O, e^{i theta} at the crank angles phi (rad),
     closed by Newton on all the angles at once from the `track` (a Track) interpolated at each;
     then per angle the closure (0, or -1 where a leash misses by more than CLOSURE_TOL rounding
     units of L, or the angle lies beyond the track's end: the mode drawn at the design position
     cannot be assembled there), the path (0, or -1 where the closed pose lies more than PREDICT
-    L from the track's: Newton left the mode's path), the Newton steps and the largest miss (m).
-    slider<i>: 1.0 where leash i is a slider, else 0.0. Numpy only (it reads the whole angle
-    axis), so the compiled path and the Array API path refuse triads by name."""
-    kinds = "".join("P" if s else "R" for s in (slider1, slider2, slider3))
+    L from the track's, or where the group's Jacobian has the other sign than along the track:
+    Newton left the mode's path, however near the mode it landed in; one of the same sign
+    nearer than PREDICT L, three modes near a cusp, is not told apart), the Newton steps and
+    the largest miss (m).
+    kind<i>: leash i's code (`LEASH_KINDS`); x, P, c as `misses` reads them. Numpy only (it
+    reads the whole angle axis), so the compiled path and the Array API path refuse triads by
+    name."""
+    kinds = leash_kinds((kind1, kind2, kind3))
     u = np.mod(np.asarray(phi, float) - phi0 + np.pi, 2 * np.pi) - np.pi
     x = (x1, x2, x3)
     O0, rot0, on = track.start(u)
-    O, rot, its, res = _newton(kinds, O0, rot0, x, tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3)),
-                               tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3)), L)
+    P = tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3))
+    c = tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3))
+    O, rot, its, res = _newton(kinds, O0, rot0, x, P, c, L)
     tol = CLOSURE_TOL * _EPS * L
     closed = on & (res <= tol)
-    left = closed & ~(pose_distance(x, O, rot, O0, rot0) <= PREDICT * L)
+    flipped = np.sign(jacobian_det(misses(kinds, O, rot, x, P, c), O)) != track.sign
+    left = closed & (~(pose_distance(x, O, rot, O0, rot0) <= PREDICT * L) | flipped)
     return O, rot, np.where(closed, 0.0, -1.0), np.where(left, -1.0, 0.0), its.astype(float), res
 
 
@@ -321,51 +353,61 @@ def iii3_positions(phi, phi0, slider1, slider2, slider3, x1, x2, x3, P1, P2, P3,
 #: iii3_positions are elementwise.
 EQUATIONS = ("leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
              "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion", "rr_tangential",
-             "iii3_polygon", "iii3_positions")
+             "line_tangential", "iii3_polygon", "iii3_positions")
+
+
+def _locus(kind: str, x, P, c, rot):
+    """Where leash `kind` (x, P, c as `misses` reads them) lets the base's origin O lie when the
+    base is at the angle rot: a circle (centre, radius) for a two-pin leash, else a line (a
+    point of it, its unit normal)."""
+    return P - x * rot, (c * rot if kind == "L" else c)
 
 
 def _false_positions(kinds: str, x: tuple, P: tuple, c: tuple, L: float, t, sign: float):
-    """The method of false positions at the trial parameters t of leash 1 (a two-pin leash's
-    angle about its outer pin; a slider's pin along its line over +-4 L as t runs over 2 pi):
-    the base turned about leash 1's inner pin until leash 2 closes (on the side `sign`, as a
-    dyad closes), and the miss of leash 3 (NaN where leash 2 cannot close). Returns O, rot, f3."""
-    X1 = P[0] + c[0] * cis(t) if kinds[0] == "R" else P[0] + 1j * c[0] * (4 * L) * (t / np.pi - 1.0)
-    r12 = x[1] - x[0]
-    rho = abs(r12)
-    if kinds[1] == "R":         # C on the circle (X1, rho) and on the circle (A2, l2)
-        d = P[1] - X1
+    """The method of false positions at the trial angles t of the base (rad): each leash puts
+    its origin on a circle or a line (`_locus`); the first two of the leashes taken two-pin
+    first, then "L", then sliders close it (two circles or a circle and a line on the side
+    `sign`; two lines meet once), and the third's miss is measured (NaN where the two cannot
+    close). Returns O, rot, f3."""
+    rot = cis(t)
+    i, j, k = sorted(range(3), key=lambda n: "RLP".index(kinds[n]))
+    (Ci, ri), (Cj, rj) = _locus(kinds[i], x[i], P[i], c[i], rot), _locus(kinds[j], x[j], P[j], c[j], rot)
+    if kinds[j] == "R":         # two circles
+        d = Cj - Ci
         dd = np.abs(d)
-        along = (rho**2 - c[1]**2 + dd**2) / (2 * dd)
-        C = X1 + d / dd * (along + 1j * sign * np.sqrt(np.maximum(rho**2 - along**2, 0.0)))
-        ok = rho**2 - along**2 >= 0
-    else:                       # C on the circle (X1, rho) and on the line (K2, normal n2)
-        foot = X1 - dot(X1 - P[1], c[1]) * c[1]
-        h2 = rho**2 - np.abs(foot - X1)**2
-        C = foot + sign * 1j * c[1] * np.sqrt(np.maximum(h2, 0.0))
-        ok = h2 >= 0
-    rot = (C - X1) / r12
-    O = X1 - x[0] * rot
-    return O, rot, np.where(ok, misses(kinds, O, rot, x, P, c)[2][2], np.nan)
+        along = (ri**2 - rj**2 + dd**2) / (2 * dd)
+        h2 = ri**2 - along**2
+        O, ok = Ci + d / dd * (along + 1j * sign * np.sqrt(np.maximum(h2, 0.0))), h2 >= 0
+    elif kinds[i] == "R":       # a circle and a line
+        foot = Ci - dot(Ci - Cj, rj) * rj
+        h2 = ri**2 - np.abs(foot - Ci)**2
+        O, ok = foot + sign * 1j * rj * np.sqrt(np.maximum(h2, 0.0)), h2 >= 0
+    else:                       # two lines
+        det = cross(ri, rj)
+        a, b = dot(Ci, ri), dot(Cj, rj)
+        O, ok = a * ri + 1j * ri * ((b - a * dot(ri, rj)) / det), det != 0
+    return O, rot, np.where(ok, misses(kinds, O, rot, x, P, c)[k][2], np.nan)
 
 
 def _roots(f3) -> np.ndarray:
     """Indices i where the sampled miss f3 changes sign between i and i + 1."""
-    return np.flatnonzero((f3[:-1] * f3[1:] <= 0) & np.isfinite(f3[:-1] * f3[1:]))
+    p = f3[:-1] * f3[1:]
+    return np.flatnonzero(np.where(np.isfinite(p), p, 1.0) <= 0)
 
 
 def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[complex, complex]]:
     """Every assembly mode (base pose O, e^{i theta}) at one position of the known joints (P, c
     scalars as `misses` reads them), by the texts' method of false positions
-    (`_false_positions`) at MODE_SAMPLES trial positions of leash 1; each change of sign of the
-    miss is refined by Newton on the whole group. Two modes closer than the samples leave no
-    change of sign: round each local minimum of |miss| the interval of its two neighbours is
+    (`_false_positions`) at MODE_SAMPLES trial angles of the base (half a step off 0, the angle
+    the model draws it at); each change of sign of the miss is refined by Newton on the whole
+    group. Two modes closer than the samples leave no change of sign: round each local minimum of |miss| the interval of its two neighbours is
     sampled MODE_SAMPLES times again and searched the same way. Modes that coincide to 1e-9 L
     are one."""
-    t = np.linspace(0.0, 2 * np.pi, MODE_SAMPLES + 1)
+    t = (np.arange(MODE_SAMPLES + 1) + 0.5) * (2 * np.pi / MODE_SAMPLES)   # the drawn mode, theta = 0, between two
     found: list[tuple[complex, complex]] = []
     for sign in (1.0, -1.0):
         O, rot, f3 = _false_positions(kinds, x, P, c, L, t, sign)
-        a = np.abs(f3)
+        a = np.where(np.isfinite(f3), np.abs(f3), np.inf)
         low = np.flatnonzero((a[1:-1] < a[:-2]) & (a[1:-1] <= a[2:])) + 1
         starts = [(O[_roots(f3)], rot[_roots(f3)])]
         for i in low:

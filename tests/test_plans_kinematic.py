@@ -57,13 +57,13 @@ def _exact_values(mech, res, plans):
             refn = P.kinematic._name_of(mech, ref) or "pi"
             exp[("acceleration", f"{refn}-n{k}")] = w * w * l
             exp[("acceleration", f"n{k}-{qn}")] = abs(e) * l
-    for s in P.kinematic._slidings(mech):
+    for s, sa in zip(P.kinematic._slidings(mech, "p"), P.kinematic._slidings(mech, "pi")):   # a frame point: the pole
         i, g = s.pair.index, s.pair.links[0]
         exp[("velocity", f"{s.start}-{s.end}")] = abs(res.kin.v_slide[0, i])
-        cor = [n for n in plans["acceleration"].segments if n.start == s.start and n.name.split("-")[1].startswith("k")]
+        cor = [n for n in plans["acceleration"].segments if n.start == sa.start and n.name.split("-")[1].startswith("k")]
         if cor:
             exp[("acceleration", cor[0].name)] = 2 * abs(res.omega(g)[0] * res.kin.v_slide[0, i])
-            exp[("acceleration", f"{cor[0].end}-{s.end}")] = abs(res.kin.a_slide[0, i])
+            exp[("acceleration", f"{cor[0].end}-{sa.end}")] = abs(res.kin.a_slide[0, i])
     return exp
 
 

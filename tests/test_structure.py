@@ -17,6 +17,7 @@ EXPECTED = {
     "scotch_yoke": ("I(0,1) <- II(2,3)", ["RPP"], 3, 4),
     "triad_six_bar": ("I(0,1) <- III(2,3,4,5)", ["RRR"], 5, 7),
     "triad_slider": ("I(0,1) <- III(2,3,4,5)", ["RRP"], 5, 7),
+    "triad_rocking_block": ("I(0,1) <- III(2,3,4,5)", ["RRR"], 5, 7),
 }
 
 

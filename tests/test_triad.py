@@ -15,7 +15,7 @@ from kinetostat.kinematics import assembly_modes, kinematics
 from kinetostat.program import constants, motion_program
 from kinetostat.virtual_work import constraint_jacobian
 
-MODELS = ("triad_six_bar", "triad_slider")
+MODELS = ("triad_six_bar", "triad_slider", "triad_rocking_block")
 PHI = np.arange(0.0, 360.0, 15.0)
 
 
@@ -224,7 +224,8 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
     (fp,) = forces.force_plans(mech, res, mu_F)
     eq = fp.equation
     (l1, _, _, a1), (l2, _, _, a2), (l3, _, _, a3) = kinetostat.kinematics.special_sides(mech, res.kin, g)
-    assert {l1, l2, l3} == {2, 4, 5} and (l1, l2) == ((5, 2) if g.kind == "RRR" else (2, 4))   # S: best-met axes
+    best = {"RRR": (5, 2), "RRP": (2, 4)}[g.kind] if g.inner == "RRR" else (2, 4)     # S: the best-met axes
+    assert {l1, l2, l3} == {2, 4, 5} and (l1, l2) == best
     name = lambda a, ell: forces.reaction_name(mech, a, ell)
     assert eq[-2:] == (name(a1, l1) + "n", name(a2, l2) + "n") and eq[0] == name(a2, l2) + "t"
     n = len(eq)
@@ -239,7 +240,7 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
 def test_the_drawing_error_simulation_refuses_a_triad_by_name(mech):
     from kinetostat.plans import drawing_error
     assert not drawing_error.draws_forces(mech)
-    with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind R.. \(III3 R..\) is not drawn"):
+    with pytest.raises(NotImplementedError, match=r"group III\(2,3,4,5\) of kind R.. \(III3 R..(, inner RRP)?\) is not drawn"):
         drawing_error.simulate(mech, n=10)
 
 
@@ -331,9 +332,9 @@ def test_any_two_leashes_define_s_so_the_numbering_does_not_matter():
 
 def test_two_modes_closer_than_the_samples_are_both_found_and_warned():
     """The crank r = 0.11716309257991407 m with the design position at 198 deg, next to the
-    fold: two modes 0.125 deg apart in the base's angle (13.420 and 13.545 deg), both between
-    two of the 3600 trial positions of leash 1 (no change of sign of the miss there: one mode was
-    listed, separation inf, no warning). Each mode found closes the three leashes (their lengths
+    fold: two modes 0.125 deg apart in the base's angle (13.420 and 13.545 deg) (with the trial
+    positions of leash 1 both lay between two of the 3600 samples, no change of sign of the miss
+    there: one mode was listed, separation inf, no warning; now the base's angle is sampled). Each mode found closes the three leashes (their lengths
     measured here from the model's points) to rounding, and the warning names the closeness."""
     text = (ROOT / "models" / "triad_six_bar.toml").read_text().replace("design_deg = 60.0", "design_deg = 198.0")
     mech = kinetostat.loads(text.replace('A = [0.10, 0.0] }\nmass = 2.0', 'A = [0.11716309257991407, 0.0] }\nmass = 2.0')
@@ -395,3 +396,25 @@ def test_the_reference_refuses_positions_in_another_mode():
     other = replace(res, kin=replace(kin, origin_z=oz, rot=rz, theta=np.angle(rz)))
     with pytest.raises(BranchMismatch, match="not in the mode continuous from the design position"):
         reference_full(mech, [60.0], res=other)
+
+
+def test_a_pose_in_a_neighbouring_mode_is_refused_however_near():
+    """A track whose poses lie in the other mode at the design position, but which keeps the
+    drawn mode's sign of the group's Jacobian: Newton closes there at once (the pose moves 0 m,
+    within PREDICT L), and the sign alone says the path was left."""
+    from kinetostat import triad
+    from kinetostat.kinematics import _known_joints, tracks
+    mech = kinetostat.load(ROOT / "models" / "triad_six_bar.toml")
+    env = {**constants(mech), **tracks(mech), "w_in": 1.0, "e_in": 0.0}
+    kinds, x, pins = _known_joints(mech, 0, env)
+    phi0 = np.radians([mech.drive.design_deg])
+    P, c = pins(phi0)
+    (am,) = assembly_modes(mech)
+    drawn = env["track0"]
+    codes = [float(triad.LEASH_KINDS.index(k)) for k in kinds]
+    L = kinetostat.kinematics.group_scales(mech)[0]
+    for i, (O, rot) in enumerate(zip(am.O, am.rot)):
+        fake = triad.Track(np.array([-np.pi, np.pi]), np.array([O, O]), np.array([rot, rot]), 0, 0.0, drawn.sign)
+        O_, rot_, closure, path, its, _ = triad.iii3_positions(phi0, phi0[0], *codes, *x, *P, *c, L, fake)
+        assert closure[0] == 0.0 and abs(O_[0] - O) <= 1e-12 * L and its[0] <= 1
+        assert path[0] == (0.0 if i == am.chosen else -1.0)

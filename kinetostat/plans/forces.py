@@ -409,13 +409,17 @@ def _links_and_loads(mech: "Mechanism", res: "Analysis", loads: dict[int, list[L
 
 def _leash_parts(mech: "Mechanism", res: "Analysis", side) -> _Parts:
     """The reaction of the known link on a triad's leash: a two-pin leash's split along its axis
-    (outer pin -> inner pin) and across it; a slider's normal force whole."""
+    (outer pin -> inner pin) and across it; a leash on an inner prismatic pair's along its axis
+    (the guide's normal) and along the guide; a slider's normal force whole."""
     ell, outer, inner, known = side
     whole = _reaction_load(mech, res, known, ell)
     if outer.kind != "R":
         return _Parts(whole)
-    u = _world(res, ell, inner.point) - _world(res, ell, outer.point)
-    u /= abs(u)
+    if inner.kind == "P":
+        u = 1j * complex(*inner.direction) * complex(res.kin.rot[0, inner.links[0]])
+    else:
+        u = _world(res, ell, inner.point) - _world(res, ell, outer.point)
+        u /= abs(u)
     n = (whole.force * u.conjugate()).real * u
     return _Parts(whole, n, whole.force - n)
 
@@ -429,9 +433,10 @@ def _special_point(mech: "Mechanism", res: "Analysis", g) -> tuple[str, complex]
 def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: Scale | None = None) -> Plan:
     """A triad's plan (Artobolevsky 1988): its four links with their loads and the carried
     reactions; each leash's outer reaction (a two-pin leash's split into R..n along its axis and
-    R..t across it; a slider's normal force at its offset x); the axes of the two leashes through
-    Assur's special point S drawn through it; the arms of each leash's moment equation about its
-    inner pin (R..t) and of the group's about S (R..n of the third leash, marked (S))."""
+    R..t across it, a leash on an inner prismatic pair's likewise, R..t along the guide; a
+    slider's normal force at its offset x); the axes of the two leashes through Assur's special
+    point S drawn through it; the arms of each two-pin leash's moment equation about its inner
+    pin (R..t) and of the group's about S (R..n of the third leash, marked (S))."""
     later = _later(mech, g)
     loads = {x: link_loads(mech, res, x) + _carried(mech, res, x, later) for x in g.links}
     parts = [_leash_parts(mech, res, side) for side in g.sides]
@@ -451,13 +456,13 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
             _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_F)
             _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_F)
             X = _world(res, ell, inner.point)
-            for ld in loads[ell]:
+            for ld in loads[ell] if inner.kind == "R" else ():
                 if abs(ld.force) > 0 and abs(ld.point - X) > 1e-12 * mech.size:
                     _arm(segs, pts, arm_name(ld.name), X, inner.point, ld.point, ld.force, mu_l)
     from ..kinematics import special_sides
-    for ell, _, inner, _ in special_sides(mech, res.kin, g)[:2]:
-        segs.append(Segment(f"axis {inner.point}{S_name}", inner.point, S_name, abs(_world(res, ell, inner.point) - S),
-                            "m", "line"))
+    for ell, outer, inner, _ in special_sides(mech, res.kin, g)[:2]:
+        on = outer.point if inner.kind == "P" else inner.point        # a point of the leash's axis
+        segs.append(Segment(f"axis {on}{S_name}", on, S_name, abs(_world(res, ell, on) - S), "m", "line"))
     for x in g.links:
         for ld in loads[x]:
             if abs(ld.force) > 0 and abs(ld.point - S) > 1e-12 * mech.size:

@@ -106,16 +106,18 @@ def _name_of(mech, point: str) -> str:
     return f"{point.lower()}{mech.point_owner(point)}" if point in split else point.lower()
 
 
-def _slidings(mech) -> list[_Sliding]:
-    """Prismatic pairs between moving links, in the order drawn, each from its known side."""
+def _slidings(mech, pole: str) -> list[_Sliding]:
+    """Prismatic pairs between moving links, in the order drawn, each from its known side (a
+    triad's inner pair: from the guide); a slider's point on a frame pin (a rocking block) is
+    the plan's `pole`."""
     out = []
     for g in mech.structure.groups:
         for idx, p in enumerate(g.pairs):
             if p.kind != "P" or 0 in p.links:
                 continue
             guide, slider = p.links
-            known = g.links[0] if idx == 1 else next(i for i in p.links if i not in g.links)
-            out.append(_Sliding(p, f"{p.point.lower()}{guide}", _name_of(mech, p.point), known == guide))
+            known = g.links[0] if idx == 1 else next((i for i in p.links if i not in g.links), p.links[0])
+            out.append(_Sliding(p, f"{p.point.lower()}{guide}", _name_of(mech, p.point) or pole, known == guide))
     return out
 
 
@@ -160,7 +162,7 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     segs = [Segment(f"p-{n}", "p", n, abs(m[1]), "m/s") for n, m in mo.items()]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, abs(mo[b][1] - mo[a][1]), "m/s") for i, a in enumerate(joints) for b in joints[i + 1:]]
-    for s in _slidings(mech):
+    for s in _slidings(mech, "p"):
         segs.append(_rel(s.start, s.end, abs(res.kin.v_slide[0, s.pair.index]), "m/s"))
     for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
         vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
@@ -190,7 +192,7 @@ def _normals(mech, g):
     """(link, reference point, point) whose relative acceleration the group's plan splits into
     normal and tangential parts, by the group's kind (a triad: each two-pin leash)."""
     if g.klass == 3:
-        return [(ell, o.point, i.point) for ell, o, i, _ in g.sides if o.kind == "R"]
+        return [(ell, o.point, i.point) for ell, o, i, _ in g.sides if o.kind == i.kind == "R"]
     p0, p1, p2 = g.pairs
     j, k = g.links
     if g.kind == "RRR":
@@ -234,7 +236,7 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
     for g in mech.structure.groups:
         for k, ref_point, q in _normals(mech, g):
             split(k, ref_point, q if q in pts else _name_of(mech, q))
-    slidings = _slidings(mech)
+    slidings = _slidings(mech, "pi")
     turning = [s for s in slidings if res.kin.omega[0, s.pair.links[0]] != 0]
     for s in slidings:
         p = s.pair

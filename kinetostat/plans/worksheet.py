@@ -24,7 +24,7 @@ from ..analysis import Analysis
 from ..solve import analyze
 from ..applied import load_magnitude
 from ..errors import SelfLockingWarning
-from ..kinematics import DIGITS_WARN, special_point_z
+from ..kinematics import DIGITS_WARN, leash_axes, special_point_z, special_sides
 from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
@@ -279,32 +279,48 @@ class _Sheet:
         self.accelerations(accel)
 
     def special_point(self, g) -> list:
-        """A triad's base link first, by Assur's special point S (the axes of leashes 1 and 2):
-        V_S and a_S from 2x2 solves, then its pins, omega and eps from leash 3. Returns the
-        acceleration steps of the base."""
+        """A triad's base link first, by Assur's special point S (the axes of the two leashes
+        that meet at the best angle, `special_sides`): V_S and a_S from 2x2 solves, then its
+        pins, omega and eps from the third. Returns the acceleration steps of the base."""
         res, b = self.res, g.links[0]
         kin = res.kin
         S = special_point_z(self.mech, kin, g)[0]
         loc = (S - kin.origin_z[0, b]) / kin.rot[0, b]
         V, A = (complex(z[0]) for z in kin.point_z(b, (loc.real, loc.imag))[1:])
-        axes = " and ".join(f"{o.point}{i.point}" if o.kind == "R" else f"⟂ guide at {i.point}"
-                            for _, o, i, _ in g.sides[:2])
+        sides = special_sides(self.mech, kin, g)
+        axes = " and ".join(f"{o.point}{i.point}" if o.kind == i.kind == "R" else
+                            f"⟂ guide at {o.point if i.kind == 'P' else i.point}" for _, o, i, _ in sides[:2])
         self.vector("kinematics", "V_S", "V_S", np.array([V.real, V.imag]), "m/s", f"ps μ_v; S on the axes {axes}")
         pts = self.link_points(b, g.pairs)
         self.velocity_rows(pts)
         wb = res.omega(b)[0]
         self.add("kinematics", f"omega_{b}", f"ω{b}", abs(wb), "rad/s", _sense(wb),
-                 f"leash {g.sides[2][0]}'s axis, arm h_S = {abs(self._arm3(g, S)):.4g} m")
+                 f"leash {sides[2][0]}'s axis, arm h_S = {abs(self._arm3(g, S, sides[2])):.4g} m")
         self.vector("accelerations", "a_S", "a_S", np.array([A.real, A.imag]), "m/s^2", "πs μ_a")
         return [("a", name, None) for name in pts]
 
-    def _arm3(self, g, S: complex) -> float:
-        """The arm of leash 3's axis about S, m."""
-        ell, outer, inner, a = g.sides[2]
-        X = complex(*self.res.position(inner.point)[0])
-        u = X - complex(*self.res.position(outer.point)[0]) if outer.kind == "R" else \
-            1j * complex(*outer.direction) * self.res.kin.rot[0, a]
-        return float(((X - S).conjugate() * u).imag / abs(u))
+    def _arm3(self, g, S: complex, side) -> float:
+        """The arm about S of the axis of the leash `side` (the one not through S), m."""
+        X, u = (complex(z[0]) for z in leash_axes(self.mech, self.res.kin, g)[g.sides.index(side)])
+        return float(((X - S).conjugate() * u).imag)
+
+    def _split(self, g, side) -> tuple:
+        """The outer pin reaction of a group's link `side` split: the unit axis e and across it t
+        (world, (2,)), and why R..t is known (None: not split). Two pins: along the link, R..t
+        from its moment about the inner pin; a triad's leash on an inner prismatic pair: along
+        the guide's normal, R..t along the guide from the leash's forces along it."""
+        link, outer, pin, _ = side
+        res = self.res
+        if outer.kind == "R" and pin.kind == "P" and g.klass == 3:
+            d = complex(*pin.direction) * complex(res.kin.rot[0, pin.links[0]])
+            return np.array([-d.imag, d.real]), np.array([d.real, d.imag]), f"Σ F along the guide = 0 of link {link}"
+        if outer.kind != "R" or pin.kind != "R":
+            return None, None, None
+        r = res.position(pin.point)[0] - res.position(outer.point)[0]
+        l = np.hypot(*r)
+        e = r / l
+        return e, np.array([-e[1], e[0]]), \
+            f"Σ M_{pin.point} = 0 of link {link}, arm {outer.point}{pin.point} = {l / self.mu_l:.4g} mm"
 
     def accelerations(self, steps) -> None:
         res, d = self.res, self.mech.drive
@@ -375,23 +391,19 @@ class _Sheet:
     def reactions(self) -> None:
         res, m = self.res, self.mech
         for g in reversed(m.structure.groups):
-            for link, outer, pin, other in g.sides:
-                if outer.kind == "R" and pin.kind == "R":
+            third = special_sides(m, res.kin, g)[2] if g.klass == 3 else None
+            split = [(side, *self._split(g, side)) for side in g.sides]
+            for (link, _, _, other), e, t, why in split:
+                if why:
                     R = res.reaction(other, link)[0]
-                    r = res.position(pin.point)[0] - res.position(outer.point)[0]
-                    l = np.hypot(*r)
-                    e = r / l
-                    t = np.array([-e[1], e[0]])
-                    arm = l / self.mu_l
                     self.add("reactions", f"Rt_{other}_{link}", f"{self.R(other, link)}t", abs(R @ t), "N",
-                             _angle(np.sign(R @ t) * t), f"Σ M_{pin.point} = 0 of link {link}, arm {outer.point}{pin.point} = {arm:.4g} mm")
-            for n, (link, outer, pin, other) in enumerate(g.sides):
-                if outer.kind == "R" and pin.kind == "R":
+                             _angle(np.sign(R @ t) * t), why)
+            for side, e, _, why in split:
+                link, other = side[0], side[3]
+                if why:
                     R = res.reaction(other, link)[0]
-                    r = res.position(pin.point)[0] - res.position(outer.point)[0]
-                    e = r / np.hypot(*r)
                     self.add("reactions", f"Rn_{other}_{link}", f"{self.R(other, link)}n", abs(R @ e), "N",
-                             _angle(np.sign(R @ e) * e), "Σ M_S = 0 of the group" if (g.klass, n) == (3, 2)
+                             _angle(np.sign(R @ e) * e), "Σ M_S = 0 of the group" if side == third
                              else "force plan of the group")
             for link, _, _, other in g.sides:
                 self.vector("reactions", f"R_{other}_{link}", self.R(other, link), res.reaction(other, link)[0], "N",

@@ -229,7 +229,8 @@ def _structure_section(doc: Doc, m: Mechanism) -> None:
              next(p.label for p in m.pairs if set(p.links) == {0, 1}), "-"]]
     for g in s.groups:
         if g.klass == 3:      # a triad: base and leashes; its mode is the one the model draws
-            rows.append([g.label, f"III3 (outer pairs {g.kind})", "-", ", ".join(map(str, g.links)),
+            inner = "" if g.inner == "RRR" else f", inner {g.inner}"
+            rows.append([g.label, f"III3 (outer pairs {g.kind}{inner})", "-", ", ".join(map(str, g.links)),
                          " / ".join(p.label for p in g.pairs), "mode drawn"])
             continue
         rows.append([g.label, g.kind, GROUP_KINDS[g.kind], f"{g.links[0]}, {g.links[1]}",
