@@ -118,12 +118,11 @@ def header(df) -> list[str]:
 def write_csv(df, f: IO[str]) -> None:
     """`df` as CSV into the open text file `f`: units in the header, values `rounded`, as pandas'
     `to_csv(index=False, float_format=FLOAT_FORMAT)` writes them (a float `FLOAT_FORMAT`, NaN
-    empty; other cells `str`, None and NaN empty; quoted where the csv module must), column by
+    empty; other cells `str`, a missing one (None, NaN, NA) empty; quoted where the csv module must), column by
     column here: pandas formats cell by cell, half of a report's CSV time."""
     def cells(col) -> list[str]:
-        if col.dtype.kind == "f":
-            return ["" if v != v else FLOAT_FORMAT % v for v in col.tolist()]
-        return ["" if v is None or v != v else str(v) for v in col.tolist()]
+        text = (lambda v: FLOAT_FORMAT % v) if col.dtype.kind == "f" else str
+        return ["" if na else text(v) for v, na in zip(col.tolist(), col.isna().tolist())]
     w = csv.writer(f, lineterminator="\n")
     w.writerow(header(df))
     w.writerows(zip(*(cells(col) for _, col in rounded(df).items())))

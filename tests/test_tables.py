@@ -94,3 +94,19 @@ def test_segments_and_worksheet_hold_plain_numbers(tmp_path):
     assert "np." not in (tmp_path / "w.csv").read_text() and w["value"].dtype == float
     exact = sheet.value("omega_1")
     assert float(w.loc[w.key == "omega_1", "value"].iloc[0]) == float(f"{exact:.12g}")
+
+
+def test_write_csv_writes_what_pandas_to_csv_writes():
+    """The CSV writer (column by column) against pandas' own to_csv of the rounded frame: floats
+    with NaN and inf, nullable integers and booleans with NA, text with a comma, a quote and a
+    newline, None; a failed design of a sweep is such a row (NA peaks, the reason in text)."""
+    df = pd.DataFrame({"x": [0.1, np.nan, np.inf, -1.5e-7, 30.0],
+                       "n": pd.array([1, None, 3, 0, -2], dtype="Int64"),
+                       "ok": pd.array([True, None, False, True, False], dtype="boolean"),
+                       "why": ['a, "b"', None, "line\nbreak", "", "plain"],
+                       "k": [1, 2, 3, 4, 5]})
+    df.attrs["units"] = {"x": "m", "n": "1", "ok": "1", "why": "text", "k": "1"}
+    want = tables.rounded(df).to_csv(index=False, header=tables.header(df), lineterminator="\n",
+                                     float_format=tables.FLOAT_FORMAT)
+    assert tables.csv_text(df) == want
+    assert "x [m],n [1]" in want and ',,,,2\n' in want          # the NA row: every missing cell empty
