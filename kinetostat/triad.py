@@ -36,7 +36,7 @@ from .groups import cis, cross, dot, magnitude, over, solve2
 __all__ = ["LEASH_KINDS", "leash_kinds", "leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
            "rr_tangential", "line_tangential", "iii3_polygon", "iii3_positions", "track", "Track", "pose_distance", "jacobian_det", "misses", "modes",
-           "MODE_SAMPLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
+           "MODE_SAMPLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "ENDS", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
 
 #: The continuation's longest step along the crank's path (rad).
 STATION = np.radians(3.0)
@@ -49,6 +49,9 @@ STEP_MIN = 1e-7
 #: track's pose interpolated for it, must land within PREDICT L of it (else: off the path).
 EASY = 6
 PREDICT = 1e-3
+#: An angle this close to an end of the path is on it (rad): the continuation stops within
+#: 1e-15 of its limit (relative), and its stations' sums round.
+ENDS = 1e-13
 MOVE = 0.05
 #: Newton steps per solve at most.
 MAX_ITER = 40
@@ -256,11 +259,17 @@ class Track:
         return bool(self.u[-1] - self.u[0] >= 2 * np.pi * (1 - 1e-12))
 
     def start(self, u):
-        """At u (rad, any turn): the pose interpolated on the path, and whether u is on it."""
-        u = self.u[0] + np.mod(u - self.u[0], 2 * np.pi)
+        """At u (rad, any turn): the pose interpolated on the path, and whether u is on it. An
+        angle within ENDS of either end is on it (at that end); on a full track, whose two ends
+        are one pose, every angle is (the seam, the half-turn from the design angle, at either)."""
+        span = self.u[-1] - self.u[0]
+        w = np.mod(u - self.u[0], 2 * np.pi)
+        seam = (w > span) & (self.full | (w - span <= ENDS) | (2 * np.pi - w <= ENDS))
+        w = np.where(seam, np.where(w - span <= 2 * np.pi - w, span, 0.0), w)
+        u = self.u[0] + w
         th = np.unwrap(np.angle(self.rot))
         O = np.interp(u, self.u, self.O.real) + 1j * np.interp(u, self.u, self.O.imag)
-        return O, np.exp(1j * np.interp(u, self.u, th)), u <= self.u[-1]
+        return O, np.exp(1j * np.interp(u, self.u, th)), w <= span
 
 
 def _follow(solve, path: list, side: float, limit: float, sign: float, x: tuple, L: float, tol: float) -> int:
