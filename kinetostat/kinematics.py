@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
            "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes", "leash_axes",
-           "MODES_CLOSE", "special_point_z", "special_sides", "tracks"]
+           "MODES_CLOSE", "triad_warnings", "special_point_z", "special_sides", "tracks"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
@@ -252,33 +252,41 @@ def _xy(z: complex) -> tuple[float, float]:
     return z.real, z.imag
 
 
-def _check_modes(mech: "Mechanism") -> None:
-    """Warn (once per mechanism) where a triad's model does not draw it assembled at the design
-    position, or where another mode is closer than MODES_CLOSE."""
-    def check() -> bool:
+def triad_warnings(mech: "Mechanism") -> tuple[str, ...]:
+    """The texts of the triads' model warnings (memoised per mechanism; `solve_checked` issues
+    them on every analysis, `kinetostat structure --modes` prints them): where a triad's model
+    does not draw it assembled at the design position, where another mode is closer than
+    MODES_CLOSE there, and where the mode's path does not close over a turn (the two ways round
+    meet in different poses)."""
+    def make() -> tuple[str, ...]:
+        out, scales, labels = [], group_scales(mech), [g.label for g in mech.structure.groups]
         for am in assembly_modes(mech):
-            L = group_scales(mech)[[g.label for g in mech.structure.groups].index(am.group)]
-            if am.drawn_miss > 1e-6 * L:
-                warnings.warn(ModelWarning(
-                    f"group {am.group}: the base link's points do not draw the group assembled at the design position "
-                    f"(design_deg = {mech.drive.design_deg:g}; the pins miss the nearest mode by {am.drawn_miss:.3g} m); "
-                    f"that mode is solved: give the triad's points in world coordinates at the design position"),
-                    stacklevel=5)
+            n = labels.index(am.group)
+            if am.drawn_miss > 1e-6 * scales[n]:
+                out.append(f"group {am.group}: the base link's points do not draw the group assembled at the design "
+                           f"position (design_deg = {mech.drive.design_deg:g}; the pins miss the nearest mode by "
+                           f"{am.drawn_miss:.3g} m); that mode is solved: give the triad's points in world coordinates "
+                           f"at the design position")
             if am.separation < MODES_CLOSE:
-                warnings.warn(ModelWarning(
-                    f"group {am.group}: another assembly mode is within {am.separation:.3g} of the group's size at the "
-                    f"design position (kinetostat structure MODEL --modes lists them)"), stacklevel=5)
-        return True
-    mech.memo("modes checked", check)
+                out.append(f"group {am.group}: another assembly mode is within {am.separation:.3g} of the group's size "
+                           f"at the design position (kinetostat structure MODEL --modes lists them)")
+            tr = tracks(mech)[f"track{n}"]
+            if tr.mismatch > PREDICT * scales[n]:
+                out.append(f"group {am.group}: the mode followed from the design position does not close over a turn: "
+                           f"at phi = {(mech.drive.design_deg + 180.0) % 360:g} deg the paths both ways round differ by "
+                           f"{tr.mismatch:.3g} m (each angle is solved on the path within 180 deg of the design angle)")
+        return tuple(out)
+    return mech.memo("triad warnings", make)
 
 
 def solve_checked(mech: "Mechanism", phi: np.ndarray,
                   unit_speed: bool = False) -> tuple[Kinematics, np.ndarray, list[Kinematics]]:
     """The kinematics at `phi` (unguarded: nothing NaN yet, `error` not set), the indices of the
     angles where some group's cond exceeds COND_CHECK, and the kinematics at those angles solved
-    again on inputs moved by PERTURB_ULPS ulps (one per sign pattern). Call under np.errstate
-    as `kinematics` does."""
-    _check_modes(mech)
+    again on inputs moved by PERTURB_ULPS ulps (one per sign pattern); the triads' model warnings
+    (`triad_warnings`) issued. Call under np.errstate as `kinematics` does."""
+    for text in triad_warnings(mech):
+        warnings.warn(ModelWarning(text), stacklevel=4)
     kin = _solve(mech, phi, mech.points_z, unit_speed)
     checked = np.flatnonzero(~(kin.cond <= COND_CHECK).all(axis=1))       # NaN cond: checked
     trials = []
@@ -325,8 +333,7 @@ def _solve(mech: "Mechanism", phi: np.ndarray, locals_: tuple[Mapping[str, compl
 def tracks(mech: "Mechanism") -> dict[str, Any]:
     """Each triad's track<n> (memoised per mechanism): its base link's path from the design
     position (`triad.track`), the known joints at each step from the motion program's steps
-    before the group's (run on that one angle). A ModelWarning where the path does not close
-    over a turn (the two ways round meet in different poses)."""
+    before the group's (run on that one angle)."""
     def make() -> dict[str, Any]:
         out: dict[str, Any] = {}
         env = dict(constants(mech), w_in=1.0, e_in=0.0)
@@ -335,13 +342,7 @@ def tracks(mech: "Mechanism") -> dict[str, Any]:
             if g.klass != 3:
                 continue
             kinds, x, pins = _known_joints(mech, n, {**env, **out})
-            out[f"track{n}"] = tr = track(kinds, pins, phi0, 0j, 1 + 0j, x, group_scales(mech)[n])
-            if tr.mismatch > PREDICT * group_scales(mech)[n]:
-                warnings.warn(ModelWarning(
-                    f"group {g.label}: the mode followed from the design position does not close over a turn: at "
-                    f"phi = {math.degrees(phi0 + math.pi) % 360:g} deg the paths both ways round differ by "
-                    f"{tr.mismatch:.3g} m (each angle is solved on the path within 180 deg of the design angle)"),
-                    stacklevel=6)
+            out[f"track{n}"] = track(kinds, pins, phi0, 0j, 1 + 0j, x, group_scales(mech)[n])
         return out
     return mech.memo("triad tracks", make)
 

@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from .._text import one_line
-from .common import CLIError, EXIT_OK, TABLE_SUFFIXES, _Out, _analyze, _fmt, _lines, _load, _model_error_lines, _parquet_engine, _save, _turn, _writable_file, bundled_models
+from .common import CLIError, EXIT_OK, TABLE_SUFFIXES, _Out, _analyze, _fmt, _lines, _load, _model_error_lines, _parquet_engine, _save, _turn, _warn, _writable_file, bundled_models
 
 
 def _summary(res, path: Path) -> list[str]:
@@ -181,9 +181,11 @@ def cmd_structure(args) -> int:
     lines.append(f"class {s.mechanism_class}, order {s.order}")
     if args.modes:
         from ..errors import AssemblyError
-        from ..kinematics import assembly_modes
+        from ..kinematics import assembly_modes, triad_warnings
         try:
             found = assembly_modes(m)
+            for text in triad_warnings(m):         # the analysis' own warnings: two modes close, ...
+                _warn(f"{path.name}: {text}")
         except AssemblyError as exc:
             raise CLIError(f"{path}: {exc}") from None
         lines += ["assembly modes at the design position:"] + [x for am in found for x in am.lines()]

@@ -48,7 +48,7 @@ def _plan_names(text: str) -> list[str]:
 
 def cmd_plans(args) -> int:
     import numpy as np
-    from ..errors import SelfLockingWarning, SingularPositionWarning
+    from ..errors import ModelWarning, SelfLockingWarning, SingularPositionWarning
     from ..plans import build, cycle_scales
     from ..plans.worksheet import worksheet
     from ..plans.lettering import lettering
@@ -78,7 +78,7 @@ def cmd_plans(args) -> int:
         raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
     at_plan = [w for w in caught if issubclass(w.category, SingularPositionWarning)
                and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
-    at_plan += [w for w in caught if issubclass(w.category, SelfLockingWarning)]
+    at_plan += [w for w in caught if issubclass(w.category, (SelfLockingWarning, ModelWarning))]   # the model's: any angle
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
     _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))
