@@ -182,16 +182,76 @@ def analyse_structure(n_links: int, pairs: Sequence[KinematicPair],
     groups = _groups(n_links, pairs, branches)
     remaining = set(range(2, n_links)).difference(*(g.links for g in groups))
     if remaining:
-        raise StructureError(
-            f"links {sorted(remaining)} do not split into class-II Assur groups (dyads) and class-III "
-            f"triads III3; a group of class IV or higher, or another class-III group, is not supported "
-            f"by kinetostat")
+        raise StructureError(_unsupported(remaining, pairs))
     unused = set(branches) - {frozenset(g.links) for g in groups}
     if unused:
         raise StructureError(f"group: branch given for {[sorted(u) for u in unused]}, "
                              f"which is not an Assur group of this mechanism "
                              f"(groups: {[g.label for g in groups]})")
     return Structure(n, len(pairs), 0, tuple(groups))
+
+
+#: The most paths the search for the most complex closed contour of a refused group walks.
+CONTOUR_WALKS = 100_000
+
+
+def _unsupported(remaining: set[int], pairs: Sequence[KinematicPair]) -> str:
+    """The refusal of the links that split into no dyad or triad III3: per set of them joined by
+    inner pairs (pairs between two of them), its links and its class by Artobolevsky's rule, the
+    number of pairs of its most complex closed contour of inner pairs, a link with k inner pairs
+    counting as a contour of k (`_contour`)."""
+    adj: dict[int, list[int]] = {x: [] for x in remaining}
+    for p in pairs:
+        if set(p.links) <= remaining:
+            adj[p.links[0]].append(p.links[1])
+            adj[p.links[1]].append(p.links[0])
+    parts, left = [], set(remaining)
+    while left:
+        part, todo = set(), [min(left)]
+        while todo:
+            x = todo.pop()
+            if x not in part:
+                part.add(x)
+                todo += adj[x]
+        left -= part
+        cycle, whole = _contour(sorted(part), adj)
+        hub = max(sorted(part), key=lambda x: len(adj[x]))
+        klass = max(len(cycle), len(adj[hub]), 2)
+        why = (f"its most complex closed contour of inner pairs, {'-'.join(map(str, cycle))}, has {len(cycle)} pairs"
+               + ("" if whole else f" (or more: the search stopped after {CONTOUR_WALKS:,} paths)")
+               if len(cycle) >= len(adj[hub]) else f"its link {hub} has {len(adj[hub])} inner pairs")
+        parts.append(f"({','.join(map(str, sorted(part)))}) of class {_roman(klass)}{'+' if not whole else ''}: {why}")
+    return (f"links {sorted(remaining)} do not split into class-II Assur groups (dyads) and class-III triads III3: "
+            f"they form the group{'s' if len(parts) > 1 else ''} {'; '.join(parts)}; kinetostat solves dyads and "
+            f"triads III3 only")
+
+
+def _contour(nodes: list[int], adj: Mapping[int, list[int]]) -> tuple[tuple[int, ...], bool]:
+    """The longest closed contour (links in order, at least 3) of the graph `adj` over `nodes`,
+    by a depth-first walk of the simple paths from each link through higher ones (at most
+    CONTOUR_WALKS paths), and whether the walk was whole."""
+    best: tuple[int, ...] = ()
+    walks = 0
+    stack = [(s,) for s in reversed(nodes)]
+    while stack and walks < CONTOUR_WALKS:
+        path = stack.pop()
+        walks += 1
+        for y in sorted(adj[path[-1]], reverse=True):      # the lowest link walked first
+            if y == path[0] and len(path) >= max(3, len(best) + 1):
+                best = path
+            elif y > path[0] and y not in path:
+                stack.append(path + (y,))
+    return best, not stack
+
+
+def _roman(n: int) -> str:
+    """n in Roman numerals, as the texts write a group's class."""
+    out = ""
+    for value, sign in ((1000, "M"), (900, "CM"), (500, "D"), (400, "CD"), (100, "C"), (90, "XC"), (50, "L"),
+                        (40, "XL"), (10, "X"), (9, "IX"), (5, "V"), (4, "IV"), (1, "I")):
+        count, n = divmod(n, value)
+        out += sign * count
+    return out
 
 
 def _groups(n_links: int, pairs: Sequence[KinematicPair],

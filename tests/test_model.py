@@ -107,7 +107,7 @@ G = [0.5, -0.3]
         f'[[pair]]\nkind = "R"\nlinks = [{i}, {j}]\npoint = "{p}"\n' for i, j, p in pins)
 
 
-def test_class_three_group_is_recognised_and_class_four_refused():
+def test_class_three_group_is_recognised_and_class_four_refused(tmp_path, cli):
     # W = 1, links 2..5 form the class-III group III3: ternary link 3 (B, D, E) with three leashes
     crank = "{ O = [0.0, 0.0], A = [0.1, 0.0] }"
     three = _linkage({1: crank, 2: "{ A = [0.0, 0.0], B = [0.3, 0.0] }",
@@ -123,8 +123,13 @@ def test_class_three_group_is_recognised_and_class_four_refused():
                      5: "{ D = [0.0, 0.0], H = [0.2, 0.0] }"},
                     [(0, 1, "O"), (1, 2, "A"), (2, 3, "B"), (3, 4, "C"), (4, 0, "F"), (4, 5, "H"), (5, 2, "D")])
     with pytest.raises(StructureError, match=r"links \[2, 3, 4, 5\] do not split into class-II Assur groups"
-                                             r" \(dyads\) and class-III triads III3; a group of class IV or higher"):
+                                             r" \(dyads\) and class-III triads III3: they form the group \(2,3,4,5\) of "
+                                             r"class IV: its most complex closed contour of inner pairs, 2-3-4-5, has 4 pairs"):
         kinetostat.loads(four)
+    (tmp_path / "four.toml").write_text(four)
+    out = cli("structure", tmp_path / "four.toml")
+    assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1
+    assert "group (2,3,4,5) of class IV" in out.stderr
 
 
 def test_wrong_mobility_is_refused():
