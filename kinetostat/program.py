@@ -491,8 +491,8 @@ class _Statics(_Build):
     def iii3(self, g: "Triad") -> None:
         """III3 in the texts' order: R^tau of each leash (a two-pin leash's from its moment about
         its inner pin; on an inner prismatic pair, from its force balance along the guide); R^n
-        of leash 3 from the group's moment about S; R^n of leashes 1, 2 from the group's force
-        polygon; the inner reactions from each leash's polygon (S: `triad.special_point`), a
+        of the leash whose axis is off S from the group's moment about S; R^n of the two whose
+        axes meet in S from the group's force polygon; the inner reactions from each leash's polygon (S: `triad.special_point`), a
         prismatic pair's acting where the leash's moment about its outer pin puts it."""
         b = g.links[0]
         X, u, T, P, m = [], [], [], [], []

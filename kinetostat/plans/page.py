@@ -301,8 +301,8 @@ def _steps(mech, plans, lang: str) -> list[dict]:
     """The force analysis in the texts' order, one vector a step: per Assur group from the last
     attached, the unknowns found from moment equations (a dyad's R^τ from ΣM about the inner
     joint, its terms R^τ·l + Σ±F·h ± M_i/μ_l = 0; a triad's R^τ of each leash about its inner pin,
-    then R^n of leash 3 from the group's moment about Assur's point S), the polygon's sides in the
-    order drawn, the inner reactions; then the initial link's loads and M_bal (M_bal + μ_l Σ±F·h =
+    then R^n of the leash whose axis is off Assur's point S from the group's moment about S), the
+    polygon's sides in the order drawn, the inner reactions; then the initial link's loads and M_bal (M_bal + μ_l Σ±F·h =
     0); then the lever's loads and F'_bal·pa + Σ±F·h = 0. A step with "moment" has its equation's
     terms written by the page's script from the sheet of the angle shown."""
     from ..solve import analyze
