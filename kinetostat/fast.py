@@ -3,7 +3,8 @@ of `kinetostat.groups`, the numpy path's very source) generated into numba kerne
 per angle, the kinematics, the loads, the reactions of every group and the balancing moment.
 
 - `analyze_fast(mech, phi_deg, out=None)`: the whole `Analysis`, as `kinetostat.analyze`
-  gives it (which calls it from `FAST_MIN` angles on), its arrays views of one flat buffer
+  gives it (which calls it from `threshold(mech)` angles on: FAST_MIN where this process holds the
+  kernel, FAST_COLD where the call would load it), its arrays views of one flat buffer
   (`buffer`: pass one as `out` to reuse caller-owned memory across calls).
 - `chunks(mech, phi_deg, size)`: the same, as read-only Analyses of `size` angles in turn,
   each a view of one buffer reused from chunk to chunk (valid until the next is asked for).
@@ -66,14 +67,19 @@ from .program import Identifiers, Program, code, constants, free_names, motion_p
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "CHUNK", "BLOCK", "available",
-           "cache_dir", "kernel", "vector_report", "bytes_per_angle"]
+__all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "available",
+           "cache_dir", "kernel", "loaded", "threshold", "vector_report", "bytes_per_angle"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
-#: compiled path. Measured with the kernel cached: it is the faster from about 300 angles (the
-#: four-bar) to 3,000 (the ICE crank-slider, with its loads); below 10^4 the gain is under
-#: 3 ms a call, less than loading the kernel (~1 s) the first time in a process.
-FAST_MIN = 10_000
+#: compiled path where this process holds the kernel already (`threshold`). Measured
+#: (reports/benchmark.md, "Where the compiled path pays"): the loaded kernel is the faster from
+#: 100 angles on the four-bar and the six-link; on the ICE (a gas diagram) the two are even at 300.
+FAST_MIN = 1_000
+#: ... and from this many where the call would load the kernel: its load from the disk cache
+#: (about 0.14 s of CPU, numba's import included; a first compile per machine takes seconds) is
+#: repaid within the call from about 1e5 positions (the six-link) to 7e5 (the four-bar; the
+#: same section).
+FAST_COLD = 500_000
 #: Angles per chunk: `chunks`' default size, and the run of angles whose loads are evaluated at once.
 CHUNK = 1 << 14
 #: Angles per block of the kernel's loop (not a multiple of 512: 4 KiB aliasing of the rows in L1).
@@ -465,6 +471,22 @@ def kernel(mech: "Mechanism", kind: str):
         return _KERNELS[src], lay
 
 
+def loaded(mech: "Mechanism", kind: str = "full") -> bool:
+    """Whether this process holds the compiled kernel of `mech`'s structure for `kind` (loaded or
+    compiled by an earlier call, for this mechanism or another of the same structure)."""
+    if refusal(mech) is not None:
+        return False
+    src = mech.memo(("kernel source", kind), lambda: _source(mech, _layout(mech), kind))
+    with _LOCK:
+        return src in _KERNELS
+
+
+def threshold(mech: "Mechanism", kind: str = "full") -> int:
+    """The positions from which the compiled path pays for `mech` in this process: FAST_MIN where
+    its `kind` kernel is `loaded`, FAST_COLD where the call would load it."""
+    return FAST_MIN if loaded(mech, kind) else FAST_COLD
+
+
 def vector_report(fn) -> dict[str, int]:
     """Counts of the packed (ymm/zmm/xmm ...pd) and scalar (...sd) double arithmetic instructions
     in a compiled kernel's assembly: how much of it LLVM vectorised."""
@@ -622,8 +644,8 @@ def analyze_fast(mech: "Mechanism", phi_deg: np.ndarray, threads: int | None = N
     rounding), with the angles the guard must see (cond > COND_CHECK, or not assembled) solved
     by the numpy path. phi_deg: (N,) read-only crank angles, deg, as `analysis.crank_angles`
     gives. Its arrays are (strided) views of one flat buffer: a fresh one (the first touch of
-    its pages costs about as much as the kernel's work on the four-bar, 3x more on the six-link:
-    reports/benchmark.md), or `out` (`buffer(mech, N)`, reused: it is overwritten, and the
+    its pages costs about as much again as the kernel's work on the four-bar, 127 against 61 ns
+    an angle, and a third more on the six-link, 428 against 318 ns: reports/benchmark.md), or `out` (`buffer(mech, N)`, reused: it is overwritten, and the
     previous Analysis with it)."""
     N = len(phi_deg)
     buf = buffer(mech, N) if out is None else _check_buffer(mech, out, N)

@@ -1,6 +1,6 @@
 """`analyze(mech, phi_deg)`: the whole kinetostatic analysis, by the path that suits the work: the
-numpy path (`analysis.exact`) below `fast.FAST_MIN` angles (and for what the kernel refuses), the
-compiled kernel (`fast`) from them on.
+numpy path (`analysis.exact`) below `fast.threshold(mech)` angles (and for what the kernel
+refuses), the compiled kernel (`fast`) from them on.
 
 May use: model, analysis, fast.
 """
@@ -22,16 +22,18 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360, friction: str | Non
     reactions and M_bal, the friction power from them); "reactions" solves the reactions with
     friction exactly (`kinetostat.friction`), group by group, on the numpy path at any number of angles.
 
-    From fast.FAST_MIN angles on it runs the compiled kernel (`fast.analyze_fast`), below them
-    the numpy path (`exact`): the same results to rounding (tests/test_fast.py). A mechanism the
-    kernel does not take (`fast.refusal`: a class-III group) and friction="reactions" (the kernel
-    has no friction in the reactions) go the numpy path at any count."""
+    From `fast.threshold(mech)` angles on it runs the compiled kernel (`fast.analyze_fast`):
+    fast.FAST_MIN (1,000) where this process holds the mechanism's kernel already, fast.FAST_COLD
+    (500,000) where the call would load it; below them the numpy path (`exact`): the same results
+    to rounding (tests/test_fast.py). A mechanism the kernel does not take (`fast.refusal`: a
+    class-III group) and friction="reactions" (the kernel has no friction in the reactions) go
+    the numpy path at any count."""
     if not isinstance(mech, Mechanism):
         raise TypeError(f"analyze: expected a Mechanism, got {type(mech).__name__}; "
                         f"read a model file with kinetostat.load(path)")
     phi_deg = crank_angles(phi_deg, steps)
     method = friction_method(mech, friction)
     if ((method != "reactions" or mech.friction is None) and len(phi_deg) >= fast.FAST_MIN and fast.available()
-            and fast.refusal(mech) is None):
+            and fast.refusal(mech) is None and len(phi_deg) >= fast.threshold(mech)):
         return fast.analyze_fast(mech, phi_deg)
     return exact(mech, phi_deg, method)

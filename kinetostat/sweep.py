@@ -94,7 +94,8 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     efficiency, NaN unless the angles are a uniform full cycle) and `n_self_locking` (the count of
     self-locking angles, `Analysis.self_locking`).
 
-    ValueError names an unknown parameter, an empty or non-finite list of values, or a bad
+    ValueError names an unknown parameter, an empty or non-finite list of values, a parameter
+    named as a column of the angles' table (with `full`), or a bad
     `chunk`; the model itself must load with its own parameters (ModelError otherwise);
     ConnectionError: no `distributed` scheduler at the address."""
     import pandas as pd
@@ -113,10 +114,19 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     if not isinstance(chunk, (int, np.integer)) or isinstance(chunk, bool) or chunk < 1:
         raise ValueError(f"chunk: expected a positive number of designs per task, got {chunk!r}")
     phi_deg = crank_angles(phi_deg, steps)
+    if full:
+        clash = [name for name in names if name in _angle_columns(base, phi_deg)]
+        if clash:
+            raise ValueError(f"sweep: parameter {clash[0]!r} has the name of a column of the angles' table "
+                             f"(full=True: the parameters lead `Analysis.to_frame`'s columns); rename it in the model")
     designs = [dict(zip(names, d)) for d in itertools.product(*values)]
     parts = [designs[k:k + chunk] for k in range(0, len(designs), chunk)]
     friction_method(base, friction)                 # ValueError for a bad method, before any design runs
-    results = _run(parts, text, source, phi_deg, full, scheduler, progress, friction)
+    from . import fast
+    n = len(designs) * len(phi_deg)                 # decided here once, so every chunk (any worker) agrees
+    compiled = (not full and n >= fast.FAST_MIN and fast.available() and fast.refusal(base) is None
+                and n >= fast.threshold(base, "peaks"))
+    results = _run(parts, text, source, phi_deg, full, scheduler, progress, friction, compiled)
     table = _tidy(pd.concat([rows for rows, _ in results], ignore_index=True), names, base, friction)
     angles = None
     if full:
@@ -129,19 +139,20 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
 # ----------------------------------------------------------------------------- one chunk of designs
 
 def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.ndarray,
-           full: bool, friction: str | None = None) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+           full: bool, friction: str | None = None, compiled: bool = False) -> tuple[pd.DataFrame, pd.DataFrame | None]:
     """The rows of `designs` (each: parameter -> value) of the model `text`: one per design (its
-    parameters, peaks, singular angles, error), and with `full` every angle's row (None without).
+    parameters, peaks, singular angles, error), and with `full` every angle's row (None without);
+    `compiled`: the peaks by the compiled kernel (`sweep` decides it for the whole sweep: where
+    its positions reach `fast.threshold` in the calling process).
     A Dask task: plain, picklable arguments."""
     import pandas as pd
     from . import fast
-    compiled = not full and len(designs) * len(phi_deg) >= fast.FAST_MIN    # where the kernel's compilation pays
     rows, frames, built = [], [], []
     with _quiet():
         for design in designs:
             try:
                 mech = loads(text, source, parameters=design)
-                kernel = (compiled and fast.refusal(mech) is None          # a triad: the numpy path
+                kernel = (compiled and fast.refusal(mech) is None            # a triad: the numpy path
                           and friction_method(mech, friction) != "reactions")   # the kernel has no friction
                 res = None if kernel else analyze(mech, phi_deg=phi_deg, friction=friction)
             except (ModelError, StructureError, AssemblyError) as exc:
@@ -233,6 +244,16 @@ def _reason(exc: Exception) -> str:
     return f"{type(exc).__name__}: {' '.join(text.split())}"
 
 
+def _angle_columns(mech: Mechanism, phi_deg: np.ndarray) -> set[str]:
+    """The columns of `mech`'s cycle table (`Analysis.to_frame`, from its first angle); none where
+    it does not assemble there (the table's writer then refuses a repeated name)."""
+    with _quiet():
+        try:
+            return set(analyze(mech, phi_deg=phi_deg[:1]).to_frame().columns)
+        except (AssemblyError, ValueError):
+            return set()
+
+
 def _with_design(df: pd.DataFrame, design: Mapping[str, float]) -> pd.DataFrame:
     """`df` (one analysis's cycle table) led by the design's parameters as columns (units: the
     table's; `sweep` adds the parameters')."""
@@ -263,19 +284,20 @@ def _quiet() -> Iterator[None]:
 # ----------------------------------------------------------------------------- running the chunks
 
 def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: np.ndarray, full: bool,
-         scheduler: Any, progress: bool, friction: str | None = None) -> list[tuple[pd.DataFrame, pd.DataFrame | None]]:
+         scheduler: Any, progress: bool, friction: str | None = None,
+         compiled: bool = False) -> list[tuple[pd.DataFrame, pd.DataFrame | None]]:
     """Every chunk's result, in the order of `parts`: in this process, or over Dask."""
     bar = _bar(len(parts), progress)
     try:
         if scheduler is None:
             out = []
             for part in parts:
-                out.append(_chunk(text, source, part, phi_deg, full, friction))
+                out.append(_chunk(text, source, part, phi_deg, full, friction, compiled))
                 bar.update()
             return out
         import dask
         keys = [f"kinetostat-sweep-chunk-{k}" for k in range(len(parts))]
-        tasks = [dask.delayed(_chunk, pure=True)(text, source, part, phi_deg, full, friction, dask_key_name=key)
+        tasks = [dask.delayed(_chunk, pure=True)(text, source, part, phi_deg, full, friction, compiled, dask_key_name=key)
                  for part, key in zip(parts, keys)]
         if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS:
             from dask.callbacks import Callback

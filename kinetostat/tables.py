@@ -92,7 +92,11 @@ def by_unit(values: Iterable[float], units: Iterable[str]) -> list[float]:
 def rounded(df, units: dict[str, str] | None = None):
     """A copy of `df` with every float column rounded to `DIGITS` significant digits of its unit's
     scale: the largest |value| among the float columns of the same unit (`units`, default
-    `attrs["units"]`; a column with no unit: its own largest |value|). NaN kept; `attrs` kept."""
+    `attrs["units"]`; a column with no unit: its own largest |value|). NaN kept; `attrs` kept.
+    ValueError: a column name that appears twice."""
+    twice = sorted(set(df.columns[df.columns.duplicated()]))
+    if twice:
+        raise ValueError(f"a table with the column {twice[0]!r} twice: a column is named once")
     units = df.attrs.get("units", {}) if units is None else units
     attrs, df = dict(df.attrs), df.copy(deep=False)
     df.attrs = {}              # pandas deep-copies `attrs` into every column `items` hands out

@@ -108,6 +108,49 @@ def test_peaks_agree_on_every_bundled_model(name):
         _peaks_agree(mech, np.arange(0.0, 360.0, 0.25))
 
 
+#: Loads besides gravity and inertia on the four-bar of SAMPLE: a table of a force against the
+#: angle, a resistance against the velocity, a spring and a damper. Its kernels are the four-bar's
+#: (the loads enter per chunk, between the motion kernel and the statics kernel), so the test
+#: compiles nothing the suite does not compile anyway.
+LOADS = """
+[[load]]
+name = "a table force"
+link = 3
+point = "B"
+direction = [0.0, -1.0]
+[load.table]
+phi_deg = [0, 90, 180, 270, 360]
+value = [0.0, 300.0, 50.0, -120.0, 0.0]
+[[load]]
+name = "a resistance"
+link = 2
+point = "C2"
+direction = "against_velocity"
+value = 150.0
+[[spring]]
+name = "a spring"
+a = { link = 0, point = "O2" }
+b = { link = 2, point = "A" }
+stiffness = 2000.0
+free_length = 0.3
+"""
+
+
+def test_both_paths_agree_with_loads_in_the_kernel():
+    """The loads-in-kernel path (tables, a resistance, a spring) on the four-bar: every array and
+    the peaks to 1e-13 of the numpy path; the same kernels as the four-bar's without loads."""
+    base = kinetostat.load(SAMPLE[0])
+    mech = kinetostat.loads(kinetostat.examples.path(SAMPLE[0]).read_text(encoding="utf-8") + LOADS)
+    assert fast._has_loads(mech) and not fast._has_loads(base)
+    assert all(fast._source(mech, fast._layout(mech), k) == fast._source(base, fast._layout(base), k)
+               for k in ("full", "peaks"))
+    phi = np.arange(0.0, 360.0, 0.5)
+    M, M0 = (exact(m, crank_angles(phi)).balancing_moment for m in (mech, base))
+    assert np.max(np.abs(M - M0)) > 0.1 * np.max(np.abs(M0))      # the loads change the answer
+    _agree(mech, phi)
+    _peaks_agree(mech, phi)
+
+
 def test_a_triad_is_refused_by_name_by_both_kernels():
     assert _refused(kinetostat.load("triad_slider"))
 
@@ -190,12 +233,24 @@ def test_peaks_of_a_batch_of_designs_equal_a_loop_of_analyze():
         assert abs(pk.M_bal[d] - np.abs(res.balancing_moment).max()) <= TOL * np.abs(res.balancing_moment).max()
 
 
-def test_analyze_takes_the_compiled_path_from_fast_min_angles_and_gives_the_same():
+def test_analyze_takes_the_compiled_path_where_it_pays_and_gives_the_same(monkeypatch):
+    """FAST_MIN angles take the compiled path where this process holds the kernel, the numpy
+    path where the call would load it (below FAST_COLD); the same results to 1e-13."""
     m = kinetostat.load("chain_unit_four_bar")
+    fast.kernel(m, "full")
+    calls = []
+    compiled = fast.analyze_fast
+    monkeypatch.setattr(fast, "analyze_fast", lambda mech, phi, **kw: calls.append(len(phi)) or compiled(mech, phi, **kw))
+    assert fast.loaded(m) and fast.threshold(m) == fast.FAST_MIN < fast.FAST_COLD
     big = kinetostat.analyze(m, steps=fast.FAST_MIN)
     ref = exact(m, crank_angles(None, fast.FAST_MIN))
     assert _close(big.forces.R, ref.forces.R) < TOL and _close(big.balancing_moment, ref.balancing_moment) < TOL
-    assert not big.forces.R.flags.writeable
+    kinetostat.analyze(m, steps=fast.FAST_MIN - 1)
+    assert calls == [fast.FAST_MIN]                      # below FAST_MIN: the numpy path
+    monkeypatch.setattr(fast, "_KERNELS", {})             # a process that has not loaded it
+    assert not fast.loaded(m) and fast.threshold(m) == fast.FAST_COLD
+    kinetostat.analyze(m, steps=fast.FAST_MIN)
+    assert calls == [fast.FAST_MIN]
 
 
 def test_the_guard_angles_are_the_numpy_paths():

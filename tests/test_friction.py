@@ -408,16 +408,17 @@ def test_plans_with_friction_draw_the_circles_and_the_tangent_reactions(ice):
     assert first.value("R_0_1") == pytest.approx(3184.85, abs=0.01) and first.value("Rf_0_1") == pytest.approx(R41, rel=1e-9)
 
 
-def test_a_sweep_of_a_model_with_friction_in_the_reactions_solves_it(tmp_path):
+def test_a_sweep_of_a_model_with_friction_in_the_reactions_solves_it(tmp_path, monkeypatch):
     """A model whose friction.method is "reactions": a sweep large enough for the compiled kernel
     (which has no friction) takes the numpy path, and its peaks are the frictional ones."""
     text = ICE.read_text().replace("radius = 0.012\n", 'radius = 0.012\nmethod = "reactions"\n', 1)
     mech = tmp_path / "ice.toml"
     mech.write_text(text)
     phi = np.linspace(0.0, 360.0, 5001)[:-1]
-    from kinetostat.fast import FAST_MIN
+    from kinetostat import fast
     from kinetostat.sweep import sweep
-    assert 2 * len(phi) >= FAST_MIN
+    monkeypatch.setattr(fast, "FAST_COLD", 0)          # the sweep large enough for the kernel, loaded or not
+    assert 2 * len(phi) >= fast.FAST_MIN
     table = sweep(mech, {"n1": [4500.0, 3000.0]}, phi_deg=phi).table
     for n1, row in zip([4500.0, 3000.0], table.itertuples()):
         res = reactions(kinetostat.load(mech, parameters={"n1": n1}), phi)

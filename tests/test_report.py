@@ -266,6 +266,28 @@ def test_log_ticks_are_plain_text():
     assert [_decade(v) for v in (1e-15, 1e-3, 1.0, 100.0)] == ["1e-15", "1e-3", "1", "1e2"]
 
 
+@pytest.mark.parametrize("lo, hi, log", [(1000 - 3e-9, 1000 + 3e-9, False), (-312.0, 110.0, False),
+                                          (-1.7e-13, 1.7e-13, False), (2e-3, 7e-3, True), (1e-16, 5.6, True)])
+def test_the_light_axes_label_ticks_that_read_back_as_the_ticks(lo, hi, log):
+    """The figures' own axes (`_axes`): within the view, at least two ticks, each label distinct and
+    read back as its grid line's value (to 1e-12 of the view's span): a curve that barely moves
+    about 1000, the shaper's moment, the lever's rounding, a log view of less than a decade."""
+    from matplotlib.figure import Figure
+    from kinetostat.report.plots import _axes
+    ax = Figure(figsize=(4, 3)).subplots()
+    ax.plot([0, 1], [lo, hi])
+    if log:
+        ax.set_yscale("log")
+    ax.set_ylim(lo, hi)
+    _axes(ax, xnumbers=False)                                        # its texts: the y labels only
+    ys = ax.texts
+    values = [float(t.get_text().replace("−", "-")) for t in ys]
+    grid = ax.collections[-1].get_segments()
+    assert len(ys) >= 2 and len(set(t.get_text() for t in ys)) == len(ys)
+    np.testing.assert_allclose(values, [seg[0][1] for seg in grid], rtol=1e-12 if log else 0, atol=0 if log else 1e-12 * (hi - lo))
+    assert all(lo <= v <= hi for v in values)
+
+
 def test_report_of_a_model_without_published_values(tmp_path, sketched_plots):
     p = tmp_path / "four_bar.toml"
     p.write_text(FOUR_BAR)

@@ -92,6 +92,19 @@ def test_a_design_the_model_refuses_keeps_its_row():
     assert sw.table["error"].iloc[1] == f'ModelError: line {line}: link[id=2].mass: must be >= 0.0, got -1.0 (= "m2")'
 
 
+def test_a_parameter_named_as_a_column_of_the_angles_table_is_refused(tmp_path, cli):
+    """With full=True the parameters lead the cycle table's columns: a parameter named phi_deg
+    would write a second phi_deg (the CSV's header one field longer than its rows); refused."""
+    text = (ROOT / "models" / "chain_unit_four_bar.toml").read_text(encoding="utf-8").replace("n_k", "phi_deg")
+    path = tmp_path / "clash.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(ValueError, match="parameter 'phi_deg' has the name of a column"):
+        kinetostat.sweep(path, {"phi_deg": [60.0, 120.0]}, steps=12, full=True)
+    assert kinetostat.sweep(path, {"phi_deg": [60.0, 120.0]}, steps=12).table.shape[0] == 2    # without full: no clash
+    p = cli("sweep", path, "--param", "phi_deg=60,120", "--steps", "12", "--full", "--out", tmp_path / "s.csv")
+    assert p.returncode == 2 and "phi_deg" in p.stderr and not (tmp_path / "s.csv").exists()
+
+
 def test_full_keeps_every_angle_with_the_design_first():
     sw = kinetostat.sweep(CHAIN, {"r": [0.05, 0.08]}, steps=12, full=True)
     a = sw.angles
@@ -225,8 +238,10 @@ def test_the_reports_study_is_the_sweep_its_command_line_writes(cli, tmp_path):
 
 
 def test_a_large_sweep_runs_the_compiled_kernel_and_equals_the_loop_of_analyze():
-    """25 designs x 2400 angles (over fast.FAST_MIN): the chunk's peaks come from one kernel
-    call; they equal analyze design by design to 1e-13."""
+    """25 designs x 2400 angles (over fast.FAST_MIN, the peaks kernel loaded): the chunk's peaks
+    come from one kernel call; they equal analyze design by design to 1e-13."""
+    from kinetostat import fast
+    fast.kernel(kinetostat.load(CHAIN), "peaks")
     sw = kinetostat.sweep(CHAIN, {"r": [0.05, 0.065, 0.08, 0.095, 0.11], "n_k": [0.0, 60.0, 120.0, 240.0, 487.0]},
                           steps=2400, chunk=25)
     for _, row in sw.table.iterrows():
@@ -240,13 +255,14 @@ def test_a_large_sweep_runs_the_compiled_kernel_and_equals_the_loop_of_analyze()
 
 @pytest.mark.parametrize("designs", [[0.6], [0.6, 0.9]])
 def test_failing_designs_keep_their_rows_on_the_compiled_path(monkeypatch, designs):
-    """The compiled path (fast.FAST_MIN lowered to 0) with designs that cannot be assembled: each
+    """The compiled path (fast.FAST_MIN and FAST_COLD lowered to 0) with designs that cannot be assembled: each
     keeps its row with the reason, and each is tried once alone after its chunk failed (once a
     RecursionError: a failing design was retried by itself, forever). The kernel's stand-in
     raises what the kernel raises, the AssemblyError of the first design that fails (the real
     kernel: the slow test below)."""
     from kinetostat import fast
     monkeypatch.setattr(fast, "FAST_MIN", 0)
+    monkeypatch.setattr(fast, "FAST_COLD", 0)
     calls = []
 
     def peaks(mechs, phi_deg):
@@ -269,6 +285,7 @@ def test_a_failing_design_beside_a_good_one_in_the_compiled_kernel(monkeypatch):
     """The issue's reproducer in small: the real kernel, r = 0.08 m (assembles) and 0.6 m (does not)."""
     from kinetostat import fast
     monkeypatch.setattr(fast, "FAST_MIN", 0)
+    monkeypatch.setattr(fast, "FAST_COLD", 0)
     sw = kinetostat.sweep(CHAIN, {"r": [0.08, 0.6]}, steps=36)
     ok, bad = sw.table.iloc[0], sw.table.iloc[1]
     assert bad["error"].startswith("AssemblyError: group II(2,3) cannot be assembled") and bad[PEAKS].isna().all()

@@ -110,3 +110,9 @@ def test_write_csv_writes_what_pandas_to_csv_writes():
                                      float_format=tables.FLOAT_FORMAT)
     assert tables.csv_text(df) == want
     assert "x [m],n [1]" in want and ',,,,2\n' in want          # the NA row: every missing cell empty
+
+
+def test_a_column_named_twice_is_refused():
+    df = pd.DataFrame([[1.0, 2.0]], columns=["phi_deg", "phi_deg"])
+    with pytest.raises(ValueError, match="column 'phi_deg' twice"):
+        tables.csv_text(df)

@@ -131,7 +131,8 @@ def throughput(mech: kinetostat.Mechanism) -> list[dict]:
     the operating system) and the median of repeated calls, and the size of the result per angle."""
     out = []
     rng = np.random.default_rng(0)
-    kinetostat.analyze(mech, steps=fast.FAST_MIN)   # memos (dead centres, diagrams), the compiled kernel loaded
+    fast.kernel(mech, "full")                       # the compiled kernel loaded: analyze takes it from FAST_MIN
+    kinetostat.analyze(mech, steps=fast.FAST_MIN)   # memos (dead centres, diagrams)
     for n in (10**4, 10**5, 10**6):
         phi = rng.uniform(0.0, 360.0, n)
         t = time.perf_counter()
@@ -143,6 +144,70 @@ def throughput(mech: kinetostat.Mechanism) -> list[dict]:
         out.append(dict(angles=n, first_seconds=first, seconds=t.wall_median, per_second=n / t.wall_median,
                         cpu_min=t.cpu_min, cpu_median=t.cpu_median, wall_min=t.wall_min, bytes_per_angle=size))
     return out
+
+
+#: The models and sizes of `crossover`: the four-bar, the ICE (a gas diagram: loads per chunk) and
+#: the six-link furnace loader (springs).
+CROSSOVER_MODELS = ("chain_unit_four_bar", "ice_crank_slider", "furnace_loader_six_bar")
+CROSSOVER_SIZES = (100, 300, 1_000, 3_000, 10_000, 100_000)
+
+
+def crossover(repeat: int = 5) -> list[dict]:
+    """Where the compiled path pays (`fast.threshold`): per model, the full analysis of N angles by
+    the numpy path (`exact`) and by the compiled kernel already loaded (`fast.analyze_fast`), CPU
+    s minimum of `repeat` calls after a warm-up, at CROSSOVER_SIZES; the kernel's load from the
+    disk cache in a fresh process (CPU s of `fast.kernel(mech, "full")` after `import kinetostat`:
+    numba's import included), minimum of 3; the smallest size where the loaded kernel is the faster,
+    and the positions from which a call that loads the kernel repays it (load / the saving per
+    angle at the largest size)."""
+    import subprocess
+    import sys
+    out = []
+    for name in CROSSOVER_MODELS:
+        mech = kinetostat.load(name)
+        fast.kernel(mech, "full")
+        sizes = []
+        for n in CROSSOVER_SIZES:
+            phi = crank_angles(None, n)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                t_np, _ = timed_runs(lambda: exact(mech, phi), repeat)
+                t_c, _ = timed_runs(lambda: fast.analyze_fast(mech, phi), repeat)
+            sizes.append(dict(angles=n, numpy=t_np.cpu_min, compiled=t_c.cpu_min))
+        probe = ("import time, kinetostat; from kinetostat import fast; m = kinetostat.load(%r); "
+                 "t = time.process_time(); fast.kernel(m, 'full'); print(time.process_time() - t)" % name)
+        load = min(float(subprocess.run([sys.executable, "-c", probe], check=True, capture_output=True,
+                                        text=True).stdout) for _ in range(3))
+        big = sizes[-1]
+        saving = (big["numpy"] - big["compiled"]) / big["angles"]
+        warm = next((r["angles"] for r in sizes if r["compiled"] < r["numpy"]), None)
+        out.append(dict(model=name, sizes=sizes, load=load, warm=warm, cold=load / saving if saving > 0 else math.inf))
+        print(f"crossover {name}: load {load:.3f} s, the loaded kernel the faster from {warm} angles, a loading call "
+              f"repaid from {out[-1]['cold']:.3g}", flush=True)
+    return out
+
+
+def crossover_lines(rows: list[dict]) -> list[str]:
+    """The report's section on where the compiled path pays (`crossover`)."""
+    head = " | ".join(f"{n:,}" for n in CROSSOVER_SIZES)
+    lines = ["## Where the compiled path pays (`fast.FAST_MIN`, `fast.FAST_COLD`)", "",
+             "`kinetostat.analyze` of N angles: the numpy path (`exact`) against the compiled kernel already "
+             "loaded in the process (`fast.analyze_fast`), CPU ms (minimum of 5 calls after a warm-up); the "
+             "kernel's load from the disk cache in a fresh process (`fast.kernel`, numba's import included; "
+             "minimum of 3); the smallest N here where the loaded kernel is the faster; and the N from which a "
+             "call that must load the kernel repays the load (load / the saving per angle at "
+             f"{CROSSOVER_SIZES[-1]:,} angles). `analyze` takes the compiled path from `FAST_MIN` = "
+             f"{fast.FAST_MIN:,} angles where the process holds the kernel, from `FAST_COLD` = {fast.FAST_COLD:,} "
+             "where the call would load it; a sweep decides once for all its positions.", "",
+             f"| model | path | {head} |", "|---|---|" + "---|" * len(CROSSOVER_SIZES)]
+    for r in rows:
+        for path in ("numpy", "compiled"):
+            lines.append(f"| {r['model']} | {path} | " + " | ".join(f"{x[path] * 1e3:.3g}" for x in r["sizes"]) + " |")
+    lines += ["", "| model | kernel load, s CPU | loaded kernel the faster from, angles | a loading call repaid from, angles |",
+              "|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['model']} | {r['load']:.3f} | {r['warm'] if r['warm'] is not None else '-'} | {r['cold']:.3g} |")
+    return lines
 
 
 def _nbytes(obj, seen: set | None = None) -> int:
@@ -478,8 +543,8 @@ def kernel_lines(study: dict) -> list[str]:
              f"{rates.flops_per_second / 1e9:.3g} GFLOP/s, memory takes {rates.bytes_per_second / 1e9:.3g} GB/s "
              f"of writes ({rates.note}); the limit of a route is max(flops / flop rate, bytes of its result / "
              f"bandwidth), from the bytes alone where its flops are not counted: these rows are full results "
-             f"(`kinetostat.analyze`: the numpy path at 360 angles, the compiled full kernel from "
-             f"{fast.FAST_MIN:,}), whose limit is their bytes; the peaks path is set against its flops in the "
+             f"(`kinetostat.analyze`: the numpy path at 360 angles, the compiled full kernel at "
+             f"{LARGE:,}), whose limit is their bytes; the peaks path is set against its flops in the "
              f"next section.", "",
              "Per angle: CPU time (this process; MuJoCo's: its C program's CPU clock) minimum / median, and wall "
              "time (median); the ratios are of CPU minima. The solver's rows: "
@@ -615,15 +680,15 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
                      f"{r['single_ms']:.3f} | {r['positions_per_cpu_s']:.3g} / {r['positions_per_s']:.3g} |")
     lines += ["", "## Solver throughput on large batches (slotted-link shaper, full analysis)", "",
               f"The result holds every point, link and pair: {thr[-1]['bytes_per_angle'] / 1e3:.1f} kB per angle. "
-              f"A warm-up call of `fast.FAST_MIN` = {fast.FAST_MIN:,} angles loads (or compiles) the compiled "
-              "kernel first, so the first call of a size pays for fresh memory from the operating system "
+              f"The compiled kernel is loaded first (`fast.kernel`) and a warm-up call of `fast.FAST_MIN` = "
+              f"{fast.FAST_MIN:,} angles made, so the first call of a size pays for fresh memory from the operating system "
               "only; repeated calls (5, the previous result released) reuse it.", "",
               "| angles | first call, s wall | repeated, s CPU min / median | repeated, s wall min / median | "
               "angles/s (repeated, wall median) |", "|---|---|---|---|---|"]
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['cpu_min']:.3f} / {r['cpu_median']:.3f} | "
                      f"{r['wall_min']:.3f} / {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + main_job_lines(kernels["main_job"], kernels["main_job_same"])
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + crossover_lines(kernels["crossover"]) + [""] + main_job_lines(kernels["main_job"], kernels["main_job_same"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -648,6 +713,8 @@ def main(argv: list[str] | None = None) -> None:
         (lambda mech, N: exact(mech, crank_angles(None, N)), "numpy path (analyze below FAST_MIN)", None),))
     print("\n".join(kernel_lines(kern)))
     kern["speed"] = speed_study(repeat=3 if args.quick else 5)
+    kern["crossover"] = crossover(repeat=3 if args.quick else 5)
+    print("\n".join(crossover_lines(kern["crossover"])))
     print("\n".join(speed_lines(kern["speed"])))
     rows = study(models, args.quick)
     if not args.quick:

@@ -130,21 +130,39 @@ def _decade(value: float) -> str:
 _TICK_PT, _PAD_PT, _LABEL_PT = 10.0, 5.0, 10.0
 
 
-def _num(value: float) -> str:
-    """A linear axis' tick label as plain text: 0, 90, −4000, 2.5e-14."""
-    return f"{value:.6g}".replace("-", "−") if value else "0"
+def _names(values, log: bool) -> list[str]:
+    """Tick labels as plain text, each with the fewest significant digits (at least 3) that tell
+    the ticks apart: 0, 90, −4000, 2.5e-14, 1000.000001 (a curve that barely moves about 1000);
+    a log axis' labels `_decade`. A negative number's sign is U+2212 (matplotlib's), an
+    exponent's sign is plain: 1e-15, −1e-14."""
+    if log:
+        return [_decade(v) for v in values]
+    for digits in range(3, 18):
+        names = [re.sub(r"e([+-])0*(\d)", lambda m: "e" + m.group(1).replace("+", "") + m.group(2),
+                        f"{v:.{digits}g}") if v else "0" for v in values]
+        if len(set(names)) == len(names):
+            break
+    return [n[0].replace("-", "−") + n[1:] for n in names]
+
+
+def _nice(n: int = 6):
+    """A linear axis' ticks: at most n + 1 at steps of 1, 2, 2.5 or 5 times a power of ten
+    (matplotlib's own default steps: never 80 or 150)."""
+    from matplotlib.ticker import MaxNLocator
+    return MaxNLocator(n, steps=[1, 2, 2.5, 5, 10])
 
 
 def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = None, ylabel_pt: float = _LABEL_PT,
           xnumbers: bool = True) -> None:
     """ax's two axes drawn light, after its data and limits are set: `x`, `y` are tick locators
-    (default MaxNLocator; a log axis takes LogLocator(numticks=6) and plain decades, `_decade`);
+    (default `_nice()`; a log axis takes LogLocator(numticks=6), with 2 and 5 between the decades
+    where the view holds fewer than two decades; labels `_names`);
     the ticks within the view are drawn as one grid line collection and a text per label, the
     axis labels as texts, in place of matplotlib's own axes, which make five artists per tick
     (half of these figures' drawing time). No tick marks: the grid carries the ticks. `xnumbers`
     False: the x grid without its labels (a panel above another on the same x)."""
     from matplotlib.collections import LineCollection
-    from matplotlib.ticker import LogLocator, MaxNLocator
+    from matplotlib.ticker import LogLocator
     from matplotlib.transforms import offset_copy
     ax.apply_aspect()
     fig = ax.figure
@@ -152,11 +170,13 @@ def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = No
     for axis, loc, label in (("x", x, xlabel), ("y", y, ylabel)):
         lo, hi = sorted(ax.get_xlim() if axis == "x" else ax.get_ylim())
         log = (ax.get_xscale() if axis == "x" else ax.get_yscale()) == "log"
-        loc = loc or (LogLocator(numticks=6) if log else MaxNLocator(5))
         f = np.log10 if log else float
         tol = 1e-9 * (f(hi) - f(lo))
-        ticks = [t for t in loc.tick_values(lo, hi) if (t > 0 or not log) and f(lo) - tol <= f(t) <= f(hi) + tol]
-        names = [(_decade if log else _num)(t) for t in ticks]
+        for loc in [loc] if loc else [LogLocator(numticks=6), LogLocator(numticks=6, subs=(1.0, 2.0, 5.0))] if log else [_nice()]:
+            ticks = [t for t in loc.tick_values(lo, hi) if (t > 0 or not log) and f(lo) - tol <= f(t) <= f(hi) + tol]
+            if len(ticks) >= 2:
+                break
+        names = _names(ticks, log)
         trans, va, ha = (ax.get_xaxis_text1_transform if axis == "x" else ax.get_yaxis_text1_transform)(_PAD_PT)
         ends = [[(t, 0), (t, 1)] if axis == "x" else [(0, t), (1, t)] for t in ticks]
         ax.add_collection(LineCollection(ends, colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
@@ -404,7 +424,6 @@ def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
 
 
 def plot_moment(run: ModelRun, path: Path) -> Path:
-    from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     fig = _figure(9.5, 6.5, left=1.0, right=0.2, top=0.6, bottom=0.6)
     fig.subplots_adjust(hspace=0.15)
@@ -421,12 +440,11 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
     ax.legend(fontsize=8, loc="best")
     _phi_axes(ax, label=False, step=30, xnumbers=False, ylabel=f"balancing moment on the crank {quantity_name(m, 'M_bal')}, N·m")
     ax2.plot(*_closed(phi, res.lever_discrepancy), color="0.3", lw=1)
-    _phi_axes(ax2, step=30, y=MaxNLocator(3), ylabel="lever − groups, N·m", ylabel_pt=9)
+    _phi_axes(ax2, step=30, y=_nice(3), ylabel="lever − groups, N·m", ylabel_pt=9)
     return _save(fig, path)
 
 
 def plot_reactions(run: ModelRun, path: Path) -> Path:
-    from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     ncols = _legend_cols(1 + len(run.results), 5)
     fig, axes, cols = _panels(len(m.pairs), f"{m.name}\nreaction magnitudes over the cycle "
@@ -442,7 +460,7 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
             handles[f"{route} ({er.route})"] = h
         ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
         ax.set_ylim(bottom=0)
-        _phi_axes(ax, label=n_ax + cols >= len(m.pairs), y=MaxNLocator(4), ylabel="|R|, N")
+        _phi_axes(ax, label=n_ax + cols >= len(m.pairs), y=_nice(4), ylabel="|R|, N")
     for ax in axes[len(m.pairs):]:
         ax.set_visible(False)
     _legend(fig, handles, ncols)
@@ -468,6 +486,7 @@ def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, 
 
 
 def plot_errors(run: ModelRun, path: Path) -> Path:
+    from matplotlib.ticker import FixedLocator
     res, m = run.res, run.mech
     qs = [q for q in quantities(m) if q == "M_drive" or q.startswith("R(")]   # the force quantities
     ncols = _legend_cols(2 * len(run.results), 4)
@@ -497,7 +516,8 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
         title = f"{quantity_name(m, q)}: balancing moment" if q == "M_drive" else \
             _pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
         ax.set_title(_wrap(title), fontsize=9, y=1.0)
-        _phi_axes(ax, label=n_ax + cols >= len(qs), ylabel=f"|error|, {unit}")
+        _phi_axes(ax, label=n_ax + cols >= len(qs), ylabel=f"|error|, {unit}",
+                  y=None if ax.get_lines() else FixedLocator([]))     # nothing drawn: no scale to read
     for ax in axes[len(qs):]:
         ax.set_visible(False)
     _legend(fig, handles, ncols)
@@ -506,7 +526,6 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
 
 def plot_hodographs(run: ModelRun, path: Path) -> Path:
     """Tip of each revolute pair's reaction vector over the cycle (as Potapov 2024 draws them, figs. 13-14)."""
-    from matplotlib.ticker import MaxNLocator
     res, m = run.res, run.mech
     pairs = [p for p in m.pairs if p.kind == "R"]
     n_legend = 1 + sum(not er.magnitudes_only for er in run.results.values())
@@ -545,7 +564,7 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
             ax.annotate(f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", R[i], xytext=(6, -14), textcoords="offset points",
                         fontsize=7, color="tab:red")
         ax.set_aspect("equal", adjustable="datalim")
-        _axes(ax, MaxNLocator(4), MaxNLocator(5), "R_x, N", "R_y, N")     # 4 on x: room for "−4000" on a narrow panel
+        _axes(ax, _nice(4), _nice(5), "R_x, N", "R_y, N")     # 4 on x: room for "−4000" on a narrow panel
         ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
     for ax in axes[len(pairs):]:
         ax.set_visible(False)
