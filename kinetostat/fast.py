@@ -489,8 +489,13 @@ def threshold(mech: "Mechanism", kind: str = "full") -> int:
 
 def vector_report(fn) -> dict[str, int]:
     """Counts of the packed (ymm/zmm/xmm ...pd) and scalar (...sd) double arithmetic instructions
-    in a compiled kernel's assembly: how much of it LLVM vectorised."""
+    in a compiled kernel's assembly: how much of it LLVM vectorised. ValueError where the kernel
+    holds no assembly to read (loaded from numba's disk cache: compile it in a fresh cache folder,
+    `CACHE_ENV`, as tests/test_fast.py does)."""
     asm = "\n".join(fn.inspect_asm().values())
+    if not asm.strip():
+        raise ValueError("vector_report: the kernel holds no assembly (loaded from numba's disk cache); "
+                         f"compile it afresh (an empty {CACHE_ENV} folder) to read it")
     ops = r"(?:add|sub|mul|div|sqrt|fmadd\w*|fmsub\w*|fnmadd\w*|fnmsub\w*|max|min)"
     packed = re.findall(rf"\bv{ops}pd\s+%?([xyz])mm", asm)
     return {"packed_ymm": packed.count("y"), "packed_zmm": packed.count("z"), "packed_xmm": packed.count("x"),

@@ -511,15 +511,16 @@ def speed_lines(sp: dict) -> list[str]:
         lines.append(f"| {r['model']} | {r['route']} | {r['angles']:,} | {ns(r['cpu_min'])} / {ns(r['cpu_median'])} | "
                      f"{ns(r['wall_min'])} / {ns(r['wall_median'])} | {1e-6 / r['cpu_min']:.3g} | "
                      f"{1e-6 / r['wall_min']:.3g} | {lim} | {ratio} |")
-    lines += ["", "| model | flops/angle (peaks loop) | bytes written/angle (full) | buffer bytes/angle | packed / scalar "
-              "instructions (peaks kernel) | compile, fresh process: peaks, full (CPU / wall s) | load from the cache: "
+    lines += ["", "| model | flops/angle (peaks loop) | bytes written/angle (full) | buffer bytes/angle | packed (zmm + "
+              "ymm + xmm) / scalar arithmetic instructions (peaks kernel) | compile, fresh process: peaks, full (CPU / wall s) | load from the cache: "
               "peaks, full (CPU / wall s) |", "|---|---|---|---|---|---|---|"]
     for name, m in sp["models"].items():
         c = m["compile"]
         v = m["vector"]
         cw = lambda k: f"{c[k]['cpu']:.2f} / {c[k]['wall']:.2f}"
         lines.append(f"| {name} | {m['flops']:.0f} | {m['written']} | {m['buffer']} | "
-                     f"{v['packed_zmm'] + v['packed_ymm'] + v['packed_xmm']} / {v['scalar']} | "
+                     f"{v['packed_zmm'] + v['packed_ymm'] + v['packed_xmm']} ({v['packed_zmm']} + {v['packed_ymm']} + "
+                     f"{v['packed_xmm']}) / {v['scalar']} | "
                      f"{cw('peaks fresh')}; {cw('full fresh')} | {cw('peaks cached')}; {cw('full cached')} |")
     return lines
 
