@@ -28,7 +28,7 @@ from typing import Any, Mapping
 
 from .core import Scale
 from .draw import SHEET_MM, scale_text, scales_of, svg, title_of
-from .i18n import num, text
+from .i18n import LANGS, num, text
 from .scales import TARGET_MM
 
 __all__ = ["Drawing", "Placement", "drawing", "layout", "pages", "AREA", "TITLE_BLOCK", "MIN_HEADING_MM"]
@@ -285,8 +285,9 @@ class OneSheet:
 
 
 def one_sheet(mech, at: float, lang: str) -> OneSheet:
-    """The plans of `mech` at crank angle `at` (deg), at the texts' scales where they all fit one
-    A3 sheet (`layout`, headings in `lang`), else with scales chosen together for that sheet: the
+    """The plans of `mech` at crank angle `at` (deg), drawn in `lang`, at the texts' scales where
+    they all fit one A3 sheet (`layout`) in every language of LANGS (so that a variant's scales do
+    not depend on the language of its pack), else with scales chosen together for that sheet: the
     scale of FIRST whose plans take the most room (their boxes' area with headings) one round step
     coarser (`scales.next_coarser`) while its reference stays FLOOR_MM long, then μ_l (its GOST
     2.302 series, LENGTH_MANTISSAS), until they fit; then each scale of FIRST back one step finer
@@ -299,16 +300,22 @@ def one_sheet(mech, at: float, lang: str) -> OneSheet:
     reference = references(mech, res)
     drawn: dict[tuple, Drawing] = {}
 
+    def drawings(plans, lg: str) -> list[Drawing]:
+        out = []
+        for k in plans:
+            key = (lg, k, *(s.value for s in scales_of(plans[k])))
+            if key not in drawn:
+                drawn[key] = drawing(plans[k], lg)
+            out.append(drawn[key])
+        return out
+
     def attempt(given: Mapping[str, float] | None):
         plans = build(mech, at=at, scales=given)
-        ds = []
-        for k in plans:
-            key = (k, *(s.value for s in scales_of(plans[k])))
-            if key not in drawn:
-                drawn[key] = drawing(plans[k], lang)
-            ds.append(drawn[key])
+        ds = drawings(plans, lang)
         places = layout(ds)
-        return plans, ds, places, all(p.page == 0 for p in places)
+        fit = all(p.page == 0 for p in places) and all(
+            all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
+        return plans, ds, places, fit
 
     plans, ds, places, fit = attempt(None)
     rule = dict(plans.scales)
