@@ -10,8 +10,8 @@ packed inside the frame, clear of the title block, never turned (`layout`: maxim
 several rules and orders). Where the plans at the texts' scales do not fit one sheet, `one_sheet`
 chooses the variant's scales together for it: velocity, acceleration and force scales a round
 step coarser first, μ_l only where they cannot make room; the title block and the key name each
-scale made coarser than the rule, and why. Plans that no scale choice fits (a model of the user's,
-not a task of the text) would go onto further sheets, and the title block would say so.
+scale made coarser than the rule, and why. Where no choice fits them, further sheets take the
+rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
 May use: the standard library, `build` of this package, `.core`, `.draw`, `.i18n`, `.labels`,
 `.scales`, `kinetostat.solve`; matplotlib inside `pages` and the text widths only.
@@ -22,7 +22,6 @@ import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from functools import lru_cache
-
 from types import MappingProxyType
 from typing import Any, Mapping
 
@@ -31,7 +30,8 @@ from .draw import SHEET_MM, scale_text, scales_of, svg, title_of
 from .i18n import LANGS, num, text
 from .scales import TARGET_MM
 
-__all__ = ["Drawing", "Placement", "drawing", "layout", "pages", "AREA", "TITLE_BLOCK", "MIN_HEADING_MM"]
+__all__ = ["Drawing", "Placement", "OneSheet", "drawing", "layout", "one_sheet", "pages", "AREA", "TITLE_BLOCK",
+           "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM"]
 
 _NS = "{http://www.w3.org/2000/svg}"
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
@@ -292,7 +292,9 @@ def one_sheet(mech, at: float, lang: str) -> OneSheet:
     coarser (`scales.next_coarser`) while its reference stays FLOOR_MM long, then μ_l (its GOST
     2.302 series, LENGTH_MANTISSAS), until they fit; then each scale of FIRST back one step finer
     while they still fit. The same `kinetostat.plans.build` that every sheet of the plans uses,
-    with these scales given. Several tries at most (each a build and the changed plans' drawings)."""
+    with these scales given; each try a build, the drawings of the plans whose scales changed
+    (in each language) and their layouts. Where no scale within _TRIES steps fits them, the last
+    try is kept (more than one sheet)."""
     from ..solve import analyze
     from . import build
     from .scales import LENGTH_MANTISSAS, next_coarser, references
@@ -339,12 +341,12 @@ def one_sheet(mech, at: float, lang: str) -> OneSheet:
             if sym in room:
                 w, h, _ = _size(d)
                 room[sym] += w * h
-        open_ = [k for k in FIRST if given[k] < coarsest[k] * (1 - 1e-9)]
+        open_ = [k for k in FIRST if room[k] and given[k] < coarsest[k] * (1 - 1e-9)]
         if open_:
             k = max(open_, key=lambda k: (room[k], -FIRST.index(k)))
             steps[k].append(given[k])
             given[k] = next_coarser(given[k])
-        else:                                    # (a packing that the floor scales did fit, missed)
+        else:                                    # (only where the search above ran out of tries)
             given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
         plans, ds, places, fit = attempt(given)
     for k in FIRST:                              # back towards the rule while they still fit
