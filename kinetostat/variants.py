@@ -577,8 +577,9 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр), and with
     `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML), and with
     `page` the interactive page (page.html, `plans.page`: the key mode, the check at phi1). With the
-    pack, every file is drawn at the scales that put all the plans on its one A3 sheet
-    (`plans.a3.one_sheet`, chosen once here); without it, at the texts' rule. The files
+    pack, the plans, worksheet and pack are drawn at the scales that put all the plans on its one
+    A3 sheet (`plans.a3.one_sheet`, chosen once here); without it, at the texts' rule (page.html
+    keeps its own scales, fixed over the cycle). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
     from .solve import analyze
