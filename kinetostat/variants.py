@@ -576,12 +576,16 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     position in `lang` ("en", "uk", "ru"), and with `cycle_csv` the analysis over the cycle
     (cycle.csv, `steps` positions, with the text's names as alias columns: R_4_3, M_зр), and with
     `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML), and with
-    `page` the interactive page (page.html, `plans.page`: the key mode, the check at phi1). The files
+    `page` the interactive page (page.html, `plans.page`: the key mode, the check at phi1). With the
+    pack, the plans, worksheet and pack are drawn at the scales that put all the plans on its one
+    A3 sheet (`plans.a3.one_sheet`, chosen once here); without it, at the texts' rule (page.html
+    keeps its own scales, fixed over the cycle). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
     from .solve import analyze
     from .plans import build as build_plans
     from .plans.lettering import with_aliases
+    from .plans.a3 import one_sheet
     from .plans.pack import pack
     from .plans.worksheet import worksheet
     from .tables import csv_text
@@ -590,9 +594,10 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     phi1 = float(v.values["phi1"])
     at = analyze(mech, phi_deg=[phi1])
     res = analyze(mech, steps=steps)
-    plans = build_plans(mech, at=phi1)
+    a3 = one_sheet(mech, phi1, lang) if teacher_pack else None      # the scales of every file below
+    plans = a3.plans if a3 else build_plans(mech, at=phi1)
     sheet = worksheet(mech, phi1, mu_l=plans.scales["mu_l"].value, lang=lang)
-    teacher = pack(v, lang, plans=plans) if teacher_pack else None
+    teacher = pack(v, lang, a3=a3) if teacher_pack else None
     with unit(out, root) as tmp:
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
         files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])

@@ -195,7 +195,9 @@ def build_parser() -> argparse.ArgumentParser:
                                     "text leaves open), its answer key at the design position phi1 (worksheet.md/"
                                     "html/csv/json and the plans' SVG sheets with segments.csv), cycle.csv and the teacher's "
                                     "pack (the student's sheet.pdf, the answer key key.pdf with the bands of a careful "
-                                    "drawing, all plans true to scale on A3 sheets plans_a3.pdf, and their HTML). "
+                                    "drawing, all plans true to scale on one A3 sheet plans_a3.pdf, and their HTML; where "
+                                    "the plans at the text's scales do not fit it, the scales are chosen together for it "
+                                    "and the key says which are coarser). "
                                     "--all writes the keys of every code (of TASK, or of all three tasks) into "
                                     "DIR/task<T>_<CODE>/ (no cycle.csv) with DIR/index.md and index.html, code -> M_bal, "
                                     "the largest reaction and the pack.")

@@ -1,27 +1,37 @@
-"""All the plans of a variant on A3 landscape sheets, each TRUE TO SCALE (1 mm of the plan's
-drawing = 1 mm on paper, at the scales its heading states): seed 002 (Logvinenko, Nadtoka
-2021, appendix B) puts them on one A3 sheet; here a further sheet takes what does not fit.
+"""All the plans of a variant on one A3 landscape sheet, each TRUE TO SCALE (1 mm of the plan's
+drawing = 1 mm on paper, at the scales its heading states), as seed 002 (Logvinenko, Nadtoka
+2021, appendix B) puts them.
 
 Each plan is drawn exactly as its own SVG sheet draws it (`draw.svg`: its lines, arrowheads,
 points and every label where `labels.Placer` put it clear of the others): the `plan` group of
 that sheet is read back (`drawing`) and redrawn by matplotlib's PDF backend in millimetres. The
 plans' extents (drawing, labels and a heading: title, then every scale the plan is drawn at) are
-shelf-packed (first fit, tallest first, columns within a shelf) inside the frame, clear of the
-title block (`layout`);
-what does not fit goes onto a further A3 sheet, never drawn smaller, and the title block says so.
+packed inside the frame, clear of the title block, never turned (`layout`: maximal rectangles,
+several rules and orders). Where the plans at the texts' scales do not fit one sheet, `one_sheet`
+chooses the variant's scales together for it: velocity, acceleration and force scales a round
+step coarser first, μ_l only where they cannot make room; the title block and the key name each
+scale made coarser than the rule, and why. Where no choice fits them, further sheets take the
+rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
-May use: the standard library, `.draw`, `.i18n`, `.labels`; matplotlib inside `pages` only.
+May use: the standard library, `build` of this package, `.core`, `.draw`, `.i18n`, `.labels`,
+`.scales`, `kinetostat.solve`; matplotlib inside `pages` and the text widths only.
 """
 from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from functools import lru_cache
+from types import MappingProxyType
+from typing import Any, Mapping
 
+from .core import Scale
 from .draw import SHEET_MM, scale_text, scales_of, svg, title_of
-from .i18n import text
+from .i18n import LANGS, num, text
+from .scales import TARGET_MM
 
-__all__ = ["Drawing", "Placement", "drawing", "layout", "pages", "AREA", "TITLE_BLOCK", "MIN_HEADING_MM"]
+__all__ = ["Drawing", "Placement", "OneSheet", "drawing", "layout", "one_sheet", "pages", "AREA", "TITLE_BLOCK",
+           "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM"]
 
 _NS = "{http://www.w3.org/2000/svg}"
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
@@ -60,6 +70,7 @@ class Placement:
     dy: float
 
 
+@lru_cache(maxsize=4096)
 def _width(s: str, size_mm: float, weight: str = "normal") -> float:
     """Advance width of `s` (mm) at `size_mm`, DejaVu Sans, as matplotlib sets it."""
     from matplotlib.font_manager import FontProperties
@@ -156,64 +167,209 @@ def _size(d: Drawing) -> tuple[float, float, float]:
     return max(d.box[2] - d.box[0], *(_width(t, size, wt) for t, size, wt in head)), d.box[3] - d.box[1] + top, top
 
 
-def _fits(x0: float, y0: float, w: float, h: float) -> bool:
-    """Whether a box fits AREA clear of the title block."""
-    clear = x0 + w <= TITLE_BLOCK[0] - 2 or y0 + h <= TITLE_BLOCK[1] - 2
-    return x0 + w <= AREA[2] and y0 + h <= AREA[3] and clear
+def _free(G: float) -> list[tuple[float, float, float, float]]:
+    """The free rectangles of an empty page for boxes grown by the gap G (right and bottom): AREA
+    above the title block, and AREA left of it (both maximal; they overlap)."""
+    x0, y0, x1, y1 = AREA
+    return [(x0, y0, x1 + G, TITLE_BLOCK[1] - 2 + G), (x0, y0, TITLE_BLOCK[0] - 2 + G, y1 + G)]
+
+
+#: The rules of `_place`, each a key of a free rectangle's corner (x, y, x1, y1) for a box w x h
+#: to take the least of: its bottom highest, then leftmost (bottom-left, y down); its right
+#: edge leftmost, then highest (columns from the left); the free rectangle it fills best (least
+#: area left), then highest.
+RULES = (lambda x, y, x1, y1, w, h: (y + h, x), lambda x, y, x1, y1, w, h: (x + w, y),
+         lambda x, y, x1, y1, w, h: ((x1 - x) * (y1 - y) - w * h, y, x))
+
+
+def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float] | None:
+    """Where a box w x h goes among the free rectangles (maximal rectangles): at the top left
+    corner of one it fits, the least by `rule` (RULES); None where it fits none. The free
+    rectangles are split around the box and those inside another dropped (in place)."""
+    spots = [(rule(fx, fy, fx1, fy1, w, h), fx, fy) for fx, fy, fx1, fy1 in free
+             if fx + w <= fx1 + 1e-9 and fy + h <= fy1 + 1e-9]
+    if not spots:
+        return None
+    _, x, y = min(spots)
+    bx0, by0, bx1, by1 = x, y, x + w, y + h
+    out = []
+    for r in free:
+        fx0, fy0, fx1, fy1 = r
+        if bx0 >= fx1 or bx1 <= fx0 or by0 >= fy1 or by1 <= fy0:
+            out.append(r)
+            continue
+        out += [c for c in ((fx0, fy0, bx0, fy1), (bx1, fy0, fx1, fy1), (fx0, fy0, fx1, by0), (fx0, by1, fx1, fy1))
+                if c[2] - c[0] > 1e-9 and c[3] - c[1] > 1e-9]
+    free[:] = [r for i, r in enumerate(out) if not any(
+        j != i and q[0] <= r[0] and q[1] <= r[1] and r[2] <= q[2] and r[3] <= q[3] and (q != r or j < i)
+        for j, q in enumerate(out))]
+    return x, y
+
+
+#: The orders `layout` tries, each a key of a (width, height) to sort by descending: height, width,
+#: area, longer side.
+ORDERS = (lambda w, h: h, lambda w, h: w, lambda w, h: w * h, lambda w, h: max(w, h))
+
+
+def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule) -> dict[int, tuple[int, float, float]]:
+    """Each box (in `order`) at (page, x, y): the first page with room (`_place` by `rule`), a new one else."""
+    pages: list[list] = []
+    out = {}
+    for i in order:
+        w, h = sizes[i][0] + _GAP, sizes[i][1] + _GAP
+        for k, free in enumerate(pages + [_free(_GAP)]):
+            spot = _place(free, w, h, rule)
+            if spot is not None:
+                if k == len(pages):
+                    pages.append(free)
+                out[i] = (k, *spot)
+                break
+        else:                                    # larger than a page: alone on a page of its own
+            pages.append([])
+            out[i] = (len(pages) - 1, AREA[0], AREA[1])
+    return out
 
 
 def layout(drawings: list[Drawing]) -> list[Placement]:
-    """Shelf packing, first fit by decreasing height, of the drawings (heading above each) into
-    AREA, clear of the title block. A shelf is as tall as its first (tallest) drawing and holds
-    columns side by side; a drawing goes under the last in a column of a shelf where it fits
-    (width and height), else into a new column of a shelf with room beside, else onto a new shelf
-    below the last of the first page with room, else onto a new page (a further A3 sheet)."""
+    """The drawings (heading above each) packed into AREA, clear of the title block and _GAP
+    apart, never turned: maximal rectangles (`_place`) by each of the RULES, the drawings taken in
+    each of the ORDERS (ties by their order here); the first packing on one page is kept, else the
+    one on the fewest pages. A drawing that fits no page's room goes onto a further page."""
     sizes = [_size(d) for d in drawings]
-    order = sorted(range(len(drawings)), key=lambda i: -sizes[i][1])
-    out: dict[int, Placement] = {}
-    shelves: list[dict] = []          # page, y, height, x (where a new column goes), columns [[x, width, next y]]
-    bottoms: list[float] = []         # per page: where its next shelf would start
-    for i in order:
-        w, h, top = sizes[i]
-        spot = None
-        for sh in shelves:            # under a column
-            for col in sh["columns"]:
-                last = col is sh["columns"][-1]       # the last column may widen into the room beside it
-                if (w <= col[1] or last) and col[2] + h <= sh["y"] + sh["height"] and _fits(col[0], col[2], w, h):
-                    spot = (sh["page"], col[0], col[2])
-                    col[1], col[2] = max(col[1], w), col[2] + h + _GAP
-                    sh["x"] = max(sh["x"], col[0] + w + _GAP)
-                    break
-            if spot:
+    best = None
+    for rule in RULES:
+        for key in ORDERS:
+            order = sorted(range(len(drawings)), key=lambda i: (-key(*sizes[i][:2]), i))
+            spots = _pack(sizes, order, rule)
+            n = 1 + max((k for k, _, _ in spots.values()), default=0)
+            if best is None or n < best[0]:
+                best = (n, spots)
+            if n == 1:
                 break
-        if spot is None:              # a new column beside, or a new shelf, or a new page
-            sh = next((sh for sh in shelves if h <= sh["height"] and _fits(sh["x"], sh["y"], w, h)), None)
-            if sh is None:
-                page = next((k for k, y in enumerate(bottoms) if _fits(AREA[0], y, w, h)), None)
-                if page is None:
-                    bottoms.append(AREA[1])
-                    page = len(bottoms) - 1
-                sh = {"page": page, "y": bottoms[page], "height": h, "x": AREA[0], "columns": []}
-                shelves.append(sh)
-                bottoms[page] += h + _GAP
-            spot = (sh["page"], sh["x"], sh["y"])
-            sh["columns"].append([sh["x"], w, sh["y"] + h + _GAP])
-            sh["x"] += w + _GAP
-        page, x, y = spot
-        d = drawings[i]
-        out[i] = Placement(d.kind, page, x - d.box[0], y + top - d.box[1])
-    return [out[i] for i in range(len(drawings))]
+        if best[0] == 1:
+            break
+    out = []
+    for i, d in enumerate(drawings):
+        page, x, y = best[1][i]
+        out.append(Placement(d.kind, page, x - d.box[0], y + sizes[i][2] - d.box[1]))
+    return out
 
 
-def pages(plans, lang: str, title: str):
-    """The A3 sheets as matplotlib Figures, with the drawings and their placements. Each page's axes
-    fill it: 1 data unit = 1 mm, y down. Lines and arrowheads carry gid "<plan kind>/<segment>"
-    ("/<segment>^" for an arrowhead, its tip first), so that a test can measure them."""
+#: Of the scales coarsened to fit one sheet, these first (in this order among equals), each while
+#: its reference (pa, πa, the largest force) stays at least FLOOR_MM long; then μ_l.
+FIRST = ("mu_v", "mu_a", "mu_F")
+_TRIES = 40                                 # steps of one scale at most (a round step is x1.25..2)
+#: The shortest reference length a scale of FIRST is coarsened to (mm): half the recommended
+#: length's lower end (`scales.TARGET_MM`), a vector still measured to about 1 %.
+FLOOR_MM = {k: TARGET_MM[k][0] / 2 for k in FIRST}
+
+
+@dataclass(frozen=True)
+class OneSheet:
+    """The plans of a variant at the scales that put them all on one A3 sheet (`one_sheet`):
+    `plans` (`kinetostat.plans.Plans`), their drawings in `lang` and placements (`layout`), the
+    scales the texts' rule chose (`rule`: symbol -> Scale) and the quantity each scale draws
+    (`reference`, SI: `scales.references`)."""
+    plans: Any
+    lang: str
+    drawings: tuple[Drawing, ...]
+    places: tuple[Placement, ...]
+    rule: Mapping[str, Scale]
+    reference: Mapping[str, float]
+
+    def coarsened(self) -> list[tuple[Scale, Scale, float]]:
+        """The scales made coarser than the rule's to fit one sheet: (rule's, chosen, the
+        reference's drawn length at the chosen one, mm), in the order of SCALE_UNITS."""
+        return [(self.rule[k], s, self.reference[k] / s.value) for k, s in self.plans.scales.items()
+                if s.value > self.rule[k].value * (1 + 1e-9)]
+
+
+def one_sheet(mech, at: float, lang: str) -> OneSheet:
+    """The plans of `mech` at crank angle `at` (deg), drawn in `lang`, at the texts' scales where
+    they all fit one A3 sheet (`layout`) in every language of LANGS (so that a variant's scales do
+    not depend on the language of its pack), else with scales chosen together for that sheet: the
+    scale of FIRST whose plans take the most room (their boxes' area with headings) one round step
+    coarser (`scales.next_coarser`) while its reference stays FLOOR_MM long, then μ_l (its GOST
+    2.302 series, LENGTH_MANTISSAS), until they fit; then each scale of FIRST back one step finer
+    while they still fit. The same `kinetostat.plans.build` that every sheet of the plans uses,
+    with these scales given; each try a build, the drawings of the plans whose scales changed
+    (in each language) and their layouts. Where no scale within _TRIES steps fits them, the last
+    try is kept (more than one sheet)."""
+    from ..solve import analyze
+    from . import build
+    from .scales import LENGTH_MANTISSAS, next_coarser, references
+    res = analyze(mech, phi_deg=[float(at)])
+    reference = references(mech, res)
+    drawn: dict[tuple, Drawing] = {}
+
+    def drawings(plans, lg: str) -> list[Drawing]:
+        out = []
+        for k in plans:
+            key = (lg, k, *(s.value for s in scales_of(plans[k])))
+            if key not in drawn:
+                drawn[key] = drawing(plans[k], lg)
+            out.append(drawn[key])
+        return out
+
+    def attempt(given: Mapping[str, float] | None):
+        plans = build(mech, at=at, scales=given)
+        ds = drawings(plans, lang)
+        places = layout(ds)
+        fit = all(p.page == 0 for p in places) and all(
+            all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
+        return plans, ds, places, fit
+
+    plans, ds, places, fit = attempt(None)
+    rule = dict(plans.scales)
+    given = {k: s.value for k, s in rule.items()}
+    coarsest = {}                                # each scale of FIRST as coarse as its floor allows
+    for k in FIRST:
+        coarsest[k] = given[k]
+        while reference[k] / next_coarser(coarsest[k]) >= FLOOR_MM[k]:
+            coarsest[k] = next_coarser(coarsest[k])
+    for _ in range(_TRIES):                      # μ_l: the finest at which they fit, the others at their floor
+        if fit or attempt({**given, **coarsest})[3]:
+            break
+        given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
+    steps: dict[str, list[float]] = {k: [] for k in FIRST}       # the values each scale of FIRST left
+    for _ in range(_TRIES):                      # the others from the rule's, the one with most room first
+        if fit:
+            break
+        room = dict.fromkeys(FIRST, 0.0)
+        for d in ds:
+            sym = plans[d.kind].scale.symbol
+            if sym in room:
+                w, h, _ = _size(d)
+                room[sym] += w * h
+        open_ = [k for k in FIRST if room[k] and given[k] < coarsest[k] * (1 - 1e-9)]
+        if open_:
+            k = max(open_, key=lambda k: (room[k], -FIRST.index(k)))
+            steps[k].append(given[k])
+            given[k] = next_coarser(given[k])
+        else:                                    # (only where the search above ran out of tries)
+            given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
+        plans, ds, places, fit = attempt(given)
+    for k in FIRST:                              # back towards the rule while they still fit
+        while fit and steps[k]:
+            trial = attempt({**given, k: steps[k][-1]})
+            if not trial[3]:
+                break
+            given[k] = steps[k].pop()
+            plans, ds, places, fit = trial
+    return OneSheet(plans, lang, tuple(ds), tuple(places), MappingProxyType(rule), MappingProxyType(reference))
+
+
+def pages(sheet: OneSheet, title: str):
+    """The A3 sheets of `sheet` (`one_sheet`: one, unless its plans fit none) as matplotlib
+    Figures. Each page's axes fill it: 1 data unit = 1 mm, y down. The title block: `title`, the
+    note that every plan is true to scale, the scales coarser than the texts' rule
+    (`OneSheet.coarsened`) and, where the plans take more than one sheet, its number. Lines and
+    arrowheads carry gid "<plan kind>/<segment>" ("/<segment>^" for an arrowhead, its tip
+    first), so that a test can measure them."""
     from matplotlib.figure import Figure
     from matplotlib.patches import Circle, Polygon
 
-    drawings = [drawing(plans[k], lang) for k in plans]
-    places = layout(drawings)
+    lang, drawings, places = sheet.lang, sheet.drawings, sheet.places
     n = max(p.page for p in places) + 1
     W, H = SHEET_MM
     figs = []
@@ -228,9 +384,13 @@ def pages(plans, lang: str, title: str):
         tb = TITLE_BLOCK
         ax.plot([tb[0], tb[0], tb[2]], [tb[3], tb[1], tb[1]], color="k", lw=0.5 * _PT)
         ax.text(24, 10, title, fontsize=4.0 * _PT, va="baseline", weight="bold")
-        notes = [text("pack.a3_true", lang), text("pack.a3_page", lang, k=k + 1, n=n)]
+        notes = [text("pack.a3_true", lang)]
         if n > 1:
-            notes.append(text("pack.a3_more", lang, n=n))
+            notes += [text("pack.a3_page", lang, k=k + 1, n=n), text("pack.a3_more", lang, n=n)]
+        if sheet.coarsened():
+            notes.append(text("pack.a3_coarser", lang, scales="; ".join(
+                text("pack.instead", lang, scale=scale_text(s, lang), rule=num(r.value, lang, 6))
+                for r, s, _ in sheet.coarsened())))
         rows = [(ln, 3.5, "bold") for ln in _lines(title, 3.5, tb[2] - tb[0] - 6, "bold")]
         rows += [(ln, 2.8, "normal") for s in notes for ln in _lines(s, 2.8, tb[2] - tb[0] - 6)]
         y = tb[1] + 5.5
@@ -265,4 +425,4 @@ def pages(plans, lang: str, title: str):
             for s, size, low in runs:
                 ax.text(x, Y(b) + low, s, fontsize=size * _PT, va="baseline", ha="left")
                 x += _width(s, size)
-    return [f for f, _ in figs], drawings, places
+    return [f for f, _ in figs]

@@ -236,6 +236,22 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "pack.a3_more": ("The plans at their scales do not fit one A3 sheet: {n} sheets, none drawn smaller",
                      "Плани у своїх масштабах не вміщуються на одному аркуші А3: {n} аркуші, жоден не зменшено",
                      "Планы в своих масштабах не помещаются на одном листе А3: {n} листа, ни один не уменьшен"),
+    "pack.a3_coarser": ("Scales coarser than the text's rule, so that all the plans fit this one sheet: {scales}",
+                        "Масштаби дрібніші, ніж за правилом посібника, щоб усі плани вмістилися на цьому одному "
+                        "аркуші: {scales}",
+                        "Масштабы мельче, чем по правилу пособия, чтобы все планы поместились на этом одном листе: "
+                        "{scales}"),
+    "pack.instead": ("{scale} (rule: {rule})", "{scale} (за правилом {rule})", "{scale} (по правилу {rule})"),
+    "pack.coarsened": ("Scales coarser than the text's rule, so that all the plans fit one A3 sheet (every length and "
+                       "band in this key is at them): {scales}.",
+                       "Масштаби дрібніші, ніж за правилом посібника, щоб усі плани вмістилися на одному аркуші А3 "
+                       "(усі довжини й межі цього ключа — у них): {scales}.",
+                       "Масштабы мельче, чем по правилу пособия, чтобы все планы поместились на одном листе А3 "
+                       "(все длины и границы этого ключа — в них): {scales}."),
+    "pack.coarsened_one": ("{scale} instead of the rule's {rule}, {ref} drawn {mm} mm, not the recommended {lo}–{hi} mm",
+                           "{scale} замість {rule} за правилом, {ref} має {mm} мм, а не рекомендовані {lo}–{hi} мм",
+                           "{scale} вместо {rule} по правилу, {ref} имеет {mm} мм, а не рекомендуемые {lo}–{hi} мм"),
+    "pack.largest_force": ("the largest force", "найбільша сила", "наибольшая сила"),
     "pack.drawn": ("drawn", "відрізок", "отрезок"),
     "pack.segments": ("Segments a student measures, mm", "Відрізки, які вимірює студент, мм",
                       "Отрезки, которые измеряет студент, мм"),

@@ -14,8 +14,12 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
   scales μ_l, μ_v, μ_a, μ_F with the reference length each draws, and every scale each plan is
   drawn at; δ with the texts' 5 % rule; every segment a student measures on the plans, in mm, with
   the scale it is drawn at.
-- `plans_a3.pdf` / `plans.html`: the plans, each true to scale, on A3 landscape sheets (seed
-  002, appendix B puts the results on one A3 sheet): a further sheet where they do not fit (`a3`).
+- `plans_a3.pdf` / `plans.html`: the plans, each true to scale, on one A3 landscape sheet (seed
+  002, appendix B puts the results on one A3 sheet; `a3`); plans.html shows each plan's own SVG
+  sheet. Where the plans at the texts' recommended lengths do not fit that sheet, their scales
+  are chosen together for it (`a3.one_sheet`), and the key states which are coarser and why: every
+  part of the pack (the key's scales, segment lengths and bands, the SVG sheets, the worksheet,
+  the A3 sheet) is drawn at those scales.
 
 Both documents are one list of blocks (headings, paragraphs, tables, the drawing area), rendered
 twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figure library; TrueType
@@ -74,16 +78,22 @@ class Table:
 @dataclass(frozen=True)
 class Pack:
     """The pack of one variant in `lang`: the blocks of the sheet and of the key (("h1"|"h2"|"p",
-    text), ("table", Table), ("area", title-block lines)), the plans, the numbers of the key as
-    printed (`answers`) and the bands (worksheet key -> (low, high), SI)."""
+    text), ("table", Table), ("area", title-block lines)), the plans on their one A3 sheet
+    (`a3`: `a3.OneSheet`), the numbers of the key as printed (`answers`) and the bands
+    (worksheet key -> (low, high), SI)."""
     name: str
     lang: str
     title: str
     sheet: tuple[tuple[str, Any], ...]
     key: tuple[tuple[str, Any], ...]
-    plans: Any
+    a3: Any
     answers: frozenset[str]
     bands: Mapping[str, tuple[float, float]]
+
+    @property
+    def plans(self):
+        """The plans (`kinetostat.plans.Plans`) at the scales of the one A3 sheet."""
+        return self.a3.plans
 
     def write(self, out_dir: str | Path) -> list[Path]:
         """PACK_FILES into `out_dir`, each atomically; returns the paths."""
@@ -93,7 +103,7 @@ class Pack:
         paths = [out / f for f in PACK_FILES]
         write_bytes(paths[0], _pdf(self.sheet, sheet_t))
         write_bytes(paths[1], _pdf(self.key, key_t))
-        write_bytes(paths[2], _plans_pdf(self.plans, self.lang, f"{text('pack.a3', self.lang)}: {self.title}"))
+        write_bytes(paths[2], _plans_pdf(self.a3, f"{text('pack.a3', self.lang)}: {self.title}"))
         write_text(paths[3], html_document(sheet_t, _html(self.sheet), self.lang))
         write_text(paths[4], html_document(key_t, _html(self.key), self.lang))
         write_text(paths[5], _plans_html(self.plans, self.lang, f"{text('pack.a3', self.lang)}: {self.title}"))
@@ -102,15 +112,17 @@ class Pack:
 
 # ============================================================================ content
 
-def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
-    """The pack of variant `v` (`variants.Variant`) in `lang` at its design position; `plans`: its
-    plans when built already (`kinetostat.plans.build`); `draws`: Monte Carlo draws of the bands."""
-    from . import build
+def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS) -> Pack:
+    """The pack of variant `v` (`variants.Variant`) in `lang` at its design position, every part
+    at the scales that put the plans on one A3 sheet (`a3`: `a3.one_sheet` in `lang`, when chosen
+    already); `draws`: Monte Carlo draws of the bands."""
+    from .a3 import one_sheet
     from .drawing_error import Scales, simulate
     check_lang(lang)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
-    plans = plans or build(mech, at=phi1)
+    a3 = a3 or one_sheet(mech, phi1, lang)
+    plans = a3.plans
     sc = plans.scales
     ws = worksheet(mech, phi1, mu_l=sc["mu_l"].value, lang=lang)
     L = lettering(mech)
@@ -130,8 +142,10 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
         sheet.append(("p", "  ".join(f"{ch} = {d}" for ch, d in v.letters.items())))
     key = [("h1", f"{text('pack.key', lang)}. {title}")]          # scales, values and bands, δ, segments
     answers: set[str] = set()
-    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers)),
-            ("h2", text("pack.plan_scales", lang)), ("table", _plan_scales_table(plans, lang, answers))]
+    key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
+    if a3.coarsened():
+        key.append(("p", _coarsened(a3, lang)))
+    key += [("h2", text("pack.plan_scales", lang)), ("table", _plan_scales_table(plans, lang, answers))]
     sheet.append(("h2", text("pack.fill", lang)))
     recs = ws.records()
     outside = False                     # an exact value beyond its band (a segment shorter than the error)
@@ -175,7 +189,7 @@ def pack(v, lang: str = "en", plans=None, draws: int = BAND_DRAWS) -> Pack:
                                                                ("pack.student", "pack.group", "pack.checked"))))))
     given = {num(v.values[r.key], lang, 6) for r in spec.rows}
     answers = {a for a in answers if a not in given and a not in ("0", "—")}
-    return Pack(v.name, lang, title, tuple(sheet), tuple(key), plans, frozenset(answers), bands)
+    return Pack(v.name, lang, title, tuple(sheet), tuple(key), a3, frozenset(answers), bands)
 
 
 def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> Table:
@@ -189,6 +203,20 @@ def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> 
         answers.add(num(s.value, lang, 6))
     return Table((text("ws.head.symbol", lang), text("ws.head.value", lang), text("ws.head.unit", lang),
                   text("pack.drawn", lang)), tuple(rows), (0.15, 0.2, 0.25, 0.4), frozenset({1}))
+
+
+def _coarsened(a3, lang: str) -> str:
+    """The key's note on the scales coarser than the texts' rule (`a3.OneSheet.coarsened`): each
+    with the rule's value and its reference's drawn length against the recommended one
+    (`scales.TARGET_MM`), and why (one A3 sheet)."""
+    from .scales import TARGET_MM
+    items = []
+    for rule, chosen, drawn_mm in a3.coarsened():
+        lo, hi = TARGET_MM[chosen.symbol]
+        items.append(text("pack.coarsened_one", lang, scale=scale_text(chosen, lang), rule=num(rule.value, lang, 6),
+                          ref=_REFERENCE.get(chosen.symbol) or text("pack.largest_force", lang),
+                          mm=num(drawn_mm, lang, decimals=1), lo=num(lo, lang), hi=num(hi, lang)))
+    return text("pack.coarsened", lang, scales="; ".join(items))
 
 
 def _plan_scales_table(plans, lang: str, answers: set[str]) -> Table:
@@ -421,10 +449,10 @@ def _pdf(blocks, title: str) -> bytes:
     return buf.getvalue()
 
 
-def _plans_pdf(plans, lang: str, title: str) -> bytes:
-    """All the plans true to scale on A3 landscape sheets (`a3.pages`: one where they fit)."""
+def _plans_pdf(a3, title: str) -> bytes:
+    """All the plans true to scale on one A3 landscape sheet (`a3.pages`)."""
     from .a3 import pages
     with _pdf_pages(title) as (pdf, buf):
-        for fig in pages(plans, lang, title)[0]:
+        for fig in pages(a3, title):
             pdf.savefig(fig)
     return buf.getvalue()

@@ -33,7 +33,7 @@ import numpy as np
 
 from .core import Scale
 
-__all__ = ["choose_scales", "round_scale", "length_scale", "coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
+__all__ = ["choose_scales", "references", "round_scale", "length_scale", "coarser", "next_coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
            "LENGTH_MANTISSAS", "FIT_MM", "MAX_EXTENT_MM", "PLAN_OF"]
 
 #: Unit of each scale, per millimetre drawn.
@@ -117,6 +117,13 @@ def coarser(value: float, factor: float) -> float:
     return min(m * 10.0 ** e for e in (k, k + 1) for m in ROUND_MANTISSAS if m * 10.0 ** e >= want)
 
 
+def next_coarser(value: float, mantissas: tuple[float, ...] = ROUND_MANTISSAS) -> float:
+    """The next round scale above `value` (a mantissa of `mantissas` x 10^k): one step of the
+    series, e.g. 0.25 -> 0.4, 0.0015 -> 0.002 (LENGTH_MANTISSAS: 0.0015 -> 0.002 -> 0.0025)."""
+    k = math.floor(math.log10(value))
+    return min(m * 10.0 ** e for e in (k, k + 1) for m in mantissas if m * 10.0 ** e > value * (1 + 1e-9))
+
+
 def check_given(given: Mapping[str, float] | None) -> dict[str, float]:
     """The user's scales, checked: known keys, finite positive numbers (ValueError naming the key)."""
     out = {}
@@ -136,6 +143,20 @@ def _extent(z: np.ndarray) -> tuple[float, float]:
     return (float(np.ptp(z.real)), float(np.ptp(z.imag)))
 
 
+def references(mech, res) -> dict[str, float]:
+    """The quantity each scale draws at its recommended length (TARGET_MM), SI, at the first angle
+    of `res`: mu_l the crank l_OA (m), mu_v |v_A| (m/s), mu_a |a_A| (m/s^2) of the crank pin,
+    mu_F the largest force (a reaction, an applied load or an inertia force; N)."""
+    d = mech.drive
+    crank = mech.links[d.link].points
+    forces = np.concatenate([np.hypot(*np.moveaxis(a[0], -1, 0)).ravel()
+                             for a in (res.forces.R, res.F_applied, res.F_i)])
+    return {"mu_l": math.dist(crank[d.pivot], crank[d.point]),
+            "mu_v": float(np.hypot(*res.velocity(d.point)[0])),
+            "mu_a": float(np.hypot(*res.acceleration(d.point)[0])),
+            "mu_F": float(np.nanmax(forces, initial=0.0))}
+
+
 def choose_scales(mech, res, given: Mapping[str, float] | None = None,
                   cycle=None) -> dict[str, Scale]:
     """Scales mu_l, mu_v, mu_a, mu_F for the plans of `res` (an Analysis at one crank angle):
@@ -143,21 +164,15 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
     Analysis over the cycle whose positions the plan of positions must fit (default: 72 steps)."""
     from ..solve import analyze
     given = check_given(given)
-    d = mech.drive
-    crank = mech.links[d.link].points
-    l_oa = math.dist(crank[d.pivot], crank[d.point])
-    vA, aA = res.velocity(d.point)[0], res.acceleration(d.point)[0]
+    ref = references(mech, res)
     if cycle is None:
         cycle = analyze(mech, steps=72, friction="first")      # positions only
     pos = np.concatenate([cycle.kin.point_z(k, p)[0] for k, link in enumerate(mech.links) if k
                           for p in link.points.values()] + [np.array([complex(*p) for p in mech.links[0].points.values()])])
     vel = np.array([0j] + [complex(*res.velocity(n)[0]) for n in mech.point_names])
     acc = np.array([0j] + [complex(*res.acceleration(n)[0]) for n in mech.point_names])
-    forces = np.concatenate([np.hypot(*np.moveaxis(a[0], -1, 0)).ravel()
-                             for a in (res.forces.R, res.F_applied, res.F_i)])
-    reference = {"mu_l": (l_oa, _extent(pos)), "mu_v": (float(np.hypot(*vA)), _extent(vel)),
-                 "mu_a": (float(np.hypot(*aA)), _extent(acc)),
-                 "mu_F": (float(np.nanmax(forces, initial=0.0)), (0.0, 0.0))}
+    reference = {"mu_l": (ref["mu_l"], _extent(pos)), "mu_v": (ref["mu_v"], _extent(vel)),
+                 "mu_a": (ref["mu_a"], _extent(acc)), "mu_F": (ref["mu_F"], (0.0, 0.0))}
     out = {}
     for key, unit in SCALE_UNITS.items():
         if key in given:
@@ -166,14 +181,13 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
             if not size <= MAX_EXTENT_MM:
                 raise ScaleError(f"{key}={value:g} {unit} would draw the {PLAN_OF[key]} plan "
                                  f"{f'{size:.3g} mm' if size < math.inf else 'beyond 1e308 mm'} across (at most {MAX_EXTENT_MM:g} mm); use a larger scale")
-        elif key == "mu_l" and l_oa > 0:
-            value = length_scale(l_oa)
+        elif key == "mu_l" and ref["mu_l"] > 0:
+            value = length_scale(ref["mu_l"])
             ext = reference[key][1]
             factor = max(ext[0] / value / FIT_MM[0], ext[1] / value / FIT_MM[1])
             if factor > 1:                   # the positions would not fit the sheet: coarser
                 value = coarser(value, factor)
         else:
-            ref, ext = reference[key]
-            value = round_scale(ref, *TARGET_MM[key], extent=ext)
+            value = round_scale(reference[key][0], *TARGET_MM[key], extent=reference[key][1])
         out[key] = Scale(key, value, unit)
     return out

@@ -1,0 +1,245 @@
+"""The one A3 sheet of plans (`kinetostat.plans.a3`): every variant's plans on ONE sheet, true to
+scale, boxes apart and clear of the title block; the scales chosen together for that sheet only
+where the texts' do not fit it (μ_l last), named in the key and on the sheet; and the same scales
+in every file of the pack, down to a length measured in the PDF."""
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import warnings
+import zlib
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat import variants
+from kinetostat.plans import a3 as A3
+from kinetostat.plans import pack as P
+from kinetostat.plans.drawing_error import Scales, simulate
+from kinetostat.plans.draw import scale_text
+from kinetostat.plans.scales import LENGTH_MANTISSAS, ROUND_MANTISSAS, next_coarser
+
+needs_poppler = pytest.mark.skipif(shutil.which("pdftotext") is None, reason="poppler's pdftotext not installed")
+PT = 72.0 / 25.4                                       # points per mm
+
+
+@lru_cache(maxsize=None)
+def _one(task: int, code: str, lang: str = "en") -> A3.OneSheet:
+    v = variants.variant(task, code)
+    return A3.one_sheet(v.mechanism(), float(v.values["phi1"]), lang)
+
+
+def _check_sheet(one: A3.OneSheet) -> None:
+    """One page; every plan's box (drawing with its heading) inside AREA, clear of the title block
+    and of every other box."""
+    assert {p.page for p in one.places} == {0}
+    boxes = []
+    for d, p in zip(one.drawings, one.places):
+        w, h, top = A3._size(d)
+        x0, y0 = d.box[0] + p.dx, d.box[1] + p.dy - top
+        x1, y1 = x0 + w, y0 + h
+        assert A3.AREA[0] - 1e-9 <= x0 and x1 <= A3.AREA[2] + 1e-9 and A3.AREA[1] - 1e-9 <= y0 and y1 <= A3.AREA[3] + 1e-9, d.kind
+        assert x1 <= A3.TITLE_BLOCK[0] or y1 <= A3.TITLE_BLOCK[1], d.kind
+        for kind, b in boxes:
+            assert x1 <= b[0] or b[2] <= x0 or y1 <= b[1] or b[3] <= y0, (d.kind, kind)
+        boxes.append((d.kind, (x0, y0, x1, y1)))
+    assert len(boxes) == len(one.plans)
+
+
+def _round(value: float, mantissas) -> bool:
+    m = value / 10.0 ** np.floor(np.log10(value))
+    return any(np.isclose(m, x) for x in mantissas)
+
+
+def test_task_1_479_fits_one_sheet_at_the_texts_scales():
+    """The shelf packer put the lever on a second sheet (66,000 of 99,000 mm² used): now all 8 plans
+    on one, at the rule's scales (OA 32 mm), nothing made coarser; the same scales in every language."""
+    one = _one(1, "479", "uk")
+    assert len(one.plans) == 8
+    _check_sheet(one)
+    assert one.coarsened() == [] and dict(one.plans.scales) == dict(one.rule)
+    assert one.plans["mechanism"].length_mm("OA") == pytest.approx(32.0)
+
+
+def test_the_scales_do_not_depend_on_the_language():
+    """Task 3 / 388 fitted at μ_l = 0.0025 with English headings and labels, at 0.004 with Ukrainian
+    ones: the scales are chosen to fit in every language, so each pack of a variant states the same."""
+    en, uk = _one(3, "388", "en"), _one(3, "388", "uk")
+    assert dict(en.plans.scales) == dict(uk.plans.scales)
+    _check_sheet(en)
+    _check_sheet(uk)
+
+
+@pytest.mark.parametrize("task, code", [(1, "905"), (2, "479"), (3, "123")])
+def test_a_sample_of_variants_fits_one_sheet(task, code):
+    """Task 2 / 479 took 3 sheets (138,000 mm² of plans at the rule's scales), 3 / 123 two: each
+    on one now; a coarsened scale is a round value of its series, one step or more above the
+    rule's, its reference (pa, πa, the largest force) at least FLOOR_MM long."""
+    one = _one(task, code)
+    _check_sheet(one)
+    for rule, chosen, mm in one.coarsened():
+        assert chosen.value > rule.value
+        assert _round(chosen.value, LENGTH_MANTISSAS if chosen.symbol == "mu_l" else ROUND_MANTISSAS), chosen
+        assert mm == pytest.approx(one.reference[chosen.symbol] / chosen.value)
+        if chosen.symbol in A3.FIRST:
+            assert mm >= A3.FLOOR_MM[chosen.symbol]
+
+
+def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
+    """Task 2 / 479: its mechanism and positions plans are 322 mm wide at the rule's μ_l = 0.0012;
+    with the velocity, acceleration and force scales at their floor they still take two sheets (in
+    a language of the pack) at μ_l one step finer than the chosen one (0.0015), so μ_l = 0.002
+    (OA 19 mm) is the finest that fits; and each other coarsened scale one step finer does not fit."""
+    one = _one(2, "479")
+    mu_l = one.plans.scales["mu_l"].value
+    assert one.rule["mu_l"].value == pytest.approx(0.0012) and mu_l == pytest.approx(0.002)
+    floor = {}
+    for k in A3.FIRST:
+        floor[k] = one.rule[k].value
+        while one.reference[k] / next_coarser(floor[k]) >= A3.FLOOR_MM[k]:
+            floor[k] = next_coarser(floor[k])
+    mech = one.plans.mech
+    plans = kinetostat.plans.build(mech, at=one.plans.at, scales={"mu_l": 0.0015, **floor})
+    assert any(max(p.page for p in A3.layout([A3.drawing(plans[k], lang) for k in plans])) >= 1
+               for lang in ("en", "uk", "ru"))
+    for rule, chosen, _ in one.coarsened():
+        if chosen.symbol in A3.FIRST:
+            finer = max(v for v in (rule.value, *(m * 10.0 ** e for e in range(-4, 5) for m in ROUND_MANTISSAS))
+                        if v < chosen.value * (1 - 1e-9))
+            given = {k: s.value for k, s in one.plans.scales.items()} | {chosen.symbol: finer}
+            plans = kinetostat.plans.build(mech, at=one.plans.at, scales=given)
+            assert any(max(p.page for p in A3.layout([A3.drawing(plans[k], lang) for k in plans])) >= 1
+                       for lang in ("en", "uk", "ru")), chosen
+
+
+def test_the_packer_counts_its_work():
+    """The packer tries RULES x ORDERS at most, each placing every plan once per page it tries."""
+    one = _one(1, "479")
+    calls = []
+    place = A3._place
+
+    def counted(*a):
+        calls.append(1)
+        return place(*a)
+    try:
+        A3._place = counted
+        A3.layout(list(one.drawings))
+    finally:
+        A3._place = place
+    assert 0 < len(calls) <= len(A3.RULES) * len(A3.ORDERS) * len(one.drawings) * 2
+
+
+def _pdf_lines(pdf: bytes) -> list[tuple[float, float, float, float]]:
+    """Every straight segment "x0 y0 m x1 y1 l" of the PDF's content streams, mm from the top left."""
+    out = []
+    for raw in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", pdf, re.S):
+        try:
+            body = zlib.decompress(raw).decode("latin-1")
+        except zlib.error:
+            continue
+        for m in re.finditer(r"(-?[\d.]+) (-?[\d.]+) m\s+(-?[\d.]+) (-?[\d.]+) l", body):
+            x0, y0, x1, y1 = (float(v) / PT for v in m.groups())
+            out.append((x0, 297.0 - y0, x1, 297.0 - y1))
+    return out
+
+
+@pytest.fixture(scope="module")
+def task2_pack():
+    """Task 2 / 479 in English, its bands from 20 draws (the scales are what is tested)."""
+    return P.pack(variants.variant(2, "479"), lang="en", a3=_one(2, "479"), draws=20)
+
+
+@pytest.fixture(scope="module")
+def task2_pdf(task2_pack, tmp_path_factory):
+    """Its plans_a3.pdf, as `Pack.write` writes it."""
+    path = tmp_path_factory.mktemp("a3") / "plans_a3.pdf"
+    path.write_bytes(P._plans_pdf(task2_pack.a3, "t"))
+    return path
+
+
+def test_the_key_length_is_the_length_in_the_pdf(task2_pack, task2_pdf):
+    """OA of task 2 / 479 at the one sheet's μ_l = 0.002: the key's segment length (19 mm) is the
+    line OA found in the PDF's content stream (the page A3, 1 mm = 1 mm) to 0.01 mm, where the
+    Figure put it; the key and the title block say why μ_l is not the rule's 0.0012."""
+    p = task2_pack
+    pdf = task2_pdf.read_bytes()
+    boxes = re.findall(rb"/MediaBox \[ 0 0 ([\d.]+) ([\d.]+) \]", pdf)
+    assert len(boxes) == 1 and [float(v) / PT for v in boxes[0]] == pytest.approx([420.0, 297.0])    # one A3 page
+    key_rows = [r for kind, x in p.key if kind == "table" and x.head[2:3] == ("Length, mm",) for r in x.rows]
+    oa = next(r for r in key_rows if r[1] == "OA" and r[0].startswith("Mechanism"))
+    assert float(oa[2]) == pytest.approx(19.0) and oa[3] == "μ_l = 0.002 m/mm"
+    fig = A3.pages(p.a3, "t")[0]
+    ax = fig.axes[0]
+    line = next(a for a in ax.lines if a.get_gid() == "mechanism/OA")
+    px = ax.transData.transform(line.get_xydata())
+    ends = np.column_stack([px[:, 0], fig.bbox.height - px[:, 1]]) / fig.dpi * 25.4
+    found = [s for s in _pdf_lines(pdf) if np.allclose(s, ends.ravel(), atol=0.01)
+             or np.allclose(s, ends[::-1].ravel(), atol=0.01)]
+    assert found, ends
+    x0, y0, x1, y1 = found[0]
+    assert np.hypot(x1 - x0, y1 - y0) == pytest.approx(p.plans["mechanism"].length_mm("OA"), abs=0.01)
+    assert np.hypot(x1 - x0, y1 - y0) == pytest.approx(float(oa[2]), abs=0.05)      # as the key prints it
+    (note,) = [x for kind, x in p.key if kind == "p" and "instead of the rule's" in x]
+    assert note.startswith("Scales coarser than the text's rule, so that all the plans fit one A3 sheet")
+    assert "μ_l = 0.002 m/mm instead of the rule's 0.0012, OA drawn 19.0 mm, not the recommended 30–36 mm" in note
+    assert note.count("instead of the rule's") == len(p.a3.coarsened()) >= 2
+
+
+@needs_poppler
+def test_the_sheet_names_the_coarsened_scales(task2_pdf):
+    info = subprocess.run(["pdfinfo", str(task2_pdf)], capture_output=True, text=True, check=True).stdout
+    assert re.search(r"Pages:\s+1\n", info)
+    page = " ".join(subprocess.run(["pdftotext", str(task2_pdf), "-"], capture_output=True,
+                                   text=True, check=True).stdout.split())
+    assert "Scales coarser than the text's rule, so that all the plans fit this one sheet" in page
+    assert "μ_l = 0.002 m/mm (rule: 0.0012)" in page
+
+
+def test_the_bands_are_drawn_at_the_one_sheets_scales(task2_pack):
+    """The key's bands are the drawing-error study at the one sheet's scales (μ_a = 200, μ_F = 100:
+    coarser than the rule's, so wider), its scales table those scales."""
+    p = task2_pack
+    sc = p.plans.scales
+    drawn = simulate(p.plans.mech, at=p.plans.at, n=20, seed=0,
+                     scales=Scales(*(sc[k].value for k in ("mu_l", "mu_v", "mu_a", "mu_F"))))
+    for k, (lo, hi) in p.bands.items():
+        assert (lo, hi) == pytest.approx(tuple(np.percentile(drawn.samples[k], P.BAND))), k
+    scales = next(x for kind, x in p.key if kind == "table" and x.rows[0][0] == "μ_l")
+    assert {r[0]: r[1] for r in scales.rows} == {"μ_l": "0.002", "μ_v": "0.25", "μ_a": "200", "μ_F": "100"}
+
+
+def test_write_key_draws_every_file_at_the_one_sheets_scales(tmp_path, monkeypatch):
+    """`write_key` chooses the scales once (`one_sheet`) and hands them to the SVG sheets, the
+    worksheet and the pack: task 2 / 479's mechanism sheet and worksheet at μ_l = 0.002, not the
+    rule's 0.0012 (which the keys without a pack keep)."""
+    got = []
+
+    class Fake:                                        # the pack itself: the tests above
+        def write(self, out):
+            return []
+    monkeypatch.setattr(P, "pack", lambda v, lang, a3=None: got.append(a3) or Fake())
+    v = variants.variant(2, "479")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        variants.write_key(v, tmp_path / "pack", lang="en", cycle_csv=False)
+        variants.write_key(v, tmp_path / "rule", lang="en", cycle_csv=False, teacher_pack=False)
+    (one,) = got
+    assert scale_text(one.plans.scales["mu_l"], "en") == "μ_l = 0.002 m/mm" and one.lang == "en"
+    for folder, mu_l in (("pack", "μ_l = 0.002 m/mm"), ("rule", "μ_l = 0.0012 m/mm")):
+        assert mu_l in (tmp_path / folder / "mechanism.svg").read_text(encoding="utf-8")
+        assert f"scale {mu_l}" in (tmp_path / folder / "worksheet.md").read_text(encoding="utf-8")
+    mu_a = scale_text(one.plans.scales["mu_a"], "en")
+    assert mu_a == "μ_a = 200 m/(s²·mm)" and mu_a in (tmp_path / "pack" / "acceleration.svg").read_text(encoding="utf-8")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("task, hundred", [(t, h) for t in sorted(variants.TASKS) for h in range(10)])
+def test_every_variant_fits_one_sheet(task, hundred):
+    """All 1000 codes of each task, a hundred a test (each under the 300 s timeout): one sheet,
+    boxes apart and clear of the title block."""
+    for code in variants.codes()[100 * hundred:100 * (hundred + 1)]:
+        v = variants.variant(task, code)
+        _check_sheet(A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "uk"))
