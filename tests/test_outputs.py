@@ -62,7 +62,7 @@ def test_model_strings_are_text_in_every_report_file(tmp_path, cli, others):
     out = tmp_path / "out"
     r = cli("report", INJECTION, *others, "--out", out, *QUICK)
     assert r.returncode == 0, r.stderr
-    assert (out / "injection" / "mechanism.png").stat().st_size > 1000
+    assert (out / "injection" / "mechanism.svg").stat().st_size > 1000
     assert all((out / p.stem / "index.md").is_file() for p in others)
     data = tomllib.loads(INJECTION.read_text(encoding="utf-8"))
     strings = [data["mechanism"]["name"], data["mechanism"]["source"], *data["mechanism"]["assumptions"],

@@ -27,7 +27,7 @@ pytest.importorskip("matplotlib")
 
 ICE = ROOT / "models" / "ice_crank_slider.toml"
 SHAPER = ROOT / "models" / "slotted_link_shaper.toml"      # a working machine
-PNGS = ["mechanism.png", "balancing_moment.png", "reactions.png", "errors.png", "hodographs.png"]
+FIGURES = ["mechanism.svg", "balancing_moment.svg", "reactions.svg", "errors.svg", "hodographs.svg"]
 
 
 def _report(out: Path, *args: str) -> subprocess.CompletedProcess:
@@ -63,7 +63,7 @@ def ice_report(tmp_path_factory) -> Path:
 @pytest.mark.slow
 def test_reruns_are_byte_identical_and_jobs_do_not_matter(tmp_path):
     """No date, run time or process-dependent byte in any file: a run in one process reproduces
-    every file of a run by two worker processes exactly, the real PNG plots included."""
+    every file of a run by two worker processes exactly, the real SVG plots included."""
     parallel, serial = tmp_path / "parallel", tmp_path / "serial"
     _report(parallel, "--jobs", "2")
     _report(serial, "--jobs", "1")
@@ -71,16 +71,16 @@ def test_reruns_are_byte_identical_and_jobs_do_not_matter(tmp_path):
     for f in files:
         assert (parallel / f).read_bytes() == (serial / f).read_bytes(), f
     plans = {m: len(kinetostat.plans.build(kinetostat.load(p))) for m, p in (("ice", ICE), ("shaper", SHAPER))}
-    # the index; ice: 5 png, md, html, csv, json, an svg per plan, segments.csv, worksheet.csv; the shaper + 1 png
+    # the index; ice: 5 figures, md, html, csv, json, an svg per plan, segments.csv, worksheet.csv; the shaper + 1 figure
     assert len(files) == 2 + (9 + plans["ice"] + 2) + (10 + plans["shaper"] + 2)
-    for png in PNGS:
-        data = (serial / "ice_crank_slider" / png).read_bytes()
-        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000, png
+    for fig in FIGURES:
+        data = (serial / "ice_crank_slider" / fig).read_text(encoding="utf-8")
+        assert "<svg" in data[:400] and len(data) > 10_000 and "<dc:date>" not in data, fig
 
 
 def test_a_rerun_writes_the_same_text_files(tmp_path, sketched_plots):
     """The sample of the above: the text files of a four-bar's report (Markdown, HTML, tables,
-    summary), written twice, are the same bytes (the PNGs' own reruns: -m slow)."""
+    summary), written twice, are the same bytes (the figures' own reruns: -m slow)."""
     p = tmp_path / "four_bar.toml"
     p.write_text(FOUR_BAR)
     for out in ("a", "b"):
@@ -93,10 +93,10 @@ def test_a_rerun_writes_the_same_text_files(tmp_path, sketched_plots):
 
 def test_report_files(ice_report):
     d = ice_report / "ice_crank_slider"
-    for name in ["index.md", "index.html", "cycle.csv", "summary.json", *PNGS]:
+    for name in ["index.md", "index.html", "cycle.csv", "summary.json", *FIGURES]:
         assert (d / name).is_file(), name
-    for png in PNGS:
-        assert (d / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", png     # sketched; real ones: -m slow
+    for fig in FIGURES:
+        assert b"<svg" in (d / fig).read_bytes()[:400], fig     # sketched; real ones: -m slow
     cycle = read_csv(d / "cycle.csv")
     assert len(cycle) == 36 and {"phi_deg", "M_bal", "M_lever", "R_0_1"} <= set(cycle.columns)
     assert cycle.attrs["units"]["R_0_1"] == "N" and cycle.attrs["units"]["M_bal"] == "N m"
@@ -167,20 +167,20 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     for symbol, value in [("V_B", "10.94"), ("R32", "6481"), (r"M\_зр (lever)", "102.97")]:
         assert re.search(rf"^\| {re.escape(symbol)} \|.*\| {value} \|.*%", md, re.M), symbol
     # images linked next to the markdown; an engine has no balancing force section
-    for png in PNGS:
-        assert f"]({png})" in md
+    for fig in FIGURES:
+        assert f"]({fig})" in md
     assert "## Balancing force" not in md
 
 
 def test_machine_report_shows_the_balancing_force(ice_report):
     d = ice_report / "slotted_link_shaper"
     md = (d / "index.md").read_text()
-    assert "## Balancing force" in md and "](balancing_force.png)" in md
+    assert "## Balancing force" in md and "](balancing_force.svg)" in md
     res = kinetostat.analyze(kinetostat.load(SHAPER), steps=36)
     F = np.linalg.norm(res.balancing_force, axis=-1)
     i = int(np.argmax(F))
     assert f"| \\|F\\_зр\\| | {F[i]:.5g} | {res.phi_deg[i]:.4g} |" in md          # the text's F_зр
-    assert (d / "balancing_force.png").read_bytes()[:4] == b"\x89PNG"
+    assert b"<svg" in (d / "balancing_force.svg").read_bytes()[:400]
 
 
 def test_report_html_is_markdown_it_rendering(ice_report):
@@ -188,9 +188,8 @@ def test_report_html_is_markdown_it_rendering(ice_report):
     d = ice_report / "ice_crank_slider"
     html = (d / "index.html").read_text()
     plans = kinetostat.plans.build(kinetostat.load(ICE))
-    assert html.count('src="data:image/png;base64,') == len(PNGS)
-    # the plans: the sheets of `kinetostat plans`, embedded, each a link to its SVG file
-    assert html.count('src="data:image/svg+xml;base64,') == len(plans)
+    # the figures and the plans (the sheets of `kinetostat plans`), embedded; each plan a link to its SVG file
+    assert html.count('src="data:image/svg+xml;base64,') == len(FIGURES) + len(plans)
     for plan in plans.values():
         name = "plan_" + kinetostat.plans.plan_file_name(plan)
         assert f'<a href="{name}"><img' in html

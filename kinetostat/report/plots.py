@@ -12,6 +12,7 @@ and the plans' lettering (`plans.lettering`, `plans.forces.reaction_name`).
 """
 from __future__ import annotations
 
+import io
 import math
 import re
 from contextlib import contextmanager
@@ -85,33 +86,24 @@ def plain_text() -> Iterator[None]:
     """Figures made in this block take every text literally: no mathtext (a model named
     "$\\frac{$" would abort the drawing) and no LaTeX, whatever the user's matplotlibrc says;
     tick labels and offsets as plain numbers (1e-13, not a mathtext power of ten); glyphs
-    unhinted (matplotlib's default hints each glyph at 8x its width: a fifth of the figures'
-    drawing time, for no difference visible at DPI)."""
+    measured unhinted (matplotlib's default hints each glyph at 8x its width, for a raster
+    the figures are not); the SVG's text as text (`_save`), without a date or random ids."""
     import matplotlib
     with matplotlib.rc_context({"text.parse_math": False, "text.usetex": False, "axes.formatter.use_mathtext": False,
-                                "text.hinting": "none"}):
+                                "text.hinting": "none", "svg.fonttype": "none", "svg.hashsalt": "kinetostat"}):
         yield
 
 
-#: Resolution of the PNGs, dots per inch.
-DPI = 110
-
-
 def _save(fig, path: Path) -> Path:
-    """PNG at DPI, reduced to a 256-colour palette without dithering: a third of the size of
-    the RGBA file and visually the same for line plots (the HTML embeds every image). The Agg
-    canvas' pixels go to Pillow (matplotlib's dependency) directly: no PNG written and read back.
-    Pillow writes no time or software chunk, so the file depends on the figure only. The file
-    is written atomically (an interrupt leaves the previous file as it was)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from PIL import Image
-    canvas = FigureCanvasAgg(fig)
-    fig.set_dpi(DPI)
-    canvas.draw()
-    img = Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
-    pal = img.convert("RGB").quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
-    with atomic(path, binary=True) as f:
-        pal.save(f, format="PNG", compress_level=6)
+    """The figure as SVG (matplotlib's SVG backend, in `plain_text`): vector lines, and text as
+    text a reader can search and copy (half the time of rendering a PNG and writing it: the
+    report's figures were its largest cost); no date or software version in the file, so it
+    depends on the figure only. Written atomically (an interrupt leaves the previous file as it was)."""
+    from matplotlib.backends.backend_svg import FigureCanvasSVG
+    buf = io.StringIO()
+    FigureCanvasSVG(fig).print_svg(buf, metadata={"Date": None, "Creator": None})
+    with atomic(path) as f:
+        f.write(buf.getvalue())
     return path
 
 

@@ -489,12 +489,12 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     machine = m.drive.kind == "machine"
     with plain_text():
         images = {
-            "mechanism": plot_mechanism(at, res, d / "mechanism.png"),
-            "moment": plot_moment(run, d / "balancing_moment.png"),
-            **({"force": plot_balancing_force(res, d / "balancing_force.png")} if machine else {}),
-            "reactions": plot_reactions(run, d / "reactions.png"),
-            "errors": plot_errors(run, d / "errors.png"),
-            "hodographs": plot_hodographs(run, d / "hodographs.png"),
+            "mechanism": plot_mechanism(at, res, d / "mechanism.svg"),
+            "moment": plot_moment(run, d / "balancing_moment.svg"),
+            **({"force": plot_balancing_force(res, d / "balancing_force.svg")} if machine else {}),
+            "reactions": plot_reactions(run, d / "reactions.svg"),
+            "errors": plot_errors(run, d / "errors.svg"),
+            "hodographs": plot_hodographs(run, d / "hodographs.svg"),
         }
     with atomic(d / "cycle.csv") as f:
         write_csv(res.to_frame(), f)
