@@ -428,11 +428,16 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
 #: `kinetostat report --jobs 2` before, measured on this machine, each in fresh processes: the
 #: commit, its models, CPU s (user + sys, every process) and wall s of each run, the load average.
 #: 4f33869: the 8 models of the session that set the target, by hand. 9e5daed: every model bundled
-#: at that commit, the session before the light axes of the figures.
+#: at that commit (before the figures' light axes and SVG), in its own checkout and virtual
+#: environment on the quiet machine, by `main_job` (3 runs).
 MAIN_JOB_BEFORE = (
     dict(commit="4f33869", cpu=(20.8, 20.1), wall=(11.8, 11.4), load="0.9-1.3",
          models=("chain_unit_four_bar", "compressor", "furnace_loader_six_bar", "ice_crank_slider",
                  "opposed_twin", "rotating_slotted_link", "scotch_yoke", "slotted_link_shaper")),
+    dict(commit="9e5daed", cpu=(21.05, 20.89, 20.62), wall=(11.13, 11.01, 10.73), load="1.4-1.7",
+         models=("chain_unit_four_bar", "compressor", "furnace_loader_six_bar", "ice_crank_slider",
+                 "opposed_twin", "rotating_slotted_link", "scotch_yoke", "slotted_link_shaper",
+                 "triad_six_bar", "triad_slider")),
 )
 
 
