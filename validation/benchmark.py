@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import itertools
 import math
 import statistics
 import time
@@ -633,7 +634,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
     df = pd.DataFrame(rows)
     df.to_csv(out / "benchmark.csv", index=False)
     fig, ax = plt.subplots(figsize=(8.5, 6))
-    markers = dict(zip(sorted(df.model.unique()), "osD^v<>pPX"))
+    markers = dict(zip(sorted(df.model.unique()), itertools.cycle("osD^v<>pPXh*")))
     colours = dict(zip(df.route.unique(), plt.rcParams["axes.prop_cycle"].by_key()["color"]))
     for (model, route), g in df.groupby(["model", "route"], sort=False):
         ax.scatter(g.seconds * 1e3, g.error.clip(lower=1e-17), marker=markers[model], color=colours[route],
