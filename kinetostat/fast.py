@@ -73,12 +73,13 @@ __all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FA
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
 #: compiled path where this process holds the kernel already (`threshold`). Measured
 #: (reports/benchmark.md, "Where the compiled path pays"): the loaded kernel is the faster from
-#: 100 angles on the four-bar and the six-link; on the ICE (a gas diagram) the two are even at 300.
-FAST_MIN = 1_000
+#: about 1,000 angles on the four-bar and 3,000 on the six-link at every larger size; on the ICE
+#: (its gas diagram evaluated per chunk) the two are about even from 1,000 to 10,000 angles.
+FAST_MIN = 10_000
 #: ... and from this many where the call would load the kernel: its load from the disk cache
-#: (about 0.14 s of CPU, numba's import included; a first compile per machine takes seconds) is
-#: repaid within the call from about 1e5 positions (the six-link) to 7e5 (the four-bar; the
-#: same section).
+#: (about 0.15 s of CPU, numba's import included; a first compile per machine takes seconds) is
+#: repaid within the call from about 1e5 positions (the six-link) to 5e5 (the ICE; the same
+#: section).
 FAST_COLD = 500_000
 #: Angles per chunk: `chunks`' default size, and the run of angles whose loads are evaluated at once.
 CHUNK = 1 << 14

@@ -23,7 +23,7 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360, friction: str | Non
     friction exactly (`kinetostat.friction`), group by group, on the numpy path at any number of angles.
 
     From `fast.threshold(mech)` angles on it runs the compiled kernel (`fast.analyze_fast`):
-    fast.FAST_MIN (1,000) where this process holds the mechanism's kernel already, fast.FAST_COLD
+    fast.FAST_MIN (10,000) where this process holds the mechanism's kernel already, fast.FAST_COLD
     (500,000) where the call would load it; below them the numpy path (`exact`): the same results
     to rounding (tests/test_fast.py). A mechanism the kernel does not take (`fast.refusal`: a
     class-III group) and friction="reactions" (the kernel has no friction in the reactions) go

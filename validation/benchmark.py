@@ -156,10 +156,10 @@ CROSSOVER_SIZES = (100, 300, 1_000, 3_000, 10_000, 100_000)
 def crossover(repeat: int = 5) -> list[dict]:
     """Where the compiled path pays (`fast.threshold`): per model, the full analysis of N angles by
     the numpy path (`exact`) and by the compiled kernel already loaded (`fast.analyze_fast`), CPU
-    s minimum of `repeat` calls after a warm-up, at CROSSOVER_SIZES; the kernel's load from the
+    s minimum of `repeat` calls or as many as fill 0.2 s, after a warm-up, at CROSSOVER_SIZES; the kernel's load from the
     disk cache in a fresh process (CPU s of `fast.kernel(mech, "full")` after `import kinetostat`:
-    numba's import included), minimum of 3; the smallest size where the loaded kernel is the faster,
-    and the positions from which a call that loads the kernel repays it (load / the saving per
+    numba's import included), minimum of 3; the smallest size from which the loaded kernel is the
+    faster at every larger size, and the positions from which a call that loads the kernel repays it (load / the saving per
     angle at the largest size)."""
     import subprocess
     import sys
@@ -172,8 +172,8 @@ def crossover(repeat: int = 5) -> list[dict]:
             phi = crank_angles(None, n)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                t_np, _ = timed_runs(lambda: exact(mech, phi), repeat)
-                t_c, _ = timed_runs(lambda: fast.analyze_fast(mech, phi), repeat)
+                t_np, _ = timed_runs(lambda: exact(mech, phi), repeat, 0.2)
+                t_c, _ = timed_runs(lambda: fast.analyze_fast(mech, phi), repeat, 0.2)
             sizes.append(dict(angles=n, numpy=t_np.cpu_min, compiled=t_c.cpu_min))
         probe = ("import time, kinetostat; from kinetostat import fast; m = kinetostat.load(%r); "
                  "t = time.process_time(); fast.kernel(m, 'full'); print(time.process_time() - t)" % name)
@@ -181,7 +181,8 @@ def crossover(repeat: int = 5) -> list[dict]:
                                         text=True).stdout) for _ in range(3))
         big = sizes[-1]
         saving = (big["numpy"] - big["compiled"]) / big["angles"]
-        warm = next((r["angles"] for r in sizes if r["compiled"] < r["numpy"]), None)
+        faster = [r["compiled"] < r["numpy"] for r in sizes]
+        warm = next((r["angles"] for n, r in enumerate(sizes) if all(faster[n:])), None)
         out.append(dict(model=name, sizes=sizes, load=load, warm=warm, cold=load / saving if saving > 0 else math.inf))
         print(f"crossover {name}: load {load:.3f} s, the loaded kernel the faster from {warm} angles, a loading call "
               f"repaid from {out[-1]['cold']:.3g}", flush=True)
@@ -193,9 +194,9 @@ def crossover_lines(rows: list[dict]) -> list[str]:
     head = " | ".join(f"{n:,}" for n in CROSSOVER_SIZES)
     lines = ["## Where the compiled path pays (`fast.FAST_MIN`, `fast.FAST_COLD`)", "",
              "`kinetostat.analyze` of N angles: the numpy path (`exact`) against the compiled kernel already "
-             "loaded in the process (`fast.analyze_fast`), CPU ms (minimum of 5 calls after a warm-up); the "
+             "loaded in the process (`fast.analyze_fast`), CPU ms (minimum of at least 5 calls, as many as fill 0.2 s, after a warm-up); the "
              "kernel's load from the disk cache in a fresh process (`fast.kernel`, numba's import included; "
-             "minimum of 3); the smallest N here where the loaded kernel is the faster; and the N from which a "
+             "minimum of 3); the smallest N here from which the loaded kernel is the faster at every larger N; and the N from which a "
              "call that must load the kernel repays the load (load / the saving per angle at "
              f"{CROSSOVER_SIZES[-1]:,} angles). `analyze` takes the compiled path from `FAST_MIN` = "
              f"{fast.FAST_MIN:,} angles where the process holds the kernel, from `FAST_COLD` = {fast.FAST_COLD:,} "
@@ -204,7 +205,7 @@ def crossover_lines(rows: list[dict]) -> list[str]:
     for r in rows:
         for path in ("numpy", "compiled"):
             lines.append(f"| {r['model']} | {path} | " + " | ".join(f"{x[path] * 1e3:.3g}" for x in r["sizes"]) + " |")
-    lines += ["", "| model | kernel load, s CPU | loaded kernel the faster from, angles | a loading call repaid from, angles |",
+    lines += ["", "| model | kernel load, s CPU | the loaded kernel the faster from, angles | a loading call repaid from, angles |",
               "|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['model']} | {r['load']:.3f} | {r['warm'] if r['warm'] is not None else '-'} | {r['cold']:.3g} |")
