@@ -72,14 +72,15 @@ __all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FA
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
 #: compiled path where this process holds the kernel already (`threshold`). Measured
-#: (reports/benchmark.md, "Where the compiled path pays"): the loaded kernel is the faster from
-#: about 1,000 angles on the four-bar and 3,000 on the six-link at every larger size; on the ICE
-#: (its gas diagram evaluated per chunk) the two are about even from 1,000 to 10,000 angles.
+#: (reports/benchmark.md, "Where the compiled path pays"): the loaded kernel is the faster at
+#: every size from 100 angles on the four-bar (3x at 10^4) and from 1,000 on the six-link (1.8x
+#: at 10^4); on the ICE (its gas diagram evaluated per chunk) neither path is reliably the faster
+#: (1.3x at 10^4, 0.9x at 10^5 in that run; 1.8x at 10^5 in an earlier one).
 FAST_MIN = 10_000
 #: ... and from this many where the call would load the kernel: its load from the disk cache
 #: (about 0.15 s of CPU, numba's import included; a first compile per machine takes seconds) is
-#: repaid within the call from about 1e5 positions (the six-link) to 5e5 (the ICE; the same
-#: section).
+#: repaid within the call from about 1.3e5 positions (the six-link) to 8.5e5 (the four-bar; the
+#: same section).
 FAST_COLD = 500_000
 #: Angles per chunk: `chunks`' default size, and the run of angles whose loads are evaluated at once.
 CHUNK = 1 << 14
