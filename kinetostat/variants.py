@@ -659,7 +659,8 @@ def summary(v: Variant, k: KeySummary, out: str | Path, lang: str = "en") -> lis
                    R=k.largest, R_value=f"{num(k.R_max, lang, 5)} {N}"),
               text("cli.cycle", lang, M=L.M_bal, M_value=f"{num(k.cycle_M_max, lang, 5)} {Nm}",
                    R_value=f"{num(k.cycle_R_max, lang, 5)} {N}"),
-              text("cli.files", lang, model=f"{v.name}.toml", n=len(k.files), out=out)]
+              text("cli.files" if any(f.name == "key.pdf" for f in k.files) else "cli.files_keys", lang,
+                   model=f"{v.name}.toml", n=len(k.files), out=out)]
     return lines
 
 

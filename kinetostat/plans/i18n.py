@@ -126,6 +126,14 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "cli.cycle": ("over the cycle: max |{M}| = {M_value}, max |R| = {R_value}",
                   "за цикл: найбільше |{M}| = {M_value}, найбільше |R| = {R_value}",
                   "за цикл: наибольшее |{M}| = {M_value}, наибольшее |R| = {R_value}"),
+    "cli.files_keys": ("model {model} (assumptions in its header), worksheet and plans at the text's rule of scales "
+                       "(no teacher's pack: its one-sheet scales may differ), `cycle.csv`: {n} files -> {out}",
+                       "модель {model} (припущення в її заголовку), розрахунковий лист і плани в масштабах за правилом "
+                       "посібника (без пакета викладача: його масштаби одного аркуша можуть відрізнятися), `cycle.csv`: "
+                       "{n} файлів -> {out}",
+                       "модель {model} (допущения в её заголовке), расчётный лист и планы в масштабах по правилу "
+                       "пособия (без пакета преподавателя: его масштабы одного листа могут отличаться), `cycle.csv`: "
+                       "{n} файлов -> {out}"),
     "cli.files": ("model {model} (assumptions in its header), worksheet, plans, `cycle.csv`, the student's sheet "
                   "`sheet.pdf`, the answer key `key.pdf` and the A3 sheet `plans_a3.pdf`: {n} files -> {out}",
                   "модель {model} (припущення в її заголовку), розрахунковий лист, плани, `cycle.csv`, аркуш "
@@ -243,11 +251,18 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                         "{scales}"),
     "pack.instead": ("{scale} (rule: {rule})", "{scale} (за правилом {rule})", "{scale} (по правилу {rule})"),
     "pack.coarsened": ("Scales coarser than the text's rule, so that all the plans fit one A3 sheet (every length and "
-                       "band in this key is at them): {scales}.",
+                       "band in this key is at them): {scales}. Give the students these scales with their sheet: drawn "
+                       "at the rule's, their lengths would match none of this key's.",
                        "Масштаби дрібніші, ніж за правилом посібника, щоб усі плани вмістилися на одному аркуші А3 "
-                       "(усі довжини й межі цього ключа — у них): {scales}.",
+                       "(усі довжини й межі цього ключа — у них): {scales}. Дайте студентам ці масштаби разом з аркушем "
+                       "завдання: у масштабах за правилом їхні довжини не збіжуться з жодною довжиною цього ключа.",
                        "Масштабы мельче, чем по правилу пособия, чтобы все планы поместились на одном листе А3 "
-                       "(все длины и границы этого ключа — в них): {scales}."),
+                       "(все длины и границы этого ключа — в них): {scales}. Дайте студентам эти масштабы вместе с "
+                       "листом задания: в масштабах по правилу их длины не совпадут ни с одной длиной этого ключа."),
+    "pack.coarsened_within": ("{scale} instead of the rule's {rule}, {ref} drawn {mm} mm (still within the recommended "
+                              "{lo}–{hi} mm)",
+                              "{scale} замість {rule} за правилом, {ref} має {mm} мм (у межах рекомендованих {lo}–{hi} мм)",
+                              "{scale} вместо {rule} по правилу, {ref} имеет {mm} мм (в пределах рекомендуемых {lo}–{hi} мм)"),
     "pack.coarsened_one": ("{scale} instead of the rule's {rule}, {ref} drawn {mm} mm, not the recommended {lo}–{hi} mm",
                            "{scale} замість {rule} за правилом, {ref} має {mm} мм, а не рекомендовані {lo}–{hi} мм",
                            "{scale} вместо {rule} по правилу, {ref} имеет {mm} мм, а не рекомендуемые {lo}–{hi} мм"),

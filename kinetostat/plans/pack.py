@@ -208,12 +208,14 @@ def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> 
 def _coarsened(a3, lang: str) -> str:
     """The key's note on the scales coarser than the texts' rule (`a3.OneSheet.coarsened`): each
     with the rule's value and its reference's drawn length against the recommended one
-    (`scales.TARGET_MM`), and why (one A3 sheet)."""
+    (`scales.TARGET_MM`: outside it, or still within it), why (one A3 sheet), and that the
+    students need these scales."""
     from .scales import TARGET_MM
     items = []
     for rule, chosen, drawn_mm in a3.coarsened():
         lo, hi = TARGET_MM[chosen.symbol]
-        items.append(text("pack.coarsened_one", lang, scale=scale_text(chosen, lang), rule=num(rule.value, lang, 6),
+        items.append(text("pack.coarsened_within" if lo <= drawn_mm <= hi else "pack.coarsened_one", lang,
+                          scale=scale_text(chosen, lang), rule=num(rule.value, lang, 6),
                           ref=_REFERENCE.get(chosen.symbol) or text("pack.largest_force", lang),
                           mm=num(drawn_mm, lang, decimals=1), lo=num(lo, lang), hi=num(hi, lang)))
     return text("pack.coarsened", lang, scales="; ".join(items))
