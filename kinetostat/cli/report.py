@@ -16,20 +16,30 @@ from .._text import one_line
 from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, _Out, _checkpoint, _close, _engines, _error, _load, _prepare, _progress, _warn, _writable_dir, bundled_models
 
 
+#: path -> (mechanism, analysis, solver seconds) of the models `cmd_report` prepared: a forked
+#: worker (or this process with --jobs 1) finds them here and does not load and analyse the model
+#: again; under another start method the dict is empty and the job does both itself.
+_PREPARED: dict[str, tuple] = {}
+
+
 def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = False,
                 friction: str = "first") -> dict:
-    """One model's report: load, analyse, run the routes, write `out/<folder>/`. Returns
-    {"summary", "warnings", "seconds"} or {"error"} (one line); raises only KeyboardInterrupt."""
+    """One model's report: load, analyse (or take both from `_PREPARED`), run the routes, write
+    `out/<folder>/`. Returns {"summary", "warnings", "seconds"} or {"error"} (one line); raises
+    only KeyboardInterrupt."""
     from ..report import run_validation, write_report
     t0 = time.perf_counter()
     try:
         from ..solve import analyze
-        mech = _load(path)
-        with warnings.catch_warnings():       # the main process printed the analysis' warnings
-            warnings.simplefilter("ignore")
-            t1 = time.perf_counter()
-            res = analyze(mech, steps=steps)
-            secs = time.perf_counter() - t1
+        if path in _PREPARED:
+            mech, res, secs = _PREPARED[path]
+        else:
+            mech = _load(path)
+            with warnings.catch_warnings():       # the main process printed the analysis' warnings
+                warnings.simplefilter("ignore")
+                t1 = time.perf_counter()
+                res = analyze(mech, steps=steps)
+                secs = time.perf_counter() - t1
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
@@ -100,6 +110,8 @@ def cmd_report(args) -> int:
     out = _writable_dir(args.out, "--out")
     paths = args.models or bundled_models()
     prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
+    _PREPARED.clear()
+    _PREPARED.update({str(p): (mech, res, secs) for p, mech, res, secs in prepared})
     order = [p for p, *_ in prepared]
     folders = unique_names([p.stem for p in order])     # never '.', '..' or a path; two a.toml: a, a-2
     t0 = time.perf_counter()
