@@ -73,14 +73,14 @@ __all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FA
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
 #: compiled path where this process holds the kernel already (`threshold`). Measured
 #: (reports/benchmark.md, "Where the compiled path pays"): the loaded kernel is the faster at
-#: every size from 100 angles on the four-bar (3x at 10^4) and from 1,000 on the six-link (1.8x
-#: at 10^4); on the ICE (its gas diagram evaluated per chunk) neither path is reliably the faster
-#: (1.3x at 10^4, 0.9x at 10^5 in that run; 1.8x at 10^5 in an earlier one).
+#: every size from 100 angles on the four-bar (3.3x at 10^4) and the six-link (1.7x); on the ICE
+#: (its gas diagram evaluated per chunk) from 3,000 (1.4x at 10^4, even at 10^5; an earlier run
+#: had it 0.9x at 10^5).
 FAST_MIN = 10_000
 #: ... and from this many where the call would load the kernel: its load from the disk cache
-#: (about 0.15 s of CPU, numba's import included; a first compile per machine takes seconds) is
-#: repaid within the call from about 1.3e5 positions (the six-link) to 8.5e5 (the four-bar; the
-#: same section).
+#: (about 0.14 s of CPU, numba's import included; a first compile per machine takes seconds) is
+#: repaid within the call from about 1.2e5 positions (the six-link) to 8.4e5 (the four-bar; on
+#: the ICE hardly ever; the same section).
 FAST_COLD = 500_000
 #: Angles per chunk: `chunks`' default size, and the run of angles whose loads are evaluated at once.
 CHUNK = 1 << 14
