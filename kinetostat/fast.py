@@ -68,7 +68,7 @@ if TYPE_CHECKING:
     from .model import Mechanism
 
 __all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "available",
-           "cache_dir", "kernel", "loaded", "threshold", "vector_report", "bytes_per_angle"]
+           "cache_dir", "kernel", "loaded", "threshold", "pays", "vector_report", "bytes_per_angle"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
 #: compiled path where this process holds the kernel already (`threshold`). Measured
@@ -489,6 +489,12 @@ def threshold(mech: "Mechanism", kind: str = "full") -> int:
     return FAST_MIN if loaded(mech, kind) else FAST_COLD
 
 
+def pays(mech: "Mechanism", n: int, kind: str = "full") -> bool:
+    """Whether `n` positions of `mech` go the compiled path: numba is there, the kernel takes
+    `mech` (`refusal`) and n reaches `threshold` (the cheap bound FAST_MIN first)."""
+    return n >= FAST_MIN and available() and refusal(mech) is None and n >= threshold(mech, kind)
+
+
 def vector_report(fn) -> dict[str, int]:
     """Counts of the packed (ymm/zmm/xmm ...pd) and scalar (...sd) double arithmetic instructions
     in a compiled kernel's assembly: how much of it LLVM vectorised. ValueError where the kernel
@@ -651,9 +657,9 @@ def analyze_fast(mech: "Mechanism", phi_deg: np.ndarray, threads: int | None = N
     rounding), with the angles the guard must see (cond > COND_CHECK, or not assembled) solved
     by the numpy path. phi_deg: (N,) read-only crank angles, deg, as `analysis.crank_angles`
     gives. Its arrays are (strided) views of one flat buffer: a fresh one (the first touch of
-    its pages costs about as much again as the kernel's work on the four-bar, 127 against 61 ns
-    an angle, and a third more on the six-link, 428 against 318 ns: reports/benchmark.md), or `out` (`buffer(mech, N)`, reused: it is overwritten, and the
-    previous Analysis with it)."""
+    its pages costs about as much again as the kernel's work on the four-bar, 123 against 60 ns
+    an angle, and a third more on the six-link, 461 against 345 ns: reports/benchmark.md), or
+    `out` (`buffer(mech, N)`, reused: it is overwritten, and the previous Analysis with it)."""
     N = len(phi_deg)
     buf = buffer(mech, N) if out is None else _check_buffer(mech, out, N)
     return _analysis(mech, phi_deg, buf, threads)

@@ -33,7 +33,6 @@ def analyze(mech: Mechanism, phi_deg=None, steps: int = 360, friction: str | Non
                         f"read a model file with kinetostat.load(path)")
     phi_deg = crank_angles(phi_deg, steps)
     method = friction_method(mech, friction)
-    if ((method != "reactions" or mech.friction is None) and len(phi_deg) >= fast.FAST_MIN and fast.available()
-            and fast.refusal(mech) is None and len(phi_deg) >= fast.threshold(mech)):
+    if (method != "reactions" or mech.friction is None) and fast.pays(mech, len(phi_deg)):
         return fast.analyze_fast(mech, phi_deg)
     return exact(mech, phi_deg, method)

@@ -124,8 +124,7 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     friction_method(base, friction)                 # ValueError for a bad method, before any design runs
     from . import fast
     n = len(designs) * len(phi_deg)                 # decided here once, so every chunk (any worker) agrees
-    compiled = (not full and n >= fast.FAST_MIN and fast.available() and fast.refusal(base) is None
-                and n >= fast.threshold(base, "peaks"))
+    compiled = not full and fast.pays(base, n, "peaks")
     results = _run(parts, text, source, phi_deg, full, scheduler, progress, friction, compiled)
     table = _tidy(pd.concat([rows for rows, _ in results], ignore_index=True), names, base, friction)
     angles = None

@@ -144,49 +144,56 @@ def _nice(n: int = 6):
     return MaxNLocator(n, steps=[1, 2, 2.5, 5, 10])
 
 
+def _ticks(lo: float, hi: float, log: bool, loc=None) -> list[float]:
+    """The ticks of `loc` within [lo, hi] (the view); without `loc`, `_nice()`, or on a log axis
+    LogLocator(numticks=6)'s decades, with 2 and 5 between them where fewer than two fall in view."""
+    from matplotlib.ticker import LogLocator
+    f = np.log10 if log else float
+    tol = 1e-9 * (f(hi) - f(lo))
+    ticks: list[float] = []
+    for loc in [loc] if loc else [LogLocator(numticks=6), LogLocator(numticks=6, subs=(1.0, 2.0, 5.0))] if log else [_nice()]:
+        ticks = [t for t in loc.tick_values(lo, hi) if (t > 0 or not log) and f(lo) - tol <= f(t) <= f(hi) + tol]
+        if len(ticks) >= 2:
+            break
+    return ticks
+
+
 def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = None, ylabel_pt: float = _LABEL_PT,
           xnumbers: bool = True) -> None:
     """ax's two axes drawn light, after its data and limits are set: `x`, `y` are tick locators
-    (default `_nice()`; a log axis takes LogLocator(numticks=6), with 2 and 5 between the decades
-    where the view holds fewer than two decades; labels `_names`);
-    the ticks within the view are drawn as one grid line collection and a text per label, the
-    axis labels as texts, in place of matplotlib's own axes, which make five artists per tick
-    (half of these figures' drawing time). No tick marks: the grid carries the ticks. `xnumbers`
-    False: the x grid without its labels (a panel above another on the same x)."""
+    (`_ticks`; labels `_names`); the ticks within the view are drawn as one grid line collection
+    and a text per label, the axis labels as texts, in place of matplotlib's own axes, which make
+    five artists per tick (half of these figures' drawing time). No tick marks: the grid carries
+    the ticks. `xnumbers` False: the x grid without its labels (a panel above another on the same x)."""
     from matplotlib.collections import LineCollection
-    from matplotlib.ticker import LogLocator
     from matplotlib.transforms import offset_copy
     ax.apply_aspect()
-    fig = ax.figure
     widest = 0
-    for axis, loc, label in (("x", x, xlabel), ("y", y, ylabel)):
-        lo, hi = sorted(ax.get_xlim() if axis == "x" else ax.get_ylim())
-        log = (ax.get_xscale() if axis == "x" else ax.get_yscale()) == "log"
-        f = np.log10 if log else float
-        tol = 1e-9 * (f(hi) - f(lo))
-        for loc in [loc] if loc else [LogLocator(numticks=6), LogLocator(numticks=6, subs=(1.0, 2.0, 5.0))] if log else [_nice()]:
-            ticks = [t for t in loc.tick_values(lo, hi) if (t > 0 or not log) and f(lo) - tol <= f(t) <= f(hi) + tol]
-            if len(ticks) >= 2:
-                break
+    for axis, loc in ((ax.xaxis, x), (ax.yaxis, y)):
+        along_x = axis is ax.xaxis
+        log = axis.get_scale() == "log"
+        ticks = _ticks(*sorted(axis.get_view_interval()), log, loc)
         names = _names(ticks, log)
-        trans, va, ha = (ax.get_xaxis_text1_transform if axis == "x" else ax.get_yaxis_text1_transform)(_PAD_PT)
-        ends = [[(t, 0), (t, 1)] if axis == "x" else [(0, t), (1, t)] for t in ticks]
-        ax.add_collection(LineCollection(ends, colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
-                                         transform=ax.get_xaxis_transform() if axis == "x" else ax.get_yaxis_transform()),
+        ax.add_collection(LineCollection([[(t, 0), (t, 1)] if along_x else [(0, t), (1, t)] for t in ticks],
+                                         colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
+                                         transform=ax.get_xaxis_transform() if along_x else ax.get_yaxis_transform()),
                           autolim=False)
-        for t, name in zip(ticks, names) if axis == "y" or xnumbers else ():
-            ax.text(*((t, 0) if axis == "x" else (0, t)), name, transform=trans, va=va, ha=ha, fontsize=_TICK_PT)
-        if axis == "y":
-            widest = max(map(len, names), default=0)
-        (ax.set_xlim if axis == "x" else ax.set_ylim)(ax.get_xlim() if axis == "x" else ax.get_ylim())
+        if along_x and not xnumbers:
+            continue
+        trans, va, ha = (ax.get_xaxis_text1_transform if along_x else ax.get_yaxis_text1_transform)(_PAD_PT)
+        for t, name in zip(ticks, names):
+            ax.text(*((t, 0) if along_x else (0, t)), name, transform=trans, va=va, ha=ha, fontsize=_TICK_PT)
+        widest = 0 if along_x else max(map(len, names), default=0)
+    ax.set_xlim(ax.get_xlim())                      # frozen: nothing added later moves the grid
+    ax.set_ylim(ax.get_ylim())
     ax.xaxis.set_visible(False)
     ax.yaxis.set_visible(False)
     if xlabel:
-        ax.text(0.5, 0, xlabel, transform=offset_copy(ax.transAxes, fig, y=-(_PAD_PT + 1.3 * _TICK_PT + 3), units="points"),
-                ha="center", va="top", fontsize=_LABEL_PT)
+        ax.text(0.5, 0, xlabel, transform=offset_copy(ax.transAxes, ax.figure, y=-(_PAD_PT + 1.3 * _TICK_PT + 3),
+                                                      units="points"), ha="center", va="top", fontsize=_LABEL_PT)
     if ylabel:
-        ax.text(0, 0.5, ylabel, transform=offset_copy(ax.transAxes, fig, x=-(_PAD_PT + 0.64 * _TICK_PT * widest + 4), units="points"),
-                ha="right", va="center", rotation=90, fontsize=ylabel_pt)
+        ax.text(0, 0.5, ylabel, transform=offset_copy(ax.transAxes, ax.figure, x=-(_PAD_PT + 0.64 * _TICK_PT * widest + 4),
+                                                      units="points"), ha="right", va="center", rotation=90, fontsize=ylabel_pt)
 
 
 def _phi_axes(ax, label: bool = True, step: int = 90, y=None, ylabel: str | None = None, ylabel_pt: float = _LABEL_PT,
