@@ -167,10 +167,10 @@ class Placer:
         if self._all_samples is None:
             x0, y0, x1, y1 = np.asarray(self._lines, float).reshape(-1, 4).T
             n = np.minimum(np.maximum(2.0, np.hypot(x1 - x0, y1 - y0) / 0.7 + 1), 1e4).astype(int)
+            start = np.cumsum(n) - n                     # each line's first sample
             line = np.repeat(np.arange(len(n)), n)
-            k = np.arange(len(line)) - np.repeat(np.cumsum(n) - n, n)
-            t = k * np.repeat(1.0 / (n - 1), n)
-            t[np.cumsum(n) - 1] = 1.0
+            t = (np.arange(n.sum()) - start[line]) * (1.0 / (n - 1))[line]
+            t[start + n - 1] = 1.0
             self._all_samples = np.column_stack([x0[line] + t * (x1 - x0)[line], y0[line] + t * (y1 - y0)[line]])
         return self._all_samples
 
