@@ -281,9 +281,10 @@ def test_engines_none_stands_alone():
 
 def test_report_without_engines(tmp_path):
     pytest.importorskip("matplotlib")
-    r = cli("report", ICE, "--engines", "none", "--steps", 36, "--out", tmp_path, "--no-progress", hide=True)
+    r = cli("report", ICE, "--engines", "none", "--steps", 36, "--out", tmp_path, "--no-progress", "--no-page", hide=True)
     assert r.returncode == 0, r.stdout + r.stderr
     md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
+    assert not (tmp_path / "ice_crank_slider" / "page.html").exists() and "page.html" not in md     # --no-page
     assert "## Against the published values" in md and r"| M\_зр (lever) |" in md      # the text's lettering
     assert r"| reference | M\_зр |" in md and "| reference | mpmath |" not in md
     assert "## The mechanism at φ = 30°" in md

@@ -23,7 +23,7 @@ pytest.importorskip("matplotlib")
 
 ICE = ROOT / "models" / "ice_crank_slider.toml"
 INJECTION = ROOT / "tests" / "hostile" / "reports" / "injection.toml"
-QUICK = ("--steps", "12", "--engines", "none", "--jobs", "1", "--no-progress")
+QUICK = ("--steps", "12", "--engines", "none", "--jobs", "1", "--no-progress", "--no-page")
 
 
 def _tokens(md: str):
@@ -215,7 +215,7 @@ def test_a_full_disk_leaves_the_old_files(args, written, tmp_path, cli, request)
 
 def _report_cmd(out: Path) -> list[str]:
     return [sys.executable, "-m", "kinetostat", "report", str(ICE), "--out", str(out), "--steps", "36",
-            "--engines", "none", "--jobs", "1", "--no-progress"]
+            "--engines", "none", "--jobs", "1", "--no-progress", "--no-page"]
 
 
 def _interrupt_when(cmd: list[str], out: Path, written: int) -> subprocess.Popen:

@@ -160,7 +160,8 @@ def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert f"validate: {len(NAMES)} model(s)" in r.stdout and " 0 FAILED" in r.stdout
 
-    r = _run(exe, "report", "--out", work / "out", "--steps", 36, "--engines", "pinocchio", "--no-progress", cwd=work)
+    r = _run(exe, "report", "--out", work / "out", "--steps", 36, "--engines", "pinocchio", "--no-progress", "--no-page",
+             cwd=work)
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert (work / "out" / "index.md").is_file()
     assert all((work / "out" / n / "index.html").is_file() for n in NAMES)

@@ -384,3 +384,45 @@ def test_split_rounds_coordinates_only():
                      '<text x="1.26" y="7.00">μ_l = 0.001 m/mm</text>')
     assert nums == [123, 25, round(12.3456789012 / LENGTH_Q), 13, 70, 1]
     assert t[1::2] == (".1", ".2", "L", ".1", ".1", ".3")
+
+
+def test_report_keeps_its_page_only_where_it_is_the_same_page(tmp_path, monkeypatch, cli):
+    """`kinetostat report` writes and links each model's page by default. A rerun keeps the page
+    it finds, without drawing it again, where the page's key is the key of the page it would draw;
+    a model text with one load changed, or other code, draws the page again. (A page of two
+    angles at scales sampled every 90 deg: quick.)"""
+    import kinetostat.plans.page as pg
+    monkeypatch.setattr(pg, "PAGE_ANGLES", (0.0, 150.0))
+    cycle = P.cycle_scales
+    monkeypatch.setattr(P, "cycle_scales", lambda mech: cycle(mech, step_deg=90.0))
+    drawn: list[str] = []
+    draw = pg.page
+    monkeypatch.setattr(pg, "page", lambda mech, **kw: drawn.append(mech.name) or draw(mech, **kw))
+    ice = next(p for p in MODELS if p.stem == "ice_crank_slider")
+    changed = tmp_path / "changed" / "ice_crank_slider.toml"      # the same folder name in the report
+    changed.parent.mkdir()
+    text = ice.read_text(encoding="utf-8")
+    assert "\nG2 = 4.9 " in text
+    changed.write_text(text.replace("\nG2 = 4.9 ", "\nG2 = 5.2 "), encoding="utf-8")
+    out = tmp_path / "r"
+    html, md = out / "ice_crank_slider" / "page.html", out / "ice_crank_slider" / "index.md"
+
+    def report(model):
+        r = cli("report", str(model), "--engines", "none", "--steps", "12", "--jobs", "1", "--no-progress",
+                "--out", str(out))
+        assert r.returncode == 0, r.stderr
+        return html.read_bytes()
+
+    first = report(ice)
+    assert len(drawn) == 1 and "](page.html)" in md.read_text(encoding="utf-8")
+    assert "[page](ice_crank_slider/page.html)" in (out / "index.md").read_text(encoding="utf-8")
+    assert pg.key_of(html) == pg.page_key(kinetostat.load(ice)) is not None
+    assert report(ice) == first and len(drawn) == 1                 # kept: the same page
+    other = report(changed)
+    assert len(drawn) == 2 and other != first and pg.key_of(html) == pg.page_key(kinetostat.load(changed))
+    old = pg.key_of(html)
+    monkeypatch.setattr(pg, "_code_digest", lambda: b"other code")
+    pg.write_page(kinetostat.load(changed), tmp_path / "again.html", reuse=html)
+    again = (tmp_path / "again.html").read_bytes()
+    assert len(drawn) == 3 and pg.key_of(tmp_path / "again.html") == pg.page_key(kinetostat.load(changed)) != old
+    assert again.replace(pg.key_of(tmp_path / "again.html").encode(), old.encode()) == other    # drawn again: the same page

@@ -39,7 +39,7 @@ def _report(out: Path, *args: str) -> subprocess.CompletedProcess:
     return r
 
 
-REPORT_ARGS = (str(ICE), str(SHAPER), "--steps", "36", "--engines", "pinocchio", "mujoco", "--no-progress")
+REPORT_ARGS = (str(ICE), str(SHAPER), "--steps", "36", "--engines", "pinocchio", "mujoco", "--no-progress", "--no-page")
 
 
 @pytest.fixture(scope="module")
@@ -331,7 +331,7 @@ def test_report_cli_errors_become_one_line(tmp_path, monkeypatch, capsys):
     from kinetostat import cli
     from kinetostat import report
 
-    def broken(run, out, folder=None, page=False, friction="first"):
+    def broken(run, out, folder=None, page=False, friction="first", reuse=None):
         raise RuntimeError("plotting failed\nsecond line")
     monkeypatch.setattr(report, "write_report", broken)
     code = cli.main(["report", str(ICE), "--out", str(tmp_path), "--steps", "12", "--engines", "pinocchio",

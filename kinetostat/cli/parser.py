@@ -108,7 +108,8 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Write OUT/<model>/index.md and a self-contained index.html per MODEL "
                                    "(default: all bundled models) with the mechanism's data, its picture, "
                                    "plots over the cycle, error tables per engine route, the seeds' published "
-                                   "values where known, and cycle.csv; plus OUT/index.md and OUT/index.html. "
+                                   "values where known, cycle.csv, the plans at the design position and the "
+                                   "interactive page; plus OUT/index.md and OUT/index.html. "
                                    "The files carry no dates or run times (a rerun reproduces them byte for "
                                    "byte); run times are printed here only. Every file is written atomically: "
                                    "Ctrl-C (exit 130) or a full disk leaves the earlier files as they were, and "
@@ -128,8 +129,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     _friction_option(r, "of the report's plans and worksheet (default first, the graphical method's; the friction "
                         "section shows both either way)")
-    r.add_argument("--page", action="store_true", help="also each model's interactive page (page.html, linked; "
-                                                       "about 40 s a model)")
+    r.add_argument("--page", action=argparse.BooleanOptionalAction, default=True,
+                   help="each model's interactive page, page.html, linked (default; --no-page: none). A page "
+                        "is drawn anew, about 15-40 s of CPU a model, only where OUT/<model>/page.html is not "
+                        "already the same page: the same model, the same code (README: the page)")
     r.set_defaults(func=cmd_report)
 
     pl = sub.add_parser("plans", help="draw the plans of the graphical method (SVG sheets, segments.csv)",

@@ -22,10 +22,10 @@ from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, _Out, _check
 _PREPARED: dict[str, tuple] = {}
 
 
-def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = False,
+def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = True,
                 friction: str = "first") -> dict:
     """One model's report: load, analyse (or take both from `_PREPARED`), run the routes, write
-    `out/<folder>/`. Returns {"summary", "warnings", "seconds"} or {"error"} (one line); raises
+    `out/<folder>/` (with `page`, its page.html kept where it is the same page). Returns {"summary", "warnings", "seconds"} or {"error"} (one line); raises
     only KeyboardInterrupt."""
     from ..report import run_validation, write_report
     t0 = time.perf_counter()
@@ -43,7 +43,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
-            summary = write_report(run, tmp, folder, page=page, friction=friction)
+            summary = write_report(run, tmp, folder, page=page, friction=friction, reuse=Path(out) / folder)
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
@@ -72,7 +72,7 @@ def _report_cost(mech) -> int:
 
 
 def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int,
-                    costs: Sequence[int] = (), page: bool = False, friction: str = "first"):
+                    costs: Sequence[int] = (), page: bool = True, friction: str = "first"):
     """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
     them in a process pool (only paths and names cross to the workers, so any start method
     works), the largest `costs` first, 1 in this process. Ctrl-C cancels the models not started

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import base64
 import gzip
+import hashlib
 import json
 import math
 import multiprocessing
@@ -35,19 +36,20 @@ import os
 import re
 import warnings
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
-from functools import partial
+from dataclasses import dataclass, fields, is_dataclass
+from collections.abc import Mapping, Sequence
+from functools import cache, partial
 from html import escape
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
-from .._io import write_text
+from .._io import write_bytes, write_text
 from .draw import TINY_MM, segment_label, svg, title_of
 from .i18n import check_lang, num, text, unit
 
-__all__ = ["page", "write_page", "encode", "PAGE_ANGLES", "TOLERANCE_PCT"]
+__all__ = ["page", "write_page", "page_key", "key_of", "encode", "PAGE_ANGLES", "TOLERANCE_PCT", "KEY_META"]
 
 #: The angles of the slider, deg (the design position is one more frame).
 PAGE_ANGLES = tuple(float(a) for a in range(360))
@@ -431,20 +433,22 @@ def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
 # ============================================================================ the page
 
 def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
-         angles=PAGE_ANGLES, fixed=None) -> str:
+         angles: Sequence[float] | None = None, fixed=None) -> str:
     """The interactive page of `mech` in `lang` (module docstring). `at`: the angle of the check
-    (and of a student's page; default the design position); `angles`: the slider's frames (deg);
+    (and of a student's page; default the design position); `angles`: the slider's frames (deg;
+    default PAGE_ANGLES);
     `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
     from ..solve import analyze
     from . import cycle_scales, starting_position
     from .lettering import lettering
     check_lang(lang)
+    key = page_key(mech, lang, student, at, angles, fixed)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
     fixed = fixed or cycle_scales(mech)
     start = starting_position(mech)
     name = lettering(mech).name(lang, mech.name)
-    frames = [at] if student else [*map(float, angles), design]
+    frames = [at] if student else [*map(float, PAGE_ANGLES if angles is None else angles), design]
 
     plans_at = partial(_plans_at, mech, start, fixed)
     check = plans_at(at)
@@ -499,7 +503,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                                                              9, mtime=0))).decode("ascii")
     res = analyze(mech, phi_deg=[at])
     blank = _blank_tables(mech, at, fixed, lang) if student else ""
-    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results, blank)
+    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results, blank, key)
 
 
 def _blank_tables(mech, at: float, fixed, lang: str) -> str:
@@ -538,7 +542,7 @@ def _obscure(data: bytes) -> bytes:
 
 
 def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
-          data_rows, items, results, blank: str = "") -> str:
+          data_rows, items, results, blank: str = "", key: str | None = None) -> str:
     from .draw import scale_text
     title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
     scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
@@ -589,6 +593,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     payload = json.dumps(data, ensure_ascii=False).replace("</", "<\\/")
     blob_tags = "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
     return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
+            + (f'<meta name="{KEY_META}" content="{key}">' if key else "") +
             f'<meta http-equiv="Content-Security-Policy" content="default-src \'none\'; style-src \'unsafe-inline\'; '
             f'script-src \'unsafe-inline\'; img-src data:">'
             f'<title>{escape(title)}</title><style>{_CSS}</style><style id="page-size">@page{{size:A3 landscape;margin:0}}</style>'
@@ -656,8 +661,97 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
 """
 
 
-def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None) -> Path:
-    """The page of `mech` (`page`) written to `out` atomically; returns its path."""
+def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None,
+               reuse: str | Path | None = None) -> Path:
+    """The page of `mech` (`page`) written to `out` atomically; returns its path. `reuse`: an
+    earlier page (e.g. the one `out` replaces); where its key (`page_key`, in its KEY_META element)
+    equals this page's, its bytes are written instead of drawing the page again."""
     path = Path(out)
-    write_text(path, page(mech, lang=lang, student=student, at=at))
+    key = page_key(mech, lang, student, at)
+    if key is not None and reuse is not None and key_of(reuse) == key:
+        write_bytes(path, Path(reuse).read_bytes())
+    else:
+        write_text(path, page(mech, lang=lang, student=student, at=at))
     return path
+
+
+# ============================================================================ what a page is drawn from
+
+#: The name of the meta element that holds a page's key (`page_key`).
+KEY_META = "kinetostat-page"
+_KEY = re.compile(r'<meta name="kinetostat-page" content="([0-9a-f]{64})">')
+#: The package's files a page's key covers: its code and data (`_code_digest`).
+_CODE_SUFFIXES = (".py", ".js", ".json")
+
+
+def page_key(mech, lang: str = "en", student: bool = False, at: float | None = None,
+             angles: Sequence[float] | None = None, fixed=None) -> str | None:
+    """What the page `page(mech, lang, student, at, angles, fixed)` is drawn from, as a SHA-256
+    hex digest: every field of the mechanism but where its file lies (`path`, `source`), the
+    arguments, and the code that draws it (every .py, .js and .json file of the installed package,
+    Python's and numpy's versions). Equal keys: the same page. None where the mechanism holds
+    something other than numbers, text, arrays and containers of them (no key: never reused)."""
+    import sys
+    h = hashlib.sha256(_code_digest() + f"|{sys.version}|{np.__version__}|".encode())
+    try:
+        _feed(h, (lang, student, at, tuple(map(float, PAGE_ANGLES if angles is None else angles)), fixed))
+        _feed(h, mech, skip=("path", "source", "structure", "_derived"))
+    except TypeError:
+        return None
+    return h.hexdigest()
+
+
+def key_of(path: str | Path) -> str | None:
+    """The key of the page written at `path` (its KEY_META element), None where there is none or
+    no file."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(2048).decode("utf-8", "replace")
+    except OSError:
+        return None
+    m = _KEY.search(head)
+    return m.group(1) if m else None
+
+
+@cache
+def _code_digest() -> bytes:
+    """SHA-256 of the package's code and data files (_CODE_SUFFIXES), by relative path, in order."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for f in sorted(p for p in root.rglob("*") if p.suffix in _CODE_SUFFIXES and "__pycache__" not in p.parts):
+        h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.digest()
+
+
+def _feed(h, x, skip: tuple[str, ...] = ()) -> None:
+    """Feed `x` to the hash `h` unambiguously: its type, then its value (a float exactly, an array
+    by dtype, shape and bytes, a dataclass field by field but `skip`, a mapping item by item);
+    TypeError for anything else (a function, an object of its own)."""
+    if x is None or isinstance(x, (bool, int, float, complex, str)):
+        h.update(f"{type(x).__name__}:{x!r};".encode())
+    elif isinstance(x, np.generic):
+        _feed(h, x.item())
+    elif isinstance(x, np.ndarray):
+        h.update(f"ndarray:{x.dtype.str}:{x.shape};".encode() + np.ascontiguousarray(x).tobytes())
+    elif is_dataclass(x) and not isinstance(x, type):
+        h.update(f"{type(x).__qualname__}{{".encode())
+        for f in fields(x):
+            if f.name not in skip:
+                h.update(f.name.encode() + b"=")
+                _feed(h, getattr(x, f.name))
+        h.update(b"}")
+    elif isinstance(x, Mapping):
+        h.update(f"map:{len(x)}{{".encode())
+        for k, v in x.items():
+            _feed(h, k)
+            _feed(h, v)
+        h.update(b"}")
+    elif isinstance(x, (tuple, list)):
+        h.update(f"{type(x).__name__}:{len(x)}(".encode())
+        for v in x:
+            _feed(h, v)
+        h.update(b")")
+    elif isinstance(x, (frozenset, set)):
+        _feed(h, sorted(x, key=repr))
+    else:
+        raise TypeError(f"cannot key a {type(x).__qualname__}")

@@ -270,11 +270,12 @@ def _published_section(doc: Doc, m: Mechanism, published: Sequence[PublishedChec
                "within"], rows, "lllrrlrrl")
 
 
-def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction: str = "first") -> list[Path]:
+def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction: str = "first",
+                   reuse: Path | None = None) -> list[Path]:
     """The plans of the graphical method at the model's design position (`kinetostat.plans`),
     one picture each, with their segments.csv and the worksheet beside them, and with `page` the
-    interactive page (`plans.page`, page.html) linked; `friction`: the method they are drawn with
-    (`plans.build`); returns the files."""
+    interactive page (`plans.page`, page.html) linked, `reuse`/page.html kept where it is the same
+    page (`write_page`); `friction`: the method they are drawn with (`plans.build`); returns the files."""
     from ..plans import build, plan_file_name, svg
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
@@ -299,7 +300,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
     files = []
     if page:
         from ..plans.page import write_page
-        files.append(write_page(m, d / "page.html"))
+        files.append(write_page(m, d / "page.html", reuse=None if reuse is None else Path(reuse) / "page.html"))
         doc.p("[The interactive page](page.html): every plan at every degree of the crank at scales fixed for "
               "the cycle, the values, the force plans step by step, a check of measured lengths (one offline file).")
     for plan in plans.values():
@@ -462,13 +463,15 @@ def _tolerance(run: ModelRun, route: str):
 
 
 def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool = False,
-                 friction: str = "first") -> dict[str, Any]:
+                 friction: str = "first", reuse: Path | None = None) -> dict[str, Any]:
     """Write `out/<folder>/` for one model (default folder: `run.stem`); returns the summary
     also saved as summary.json.
 
     `folder` is a name of ASCII letters, digits, '_' and '-' (`kinetostat._io.safe_name`), and
     the folder must resolve to a place inside `out` (ValueError otherwise); `page`: also the
-    model's interactive page, page.html, linked from the plans' section; `friction`: the method
+    model's interactive page, page.html, linked from the plans' section (`reuse`: the folder of an
+    earlier report, whose page.html is kept where it is the same page: `plans.page.write_page`);
+    `friction`: the method
     of the plans and worksheet ("first": the graphical method's; "reactions": with friction in the
     reactions, a model with [friction] only). Every file is
     written atomically: an interrupted or failed run leaves each earlier file as it was. Every
@@ -575,7 +578,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
     _published_section(doc, m, published)
-    plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first")
+    plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first", reuse)
 
     sing = int(np.sum(res.singular))
     if run.warnings or sing:
@@ -594,6 +597,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     doc.write(d)
 
     summary = dict(stem=folder, name=m.name, formula=m.structure.formula, positions=N, plans=bool(plan_files),
+                   page=any(p.name == "page.html" for p in plan_files),
                    sources=[w.key for w in works],
                    units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|; "
                                     f"'rounding' below {ROUNDING:.1e})",
@@ -653,6 +657,8 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
             (f" (max {pub['worst_percent']:.2f} %)" if pub.get("worst_percent") is not None else "")
         verdict = "**PASS**" if s["passed"] and s["checked"] else "**FAIL**" if not s["passed"] else "not checked"
         plans = f"[plans]({s['stem']}/index.md#{slug(PLANS_HEADING)})" if s.get("plans") else "-"
+        if s.get("page"):
+            plans += f", [page]({s['stem']}/page.html)"
         rows.append([f"[{s['stem']}]({s['stem']}/index.md)", verdict, f"{esc(s['name'])}; `{s['formula']}`", pubcell,
                      plans])
     doc.table(["model", "result", "mechanism; structure formula", "published values", "plans"], rows, "lllll")
