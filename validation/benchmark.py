@@ -431,7 +431,7 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
 #: commit, its models, CPU s (user + sys, every process) and wall s of each run, the load average.
 #: 4f33869: the 8 models of the session that set the target, by hand. 9e5daed: every model bundled
 #: at that commit (before the figures' light axes and SVG), in its own checkout and virtual
-#: environment on the quiet machine, by `main_job` (3 runs).
+#: environment on the quiet machine, by `_report_run` (3 runs, each into an empty folder).
 MAIN_JOB_BEFORE = (
     dict(commit="4f33869", cpu=(20.8, 20.1), wall=(11.8, 11.4), load="0.9-1.3",
          models=("chain_unit_four_bar", "compressor", "furnace_loader_six_bar", "ice_crank_slider",
@@ -448,48 +448,68 @@ def _n_models() -> int:
     return len(list((ROOT / "models").glob("*.toml")))
 
 
-def main_job(runs: int = 3, models: tuple[str, ...] = ()) -> dict:
-    """`kinetostat report` for `models` (default every bundled model; --jobs 2, the default on 2
-    cores), `runs` times in fresh processes into a temporary folder: CPU time of the command and
-    its workers (user + sys, from getrusage of the waited-for children) and wall time, s; the
-    load before and after."""
+def _report_run(folder: str, models: tuple[str, ...] = ()) -> tuple[float, float]:
+    """One `kinetostat report --jobs 2` of `models` (default every bundled one) into `folder`, in a
+    fresh process: (CPU s of the command and its workers, user + sys from getrusage of the
+    waited-for children; wall s)."""
     import resource
     import subprocess
     import sys
+    r0, w0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+    subprocess.run([sys.executable, "-m", "kinetostat", "report", *models, "--jobs", "2", "--no-progress",
+                    "--out", folder], check=True, capture_output=True)
+    w, r1 = time.perf_counter() - w0, resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, w
+
+
+def main_job(runs: int = 3) -> dict:
+    """`kinetostat report` (--jobs 2, the default on 2 cores) in fresh processes, all into one
+    temporary folder: first every bundled model into the empty folder (each page drawn), then
+    `runs` times every bundled model and `runs` times the models of each MAIN_JOB_BEFORE entry
+    (each page kept: the folder holds the same page, as a checkout's reports/ does). Returns
+    {"drawn", "kept", "same"}: CPU and wall s of each run, the load before and after, the models."""
     import tempfile
     from .kernels import cpu_info
-    cpu, wall, load = [], [], [cpu_info()["load"]]
-    for _ in range(runs):
-        with tempfile.TemporaryDirectory(prefix="kinetostat-report-") as folder:
-            r0, w0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-            subprocess.run([sys.executable, "-m", "kinetostat", "report", *models, "--jobs", "2", "--no-progress",
-                            "--out", folder], check=True, capture_output=True)
-            w, r1 = time.perf_counter() - w0, resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
-        wall.append(w)
-        print(f"main job: kinetostat report, {len(models) or _n_models()} models: {cpu[-1]:.1f} s CPU, "
-              f"{wall[-1]:.1f} s wall", flush=True)
-    load.append(cpu_info()["load"])
-    return dict(cpu=cpu, wall=wall, load=load, n=len(models) or _n_models())
+    n = _n_models()
+
+    def measured(folder: str, models: tuple[str, ...], times: int, what: str) -> dict:
+        load, cpu, wall = [cpu_info()["load"]], [], []
+        for _ in range(times):
+            c, w = _report_run(folder, models)
+            cpu.append(c)
+            wall.append(w)
+            print(f"main job: kinetostat report, {len(models) or n} models, pages {what}: {c:.1f} s CPU, {w:.1f} s wall",
+                  flush=True)
+        return dict(cpu=cpu, wall=wall, load=load + [cpu_info()["load"]], n=len(models) or n)
+
+    with tempfile.TemporaryDirectory(prefix="kinetostat-report-") as folder:
+        drawn = measured(folder, (), 1, "drawn")
+        kept = measured(folder, (), runs, "kept")
+        same = [measured(folder, b["models"], runs, "kept") for b in MAIN_JOB_BEFORE]
+    return dict(drawn=drawn, kept=kept, same=same)
 
 
-def main_job_lines(mj: dict, same: list[dict]) -> list[str]:
-    """The report's section on `kinetostat report` (`main_job`: `mj` every bundled model, `same[i]`
-    the models of MAIN_JOB_BEFORE[i])."""
+def main_job_lines(mj: dict) -> list[str]:
+    """The report's section on `kinetostat report` (`main_job`)."""
     row = lambda name, r: (f"| {name} | {r['n']} | {len(r['cpu'])} | {min(r['cpu']):.1f} / {statistics.median(r['cpu']):.1f} | "
                            f"{min(r['wall']):.1f} / {statistics.median(r['wall']):.1f} |")
+    kept = mj["kept"]
     lines = ["## The main job: `kinetostat report` for every bundled model", "",
              "`kinetostat report --jobs 2` (per model: the solver, 5 engine routes, the 40-digit reference, "
-             "plots, plans, HTML), in a fresh process per run; CPU = user + sys of the command and its two "
-             "workers. Target: <= 10 s wall on this 2-core machine for every bundled model. Before: each "
-             "commit below on its own models, measured on this machine at the load average given. After: "
-             f"this run, on those models and on every bundled model now ({mj['n']}); load average "
-             f"{mj['load'][0]} before and {mj['load'][1]} after.", "",
+             "plots, plans, the interactive page, HTML), in a fresh process per run; CPU = user + sys of the "
+             "command and its two workers. Target: <= 10 s wall on this 2-core machine for every bundled "
+             "model. A model's interactive page is drawn only where the folder does not already hold the same "
+             "page (`plans.page.page_key`): \"pages kept\" is the folder of an earlier run with the same code and "
+             "models, as the committed reports/ are for a checkout; \"pages drawn\" an empty folder, or any "
+             "change to the package's code. Before: each commit below on its own models (no pages then), "
+             f"measured on this machine at the load average given. After: this run; load average "
+             f"{mj['drawn']['load'][0]} before the first run and {kept['load'][1]} after the kept runs.", "",
              "| the main job | models | runs | CPU s min / median | wall s min / median |", "|---|---|---|---|---|"]
-    for b, r in zip(MAIN_JOB_BEFORE, same):
+    for b, r in zip(MAIN_JOB_BEFORE, mj["same"]):
         lines += [row(f"before ({b['commit']}, load {b['load']})", dict(b, n=len(b["models"]))),
-                  row(f"after (this run), the models of {b['commit']}", r)]
-    return lines + [row("after (this run), every bundled model", mj)]
+                  row(f"after (this run), the models of {b['commit']}, pages kept", r)]
+    return lines + [row("after (this run), every bundled model, pages kept", kept),
+                    row("after (this run), every bundled model, pages drawn", mj["drawn"])]
 
 
 def speed_lines(sp: dict) -> list[str]:
@@ -696,7 +716,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['cpu_min']:.3f} / {r['cpu_median']:.3f} | "
                      f"{r['wall_min']:.3f} / {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + crossover_lines(kernels["crossover"]) + [""] + main_job_lines(kernels["main_job"], kernels["main_job_same"])
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + crossover_lines(kernels["crossover"]) + [""] + main_job_lines(kernels["main_job"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -727,7 +747,6 @@ def main(argv: list[str] | None = None) -> None:
     rows = study(models, args.quick)
     if not args.quick:
         kern["main_job"] = main_job()
-        kern["main_job_same"] = [main_job(models=b["models"]) for b in MAIN_JOB_BEFORE]
         kern["machine"] = (machine, cpu_info())
         write_report(rows, kin_rows, thr, kern, args.out)
         print(f"wrote {args.out / 'benchmark.md'}")
