@@ -688,11 +688,12 @@ def page_key(mech, lang: str = "en", student: bool = False, at: float | None = N
              angles: Sequence[float] | None = None, fixed=None) -> str | None:
     """What the page `page(mech, lang, student, at, angles, fixed)` is drawn from, as a SHA-256
     hex digest: every field of the mechanism but where its file lies (`path`, `source`), the
-    arguments, and the code that draws it (every .py, .js and .json file of the installed package,
-    Python's and numpy's versions). Equal keys: the same page. None where the mechanism holds
-    something other than numbers, text, arrays and containers of them (no key: never reused)."""
-    import sys
-    h = hashlib.sha256(_code_digest() + f"|{sys.version}|{np.__version__}|".encode())
+    arguments, and the code that draws it (every .py, .js and .json file of the installed package).
+    Equal keys: the same page. The libraries' versions are not part of it (a checkout's pages stay
+    current on another machine): they change a page's numbers only by rounding. None where the
+    mechanism holds something other than numbers, text, arrays and containers of them (no key:
+    never reused)."""
+    h = hashlib.sha256(_code_digest())
     try:
         _feed(h, (lang, student, at, tuple(map(float, PAGE_ANGLES if angles is None else angles)), fixed))
         _feed(h, mech, skip=("path", "source", "structure", "_derived"))
