@@ -689,8 +689,9 @@ def page_key(mech, lang: str = "en", student: bool = False, at: float | None = N
     """What the page `page(mech, lang, student, at, angles, fixed)` is drawn from, as a SHA-256
     hex digest: every field of the mechanism but where its file lies (`path`, `source`), the
     arguments, and the code that draws it (every .py, .js and .json file of the installed package).
-    Equal keys: the same page. The libraries' versions are not part of it (a checkout's pages stay
-    current on another machine): they change a page's numbers only by rounding. None where the
+    Equal keys: the same page. The libraries' versions are left out by choice, so that a
+    checkout's committed pages stay current on another machine: a page drawn with other versions
+    of numpy or Python is kept. None where the
     mechanism holds something other than numbers, text, arrays and containers of them (no key:
     never reused)."""
     h = hashlib.sha256(_code_digest())
