@@ -62,7 +62,6 @@ COORDINATES = frozenset({"x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "dx", "dy
 COORD_DECIMALS = 1
 _TAG = re.compile(r"(<[^>]*>)")
 _ATTR = re.compile(r'([\w:-]+)="([^"]*)"')
-_NOTES = re.compile(r'<g id="notes">.*?</g>\n?', re.S)
 
 # ============================================================================ the numbers, small
 
@@ -223,7 +222,7 @@ def _b64gz(data: bytes) -> str:
 def _sheets_of(plans, lang: str, name: str) -> dict[str, str]:
     """The page's sheets of one angle: `draw.svg` with the contract, without the notes (the page's
     tables hold them) and the XML declaration."""
-    return {kind: _NOTES.sub("", svg(p, lang=lang, mechanism=name, contract=True)).split("?>", 1)[-1].lstrip()
+    return {kind: svg(p, lang=lang, mechanism=name, contract=True, notes=False).split("?>", 1)[-1].lstrip()
             for kind, p in plans.items()}
 
 
