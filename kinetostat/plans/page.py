@@ -60,7 +60,9 @@ _NUM = re.compile(r"(-?)(\d+)(?:([.,])(\d+))?")
 #: The attributes that place a drawing's elements (mm), and their decimals in the page.
 COORDINATES = frozenset({"x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "dx", "dy", "points", "d"})
 COORD_DECIMALS = 1
-_TAG = re.compile(r"(<[^>]*>)")
+#: A tag, or (between tags) a number: `_NUM`'s groups after the tag's.
+_PIECE = re.compile(r"(<[^>]*>)|" + _NUM.pattern)
+_COORD_FORMAT = f"\x00.{COORD_DECIMALS}\x00"
 _ATTR = re.compile(r'([\w:-]+)="([^"]*)"')
 
 # ============================================================================ the numbers, small
@@ -108,43 +110,45 @@ def _slot_keys(template: tuple[str, ...]) -> list[tuple]:
 def _split(sheet: str) -> tuple[tuple[str, ...], list[int]]:
     """A sheet as (template, numbers): data-length-mm as integers of LENGTH_Q; a drawing's
     coordinates (COORDINATES' attributes) rounded to COORD_DECIMALS (0.1 mm: finer than a ruler
-    reads); every other number (a stroke's width, a font's size, a number in a text) as written."""
-    parts: list[str] = [""]
+    reads); every other number (a stroke's width, a font's size, a number in a text) as written;
+    a zero-padded number ("000" of a colour) kept as text. One pass of `re.sub` over the sheet,
+    each number replaced by its format between two NULs (which XML cannot hold), then split there."""
     nums: list[int] = []
+    push = nums.append
 
-    def numbers(piece: str, places: int | None) -> None:
-        last = 0
-        for m in _NUM.finditer(piece):
-            sign, whole, sep, frac = m.groups()
-            if len(whole) > 1 and whole[0] == "0":        # a zero-padded number: kept as text
-                continue
-            parts[-1] += piece[last:m.start()]
-            last = m.end()
-            d = len(frac) if frac else 0
-            n = int(whole + (frac or ""))
-            if places is not None and d > places and sep == ".":     # "217,69": two integers of a list
-                n, d = (n + 5 * 10 ** (d - places - 1)) // 10 ** (d - places), places
-            parts.append(f"{sep or '.'}{d}" if d else "")
-            parts.append("")
-            nums.append(-n if sign else n)
-        parts[-1] += piece[last:]
+    def as_written(m: re.Match) -> str:                  # of `_NUM` or of `_PIECE`
+        sign, whole, sep, frac = m.groups()[-4:]
+        if len(whole) > 1 and whole[0] == "0":
+            return m[0]
+        if frac:
+            n = int(whole + frac)
+            push(-n if sign else n)
+            return f"\x00{sep}{len(frac)}\x00"
+        push(-int(whole) if sign else int(whole))
+        return "\x00\x00"
 
-    for k, piece in enumerate(_TAG.split(sheet)):
-        if not k % 2:                                     # text between tags: as written
-            numbers(piece, None)
-            continue
-        last = 0
-        for m in _ATTR.finditer(piece):
-            name, value = m.groups()
-            parts[-1] += piece[last:m.start(2)]
-            last = m.end(2)
-            if name == "data-length-mm":
-                parts += ["L", ""]
-                nums.append(round(float(value) / LENGTH_Q))
-            else:
-                numbers(value, COORD_DECIMALS if name in COORDINATES else None)
-        parts[-1] += piece[last:]
-    return tuple(parts), nums
+    def coordinate(m: re.Match) -> str:
+        sign, whole, sep, frac = m.groups()
+        if not frac or len(frac) <= COORD_DECIMALS or sep != ".":     # "217,69": two integers of a list
+            return as_written(m)
+        if len(whole) > 1 and whole[0] == "0":
+            return m[0]
+        cut = 10 ** (len(frac) - COORD_DECIMALS)
+        n = (int(whole + frac) + cut // 2) // cut
+        push(-n if sign else n)
+        return _COORD_FORMAT
+
+    def attribute(m: re.Match) -> str:
+        name, value = m.groups()
+        if name == "data-length-mm":
+            push(round(float(value) / LENGTH_Q))
+            return 'data-length-mm="\x00L\x00"'
+        return f'{name}="{_NUM.sub(coordinate if name in COORDINATES else as_written, value)}"'
+
+    def piece(m: re.Match) -> str:                       # a tag: its attributes; else a number in a text
+        return _ATTR.sub(attribute, m[0]) if m[1] else as_written(m)
+
+    return tuple(_PIECE.sub(piece, sheet).split("\x00")), nums
 
 
 def _varints(values: np.ndarray) -> bytes:
