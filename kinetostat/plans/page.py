@@ -8,15 +8,18 @@ student's measured lengths, and print at true scale.
 
 Key mode (default): the sheets of `kinetostat plans` (`draw.svg`, the same lettering and label
 placement) at every whole degree and the design position, every scale fixed for the whole cycle
-(`cycle_scales`), without the sheets' notes (the page's tables take their place); the worksheet's
-values; "Next step". Student mode (`student=True`): no answer in the page: the data, the empty
-tables, an A3 sheet with a millimetre grid at true scale, and the check of typed lengths.
+(`cycle_scales`), the plan of positions' 12 positions and paths made once for all of them
+(`fixed_positions`), drawn without the sheets' notes (`svg(notes=False)`: the page's tables take
+their place); the worksheet's values; "Next step". Student mode (`student=True`): no answer in
+the page: the data, the empty tables, an A3 sheet with a millimetre grid at true scale, and the
+check of typed lengths.
 
-Small: the sheets of all angles are cut into templates (the markup, a few per plan) and numbers;
-the numbers of each template slot are stored as second differences over the angle (the drawing's
-coordinates at 0.01 mm, each segment's length and each value to 12 significant digits), as
-zigzag varints, gzip-compressed and base64-encoded; the page's script (vanilla JavaScript, the
-browser's own DecompressionStream) decodes them once and builds the sheet of the angle chosen.
+Small: the sheets of all angles are cut into templates (the markup, a few per plan) and numbers
+(`_split`, one regex pass a sheet); the numbers of each template slot are stored as second
+differences over the angle (the drawing's coordinates at 0.1 mm, each segment's length and each
+value to 12 significant digits), as zigzag varints, gzip-compressed and base64-encoded; the
+page's script (vanilla JavaScript, the browser's own DecompressionStream) decodes them once and
+builds the sheet of the angle chosen.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
 `data-plan`, `data-segment`, `data-length-mm` as in segments.csv; every value cell `data-symbol`,
 `data-value`.
@@ -248,22 +251,23 @@ def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict
     return out
 
 
-def _plans_at(mech, start: float, fixed, a: float):
-    """The plans at `a` deg at the page's scales; None at a singular position."""
+def _plans_at(mech, positions, fixed, a: float):
+    """The plans at `a` deg at the page's scales, the plan of positions on its 12 positions and
+    paths made once (`fixed_positions`); None at a singular position."""
     from . import build
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            return build(mech, at=a, starting_deg=start, fixed=fixed)
+            return build(mech, at=a, fixed=fixed, positions=positions)
         except ValueError:                     # a singular position
             return None
 
 
-def _frame(mech, start: float, fixed, lang: str, name: str, a: float) -> tuple[dict, dict | None, list | None]:
+def _frame(mech, positions, fixed, lang: str, name: str, a: float) -> tuple[dict, dict | None, list | None]:
     """One frame of the slider: each plan's sheet `_split` (kind -> (template, numbers)), the
     worksheet's values (key -> value) and its records; ({}, None, None) at a singular position."""
     from .worksheet import worksheet
-    plans = _plans_at(mech, start, fixed, a)
+    plans = _plans_at(mech, positions, fixed, a)
     if plans is None:
         return {}, None, None
     with warnings.catch_warnings():
@@ -439,17 +443,17 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     (and of a student's page; default the design position); `angles`: the slider's frames (deg);
     `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
     from ..solve import analyze
-    from . import cycle_scales, starting_position
+    from . import cycle_scales, fixed_positions
     from .lettering import lettering
     check_lang(lang)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
     fixed = fixed or cycle_scales(mech)
-    start = starting_position(mech)
+    positions = fixed_positions(mech, fixed.base["mu_l"])
     name = lettering(mech).name(lang, mech.name)
     frames = [at] if student else [*map(float, angles), design]
 
-    plans_at = partial(_plans_at, mech, start, fixed)
+    plans_at = partial(_plans_at, mech, positions, fixed)
     check = plans_at(at)
     if check is None:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
@@ -464,7 +468,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     if not student:
         per_kind: dict[str, list] = {k: [] for k in check}
         values, rows = [], None
-        for split, got, records in _map(partial(_frame, mech, start, fixed, lang, name), frames):
+        for split, got, records in _map(partial(_frame, mech, positions, fixed, lang, name), frames):
             for kind in per_kind:
                 per_kind[kind].append(split.get(kind))
             if got is not None:
