@@ -136,6 +136,8 @@ def _constant(a: np.ndarray) -> np.ndarray:
 #: 45 deg, on rings of these clearances (mm), at a cost of 1.2 per mm, 0.3 more below the anchor.
 _DIRS = _constant(np.column_stack([np.cos(np.radians(np.arange(0, 360, 22.5) + 45.0)),
                                    -np.sin(np.radians(np.arange(0, 360, 22.5) + 45.0))]))
+_ABS_DIRS = _constant(np.abs(_DIRS))
+_REACH = _constant(_ABS_DIRS.max(axis=0))      # a label's half size times this: how far its box reaches
 _RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0])[:, None, None])
 _RING_COST = _constant(1.2 * _RINGS[:, :, 0] + np.where(_DIRS[:, 1] > 0, 0.3, 0.0))
 #: Beside a segment: at these fractions T of its length, on either side S, at these clearances R
@@ -217,19 +219,21 @@ class Placer:
         `base`, against the obstacles and samples near the batch, until the next base exceeds the
         best cost found (a count only adds): the same choice as testing all."""
         bx0, by0, bx1, by1 = self.bounds
-        out = (boxes[:, 0] < bx0) | (boxes[:, 1] < by0) | (boxes[:, 2] > bx1) | (boxes[:, 3] > by1)
+        out = ((boxes[:, :2] < (bx0, by0)) | (boxes[:, 2:] > (bx1, by1))).any(axis=1)
         cost = np.where(out, np.inf, base.astype(float))
         order = np.lexsort((np.arange(len(cost)), cost))
         ob = self._obstacles()
+        o0, o1, o2, o3 = ob.T
         s_all, xs = self._samples_by_x() if self._lines else (None, None)
-        best, k_best = np.inf, 0
+        best, k_best = math.inf, 0
         for start in range(0, len(order), 32):
             idx = order[start:start + 32]
-            if not (np.isfinite(cost[idx[0]]) and cost[idx[0]] <= best):
+            first = float(cost[idx[0]])
+            if first == math.inf or first > best:
                 break
             c, b = cost[idx], boxes[idx]
-            lo, hi = b[:, :2].min(axis=0), b[:, 2:].max(axis=0)
-            near = ob[(ob[:, 2] > lo[0]) & (ob[:, 0] < hi[0]) & (ob[:, 3] > lo[1]) & (ob[:, 1] < hi[1])]
+            (lo0, lo1), (hi0, hi1) = b[:, :2].min(axis=0).tolist(), b[:, 2:].max(axis=0).tolist()
+            near = ob[(o2 > lo0) & (o0 < hi0) & (o3 > lo1) & (o1 < hi1)]
             keep = c <= best                            # free and not already beaten
             if len(near):
                 keep &= ~((b[:, None, 0] < near[None, :, 2]) & (b[:, None, 2] > near[None, :, 0])
@@ -238,9 +242,10 @@ class Placer:
                 continue
             idx, c, b = idx[keep], c[keep], b[keep]
             if s_all is not None:                       # the samples strictly inside some box left
-                lo, hi = b[:, :2].min(axis=0), b[:, 2:].max(axis=0)
-                s = s_all[np.searchsorted(xs, lo[0], "right"):np.searchsorted(xs, hi[0], "left")]
-                s = s[(s[:, 1] > lo[1]) & (s[:, 1] < hi[1])]
+                (lo0, lo1), (hi0, hi1) = b[:, :2].min(axis=0).tolist(), b[:, 2:].max(axis=0).tolist()
+                s = s_all[xs.searchsorted(lo0, "right"):xs.searchsorted(hi0, "left")]
+                y = s[:, 1]
+                s = s[(y > lo1) & (y < hi1)]
                 if len(s):
                     inside = ((s[None, :, 0] > b[:, None, 0]) & (s[None, :, 0] < b[:, None, 2])
                               & (s[None, :, 1] > b[:, None, 1]) & (s[None, :, 1] < b[:, None, 3]))
@@ -253,9 +258,8 @@ class Placer:
 
     def _boxes_at(self, centres: np.ndarray, w: float, up: float, down: float) -> np.ndarray:
         """Boxes of a label whose box centre is at each of `centres` (K, 2)."""
-        h = up + down
-        return np.column_stack([centres[:, 0] - w / 2, centres[:, 1] - h / 2,
-                                centres[:, 0] + w / 2, centres[:, 1] + h / 2])
+        half = (w / 2, (up + down) / 2)
+        return np.concatenate([centres - half, centres + half], axis=1)
 
     def place(self, name: str, size: float, ax: float, ay: float,
               along: tuple[float, float] | None = None) -> Placed:
@@ -276,7 +280,7 @@ class Placer:
                 base.append(R[:, 0] + _ALONG_OFF * min(L, 20.0) / 20.0)
             ax, ay = (ax + along[0]) / 2, (ay + along[1]) / 2
             A = np.array([ax, ay])
-        cands.append((A + _DIRS * (_RINGS + (np.abs(_DIRS) @ half)[:, None])).reshape(-1, 2))
+        cands.append((A + _DIRS * (_RINGS + (_ABS_DIRS @ half)[:, None])).reshape(-1, 2))
         base.append((_RING_COST + (2.0 if along is not None else 0.0)).reshape(-1))
         cands_a = np.concatenate(cands)
         boxes = self._boxes_at(cands_a, w, up, down)
@@ -285,7 +289,7 @@ class Placer:
         box = (float(x0), float(y0), float(x1), float(y1))
         cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
         leader = None
-        if math.hypot(cx - ax, cy - ay) - float(np.abs(_DIRS).max(axis=0) @ half) > 6.0:
+        if math.hypot(cx - ax, cy - ay) - float(_REACH @ half) > 6.0:
             qx, qy = min(max(ax, x0), x1), min(max(ay, y0), y1)
             leader = (ax, ay, float(qx), float(qy))
         pl = Placed(name, float(x0), float(y0 + up), size, box, leader)
