@@ -33,10 +33,16 @@ def xml_safe(s: str) -> str:
     return _NOT_XML.sub(_escaped, s)
 
 
+#: A text `xml_escape` leaves as it is: no & < > ", no control character, surrogate or non-character.
+_XML_PLAIN = re.compile("[^&<>\"\x00-\x1f\ud800-\udfff\ufffe\uffff]*")
+
+
 def xml_escape(s: str) -> str:
     """`s` as XML character data or a quoted attribute's value, on one line: & < > " escaped,
     newline, return and tab as character references (an attribute keeps them), other controls
     as "\\x.."."""
+    if _XML_PLAIN.fullmatch(s):                    # most names and labels: nothing to do
+        return s
     return escape(xml_safe(s), {'"': "&quot;", "\n": "&#10;", "\r": "&#13;", "\t": "&#9;"})
 
 

@@ -139,6 +139,24 @@ def test_positions_plan_has_twelve_positions_design_and_paths(ice_plans):
     assert pos.points["A"] == pytest.approx(pos.points["A1"], abs=1e-12)
 
 
+def test_positions_made_once_draw_the_same_plan_and_only_for_their_mechanism_and_scale(ice_plans):
+    """The 12 positions and paths made once for many angles (`fixed_positions`, as the page uses
+    them) draw the plan of positions `build` draws without them; another mechanism's or another
+    scale's are refused, naming `fixed`."""
+    mech = ice_plans.mech
+    fixed = P.fixed_positions(mech, ice_plans.scales["mu_l"])
+    for at in (30.0, 200.0):
+        alone = P.build(mech, at=at, scales=SEED_002_SCALES, only=["positions"])["positions"]
+        made = P.build(mech, at=at, scales=SEED_002_SCALES, only=["positions"], positions=fixed)["positions"]
+        assert (made.points, made.paths, made.notes) == (alone.points, alone.paths, alone.notes)
+        assert P.svg(made) == P.svg(alone)                 # its segments (a branch mark's value is NaN)
+    other = kinetostat.load(ROOT / "models" / "ice_crank_slider.toml")         # equal, but another object
+    with pytest.raises(ValueError, match="fixed"):
+        P.build(other, at=30, scales=SEED_002_SCALES, only=["positions"], positions=fixed)
+    with pytest.raises(ValueError, match="fixed"):
+        P.build(mech, at=30, scales={**SEED_002_SCALES, "mu_l": 0.002}, only=["positions"], positions=fixed)
+
+
 def test_svg_sheet(ice_plans, tmp_path):
     written = ice_plans.write(tmp_path, lang="uk")
     assert {p.name for p in written} == {"mechanism.svg", "positions.svg", "velocity.svg", "acceleration.svg", "group_2-3.svg",

@@ -34,12 +34,12 @@ from .draw import figure, fits, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
 from .lettering import lettering
 from .mechanism import mechanism_plan
-from .kinematic import acceleration_plan, positions_plan, starting_position, velocity_plan
+from .kinematic import FixedPositions, acceleration_plan, fixed_positions, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
 from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
 
 __all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS", "svg", "figure",
-           "choose_scales", "starting_position", "plan_file_name", "CycleScales", "cycle_scales"]
+           "choose_scales", "starting_position", "fixed_positions", "plan_file_name", "CycleScales", "cycle_scales"]
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
 #: Plan or list of Plans).
@@ -139,12 +139,13 @@ def cycle_scales(mech, step_deg: float = 5.0) -> CycleScales:
     return CycleScales(MappingProxyType(base), MappingProxyType(plan), MappingProxyType(forces_on))
 
 
-def _positions(mech, res, sc, starting_deg: float | None) -> Plan:
+def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions | None) -> Plan:
     """The plan of positions at mu_l; where the other branch's dashed mark alone would run off the
     sheet (a slider's other branch below the crank), the mark left out and noted (the scale rule
     keeps the crank at the length the text asks)."""
-    plan = positions_plan(mech, res, sc, starting_deg=starting_deg)
-    return plan if fits(plan) <= 1 else positions_plan(mech, res, sc, starting_deg=starting_deg, other_branch=False)
+    fixed = fixed or fixed_positions(mech, sc["mu_l"], starting_deg)
+    plan = positions_plan(mech, res, sc, fixed=fixed)
+    return plan if fits(plan) <= 1 else positions_plan(mech, res, sc, other_branch=False, fixed=fixed)
 
 
 class Plans(Mapping):
@@ -220,7 +221,8 @@ def plan_file_name(plan: Plan, suffix: str = ".svg") -> str:
 
 def build(mech, at: float | None = None, scales: Mapping[str, float] | None = None,
           starting_deg: float | None = None, only: Iterable[str] | None = None,
-          fixed: CycleScales | None = None, friction: str = "first") -> Plans:
+          fixed: CycleScales | None = None, friction: str = "first",
+          positions: FixedPositions | None = None) -> Plans:
     """The plans of `mech` at crank angle `at` (deg; default: the model's design position
     `drive.design_deg`). `scales`: any of mu_l [m/mm], mu_v [m/(s mm)], mu_a [m/(s^2 mm)],
     mu_F [N/mm] (the others chosen by the texts' rule, `choose_scales`); `starting_deg`: position
@@ -228,7 +230,9 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     to draw (default all); `fixed`: every plan at these scales (`cycle_scales`; `scales` then
     unused). `friction`: "first" (default: the frictionless reactions of the graphical method) or
     "reactions" (a model with [friction]: the group plans, force polygons and crank plan with the
-    reactions with friction, each revolute pair's friction circle drawn, `forces`). ValueError for
+    reactions with friction, each revolute pair's friction circle drawn, `forces`). `positions`:
+    the plan of positions' 12 positions and paths made once for many angles (`fixed_positions` of
+    `mech` at the mu_l drawn at; `starting_deg` then unused). ValueError for
     a bad angle or name, or an angle with no equilibrium with friction; ScaleError (a ValueError)
     for a scale that would draw a plan beyond MAX_EXTENT_MM."""
     import math
@@ -257,7 +261,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
                          "size to draw; the statics is in the tables (reactions, balancing moment)")
     sc = dict(fixed.base) if fixed is not None else choose_scales(mech, res, scales)
     steps = dict(BUILDERS) | (fixed.builders() if fixed is not None else {})
-    steps["positions"] = partial(_positions, starting_deg=starting_deg)
+    steps["positions"] = partial(_positions, starting_deg=starting_deg, fixed=positions)
     plans: list[Plan] = []
     for name in names:
         if name in chosen:

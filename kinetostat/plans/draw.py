@@ -272,10 +272,11 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
     return out
 
 
-def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool,
-                 nofit: bool = False) -> tuple[list[str], tuple[float, float, float, float]]:
-    """SVG of the notes and the drawing area they leave: below the plan (bottom left, from the
-    frame's bottom up, beside the title block) or, for a tall plan, in a column at its left."""
+def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit: bool = False,
+                 draw: bool = True) -> tuple[list[str], tuple[float, float, float, float]]:
+    """SVG of the notes (none where not `draw`) and the drawing area they leave: below the plan
+    (bottom left, from the frame's bottom up, beside the title block) or, for a tall plan, in a
+    column at its left."""
     x0 = _FRAME[0] + 3
     width = _LEFT_NOTES_MM if left else _TITLE_BLOCK[0] - 3 - x0
     lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
@@ -287,30 +288,33 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool,
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
     top = _AREA[1] if left else _FRAME[3] - 1.5 - height
-    out = ['<g id="notes">']
-    y = top + ASCENT * _NOTE_MM
-    for line in lines:
-        out.append(_t(x0, y, line, _NOTE_MM))
-        y += _LINE_STEP
-    for k, r in enumerate(rows):
-        out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
-    out.append("</g>")
+    out = []
+    if draw:
+        out.append('<g id="notes">')
+        y = top + ASCENT * _NOTE_MM
+        for line in lines:
+            out.append(_t(x0, y, line, _NOTE_MM))
+            y += _LINE_STEP
+        for k, r in enumerate(rows):
+            out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
+        out.append("</g>")
     if left:
         return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None
     return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0))
 
 
-def _layout(plan: Plan, lang: str, tiny: dict[str, str]) -> tuple[list[str], tuple[float, float, float, float]]:
-    """The notes and the drawing area: notes below where the plan fits above them, else in a
-    column at its left where it fits beside them, else below with a note that it does not fit
-    (fitting: with MIN_DRAWN_MM to spare on every side, for a vector drawn out of scale)."""
+def _layout(plan: Plan, lang: str, tiny: dict[str, str],
+            draw: bool = True) -> tuple[list[str], tuple[float, float, float, float]]:
+    """The notes (SVG where `draw`) and the drawing area: notes below where the plan fits above
+    them, else in a column at its left where it fits beside them, else below with a note that it
+    does not fit (fitting: with MIN_DRAWN_MM to spare on every side, for a vector drawn out of scale)."""
     x0, y0, x1, y1 = extent(plan)
     for left in (False, True):
-        notes, area = _notes_block(plan, lang, tiny, left)
+        notes, area = _notes_block(plan, lang, tiny, left, draw=draw)
         if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
                 and y1 - y0 + 2 * MIN_DRAWN_MM <= area[3] - area[1]:      # room for a vector drawn out of scale
             return notes, area
-    return _notes_block(plan, lang, tiny, False, nofit=True)
+    return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw)
 
 
 def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
@@ -348,15 +352,16 @@ def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float,
             (b[0] - ux * 0.6 * h, b[1] - uy * 0.6 * h))
 
 
-def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = False) -> str:
+def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = False, notes: bool = True) -> str:
     """The plan on an A3 landscape sheet, true to scale (1 user unit = 1 mm), as SVG text.
     `contract`: every segment's element carries data-plan, data-segment and data-length-mm (its
     length at the scale, as in segments.csv; a negligible vector, not drawn, an empty <g>): the
-    interactive page's contract (`page`)."""
+    interactive page's contract (`page`). `notes`: False leaves the notes out, their room kept
+    (the plan drawn where it is with them; the page's tables hold them)."""
     _lang(lang)
     tiny = _tiny(plan)
     x0, y0, x1, y1 = extent(plan)
-    notes, (ax0, ay0, ax1, ay1) = _layout(plan, lang, tiny)
+    block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, tiny, draw=notes)
     tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
 
     def P(z: complex) -> tuple[float, float]:
@@ -451,7 +456,7 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = Fals
     out += labels
     out.append("</g>")
     out += _title_block(plan, lang, mechanism)
-    out += notes
+    out += block
     out.append("</svg>")
     return "\n".join(out) + "\n"
 

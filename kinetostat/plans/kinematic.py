@@ -20,14 +20,16 @@ May use: numpy, `kinetostat.solve` (the exact results: never re-solved here), `.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from types import MappingProxyType
 from typing import NamedTuple
 
 import numpy as np
 
 from .core import Plan, Scale, Segment
 
-__all__ = ["positions_plan", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
+__all__ = ["positions_plan", "fixed_positions", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
 
 #: Positions of the plan of positions: every 30 deg.
@@ -423,16 +425,24 @@ def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list, das
     return notes
 
 
-def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | None = None,
-                   other_branch: bool = True) -> Plan:
-    """The plan of positions (seed 002 fig. 1.5): 12 positions every 30 deg in the drive's sense
-    from the starting position (found by `starting_position` unless given), the design position
-    of `res` (plain names), the paths of every centre of mass and the assembly branch of each
-    group (notes; the other branch dashed, unless `other_branch` is False): all at mu_l. Link segments' values are the exact
-    distances between their points, m."""
+@dataclass(frozen=True)
+class FixedPositions:
+    """The part of `mech`'s plan of positions at scale `mu` that no design position moves
+    (`fixed_positions`): the 12 positions from `start` (deg), their points (plan units, mm) and
+    segments, and the path of every centre of mass."""
+    mech: object
+    mu: Scale
+    start: float
+    points: Mapping[str, complex]
+    segments: tuple[Segment, ...]
+    paths: Mapping[str, tuple[complex, ...]]
+
+
+def fixed_positions(mech, mu: Scale, starting_deg: float | None = None) -> FixedPositions:
+    """The 12 positions every 30 deg in the drive's sense from the starting position (found by
+    `starting_position` unless given) and the paths of the centres of mass (PATH_STEPS angles), at
+    `mu`: made once for the plans of many angles (`positions_plan`'s `fixed`)."""
     from ..solve import analyze
-    at = float(res.phi_deg[0])
-    mu = scales["mu_l"]
     start = starting_position(mech) if starting_deg is None else float(starting_deg)
     if not math.isfinite(start):
         raise ValueError(f"starting position: expected a finite angle in degrees, got {starting_deg!r}")
@@ -441,12 +451,31 @@ def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | No
     segs: list[Segment] = []
     for i in range(N_POSITIONS):
         _draw_position(mech, twelve, i, i, mu.value, points, segs)
-    _draw_position(mech, res, 0, None, mu.value, points, segs)
-    notes = [f"position 0 at phi = {start:.6g} deg (crank and rod in line), then every 30 deg; "
-             f"design position phi = {at:g} deg drawn with plain letters"]
-    notes += _branch_marks(mech, at, res, mu.value, points, segs, other_branch)
     cycle = analyze(mech, phi_deg=np.arange(PATH_STEPS + 1) * 360.0 / PATH_STEPS)
     paths = {link.com: tuple(_z(cycle, link.com) / mu.value) for link in mech.links[1:]
              if link.com and link.com not in mech.links[0].points}
+    return FixedPositions(mech, mu, start, MappingProxyType(points), tuple(segs), MappingProxyType(paths))
+
+
+def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | None = None,
+                   other_branch: bool = True, fixed: FixedPositions | None = None) -> Plan:
+    """The plan of positions (seed 002 fig. 1.5): 12 positions every 30 deg in the drive's sense
+    from the starting position (found by `starting_position` unless given), the design position
+    of `res` (plain names), the paths of every centre of mass and the assembly branch of each
+    group (notes; the other branch dashed, unless `other_branch` is False): all at mu_l. Link segments' values are the exact
+    distances between their points, m. `fixed`: the 12 positions and the paths made already
+    (`fixed_positions` of this `mech` at mu_l; `starting_deg` then unused)."""
+    at = float(res.phi_deg[0])
+    mu = scales["mu_l"]
+    if fixed is None:
+        fixed = fixed_positions(mech, mu, starting_deg)
+    elif fixed.mech is not mech or fixed.mu != mu:
+        raise ValueError(f"fixed: the positions of {fixed.mech.name} at {fixed.mu}, not of {mech.name} at {mu}")
+    points = dict(fixed.points)
+    segs = list(fixed.segments)
+    _draw_position(mech, res, 0, None, mu.value, points, segs)
+    notes = [f"position 0 at phi = {fixed.start:.6g} deg (crank and rod in line), then every 30 deg; "
+             f"design position phi = {at:g} deg drawn with plain letters"]
+    notes += _branch_marks(mech, at, res, mu.value, points, segs, other_branch)
     return Plan("positions", f"Plan of positions, design position phi = {at:g} deg", mu, at, points,
-                tuple(segs), paths, tuple(notes))
+                tuple(segs), fixed.paths, tuple(notes))

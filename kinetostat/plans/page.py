@@ -8,15 +8,18 @@ student's measured lengths, and print at true scale.
 
 Key mode (default): the sheets of `kinetostat plans` (`draw.svg`, the same lettering and label
 placement) at every whole degree and the design position, every scale fixed for the whole cycle
-(`cycle_scales`), without the sheets' notes (the page's tables take their place); the worksheet's
-values; "Next step". Student mode (`student=True`): no answer in the page: the data, the empty
-tables, an A3 sheet with a millimetre grid at true scale, and the check of typed lengths.
+(`cycle_scales`), the plan of positions' 12 positions and paths made once for all of them
+(`fixed_positions`), drawn without the sheets' notes (`svg(notes=False)`: the page's tables take
+their place); the worksheet's values; "Next step". Student mode (`student=True`): no answer in
+the page: the data, the empty tables, an A3 sheet with a millimetre grid at true scale, and the
+check of typed lengths.
 
-Small: the sheets of all angles are cut into templates (the markup, a few per plan) and numbers;
-the numbers of each template slot are stored as second differences over the angle (the drawing's
-coordinates at 0.01 mm, each segment's length and each value to 12 significant digits), as
-zigzag varints, gzip-compressed and base64-encoded; the page's script (vanilla JavaScript, the
-browser's own DecompressionStream) decodes them once and builds the sheet of the angle chosen.
+Small: the sheets of all angles are cut into templates (the markup, a few per plan) and numbers
+(`_split`, one regex pass a sheet); the numbers of each template slot are stored as second
+differences over the angle (the drawing's coordinates at 0.1 mm, each segment's length and each
+value to 12 significant digits), as zigzag varints, gzip-compressed and base64-encoded; the
+page's script (vanilla JavaScript, the browser's own DecompressionStream) decodes them once and
+builds the sheet of the angle chosen.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
 `data-plan`, `data-segment`, `data-length-mm` as in segments.csv; every value cell `data-symbol`,
 `data-value`.
@@ -62,9 +65,10 @@ _NUM = re.compile(r"(-?)(\d+)(?:([.,])(\d+))?")
 #: The attributes that place a drawing's elements (mm), and their decimals in the page.
 COORDINATES = frozenset({"x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "dx", "dy", "points", "d"})
 COORD_DECIMALS = 1
-_TAG = re.compile(r"(<[^>]*>)")
+#: A tag, or (between tags) a number: `_NUM`'s groups after the tag's.
+_PIECE = re.compile(r"(<[^>]*>)|" + _NUM.pattern)
+_COORD_FORMAT = f"\x00.{COORD_DECIMALS}\x00"
 _ATTR = re.compile(r'([\w:-]+)="([^"]*)"')
-_NOTES = re.compile(r'<g id="notes">.*?</g>\n?', re.S)
 
 # ============================================================================ the numbers, small
 
@@ -111,43 +115,45 @@ def _slot_keys(template: tuple[str, ...]) -> list[tuple]:
 def _split(sheet: str) -> tuple[tuple[str, ...], list[int]]:
     """A sheet as (template, numbers): data-length-mm as integers of LENGTH_Q; a drawing's
     coordinates (COORDINATES' attributes) rounded to COORD_DECIMALS (0.1 mm: finer than a ruler
-    reads); every other number (a stroke's width, a font's size, a number in a text) as written."""
-    parts: list[str] = [""]
+    reads); every other number (a stroke's width, a font's size, a number in a text) as written;
+    a zero-padded number ("000" of a colour) kept as text. One pass of `re.sub` over the sheet,
+    each number replaced by its format between two NULs (which XML cannot hold), then split there."""
     nums: list[int] = []
+    push = nums.append
 
-    def numbers(piece: str, places: int | None) -> None:
-        last = 0
-        for m in _NUM.finditer(piece):
-            sign, whole, sep, frac = m.groups()
-            if len(whole) > 1 and whole[0] == "0":        # a zero-padded number: kept as text
-                continue
-            parts[-1] += piece[last:m.start()]
-            last = m.end()
-            d = len(frac) if frac else 0
-            n = int(whole + (frac or ""))
-            if places is not None and d > places and sep == ".":     # "217,69": two integers of a list
-                n, d = (n + 5 * 10 ** (d - places - 1)) // 10 ** (d - places), places
-            parts.append(f"{sep or '.'}{d}" if d else "")
-            parts.append("")
-            nums.append(-n if sign else n)
-        parts[-1] += piece[last:]
+    def as_written(m: re.Match) -> str:                  # of `_NUM` or of `_PIECE`
+        sign, whole, sep, frac = m.groups()[-4:]
+        if len(whole) > 1 and whole[0] == "0":
+            return m[0]
+        if frac:
+            n = int(whole + frac)
+            push(-n if sign else n)
+            return f"\x00{sep}{len(frac)}\x00"
+        push(-int(whole) if sign else int(whole))
+        return "\x00\x00"
 
-    for k, piece in enumerate(_TAG.split(sheet)):
-        if not k % 2:                                     # text between tags: as written
-            numbers(piece, None)
-            continue
-        last = 0
-        for m in _ATTR.finditer(piece):
-            name, value = m.groups()
-            parts[-1] += piece[last:m.start(2)]
-            last = m.end(2)
-            if name == "data-length-mm":
-                parts += ["L", ""]
-                nums.append(round(float(value) / LENGTH_Q))
-            else:
-                numbers(value, COORD_DECIMALS if name in COORDINATES else None)
-        parts[-1] += piece[last:]
-    return tuple(parts), nums
+    def coordinate(m: re.Match) -> str:
+        sign, whole, sep, frac = m.groups()
+        if not frac or len(frac) <= COORD_DECIMALS or sep != ".":     # "217,69": two integers of a list
+            return as_written(m)
+        if len(whole) > 1 and whole[0] == "0":
+            return m[0]
+        cut = 10 ** (len(frac) - COORD_DECIMALS)
+        n = (int(whole + frac) + cut // 2) // cut
+        push(-n if sign else n)
+        return _COORD_FORMAT
+
+    def attribute(m: re.Match) -> str:
+        name, value = m.groups()
+        if name == "data-length-mm":
+            push(round(float(value) / LENGTH_Q))
+            return 'data-length-mm="\x00L\x00"'
+        return f'{name}="{_NUM.sub(coordinate if name in COORDINATES else as_written, value)}"'
+
+    def piece(m: re.Match) -> str:                       # a tag: its attributes; else a number in a text
+        return _ATTR.sub(attribute, m[0]) if m[1] else as_written(m)
+
+    return tuple(_PIECE.sub(piece, sheet).split("\x00")), nums
 
 
 def _varints(values: np.ndarray) -> bytes:
@@ -225,7 +231,7 @@ def _b64gz(data: bytes) -> str:
 def _sheets_of(plans, lang: str, name: str) -> dict[str, str]:
     """The page's sheets of one angle: `draw.svg` with the contract, without the notes (the page's
     tables hold them) and the XML declaration."""
-    return {kind: _NOTES.sub("", svg(p, lang=lang, mechanism=name, contract=True)).split("?>", 1)[-1].lstrip()
+    return {kind: svg(p, lang=lang, mechanism=name, contract=True, notes=False).split("?>", 1)[-1].lstrip()
             for kind, p in plans.items()}
 
 
@@ -247,22 +253,23 @@ def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict
     return out
 
 
-def _plans_at(mech, start: float, fixed, a: float):
-    """The plans at `a` deg at the page's scales; None at a singular position."""
+def _plans_at(mech, positions, fixed, a: float):
+    """The plans at `a` deg at the page's scales, the plan of positions on its 12 positions and
+    paths made once (`fixed_positions`); None at a singular position."""
     from . import build
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            return build(mech, at=a, starting_deg=start, fixed=fixed)
+            return build(mech, at=a, fixed=fixed, positions=positions)
         except ValueError:                     # a singular position
             return None
 
 
-def _frame(mech, start: float, fixed, lang: str, name: str, a: float) -> tuple[dict, dict | None, list | None]:
+def _frame(mech, positions, fixed, lang: str, name: str, a: float) -> tuple[dict, dict | None, list | None]:
     """One frame of the slider: each plan's sheet `_split` (kind -> (template, numbers)), the
     worksheet's values (key -> value) and its records; ({}, None, None) at a singular position."""
     from .worksheet import worksheet
-    plans = _plans_at(mech, start, fixed, a)
+    plans = _plans_at(mech, positions, fixed, a)
     if plans is None:
         return {}, None, None
     with warnings.catch_warnings():
@@ -439,18 +446,18 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     default PAGE_ANGLES);
     `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
     from ..solve import analyze
-    from . import cycle_scales, starting_position
+    from . import cycle_scales, fixed_positions
     from .lettering import lettering
     check_lang(lang)
     key = page_key(mech, lang, student, at, angles, fixed)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
     fixed = fixed or cycle_scales(mech)
-    start = starting_position(mech)
+    positions = fixed_positions(mech, fixed.base["mu_l"])
     name = lettering(mech).name(lang, mech.name)
     frames = [at] if student else [*map(float, PAGE_ANGLES if angles is None else angles), design]
 
-    plans_at = partial(_plans_at, mech, start, fixed)
+    plans_at = partial(_plans_at, mech, positions, fixed)
     check = plans_at(at)
     if check is None:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
@@ -465,7 +472,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     if not student:
         per_kind: dict[str, list] = {k: [] for k in check}
         values, rows = [], None
-        for split, got, records in _map(partial(_frame, mech, start, fixed, lang, name), frames):
+        for split, got, records in _map(partial(_frame, mech, positions, fixed, lang, name), frames):
             for kind in per_kind:
                 per_kind[kind].append(split.get(kind))
             if got is not None:

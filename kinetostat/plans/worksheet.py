@@ -487,8 +487,8 @@ class _Sheet:
                 self.add("friction", f"phi_f_{i}_{j}", f"φ_f{R[1:]}", math.degrees(math.atan(f)), "deg", "", "tan φ_f = f")
                 self.add("friction", f"Ff_{i}_{j}", f"F_f{R[1:]}", abs(q), "N", "",
                          f"f |N{R[1:]}|, along the guide, against the sliding")
-        M0, M1, Mf = (ex.balancing_moment_frictionless[0], analyze(m, phi_deg=[at], friction="first")
-                      .balancing_moment_with_friction[0], ex.balancing_moment[0])
+        first = self.res if ex is not self.res else analyze(m, phi_deg=[at], friction="first")   # the sheet's own, or made
+        M0, M1, Mf = ex.balancing_moment_frictionless[0], first.balancing_moment_with_friction[0], ex.balancing_moment[0]
         if ex is self.res:             # the sheet's M_bal is the frictional one: the frictionless one beside it
             self.add("friction", "M_bal_0", f"{L.M_bal},0", M0, "N m", _sense(M0), "frictionless")
         self.add("friction", "M_bal_first", f"{L.M_bal} + P_f/ω1", M1, "N m", _sense(M1), "first approximation")
