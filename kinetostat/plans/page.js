@@ -127,7 +127,8 @@
         frames[f][i] = v;
       });
     }
-    kinds.push({kind: K.kind, templates: K.templates, tids: K.frames, frames});
+    const templates = K.templates.map((ix) => ix.map((i) => K.lines[i]).join("\n").split("\0"));   // page.py _lines
+    kinds.push({kind: K.kind, templates, tids: K.frames, frames});
   }
   const rows = D.rows, ncol = rows.length, nf = D.frames.length;
   const vals = varints(await bytes("values"));

@@ -15,7 +15,8 @@ the page: the data, the empty tables, an A3 sheet with a millimetre grid at true
 check of typed lengths.
 
 Small: the sheets of all angles are cut into templates (the markup, a few per plan) and numbers
-(`_split`, one regex pass a sheet); the numbers of each template slot are stored as second
+(`_split`, one regex pass a sheet), each plan's templates stored as a table of their distinct
+lines (`_lines`); the numbers of each template slot are stored as second
 differences over the angle (the drawing's coordinates at 0.1 mm, each segment's length and each
 value to 12 significant digits), as zigzag varints, gzip-compressed and base64-encoded; the
 page's script (vanilla JavaScript, the browser's own DecompressionStream) decodes them once and
@@ -220,6 +221,16 @@ def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
     d = _second_differences(np.rint(scaled).astype(np.int64))
     mask = (~np.isfinite(values)).astype(np.int64)
     return exps, _varints(np.concatenate([mask.T.ravel(), d.T.ravel()]))
+
+
+def _lines(templates: tuple[tuple[str, ...], ...]) -> tuple[list[str], list[list[int]]]:
+    """Templates as one table of their distinct lines and each template as its lines' indices (a
+    template joined by NUL, split at newlines; the page's script joins and splits back): the
+    templates of one plan differ by a few lines (a leader, a label, a vector drawn or not), and
+    gzip's 32 kB window would not reach the template before a large one."""
+    table: dict[str, int] = {}
+    rows = [[table.setdefault(line, len(table)) for line in "\0".join(t).split("\n")] for t in templates]
+    return list(table), rows
 
 
 def _b64gz(data: bytes) -> str:
@@ -486,7 +497,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         kinds = []
         for kind, sheets in per_kind.items():
             enc = _encode_split(sheets)
-            kinds.append({"kind": kind, "templates": enc.templates, "keys": enc.keys, "frames": enc.frames})
+            lines, templates = _lines(enc.templates)
+            kinds.append({"kind": kind, "lines": lines, "templates": templates, "keys": enc.keys, "frames": enc.frames})
             blobs[f"k{len(kinds) - 1}"] = _b64gz(enc.data)
         blobs["values"] = _b64gz(vbytes)
         data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
