@@ -142,7 +142,7 @@ def test_positions_plan_has_twelve_positions_design_and_paths(ice_plans):
 def test_positions_made_once_draw_the_same_plan_and_only_for_their_mechanism_and_scale(ice_plans):
     """The 12 positions and paths made once for many angles (`fixed_positions`, as the page uses
     them) draw the plan of positions `build` draws without them; another mechanism's or another
-    scale's are refused, naming `fixed`."""
+    scale's, or those from another starting position, are refused, naming `fixed`."""
     mech = ice_plans.mech
     fixed = P.fixed_positions(mech, ice_plans.scales["mu_l"])
     for at in (30.0, 200.0):
@@ -155,6 +155,8 @@ def test_positions_made_once_draw_the_same_plan_and_only_for_their_mechanism_and
         P.build(other, at=30, scales=SEED_002_SCALES, only=["positions"], positions=fixed)
     with pytest.raises(ValueError, match="fixed"):
         P.build(mech, at=30, scales={**SEED_002_SCALES, "mu_l": 0.002}, only=["positions"], positions=fixed)
+    with pytest.raises(ValueError, match="starting_deg = 45"):           # made from the dead centre, not 45 deg
+        P.build(mech, at=30, scales=SEED_002_SCALES, only=["positions"], positions=fixed, starting_deg=45)
 
 
 def test_svg_sheet(ice_plans, tmp_path):

@@ -144,8 +144,8 @@ def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions 
     sheet (a slider's other branch below the crank), the mark left out and noted (the scale rule
     keeps the crank at the length the text asks)."""
     fixed = fixed or fixed_positions(mech, sc["mu_l"], starting_deg)
-    plan = positions_plan(mech, res, sc, fixed=fixed)
-    return plan if fits(plan) <= 1 else positions_plan(mech, res, sc, other_branch=False, fixed=fixed)
+    plan = positions_plan(mech, res, sc, starting_deg, fixed=fixed)
+    return plan if fits(plan) <= 1 else positions_plan(mech, res, sc, starting_deg, other_branch=False, fixed=fixed)
 
 
 class Plans(Mapping):
@@ -232,7 +232,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     "reactions" (a model with [friction]: the group plans, force polygons and crank plan with the
     reactions with friction, each revolute pair's friction circle drawn, `forces`). `positions`:
     the plan of positions' 12 positions and paths made once for many angles (`fixed_positions` of
-    `mech` at the mu_l drawn at; `starting_deg` then unused). ValueError for
+    `mech` at the mu_l drawn at; from `starting_deg` where it is given, else ValueError). ValueError for
     a bad angle or name, or an angle with no equilibrium with friction; ScaleError (a ValueError)
     for a scale that would draw a plan beyond MAX_EXTENT_MM."""
     import math

@@ -464,13 +464,15 @@ def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | No
     of `res` (plain names), the paths of every centre of mass and the assembly branch of each
     group (notes; the other branch dashed, unless `other_branch` is False): all at mu_l. Link segments' values are the exact
     distances between their points, m. `fixed`: the 12 positions and the paths made already
-    (`fixed_positions` of this `mech` at mu_l; `starting_deg` then unused)."""
+    (`fixed_positions` of this `mech` at mu_l, from `starting_deg` where it is given)."""
     at = float(res.phi_deg[0])
     mu = scales["mu_l"]
     if fixed is None:
         fixed = fixed_positions(mech, mu, starting_deg)
     elif fixed.mech is not mech or fixed.mu != mu:
         raise ValueError(f"fixed: the positions of {fixed.mech.name} at {fixed.mu}, not of {mech.name} at {mu}")
+    elif starting_deg is not None and float(starting_deg) != fixed.start:
+        raise ValueError(f"fixed: positions from {fixed.start:g} deg, not from starting_deg = {starting_deg:g} deg")
     points = dict(fixed.points)
     segs = list(fixed.segments)
     _draw_position(mech, res, 0, None, mu.value, points, segs)

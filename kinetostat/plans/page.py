@@ -53,7 +53,7 @@ from .._io import write_bytes, write_text
 from .draw import TINY_MM, segment_label, svg, title_of
 from .i18n import check_lang, num, text, unit
 
-__all__ = ["page", "write_page", "page_key", "key_of", "encode", "PAGE_ANGLES", "TOLERANCE_PCT", "KEY_META"]
+__all__ = ["page", "write_page", "page_key", "key_of", "code_files", "encode", "PAGE_ANGLES", "TOLERANCE_PCT", "KEY_META"]
 
 #: The angles of the slider, deg (the design position is one more frame).
 PAGE_ANGLES = tuple(float(a) for a in range(360))
@@ -522,7 +522,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                                                              9, mtime=0))).decode("ascii")
     res = analyze(mech, phi_deg=[at])
     blank = _blank_tables(mech, at, fixed, lang) if student else ""
-    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results, blank, key)
+    return _sealed(_html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results, blank, key))
 
 
 def _blank_tables(mech, at: float, fixed, lang: str) -> str:
@@ -683,8 +683,8 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
 def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None,
                reuse: str | Path | None = None) -> Path:
     """The page of `mech` (`page`) written to `out` atomically; returns its path. `reuse`: an
-    earlier page (e.g. the one `out` replaces); where its key (`page_key`, in its KEY_META element)
-    equals this page's, its bytes are written instead of drawing the page again."""
+    earlier page (e.g. the one `out` replaces); where it is whole and its key (`key_of`) equals
+    this page's (`page_key`), its bytes are written instead of drawing the page again."""
     path = Path(out)
     key = page_key(mech, lang, student, at)
     if key is not None and reuse is not None and key_of(reuse) == key:
@@ -698,50 +698,105 @@ def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, a
 
 #: The name of the meta element that holds a page's key (`page_key`).
 KEY_META = "kinetostat-page"
-_KEY = re.compile(r'<meta name="kinetostat-page" content="([0-9a-f]{64})">')
-#: The package's files a page's key covers: its code and data (`_code_digest`).
-_CODE_SUFFIXES = (".py", ".js", ".json")
+_KEY = re.compile(rb'<meta name="kinetostat-page" content="([0-9a-f]{64})">')
+#: A page's last line: the SHA-256 of every byte before it (`_sealed`, `key_of`).
+_SEAL = re.compile(rb"<!-- kinetostat-page-sha256 ([0-9a-f]{64}) -->\n\Z")
 
 
 def page_key(mech, lang: str = "en", student: bool = False, at: float | None = None,
              angles: Sequence[float] | None = None, fixed=None) -> str | None:
     """What the page `page(mech, lang, student, at, angles, fixed)` is drawn from, as a SHA-256
-    hex digest: every field of the mechanism but where its file lies (`path`, `source`), the
-    arguments, and the code that draws it (every .py, .js and .json file of the installed package).
-    Equal keys: the same page. The libraries' versions are left out by choice, so that a
-    checkout's committed pages stay current on another machine: a page drawn with other versions
-    of numpy or Python is kept. None where the
-    mechanism holds something other than numbers, text, arrays and containers of them (no key:
-    never reused)."""
+    hex digest: every field of the mechanism but where its file lies (`path`), the arguments, and
+    the code that draws it (`code_files`). Equal keys: the same page. The libraries' versions are
+    left out by choice, so that a checkout's committed pages stay current on another machine: a
+    page drawn with other versions of numpy or Python is kept. None where the mechanism holds
+    something other than numbers, text, arrays and containers of them (no key: never reused)."""
     h = hashlib.sha256(_code_digest())
     try:
         _feed(h, (lang, student, at, tuple(map(float, PAGE_ANGLES if angles is None else angles)), fixed))
-        _feed(h, mech, skip=("path", "source", "structure", "_derived"))
+        _feed(h, mech, skip=("path", "structure", "_derived"))
     except TypeError:
         return None
     return h.hexdigest()
 
 
 def key_of(path: str | Path) -> str | None:
-    """The key of the page written at `path` (its KEY_META element), None where there is none or
-    no file."""
+    """The key of the page written at `path` (its KEY_META element); None where there is no file,
+    no key, or the page is not whole (its last line, the SHA-256 of the bytes before it, missing or
+    not theirs: a page cut short or edited)."""
     try:
-        with open(path, "rb") as f:
-            head = f.read(2048).decode("utf-8", "replace")
+        data = Path(path).read_bytes()
     except OSError:
         return None
-    m = _KEY.search(head)
-    return m.group(1) if m else None
+    seal = _SEAL.search(data)
+    if seal is None or hashlib.sha256(data[:seal.start()]).hexdigest().encode() != seal.group(1):
+        return None
+    m = _KEY.search(data, 0, 4096)
+    return m.group(1).decode() if m else None
+
+
+def _sealed(html: str) -> str:
+    """`html` with its seal: a last line holding the SHA-256 of its UTF-8 bytes."""
+    return f"{html}<!-- kinetostat-page-sha256 {hashlib.sha256(html.encode()).hexdigest()} -->\n"
 
 
 @cache
 def _code_digest() -> bytes:
-    """SHA-256 of the package's code and data files (_CODE_SUFFIXES), by relative path, in order."""
+    """SHA-256 of the code a page is drawn by (`code_files`), each file by its path relative to the
+    package and its bytes, in order."""
     root = Path(__file__).resolve().parents[1]
     h = hashlib.sha256()
-    for f in sorted(p for p in root.rglob("*") if p.suffix in _CODE_SUFFIXES and "__pycache__" not in p.parts):
+    for f in code_files():
         h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
     return h.digest()
+
+
+def code_files() -> list[Path]:
+    """The files of the code a page is drawn by, sorted: this module and every module of the
+    package it imports, directly or through others, at module level or inside a function (read
+    from their source, with each package's __init__), and the .js and .json files in their
+    folders. An edit to another module (the command line, the reports) leaves a page's key as it
+    is."""
+    root = Path(__file__).resolve().parents[1]
+    todo, seen = [Path(__file__).resolve()], set()
+    while todo:
+        f = todo.pop()
+        if f not in seen:
+            seen.add(f)
+            todo += _imported(f, root)
+    return sorted(seen | {g for f in seen for g in f.parent.iterdir() if g.suffix in (".js", ".json")})
+
+
+#: An import statement: `from X import names` (X relative or absolute; names in parentheses over
+#: lines) or `import names`, at any indentation; one in a docstring counts too (more, never less).
+_IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#;]*)|import[ \t]+([^\n#;]*))", re.M)
+
+
+def _imported(f: Path, root: Path) -> list[Path]:
+    """The package's modules the module `f` imports (relative or absolute; of `from X import a`, X
+    and a submodule a), each with the __init__ of every package on its way."""
+    package = [*f.parent.relative_to(root.parent).parts]          # e.g. ["kinetostat", "plans"]
+    out = []
+
+    def add(parts: list[str]) -> None:
+        if not parts or parts[0] != root.name:
+            return
+        for n in range(1, len(parts) + 1):
+            p = root.parent.joinpath(*parts[:n])
+            out.extend(g for g in (p / "__init__.py", p.with_suffix(".py")) if g.is_file())
+    names = lambda text: [a.split()[0] for a in text.strip("() \t\n").replace("\n", " ").split(",") if a.strip()]
+    for m in _IMPORT.finditer(f.read_text(encoding="utf-8")):
+        source, what, plain = m.groups()
+        if plain is not None:
+            for name in names(plain):
+                add(name.split("."))
+            continue
+        level = len(source) - len(source.lstrip("."))
+        base = (package[:len(package) - level + 1] if level else []) + [x for x in source.lstrip(".").split(".") if x]
+        add(base)
+        for name in names(what):
+            add(base + [name])
+    return out
 
 
 def _feed(h, x, skip: tuple[str, ...] = ()) -> None:
