@@ -332,9 +332,9 @@ def test_whole_page_against_plans_cycle_scales(chromium, tmp_path, cli):
 
 @pytest.mark.slow
 def test_report_and_variant_link_their_pages(tmp_path, cli):
-    """`report --page` writes page.html beside the report and links it; `variant 1 479 --page`
-    writes the variant's page with its check at phi1."""
-    r = cli("report", "ice_crank_slider", "--engines", "none", "--steps", "36", "--page", "--out", str(tmp_path / "r"),
+    """`report` writes page.html beside the report and links it; `variant 1 479 --page` writes the
+    variant's page with its check at phi1."""
+    r = cli("report", "ice_crank_slider", "--engines", "none", "--steps", "36", "--out", str(tmp_path / "r"),
             "--no-progress")
     assert r.returncode == 0, r.stderr
     folder = next(p for p in (tmp_path / "r").iterdir() if p.is_dir())
@@ -388,9 +388,10 @@ def test_split_rounds_coordinates_only():
 
 def test_report_keeps_its_page_only_where_it_is_the_same_page(tmp_path, monkeypatch, cli):
     """`kinetostat report` writes and links each model's page by default. A rerun keeps the page
-    it finds, without drawing it again, where the page's key is the key of the page it would draw;
-    a model text with one load changed, or other code, draws the page again. (A page of two
-    angles at scales sampled every 90 deg: quick.)"""
+    it finds, without drawing it again, where the page is whole and its key is the key of the page
+    it would draw, and says which; a model text with one load changed, other code, or a page cut
+    short or edited draws the page again; --no-page removes the earlier page. (A page of two angles
+    at scales sampled every 90 deg: quick.)"""
     import kinetostat.plans.page as pg
     monkeypatch.setattr(pg, "PAGE_ANGLES", (0.0, 150.0))
     cycle = P.cycle_scales
@@ -399,40 +400,43 @@ def test_report_keeps_its_page_only_where_it_is_the_same_page(tmp_path, monkeypa
     draw = pg.page
     monkeypatch.setattr(pg, "page", lambda mech, **kw: drawn.append(mech.name) or draw(mech, **kw))
     ice = next(p for p in MODELS if p.stem == "ice_crank_slider")
-    changed = tmp_path / "changed" / "ice_crank_slider.toml"      # the same folder name in the report
-    changed.parent.mkdir()
     text = ice.read_text(encoding="utf-8")
     assert "\nG2 = 4.9 " in text
-    changed.write_text(text.replace("\nG2 = 4.9 ", "\nG2 = 5.2 "), encoding="utf-8")
+    (tmp_path / "changed.toml").write_text(text.replace("\nG2 = 4.9 ", "\nG2 = 5.2 "), encoding="utf-8")
+    changed = kinetostat.load(tmp_path / "changed.toml")
     out = tmp_path / "r"
     html, md = out / "ice_crank_slider" / "page.html", out / "ice_crank_slider" / "index.md"
 
-    def report(model):
-        r = cli("report", str(model), "--engines", "none", "--steps", "8", "--jobs", "1", "--no-progress",
-                "--out", str(out))
+    def report(*more) -> str:
+        r = cli("report", str(ice), "--engines", "none", "--steps", "8", "--jobs", "1", "--no-progress",
+                "--out", str(out), *more)
         assert r.returncode == 0, r.stderr
-        return html.read_bytes()
+        return r.stdout
 
-    first = report(ice)
-    assert len(drawn) == 1 and "](page.html)" in md.read_text(encoding="utf-8")
+    said = report()
+    first = html.read_bytes()
+    assert len(drawn) == 1 and ", page drawn  ->" in said and "](page.html)" in md.read_text(encoding="utf-8")
     assert "[page](ice_crank_slider/page.html)" in (out / "index.md").read_text(encoding="utf-8")
     assert pg.key_of(html) == pg.page_key(kinetostat.load(ice)) is not None
-    assert report(ice) == first and len(drawn) == 1                 # kept: the same page
-    other = report(changed)
-    assert len(drawn) == 2 and other != first and pg.key_of(html) == pg.page_key(kinetostat.load(changed))
-    old = pg.key_of(html)
+    assert ", page kept  ->" in report() and html.read_bytes() == first and len(drawn) == 1    # kept: the same page
+
+    def write(name: str, reuse) -> bytes:
+        pg.write_page(changed, tmp_path / name, reuse=reuse)
+        return (tmp_path / name).read_bytes()
+    other = write("other.html", html)                                  # another model: drawn
+    assert len(drawn) == 2 and other != first and pg.key_of(tmp_path / "other.html") == pg.page_key(changed)
+    assert write("same.html", tmp_path / "other.html") == other and len(drawn) == 2
     monkeypatch.setattr(pg, "_code_digest", lambda: b"other code")
-    pg.write_page(kinetostat.load(changed), tmp_path / "again.html", reuse=html)
-    again = (tmp_path / "again.html").read_bytes()
-    assert len(drawn) == 3 and pg.key_of(tmp_path / "again.html") == pg.page_key(kinetostat.load(changed)) != old
+    again = write("again.html", tmp_path / "other.html")               # other code: drawn, the same page
+    assert len(drawn) == 3 and pg.key_of(tmp_path / "again.html") == pg.page_key(changed) != pg.key_of(tmp_path / "other.html")
     unkeyed = lambda b: re.sub(rb'<meta name="kinetostat-page" content="\w+">|<!-- kinetostat-page-sha256 \w+ -->\n$', b"", b)
-    assert unkeyed(again) == unkeyed(other)                           # drawn again: the same page
-    html.write_bytes(other[:-100] + other[-99:])                      # a page edited by one byte
-    assert pg.key_of(html) is None
-    html.write_bytes(other[:len(other) // 2])                         # a page cut short
-    assert pg.key_of(html) is None
-    pg.write_page(kinetostat.load(changed), tmp_path / "whole.html", reuse=html)
-    assert len(drawn) == 4 and (tmp_path / "whole.html").read_bytes() == again     # drawn again, whole
+    assert unkeyed(again) == unkeyed(other)
+    for bad in (again[:-100] + again[-99:], again[:len(again) // 2]):   # a page edited by one byte, cut short
+        (tmp_path / "bad.html").write_bytes(bad)
+        assert pg.key_of(tmp_path / "bad.html") is None
+    assert write("whole.html", tmp_path / "bad.html") == again and len(drawn) == 4
+    report("--no-page")
+    assert not html.exists() and "page.html" not in md.read_text(encoding="utf-8")        # none, none linked
 
 
 def test_a_pages_key_covers_the_modules_it_imports():
@@ -487,3 +491,23 @@ def test_the_committed_reports_hold_current_pages():
         if pg.key_of(page) != pg.page_key(kinetostat.load(path)):
             stale.append(path.stem)
     assert not stale, f"reports/<model>/page.html missing or stale for {stale}: run `kinetostat report` and commit reports/"
+
+
+def test_variant_all_writes_a_page_per_code_linked_from_its_index(tmp_path, monkeypatch, cli):
+    """`kinetostat variant 1 --all --page` (one code here): each code's folder holds its page, in
+    the key's language with the check at phi1, and both indexes link it. (Two angles: quick.)"""
+    import kinetostat.plans.page as pg
+    from kinetostat import variants
+    monkeypatch.setattr(variants, "codes", lambda: ["479"])
+    monkeypatch.setattr(pg, "PAGE_ANGLES", (0.0, 150.0))
+    cycle = P.cycle_scales
+    monkeypatch.setattr(P, "cycle_scales", lambda mech: cycle(mech, step_deg=90.0))
+    run = cli("variant", "1", "--all", "--page", "--no-pack", "--out", tmp_path, "--no-progress")
+    assert run.returncode == 0, run.stderr
+    page = tmp_path / "task1_479" / "page.html"
+    v = variants.variant(1, "479")
+    phi1 = variants.values(1, "479")["phi1"]
+    assert pg.key_of(page) == pg.page_key(v.mechanism(), lang="uk", at=phi1)
+    assert '<html lang="uk">' in page.read_text(encoding="utf-8")
+    for index in ("index.md", "index.html"):
+        assert "task1_479/page.html" in (tmp_path / index).read_text(encoding="utf-8")

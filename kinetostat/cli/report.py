@@ -25,11 +25,13 @@ _PREPARED: dict[str, tuple] = {}
 def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = True,
                 friction: str = "first") -> dict:
     """One model's report: load, analyse (or take both from `_PREPARED`), run the routes, write
-    `out/<folder>/` (with `page`, its page.html kept where it is the same page). Returns {"summary", "warnings", "seconds"} or {"error"} (one line); raises
-    only KeyboardInterrupt."""
+    `out/<folder>/` (with `page`, its page.html kept where it is the same page; without, an
+    earlier page.html removed). Returns {"summary", "warnings", "seconds", "page": "kept", "drawn" or
+    None} or {"error"} (one line); raises only KeyboardInterrupt."""
     from ..report import run_validation, write_report
     t0 = time.perf_counter()
     try:
+        from ..plans.page import key_of
         from ..solve import analyze
         if path in _PREPARED:
             mech, res, secs = _PREPARED[path]
@@ -42,14 +44,19 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
                 secs = time.perf_counter() - t1
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
+        earlier = Path(out) / folder / "page.html"
+        before = key_of(earlier) if page else None
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
             summary = write_report(run, tmp, folder, page=page, friction=friction, reuse=Path(out) / folder)
+        if not page and (earlier.is_file() or earlier.is_symlink()):
+            earlier.unlink()                  # an earlier run's page, no longer linked
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
         msg = str(exc).strip().splitlines()
         return {"error": f"{type(exc).__name__}: {msg[0] if msg else ''}".rstrip(": ")}
-    return {"summary": summary, "warnings": run.warnings, "seconds": time.perf_counter() - t0}
+    page_state = None if not page else "kept" if before is not None and key_of(earlier) == before else "drawn"
+    return {"summary": summary, "warnings": run.warnings, "seconds": time.perf_counter() - t0, "page": page_state}
 
 
 def _worker_init() -> None:
@@ -136,7 +143,8 @@ def cmd_report(args) -> int:
             n_fail += not s["passed"]
             status = "PASS" if s["passed"] and s["checked"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
-            _Out.write(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s"
+            page = f", page {r['page']}" if r.get("page") else ""
+            _Out.write(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s{page}"
                                 f"  -> {out / s['stem'] / 'index.html'}"))
         index = out / "index.md"
         keep = n_err and index.exists()     # a model without a report: the earlier index is not lost

@@ -35,8 +35,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "plan.forces": ("Force plan of group", "План сил групи", "План сил группы"),
     "plan.crank": ("Plan of the initial link", "План початкової ланки", "План начального звена"),
     "plan.lever": ("Zhukovsky's lever", "Важіль Жуковського", "Рычаг Жуковского"),
-    "plan.mechanism": ("Mechanism at the design position", "Механізм у розрахунковому положенні",
-                       "Механизм в расчётном положении"),
+    "plan.mechanism": ("Mechanism", "Механізм", "Механизм"),      # at any angle: "φ = …" follows
     # title block and notes
     "angle": ("crank angle", "кут кривошипа", "угол кривошипа"),
     "scale": ("scale", "масштаб", "масштаб"),

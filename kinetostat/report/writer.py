@@ -302,7 +302,9 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
         from ..plans.page import write_page
         files.append(write_page(m, d / "page.html", reuse=None if reuse is None else Path(reuse) / "page.html"))
         doc.p("[The interactive page](page.html): every plan at every degree of the crank at scales fixed for "
-              "the cycle, the values, the force plans step by step, a check of measured lengths (one offline file).")
+              "the cycle, the values, the force plans step by step, a check of measured lengths (one offline file"
+              + ("; the graphical method's first approximation: reactions without friction" if m.friction is not None else "")
+              + ").")
     for plan in plans.values():
         path = d / ("plan_" + plan_file_name(plan, ".svg"))
         write_text(path, svg(plan, mechanism=m.name))
