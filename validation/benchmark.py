@@ -501,7 +501,7 @@ def main_job_lines(mj: dict) -> list[str]:
              "model. A model's interactive page is drawn only where the folder does not already hold the same "
              "page (`plans.page.page_key`): \"pages kept\" is the folder of an earlier run with the same code and "
              "models, as the committed reports/ are for a checkout; \"pages drawn\" an empty folder, or any "
-             "change to the package's code. Before: each commit below on its own models (no pages then), "
+             "change to the code a page is drawn by (`plans.page.code_files`). Before: each commit below on its own models (no pages then), "
              f"measured on this machine at the load average given. After: this run; load average "
              f"{mj['drawn']['load'][0]} before the first run and {kept['load'][1]} after the kept runs.", "",
              "| the main job | models | runs | CPU s min / median | wall s min / median |", "|---|---|---|---|---|"]
