@@ -389,7 +389,8 @@ def test_split_rounds_coordinates_only():
 def test_report_keeps_its_page_only_where_it_is_the_same_page(tmp_path, monkeypatch, cli):
     """`kinetostat report` writes and links each model's page by default. A rerun keeps the page
     it finds, without drawing it again, where the page is whole and its key is the key of the page
-    it would draw, and says which; a model text with one load changed, other code, or a page cut
+    it would draw (the same model file elsewhere too), and says which; a model text with one load
+    changed, other code, or a page cut
     short or edited draws the page again; --no-page removes the earlier page. (A page of two angles
     at scales sampled every 90 deg: quick.)"""
     import kinetostat.plans.page as pg
@@ -419,6 +420,10 @@ def test_report_keeps_its_page_only_where_it_is_the_same_page(tmp_path, monkeypa
     assert "[page](ice_crank_slider/page.html)" in (out / "index.md").read_text(encoding="utf-8")
     assert pg.key_of(html) == pg.page_key(kinetostat.load(ice)) is not None
     assert ", page kept  ->" in report() and html.read_bytes() == first and len(drawn) == 1    # kept: the same page
+    (tmp_path / "elsewhere").mkdir()                                   # the same model in another folder: kept
+    (tmp_path / "elsewhere" / "copy.toml").write_text(text, encoding="utf-8")
+    pg.write_page(kinetostat.load(tmp_path / "elsewhere" / "copy.toml"), tmp_path / "copy.html", reuse=html)
+    assert (tmp_path / "copy.html").read_bytes() == first and len(drawn) == 1
 
     def write(name: str, reuse) -> bytes:
         pg.write_page(changed, tmp_path / name, reuse=reuse)

@@ -706,7 +706,8 @@ _SEAL = re.compile(rb"<!-- kinetostat-page-sha256 ([0-9a-f]{64}) -->\n\Z")
 def page_key(mech, lang: str = "en", student: bool = False, at: float | None = None,
              angles: Sequence[float] | None = None, fixed=None) -> str | None:
     """What the page `page(mech, lang, student, at, angles, fixed)` is drawn from, as a SHA-256
-    hex digest: every field of the mechanism but where its file lies (`path`), the arguments, and
+    hex digest: every field of the mechanism but where its file lies (its `path`, and that path
+    wherever a text holds it, as a drive's `source` does), the arguments, and
     the code that draws it (`code_files`). Equal keys: the same page. The libraries' versions are
     left out by choice, so that a checkout's committed pages stay current on another machine: a
     page drawn with other versions of numpy or Python is kept. None where the mechanism holds
@@ -714,7 +715,7 @@ def page_key(mech, lang: str = "en", student: bool = False, at: float | None = N
     h = hashlib.sha256(_code_digest())
     try:
         _feed(h, (lang, student, at, tuple(map(float, PAGE_ANGLES if angles is None else angles)), fixed))
-        _feed(h, mech, skip=("path", "structure", "_derived"))
+        _feed(h, mech, skip=("path", "structure", "_derived"), where=mech.path)
     except TypeError:
         return None
     return h.hexdigest()
@@ -799,10 +800,13 @@ def _imported(f: Path, root: Path) -> list[Path]:
     return out
 
 
-def _feed(h, x, skip: tuple[str, ...] = ()) -> None:
-    """Feed `x` to the hash `h` unambiguously: its type, then its value (a float exactly, an array
-    by dtype, shape and bytes, a dataclass field by field but `skip`, a mapping item by item);
-    TypeError for anything else (a function, an object of its own)."""
+def _feed(h, x, skip: tuple[str, ...] = (), where: str | None = None) -> None:
+    """Feed `x` to the hash `h` unambiguously: its type, then its value (a float exactly, a text
+    with the path `where` in it made a placeholder, an array by dtype, shape and bytes, a
+    dataclass field by field but `skip`, a mapping item by item); TypeError for anything else (a
+    function, an object of its own)."""
+    if isinstance(x, str) and where:
+        x = x.replace(where, "\0model file\0")
     if x is None or isinstance(x, (bool, int, float, complex, str)):
         h.update(f"{type(x).__name__}:{x!r};".encode())
     elif isinstance(x, np.generic):
@@ -814,20 +818,20 @@ def _feed(h, x, skip: tuple[str, ...] = ()) -> None:
         for f in fields(x):
             if f.name not in skip:
                 h.update(f.name.encode() + b"=")
-                _feed(h, getattr(x, f.name))
+                _feed(h, getattr(x, f.name), where=where)
         h.update(b"}")
     elif isinstance(x, Mapping):
         h.update(f"map:{len(x)}{{".encode())
         for k, v in x.items():
-            _feed(h, k)
-            _feed(h, v)
+            _feed(h, k, where=where)
+            _feed(h, v, where=where)
         h.update(b"}")
     elif isinstance(x, (tuple, list)):
         h.update(f"{type(x).__name__}:{len(x)}(".encode())
         for v in x:
-            _feed(h, v)
+            _feed(h, v, where=where)
         h.update(b")")
     elif isinstance(x, (frozenset, set)):
-        _feed(h, sorted(x, key=repr))
+        _feed(h, sorted(x, key=repr), where=where)
     else:
         raise TypeError(f"cannot key a {type(x).__qualname__}")
