@@ -48,15 +48,19 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
         before = key_of(earlier) if page else None
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
             summary = write_report(run, tmp, folder, page=page, friction=friction, reuse=Path(out) / folder)
+        notes = list(run.warnings)
         if not page and (earlier.is_file() or earlier.is_symlink()):
-            earlier.unlink()                  # an earlier run's page, no longer linked
+            try:
+                earlier.unlink()              # an earlier run's page, no longer linked
+            except OSError as exc:
+                notes.append(f"report written; the earlier {earlier} not removed: {exc.strerror or exc}")
     except OSError as exc:
         return {"error": f"cannot write the report into {out}: {exc.strerror or exc}"}
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
         msg = str(exc).strip().splitlines()
         return {"error": f"{type(exc).__name__}: {msg[0] if msg else ''}".rstrip(": ")}
     page_state = None if not page else "kept" if before is not None and key_of(earlier) == before else "drawn"
-    return {"summary": summary, "warnings": run.warnings, "seconds": time.perf_counter() - t0, "page": page_state}
+    return {"summary": summary, "warnings": notes, "seconds": time.perf_counter() - t0, "page": page_state}
 
 
 def _worker_init() -> None:

@@ -756,8 +756,8 @@ def code_files() -> list[Path]:
     """The files of the code a page is drawn by, sorted: this module and every module of the
     package it imports, directly or through others, at module level or inside a function (read
     from their source, with each package's __init__), and the .js and .json files in their
-    folders. An edit to another module (the command line, the reports) leaves a page's key as it
-    is."""
+    folders (regular files, not hidden, not an editor's lock). An edit to another module (the
+    command line, the reports) leaves a page's key as it is."""
     root = Path(__file__).resolve().parents[1]
     todo, seen = [Path(__file__).resolve()], set()
     while todo:
@@ -765,11 +765,15 @@ def code_files() -> list[Path]:
         if f not in seen:
             seen.add(f)
             todo += _imported(f, root)
-    return sorted(seen | {g for f in seen for g in f.parent.iterdir() if g.suffix in (".js", ".json")})
+    data = {g for f in seen for g in f.parent.iterdir()
+            if g.suffix in (".js", ".json") and g.name[0] not in ".#" and g.is_file() and not g.is_symlink()}
+    return sorted(seen | data)
 
 
-#: An import statement: `from X import names` (X relative or absolute; names in parentheses over
-#: lines) or `import names`, at any indentation; one in a docstring counts too (more, never less).
+#: An import statement at the start of a line: `from X import names` (X relative or absolute;
+#: names in parentheses over lines, with comments) or `import names`, at any indentation; one in a
+#: docstring counts too. Not seen: an import after `;` or continued by a backslash (a test checks
+#: the package's sources against Python's parser).
 _IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#;]*)|import[ \t]+([^\n#;]*))", re.M)
 
 
@@ -785,7 +789,7 @@ def _imported(f: Path, root: Path) -> list[Path]:
         for n in range(1, len(parts) + 1):
             p = root.parent.joinpath(*parts[:n])
             out.extend(g for g in (p / "__init__.py", p.with_suffix(".py")) if g.is_file())
-    names = lambda text: [a.split()[0] for a in text.strip("() \t\n").replace("\n", " ").split(",") if a.strip()]
+    names = lambda text: [a.split()[0] for a in re.sub(r"#[^\n]*", "", text).strip("() \t\n").split(",") if a.strip()]
     for m in _IMPORT.finditer(f.read_text(encoding="utf-8")):
         source, what, plain = m.groups()
         if plain is not None:
