@@ -47,7 +47,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
         earlier = Path(out) / folder / "page.html"
         before = key_of(earlier) if page else None
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
-            summary = write_report(run, tmp, folder, page=page, friction=friction, reuse=Path(out) / folder)
+            summary = write_report(run, tmp, folder, page=page, friction=friction, reuse=earlier.parent)
         notes = list(run.warnings)
         if not page and (earlier.is_file() or earlier.is_symlink()):
             try:

@@ -698,7 +698,7 @@ def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, a
 
 #: The name of the meta element that holds a page's key (`page_key`).
 KEY_META = "kinetostat-page"
-_KEY = re.compile(rb'<meta name="kinetostat-page" content="([0-9a-f]{64})">')
+_KEY = re.compile(rb'<meta name="' + KEY_META.encode() + rb'" content="([0-9a-f]{64})">')
 #: A page's last line: the SHA-256 of every byte before it (`_sealed`, `key_of`).
 _SEAL = re.compile(rb"<!-- kinetostat-page-sha256 ([0-9a-f]{64}) -->\n\Z")
 
@@ -814,7 +814,7 @@ def _feed(h, x, skip: tuple[str, ...] = (), where: str | None = None) -> None:
     if x is None or isinstance(x, (bool, int, float, complex, str)):
         h.update(f"{type(x).__name__}:{x!r};".encode())
     elif isinstance(x, np.generic):
-        _feed(h, x.item())
+        _feed(h, x.item(), where=where)
     elif isinstance(x, np.ndarray):
         h.update(f"ndarray:{x.dtype.str}:{x.shape};".encode() + np.ascontiguousarray(x).tobytes())
     elif is_dataclass(x) and not isinstance(x, type):
