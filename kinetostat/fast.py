@@ -25,8 +25,9 @@ flags the angle, below). The primitives agree with numpy's operators to rounding
 |z| and complex / complex overflow or underflow outside that range (|1e155| is inf,
 (1+1j)/(1e155+1e155j) is 0), |inf + nan j| is nan (numpy: inf), phase(inf + inf j) is nan
 (numpy: pi/4), (1+1j)/(inf+0j) is nan (numpy: 0), and cis reduces its angle exactly only to
-|th| ~ 1e6 rad. The generated module is written to a cache folder (`cache_dir`)
-under the hash of its source and compiled with numba's disk cache: compiled once per machine.
+|th| ~ 1e6 rad. The generated module is written to a cache folder (`cache_dir`) under the hash
+of its source and compiled with numba's disk cache: compiled once per machine. What of that
+folder is trusted, and how, is `kernel_cache`'s.
 
 Angles where a group's plan is ill-conditioned (cond > COND_CHECK), cannot be assembled, or
 give a non-finite peak, are flagged by the kernel and solved again by the numpy path with its
@@ -35,30 +36,26 @@ of motion) are evaluated by `applied.applied_wrenches` per chunk of CHUNK angles
 a first pass of the motion kernel (the kinematics only) wrote, and read by the full or the
 peaks kernel.
 
-May use: numpy, numba, program, groups, kinematics, kinetostatics, applied, planar, analysis (the
+May use: numpy, numba, kernel_cache (the kernels' folder), program, groups, kinematics, kinetostatics, applied, planar, analysis (the
 result and the numpy path), model and structure (for type hints).
 """
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 import inspect
 import math
 import os
 import re
-import sys
-import tempfile
 import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterator, Sequence
 
 import numpy as np
 
-from . import groups
+from . import groups, kernel_cache
 from .analysis import Analysis, _read_only, exact
 from .applied import applied_wrenches
+from .kernel_cache import CACHE_ENV, cache_dir
 from .kinematics import COND_CHECK, DIGITS_WARN, Kinematics, a_priori_error
 from .kinetostatics import Forces, friction_power, lever_moment
 from .planar import as_xy
@@ -88,8 +85,6 @@ CHUNK = 1 << 14
 BLOCK = 264
 #: Threads the kernel runs on (one per core by default).
 THREADS = os.cpu_count() or 1
-#: The environment variable naming the kernels' cache folder.
-CACHE_ENV = "KINETOSTAT_CACHE"
 
 
 def available() -> bool:
@@ -99,15 +94,6 @@ def available() -> bool:
     except ImportError:       # pragma: no cover - numba is a dependency
         return False
     return True
-
-
-def cache_dir() -> Path:
-    """The folder of the generated kernel modules and numba's cache of them: $KINETOSTAT_CACHE,
-    else $XDG_CACHE_HOME/kinetostat, else ~/.cache/kinetostat."""
-    if os.environ.get(CACHE_ENV):
-        return Path(os.environ[CACHE_ENV])
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "kinetostat"
 
 
 # ----------------------------------------------------------------------------- the compiled primitives
@@ -439,28 +425,6 @@ def _module(kernel_source: str) -> str:
         "kernel = numba.njit(nogil=True, error_model='numpy', cache=True)(kernel)", ""])
 
 
-def _load(text: str) -> Any:
-    """Import the generated module `text`, written once to the cache folder as k<hash>.py
-    (numba keeps its compiled code beside it, in __pycache__)."""
-    name = "k" + hashlib.sha256(text.encode()).hexdigest()[:20]
-    folder = cache_dir()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{name}.py"
-        if not path.exists():
-            tmp = folder / f".{name}.{os.getpid()}.{threading.get_ident()}.tmp"
-            tmp.write_text(text, encoding="utf-8")
-            os.replace(tmp, path)            # atomic: a process beside this one sees it whole or not at all
-    except OSError:                          # no writable cache: a private folder for this process
-        path = Path(tempfile.mkdtemp(prefix="kinetostat-")) / f"{name}.py"
-        path.write_text(text, encoding="utf-8")
-    spec = importlib.util.spec_from_file_location(f"kinetostat_kernel_{name}", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module          # numba's cache finds the kernel's environment by module name
-    spec.loader.exec_module(module)
-    return module
-
-
 def kernel(mech: "Mechanism", kind: str):
     """The compiled kernel of `mech`'s structure for `kind` ("full", "peaks" or "motion") and its layout:
     generated once per structure (designs enter through C; structures whose programs differ
@@ -469,7 +433,7 @@ def kernel(mech: "Mechanism", kind: str):
     src = mech.memo(("kernel source", kind), lambda: _source(mech, lay, kind))
     with _LOCK:
         if src not in _KERNELS:
-            _KERNELS[src] = _load(_module(src)).kernel
+            _KERNELS[src] = kernel_cache.load(_module(src)).kernel
         return _KERNELS[src], lay
 
 

@@ -1,0 +1,190 @@
+"""The folder of the compiled kernels, and what of it is trusted.
+
+`fast` generates each kernel as a Python module and compiles it with numba's disk cache, so
+that a later process loads the machine code instead of compiling it again. Two kinds of file
+in that folder would run as code if they were planted: the module itself, and numba's cache of
+it (`__pycache__/*.nbi`, `*.nbc`: pickles, unpickled when the kernel is first called). So:
+
+- `folder()` is the cache folder (`cache_dir`) only where this user alone can write it and every
+  folder above it (`untrusted`: owned by this user or root, writable by nobody else unless
+  sticky, as OpenSSH checks a key's path); a folder it creates is made 0700. Anywhere else,
+  one warning (`KernelCacheWarning`) and a private temporary folder of this process instead,
+  removed when the process exits.
+- `load(text)` never imports the file: it runs `text` itself, the source generated now, so
+  Python's bytecode cache (`__pycache__/*.pyc`) is never read. The file on disk, which numba
+  stamps its cache with, is compared byte for byte with `text` and rewritten where it differs
+  (missing, empty, cut short, foreign, not a regular file); numba's pickles of that module are
+  removed whenever it is. The pickles are read only from a trusted folder: where numba would
+  keep them elsewhere (NUMBA_CACHE_DIR) and that folder is not trusted, the kernel compiles
+  in memory, with one warning.
+
+What is trusted, then: numba's pickles in a folder only this user can write, beside a module
+that holds exactly the source generated now. A cache folder restored from elsewhere (a CI cache
+of an untrusted branch) is trusted as the user's own: do not restore one from a source you do
+not trust. On Windows the folders' owners and permissions are not checked.
+
+May use: the standard library, numba (its cache object), and `_io` (atomic writes).
+"""
+from __future__ import annotations
+
+import atexit
+import hashlib
+import os
+import shutil
+import stat
+import sys
+import tempfile
+import threading
+import types
+import warnings
+from pathlib import Path
+
+from ._io import write_bytes
+
+__all__ = ["CACHE_ENV", "KernelCacheWarning", "cache_dir", "folder", "untrusted", "load"]
+
+#: The environment variable naming the kernels' cache folder.
+CACHE_ENV = "KINETOSTAT_CACHE"
+
+
+class KernelCacheWarning(UserWarning):
+    """The kernels' cache folder (or numba's cache of them) cannot be trusted or used: the kernels
+    are compiled in a private temporary folder, or in memory, instead."""
+
+
+def cache_dir() -> Path:
+    """The folder of the generated kernel modules and numba's cache of them: $KINETOSTAT_CACHE,
+    else $XDG_CACHE_HOME/kinetostat, else ~/.cache/kinetostat."""
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "kinetostat"
+
+
+def untrusted(path: str | Path) -> str | None:
+    """Why the folder `path` cannot be trusted with code (its words, to follow the path in a
+    message), or None where only this user (and root) can write it and every folder above it.
+    A folder above may be writable by others where it is sticky (/tmp). None on Windows."""
+    if os.name != "posix":
+        return None
+    uid = os.geteuid()
+    real = Path(os.path.realpath(path))
+    try:
+        st = os.stat(real)
+    except OSError as exc:
+        return f"cannot be read ({exc.strerror})"
+    if not stat.S_ISDIR(st.st_mode):
+        return "is not a folder"
+    if st.st_uid != uid:
+        return f"is owned by another user (uid {st.st_uid})"
+    if st.st_mode & 0o022:
+        return f"can be written by other users (mode {stat.filemode(st.st_mode)})"
+    for above in real.parents:
+        st = os.stat(above)
+        if st.st_uid not in (0, uid):
+            return f"lies in {above}, owned by another user (uid {st.st_uid})"
+        if st.st_mode & 0o022 and not st.st_mode & stat.S_ISVTX:
+            return f"lies in {above}, which other users can write (mode {stat.filemode(st.st_mode)})"
+    return None
+
+
+_LOCK = threading.Lock()
+_SCRATCH: list[Path] = []        # this process's private temporary folder, once made
+
+
+def _scratch() -> Path:
+    """This process's private temporary folder (0700, made once), removed when it exits."""
+    if not _SCRATCH:
+        _SCRATCH.append(Path(tempfile.mkdtemp(prefix="kinetostat-kernels-")))
+        atexit.register(shutil.rmtree, _SCRATCH[0], True)
+    return _SCRATCH[0]
+
+
+def _warn(message: str) -> None:
+    warnings.warn(message, KernelCacheWarning, stacklevel=4)
+
+
+def folder() -> Path:
+    """The folder the kernel modules are written to: `cache_dir()` (made 0700 where it is new)
+    where it can be made and is trusted (`untrusted`), else this process's private temporary
+    folder, with one `KernelCacheWarning` saying why."""
+    wanted = cache_dir()
+    try:
+        wanted.parent.mkdir(parents=True, exist_ok=True)
+        wanted.mkdir(mode=0o700, exist_ok=True)
+        why = untrusted(wanted)
+    except OSError as exc:
+        why = f"cannot be made ({exc.strerror or exc})"
+    if why is None:
+        return wanted
+    with _LOCK:
+        fresh = not _SCRATCH
+        scratch = _scratch()
+    if fresh:
+        _warn(f"the kernel cache {wanted} {why}: kernels are compiled in a private temporary folder for this "
+              f"process ({scratch}); set {CACHE_ENV} to a folder only you can write to keep them")
+    return scratch
+
+
+def _read(path: Path, limit: int) -> bytes | None:
+    """At most `limit` bytes of the regular file `path` (a link is not followed, a FIFO does not
+    block), or None where it is not there or not a regular file."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+    except OSError:
+        return None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        return None
+    with os.fdopen(fd, "rb") as f:
+        return f.read(limit)
+
+
+def _rewrite(path: Path, data: bytes) -> bool:
+    """Make the file `path` hold exactly `data`; True where it had to be written."""
+    if _read(path, len(data) + 1) == data:
+        return False
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    elif os.path.lexists(path) and not stat.S_ISREG(os.lstat(path).st_mode):
+        path.unlink()                     # a link, FIFO or device: replaced by a file, never written through
+    write_bytes(path, data)
+    return True
+
+
+def _pickles(where: Path, stem: str) -> list[Path]:
+    """numba's cache files of the module `stem` in its cache folder `where`."""
+    return [p for p in where.glob(f"{stem}.*") if p.suffix in (".nbi", ".nbc")]
+
+
+def load(text: str) -> types.ModuleType:
+    """The generated module `text`, run from the file k<hash of text>.py of `folder()`, which is
+    made to hold `text` first; its `kernel`'s disk cache is numba's where that is trusted (the
+    pickles removed where the file was rewritten), else none."""
+    from numba.core.caching import NullCache
+
+    name = "k" + hashlib.sha256(text.encode()).hexdigest()[:20]
+    home = folder()
+    path = home / f"{name}.py"
+    data = text.encode("utf-8")
+    try:
+        rewritten = _rewrite(path, data)
+    except OSError as exc:                 # a folder that refuses the write: the private one
+        home = _scratch()
+        _warn(f"cannot write the kernel {path} ({exc.strerror or exc}): compiled in {home}")
+        path = home / f"{name}.py"
+        rewritten = _rewrite(path, data)
+    module = types.ModuleType(f"kinetostat_kernel_{name}")
+    module.__file__ = str(path)
+    sys.modules[module.__name__] = module          # numba's cache finds the kernel's environment by module name
+    exec(compile(text, str(path), "exec"), module.__dict__)
+    kernel = module.kernel
+    where = Path(kernel._cache.cache_path)         # where numba keeps (and would unpickle) the compiled code
+    why = untrusted(where)
+    if why is not None:
+        _warn(f"numba's cache folder {where} {why}: the kernel {name} is compiled in memory, not cached")
+        kernel._cache = NullCache()
+    elif rewritten:
+        for p in _pickles(where, name):
+            p.unlink(missing_ok=True)
+    return module

@@ -1,0 +1,194 @@
+"""Hostile kernel cache (issue 35, class 1): a module or a numba pickle planted in the kernels'
+cache folder never runs; a folder others can write is bypassed with one warning; a corrupt entry
+is rebuilt; the private fallback folder is removed on exit.
+
+The generated module here is a one-line numba function with the kernel's name and disk cache
+(`kernel_cache.load` takes any such text), so that each test compiles in a fraction of a second
+instead of the seconds a mechanism's kernel takes; `test_a_mechanism_kernel_...` runs the real one.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import pickle
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import pytest
+
+from kinetostat import kernel_cache
+from kinetostat.kernel_cache import KernelCacheWarning
+
+POSIX = pytest.mark.skipif(os.name != "posix", reason="owners and modes are POSIX")
+TEXT = "import numba\ndef kernel(x):\n    return x + 1\nkernel = numba.njit(cache=True)(kernel)\n"
+NAME = "k" + hashlib.sha256(TEXT.encode()).hexdigest()[:20]
+
+
+class _Planted:
+    """A pickle that creates the file `marker` when it is loaded (what an attacker plants)."""
+
+    def __init__(self, marker: Path):
+        self.marker = str(marker)
+
+    def __reduce__(self):
+        return (open, (self.marker, "w"))
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch) -> Path:
+    """An empty cache folder of this test (private: its parents are pytest's 0700 folder)."""
+    folder = tmp_path / "cache"
+    monkeypatch.setenv(kernel_cache.CACHE_ENV, str(folder))
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setattr(kernel_cache, "_SCRATCH", [])        # this test's own fallback folder, if any
+    return folder
+
+
+def _plant_index(folder: Path, marker: Path) -> Path:
+    """A numba cache index of NAME's kernel (numba's very file name) that runs code when read."""
+    tag = f"py{sys.version_info.major}{sys.version_info.minor}"
+    index = folder / "__pycache__" / f"{NAME}.kernel-2.{tag}.nbi"
+    index.parent.mkdir(parents=True, exist_ok=True)
+    index.write_bytes(pickle.dumps(_Planted(marker)))
+    return index
+
+
+def _load_and_call(expect_warning: bool = False):
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        module = kernel_cache.load(TEXT)
+        assert module.kernel(41) == 42
+    ours = [w for w in seen if issubclass(w.category, KernelCacheWarning)]
+    assert len(ours) == (1 if expect_warning else 0), [str(w.message) for w in ours]
+    return module, (str(ours[0].message) if ours else "")
+
+
+@POSIX
+def test_a_foreign_module_is_rewritten_and_never_run(cache, tmp_path):
+    marker = tmp_path / "ran"
+    cache.mkdir(mode=0o700)
+    (cache / f"{NAME}.py").write_text(f"open({str(marker)!r}, 'w')\nkernel = lambda x: x + 1\n")
+    module, _ = _load_and_call()
+    assert not marker.exists()
+    assert (cache / f"{NAME}.py").read_text() == TEXT
+    assert module.__file__ == str(cache / f"{NAME}.py")
+
+
+@POSIX
+def test_a_planted_bytecode_file_beside_the_right_module_is_never_run(cache, tmp_path):
+    """Python's import would run a .pyc whose header matches the module's mtime and size."""
+    marker = tmp_path / "ran"
+    cache.mkdir(mode=0o700)
+    source = cache / f"{NAME}.py"
+    source.write_text(TEXT)
+    st = source.stat()
+    code = compile(f"open({str(marker)!r}, 'w')\nkernel = lambda x: x + 1\n", str(source), "exec")
+    pyc = Path(importlib.util.cache_from_source(str(source)))
+    pyc.parent.mkdir()
+    pyc.write_bytes(importlib._bootstrap_external._code_to_timestamp_pyc(code, st.st_mtime, st.st_size))
+    _load_and_call()
+    assert not marker.exists()
+
+
+@POSIX
+def test_a_planted_numba_pickle_beside_a_foreign_module_is_removed_unread(cache, tmp_path):
+    marker = tmp_path / "ran"
+    cache.mkdir(mode=0o700)
+    (cache / f"{NAME}.py").write_text(TEXT + "# foreign\n")
+    index = _plant_index(cache, marker)
+    module, _ = _load_and_call()
+    assert module.kernel._cache._cache_file._index_path == str(index)      # the file numba reads
+    assert not marker.exists()
+
+
+@POSIX
+@pytest.mark.parametrize("where", ["folder", "pycache"])
+def test_a_folder_others_can_write_is_bypassed_with_one_warning(cache, tmp_path, where):
+    """A world-writable cache folder (or numba's __pycache__ in it): the planted pickle stays
+    unread, and the kernel is compiled in the private folder or in memory."""
+    marker = tmp_path / "ran"
+    cache.mkdir()
+    (cache / f"{NAME}.py").write_text(TEXT)
+    index = _plant_index(cache, marker)
+    os.chmod(cache if where == "folder" else index.parent, 0o777)
+    module, message = _load_and_call(expect_warning=True)
+    assert "can be written by other users" in message and "\n" not in message
+    assert not marker.exists()
+    if where == "folder":
+        assert Path(module.__file__).parent == kernel_cache._SCRATCH[0]
+    else:
+        assert "compiled in memory" in message
+
+
+@POSIX
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="chown needs root")
+def test_a_folder_owned_by_another_user_is_bypassed(cache, tmp_path):
+    marker = tmp_path / "ran"
+    cache.mkdir(mode=0o700)
+    (cache / f"{NAME}.py").write_text(f"open({str(marker)!r}, 'w')\n")
+    os.chown(cache, 65534, 65534)
+    _, message = _load_and_call(expect_warning=True)
+    assert "owned by another user (uid 65534)" in message and not marker.exists()
+
+
+@POSIX
+def test_the_folder_is_made_private(cache):
+    _load_and_call()
+    assert cache.stat().st_mode & 0o777 == 0o700
+
+
+@pytest.mark.parametrize("entry", ["empty", "cut short", "a folder", "a FIFO"])
+def test_a_corrupt_entry_is_rebuilt(cache, entry):
+    cache.mkdir(mode=0o700)
+    path = cache / f"{NAME}.py"
+    if entry == "empty":
+        path.write_text("")
+    elif entry == "cut short":
+        path.write_text(TEXT[:30])
+    elif entry == "a folder":
+        path.mkdir()
+    elif hasattr(os, "mkfifo"):
+        os.mkfifo(path)
+    else:
+        pytest.skip("no FIFOs here")
+    _load_and_call()
+    assert path.is_file() and path.read_text() == TEXT
+
+
+@POSIX
+def test_the_private_fallback_folder_is_removed_on_exit(tmp_path):
+    """A cache path that cannot be a folder: one warning line, and no kinetostat-* folder left."""
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("")
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = dict(os.environ, KINETOSTAT_CACHE=str(blocker), TMPDIR=str(scratch))
+    script = ("from kinetostat import kernel_cache; m = kernel_cache.load(" + repr(TEXT) + "); "
+              "assert m.kernel(1) == 2; import os; print(os.listdir(" + repr(str(scratch)) + "))")
+    p = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert "kinetostat-kernels-" in p.stdout                      # it was used while the process ran
+    assert list(scratch.iterdir()) == []                          # and is gone after it
+    lines = [ln for ln in p.stderr.splitlines() if "KernelCacheWarning" in ln]
+    assert len(lines) == 1 and "cannot be made" in lines[0], p.stderr
+
+
+@POSIX
+def test_a_mechanism_kernel_comes_from_a_planted_folder_unharmed(cache, tmp_path, monkeypatch):
+    """The real path: `fast.kernel` of a bundled model with its module planted (a foreign file
+    under its very name): the planted code never runs and the kernel's module is the generated one."""
+    import kinetostat
+    from kinetostat import fast
+    monkeypatch.setattr(fast, "_KERNELS", {})
+    m = kinetostat.load("chain_unit_four_bar")
+    text = fast._module(fast._source(m, fast._layout(m), "full"))
+    name = "k" + hashlib.sha256(text.encode()).hexdigest()[:20]
+    marker = tmp_path / "ran"
+    cache.mkdir(mode=0o700)
+    (cache / f"{name}.py").write_text(f"open({str(marker)!r}, 'w')\nkernel = None\n")
+    fn, _ = fast.kernel(m, "full")
+    assert fn is not None and not marker.exists()
+    assert (cache / f"{name}.py").read_text() == text
