@@ -485,19 +485,6 @@ def test_a_pages_key_covers_the_modules_it_imports():
     assert not [n for n in names if n.startswith(("cli/", "report/"))]
 
 
-def test_the_committed_reports_hold_current_pages():
-    """Each bundled model's committed report holds its page, drawn by this code from this model
-    (its key, `page_key`), so that the main job in a checkout draws none. After a change to the
-    code a page is drawn by (`code_files`) or to a model: run `kinetostat report`, commit reports/."""
-    import kinetostat.plans.page as pg
-    stale = []
-    for path in MODELS:
-        page = ROOT / "reports" / path.stem / "page.html"
-        if pg.key_of(page) != pg.page_key(kinetostat.load(path)):
-            stale.append(path.stem)
-    assert not stale, f"reports/<model>/page.html missing or stale for {stale}: run `kinetostat report` and commit reports/"
-
-
 def test_variant_all_writes_a_page_per_code_linked_from_its_index(tmp_path, monkeypatch, cli):
     """`kinetostat variant 1 --all --page` (one code here): each code's folder holds its page, in
     the key's language with the check at phi1, and both indexes link it. (Two angles: quick.)"""
