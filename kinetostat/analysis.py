@@ -21,7 +21,7 @@ from . import friction as _friction, groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, dot_z
 from .friction import relative_rate
-from .errors import SelfLockingWarning, SingularPositionWarning, self_locking_message
+from .errors import SelfLockingWarning, SingularPositionWarning, UndefinedFigureWarning, self_locking_message
 from .model import Mechanism, _abbreviate
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "deviation",
@@ -289,8 +289,11 @@ class Analysis:
     def friction_energy(self) -> np.ndarray:
         """(n_pairs,) energy lost in each pair over one revolution, J: the integral of its power
         over the crank angle (`_cycle_integral`). Needs the angles of a uniform full cycle, as
-        `analyze(mech, steps=N)` gives."""
-        return self._cycle_integral(lambda r: r._friction_power(r._unit_motion()), "friction_energy")
+        `analyze(mech, steps=N)` gives. NaN, with an UndefinedFigureWarning, where some angle of the
+        integral has no equilibrium with friction."""
+        E = self._cycle_integral(lambda r: r._friction_power(r._unit_motion()), "friction_energy")
+        self._warn_undefined("friction_energy", self._unsolved_in_cycle())
+        return E
 
     def _friction_power(self, kin: Kinematics) -> np.ndarray:
         """(N, n_pairs) power lost in each pair at the motion `kin` (the same angles), W: from the
@@ -410,12 +413,49 @@ class Analysis:
         """Efficiency over one revolution, 1: the same rule as `efficiency` over the works of the
         balancing moment without (W0) and with (Wf) friction: W0 / Wf where the drive does work
         on the loads over the cycle (W0 > 0), Wf / W0 where the loads drive it (an engine).
-        Needs a uniform full cycle of angles (NaN if any angle has no equilibrium)."""
+        Needs a uniform full cycle of angles. NaN, with an UndefinedFigureWarning saying why
+        (`cycle_efficiency_reason`), where the loads do no net work over the cycle (|W0| at
+        rounding level, `friction.cycle_efficiency`) or some angle has no equilibrium."""
+        eta, why = self._cycle_efficiency
+        self._warn_undefined("cycle_efficiency", why)
+        return eta
+
+    def cycle_efficiency_reason(self) -> str:
+        """Why `cycle_efficiency` is NaN ("" where it is a number), without a warning."""
+        return self._cycle_efficiency[1]
+
+    @cached_property
+    def _cycle_efficiency(self) -> tuple[float, str]:
+        """The cycle efficiency and why it is undefined ("" where it is not)."""
         def drive(r: Analysis) -> np.ndarray:
             w1 = r._unit_motion().omega[:, 1]
-            return np.stack([r.balancing_moment_frictionless * w1, r.balancing_moment_with_friction * w1], -1)
-        W0, Wf = self._cycle_integral(drive, "cycle_efficiency")
-        return float(W0 / Wf if W0 > 0 else Wf / W0)
+            P0 = r.balancing_moment_frictionless * w1
+            return np.stack([P0, r.balancing_moment_with_friction * w1, np.abs(P0)], -1)
+        W0, Wf, scale = self._cycle_integral(drive, "cycle_efficiency")
+        eta = _friction.cycle_efficiency(W0, Wf, scale)
+        why = self._unsolved_in_cycle()
+        if not why and not np.isfinite(W0 + Wf + scale):
+            why = "the drive's work over the cycle is not finite (NaN at singular positions)"
+        elif not why and np.isnan(eta):
+            why = (f"the loads do no net work over the cycle (the frictionless drive's work {W0:.3g} J is rounding "
+                   f"of the {scale:.3g} J it moves to and fro)")
+        return eta, why
+
+    @staticmethod
+    def _warn_undefined(who: str, why: str) -> None:
+        """An UndefinedFigureWarning: `who` is NaN because `why` (nothing where `why` is "")."""
+        if why:
+            warnings.warn(UndefinedFigureWarning(f"{who}: undefined (NaN): {why}", why), stacklevel=3)
+
+    def _unsolved_in_cycle(self) -> str:
+        """"" where every angle of the cycle integrals (`_cycle_nodes`) has an equilibrium, else
+        how many have none, and where."""
+        at = self._cycle_nodes[0]
+        if at.friction is None or at.friction.solved.all():
+            return ""
+        phi = np.mod(at.phi_deg[~at.friction.solved], 360.0)
+        return (f"no equilibrium with friction at {len(phi)} of the cycle's {len(at.phi_deg)} integration angles "
+                f"(phi = {phi.min():.6g} .. {phi.max():.6g} deg; self-locking)")
 
     def _unit_motion(self) -> Kinematics:
         """The motion at the same angles at unit crank speed (d phi/dt = 1 rad/s): its velocities
@@ -438,9 +478,19 @@ class Analysis:
         phi = self.phi_deg
         if not np.allclose(phi, phi[0] + np.arange(len(phi)) * 360.0 / len(phi), rtol=0, atol=1e-9):
             raise ValueError(f"{who}: needs the angles of a uniform full cycle (analyze with steps=N)")
+        at, weights = self._cycle_nodes
+        if weights is None:
+            return integrand(self).mean(axis=0) * 2 * np.pi
+        return np.tensordot(weights, integrand(at), axes=(0, 0))
+
+    @cached_property
+    def _cycle_nodes(self) -> tuple["Analysis", np.ndarray | None]:
+        """The result at the angles of the cycle integrals and their weights, rad (`_cycle_integral`):
+        this result and None (the periodic trapezoid rule), or the Gauss-Legendre nodes between
+        the `_breakpoints` solved again by the same method."""
         edges = self._breakpoints if self.mech.friction is not None else np.empty(0)
         if not len(edges):
-            return integrand(self).mean(axis=0) * 2 * np.pi
+            return self, None
         x, w = np.polynomial.legendre.leggauss(CYCLE_NODES)
         lo, hi = edges, np.append(edges[1:], edges[0] + 360.0)
         nodes = (0.5 * (lo + hi)[:, None] + 0.5 * (hi - lo)[:, None] * x).ravel()
@@ -449,8 +499,7 @@ class Analysis:
             warnings.simplefilter("ignore", SelfLockingWarning)
             warnings.simplefilter("ignore", SingularPositionWarning)
             at = exact(self.mech, nodes, "reactions" if self.friction is not None else "first")
-        values = integrand(at)
-        return np.tensordot(weights, values, axes=(0, 0))
+        return at, weights
 
     @cached_property
     def _breakpoints(self) -> np.ndarray:
@@ -495,7 +544,9 @@ class Analysis:
         """Work of each load over one revolution, J (positive: the load drives the mechanism): the
         integral over the crank angle of its power per unit crank speed, F . dv/dphi + M
         d omega/dphi (the same as the time integral of F . v + M omega where the crank turns, and
-        defined at standstill, as the texts' J per revolution). Needs a uniform full cycle of angles.
+        defined at standstill, as the texts' J per revolution). Needs a uniform full cycle of angles;
+        with friction in the reactions, NaN entries and an UndefinedFigureWarning where some angle of
+        the integral has no equilibrium.
 
         Keys: "gravity k" and "inertia k" per link with mass or inertia (inertia: F_i = -m a_S at
         S and M_i = -I_S eps; -(change of kinetic energy), 0 over a steady cycle); "load NAME"
@@ -508,6 +559,7 @@ class Analysis:
         supply on top (seed 003)."""
         names = list(self._work_per_radian())
         W = self._cycle_integral(lambda r: np.stack(list(r._work_per_radian().values()), axis=-1), "work")
+        self._warn_undefined("work", self._unsolved_in_cycle())
         return MappingProxyType(dict(zip(names, W.tolist())))
 
     def _work_per_radian(self) -> dict[str, np.ndarray]:

@@ -12,7 +12,7 @@ import numpy as np
 from ._text import one_line
 
 __all__ = ["ModelError", "ModelFileNotFound", "ModelWarning", "AssemblyError", "StructureError",
-           "SingularPositionWarning"]
+           "SingularPositionWarning", "UndefinedFigureWarning"]
 
 
 class ModelError(ValueError):
@@ -102,7 +102,7 @@ def singular_message(group: str, phi_deg: np.ndarray, cond: np.ndarray, digits: 
 class SelfLockingWarning(UserWarning):
     """With friction in the reactions, the self-locking crank angles, each with its reason
     (`Analysis.self_locking_reason`): "no equilibrium" (neither the friction passes nor Newton's
-    method find one: M_bal and the forces NaN), "wedged" (a pair's friction gain >= 1: an
+    method find one: M_bal, the forces and the friction power NaN), "wedged" (a pair's friction gain >= 1: an
     equilibrium exists but is not the only one; M_bal is the one reached from the frictionless
     solution, eta NaN) or "eta<=0" (the loads cannot drive the crank through friction: M_bal is
     the equilibrium value, the drive must help). `phi_deg` lists the angles, `reasons` the
@@ -116,7 +116,7 @@ class SelfLockingWarning(UserWarning):
 
 #: What M_bal means at a self-locking angle of each reason (`SelfLockingWarning`).
 SELF_LOCKING_MEANING = {
-    "no equilibrium": "no finite drive moves the mechanism: M_bal and the reactions NaN",
+    "no equilibrium": "no finite drive moves the mechanism: M_bal, the reactions and the friction power NaN",
     "wedged": "a pair's friction gain >= 1, the equilibrium not unique: M_bal is the one reached from the "
               "frictionless solution, eta NaN",
     "eta<=0": "the loads cannot drive the crank through friction: M_bal is the equilibrium, the drive helps",
@@ -129,3 +129,13 @@ def self_locking_message(phi_deg: np.ndarray, reasons) -> str:
     parts = [f"{key} at phi = {_angle_list(np.round(np.asarray(phi_deg)[reasons == key], 9))} ({why})"
              for key, why in SELF_LOCKING_MEANING.items() if (reasons == key).any()]
     return f"self-locking with friction in the reactions at {len(reasons)} angle(s): " + "; ".join(parts)
+
+
+class UndefinedFigureWarning(UserWarning):
+    """A figure over the cycle with friction (`cycle_efficiency`, `friction_energy`, `work`) is
+    undefined and returned as NaN; `reason` says why (the loads do no net work over the cycle, or
+    no equilibrium with friction at some of its angles)."""
+
+    def __init__(self, message: str, reason: str = ""):
+        super().__init__(message)
+        self.reason = reason

@@ -46,8 +46,8 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Mechanism
 
-__all__ = ["FrictionSolution", "solve", "power", "relative_rate", "motion_sense", "efficiency", "METHODS", "RATE_TOL", "MAX_PASSES",
-           "DEAD_CENTRE"]
+__all__ = ["FrictionSolution", "solve", "power", "relative_rate", "motion_sense", "efficiency", "cycle_efficiency",
+           "METHODS", "RATE_TOL", "MAX_PASSES", "DEAD_CENTRE", "NO_NET_WORK"]
 
 #: analyze(friction=...): seed 003's first approximation, or friction in the reactions.
 METHODS = ("first", "reactions")
@@ -59,6 +59,13 @@ MAX_PASSES = 60
 NEWTON_STEPS = 40
 #: eta is undefined (NaN) near a dead centre: where |M0| <= DEAD_CENTRE x |Mf - M0| (`Analysis.efficiency`).
 DEAD_CENTRE = 0.1
+#: The cycle efficiency is undefined (NaN) where the frictionless drive's work over the cycle is at
+#: rounding level: |W0| <= NO_NET_WORK x the integral of |M0 omega_1| over the cycle (`cycle_efficiency`).
+#: The loads then do no net work (gravity and inertia only, over a steady cycle): W0 is the rounding
+#: left of terms that cancel, found at 2e-17 .. 6e-16 of that integral (a few eps) on the bundled
+#: four-bar and triads; 1e-12 leaves room for the digits a solve near a toggle loses, and the
+#: smallest real net work of a bundled machine is 0.19 of it (the ICE).
+NO_NET_WORK = 1e-12
 #: Power-iteration steps for a stage's friction gain (`_gain`).
 GAIN_STEPS = 40
 #: Converged: the largest change of a stage's reactions in one pass below this x its largest reaction.
@@ -79,7 +86,8 @@ class FrictionSolution:
     passes: np.ndarray    # (N, n_groups + 1) int: fixed-point passes of each stage (groups in the
                           #   order solved, then the initial link); above MAX_PASSES: MAX_PASSES +
                           #   the Newton steps that found the equilibrium; 0 where singular or unsolved
-    solved: np.ndarray    # (N,) bool: an equilibrium found at every stage (False: NaN forces)
+    solved: np.ndarray    # (N,) bool: an equilibrium found at every stage (False: NaN forces, friction
+                          #   loads and so friction power)
     wedged: np.ndarray    # (N,) bool: at some stage a pair wedges: with no other load, the friction
                           #   loads call for reactions whose friction is at least as large (`_gain`
                           #   >= 1): self-locking; the equilibrium found there need not be the only one
@@ -226,6 +234,8 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
             solved &= ~failed
             for k in names:
                 env[k] = np.where(failed, np.nan, env[k])
+    load[~solved] = np.nan                   # no equilibrium: no friction load (not the last pass's)
+    F_fr[~solved], M_fr[~solved] = np.nan, np.nan
     frc = packed(mech, env, N)
     for p in mech.pairs:                     # a guide's reaction leans: its friction force joins the normal one
         if p.kind == "P":
@@ -258,7 +268,8 @@ def _newton(apply, friction, q: np.ndarray, todo: np.ndarray) -> tuple[np.ndarra
     H(q) = friction(apply(q)) - q, its Jacobian by forward differences (n + 1 stage runs a step,
     over all angles at once; the other angles keep their q). Returns the loads, the reactions
     apply gives with them, and the steps each angle took (0: no root found: H not below
-    PASS_TOL of the loads within NEWTON_STEPS)."""
+    PASS_TOL of the loads within NEWTON_STEPS, or the Jacobian singular to rounding, as where two
+    pairs' friction loads enter the stage only as their sum: no root, or no unique one)."""
     N, n = q.shape
     steps = np.zeros(N, int)
     for k in range(1, NEWTON_STEPS + 1):
@@ -276,6 +287,8 @@ def _newton(apply, friction, q: np.ndarray, todo: np.ndarray) -> tuple[np.ndarra
             dq = q.copy()
             dq[:, c] += h
             J[:, :, c] = (friction(apply(dq)) - dq - H) / h[:, None]
+        finite = np.isfinite(J).all(axis=(1, 2))
+        todo = todo & ~(finite & (np.linalg.matrix_rank(np.where((todo & finite)[:, None, None], J, np.eye(n))) < n))
         with np.errstate(all="ignore"):
             step = np.linalg.solve(np.where(todo[:, None, None], J, np.eye(n)), np.where(todo[:, None], -H, 0.0)[..., None])
         q = np.where(todo[:, None], q + step[..., 0], q)
@@ -299,3 +312,13 @@ def efficiency(M0: np.ndarray, Mf: np.ndarray, turn: np.ndarray, tol: np.ndarray
     with np.errstate(divide="ignore", invalid="ignore"):
         eta = np.where(M0 * turn >= 0, M0 / Mf, Mf / M0) + 0.0      # + 0.0: no -0
     return np.where((np.abs(M0) <= tol) & (np.abs(Mf) <= tol), np.nan, eta)
+
+
+def cycle_efficiency(W0: float, Wf: float, scale: float) -> float:
+    """Efficiency over one revolution, 1, from the works of the balancing moment without (W0)
+    and with (Wf) friction, J, by the rule of `efficiency`: W0 / Wf where W0 > 0, Wf / W0 where
+    the loads drive the crank. NaN where |W0| <= NO_NET_WORK x `scale` (the integral of |M0
+    omega_1| over the cycle, J): the loads do no net work, W0 is rounding."""
+    if not abs(W0) > NO_NET_WORK * scale:
+        return float("nan")
+    return float(W0 / Wf if W0 > 0 else Wf / W0)

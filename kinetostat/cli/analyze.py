@@ -74,8 +74,8 @@ def _summary(res, path: Path) -> list[str]:
 def _friction_lines(res) -> list[str]:
     """The summary's friction lines: the method, the self-locking angles by reason (on a uniform
     full cycle the zones, edges to 1e-9 deg), eta elsewhere; with friction in the reactions the
-    frictionless and frictional peak M_bal, the passes, the friction power per pair and the
-    cycle efficiency (on a uniform full cycle)."""
+    frictionless and frictional peak M_bal, the passes, the friction power per pair (where an
+    equilibrium exists) and the cycle efficiency (on a uniform full cycle), or why it is undefined."""
     import warnings
 
     import numpy as np
@@ -109,7 +109,8 @@ def _friction_lines(res) -> list[str]:
     lines.append("  peak friction power: " + ", ".join(
         f"{q.label} {_fmt(float(np.nanmax(P[:, q.index])), 'W')}" for q in m.pairs if np.isfinite(P[:, q.index]).any()))
     if cycle:
-        lines.append(f"  cycle efficiency: {res.cycle_efficiency():.6g}")
+        why = res.cycle_efficiency_reason()
+        lines.append(f"  cycle efficiency: undefined: {why}" if why else f"  cycle efficiency: {res.cycle_efficiency():.6g}")
     return lines
 
 

@@ -10,7 +10,7 @@ import math
 from types import MappingProxyType
 from typing import Iterator, Mapping
 
-from .limits import FASTEST_PIN, FORCE_SCALE, GYRATION_SPANS, LARGEST_LINK
+from .limits import FASTEST_PIN, FORCE_SCALE, FRICTION_F, GYRATION_SPANS, JOURNAL_SPANS, LARGEST_LINK
 from .mechanism import Mechanism, extent
 from .parts import Friction, Link, Pair, Vec
 
@@ -100,6 +100,7 @@ def doubts(mech: Mechanism, group_tables: Mapping[frozenset, tuple[int, tuple]],
                 f"the diagram's largest force is {peak:.4g} N, below {FORCE_SCALE:g} of the mechanism's weights "
                 f"and inertia forces ({scale / FORCE_SCALE:.4g} N): is a pressure in MPa multiplied by an area "
                 f"in m^2? (scale in N per table unit: 1 MPa = 1e6 Pa)")
+    yield from friction_doubts(mech)
     for g in mech.structure.groups:
         n, listed = group_tables.get(frozenset(g.links), (None, ()))
         if g.kind == "RRR" and n is not None and listed[0] > listed[1]:
@@ -120,6 +121,25 @@ def doubts(mech: Mechanism, group_tables: Mapping[frozenset, tuple[int, tuple]],
                 f"{abs(slider.points[off[0]][1] - y0):.4g} m off the guide line in it; if the points were "
                 f"drawn in another frame (e.g. the world's), give slider_axis = the guide direction in "
                 f"that frame (slider_axis = [1.0, 0.0] confirms the default)")
+
+
+def friction_doubts(mech: Mechanism) -> Iterator[tuple[str, str]]:
+    """(field path, message) for friction figures far out of the usual: f above FRICTION_F, a
+    journal radius in use (a revolute pair's own, or the default) above JOURNAL_SPANS x the
+    largest link."""
+    fr = mech.friction
+    if fr is None:
+        return
+    if fr.f > FRICTION_F:
+        yield "friction.f", (f"{fr.f:g} is a friction angle of {math.degrees(math.atan(fr.f)):.3g} deg (warned above "
+                             f"{FRICTION_F:g}; metal pairs take 0.01 .. 0.3): is it a percentage or an angle?")
+    limit = JOURNAL_SPANS * mech.size
+    used = {("friction.radius" if p.radius is None else f"pair[{p.index}].radius"): (fr.radius if p.radius is None else p.radius)
+            for p in mech.pairs if p.kind == "R"}
+    for path, r in used.items():
+        if r is not None and r > limit:
+            yield path, (f"a journal radius of {r:.4g} m is more than {JOURNAL_SPANS:g} of the largest link "
+                         f"({mech.size:.4g} m): is it in metres? (f r = {fr.f * r:.4g} m is the friction circle)")
 
 
 def turned_slider(link: Link, axis: Vec) -> Link:

@@ -38,6 +38,11 @@ LARGEST_LINK, FASTEST_PIN = 20.0, 340.0
 #: force diagram whose largest force is below this fraction of the mechanism's weights and
 #: inertia forces (a pressure in MPa times an area in m^2?).
 GYRATION_SPANS, FORCE_SCALE = 100.0, 1e-4
+#: Warned: a reduced friction coefficient above FRICTION_F (a friction angle above 45 deg: dry metal
+#: pairs take 0.1 .. 0.3, lubricated ones 0.01 .. 0.1; a percentage or an angle typed as f exceeds
+#: it), and a journal radius above JOURNAL_SPANS of the largest link (a journal wider than the
+#: linkage: a radius in millimetres, or a diameter of the wrong unit).
+FRICTION_F, JOURNAL_SPANS = 1.0, 0.5
 
 #: Most parameters of one file, and most values one parameter takes in a study.
 MAX_PARAMETERS, MAX_STUDY_VALUES = 1000, 50

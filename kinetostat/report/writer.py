@@ -418,7 +418,9 @@ def _friction_section(doc: Doc, m: Mechanism, res) -> None:
             [f"η at φ = {phi0:g}°, 1", "1", _fmt(first.efficiency[0]), _fmt(at.efficiency[0])]]
     try:
         lost0, lost = res.friction_energy(), ex.friction_energy()
-        rows.append(["cycle efficiency, 1", "1", _fmt(res.cycle_efficiency()), _fmt(ex.cycle_efficiency())])
+        rows.append(["cycle efficiency, 1", "1"] + [esc(f"undefined: {r.cycle_efficiency_reason()}")
+                                                     if r.cycle_efficiency_reason() else _fmt(r.cycle_efficiency())
+                                                     for r in (res, ex)])
         rows += [[f"energy lost in {esc(_pair_name(m, p))} per cycle, J", "0", _fmt(lost0[p.index]), _fmt(lost[p.index])]
                  for p in m.pairs]
     except ValueError:                  # not a uniform full cycle: no cycle integrals
