@@ -16,11 +16,11 @@ drive or point of the quantity, and the line of the route's tolerance), then a v
 a small table, under a header "<model> <route> <quantity>". Each
 item's JUnit <properties>: error, measure, tolerance, max_abs, unit, phi_deg, trust, route, file,
 line. Under GitHub Actions: `::error file=...,line=...` commands and a Markdown summary in
-$GITHUB_STEP_SUMMARY. Text from a model file (a published value's source, a symbol) reaches
-the terminal on one line (`kinetostat._text.one_line`: a newline shown as "\\n", so that no line
-of it is read as a workflow command), the commands and the summary through their own escaping
-(`kinetostat.report.ci`). The fixture `kinetostat_regression` is `kinetostat.testing.check_cycle`
-with the model and expected files taken from the test file's folder (`--kinetostat-regen`
+$GITHUB_STEP_SUMMARY. Text from a model file (a published value's source) reaches each of these
+through its channel's escaping (`kinetostat.report.ci`): a failure's lines `one_line` (a newline
+shown as "\\n", so that no line of it is read as a workflow command), the commands and the
+summary's cells escaped as GitHub and Markdown need. The fixture `kinetostat_regression` is
+`kinetostat.testing.check_cycle` with the model and expected files taken from the test file's folder (`--kinetostat-regen`
 rewrites the expected file).
 
 It lives in the harness so that pytest's start-up imports only this module (no numpy, no
@@ -199,18 +199,16 @@ class CheckItem(pytest.Item):
         return p.relative_to(self.config.rootpath).as_posix() if p.is_relative_to(self.config.rootpath) else str(p)
 
     def runtest(self) -> None:
-        from kinetostat._text import one_line
         from kinetostat.report.ci import failure_text, tolerance_where
 
         run = self.model.run(self.route)
         if self.route in run.errors:
-            raise CheckFailed(one_line(f"{self.where}: route {self.route} raised on {run.stem}: "
-                                       f"{run.errors[self.route]}"))
+            raise CheckFailed(f"{self.where}: route {self.route} raised on {run.stem}: {run.errors[self.route]}")
         if self.route in run.skipped:
-            pytest.skip(one_line(f"route {self.route}: {run.skipped[self.route]}"))
+            pytest.skip(f"route {self.route}: {run.skipped[self.route]}")
         c = next((c for c in run.checks if c.route == self.route and c.quantity == self.quantity), None)
         if c is None:
-            raise CheckFailed(one_line(f"{self.where}: route {self.route} returned no row for {self.quantity}"))
+            raise CheckFailed(f"{self.where}: route {self.route} returned no row for {self.quantity}")
         self.user_properties += [("check", c.name), ("error", c.error), ("measure", c.measure),
                                  ("tolerance", c.tolerance), ("max_abs", c.max_abs), ("unit", c.unit),
                                  ("phi_deg", c.phi_deg), ("passed", c.passed), ("detail", c.detail)]
@@ -226,9 +224,8 @@ class CheckItem(pytest.Item):
         return super().repr_failure(excinfo, style)
 
     def reportinfo(self):
-        from kinetostat._text import one_line
         return self.path, (self.where.line - 1 if self.where.line else None), \
-            one_line(f"{self.path.stem} {self.route} {self.quantity}")
+            f"{self.path.stem} {self.route} {self.quantity}"
 
 
 class _Gate:
