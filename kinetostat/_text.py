@@ -1,5 +1,7 @@
-"""Text from a model file (names, notes, expressions) made safe for each place it is written:
-XML (MJCF, URDF, SVG, JUnit), CSV cells opened by spreadsheets, Markdown, and the terminal.
+"""Text from a model file (names, notes, expressions) made safe for each place it is written, one
+function per place: XML (MJCF, URDF, SVG, JUnit), CSV cells opened by spreadsheets, Markdown (also
+GitHub's step summary), GitHub Actions' workflow commands, JSON inside an HTML <script> element,
+and the terminal.
 
 May use: the standard library only.
 """
@@ -7,10 +9,12 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+import json
 from typing import Any
 from xml.sax.saxutils import escape
 
-__all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "visible", "one_line"]
+__all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "workflow_command_text",
+           "script_json", "visible", "one_line"]
 
 #: Characters XML 1.0 cannot hold, even as a character reference.
 _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
@@ -71,6 +75,28 @@ def markdown_text(s: str) -> str:
     controls visible, one line."""
     s = _MARKDOWN.sub(r"\\\1", one_line(s))
     return s.replace("&", "&amp;").replace("<", "&lt;")
+
+
+def workflow_command_text(s: str, prop: bool = False) -> str:
+    """`s` as the message (or, `prop`, a property's value: file, title) of a GitHub Actions
+    workflow command `::error file=...,title=...::message`, by the runner's rules: % CR LF as
+    %25 %0D %0A, and in a property : and , as %3A %2C; other controls visible ("\\x1b"). No
+    newline is left to start a line of its own, which the runner would read as a command."""
+    s = visible(s.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A"))
+    return s.replace(":", "%3A").replace(",", "%2C") if prop else s
+
+
+#: What JSON may hold that ends or changes an HTML <script> element (`</script>`, `<!--`, `]]>`)
+#: or a JavaScript line (U+2028, U+2029), each written as its \\u escape.
+_SCRIPT_UNSAFE = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+
+
+def script_json(x: Any) -> str:
+    """`x` as JSON that an HTML <script> element (a page's data block) holds whole: < > & and
+    U+2028/U+2029 as \\u escapes, so that no text in it (`</script>`, `<!--<script>`) ends the
+    element or swallows the next one; JSON.parse gives back the same text."""
+    s = json.dumps(x, ensure_ascii=False)
+    return s.translate(str.maketrans(_SCRIPT_UNSAFE))
 
 
 def visible(s: str) -> str:

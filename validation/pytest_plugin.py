@@ -16,8 +16,11 @@ drive or point of the quantity, and the line of the route's tolerance), then a v
 a small table, under a header "<model> <route> <quantity>". Each
 item's JUnit <properties>: error, measure, tolerance, max_abs, unit, phi_deg, trust, route, file,
 line. Under GitHub Actions: `::error file=...,line=...` commands and a Markdown summary in
-$GITHUB_STEP_SUMMARY. The fixture `kinetostat_regression` is `kinetostat.testing.check_cycle`
-with the model and expected files taken from the test file's folder (`--kinetostat-regen`
+$GITHUB_STEP_SUMMARY. Text from a model file (a published value's source) reaches each of these
+through its channel's escaping (`kinetostat.report.ci`): a failure's lines `one_line` (a newline
+shown as "\\n", so that no line of it is read as a workflow command), the commands and the
+summary's cells escaped as GitHub and Markdown need. The fixture `kinetostat_regression` is
+`kinetostat.testing.check_cycle` with the model and expected files taken from the test file's folder (`--kinetostat-regen`
 rewrites the expected file).
 
 It lives in the harness so that pytest's start-up imports only this module (no numpy, no

@@ -33,6 +33,17 @@ _WANTED = {"number": "a number", "integer": "an integer", "link": "a link id", "
            "vector": "[x, y]", "direction": "a direction [x, y]", "map": "a table"}
 
 
+#: Control characters (C0, DEL, C1), which no name holds: a name is one line of text.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
+
+
+def _control(name: str) -> str:
+    """The first control character of `name` as the reader names it ("U+001B at character 3"),
+    or "" where it has none."""
+    m = _CONTROL.search(name)
+    return "" if m is None else f"U+{ord(m[0]):04X} at character {m.start() + 1}"
+
+
 def _in_range(f: Field, x: Any) -> bool:
     """Is `x` (a number, or a string's length and characters) within the field's range and choices?"""
     if isinstance(x, str):
@@ -240,6 +251,10 @@ class ReaderCore:
         if f.max_length is not None and len(x) > f.max_length and not f.rule:
             self.err(f"{path}: {len(x)} characters, at most {f.max_length} (it labels plots and plans)")
             return None
+        if f.one_line and _control(x):
+            self.err(f"{path}: {x!r:.{MAX_SHOWN}} holds the control character {_control(x)}: a name is one "
+                     f"line of text")
+            return None
         if not _in_range(f, x):
             self.out_of_range(f, path, repr(x))
             return None
@@ -386,6 +401,11 @@ class ReaderCore:
             if len(name) > MAX_NAME:
                 self.err(f"{where}: a point name of {len(name)} characters ({name[:20]!r}...), at most {MAX_NAME} "
                          f"(it labels plots and plans)")
+                self.points_unread.add((lid, name))
+                continue
+            if f.one_line and _control(name):
+                self.err(f"{where}: the point name {name!r:.{MAX_SHOWN}} holds the control character "
+                         f"{_control(name)}: a name is one line of text")
                 self.points_unread.add((lid, name))
                 continue
             v = self.vec(xy, f"{where}.{name}")

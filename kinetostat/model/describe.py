@@ -211,8 +211,10 @@ def _bounds(f: Field) -> str:
     if low or high:
         return ", ".join(b for b in (low, high) if b)
     if f.max_length is not None:
-        return f"at most {f.max_length}" + (" characters" if f.type == "string" else "")
-    return ""
+        return f"at most {f.max_length}" + (" characters" if f.type == "string" else "") + (
+            "" if not f.one_line else ", no control characters" if f.type == "string" else
+            ", names without control characters")
+    return "no control characters" if f.one_line else ""
 
 
 def format_md(text: str) -> str:

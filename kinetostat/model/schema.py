@@ -46,6 +46,7 @@ class Field:
     exclusive_maximum: float | None = None   # value < exclusive_maximum (as minimum)
     min_length: int = 0               # strings: fewest characters; tables: fewest tables
     printable: bool = False           # strings (a map's too): printable characters only
+    one_line: bool = False            # strings, the names of points: a name, no control character (C0, DEL, C1)
     increasing: bool = False          # series: strictly increasing
     rule: str = ""                    # the message when out of range or choices (links: the same id twice), "{minimum}"
                                       # etc. filled in from the field, "{value}" the value (else ", got" it follows);
@@ -101,7 +102,7 @@ LANGUAGES = ("en", "uk", "ru")
 
 
 def _name(doc: str, default: str) -> Field:
-    return Field("name", "string", doc, default=default, max_length=MAX_NAME)
+    return Field("name", "string", doc, default=default, max_length=MAX_NAME, one_line=True)
 
 
 GEAR = Section("drive.gear", "The last gear pair of a working machine (drive.kind = \"machine\"; Kiriienko 2019, sec. 7.1).", (
@@ -163,7 +164,7 @@ LINK = Section("link", "A moving link, one table each, numbered as in the text (
           rule="moving links are numbered from {minimum} (0 is the frame)"),
     _name("the link's name", "link <id>"),
     Field("points", "points", "named points in the link's local frame", "m", default=REQUIRED, expression=True,
-          max_length=MAX_POINTS),
+          max_length=MAX_POINTS, one_line=True),
     _num("mass", "mass (or weight)", "kg", default=0.0, minimum=0.0),
     _num("weight", "weight, converted with g (or mass)", "N", minimum=0.0),
     _num("I_S", "moment of inertia about the centre of mass", "kg m^2", default=0.0, minimum=0.0),
@@ -248,7 +249,7 @@ FRICTION = Section("friction", "Friction in the pairs (TMM course text on fricti
 
 _AT_POINT, _OF_LINK = ("velocity", "acceleration"), ("omega", "eps", "inertia_force", "inertia_moment")
 PUBLISHED = Section("published", "A value the source prints for this model, checked by `kinetostat validate`.", (
-    Field("symbol", "string", "as the source names it (unique in the file)", default=REQUIRED),
+    Field("symbol", "string", "as the source names it (unique in the file)", default=REQUIRED, one_line=True),
     Field("meaning", "string", "what it is, in this project's terms", default=""),
     Field("quantity", "string", "what it measures (a magnitude)", default=REQUIRED, choices=tuple(PUBLISHED_UNITS)),
     Field("point", "point", "velocity, acceleration: the point", default=REQUIRED, when=("quantity", _AT_POINT)),
@@ -269,7 +270,7 @@ PUBLISHED = Section("published", "A value the source prints for this model, chec
 ), array=True)
 
 STUDY = Section("study", "A parameter study: the largest |R(i,j)| over the cycle for every combination of values.", (
-    Field("title", "string", "the study's title", default="parameter study"),
+    Field("title", "string", "the study's title", default="parameter study", one_line=True),
     Field("vary", "map", "one or two parameters and their values (first: rows, second: columns)", default=REQUIRED,
           items="numbers", max_length=2),
     Field("pair", "links", "R(i, j) tabulated: force of link i on link j", default=REQUIRED),
@@ -293,7 +294,7 @@ MODEL = Section("<top level>", "A kinetostat mechanism model: one planar linkage
           items="number", max_length=MAX_PARAMETERS),
     Field("drive", "table", DRIVE.doc, default=REQUIRED, section=DRIVE),
     Field("frame", "points", "link 0: its points in world coordinates", "m", default=REQUIRED, expression=True,
-          max_length=MAX_POINTS),
+          max_length=MAX_POINTS, one_line=True),
     Field("link", "tables", LINK.doc, default=REQUIRED, section=LINK),
     Field("pair", "tables", PAIR.doc, section=PAIR),
     Field("group", "tables", GROUP.doc, section=GROUP),

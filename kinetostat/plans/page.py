@@ -26,7 +26,8 @@ The page contract (the README): `<input type="range" id="phi">`; every segment's
 `data-value`.
 
 May use: the plans (`build`, `cycle_scales`, `draw`, `forces`, `worksheet`, `drawing_error`,
-`i18n`, `lettering`), the solver, numpy, the standard library. Never matplotlib, never the harness.
+`i18n`, `lettering`), the solver, `kinetostat._text` (`script_json`: the data block's JSON),
+numpy, the standard library. Never matplotlib, never the harness.
 """
 from __future__ import annotations
 
@@ -50,6 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import write_bytes, write_text
+from .._text import script_json
 from .draw import TINY_MM, segment_label, svg, title_of
 from .i18n import check_lang, num, text, unit
 
@@ -609,7 +611,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                 f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><table>{data_table}</table></section>'
                 + check)
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
-    payload = json.dumps(data, ensure_ascii=False).replace("</", "<\\/")
+    payload = script_json(data)                 # no name in it (`</script>`, `<!--<script>`) ends its element
     blob_tags = "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
     return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
             + (f'<meta name="{KEY_META}" content="{key}">' if key else "") +

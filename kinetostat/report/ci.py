@@ -3,10 +3,12 @@ a published value, of the pair, drive or point a route's quantity belongs to) an
 route's tolerance is set; one failure as a verdict line and a small table; GitHub Actions'
 `::error file=...,line=...` commands; and the Markdown summary of a run, verdict first, for
 $GITHUB_STEP_SUMMARY. Used by `kinetostat validate` and the pytest plugin
-(`kinetostat_validation.pytest_plugin`).
+(`kinetostat_validation.pytest_plugin`). Every text from a model reaches each channel through
+its one escaping function of `kinetostat._text`: `one_line` (the terminal),
+`workflow_command_text` (the commands), `markdown_text` (the summary's cells).
 
-May use: the standard library, the model's line finder, the runs room; the harness inside the
-function that needs it.
+May use: the standard library, `kinetostat._text`, the model's line finder, the runs room; the
+harness inside the function that needs it.
 """
 from __future__ import annotations
 
@@ -17,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Sequence
 
+from .._text import markdown_text, one_line, workflow_command_text
 from ..model import Mechanism, _Lines
 from .runs import LEVER_ROUTE, PUBLISHED_ROUTE, Check, ModelRun, trust
 
@@ -142,7 +145,8 @@ def verdict_line(c: Check, where: Where | None) -> str:
 
 def failure_text(c: Check, where: Where | None, tolerance_at: Where | None) -> str:
     """A failed check for people: the verdict line, a small table (error, tolerance, unit, the
-    angle of the worst error, route, trust), the check's own line and where its tolerance is set."""
+    angle of the worst error, route, trust), the check's own line and where its tolerance is set;
+    each line `one_line` (a newline in a published value's source shown as "\\n")."""
     err, tol, phi = measured(c)
     head = ["error", "tolerance", "max |diff|", "unit", "angle", "route"]
     row = [err, tol, f"{_num(c.max_abs, '.4g')}", c.unit or "-", phi, c.route]
@@ -154,12 +158,7 @@ def failure_text(c: Check, where: Where | None, tolerance_at: Where | None) -> s
              f"  trust: {c.trust if c.route != PUBLISHED_ROUTE else 'the published value (source above)'}"]
     if tolerance_at is not None:
         lines.append(f"  tolerance set at {tolerance_at}")
-    return "\n".join(lines)
-
-
-def _escape(text: str, prop: bool = False) -> str:
-    text = text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
-    return text.replace(":", "%3A").replace(",", "%2C") if prop else text
+    return "\n".join(map(one_line, lines))
 
 
 def annotation(where: Where, title: str, message: str, workspace: str | None = None) -> str:
@@ -172,10 +171,10 @@ def annotation(where: Where, title: str, message: str, workspace: str | None = N
         file = os.path.relpath(os.path.abspath(file), base)
     except ValueError:                      # another drive (Windows)
         pass
-    loc = f"file={_escape(file.replace(os.sep, '/'), True)}"
+    loc = f"file={workflow_command_text(file.replace(os.sep, '/'), True)}"
     if where.line is not None:
         loc += f",line={where.line}"
-    return f"::error {loc},title={_escape(title, True)}::{_escape(message)}"
+    return f"::error {loc},title={workflow_command_text(title, True)}::{workflow_command_text(message)}"
 
 
 def annotations(outcomes: Iterable[Outcome]) -> list[str]:
@@ -188,14 +187,11 @@ def annotations(outcomes: Iterable[Outcome]) -> list[str]:
     return out
 
 
-def _cell(text: str) -> str:
-    return text.replace("|", "\\|").replace("\n", " ")
-
-
 def summary_markdown(outcomes: Sequence[Outcome], title: str) -> str:
     """The run as Markdown, verdict first: counts, a table of the failed checks and route errors
     (where, error, tolerance, unit, angle, route, trust), the skipped routes with their reasons,
-    and every check in a collapsed table."""
+    and every check in a collapsed table; every cell's text `markdown_text` (shown as text: no
+    tag, link or extra cell)."""
     count = {s: sum(o.status == s for o in outcomes) for s in ("passed", "failed", "skipped", "error")}
     ok = not count["failed"] and not count["error"] and any(o.status == "passed" and o.route != LEVER_ROUTE
                                                             for o in outcomes)
@@ -207,18 +203,18 @@ def summary_markdown(outcomes: Sequence[Outcome], title: str) -> str:
 
     def row(o: Outcome) -> str:
         if o.check is None:
-            return (f"| {_cell(o.name)} | {_cell(str(o.where or ''))} | {o.status.upper()}: {_cell(o.message)} "
-                    f"| | | | {o.route} | {_cell(o.trust)} |")
-        err, tol, phi = measured(o.check)
-        return (f"| {_cell(o.name)} | {_cell(str(o.where or ''))} | {err} | {tol} | {_cell(o.check.unit)} | {phi} "
-                f"| {o.route} | {_cell(o.trust)} |")
+            cells = [o.name, str(o.where or ""), f"{o.status.upper()}: {o.message}", "", "", "", o.route, o.trust]
+        else:
+            err, tol, phi = measured(o.check)
+            cells = [o.name, str(o.where or ""), err, tol, o.check.unit, phi, o.route, o.trust]
+        return "| " + " | ".join(map(markdown_text, cells)) + " |"
 
     bad = [o for o in outcomes if o.status in ("failed", "error")]
     if bad:
         lines += ["### Failed", "", head, *map(row, bad), ""]
     skipped = dict.fromkeys(f"{o.route}: {o.message}" for o in outcomes if o.status == "skipped")
     if skipped:
-        lines += ["### Skipped", "", *(f"- {_cell(s)}" for s in skipped), ""]
+        lines += ["### Skipped", "", *(f"- {markdown_text(s)}" for s in skipped), ""]
     ran = [o for o in outcomes if o.check is not None]
     if ran:
         lines += ["<details><summary>Every check</summary>", "", head, *map(row, ran), "", "</details>", ""]
