@@ -2,7 +2,7 @@
 that computes it (`exact`); `kinetostat.solve.analyze` chooses between it and the compiled path.
 
 May use: model, groups, kinematics, kinetostatics, applied, planar, friction, errors; pandas only inside
-`to_frame`.
+`to_frame`; `plans.lettering` (the pairs' names) only inside `exact`, where a warning names pairs.
 """
 from __future__ import annotations
 
@@ -21,7 +21,8 @@ from . import friction as _friction, groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, dot_z
 from .friction import relative_rate
-from .errors import SelfLockingWarning, SingularPositionWarning, UndefinedFigureWarning, self_locking_message
+from .errors import (SelfLockingWarning, SingularFrictionWarning, SingularPositionWarning, UndefinedFigureWarning,
+                     self_locking_message, singular_friction_message)
 from .model import Mechanism, _abbreviate
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "deviation",
@@ -717,7 +718,8 @@ def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Anal
     """`analyze` by the numpy path at the crank angles `phi_deg` (deg, (N,)), with the accuracy
     guard: where a group's cond exceeds COND_CHECK the error is measured by perturbed re-solves.
     `friction`: "first" or "reactions" (see `analyze`); a SelfLockingWarning names the angles
-    where friction in the reactions leaves no equilibrium."""
+    where friction in the reactions leaves no equilibrium, and a SingularFrictionWarning those of
+    them where Newton's Jacobian is singular, with the pairs whose friction loads it found dependent."""
     reactions = friction == "reactions" and mech.friction is not None
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # NaN only at angles marked singular
         kin, checked, trials = solve_checked(mech, np.radians(phi_deg))
@@ -733,6 +735,13 @@ def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Anal
         why = res.self_locking_reason
         warnings.warn(SelfLockingWarning(self_locking_message(phi_deg[why != ""], why[why != ""]),
                                          phi_deg[why != ""], why[why != ""]), stacklevel=3)
+        tied = res.friction.dependent & ~res.singular[:, None]
+        if tied.any():
+            from .plans.lettering import pair_name      # not at the top: plans imports this module
+            at = tied.any(axis=1)
+            names = [tuple(pair_name(mech, p) for p in mech.pairs if row[p.index]) for row in tied[at]]
+            warnings.warn(SingularFrictionWarning(singular_friction_message(phi_deg[at], names), phi_deg[at], names),
+                          stacklevel=3)
     return _read_only(res)
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import kinetostat
-from kinetostat import ModelWarning, SelfLockingWarning, UndefinedFigureWarning
+from kinetostat import ModelWarning, SelfLockingWarning, SingularFrictionWarning, UndefinedFigureWarning
 from conftest import ROOT
 
 
@@ -98,14 +98,28 @@ def test_no_equilibrium_gives_nan_friction_power_and_undefined_cycle_figures():
         assert np.isnan(res.friction_energy()).all()
 
 
-def test_singular_friction_jacobian_is_no_equilibrium_not_a_traceback():
+YOKE_GUIDES = "R32 slider A on guide K and R03 slider Y on guide H"     # as the report names them
+
+
+def test_singular_friction_jacobian_is_no_equilibrium_naming_the_angles_and_the_pairs():
     """The scotch yoke with f = 1: the two guides' friction loads enter the group only as their sum,
-    Newton's Jacobian is singular (before: numpy.linalg.LinAlgError out of analyze and the CLI)."""
-    with pytest.warns(SelfLockingWarning, match=r"no equilibrium at phi = \[") as w:
+    Newton's Jacobian is singular (before: numpy.linalg.LinAlgError out of analyze and the CLI; then the
+    angles only). One warning line names the angles and the pairs it cannot tell apart: the two guides,
+    not the block's pin."""
+    with pytest.warns(SelfLockingWarning) as w:
         res = kinetostat.analyze(_load(_with_friction("scotch_yoke", 1.0, 0.01)), steps=36)
     none = res.self_locking_reason == "no equilibrium"
-    assert none.sum() >= 24 and set(res.phi_deg[none]) <= set(w[0].message.phi_deg)
+    assert none.sum() >= 24 and "no equilibrium at phi = [" in str(w[0].message)
+    assert set(res.phi_deg[none]) <= set(w[0].message.phi_deg)
     assert np.isnan(res.friction_power[none]).all() and np.isnan(res.balancing_moment[none]).all()
+    tied = [x.message for x in w if x.category is SingularFrictionWarning]
+    assert len(tied) == 1, [str(x.message) for x in w]
+    text = str(tied[0])
+    assert "\n" not in text and text.startswith(f"friction solve singular at {none.sum()} angle(s): the friction "
+                                                f"loads of the pairs {YOKE_GUIDES} at phi = [10, 20, 30, ")
+    assert list(tied[0].phi_deg) == list(res.phi_deg[none]) and set(tied[0].pairs) == {tuple(YOKE_GUIDES.split(" and "))}
+    assert res.friction.dependent[none][:, 2:].all() and not res.friction.dependent[:, :2].any()
+    assert not res.friction.dependent[~none].any()
 
 
 @pytest.mark.parametrize("f, radius, pair_radius, field", [
@@ -139,3 +153,6 @@ def test_cli_says_why_the_cycle_efficiency_is_undefined(cli, tmp_path):
     r = cli("analyze", path, "--steps", "36")
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     assert "cycle efficiency: undefined: no equilibrium with friction" in r.stdout
+    tied = [x for x in r.stderr.splitlines() if "friction solve singular" in x]
+    assert len(tied) == 1 and tied[0].startswith("kinetostat: warning: chain.toml: friction solve singular at 35 "
+                                                 f"angle(s): the friction loads of the pairs {YOKE_GUIDES} at phi = [10, "), r.stderr
