@@ -348,14 +348,26 @@ class Analysis:
         moment friction takes: a ratio ruled by the vanishing M0, |eta| above about 10 or below
         0.09)
         or where both moments are rounding (below 1e-12 x the largest reaction x size); NaN where
-        no equilibrium was found and where a pair wedges (`self_locking_reason`)."""
+        no equilibrium was found and where a pair wedges (`self_locking_reason`); `efficiency_reason`
+        says why at each angle."""
+        return np.where(self.efficiency_reason != "", np.nan, self._eta())
+
+    @property
+    def efficiency_reason(self) -> np.ndarray:
+        """(N,) str: why `efficiency` is undefined (NaN) at each angle, "" where it is a number."""
         eta = self._eta()
         M0, Mf = self.balancing_moment_frictionless, self.balancing_moment_with_friction
         with np.errstate(invalid="ignore"):
             dead = np.abs(M0) <= _friction.DEAD_CENTRE * np.abs(Mf - M0)
+        why = np.where(np.isnan(eta), "the balancing moment is NaN", "")
+        why = np.where(np.isnan(eta) & np.isfinite(M0) & np.isfinite(Mf),
+                       "both balancing moments at rounding level (a dead centre)", why)
+        why = np.where(dead, f"near a dead centre (the frictionless balancing moment at most {_friction.DEAD_CENTRE:g} of "
+                             "the moment friction takes)", why)
         if self.friction is not None:
-            dead |= self.friction.wedged | ~self.friction.solved
-        return np.where(dead, np.nan, eta)
+            why = np.where(self.friction.wedged, "a pair wedges (friction gain >= 1: the equilibrium is not unique)", why)
+            why = np.where(~self.friction.solved, "no equilibrium with friction (self-locking)", why)
+        return np.where(self.singular, "singular position (its values NaN)", why).astype(object)
 
     @property
     def self_locking(self) -> np.ndarray:

@@ -156,3 +156,25 @@ def test_cli_says_why_the_cycle_efficiency_is_undefined(cli, tmp_path):
     tied = [x for x in r.stderr.splitlines() if "friction solve singular" in x]
     assert len(tied) == 1 and tied[0].startswith("kinetostat: warning: chain.toml: friction solve singular at 35 "
                                                  f"angle(s): the friction loads of the pairs {YOKE_GUIDES} at phi = [10, "), r.stderr
+
+
+@pytest.mark.parametrize("model, at, why", [
+    (_with_friction("scotch_yoke", 1.0, 0.01), 30.0, "no equilibrium with friction (self-locking)"),
+    ("ice_crank_slider", 0.0, "near a dead centre (the frictionless balancing moment at most 0.1 of the moment friction takes)"),
+])
+def test_worksheet_says_why_eta_is_undefined(model, at, why):
+    """Before: the eta row a bare NaN (a dash in the sheet, null in its JSON) with its formula as the note."""
+    from kinetostat.plans.worksheet import worksheet
+    mech = kinetostat.load(model) if "\n" not in model else _load(model)
+    row = next(r for r in worksheet(mech, at=at).rows if r.key == "eta")
+    assert math.isnan(row.value) and row.note == f"undefined: {why}"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SelfLockingWarning)
+        assert kinetostat.analyze(mech, phi_deg=[at], friction="reactions").efficiency_reason[0] == why
+
+
+def test_cli_values_table_says_why_eta_is_undefined(cli):
+    r = cli("analyze", ROOT / "models" / "ice_crank_slider.toml", "--at", "0", "30", "180", "--friction", "reactions")
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    assert "  eta undefined at phi = 0, 180 deg: near a dead centre (the frictionless balancing moment at most 0.1 " \
+           "of the moment friction takes)" in r.stdout.splitlines(), r.stdout

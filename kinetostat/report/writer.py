@@ -9,7 +9,7 @@ import json
 import math
 import warnings
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -389,6 +389,11 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
     doc.table(["quantity", "route against group by group", "max |difference|", "peak relative, 1"], rows, "llrr")
 
 
+def _figure(value: Callable[[], float], why: str) -> str:
+    """A figure's table cell: `value()`, or "undefined: `why`" where it is undefined (value not called)."""
+    return esc(f"undefined: {why}") if why else _fmt(value())
+
+
 def _friction_section(doc: Doc, m: Mechanism, res) -> None:
     """With [friction]: the exact solution with friction in the reactions beside the first
     approximation of the course text (`res`, the cycle the engines checked): M_bal at the design
@@ -415,12 +420,10 @@ def _friction_section(doc: Doc, m: Mechanism, res) -> None:
     phi0 = m.drive.design_deg
     rows = [[f"{M} at φ = {phi0:g}°, N·m", _fmt(at.balancing_moment_frictionless[0]),
              _fmt(first.balancing_moment_with_friction[0]), _fmt(at.balancing_moment[0])],
-            [f"η at φ = {phi0:g}°, 1", "1", _fmt(first.efficiency[0]), _fmt(at.efficiency[0])]]
+            [f"η at φ = {phi0:g}°, 1", "1"] + [_figure(lambda: r.efficiency[0], r.efficiency_reason[0]) for r in (first, at)]]
     try:
         lost0, lost = res.friction_energy(), ex.friction_energy()
-        rows.append(["cycle efficiency, 1", "1"] + [esc(f"undefined: {r.cycle_efficiency_reason()}")
-                                                     if r.cycle_efficiency_reason() else _fmt(r.cycle_efficiency())
-                                                     for r in (res, ex)])
+        rows.append(["cycle efficiency, 1", "1"] + [_figure(r.cycle_efficiency, r.cycle_efficiency_reason()) for r in (res, ex)])
         rows += [[f"energy lost in {esc(pair_name(m, p))} per cycle, J", "0", _fmt(lost0[p.index]), _fmt(lost[p.index])]
                  for p in m.pairs]
     except ValueError:                  # not a uniform full cycle: no cycle integrals
