@@ -434,7 +434,8 @@ class Analysis:
         return eta
 
     def cycle_efficiency_reason(self) -> str:
-        """Why `cycle_efficiency` is NaN ("" where it is a number), without a warning."""
+        """Why `cycle_efficiency` is NaN ("" where it is a number), without a warning: the cause,
+        then its figures in parentheses."""
         return self._cycle_efficiency[1]
 
     @cached_property
@@ -467,8 +468,8 @@ class Analysis:
         if at.friction is None or at.friction.solved.all():
             return ""
         phi = np.mod(at.phi_deg[~at.friction.solved], 360.0)
-        return (f"no equilibrium with friction at {len(phi)} of the cycle's {len(at.phi_deg)} integration angles "
-                f"(phi = {phi.min():.6g} .. {phi.max():.6g} deg; self-locking)")
+        return (f"no equilibrium with friction at some angles of the cycle ({len(phi)} of its {len(at.phi_deg)} "
+                f"integration angles, phi = {phi.min():.6g} .. {phi.max():.6g} deg; self-locking)")
 
     def _unit_motion(self) -> Kinematics:
         """The motion at the same angles at unit crank speed (d phi/dt = 1 rad/s): its velocities

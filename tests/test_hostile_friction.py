@@ -92,7 +92,7 @@ def test_no_equilibrium_gives_nan_friction_power_and_undefined_cycle_figures():
     assert none.sum() == 8 and np.isnan(res.friction_power[none]).all() and np.isnan(res.friction.load[none]).all()
     assert np.isfinite(res.friction_power[~none]).all() and np.isnan(res.balancing_moment[none]).all()
     with pytest.warns(UndefinedFigureWarning, match=r"cycle_efficiency: undefined \(NaN\): no equilibrium with friction "
-                                                   r"at \d+ of the cycle's \d+ integration angles \(phi = 1[34]\d"):
+                                                   r"at some angles of the cycle \(\d+ of its \d+ integration angles, phi = 1[34]\d"):
         assert math.isnan(res.cycle_efficiency())
     with pytest.warns(UndefinedFigureWarning, match=r"friction_energy: undefined \(NaN\): no equilibrium"):
         assert np.isnan(res.friction_energy()).all()
@@ -178,3 +178,22 @@ def test_cli_values_table_says_why_eta_is_undefined(cli):
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     assert "  eta undefined at phi = 0, 180 deg: near a dead centre (the frictionless balancing moment at most 0.1 " \
            "of the moment friction takes)" in r.stdout.splitlines(), r.stdout
+
+
+def test_sweep_says_once_why_eta_cycle_is_undefined(tmp_path):
+    """Before: one UndefinedFigureWarning per design (a flood over a large sweep) and a bare NaN in the
+    table. Now: each design's reason in eta_cycle_reason, one warning counting the designs by cause."""
+    path = tmp_path / "chain.toml"
+    path.write_text(NO_NET_WORK["chain_unit_four_bar"])
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        sw = kinetostat.sweep(path, {"r": [0.05, 0.08, 0.11]}, steps=36)
+    msgs = [str(x.message) for x in w if issubclass(x.category, UndefinedFigureWarning)]
+    assert msgs == ["sweep: eta_cycle undefined (NaN) for 3 of 3 design(s): 3 where the loads do no net work over "
+                    "the cycle (each design's reason in eta_cycle_reason)"], msgs
+    assert sw.table["eta_cycle"].isna().all() and sw.table.attrs["units"]["eta_cycle_reason"] == "text"
+    assert sw.table["eta_cycle_reason"].str.startswith("the loads do no net work over the cycle (the frictionless").all()
+    with warnings.catch_warnings():            # not a full cycle: no cycle efficiency asked for, no warning
+        warnings.simplefilter("error", UndefinedFigureWarning)
+        sw = kinetostat.sweep(path, {"r": [0.05, 0.08]}, phi_deg=[10.0, 20.0])
+    assert (sw.table["eta_cycle_reason"] == "the angles are not a uniform full cycle (sweep with steps=N)").all()
