@@ -31,7 +31,7 @@ from . import examples, plans, variants   # after the handler: these imports tak
 from .analysis import Analysis, InertiaLoad
 from .solve import analyze
 from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning, SelfLockingWarning,
-                     SingularPositionWarning, StructureError, UndefinedFigureWarning)
+                     SingularFrictionWarning, SingularPositionWarning, StructureError, UndefinedFigureWarning)
 from .kinematics import COND_CHECK, COND_MAX, DIGITS_MIN, DIGITS_WARN
 from .model import Mechanism, from_dict, load, loads
 from .structure import AssurGroup, Structure
@@ -40,6 +40,6 @@ from .virtual_work import VirtualWork, virtual_work
 
 __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
-           "AssemblyError", "SingularPositionWarning", "SelfLockingWarning", "UndefinedFigureWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
+           "AssemblyError", "SingularPositionWarning", "SelfLockingWarning", "SingularFrictionWarning", "UndefinedFigureWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "examples", "plans", "variants", "sweep", "Sweep"]
 __version__ = "0.1.0"

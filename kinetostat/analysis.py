@@ -2,7 +2,7 @@
 that computes it (`exact`); `kinetostat.solve.analyze` chooses between it and the compiled path.
 
 May use: model, groups, kinematics, kinetostatics, applied, planar, friction, errors; pandas only inside
-`to_frame`.
+`to_frame`; `plans.lettering` (the pairs' names) only inside `exact`, where a warning names pairs.
 """
 from __future__ import annotations
 
@@ -21,7 +21,8 @@ from . import friction as _friction, groups
 from .applied import applied_moment, applied_wrenches, com_motion, load_magnitude, point_forces
 from .planar import as_xy, as_z, dot_z
 from .friction import relative_rate
-from .errors import SelfLockingWarning, SingularPositionWarning, UndefinedFigureWarning, self_locking_message
+from .errors import (SelfLockingWarning, SingularFrictionWarning, SingularPositionWarning, UndefinedFigureWarning,
+                     self_locking_message, singular_friction_message)
 from .model import Mechanism, _abbreviate
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "deviation",
@@ -347,14 +348,26 @@ class Analysis:
         moment friction takes: a ratio ruled by the vanishing M0, |eta| above about 10 or below
         0.09)
         or where both moments are rounding (below 1e-12 x the largest reaction x size); NaN where
-        no equilibrium was found and where a pair wedges (`self_locking_reason`)."""
+        no equilibrium was found and where a pair wedges (`self_locking_reason`); `efficiency_reason`
+        says why at each angle."""
+        return np.where(self.efficiency_reason != "", np.nan, self._eta())
+
+    @property
+    def efficiency_reason(self) -> np.ndarray:
+        """(N,) str: why `efficiency` is undefined (NaN) at each angle, "" where it is a number."""
         eta = self._eta()
         M0, Mf = self.balancing_moment_frictionless, self.balancing_moment_with_friction
         with np.errstate(invalid="ignore"):
             dead = np.abs(M0) <= _friction.DEAD_CENTRE * np.abs(Mf - M0)
+        why = np.where(np.isnan(eta), "the balancing moment is NaN", "")
+        why = np.where(np.isnan(eta) & np.isfinite(M0) & np.isfinite(Mf),
+                       "both balancing moments at rounding level (a dead centre)", why)
+        why = np.where(dead, f"near a dead centre (the frictionless balancing moment at most {_friction.DEAD_CENTRE:g} of "
+                             "the moment friction takes)", why)
         if self.friction is not None:
-            dead |= self.friction.wedged | ~self.friction.solved
-        return np.where(dead, np.nan, eta)
+            why = np.where(self.friction.wedged, "a pair wedges (friction gain >= 1: the equilibrium is not unique)", why)
+            why = np.where(~self.friction.solved, "no equilibrium with friction (self-locking)", why)
+        return np.where(self.singular, "singular position (its values NaN)", why).astype(object)
 
     @property
     def self_locking(self) -> np.ndarray:
@@ -421,7 +434,8 @@ class Analysis:
         return eta
 
     def cycle_efficiency_reason(self) -> str:
-        """Why `cycle_efficiency` is NaN ("" where it is a number), without a warning."""
+        """Why `cycle_efficiency` is NaN ("" where it is a number), without a warning: the cause,
+        then its figures in parentheses."""
         return self._cycle_efficiency[1]
 
     @cached_property
@@ -454,8 +468,8 @@ class Analysis:
         if at.friction is None or at.friction.solved.all():
             return ""
         phi = np.mod(at.phi_deg[~at.friction.solved], 360.0)
-        return (f"no equilibrium with friction at {len(phi)} of the cycle's {len(at.phi_deg)} integration angles "
-                f"(phi = {phi.min():.6g} .. {phi.max():.6g} deg; self-locking)")
+        return (f"no equilibrium with friction at some angles of the cycle ({len(phi)} of its {len(at.phi_deg)} "
+                f"integration angles, phi = {phi.min():.6g} .. {phi.max():.6g} deg; self-locking)")
 
     def _unit_motion(self) -> Kinematics:
         """The motion at the same angles at unit crank speed (d phi/dt = 1 rad/s): its velocities
@@ -717,7 +731,8 @@ def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Anal
     """`analyze` by the numpy path at the crank angles `phi_deg` (deg, (N,)), with the accuracy
     guard: where a group's cond exceeds COND_CHECK the error is measured by perturbed re-solves.
     `friction`: "first" or "reactions" (see `analyze`); a SelfLockingWarning names the angles
-    where friction in the reactions leaves no equilibrium."""
+    where friction in the reactions leaves no equilibrium, and a SingularFrictionWarning those of
+    them where Newton's Jacobian is singular, with the pairs whose friction loads it found dependent."""
     reactions = friction == "reactions" and mech.friction is not None
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # NaN only at angles marked singular
         kin, checked, trials = solve_checked(mech, np.radians(phi_deg))
@@ -733,6 +748,13 @@ def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Anal
         why = res.self_locking_reason
         warnings.warn(SelfLockingWarning(self_locking_message(phi_deg[why != ""], why[why != ""]),
                                          phi_deg[why != ""], why[why != ""]), stacklevel=3)
+        tied = res.friction.dependent & ~res.singular[:, None]
+        if tied.any():
+            from .plans.lettering import pair_name      # not at the top: plans imports this module
+            at = tied.any(axis=1)
+            names = [tuple(pair_name(mech, p) for p in mech.pairs if row[p.index]) for row in tied[at]]
+            warnings.warn(SingularFrictionWarning(singular_friction_message(phi_deg[at], names), phi_deg[at], names),
+                          stacklevel=3)
     return _read_only(res)
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from ._text import one_line
 
 __all__ = ["ModelError", "ModelFileNotFound", "ModelWarning", "AssemblyError", "StructureError",
-           "SingularPositionWarning", "UndefinedFigureWarning"]
+           "SingularPositionWarning", "SelfLockingWarning", "SingularFrictionWarning", "UndefinedFigureWarning"]
 
 
 class ModelError(ValueError):
@@ -129,6 +129,29 @@ def self_locking_message(phi_deg: np.ndarray, reasons) -> str:
     parts = [f"{key} at phi = {_angle_list(np.round(np.asarray(phi_deg)[reasons == key], 9))} ({why})"
              for key, why in SELF_LOCKING_MEANING.items() if (reasons == key).any()]
     return f"self-locking with friction in the reactions at {len(reasons)} angle(s): " + "; ".join(parts)
+
+
+class SingularFrictionWarning(SelfLockingWarning):
+    """With friction in the reactions, Newton's method stopped on a Jacobian singular to rounding:
+    the friction loads of some pairs are not independent in their group (the yoke's two guides'
+    enter it only as their sum), so no equilibrium, or no unique one, is found at those angles
+    (self-locking, "no equilibrium"). `phi_deg` lists the angles, `pairs` the names of the pairs
+    at each (a tuple of names per angle)."""
+
+    def __init__(self, message: str, phi_deg=(), pairs=()):
+        self.pairs = tuple(tuple(names) for names in pairs)
+        super().__init__(message, phi_deg, ("no equilibrium",) * len(self.pairs))
+
+
+def singular_friction_message(phi_deg: np.ndarray, pairs) -> str:
+    """The warning's one-line text: the angles where Newton's Jacobian is singular, grouped by the
+    pairs (their names, a tuple per angle) whose friction loads it found dependent."""
+    phi = np.round(np.asarray(phi_deg, dtype=float), 9)
+    parts = [f"{' and '.join(names)} at phi = {_angle_list(phi[[p == names for p in pairs]])}"
+             for names in dict.fromkeys(pairs)]
+    return (f"friction solve singular at {len(pairs)} angle(s): the friction loads of the pairs "
+            + "; of ".join(parts) + " are not independent in their group (Newton's Jacobian singular to "
+            "rounding): no equilibrium found there (M_bal, the reactions and the friction power NaN)")
 
 
 class UndefinedFigureWarning(UserWarning):

@@ -47,7 +47,7 @@ if TYPE_CHECKING:
     from .model import Mechanism
 
 __all__ = ["FrictionSolution", "solve", "power", "relative_rate", "motion_sense", "efficiency", "cycle_efficiency",
-           "METHODS", "RATE_TOL", "MAX_PASSES", "DEAD_CENTRE", "NO_NET_WORK"]
+           "METHODS", "RATE_TOL", "MAX_PASSES", "DEAD_CENTRE", "NO_NET_WORK", "NULL_SHARE"]
 
 #: analyze(friction=...): seed 003's first approximation, or friction in the reactions.
 METHODS = ("first", "reactions")
@@ -66,6 +66,10 @@ DEAD_CENTRE = 0.1
 #: four-bar and triads; 1e-12 leaves room for the digits a solve near a toggle loses, and the
 #: smallest real net work of a bundled machine is 0.19 of it (the ICE).
 NO_NET_WORK = 1e-12
+#: Where Newton's Jacobian is singular to rounding, a pair takes part in it (`FrictionSolution.dependent`)
+#: where its share of the null vector is at least this x the largest share (the yoke at f = 1: its two
+#: guides 0.71 each, the block's pin 0.01).
+NULL_SHARE = 0.1
 #: Power-iteration steps for a stage's friction gain (`_gain`).
 GAIN_STEPS = 40
 #: Converged: the largest change of a stage's reactions in one pass below this x its largest reaction.
@@ -91,6 +95,9 @@ class FrictionSolution:
     wedged: np.ndarray    # (N,) bool: at some stage a pair wedges: with no other load, the friction
                           #   loads call for reactions whose friction is at least as large (`_gain`
                           #   >= 1): self-locking; the equilibrium found there need not be the only one
+    dependent: np.ndarray  # (N, n_pairs) bool: the pairs whose friction loads Newton's Jacobian found
+                          #   dependent (singular to rounding, the pairs of its null vector, NULL_SHARE),
+                          #   where Newton stopped: no equilibrium found there (False elsewhere)
 
     def __repr__(self) -> str:
         return f"FrictionSolution(positions={len(self.solved)}, passes<={int(self.passes.max(initial=0))})"
@@ -174,7 +181,7 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
     F_fr, M_fr = np.zeros((N, L), complex), np.zeros((N, L))
     bounds = prog.stages + (len(prog.steps),)
     passes = np.zeros((N, len(prog.stages)), int)
-    solved, wedged = np.ones(N, bool), np.zeros(N, bool)
+    solved, wedged, dependent = np.ones(N, bool), np.zeros(N, bool), np.zeros((N, n), bool)
     names = [f"{s}{k}" for s in "FM" for k in range(1, L)]
     for st in range(len(prog.stages)):
         segment = mech.memo(("friction_stage", st), lambda: _segment(prog, bounds[st], bounds[st + 1]))
@@ -221,7 +228,8 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
                 break
             q = friction(R)
         if not done.all():                 # the passes do not converge there: Newton on the friction loads
-            applied, R, newton = _newton(apply, friction, np.where(done[:, None], applied, q0), ~done)
+            applied, R, newton, tied = _newton(apply, friction, np.where(done[:, None], applied, q0), ~done)
+            dependent[:, [p.index for p in pairs]] |= tied
             passes[newton > 0, st] = MAX_PASSES + newton[newton > 0]
             done |= newton > 0
         dF, dM = wrench
@@ -243,7 +251,8 @@ def solve(mech: "Mechanism", kin: "Kinematics", F: np.ndarray, M: np.ndarray, M_
     if not solved.all():
         frc = Forces(*(np.where(solved.reshape((N,) + (1,) * (a.ndim - 1)), a, np.nan)
                        for a in (frc.R, frc.normal, frc.m, frc.M_bal, frc.F_bal)))
-    return frc, FrictionSolution(np.asarray(M_bal_frictionless, float), load, F_fr, M_fr, passes, solved, wedged)
+    return frc, FrictionSolution(np.asarray(M_bal_frictionless, float), load, F_fr, M_fr, passes, solved, wedged,
+                                 dependent)
 
 
 def _gain(T, q: np.ndarray) -> np.ndarray:
@@ -263,15 +272,17 @@ def _gain(T, q: np.ndarray) -> np.ndarray:
     return gain
 
 
-def _newton(apply, friction, q: np.ndarray, todo: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _newton(apply, friction, q: np.ndarray, todo: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Newton's method on a stage's friction loads q (N, n) at the angles `todo`: the root of
     H(q) = friction(apply(q)) - q, its Jacobian by forward differences (n + 1 stage runs a step,
     over all angles at once; the other angles keep their q). Returns the loads, the reactions
-    apply gives with them, and the steps each angle took (0: no root found: H not below
-    PASS_TOL of the loads within NEWTON_STEPS, or the Jacobian singular to rounding, as where two
-    pairs' friction loads enter the stage only as their sum: no root, or no unique one)."""
+    apply gives with them, the steps each angle took (0: no root found: H not below PASS_TOL of
+    the loads within NEWTON_STEPS, or the Jacobian singular to rounding, as where two pairs'
+    friction loads enter the stage only as their sum: no root, or no unique one) and (N, n) bool
+    the pairs of the null vector where Newton stopped on a singular Jacobian (share >= NULL_SHARE)."""
     N, n = q.shape
     steps = np.zeros(N, int)
+    dependent = np.zeros((N, n), bool)
     for k in range(1, NEWTON_STEPS + 1):
         R = apply(q)
         H = friction(R) - q
@@ -288,12 +299,16 @@ def _newton(apply, friction, q: np.ndarray, todo: np.ndarray) -> tuple[np.ndarra
             dq[:, c] += h
             J[:, :, c] = (friction(apply(dq)) - dq - H) / h[:, None]
         finite = np.isfinite(J).all(axis=(1, 2))
-        todo = todo & ~(finite & (np.linalg.matrix_rank(np.where((todo & finite)[:, None, None], J, np.eye(n))) < n))
+        _, s, vt = np.linalg.svd(np.where((todo & finite)[:, None, None], J, np.eye(n)))
+        singular = todo & finite & (s[:, -1] <= s[:, 0] * n * np.finfo(float).eps)   # numpy's matrix_rank rule
+        null = np.abs(vt[:, -1, :])
+        dependent |= singular[:, None] & (null >= NULL_SHARE * null.max(axis=1, keepdims=True))
+        todo = todo & ~singular
         with np.errstate(all="ignore"):
             step = np.linalg.solve(np.where(todo[:, None, None], J, np.eye(n)), np.where(todo[:, None], -H, 0.0)[..., None])
         q = np.where(todo[:, None], q + step[..., 0], q)
     R = apply(q)
-    return q, R, steps
+    return q, R, steps, dependent
 
 
 def _segment(prog: Program, start: int, stop: int) -> Program:

@@ -15,7 +15,8 @@ A design whose mechanism does not load, build or assemble keeps its row: NaN pea
 reason in the `error` column (the sweep goes on). Warnings (singular positions, doubts about a
 model) are not printed: the table's `n_singular` and `singular_deg` say where a design is singular
 (values NaN), `warned_deg` and `worst_digits` where its values are kept with fewer than
-DIGITS_WARN digits and the fewest digits there.
+DIGITS_WARN digits and the fewest digits there; `eta_cycle_reason` why a design's cycle efficiency
+is undefined, and one UndefinedFigureWarning after the sweep counts those designs by cause.
 
 May use: model, analysis, solve, fast, errors, examples, units; pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
@@ -37,7 +38,8 @@ import numpy as np
 
 from .analysis import Analysis, crank_angles, friction_method
 from .solve import analyze
-from .errors import AssemblyError, ModelError, ModelWarning, SelfLockingWarning, SingularPositionWarning, StructureError
+from .errors import (AssemblyError, ModelError, ModelWarning, SelfLockingWarning, SingularPositionWarning, StructureError,
+                     UndefinedFigureWarning)
 from .model import Mechanism, _read_text, _suggest, load, loads
 from .units import parameter_units
 
@@ -52,6 +54,8 @@ CHUNK = 32
 LOCAL_SCHEDULERS = ("threads", "processes")
 #: Most designs of one sweep (the product of the parameters' numbers of values), checked before any is made.
 MAX_DESIGNS = 1_000_000
+#: `eta_cycle_reason` where the angles are not a uniform full cycle (no cycle efficiency to give).
+NOT_A_CYCLE = "the angles are not a uniform full cycle (sweep with steps=N)"
 #: Seconds to wait for a distributed scheduler to answer, and for its first worker.
 CONNECT_TIMEOUT = 10.0
 
@@ -91,8 +95,10 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     address of a `distributed` scheduler; or a `distributed.Client`. `chunk`: designs per task.
     `progress`: a tqdm bar over the chunks on stderr. `friction`: as `analyze` takes it (default:
     the model's); with friction in the reactions each row also has `eta_cycle` (the cycle
-    efficiency, NaN unless the angles are a uniform full cycle) and `n_self_locking` (the count of
-    self-locking angles, `Analysis.self_locking`).
+    efficiency, NaN unless the angles are a uniform full cycle), `eta_cycle_reason` (why it is NaN,
+    `Analysis.cycle_efficiency_reason`; "" where it is a number) and `n_self_locking` (the count of
+    self-locking angles, `Analysis.self_locking`); one UndefinedFigureWarning, after the sweep,
+    counts the designs whose eta_cycle is undefined over a uniform full cycle, by cause.
 
     ValueError names an unknown parameter, an empty or non-finite list of values, a parameter
     named as a column of the angles' table (with `full`), or a bad
@@ -127,6 +133,8 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     compiled = not full and fast.pays(base, n, "peaks")
     results = _run(parts, text, source, phi_deg, full, scheduler, progress, friction, compiled)
     table = _tidy(pd.concat([rows for rows, _ in results], ignore_index=True), names, base, friction)
+    if "eta_cycle_reason" in table:
+        _warn_undefined_eta(table["eta_cycle_reason"])
     angles = None
     if full:
         frames = [a for _, a in results if a is not None and len(a)]
@@ -204,14 +212,28 @@ def _peaks_into(rows: list[dict], built: list[tuple[int, Mechanism]], phi_deg: n
 
 def _friction_columns(res: Analysis) -> dict[str, Any]:
     """With friction in the reactions: the cycle efficiency (NaN unless the angles are a uniform
-    full cycle) and the number of self-locking angles; nothing otherwise."""
+    full cycle), why it is NaN (no warning per design) and the number of self-locking angles;
+    nothing otherwise."""
     if res.friction is None:
         return {}
     try:
-        eta = res.cycle_efficiency()
-    except ValueError:                   # not a uniform full cycle
-        eta = math.nan
-    return {"eta_cycle": eta, "n_self_locking": int(res.self_locking.sum())}
+        why = res.cycle_efficiency_reason()
+    except ValueError:
+        why = NOT_A_CYCLE
+    return {"eta_cycle": math.nan if why else res.cycle_efficiency(), "eta_cycle_reason": why,
+            "n_self_locking": int(res.self_locking.sum())}
+
+
+def _warn_undefined_eta(reasons: pd.Series) -> None:
+    """One UndefinedFigureWarning for all the designs whose eta_cycle is undefined over a uniform
+    full cycle (`reasons`: the eta_cycle_reason column): how many, and how many of them by each
+    cause (a reason's text before its figures in parentheses)."""
+    causes = reasons[(reasons != "") & (reasons != NOT_A_CYCLE)].str.split(" (", n=1, regex=False).str[0]
+    if len(causes):
+        why = "; ".join(f"{n} where {cause}" for cause, n in causes.value_counts(sort=False).items())
+        warnings.warn(UndefinedFigureWarning(f"sweep: eta_cycle undefined (NaN) for {len(causes)} of {len(reasons)} "
+                                             f"design(s): {why} (each design's reason in eta_cycle_reason)", why),
+                      stacklevel=3)
 
 
 def _accuracy(warned_deg: np.ndarray, worst: float) -> dict[str, Any]:
@@ -404,10 +426,11 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism, friction: str 
     peaks = list(_peak_columns(base))
     exact = base.friction is not None and friction_method(base, friction) == "reactions"
     table = table.reindex(columns=[*names, *peaks, "n_singular", "singular_deg", "worst_digits", "warned_deg",
-                                   *(["eta_cycle", "n_self_locking"] if exact else []), "error"])
+                                   *(["eta_cycle", "eta_cycle_reason", "n_self_locking"] if exact else []), "error"])
     if exact:
         table["eta_cycle"] = table["eta_cycle"].astype(float)
         table["n_self_locking"] = table["n_self_locking"].astype("Int64")
+        table["eta_cycle_reason"] = table["eta_cycle_reason"].astype(object).fillna("").astype(str)
     table["worst_digits"] = table["worst_digits"].astype(float)
     table["warned_deg"] = table["warned_deg"].astype(object).fillna("").astype(str)
     table[peaks] = table[peaks].astype(float)
@@ -417,7 +440,7 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism, friction: str 
     table.attrs.update(mechanism=base.name, units={
         **_parameter_units(base, names), **{c: "N m" if c == "peak_M_bal" else "N" for c in peaks},
         "n_singular": "1", "singular_deg": "deg", "worst_digits": "1", "warned_deg": "deg", "error": "text",
-        **({"eta_cycle": "1", "n_self_locking": "1"} if exact else {})})
+        **({"eta_cycle": "1", "eta_cycle_reason": "text", "n_self_locking": "1"} if exact else {})})
     return table
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import kinetostat
-from kinetostat import ModelWarning, SelfLockingWarning, UndefinedFigureWarning
+from kinetostat import ModelWarning, SelfLockingWarning, SingularFrictionWarning, UndefinedFigureWarning
 from conftest import ROOT
 
 
@@ -92,20 +92,34 @@ def test_no_equilibrium_gives_nan_friction_power_and_undefined_cycle_figures():
     assert none.sum() == 8 and np.isnan(res.friction_power[none]).all() and np.isnan(res.friction.load[none]).all()
     assert np.isfinite(res.friction_power[~none]).all() and np.isnan(res.balancing_moment[none]).all()
     with pytest.warns(UndefinedFigureWarning, match=r"cycle_efficiency: undefined \(NaN\): no equilibrium with friction "
-                                                   r"at \d+ of the cycle's \d+ integration angles \(phi = 1[34]\d"):
+                                                   r"at some angles of the cycle \(\d+ of its \d+ integration angles, phi = 1[34]\d"):
         assert math.isnan(res.cycle_efficiency())
     with pytest.warns(UndefinedFigureWarning, match=r"friction_energy: undefined \(NaN\): no equilibrium"):
         assert np.isnan(res.friction_energy()).all()
 
 
-def test_singular_friction_jacobian_is_no_equilibrium_not_a_traceback():
+YOKE_GUIDES = "R32 slider A on guide K and R03 slider Y on guide H"     # as the report names them
+
+
+def test_singular_friction_jacobian_is_no_equilibrium_naming_the_angles_and_the_pairs():
     """The scotch yoke with f = 1: the two guides' friction loads enter the group only as their sum,
-    Newton's Jacobian is singular (before: numpy.linalg.LinAlgError out of analyze and the CLI)."""
-    with pytest.warns(SelfLockingWarning, match=r"no equilibrium at phi = \[") as w:
+    Newton's Jacobian is singular (before: numpy.linalg.LinAlgError out of analyze and the CLI; then the
+    angles only). One warning line names the angles and the pairs it cannot tell apart: the two guides,
+    not the block's pin."""
+    with pytest.warns(SelfLockingWarning) as w:
         res = kinetostat.analyze(_load(_with_friction("scotch_yoke", 1.0, 0.01)), steps=36)
     none = res.self_locking_reason == "no equilibrium"
-    assert none.sum() >= 24 and set(res.phi_deg[none]) <= set(w[0].message.phi_deg)
+    assert none.sum() >= 24 and "no equilibrium at phi = [" in str(w[0].message)
+    assert set(res.phi_deg[none]) <= set(w[0].message.phi_deg)
     assert np.isnan(res.friction_power[none]).all() and np.isnan(res.balancing_moment[none]).all()
+    tied = [x.message for x in w if x.category is SingularFrictionWarning]
+    assert len(tied) == 1, [str(x.message) for x in w]
+    text = str(tied[0])
+    assert "\n" not in text and text.startswith(f"friction solve singular at {none.sum()} angle(s): the friction "
+                                                f"loads of the pairs {YOKE_GUIDES} at phi = [10, 20, 30, ")
+    assert list(tied[0].phi_deg) == list(res.phi_deg[none]) and set(tied[0].pairs) == {tuple(YOKE_GUIDES.split(" and "))}
+    assert res.friction.dependent[none][:, 2:].all() and not res.friction.dependent[:, :2].any()
+    assert not res.friction.dependent[~none].any()
 
 
 @pytest.mark.parametrize("f, radius, pair_radius, field", [
@@ -139,3 +153,47 @@ def test_cli_says_why_the_cycle_efficiency_is_undefined(cli, tmp_path):
     r = cli("analyze", path, "--steps", "36")
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     assert "cycle efficiency: undefined: no equilibrium with friction" in r.stdout
+    tied = [x for x in r.stderr.splitlines() if "friction solve singular" in x]
+    assert len(tied) == 1 and tied[0].startswith("kinetostat: warning: chain.toml: friction solve singular at 35 "
+                                                 f"angle(s): the friction loads of the pairs {YOKE_GUIDES} at phi = [10, "), r.stderr
+
+
+@pytest.mark.parametrize("model, at, why", [
+    (_with_friction("scotch_yoke", 1.0, 0.01), 30.0, "no equilibrium with friction (self-locking)"),
+    ("ice_crank_slider", 0.0, "near a dead centre (the frictionless balancing moment at most 0.1 of the moment friction takes)"),
+])
+def test_worksheet_says_why_eta_is_undefined(model, at, why):
+    """Before: the eta row a bare NaN (a dash in the sheet, null in its JSON) with its formula as the note."""
+    from kinetostat.plans.worksheet import worksheet
+    mech = kinetostat.load(model) if "\n" not in model else _load(model)
+    row = next(r for r in worksheet(mech, at=at).rows if r.key == "eta")
+    assert math.isnan(row.value) and row.note == f"undefined: {why}"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SelfLockingWarning)
+        assert kinetostat.analyze(mech, phi_deg=[at], friction="reactions").efficiency_reason[0] == why
+
+
+def test_cli_values_table_says_why_eta_is_undefined(cli):
+    r = cli("analyze", ROOT / "models" / "ice_crank_slider.toml", "--at", "0", "30", "180", "--friction", "reactions")
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    assert "  eta undefined at phi = 0, 180 deg: near a dead centre (the frictionless balancing moment at most 0.1 " \
+           "of the moment friction takes)" in r.stdout.splitlines(), r.stdout
+
+
+def test_sweep_says_once_why_eta_cycle_is_undefined(tmp_path):
+    """Before: one UndefinedFigureWarning per design (a flood over a large sweep) and a bare NaN in the
+    table. Now: each design's reason in eta_cycle_reason, one warning counting the designs by cause."""
+    path = tmp_path / "chain.toml"
+    path.write_text(NO_NET_WORK["chain_unit_four_bar"])
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        sw = kinetostat.sweep(path, {"r": [0.05, 0.08, 0.11]}, steps=36)
+    msgs = [str(x.message) for x in w if issubclass(x.category, UndefinedFigureWarning)]
+    assert msgs == ["sweep: eta_cycle undefined (NaN) for 3 of 3 design(s): 3 where the loads do no net work over "
+                    "the cycle (each design's reason in eta_cycle_reason)"], msgs
+    assert sw.table["eta_cycle"].isna().all() and sw.table.attrs["units"]["eta_cycle_reason"] == "text"
+    assert sw.table["eta_cycle_reason"].str.startswith("the loads do no net work over the cycle (the frictionless").all()
+    with warnings.catch_warnings():            # not a full cycle: no cycle efficiency asked for, no warning
+        warnings.simplefilter("error", UndefinedFigureWarning)
+        sw = kinetostat.sweep(path, {"r": [0.05, 0.08]}, phi_deg=[10.0, 20.0])
+    assert (sw.table["eta_cycle_reason"] == "the angles are not a uniform full cycle (sweep with steps=N)").all()

@@ -68,6 +68,10 @@ def _summary(res, path: Path) -> list[str]:
                      f"{int(res.friction.passes[n].max()):6d} ") if exact else ""
             lines.append(f"  {phi[n]:9.4g} {M[n]:12.6g} {extra}" + " ".join(
                 f"{np.linalg.norm(res.forces.R[n, p.index]):13.6g}" for p in m.pairs))
+        if exact:                      # a NaN eta with its reason
+            why = res.efficiency_reason
+            lines += [f"  eta undefined at phi = {', '.join(f'{a:g}' for a in phi[why == r])} deg: {r}"
+                      for r in dict.fromkeys(why[why != ""])]
     return lines
 
 

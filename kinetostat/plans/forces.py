@@ -35,7 +35,7 @@ import numpy as np
 
 from ..applied import applied_moment, point_forces
 from .core import Plan, Result, Scale, Segment
-from .lettering import lettering
+from .lettering import lettering, link_number, reaction_name
 from .scales import round_scale
 
 if TYPE_CHECKING:
@@ -71,16 +71,6 @@ def frame_number(mech: "Mechanism") -> int:
     """The number the texts give the frame: 0 (seed 000) unless the model's lettering or a
     published reaction letters it otherwise (seed 002's ICE: R43 for the pair (0, 3), the frame is 4)."""
     return lettering(mech).frame
-
-
-def _label(mech: "Mechanism", k: int) -> int:
-    return frame_number(mech) if k == 0 else k
-
-
-def reaction_name(mech: "Mechanism", i: int, j: int, part: str = "") -> str:
-    """R<i><j> (force of link i on link j) as the texts letter it; part "n" or "t" for a component."""
-    a, b = _label(mech, i), _label(mech, j)
-    return f"R{a}{b}{part}" if a < 10 and b < 10 else f"R{a},{b}{part}"
 
 
 def arm_name(load: str) -> str:
@@ -336,7 +326,7 @@ def _link_drawing(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: l
         if p.kind == "P" and k in p.links:
             X = _world(res, p.links[1], p.point) / mu_l.value
             d = complex(*p.direction) * complex(res.kin.rot[0, p.links[0]])
-            name = f"guide P({_label(mech, p.links[0])},{_label(mech, p.links[1])})"     # the text's numbers
+            name = f"guide P({link_number(mech, p.links[0])},{link_number(mech, p.links[1])})"     # the text's numbers
             pts[f"{name}:from"], pts[f"{name}:to"] = X - 40 * d, X + 40 * d
             segs.append(Segment(name, f"{name}:from", f"{name}:to", float("nan"), "", "line"))
 

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Mapping
 if TYPE_CHECKING:
     from ..model import Mechanism
 
-__all__ = ["Lettering", "lettering", "with_aliases", "DEFAULT"]
+__all__ = ["Lettering", "lettering", "link_number", "reaction_name", "pair_name", "with_aliases", "DEFAULT"]
 
 
 @dataclass(frozen=True)
@@ -75,6 +75,23 @@ def lettering(mech: "Mechanism") -> Lettering:
                      loads=MappingProxyType(dict(given.get("loads", {}))),
                      names=MappingProxyType(dict(given.get("name", {}))),
                      language=str(given.get("language", "")))
+
+
+def link_number(mech: "Mechanism", k: int) -> int:
+    """Link k's number as the text letters it: the frame's (`Lettering.frame`) for k = 0, else k."""
+    return lettering(mech).frame if k == 0 else k
+
+
+def reaction_name(mech: "Mechanism", i: int, j: int, part: str = "") -> str:
+    """R<i><j> (force of link i on link j) as the texts letter it; part "n" or "t" for a component."""
+    a, b = link_number(mech, i), link_number(mech, j)
+    return f"R{a}{b}{part}" if a < 10 and b < 10 else f"R{a},{b}{part}"
+
+
+def pair_name(mech: "Mechanism", p) -> str:
+    """A pair as the outputs name it: its reaction and where it acts (R43 at B; R32 slider A on guide K)."""
+    where = f"at {p.point}" if p.kind == "R" else f"slider {p.point} on guide {p.guide}"
+    return f"{reaction_name(mech, *p.links)} {where}"
 
 
 def with_aliases(df, mech: "Mechanism"):

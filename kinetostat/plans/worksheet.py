@@ -461,7 +461,7 @@ class _Sheet:
         """The friction terms (a model with [friction]): per pair the friction circle rho = f r and
         the friction moment f r |R|, or the friction angle arctg f and force f |N|, from the
         exact solution with friction in the reactions; M_bal with friction, the first
-        approximation's and eta."""
+        approximation's and eta (where it is undefined, why in its note)."""
         m, L = self.mech, self.L
         if m.friction is None:
             return
@@ -494,7 +494,8 @@ class _Sheet:
         self.add("friction", "M_bal_first", f"{L.M_bal} + P_f/ω1", M1, "N m", _sense(M1), "first approximation")
         self.add("friction", "M_bal_friction", f"{L.M_bal},f", Mf, "N m", _sense(Mf),
                  f"friction in the reactions, {int(ex.friction.passes[0].max())} passes")
-        self.add("friction", "eta", "η", ex.efficiency[0], "1", "",
+        why = ex.efficiency_reason[0]
+        self.add("friction", "eta", "η", ex.efficiency[0], "1", "", f"undefined: {why}" if why else
                  f"{L.M_bal} / {L.M_bal},f" if M0 * ex.omega(1)[0] >= 0 else f"{L.M_bal},f / {L.M_bal}")
 
 

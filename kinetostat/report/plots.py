@@ -8,7 +8,7 @@ Names as the model's text letters them (`plans.lettering`: R43 for the ICE's R(0
 quantity a figure or a table shows goes through `quantity_name`.
 
 May use: numpy, matplotlib, the solver's results, the runs room, `kinetostat._io` (atomic writes)
-and the plans' lettering (`plans.lettering`, `plans.forces.reaction_name`).
+and the plans' lettering (`plans.lettering`).
 """
 from __future__ import annotations
 
@@ -24,8 +24,7 @@ import numpy as np
 from .._io import atomic
 from ..analysis import Analysis
 from ..model import Mechanism
-from ..plans.forces import reaction_name
-from ..plans.lettering import lettering
+from ..plans.lettering import lettering, pair_name, reaction_name
 from .runs import ModelRun, quantities
 
 
@@ -202,12 +201,6 @@ def _phi_axes(ax, label: bool = True, step: int = 90, y=None, ylabel: str | None
     from matplotlib.ticker import FixedLocator
     ax.set_xlim(0, 360)
     _axes(ax, FixedLocator(range(0, 361, step)), y, "crank angle φ, deg" if label else None, ylabel, ylabel_pt, xnumbers)
-
-
-def _pair_name(mech: Mechanism, p) -> str:
-    i, j = p.links
-    where = f"at {p.point}" if p.kind == "R" else f"slider {p.point} on guide {p.guide}"
-    return f"{reaction_name(mech, i, j)} {where}"
 
 
 def quantity_name(mech: Mechanism, q: str) -> str:
@@ -457,7 +450,7 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
             col, ls = _style(route, n)
             h, = ax.plot(*_closed(er.phi_deg, np.linalg.norm(er.R[:, p.index], axis=-1)), **_line(er, res, col, ls, 1.5))
             handles[f"{route} ({er.route})"] = h
-        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
+        ax.set_title(_wrap(f"{pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
         ax.set_ylim(bottom=0)
         _phi_axes(ax, label=n_ax + cols >= len(m.pairs), y=_nice(4), ylabel="|R|, N")
     for ax in axes[len(m.pairs):]:
@@ -513,7 +506,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
                     transform=ax.transAxes, ha="center", va="center", fontsize=8, color="0.4")
             ax.set_yscale("log")
         title = f"{quantity_name(m, q)}: balancing moment" if q == "M_drive" else \
-            _pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
+            pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
         ax.set_title(_wrap(title), fontsize=9, y=1.0)
         _phi_axes(ax, label=n_ax + cols >= len(qs), ylabel=f"|error|, {unit}",
                   y=None if ax.get_lines() else FixedLocator([]))     # nothing drawn: no scale to read
@@ -564,7 +557,7 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
                         fontsize=7, color="tab:red")
         ax.set_aspect("equal", adjustable="datalim")
         _axes(ax, _nice(4), _nice(5), "R_x, N", "R_y, N")     # 4 on x: room for "−4000" on a narrow panel
-        ax.set_title(_wrap(f"{_pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
+        ax.set_title(_wrap(f"{pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
     for ax in axes[len(pairs):]:
         ax.set_visible(False)
     _legend(fig, handles, ncols)

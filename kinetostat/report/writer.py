@@ -9,7 +9,7 @@ import json
 import math
 import warnings
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -22,7 +22,7 @@ from ..sweep import sweep
 from .. import units as model_units
 from ..tables import error, plain, write_csv
 from .document import ROUNDING, Doc, _err, _fmt, _is_rounding, _rel, esc, slug
-from .plots import (_pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
+from .plots import (pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
 from .runs import ModelRun, trust
@@ -384,9 +384,14 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
     M = esc(quantity_name(m, "M_bal"))
     rows = [row(M, "Zhukovsky's lever", res.lever_moment, res.balancing_moment, "N·m"),
             row(M, "d'Alembert–Lagrange", vw.balancing_moment, res.balancing_moment, "N·m")]
-    rows += [row(esc(_pair_name(m, p)), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
+    rows += [row(esc(pair_name(m, p)), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
              for p in m.pairs]
     doc.table(["quantity", "route against group by group", "max |difference|", "peak relative, 1"], rows, "llrr")
+
+
+def _figure(value: Callable[[], float], why: str) -> str:
+    """A figure's table cell: `value()`, or "undefined: `why`" where it is undefined (value not called)."""
+    return esc(f"undefined: {why}") if why else _fmt(value())
 
 
 def _friction_section(doc: Doc, m: Mechanism, res) -> None:
@@ -415,13 +420,11 @@ def _friction_section(doc: Doc, m: Mechanism, res) -> None:
     phi0 = m.drive.design_deg
     rows = [[f"{M} at φ = {phi0:g}°, N·m", _fmt(at.balancing_moment_frictionless[0]),
              _fmt(first.balancing_moment_with_friction[0]), _fmt(at.balancing_moment[0])],
-            [f"η at φ = {phi0:g}°, 1", "1", _fmt(first.efficiency[0]), _fmt(at.efficiency[0])]]
+            [f"η at φ = {phi0:g}°, 1", "1"] + [_figure(lambda: r.efficiency[0], r.efficiency_reason[0]) for r in (first, at)]]
     try:
         lost0, lost = res.friction_energy(), ex.friction_energy()
-        rows.append(["cycle efficiency, 1", "1"] + [esc(f"undefined: {r.cycle_efficiency_reason()}")
-                                                     if r.cycle_efficiency_reason() else _fmt(r.cycle_efficiency())
-                                                     for r in (res, ex)])
-        rows += [[f"energy lost in {esc(_pair_name(m, p))} per cycle, J", "0", _fmt(lost0[p.index]), _fmt(lost[p.index])]
+        rows.append(["cycle efficiency, 1", "1"] + [_figure(r.cycle_efficiency, r.cycle_efficiency_reason()) for r in (res, ex)])
+        rows += [[f"energy lost in {esc(pair_name(m, p))} per cycle, J", "0", _fmt(lost0[p.index]), _fmt(lost[p.index])]
                  for p in m.pairs]
     except ValueError:                  # not a uniform full cycle: no cycle integrals
         pass
@@ -547,7 +550,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
           "engine route overlaid.")
     doc.img(images["reactions"], "Reaction magnitudes over the cycle, N")
     doc.table(["pair", "max |R|, N", "at φ, deg", "min |R|, N", "at φ, deg"],
-              [[esc(_pair_name(m, p)), *_extremes(np.linalg.norm(res.forces.R[:, p.index], axis=-1), res.phi_deg)]
+              [[esc(pair_name(m, p)), *_extremes(np.linalg.norm(res.forces.R[:, p.index], axis=-1), res.phi_deg)]
                for p in m.pairs], "lrrrr")
 
     _three_routes_section(doc, m, res)
