@@ -1,8 +1,8 @@
 """The whole kinetostatic analysis as one frozen result object (`Analysis`), and the numpy path
 that computes it (`exact`); `kinetostat.solve.analyze` chooses between it and the compiled path.
 
-May use: model, groups, kinematics, kinetostatics, applied, planar, friction, errors; pandas only inside
-`to_frame`; `plans.lettering` (the pairs' names) only inside `exact`, where a warning names pairs.
+May use: model (with `model.lettering`: the pairs' names a warning gives), groups, kinematics,
+kinetostatics, applied, planar, friction, errors; pandas only inside `to_frame`.
 """
 from __future__ import annotations
 
@@ -24,6 +24,7 @@ from .friction import relative_rate
 from .errors import (SelfLockingWarning, SingularFrictionWarning, SingularPositionWarning, UndefinedFigureWarning,
                      self_locking_message, singular_friction_message)
 from .model import Mechanism, _abbreviate
+from .model.lettering import pair_name
 
 __all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "deviation",
            "force_deviation"]
@@ -750,7 +751,6 @@ def exact(mech: Mechanism, phi_deg: np.ndarray, friction: str = "first") -> Anal
                                          phi_deg[why != ""], why[why != ""]), stacklevel=3)
         tied = res.friction.dependent & ~res.singular[:, None]
         if tied.any():
-            from .plans.lettering import pair_name      # not at the top: plans imports this module
             at = tied.any(axis=1)
             names = [tuple(pair_name(mech, p) for p in mech.pairs if row[p.index]) for row in tied[at]]
             warnings.warn(SingularFrictionWarning(singular_friction_message(phi_deg[at], names), phi_deg[at], names),

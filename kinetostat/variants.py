@@ -560,7 +560,7 @@ class KeySummary:
 
 def _largest(res, mech: Mechanism, n: int = 0) -> tuple[str, float]:
     """The most loaded pair at angle n, named as the model's text names its reaction (R43), N."""
-    from .plans.lettering import lettering
+    from .model.lettering import lettering
     frame = lettering(mech).frame
     mags = {"R" + "".join(str(k or frame) for k in p.links): float(np.linalg.norm(res.forces.R[n, p.index]))
             for p in mech.pairs}
@@ -584,7 +584,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     (default: itself), ValueError otherwise."""
     from .solve import analyze
     from .plans import build as build_plans
-    from .plans.lettering import with_aliases
+    from .model.lettering import with_aliases
     from .plans.a3 import one_sheet
     from .plans.pack import pack
     from .plans.worksheet import worksheet
@@ -666,7 +666,7 @@ def summary(v: Variant, k: KeySummary, out: str | Path, lang: str = "en") -> lis
 
 def lettering_of(task: int):
     """The lettering of task `task`'s variants (that of its bundled model)."""
-    from .plans.lettering import lettering
+    from .model.lettering import lettering
     return lettering(_bundled(TASKS[task].bundled))
 
 

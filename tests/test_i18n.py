@@ -15,7 +15,7 @@ import kinetostat
 import kinetostat.plans as P
 from kinetostat import variants
 from kinetostat.plans.i18n import LANGS, MESSAGES, PHRASES, UNITS, num, phrase, text, unit, words_en
-from kinetostat.plans.lettering import lettering, with_aliases
+from kinetostat.model.lettering import lettering, with_aliases
 from kinetostat.plans.worksheet import worksheet
 
 

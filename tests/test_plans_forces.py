@@ -11,7 +11,7 @@ import pytest
 import kinetostat
 from kinetostat.plans.core import Scale
 from kinetostat.plans.forces import crank_plan, default_mu_F, force_plans, group_plans, link_loads, reaction_name
-from kinetostat.plans.lettering import lettering
+from kinetostat.model.lettering import lettering
 from kinetostat.plans.lever import lever_check, lever_plan, pole_moment
 
 MODELS = sorted((Path(__file__).parent.parent / "models").glob("*.toml"))

@@ -20,7 +20,7 @@ import kinetostat
 import kinetostat.plans as P
 from kinetostat import variants
 from kinetostat.plans.draw import svg
-from kinetostat.plans.lettering import lettering
+from kinetostat.model.lettering import lettering
 
 import sheet_browser
 from conftest import MODELS

@@ -51,7 +51,7 @@ def cmd_plans(args) -> int:
     from ..errors import ModelWarning, SelfLockingWarning, SingularPositionWarning
     from ..plans import build, cycle_scales
     from ..plans.worksheet import worksheet
-    from ..plans.lettering import lettering
+    from ..model.lettering import lettering
     from ..plans.scales import ScaleError
     path = Path(args.model)
     mech = _load(path)
@@ -86,7 +86,7 @@ def cmd_plans(args) -> int:
 
 
 def cmd_page(args) -> int:
-    from ..plans.lettering import lettering
+    from ..model.lettering import lettering
     from ..plans.page import write_page
     mech = _load(Path(args.model))
     out = _writable_file(args.out, "--out")

@@ -38,7 +38,7 @@ class Mechanism:
     expressions: Mapping[str, tuple[str, float]] = field(default_factory=lambda: MappingProxyType({}))
     study: Study | None = None
     #: `[lettering]`: the names the model's source text uses (frame, M_bal, F_bal, loads, name,
-    #: language), as given; read through `kinetostat.plans.lettering.lettering`
+    #: language), as given; read through `kinetostat.model.lettering.lettering`
     lettering: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     #: Structural analysis (mobility, Assur groups, structure formula), derived from the pairs
     #: when the mechanism is built; raises StructureError for what kinetostat does not analyse.

@@ -32,7 +32,7 @@ from ..tables import FLOAT_FORMAT, by_unit, rounded
 from .core import SEGMENT_COLUMNS, Plan, Scale, Segment, extent
 from .draw import figure, fits, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
-from .lettering import lettering
+from ..model.lettering import lettering
 from .mechanism import mechanism_plan
 from .kinematic import FixedPositions, acceleration_plan, fixed_positions, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan

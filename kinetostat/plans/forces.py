@@ -35,7 +35,7 @@ import numpy as np
 
 from ..applied import applied_moment, point_forces
 from .core import Plan, Result, Scale, Segment
-from .lettering import lettering, link_number, reaction_name
+from ..model.lettering import lettering, link_number, reaction_name
 from .scales import round_scale
 
 if TYPE_CHECKING:

@@ -21,7 +21,7 @@ import numpy as np
 
 from .core import Plan, Result, Scale, Segment
 from .forces import _scale, _single, arm_name, force_scale, link_couples, link_loads
-from .lettering import lettering
+from ..model.lettering import lettering
 
 if TYPE_CHECKING:
     from ..analysis import Analysis

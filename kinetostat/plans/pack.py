@@ -26,7 +26,7 @@ twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figur
 DejaVu Sans embedded as Type 42 with its Unicode map, so pdftotext reads the Cyrillic back) and to
 HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
-May use: `build` of this package, `.a3`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `.lettering`,
+May use: `build` of this package, `.a3`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `model.lettering`,
 `kinetostat._io`; matplotlib inside the PDF writers only. Never the harness, nor `kinetostat.variants` (the variant
 is passed in and says its task, title and letters).
 """
@@ -45,7 +45,7 @@ import numpy as np
 from .._io import write_bytes, write_text
 from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
-from .lettering import lettering
+from ..model.lettering import lettering
 from .worksheet import CSS, Worksheet, html_document, worksheet
 
 __all__ = ["Pack", "pack", "BAND", "BAND_DRAWS", "PACK_FILES"]

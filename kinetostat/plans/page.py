@@ -329,7 +329,7 @@ def _steps(mech, plans, lang: str) -> list[dict]:
     terms written by the page's script from the sheet of the angle shown."""
     from ..solve import analyze
     from .forces import _carried, _group_label, _later, _moment_equations, link_couples, link_loads, reaction_name
-    from .lettering import lettering
+    from ..model.lettering import lettering
     L = lettering(mech)
     any_plan = next(iter(plans.values()))
     with warnings.catch_warnings():
@@ -460,7 +460,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
     from ..solve import analyze
     from . import cycle_scales, fixed_positions
-    from .lettering import lettering
+    from ..model.lettering import lettering
     check_lang(lang)
     key = page_key(mech, lang, student, at, angles, fixed)
     design = float(getattr(mech.drive, "design_deg", 30.0))

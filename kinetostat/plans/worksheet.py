@@ -30,7 +30,7 @@ from .._text import csv_cell, markdown_text
 from ..model import Mechanism
 from ..tables import FLOAT_FORMAT, by_unit, plain
 from .i18n import ZERO, accuracy, check_lang, num, phrase, text, unit
-from .lettering import lettering
+from ..model.lettering import lettering
 from .scales import choose_scales
 
 __all__ = ["Row", "Worksheet", "worksheet", "COLUMNS", "CSS", "html_document"]

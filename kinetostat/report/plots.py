@@ -4,11 +4,11 @@ beyond `plain_text`'s settings while the figures are made).
 Every text of a figure is plain text: a model's name or a point's name is never parsed as a
 mathtext formula or given to LaTeX (`plain_text`).
 
-Names as the model's text letters them (`plans.lettering`: R43 for the ICE's R(0,3), M_зр): every
+Names as the model's text letters them (`model.lettering`: R43 for the ICE's R(0,3), M_зр): every
 quantity a figure or a table shows goes through `quantity_name`.
 
 May use: numpy, matplotlib, the solver's results, the runs room, `kinetostat._io` (atomic writes)
-and the plans' lettering (`plans.lettering`).
+and the model's lettering (`model.lettering`).
 """
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ import numpy as np
 from .._io import atomic
 from ..analysis import Analysis
 from ..model import Mechanism
-from ..plans.lettering import lettering, pair_name, reaction_name
+from ..model.lettering import lettering, pair_name, reaction_name
 from .runs import ModelRun, quantities
 
 

@@ -18,7 +18,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Mapping
 
 if TYPE_CHECKING:
-    from ..model import Mechanism
+    from .mechanism import Mechanism
 
 __all__ = ["Lettering", "lettering", "link_number", "reaction_name", "pair_name", "with_aliases", "DEFAULT"]
 
