@@ -52,7 +52,8 @@ CHUNK = 32
 LOCAL_SCHEDULERS = ("threads", "processes")
 #: Most designs of one sweep (the product of the parameters' numbers of values), checked before any is made.
 MAX_DESIGNS = 1_000_000
-#: Seconds to wait for a distributed scheduler to answer, and for its first worker.
+#: Seconds to wait for a distributed scheduler to answer (to connect and send its greeting), and
+#: for its first worker.
 CONNECT_TIMEOUT = 10.0
 
 
@@ -329,7 +330,11 @@ def _distributed(tasks: list, scheduler: Any, bar) -> list:
                                   f"needs its security or transport set up: connect a distributed.Client yourself "
                                   f"and pass it (the API's scheduler=client)")
         try:
+            _greeted(scheduler, CONNECT_TIMEOUT)
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except TimeoutError:
+            raise ConnectionError(f"scheduler {scheduler!r}: no answer within {CONNECT_TIMEOUT:g} s (CONNECT_TIMEOUT); "
+                                  f"is a distributed scheduler listening there?") from None
         except (OSError, ValueError, TypeError) as exc:
             raise ConnectionError(f"scheduler {scheduler!r}: no distributed scheduler there ({exc}); "
                                   f"or use {' or '.join(map(repr, LOCAL_SCHEDULERS))}") from None
@@ -344,6 +349,20 @@ def _distributed(tasks: list, scheduler: Any, bar) -> list:
         raise TypeError(f"scheduler: expected None, {' or '.join(map(repr, LOCAL_SCHEDULERS))}, a distributed "
                         f"scheduler's address or a distributed.Client, got {type(scheduler).__name__}")
     return _gather(scheduler, tasks, bar, as_completed)
+
+
+def _greeted(address: str, timeout: float) -> None:
+    """Connect to the distributed scheduler at `address` and read its greeting (distributed's
+    handshake) within `timeout` s, then hang up: TimeoutError where the port accepts but never
+    answers, which `distributed.Client` would wait on for ever."""
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def hello() -> None:
+        comm = await connect(address, timeout=timeout)
+        await comm.close()
+    asyncio.run(asyncio.wait_for(hello(), timeout))
 
 
 def _gather(client, tasks: list, bar, as_completed) -> list:
