@@ -354,15 +354,18 @@ def _distributed(tasks: list, scheduler: Any, bar) -> list:
 def _greeted(address: str, timeout: float) -> None:
     """Connect to the distributed scheduler at `address` and read its greeting (distributed's
     handshake) within `timeout` s, then hang up: TimeoutError where the port accepts but never
-    answers, which `distributed.Client` would wait on for ever."""
+    answers, which `distributed.Client` would wait on for ever. In a thread of its own, with
+    its own event loop (the caller's thread may run one: a notebook's)."""
     import asyncio
+    from concurrent.futures import ThreadPoolExecutor
 
     from distributed.comm import connect
 
     async def hello() -> None:
         comm = await connect(address, timeout=timeout)
         await comm.close()
-    asyncio.run(asyncio.wait_for(hello(), timeout))
+    with ThreadPoolExecutor(1) as pool:
+        pool.submit(lambda: asyncio.run(asyncio.wait_for(hello(), timeout))).result()
 
 
 def _gather(client, tasks: list, bar, as_completed) -> list:

@@ -117,7 +117,10 @@ def test_the_gate_reports_an_unreadable_toml_and_goes_on(pytester):
 
 # ============================================================================ waits
 
-def test_a_scheduler_that_accepts_and_never_answers_times_out(monkeypatch):
+@pytest.mark.parametrize("in_loop", [False, True], ids=["plain", "inside a running event loop"])
+def test_a_scheduler_that_accepts_and_never_answers_times_out(in_loop, monkeypatch):
+    """Also called where an event loop runs (a notebook's)."""
+    import asyncio
     pytest.importorskip("distributed")
     sweep_module = sys.modules["kinetostat.sweep"]
     monkeypatch.setattr(sweep_module, "CONNECT_TIMEOUT", 0.5)
@@ -126,7 +129,11 @@ def test_a_scheduler_that_accepts_and_never_answers_times_out(monkeypatch):
     threading.Thread(target=lambda: held.extend(iter(lambda: server.accept()[0], None)), daemon=True).start()
     address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
     try:
-        exc = _within(lambda: kinetostat.sweep("ice_crank_slider", {"l_OA": [0.036]}, steps=12, scheduler=address), 20)
+        call = lambda: kinetostat.sweep("ice_crank_slider", {"l_OA": [0.036]}, steps=12, scheduler=address)
+
+        async def inside_a_loop():
+            return call()
+        exc = _within((lambda: asyncio.run(inside_a_loop())) if in_loop else call, 20)
     finally:
         server.close()
         for s in held:
