@@ -167,3 +167,11 @@ def test_a_table_longer_than_the_limit_is_refused_naming_the_field(table, field,
     with pytest.raises(ModelError) as exc:
         kinetostat.loads(table(51))
     assert f"{field}: 51 values, at most 50 (MAX_TABLE_POINTS)" in str(exc.value)
+
+
+def test_an_expected_cycle_that_is_a_fifo_is_refused_unread(tmp_path):
+    from kinetostat.testing import check_cycle
+    fifo = tmp_path / "expected.csv"
+    os.mkfifo(fifo)                     # pandas' read_csv waited for a writer for ever
+    exc = _within(lambda: check_cycle("ice_crank_slider", expected=fifo, steps=12))
+    assert isinstance(exc, ValueError) and f"{fifo}: the expected file is not read: a FIFO" in str(exc), exc
