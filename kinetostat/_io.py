@@ -1,6 +1,8 @@
 """Output files: atomic writes (a temporary file in the same folder, renamed into place; a device
 or FIFO named by the user written as a stream), sets of files swapped in as a unit, folder names
-made from model file names, and the check that a written path stays inside its folder.
+made from model file names, and the check that a written path stays inside its folder. Input
+files and earlier outputs: read whole only where regular and of bounded size (`read_regular`),
+so that a FIFO never blocks and /dev/zero is never read.
 
 May use: the standard library only.
 """
@@ -18,7 +20,7 @@ from pathlib import Path
 from typing import IO, Iterator
 
 __all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside",
-           "is_stream", "unit"]
+           "is_stream", "unit", "read_regular", "NotRegularFile", "FileTooLarge", "open_append"]
 
 #: The temporary files of the writes in progress in this process (`remove_temporary`).
 _PENDING: set[str] = set()
@@ -209,6 +211,69 @@ def unit(folder: str | Path, root: str | Path | None = None) -> Iterator[Path]:
     finally:
         _remove(tmp)
         _PENDING.discard(tmp)
+
+
+class NotRegularFile(OSError):
+    """A file read as an input or an earlier output, or appended to, is not a regular file (a
+    FIFO, a device, a socket or a directory, also through a link); `filename` names it, `kind`
+    says what it is ("a FIFO")."""
+
+    def __init__(self, path: str, mode: int):
+        self.kind = ("a directory" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else
+                     "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else
+                     "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+        super().__init__(22, f"{self.kind}, not a regular file; left as it is", path)
+
+
+class FileTooLarge(OSError):
+    """A file read as an input or an earlier output holds more bytes than its reader's limit;
+    `filename` names it, `limit` is the limit in bytes."""
+
+    def __init__(self, path: str, limit: int):
+        super().__init__(27, f"larger than {limit} bytes, the most read", path)      # errno 27: EFBIG
+        self.limit = limit
+
+
+#: Opening flags of a file read or appended to: never waiting for a FIFO's other end.
+_NO_WAIT = getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+
+
+def read_regular(path: str | Path, limit: int) -> bytes:
+    """The bytes of the regular file `path` (links followed), at most `limit` of them.
+
+    Opened without blocking (O_NONBLOCK: a FIFO with no writer does not hang the open) and
+    checked on the opened descriptor (`fstat`, so that nothing can be swapped in between):
+    `NotRegularFile` for a FIFO, device (/dev/zero, also through a link), socket or directory,
+    `FileTooLarge` for more than `limit` bytes (also where the file grows while read). Other
+    OSErrors (FileNotFoundError, PermissionError) as `os.open` raises them."""
+    fd = os.open(path, os.O_RDONLY | _NO_WAIT)
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise NotRegularFile(str(path), st.st_mode)
+        if st.st_size > limit:
+            raise FileTooLarge(str(path), limit)
+    except BaseException:
+        os.close(fd)
+        raise
+    with os.fdopen(fd, "rb") as f:
+        data = f.read(limit + 1)
+    if len(data) > limit:
+        raise FileTooLarge(str(path), limit)
+    return data
+
+
+def open_append(path: str | Path) -> IO[str]:
+    """`path` opened to append UTF-8 text, created where missing: a regular file only. Opened
+    without blocking (a FIFO with no reader raises at once instead of waiting) and checked on
+    the opened descriptor: `NotRegularFile` for a FIFO, device or socket."""
+    fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | _NO_WAIT, 0o666)
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        raise NotRegularFile(str(path), st.st_mode)
+    os.set_blocking(fd, True)
+    return os.fdopen(fd, "a", encoding="utf-8")
 
 
 def remove_temporary() -> None:

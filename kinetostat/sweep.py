@@ -56,7 +56,8 @@ LOCAL_SCHEDULERS = ("threads", "processes")
 MAX_DESIGNS = 1_000_000
 #: `eta_cycle_reason` where the angles are not a uniform full cycle (no cycle efficiency to give).
 NOT_A_CYCLE = "the angles are not a uniform full cycle (sweep with steps=N)"
-#: Seconds to wait for a distributed scheduler to answer, and for its first worker.
+#: Seconds to wait for a distributed scheduler to answer (to connect and send its greeting), and
+#: for its first worker.
 CONNECT_TIMEOUT = 10.0
 
 
@@ -351,7 +352,11 @@ def _distributed(tasks: list, scheduler: Any, bar) -> list:
                                   f"needs its security or transport set up: connect a distributed.Client yourself "
                                   f"and pass it (the API's scheduler=client)")
         try:
+            _greeted(scheduler, CONNECT_TIMEOUT)
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except TimeoutError:
+            raise ConnectionError(f"scheduler {scheduler!r}: no answer within {CONNECT_TIMEOUT:g} s (CONNECT_TIMEOUT); "
+                                  f"is a distributed scheduler listening there?") from None
         except (OSError, ValueError, TypeError) as exc:
             raise ConnectionError(f"scheduler {scheduler!r}: no distributed scheduler there ({exc}); "
                                   f"or use {' or '.join(map(repr, LOCAL_SCHEDULERS))}") from None
@@ -366,6 +371,23 @@ def _distributed(tasks: list, scheduler: Any, bar) -> list:
         raise TypeError(f"scheduler: expected None, {' or '.join(map(repr, LOCAL_SCHEDULERS))}, a distributed "
                         f"scheduler's address or a distributed.Client, got {type(scheduler).__name__}")
     return _gather(scheduler, tasks, bar, as_completed)
+
+
+def _greeted(address: str, timeout: float) -> None:
+    """Connect to the distributed scheduler at `address` and read its greeting (distributed's
+    handshake) within `timeout` s, then hang up: TimeoutError where the port accepts but never
+    answers, which `distributed.Client` would wait on for ever. In a thread of its own, with
+    its own event loop (the caller's thread may run one: a notebook's)."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+
+    async def hello() -> None:
+        comm = await connect(address, timeout=timeout)
+        await comm.close()
+    with ThreadPoolExecutor(1) as pool:
+        pool.submit(lambda: asyncio.run(asyncio.wait_for(hello(), timeout))).result()
 
 
 def _gather(client, tasks: list, bar, as_completed) -> list:

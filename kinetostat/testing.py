@@ -10,7 +10,7 @@ differs writes `<expected>.obtained.csv` beside it and raises `CycleMismatch`, w
 lists the columns beyond tolerance; `regenerate=True` (or $KINETOSTAT_REGENERATE=1, or pytest's
 `--kinetostat-regen` with the `kinetostat_regression` fixture) rewrites the expected file instead.
 
-May use: numpy, pandas, the solver.
+May use: numpy, pandas, the solver, `_io` (atomic writes, bounded reads).
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from ._io import atomic
+from ._io import FileTooLarge, NotRegularFile, atomic, read_regular
 from .solve import analyze
 from .model import Mechanism, load
 
@@ -82,10 +82,22 @@ def _write(df, path: Path) -> None:
         out.to_csv(f, index=False, float_format="%.17g", lineterminator="\n")
 
 
+#: Largest expected file read, bytes (a cycle of 360 positions of a bundled model: 0.3-0.6 MB).
+MAX_EXPECTED_BYTES = 256 * 2**20
+
+
 def _read(path: Path):
+    """The expected table at `path`: a regular file of at most MAX_EXPECTED_BYTES (`read_regular`:
+    a FIFO or a device there is a ValueError naming it, never waited on or read)."""
+    import io
+
     import pandas as pd
 
-    raw = pd.read_csv(path)
+    try:
+        data = read_regular(path, MAX_EXPECTED_BYTES)
+    except (NotRegularFile, FileTooLarge) as exc:
+        raise ValueError(f"{path}: the expected file is not read: {exc.strerror}") from None
+    raw = pd.read_csv(io.BytesIO(data))
     names, units = [], {}
     for head in raw.columns:
         name, _, unit = str(head).rpartition(" [")

@@ -1,7 +1,7 @@
 """The units of a model's fields and [parameters], as a model file states them (SI throughout,
 models/FORMAT.md), in the ASCII spelling of the tables' units ("kg m^2", "rad/s^2").
 
-May use: the standard library; a Mechanism is passed in (its `parameters`, `expressions`, `path`).
+May use: the standard library, the model reader (`_read_text`); a Mechanism is passed in (its `parameters`, `expressions`, `path`).
 """
 from __future__ import annotations
 
@@ -29,11 +29,21 @@ def field_unit(path: str) -> str | None:
     return _FIELD_UNITS.get(re.sub(r"\[[^\]]*\]$", "", path).rsplit(".", 1)[-1])
 
 
+def _model_text(path: str | None) -> str:
+    """The text of the model file at `path` (`_read_text`: a regular file of bounded size); ""
+    where there is none or it cannot be read."""
+    from .model import _read_text
+    try:
+        return _read_text(Path(path)) if path else ""
+    except ValueError:                  # ModelError: not there, not a regular file, too large
+        return ""
+
+
 def parameter_units(m: Any) -> dict[str, str]:
     """The unit of each of the Mechanism `m`'s [parameters]: that of a field given as the
     parameter's name alone, else the one the model file's comment on the parameter states
     ("# crank length, m"; a ratio "l_AB / l_OA" is 1), else `NOT_STATED`."""
-    text = Path(m.path).read_text(encoding="utf-8") if m.path and Path(m.path).is_file() else ""
+    text = _model_text(m.path)
     out = {}
     for name in m.parameters:
         unit = next((u for path, (expr, _) in m.expressions.items()

@@ -341,7 +341,7 @@ def test_a_file_name_longer_than_255_bytes(args, tmp_path, cli):
     assert r.stderr.count("\n") == 1
 
 
-@pytest.mark.parametrize("steps, size", [(10**9, "GB"), (10**20, "ZB")])
+@pytest.mark.parametrize("steps, size", [(10**9, "TB"), (10**20, "ZB")])
 def test_steps_beyond_memory_are_refused_before_allocating(steps, size, cli):
     """The message names the bytes the result would need (and per crank position); nothing of
     that size is allocated: the peak of Python's and numpy's allocations stays small."""
@@ -352,6 +352,6 @@ def test_steps_beyond_memory_are_refused_before_allocating(steps, size, cli):
     finally:
         tracemalloc.stop()
     assert r.returncode == 2
-    assert f"--steps {steps}: the result alone would need " in r.stderr and f" {size} of memory (" in r.stderr
-    assert "bytes per crank position for this model)" in r.stderr and "use fewer steps" in r.stderr
+    assert f"--steps {steps}: the analysis would need about " in r.stderr and f" {size} of memory (" in r.stderr
+    assert "kB per crank position for this model)" in r.stderr and "use fewer steps" in r.stderr
     assert peak < 50e6, peak

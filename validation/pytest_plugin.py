@@ -2,7 +2,9 @@
 collected as tests, one item per route and quantity and one per published value, e.g.
 `models/ice_crank_slider.toml::reference::R_1_2` and `...::published::M_bal_lever`.
 
-Opt-in: `pytest --kinetostat [PATHS]` collects every visited `*.toml` with a `[mechanism]` table;
+Opt-in: `pytest --kinetostat [PATHS]` collects every visited `*.toml` with a `[mechanism]` table
+(one that is not a regular file or holds more than the model's MAX_FILE_BYTES is not read: one
+failing item `<file>::read` says so, and the gate goes on);
 the ini option `kinetostat_models` (glob patterns relative to the rootdir, like
 `--doctest-glob`) collects the visited TOML files it matches when `--kinetostat` is not given
 (with the flag, the patterns are not applied).
@@ -96,9 +98,13 @@ def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Col
         if not any(fnmatch.fnmatch(rel, p) for p in patterns):
             return None
     else:
+        from kinetostat._io import FileTooLarge, NotRegularFile, read_regular
+        from kinetostat.model import MAX_FILE_BYTES
         try:
-            if not _MECHANISM.search(file_path.read_bytes()):
+            if not _MECHANISM.search(read_regular(file_path, MAX_FILE_BYTES)):
                 return None
+        except (NotRegularFile, FileTooLarge) as exc:       # a model or not: it cannot be told without reading it
+            return UnreadFile.from_parent(parent, path=file_path, why=exc.strerror)
         except OSError:
             return None
     return ModelFile.from_parent(parent, path=file_path)
@@ -123,12 +129,13 @@ class ModelFile(pytest.File):
 
     def collect(self):
         from kinetostat import load
+        from kinetostat.model import _read_text
         from kinetostat.report import quantities
         from kinetostat.report.ci import model_lines
         from kinetostat_validation.compare import LEVER, ROUTES
 
         self.mech = load(self.path)
-        self.lines = model_lines(self.mech, self.path.read_text(encoding="utf-8"))
+        self.lines = model_lines(self.mech, _read_text(self.path))
         self._res = None
         self._runs: dict[str, Any] = {}
         self.add_marker("kinetostat")
@@ -160,6 +167,36 @@ class ModelFile(pytest.File):
         if isinstance(excinfo.value, (ModelError, StructureError, AssemblyError)):
             return f"{self.path}: {excinfo.value}"
         return super().repr_failure(excinfo, style)
+
+
+class UnreadFile(pytest.File):
+    """A visited *.toml that is not read (a FIFO, a device, or more than MAX_FILE_BYTES): one
+    failing item, `<file>::read`, that says why; the other files are checked as usual."""
+
+    def __init__(self, *, why: str, **kw):
+        super().__init__(**kw)
+        self.why = why
+
+    def collect(self):
+        self.add_marker("kinetostat")
+        yield UnreadItem.from_parent(self, name="read")
+
+
+class UnreadItem(pytest.Item):
+    """The item of an `UnreadFile`: fails with the file's name and the reason it was not read."""
+
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.user_properties += [("route", "(model file)"), ("trust", ""), ("file", str(self.path)), ("line", "")]
+
+    def runtest(self) -> None:
+        raise CheckFailed(f"{self.path}: not read as a model file: {self.parent.why}")
+
+    def repr_failure(self, excinfo, style=None):
+        return str(excinfo.value) if isinstance(excinfo.value, CheckFailed) else super().repr_failure(excinfo, style)
+
+    def reportinfo(self):
+        return self.path, None, f"{self.path.name} not read"
 
 
 class Route(pytest.Collector):

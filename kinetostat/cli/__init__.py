@@ -3,7 +3,8 @@ variant, sweep, schema (also `python -m kinetostat`).
 
 Exit codes: 0 success; 1 `validate` found a check beyond tolerance or a route that raised, or
 `report` could not make a model's report; 2 bad input or options (model file, structure,
-assembly, angles, engine names, output path, stdout that cannot be written); 3 `validate`: no
+assembly, angles, engine names, output path, stdout that cannot be written, `--steps` beyond the
+memory the process may take: MemoryError, or refused before by the memory guard); 3 `validate`: no
 failure, but a model that nothing checked (every route skipped, no published values), or a
 route named with --engines whose engine is not installed; 130 interrupted (Ctrl-C). `sweep`
 exits 0 once its table is written, also where designs failed (each keeps its row with the
@@ -56,6 +57,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         except KeyboardInterrupt:
             _error("interrupted")
             return EXIT_INTERRUPTED
+        except MemoryError:              # what the memory guard (`--steps`) could not foresee
+            _error("out of memory (MemoryError); use fewer --steps, or give the process more memory")
+            return EXIT_USAGE
         except BrokenPipeError:          # `kinetostat ... | head`: the reader has what it wanted
             _quiet_stdout()
             return EXIT_OK

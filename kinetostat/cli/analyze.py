@@ -146,7 +146,8 @@ def cmd_analyze(args) -> int:
         _writable_file(out, "--out")
     path = Path(args.model)
     mech = _load(path)
-    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps, friction=args.friction)
+    res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps, friction=args.friction,
+                      out=out)
     lines = _summary(res, path)
     if len(res.phi_deg) == 1:
         lines += _worksheet_lines(mech, float(res.phi_deg[0]))

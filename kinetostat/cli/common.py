@@ -290,68 +290,127 @@ def _size(n: float) -> str:
     return f"{n * 1e24:.3g} bytes"
 
 
-def _available_memory() -> int | None:
-    """Bytes of memory available now (Linux: MemAvailable; else free physical pages), or None."""
+def _read_number(path: str) -> int | None:
+    """The integer a /proc or /sys file holds (its first word), None where it is missing, "max" or not a number."""
     try:
-        with open("/proc/meminfo", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
+        with open(path, encoding="ascii") as f:
+            return int(f.read(64).split()[0])
     except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (AttributeError, ValueError, OSError):
         return None
 
 
-def _result_bytes(x, seen: set[int] | None = None) -> int:
-    """Bytes of the numpy arrays an analysis result holds (the mechanism itself not counted)."""
-    import numpy as np
-    from ..model import Mechanism
-    seen = set() if seen is None else seen
-    if id(x) in seen or isinstance(x, (Mechanism, str, bytes, int, float, type(None))):
-        return 0
-    seen.add(id(x))
-    if isinstance(x, np.ndarray):
-        return x.nbytes
-    if isinstance(x, dict):
-        return sum(_result_bytes(v, seen) for v in x.values())
-    if isinstance(x, (list, tuple)):
-        return sum(_result_bytes(v, seen) for v in x)
-    fields = getattr(x, "__dict__", None)
-    return sum(_result_bytes(v, seen) for v in fields.values()) if fields else 0
+def _status_bytes(field: str) -> int | None:
+    """A "kB" line of /proc/self/status (VmSize) or /proc/meminfo (MemAvailable), bytes; None where there is none."""
+    for path in ("/proc/self/status", "/proc/meminfo"):
+        try:
+            with open(path, encoding="ascii") as f:
+                for line in f:
+                    if line.startswith(field + ":"):
+                        return int(line.split()[1]) * 1024
+        except (OSError, ValueError, IndexError):
+            pass
+    return None
 
 
-#: `--steps` is refused where the result alone would need more than the memory available now.
-#: The bytes per crank position are measured on this many positions of the model.
-_SAMPLE_STEPS = 4
+def _available_memory() -> int | None:
+    """Bytes of memory this process may still take, or None where nothing is known: the least of
+    the memory available (Linux: MemAvailable; else free physical pages), the address-space
+    limit (RLIMIT_AS) less the process's size (VmSize), and its cgroup's limit less its use
+    (v2: memory.max - memory.current; v1: memory.limit_in_bytes - memory.usage_in_bytes)."""
+    free = [_status_bytes("MemAvailable")]
+    if free[0] is None:
+        try:
+            free = [os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")]
+        except (AttributeError, ValueError, OSError):
+            free = []
+    try:
+        import resource
+        limit = resource.getrlimit(resource.RLIMIT_AS)[0]
+        size = _status_bytes("VmSize")
+        if limit != resource.RLIM_INFINITY and size is not None:
+            free.append(limit - size)
+    except (ImportError, OSError, ValueError):
+        pass
+    for cap, used in (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                      ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes")):
+        c, u = _read_number(cap), _read_number(used)
+        if c is not None and u is not None:
+            free.append(c - u)
+    known = [x for x in free if x is not None]
+    return max(0, min(known)) if known else None
 
 
-def _check_memory(mech, steps: int) -> None:
-    """Refuse `steps` before anything is allocated where the result's arrays (measured per crank
-    position on a few positions of this model) would not fit in the memory available now."""
+#: `--steps` is refused where the analysis (and its table, with --out) would need more than the
+#: memory this process may still take (`_available_memory`). The analysis' bytes per crank
+#: position are measured on the model by a probe: the slope of tracemalloc's peak over two runs
+#: of these many positions.
+PROBE_STEPS = (8, 136)
+#: The analysis' peak over the probe's slope: the peak per position varies with the number of
+#: positions (ice_crank_slider: 1230 bytes at 1000 positions, the probe's 1215, 2207 at 16,000).
+ANALYSIS_HEADROOM = 2.0
+#: Bytes per cell (position x column) of the table an output path builds on top of the
+#: analysis: documented constants, measured with tracemalloc at 20,000 positions
+#: (ice_crank_slider, 81 columns; chain_unit_four_bar, 108): the DataFrame, its rounded copy and
+#: a chunk of text, 27-29 for .csv and 24 for .json (both written a chunk of rows at a time);
+#: .parquet taken as .csv (pyarrow's memory, which tracemalloc does not see: by the peak RSS,
+#: below the CSV's); "-" (CSV on stdout, its whole text built first) 37.
+TABLE_CELL_BYTES = {".csv": 32, ".json": 32, ".parquet": 32, "-": 48}
+
+
+def _probe(mech):
+    """(the analysis' bytes per crank position, the last probe run's result): tracemalloc's peak
+    of `analyze` on PROBE_STEPS positions, its slope (where tracemalloc already traces, as under
+    a test, its trace goes on)."""
+    import tracemalloc
     from ..solve import analyze
+    analyze(mech, steps=PROBE_STEPS[0])      # the imports and caches of a first run are no position's
+    own = not tracemalloc.is_tracing()
+    if own:
+        tracemalloc.start()
+    try:
+        peaks = []
+        for n in PROBE_STEPS:
+            base = tracemalloc.get_traced_memory()[0]
+            tracemalloc.reset_peak()
+            res = analyze(mech, steps=n)
+            peaks.append(tracemalloc.get_traced_memory()[1] - base)
+    finally:
+        if own:
+            tracemalloc.stop()
+    return max(peaks[1] - peaks[0], 0) / (PROBE_STEPS[1] - PROBE_STEPS[0]), res
+
+
+def _check_memory(mech, steps: int, out: str | None = None) -> None:
+    """Refuse `steps` before anything is allocated where the analysis (ANALYSIS_HEADROOM times
+    the bytes per crank position a probe measures on this model) and, with `out` (--out: a file
+    whose suffix picks the format, or "-"), its table (TABLE_CELL_BYTES per cell) would not fit
+    in the memory this process may still take (`_available_memory`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            per_angle = _result_bytes(analyze(mech, steps=_SAMPLE_STEPS)) / _SAMPLE_STEPS
+            per_angle, res = _probe(mech)
+            per_angle *= ANALYSIS_HEADROOM
+            if out is not None:
+                cell = TABLE_CELL_BYTES.get("-" if out == "-" else Path(out).suffix.lower(), TABLE_CELL_BYTES["-"])
+                per_angle += cell * len(res.to_frame().columns)
         except Exception:                # noqa: BLE001 -- the real analysis reports the fault
             return
     need, free = steps * per_angle, _available_memory()
     if free is not None and need > free:
-        raise CLIError(f"--steps {steps}: the result alone would need {_size(need)} of memory "
+        what = "the analysis" + (f" and its table (--out {out})" if out is not None else "")
+        raise CLIError(f"--steps {steps}: {what} would need about {_size(need)} of memory "
                        f"({_size(per_angle)} per crank position for this model), and {_size(free)} is "
-                       f"available; use fewer steps (at most about {int(free // per_angle):,})")
+                       f"available to this process; use fewer steps (at most about {int(free // per_angle):,})")
 
 
-def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | None = None):
+def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | None = None, out: str | None = None):
     """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each;
-    `steps` that would not fit in memory are refused before anything is allocated."""
+    `steps` that would not fit in memory (with `out`, the --out table's too) are refused before
+    anything is allocated."""
     from ..solve import analyze
     from ..errors import AssemblyError, ModelError
     if phi_deg is None:
-        _check_memory(mech, steps)
+        _check_memory(mech, steps, out)
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -19,7 +19,7 @@ from ..structure import Structure, analyse_structure
 from .core import _suggest
 from .laws import _periodic_spline, _spline_at
 from .limits import (FASTEST_PIN, LAW_VARIABLES, MAX_FILE_BYTES, MAX_KEY, MAX_KEY_MEMORY, MAX_NAME, MAX_PARAMETERS,
-                     MAX_POINTS, MAX_PROBLEMS, MAX_PUBLISHED_ANGLES, MAX_SHOWN, MAX_VALUE, MIN_GEAR, MIN_LENGTH)
+                     MAX_POINTS, MAX_PROBLEMS, MAX_PUBLISHED_ANGLES, MAX_SHOWN, MAX_TABLE_POINTS, MAX_VALUE, MIN_GEAR, MIN_LENGTH)
 from .lines import _Lines
 from .mechanism import Mechanism, _abbreviate
 from .parts import (PUBLISHED_UNITS, Body, Characteristic, Drive, Friction, Gear, Link, Load, Pair, Published, SpeedLaw,

@@ -15,7 +15,7 @@ import sys
 from typing import Any, Mapping
 
 from ..expressions import ExpressionError, parse as parse_expression, shown_number, suggest
-from .limits import MAX_NAME, MAX_PROBLEMS, MAX_SHOWN, MAX_VALUE, _finite, _subnormal
+from .limits import MAX_NAME, MAX_PROBLEMS, MAX_SHOWN, MAX_TABLE_POINTS, MAX_VALUE, _finite, _subnormal
 from .lines import _Lines
 from .parts import Link, Pair, Vec
 from .schema import MODEL, REQUIRED, Field, Section
@@ -290,7 +290,10 @@ class ReaderCore:
 
     def series(self, f: Field, x: Any, path: str) -> tuple[float, ...] | None:
         """A list of at least two finite numbers (each may be an expression), each within the
-        field's range, strictly increasing if the field says so."""
+        field's range, strictly increasing if the field says so; at most MAX_TABLE_POINTS."""
+        if isinstance(x, list) and len(x) > MAX_TABLE_POINTS:
+            self.err(f"{path}: {len(x)} values, at most {MAX_TABLE_POINTS} (MAX_TABLE_POINTS)")
+            return None
         if isinstance(x, list):
             x = [self.scalar(v, f"{path}[{i}]") for i, v in enumerate(x)]
             if None in x:

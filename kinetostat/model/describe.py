@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 from typing import Any, TextIO
 
-from .limits import MAX_STUDY_VALUES, MAX_VALUE
+from .limits import MAX_STUDY_VALUES, MAX_TABLE_POINTS, MAX_VALUE
 from .schema import MODEL, REQUIRED, Field, Section, sections
 
 #: The JSON Schema shipped in the wheel (package data), as `json_schema()` writes it.
@@ -99,7 +99,7 @@ def _field(f: Field) -> dict:
                            **({"maxLength": f.max_length} if f.max_length else {})},
         "strings": lambda: {"type": "array", "items": {"type": "string"}},
         "vector": lambda: vector, "direction": lambda: vector,
-        "series": lambda: {"type": "array", "items": _number(f), "minItems": 2},
+        "series": lambda: {"type": "array", "items": _number(f), "minItems": 2, "maxItems": MAX_TABLE_POINTS},
         "points": lambda: {"type": "object", "additionalProperties": vector, "minProperties": 1,
                            "maxProperties": f.max_length},
         "point": lambda: {"type": "string"},
@@ -164,7 +164,7 @@ def _describe(f: Field, unit: bool = True) -> str:
 # ----------------------------------------------------------------------------- models/FORMAT.md
 
 _TYPES = {"number": "number", "integer": "integer", "string": "string", "strings": "list of strings",
-          "vector": "[x, y]", "direction": "[x, y], nonzero", "series": "list of >= 2 numbers",
+          "vector": "[x, y]", "direction": "[x, y], nonzero", "series": f"list of 2..{MAX_TABLE_POINTS} numbers",
           "points": "table of name = [x, y]", "point": "point name", "link": "link id", "links": "[i, j]",
           "angles": "number or list", "com": "point name or [x, y]",
           "load_direction": "[x, y] or string", "characteristic": "table or expression", "map": "table of names",

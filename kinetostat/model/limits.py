@@ -14,7 +14,8 @@ LAW_VARIABLES = ("phi", "omega")
 
 #: Longest key (or table header) of a model file, characters.
 MAX_KEY = 10_000
-#: Largest model file read, bytes (a model is a few kB; 4000 links take 0.8 MB).
+#: Largest model file read (or text parsed), bytes (a model is a few kB, the largest bundled one
+#: 16 kB; 4000 links take 0.8 MB).
 MAX_FILE_BYTES = 32 * 2**20
 #: Memory tomllib may take for the keys of one file, estimated as _KEY_BYTES per key plus
 #: _LEVEL_BYTES per square of its depth (fitted to measurements: 266k two-level keys of a
@@ -25,6 +26,10 @@ _KEY_BYTES, _LEVEL_BYTES = 800, 9
 MAX_VALUE = 1e12
 #: Most points of one link.
 MAX_POINTS = 10_000
+#: Most values of one table's list (a law of motion's omega_table, a load diagram, a motor
+#: characteristic): a measured diagram has a few hundred; 200,000 load in about 7 s, 10^6 took
+#: over a minute.
+MAX_TABLE_POINTS = 200_000
 #: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
 #: lengths stay normal numbers.
 MIN_LENGTH = 1e-150

@@ -27,7 +27,7 @@ REQUIRED = "required"
 @dataclass(frozen=True)
 class Field:
     """One field of a table. `type`: number, integer, string, strings (a list of them), vector
-    ([x, y]), direction (a nonzero [x, y]), series (a list of >= 2 numbers), points (named
+    ([x, y]), direction (a nonzero [x, y]), series (a list of 2..MAX_TABLE_POINTS numbers), points (named
     [x, y]), point (a point's name), link (a link's id), links ([i, j]), angles (a number or a
     list), com (a point's name or [x, y]), load_direction, characteristic, map (a table of named
     `items`), table or tables (`section`, a nested table or array of tables)."""

@@ -1,15 +1,15 @@
 """From a file, a text or a dict to a Mechanism: the file read safely (a regular file, bounded
 size, UTF-8), the TOML parsed at a bounded cost, then read by the reader.
 
-May use: the standard library, errors, expressions, examples, limits, mechanism, reader.
+May use: the standard library, _io (`read_regular`), errors, expressions, examples, limits, mechanism, reader.
 """
 from __future__ import annotations
 
-import stat
 import tomllib
 from pathlib import Path
 from typing import Any, Mapping
 
+from .._io import FileTooLarge, NotRegularFile, read_regular
 from ..errors import ModelError, ModelFileNotFound
 from ..expressions import suggestion_budget
 from .limits import _KEY_BYTES, _LEVEL_BYTES, MAX_FILE_BYTES, MAX_KEY, MAX_KEY_MEMORY
@@ -29,23 +29,18 @@ def load(path: str | Path, parameters: Mapping[str, Any] | None = None) -> Mecha
 
 def _read_text(path: Path) -> str:
     """The text of a model file: a regular file (never a FIFO or a device, which would block or
-    never end) of at most MAX_FILE_BYTES, UTF-8."""
+    never end: `read_regular`) of at most MAX_FILE_BYTES, UTF-8."""
     try:
-        st = path.stat()
-        if not stat.S_ISREG(st.st_mode):
-            what = "a directory" if stat.S_ISDIR(st.st_mode) else "not a regular file (a FIFO, device or socket)"
-            raise ModelError([f"cannot read file: {what}; a model is a regular TOML file"], source=str(path))
-        if st.st_size > MAX_FILE_BYTES:
-            raise ModelError([f"file of {st.st_size} bytes is too large for a model (at most {MAX_FILE_BYTES})"],
-                             source=str(path))
-        with open(path, "rb") as f:
-            raw = f.read(MAX_FILE_BYTES + 1)      # the size may change between stat and read
+        raw = read_regular(path, MAX_FILE_BYTES)
     except FileNotFoundError:
         raise ModelFileNotFound(str(path)) from None
+    except NotRegularFile as exc:
+        raise ModelError([f"cannot read file: {exc.kind}, not a regular file; a model is a regular TOML file"], source=str(path)) from None
+    except FileTooLarge:
+        raise ModelError([f"file is too large for a model (at most {MAX_FILE_BYTES} bytes, MAX_FILE_BYTES)"],
+                         source=str(path)) from None
     except OSError as exc:
         raise ModelError([f"cannot read file: {exc.strerror}"], source=str(path)) from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise ModelError([f"file is too large for a model (more than {MAX_FILE_BYTES} bytes)"], source=str(path))
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -54,7 +49,10 @@ def _read_text(path: Path) -> str:
 
 
 def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | None = None) -> Mechanism:
-    """Parse a model from TOML text; `parameters` as for `load`."""
+    """Parse a model from TOML text (at most MAX_FILE_BYTES characters); `parameters` as for `load`."""
+    if len(text) > MAX_FILE_BYTES:
+        raise ModelError([f"a text of {len(text)} characters is too large for a model (at most {MAX_FILE_BYTES}, "
+                          f"MAX_FILE_BYTES)"], source=source)
     _check_key_cost(text, source)
     try:
         data = tomllib.loads(text)

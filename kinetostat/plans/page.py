@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._io import write_bytes, write_text
+from .._io import read_regular, write_bytes, write_text
 from .._text import script_json
 from .draw import TINY_MM, segment_label, svg, title_of
 from .i18n import check_lang, num, text, unit
@@ -689,8 +689,9 @@ def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, a
     this page's (`page_key`), its bytes are written instead of drawing the page again."""
     path = Path(out)
     key = page_key(mech, lang, student, at)
-    if key is not None and reuse is not None and key_of(reuse) == key:
-        write_bytes(path, Path(reuse).read_bytes())
+    earlier = _earlier_page(reuse) if key is not None and reuse is not None else None
+    if earlier is not None and _key_in(earlier) == key:
+        write_bytes(path, earlier)
     else:
         write_text(path, page(mech, lang=lang, student=student, at=at))
     return path
@@ -723,14 +724,30 @@ def page_key(mech, lang: str = "en", student: bool = False, at: float | None = N
     return h.hexdigest()
 
 
-def key_of(path: str | Path) -> str | None:
-    """The key of the page written at `path` (its KEY_META element); None where there is no file,
-    no key, or the page is not whole (its last line, the SHA-256 of the bytes before it, missing or
-    not theirs: a page cut short or edited)."""
+#: Largest earlier page read (`key_of`, `write_page(reuse=)`), bytes: the bundled models' pages
+#: are below 1 MB; a larger file is not read, and the page is drawn again.
+MAX_PAGE_BYTES = 64 * 2**20
+
+
+def _earlier_page(path: str | Path) -> bytes | None:
+    """The bytes of the earlier page at `path`: a regular file of at most MAX_PAGE_BYTES
+    (`read_regular`: a FIFO or /dev/zero there is not read); None otherwise."""
     try:
-        data = Path(path).read_bytes()
+        return read_regular(path, MAX_PAGE_BYTES)
     except OSError:
         return None
+
+
+def key_of(path: str | Path) -> str | None:
+    """The key of the page written at `path` (its KEY_META element); None where there is no file,
+    no regular file of at most MAX_PAGE_BYTES, no key, or the page is not whole (its last line, the
+    SHA-256 of the bytes before it, missing or not theirs: a page cut short or edited)."""
+    data = _earlier_page(path)
+    return None if data is None else _key_in(data)
+
+
+def _key_in(data: bytes) -> str | None:
+    """The key of the page `data` (`key_of`)."""
     seal = _SEAL.search(data)
     if seal is None or hashlib.sha256(data[:seal.start()]).hexdigest().encode() != seal.group(1):
         return None

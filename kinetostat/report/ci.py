@@ -7,8 +7,8 @@ $GITHUB_STEP_SUMMARY. Used by `kinetostat validate` and the pytest plugin
 its one escaping function of `kinetostat._text`: `one_line` (the terminal),
 `workflow_command_text` (the commands), `markdown_text` (the summary's cells).
 
-May use: the standard library, `kinetostat._text`, the model's line finder, the runs room; the
-harness inside the function that needs it.
+May use: the standard library, `kinetostat._text`, the model's line finder and file reader, `_io`
+(appending to a regular file), the runs room; the harness inside the function that needs it.
 """
 from __future__ import annotations
 
@@ -19,8 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Sequence
 
+from .._io import open_append
 from .._text import markdown_text, one_line, workflow_command_text
-from ..model import Mechanism, _Lines
+from ..model import Mechanism, _Lines, _read_text
 from .runs import LEVER_ROUTE, PUBLISHED_ROUTE, Check, ModelRun, trust
 
 @dataclass(frozen=True)
@@ -102,7 +103,7 @@ def run_outcomes(runs: Sequence[ModelRun]) -> list[Outcome]:
     for run in runs:
         file = "" if run.path is None else str(run.path)
         try:
-            lines = model_lines(run.mech, run.path.read_text(encoding="utf-8")) if run.path is not None else {}
+            lines = model_lines(run.mech, _read_text(run.path)) if run.path is not None else {}
         except (OSError, ValueError):
             lines = {}
         routes = list(run.engines) + ([PUBLISHED_ROUTE] if run.published or PUBLISHED_ROUTE in run.errors else [])
@@ -222,11 +223,13 @@ def summary_markdown(outcomes: Sequence[Outcome], title: str) -> str:
 
 
 def write_summary(markdown: str) -> bool:
-    """Append `markdown` to $GITHUB_STEP_SUMMARY when it is set; True if written. An OSError (a
-    path that cannot be written) is the caller's to report as one warning line."""
+    """Append `markdown` to $GITHUB_STEP_SUMMARY when it is set; True if written. Only to a
+    regular file (`open_append`: a FIFO, device or socket raises at once, never blocks). An
+    OSError (a path that cannot be written, or is not a regular file) is the caller's to report
+    as one warning line."""
     dest = os.environ.get("GITHUB_STEP_SUMMARY")
     if not dest:
         return False
-    with open(dest, "a", encoding="utf-8") as f:
+    with open_append(dest) as f:
         f.write(markdown.rstrip("\n") + "\n\n")
     return True
