@@ -23,7 +23,7 @@ that holds exactly the source generated now. A cache folder restored from elsewh
 of an untrusted branch) is trusted as the user's own: do not restore one from a source you do
 not trust. On Windows the folders' owners and permissions are not checked.
 
-May use: the standard library, numba (its cache object), and `_io` (atomic writes).
+May use: the standard library, numba (its cache object), and `_io` (atomic writes, bounded reads).
 """
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ import types
 import warnings
 from pathlib import Path
 
-from ._io import write_bytes
+from ._io import read_regular, write_bytes
 
 __all__ = ["CACHE_ENV", "KernelCacheWarning", "cache_dir", "folder", "untrusted", "load"]
 
@@ -126,28 +126,18 @@ def folder() -> Path:
     return scratch
 
 
-def _read(path: Path, limit: int) -> bytes | None:
-    """At most `limit` bytes of the regular file `path` (a link is not followed, a FIFO does not
-    block), or None where it is not there or not a regular file."""
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
-    except OSError:
-        return None
-    if not stat.S_ISREG(os.fstat(fd).st_mode):
-        os.close(fd)
-        return None
-    with os.fdopen(fd, "rb") as f:
-        return f.read(limit)
-
-
 def _rewrite(path: Path, data: bytes) -> bool:
-    """Make the file `path` hold exactly `data`; True where it had to be written."""
-    if _read(path, len(data) + 1) == data:
-        return False
+    """Make the file `path` hold exactly `data` (a link, FIFO, device or folder there replaced, never
+    followed or waited on); True where it had to be written."""
+    try:
+        if not path.is_symlink() and read_regular(path, len(data)) == data:
+            return False
+    except OSError:                       # not there, not a regular file, or longer than `data`
+        pass
     if path.is_dir() and not path.is_symlink():
         shutil.rmtree(path)
     elif os.path.lexists(path) and not stat.S_ISREG(os.lstat(path).st_mode):
-        path.unlink()                     # a link, FIFO or device: replaced by a file, never written through
+        path.unlink()
     write_bytes(path, data)
     return True
 
