@@ -9,7 +9,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-__all__ = ["field_unit", "parameter_units", "NOT_STATED"]
+__all__ = ["field_unit", "parameter_units", "NOT_STATED", "PRESSURES"]
 
 #: A parameter's unit where neither a field nor the model file's comment gives one.
 NOT_STATED = "not stated"
@@ -18,8 +18,10 @@ _FIELD_UNITS = {"mass": "kg", "I_S": "kg m^2", "rpm": "rpm", "omega": "rad/s", "
                 "z_wheel": "1", "z_pinion": "1", "scale": "N", "stiffness": "N/m", "free_length": "m", "radius": "m",
                 "f": "1", "value": "N or N m"}
 #: Units a model file's comment may state for a parameter ("r = 0.080  # crank length, m").
-_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", "Pa", "m^2", "rad/s",
-                 "rad/s^2", "deg", "m/s^2", "s", "1"}
+_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", "Pa", "kPa", "MPa", "bar",
+                 "m^2", "rad/s", "rad/s^2", "deg", "m/s^2", "s", "1"}
+#: The units of pressure a comment may state (SI: Pa; the others are not the file's units).
+PRESSURES = ("Pa", "kPa", "MPa", "bar")
 
 
 def field_unit(path: str) -> str | None:
@@ -29,11 +31,13 @@ def field_unit(path: str) -> str | None:
     return _FIELD_UNITS.get(re.sub(r"\[[^\]]*\]$", "", path).rsplit(".", 1)[-1])
 
 
-def parameter_units(m: Any) -> dict[str, str]:
+def parameter_units(m: Any, text: str | None = None) -> dict[str, str]:
     """The unit of each of the Mechanism `m`'s [parameters]: that of a field given as the
     parameter's name alone, else the one the model file's comment on the parameter states
-    ("# crank length, m"; a ratio "l_AB / l_OA" is 1), else `NOT_STATED`."""
-    text = Path(m.path).read_text(encoding="utf-8") if m.path and Path(m.path).is_file() else ""
+    ("# crank length, m"; a ratio "l_AB / l_OA" is 1), else `NOT_STATED`. `text`: the model
+    file's text (default: read from `m.path`)."""
+    if text is None:
+        text = Path(m.path).read_text(encoding="utf-8") if m.path and Path(m.path).is_file() else ""
     out = {}
     for name in m.parameters:
         unit = next((u for path, (expr, _) in m.expressions.items()

@@ -157,6 +157,14 @@ def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bo
         raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
 
 
+def _os_reason(exc: OSError, path: str | Path) -> str:
+    """An OSError's reason, led by the file it names where that is not `path` itself (a file in
+    the way inside an output folder: "out/task1_000: File exists")."""
+    reason = exc.strerror or str(exc)
+    named = exc.filename
+    return f"{named}: {reason}" if named and os.fspath(named) != os.fspath(path) else reason
+
+
 def _warn(msg: str) -> None:
     _Out.write(f"kinetostat: warning: {one_line(msg)}", err=True)
 
