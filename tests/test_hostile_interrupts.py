@@ -15,11 +15,14 @@ import pytest
 
 from conftest import ROOT
 
-#: A process that starts a write (a file, and a set of files) in the folder argv[1] and waits in it.
+#: A process that starts a write (a file, and a set of files) in the folder argv[1] and waits in
+#: it: kinetostat._io loaded from its file alone (the standard library only), so that it starts at once.
 WRITER = """
-import sys, time
-from kinetostat._io import atomic, unit
-with unit(sys.argv[1]) as tmp, atomic(sys.argv[1] + "/a.csv") as f:
+import importlib.util, sys, time
+spec = importlib.util.spec_from_file_location("_io", sys.argv[2])
+io = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(io)
+with io.unit(sys.argv[1]) as tmp, io.atomic(sys.argv[1] + "/a.csv") as f:
     f.write("half a table")
     print("writing", flush=True)
     time.sleep(600)
@@ -28,7 +31,8 @@ with unit(sys.argv[1]) as tmp, atomic(sys.argv[1] + "/a.csv") as f:
 
 def _writers(folder: Path, n: int) -> list[subprocess.Popen]:
     """`n` processes, each in the middle of a write into `folder` (WRITER)."""
-    ps = [subprocess.Popen([sys.executable, "-c", WRITER, str(folder)], stdout=subprocess.PIPE, cwd=ROOT)
+    ps = [subprocess.Popen([sys.executable, "-c", WRITER, str(folder), str(ROOT / "kinetostat" / "_io.py")],
+                           stdout=subprocess.PIPE, cwd=ROOT)
           for _ in range(n)]
     assert [p.stdout.readline() for p in ps] == [b"writing\n"] * n
     return ps

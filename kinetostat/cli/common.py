@@ -117,7 +117,7 @@ def _unraisable(previous: Callable) -> Callable:
 @contextmanager
 def _interrupts() -> Iterator[None]:
     """`_on_sigint` as the SIGINT handler while a command runs (main thread only), and `_unraisable`
-    as sys.unraisablehook; then the old ones."""
+    as sys.unraisablehook; then the old ones, and no Ctrl-C recorded (it was this command's)."""
     _Interrupt.seen = False
     try:
         old = signal.signal(signal.SIGINT, _on_sigint)
@@ -130,6 +130,7 @@ def _interrupts() -> Iterator[None]:
     finally:
         signal.signal(signal.SIGINT, old)
         sys.unraisablehook = hook
+        _Interrupt.seen = False
 
 
 def _is_stdout(path: str | Path) -> bool:
