@@ -314,9 +314,9 @@ def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: n
 
 @contextmanager
 def _workers(scheduler: str, tasks: int) -> Iterator[dict[str, Any]]:
-    """Dask's keyword for the local `scheduler`: for "processes", a pool of worker processes (at
-    most one per core, and per task) that ignore Ctrl-C, ended with the block (terminated: an
-    interrupted sweep leaves no worker running). The terminal sends Ctrl-C to the whole group:
+    """Dask's keyword for the local `scheduler`: for "processes", a pool of worker processes (as
+    many as Dask's num_workers, by default one per core; at most one per task) that ignore
+    Ctrl-C, ended with the block (terminated: an interrupted sweep leaves no worker running). The terminal sends Ctrl-C to the whole group:
     the main process reports it, and no worker prints a traceback, also one still starting
     Python: each starts with SIGINT blocked (this thread's mask while the pool starts, which a
     new process inherits) and ignores it before unblocking it. A Ctrl-C while the pool starts is
@@ -326,10 +326,13 @@ def _workers(scheduler: str, tasks: int) -> Iterator[dict[str, Any]]:
         return
     import functools
     import signal
+    import dask
     from dask.multiprocessing import get_context, initialize_worker_process
     from dask.system import CPU_COUNT
     from ._io import _sigint_deferred
     blocks = hasattr(signal, "pthread_sigmask")
+    n = max(1, min(dask.config.get("num_workers", None) or CPU_COUNT, tasks))
+    start = functools.partial(initialize_worker_process, user_initializer=_ignore_sigint)
     pool = None
     try:
         if blocks:
@@ -338,8 +341,7 @@ def _workers(scheduler: str, tasks: int) -> Iterator[dict[str, Any]]:
         with _sigint_deferred():
             old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if blocks else None
             try:
-                pool = get_context().Pool(max(1, min(CPU_COUNT, tasks)), initializer=functools.partial(
-                    initialize_worker_process, user_initializer=_ignore_sigint))
+                pool = get_context().Pool(n, initializer=start)
             finally:
                 if blocks:
                     signal.pthread_sigmask(signal.SIG_SETMASK, old)
