@@ -256,9 +256,9 @@ def unit(folder: str | Path, root: str | Path | None = None) -> Iterator[Path]:
     followed; a place outside `folder` through a linked subfolder is ValueError, nothing moved),
     with Ctrl-C held back until the last rename: a reader sees the old set or the new one, never
     a mix. An exception, a full disk or an interrupt in the block (also one swallowed on the way,
-    `checkpoint`) leaves `folder` as it was; the
-    hidden folder is always removed (a killed write's, by the next, `remove_stale`). Files of
-    `folder` the block did not write stay as they are.
+    `checkpoint`) leaves `folder` as it was; the hidden folder is always removed (a killed
+    write's, by the next write there, `remove_stale`). Files of `folder` the block did not write
+    stay as they are.
     `root` (default `folder`): `folder` and every place written must resolve inside it (a
     `folder` that is a planted link to elsewhere: ValueError before anything is written)."""
     folder = Path(folder)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 __all__ = ["field_unit", "parameter_units", "NOT_STATED", "PRESSURES"]
 
@@ -18,10 +18,11 @@ _FIELD_UNITS = {"mass": "kg", "I_S": "kg m^2", "rpm": "rpm", "omega": "rad/s", "
                 "z_wheel": "1", "z_pinion": "1", "scale": "N", "stiffness": "N/m", "free_length": "m", "radius": "m",
                 "f": "1", "value": "N or N m"}
 #: Units a model file's comment may state for a parameter ("r = 0.080  # crank length, m").
-_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", "Pa", "kPa", "MPa", "bar",
-                 "m^2", "rad/s", "rad/s^2", "deg", "m/s^2", "s", "1"}
-#: The units of pressure a comment may state (SI: Pa; the others are not the file's units).
-PRESSURES = ("Pa", "kPa", "MPa", "bar")
+#: The units of pressure a comment may state, each with the pascals it holds (SI: Pa; the others
+#: are not the file's units).
+PRESSURES = {"Pa": "1", "kPa": "1e3", "MPa": "1e6", "bar": "1e5"}
+_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", *PRESSURES, "m^2", "rad/s",
+                 "rad/s^2", "deg", "m/s^2", "s", "1"}
 
 
 def field_unit(path: str) -> str | None:
@@ -31,15 +32,15 @@ def field_unit(path: str) -> str | None:
     return _FIELD_UNITS.get(re.sub(r"\[[^\]]*\]$", "", path).rsplit(".", 1)[-1])
 
 
-def parameter_units(m: Any, text: str | None = None) -> dict[str, str]:
-    """The unit of each of the Mechanism `m`'s [parameters]: that of a field given as the
-    parameter's name alone, else the one the model file's comment on the parameter states
-    ("# crank length, m"; a ratio "l_AB / l_OA" is 1), else `NOT_STATED`. `text`: the model
-    file's text (default: read from `m.path`)."""
+def parameter_units(m: Any, text: str | None = None, names: Iterable[str] | None = None) -> dict[str, str]:
+    """The unit of each of the Mechanism `m`'s [parameters] (or of those `names`): that of a
+    field given as the parameter's name alone, else the one the model file's comment on the
+    parameter states ("# crank length, m"; a ratio "l_AB / l_OA" is 1), else `NOT_STATED`.
+    `text`: the model file's text (default: read from `m.path`)."""
     if text is None:
         text = Path(m.path).read_text(encoding="utf-8") if m.path and Path(m.path).is_file() else ""
     out = {}
-    for name in m.parameters:
+    for name in m.parameters if names is None else names:
         unit = next((u for path, (expr, _) in m.expressions.items()
                      if not path.startswith("parameters.") and expr.strip() == name
                      and (u := field_unit(path)) is not None), None)

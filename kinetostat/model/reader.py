@@ -2,7 +2,7 @@
 an immutable Mechanism; every problem collected and reported at once, each with its field path
 and line, and what only follows from a problem already reported left out.
 
-May use: the standard library, errors, units, limits, mechanism, schema, checks, read_*.
+May use: the standard library, errors, limits, mechanism, schema, checks, read_*.
 """
 from __future__ import annotations
 
@@ -10,7 +10,6 @@ import warnings
 from types import MappingProxyType
 
 from ..errors import ModelError, ModelWarning, StructureError
-from ..units import parameter_units
 from .checks import doubts, missing_radii
 from .limits import MAX_PROBLEMS, MIN_G
 from .mechanism import Mechanism
@@ -65,7 +64,7 @@ class _Reader(ParameterReading, LinkReading, DriveReading, LoadReading, RecordRe
                              expressions=MappingProxyType(self.expressions), study=study, lettering=lettering)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
-        for path, msg in doubts(mech, self.group_tables, self.slider_axes, parameter_units(mech, self.text)):
+        for path, msg in doubts(mech, self.group_tables, self.slider_axes, self.text):
             line = self.line_of(path)
             warnings.warn(f"{self.source}: {'' if line is None else f'line {line}: '}{path}: {msg}",
                           ModelWarning, stacklevel=4)
