@@ -86,7 +86,7 @@ def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> 
 
 #: A law's value between two checked angles that exceeds this many times the largest value at
 #: those angles is a pole (`pole`).
-POLE_RISE = 1e6
+POLE_RISE = 1e3
 
 
 def pole(law: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], phi: np.ndarray, w: np.ndarray,
