@@ -1,29 +1,96 @@
 """Output files: atomic writes (a temporary file in the same folder, renamed into place; a device
-or FIFO named by the user written as a stream), sets of files swapped in as a unit, folder names
-made from model file names, and the check that a written path stays inside its folder. Input
-files and earlier outputs: read whole only where regular and of bounded size (`read_regular`),
-so that a FIFO never blocks and /dev/zero is never read.
+or FIFO named by the user written as a stream), sets of files swapped in as a unit, the
+leftovers of killed writes removed by the next write into their folder, folder names made from
+model file names, and the check that a written path stays inside its folder. Input files and
+earlier outputs: read whole only where regular and of bounded size (`read_regular`), so that a
+FIFO never blocks and /dev/zero is never read.
 
 May use: the standard library only.
 """
 from __future__ import annotations
 
+import hashlib
 import os
 import re
 import secrets
 import shutil
 import signal
+import socket
 import stat
 import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Iterator
 
-__all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "safe_name", "unique_names", "inside",
-           "is_stream", "unit", "read_regular", "NotRegularFile", "FileTooLarge", "open_append"]
+__all__ = ["atomic", "write_text", "write_bytes", "remove_temporary", "remove_stale", "temporary_affixes",
+           "safe_name", "unique_names", "inside", "is_stream", "unit", "read_regular", "NotRegularFile", "FileTooLarge",
+           "open_append"]
 
 #: The temporary files of the writes in progress in this process (`remove_temporary`).
 _PENDING: set[str] = set()
+
+#: The name of every temporary file or folder kinetostat writes: `.kinetostat-HOST-PID-RANDOM.tmp`,
+#: HOST 8 hex digits of the machine's name, PID the writing process's id (`remove_stale`).
+_TEMPORARY = re.compile(r"\.kinetostat-([0-9a-f]{8})-(\d{1,10})-\w+\.tmp")
+
+
+def _host() -> str:
+    """8 hex digits of this machine's name: a temporary name's HOST."""
+    return hashlib.sha256(socket.gethostname().encode("utf-8", "surrogateescape")).hexdigest()[:8]
+
+
+def temporary_affixes() -> tuple[str, str]:
+    """The prefix and suffix of this process's temporary names (`_TEMPORARY`): for tempfile."""
+    return f".kinetostat-{_host()}-{os.getpid()}-", ".tmp"
+
+
+def _temporary_name(folder: Path) -> str:
+    prefix, suffix = temporary_affixes()
+    return str(folder / f"{prefix}{secrets.token_hex(6)}{suffix}")
+
+
+def _running(pid: int) -> bool:
+    """Whether process `pid` runs on this machine; True where that cannot be told (Windows,
+    where signal 0 would end the process; a process of another user)."""
+    if pid == os.getpid() or os.name == "nt":
+        return True
+    try:
+        os.kill(pid, 0)
+    except (ProcessLookupError, OverflowError):   # no such process; no process id is that large
+        return False
+    except OSError:
+        return True
+    return True
+
+
+def remove_stale(folder: str | Path) -> None:
+    """Remove the leftovers of killed writes from `folder` (SIGKILL, a power cut: no chance to
+    clean up): the files and folders named as kinetostat names its temporary ones (`_TEMPORARY`)
+    that were made on this machine by a process that no longer runs. A write running now in
+    another process keeps its own; so does a leftover from another machine (a shared folder),
+    and one whose process id another process has taken since (until that one ends)."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return
+    host = _host()
+    for name in names:
+        m = _TEMPORARY.fullmatch(name)
+        if m and m[1] == host and not _running(int(m[2])):
+            _remove(os.path.join(folder, name))
+
+
+class Interrupt:
+    """Ctrl-C seen by the command line's handler (`kinetostat.cli.common`), also one whose
+    KeyboardInterrupt was swallowed where it landed (a garbage-collection callback, a __del__):
+    `checkpoint` raises it again, and a write calls it before it puts its file or set in place."""
+    seen = False
+
+
+def checkpoint() -> None:
+    """Raise KeyboardInterrupt if Ctrl-C was pressed (`Interrupt`), also if its first raise was swallowed."""
+    if Interrupt.seen:
+        raise KeyboardInterrupt
 
 
 def _file_mode(path: Path) -> int:
@@ -89,10 +156,12 @@ def atomic(path: str | Path, binary: bool = False, stream: bool = False) -> Iter
     """A file opened for writing that becomes `path` only when the block ends normally.
 
     The data go to a temporary file in `path`'s folder (a short name of its own, so that a
-    `path` of 255 bytes still works), which is flushed, given the mode of the file it replaces
+    `path` of 255 bytes still works; the leftovers of killed writes there are removed first,
+    `remove_stale`), which is flushed, given the mode of the file it replaces
     and `os.replace`d onto `path`: a reader never sees half a file. An exception in the block,
     a full disk or an interrupt (KeyboardInterrupt) removes the temporary file and leaves the
-    old `path` as it was. Text is UTF-8; a name the file system cannot hold raises OSError.
+    old `path` as it was, also a Ctrl-C whose KeyboardInterrupt was swallowed on the way
+    (`checkpoint`). Text is UTF-8; a name the file system cannot hold raises OSError.
 
     Only a regular file (or a link, which is replaced, never followed) is replaced. A device,
     FIFO, socket or link to a process's own stream at `path` (`is_stream`) is written as a stream where `stream` (a path the
@@ -107,10 +176,11 @@ def atomic(path: str | Path, binary: bool = False, stream: bool = False) -> Iter
         with open(path, "ab" if binary else "a", **({} if binary else {"encoding": "utf-8", "newline": ""})) as f:
             yield f
         return
+    remove_stale(path.parent)
     tmp = None
     try:
         for _ in range(100):     # named before it exists: an interrupt at any moment leaves no file behind
-            tmp = str(path.parent / f".kinetostat-{secrets.token_hex(6)}.tmp")
+            tmp = _temporary_name(path.parent)
             _PENDING.add(tmp)
             try:
                 fd = os.open(tmp, _TEMPORARY_FLAGS, 0o600)
@@ -123,6 +193,7 @@ def atomic(path: str | Path, binary: bool = False, stream: bool = False) -> Iter
         with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding="utf-8", newline="")) as f:
             yield f
         os.chmod(tmp, _file_mode(path))
+        checkpoint()
         os.replace(tmp, path)
     except BaseException:
         _remove(tmp)
@@ -187,8 +258,10 @@ def unit(folder: str | Path, root: str | Path | None = None) -> Iterator[Path]:
     each file is renamed onto its place in `folder` (links in their way replaced, never
     followed; a place outside `folder` through a linked subfolder is ValueError, nothing moved),
     with Ctrl-C held back until the last rename: a reader sees the old set or the new one, never
-    a mix. An exception, a full disk or an interrupt in the block leaves `folder` as it was; the
-    hidden folder is always removed. Files of `folder` the block did not write stay as they are.
+    a mix. An exception, a full disk or an interrupt in the block (also one swallowed on the way,
+    `checkpoint`) leaves `folder` as it was; the hidden folder is always removed (a killed
+    write's, by the next write there, `remove_stale`). Files of `folder` the block did not write
+    stay as they are.
     `root` (default `folder`): `folder` and every place written must resolve inside it (a
     `folder` that is a planted link to elsewhere: ValueError before anything is written)."""
     folder = Path(folder)
@@ -197,13 +270,15 @@ def unit(folder: str | Path, root: str | Path | None = None) -> Iterator[Path]:
         inside(root, folder)
     folder.mkdir(parents=True, exist_ok=True)
     inside(root, folder)
+    remove_stale(folder)
     tmp = None
     try:
-        tmp = str(folder / f".kinetostat-{secrets.token_hex(6)}.tmp")
+        tmp = _temporary_name(folder)
         _PENDING.add(tmp)
         os.mkdir(tmp, 0o700)
         yield Path(tmp)
         moves = _moves(Path(tmp), folder, root)
+        checkpoint()                    # a Ctrl-C swallowed while the set was written: the old set stays
         with _sigint_deferred():
             for src, dst in moves:
                 dst.parent.mkdir(parents=True, exist_ok=True)

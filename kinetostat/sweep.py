@@ -18,7 +18,7 @@ model) are not printed: the table's `n_singular` and `singular_deg` say where a 
 DIGITS_WARN digits and the fewest digits there; `eta_cycle_reason` why a design's cycle efficiency
 is undefined, and one UndefinedFigureWarning after the sweep counts those designs by cause.
 
-May use: model, analysis, solve, fast, errors, examples, units; pandas (imported when a sweep runs, so that
+May use: model, analysis, solve, fast, errors, examples, units, _io (Ctrl-C held back); pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
 Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
 `kinetostat.report`.
@@ -40,7 +40,7 @@ from .analysis import Analysis, crank_angles, friction_method
 from .solve import analyze
 from .errors import (AssemblyError, ModelError, ModelWarning, SelfLockingWarning, SingularPositionWarning, StructureError,
                      UndefinedFigureWarning)
-from .model import Mechanism, _read_text, _suggest, load, loads
+from .model import Mechanism, _read_text, _suggest, load, loads, model_text
 from .units import parameter_units
 
 if TYPE_CHECKING:
@@ -328,19 +328,60 @@ def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: n
             def count(key, result, dsk, state, worker_id):
                 if key in finished:
                     bar.update()
-            quiet = {"initializer": _ignore_sigint} if scheduler == "processes" else {}
-            with warnings.catch_warnings(), Callback(posttask=count):
-                return list(dask.compute(*tasks, scheduler=scheduler, **quiet))
+            with warnings.catch_warnings(), Callback(posttask=count), _workers(scheduler, len(parts)) as pool:
+                return list(dask.compute(*tasks, scheduler=scheduler, **pool))
         return _distributed(tasks, scheduler, bar)
     finally:
         bar.close()
 
 
+@contextmanager
+def _workers(scheduler: str, tasks: int) -> Iterator[dict[str, Any]]:
+    """Dask's keyword for the local `scheduler`: for "processes", a pool of worker processes (as
+    many as Dask's num_workers, by default one per core; at most one per task) that ignore
+    Ctrl-C, ended with the block (terminated: an interrupted sweep leaves no worker running). The terminal sends Ctrl-C to the whole group:
+    the main process reports it, and no worker prints a traceback, also one still starting
+    Python: each starts with SIGINT blocked (this thread's mask while the pool starts, which a
+    new process inherits) and ignores it before unblocking it. A Ctrl-C while the pool starts is
+    held back till it has started (`_io._sigint_deferred`), so that no worker is left half-made."""
+    if scheduler != "processes":
+        yield {}
+        return
+    import functools
+    import signal
+    import dask
+    from dask.multiprocessing import get_context, initialize_worker_process
+    from dask.system import CPU_COUNT
+    from ._io import _sigint_deferred
+    blocks = hasattr(signal, "pthread_sigmask")
+    n = max(1, min(dask.config.get("num_workers", None) or CPU_COUNT, tasks))
+    start = functools.partial(initialize_worker_process, user_initializer=_ignore_sigint)
+    pool = None
+    try:
+        if blocks:
+            from multiprocessing import resource_tracker
+            resource_tracker.ensure_running()     # started first: starting it unblocks SIGINT in this thread
+        with _sigint_deferred():
+            old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if blocks else None
+            try:
+                pool = get_context().Pool(n, initializer=start)
+            finally:
+                if blocks:
+                    signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        yield {"pool": pool}
+    finally:
+        if pool is not None:
+            pool.terminate()
+            pool.join()
+
+
 def _ignore_sigint() -> None:
-    """A worker process ignores Ctrl-C (the terminal sends it to the whole group): the main
-    process reports the interruption, and no worker prints a KeyboardInterrupt traceback."""
+    """A worker process ignores Ctrl-C (the terminal sends it to the whole group), then takes
+    SIGINT off the mask it was started with (`_workers`)."""
     import signal
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def _distributed(tasks: list, scheduler: Any, bar) -> list:
@@ -468,7 +509,7 @@ def _tidy(table: pd.DataFrame, names: list[str], base: Mechanism, friction: str 
 
 def _parameter_units(base: Mechanism, names: list[str]) -> dict[str, str]:
     """The unit of each swept parameter (`kinetostat.units.parameter_units`; g in m/s^2)."""
-    stated = {**parameter_units(base), "g": "m/s^2"}
+    stated = {**parameter_units(base, model_text(base)), "g": "m/s^2"}
     return {name: stated[name] for name in names}
 
 

@@ -1,15 +1,15 @@
 """The units of a model's fields and [parameters], as a model file states them (SI throughout,
 models/FORMAT.md), in the ASCII spelling of the tables' units ("kg m^2", "rad/s^2").
 
-May use: the standard library, the model reader (`_read_text`); a Mechanism is passed in (its `parameters`, `expressions`, `path`).
+May use: the standard library only; a Mechanism and its model file's text are passed in (its
+`parameters`, `expressions`).
 """
 from __future__ import annotations
 
 import re
-from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
-__all__ = ["field_unit", "parameter_units", "NOT_STATED"]
+__all__ = ["field_unit", "parameter_units", "NOT_STATED", "PRESSURES"]
 
 #: A parameter's unit where neither a field nor the model file's comment gives one.
 NOT_STATED = "not stated"
@@ -18,7 +18,10 @@ _FIELD_UNITS = {"mass": "kg", "I_S": "kg m^2", "rpm": "rpm", "omega": "rad/s", "
                 "z_wheel": "1", "z_pinion": "1", "scale": "N", "stiffness": "N/m", "free_length": "m", "radius": "m",
                 "f": "1", "value": "N or N m"}
 #: Units a model file's comment may state for a parameter ("r = 0.080  # crank length, m").
-_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", "Pa", "m^2", "rad/s",
+#: The units of pressure a comment may state, each with the pascals it holds (SI: Pa; the others
+#: are not the file's units).
+PRESSURES = {"Pa": "1", "kPa": "1e3", "MPa": "1e6", "bar": "1e5"}
+_STATED_UNITS = {"m", "mm", "rpm", "kg", "kg m^2", "kg/m", "kg/m^3", "N", "N m", "N/m", *PRESSURES, "m^2", "rad/s",
                  "rad/s^2", "deg", "m/s^2", "s", "1"}
 
 
@@ -29,23 +32,13 @@ def field_unit(path: str) -> str | None:
     return _FIELD_UNITS.get(re.sub(r"\[[^\]]*\]$", "", path).rsplit(".", 1)[-1])
 
 
-def _model_text(path: str | None) -> str:
-    """The text of the model file at `path` (`_read_text`: a regular file of bounded size); ""
-    where there is none or it cannot be read."""
-    from .model import _read_text
-    try:
-        return _read_text(Path(path)) if path else ""
-    except ValueError:                  # ModelError: not there, not a regular file, too large
-        return ""
-
-
-def parameter_units(m: Any) -> dict[str, str]:
-    """The unit of each of the Mechanism `m`'s [parameters]: that of a field given as the
-    parameter's name alone, else the one the model file's comment on the parameter states
-    ("# crank length, m"; a ratio "l_AB / l_OA" is 1), else `NOT_STATED`."""
-    text = _model_text(m.path)
+def parameter_units(m: Any, text: str, names: Iterable[str] | None = None) -> dict[str, str]:
+    """The unit of each of the Mechanism `m`'s [parameters] (or of those `names`): that of a
+    field given as the parameter's name alone, else the one the model file's comment on the
+    parameter states ("# crank length, m"; a ratio "l_AB / l_OA" is 1), else `NOT_STATED`.
+    `text`: the model file's text ("" where there is none; `kinetostat.model.model_text`)."""
     out = {}
-    for name in m.parameters:
+    for name in m.parameters if names is None else names:
         unit = next((u for path, (expr, _) in m.expressions.items()
                      if not path.startswith("parameters.") and expr.strip() == name
                      and (u := field_unit(path)) is not None), None)

@@ -20,7 +20,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, IO, Iterable, Iterator, Sequence
 
-from .._io import _sigint_deferred, atomic, is_stream
+from .._io import Interrupt as _Interrupt, _sigint_deferred, atomic, checkpoint as _checkpoint, is_stream, \
+    temporary_affixes
 from .._text import one_line, visible
 
 
@@ -95,37 +96,41 @@ def _quiet_stdout() -> None:
         pass
 
 
-class _Interrupt:
-    """Ctrl-C while a command runs. The handler records it before it raises KeyboardInterrupt:
-    an interrupt that lands in a garbage-collection callback or a __del__ is swallowed there
-    ("Exception ignored in ..."), and the next `_checkpoint` raises it again."""
-    seen = False
-
-
 def _on_sigint(signum, frame) -> None:
+    """Ctrl-C while a command runs: recorded (`kinetostat._io.Interrupt`) before KeyboardInterrupt
+    is raised. One that lands in a garbage-collection callback or a __del__ is swallowed there,
+    unprinted (`_unraisable`), and the next `_checkpoint`, or a write before it puts its file in
+    place, raises it again."""
     _Interrupt.seen = True
     raise KeyboardInterrupt
 
 
-def _checkpoint() -> None:
-    """Raise KeyboardInterrupt if Ctrl-C was pressed, also if its first raise was swallowed."""
-    if _Interrupt.seen:
-        raise KeyboardInterrupt
+def _unraisable(previous: Callable) -> Callable:
+    """A `sys.unraisablehook` that drops a swallowed KeyboardInterrupt (recorded already: no
+    "Exception ignored in ..." traceback) and passes anything else to `previous`."""
+    def hook(unraisable) -> None:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            previous(unraisable)
+    return hook
 
 
 @contextmanager
 def _interrupts() -> Iterator[None]:
-    """`_on_sigint` as the SIGINT handler while a command runs (main thread only), then the old one."""
+    """`_on_sigint` as the SIGINT handler while a command runs (main thread only), and `_unraisable`
+    as sys.unraisablehook; then the old ones, and no Ctrl-C recorded (it was this command's)."""
     _Interrupt.seen = False
     try:
         old = signal.signal(signal.SIGINT, _on_sigint)
     except ValueError:                   # not the main thread: leave the handler as it is
         yield
         return
+    hook, sys.unraisablehook = sys.unraisablehook, _unraisable(sys.unraisablehook)
     try:
         yield
     finally:
         signal.signal(signal.SIGINT, old)
+        sys.unraisablehook = hook
+        _Interrupt.seen = False
 
 
 def _is_stdout(path: str | Path) -> bool:
@@ -155,6 +160,14 @@ def _save(path: str | Path, option: str, write: Callable[[IO], None], binary: bo
             write(f)
     except OSError as exc:
         raise CLIError(f"cannot write {option} {path}: {exc.strerror or exc}") from None
+
+
+def _os_reason(exc: OSError, path: str | Path) -> str:
+    """An OSError's reason, led by the file it names where that is not `path` itself (a file in
+    the way inside an output folder: "out/task1_000: File exists")."""
+    reason = exc.strerror or str(exc)
+    named = exc.filename
+    return f"{named}: {reason}" if named and os.fspath(named) != os.fspath(path) else reason
 
 
 def _warn(msg: str) -> None:
@@ -429,6 +442,13 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | N
     return res, time.perf_counter() - t0
 
 
+def _probe(folder: Path) -> IO:
+    """An empty temporary file in `folder`, named as the writes' own (`kinetostat._io.temporary_affixes`:
+    a killed command's probe is removed by the next write there), gone when closed."""
+    prefix, suffix = temporary_affixes()
+    return tempfile.NamedTemporaryFile(dir=folder, prefix=prefix, suffix=suffix)
+
+
 def _writable_file(path: str, option: str) -> Path:
     """Check that `path` can be written now (so that a long run does not fail at its end): its
     folder takes a temporary file, and the name itself is one the file system can hold."""
@@ -442,7 +462,7 @@ def _writable_file(path: str, option: str) -> Path:
             raise CLIError(f"cannot write {option} {p}: it is a directory")
         if len(os.fsencode(p.name)) > os.pathconf(p.parent, "PC_NAME_MAX"):
             raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
-        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p.parent, prefix=".kinetostat-probe-"):
+        with _sigint_deferred(), _probe(p.parent):
             pass                         # Ctrl-C held back till the probe is gone: none left behind
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
@@ -453,7 +473,7 @@ def _writable_dir(path: str, option: str) -> Path:
     p = Path(path)
     try:
         p.mkdir(parents=True, exist_ok=True)
-        with _sigint_deferred(), tempfile.NamedTemporaryFile(dir=p, prefix=".kinetostat-probe-"):
+        with _sigint_deferred(), _probe(p):
             pass
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None

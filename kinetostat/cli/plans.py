@@ -15,8 +15,8 @@ from pathlib import Path
 
 from .._io import unit
 from .._text import one_line
-from .common import (CLIError, EXIT_OK, _Out, _checkpoint, _close, _lines, _load, _progress, _size, _turn, _warn,
-                     _writable_dir, _writable_file)
+from .common import (CLIError, EXIT_OK, _Out, _checkpoint, _close, _lines, _load, _os_reason, _progress, _size,
+                     _turn, _warn, _writable_dir, _writable_file)
 
 
 def _scale_item(text: str) -> tuple[str, float]:
@@ -138,13 +138,13 @@ def cmd_variant(args) -> int:
                 except (AssemblyError, ModelError, ValueError) as exc:   # also a folder linked outside --out
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:
-                    raise CLIError(f"cannot write --out {out}: {exc.strerror or exc}") from None
+                    raise CLIError(f"cannot write --out {out}: {_os_reason(exc, out)}") from None
             bar.update()
         if args.all:
             try:
                 index = variants.write_index(out, keys, args.lang)
             except OSError as exc:
-                raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
+                raise CLIError(f"cannot write the index into {out}: {_os_reason(exc, out)}") from None
     finally:
         _close(bar)
     if args.all:

@@ -2,7 +2,7 @@
 contradiction is an error), and what loads but looks like a mistake (a ModelWarning). Each is
 a function yielding its messages; the reader records them.
 
-May use: the standard library, limits, parts, mechanism.
+May use: the standard library, expressions, limits, parts, mechanism, units.
 """
 from __future__ import annotations
 
@@ -10,6 +10,8 @@ import math
 from types import MappingProxyType
 from typing import Iterator, Mapping
 
+from ..expressions import parse as parse_expression
+from ..units import PRESSURES, parameter_units
 from .limits import FASTEST_PIN, FORCE_SCALE, FRICTION_F, GYRATION_SPANS, JOURNAL_SPANS, LARGEST_LINK
 from .mechanism import Mechanism, extent
 from .parts import Friction, Link, Pair, Vec
@@ -72,9 +74,10 @@ def missing_radii(friction: Friction | None, pairs: list[Pair]) -> Iterator[str]
 
 
 def doubts(mech: Mechanism, group_tables: Mapping[frozenset, tuple[int, tuple]],
-           slider_axes: set[int]) -> Iterator[tuple[str, str]]:
+           slider_axes: set[int], text: str = "") -> Iterator[tuple[str, str]]:
     """(field path, message) for what loads but looks like a mistake: a number far out of
-    the usual, or a rule the file relies on that is easily misread."""
+    the usual, or a rule the file relies on that is easily misread. `text`: the model file's
+    (its comments state the parameters' units)."""
     crank = mech.links[1].points
     r = math.dist(crank[mech.drive.pivot], crank[mech.drive.point])
     if mech.size > LARGEST_LINK or r * mech.drive.omega > FASTEST_PIN:
@@ -101,6 +104,7 @@ def doubts(mech: Mechanism, group_tables: Mapping[frozenset, tuple[int, tuple]],
                 f"and inertia forces ({scale / FORCE_SCALE:.4g} N): is a pressure in MPa multiplied by an area "
                 f"in m^2? (scale in N per table unit: 1 MPa = 1e6 Pa)")
     yield from friction_doubts(mech)
+    yield from _pressure_doubts(mech, text)
     for g in mech.structure.groups:
         n, listed = group_tables.get(frozenset(g.links), (None, ()))
         if g.kind == "RRR" and n is not None and listed[0] > listed[1]:
@@ -140,6 +144,30 @@ def friction_doubts(mech: Mechanism) -> Iterator[tuple[str, str]]:
         if r is not None and r > limit:
             yield path, (f"a journal radius of {r:.4g} m is more than {JOURNAL_SPANS:g} of the largest link "
                          f"({mech.size:.4g} m): is it in metres? (f r = {fr.f * r:.4g} m is the friction circle)")
+
+
+def _pressure_doubts(mech: Mechanism, text: str) -> Iterator[tuple[str, str]]:
+    """A force diagram's scale (N per table unit) that reads a pressure parameter (its unit as
+    the model file `text` states it): stated in another unit than Pa (the file's SI), or
+    combined with values beyond 1, which are then not the fractions of that pressure (p/p_max)
+    that such a scale (area x p_max) multiplies."""
+    for n, ld in enumerate(mech.loads):
+        path = f"load[{n}].table.scale"
+        if ld.kind != "force" or ld.table is None or path not in mech.expressions:
+            continue
+        read = parse_expression(mech.expressions[path][0]).names & set(mech.parameters)   # it parsed when read
+        units = parameter_units(mech, text, sorted(read))
+        for name in sorted(p for p in read if units[p] in PRESSURES):
+            if units[name] != "Pa":
+                yield path, (f"reads parameters.{name}, stated in {units[name]}; the scale is in N per table unit "
+                             f"and the file's units are SI: give {name} in Pa (1 {units[name]} = "
+                             f"{PRESSURES[units[name]]} Pa)")
+            elif max(map(abs, ld.table.value)) > 1:
+                yield f"load[{n}].table.value", (
+                    f"the diagram's values reach {max(map(abs, ld.table.value)):.4g}, but its scale "
+                    f"(\"{mech.expressions[path][0]:.60}\" = {ld.table.scale:.6g} N) already holds the pressure "
+                    f"parameters.{name}: the values are then fractions of it (at most 1); are they pressures "
+                    f"(MPa)? Give them as p/{name}, or a scale of the area alone (m^2, values in Pa)")
 
 
 def turned_slider(link: Link, axis: Vec) -> Link:

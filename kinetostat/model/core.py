@@ -84,6 +84,7 @@ class ReaderCore:
         self.values: dict[str, float] = {}        # parameters and g, as expressions read them
         self.failed: set[str] = set()             # parameters (or g) whose value is in error
         self.expressions: dict[str, tuple[str, float]] = {}   # field path -> (expression, value)
+        self.text = text or ""                    # the file's text (its comments state parameters' units)
         self.where_lines = _Lines(text) if text is not None else None
         self.link_table: dict[int, int] = {}      # link id -> index of its [[link]] table
         # causes already reported, whose consequences are not reported again:

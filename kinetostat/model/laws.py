@@ -1,11 +1,14 @@
-"""What laws of motion and motor characteristics evaluate: parsed expressions, kept, and the
-periodic cubic spline through a table of omega(phi).
+"""What laws of motion and motor characteristics evaluate: parsed expressions, kept, the
+periodic cubic spline through a table of omega(phi), and the search for a pole of omega(phi)
+between checked angles.
 
 May use: the standard library, numpy, expressions.
 """
 from __future__ import annotations
 
 import functools
+import math
+from typing import Callable
 
 import numpy as np
 
@@ -79,3 +82,43 @@ def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> 
     value = ye[i] * (a / h) + ye[i + 1] * (b / h) + (me[i] * a * (a * a - h * h) + me[i + 1] * b * (b * b - h * h)) / (6 * h)
     slope = (-me[i] * a**2 + me[i + 1] * b**2) / (2 * h) - ca + cb
     return value, slope
+
+
+#: A law's value between two checked angles that exceeds this many times the largest value at
+#: those angles is a pole (`pole`).
+POLE_RISE = 1e3
+
+
+def pole(law: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], phi: np.ndarray, w: np.ndarray,
+         dw: np.ndarray, depth: int = 60, most: int = 256) -> tuple[float, float, float, float] | None:
+    """Where omega(phi) = `law(phi)[0]` grows without bound between the neighbouring angles `phi`
+    (rad, increasing) at which it took the values `w` (rad/s, finite) and slopes `dw`: the
+    interval is halved where its cubic through the ends' values and slopes misses the value at
+    its middle by more than 1e-3 (a smooth law soon stops; a pole never, however short the
+    interval), until the middle's value is not finite or exceeds POLE_RISE times the largest of
+    `w`. Returns (the checked angles on either side, the angle reached, |omega| there: inf, or
+    NaN where omega is not real there), deg and rad/s; None where nothing is found within
+    `depth` halvings."""
+    top = max(float(np.abs(w).max()), 1e-300)
+    k = np.arange(len(phi) - 1)                       # each interval's first checked angle
+    lo, hi, wa, wb, da, db = phi[:-1], phi[1:], w[:-1], w[1:], dw[:-1], dw[1:]
+    for _ in range(depth):
+        mid = (lo + hi) / 2
+        with np.errstate(all="ignore"):
+            wm, dm = law(mid)
+            wild = ~(np.isfinite(wm) & np.isfinite(dm)) | (np.abs(wm) > POLE_RISE * top)
+            if wild.any():
+                n = int(np.argmax(wild))
+                return (math.degrees(phi[k[n]]), math.degrees(phi[k[n] + 1]), math.degrees(mid[n]),
+                        float(abs(wm[n])))
+            cubic = (wa + wb) / 2 + (hi - lo) / 8 * (da - db)
+            miss = np.abs(wm - cubic) / (np.maximum(np.maximum(np.abs(wa), np.abs(wb)), np.abs(wm)) + 1e-12 * top)
+        odd = np.flatnonzero(miss > 1e-3)
+        if len(odd) == 0:
+            return None
+        odd = odd[np.argsort(-np.abs(wm[odd]))[:most]]      # the largest values, where a pole would be
+        k = np.concatenate([k[odd], k[odd]])
+        lo, hi = np.concatenate([lo[odd], mid[odd]]), np.concatenate([mid[odd], hi[odd]])
+        wa, wb = np.concatenate([wa[odd], wm[odd]]), np.concatenate([wm[odd], wb[odd]])
+        da, db = np.concatenate([da[odd], dm[odd]]), np.concatenate([dm[odd], db[odd]])
+    return None

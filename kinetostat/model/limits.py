@@ -33,6 +33,9 @@ MAX_TABLE_POINTS = 200_000
 #: Shortest nonzero span of a link, m: sqrt of the smallest normal double, so that squares of
 #: lengths stay normal numbers.
 MIN_LENGTH = 1e-150
+#: Smallest nonzero g, m/s^2: below it the weights g m and their moments g m x turn subnormal or
+#: zero (3e-308 is a normal double, but 0.8 kg times it is not).
+MIN_G = 1e-150
 #: Smallest base radius of the drive's gear wheel, relative to the largest link.
 MIN_GEAR = 1e-6
 #: A ModelWarning asks whether a model was drawn in millimetres above these: the largest link,

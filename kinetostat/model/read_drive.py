@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from .core import ReaderCore
-from .laws import mentions_phi
+from .laws import mentions_phi, pole
 from .limits import MAX_SHOWN, MAX_VALUE, MIN_GEAR
 from .mechanism import extent
 from .parts import Drive, Gear, Link, Pair, SpeedLaw
@@ -114,6 +114,14 @@ class DriveReading(ReaderCore):
             self.err(f"{where}: omega(phi) is not finite (or not real) over the whole revolution: so at phi = "
                      f"{at[0]:.4g} deg" + (f" ({len(at)} of 721 angles checked, up to {at[-1]:.4g} deg)"
                                            if len(at) > 1 else ""))
+        elif law.expression is not None and (p := pole(law, phi, w, dw)) is not None:
+            a, b, at, value = p
+            self.err(f"{where}: omega(phi) " + (
+                f"is not finite (or not real) at phi = {at:.8g} deg, between the angles checked {a:.4g} and "
+                f"{b:.4g} deg" if math.isnan(value) else
+                f"has a pole between phi = {a:.4g} and {b:.4g} deg (checked every 0.5 deg): it reaches "
+                f"{value:.4g} rad/s at phi = {at:.8g} deg, against at most {np.abs(w).max():.4g} rad/s at "
+                f"the angles checked"))
         elif (w < 0).any():
             self.err(f"{where}: omega(phi) must be >= 0 (in the drive's sense); it is "
                      f"{w.min():.4g} rad/s at phi = {np.degrees(phi[np.argmin(w)]):.4g} deg")

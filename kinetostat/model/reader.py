@@ -11,7 +11,7 @@ from types import MappingProxyType
 
 from ..errors import ModelError, ModelWarning, StructureError
 from .checks import doubts, missing_radii
-from .limits import MAX_PROBLEMS
+from .limits import MAX_PROBLEMS, MIN_G
 from .mechanism import Mechanism
 from .read_drive import DriveReading
 from .read_links import LinkReading
@@ -34,6 +34,10 @@ class _Reader(ParameterReading, LinkReading, DriveReading, LoadReading, RecordRe
         source = self.read(MECHANISM, head, "source", "mechanism")
         assumptions = self.read(MECHANISM, head, "assumptions", "mechanism") or ()
         g = self.read(MECHANISM, head, "g", "mechanism")
+        if g is not None and 0 < g < MIN_G:
+            self.err(f"mechanism.g: {g:g} m/s^2 is below {MIN_G:g}: the weights g m would lose their digits or "
+                     f"vanish; write 0 to switch gravity off, or g in m/s^2 (9.81)")
+            g = None
 
         links = self.links(g)
         pairs = self.pairs(links)
@@ -60,7 +64,7 @@ class _Reader(ParameterReading, LinkReading, DriveReading, LoadReading, RecordRe
                              expressions=MappingProxyType(self.expressions), study=study, lettering=lettering)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
-        for path, msg in doubts(mech, self.group_tables, self.slider_axes):
+        for path, msg in doubts(mech, self.group_tables, self.slider_axes, self.text):
             line = self.line_of(path)
             warnings.warn(f"{self.source}: {'' if line is None else f'line {line}: '}{path}: {msg}",
                           ModelWarning, stacklevel=4)

@@ -48,6 +48,15 @@ def _read_text(path: Path) -> str:
                          source=str(path)) from None
 
 
+def model_text(mech: Mechanism) -> str:
+    """The text of `mech`'s model file as it is now (read as `load` reads it), "" where the model
+    has no file or it can no longer be read."""
+    try:
+        return _read_text(Path(mech.path)) if mech.path else ""
+    except ValueError:                  # ModelError: gone, not a regular file, too large, not UTF-8
+        return ""
+
+
 def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | None = None) -> Mechanism:
     """Parse a model from TOML text (at most MAX_FILE_BYTES characters); `parameters` as for `load`."""
     if len(text) > MAX_FILE_BYTES:

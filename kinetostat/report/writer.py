@@ -15,7 +15,7 @@ import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
 from ..solve import analyze
-from ..model import Mechanism
+from ..model import Mechanism, model_text
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 from ..sweep import sweep
@@ -77,7 +77,7 @@ def _unit_text(unit: str) -> str:
 
 def parameter_units(m: Mechanism) -> dict[str, str]:
     """Each [parameter]'s unit (`kinetostat.units.parameter_units`) as the report prints it."""
-    return {name: _unit_text(u) for name, u in model_units.parameter_units(m).items()}
+    return {name: _unit_text(u) for name, u in model_units.parameter_units(m, model_text(m)).items()}
 
 
 def _parameters_section(doc: Doc, m: Mechanism) -> None:
