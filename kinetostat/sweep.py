@@ -20,7 +20,8 @@ is undefined, and one UndefinedFigureWarning after the sweep counts those design
 
 May use: model, analysis, solve, fast, errors, examples, units; pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
-Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
+Dask scheduler), tqdm (only for a progress bar) and xarray (only in `Sweep.to_xarray`, through analysis'
+`_xarray`). Never the harness, the engines, matplotlib or
 `kinetostat.report`.
 """
 from __future__ import annotations
