@@ -99,15 +99,14 @@ class Sweep:
         n_axes = len(self.shape)
         names = list(self.table.columns[:n_axes])
         units = self.table.attrs["units"]
-        axes = (*names,)
+        axes = tuple(names)
         coords = {}
         for k, name in enumerate(names):
             grid = self.table[name].to_numpy(dtype=float).reshape(self.shape)
             coords[name] = _labelled(name, grid[tuple(slice(None) if a == k else 0 for a in range(n_axes))],
                                      units[name], "none", f"swept parameter {name}")
         data = {col: _labelled(axes, _design_values(self.table[col]).reshape(self.shape), units[col], "none",
-                               _TABLE_MEANING.get(col.removeprefix("peak_") if col.startswith("peak_") else col,
-                                                  f"largest |{col.removeprefix('peak_')}| over the cycle"))
+                               _meaning(col))
                 for col in self.table.columns[n_axes:]}
         if self.angles is not None:
             coords["phi"] = _labelled("phi", self.phi_deg, "deg", "world",
@@ -119,20 +118,27 @@ class Sweep:
                     continue
                 values = np.full((len(ran), len(self.phi_deg)), np.nan)
                 values[ran] = self.angles[col].to_numpy(dtype=float).reshape(int(ran.sum()), len(self.phi_deg))
-                data[col] = _labelled((*axes, "phi"), values.reshape(*self.shape, len(self.phi_deg)),
-                                      angle_units.get(col, ""), "world", f"{col} at each crank angle (Analysis.to_frame)")
+                unit = angle_units[col]
+                data[col] = _labelled((*axes, "phi"), values.reshape(*self.shape, len(self.phi_deg)), unit,
+                                      "none" if unit in ("1", "bool") else "world",
+                                      f"{col} at each crank angle (Analysis.to_frame)")
         return xr.Dataset(data, coords=coords, attrs={
-            "mechanism": self.table.attrs.get("mechanism", ""),
+            "mechanism": self.table.attrs["mechanism"],
             "conventions": f"design axes ({', '.join(names)}) before the crank-angle axis phi; {FRAME_NOTE}"})
 
 
-#: What each column of a sweep's table holds (`Sweep.to_xarray`'s long names; a peak: "largest |col| over the cycle").
+#: What each column of a sweep's table but the peaks holds (`Sweep.to_xarray`'s long names).
 _TABLE_MEANING = {
     "n_singular": "number of singular crank angles", "singular_deg": "the singular crank angles",
     "worst_digits": "fewest significant digits left among the warned angles",
     "warned_deg": "the crank angles kept with fewer than DIGITS_WARN digits", "eta_cycle": "cycle efficiency",
     "eta_cycle_reason": "why eta_cycle is NaN", "n_self_locking": "number of self-locking crank angles",
     "error": "why the design failed ('' where it ran)"}
+
+
+def _meaning(col: str) -> str:
+    """What the sweep table's column `col` holds: a peak's, or `_TABLE_MEANING`'s."""
+    return f"largest |{col.removeprefix('peak_')}| over the cycle" if col.startswith("peak_") else _TABLE_MEANING[col]
 
 
 def _design_values(col: pd.Series) -> np.ndarray:
