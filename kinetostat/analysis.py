@@ -2,7 +2,8 @@
 that computes it (`exact`); `kinetostat.solve.analyze` chooses between it and the compiled path.
 
 May use: model (with `model.lettering`: the pairs' names a warning gives), groups, kinematics,
-kinetostatics, applied, planar, friction, errors; pandas only inside `to_frame`.
+kinetostatics, applied, planar, friction, errors; pandas only inside `to_frame`, xarray (an optional
+extra) only inside `to_xarray`.
 """
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ from .errors import (SelfLockingWarning, SingularFrictionWarning, SingularPositi
 from .model import Mechanism, _abbreviate
 from .model.lettering import pair_name
 
-__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "deviation",
+__all__ = ["Analysis", "InertiaLoad", "CentreOfOscillation", "exact", "friction_method", "crank_angles", "FRAME_NOTE", "DATASET_NOTE", "deviation",
            "force_deviation"]
 
 #: The frame and sign conventions of every vector, moment and angle of a result (also in
@@ -36,6 +37,13 @@ FRAME_NOTE = ("SI units; world frame: x right, y up, gravity along -y; moments, 
               "from the model's drive.reference in the drive's sense; R_i_j, Rx_i_j, Ry_i_j: force exerted "
               "by link i on link j (R_j_i = -R_i_j); M_bal: moment the drive applies to the crank; inertia "
               "loads: main vector at the centre of mass and main moment; NaN where singular is True")
+#: The same conventions in the names of `Analysis.to_xarray` (its attrs["conventions"]).
+DATASET_NOTE = ("SI units; world frame: x right, y up, gravity along -y; moments, angles (theta from the world "
+                "x axis), angular velocities and accelerations about +z (counter-clockwise positive); phi: crank "
+                "angle from the drive's reference direction in the drive's sense (the phi coordinate's attrs); "
+                "R: force exerted by link i on link j of each pair (the pair's coordinates i and j; R_ji = -R_ij); "
+                "M_bal: moment the drive applies to the crank; F_i: inertia main vector at the centre of mass, "
+                "M_i: main moment; NaN where singular is True")
 
 
 #: Gauss-Legendre nodes per smooth piece of a cycle integral with friction (`Analysis._cycle_integral`).
@@ -697,6 +705,115 @@ class Analysis:
         df = pd.DataFrame(cols)
         df.attrs.update(mechanism=m.name, units=units, frame=FRAME_NOTE)
         return df
+
+    # -- labelled arrays
+    def to_xarray(self):
+        """The whole analysis as an xarray Dataset (the optional extra: pip install 'kinetostat[xarray]').
+
+        Dimensions: `phi` (crank angle, deg: from the drive's reference direction in its sense,
+        both in the coordinate's attrs), `point` (the model's point names; `point_link` its
+        link), `link` (the moving links' ids; `link_name`), `pair` (each pair as the outputs name
+        it, `pair_name`: "R12 at A"; `i`, `j` the model's link ids of R_ij, `pair_kind` R or P),
+        `xy` (x, y of a world vector), `group` (the Assur groups).
+
+        Variables (every one with attrs units, frame, long_name): position, velocity,
+        acceleration (phi, point, xy) [m, m/s, m/s^2]; theta, omega, eps (phi, link) [rad,
+        rad/s, rad/s^2]; F_applied (phi, link, xy) [N], M_applied (phi, link) [N m] (applied
+        loads without inertia, the moment about the link's local origin); F_i (phi, link, xy)
+        [N], M_i (phi, link) [N m] (inertia main vector at the centre of mass, main moment); R
+        (phi, pair, xy) [N] (force exerted by link i on link j); M_bal, M_lever (phi) [N m]; for a
+        working machine F_bal (phi, xy) [N]; with friction P_fr (phi, pair) [W], eta (phi) [1],
+        self_locking (phi) [bool], and with friction in the reactions M_bal_0 (phi) [N m], M_fr
+        (phi, revolute_pair) [N m] (friction moment on link j) and F_fr (phi, prismatic_pair) [N]
+        (friction force on the slider along the guide); error (phi) [1] (the singular guard's
+        estimate of the relative error), singular (phi) [bool], cond (phi, group) [1].
+        The arrays are the Analysis' own (read-only). `attrs`: mechanism, model_file, g [m/s^2],
+        drive, friction_method, conventions.
+        """
+        xr = _xarray()
+        m, world = self.mech, "world"
+        moving = [link.id for link in m.links[1:]]
+        pairs = list(m.pairs)
+        order = [p.index for p in pairs]
+        by_point = [self._point(name) for name in m.point_names]
+        sense = "counter-clockwise" if m.drive.sense > 0 else "clockwise"
+        reference = f"({m.drive.reference[0]:g}, {m.drive.reference[1]:g}) in the world frame"
+        coords = {
+            "phi": _labelled("phi", self.phi_deg, "deg", world, "crank angle", reference_direction=reference,
+                             sense=sense),
+            "point": ("point", m.point_names), "point_link": ("point", [m.point_owner(n) for n in m.point_names]),
+            "link": ("link", moving), "link_name": ("link", [m.links[k].name for k in moving]),
+            "pair": ("pair", [pair_name(m, p) for p in pairs]),
+            "i": ("pair", [p.links[0] for p in pairs], {"long_name": "id of the link exerting R"}),
+            "j": ("pair", [p.links[1] for p in pairs], {"long_name": "id of the link R acts on"}),
+            "pair_kind": ("pair", [p.kind for p in pairs]),
+            "xy": ("xy", ["x", "y"]),
+            "group": ("group", [g.label for g in m.structure.groups])}
+        vectors, links, angle = ("phi", "point", "xy"), ("phi", "link"), ("phi",)
+        data = {
+            "position": _labelled(vectors, np.stack([k[0] for k in by_point], axis=1), "m", world, "position of the point"),
+            "velocity": _labelled(vectors, np.stack([k[1] for k in by_point], axis=1), "m/s", world, "velocity of the point"),
+            "acceleration": _labelled(vectors, np.stack([k[2] for k in by_point], axis=1), "m/s^2", world,
+                                      "acceleration of the point"),
+            "theta": _labelled(links, self.kin.theta[:, moving], "rad", world,
+                               "angle of the link's local frame from the world x axis, about +z"),
+            "omega": _labelled(links, self.kin.omega[:, moving], "rad/s", world, "angular velocity, about +z"),
+            "eps": _labelled(links, self.kin.eps[:, moving], "rad/s^2", world, "angular acceleration, about +z"),
+            "F_applied": _labelled(links + ("xy",), self.F_applied[:, moving], "N", world,
+                                   "applied loads without inertia: their resultant force"),
+            "M_applied": _labelled(links, self.M_applied[:, moving], "N m", world,
+                                   "applied loads without inertia: their moment about the link's local origin, about +z"),
+            "F_i": _labelled(links + ("xy",), self.F_i[:, moving], "N", world,
+                             "inertia main vector -m a_S, at the centre of mass"),
+            "M_i": _labelled(links, self.M_i[:, moving], "N m", world, "inertia main moment -I_S eps, about +z"),
+            "R": _labelled(("phi", "pair", "xy"), self.forces.R[:, order], "N", world,
+                           "reaction: force exerted by link i on link j in the pair"),
+            "M_bal": _labelled(angle, self.balancing_moment, "N m", world,
+                               "balancing moment: the moment the drive applies to the crank, about +z"),
+            "M_lever": _labelled(angle, self.lever_moment, "N m", world, "balancing moment by Zhukovsky's lever"),
+            "error": _labelled(angle, self.error, "1", "none",
+                               "estimated relative error of the values (the singular guard; inf where singular)"),
+            "singular": _labelled(angle, self.singular, "bool", "none", "a group at a singular position (values NaN)"),
+            "cond": _labelled(("phi", "group"), self.cond, "1", "none", "condition number of the group's plan")}
+        if m.drive.kind == "machine":
+            data["F_bal"] = _labelled(("phi", "xy"), self.balancing_force, "N", world,
+                                      "balancing force of the pinion on the crank's gear, at the pitch point")
+        if m.friction is not None:
+            data.update(
+                P_fr=_labelled(("phi", "pair"), self.friction_power[:, order], "W", "none", "power lost in the pair (>= 0)"),
+                eta=_labelled(angle, self.efficiency, "1", "none", "instantaneous efficiency"),
+                self_locking=_labelled(angle, self.self_locking, "bool", "none", "self-locking at this angle"))
+        if self.friction is not None:
+            data["M_bal_0"] = _labelled(angle, self.balancing_moment_frictionless, "N m", world,
+                                        "balancing moment without friction, about +z")
+            for kind, name, dim, unit, meaning in (("R", "M_fr", "revolute_pair", "N m", "friction moment on link j, about +z"),
+                                                   ("P", "F_fr", "prismatic_pair", "N",
+                                                    "friction force on the slider, along the guide")):
+                these = [p for p in pairs if p.kind == kind]
+                if these:
+                    coords[dim] = (dim, [pair_name(m, p) for p in these])
+                    data[name] = _labelled(("phi", dim), self.friction.load[:, [p.index for p in these]], unit, world,
+                                           meaning)
+        method = "reactions" if self.friction is not None else "first" if m.friction is not None else "none"
+        return xr.Dataset(data, coords=coords, attrs={
+            "mechanism": m.name, "model_file": m.path or "", "g": m.g, "g_units": "m/s^2", "drive": m.drive.kind,
+            "friction_method": method, "conventions": DATASET_NOTE})
+
+
+def _xarray():
+    """The xarray module, or an ImportError naming the optional extra that installs it."""
+    try:
+        import xarray
+    except ImportError:
+        raise ImportError("to_xarray needs xarray, an optional extra: pip install 'kinetostat[xarray]'",
+                          name="xarray") from None
+    return xarray
+
+
+def _labelled(dims, values, units: str, frame: str, long_name: str, **more: str) -> tuple:
+    """An xarray variable (dims, values, attrs) that says its unit, its frame ("world", or
+    "none" for a quantity of no direction) and what it is."""
+    return dims, values, {"units": units, "frame": frame, "long_name": long_name, **more}
 
 
 def crank_angles(phi_deg=None, steps: int = 360) -> np.ndarray:

@@ -20,7 +20,8 @@ is undefined, and one UndefinedFigureWarning after the sweep counts those design
 
 May use: model, analysis, solve, fast, errors, examples, units, _io (Ctrl-C held back); pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
-Dask scheduler) and tqdm (only for a progress bar). Never the harness, the engines, matplotlib or
+Dask scheduler), tqdm (only for a progress bar) and xarray (only in `Sweep.to_xarray`, through analysis'
+`_xarray`). Never the harness, the engines, matplotlib or
 `kinetostat.report`.
 """
 from __future__ import annotations
@@ -36,7 +37,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 import numpy as np
 
-from .analysis import Analysis, crank_angles, friction_method
+from .analysis import FRAME_NOTE, Analysis, _labelled, _xarray, crank_angles, friction_method
 from .solve import analyze
 from .errors import (AssemblyError, ModelError, ModelWarning, SelfLockingWarning, SingularPositionWarning, StructureError,
                      UndefinedFigureWarning)
@@ -82,6 +83,67 @@ class Sweep:
         if name not in valid:
             raise KeyError(f"no peak of {col!r}{_suggest(name, valid)}. Peaks: {[c[5:] for c in valid]}")
         return self.table[name].to_numpy(dtype=float).reshape(self.shape)
+
+    def to_xarray(self):
+        """The sweep as an xarray Dataset (the optional extra: pip install 'kinetostat[xarray]').
+
+        One dimension per swept parameter, in the sweep's order (its values the coordinate, its
+        unit the model's, "not stated" where the model states none), then, where the angles are
+        kept (`full`), the crank angle `phi` (deg): the design axes before the crank-angle axis.
+        Variables over the design axes: the table's columns (peak_R_i_j, peak_M_bal, n_singular,
+        ..., error); with the angles kept also every numeric column of the angles' table
+        (`Analysis.to_frame`'s names: x_A, omega_2, Rx_0_1, M_bal, ...) over (designs, phi). Every
+        variable has attrs units (the table's), frame and long_name. Counts and flags are floats:
+        NaN where a design failed (its `error` says why)."""
+        xr = _xarray()
+        n_axes = len(self.shape)
+        names = list(self.table.columns[:n_axes])
+        units = self.table.attrs["units"]
+        axes = tuple(names)
+        coords = {}
+        for k, name in enumerate(names):
+            grid = self.table[name].to_numpy(dtype=float).reshape(self.shape)
+            coords[name] = _labelled(name, grid[tuple(slice(None) if a == k else 0 for a in range(n_axes))],
+                                     units[name], "none", f"swept parameter {name}")
+        data = {col: _labelled(axes, _design_values(self.table[col]).reshape(self.shape), units[col], "none",
+                               _meaning(col))
+                for col in self.table.columns[n_axes:]}
+        if self.angles is not None:
+            coords["phi"] = _labelled("phi", self.phi_deg, "deg", "world",
+                                      "crank angle from the model's drive reference in the drive's sense")
+            ran = (self.table["error"] == "").to_numpy()
+            angle_units = self.angles.attrs.get("units", {})
+            for col in self.angles.columns[n_axes:]:
+                if col == "phi_deg" or self.angles[col].dtype.kind not in "biuf":
+                    continue
+                values = np.full((len(ran), len(self.phi_deg)), np.nan)
+                values[ran] = self.angles[col].to_numpy(dtype=float).reshape(int(ran.sum()), len(self.phi_deg))
+                unit = angle_units[col]
+                data[col] = _labelled((*axes, "phi"), values.reshape(*self.shape, len(self.phi_deg)), unit,
+                                      "none" if unit in ("1", "bool") else "world",
+                                      f"{col} at each crank angle (Analysis.to_frame)")
+        return xr.Dataset(data, coords=coords, attrs={
+            "mechanism": self.table.attrs["mechanism"],
+            "conventions": f"design axes ({', '.join(names)}) before the crank-angle axis phi; {FRAME_NOTE}"})
+
+
+#: What each column of a sweep's table but the peaks holds (`Sweep.to_xarray`'s long names).
+_TABLE_MEANING = {
+    "n_singular": "number of singular crank angles", "singular_deg": "the singular crank angles",
+    "worst_digits": "fewest significant digits left among the warned angles",
+    "warned_deg": "the crank angles kept with fewer than DIGITS_WARN digits", "eta_cycle": "cycle efficiency",
+    "eta_cycle_reason": "why eta_cycle is NaN", "n_self_locking": "number of self-locking crank angles",
+    "error": "why the design failed ('' where it ran)"}
+
+
+def _meaning(col: str) -> str:
+    """What the sweep table's column `col` holds: a peak's, or `_TABLE_MEANING`'s."""
+    return f"largest |{col.removeprefix('peak_')}| over the cycle" if col.startswith("peak_") else _TABLE_MEANING[col]
+
+
+def _design_values(col: pd.Series) -> np.ndarray:
+    """A column of the sweep's table as an array: text as str, numbers (counts too) as float, NaN for a missing value."""
+    return col.to_numpy(dtype=float, na_value=np.nan) if col.dtype.kind in "biuf" else col.to_numpy(dtype=str)
 
 
 def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: int = 360, phi_deg=None,
