@@ -30,6 +30,9 @@ exclude_patterns = ["_build"]
 myst_enable_extensions = ["colon_fence"]
 myst_heading_anchors = 3            # "#the-interactive-page" anchors for the moved README sections
 
+#: `name` in a docstring is code (the docstrings' convention), not rST's default italic title.
+default_role = "literal"
+
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"   # hints beside the prose, not in long signatures
 autodoc_default_options = {"members": True, "show-inheritance": True}
