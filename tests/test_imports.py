@@ -2,9 +2,9 @@
 directly or through others, a module that imports it back (module-level and function-level
 imports alike, relative and absolute, type-checking ones too, and the `__init__` of every package
 above an imported module, which the import runs), and no room imports a room of a higher layer
-or one its line in the README's "How it works" does not name, nor does its line name a room it
-does not import. The layers and the rooms are read from the README (one source of truth), so the
-map stays true."""
+or one its line in the documentation's "How it works" (docs/explanation/how-it-works.md) does not
+name, nor does its line name a room it does not import. The layers and the rooms are read from
+that page (one source of truth), so the map stays true."""
 from __future__ import annotations
 
 import ast
@@ -16,8 +16,8 @@ import pytest
 from conftest import ROOT
 
 PACKAGES = {"kinetostat": ROOT / "kinetostat", "kinetostat_validation": ROOT / "validation"}
-README = (ROOT / "README.md").read_text(encoding="utf-8")
-HARNESS_USERS = {"report", "cli"}        # the only rooms that may import the harness (README)
+HOW_IT_WORKS = (ROOT / "docs" / "explanation" / "how-it-works.md").read_text(encoding="utf-8")
+HARNESS_USERS = {"report", "cli"}        # the only rooms that may import the harness (How it works)
 
 
 def _modules() -> dict[str, tuple[Path, bool]]:
@@ -105,30 +105,30 @@ def _cycle() -> list[str] | None:
 
 
 def _room(module: str) -> str:
-    """The README's name of the room a package module belongs to: `plans` for kinetostat.plans.draw,
+    """How it works' name of the room a package module belongs to: `plans` for kinetostat.plans.draw,
     `__init__` for the package itself."""
     parts = module.split(".")
     return "__init__" if len(parts) == 1 else parts[1]
 
 
 def _layers() -> dict[str, int]:
-    """room -> its layer (0 the lowest), from the README's picture of the layers."""
-    block = re.search(r"<!-- layers:.*?-->\n```text\n(.*?)\n```", README, flags=re.S)
-    assert block, "README: the picture of the layers (<!-- layers: ... --> and a text block) is missing"
+    """room -> its layer (0 the lowest), from How it works' picture of the layers."""
+    block = re.search(r"<!-- layers:.*?-->\n```text\n(.*?)\n```", HOW_IT_WORKS, flags=re.S)
+    assert block, "How it works: the picture of the layers (<!-- layers: ... --> and a text block) is missing"
     rows = block.group(1).splitlines()[::-1]
     layer = {}
     for n, row in enumerate(rows):
         rooms = re.split(r"\s{2,}", row.strip())[1]
         for room in rooms.split(", "):
-            assert room not in layer, f"README: room {room} stands in two layers"
+            assert room not in layer, f"How it works: room {room} stands in two layers"
             layer[room] = n
     return layer
 
 
 def _uses() -> dict[str, set[str]]:
-    """room -> the rooms its line in the README's list says it uses."""
+    """room -> the rooms its line in How it works' list says it uses."""
     out = {}
-    for name, text in re.findall(r"^- `([\w]+)/?` — (.*?)(?=^- `|^\n)", README, flags=re.S | re.M):
+    for name, text in re.findall(r"^- `([\w]+)/?` — (.*?)(?=^- `|^\n)", HOW_IT_WORKS, flags=re.S | re.M):
         said = re.search(r"Uses: (.*?)\.\s*$", " ".join(text.split()))
         if said:
             out[name] = set() if said.group(1) == "none" else set(said.group(1).split(", "))
@@ -186,10 +186,10 @@ def _used() -> dict[str, set[str]]:
 
 
 def test_a_rooms_line_names_only_rooms_it_uses():
-    """The other direction of the map: a room its README line names under "Uses:" is imported."""
+    """The other direction of the map: a room its line in How it works names under "Uses:" is imported."""
     used = _used()
     stale = {room: sorted(said - used[room]) for room, said in USES.items() if said - used[room]}
-    assert not stale, f"README 'Uses:' names rooms the code does not import: {stale}"
+    assert not stale, f"How it works' 'Uses:' names rooms the code does not import: {stale}"
     USES["tables"] = USES["tables"] | {"plans"}       # a stale entry, made up: it must be seen
     try:
         assert {room for room, said in USES.items() if said - used[room]} == {"tables"}
@@ -200,8 +200,8 @@ def test_a_rooms_line_names_only_rooms_it_uses():
 @pytest.mark.parametrize("module", PACKAGE_MODULES)
 def test_a_room_uses_only_its_layer_and_those_below_and_what_its_line_names(module):
     room = _room(module)
-    assert room in LAYERS, f"{module}: room {room} is on no layer of the README's picture (How it works)"
-    assert room in USES, f"{module}: room {room} has no line with 'Uses: ...' in the README's list (How it works)"
+    assert room in LAYERS, f"{module}: room {room} is on no layer of the picture in How it works"
+    assert room in USES, f"{module}: room {room} has no line with 'Uses: ...' in the list of How it works"
     for target, line in GRAPH[module].items():
         if target.split(".")[0] != "kinetostat":
             assert room in HARNESS_USERS, f"{module}, line {line}: imports the harness {target}"
@@ -210,8 +210,8 @@ def test_a_room_uses_only_its_layer_and_those_below_and_what_its_line_names(modu
         if other == room:
             continue
         assert LAYERS[other] <= LAYERS[room], (f"{module}, line {line}: imports {target}, of the layer above "
-                                               f"(README: {other} stands above {room})")
-        assert other in USES[room], f"{module}, line {line}: imports {target}; the README's line of {room} does not name {other}"
+                                               f"(How it works: {other} stands above {room})")
+        assert other in USES[room], f"{module}, line {line}: imports {target}; the line of {room} in How it works does not name {other}"
 
 
 def test_the_map_names_only_rooms_that_exist():

@@ -38,6 +38,7 @@ One body per moving link (named `link<k>`), nested as the scene's spanning tree;
 (axis 0 0 1) or slide joint per tree pair, placed so that qpos = 0 is the scene's q = 0
 (scene.py: child angle = parent angle + rel_angle [+ q]; the anchors coincide, a prismatic
 child's anchor moved by q * axis). No geoms (no contacts). Loops:
+
 - a cut revolute pair i-j: `<connect site1 site2>` with site1 on link j = pair.links[1] and
   site2 on link i at the pair's point. MuJoCo's connect row force is the force on site1's
   body, so the in-plane rows (x, y) are R = force of pair.links[0] on pair.links[1].
@@ -58,6 +59,7 @@ inertia of moving bodies must be larger than mjMINVAL"), and wants A + B >= C. T
 each body its mass and I_S as the z inertia, x and y inertia entries equal to the z entry
 (only z rotation exists in a planar model), and a placeholder floor where a value is zero:
 massless links (a balanced crank, neglected blocks) and the helper bodies.
+
 - exact route: the placeholders are EXACT_FLOOR (1e-12) of the scene's mass / inertia scales,
   and after compiling `body_mass` and `body_inertia` are overwritten with the exact values
   (zero where the link is massless). mj_rne, mj_comPos and mj_rnePostConstraint read them

@@ -7,6 +7,7 @@ child link's local frame shifted to the child's anchor (`anchor_child`), so a li
 p sits at p - anchor_child in its joint frame (link 0, the frame, is the world itself).
 
 Loop closures (the scene's cut pairs):
+
 - cut R pair: a `RigidConstraintModel(CONTACT_3D)` between the two links at the pin, in
   LOCAL_WORLD_ALIGNED axes; its z row is identically zero in a planar model and is dropped.
   Measured on pin 4.1.0: the constraint's velocity is v(c1 on body 1) - v(c2 on body 2), so
@@ -374,8 +375,10 @@ def forward_round_trip(scene: Scene, tau: np.ndarray, method: str = "auto") -> n
 
     method "kkt": the KKT system of Pinocchio's mass matrix (crba), rnea(q, v, 0, fext),
       constraint Jacobian and drift (J-dot v): [M -Jc^T; Jc 0] [qdd; lambda] = [S tau - b; gamma].
+
     method "constraintDynamics": Pinocchio's own `pin.constraintDynamics` (proximal Cholesky);
       its rigid constraints cannot slide, so it needs a scene whose cut pairs are all revolute.
+
     "auto": constraintDynamics when every cut is revolute, the KKT otherwise.
     """
     ps = PinocchioScene(scene)

@@ -170,7 +170,7 @@ class ModelFile(pytest.File):
 
 
 class UnreadFile(pytest.File):
-    """A visited *.toml that is not read (a FIFO, a device, or more than MAX_FILE_BYTES): one
+    """A visited `*.toml` that is not read (a FIFO, a device, or more than MAX_FILE_BYTES): one
     failing item, `<file>::read`, that says why; the other files are checked as usual."""
 
     def __init__(self, *, why: str, **kw):

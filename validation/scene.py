@@ -5,6 +5,7 @@ loop-closing pairs cut, inertias at the centres of mass, and the exact joint tra
 the solver for the prescribed crank motion.
 
 Joint coordinates (q = 0 is the placement below, not an assembled configuration):
+
 - revolute joint: child angle = parent angle + rel_angle + q, q wrapped to [-pi, pi) and 0 at
   phi = 0 in every scene of the mechanism (so scenes at different angles share one engine
   model); the anchor points
@@ -12,6 +13,7 @@ Joint coordinates (q = 0 is the placement below, not an assembled configuration)
 - prismatic joint: child angle = parent angle + rel_angle; the child's anchor sits at the
   parent's anchor + q * axis (axis in the parent frame). q is the slider point's travel
   along the guide direction from the guide point, whichever of the two links is the parent.
+
 Child frame origin in the parent frame: a_p + q*axis - R(rel_angle [+ q]) a_c.
 
 The drive: an engine's crank is driven by a pure moment about its pivot. A working machine's

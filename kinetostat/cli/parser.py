@@ -132,7 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--page", action=argparse.BooleanOptionalAction, default=True,
                    help="each model's interactive page, page.html, linked (default; --no-page: none). A page "
                         "is drawn anew, about 15-40 s of CPU a model, only where OUT/<model>/page.html is not "
-                        "already the same page: the same model, the same code (README: the page)")
+                        "already the same page: the same model, the same code (docs: The interactive page)")
     r.set_defaults(func=cmd_report)
 
     pl = sub.add_parser("plans", help="draw the plans of the graphical method (SVG sheets, segments.csv)",
@@ -167,7 +167,7 @@ def build_parser() -> argparse.ArgumentParser:
     pg = sub.add_parser("page", help="the interactive page of a mechanism: one offline HTML file, an angle slider "
                                      "over every plan", description="Write one self-contained HTML file (no network): "
                         "MODEL's plans at every degree and the design position at scales fixed for the cycle, the "
-                        "values table, the force plans step by step, a check of measured lengths (README: the page).")
+                        "values table, the force plans step by step, a check of measured lengths (docs: The interactive page).")
     pg.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
     pg.add_argument("--lang", choices=("en", "uk", "ru"), default=None, help="language (default: the model's, else en)")
     pg.add_argument("--student", action="store_true", help="the student's page: data, empty tables, the grid; no answer")

@@ -176,7 +176,7 @@ def field_tables() -> str:
     out = []
     for s in sections():
         head = "Top level" if s is MODEL else (f"`[[{s.name}]]`" if s.array else f"`[{s.name}]`")
-        out += [f"#### {head}", "", _doc(s).replace("|", "\\|"), "", "| field | type | unit | range | default | expression | description |",
+        out += [f"### {head}", "", _doc(s).replace("|", "\\|"), "", "| field | type | unit | range | default | expression | description |",
                 "|---|---|---|---|---|---|---|"]
         for f in s.fields:
             kind = _TYPES[f.type] + (": " + ", ".join(f"`{json.dumps(c)}`" for c in f.choices) if f.choices else "")
