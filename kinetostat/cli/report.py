@@ -1,9 +1,10 @@
 """`report`: the per-mechanism error reports, in worker processes (`--jobs`), most work first.
 
-May use: `.common`, the solver, `kinetostat.report` and the harness (imported inside the command).
+May use: `.common`, `kinetostat._forecast` (the estimated time), the solver, `kinetostat.report` and the harness (imported inside the command).
 """
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import time
@@ -11,15 +12,18 @@ import warnings
 from pathlib import Path
 from typing import Sequence
 
+from .._forecast import Forecast
 from .._io import unique_names, unit
 from .._text import one_line
-from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, _Out, _checkpoint, _close, _engines, _error, _load, _prepare, _progress, _warn, _writable_dir, bundled_models
+from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, _checkpoint, _close, _done, _engines, _error, _load, _prepare, _progress, _warn, _writable_dir, bundled_models
 
 
 #: path -> (mechanism, analysis, solver seconds) of the models `cmd_report` prepared: a forked
 #: worker (or this process with --jobs 1) finds them here and does not load and analyse the model
 #: again; under another start method the dict is empty and the job does both itself.
 _PREPARED: dict[str, tuple] = {}
+
+log = logging.getLogger(__name__)
 
 
 def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = True,
@@ -128,14 +132,19 @@ def cmd_report(args) -> int:
     t0 = time.perf_counter()
     summaries: dict[int, dict] = {}
     n_fail, n_err = 0, 0
+    jobs, cores = args.jobs or os.cpu_count() or 1, os.cpu_count() or 1
+    eta = Forecast(log, len(order), "model(s)", parallel=jobs,
+                   faster=([f"--jobs {cores}"] if jobs < cores else []) + (["--no-page"] if args.page else [])
+                   + (["--engines none"] if engines != ["reference"] else []))
     bar = _progress(len(order), "report", not args.no_progress)
     try:
-        for n, r in _report_results(order, folders, engines, args.steps, out, args.jobs or os.cpu_count() or 1,
+        for n, r in _report_results(order, folders, engines, args.steps, out, jobs,
                                     [_report_cost(mech) for _, mech, *_ in prepared], args.page,
                                     args.friction or "first"):
             _checkpoint()
             path = order[n]
             bar.update()
+            eta.done()
             if "error" in r:
                 n_err += 1
                 _error(f"{path.name}: {r['error']} (no report written)")
@@ -148,7 +157,7 @@ def cmd_report(args) -> int:
             status = "PASS" if s["passed"] and s["checked"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
             page = f", page {r['page']}" if r.get("page") else ""
-            _Out.write(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s{page}"
+            _done(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s{page}"
                                 f"  -> {out / s['stem'] / 'index.html'}"))
         index = out / "index.md"
         keep = n_err and index.exists()     # a model without a report: the earlier index is not lost
@@ -159,7 +168,7 @@ def cmd_report(args) -> int:
                 raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
         _close(bar)
-    _Out.write(one_line(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
+    _done(one_line(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
                         + (f", {n_err} without a report (errors above)" if n_err else "")
                         + (f"; the earlier index {index} stays as it was" if keep else
                            f"; index -> {index} and {index.with_suffix('.html')}")
