@@ -31,14 +31,15 @@ def duration(seconds: float) -> str:
 class Forecast:
     """Counts the items of a job of `total` `items` ("model(s)", "variant(s)"); when the first is
     done (`done`), one line on `logger`: about how long the remaining items will take at the first
-    one's pace (shared by `parallel` workers), and the options that make the job faster (`faster`,
-    left out where none applies); at INFO where that is at least LONG seconds, else at DEBUG.
+    one's pace, and the options that make the job faster (`faster`, left out where none applies);
+    at INFO where that is at least LONG seconds, else at DEBUG. With `parallel` workers, the
+    items started with the first end about with it, and the rest run `parallel` at a time.
     Nothing for a job of one item."""
 
     def __init__(self, logger: logging.Logger, total: int, items: str, faster: Sequence[str] = (),
                  parallel: int = 1):
         self.logger, self.total, self.items, self.faster = logger, total, items, tuple(faster)
-        self.parallel = max(1, min(parallel, total - 1))
+        self.parallel = max(1, min(parallel, total))
         self.started, self.count = now(), 0
 
     def done(self, n: int = 1) -> None:
@@ -48,7 +49,7 @@ class Forecast:
         left = self.total - self.count
         if first and left > 0:
             secs = (now() - self.started) / n
-            rest = secs * math.ceil(left / self.parallel)
+            rest = secs * math.ceil(max(left - (self.parallel - 1), 0) / self.parallel)
             hint = f"; faster: {' / '.join(self.faster)}" if self.faster else ""
             self.logger.log(logging.INFO if rest >= LONG else logging.DEBUG,
                             "about %s for the remaining %d %s (%s for the first%s)%s", duration(rest), left,

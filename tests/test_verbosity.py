@@ -66,9 +66,9 @@ def test_a_long_report_says_its_time_and_what_is_faster(cli, tmp_path, monkeypat
     assert [s for s in r.stderr.splitlines() if not s.startswith("kinetostat: error: ")] == [
         "about 2 min for the remaining 2 model(s) (2 min for the first, 2 at a time); faster: --jobs 4 / --no-page "
         "/ --engines none"]
-    r = cli("report", *models, "--steps", "8", "--no-page", "--engines", "none", "--out", tmp_path)
-    assert [s for s in r.stderr.splitlines() if not s.startswith("kinetostat: error: ")] == [
-        "about 2 min for the remaining 2 model(s) (2 min for the first, 2 at a time)"]
+    r = cli("report", *models * 2, "--steps", "8", "--no-page", "--engines", "none", "--out", tmp_path)
+    assert [s for s in r.stderr.splitlines() if not s.startswith("kinetostat: error: ")] == [       # 4 started
+        "about 2 min for the remaining 5 model(s) (2 min for the first, 4 at a time)"]
     r = cli("-q", "report", *models, "--steps", "8", "--out", tmp_path)
     assert "about" not in r.stderr and r.stderr.count("kinetostat: error: ") == 3
 
@@ -94,7 +94,15 @@ def test_a_long_sweep_says_its_time_and_what_is_faster(cli, tmp_path, clock):
     assert (r.returncode, r.stdout, r.stderr) == (0, "", "")
 
 
-def test_a_forecast_at_the_first_items_pace(caplog, clock):
+def test_validate_and_variant_all_say_their_time(cli, tmp_path, monkeypatch, clock):
+    r = cli("validate", FOUR_BAR_MODEL, FOUR_BAR_MODEL, "--engines", "none", "--steps", "8")
+    assert r.returncode == 0 and r.stderr == "about 2 min for the remaining 1 model(s) (2 min for the first)\n"
+    monkeypatch.setattr("kinetostat.variants.codes", lambda: ["479"])            # one code of each task
+    r = cli("variant", "--all", "--no-pack", "--out", tmp_path)
+    assert r.returncode == 0 and r.stderr == "about 4 min for the remaining 2 variant(s) (2 min for the first); faster: one TASK\n"
+
+
+def test_a_forecast_at_the_first_items_pace(caplog, clock, monkeypatch):
     log = logging.getLogger("kinetostat.test")
     caplog.set_level(logging.DEBUG, "kinetostat")
     eta = _forecast.Forecast(log, 1000, "variant(s)", faster=["--no-pack", "one TASK"])
@@ -103,8 +111,14 @@ def test_a_forecast_at_the_first_items_pace(caplog, clock):
     assert [(r.levelno, r.getMessage()) for r in caplog.records] == [
         (logging.INFO, "about 33.3 h for the remaining 999 variant(s) (2 min for the first); faster: --no-pack / one TASK")]
     caplog.clear()
-    _forecast.Forecast(log, 9, "model(s)", parallel=4).done()      # 8 left, 4 at a time: 2 rounds
+    _forecast.Forecast(log, 9, "model(s)", parallel=4).done()      # 8 left, 3 of them ending with the first: 2 rounds
     assert caplog.records[0].getMessage() == "about 4 min for the remaining 8 model(s) (2 min for the first, 4 at a time)"
+    caplog.clear()
+    monkeypatch.setattr(_forecast, "LONG", 300.0)                  # a job that is not long: its forecast for -v only
+    _forecast.Forecast(log, 3, "model(s)").done()
+    assert [(r.levelno, r.getMessage()) for r in caplog.records] == [
+        (logging.DEBUG, "about 4 min for the remaining 2 model(s) (2 min for the first)")]
+    monkeypatch.setattr(_forecast, "LONG", 30.0)
     caplog.clear()
     _forecast.Forecast(log, 1, "model(s)").done()                  # a job of one item: nothing to forecast
     _forecast.Forecast(log, 65, "design(s)").done(32)              # the first chunk: 3.75 s a design

@@ -15,7 +15,7 @@ from typing import Sequence
 from .._forecast import Forecast
 from .._io import unique_names, unit
 from .._text import one_line
-from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, _checkpoint, _close, _done, _engines, _error, _load, _prepare, _progress, _warn, _writable_dir, bundled_models
+from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, NORMAL, _Out, _checkpoint, _close, _done, _engines, _error, _load, _log_lines, _prepare, _progress, _warn, _writable_dir, bundled_models
 
 
 #: path -> (mechanism, analysis, solver seconds) of the models `cmd_report` prepared: a forked
@@ -67,12 +67,16 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
     return {"summary": summary, "warnings": notes, "seconds": time.perf_counter() - t0, "page": page_state}
 
 
-def _worker_init() -> None:
+def _worker_init(verbosity: int = NORMAL) -> None:
     """A report worker ends at once, silently, on Ctrl-C (the terminal sends it to the whole
     process group): the main process reports the interruption. A KeyboardInterrupt would not
     do, as it can land in a garbage-collection callback, which swallows it. The temporary file
-    of a write in progress is removed first (the files already written stay as they are)."""
+    of a write in progress is removed first (the files already written stay as they are). Its
+    log lines go to stderr at the command's `verbosity`, under any start method, printed
+    plainly (the progress bar is the main process's)."""
     from .._io import remove_temporary
+    _Out.bar = None
+    _log_lines(verbosity)
 
     def end(signum, frame):
         remove_temporary()
@@ -87,17 +91,18 @@ def _report_cost(mech) -> int:
 
 
 def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int,
-                    costs: Sequence[int] = (), page: bool = True, friction: str = "first"):
+                    costs: Sequence[int] = (), page: bool = True, friction: str = "first", verbosity: int = NORMAL):
     """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
     them in a process pool (only paths and names cross to the workers, so any start method
-    works), the largest `costs` first, 1 in this process. Ctrl-C cancels the models not started
-    and raises KeyboardInterrupt here."""
+    works), the largest `costs` first, 1 in this process; the workers log at `verbosity`. Ctrl-C
+    cancels the models not started and raises KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
         for n, p in enumerate(paths):
             yield n, _report_job(str(p), engines, steps, str(out), folders[n], page, friction)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init,
+                               initargs=(verbosity,))
     try:
         first = sorted(range(len(paths)), key=lambda n: -costs[n] if costs else 0)
         futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n], page, friction): n
@@ -140,7 +145,7 @@ def cmd_report(args) -> int:
     try:
         for n, r in _report_results(order, folders, engines, args.steps, out, jobs,
                                     [_report_cost(mech) for _, mech, *_ in prepared], args.page,
-                                    args.friction or "first"):
+                                    args.friction or "first", args.verbosity):
             _checkpoint()
             path = order[n]
             bar.update()
