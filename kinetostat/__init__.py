@@ -10,11 +10,18 @@
 
 The plans of the graphical method: `kinetostat.plans.build(mech, at=30)`.
 
+Progress and diagnostics that are not warnings go to the logger `logging.getLogger("kinetostat")`
+(each module's logger under it); the package gives it a NullHandler only, so an application
+configures logging itself (the command line: one stderr handler, -q and -v).
+
 The solver's public names. May use: the solver modules only (never the harness
 `kinetostat_validation`, the engines, matplotlib or `kinetostat.report`).
 """
+import logging as _logging
 import os as _os
 import sys as _sys
+
+_logging.getLogger(__name__).addHandler(_logging.NullHandler())
 
 
 def _interrupted_while_starting(signum, frame) -> None:

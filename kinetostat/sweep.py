@@ -18,7 +18,8 @@ model) are not printed: the table's `n_singular` and `singular_deg` say where a 
 DIGITS_WARN digits and the fewest digits there; `eta_cycle_reason` why a design's cycle efficiency
 is undefined, and one UndefinedFigureWarning after the sweep counts those designs by cause.
 
-May use: model, analysis, solve, fast, errors, examples, units, _io (Ctrl-C held back); pandas (imported when a sweep runs, so that
+May use: model, analysis, solve, fast, errors, examples, units, _io (Ctrl-C held back), _forecast (the
+estimated time, logged once the first chunk is done in this process); pandas (imported when a sweep runs, so that
 `import kinetostat` does not load it); dask and distributed (imported only for a
 Dask scheduler), tqdm (only for a progress bar) and xarray (only in `Sweep.to_xarray`, through analysis'
 `_xarray`). Never the harness, the engines, matplotlib or
@@ -27,6 +28,7 @@ Dask scheduler), tqdm (only for a progress bar) and xarray (only in `Sweep.to_xa
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 import threading
 import warnings
@@ -37,6 +39,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping
 
 import numpy as np
 
+from ._forecast import Forecast
 from .analysis import FRAME_NOTE, Analysis, _labelled, _xarray, crank_angles, friction_method
 from .solve import analyze
 from .errors import (AssemblyError, ModelError, ModelWarning, SelfLockingWarning, SingularPositionWarning, StructureError,
@@ -48,6 +51,8 @@ if TYPE_CHECKING:
     import pandas as pd
 
 __all__ = ["Sweep", "sweep", "CHUNK", "LOCAL_SCHEDULERS"]
+
+log = logging.getLogger(__name__)
 
 #: Designs per Dask task, by default.
 CHUNK = 32
@@ -156,7 +161,9 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     `full`: also keep every angle's row (`Sweep.angles`). `scheduler`: None runs in this
     process (no Dask); "threads" or "processes": Dask's local schedulers; another string: the
     address of a `distributed` scheduler; or a `distributed.Client`. `chunk`: designs per task.
-    `progress`: a tqdm bar over the chunks on stderr. `friction`: as `analyze` takes it (default:
+    `progress`: a tqdm bar over the chunks on stderr. In this process, the time the remaining
+    designs will take is logged once the first chunk is done (INFO, logger "kinetostat.sweep").
+    `friction`: as `analyze` takes it (default:
     the model's); with friction in the reactions each row also has `eta_cycle` (the cycle
     efficiency, NaN unless the angles are a uniform full cycle), `eta_cycle_reason` (why it is NaN,
     `Analysis.cycle_efficiency_reason`; "" where it is a number) and `n_self_locking` (the count of
@@ -370,14 +377,19 @@ def _quiet() -> Iterator[None]:
 def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: np.ndarray, full: bool,
          scheduler: Any, progress: bool, friction: str | None = None,
          compiled: bool = False) -> list[tuple[pd.DataFrame, pd.DataFrame | None]]:
-    """Every chunk's result, in the order of `parts`: in this process, or over Dask."""
+    """Every chunk's result, in the order of `parts`: in this process (each chunk logged, DEBUG;
+    the time of the rest logged after the first, INFO: `Forecast`), or over Dask."""
     bar = _bar(len(parts), progress)
     try:
         if scheduler is None:
             out = []
-            for part in parts:
+            eta = Forecast(log, sum(map(len, parts)), "design(s)",
+                           faster=["--scheduler processes (the API's scheduler='processes')"])
+            for k, part in enumerate(parts):
                 out.append(_chunk(text, source, part, phi_deg, full, friction, compiled))
+                log.debug("sweep: chunk %d of %d done (%d design(s))", k + 1, len(parts), len(part))
                 bar.update()
+                eta.done(len(part))
             return out
         import dask
         keys = [f"kinetostat-sweep-chunk-{k}" for k in range(len(parts))]

@@ -44,11 +44,19 @@ class ColumnDiff:
     obtained: float
 
 
-class CycleMismatch(AssertionError):
-    """The cycle differs from the expected file; `diffs` lists the columns beyond tolerance."""
+#: How a mismatch's message says to accept the obtained values through this API (the pytest
+#: fixture names its `--kinetostat-regen` instead).
+ACCEPT = "to accept the obtained values: regenerate=True, or KINETOSTAT_REGENERATE=1 in the environment"
 
-    def __init__(self, message: str, diffs: Sequence[ColumnDiff] = ()):
-        super().__init__(message)
+
+class CycleMismatch(AssertionError):
+    """The cycle differs from the expected file; `diffs` lists the columns beyond tolerance.
+    `finding` is the message without the line `accept` (how to accept the obtained values, ""
+    where there is nothing to accept), which ends it where given."""
+
+    def __init__(self, message: str, diffs: Sequence[ColumnDiff] = (), accept: str = ""):
+        super().__init__(f"{message}\n{accept}" if accept else message)
+        self.finding, self.accept = message, accept
         self.diffs = tuple(diffs)
 
 
@@ -164,8 +172,9 @@ def check_cycle(model: Mechanism | str | Path, expected: str | Path, *, rtol: fl
     ("N", "N m", "m/s^2", ...) to an absolute tolerance in that unit (0 for those not named).
     `regenerate` (default: $KINETOSTAT_REGENERATE) rewrites `expected` and passes. A missing
     expected file is written and the check fails, so that a first run is never taken as a pass.
-    On a difference `<expected>.obtained.csv` is written and `CycleMismatch` raised (a pass
-    removes it). Returns the expected file's path.
+    On a difference `<expected>.obtained.csv` is written and `CycleMismatch` raised, its message
+    ending with how to accept the obtained values (ACCEPT); a pass removes the obtained file.
+    Returns the expected file's path.
     """
     __tracebackhide__ = True             # pytest: a mismatch shows its table, not this function's source
     path = Path(expected)
@@ -209,4 +218,4 @@ def check_cycle(model: Mechanism | str | Path, expected: str | Path, *, rtol: fl
             f"obtained written to {out}")
     body = "\n".join(f"  {p}" for p in problems) if problems else (
         f"{len(diffs)} of {len(obt.columns)} columns beyond tolerance:\n" + _table(diffs))
-    raise CycleMismatch(f"{head}\n{body}", diffs)
+    raise CycleMismatch(f"{head}\n{body}", diffs, ACCEPT)

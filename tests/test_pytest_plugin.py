@@ -200,6 +200,8 @@ def test_check_cycle_catches_a_tenth_of_a_percent_of_one_mass(tmp_path):
         check_cycle(heavier, expected, steps=36)
     diffs = {d.column: d for d in exc.value.diffs}
     assert obtained_path(expected).exists() and "obtained written to" in str(exc.value)
+    assert str(exc.value).splitlines()[-1] == ("to accept the obtained values: regenerate=True, or "
+                                               "KINETOSTAT_REGENERATE=1 in the environment")
     # the differences, in each column's unit, are the two solutions' own
     old, new = (kinetostat.analyze(m, steps=36) for m in (kinetostat.loads(four_bar()), heavier))
     d = diffs["M_bal"]
@@ -232,6 +234,8 @@ def test_regression_fixture_regenerates_with_the_flag(pytester):
     out = r.stdout.str()
     assert obtained_path(expected).exists() and "columns beyond tolerance" in out
     assert "def check" not in out and "check_cycle(" not in out and "testing.py" not in out   # the table, no source
+    assert ("to accept the obtained values: run pytest again with --kinetostat-regen (or KINETOSTAT_REGENERATE=1 "
+            "in the environment)") in out and "regenerate=True" not in out          # the flag, not the API's argument
     run(pytester, "tests", "--kinetostat-regen").assert_outcomes(passed=1)
     run(pytester, "tests").assert_outcomes(passed=1)
 

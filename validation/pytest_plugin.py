@@ -347,13 +347,19 @@ def _outcome(report: pytest.TestReport, props: dict):
     return Outcome(report.nodeid, status, props["route"], where, props["trust"], check, message)
 
 
+#: The last line of a failing `kinetostat_regression` check: how to accept the obtained values.
+REGEN_ACCEPT = ("to accept the obtained values: run pytest again with --kinetostat-regen "
+                "(or KINETOSTAT_REGENERATE=1 in the environment)")
+
+
 @pytest.fixture
 def kinetostat_regression(request: pytest.FixtureRequest) -> Callable[..., Path]:
     """`check(model, expected=None, **kw)`: `kinetostat.testing.check_cycle` with the expected CSV
     at `<test file's folder>/<test module>/<test name>.csv` unless `expected` is given. A relative
     `model` or `expected` path is taken from the test file's folder (not the current directory).
     `--kinetostat-regen` rewrites the expected file (keywords as check_cycle's: rtol, atol, steps,
-    columns). A mismatch fails the test with check_cycle's message and table alone (no traceback)."""
+    columns). A mismatch fails the test with check_cycle's message and table alone (no traceback),
+    ending with how to accept the obtained values: the flag (REGEN_ACCEPT)."""
     from kinetostat.testing import CycleMismatch, check_cycle
 
     def check(model, expected: str | Path | None = None, **kw) -> Path:
@@ -369,6 +375,6 @@ def kinetostat_regression(request: pytest.FixtureRequest) -> Callable[..., Path]
         try:
             return check_cycle(model, here / expected, **kw)
         except CycleMismatch as exc:
-            message = str(exc)
+            message = f"{exc.finding}\n{REGEN_ACCEPT}" if exc.accept else str(exc)
         pytest.fail(message, pytrace=False)        # outside the except: no "during handling" chain
     return check

@@ -14,6 +14,8 @@ disk leaves the previous file as it was; a device, FIFO, or the process's own st
 (also through a link, e.g. /dev/stderr) named as an output is written as a stream, never replaced; the files of `plans`, `variant` and each model's `report` are
 swapped in as a set (`kinetostat._io.unit`). Text from a model is printed with its control
 characters visible, and every error, warning and summary line stays one line (a newline as \\n).
+-q (errors only) and -v (also progress lines), before or after the command, set the level of the
+package logger `kinetostat`, to which `main` gives one stderr handler while a command runs.
 
 The rooms: `common` (what every command shares: exit codes, errors, output, interrupts, atomic
 saving, progress, loading), one module per command or group of related commands (`analyze`:
@@ -30,7 +32,7 @@ import warnings
 from typing import Sequence
 
 from .common import (EXIT_FAIL, EXIT_INTERRUPTED, EXIT_NOT_CHECKED, EXIT_OK, EXIT_USAGE, CLIError, _checkpoint,
-                     _error, _interrupts, _quiet_stdout, _readable_streams, _showwarning, bundled_models)
+                     _error, _interrupts, _logging, _quiet_stdout, _readable_streams, _showwarning, bundled_models)
 from .parser import build_parser
 from .sweep import _param, _range, _RangeError
 from .validate import exit_code, validation_table
@@ -47,8 +49,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         try:
             parser = build_parser()
             args = parser.parse_args(argv)
-            code = args.func(args)
-            _checkpoint()
+            with _logging(args.verbosity):
+                code = args.func(args)
+                _checkpoint()
             sys.stdout.flush()           # stdout on a full disk fails here, not at the interpreter's exit
             return code
         except CLIError as exc:

@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from .._text import one_line
-from .common import CLIError, EXIT_OK, TABLE_SUFFIXES, _Out, _analyze, _fmt, _lines, _load, _model_error_lines, _parquet_engine, _save, _turn, _warn, _writable_file, bundled_models
+from .common import CLIError, EXIT_OK, TABLE_SUFFIXES, _Out, _analyze, _done, _fmt, _lines, _load, _model_error_lines, _parquet_engine, _save, _turn, _warn, _writable_file, bundled_models
 
 
 def _summary(res, path: Path) -> list[str]:
@@ -219,7 +219,7 @@ def cmd_export(args) -> int:
         _Out.write(text.rstrip("\n"))
         return EXIT_OK
     _save(args.output, "-o", lambda f: f.write(text))
-    _Out.write(one_line(f"{args.format.upper()} of {path.name} -> {args.output}"))
+    _done(one_line(f"{args.format.upper()} of {path.name} -> {args.output}"))
     return EXIT_OK
 
 
@@ -240,7 +240,7 @@ def cmd_examples(args) -> int:
                            f"(--force replaces them)") from None
         except OSError as exc:
             raise CLIError(f"cannot write --copy {args.copy}: {exc.strerror or exc}") from None
-        _Out.write(one_line(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}"))
+        _done(one_line(f"{len(written)} files ({', '.join(p.name for p in written)}) -> {args.copy}"))
         return EXIT_OK
     lines = [f"bundled models in {examples.models_dir()} (by name: kinetostat.load(NAME); "
              f"copies: kinetostat examples --copy DIR):"]

@@ -1,4 +1,5 @@
 """What every command shares: exit codes, CLIError, output that does not break a progress bar,
+the verbosity (-q, -v: the package logger's level and its one stderr handler, `_logging`),
 interrupts, atomic saving (`_save`), warnings as one line, progress bars, the argument types,
 loading a model (`_load`), the analysis with its memory check (`_analyze`), writable outputs,
 the engine routes (`_engines`) and the models prepared for them (`_prepare`).
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import logging
 import math
 import os
 import signal
@@ -26,6 +28,13 @@ from .._text import one_line, visible
 
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_NOT_CHECKED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+
+#: The verbosity of -q (errors only), of neither option, and of -v (also the progress lines).
+QUIET, NORMAL, VERBOSE = -1, 0, 1
+#: The package logger's level at each verbosity.
+LOG_LEVELS = {QUIET: logging.ERROR, NORMAL: logging.INFO, VERBOSE: logging.DEBUG}
+
+log = logging.getLogger(__name__)
 
 
 TABLE_SUFFIXES = (".csv", ".parquet", ".json")
@@ -60,6 +69,52 @@ class _Out:
             raise
         except OSError as exc:           # stdout on a full disk: one error line, not a traceback
             raise CLIError(f"cannot write to {'stderr' if err else 'stdout'}: {exc.strerror or exc}") from None
+
+
+class _LogLines(logging.Handler):
+    """The command line's one handler of the package logger: each record one line on stderr,
+    through `_Out` (a progress bar stays whole); a warning or error led by "kinetostat: warning: "
+    or "kinetostat: error: ", progress and information lines as they are."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        lead = f"kinetostat: {record.levelname.lower()}: " if record.levelno >= logging.WARNING else ""
+        _Out.write(lead + one_line(record.getMessage()), err=True)
+
+
+def _log_lines(verbosity: int) -> None:
+    """The package logger at the level of `verbosity` (LOG_LEVELS) with one `_LogLines` handler
+    (one inherited by a forked worker replaced), not passed on to the root logger's handlers."""
+    package = logging.getLogger("kinetostat")
+    package.handlers[:] = [h for h in package.handlers if not isinstance(h, _LogLines)] + [_LogLines()]
+    package.setLevel(LOG_LEVELS[verbosity])
+    package.propagate = False
+
+
+@contextmanager
+def _logging(verbosity: int) -> Iterator[None]:
+    """`_log_lines(verbosity)` while a command runs, then the package logger as it was."""
+    package = logging.getLogger("kinetostat")
+    saved = package.level, package.propagate, list(package.handlers)
+    _log_lines(verbosity)
+    try:
+        yield
+    finally:
+        package.handlers[:] = saved[2]
+        package.setLevel(saved[0])
+        package.propagate = saved[1]
+
+
+def _quiet() -> bool:
+    """-q: errors only (no progress bar, information line, warning or `_done` line)."""
+    return not log.isEnabledFor(logging.INFO)
+
+
+def _done(text: str) -> None:
+    """Lines on stdout saying what a command wrote where (a report's models, a sweep's table,
+    the files of plans, page, export, variant --all), each made one line by the caller
+    (`one_line`, `_lines`); none under -q."""
+    if not _quiet():
+        _Out.write(text)
 
 
 def _lines(lines: Iterable[str]) -> str:
@@ -171,7 +226,9 @@ def _os_reason(exc: OSError, path: str | Path) -> str:
 
 
 def _warn(msg: str) -> None:
-    _Out.write(f"kinetostat: warning: {one_line(msg)}", err=True)
+    """The warning line, made one line; none under -q."""
+    if log.isEnabledFor(logging.WARNING):
+        _Out.write(f"kinetostat: warning: {one_line(msg)}", err=True)
 
 
 def _showwarning(message, category, filename, lineno, file=None, line=None):
@@ -186,8 +243,8 @@ class _NoBar:
 
 
 def _progress(total: int, desc: str, enabled: bool):
-    """A tqdm bar on stderr when stderr is a terminal (and tqdm is installed), else a no-op."""
-    if not enabled or not sys.stderr.isatty():
+    """A tqdm bar on stderr when stderr is a terminal (and tqdm is installed), and not -q; else a no-op."""
+    if not enabled or _quiet() or not sys.stderr.isatty():
         return _NoBar()
     try:
         from tqdm import tqdm
@@ -513,6 +570,7 @@ def _prepare(paths: Sequence[str | Path], steps: int):
             problems.append(exc)
             continue
         jobs.append((Path(path), mech, res, secs))
+        log.debug("%s: loaded and analysed over %d positions in %.2f s", Path(path).name, steps, secs)
     if problems:
         for p in problems[:-1]:
             _error(p)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 
 from .analyze import cmd_analyze, cmd_examples, cmd_export, cmd_schema, cmd_structure
-from .common import _Parser, _angle, _jobs, _positive, _steps
+from .common import NORMAL, QUIET, VERBOSE, _Parser, _angle, _jobs, _positive, _steps
 from .plans import _plan_names, _scale_item, cmd_page, cmd_plans, cmd_variant
 from .report import cmd_report
 from .sweep import _param, cmd_sweep
@@ -20,6 +20,18 @@ def _friction_option(parser: argparse.ArgumentParser, default: str) -> None:
     parser.add_argument("--friction", choices=["first", "reactions"], default=None,
                         help="a model with [friction]: 'first' (the first approximation: frictionless reactions) or "
                              f"'reactions' (friction in the reactions, exact); {default}")
+
+
+def _verbosity_options(parser: argparse.ArgumentParser, default) -> None:
+    """-q/--quiet and -v/--verbose into `verbosity`; a command's own take `default`
+    argparse.SUPPRESS, so that the ones given before the command stay."""
+    g = parser.add_mutually_exclusive_group()
+    g.add_argument("-q", "--quiet", dest="verbosity", action="store_const", const=QUIET, default=default,
+                   help="errors only on stderr: no progress bar, information line or warning; no line saying "
+                        "which files were written; results (tables, --out -) still go to stdout")
+    g.add_argument("-v", "--verbose", dest="verbosity", action="store_const", const=VERBOSE, default=default,
+                   help="also the progress lines on stderr: per model its analysis, each engine route, the "
+                        "figures and plans of a report, each variant, each chunk of a sweep")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -34,6 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "Bundled models ship inside the package ('kinetostat examples' lists them); "
                        "$KINETOSTAT_MODELS names another folder of *.toml models to use instead.")
     p.add_argument("--version", action="version", version=f"kinetostat {__version__}")
+    _verbosity_options(p, NORMAL)
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     routes = "pinocchio, mujoco, mujoco-sim, pymunk, reference (40-digit mpmath, no engine); none: reference only"
@@ -251,4 +264,6 @@ def build_parser() -> argparse.ArgumentParser:
                          "efficiency eta_cycle and n_self_locking, the count of self-locking angles")
     sw.add_argument("--no-progress", action="store_true", help="no progress bar")
     sw.set_defaults(func=cmd_sweep)
+    for command in sub.choices.values():     # -q/-v also after the command: kinetostat report -q ...
+        _verbosity_options(command, argparse.SUPPRESS)
     return p

@@ -2,21 +2,25 @@
 page of a mechanism) and `variant` (the task variants of Logvinenko, Nadtoka 2021 and their answer
 keys).
 
-May use: `.common`, the solver, `kinetostat.plans`, `kinetostat.variants`.
+May use: `.common`, `kinetostat._forecast` (the estimated time of --all), the solver, `kinetostat.plans`, `kinetostat.variants`.
 """
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import sys
 import time
 import warnings
 from pathlib import Path
 
+from .._forecast import Forecast
 from .._io import unit
 from .._text import one_line
-from .common import (CLIError, EXIT_OK, _Out, _checkpoint, _close, _lines, _load, _os_reason, _progress, _size,
+from .common import (CLIError, EXIT_OK, _Out, _checkpoint, _close, _done, _lines, _load, _os_reason, _progress, _size,
                      _turn, _warn, _writable_dir, _writable_file)
+
+log = logging.getLogger(__name__)
 
 
 def _scale_item(text: str) -> tuple[str, float]:
@@ -81,7 +85,7 @@ def cmd_plans(args) -> int:
     at_plan += [w for w in caught if issubclass(w.category, (SelfLockingWarning, ModelWarning))]   # the model's: any angle
     for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
         _warn(f"{path.name}: {text}")
-    _Out.write(one_line(plans.summary(path.name, len(written), out, args.lang)))
+    _done(one_line(plans.summary(path.name, len(written), out, args.lang)))
     return EXIT_OK
 
 
@@ -95,7 +99,7 @@ def cmd_page(args) -> int:
                           at=_turn(args.at, "--at"))
     except ValueError as exc:
         raise CLIError(f"--at {args.at if args.at is not None else 'design position'}: {exc}") from None
-    _Out.write(one_line(f"{Path(args.model).name}: page -> {path} ({_size(path.stat().st_size)})"))
+    _done(one_line(f"{Path(args.model).name}: page -> {path} ({_size(path.stat().st_size)})"))
     return EXIT_OK
 
 
@@ -118,12 +122,14 @@ def cmd_variant(args) -> int:
     import importlib.util
     teacher_pack = not args.no_pack and importlib.util.find_spec("matplotlib") is not None
     if not (args.no_pack or teacher_pack):          # a plain install: the keys, and a word on the pack
-        _Out.write("no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf): its PDFs need matplotlib: "
-                   "pip install 'kinetostat[reports]'", err=True)
+        log.info("no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf): its PDFs need matplotlib: "
+                 "pip install 'kinetostat[reports]'")
     default = "task_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
     t0 = time.perf_counter()
     keys = []
+    eta = Forecast(log, len(jobs), "variant(s)", faster=(["--no-pack"] if teacher_pack else [])
+                   + (["no --page"] if args.page else []) + (["one TASK"] if args.task is None else []))
     bar = _progress(len(jobs), "variants", args.all and not args.no_progress)
     try:
         for job in jobs:
@@ -139,7 +145,9 @@ def cmd_variant(args) -> int:
                     raise CLIError(f"task {v.task} variant {v.code}: {exc}") from None
                 except OSError as exc:
                     raise CLIError(f"cannot write --out {out}: {_os_reason(exc, out)}") from None
+            log.debug("task %d variant %s: the key, %d files", v.task, v.code, len(keys[-1].files))
             bar.update()
+            eta.done()
         if args.all:
             try:
                 index = variants.write_index(out, keys, args.lang)
@@ -149,7 +157,7 @@ def cmd_variant(args) -> int:
         _close(bar)
     if args.all:
         from ..plans.i18n import num, text
-        _Out.write(one_line(text("cli.all", args.lang, keys=len(keys), tasks=", ".join(map(str, tasks)), out=out,
+        _done(one_line(text("cli.all", args.lang, keys=len(keys), tasks=", ".join(map(str, tasks)), out=out,
                                  index=index, s=num(time.perf_counter() - t0, args.lang, decimals=1))))
         return EXIT_OK
     lines = variants.summary(jobs[0], keys[0], out, args.lang)

@@ -1,9 +1,10 @@
 """`report`: the per-mechanism error reports, in worker processes (`--jobs`), most work first.
 
-May use: `.common`, the solver, `kinetostat.report` and the harness (imported inside the command).
+May use: `.common`, `kinetostat._forecast` (the estimated time), the solver, `kinetostat.report` and the harness (imported inside the command).
 """
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import time
@@ -11,15 +12,18 @@ import warnings
 from pathlib import Path
 from typing import Sequence
 
+from .._forecast import Forecast
 from .._io import unique_names, unit
 from .._text import one_line
-from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, _Out, _checkpoint, _close, _engines, _error, _load, _prepare, _progress, _warn, _writable_dir, bundled_models
+from .common import CLIError, EXIT_FAIL, EXIT_INTERRUPTED, EXIT_OK, NORMAL, _Out, _checkpoint, _close, _done, _engines, _error, _load, _log_lines, _prepare, _progress, _warn, _writable_dir, bundled_models
 
 
 #: path -> (mechanism, analysis, solver seconds) of the models `cmd_report` prepared: a forked
 #: worker (or this process with --jobs 1) finds them here and does not load and analyse the model
 #: again; under another start method the dict is empty and the job does both itself.
 _PREPARED: dict[str, tuple] = {}
+
+log = logging.getLogger(__name__)
 
 
 def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = True,
@@ -63,12 +67,16 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
     return {"summary": summary, "warnings": notes, "seconds": time.perf_counter() - t0, "page": page_state}
 
 
-def _worker_init() -> None:
+def _worker_init(verbosity: int = NORMAL) -> None:
     """A report worker ends at once, silently, on Ctrl-C (the terminal sends it to the whole
     process group): the main process reports the interruption. A KeyboardInterrupt would not
     do, as it can land in a garbage-collection callback, which swallows it. The temporary file
-    of a write in progress is removed first (the files already written stay as they are)."""
+    of a write in progress is removed first (the files already written stay as they are). Its
+    log lines go to stderr at the command's `verbosity`, under any start method, printed
+    plainly (the progress bar is the main process's)."""
     from .._io import remove_temporary
+    _Out.bar = None
+    _log_lines(verbosity)
 
     def end(signum, frame):
         remove_temporary()
@@ -83,17 +91,18 @@ def _report_cost(mech) -> int:
 
 
 def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int,
-                    costs: Sequence[int] = (), page: bool = True, friction: str = "first"):
+                    costs: Sequence[int] = (), page: bool = True, friction: str = "first", verbosity: int = NORMAL):
     """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
     them in a process pool (only paths and names cross to the workers, so any start method
-    works), the largest `costs` first, 1 in this process. Ctrl-C cancels the models not started
-    and raises KeyboardInterrupt here."""
+    works), the largest `costs` first, 1 in this process; the workers log at `verbosity`. Ctrl-C
+    cancels the models not started and raises KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
         for n, p in enumerate(paths):
             yield n, _report_job(str(p), engines, steps, str(out), folders[n], page, friction)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init)
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init,
+                               initargs=(verbosity,))
     try:
         first = sorted(range(len(paths)), key=lambda n: -costs[n] if costs else 0)
         futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n], page, friction): n
@@ -128,14 +137,19 @@ def cmd_report(args) -> int:
     t0 = time.perf_counter()
     summaries: dict[int, dict] = {}
     n_fail, n_err = 0, 0
+    jobs, cores = args.jobs or os.cpu_count() or 1, os.cpu_count() or 1
+    eta = Forecast(log, len(order), "model(s)", parallel=jobs,
+                   faster=([f"--jobs {cores}"] if jobs < cores else []) + (["--no-page"] if args.page else [])
+                   + (["--engines none"] if engines != ["reference"] else []))
     bar = _progress(len(order), "report", not args.no_progress)
     try:
-        for n, r in _report_results(order, folders, engines, args.steps, out, args.jobs or os.cpu_count() or 1,
+        for n, r in _report_results(order, folders, engines, args.steps, out, jobs,
                                     [_report_cost(mech) for _, mech, *_ in prepared], args.page,
-                                    args.friction or "first"):
+                                    args.friction or "first", args.verbosity):
             _checkpoint()
             path = order[n]
             bar.update()
+            eta.done()
             if "error" in r:
                 n_err += 1
                 _error(f"{path.name}: {r['error']} (no report written)")
@@ -148,7 +162,7 @@ def cmd_report(args) -> int:
             status = "PASS" if s["passed"] and s["checked"] else "FAIL" if not s["passed"] else "NOT CHECKED"
             routes = ", ".join(f"{name} {info['status']}" for name, info in s["routes"].items())
             page = f", page {r['page']}" if r.get("page") else ""
-            _Out.write(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s{page}"
+            _done(one_line(f"{path.stem:<26s} {status:<5s} ({routes})  {r['seconds']:5.1f} s{page}"
                                 f"  -> {out / s['stem'] / 'index.html'}"))
         index = out / "index.md"
         keep = n_err and index.exists()     # a model without a report: the earlier index is not lost
@@ -159,7 +173,7 @@ def cmd_report(args) -> int:
                 raise CLIError(f"cannot write the index into {out}: {exc.strerror or exc}") from None
     finally:
         _close(bar)
-    _Out.write(one_line(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
+    _done(one_line(f"report: {len(summaries)} mechanism(s), {n_fail} with failed checks"
                         + (f", {n_err} without a report (errors above)" if n_err else "")
                         + (f"; the earlier index {index} stays as it was" if keep else
                            f"; index -> {index} and {index.with_suffix('.html')}")

@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from .common import CLIError, EXIT_OK, _Out, _lines, _load, _parquet_engine, _save, _writable_file
+from .common import CLIError, EXIT_OK, _done, _lines, _load, _parquet_engine, _quiet, _save, _writable_file
 
 
 def _param(text: str) -> tuple[str, list[float]]:
@@ -89,7 +89,7 @@ def cmd_sweep(args) -> int:
     try:
         sw = sweep(mech, dict(args.param), steps=args.steps, full=args.full, scheduler=args.scheduler,
                    friction=args.friction,
-                   chunk=args.chunk, progress=not args.no_progress and sys.stderr.isatty())
+                   chunk=args.chunk, progress=not args.no_progress and not _quiet() and sys.stderr.isatty())
     except ValueError as exc:
         raise CLIError(f"--param: {str(exc).removeprefix('sweep: ')}") from None
     except ConnectionError as exc:       # no distributed scheduler at that address
@@ -115,5 +115,5 @@ def cmd_sweep(args) -> int:
         from ..kinematics import DIGITS_WARN
         lines.append(f"{len(warned)} design(s) keep values with fewer than {DIGITS_WARN} significant digits near a "
                      f"singular position, down to {warned.min():.1f} (columns worst_digits, warned_deg)")
-    _Out.write(_lines(lines))
+    _done(_lines(lines))
     return EXIT_OK

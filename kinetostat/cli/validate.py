@@ -1,16 +1,20 @@
 """`validate`: the solver cross-checked against the engine routes, its table, JSON and GitHub
 annotations, and its exit code (`exit_code`).
 
-May use: `.common`, the solver, the harness (imported inside the command).
+May use: `.common`, `kinetostat._forecast` (the estimated time), the solver, the harness (imported inside the command).
 """
 from __future__ import annotations
 
+import logging
 import os
 import time
 from typing import Sequence
 
+from .._forecast import Forecast
 from .._text import one_line
-from .common import EXIT_FAIL, EXIT_NOT_CHECKED, EXIT_OK, _Out, _checkpoint, _close, _engines, _error, _is_stdout, _lines, _prepare, _progress, _save, _warn, _writable_file, bundled_models
+from .common import EXIT_FAIL, EXIT_NOT_CHECKED, EXIT_OK, _Out, _checkpoint, _done, _close, _engines, _error, _is_stdout, _lines, _prepare, _progress, _save, _warn, _writable_file, bundled_models
+
+log = logging.getLogger(__name__)
 
 
 def exit_code(runs, absent: Sequence[str] = ()) -> int:
@@ -85,6 +89,7 @@ def cmd_validate(args) -> int:
     jobs = _prepare(paths, args.steps)
     runs = []
     t0 = time.perf_counter()
+    eta = Forecast(log, len(jobs), "model(s)", faster=["--engines none"] if engines != ["reference"] else [])
     bar = _progress(len(jobs) * len(engines), "validate", not args.no_progress)
     try:
         for path, mech, res, secs in jobs:
@@ -96,6 +101,7 @@ def cmd_validate(args) -> int:
             for w in run.warnings:
                 _warn(f"{path.name}: {w}")
             _Out.write(validation_table(run), err=err)
+            eta.done()
     finally:
         _close(bar)
     checks = [c for run in runs for c in run.checks]
@@ -125,7 +131,7 @@ def cmd_validate(args) -> int:
         from ..report import junit_xml
         tree = junit_xml(runs)
         _save(junit, "--junit", lambda f: tree.write(f, encoding="utf-8", xml_declaration=True), binary=True)
-        _Out.write(one_line(f"JUnit XML -> {junit}"))
+        _done(one_line(f"JUnit XML -> {junit}"))
     return code
 
 
@@ -155,4 +161,4 @@ def _write_validation_json(runs, code: int, dest) -> None:
         _Out.write(text.rstrip("\n"))
         return
     _save(dest, "--json", lambda f: f.write(text))
-    _Out.write(one_line(f"JSON -> {dest}"))
+    _done(one_line(f"JSON -> {dest}"))

@@ -6,6 +6,7 @@ functions that need it. Never matplotlib.
 """
 from __future__ import annotations
 
+import logging
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -19,6 +20,8 @@ from ..analysis import Analysis
 from ..solve import analyze
 from ..model import Mechanism
 from .published import PublishedCheck, published_rows
+
+log = logging.getLogger(__name__)
 
 #: The route name under which a model's published values are checked.
 PUBLISHED_ROUTE = "published"
@@ -175,7 +178,7 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
     Each route runs in its own `compare(..., engines=[route], res=res)` call; an exception of a
     route is recorded in `errors` (that route fails) and the other routes still run. Warnings
     raised meanwhile are collected, one line each, in `warnings`. `on_route(route)` is called
-    after each route (progress bars).
+    after each route (progress bars); each route's verdict and time is logged (DEBUG).
     """
     from kinetostat_validation.compare import LEVER, TOLERANCES, compare, lever_row
 
@@ -216,6 +219,7 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
         if route in TOLERANCES:
             run.tolerances[route] = TOLERANCES[route]
         _record(caught, f"{route}: ", run.warnings)
+        log.debug("%s: route %s %s (%.1f s)", run.stem, route, run.status(route), run.seconds[route])
         if on_route is not None:
             on_route(route)
     return run

@@ -6,6 +6,7 @@ harness's tolerances.
 from __future__ import annotations
 
 import json
+import logging
 import math
 import warnings
 from pathlib import Path
@@ -18,6 +19,8 @@ from ..solve import analyze
 from ..model import Mechanism, model_text
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
+
+log = logging.getLogger(__name__)
 from ..sweep import sweep
 from .. import units as model_units
 from ..tables import error, plain, write_csv
@@ -506,6 +509,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
             "errors": plot_errors(run, d / "errors.svg"),
             "hodographs": plot_hodographs(run, d / "hodographs.svg"),
         }
+    log.debug("%s: figures %s", folder, ", ".join(images))
     with atomic(d / "cycle.csv") as f:
         write_csv(res.to_frame(), f)
 
@@ -586,6 +590,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
 
     _published_section(doc, m, published)
     plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first", reuse)
+    log.debug("%s: plans and worksheet, %d files%s", folder, len(plan_files),
+              ", page.html" if any(p.name == "page.html" for p in plan_files) else "")
 
     sing = int(np.sum(res.singular))
     if run.warnings or sing:
