@@ -93,16 +93,30 @@ def plain_text() -> Iterator[None]:
         yield
 
 
+#: A path's data in matplotlib's SVG, and a coordinate in it (six decimals of a point, one per line).
+_PATH_DATA = re.compile(r'(?<= d=")[^"]*')
+_COORDINATE = re.compile(r"-?\d+\.\d+")
+
+
+def _compact(svg: str) -> str:
+    """matplotlib's SVG with every path's coordinates to 0.01 pt (a hundredth of a point, far
+    below any screen's pixel or printer's dot) and its commands on one line: a third of the
+    bytes of the report's figures, drawn the same."""
+    def point(m: re.Match) -> str:
+        return f"{round(float(m[0]), 2) + 0.0:.2f}".rstrip("0").rstrip(".")
+    return _PATH_DATA.sub(lambda m: _COORDINATE.sub(point, " ".join(m[0].split())), svg)
+
+
 def _save(fig, path: Path) -> Path:
-    """The figure as SVG (matplotlib's SVG backend, in `plain_text`): vector lines, and text as
-    text a reader can search and copy (half the time of rendering a PNG and writing it: the
-    report's figures were its largest cost); no date or software version in the file, so it
-    depends on the figure only. Written atomically (an interrupt leaves the previous file as it was)."""
+    """The figure as SVG (matplotlib's SVG backend, in `plain_text`, `_compact`): vector lines,
+    and text as text a reader can search and copy (half the time of rendering a PNG and writing
+    it: the report's figures were its largest cost); no date or software version in the file, so
+    it depends on the figure only. Written atomically (an interrupt leaves the previous file as it was)."""
     from matplotlib.backends.backend_svg import FigureCanvasSVG
     buf = io.StringIO()
     FigureCanvasSVG(fig).print_svg(buf, metadata={"Date": None, "Creator": None})
     with atomic(path) as f:
-        f.write(buf.getvalue())
+        f.write(_compact(buf.getvalue()))
     return path
 
 
