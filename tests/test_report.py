@@ -499,9 +499,10 @@ def test_report_check_says_a_rerun_reproduces_or_prints_each_difference(tmp_path
     assert "check: 1 difference(s)" in out
 
 
-def test_figures_keep_every_path_to_a_hundredth_of_a_point_in_fewer_bytes():
-    """`plots._compact`: the same paths (commands and coordinates to 0.005 pt) in under 70 % of
-    matplotlib's bytes of path data; what is not path data is untouched."""
+def test_figures_keep_every_coordinate_to_a_hundredth_of_a_point_in_fewer_bytes():
+    """`plots._compact`: the same paths, texts and markers (commands, and coordinates to 0.005 pt)
+    in under 70 % of matplotlib's bytes of coordinates; everything else untouched, the texts'
+    font named once (DejaVu Sans, `plain_text`)."""
     from matplotlib.backends.backend_svg import FigureCanvasSVG
     from matplotlib.figure import Figure
     from kinetostat.report.plots import _compact, plain_text
@@ -514,7 +515,7 @@ def test_figures_keep_every_path_to_a_hundredth_of_a_point_in_fewer_bytes():
         FigureCanvasSVG(fig).print_svg(buf, metadata={"Date": None, "Creator": None})
     svg = buf.getvalue()
     small = _compact(svg)
-    paths = re.compile(r' d="([^"]*)"')
+    paths = re.compile(r' (?:d|x|y|transform)="([^"]*)"')
     before, after = paths.findall(svg), paths.findall(small)
     assert len(before) == len(after) > 2 and sum(map(len, after)) < 0.7 * sum(map(len, before))
     for a, b in zip(before, after):
@@ -522,3 +523,4 @@ def test_figures_keep_every_path_to_a_hundredth_of_a_point_in_fewer_bytes():
         np.testing.assert_allclose([float(v) for v in re.findall(r"-?\d+\.?\d*", b)],
                                    [float(v) for v in re.findall(r"-?\d+\.?\d*", a)], atol=0.005 + 1e-12)
     assert paths.sub("", small) == paths.sub("", svg)
+    assert "font-family: 'DejaVu Sans', sans-serif;" in small and "Bitstream" not in small
