@@ -147,7 +147,9 @@ def _cycle(model: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]
                 yield Difference(model, "cycle.csv", c, f"φ = {phi[k]:g}°", str(a.iloc[k]), str(b.iloc[k]), "equal")
             continue
         x, y = a.to_numpy(dtype=float), b.to_numpy(dtype=float)
-        d, unit = x - y, units[c]
+        unit = units[c]
+        with np.errstate(invalid="ignore"):        # inf - inf: an infinite value on both sides is equal
+            d = np.where(x == y, 0.0, x - y)
         if unit in _TURN:
             d = (d + _TURN[unit] / 2) % _TURN[unit] - _TURN[unit] / 2
         tol, said = rtol * scale[unit], f"{rtol:g} of the {unit} scale {scale[unit]:.6g} {unit}"
@@ -156,7 +158,7 @@ def _cycle(model: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]
             force = units[reaction]
             d = np.abs(old[reaction].to_numpy(dtype=float)) * d * (2 * math.pi / _TURN[unit])
             tol, said = rtol * scale[force], f"|{reaction}| x turn within {rtol:g} of the {force} scale {scale[force]:.6g} {force}"
-        d = np.where(np.isnan(x) & np.isnan(y), 0.0, np.abs(d))
+        d = np.where((np.isnan(x) & np.isnan(y)) | (x == y), 0.0, np.abs(d))
         d = np.where(np.isnan(d), np.inf, d)
         if d.size and float(d.max()) > tol:
             k = int(np.argmax(d))
