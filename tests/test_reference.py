@@ -83,7 +83,7 @@ def test_the_sample_holds_the_peaks_and_the_largest_inertia_loads():
     mech = kinetostat.load(ICE)
     res = kinetostat.analyze(mech, steps=360)
     idx = set(ref.sample_angles(res).tolist())
-    assert set(range(0, 360, 60)) <= idx
+    assert set(range(0, 360, 360 // ref.EVENLY_SPACED)) <= idx
     assert int(np.argmax(np.abs(res.balancing_moment))) in idx
     for p in mech.pairs:
         assert int(np.argmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))) in idx
@@ -103,3 +103,11 @@ def test_the_route_catches_a_coupler_one_per_mille_heavier():
     assert not c.passed and {"M_drive", "R(1,2)", "R(2,3)"} <= failed
     worst = max(r.peak_relative for r in c.rows)
     assert 1e-5 < worst < 1e-2
+
+
+def test_the_sample_is_stated_from_one_constant():
+    """How many and which angles the reference re-solves: SAMPLE, made from EVENLY_SPACED, is what
+    the route's tolerance (and so every report's table of routes) and the accuracy page of the docs say."""
+    assert ref.SAMPLE.startswith(f"{ref.EVENLY_SPACED} equally spaced crank angles (every {360 // ref.EVENLY_SPACED}°)")
+    assert ref.SAMPLE in cmp.TOLERANCES["reference"].reason
+    assert ref.SAMPLE in " ".join((ROOT / "docs" / "explanation" / "accuracy.md").read_text(encoding="utf-8").split())

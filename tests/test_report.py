@@ -1,5 +1,5 @@
-"""The per-mechanism error reports: the files, their tables, the embedded images, the index,
-and the comparison with the seeds' published values."""
+"""The per-mechanism error reports: the files, their tables, the linked images, the index, the
+comparison with the seeds' published values, and the check of a rerun against earlier reports."""
 from __future__ import annotations
 
 import contextlib
@@ -20,7 +20,7 @@ import kinetostat.report
 from conftest import FOUR_BAR, MODELS, ROOT, sketch_plots
 from kinetostat import cli
 from kinetostat.report import published_rows, run_validation, write_index, write_report
-from kinetostat.report.document import Doc
+from kinetostat.report.document import ROUNDING_NOTE, Doc
 from kinetostat.tables import read_csv
 
 pytest.importorskip("matplotlib")
@@ -158,9 +158,11 @@ def test_report_markdown_has_data_tables_and_images(ice_report):
     rows = re.findall(r"^\| (pinocchio|mujoco) \| (M\\_зр|R\d\d) \| (.*?) \| (.*?) \| (.*?) \| 1e-09 \|"
                       r".*\| \*\*PASS\*\* \|$", md, re.M)
     assert len(rows) == 10
-    # exact routes agree to rounding: shown as such, never as a meaningless "8.0452e-14 N"
-    assert all(r[2] == "≈ 0 (rounding)" and r[3] == "-" and r[4] == "rounding" for r in rows), rows
-    assert not re.search(r"\de-1[3-9] N", md)
+    # exact routes agree to rounding: their digits, marked as at rounding level (angle left out)
+    assert all(re.fullmatch(r"\d\.\d\de-1[1-9] N( m)? †", r[2]) and r[3] == "-"
+               and re.fullmatch(r"\d\.\d\de-1[5-9] †", r[4]) for r in rows), rows
+    assert "≈ 0" not in md and "(rounding)" not in md and not re.search(r"\| rounding[ |]", md)
+    assert f"\n{ROUNDING_NOTE}\n" in md
     assert "| route | kind | tolerance (peak-relative, 1) | why this tolerance |" in md
     # the seed's published values, with the difference in %
     assert "## Against the published values" in md
@@ -188,13 +190,16 @@ def test_report_html_is_markdown_it_rendering(ice_report):
     d = ice_report / "ice_crank_slider"
     html = (d / "index.html").read_text()
     plans = kinetostat.plans.build(kinetostat.load(ICE))
-    # the figures and the plans (the sheets of `kinetostat plans`), embedded; each plan a link to its SVG file
-    assert html.count('src="data:image/svg+xml;base64,') == len(FIGURES) + len(plans)
+    # the figures and the plans (the sheets of `kinetostat plans`), linked as the files beside the page,
+    # never embedded; each plan a link to its SVG file
+    for fig in FIGURES:
+        assert html.count(f'src="{fig}"') == 1, fig
     for plan in plans.values():
         name = "plan_" + kinetostat.plans.plan_file_name(plan)
-        assert f'<a href="{name}"><img' in html
+        assert f'<a href="{name}"><img src="{name}"' in html
         assert (d / name).read_text() == kinetostat.plans.svg(plan, mechanism=kinetostat.load(ICE).name)
-    assert not re.search(r'src="(?!data:)', html)
+    assert "data:" not in html and "<svg" not in html
+    assert html.count("<img ") == len(FIGURES) + len(plans) and len(html) < 100_000
     assert '<div class="scroll"><table>' in html and 'class="pass"' in html
     assert 'href="../index.html"' in html and 'href="cycle.csv"' in html
     # the body is markdown-it's rendering of the Markdown file (tables as it renders them)
@@ -212,7 +217,9 @@ def test_index_lists_only_this_run(ice_report):
     assert "[plans](ice_crank_slider/index.md#plans-of-the-graphical-method)" in md
     assert "[slotted_link_shaper](slotted_link_shaper/index.md)" in md
     assert "stale" not in md
-    assert "rounding ≤ 1e-09 PASS" in md          # beside each error the route's tolerance
+    # beside each error (its digits, marked at rounding level) the route's tolerance
+    assert re.search(r"\| \d\.\d\de-1[5-9] † ≤ 1e-09 PASS \|", md) and f"\n{ROUNDING_NOTE}\n" in md
+    assert "rounding ≤" not in md
     assert "15/15 within" in md
     html = (ice_report / "index.html").read_text()
     assert 'href="ice_crank_slider/index.html"' in html and "stale" not in html
@@ -363,13 +370,14 @@ def test_doc_renders_markdown_and_html():
     assert 'href="javascript' not in html
 
 
-def test_rounding_is_shown_as_such():
-    """The rule: below 1000 ulp of the peak (2.2e-13 of it) an error is rounding."""
+def test_an_error_at_rounding_level_keeps_its_digits_and_is_marked():
+    """The rule: below 1000 ulp of the peak (2.2e-13 of it) an error is at rounding level: its
+    digits printed, the mark beside them; an exact 0 is 0."""
     from kinetostat.report.document import ROUNDING, _err, _rel
     assert ROUNDING == pytest.approx(2.22e-13, rel=1e-3)
-    assert _err(8.0452e-14, 1200.0, "N") == "≈ 0 (rounding)"
+    assert _err(8.0452e-14, 1200.0, "N") == "8.05e-14 N †"
     assert _err(8.0452e-14, 0.1, "N") == "8.05e-14 N"         # 8e-13 of a 0.1 N peak: a real number
-    assert _rel(1.1e-15) == "rounding" and _rel(3e-13) == "3.00e-13"
+    assert _rel(1.1e-15) == "1.10e-15 †" and _rel(3e-13) == "3.00e-13" and _rel(0.0) == _err(0.0, 1.0, "N")[:1] == "0"
 
 
 def test_report_shows_friction_in_the_reactions_beside_the_first_approximation(ice_report):
@@ -386,5 +394,133 @@ def test_report_shows_friction_in_the_reactions_beside_the_first_approximation(i
     assert "| quantity | frictionless | first approximation | friction in the reactions |" in md
     zone = re.search(r"edges to 1e-9° by bisection on the crank angle: 0\.000000000° to (1\.\d{9})°", md)
     assert zone and 1.0 < float(zone.group(1)) < 2.0
-    assert "their joint friction is a constant limit torque" in md and "≈ 0 (rounding)" in md
+    assert "their joint friction is a constant limit torque" in md
+    checks = md.split("## Friction in the reactions")[1].split("\n## ")[0]
+    assert re.search(r"max \|difference\| \d\.\d+e-1\d N·m †", checks) and ROUNDING_NOTE in checks
     assert "## Friction in the reactions" not in (ice_report / "slotted_link_shaper" / "index.md").read_text()
+
+
+@pytest.fixture(scope="module")
+def four_bar_runs(tmp_path_factory) -> Path:
+    """The four-bar's report and index written twice (plots sketched), into a/ and b/."""
+    folder = tmp_path_factory.mktemp("reruns")
+    p = folder / "four_bar.toml"
+    p.write_text(FOUR_BAR)
+    with pytest.MonkeyPatch.context() as mp:
+        sketch_plots(mp)
+        for name in ("a", "b"):
+            summary = write_report(run_validation(kinetostat.load(p), [], steps=12, path=p), folder / name)
+            write_index(folder / name, [summary])
+    return folder
+
+
+def _rerun(runs: Path, tmp_path: Path) -> tuple[Path, Path]:
+    """A copy of the rerun b/ to change, and the earlier run a/."""
+    import shutil
+    return Path(shutil.copytree(runs / "b", tmp_path / "b")), runs / "a"
+
+
+def test_the_check_passes_a_rerun_and_names_only_a_number_beyond_its_tolerance(tmp_path, four_bar_runs):
+    """compare_reports on a real rerun: nothing; then, in the rerun, a reaction moved by 1e-9 of the
+    force scale (beyond 1e-11), the balancing moment by 3e-12 of its scale, the lever's error at
+    rounding level changed and an error figure of the index rewritten (all within): exactly the
+    reaction is named, with its angle, both values and the tolerance."""
+    import pandas as pd
+    from kinetostat.report import compare_reports
+    b, a = _rerun(four_bar_runs, tmp_path)
+    assert compare_reports(b, a) == []
+    cycle = b / "four_bar" / "cycle.csv"
+    df = pd.read_csv(cycle)
+    force = max(df[c].abs().max() for c in df.columns if c.endswith(" [N]"))
+    moment = max(df[c].abs().max() for c in df.columns if c.endswith(" [N m]"))
+    df.loc[3, "R_0_1 [N]"] += 1e-9 * force
+    df.loc[5, "M_bal [N m]"] += 3e-12 * moment
+    df.to_csv(cycle, index=False, float_format="%.17g")
+    summary = b / "four_bar" / "summary.json"
+    data = json.loads(summary.read_text())
+    assert 0 < data["routes"]["lever"]["worst"] < 1e-13
+    data["routes"]["lever"]["worst"] *= 1.7
+    summary.write_text(json.dumps(data, indent=1))
+    index = b / "index.md"
+    text = index.read_text()
+    figure = re.search(r"\d\.\d\de-1\d †", text).group(0)
+    index.write_text(text.replace(figure, "9.99e-15 †"))
+    diffs = compare_reports(b, a)
+    phi = float(df.loc[3, "phi_deg [deg]"])
+    assert [(d.model, d.file, d.what, d.where) for d in diffs] == [("four_bar", "cycle.csv", "R_0_1 [N]", f"φ = {phi:g}°")]
+    was = float(pd.read_csv(a / "four_bar" / "cycle.csv").loc[3, "R_0_1 [N]"])
+    assert float(diffs[0].committed) == pytest.approx(was, rel=1e-11)
+    assert float(diffs[0].fresh) == pytest.approx(was + 1e-9 * force, rel=1e-11)
+    assert str(diffs[0]).startswith("four_bar/cycle.csv: R_0_1 [N] at φ = ") and f"1e-11 of the N scale {force:.6g} N" in str(diffs[0])
+
+
+def test_the_check_names_a_changed_verdict_a_missing_file_and_a_changed_line(tmp_path, four_bar_runs):
+    """Beyond numbers: a route's status, a file only one side has, a word of the Markdown."""
+    from kinetostat.report import compare_reports
+    b, a = _rerun(four_bar_runs, tmp_path)
+    d = b / "four_bar"
+    data = json.loads((d / "summary.json").read_text())
+    data["routes"]["lever"]["status"] = "FAIL"
+    (d / "summary.json").write_text(json.dumps(data, indent=1))
+    (d / "worksheet.csv").unlink()
+    (d / "index.md").write_text((d / "index.md").read_text().replace("Mechanism data", "Mechanism figures"))
+    found = {(x.file, x.what, x.fresh, x.committed) for x in compare_reports(b, a)}
+    assert ("summary.json", "routes.lever.status", '"FAIL"', '"PASS"') in found
+    assert ("worksheet.csv", "file", "absent", "present") in found
+    assert any(f == "index.md" and w == "text" and "figures" in a and "data" in b for f, w, a, b in found)
+    assert len(found) == 3 + 1       # and the table of contents' line naming the same heading
+
+
+def test_report_check_refuses_its_own_output_folder_and_a_missing_one(tmp_path, capsys):
+    """--check names a folder of earlier reports other than --out: else exit 2 and one error line,
+    before any model runs."""
+    for check in (tmp_path, tmp_path / "nowhere"):
+        code = cli.main(["report", str(ICE), "--out", str(tmp_path), "--check", str(check), "--no-progress"])
+        err = capsys.readouterr().err
+        assert code == 2 and "Traceback" not in err and f"--check {check}:" in err, err
+
+
+def test_report_check_says_a_rerun_reproduces_or_prints_each_difference(tmp_path, capsys, sketched_plots):
+    """`kinetostat report --out B --check A`: a rerun that reproduces A exits 0 and says so; where
+    it differs (A's count of checks edited), each difference is printed and the command fails."""
+    p = tmp_path / "four_bar.toml"
+    p.write_text(FOUR_BAR)
+    args = ["report", str(p), "--steps", "12", "--engines", "none", "--no-page", "--no-progress", "--jobs", "1"]
+    assert cli.main([*args, "--out", str(tmp_path / "a")]) == 0
+    capsys.readouterr()
+    assert cli.main([*args, "--out", str(tmp_path / "b"), "--check", str(tmp_path / "a")]) == 0    # a rerun
+    assert f"check: {tmp_path / 'b'} reproduces {tmp_path / 'a'} within every tolerance" in capsys.readouterr().out
+    summary = tmp_path / "a" / "four_bar" / "summary.json"
+    summary.write_text(summary.read_text().replace('"checks": ', '"checks": 1'))
+    from kinetostat.cli.report import _check           # the command's last step, on B as written
+    assert _check(tmp_path / "b", tmp_path / "a") is False
+    out = capsys.readouterr().out
+    assert re.search(r"^check: four_bar/summary.json: checks: rerun (\d+), committed 1\1 \(tolerance: equal\)$", out, re.M)
+    assert "check: 1 difference(s)" in out
+
+
+def test_figures_keep_every_coordinate_to_a_hundredth_of_a_point_in_fewer_bytes():
+    """`plots._compact`: the same paths, texts and markers (commands, and coordinates to 0.005 pt)
+    in under 70 % of matplotlib's bytes of coordinates; everything else untouched, the texts'
+    font named once (DejaVu Sans, `plain_text`)."""
+    from matplotlib.backends.backend_svg import FigureCanvasSVG
+    from matplotlib.figure import Figure
+    from kinetostat.report.plots import _compact, plain_text
+    with plain_text():
+        fig = Figure(figsize=(4, 3))
+        x = np.linspace(0, 2 * np.pi, 361)
+        wiggle = np.random.default_rng(1).normal(size=x.size)         # kept by matplotlib's path simplification
+        fig.add_subplot().plot(x, np.sin(x) + 0.1 * wiggle, x, 1e-3 * wiggle)
+        buf = io.StringIO()
+        FigureCanvasSVG(fig).print_svg(buf, metadata={"Date": None, "Creator": None})
+    svg = buf.getvalue()
+    small = _compact(svg)
+    paths = re.compile(r' (?:d|x|y|transform)="([^"]*)"')
+    before, after = paths.findall(svg), paths.findall(small)
+    assert len(before) == len(after) > 2 and sum(map(len, after)) < 0.7 * sum(map(len, before))
+    for a, b in zip(before, after):
+        assert re.sub(r"[-\d.]+", "#", " ".join(a.split())) == re.sub(r"[-\d.]+", "#", b)     # the same commands
+        np.testing.assert_allclose([float(v) for v in re.findall(r"-?\d+\.?\d*", b)],
+                                   [float(v) for v in re.findall(r"-?\d+\.?\d*", a)], atol=0.005 + 1e-12)
+    assert paths.sub("", small) == paths.sub("", svg)
+    assert "font-family: 'DejaVu Sans', sans-serif;" in small and "Bitstream" not in small

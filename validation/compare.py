@@ -5,9 +5,10 @@ returns a `Comparison`: per route and quantity (driving moment, each pair's reac
 absolute error, the max error relative to the cycle's peak, the RMS (relative to the peak),
 and pass/fail against the route's tolerance in `TOLERANCES`. An engine that is not installed
 is reported as skipped, never passed. The route "reference" needs no engine, only mpmath: the
-40-digit re-solution of `reference.py` at a sample of the cycle's angles.
+40-digit re-solution of `reference.py` at a sample of the cycle's angles (`reference.SAMPLE`).
 
-May use: kinetostat, the scene, and each route's adapter (imported when the route runs).
+May use: kinetostat, the scene, the reference's SAMPLE (its text), and each route's adapter
+(imported when the route runs).
 """
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ import numpy as np
 from kinetostat import Analysis, Mechanism, analyze
 from kinetostat.kinetostatics import friction_power, gear_force
 
+from .reference import SAMPLE
 from .scene import EngineResult, Scene, build_scene, tracked_points
 
 __all__ = ["ROUTES", "TOLERANCES", "LEVER", "Tolerance", "Row", "Comparison", "compare", "errors", "series",
@@ -58,10 +60,9 @@ TOLERANCES: dict[str, Tolerance] = {
                               "sample; the public API gives impulse magnitudes, so |M_drive| and |R| are "
                               "compared; positions and velocities of the points, no accelerations"),
     "reference": Tolerance(1e-11, "the whole problem solved again in mpmath at 40 digits (another formulation: "
-                                  "all loop closures at once, one global Newton-Euler system) at 12 equally "
-                                  "spaced angles plus the angle of each quantity's peak: the solver's rounding "
-                                  "only, measured 2e-16 .. 1.4e-15 on the bundled models and 1.3e-13 on a crank "
-                                  "bearing whose small load is the difference of two large opposed gas forces "
+                                  f"all loop closures at once, one global Newton-Euler system) at {SAMPLE}: "
+                                  "the solver's rounding only, measured 2e-16 .. 1.4e-15 on the bundled models "
+                                  "and 1.3e-13 on a crank bearing whose small load is the difference of two large opposed gas forces "
                                   "(opposed_twin); 1e-11 leaves room for such cancellation, while a wrong "
                                   "inertia, load or sign shows at 1e-4 .. 1"),
     "lever": Tolerance(1e-11, "an internal identity: the balancing moment from the velocity plan alone "

@@ -67,10 +67,16 @@ from kinetostat.friction import RATE_TOL
 
 from .scene import EngineResult, Scene
 
-__all__ = ["DPS", "Reference", "reference", "reference_full", "BranchMismatch", "sample_angles", "route"]
+__all__ = ["DPS", "EVENLY_SPACED", "SAMPLE", "Reference", "reference", "reference_full", "BranchMismatch", "sample_angles", "route"]
 
 #: Working precision of the reference, decimal digits.
 DPS = 40
+#: The route "reference" re-solves this many equally spaced crank angles of the cycle, plus the
+#: angles where the solver's error shows most (`sample_angles`).
+EVENLY_SPACED = 6
+#: The route's angles as the tolerances, the reports and the README state them (from EVENLY_SPACED).
+SAMPLE = (f"{EVENLY_SPACED} equally spaced crank angles (every {360 / EVENLY_SPACED:g}°) plus the angle of each "
+          "quantity's peak (the largest |M_bal|, each pair's largest |R|) and each moving link's largest |ε|")
 
 
 class BranchMismatch(AssertionError):
@@ -732,9 +738,9 @@ def peak_relative_error(res: Analysis, ref: Reference) -> dict[str, float]:
     return out
 
 
-def sample_angles(res: Analysis, n: int = 6) -> np.ndarray:
-    """Indices of `res`'s angles for the reference route, sorted, without repeats: `n` equally
-    spaced over the cycle (every 60 deg by default), and the angles where an error of the solver
+def sample_angles(res: Analysis, n: int = EVENLY_SPACED) -> np.ndarray:
+    """Indices of `res`'s angles for the reference route (SAMPLE), sorted, without repeats: `n`
+    equally spaced over the cycle, and the angles where an error of the solver
     shows most: the largest |M_bal| and each pair's largest |R| (the peak-relative error's
     denominator is there, and an error in proportion to the load is largest there), and each
     moving link's largest |eps| (the largest inertia loads)."""
@@ -748,7 +754,7 @@ def sample_angles(res: Analysis, n: int = 6) -> np.ndarray:
     return np.array(sorted(idx), dtype=int)
 
 
-def route(scene: Scene, n: int = 6) -> EngineResult:
+def route(scene: Scene, n: int = EVENLY_SPACED) -> EngineResult:
     """The gate's route "reference": the 40-digit answer at `sample_angles(scene.res, n)`, each
     angle taken as the double the solver works with (angle="double"). The Newton start comes
     from a fresh solver run at those angles, not from the result under test."""

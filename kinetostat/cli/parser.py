@@ -40,7 +40,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="kinetostat",
                 description="Kinetostatic analysis of planar linkages (graphical-analytic method, computed "
                             "exactly over the crank cycle) and its cross-validation against physics engines.",
-                epilog="Exit codes: 0 ok; 1 validate: a check failed (report: a model's report not made); 2 bad input or options; 3 validate: "
+                epilog="Exit codes: 0 ok; 1 validate: a check failed (report: a model's report not made, or --check found a "
+                       "difference); 2 bad input or options; 3 validate: "
                        "nothing failed but a model was not checked (or a route named with --engines is not "
                        "installed); 130 interrupted (Ctrl-C). "
                        "Bundled models ship inside the package ('kinetostat examples' lists them); "
@@ -118,19 +119,21 @@ def build_parser() -> argparse.ArgumentParser:
     v.set_defaults(func=cmd_validate)
 
     r = sub.add_parser("report", help="write the per-mechanism error reports (Markdown + HTML + plots)",
-                       description="Write OUT/<model>/index.md and a self-contained index.html per MODEL "
+                       description="Write OUT/<model>/index.md and index.html (its figures linked, files beside it) per MODEL "
                                    "(default: all bundled models) with the mechanism's data, its picture, "
                                    "plots over the cycle, error tables per engine route, the seeds' published "
                                    "values where known, cycle.csv, the plans at the design position and the "
                                    "interactive page; plus OUT/index.md and OUT/index.html. "
-                                   "The files carry no dates or run times (a rerun reproduces them byte for "
-                                   "byte); run times are printed here only. Every file is written atomically: "
+                                   "The files carry no dates or run times (printed here only); a rerun "
+                                   "reproduces the numbers within their tolerances, not byte for byte (errors "
+                                   "at rounding level differ in their last digits from machine to machine): "
+                                   "--check DIR compares the rerun with DIR. Every file is written atomically: "
                                    "Ctrl-C (exit 130) or a full disk leaves the earlier files as they were, and "
                                    "when a model's report cannot be made the earlier index stays. Folders are "
                                    "named after the model files (ASCII letters, digits, '_', '-'; a repeated "
                                    "name gets -2, -3). Exits 0 once the reports are written, also when checks "
                                    "fail (use 'kinetostat validate' as the gate); 1 when a model's report could "
-                                   "not be made.")
+                                   "not be made or --check found a difference.")
     r.add_argument("models", metavar="MODEL", nargs="*",
                    help="model files or bundled models' names (default: every bundled model, see 'kinetostat examples')")
     r.add_argument("--out", metavar="DIR", default="reports", help="output directory (default: ./reports)")
@@ -140,6 +143,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="models reported in parallel by N worker processes (default: the number of cores; "
                         "1: in this process)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--check", metavar="DIR",
+                   help="then compare OUT with the earlier reports in DIR (e.g. the committed reports/, OUT "
+                        "elsewhere) and print each difference: model, file, quantity, angle or line, both "
+                        "values and the tolerance (README: Reports); every number within its tolerance, every "
+                        "other text equal but for the libraries' versions")
     _friction_option(r, "of the report's plans and worksheet (default first, the graphical method's; the friction "
                         "section shows both either way)")
     r.add_argument("--page", action=argparse.BooleanOptionalAction, default=True,

@@ -128,6 +128,7 @@ def cmd_report(args) -> int:
         raise CLIError(f"--steps {args.steps}: a report over the cycle needs at least {MIN_REPORT_STEPS} positions")
     engines = _engines(args.engines)
     out = _writable_dir(args.out, "--out")
+    earlier = _earlier_reports(args.check, out) if args.check is not None else None
     paths = args.models or bundled_models()
     prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
     _PREPARED.clear()
@@ -178,4 +179,28 @@ def cmd_report(args) -> int:
                         + (f"; the earlier index {index} stays as it was" if keep else
                            f"; index -> {index} and {index.with_suffix('.html')}")
                         + f"; {time.perf_counter() - t0:.1f} s"))
-    return EXIT_FAIL if n_err else EXIT_OK
+    same = True if earlier is None else _check(out, earlier)
+    return EXIT_FAIL if n_err or not same else EXIT_OK
+
+
+def _earlier_reports(path: str, out: Path) -> Path:
+    """--check's folder: an existing folder of reports other than `out` (CLIError otherwise)."""
+    p = Path(path)
+    if not p.is_dir():
+        raise CLIError(f"--check {path}: not a folder of reports")
+    if p.resolve() == out.resolve():
+        raise CLIError(f"--check {path}: the same folder as --out; write the rerun elsewhere (--out) and "
+                       f"compare it with {path}")
+    return p
+
+
+def _check(out: Path, earlier: Path) -> bool:
+    """Print each difference of the reports in `out` from those in `earlier` and a last line;
+    True when there is none."""
+    from ..report import compare_reports
+    diffs = compare_reports(out, earlier)
+    for d in diffs:
+        _Out.write(one_line(f"check: {d}"))
+    _Out.write(one_line(f"check: {len(diffs)} difference(s) of {out} from {earlier} beyond their tolerances" if diffs
+                        else f"check: {out} reproduces {earlier} within every tolerance"))
+    return not diffs

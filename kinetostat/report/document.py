@@ -1,17 +1,18 @@
-"""A small document model written as Markdown, and that same Markdown rendered to one
-self-contained HTML page by markdown-it-py; number formats of the reports.
+"""A small document model written as Markdown, and that same Markdown rendered to an HTML page
+by markdown-it-py; number formats of the reports.
 
 The HTML is markdown-it's CommonMark rendering (tables enabled, raw HTML off, so any HTML or
 `javascript:` link in a model's strings comes out escaped or as text) with: heading ids by
 GitHub's rule (the table of contents links work in both), links to a report's `index.md` turned
-into its `index.html` (other `.md` files, the studies, stay Markdown), images (PNG, SVG) embedded as data URIs, tables wrapped in a horizontally scrolling box.
+into its `index.html` (other `.md` files, the studies, stay Markdown), images (PNG, SVG) linked
+as the files beside the page that they are (`<img src="reactions.svg">`, as in the Markdown),
+tables wrapped in a horizontally scrolling box.
 
 May use: the standard library, `kinetostat._io` (atomic writes) and markdown-it-py (imported inside
 `Doc.html`).
 """
 from __future__ import annotations
 
-import base64
 import html
 import math
 import re
@@ -22,9 +23,15 @@ from typing import Any, Sequence
 
 from .._io import write_text
 
-#: An error smaller than this fraction of the cycle's peak is rounding (1000 units in the last
-#: place of the peak): an exact route that agrees to machine precision reads "rounding", not a number.
+#: An error smaller than this fraction of the cycle's peak is at rounding level (1000 units in the
+#: last place of the peak): printed with its digits and ROUNDING_MARK beside them.
 ROUNDING = 1000 * sys.float_info.epsilon
+#: Beside an error at rounding level (`_rel`, `_err`); ROUNDING_NOTE says what it means.
+ROUNDING_MARK = "†"
+#: The footnote of every table or list that prints ROUNDING_MARK.
+ROUNDING_NOTE = (f"{ROUNDING_MARK}: below {ROUNDING:.1e} of the cycle's peak (1000 units in its last place), "
+                 "at rounding level: the two routes agree to machine precision, and these digits differ from "
+                 "machine to machine")
 
 
 def _fmt(x: float | None, digits: int = 4) -> str:
@@ -45,8 +52,8 @@ def _fe(x: float | None) -> str:
 
 
 def _rel(x: float | None) -> str:
-    """A peak-relative error: "rounding" below ROUNDING, else three significant digits."""
-    return "rounding" if _is_rounding(x) else _fe(x)
+    """A peak-relative error to three significant digits, ROUNDING_MARK beside it below ROUNDING (not 0)."""
+    return _fe(x) + (f" {ROUNDING_MARK}" if x and _is_rounding(x) else "")
 
 
 def _is_rounding(x: float | None) -> bool:
@@ -54,10 +61,10 @@ def _is_rounding(x: float | None) -> bool:
 
 
 def _err(x: float | None, peak: float, unit: str) -> str:
-    """An absolute error in `unit`: "≈ 0 (rounding)" where it is below ROUNDING × peak."""
-    if x is not None and math.isfinite(x) and abs(x) < ROUNDING * abs(peak):
-        return "≈ 0 (rounding)"
-    return f"{_fmt(x)} {unit}" if x is not None and math.isfinite(x) else "n/a"
+    """An absolute error in `unit` (`_fmt`), ROUNDING_MARK beside it where it is below ROUNDING × peak (not 0)."""
+    if x is None or not math.isfinite(x):
+        return "n/a"
+    return f"{_fmt(x)} {unit}" + (f" {ROUNDING_MARK}" if 0 < abs(x) < ROUNDING * abs(peak) else "")
 
 
 #: Markup characters that act anywhere in a line: code, emphasis, links and images, autolinks and
@@ -170,13 +177,13 @@ class Doc:
         """`folder/name.md` and `folder/name.html` (the HTML rendered from that Markdown); the .md path."""
         text = self.markdown()
         write_text(Path(folder) / f"{name}.md", text)
-        write_text(Path(folder) / f"{name}.html", self.html(folder, text))
+        write_text(Path(folder) / f"{name}.html", self.html(text))
         return Path(folder) / f"{name}.md"
 
     # -- HTML
-    def html(self, base: Path | None = None, markdown: str | None = None) -> str:
+    def html(self, markdown: str | None = None) -> str:
         """The page rendered from `markdown()` (or the given `markdown`, the same text already
-        written); images read from `base` (the report's folder)."""
+        written); images stay links to their files, beside the page as beside the Markdown."""
         md = _markdown_it()
         tokens = md.parse(self.markdown() if markdown is None else markdown)
         seen: dict[str, int] = {}
@@ -191,18 +198,10 @@ class Doc:
                     path, hash_, frag = href.partition("#")
                     if not re.match(r"^[a-z][a-z0-9+.-]*:", href) and (path == "index.md" or path.endswith("/index.md")):
                         c.attrSet("href", path[:-3] + ".html" + hash_ + frag)
-                elif c.type == "image" and base is not None:
-                    f = Path(base) / str(c.attrGet("src") or "")
-                    if f.is_file() and f.suffix in _MIME:
-                        c.attrSet("src", f"data:{_MIME[f.suffix]};base64," + base64.b64encode(f.read_bytes()).decode("ascii"))
         md.add_render_rule("table_open", lambda *a: '<div class="scroll"><table>\n')
         md.add_render_rule("table_close", lambda *a: "</table></div>\n")
         body = md.renderer.render(tokens, md.options, {})
         return _HTML.format(title=html.escape(self.title), body=body)
-
-
-#: Images embedded in the HTML as data URIs, by file suffix.
-_MIME = {".png": "image/png", ".svg": "image/svg+xml"}
 
 
 def _headings(markdown: str) -> list[tuple[int, str, str]]:

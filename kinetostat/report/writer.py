@@ -24,7 +24,7 @@ log = logging.getLogger(__name__)
 from ..sweep import sweep
 from .. import units as model_units
 from ..tables import error, plain, write_csv
-from .document import ROUNDING, Doc, _err, _fmt, _is_rounding, _rel, esc, slug
+from .document import ROUNDING, ROUNDING_MARK, ROUNDING_NOTE, Doc, _err, _fmt, _is_rounding, _rel, esc, slug
 from .plots import (pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions)
 from .published import PublishedCheck
@@ -46,14 +46,14 @@ REPO_NOTE = ("*Paths `validation/...` name files of the project's source reposit
 
 def study_page(out: Path, name: str, title: str) -> str:
     """The study `out/name` (Markdown) rendered beside it as HTML, as the reports are (`Doc.html`:
-    the same Markdown, images embedded), with REPO_NOTE under its title where it names a path of
+    the same Markdown, images linked), with REPO_NOTE under its title where it names a path of
     validation/; returns the HTML file's name."""
     md = (Path(out) / name).read_text(encoding="utf-8")
     if "validation/" in md:
         head, sep, rest = md.partition("\n")
         md = f"{head}{sep}\n{REPO_NOTE}\n{rest}" if head.startswith("#") else f"{REPO_NOTE}\n\n{md}"
     page = Path(name).with_suffix(".html").name
-    write_text(Path(out) / page, Doc(title).html(out, md))
+    write_text(Path(out) / page, Doc(title).html(md))
     return page
 
 
@@ -81,6 +81,13 @@ def _unit_text(unit: str) -> str:
 def parameter_units(m: Mechanism) -> dict[str, str]:
     """Each [parameter]'s unit (`kinetostat.units.parameter_units`) as the report prints it."""
     return {name: _unit_text(u) for name, u in model_units.parameter_units(m, model_text(m)).items()}
+
+
+def _rounding_note(doc: Doc, texts: Sequence[Any]) -> None:
+    """ROUNDING_NOTE as a paragraph where any of `texts` (the cells or lines just written) carries
+    ROUNDING_MARK."""
+    if any(ROUNDING_MARK in str(t) for t in texts):
+        doc.p(ROUNDING_NOTE)
 
 
 def _parameters_section(doc: Doc, m: Mechanism) -> None:
@@ -378,8 +385,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
           "group by group (the solver), Zhukovsky's lever (the balancing moment from the velocity plan) and "
           "d'Alembert–Lagrange (Potapov 2024: each reaction component from the virtual work of all loads, inertia "
           "included, in the virtual motion of the mechanism with that one constraint released; "
-          "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak "
-          f"(\"rounding\" below {ROUNDING:.1e}: the digits of a rounding error differ between machines).")
+          "`kinetostat.virtual_work`). Max |difference| over the cycle, and relative to the cycle's peak.")
     def row(quantity: str, route: str, a, b, unit: str) -> list[str]:
         x, peak = worst(a, b)
         return [quantity, route, _err(x, peak, unit), _rel(x / peak) if peak > 0 and math.isfinite(x) else "n/a"]
@@ -390,6 +396,7 @@ def _three_routes_section(doc: Doc, m: Mechanism, res) -> None:
     rows += [row(esc(pair_name(m, p)), "d'Alembert–Lagrange", vw.reaction(*p.links), res.reaction(*p.links), "N")
              for p in m.pairs]
     doc.table(["quantity", "route against group by group", "max |difference|", "peak relative, 1"], rows, "llrr")
+    _rounding_note(doc, [c for r in rows for c in r])
 
 
 def _figure(value: Callable[[], float], why: str) -> str:
@@ -442,12 +449,14 @@ def _friction_section(doc: Doc, m: Mechanism, res) -> None:
         peak = np.nanmax(np.abs(ex.balancing_moment))
         dP = (ex.balancing_moment - ex.balancing_moment_frictionless) * ex.omega(1) - ex.friction_power_total
         W = ex.work()
-        doc.ul([f"Zhukovsky's lever with the friction loads applied against group by group: max |difference| "
-                f"{_err(float(np.max(np.abs(ex.lever_discrepancy[ok]))), peak, 'N·m')}",
-                f"power balance, ({M} − {M},0)·ω₁ against the sum of the pairs' friction powers: max |difference| "
-                f"{_err(float(np.max(np.abs(dP[ok]))), float(np.nanmax(ex.friction_power_total)), 'W')}",
-                f"work over the cycle, all loads, {M} and friction: sum {_fmt(sum(W.values()))} J "
-                f"(of {_fmt(sum(abs(v) for v in W.values()))} J moved)" if len(W) else "work: n/a"])
+        checks = [f"Zhukovsky's lever with the friction loads applied against group by group: max |difference| "
+                  f"{_err(float(np.max(np.abs(ex.lever_discrepancy[ok]))), peak, 'N·m')}",
+                  f"power balance, ({M} − {M},0)·ω₁ against the sum of the pairs' friction powers: max |difference| "
+                  f"{_err(float(np.max(np.abs(dP[ok]))), float(np.nanmax(ex.friction_power_total)), 'W')}",
+                  f"work over the cycle, all loads, {M} and friction: sum {_fmt(sum(W.values()))} J "
+                  f"(of {_fmt(sum(abs(v) for v in W.values()))} J moved)" if len(W) else "work: n/a"]
+        doc.ul(checks)
+        _rounding_note(doc, checks)
 
 
 def _error_rows(run: ModelRun) -> list[list[str]]:
@@ -486,8 +495,9 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     reactions, a model with [friction] only). Every file is
     written atomically: an interrupted or failed run leaves each earlier file as it was. Every
     file depends only on the model, the routes and the steps (and the libraries' versions): no
-    dates and no run times, so a rerun reproduces them byte for byte. Run times are printed by
-    the command line only.
+    dates and no run times (printed by the command line only). A rerun reproduces the numbers
+    within their tolerances, not byte for byte: errors at rounding level differ in their last
+    digits from machine to machine (`kinetostat.report.compare_reports` checks a rerun).
     """
     m, res = run.mech, run.res
     folder = run.stem if folder is None else folder
@@ -539,9 +549,11 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     doc.h(2, "Balancing moment")
     lever = np.nanmax(np.abs(res.lever_discrepancy)) if np.any(np.isfinite(res.lever_discrepancy)) else float("nan")
     peak_m = np.nanmax(np.abs(res.balancing_moment)) if np.any(np.isfinite(res.balancing_moment)) else 0.0
-    doc.p(f"Group by group (force analysis from the last Assur group to the crank) against Zhukovsky's lever "
-          f"and against each engine route's driving moment. Largest |lever − groups| over the cycle: "
-          f"{_err(lever, peak_m, 'N·m')}.")
+    lever_text = (f"Group by group (force analysis from the last Assur group to the crank) against Zhukovsky's lever "
+                  f"and against each engine route's driving moment. Largest |lever − groups| over the cycle: "
+                  f"{_err(lever, peak_m, 'N·m')}.")
+    doc.p(lever_text)
+    _rounding_note(doc, [lever_text])
     doc.img(images["moment"], "Balancing moment on the crank over the cycle, N·m")
     doc.table(["quantity", "max, N·m", "at φ, deg", "min, N·m", "at φ, deg"],
               [[esc(quantity_name(m, "M_bal")), *_extremes(res.balancing_moment, res.phi_deg)]], "lrrrr")
@@ -565,12 +577,14 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     doc.p("Per route and quantity: max |engine − kinetostat| over the cycle (absolute) and the crank angle "
           "where it occurs, the maximum (peak relative) and RMS of the error relative to the cycle's peak "
           "|kinetostat|, beside the route's tolerance. Routes that only give magnitudes (pymunk) are compared "
-          f"in magnitude. An error below {ROUNDING:.1e} of the peak (1000 units in the last place) is "
-          "rounding and reads so (the two agree to machine precision; its angle is then left out).")
+          f"in magnitude. The angle of an error at rounding level ({ROUNDING_MARK}) is left out: "
+          "it is where the rounding happens to peak.")
     if run.results:
         doc.img(images["errors"], "|engine − kinetostat| over the cycle, log scale; dashed: tolerance × peak")
+    error_rows = _error_rows(run)
     doc.table(["route", "quantity", "max abs error", "at φ, deg", "peak relative, 1", "tolerance, 1", "RMS relative, 1",
-               "angles compared", "result"], _error_rows(run), "llrrrrrrl")
+               "angles compared", "result"], error_rows, "llrrrrrrl")
+    _rounding_note(doc, [c for r in error_rows for c in r])
     doc.h(3, "Routes and their tolerances")
     rows = []
     for route in routes:
@@ -613,7 +627,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
                    page=any(p.name == "page.html" for p in plan_files),
                    sources=[w.key for w in works],
                    units=dict(worst="1 (largest |route - kinetostat| over the cycle's peak |kinetostat|; "
-                                    f"'rounding' below {ROUNDING:.1e})",
+                                    f"below {ROUNDING:.1e}: at rounding level, its digits differ from machine to "
+                                    "machine)",
                               tolerance="1 (of the peak)", worst_percent="%"),
                    passed=run.passed, checked=run.checked, checks=len(run.checks), failed=sum(not c.passed for c in run.checks),
                    routes={r: dict(status=run.status(r), worst=_worst(run, r),
@@ -626,11 +641,10 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     return _clean(summary)
 
 
-def _worst(run: ModelRun, route: str) -> float | str | None:
-    """The route's worst peak-relative error to `ERROR_DIGITS` (`kinetostat.tables.error`), or
-    "rounding" below ROUNDING (its digits differ between machines)."""
+def _worst(run: ModelRun, route: str) -> float | None:
+    """The route's worst peak-relative error to `ERROR_DIGITS` (`kinetostat.tables.error`)."""
     w = run.worst(route)
-    return None if w is None else "rounding" if _is_rounding(w) else error(w)
+    return None if w is None else error(w)
 
 
 def _work(w: Work) -> str:
@@ -678,7 +692,7 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
     doc.h(2, "Errors route by route")
     doc.p(f"Each cell: the worst peak-relative error of the route over the mechanism's quantities (driving "
           f"moment, every reaction; |route − kinetostat| over the cycle's peak |kinetostat|, dimensionless), "
-          f"the route's tolerance, and the verdict. An error below {ROUNDING:.1e} of the peak is rounding. "
+          f"the route's tolerance, and the verdict. "
           f"The tolerances and why: each report's table *Routes and their tolerances*.")
     rows = []
     for s in sums:
@@ -692,9 +706,10 @@ def write_index(out: Path, summaries: list[dict[str, Any]]) -> Path:
             else:
                 tol = f" ≤ {info['tolerance']:.0e}" if info.get("tolerance") is not None else ""
                 verdict = "PASS" if info["status"] == "PASS" else "**FAIL**"
-                cells.append(f"{_rel(info['worst']) if info['worst'] != 'rounding' else 'rounding'}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
+                cells.append(f"{_rel(info['worst'])}{tol if verdict == 'PASS' else tol.replace('≤', '>')} {verdict}")
         rows.append([f"[{s['stem']}]({s['stem']}/index.md)", *cells])
     doc.table(["model", *routes], rows, "l" + "r" * len(routes))
+    _rounding_note(doc, [c for r in rows for c in r])
     studies = [(name, title) for name, title in STUDIES if (out / name).is_file()]
     if studies:
         doc.h(2, "Studies")
