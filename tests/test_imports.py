@@ -234,3 +234,19 @@ def test_the_model_package_keeps_the_names_of_the_module_it_replaced():
     for name in ("MAX_KEY", "MAX_KEY_MEMORY", "MAX_FILE_BYTES", "MAX_VALUE", "MAX_POINTS", "MIN_LENGTH", "MIN_GEAR",
                  "MAX_PUBLISHED_ANGLES", "MAX_SHOWN", "MAX_NAME", "MAX_PROBLEMS", "MAX_PARAMETERS", "LAW_VARIABLES"):
         assert getattr(model, name) is getattr(limits, name), name
+
+
+def test_no_module_defines_a_name_twice():
+    """A module's top-level function or class defined twice keeps the last one alone: two merged
+    branches each added `cli.common._probe` (the memory guard's probe of a model, then a
+    writability probe of a folder), and the guard called the folder's with a model, caught the
+    TypeError and checked nothing."""
+    twice = {}
+    for name, (path, _) in _modules().items():
+        seen: set[str] = set()
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                if node.name in seen:
+                    twice.setdefault(name, []).append(node.name)
+                seen.add(node.name)
+    assert not twice, twice

@@ -499,7 +499,7 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | N
     return res, time.perf_counter() - t0
 
 
-def _probe(folder: Path) -> IO:
+def _probe_file(folder: Path) -> IO:
     """An empty temporary file in `folder`, named as the writes' own (`kinetostat._io.temporary_affixes`:
     a killed command's probe is removed by the next write there), gone when closed."""
     prefix, suffix = temporary_affixes()
@@ -519,7 +519,7 @@ def _writable_file(path: str, option: str) -> Path:
             raise CLIError(f"cannot write {option} {p}: it is a directory")
         if len(os.fsencode(p.name)) > os.pathconf(p.parent, "PC_NAME_MAX"):
             raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
-        with _sigint_deferred(), _probe(p.parent):
+        with _sigint_deferred(), _probe_file(p.parent):
             pass                         # Ctrl-C held back till the probe is gone: none left behind
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
@@ -530,7 +530,7 @@ def _writable_dir(path: str, option: str) -> Path:
     p = Path(path)
     try:
         p.mkdir(parents=True, exist_ok=True)
-        with _sigint_deferred(), _probe(p):
+        with _sigint_deferred(), _probe_file(p):
             pass
     except OSError as exc:
         raise CLIError(f"cannot write {option} {p}: {exc.strerror or exc}") from None
