@@ -14,7 +14,8 @@ it (`__pycache__/*.nbi`, `*.nbc`: pickles, unpickled when the kernel is first ca
   Python's bytecode cache (`__pycache__/*.pyc`) is never read. The file on disk, which numba
   stamps its cache with, is compared byte for byte with `text` and rewritten where it differs
   (missing, empty, cut short, foreign, not a regular file); numba's pickles of that module are
-  removed whenever it is. The pickles are read only from a trusted folder: where numba would
+  removed whenever it is, and where numba's index of it does not read whole (empty, cut
+  short). The pickles are read only from a trusted folder: where numba would
   keep them elsewhere (NUMBA_CACHE_DIR) and that folder is not trusted, the kernel compiles
   in memory, with one warning.
 
@@ -174,7 +175,17 @@ def load(text: str) -> types.ModuleType:
     if why is not None:
         _warn(f"numba's cache folder {where} {why}: the kernel {name} is compiled in memory, not cached")
         kernel._cache = NullCache()
-    elif rewritten:
+    elif rewritten or not _index_readable(kernel):
         for p in _pickles(where, name):
             p.unlink(missing_ok=True)
     return module
+
+
+def _index_readable(kernel) -> bool:
+    """Whether numba's index of `kernel` (in a trusted folder) is missing or reads whole: an empty
+    or cut-short one (a write killed, a full disk) would raise on every later call, never rebuilt."""
+    try:
+        kernel._cache._cache_file._load_index()
+    except Exception:                  # noqa: BLE001 -- EOFError, UnpicklingError, a foreign pickle's own
+        return False
+    return True

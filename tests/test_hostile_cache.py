@@ -192,3 +192,17 @@ def test_a_mechanism_kernel_comes_from_a_planted_folder_unharmed(cache, tmp_path
     fn, _ = fast.kernel(m, "full")
     assert fn is not None and not marker.exists()
     assert (cache / f"{name}.py").read_text() == text
+
+
+@pytest.mark.parametrize("index", [b"", b"\x80\x04garbage"])
+def test_a_corrupt_numba_index_beside_the_right_module_is_rebuilt(cache, index):
+    """Before: numba's EOFError (an empty index) or UnpicklingError on every call, never rebuilt."""
+    cache.mkdir(mode=0o700)
+    (cache / f"{NAME}.py").write_text(TEXT)
+    tag = f"py{sys.version_info.major}{sys.version_info.minor}"
+    path = cache / "__pycache__" / f"{NAME}.kernel-2.{tag}.nbi"
+    path.parent.mkdir()
+    path.write_bytes(index)
+    module, _ = _load_and_call()
+    assert module.kernel._cache._cache_file._index_path == str(path)      # the file numba reads
+    assert path.stat().st_size > len(index)                                 # written anew by numba
