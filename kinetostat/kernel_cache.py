@@ -14,15 +14,20 @@ it (`__pycache__/*.nbi`, `*.nbc`: pickles, unpickled when the kernel is first ca
   Python's bytecode cache (`__pycache__/*.pyc`) is never read. The file on disk, which numba
   stamps its cache with, is compared byte for byte with `text` and rewritten where it differs
   (missing, empty, cut short, foreign, not a regular file); numba's pickles of that module are
-  removed whenever it is, and where numba's index of it does not read whole (empty, cut
-  short). The pickles are read only from a trusted folder: where numba would
-  keep them elsewhere (NUMBA_CACHE_DIR) and that folder is not trusted, the kernel compiles
-  in memory, with one warning.
+  removed whenever it is.
+- numba's pickles are signed: once numba has saved them, an HMAC-SHA256 of every pickle of the
+  module (`k<hash>.sig` beside them) under this user's key (`key_path()`: 32 random bytes,
+  0600, kept outside the cache folder). Before numba reads them, the signature is checked, and
+  pickles it does not hold (planted, restored from another machine or user, cut short, written
+  by an earlier version) are removed unread, so that numba compiles afresh. The pickles are read
+  only from a trusted folder: where numba would keep them elsewhere (NUMBA_CACHE_DIR) and that
+  folder is not trusted, the kernel compiles in memory, with one warning.
 
-What is trusted, then: numba's pickles in a folder only this user can write, beside a module
-that holds exactly the source generated now. A cache folder restored from elsewhere (a CI cache
-of an untrusted branch) is trusted as the user's own: do not restore one from a source you do
-not trust. On Windows the folders' owners and permissions are not checked.
+What is trusted, then: the key file, and pickles it signed in a folder only this user can write.
+A kernel cache restored from elsewhere (a CI cache of an untrusted branch) is not: its pickles
+are removed and compiled again. Where the key cannot be kept (no writable home), one warning,
+and a key of this process: kernels are then compiled once per process. On Windows the folders'
+owners and permissions are not checked.
 
 May use: the standard library, numba (its cache object), and `_io` (atomic writes, bounded reads).
 """
@@ -30,7 +35,9 @@ from __future__ import annotations
 
 import atexit
 import hashlib
+import hmac
 import os
+import secrets
 import shutil
 import stat
 import sys
@@ -42,10 +49,13 @@ from pathlib import Path
 
 from ._io import read_regular, write_bytes
 
-__all__ = ["CACHE_ENV", "KernelCacheWarning", "cache_dir", "folder", "untrusted", "load"]
+__all__ = ["CACHE_ENV", "KernelCacheWarning", "cache_dir", "key_path", "folder", "untrusted", "load"]
 
 #: The environment variable naming the kernels' cache folder.
 CACHE_ENV = "KINETOSTAT_CACHE"
+#: The most bytes of numba's pickles of one kernel that are read to check their signature (a
+#: kernel's are about 0.5 MB).
+MAX_PICKLES = 256 * 2**20
 
 
 class KernelCacheWarning(UserWarning):
@@ -69,6 +79,14 @@ def untrusted(path: str | Path) -> str | None:
     if os.name != "posix":
         return None
     uid = os.geteuid()
+    given = Path(os.path.abspath(path))
+    for part in [given, *given.parents]:          # a link on the way another user could turn elsewhere
+        try:
+            st = os.lstat(part)
+        except OSError:
+            continue
+        if stat.S_ISLNK(st.st_mode) and st.st_uid not in (0, uid):
+            return f"is reached through the link {part}, owned by another user (uid {st.st_uid})"
     real = Path(os.path.realpath(path))
     try:
         st = os.stat(real)
@@ -89,8 +107,59 @@ def untrusted(path: str | Path) -> str | None:
     return None
 
 
+def key_path() -> Path:
+    """The file of this user's key that signs numba's pickles of the kernels: outside the cache
+    folder, in $XDG_CONFIG_HOME/kinetostat (else ~/.config/kinetostat)."""
+    base = os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config"
+    return Path(base) / "kinetostat" / "kernel-cache.key"
+
+
 _LOCK = threading.Lock()
 _SCRATCH: list[Path] = []        # this process's private temporary folder, once made
+_KEY: list[bytes] = []           # the key, once read or made
+
+
+def _read_key(path: Path) -> bytes:
+    """The key at `path`, made first where missing (32 random bytes, 0600, linked into place
+    whole); OSError or ValueError saying why it cannot be trusted."""
+    path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+    if not os.path.lexists(path):
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}")
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "wb") as f:
+            f.write(secrets.token_bytes(32))
+        try:
+            os.link(tmp, path)                 # whole or not at all; another process's key wins a race
+        except FileExistsError:
+            pass
+        finally:
+            tmp.unlink()
+    why = untrusted(path.parent)
+    st = os.lstat(path)
+    if why is None and os.name == "posix" and (not stat.S_ISREG(st.st_mode) or st.st_uid != os.geteuid()
+                                                or st.st_mode & 0o077):
+        why = f"is not a file only you can read (mode {stat.filemode(st.st_mode)}, uid {st.st_uid})"
+    key = b"" if why else read_regular(path, 64)
+    if why is None and len(key) != 32:
+        why = "is not a key kinetostat made"
+    if why:
+        raise ValueError(why)
+    return key
+
+
+def _key() -> bytes:
+    """This user's key (`key_path`); where it cannot be kept or trusted, one warning and a key of
+    this process (no kernel compiled by another process is then reused)."""
+    with _LOCK:
+        if not _KEY:
+            path = key_path()
+            try:
+                _KEY.append(_read_key(path))
+            except (OSError, ValueError) as exc:
+                _warn(f"the kernel cache's key {path} {getattr(exc, 'strerror', None) or exc}: kernels compiled by "
+                      f"other processes are not reused")
+                _KEY.append(secrets.token_bytes(32))
+        return _KEY[0]
 
 
 def _scratch() -> Path:
@@ -148,10 +217,55 @@ def _pickles(where: Path, stem: str) -> list[Path]:
     return [p for p in where.glob(f"{stem}.*") if p.suffix in (".nbi", ".nbc")]
 
 
+def _signature(where: Path, stem: str) -> bytes:
+    """The HMAC-SHA256, under this user's key, of numba's pickles of the module `stem` in `where`
+    (their names, sizes and bytes, in the order of their names)."""
+    mac = hmac.new(_key(), digestmod="sha256")
+    for p in sorted(_pickles(where, stem)):
+        data = read_regular(p, MAX_PICKLES)
+        mac.update(p.name.encode() + b"\0" + len(data).to_bytes(8, "little") + data)
+    return mac.digest()
+
+
+def _signed(where: Path, stem: str) -> bool:
+    """Whether the pickles of `stem` in `where` are those this user's key signed."""
+    try:
+        return hmac.compare_digest(read_regular(where / f"{stem}.sig", 64), _signature(where, stem))
+    except OSError:
+        return False
+
+
+def _unsign(where: Path, stem: str) -> None:
+    """Remove the pickles of `stem` in `where` and their signature."""
+    for p in [*_pickles(where, stem), where / f"{stem}.sig"]:
+        p.unlink(missing_ok=True)
+
+
+def _sign_cache(cache, where: Path, stem: str) -> None:
+    """numba's disk cache `cache` of the kernel `stem` made to read only pickles this user's key
+    signed (others removed unread first) and to sign what it saves."""
+    load_overload, save_overload = cache.load_overload, cache.save_overload
+
+    def load_signed(sig, target_context):
+        if not _signed(where, stem):
+            _unsign(where, stem)
+        return load_overload(sig, target_context)
+
+    def save_signed(sig, data):
+        save_overload(sig, data)
+        try:
+            write_bytes(where / f"{stem}.sig", _signature(where, stem))
+        except OSError:                   # unsigned: compiled again by the next process
+            pass
+
+    cache.load_overload, cache.save_overload = load_signed, save_signed
+
+
 def load(text: str) -> types.ModuleType:
     """The generated module `text`, run from the file k<hash of text>.py of `folder()`, which is
-    made to hold `text` first; its `kernel`'s disk cache is numba's where that is trusted (the
-    pickles removed where the file was rewritten), else none."""
+    made to hold `text` first; its `kernel`'s disk cache is numba's, reading only pickles this
+    user's key signed, where that folder is trusted (the pickles removed where the file was
+    rewritten), else none."""
     from numba.core.caching import NullCache
 
     name = "k" + hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -175,17 +289,8 @@ def load(text: str) -> types.ModuleType:
     if why is not None:
         _warn(f"numba's cache folder {where} {why}: the kernel {name} is compiled in memory, not cached")
         kernel._cache = NullCache()
-    elif rewritten or not _index_readable(kernel):
-        for p in _pickles(where, name):
-            p.unlink(missing_ok=True)
+    else:
+        if rewritten:
+            _unsign(where, name)
+        _sign_cache(kernel._cache, where, name)
     return module
-
-
-def _index_readable(kernel) -> bool:
-    """Whether numba's index of `kernel` (in a trusted folder) is missing or reads whole: an empty
-    or cut-short one (a write killed, a full disk) would raise on every later call, never rebuilt."""
-    try:
-        kernel._cache._cache_file._load_index()
-    except Exception:                  # noqa: BLE001 -- EOFError, UnpicklingError, a foreign pickle's own
-        return False
-    return True

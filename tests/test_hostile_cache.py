@@ -1,5 +1,6 @@
 """Hostile kernel cache (issue 35, class 1): a module or a numba pickle planted in the kernels'
-cache folder never runs; a folder others can write is bypassed with one warning; a corrupt entry
+cache folder never runs, also beside the right module (a cache restored from elsewhere: not signed
+by this user's key); a folder others can write is bypassed with one warning; a corrupt entry
 is rebuilt; the private fallback folder is removed on exit.
 
 The generated module here is a one-line numba function with the kernel's name and disk cache
@@ -44,6 +45,8 @@ def cache(tmp_path, monkeypatch) -> Path:
     monkeypatch.setenv(kernel_cache.CACHE_ENV, str(folder))
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.setattr(kernel_cache, "_SCRATCH", [])        # this test's own fallback folder, if any
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))    # and its own key
+    monkeypatch.setattr(kernel_cache, "_KEY", [])
     return folder
 
 
@@ -206,3 +209,44 @@ def test_a_corrupt_numba_index_beside_the_right_module_is_rebuilt(cache, index):
     module, _ = _load_and_call()
     assert module.kernel._cache._cache_file._index_path == str(path)      # the file numba reads
     assert path.stat().st_size > len(index)                                 # written anew by numba
+
+
+@POSIX
+def test_a_planted_pickle_beside_the_right_module_is_removed_unread_and_the_new_one_signed(cache, tmp_path):
+    """A restored cache: the module is the generated one, its numba index planted. Not signed by
+    this user's key, it is removed unread; what numba then saves is signed, and read back."""
+    marker = tmp_path / "ran"
+    cache.mkdir(mode=0o700)
+    (cache / f"{NAME}.py").write_text(TEXT)
+    index = _plant_index(cache, marker)
+    module, _ = _load_and_call()
+    assert not marker.exists()
+    assert (cache / "__pycache__" / f"{NAME}.sig").stat().st_size == 32
+    assert kernel_cache.key_path().stat().st_mode & 0o777 == 0o600
+    again = kernel_cache.load(TEXT)                 # a kernel of its own: numba reads the signed pickles
+    assert again.kernel(1) == 2 and sum(again.kernel.stats.cache_hits.values()) == 1
+    index.write_bytes(index.read_bytes() + b"x")    # one byte more: the signature no longer holds
+    third = kernel_cache.load(TEXT)
+    assert third.kernel(1) == 2 and sum(third.kernel.stats.cache_misses.values()) == 1
+
+
+@POSIX
+def test_a_key_others_can_read_is_not_used(cache, tmp_path):
+    key = kernel_cache.key_path()
+    key.parent.mkdir(parents=True)
+    key.write_bytes(b"k" * 32)
+    os.chmod(key, 0o644)
+    _, message = _load_and_call(expect_warning=True)
+    assert "is not a file only you can read" in message and "not reused" in message
+
+
+@POSIX
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0, reason="lchown to another user needs root")
+def test_a_link_owned_by_another_user_on_the_way_is_not_trusted(tmp_path):
+    private = tmp_path / "private"
+    private.mkdir(mode=0o700)
+    link = tmp_path / "link"
+    link.symlink_to(private)
+    os.lchown(link, 65534, 65534)
+    assert "through the link" in kernel_cache.untrusted(link)
+    assert kernel_cache.untrusted(private) is None
