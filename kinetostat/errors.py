@@ -25,7 +25,7 @@ class ModelError(ValueError):
         self.source = source
         self.lines = list(lines) if lines is not None else [None] * len(self.problems)
         text = "\n".join(f"  - {p}" for p in self.located)
-        super().__init__(f"{source}: {len(self.problems)} problem(s):\n{text}")
+        super().__init__(f"{one_line(source)}: {len(self.problems)} problem(s):\n{text}")
 
     @property
     def located(self) -> list[str]:

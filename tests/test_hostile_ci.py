@@ -4,6 +4,7 @@ no markup in $GITHUB_STEP_SUMMARY, and leaves the JUnit XML well-formed, in the 
 and in `kinetostat validate`; each channel's one escaping function holds the text as text."""
 from __future__ import annotations
 
+import os
 import re
 import xml.etree.ElementTree as ET
 
@@ -107,3 +108,18 @@ def test_validate_forges_no_command_and_no_markup(cli, tmp_path):
     root = ET.parse(tmp_path / "v.xml").getroot()                    # well-formed, U+0001 written as \x01
     (failure,) = root.iter("failure")
     assert "source: \\x01x\n::error::forged\n::add-mask::secret <img" in failure.text
+
+
+@pytest.mark.skipif(os.name != "posix", reason="a newline in a file name")
+def test_a_model_file_name_forges_no_command(pytester, monkeypatch):
+    """Before: a collected model file named 'evil\\n::error::forged.toml' that fails to load put
+    '::error::forged...' lines on stdout (its path in the failure's text and in pytest's own
+    headers). Now it is not collected, one escaped line names it, and the gate fails."""
+    (pytester.path / "evil\n::error::forged.toml").write_text("[mechanism]\n", encoding="utf-8")
+    monkeypatch.setenv("GITHUB_ACTIONS", "true")
+    r = pytester.runpytest_inprocess("--kinetostat", ".", "--kinetostat-steps", "12", "-p", "no:cacheprovider",
+                                     "-p", "no:hypothesispytest")
+    out = r.stdout.str()
+    assert not _commands(out), out
+    assert "kinetostat: not collected: " in out and "evil\\n::error::forged.toml" in out
+    assert r.ret == pytest.ExitCode.TESTS_FAILED
