@@ -175,3 +175,22 @@ def test_an_expected_cycle_that_is_a_fifo_is_refused_unread(tmp_path):
     os.mkfifo(fifo)                     # pandas' read_csv waited for a writer for ever
     exc = _within(lambda: check_cycle("ice_crank_slider", expected=fifo, steps=12))
     assert isinstance(exc, ValueError) and f"{fifo}: the expected file is not read: a FIFO" in str(exc), exc
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="POSIX only")
+def test_report_check_reads_earlier_files_bounded_and_never_waits_on_a_fifo(tmp_path, monkeypatch):
+    """`report --check`'s comparison reads the committed reports, earlier outputs: a FIFO there
+    is not a file of the report (never opened), and a file over MAX_REPORT_BYTES is named as
+    not read instead of read whole."""
+    from kinetostat.report import rerun
+    for side in ("fresh", "old"):
+        (tmp_path / side / "m").mkdir(parents=True)
+        (tmp_path / side / "m" / "summary.json").write_text("{}", encoding="utf-8")
+        (tmp_path / side / "m" / "index.md").write_text("# m\n" + "x" * 100, encoding="utf-8")
+        (tmp_path / side / "m" / "worksheet.csv").write_text("a\n", encoding="utf-8")
+    os.remove(tmp_path / "old" / "m" / "worksheet.csv")
+    os.mkfifo(tmp_path / "old" / "m" / "worksheet.csv")
+    monkeypatch.setattr(rerun, "MAX_REPORT_BYTES", 50)
+    got = {d.file: d for d in rerun.compare_reports(tmp_path / "fresh", tmp_path / "old")}
+    assert got["worksheet.csv"].committed == "absent"
+    assert "not read (" in got["index.md"].committed and "index.md" in got["index.md"].committed

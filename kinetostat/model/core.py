@@ -33,8 +33,10 @@ _WANTED = {"number": "a number", "integer": "an integer", "link": "a link id", "
            "vector": "[x, y]", "direction": "a direction [x, y]", "map": "a table"}
 
 
-#: Control characters (C0, DEL, C1), which no name holds: a name is one line of text.
-_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
+#: Control characters (C0, DEL, C1), the line and paragraph separators (U+2028, U+2029) and the
+#: bidirectional embeddings, overrides and isolates (U+202A-U+202E, U+2066-U+2069, which reorder
+#: how a text reads: "Trojan source"), which no name holds: a name is one line of text.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029\u202a-\u202e\u2066-\u2069]")
 
 
 def _control(name: str) -> str:

@@ -21,11 +21,12 @@ per model folder of the rerun (one holding a summary.json):
   e-notation (the error figures, checked in summary.json) and a relative 1e-9 in other numbers
   (12 printed digits).
 
-May use: numpy, `kinetostat.tables` (reading the CSV), `kinetostat.plans.page` (a page's key), the
+May use: numpy, `_io` (bounded reads of regular files), `kinetostat.tables` (reading the CSV), `kinetostat.plans.page` (a page's key), the
 document's ROUNDING and the harness's tolerances (imported inside `compare_reports`).
 """
 from __future__ import annotations
 
+import io
 import json
 import math
 import re
@@ -35,6 +36,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from .._io import read_regular
 from .document import ROUNDING
 
 #: Relative difference allowed in a number of a text file that is not in e-notation (12 digits printed).
@@ -47,6 +49,8 @@ _NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w
 _VERSIONS = re.compile(r"kinetostat \d\S*?(?:, [A-Za-z][\w-]* \d[^,\s]*?)*(?=\.?(?:\s|$|<))")
 #: At most this many differences named per text file (the rest counted).
 TEXT_LIMIT = 10
+#: The most bytes of one report file that are read (an earlier output: a regular file only, `read_regular`).
+MAX_REPORT_BYTES = 256 * 2**20
 
 
 @dataclass(frozen=True)
@@ -127,7 +131,7 @@ def _cycle(model: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]
     from kinetostat_validation.compare import TOLERANCES
 
     rtol = TOLERANCES["reference"].peak_relative
-    new, old = read_csv(fresh_path), read_csv(old_path)
+    new, old = (read_csv(io.StringIO(_read(p))) for p in (fresh_path, old_path))
     head = [f"{c} [{new.attrs['units'][c]}]" for c in new.columns]
     was = [f"{c} [{old.attrs['units'][c]}]" for c in old.columns]
     if head != was or len(new) != len(old):
@@ -195,8 +199,7 @@ def _excerpt(s: str, other: str, width: int = 60) -> str:
 
 
 def _text(model: str, name: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]:
-    new = fresh_path.read_text(encoding="utf-8").splitlines()
-    old = old_path.read_text(encoding="utf-8").splitlines()
+    new, old = _read(fresh_path).splitlines(), _read(old_path).splitlines()
     found = [d for n, (a, b) in enumerate(zip(new, old), 1) if (d := _line(model, name, n, a, b)) is not None]
     yield from found[:TEXT_LIMIT]
     if len(found) > TEXT_LIMIT:
@@ -205,9 +208,22 @@ def _text(model: str, name: str, fresh_path: Path, old_path: Path) -> Iterator[D
         yield Difference(model, name, "lines", "", str(len(new)), str(len(old)), "equal")
 
 
+def _read(path: Path) -> str:
+    """The text of the report file `path`: a regular file of at most MAX_REPORT_BYTES (OSError else)."""
+    return read_regular(path, MAX_REPORT_BYTES).decode("utf-8", "replace")
+
+
 def _file(model: str, name: str, fresh: Path, old: Path) -> Iterator[Difference]:
+    try:
+        yield from _compared(model, name, fresh, old)
+    except OSError as exc:           # a FIFO, a device, too large: named, not waited on
+        yield Difference(model, name, "file", "", "", f"not read ({exc.strerror or exc}): {exc.filename}",
+                         "a regular file")
+
+
+def _compared(model: str, name: str, fresh: Path, old: Path) -> Iterator[Difference]:
     if name == "summary.json":
-        yield from _json(model, json.loads(fresh.read_text(encoding="utf-8")), json.loads(old.read_text(encoding="utf-8")))
+        yield from _json(model, json.loads(_read(fresh)), json.loads(_read(old)))
     elif name == "cycle.csv":
         yield from _cycle(model, fresh, old)
     elif name == "page.html":
