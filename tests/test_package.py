@@ -193,3 +193,19 @@ def test_the_commands_take_a_bundled_models_name(cli, tmp_path):
     assert r.returncode == 0, r.stderr
     missing = cli("analyze", "no_such_model", cwd=tmp_path)
     assert missing.returncode == 2 and "model file not found: no_such_model" in missing.stderr
+
+
+def test_a_missing_path_that_names_a_bundled_model_names_it(cli, tmp_path, monkeypatch):
+    """`models/ice_crank_slider.toml` from a folder without it (a README line run elsewhere): one
+    error line naming the bundled model and the copy command, from the CLI and from load; a
+    path that names no bundled model gets no hint."""
+    r = cli("analyze", "models/ice_crank_slider.toml", "--at", "30", cwd=tmp_path)
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr
+    assert ("model file not found: models/ice_crank_slider.toml; ice_crank_slider is a bundled model: "
+            "kinetostat.load('ice_crank_slider')") in r.stderr and "kinetostat examples --copy models" in r.stderr
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(kinetostat.ModelFileNotFound) as e:
+        kinetostat.load("models/ice_crank_slider.toml")
+    assert e.value.problems == ["cannot read file: no such file; " + kinetostat.examples.hint("models/ice_crank_slider.toml")]
+    assert "`kinetostat report ice_crank_slider`" in e.value.problems[0]
+    assert kinetostat.examples.hint("models/no_such_model.toml") == kinetostat.examples.hint("ice_crank_slider.csv") == ""
