@@ -4,8 +4,10 @@ installed into a fresh virtual environment and run from a folder outside the che
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
+import tomllib
 import venv
 from pathlib import Path
 
@@ -209,3 +211,11 @@ def test_a_missing_path_that_names_a_bundled_model_names_it(cli, tmp_path, monke
     assert e.value.problems == ["cannot read file: no such file; " + kinetostat.examples.hint("models/ice_crank_slider.toml")]
     assert "`kinetostat report ice_crank_slider`" in e.value.problems[0]
     assert kinetostat.examples.hint("models/no_such_model.toml") == kinetostat.examples.hint("ice_crank_slider.csv") == ""
+
+
+def test_the_version_is_the_changelogs_latest_release():
+    """pyproject.toml, kinetostat.__version__ (--version, the reports) and CHANGELOG.md's newest
+    release heading (`## [0.2.0] - 2026-11-29`, keep-a-changelog) name one version."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["version"]
+    releases = re.findall(r"^## \[(\d+\.\d+\.\d+)\] - \d{4}-\d{2}-\d{2}$", (ROOT / "CHANGELOG.md").read_text(encoding="utf-8"), re.M)
+    assert project == kinetostat.__version__ == releases[0] == "0.2.0" and releases[-1] == "0.1.0"
