@@ -17,6 +17,7 @@ import kinetostat
 from conftest import MODELS, ROOT
 from kinetostat import examples
 from kinetostat.cli import EXIT_OK, EXIT_USAGE
+from test_readme import examples, readme_python, run_example
 
 NAMES = [p.stem for p in MODELS]
 FOREIGN = 'raise ImportError("the foreign validation package of the working directory was imported")\n'
@@ -139,7 +140,9 @@ def test_a_foreign_validation_folder_does_not_shadow_the_harness(foreign_cwd):
 def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
     """Build the wheel, install it with [all] into a new virtual environment (no system site
     packages, nothing of the checkout), and run the commands from a folder outside the checkout
-    that holds a foreign `validation/` package. ~1.5 min: the install (~35 s) and the report."""
+    that holds a foreign `validation/` package (~1.5 min: the install, ~35 s, and the report); then
+    the README's Python and every example of its bash blocks, each from an empty folder (as
+    tests/test_readme.py's slow tests do, but with the wheel: the long part)."""
     dist = tmp_path / "dist"
     r = _run(sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", dist, ROOT, cwd=tmp_path)
     assert r.returncode == 0, r.stderr
@@ -180,6 +183,16 @@ def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
              cwd=work)
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert (work / "reports" / "scotch_yoke" / "index.md").is_file()
+
+    # the README's examples, each from an empty folder, with this wheel installed (tests/test_readme.py)
+    empty = tmp_path / "readme"
+    empty.mkdir()
+    r = _run(py, "-c", readme_python(), cwd=empty)
+    assert r.returncode == 0, r.stderr[-3000:]
+    for n, command in enumerate(examples()):
+        (empty / str(n)).mkdir()
+        r = run_example(command, empty / str(n), bin_)
+        assert r.returncode == 0 and "Traceback" not in r.stderr, (command, r.stdout[-2000:], r.stderr[-2000:])
 
 
 def test_the_commands_take_a_bundled_models_name(cli, tmp_path):
