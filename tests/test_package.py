@@ -17,7 +17,7 @@ import kinetostat
 from conftest import MODELS, ROOT
 from kinetostat import examples
 from kinetostat.cli import EXIT_OK, EXIT_USAGE
-from test_readme import examples, readme_python, run_example
+from test_readme import readme_examples, readme_python, run_example
 
 NAMES = [p.stem for p in MODELS]
 FOREIGN = 'raise ImportError("the foreign validation package of the working directory was imported")\n'
@@ -189,7 +189,7 @@ def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
     empty.mkdir()
     r = _run(py, "-c", readme_python(), cwd=empty)
     assert r.returncode == 0, r.stderr[-3000:]
-    for n, command in enumerate(examples()):
+    for n, command in enumerate(readme_examples()):
         (empty / str(n)).mkdir()
         r = run_example(command, empty / str(n), bin_)
         assert r.returncode == 0 and "Traceback" not in r.stderr, (command, r.stdout[-2000:], r.stderr[-2000:])

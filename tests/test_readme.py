@@ -132,7 +132,7 @@ QUICK = {"kinetostat analyze ice_crank_slider --at 30", "kinetostat structure sl
          "kinetostat examples --copy my_models"}
 
 
-def examples() -> list[str]:
+def readme_examples() -> list[str]:
     """The README's bash-block commands a user runs (kinetostat, python -m), each once, less CHECKOUT and NOT_RUN."""
     lines = dict.fromkeys(shlex.join(w) for w in _shell_commands(inline=False))
     return [c for c in lines if c not in CHECKOUT and c not in NOT_RUN]
@@ -140,7 +140,7 @@ def examples() -> list[str]:
 
 def test_the_commands_left_out_or_run_by_default_are_the_readmes():
     assert CHECKOUT | set(NOT_RUN) <= {shlex.join(w) for w in _shell_commands(inline=False)}
-    assert QUICK <= set(examples()) and len(examples()) >= 18
+    assert QUICK <= set(readme_examples()) and len(readme_examples()) >= 18
 
 
 def user_env() -> dict:
@@ -157,7 +157,7 @@ def run_example(command: str, cwd: Path, bindir: Path = Path(sys.executable).par
                           timeout=3600, stdin=subprocess.DEVNULL)
 
 
-@pytest.mark.parametrize("command", [c if c in QUICK else pytest.param(c, marks=pytest.mark.slow) for c in examples()])
+@pytest.mark.parametrize("command", [c if c in QUICK else pytest.param(c, marks=pytest.mark.slow) for c in readme_examples()])
 def test_a_readme_command_runs_from_an_empty_folder(command, tmp_path):
     r = run_example(command, tmp_path)
     assert r.returncode == 0 and "Traceback" not in r.stderr, (r.stdout[-2000:], r.stderr[-2000:])
