@@ -269,7 +269,8 @@ def _load(path: str | Path):
     from ..model import load
     p = resolve(path)
     if not p.exists():
-        raise CLIError(f"model file not found: {p}" + (f"; {hint(p)}" if hint(p) else ""))
+        bundled = hint(p)
+        raise CLIError(f"model file not found: {p}" + (f"; {bundled}" if bundled else ""))
     if p.is_dir():
         raise CLIError(f"model file expected, got a directory: {p}")
     try:
