@@ -157,7 +157,12 @@ def run_example(command: str, cwd: Path, bindir: Path = Path(sys.executable).par
                           timeout=3600, stdin=subprocess.DEVNULL)
 
 
-@pytest.mark.parametrize("command", [c if c in QUICK else pytest.param(c, marks=pytest.mark.slow) for c in readme_examples()])
+#: The slow examples' own time limit: the suite's 300 s (pyproject's pytest timeout) is shorter
+#: than a report of every model with its pages, or the stability study, on 2 cores.
+SLOW = [pytest.mark.slow, pytest.mark.timeout(3600)]
+
+
+@pytest.mark.parametrize("command", [c if c in QUICK else pytest.param(c, marks=SLOW) for c in readme_examples()])
 def test_a_readme_command_runs_from_an_empty_folder(command, tmp_path):
     r = run_example(command, tmp_path)
     assert r.returncode == 0 and "Traceback" not in r.stderr, (r.stdout[-2000:], r.stderr[-2000:])
