@@ -137,6 +137,7 @@ def test_a_foreign_validation_folder_does_not_shadow_the_harness(foreign_cwd):
 # ----------------------------------------------------------------------------- the wheel, installed
 
 @pytest.mark.slow
+@pytest.mark.timeout(4 * 3600)     # the README's examples besides the install: longer than the suite's 300 s
 def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
     """Build the wheel, install it with [all] into a new virtual environment (no system site
     packages, nothing of the checkout), and run the commands from a folder outside the checkout
