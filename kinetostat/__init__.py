@@ -49,4 +49,4 @@ __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
            "AssemblyError", "SingularPositionWarning", "SelfLockingWarning", "SingularFrictionWarning", "UndefinedFigureWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "examples", "plans", "variants", "sweep", "Sweep"]
-__version__ = "0.1.0"
+__version__ = "0.2.0"

@@ -34,10 +34,11 @@ class ModelError(ValueError):
 
 
 class ModelFileNotFound(ModelError, FileNotFoundError):
-    """The model file does not exist (`except FileNotFoundError` catches it too)."""
+    """The model file does not exist (`except FileNotFoundError` catches it too); `hint`: a line
+    that names a bundled model of that name (`kinetostat.examples.hint`)."""
 
-    def __init__(self, path: str):
-        super().__init__(["cannot read file: no such file"], source=path)
+    def __init__(self, path: str, hint: str = ""):
+        super().__init__(["cannot read file: no such file" + (f"; {hint}" if hint else "")], source=path)
         self.errno, self.strerror, self.filename = errno.ENOENT, "No such file or directory", path
 
     def __str__(self) -> str:

@@ -17,7 +17,7 @@ import os
 import shutil
 from pathlib import Path
 
-__all__ = ["models_dir", "names", "path", "resolve", "copy"]
+__all__ = ["models_dir", "names", "path", "resolve", "hint", "copy"]
 
 
 def models_dir() -> Path:
@@ -53,6 +53,17 @@ def resolve(model: str | Path) -> Path:
     if not p.exists() and p.parent == Path(".") and p.suffix in ("", ".toml") and p.stem in names():
         return path(p.stem)
     return p
+
+
+def hint(model: str | Path) -> str:
+    """One line for a model file that does not exist but is named as a bundled model is
+    (`models/ice_crank_slider.toml` run from a folder without it): that model's name and how to
+    read it from any folder or copy it there; "" for any other path."""
+    p = Path(model)
+    if p.exists() or p.suffix not in ("", ".toml") or p.stem not in names():
+        return ""
+    return (f"{p.stem} is a bundled model: kinetostat.load({p.stem!r}) and `kinetostat report {p.stem}` read it "
+            f"from any folder, `kinetostat examples --copy {p.parent}` copies the bundled models there")
 
 
 def copy(dest: str | Path, overwrite: bool = False) -> list[Path]:

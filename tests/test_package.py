@@ -4,8 +4,10 @@ installed into a fresh virtual environment and run from a folder outside the che
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
+import tomllib
 import venv
 from pathlib import Path
 
@@ -15,6 +17,7 @@ import kinetostat
 from conftest import MODELS, ROOT
 from kinetostat import examples
 from kinetostat.cli import EXIT_OK, EXIT_USAGE
+from test_readme import readme_examples, readme_python, run_example
 
 NAMES = [p.stem for p in MODELS]
 FOREIGN = 'raise ImportError("the foreign validation package of the working directory was imported")\n'
@@ -134,10 +137,13 @@ def test_a_foreign_validation_folder_does_not_shadow_the_harness(foreign_cwd):
 # ----------------------------------------------------------------------------- the wheel, installed
 
 @pytest.mark.slow
+@pytest.mark.timeout(4 * 3600)     # the README's examples besides the install: longer than the suite's 300 s
 def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
     """Build the wheel, install it with [all] into a new virtual environment (no system site
     packages, nothing of the checkout), and run the commands from a folder outside the checkout
-    that holds a foreign `validation/` package. ~1.5 min: the install (~35 s) and the report."""
+    that holds a foreign `validation/` package (~1.5 min: the install, ~35 s, and the report); then
+    the README's Python and every example of its bash blocks, each from an empty folder (as
+    tests/test_readme.py's slow tests do, but with the wheel: the long part)."""
     dist = tmp_path / "dist"
     r = _run(sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", dist, ROOT, cwd=tmp_path)
     assert r.returncode == 0, r.stderr
@@ -179,6 +185,17 @@ def test_wheel_in_a_fresh_environment(tmp_path, foreign_cwd):
     assert r.returncode == EXIT_OK, r.stdout + r.stderr
     assert (work / "reports" / "scotch_yoke" / "index.md").is_file()
 
+    # the README's and the docs' examples, each from an empty folder, with this wheel installed (tests/test_readme.py)
+    empty = tmp_path / "readme"
+    empty.mkdir()
+    for code in readme_python():
+        r = _run(py, "-c", code, cwd=empty)
+        assert r.returncode == 0, r.stderr[-3000:]
+    for n, command in enumerate(readme_examples()):
+        (empty / str(n)).mkdir()
+        r = run_example(command, empty / str(n), bin_)
+        assert r.returncode == 0 and "Traceback" not in r.stderr, (command, r.stdout[-2000:], r.stderr[-2000:])
+
 
 def test_the_commands_take_a_bundled_models_name(cli, tmp_path):
     """`kinetostat analyze ice_crank_slider` means the bundled model, as kinetostat.load does;
@@ -193,3 +210,27 @@ def test_the_commands_take_a_bundled_models_name(cli, tmp_path):
     assert r.returncode == 0, r.stderr
     missing = cli("analyze", "no_such_model", cwd=tmp_path)
     assert missing.returncode == 2 and "model file not found: no_such_model" in missing.stderr
+
+
+def test_a_missing_path_that_names_a_bundled_model_names_it(cli, tmp_path, monkeypatch):
+    """`models/ice_crank_slider.toml` from a folder without it (a README line run elsewhere): one
+    error line naming the bundled model and the copy command, from the CLI and from load; a
+    path that names no bundled model gets no hint."""
+    r = cli("analyze", "models/ice_crank_slider.toml", "--at", "30", cwd=tmp_path)
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr
+    assert ("model file not found: models/ice_crank_slider.toml; ice_crank_slider is a bundled model: "
+            "kinetostat.load('ice_crank_slider')") in r.stderr and "kinetostat examples --copy models" in r.stderr
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(kinetostat.ModelFileNotFound) as e:
+        kinetostat.load("models/ice_crank_slider.toml")
+    assert e.value.problems == ["cannot read file: no such file; " + kinetostat.examples.hint("models/ice_crank_slider.toml")]
+    assert "`kinetostat report ice_crank_slider`" in e.value.problems[0]
+    assert kinetostat.examples.hint("models/no_such_model.toml") == kinetostat.examples.hint("ice_crank_slider.csv") == ""
+
+
+def test_the_version_is_the_changelogs_latest_release():
+    """pyproject.toml, kinetostat.__version__ (--version, the reports) and CHANGELOG.md's newest
+    release heading (`## [0.2.0] - 2026-11-29`, keep-a-changelog) name one version."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["version"]
+    releases = re.findall(r"^## \[(\d+\.\d+\.\d+)\] - \d{4}-\d{2}-\d{2}$", (ROOT / "CHANGELOG.md").read_text(encoding="utf-8"), re.M)
+    assert project == kinetostat.__version__ == releases[0] == "0.2.0" and releases[-1] == "0.1.0"

@@ -1,5 +1,7 @@
-"""The README's and the documentation pages' examples run as written: each page's Python blocks in
-a fresh interpreter that ran only `import kinetostat` (the slow pages with -m slow), every page's
+"""The README's and the documentation pages' examples run as written, from an empty folder: each
+page's Python blocks in a fresh interpreter that ran only `import kinetostat` (the slow pages with
+-m slow); the commands of their bash blocks (a quick sample by default, the rest with -m slow;
+tests/test_package.py runs them with the wheel installed); every page's
 inline `kinetostat.` names and calls with literal arguments in one such interpreter, and every `kinetostat ...` shell command a page shows parses with the
 command line's own parser, its model files exist, and every `python -m MODULE` it shows names a
 module that exists. The pages: README.md and every docs/**/*.md (not the built site)."""
@@ -7,6 +9,7 @@ from __future__ import annotations
 
 import ast
 import importlib.util
+import os
 import re
 import shlex
 import subprocess
@@ -116,21 +119,37 @@ def test_the_pages_inline_names_resolve_in_a_fresh_interpreter():
     assert r.returncode == 0, r.stderr[-3000:]
 
 
+def page_python(page: Path) -> str:
+    """The program of a page's Python: `import kinetostat`, its blocks in order, the checks of what
+    they leave behind."""
+    return "import kinetostat\n" + "\n".join(_blocks(_text(page), "python")) + "\n" + AFTER.get(_name(page), "")
+
+
+def readme_python() -> list[str]:
+    """The programs of every page's Python (`page_python`), one per page that has any."""
+    return [page_python(p) for p in WITH_PYTHON]
+
+
+def user_env() -> dict:
+    """This environment less what could point a command at the checkout's models or code."""
+    return {k: v for k, v in os.environ.items() if k not in ("KINETOSTAT_MODELS", "PYTHONPATH")}
+
+
 @pytest.mark.parametrize("page", [pytest.param(p, id=_name(p), marks=[pytest.mark.slow] if _name(p) in SLOW else [])
                                   for p in WITH_PYTHON])
-def test_the_pages_python_runs_in_a_fresh_interpreter(page):
+def test_the_pages_python_runs_in_a_fresh_interpreter_from_an_empty_folder(page, tmp_path):
     """One process per page: `import kinetostat` alone, then the page's Python blocks in order,
-    from the checkout, and the checks of what they leave behind."""
-    code = "import kinetostat\n" + "\n".join(_blocks(_text(page), "python")) + "\n" + AFTER.get(_name(page), "")
-    r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    in an empty folder, and the checks of what they leave behind."""
+    r = subprocess.run([sys.executable, "-c", page_python(page)], cwd=tmp_path, env=user_env(), capture_output=True,
+                       text=True, timeout=120)
     assert r.returncode == 0, f"{_name(page)}:\n{r.stderr[-3000:]}"
 
 
-def _shell_commands(text: str) -> list[list[str]]:
-    """Every command line of a page's bash blocks and inline spans that runs kinetostat or
+def _shell_commands(text: str, inline: bool = True) -> list[list[str]]:
+    """Every command line of a page's bash blocks (and inline spans) that runs kinetostat or
     `python -m`: comments and output redirections (`> FILE`) dropped, `.venv/bin/` and `&&` chains split."""
     lines = [ln.split("  #")[0].split(" # ")[0] for b in _blocks(text, "bash") for ln in b.splitlines()]
-    lines += [s for s in _inline(text) if s.startswith(("kinetostat ", "python -m "))]
+    lines += [s for s in _inline(text) if s.startswith(("kinetostat ", "python -m "))] if inline else []
     out = []
     for line in lines:
         for part in line.split("&&"):
@@ -169,3 +188,45 @@ def test_the_pages_shell_commands_parse(page):
         assert callable(args.func), (_name(page), argv)
     for module in {w[2] for w in commands if w[0].startswith("python") and w[1] == "-m"} - {"venv"}:
         assert importlib.util.find_spec(module) is not None, (_name(page), module)
+
+
+#: Commands of the bash blocks that make or test the checkout (a venv, an editable install, its
+#: test suite, the docs' build), not examples of use: not run from an empty folder.
+CHECKOUT = {"python3 -m venv .venv", "python -m pip install -e '.[all]'", "python -m pytest -q",
+            "python -m pytest -m slow", "python -m sphinx -W -b html docs docs/_build/html"}
+#: Examples not run even with -m slow: (command, why).
+NOT_RUN = {"kinetostat variant 2 --all --out keys": "every code of task 2, about 1000 keys: hours"}
+#: Examples run by default (a second each); every other one is slow.
+QUICK = {"kinetostat analyze ice_crank_slider --at 30", "kinetostat structure slotted_link_shaper",
+         "kinetostat examples --copy my_models"}
+#: The slow examples' own time limit: the suite's 300 s (pyproject's pytest timeout) is shorter
+#: than a report of every model with its pages, or the stability study, on 2 cores.
+SLOW_RUN = [pytest.mark.slow, pytest.mark.timeout(3600)]
+
+
+def readme_examples() -> list[str]:
+    """The commands of every page's bash blocks a user runs (kinetostat, python -m), each once, less
+    CHECKOUT and NOT_RUN."""
+    lines = dict.fromkeys(shlex.join(w) for p in PAGES for w in _shell_commands(_text(p), inline=False))
+    return [c for c in lines if c not in CHECKOUT and c not in NOT_RUN]
+
+
+def test_the_commands_left_out_or_run_by_default_are_the_pages():
+    shown = {shlex.join(w) for p in PAGES for w in _shell_commands(_text(p), inline=False)}
+    assert CHECKOUT | set(NOT_RUN) <= shown
+    assert QUICK <= set(readme_examples()) and len(readme_examples()) >= 18
+
+
+def run_example(command: str, cwd: Path, bindir: Path = Path(sys.executable).parent) -> subprocess.CompletedProcess:
+    """A page's command run as its reader would, in `cwd`, by the programs of `bindir` (this
+    interpreter's, or a fresh venv's): `kinetostat` its entry point, `python` its interpreter."""
+    argv = shlex.split(command)
+    program = bindir / "kinetostat" if argv[0] == "kinetostat" else bindir / "python"
+    return subprocess.run([str(program), *argv[1:]], cwd=cwd, env=user_env(), capture_output=True, text=True,
+                          timeout=3600, stdin=subprocess.DEVNULL)
+
+
+@pytest.mark.parametrize("command", [c if c in QUICK else pytest.param(c, marks=SLOW_RUN) for c in readme_examples()])
+def test_a_pages_command_runs_from_an_empty_folder(command, tmp_path):
+    r = run_example(command, tmp_path)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, (r.stdout[-2000:], r.stderr[-2000:])

@@ -8,6 +8,8 @@ import dataclasses
 import io
 import json
 import re
+import shutil
+import subprocess
 import tomllib
 from pathlib import Path
 
@@ -151,9 +153,11 @@ def _reader_path(data: dict, exc) -> str:
         else:
             out += ("." if out else "") + step
             node = node[step]
-    named = re.search(r"must (?:not )?contain [\[{]'(\w+)'", exc.message)   # the missing or unknown field
-    if named:       # the reader names an unknown key of the file's top level so
-        out += "." + named[1] if out else ("<top level>." if "not" in exc.message else "") + named[1]
+    named = re.search(r"must contain \['(\w+)'", exc.message)   # the missing field
+    if named:
+        out += "." + named[1] if out else named[1]
+    if len(steps) == 1 and exc.rule == "not":    # the reader names an unknown key of the file's top level so
+        out = "<top level>." + out
     return out.replace(".[", "[")
 
 
@@ -272,3 +276,48 @@ def test_an_integer_field_is_an_integer(edit, where, validate):
         assert e.value.message == f"data.{where} must be integer"
     with pytest.raises(ModelError, match="expected"):
         kinetostat.loads(text)
+
+
+#: One misspelt key per table: (text edit of the four-bar, the key's path as fastjsonschema writes it).
+MISSPELT = [
+    (('[[link]]\nid = 1', '[[link]]\nid = 1\nmasss = 1.0'), "data.link[0].masss"),
+    (('[drive]', '[drive]\nrmp = 60.0'), "data.drive.rmp"),
+    (('[mechanism]', '[linkk]\nid = 9\n\n[mechanism]'), "data.linkk"),
+]
+
+
+@pytest.mark.parametrize("edit, where", MISSPELT, ids=["link", "drive", "top_level"])
+def test_an_unknown_key_fails_at_the_key_not_at_its_table(edit, where, validate):
+    """An editor marks where the validator's error sits: at the key, not at the whole table (taplo
+    marked every key and value of the [[link]] table, 19 errors for one key, for an error at the table)."""
+    with pytest.raises(fastjsonschema.JsonSchemaValueException) as e:
+        validate(tomllib.loads(four_bar(edit)))
+    assert e.value.name == where and e.value.rule == "not"
+
+
+def test_no_table_of_the_json_schema_refuses_unknown_keys_as_a_whole():
+    """No `additionalProperties: false` anywhere: every table's unknown keys fail one by one, at their own path."""
+    def objects(node):
+        if isinstance(node, dict):
+            yield node
+            for v in node.values():
+                yield from objects(v)
+        elif isinstance(node, list):
+            for v in node:
+                yield from objects(v)
+    tables = [o for o in objects(describe.json_schema()) if "properties" in o and o.get("type") == "object"]
+    assert len(tables) >= 10 and all(o["additionalProperties"] == describe.UNKNOWN_KEY for o in tables)
+    assert not any(o.get("additionalProperties") is False for o in objects(describe.json_schema()))
+
+
+@pytest.mark.skipif(shutil.which("taplo") is None, reason="taplo (pip install taplo) not on PATH")
+def test_taplo_reports_one_misspelt_key_once(tmp_path):
+    """The editors' validator itself: one error, on the key's line."""
+    model = tmp_path / "m.toml"
+    model.write_text(four_bar(MISSPELT[0][0]), encoding="utf-8")
+    r = subprocess.run(["taplo", "check", "--schema", describe.SCHEMA_FILE.as_uri(), str(model)],
+                       capture_output=True, text=True, timeout=60)
+    errors = [line for line in (r.stdout + r.stderr).splitlines() if line.startswith("error")]
+    assert r.returncode != 0 and len(errors) == 1, r.stdout + r.stderr
+    line = four_bar(MISSPELT[0][0]).splitlines().index("masss = 1.0") + 1
+    assert f"m.toml:{line}:" in r.stdout + r.stderr

@@ -1,6 +1,7 @@
 """Benchmark: run time against error for the solver and every engine route, per bundled model.
 
-    python -m kinetostat_validation.benchmark              # full study: writes reports/benchmark.{md,csv,png}
+    python -m kinetostat_validation.benchmark              # full study: writes ./reports/benchmark.{md,csv,png}
+    python -m kinetostat_validation.benchmark --out DIR    # ... into DIR instead
     python -m kinetostat_validation.benchmark --quick      # fewer repeats and settings, prints only
 
 Every route runs over the same full cycle (360 angles) and is timed as the median of repeated
@@ -17,11 +18,10 @@ in reused chunks, into one reused buffer and into fresh memory) beside the scala
 commit BEFORE, the numpy path and MuJoCo's kernels, in interleaved rounds, CPU and wall time,
 each against its own limit, with the CPU, its flags and its load recorded.
 
-May use: kinetostat, the scene, compare, reference, the engine adapters, kernels, matplotlib.
+May use: kinetostat, the scene, compare, reference, the engine adapters, kernels, study_cli, matplotlib.
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import itertools
 import math
@@ -40,6 +40,7 @@ from kinetostat.kinematics import kinematics
 
 from .compare import errors
 from .scene import EngineResult, Scene, build_scene
+from .study_cli import parser, require_plots
 
 ROOT = Path(__file__).resolve().parents[1]
 ANGLES = 360
@@ -378,7 +379,7 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
     before = _before_fast()
     models, rows = {}, []
     for name in SPEED_MODELS:
-        mech = kinetostat.load(ROOT / "models" / f"{name}.toml")
+        mech = kinetostat.load(name)
         phi = crank_angles(None, N)
         out = fast.buffer(mech, N_full)
         routes = {
@@ -445,7 +446,7 @@ MAIN_JOB_BEFORE = (
 
 def _n_models() -> int:
     """How many models `kinetostat report` runs: every bundled one."""
-    return len(list((ROOT / "models").glob("*.toml")))
+    return len(kinetostat.examples.names())
 
 
 def _report_run(folder: str, models: tuple[str, ...] = ()) -> tuple[float, float]:
@@ -721,19 +722,20 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = parser("benchmark", __doc__)
     ap.add_argument("--quick", action="store_true", help="fewer repeats and settings; print only")
-    ap.add_argument("--out", type=Path, default=ROOT / "reports", help="folder for benchmark.{md,csv,png}")
     args = ap.parse_args(argv)
+    if not args.quick:
+        require_plots(ap)
     from .kernels import cpu_info
     machine = cpu_info()
-    models = sorted((ROOT / "models").glob("*.toml"))
+    models = [kinetostat.examples.path(name) for name in kinetostat.examples.names()]
     kin_rows = kinematics_table(models)
     for r in kin_rows:
         print(f"{r['model']:24s} kinematics {r['kinematics_ms']:.3f} ms, analysis {r['analysis_ms']:.3f} ms "
               f"(one angle {r['single_ms']:.3f} ms), "
               f"{r['positions_per_s']:.3g} positions/s")
-    thr = throughput(kinetostat.load(ROOT / "models" / "slotted_link_shaper.toml"))
+    thr = throughput(kinetostat.load("slotted_link_shaper"))
     for r in thr:
         print(f"throughput: {r['angles']:>9,} angles in {r['seconds']:.3f} s (first call {r['first_seconds']:.3f} s) "
               f"= {r['per_second']:.3g} angles/s")

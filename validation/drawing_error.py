@@ -4,12 +4,13 @@ balancing moments (force plans against Zhukovsky's lever) is safe.
 
 The Monte Carlo itself is `kinetostat.plans.drawing_error.simulate`; this driver runs it on seed
 002's worked example (the ICE at 30 deg, the text's scales) and on the chain-unit four-bar (RRR),
-over the reading precision, the scales and the crank angle, and writes reports/drawing_error.md
-and reports/drawing_error.png (fixed seed, fixed layout, no timestamps: the same files every run).
+over the reading precision, the scales and the crank angle, and writes drawing_error.md and
+drawing_error.png (fixed seed, fixed layout, no timestamps: the same files every run).
 
-`python -m kinetostat_validation.drawing_error`
+`python -m kinetostat_validation.drawing_error [--out DIR]` writes them into DIR, by default
+./reports of the working directory.
 
-May use: kinetostat.plans, kinetostat.report.sources (the works cited), matplotlib.
+May use: kinetostat.plans, kinetostat.report.sources (the works cited), study_cli, matplotlib.
 """
 from __future__ import annotations
 
@@ -23,9 +24,10 @@ import kinetostat
 from kinetostat.plans.drawing_error import DrawnSolution, default_scales, simulate
 from kinetostat.report.sources import cited
 
+from .study_cli import parser, require_plots
+
 __all__ = ["PUBLISHED", "main", "study"]
 
-ROOT = Path(__file__).resolve().parents[1]
 N = 20000
 SEED = 2026
 PRECISIONS = (0.1, 0.25, 0.5)          # mm and deg together: a reading of ±p mm, a direction of ±p deg
@@ -269,9 +271,11 @@ def write_report(r: dict, md: Path, png: Path) -> None:
 
 
 def main(argv=None) -> int:
-    out = ROOT / "reports"
-    out.mkdir(exist_ok=True)
+    ap = parser("drawing_error", __doc__)
+    out = ap.parse_args(argv).out
+    require_plots(ap)
     r = study()
+    out.mkdir(parents=True, exist_ok=True)
     png, md = out / "drawing_error.png", out / "drawing_error.md"
     write_plot(r, png)
     write_report(r, md, png)

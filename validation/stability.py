@@ -32,9 +32,10 @@ reference at the same double inputs), the problem's **ulp-sensitivity** (the lar
 the 40-digit answer when one input, a coordinate of a point or the crank angle, moves by one
 ulp), and the guard's **estimate** (`res.error`).
 
-`python -m kinetostat_validation.stability` writes reports/stability.md and reports/stability.png.
+`python -m kinetostat_validation.stability [--out DIR]` writes stability.md and stability.png into
+DIR, by default ./reports of the working directory.
 
-May use: kinetostat, the scene, reference, the pymunk adapter, matplotlib.
+May use: kinetostat, the scene, reference, the pymunk adapter, study_cli, matplotlib.
 """
 from __future__ import annotations
 
@@ -55,11 +56,11 @@ from kinetostat.kinematics import Kinematics, solve_checked
 from kinetostat.kinetostatics import Forces
 
 from .reference import BranchMismatch, Reference, reference_full
+from .study_cli import parser, require_plots
 
 __all__ = ["FAMILIES", "Step", "run_family", "run_all", "NEAR", "Near", "measure", "run_near",
            "write_report", "main"]
 
-ROOT = Path(__file__).resolve().parents[1]
 DENSE = 3600            # angles of the cycle scanned for the condition number
 COARSE = np.arange(0.0, 360.0, 30.0)
 
@@ -658,10 +659,12 @@ def write_report(results: dict[str, list[Step]], near: dict[str, list[Near]], md
 
 
 def main(argv=None) -> int:
+    ap = parser("stability", __doc__)
+    out = ap.parse_args(argv).out
+    require_plots(ap)
     t0 = time.perf_counter()
     results, near = run_all(), run_near()
-    out = ROOT / "reports"
-    out.mkdir(exist_ok=True)
+    out.mkdir(parents=True, exist_ok=True)
     png, md = out / "stability.png", out / "stability.md"
     write_plot(results, near, png)
     write_report(results, near, md, png, time.perf_counter() - t0)

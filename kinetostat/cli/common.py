@@ -335,11 +335,12 @@ def _load(path: str | Path):
     """Load a model file, or a bundled model by name; every expected fault becomes a CLIError
     naming the file."""
     from ..errors import ModelError, StructureError
-    from ..examples import resolve
+    from ..examples import hint, resolve
     from ..model import load
     p = resolve(path)
     if not p.exists():
-        raise CLIError(f"model file not found: {p}")
+        bundled = hint(p)
+        raise CLIError(f"model file not found: {p}" + (f"; {bundled}" if bundled else ""))
     if p.is_dir():
         raise CLIError(f"model file expected, got a directory: {p}")
     try:

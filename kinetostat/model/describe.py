@@ -21,6 +21,11 @@ from .schema import MODEL, REQUIRED, Field, Section, sections
 SCHEMA_FILE = Path(__file__).with_name("model.schema.json")
 #: The file format's reference, whose field tables sit between these markers.
 FORMAT_MD = Path(__file__).resolve().parents[2] / "models" / "FORMAT.md"
+#: What an unknown key of a table must match: nothing. A schema, not `additionalProperties: false`,
+#: so that a validator fails at the key's own path, not at the table's: taplo (Even Better TOML)
+#: marks every key and value of a table for an error at the table (one misspelt key of a [[link]]
+#: gave 19 errors; tamasfe/taplo#515), and the key's path alone for an error at the key.
+UNKNOWN_KEY: dict[str, Any] = {"not": {}}
 BEGIN, END = "<!-- fields: begin (generated from kinetostat/model/schema.py; do not edit) -->", "<!-- fields: end -->"
 
 def json_schema() -> dict:
@@ -34,7 +39,7 @@ def json_schema() -> dict:
 
 def _section(s: Section) -> dict:
     out: dict[str, Any] = {"type": "object", "description": _doc(s),
-                           "properties": {f.name: _field(f) for f in s.fields}, "additionalProperties": False}
+                           "properties": {f.name: _field(f) for f in s.fields}, "additionalProperties": UNKNOWN_KEY}
     required = [f.name for f in s.fields if f.default == REQUIRED and f.when is None]
     if required:
         out["required"] = required

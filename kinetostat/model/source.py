@@ -33,7 +33,8 @@ def _read_text(path: Path) -> str:
     try:
         raw = read_regular(path, MAX_FILE_BYTES)
     except FileNotFoundError:
-        raise ModelFileNotFound(str(path)) from None
+        from ..examples import hint
+        raise ModelFileNotFound(str(path), hint(path)) from None
     except NotRegularFile as exc:
         raise ModelError([f"cannot read file: {exc.kind}, not a regular file; a model is a regular TOML file"], source=str(path)) from None
     except FileTooLarge:
