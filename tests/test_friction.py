@@ -23,7 +23,7 @@ import kinetostat
 from conftest import EVERY_KIND, sampled
 from kinetostat.errors import SelfLockingWarning
 from kinetostat.friction import MAX_PASSES, NEWTON_STEPS, RATE_TOL, relative_rate
-from test_properties import KINDS, _SETTINGS, valid
+from test_properties import KINDS, _SETTINGS, dead_centres, valid
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 ICE = MODELS / "ice_crank_slider.toml"
@@ -335,6 +335,7 @@ def test_random_mechanisms_with_friction(kind, size):
             warnings.simplefilter("ignore", kinetostat.SingularPositionWarning)
             res = kinetostat.analyze(mech, at, friction="reactions")
         ok = res.friction.solved & ~res.friction.wedged & ~res.singular    # a wedged pair: not unique
+        ok &= ~dead_centres(res)      # a load against a velocity of ~0: its direction is rounding (test_properties)
         F, length = scales(res)
         assume(ok.any() and F.max() > 0)
         ref = reference_full(mech, at[ok], friction=True)      # where the passes found the equilibrium
