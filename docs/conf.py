@@ -56,3 +56,6 @@ def _bars_as_text(app, what, name, obj, options, lines: list[str]) -> None:
 
 def setup(app) -> None:
     app.connect("autodoc-process-docstring", _bars_as_text)
+
+# Option names such as --out stay as typed: no "--" turned into an en dash.
+smartquotes = False
