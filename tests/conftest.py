@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import warnings
 from dataclasses import dataclass
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -213,3 +214,19 @@ def kinetic_energy(mech, phi_deg) -> np.ndarray:
             T += 0.5 * link.mass * np.sum(v * v, axis=-1)
         T += 0.5 * link.I_S * r.omega(link.id) ** 2
     return T
+
+
+def within(call, seconds: float = 10.0):
+    """`call()` in a thread: what it returned or raised; a failure where it does not end in time."""
+    out: list = []
+
+    def run():
+        try:
+            out.append(call())
+        except BaseException as exc:        # noqa: BLE001 (handed to the test)
+            out.append(exc)
+    t = threading.Thread(target=run, daemon=True)
+    t.start()
+    t.join(seconds)
+    assert out, f"{call} did not return within {seconds} s"
+    return out[0]

@@ -33,7 +33,7 @@ import pytest
 
 import kinetostat
 from kinetostat import AssemblyError, ModelError, SingularPositionWarning, StructureError
-from conftest import FOUR_BAR, ROOT
+from conftest import FOUR_BAR, ROOT, within
 
 HOSTILE = Path(__file__).resolve().parent / "hostile"
 CORPUS = sorted(HOSTILE.glob("*.toml"))
@@ -197,31 +197,13 @@ def test_missing_file_and_directory(tmp_path):
         kinetostat.load(tmp_path)
 
 
-def _load_within(path, seconds: float = 10.0):
-    """kinetostat.load(path) in a thread: its exception, or a failure if it does not return."""
-    import threading
-    out: list = []
-
-    def run():
-        try:
-            kinetostat.load(path)
-            out.append(None)
-        except Exception as exc:       # noqa: BLE001 (handed to the test)
-            out.append(exc)
-    t = threading.Thread(target=run, daemon=True)
-    t.start()
-    t.join(seconds)
-    assert out, f"load({path}) did not return within {seconds} s"
-    return out[0]
-
-
 @pytest.mark.skipif(not Path("/dev/zero").exists() or not hasattr(__import__("os"), "mkfifo"), reason="POSIX only")
 def test_fifo_and_device_are_refused_without_reading(tmp_path):
     import os
     fifo = tmp_path / "model.toml"
     os.mkfifo(fifo)                          # opening it for reading would block until a writer comes
     for path in (fifo, Path("/dev/zero")):   # /dev/zero would never end
-        exc = _load_within(path)
+        exc = within(lambda: kinetostat.load(path))
         assert isinstance(exc, ModelError) and "not a regular file" in str(exc), exc
 
 
@@ -230,7 +212,7 @@ def test_oversized_file_is_refused_before_reading(tmp_path):
     big = tmp_path / "big.toml"
     with open(big, "wb") as f:               # sparse: no disk used, nothing read
         f.truncate(MAX_FILE_BYTES + 1)
-    exc = _load_within(big)
+    exc = within(lambda: kinetostat.load(big))
     assert isinstance(exc, ModelError) and f"at most {MAX_FILE_BYTES}" in str(exc), exc
 
 

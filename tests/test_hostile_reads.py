@@ -14,29 +14,13 @@ from pathlib import Path
 import pytest
 
 import kinetostat
-from conftest import FOUR_BAR, ROOT
+from conftest import FOUR_BAR, ROOT, within
 from kinetostat import ModelError
 from kinetostat.model import MAX_FILE_BYTES
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "mkfifo") or not Path("/dev/zero").exists(), reason="POSIX only")
 
 pytest_plugins = ["pytester"]
-
-
-def _within(call, seconds: float = 10.0):
-    """`call()` in a thread: what it returned or raised; a failure where it does not end in time."""
-    out: list = []
-
-    def run():
-        try:
-            out.append(call())
-        except BaseException as exc:        # noqa: BLE001 (handed to the test)
-            out.append(exc)
-    t = threading.Thread(target=run, daemon=True)
-    t.start()
-    t.join(seconds)
-    assert out, f"{call} did not return within {seconds} s"
-    return out[0]
 
 
 def _zero_link(tmp_path: Path, name: str) -> Path:
@@ -48,7 +32,7 @@ def _zero_link(tmp_path: Path, name: str) -> Path:
 # ============================================================================ inputs and earlier outputs
 
 def test_a_model_linked_to_dev_zero_is_refused_as_a_device(tmp_path):
-    exc = _within(lambda: kinetostat.load(_zero_link(tmp_path, "model.toml")))
+    exc = within(lambda: kinetostat.load(_zero_link(tmp_path, "model.toml")))
     assert isinstance(exc, ModelError) and "a device, not a regular file" in str(exc), exc
 
 
@@ -63,10 +47,10 @@ def test_an_earlier_page_that_is_no_regular_file_is_not_read_and_the_page_is_dra
     else:
         with open(earlier, "wb") as f:       # sparse: nothing on disk
             f.truncate(page_module.MAX_PAGE_BYTES + 1)
-    assert _within(lambda: page_module.key_of(earlier)) is None
+    assert within(lambda: page_module.key_of(earlier)) is None
     monkeypatch.setattr(page_module, "page", lambda *a, **k: "<p>drawn</p>")       # no real drawing
     out = tmp_path / "new.html"
-    got = _within(lambda: page_module.write_page(kinetostat.load("ice_crank_slider"), out, reuse=earlier))
+    got = within(lambda: page_module.write_page(kinetostat.load("ice_crank_slider"), out, reuse=earlier))
     assert got == out and out.read_text(encoding="utf-8") == "<p>drawn</p>"
     assert kind != "fifo" or stat.S_ISFIFO(os.lstat(earlier).st_mode)
 
@@ -81,7 +65,7 @@ def test_the_step_summary_is_not_written_into_a_fifo(reader, tmp_path, monkeypat
     fd = os.open(fifo, os.O_RDONLY | os.O_NONBLOCK) if reader else None
     try:
         monkeypatch.setenv("GITHUB_STEP_SUMMARY", str(fifo))
-        exc = _within(lambda: ci.write_summary("## kinetostat: PASS\n"))
+        exc = within(lambda: ci.write_summary("## kinetostat: PASS\n"))
         assert isinstance(exc, OSError) and exc.filename == str(fifo), exc
         assert not reader or "a FIFO, not a regular file" in exc.strerror
         assert fd is None or os.read(fd, 100) == b""                      # nothing written into it
@@ -105,7 +89,7 @@ def test_the_gate_reports_an_unreadable_toml_and_goes_on(pytester):
     os.mkfifo(models / "fifo.toml")                  # not visited
     with open(models / "big.toml", "wb") as f:       # sparse: nothing on disk, nothing read
         f.truncate(MAX_FILE_BYTES + 1)
-    r = _within(lambda: pytester.runpytest_inprocess("--kinetostat", "models", "--kinetostat-steps", "12",
+    r = within(lambda: pytester.runpytest_inprocess("--kinetostat", "models", "--kinetostat-steps", "12",
                                                       "-k", "read or lever", "-p", "no:cacheprovider",
                                                       "-p", "no:hypothesispytest"), 120)
     out = r.stdout.str()
@@ -133,7 +117,7 @@ def test_a_scheduler_that_accepts_and_never_answers_times_out(in_loop, monkeypat
 
         async def inside_a_loop():
             return call()
-        exc = _within((lambda: asyncio.run(inside_a_loop())) if in_loop else call, 20)
+        exc = within((lambda: asyncio.run(inside_a_loop())) if in_loop else call, 20)
     finally:
         server.close()
         for s in held:
@@ -173,7 +157,7 @@ def test_an_expected_cycle_that_is_a_fifo_is_refused_unread(tmp_path):
     from kinetostat.testing import check_cycle
     fifo = tmp_path / "expected.csv"
     os.mkfifo(fifo)                     # pandas' read_csv waited for a writer for ever
-    exc = _within(lambda: check_cycle("ice_crank_slider", expected=fifo, steps=12))
+    exc = within(lambda: check_cycle("ice_crank_slider", expected=fifo, steps=12))
     assert isinstance(exc, ValueError) and f"{fifo}: the expected file is not read: a FIFO" in str(exc), exc
 
 
