@@ -426,6 +426,10 @@ ANALYSIS_HEADROOM = 2.0
 #: .parquet taken as .csv (pyarrow's memory, which tracemalloc does not see: by the peak RSS,
 #: below the CSV's); "-" (CSV on stdout, its whole text built first) 37.
 TABLE_CELL_BYTES = {".csv": 32, ".json": 32, ".parquet": 32, "-": 48}
+#: Bytes per crank position above any the guard has counted on a bundled model, headroom and a
+#: stdout table included (ice_crank_slider 6.3 kB, furnace_loader_six_bar 10.5 kB, triad_six_bar
+#: 11.2 kB): where `steps` of these fit, the probe's three analyses are not run.
+CERTAINLY_FITS = 64 * 1024
 
 
 def _probe(mech):
@@ -455,7 +459,11 @@ def _check_memory(mech, steps: int, out: str | None = None) -> None:
     """Refuse `steps` before anything is allocated where the analysis (ANALYSIS_HEADROOM times
     the bytes per crank position a probe measures on this model) and, with `out` (--out: a file
     whose suffix picks the format, or "-"), its table (TABLE_CELL_BYTES per cell) would not fit
-    in the memory this process may still take (`_available_memory`)."""
+    in the memory this process may still take (`_available_memory`); no probe where even
+    CERTAINLY_FITS bytes a position fit."""
+    free = _available_memory()
+    if free is None or steps * CERTAINLY_FITS <= free:
+        return
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -466,8 +474,8 @@ def _check_memory(mech, steps: int, out: str | None = None) -> None:
                 per_angle += cell * len(res.to_frame().columns)
         except Exception:                # noqa: BLE001 -- the real analysis reports the fault
             return
-    need, free = steps * per_angle, _available_memory()
-    if free is not None and need > free:
+    need = steps * per_angle
+    if need > free:
         what = "the analysis" + (f" and its table (--out {out})" if out is not None else "")
         raise CLIError(f"--steps {steps}: {what} would need about {_size(need)} of memory "
                        f"({_size(per_angle)} per crank position for this model), and {_size(free)} is "
