@@ -2,7 +2,9 @@
 sheet, lettered segments, and the scale that turns a drawn length into the quantity it stands for.
 
 Every plan of the method (positions, velocity, acceleration, a group's plan and force plan, the
-initial link, Zhukovsky's lever) is a `Plan`: data first, drawn later (SVG sheets, matplotlib
+initial link, Zhukovsky's lever) is built for N crank angles at once as a `PlanCycle` (arrays with
+a leading angle axis: every point, segment value, path and result), and `PlanCycle.at(i)` is the
+`Plan` of one angle (scalars); a sheet of one angle is the N = 1 case. Data first, drawn later (SVG sheets, matplotlib
 figures) by `draw`, which this module never imports. A segment's drawn length times the plan's scale is the
 magnitude of the quantity it stands for (`Segment.value`, SI).
 
@@ -15,7 +17,9 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Mapping
 
-__all__ = ["Scale", "Segment", "Result", "Plan", "SEGMENT_COLUMNS", "extent"]
+import numpy as np
+
+__all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -54,6 +58,7 @@ class Segment:
     kind: str = "vector"
     scale: Scale | None = None   # a segment drawn at another scale than its plan's (the loads on a
                                  # group plan, at a force scale); None: the plan's scale
+    # In a PlanCycle, `value` is an (N,) array over its angles.
 
 
 @dataclass(frozen=True)
@@ -62,7 +67,7 @@ class Result:
     `value` SI in `unit`, and `how`: a key of the message catalogue (`i18n.MESSAGES`) saying how
     it is obtained, or ""."""
     symbol: str
-    value: float
+    value: float         # in a PlanCycle: an (N,) array over its angles
     unit: str
     how: str = ""
 
@@ -127,3 +132,125 @@ def extent(plan: Plan) -> tuple[float, float, float, float]:
     if not zs:
         return 0.0, 0.0, 0.0, 0.0
     return min(z.real for z in zs), min(z.imag for z in zs), max(z.real for z in zs), max(z.imag for z in zs)
+
+
+def _one(x, i: int) -> float:
+    return float(np.asarray(x).reshape(-1)[i if np.size(x) > 1 else 0])
+
+
+@dataclass(frozen=True, eq=False)
+class PlanCycle:
+    """A plan of the method at N crank angles at once, every scale fixed for them: what the plan
+    builders make. The same element (point, segment, path) at every angle; where it is not drawn
+    at an angle its points are NaN there. `at(i)` is the `Plan` of angle i.
+
+    Arrays, each with the leading angle axis N: `phi_deg` (N,) deg; `points[name]` (N,) complex,
+    mm on the sheet (x right, y up); each segment's `value` and each result's `value` (N,) SI;
+    `paths[name]` (N, K) complex mm, or (1, K) where the path is the same at every angle;
+    `accuracy`: (digits left (N,), the count under which a sheet states it) or None."""
+    kind: str
+    titles: tuple[str, ...]                # (N,) the title at each angle
+    scale: Scale
+    phi_deg: np.ndarray
+    points: Mapping[str, np.ndarray]
+    segments: tuple[Segment, ...]
+    paths: Mapping[str, np.ndarray] = field(default_factory=dict)
+    notes: tuple[tuple[str, ...], ...] = ()   # (N,) each angle's notes (see Plan.notes); () none at any
+    results: tuple[Result, ...] = ()
+    equation: tuple[str, ...] = ()
+    accuracy: tuple[np.ndarray, int] | None = None
+
+    def __post_init__(self) -> None:
+        phi = np.atleast_1d(np.asarray(self.phi_deg, dtype=float))
+        n = len(phi)
+        object.__setattr__(self, "phi_deg", phi)
+        object.__setattr__(self, "titles", tuple(self.titles))
+        if len(self.titles) != n:
+            raise ValueError(f"{self.kind}: {len(self.titles)} titles for {n} angles")
+        pts = {k: np.broadcast_to(np.asarray(v, dtype=complex), (n,)) for k, v in self.points.items()}
+        object.__setattr__(self, "points", MappingProxyType(pts))
+        paths = {k: np.atleast_2d(np.asarray(v, dtype=complex)) for k, v in self.paths.items()}
+        object.__setattr__(self, "paths", MappingProxyType(paths))
+        object.__setattr__(self, "notes", tuple(tuple(x) for x in self.notes))
+        object.__setattr__(self, "results", tuple(self.results))
+        object.__setattr__(self, "equation", tuple(self.equation))
+
+    @property
+    def n(self) -> int:
+        """The number of angles."""
+        return len(self.phi_deg)
+
+    @classmethod
+    def of(cls, plan: Plan) -> "PlanCycle":
+        """The plan of one angle as a cycle of N = 1."""
+        acc = None if plan.accuracy is None else (np.array([plan.accuracy[0]]), plan.accuracy[1])
+        return cls(plan.kind, (plan.title,), plan.scale, np.array([plan.phi_deg]),
+                   {k: np.array([v]) for k, v in plan.points.items()},
+                   tuple(Segment(s.name, s.start, s.end, np.array([s.value], dtype=float), s.unit, s.kind, s.scale)
+                         for s in plan.segments),
+                   {k: np.array([v], dtype=complex) for k, v in plan.paths.items()},
+                   (plan.notes,), tuple(Result(r.symbol, np.array([r.value]), r.unit, r.how) for r in plan.results),
+                   plan.equation, acc)
+
+    def length_mm(self, name: str) -> np.ndarray:
+        """Drawn length of the segment `name` at every angle, mm, (N,)."""
+        s = next((s for s in self.segments if s.name == name), None)
+        if s is None:
+            raise KeyError(f"{self.kind}: no segment {name!r}; segments: {', '.join(s.name for s in self.segments)}")
+        return np.abs(self.points[s.end] - self.points[s.start])
+
+    def at(self, i: int) -> Plan:
+        """The plan of angle i (0 <= i < n): scalars where the cycle holds arrays."""
+        if not -self.n <= i < self.n:
+            raise IndexError(f"{self.kind}: angle index {i} out of range for {self.n} angles")
+        acc = None
+        if self.accuracy is not None and float(self.accuracy[0][i]) < self.accuracy[1]:
+            acc = (float(self.accuracy[0][i]), self.accuracy[1])
+        return Plan(self.kind, self.titles[i], self.scale, float(self.phi_deg[i]),
+                    {k: complex(v[i]) for k, v in self.points.items()},
+                    tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale) for s in self.segments),
+                    {k: tuple(map(complex, v[i if len(v) > 1 else 0])) for k, v in self.paths.items()},
+                    self.notes[i] if self.notes else (),
+                    tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how) for r in self.results),
+                    self.equation, acc)
+
+    def __repr__(self) -> str:
+        return (f"PlanCycle({self.kind!r}, {self.n} angles, {self.scale}, points={len(self.points)}, "
+                f"segments={len(self.segments)})")
+
+
+@dataclass(frozen=True, eq=False)
+class Element:
+    """One element of a drawn sheet over N angles, in sheet millimetres (x right, y down: SVG's
+    user units), ready to write at any angle i. `tag`: "line" (xy[i] = its two ends), "path" (a
+    closed polygon through xy[i]: an arrowhead), "polyline" (through xy[i]), "circle" (centre
+    xy[i, 0]; its "r" in attrs), "text" (a label or a line of text: anchor xy[i, 0]; its markup
+    `texts[variant[i]]`, tspans placed relative to it). `xy` (N, M, 2) float, or (1, M, 2) where the
+    same at every angle; a NaN at angle i: the element is not drawn there. `attrs`: attributes the
+    same at every angle (stroke, class, data-plan, data-segment, ...); `title`: its tooltip, or "".
+    `length_mm` (N,): a segment's drawn length at its scale (the page contract's data-length-mm),
+    or None."""
+    tag: str
+    xy: np.ndarray
+    attrs: Mapping[str, str] = field(default_factory=dict)
+    title: str = ""
+    texts: tuple[str, ...] = ()
+    variant: np.ndarray | None = None
+    length_mm: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "xy", np.asarray(self.xy, dtype=float))
+        object.__setattr__(self, "attrs", MappingProxyType(dict(self.attrs)))
+        object.__setattr__(self, "texts", tuple(self.texts))
+
+
+@dataclass(frozen=True, eq=False)
+class Drawing:
+    """A plan's sheet at N angles as arrays (`draw.drawing`): `static` the SVG markup the same at
+    every angle (the sheet's frame, the parts of the title block that do not change), then
+    `elements` in the order drawn. `svg(i)` in Python and the page's script in a browser write the
+    same sheet of angle i from these arrays."""
+    kind: str
+    phi_deg: np.ndarray                    # (N,) deg
+    static: str
+    elements: tuple[Element, ...]
