@@ -235,10 +235,10 @@ def _normals(mech, g):
 
 def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     """The acceleration plan (seed 002 fig. 1.8, seed 000 sec. 6.3) at every angle of `res`: pole
-    pi; the crank pin (normal and tangential parts where the crank accelerates at some angle); per
+    pi; the crank pin (normal and tangential parts at the angles where the crank accelerates); per
     group the normal `r-n<k>` and tangential `n<k>-q` parts of each turning link, the Coriolis
-    `-k` and relative `k-` parts of a block on a moving guide (where the guide turns at some
-    angle; at an angle where it does not, the Coriolis part has zero length); pi-x for every
+    `-k` and relative `k-` parts of a block on a moving guide at the angles where the guide turns
+    (where it stands still: the relative part alone, `drawn` there); pi-x for every
     point, the relative accelerations of each floating link's joints (a-b), like points by
     similarity, and a triad's special point s with its construction from the outer pins of the
     two leashes through S (e.g. a-s): all at mu_a."""
@@ -249,7 +249,9 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     segs: list[Segment] = []
     unit = "m/s^2"
 
-    def split(k: int, ref_point: str, q: str) -> None:
+    def split(k: int, ref_point: str, q: str, where: np.ndarray | None = None) -> None:
+        """The normal and tangential parts of q relative to the reference point (at the angles
+        `where` only: NaN, not drawn, at the others)."""
         ref = _name_of(mech, ref_point) if ref_point in mech.point_names else ref_point
         start = ref or "pi"
         r_ref, a_ref = (mo[ref][0], mo[ref][2]) if ref else (complex(*mech.links[0].points[ref_point]), 0j)
@@ -257,11 +259,14 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         l = np.abs(mo[q][0] - r_ref)
         n = f"n{k}"
         points[n] = (a_ref - w * w * (mo[q][0] - r_ref)) / mu.value
+        if where is not None:
+            points[n] = np.where(where, points[n], np.nan)
         segs.extend([Segment(f"{start}-{n}", start, n, w * w * l, unit), Segment(f"{n}-{q}", n, q, np.abs(e) * l, unit)])
 
     d = mech.drive
-    if _any(res.kin.eps[:, d.link], res):
-        split(d.link, d.pivot, _name_of(mech, d.point))
+    eps = res.kin.eps[:, d.link]
+    if _any(eps, res):                  # the crank pin's parts where the crank accelerates
+        split(d.link, d.pivot, _name_of(mech, d.point), eps != 0)
     for g in mech.structure.groups:
         for k, ref_point, q in _normals(mech, g):
             split(k, ref_point, q if q in pts else _name_of(mech, q))
@@ -272,13 +277,15 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         guide = p.links[0]
         w = res.kin.omega[:, guide]
         v_r, a_r = res.kin.v_slide[:, p.index], res.kin.a_slide[:, p.index]
-        if s in turning:
+        if s in turning:                 # where the guide stands still: no Coriolis part, k not drawn
             dw = complex(*p.direction) * res.kin.rot[:, guide]
             cor = 2j * w * v_r * dw                      # slider's acceleration = guide point's + cor + a_r d
             kname = "k" if len(turning) == 1 else f"k{turning.index(s) + 1}"
-            points[kname] = points[s.start] + (cor if s.from_guide else -cor) / mu.value
+            points[kname] = np.where(w != 0, points[s.start] + (cor if s.from_guide else -cor) / mu.value, np.nan)
             segs += [Segment(f"{s.start}-{kname}", s.start, kname, 2 * np.abs(w * v_r), unit),
                      Segment(f"{kname}-{s.end}", kname, s.end, np.abs(a_r), unit)]
+            if not np.all(w != 0):
+                segs.append(Segment(f"{s.start}-{s.end}", s.start, s.end, np.abs(a_r), unit, drawn=w == 0))
         else:
             segs.append(_rel(s.start, s.end, np.abs(a_r), unit))
     segs += [Segment(f"pi-{n}", "pi", n, np.abs(m[2]), unit) for n, m in mo.items()]
