@@ -89,9 +89,9 @@ def test_cycle_equals_one_angle_builds(path):
     mech = kinetostat.load(path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fixed = P.cycle_scales(mech, step_deg=90.0)
-        positions = P.fixed_positions(mech, fixed.base["mu_l"])
         res = kinetostat.analyze(mech, phi_deg=ANGLES, friction="first")
+        fixed = P.CycleScales(P.choose_scales(mech, res, cycle=res), {}, {})     # the kinematic plans' scales
+        positions = P.fixed_positions(mech, fixed.base["mu_l"], starting_deg=0.0)
         cycles = P.build_cycle(mech, res, fixed, positions, only=KINDS)
         assert all(c.n == len(ANGLES) for c in cycles.values())
         for i, at in enumerate(ANGLES):
