@@ -67,10 +67,8 @@ def _shim_stack(plans: list[Plan | None], phi) -> PlanCycle:
         have = [d.get(name) for d in segs_at]
         s = next(x for x in have if x is not None)
         scales = [x.scale for x in have if x is not None and x.scale is not None]
-        drawn = np.array([x is not None for x in have])
         segments.append(Segment(s.name, s.start, s.end, np.array([x.value if x else np.nan for x in have], float),
-                                s.unit, s.kind, max(scales, key=lambda c: c.value) if scales else None,
-                                None if drawn.all() else drawn))
+                                s.unit, s.kind, max(scales, key=lambda c: c.value) if scales else None))
     width = {k: max(len(p.paths[k]) for p in made if k in p.paths) for k in path_names}
     paths = {k: np.array([list(p.paths[k]) + [np.nan] * (width[k] - len(p.paths[k]))
                           if p is not None and k in p.paths else [np.nan] * width[k] for p in plans], complex)

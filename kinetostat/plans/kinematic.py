@@ -48,6 +48,12 @@ def _ok(res) -> np.ndarray:
     return ~np.asarray(res.singular, bool)
 
 
+def _where(on: np.ndarray | None, value: np.ndarray) -> np.ndarray:
+    """A segment's value at the angles `on` (N,) bool (None: all), NaN at the others: the segment
+    is not drawn there (`PlanCycle.drawn`)."""
+    return value if on is None else np.where(on, value, np.nan)
+
+
 def _any(values, res) -> bool:
     """Whether an element whose existence `values` (N,) decide is drawn at some angle of `res`
     (`values` != 0 at a non-singular angle): such an element is in the plan at every angle."""
@@ -183,7 +189,7 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
         vS = _point_motion(res.kin, b, local)[1]
         points[name] = vS / mu.value
-        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, np.abs(vS - (mo[r][1] if r else 0j)), "m/s", drawn=on)
+        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s")
                  for r, on in refs]
     return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points, tuple(segs))
 
@@ -192,7 +198,8 @@ def _special(mech, res, pts: dict) -> list[tuple[str, int, np.ndarray, list[tupl
     """Per triad: the plan name of Assur's special point S (a point of the base link), the base,
     S's local coordinates on it (N,), and the references of the leashes through S: (the plan name
     of the leash's outer pin, "" for a point of the frame at the pole; the angles (N,) bool where
-    its axis passes through S, None: at every angle). S lies on two of the three leashes' axes
+    its axis passes through S, None: at every angle; its segment NaN, not drawn, at the others).
+    S lies on two of the three leashes' axes
     (`kinematics.special_sides`), which two may change over the cycle; the references are in the
     solver's order at the first angle."""
     from ..kinematics import leash_axes
@@ -238,7 +245,7 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     pi; the crank pin (normal and tangential parts at the angles where the crank accelerates); per
     group the normal `r-n<k>` and tangential `n<k>-q` parts of each turning link, the Coriolis
     `-k` and relative `k-` parts of a block on a moving guide at the angles where the guide turns
-    (where it stands still: the relative part alone, `drawn` there); pi-x for every
+    (where it stands still: the relative part alone, NaN, not drawn, elsewhere); pi-x for every
     point, the relative accelerations of each floating link's joints (a-b), like points by
     similarity, and a triad's special point s with its construction from the outer pins of the
     two leashes through S (e.g. a-s): all at mu_a."""
@@ -285,7 +292,7 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
             segs += [Segment(f"{s.start}-{kname}", s.start, kname, 2 * np.abs(w * v_r), unit),
                      Segment(f"{kname}-{s.end}", kname, s.end, np.abs(a_r), unit)]
             if not np.all(w != 0):
-                segs.append(Segment(f"{s.start}-{s.end}", s.start, s.end, np.abs(a_r), unit, drawn=w == 0))
+                segs.append(Segment(f"{s.start}-{s.end}", s.start, s.end, _where(w == 0, np.abs(a_r)), unit))
         else:
             segs.append(_rel(s.start, s.end, np.abs(a_r), unit))
     segs += [Segment(f"pi-{n}", "pi", n, np.abs(m[2]), unit) for n, m in mo.items()]
@@ -293,7 +300,7 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         aS = _point_motion(res.kin, b, local)[2]
         points[name] = aS / mu.value
         segs.append(Segment(f"pi-{name}", "pi", name, np.abs(aS), unit))
-        segs += [Segment(f"{r}-{name}", r, name, np.abs(aS - mo[r][2]), unit, drawn=on) for r, on in refs if r]
+        segs += [Segment(f"{r}-{name}", r, name, _where(on, np.abs(aS - mo[r][2])), unit) for r, on in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
     return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,

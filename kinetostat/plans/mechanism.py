@@ -79,7 +79,7 @@ def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
     runs in it (O2-S3 on to B), and every point not on a drawn line joined to the nearest drawn
     point on the sheet (B-S5-T of a ram; distances within 1e-9 of each other tie, broken by
     name: a point midway between two pins joins the first by name at every angle), angle by
-    angle: a join made at some angles only is `drawn` there."""
+    angle: a join made at some angles only is NaN, not drawn, at the others."""
     n_at = len(res.phi_deg)
     names = list(mech.links[k].points)
     on_line = {n for s in segs if s.kind == "link" for n in (s.start, s.end)}
@@ -120,8 +120,7 @@ def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
             done[at, A[j]] = True
     for (a, b), at in joins.items():
         na, nb = names[a], names[b]
-        segs.append(Segment(f"{nb}{na}", nb, na, np.abs(pts[na] - pts[nb]) * mu.value, "m", "link",
-                            drawn=None if at.all() else at))
+        segs.append(Segment(f"{nb}{na}", nb, na, np.where(at, np.abs(pts[na] - pts[nb]) * mu.value, np.nan), "m", "link"))
 
 
 def mechanism_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
