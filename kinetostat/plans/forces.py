@@ -104,7 +104,7 @@ def _scale(mu, symbol: str, unit: str) -> Scale:
 def force_scale(forces, longest_mm: float = 40.0) -> Scale:
     """A round force scale (N/mm) at which the largest of `forces` (N; scalars or arrays over the
     angles, NaN left out) is drawn between half of `longest_mm` and `longest_mm` (`scales.round_scale`)."""
-    sizes = [np.abs(np.asarray(f)).reshape(-1) for f in forces]
+    sizes = [_abs(f).reshape(-1) for f in forces]
     every = np.concatenate(sizes) if sizes else np.zeros(0)
     largest = float(np.nanmax(every)) if np.isfinite(every).any() else 0.0
     return Scale("mu_F", round_scale(largest, longest_mm / 2, longest_mm), "N/mm")
@@ -172,7 +172,7 @@ def link_couples(mech: "Mechanism", res: "Analysis", k: int) -> list[Couple]:
 
 def _guide(res: "Analysis", p) -> np.ndarray:
     """(N,) complex: the unit direction of prismatic pair p's guide in the world."""
-    return complex(*p.direction) * res.kin.rot[:, p.links[0]]
+    return _mul(complex(*p.direction), res.kin.rot[:, p.links[0]])
 
 
 def _reaction_load(mech: "Mechanism", res: "Analysis", i: int, j: int, name: str | None = None) -> Load:
@@ -199,10 +199,39 @@ def _nice(x: float) -> float:
     return max(m * e for m in (1.0, 2.0, 5.0) if m * e <= max(x, 1.0))
 
 
+def _abs(z) -> np.ndarray:
+    """|z| as Python's abs of a complex rounds it (hypot; numpy's abs of a complex differs in the last bit)."""
+    z = np.asarray(z)
+    return np.hypot(z.real, z.imag)
+
+
+def _mul(a, b) -> np.ndarray:
+    """a b for complex a, b, rounded as Python's complex product (numpy's may fuse a multiply-add)."""
+    a, b = np.asarray(a, dtype=complex), np.asarray(b, dtype=complex)
+    out = np.empty(np.broadcast(a, b).shape, dtype=complex)
+    out.real, out.imag = a.real * b.real - a.imag * b.imag, a.real * b.imag + a.imag * b.real
+    return out
+
+
+def _dot(a, b) -> np.ndarray:
+    """Re(a conj(b)): the dot product of complex a, b as 2-vectors."""
+    a, b = np.asarray(a, dtype=complex), np.asarray(b, dtype=complex)
+    return a.real * b.real + a.imag * b.imag
+
+
+def _over(z, s) -> np.ndarray:
+    """z / s for complex z and real s, each part divided as Python's complex / float divides it
+    (numpy's complex division multiplies by 1/s: the last bit differs)."""
+    z, s = np.asarray(z, dtype=complex), np.asarray(s, dtype=float)
+    out = np.empty(np.broadcast(z, s).shape, dtype=complex)
+    out.real, out.imag = z.real / s, z.imag / s
+    return out
+
+
 def _unit(F: np.ndarray) -> np.ndarray:
     """F / |F| (N,), NaN where F = 0."""
-    a = np.abs(F)
-    return np.where(a > 0, F / np.where(a > 0, a, 1.0), np.nan)
+    a = _abs(F)
+    return np.where(a > 0, _over(F, np.where(a > 0, a, 1.0)), np.nan)
 
 
 def _friction_offset(res: "Analysis", p) -> np.ndarray:
@@ -213,8 +242,8 @@ def _friction_offset(res: "Analysis", p) -> np.ndarray:
     if res.friction is None:
         return np.zeros(len(res.phi_deg), dtype=complex)
     R, q = _z(res.forces.R[:, p.index]), res.friction.load[:, p.index]
-    a2 = np.abs(R) ** 2
-    return np.where(a2 > 0, -q * 1j * R / np.where(a2 > 0, a2, 1.0), 0j)
+    a2 = _abs(R) ** 2
+    return np.where(a2 > 0, _over(-q * 1j * R, np.where(a2 > 0, a2, 1.0)), 0j)
 
 
 def _finite_corner(pts: dict, n: int) -> np.ndarray:
@@ -246,9 +275,9 @@ def _friction_circles(mech: "Mechanism", res: "Analysis", pairs, pts: dict, segs
         if p.kind == "R":
             rho = mech.friction.f * (p.radius if p.radius is not None else mech.friction.radius)
             pin = _world(res, p.links[1], p.point)
-            paths[f"friction circle ρ{name}"] = _circle(pin / mu_l.value, rho / mu_l.value)
+            paths[f"friction circle ρ{name}"] = _circle(_over(pin, mu_l.value), rho / mu_l.value)
             u = _friction_offset(res, p)
-            pts[f"ρ{name}:pin"], pts[f"ρ{name}:touch"] = pin / mu_l.value, (pin + u) / mu_l.value
+            pts[f"ρ{name}:pin"], pts[f"ρ{name}:touch"] = _over(pin, mu_l.value), _over(pin + u, mu_l.value)
             segs.append(Segment(f"ρ{name}", f"ρ{name}:pin", f"ρ{name}:touch", np.full(n, rho), "m", "arm"))
             drawn = rho / mu_l.value
             notes.append(f"friction circle ρ{name} = f r = {rho * 1e3:.4g} mm, drawn {drawn:.3g} mm: R{name} is tangent to it")
@@ -256,7 +285,7 @@ def _friction_circles(mech: "Mechanism", res: "Analysis", pairs, pts: dict, segs
                 k = _nice(DETAIL_RADIUS_MM / drawn)
                 corner = corner - 3.4j * DETAIL_RADIUS_MM
                 C = corner + DETAIL_RADIUS_MM
-                t = C + k * u / mu_l.value
+                t = C + _over(k * u, mu_l.value)
                 paths[f"detail ρ{name} x{k:g}"] = _circle(C, k * drawn)
                 pts[f"ρ{name} x{k:g}:pin"], pts[f"ρ{name} x{k:g}:touch"] = C, t
                 segs.append(Segment(f"ρ{name} x{k:g}", f"ρ{name} x{k:g}:pin", f"ρ{name} x{k:g}:touch", np.full(n, rho),
@@ -302,7 +331,7 @@ class _Parts:
 
 def _split(whole: Load, u: np.ndarray) -> _Parts:
     """`whole` split along the unit u (N,) and across it."""
-    n = (whole.force * u.conjugate()).real * u
+    n = _dot(whole.force, u) * u
     return _Parts(whole, n, whole.force - n)
 
 
@@ -313,7 +342,7 @@ def _outer(mech: "Mechanism", res: "Analysis", g: "AssurGroup", side: int) -> _P
     if not ((g.kind == "RRR") or (g.kind == "RRP" and side == 0)):
         return _Parts(whole)
     u = _world(res, link, g.pairs[1].point) - _world(res, link, pair.point)
-    return _split(whole, u / np.abs(u))
+    return _split(whole, _over(u, _abs(u)))
 
 
 def _moment_equations(g: "AssurGroup") -> list[tuple[tuple[int, ...], str]]:
@@ -329,20 +358,20 @@ def _moment_equations(g: "AssurGroup") -> list[tuple[tuple[int, ...], str]]:
 def _foot(X: np.ndarray, F: np.ndarray, M: np.ndarray) -> np.ndarray:
     """Foot of the perpendicular from M on the line through X along F (NaN where F = 0)."""
     u = _unit(F)
-    return X + ((M - X) * u.conjugate()).real * u
+    return X + _dot(M - X, u) * u
 
 
 def _arrow(segs: list, pts: dict, name: str, X: np.ndarray, F: np.ndarray, mu_l: Scale, mu_F: Scale) -> None:
     """A force F (N) at world point X (m), each (N,), drawn at mu_F from X/mu_l."""
     start = f"{name}:from"
-    pts[start] = X / mu_l.value
-    pts[f"{name}:to"] = pts[start] + F / mu_F.value
-    segs.append(Segment(name, start, f"{name}:to", np.abs(F), "N", "vector", mu_F))
+    pts[start] = _over(X, mu_l.value)
+    pts[f"{name}:to"] = pts[start] + _over(F, mu_F.value)
+    segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
 
 
 def _has_arm(mech: "Mechanism", F: np.ndarray, X: np.ndarray, M: np.ndarray) -> np.ndarray:
     """(N,) bool: where force F through X has an arm about M (F not zero, X off M)."""
-    return (np.abs(F) > 0) & (np.abs(X - M) > 1e-12 * mech.size)
+    return (_abs(F) > 0) & (_abs(X - M) > 1e-12 * mech.size)
 
 
 def _arm(mech: "Mechanism", segs: list, pts: dict, name: str, M: np.ndarray, M_name: str, X: np.ndarray,
@@ -353,9 +382,9 @@ def _arm(mech: "Mechanism", segs: list, pts: dict, name: str, M: np.ndarray, M_n
     if not has.any():
         return
     foot = np.where(has, _foot(X, F, M), np.nan)
-    pts[M_name] = M / mu_l.value
-    pts[f"{name}:foot"] = foot / mu_l.value
-    segs.append(Segment(name, M_name, f"{name}:foot", np.abs(foot - M), "m", "arm"))
+    pts[M_name] = _over(M, mu_l.value)
+    pts[f"{name}:foot"] = _over(foot, mu_l.value)
+    segs.append(Segment(name, M_name, f"{name}:foot", _abs(foot - M), "m", "arm"))
 
 
 def _couple_path(S: np.ndarray, moment: np.ndarray, radius_mm: float) -> np.ndarray:
@@ -372,14 +401,14 @@ def _link_drawing(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: l
     joints += [p.guide for p in mech.pairs if p.links[0] == k and p.guide in mech.links[k].points]
     names = list(dict.fromkeys(joints)) or list(mech.links[k].points)[:1]
     for name in mech.links[k].points:
-        pts[name] = _world(res, k, name) / mu_l.value
+        pts[name] = _over(_world(res, k, name), mu_l.value)
     for a in range(len(names)):
         for b in range(a + 1, len(names)):
             A, B = names[a], names[b]
-            segs.append(Segment(f"{A}{B}", A, B, np.abs(pts[B] - pts[A]) * mu_l.value, "m", "link"))
+            segs.append(Segment(f"{A}{B}", A, B, _abs(pts[B] - pts[A]) * mu_l.value, "m", "link"))
     for p in mech.pairs:
         if p.kind == "P" and k in p.links:
-            X = _world(res, p.links[1], p.point) / mu_l.value
+            X = _over(_world(res, p.links[1], p.point), mu_l.value)
             d = _guide(res, p)
             name = f"guide P({link_number(mech, p.links[0])},{link_number(mech, p.links[1])})"     # the text's numbers
             pts[f"{name}:from"], pts[f"{name}:to"] = X - 40 * d, X + 40 * d
@@ -464,7 +493,7 @@ def _links_and_loads(mech: "Mechanism", res: "Analysis", loads: dict[int, list[L
         for c in link_couples(mech, res, x):
             link = mech.links[x]
             S = _world(res, x, link.com) if link.com else res.kin.origin_z[:, x]
-            paths[c.name] = _couple_path(S / mu_l.value, c.moment, 8.0)
+            paths[c.name] = _couple_path(_over(S, mu_l.value), c.moment, 8.0)
         _resultant(mech, res, x, pts, segs, mu_l, mu_F)
 
 
@@ -479,7 +508,7 @@ def _leash_parts(mech: "Mechanism", res: "Analysis", side) -> _Parts:
     if inner.kind == "P":
         return _split(whole, 1j * _guide(res, inner))
     u = _world(res, ell, inner.point) - _world(res, ell, outer.point)
-    return _split(whole, u / np.abs(u))
+    return _split(whole, _over(u, _abs(u)))
 
 
 def _special_point(mech: "Mechanism", res: "Analysis", g) -> tuple[str, np.ndarray]:
@@ -547,7 +576,7 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
     paths: dict[str, np.ndarray] = {}
     _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_F)
     S_name, S = _special_point(mech, res, g)
-    pts[S_name] = S / mu_l.value
+    pts[S_name] = _over(S, mu_l.value)
     for (ell, outer, inner, _), o in zip(g.sides, parts):
         w = o.whole
         if o.normal is None:
@@ -564,7 +593,7 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
         drawn = []
         for ell, outer, inner, _ in sides[:2]:
             on = outer.point if inner.kind == "P" else inner.point        # a point of the leash's axis
-            drawn.append(Segment(f"axis {on}{S_name}", on, S_name, np.abs(_world(res, ell, on) - S), "m", "line"))
+            drawn.append(Segment(f"axis {on}{S_name}", on, S_name, _abs(_world(res, ell, on) - S), "m", "line"))
         axes.append((where, {}, _masked(drawn, where)))
     segs += _merged(axes)[1]
     for x in g.links:
@@ -615,7 +644,7 @@ def _resultant(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: list
         return
     S, K = _world(res, k, link.com), np.where(has, _z(il.point), np.nan)
     _arrow(segs, pts, f"F_i{k}(h)", K, np.where(has, F, np.nan), mu_l, mu_F)
-    pts[f"z_{k}:S"] = S / mu_l.value
+    pts[f"z_{k}:S"] = _over(S, mu_l.value)
     segs.append(Segment(f"z_{k}", f"z_{k}:S", f"F_i{k}(h):from", np.where(has, il.h, np.nan), "m", "arm"))
 
 
@@ -627,8 +656,8 @@ def _offset(mech: "Mechanism", res: "Analysis", p, pts: dict, segs: list, mu_l: 
         return
     X = _world(res, p.links[1], p.point)
     name = "x_" + reaction_name(mech, *p.links)[1:]
-    pts[f"{name}:from"], pts[f"{name}:to"] = X / mu_l.value, (X + x * _guide(res, p)) / mu_l.value
-    segs.append(Segment(name, f"{name}:from", f"{name}:to", np.abs(x), "m", "arm"))
+    pts[f"{name}:from"], pts[f"{name}:to"] = _over(X, mu_l.value), (X + x * _guide(res, p)) / mu_l.value   # rounded as before
+    segs.append(Segment(name, f"{name}:from", f"{name}:to", _abs(x), "m", "arm"))
 
 
 def _polygon(mech: "Mechanism", res: "Analysis", g: "AssurGroup") -> tuple[list[tuple[str, np.ndarray]], int, int]:
@@ -685,11 +714,11 @@ def _dyad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Plan
     oj, ok = _outer(mech, res, g, 0), _outer(mech, res, g, 1)
     X = _vertex(start_j)
     if oj.normal is not None:     # whole pin reactions as chords: R = R^n + R^tau
-        segs.append(Segment(oj.whole.name, X, _vertex(1), np.abs(oj.whole.force), "N"))
+        segs.append(Segment(oj.whole.name, X, _vertex(1), _abs(oj.whole.force), "N"))
     if ok.normal is not None:
         first = len(seq) - 3
-        segs.append(Segment(ok.whole.name, _vertex(first), _vertex(first + 2), np.abs(ok.whole.force), "N"))
-    segs.append(Segment(reaction_name(mech, k, j), _vertex(end_j), X, np.abs(_z(res.reaction(k, j))), "N"))
+        segs.append(Segment(ok.whole.name, _vertex(first), _vertex(first + 2), _abs(ok.whole.force), "N"))
+    segs.append(Segment(reaction_name(mech, k, j), _vertex(end_j), X, _abs(_z(res.reaction(k, j))), "N"))
     return _cycle(f"forces:{_group_label(g)}", f"Force plan of group {_group_label(g)} ({g.kind}): "
                   + " + ".join(name for name, _ in seq) + " = 0", mu_F, res, pts, segs,
                   equation=tuple(name for name, _ in seq),
@@ -704,8 +733,8 @@ def _closed_polygon(seq: list[tuple[str, np.ndarray]], mu_F: Scale) -> tuple[dic
     for n, (name, F) in enumerate(seq):
         a, b = _vertex(n), _vertex((n + 1) % len(seq))
         if b not in pts:
-            pts[b] = pts[a] + F / mu_F.value
-        segs.append(Segment(name, a, b, np.abs(F), "N"))
+            pts[b] = pts[a] + _over(F, mu_F.value)
+        segs.append(Segment(name, a, b, _abs(F), "N"))
     return pts, segs
 
 
@@ -724,10 +753,10 @@ def _triad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Pla
         for (ell, _, _, known), w in zip(sides, whole):
             if w is not None:
                 segs.append(Segment(reaction_name(mech, known, ell), _vertex(w[0] % m), _vertex(w[1] % m),
-                                    np.abs(_z(res.reaction(known, ell))), "N"))
+                                    _abs(_z(res.reaction(known, ell))), "N"))
         for (ell, _, _, _), (a, b) in zip(sides, spans):
             segs.append(Segment(reaction_name(mech, g.links[0], ell), _vertex(b % m), _vertex(a % m),
-                                np.abs(_z(res.reaction(g.links[0], ell))), "N"))
+                                _abs(_z(res.reaction(g.links[0], ell))), "N"))
         parts.append((where, pts, _masked(segs, where)))
         equations.append(tuple(name for name, _ in seq))
     pts, segs = _merged(parts)
@@ -772,7 +801,7 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
     for ld in on_crank:
         _arm(mech, segs, pts, arm_name(ld.name), O, dr.pivot, ld.point, ld.force, mu_l)
     for c in link_couples(mech, res, 1):
-        paths[c.name] = _couple_path(O / mu_l.value, c.moment, 6.0)
+        paths[c.name] = _couple_path(_over(O, mu_l.value), c.moment, 6.0)
     R01 = _reaction_load(mech, res, 0, 1)
     _arrow(segs, pts, R01.name, R01.point, R01.force, mu_l, mu_F)
     M_bal = np.asarray(res.balancing_moment, dtype=float)
@@ -781,25 +810,25 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
         e = complex(*gear.centre_direction)
         r_pinion = gear.r_w * gear.z_pinion / gear.z_wheel
         P = O + gear.r_w * e
-        paths["pitch circle of the wheel"] = _circle(O / mu_l.value, gear.r_w / mu_l.value)
-        paths["pitch circle of the pinion"] = _circle((O + (gear.r_w + r_pinion) * e) / mu_l.value, r_pinion / mu_l.value)
+        paths["pitch circle of the wheel"] = _circle(_over(O, mu_l.value), gear.r_w / mu_l.value)
+        paths["pitch circle of the pinion"] = _circle(_over(O + (gear.r_w + r_pinion) * e, mu_l.value), r_pinion / mu_l.value)
         F_bal = _z(res.balancing_force)
-        line = np.where(np.abs(F_bal) > 0, _unit(F_bal), _line_of_action(gear, M_bal))
-        pts["P"] = P / mu_l.value
+        line = np.where(_abs(F_bal) > 0, _unit(F_bal), _line_of_action(gear, M_bal))
+        pts["P"] = _over(P, mu_l.value)
         pts["line of action:from"], pts["line of action:to"] = pts["P"] - 40 * line, pts["P"] + 40 * line
         segs.append(Segment("line of action", "line of action:from", "line of action:to", np.full(len(P), np.nan),
                             "", "line"))
         _arrow(segs, pts, L.F_bal, P, F_bal, mu_l, mu_F)
         foot = _foot(P, line, O)
-        pts["r_b:foot"] = foot / mu_l.value
-        segs.append(Segment("r_b", dr.pivot, "r_b:foot", np.abs(foot - O), "m", "arm"))
+        pts["r_b:foot"] = _over(foot, mu_l.value)
+        segs.append(Segment("r_b", dr.pivot, "r_b:foot", _abs(foot - O), "m", "arm"))
         titles = [f"Initial link: gear mesh alpha_w = {gear.alpha_w_deg:g} deg, {L.F_bal} = {f:.6g} N, "
                   f"r_b = {gear.r_b * 1e3:.6g} mm, {L.M_bal} = {L.F_bal} r_b = {m:.6g} N m"
-                  for f, m in zip(np.abs(F_bal).tolist(), M_bal.tolist())]
-        results = (Result(L.F_bal, np.abs(F_bal), "N"), Result("r_b", np.full(len(P), gear.r_b), "m"),
+                  for f, m in zip(_abs(F_bal).tolist(), M_bal.tolist())]
+        results = (Result(L.F_bal, _abs(F_bal), "N"), Result("r_b", np.full(len(P), gear.r_b), "m"),
                    Result(L.M_bal, M_bal, "N m", "M = F r_b"))
     else:
-        paths[L.M_bal] = _couple_path(O / mu_l.value, M_bal, 10.0)
+        paths[L.M_bal] = _couple_path(_over(O, mu_l.value), M_bal, 10.0)
         titles = [f"Initial link: balancing couple {L.M_bal} = {m:.6g} N m" for m in M_bal.tolist()]
         results = (Result(L.M_bal, M_bal, "N m", "M = sum"),)
     notes = _friction_circles(mech, res, [p for p in mech.pairs if dr.link in p.links], pts, segs, paths, mu_l)

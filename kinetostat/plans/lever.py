@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .core import Plan, PlanCycle, Result, Scale, Segment
-from .forces import _cycle, _drawable, _scale, _unit, arm_name, force_scale, link_couples, link_loads
+from .forces import _abs, _cycle, _dot, _drawable, _over, _scale, _unit, arm_name, force_scale, link_couples, link_loads
 from ..model.lettering import lettering
 
 if TYPE_CHECKING:
@@ -57,9 +57,9 @@ def _image(mech: "Mechanism", res: "Analysis", k: int, name: str, mu_v: Scale, p
     that name) on the turned plan: lower case, with the link's number where another link's point
     of that name moves otherwise at any of the angles. Added to pts ((N,) complex, mm)."""
     v = np.asarray(res.kin.velocity_z(k, mech.links[k].points[name] if local is None else local), dtype=complex)
-    z = 1j * v / mu_v.value
+    z = _over(1j * v, mu_v.value)
     key = name.lower()
-    if key in pts and (np.abs(pts[key] - z) > 1e-9 * np.maximum(1.0, np.abs(z))).any():
+    if key in pts and (_abs(pts[key] - z) > 1e-9 * np.maximum(1.0, _abs(z))).any():
         key = f"{key}{k}"
     pts[key] = z
     return key
@@ -91,16 +91,16 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
         link = mech.links[k]
         images = [_image(mech, res, k, name, mu_v, pts) for name in link.points]
         for name, img in zip(link.points, images):
-            off = np.abs(pts[img]) > 0
+            off = _abs(pts[img]) > 0
             if off.any() and f"p-{img}" not in {s.name for s in segs}:
-                segs.append(Segment(f"p-{img}", "p", img, np.where(off, np.abs(pts[img]) * mu_v.value, np.nan), "m/s"))
+                segs.append(Segment(f"p-{img}", "p", img, np.where(off, _abs(pts[img]) * mu_v.value, np.nan), "m/s"))
         joints = list(dict.fromkeys(p.point for p in mech.pairs if k in p.links and p.point in link.points))
         for m, a in enumerate(joints):
             for b in joints[m + 1:]:
                 ia, ib = images[list(link.points).index(a)], images[list(link.points).index(b)]
-                off = (np.abs(pts[ia]) > 0) & (np.abs(pts[ib]) > 0)    # a link pivoted on the frame: its image is p-x
+                off = (_abs(pts[ia]) > 0) & (_abs(pts[ib]) > 0)    # a link pivoted on the frame: its image is p-x
                 if off.any():
-                    segs.append(Segment(f"{ia}-{ib}", ia, ib, np.where(off, np.abs(pts[ib] - pts[ia]) * mu_v.value, np.nan),
+                    segs.append(Segment(f"{ia}-{ib}", ia, ib, np.where(off, _abs(pts[ib] - pts[ia]) * mu_v.value, np.nan),
                                         "m/s", "link"))
         for ld in link_loads(mech, res, k):
             forces.append((ld.name, images[list(link.points).index(ld.at)], ld.force))
@@ -110,7 +110,7 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
                 continue
             (a, la), (b, lb) = _couple_ends(mech, k)
             A, B = (np.asarray(res.kin.position_z(k, q), dtype=complex) for q in (la, lb))
-            F = np.where(acts, c.moment / np.abs(A - B) ** 2 * 1j * (A - B), np.nan)   # F at A, -F at B: (A - B) x F = M
+            F = np.where(acts, c.moment / _abs(A - B) ** 2 * 1j * (A - B), np.nan)   # F at A, -F at B: (A - B) x F = M
             for name, local, f in ((a, la, F), (b, lb, -F)):
                 forces.append((f"{c.name}/l ({name.lower()})", _image(mech, res, k, name, mu_v, pts, local), f))
     total = sum(np.where(np.isnan(F), 0.0, _moment(pts[at], F)) for _, at, F in forces)   # a couple acts where not NaN
@@ -122,38 +122,38 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
     mu_F = mu_F or force_scale([F for _, _, F in forces])
     for name, at, F in forces:
         start = f"{name}:from"
-        pts[start], pts[f"{name}:to"] = pts[at], pts[at] + F / mu_F.value
-        segs.append(Segment(name, start, f"{name}:to", np.abs(F), "N", "vector", mu_F))
-        has = (np.abs(F) > 0) & (np.abs(pts[at]) > 0)
+        pts[start], pts[f"{name}:to"] = pts[at], pts[at] + _over(F, mu_F.value)
+        segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
+        has = (_abs(F) > 0) & (_abs(pts[at]) > 0)
         if name != F_name and has.any():
             u = _unit(F)
-            foot = np.where(has, pts[at] - (pts[at] * u.conjugate()).real * u, np.nan)
+            foot = np.where(has, pts[at] - _dot(pts[at], u) * u, np.nan)
             pts[f"{arm_name(name)}:foot"] = foot
-            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", np.abs(foot) * NATURAL.value, "mm", "arm",
+            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", _abs(foot) * NATURAL.value, "mm", "arm",
                                 NATURAL))
     omega1 = np.asarray(res.omega(mech.drive.link), dtype=float)
     M_lever = total * mu_v.value / omega1
     M_forces = np.asarray(res.balancing_moment, dtype=float)
     delta = np.where(M_lever != 0, (M_lever - M_forces) / np.where(M_lever != 0, M_lever, 1.0) * 100, 0.0)
     within = tuple("within 5" if abs(d) <= TOLERANCE_PCT else "beyond 5" for d in delta.tolist())
-    results = (Result(F_name, np.abs(F_bal), "N", "by lever"), Result(L.lever(L.M_bal), M_lever, "N m", "by lever"),
+    results = (Result(F_name, _abs(F_bal), "N", "by lever"), Result(L.lever(L.M_bal), M_lever, "N m", "by lever"),
                Result(L.M_bal, M_forces, "N m", "by force plans"),
                Result("δ", delta, "%", within[0] if len(set(within)) == 1 else within))
     titles = [f"Zhukovsky's lever (velocity plan turned by 90 deg ccw): {F_name} = {f:.6g} N "
               f"at {crank_pin}, {L.lever(L.M_bal)} = {m:.6g} N m; forces drawn at {mu_F}"
-              for f, m in zip(np.abs(F_bal).tolist(), M_lever.tolist())]
+              for f, m in zip(_abs(F_bal).tolist(), M_lever.tolist())]
     return _cycle("lever", titles, mu_v, res, pts, segs, results=results)
 
 
 def _moment(r, F):
     """z-moment of force F at r about the origin (N mm for r in mm); scalars or arrays."""
-    return (np.conjugate(r) * F).imag
+    return np.real(r) * np.imag(F) - np.imag(r) * np.real(F)
 
 
 def _across(pa: np.ndarray, moment: np.ndarray) -> np.ndarray:
     """The force across pa at the end of pa whose moment about the pole is `moment` (0 where pa = 0)."""
-    a = np.abs(pa)
-    return np.where(a > 0, moment / np.where(a > 0, a, 1.0) * 1j * pa / np.where(a > 0, a, 1.0), 0j)
+    a = _abs(pa)
+    return np.where(a > 0, _over(moment / np.where(a > 0, a, 1.0) * 1j * pa, np.where(a > 0, a, 1.0)), 0j)
 
 
 def pole_moment(plan: Plan | PlanCycle, without: tuple[str, ...] | None = None):
@@ -167,9 +167,9 @@ def pole_moment(plan: Plan | PlanCycle, without: tuple[str, ...] | None = None):
     for s in plan.segments:
         if s.unit == "N" and s.name not in without:
             d = np.asarray(plan.points[s.end] - plan.points[s.start])
-            a = np.abs(d)
+            a = _abs(d)
             with np.errstate(invalid="ignore", divide="ignore"):
-                term = np.where(a > 0, _moment(plan.points[s.start] - plan.points["p"], d / np.where(a > 0, a, 1.0) * s.value), 0.0)
+                term = np.where(a > 0, _moment(plan.points[s.start] - plan.points["p"], _over(d, np.where(a > 0, a, 1.0)) * s.value), 0.0)
             total = total + np.nan_to_num(term)
     return float(total) if isinstance(plan, Plan) else np.broadcast_to(total, (plan.n,)).copy()
 
