@@ -76,10 +76,6 @@ def _differences(cycle: Plan, one: Plan) -> list[str]:
     return out
 
 
-#: The plans built on arrays here (the force plans: forces.py's builders, wrapped until they are).
-KINDS = ("mechanism", "positions", "velocity", "acceleration")
-
-
 @pytest.mark.parametrize("path", sampled(MODELS, keep=("ice_crank_slider", "triad_slider")))
 def test_cycle_equals_one_angle_builds(path):
     """Every plan kind of the cycle at 24 angles (one analysis, one build) is, angle by angle, the
@@ -90,15 +86,15 @@ def test_cycle_equals_one_angle_builds(path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = kinetostat.analyze(mech, phi_deg=ANGLES, friction="first")
-        fixed = P.CycleScales(P.choose_scales(mech, res, cycle=res), {}, {})     # the kinematic plans' scales
+        fixed = P.cycle_scales(mech, res=res)
         positions = P.fixed_positions(mech, fixed.base["mu_l"], starting_deg=0.0)
-        cycles = P.build_cycle(mech, res, fixed, positions, only=KINDS)
+        cycles = P.build_cycle(mech, res, fixed, positions)
         assert all(c.n == len(ANGLES) for c in cycles.values())
         for i, at in enumerate(ANGLES):
             if res.singular[i]:
                 assert all(np.isnan(list(c.at(i).points.values())).all() for c in cycles.values())
                 continue
-            one = P.build(mech, at=float(at), fixed=fixed, positions=positions, only=KINDS)
+            one = P.build(mech, at=float(at), fixed=fixed, positions=positions)
             assert list(one) == list(cycles)
             for kind, plan in one.items():
                 assert _differences(cycles[kind].at(i), plan) == [], f"{kind} at {at:g} deg"
