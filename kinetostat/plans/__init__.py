@@ -8,7 +8,9 @@
     >>> fig = kinetostat.plans.figure(plans["acceleration"], lang="uk")   # a matplotlib Figure
     >>> plans.write("out", lang="en")                       # one SVG sheet per plan + segments.csv
 
-`build` -> `Plans`, a frozen mapping kind -> `Plan` (`core`); scales by the texts' rule or given
+`build` -> `Plans`, a frozen mapping kind -> `Plan` (`core`), the N = 1 case of `build_cycle`
+(every plan at the N angles of one analysis, `PlanCycle`s at the cycle's scales, `cycle_scales`);
+scales by the texts' rule or given
 (`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
 there and only when a figure is drawn).
 
@@ -34,13 +36,13 @@ from .draw import ROOM_MM, figure, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
 from ..model.lettering import lettering
 from .mechanism import mechanism_plan
-from .kinematic import FixedPositions, acceleration_plan, fixed_positions, positions_plan, starting_position, velocity_plan
+from .kinematic import FixedPositions, acceleration_plan, assembled, fixed_positions, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
 from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
 
 __all__ = ["build", "build_cycle", "Plans", "BUILDERS", "Plan", "PlanCycle", "Scale", "Segment", "SEGMENT_COLUMNS", "svg",
            "figure", "choose_scales", "starting_position", "fixed_positions", "plan_file_name", "CycleScales",
-           "cycle_scales", "fits"]
+           "cycle_scales", "fits_cycle"]
 
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
@@ -66,7 +68,7 @@ def _crank(mech, res, sc) -> list[PlanCycle]:
     return _fitted(lambda mu: crank_plan(mech, res, sc["mu_l"], mu), mu_F)
 
 
-def fits(cycle: PlanCycle):
+def fits_cycle(cycle: PlanCycle):
     """(N,): by how much the plan exceeds the room of its sheet (`draw.ROOM_MM`) at each angle of
     the cycle: <= 1 where it fits (`draw.fits` angle by angle)."""
     import numpy as np
@@ -76,7 +78,7 @@ def fits(cycle: PlanCycle):
 
 def _fitted(make: Callable, mu: Scale) -> list[PlanCycle]:
     """make(mu) -> a PlanCycle or a list of them, made again at the next coarser round scale while
-    one of them overflows its sheet at some angle (`fits`: a group's reaction far out on its guide,
+    one of them overflows its sheet at some angle (`fits_cycle`: a group's reaction far out on its guide,
     a polygon longer than its largest force, a lever whose forces reach beyond the velocity plan):
     the sheet states the scale it is drawn at. A few tries at most; the last is kept."""
     import numpy as np
@@ -84,7 +86,7 @@ def _fitted(make: Callable, mu: Scale) -> list[PlanCycle]:
     for _ in range(4):
         made = make(Scale(mu.symbol, value, mu.unit))
         plans = list(made) if isinstance(made, (list, tuple)) else [made]
-        factor = max(float(np.max(fits(p), initial=0.0)) for p in plans)
+        factor = max(float(np.max(fits_cycle(p), initial=0.0)) for p in plans)
         if factor <= 1:
             break
         value = coarser(value, factor)
@@ -130,17 +132,17 @@ def cycle_scales(mech, step_deg: float = 5.0, res=None) -> CycleScales:
     sheet at every angle (a peak between two angles 5 deg apart exceeds the sampled one by under
     0.4 % of a cosine; the round scales leave more room). One analysis (none where `res` is
     given), one build of the plans at every angle at the base scales, each plan's scale then
-    made coarser while it overflows its sheet at some angle. Singular positions are left out."""
+    made coarser while it overflows its sheet at some angle. Singular positions and angles where
+    the linkage does not assemble are left out."""
     import warnings
 
     import numpy as np
 
-    from ..solve import analyze
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        if res is None:
-            res = analyze(mech, phi_deg=cycle_angles(mech, step_deg), friction="first")
-        keep = ~np.asarray(res.singular, bool) & (res.omega(1) != 0)
+        if res is None:                             # where the linkage does not assemble: no plans
+            res = assembled(mech, cycle_angles(mech, step_deg), friction="first")[0]
+        keep = np.zeros(0, bool) if res is None else ~np.asarray(res.singular, bool) & (res.omega(1) != 0)
         if not keep.any():
             raise ValueError(f"{mech.name}: no crank angle where the plans can be drawn")
         drawn = res.take(np.flatnonzero(keep))
@@ -166,7 +168,7 @@ def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions 
     noted (the scale rule keeps the crank at the length the text asks)."""
     fixed = fixed or fixed_positions(mech, sc["mu_l"], starting_deg)
     plan = positions_plan(mech, res, sc, starting_deg, fixed=fixed)
-    fit = fits(plan) <= 1
+    fit = fits_cycle(plan) <= 1
     return plan if fit.all() else positions_plan(mech, res, sc, starting_deg, other_branch=fit, fixed=fixed)
 
 

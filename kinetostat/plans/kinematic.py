@@ -15,7 +15,12 @@ crank pin `a1` in a slotted-link group, the guide's point `b3` when the guide is
 `k2`, ... when a plan has several. The plan of positions names each position's points with the
 position number (`A3`, `S2_3` where the name ends in a digit) and the design position's plain.
 
-May use: numpy, `kinetostat.solve` (the exact results: never re-solved here), `.core`.
+Every plan is built for the N angles of one analysis at once (`core.PlanCycle`); an element that
+exists at some angles only is NaN (not drawn) at the others.
+
+May use: numpy, `kinetostat.solve` (the exact results: the plans' own analysis is never re-solved;
+solved here once each: the cycle of positions, the starting position, the other assembly branch
+at the angles drawn), `kinetostat.kinematics` and `kinetostat.triad` (Assur's special point), `.core`.
 """
 from __future__ import annotations
 
@@ -29,7 +34,7 @@ import numpy as np
 
 from .core import PlanCycle, Scale, Segment
 
-__all__ = ["positions_plan", "fixed_positions", "other_branches", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
+__all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
 
 #: Positions of the plan of positions: every 30 deg.
@@ -427,27 +432,36 @@ def _draw_position(mech, res, idx, label: int | None, mu: float, points: dict, s
                                     np.abs(zb - za) * mu, "m", "link" if label is None else "position"))
 
 
-def other_branches(mech, res) -> dict:
-    """Per group with two assembly branches (`mech.branches`): the analysis of the mechanism with
-    that group's other branch at the angles of `res`, one solve for all of them, and the angles
-    (N,) bool where it assembles; None where it assembles at none."""
+def assembled(mech, phi_deg, **options):
+    """(the analysis of `mech` at the angles `phi_deg` where it assembles, those angles (N,) bool):
+    one solve, and one more without the angles an AssemblyError named; (None, all False) where it
+    does not assemble at the rest either (or the model is refused: a ValueError). `options`: of
+    `analyze`."""
     from ..errors import AssemblyError
     from ..solve import analyze
+    phi = np.asarray(phi_deg, float)
+    where = np.ones(len(phi), bool)
+    for _ in range(2):
+        try:
+            return analyze(mech, phi_deg=phi[where], **options), where
+        except AssemblyError as exc:
+            where = where & ~np.isin(np.round(phi, 9), exc.phi_deg)
+            if not where.any():
+                break
+        except (ValueError, KeyError):
+            break
+    return None, np.zeros(len(phi), bool)
+
+
+def other_branches(mech, res) -> dict:
+    """Per group with two assembly branches (`mech.branches`): (the analysis of the mechanism with
+    that group's other branch at the angles of `res` where it assembles, those angles (N,) bool),
+    one solve for all of them (`assembled`); left out where it assembles at none."""
     out = {}
     for key, b in mech.branches.items():
-        other = replace(mech, branches={**mech.branches, key: -b})
-        phi = np.asarray(res.phi_deg, float)
-        where = np.ones(len(phi), bool)
-        for _ in range(2):                 # the angles where it fails left out, once
-            try:
-                out[key] = (analyze(other, phi_deg=phi[where]), where)
-                break
-            except AssemblyError as exc:
-                where &= ~np.isin(np.round(phi, 9), exc.phi_deg)
-                if not where.any():
-                    break
-            except (ValueError, KeyError):
-                break
+        alt, where = assembled(replace(mech, branches={**mech.branches, key: -b}), res.phi_deg)
+        if alt is not None:
+            out[key] = (alt, where)
     return out
 
 
