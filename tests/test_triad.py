@@ -204,14 +204,14 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
     res = kinetostat.analyze(mech, phi_deg=[60.0])
     g = mech.structure.groups[0]
     sc = choose_scales(mech, res)
-    v = kinematic.velocity_plan(mech, res, sc)
+    v = kinematic.velocity_plan(mech, res, sc).at(0)          # the cycle of one angle
     S = special_point_z(mech, res.kin, g)[0]
     b = g.links[0]
     local = (S - res.kin.origin_z[0, b]) / res.kin.rot[0, b]
     vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
     assert abs(v.points["s"] * sc["mu_v"].value - vS) <= 1e-12 * abs(vS)
     assert {s.name for s in v.segments} >= {"a-s", "p-s"}
-    acc = kinematic.acceleration_plan(mech, res, sc)
+    acc = kinematic.acceleration_plan(mech, res, sc).at(0)
     aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
     a_A = complex(res.kin.point_z(1, tuple(mech.links[1].points["A"]))[2][0])
     seg = acc.segment("a-s")
