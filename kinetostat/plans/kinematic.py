@@ -41,6 +41,8 @@ __all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "
 N_POSITIONS = 12
 #: Crank angles sampled for the path of a centre of mass.
 PATH_STEPS = 180
+#: Angles a round of the search for the starting position analyses at once.
+SECTIONS = 63
 
 
 def _titles(text: str, res) -> tuple[str, ...]:
@@ -355,7 +357,8 @@ def starting_position(mech, steps: int = 720) -> float:
     """The texts' starting position (seed 002: crank and rod stretched in one line), crank angle
     in deg in [0, 360): the first dead centre of the first group driven by a link turning about
     a frame pin that has one (module docstring of `_dead_centre_functions`), found by a scan of
-    `steps` angles and bisection to ~1e-13 deg. 0 (the model's reference) when there is none."""
+    `steps` angles, then its bracket cut in SECTIONS + 1 parts by one analysis a round, to the
+    resolution of a float (~1e-14 deg). 0 (the model's reference) when there is none."""
     from ..solve import analyze
     phi = np.arange(steps) * 360.0 / steps
     cyc = analyze(mech, phi_deg=phi)
@@ -369,16 +372,19 @@ def starting_position(mech, steps: int = 720) -> float:
         if val[i] == 0:
             return float(phi[i])
         lo, hi, flo = phi[i], phi[i] + 360.0 / steps, val[i]
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            fm = f(analyze(mech, phi_deg=[mid]))[0][0]
-            if fm == 0 or mid in (lo, hi):
+        for _ in range(16):                 # each round: SECTIONS angles in one analysis
+            inner = np.unique(lo + (hi - lo) * np.arange(1, SECTIONS + 1) / (SECTIONS + 1))
+            inner = inner[(inner > lo) & (inner < hi)]
+            if not len(inner):
                 break
-            if np.sign(fm) == np.sign(flo):
-                lo, flo = mid, fm
-            else:
-                hi = mid
-        return float(mid % 360.0)
+            fm = f(analyze(mech, phi_deg=inner))[0]
+            if np.any(fm == 0):
+                return float(inner[np.argmax(fm == 0)] % 360.0)
+            changed = np.flatnonzero(np.sign(fm) != np.sign(flo))
+            j = int(changed[0]) if len(changed) else len(inner)
+            lo, flo = (inner[j - 1], fm[j - 1]) if j else (lo, flo)
+            hi = inner[j] if j < len(inner) else hi
+        return float(0.5 * (lo + hi) % 360.0)
     return 0.0
 
 
