@@ -112,3 +112,23 @@ def test_build_analyses_once(monkeypatch):
     monkeypatch.setattr(solve, "analyze", lambda *a, **k: calls.append(k.get("phi_deg")) or real(*a, **k))
     P.build(mech, at=30.0, fixed=fixed, positions=positions)
     assert len(calls) == 2          # the angle, and the other branch of the slider's group at it
+
+
+def test_a_singular_angle_of_the_cycle_draws_nothing():
+    """A toggle at 180 deg (tests/hostile/singular_toggle.toml): in a cycle over 30, 179 and 180 deg
+    every plan's points are NaN at 180 (nothing drawn there), and the other angles are the
+    one-angle builds, 179 deg stating its 8 digits left."""
+    from conftest import ROOT
+    mech = kinetostat.load(ROOT / "tests" / "hostile" / "singular_toggle.toml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = kinetostat.analyze(mech, phi_deg=[30.0, 179.0, 180.0], friction="first")
+        fixed = P.cycle_scales(mech, res=res)
+        cycles = P.build_cycle(mech, res, fixed)
+        ones = [P.build(mech, at=at, fixed=fixed, positions=P.fixed_positions(mech, fixed.base["mu_l"])) for at in (30.0, 179.0)]
+    assert list(res.singular) == [False, False, True]
+    for kind, cycle in cycles.items():
+        assert np.isnan(np.array(list(cycle.points.values()))[:, 2]).all(), kind
+        for i, one in enumerate(ones):
+            assert _differences(cycle.at(i), one[kind]) == [], f"{kind} at {one.at:g} deg"
+    assert cycles["velocity"].at(1).accuracy[0] == pytest.approx(8.0, abs=0.1)
