@@ -20,7 +20,7 @@ exists at some angles only is NaN (not drawn) at the others.
 
 May use: numpy, `kinetostat.solve` (the exact results: the plans' own analysis is never re-solved;
 solved here once each: the cycle of positions, the starting position, the other assembly branch
-at the angles drawn), `kinetostat.kinematics` and `kinetostat.triad` (Assur's special point), `.core`.
+at the angles drawn), `kinetostat.kinematics` (Assur's special point), `.core`.
 """
 from __future__ import annotations
 
@@ -209,16 +209,15 @@ def _special(mech, res, pts: dict) -> list[tuple[str, int, np.ndarray, list[tupl
     S lies on two of the three leashes' axes
     (`kinematics.special_sides`), which two may change over the cycle; the references are in the
     solver's order at the first angle."""
-    from ..kinematics import leash_axes
-    from ..triad import special_point
+    from ..kinematics import special_index, special_point_z
     out = []
     for n, g in enumerate(g for g in mech.structure.groups if g.klass == 3):
         name = "s" if n == 0 else f"s{n + 1}'"
         name = name if name not in pts else f"{name}'"
         b = g.links[0]
-        S, _, k = special_point(*(v for axis in leash_axes(mech, res.kin, g) for v in axis))
+        S, k = special_point_z(mech, res.kin, g), special_index(mech, res.kin, g)
         local = (S - res.kin.origin_z[:, b]) / res.kin.rot[:, b]
-        first = int(k[0]) if np.isfinite(k[0]) else 0
+        first = int(k[0]) % 3
         refs = []
         for j in ((first + 1) % 3, (first + 2) % 3, first):        # the sides in the solver's order
             on = (k != j) | ~_ok(res)
