@@ -5,15 +5,13 @@ from __future__ import annotations
 
 import json
 import math
-import warnings
 
 import numpy as np
 import pytest
 
 import kinetostat
 from conftest import EVERY_KIND, MODELS, sampled
-from kinetostat.errors import SelfLockingWarning
-from kinetostat.plans.worksheet import worksheet, worksheet_cycle
+from kinetostat.plans.worksheet import analyses, worksheet, worksheet_cycle
 
 # seed 002 sec. 1.2.2-1.2.3 at phi = 30 deg (drawn and measured: the text rounds)
 SEED_002 = {"V_B": 10.94, "V_BA": 14.92, "V_S2": 12.2, "omega_2": 135.6, "a_A": 7994.38, "a_B": 8311,
@@ -126,16 +124,6 @@ def test_a_rod_at_rest_has_no_sense():
     assert moving.value("omega_2") > 0.1 and moving.row("omega_2").direction in ("cw", "ccw")
 
 
-def _analyses(mech, angles, friction="first"):
-    """`analyze` at `angles` in `friction`'s mode, and in the other mode where the model has friction."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SelfLockingWarning)
-        res = kinetostat.analyze(mech, phi_deg=angles, friction=friction)
-        other = None if mech.friction is None else \
-            kinetostat.analyze(mech, phi_deg=angles, friction="reactions" if friction == "first" else "first")
-    return res, other
-
-
 def _close(a: float, b: float, scale: float) -> bool:
     return (math.isnan(a) and math.isnan(b)) or abs(a - b) <= 1e-12 * max(abs(a), abs(b), scale)
 
@@ -150,7 +138,7 @@ def test_the_cycle_is_the_one_angle_worksheet_at_every_angle(path, friction):
     if friction == "reactions" and mech.friction is None:
         pytest.skip("no [friction]")
     angles = np.arange(0.0, 360.0, 15.0)
-    res, other = _analyses(mech, angles, friction)
+    res, other = analyses(mech, angles, friction)
     cyc = worksheet_cycle(mech, res, 0.002, "uk", other)
     assert cyc.values.shape == (24, len(cyc.rows)) and cyc.n == 24
     largest = {"%": 100.0}                # δ: the lever's and the groups' M_зр agree to rounding
@@ -179,16 +167,20 @@ def test_the_cycle_analyses_nothing(monkeypatch):
     solver is not called again."""
     import kinetostat.plans.worksheet as W
     mech = kinetostat.load("ice_crank_slider")                  # has [friction]
-    res, other = _analyses(mech, [30.0, 60.0])
+    res, other = analyses(mech, [30.0, 60.0])
     monkeypatch.setattr(W, "analyze", lambda *a, **k: pytest.fail("analyze called"))
     cyc = worksheet_cycle(mech, res, 0.001, friction_res=other)
     assert cyc.at(1).value("M_bal_friction") == pytest.approx(float(other.balancing_moment[1]), rel=1e-12)
 
 
-def test_a_friction_model_needs_the_other_mode():
+def test_the_friction_rows_come_from_the_other_mode():
+    """A model with [friction]: its friction rows with the analysis in the other mode at the same
+    angles, none without it; the wrong mode or other angles: ValueError naming friction_res."""
     mech = kinetostat.load("ice_crank_slider")
-    res, other = _analyses(mech, [30.0])
-    for bad in (None, res, _analyses(mech, [31.0])[1]):        # none, the same mode, other angles
+    res, other = analyses(mech, [30.0])
+    assert worksheet_cycle(mech, res, 0.001, friction_res=other).at(0).section("friction")
+    assert not worksheet_cycle(mech, res, 0.001).at(0).section("friction")
+    for bad in (res, analyses(mech, [31.0])[1]):               # the same mode, other angles
         with pytest.raises(ValueError, match="friction_res: .*friction='reactions'"):
             worksheet_cycle(mech, res, 0.001, friction_res=bad)
     with pytest.raises(ValueError, match="mu_l"):

@@ -1,6 +1,8 @@
 """The worksheet of the graphical-analytic method (issue 12, item 3): every intermediate value the
 texts write down at one crank position, in their order (seed 002 sec. 1.2.2-1.2.3, seed 000
-secs. 4, 6-8), with units and senses, taken from the exact solution (`analyze`).
+secs. 4, 6-8), with units and senses, taken from the exact solution (`analyze`). Built for the N
+angles of one analysis at once (`worksheet_cycle`: each row's value an (N,) array; `at(i)` the
+`Worksheet` of angle i); `worksheet(mech, at)` is its case of one angle.
 
 Order: the initial link and each Assur group in the order of attachment (velocities, then
 accelerations), the inertia loads and the applied loads, the reactions group by group from the
@@ -24,7 +26,7 @@ from ..analysis import Analysis
 from ..solve import analyze
 from ..applied import load_magnitude
 from ..errors import SelfLockingWarning
-from ..kinematics import DIGITS_WARN, leash_axes, special_point_z, special_sides_index
+from ..kinematics import DIGITS_WARN, leash_axes, special_point_z, special_index
 from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
@@ -33,7 +35,7 @@ from .i18n import ZERO, accuracy, check_lang, num, phrase, text, unit
 from ..model.lettering import lettering
 from .scales import choose_scales
 
-__all__ = ["Row", "Worksheet", "worksheet", "CycleRow", "WorksheetCycle", "worksheet_cycle", "COLUMNS", "CSS", "html_document"]
+__all__ = ["Row", "Worksheet", "worksheet", "CycleRow", "WorksheetCycle", "worksheet_cycle", "analyses", "COLUMNS", "CSS", "html_document"]
 
 #: Columns of the worksheet's table (CSV, JSON, frame).
 COLUMNS = ("section", "key", "symbol", "value", "unit", "direction", "note")
@@ -389,12 +391,12 @@ class _Sheet:
 
     def special_point(self, g) -> list:
         """A triad's base link first, by Assur's special point S (the axes of the two leashes
-        that meet at the best angle at each angle, `special_sides_index`): V_S and a_S from 2x2
+        that meet at the best angle at each angle, `special_index`): V_S and a_S from 2x2
         solves, then its pins, omega and eps from the third. Returns the acceleration steps of the base."""
         res, b = self.res, g.links[0]
         kin = res.kin
         S = special_point_z(self.mech, kin, g)
-        k = special_sides_index(self.mech, kin, g)
+        k = special_index(self.mech, kin, g)
         r = (S - kin.origin_z[:, b]) / kin.rot[:, b] * kin.rot[:, b]      # as kin.point_z takes the local point
         w, e = kin.omega[:, b], kin.eps[:, b]
         V, A = kin.v_z[:, b] + 1j * w * r, kin.a_z[:, b] + (1j * e - w**2) * r
@@ -503,7 +505,7 @@ class _Sheet:
     def reactions(self) -> None:
         res, m = self.res, self.mech
         for g in reversed(m.structure.groups):
-            third = special_sides_index(m, res.kin, g) if g.klass == 3 else None   # g.sides[third]: by Σ M_S
+            third = special_index(m, res.kin, g) if g.klass == 3 else None   # g.sides[third]: by Σ M_S
             split = [(j, side, *self._split(g, side)) for j, side in enumerate(g.sides)]
             for _, (link, _, _, other), e, t, why, x in split:
                 if why:
@@ -610,24 +612,36 @@ def _point_of(res: Analysis, k: int, name: str) -> np.ndarray:
     return res.kin.v_origin[:, k] + res.omega(k)[:, None] * _across(r)
 
 
+def analyses(mech: Mechanism, phi_deg, friction: str = "first") -> tuple[Analysis, Analysis | None]:
+    """The analyses a worksheet of `mech` at the angles `phi_deg` (deg) is built from
+    (`worksheet_cycle`): in the mode `friction` ("first": the graphical method's frictionless
+    reactions, or "reactions"), and for a model with [friction] in the other mode too (its
+    friction rows), else None. Self-locking is not warned of: the sheet's rows state eta."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SelfLockingWarning)
+        res = analyze(mech, phi_deg=phi_deg, friction=friction)
+        other = None if mech.friction is None else \
+            analyze(mech, phi_deg=phi_deg, friction="reactions" if friction == "first" else "first")
+    return res, other
+
+
 def worksheet_cycle(mech: Mechanism, res: Analysis, mu_l: float, lang: str = "en",
                     friction_res: Analysis | None = None) -> WorksheetCycle:
     """The worksheet of `mech` at every crank angle of `res` (its analysis, `analyze`; the
     graphical method's is frictionless, friction="first"), arms and z in mm at `mu_l` (m/mm),
-    in `lang`. A model with [friction] needs `friction_res`: its analysis at the same angles in
-    the other friction mode (friction="reactions" beside a frictionless `res`, "first" beside
-    one with friction in the reactions) for its friction rows. No Python loop over the angles."""
+    in `lang`. The friction rows of a model with [friction] from `friction_res`: its analysis at
+    the same angles in the other friction mode (friction="reactions" beside a frictionless `res`,
+    "first" beside one with friction in the reactions; `analyses` makes both); without it the
+    sheet has no friction section. No Python loop over the angles."""
     check_lang(lang)
     if not (isinstance(mu_l, (int, float)) and not isinstance(mu_l, bool) and math.isfinite(mu_l) and mu_l > 0):
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
     pair = None
-    if mech.friction is not None:
+    if mech.friction is not None and friction_res is not None:
         other = "first" if res.friction is not None else "reactions"
-        if friction_res is None or (friction_res.friction is None) != (other == "first") \
-                or not np.array_equal(friction_res.phi_deg, res.phi_deg):
-            raise ValueError(f"friction_res: {mech.name!r} has [friction]: its friction rows need its analysis "
-                             f"at the angles of res with friction={other!r}, "
-                             f"got {'none' if friction_res is None else friction_res}")
+        if (friction_res.friction is None) != (other == "first") or not np.array_equal(friction_res.phi_deg, res.phi_deg):
+            raise ValueError(f"friction_res: expected the analysis of {mech.name!r} at the angles of res with "
+                             f"friction={other!r} (its friction rows), got {friction_res}")
         pair = (res, friction_res) if other == "first" else (friction_res, res)
     sheet = _Sheet(res, float(mu_l))
     sheet.kinematics()
@@ -658,11 +672,7 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
     if friction not in ("first", "reactions"):
         raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SelfLockingWarning)       # the sheet's friction rows state eta
-        res = analyze(mech, phi_deg=[float(at)], friction=friction)   # default: the graphical method's, frictionless
-        other = None if mech.friction is None else \
-            analyze(mech, phi_deg=[float(at)], friction="reactions" if friction == "first" else "first")
+    res, other = analyses(mech, [float(at)], friction)
     if mu_l is None:
         mu_l = choose_scales(mech, res)["mu_l"].value
     return worksheet_cycle(mech, res, float(mu_l), lang, other).at(0)
