@@ -41,6 +41,7 @@ def text_width(s: str, size_mm: float, bold: bool = False) -> float:
     return stringWidth(s, BOLD if bold else FONT, size_mm)
 
 
+@lru_cache(maxsize=64)
 def _rgb(colour: str) -> tuple[float, float, float]:
     """An SVG colour "#rgb" or "#rrggbb" as RGB fractions."""
     h = colour.lstrip("#")
@@ -61,23 +62,31 @@ class Canvas:
         self._c.setTitle(title)
         self._c.setCreator("kinetostat")
         self._h = None
+        self._state: dict[str, object] = {}          # the graphics state set on this page (set once)
 
     def page(self, size_mm: tuple[float, float]) -> None:
         """A new page of `size_mm` (width, height): the one before it closed."""
         if self._h is not None:
             self._c.showPage()
+        self._state = {}
         self._c.setPageSize((size_mm[0] * PT, size_mm[1] * PT))
         self._h = size_mm[1]
 
     def _xy(self, x: float, y: float) -> tuple[float, float]:
         return x * PT, (self._h - y) * PT
 
+    def _set(self, key: str, value, setter) -> None:
+        """`setter(*value)` unless `key` is at `value` on this page already."""
+        if self._state.get(key) != value:
+            self._state[key] = value
+            setter(*value)
+
     def _stroke(self, width: float, colour: str, dash: tuple[float, ...], round_cap: bool) -> None:
         c = self._c
-        c.setLineWidth(width * PT)
-        c.setStrokeColorRGB(*_rgb(colour))
-        c.setDash([d * PT for d in dash] if dash else [])
-        c.setLineCap(1 if round_cap else 0)
+        self._set("width", (width * PT,), c.setLineWidth)
+        self._set("stroke", _rgb(colour), c.setStrokeColorRGB)
+        self._set("dash", ([d * PT for d in dash],), c.setDash)
+        self._set("cap", (1 if round_cap else 0,), c.setLineCap)
 
     def line(self, x0: float, y0: float, x1: float, y1: float, width: float, colour: str = "#000",
              dash: tuple[float, ...] = (), round_cap: bool = False) -> None:
@@ -96,7 +105,7 @@ class Canvas:
 
     def polygon(self, points, colour: str = "#000") -> None:
         """A filled closed polygon through `points` (mm), no outline."""
-        self._c.setFillColorRGB(*_rgb(colour))
+        self._set("fill", _rgb(colour), self._c.setFillColorRGB)
         path = self._c.beginPath()
         path.moveTo(*self._xy(*points[0]))
         for p in points[1:]:
@@ -106,14 +115,14 @@ class Canvas:
 
     def dot(self, x: float, y: float, r: float, colour: str = "#000") -> None:
         """A filled circle of radius `r` (mm) at (x, y)."""
-        self._c.setFillColorRGB(*_rgb(colour))
+        self._set("fill", _rgb(colour), self._c.setFillColorRGB)
         self._c.circle(*self._xy(x, y), r * PT, stroke=0, fill=1)
 
     def text(self, x: float, y: float, s: str, size_mm: float, bold: bool = False, right: bool = False) -> None:
         """`s` with its baseline at y, starting (`right`: ending) at x, `size_mm` high (em), black."""
         c = self._c
-        c.setFillColorRGB(0, 0, 0)
-        c.setFont(BOLD if bold else FONT, size_mm * PT)
+        self._set("fill", (0.0, 0.0, 0.0), c.setFillColorRGB)
+        self._set("font", (BOLD if bold else FONT, size_mm * PT), c.setFont)
         (c.drawRightString if right else c.drawString)(*self._xy(x, y), s)
 
     def getvalue(self) -> bytes:
