@@ -116,6 +116,24 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
                        for lang in ("en", "uk", "ru")), chosen
 
 
+def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
+    """Task 2 / 479 (its search comes back to scales tried before): `one_sheet` builds the plans of
+    each choice of scales once (was: 9 builds for 7 choices) and draws each plan once a language
+    at its scales; the same sheet as `_one` (no state kept between calls)."""
+    import kinetostat.plans as KP
+    built, drawn = [], []
+    build, drawing = KP.build, A3.drawing
+    monkeypatch.setattr(KP, "build", lambda mech, at, scales=None: built.append(
+        None if scales is None else tuple(sorted(scales.items()))) or build(mech, at=at, scales=scales))
+    monkeypatch.setattr(A3, "drawing", lambda plan, lang: drawn.append(
+        (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or drawing(plan, lang))
+    v = variants.variant(2, "479")
+    one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
+    assert len(built) == len(set(built)) >= 5
+    assert len(drawn) == len(set(drawn)) and {lang for lang, _, _ in drawn} == {"en", "uk", "ru"}
+    assert one.places == _one(2, "479").places and one.drawings == _one(2, "479").drawings
+
+
 def test_the_packer_counts_its_work():
     """The packer tries RULES x ORDERS at most, each placing every plan once per page it tries."""
     one = _one(1, "479")

@@ -95,7 +95,7 @@ def _pts(s: str) -> list[tuple[float, float]]:
 
 def drawing(plan, lang: str) -> Drawing:
     """The `plan` group of the plan's SVG sheet (`draw.svg`) as primitives, with its box."""
-    root = ET.fromstring(svg(plan, lang=lang).encode("utf-8"))
+    root = ET.fromstring(svg(plan, lang=lang, notes=False).encode("utf-8"))
     group = next(g for g in root.iter(f"{_NS}g") if g.get("id") == "plan")
     lines, polylines, polygons, dots, texts = [], [], [], [], []
     xs, ys = [], []
@@ -111,10 +111,14 @@ def drawing(plan, lang: str) -> Drawing:
         elif tag == "polyline":
             p = _pts(el.get("points"))
             polylines.append((p, float(el.get("stroke-width")), el.get("stroke")))
+            xs += [a for a, _ in p]
+            ys += [b for _, b in p]
         elif tag == "path":                      # an arrowhead, its tip first: of the line before it
             p = _pts(el.get("d"))
             owner = lines[-1][7] if lines and "arc" not in el.get("class", "") else ""
             polygons.append((p, el.get("fill", "#000"), owner))
+            xs += [a for a, _ in p]
+            ys += [b for _, b in p]
         elif tag == "circle":
             x, y, r = (float(el.get(k)) for k in ("cx", "cy", "r"))
             dots.append((x, y, r))
@@ -131,9 +135,6 @@ def drawing(plan, lang: str) -> Drawing:
             texts.append((x, y, tuple(runs)))
             xs += [x, x + w]
             ys += [y - 0.95 * size, y + low + 0.3 * size]
-        for p in ([] if tag not in ("polyline", "path") else _pts(el.get("points") or el.get("d"))):
-            xs.append(p[0])
-            ys.append(p[1])
     scales = "; ".join(scale_text(s, lang) for s in scales_of(plan))
     box = (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
     return Drawing(plan.kind, (title_of(plan, lang), f"{text('scales', lang)}: {scales}"), tuple(lines),
@@ -309,13 +310,18 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
             out.append(drawn[key])
         return out
 
+    tried: dict[tuple | None, tuple] = {}
+
     def attempt(given: Mapping[str, float] | None):
-        plans = build(mech, at=at, scales=given)
-        ds = drawings(plans, lang)
-        places = layout(ds)
-        fit = all(p.page == 0 for p in places) and all(
-            all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
-        return plans, ds, places, fit
+        key = None if given is None else tuple(sorted(given.items()))
+        if key not in tried:                     # the searches below come back to scales tried before
+            plans = build(mech, at=at, scales=given)
+            ds = drawings(plans, lang)
+            places = layout(ds)
+            fit = all(p.page == 0 for p in places) and all(
+                all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
+            tried[key] = plans, ds, places, fit
+        return tried[key]
 
     plans, ds, places, fit = attempt(None)
     rule = dict(plans.scales)
