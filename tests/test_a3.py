@@ -118,7 +118,7 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
 
 def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
     """Task 2 / 479 (its search comes back to scales tried before): `one_sheet` builds the plans of
-    each choice of scales once (was: 9 builds for 7 choices) and draws each plan once a language
+    each choice of scales once (was: 9 builds for 8 choices) and draws each plan once a language
     at its scales; the same sheet as `_one` (no state kept between calls)."""
     import kinetostat.plans as KP
     built, drawn = [], []
