@@ -2,9 +2,11 @@
 page's top left (y down), DejaVu Sans and DejaVu Sans Bold embedded as TrueType subsets with their
 Unicode map (so that pdftotext reads the Cyrillic back), and their advance widths.
 
-The fonts are bundled in `fonts/` (DejaVu Sans 2.37 cut to Latin, Greek, Cyrillic, punctuation,
-arrows and mathematical operators; its licence in fonts/LICENSE_DEJAVU), so that every install
-writes the pack.
+The fonts are bundled in `fonts/` (its licence in fonts/LICENSE_DEJAVU), so that every install
+writes the pack: DejaVu Sans 2.35 as matplotlib ships it, cut to Latin, Greek, Cyrillic,
+punctuation, arrows and mathematical operators by fontTools:
+`pyftsubset DejaVuSans.ttf --unicodes=U+0020-024F,U+0300-036F,U+0370-052F,U+2000-22FF,U+25A0-25FF
+--no-hinting --layout-features='' --name-IDs='*' --name-languages='*'` (the same for the bold).
 
 May use: reportlab, the standard library. Never matplotlib.
 """
