@@ -4,6 +4,7 @@ where the texts' do not fit it (μ_l last), named in the key and on the sheet; a
 in every file of the pack, down to a length measured in the PDF."""
 from __future__ import annotations
 
+import base64
 import re
 import shutil
 import subprocess
@@ -115,6 +116,24 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
                        for lang in ("en", "uk", "ru")), chosen
 
 
+def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
+    """Task 2 / 479 (its search comes back to scales tried before): `one_sheet` builds the plans of
+    each choice of scales once (was: 9 builds for 8 choices) and draws each plan once a language
+    at its scales; the same sheet as `_one` (no state kept between calls)."""
+    import kinetostat.plans as KP
+    built, drawn = [], []
+    build, drawing = KP.build, A3.drawing
+    monkeypatch.setattr(KP, "build", lambda mech, at, scales=None: built.append(
+        None if scales is None else tuple(sorted(scales.items()))) or build(mech, at=at, scales=scales))
+    monkeypatch.setattr(A3, "drawing", lambda plan, lang: drawn.append(
+        (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or drawing(plan, lang))
+    v = variants.variant(2, "479")
+    one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
+    assert len(built) == len(set(built)) >= 5
+    assert len(drawn) == len(set(drawn)) and {lang for lang, _, _ in drawn} == {"en", "uk", "ru"}
+    assert one.places == _one(2, "479").places and one.drawings == _one(2, "479").drawings
+
+
 def test_the_packer_counts_its_work():
     """The packer tries RULES x ORDERS at most, each placing every plan once per page it tries."""
     one = _one(1, "479")
@@ -133,12 +152,15 @@ def test_the_packer_counts_its_work():
 
 
 def _pdf_lines(pdf: bytes) -> list[tuple[float, float, float, float]]:
-    """Every straight segment "x0 y0 m x1 y1 l" of the PDF's content streams, mm from the top left."""
+    """Every straight segment "x0 y0 m x1 y1 l" of the PDF's content streams (Flate, or ASCII85
+    then Flate, as reportlab writes them), mm from the top left."""
     out = []
-    for raw in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", pdf, re.S):
+    for head, raw in re.findall(rb"<<([^>]*)>>\s*stream\r?\n(.*?)\r?\n?endstream", pdf, re.S):
         try:
+            if b"ASCII85Decode" in head:
+                raw = base64.a85decode(raw.strip().removeprefix(b"<~").removesuffix(b"~>"))
             body = zlib.decompress(raw).decode("latin-1")
-        except zlib.error:
+        except (zlib.error, ValueError):
             continue
         for m in re.finditer(r"(-?[\d.]+) (-?[\d.]+) m\s+(-?[\d.]+) (-?[\d.]+) l", body):
             x0, y0, x1, y1 = (float(v) / PT for v in m.groups())
@@ -163,7 +185,7 @@ def task2_pdf(task2_pack, tmp_path_factory):
 def test_the_key_length_is_the_length_in_the_pdf(task2_pack, task2_pdf):
     """OA of task 2 / 479 at the one sheet's μ_l = 0.002: the key's segment length (19 mm) is the
     line OA found in the PDF's content stream (the page A3, 1 mm = 1 mm) to 0.01 mm, where the
-    Figure put it; the key and the title block say why μ_l is not the rule's 0.0012."""
+    page (`A3.pages`) put it; the key and the title block say why μ_l is not the rule's 0.0012."""
     p = task2_pack
     pdf = task2_pdf.read_bytes()
     boxes = re.findall(rb"/MediaBox \[ 0 0 ([\d.]+) ([\d.]+) \]", pdf)
@@ -171,11 +193,8 @@ def test_the_key_length_is_the_length_in_the_pdf(task2_pack, task2_pdf):
     key_rows = [r for kind, x in p.key if kind == "table" and x.head[2:3] == ("Length, mm",) for r in x.rows]
     oa = next(r for r in key_rows if r[1] == "OA" and r[0].startswith("Mechanism"))
     assert float(oa[2]) == pytest.approx(19.0) and oa[3] == "μ_l = 0.002 m/mm"
-    fig = A3.pages(p.a3, "t")[0]
-    ax = fig.axes[0]
-    line = next(a for a in ax.lines if a.get_gid() == "mechanism/OA")
-    px = ax.transData.transform(line.get_xydata())
-    ends = np.column_stack([px[:, 0], fig.bbox.height - px[:, 1]]) / fig.dpi * 25.4
+    (page,) = A3.pages(p.a3, "t")
+    ends = np.reshape(next(ln[:4] for ln in page.lines if ln[7] == "mechanism/OA"), (2, 2))
     found = [s for s in _pdf_lines(pdf) if np.allclose(s, ends.ravel(), atol=0.01)
              or np.allclose(s, ends[::-1].ravel(), atol=0.01)]
     assert found, ends

@@ -114,6 +114,7 @@ def test_the_wheel_without_extras_runs_every_command(tmp_path):
         assert r2.stderr.count("\n") == 1 and phrase in r2.stderr, r2.stderr
     assert (work / "plans" / "worksheet.html").is_file() and (work / "key_479" / "worksheet.html").is_file()
     assert (work / "key_479" / "cycle.csv").is_file() and (work / "sweep.csv").is_file()
+    assert (work / "key_479" / "key.pdf").is_file() and (work / "key_479" / "plans_a3.pdf").is_file()   # fonts in the wheel
     assert "0 model(s) NOT CHECKED" in r.stdout and " 0 FAILED" in r.stdout
 
 

@@ -181,36 +181,36 @@ def test_the_crank_lands_at_30_to_35_mm(task, code, want):
     assert v.values["l_OA"] / sc["mu_l"].value == pytest.approx(want)
 
 
-def test_a_plain_install_writes_the_key_and_says_why_no_pack(cli, tmp_path, monkeypatch):
-    """Without matplotlib (no extra `reports`) the key is written, the pack left out with one line."""
-    import importlib.util
-    find_spec = importlib.util.find_spec
-    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else find_spec(name, *a))
-    run = cli("variant", "3", "479", "--out", tmp_path)
+def test_a_plain_install_writes_the_whole_pack(cli, tmp_path, monkeypatch):
+    """Without matplotlib and the harness (neither is in the core install; each import of them
+    fails here) `variant` writes the key and the whole pack: its PDFs by reportlab with the bundled
+    DejaVu Sans (the pack was left out without matplotlib)."""
+    import sys
+    for name in ("matplotlib", "kinetostat_validation"):
+        monkeypatch.setitem(sys.modules, name, None)
+    run = cli("variant", "3", "479", "--out", tmp_path, "--lang", "ru")
     assert run.returncode == 0, run.stderr
-    assert "pip install 'kinetostat[reports]'" in run.stderr and (tmp_path / "worksheet.html").is_file()
-    assert not (tmp_path / "key.pdf").exists()
+    assert "pip install" not in run.stderr and (tmp_path / "worksheet.html").is_file()
+    for name in P.PACK_FILES:
+        assert (tmp_path / name).stat().st_size > 0, name
+    if shutil.which("pdftotext"):
+        assert "Ключ ответов" in pdftext(tmp_path / "key.pdf")
 
 
-def _measured(fig, artist_xy) -> np.ndarray:
-    """Points of an artist as they land on the page, mm from its top left (the transform the PDF uses)."""
-    px = artist_xy(fig)
-    return np.column_stack([px[:, 0], fig.bbox.height - px[:, 1]]) / fig.dpi * 25.4
-
-
-def _drawn(figs, gid: str) -> np.ndarray:
-    """The ends (a line) or vertices (an arrowhead) of the artist `gid` on its page, mm."""
-    for fig in figs:
-        ax = fig.axes[0]
-        for a in list(ax.lines) + list(ax.patches):
-            if a.get_gid() == gid:
-                xy = a.get_xydata() if hasattr(a, "get_xydata") else a.get_xy()
-                return _measured(fig, lambda f: ax.transData.transform(xy))
+def _drawn(pages, gid: str) -> np.ndarray:
+    """The ends (a line) or vertices (an arrowhead) of the primitive `gid` on its page (`a3.pages`), mm."""
+    for page in pages:
+        for ln in page.lines:
+            if ln[7] == gid:
+                return np.reshape(ln[:4], (2, 2))
+        for pts, _, g in page.polygons:
+            if g == gid:
+                return np.array(pts)
     raise KeyError(gid)
 
 
 def test_the_a3_sheet_draws_every_plan_true_to_scale(pack_uk):
-    """Measured on the page as the PDF backend places it: OA is the key's 32 mm (l_OA / μ_l), a side
+    """Measured on the page as the PDF draws it (`a3.pages`, drawn 1:1 by `a3.draw_page`): OA is the key's 32 mm (l_OA / μ_l), a side
     of the force polygon its segments.csv length, every vector of the crank plan drawn (line and
     arrowhead, to its tip) at its length; panels apart and clear of the title block."""
     from kinetostat.plans.a3 import AREA, TITLE_BLOCK, pages

@@ -233,7 +233,7 @@ def build_parser() -> argparse.ArgumentParser:
     va.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
                     help="language of the key and the index (default uk: the language of Logvinenko, Nadtoka 2021)")
     va.add_argument("--no-pack", action="store_true", help="no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf "
-                                                           "and their HTML): the keys only, about 4 s faster a code")
+                                                           "and their HTML): the keys only, about 1 s faster a code")
     va.add_argument("--no-progress", action="store_true", help="no progress bar (--all)")
     va.add_argument("--page", action="store_true", help="also the variant's interactive page (page.html, linked from "
                                                         "the index; about 40 s a code)")

@@ -119,11 +119,7 @@ def cmd_variant(args) -> int:
     except ValueError as exc:
         raise CLIError(f"{exc} (see 'kinetostat variant --help')") from None
     args.lang = args.lang or "uk"                   # seed 002's language (its models' [lettering])
-    import importlib.util
-    teacher_pack = not args.no_pack and importlib.util.find_spec("matplotlib") is not None
-    if not (args.no_pack or teacher_pack):          # a plain install: the keys, and a word on the pack
-        log.info("no teacher's pack (sheet.pdf, key.pdf, plans_a3.pdf): its PDFs need matplotlib: "
-                 "pip install 'kinetostat[reports]'")
+    teacher_pack = not args.no_pack
     default = "task_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
     t0 = time.perf_counter()

@@ -4,7 +4,8 @@ drawing = 1 mm on paper, at the scales its heading states), as seed 002 (Logvine
 
 Each plan is drawn exactly as its own SVG sheet draws it (`draw.svg`: its lines, arrowheads,
 points and every label where `labels.Placer` put it clear of the others): the `plan` group of
-that sheet is read back (`drawing`) and redrawn by matplotlib's PDF backend in millimetres. The
+that sheet is read back (`drawing`), placed on the page (`pages`) and drawn into the PDF in
+millimetres (`draw_page`, `.pdf`). The
 plans' extents (drawing, labels and a heading: title, then every scale the plan is drawn at) are
 packed inside the frame, clear of the title block, never turned (`layout`: maximal rectangles,
 several rules and orders). Where the plans at the texts' scales do not fit one sheet, `one_sheet`
@@ -14,23 +15,23 @@ scale made coarser than the rule, and why. Where no choice fits them, further sh
 rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
 May use: the standard library, `build` of this package, `.core`, `.draw`, `.i18n`, `.labels`,
-`.scales`, `kinetostat.solve`; matplotlib inside `pages` and the text widths only.
+`.scales`, `.pdf`, `kinetostat.solve`. Never matplotlib.
 """
 from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from functools import lru_cache
 from types import MappingProxyType
 from typing import Any, Mapping
 
 from .core import Scale
 from .draw import SHEET_MM, scale_text, scales_of, svg, title_of
 from .i18n import LANGS, num, text
+from .pdf import text_width
 from .scales import TARGET_MM
 
-__all__ = ["Drawing", "Placement", "OneSheet", "drawing", "layout", "one_sheet", "pages", "AREA", "TITLE_BLOCK",
+__all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
            "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM"]
 
 _NS = "{http://www.w3.org/2000/svg}"
@@ -43,7 +44,6 @@ TITLE_BLOCK = (230.0, 247.0, 415.0, 292.0)
 #: lines no wider than the drawing, or than this where the drawing is narrower, mm.
 MIN_HEADING_MM = 50.0
 _GAP = 4.0                                  # between two drawings, mm
-_PT = 72.0 / 25.4                           # points per mm
 
 
 @dataclass(frozen=True)
@@ -70,13 +70,9 @@ class Placement:
     dy: float
 
 
-@lru_cache(maxsize=4096)
 def _width(s: str, size_mm: float, weight: str = "normal") -> float:
-    """Advance width of `s` (mm) at `size_mm`, DejaVu Sans, as matplotlib sets it."""
-    from matplotlib.font_manager import FontProperties
-    from matplotlib.textpath import text_to_path
-    prop = FontProperties(family="DejaVu Sans", size=size_mm * _PT, weight=weight)
-    return text_to_path.get_text_width_height_descent(s, prop, ismath=False)[0] / _PT
+    """Advance width of `s` (mm) at `size_mm`, DejaVu Sans of `weight` ("normal", "bold"), as the PDF sets it."""
+    return text_width(s, size_mm, weight == "bold")
 
 
 def _lines(s: str, size_mm: float, width_mm: float, weight: str = "normal") -> list[str]:
@@ -99,7 +95,7 @@ def _pts(s: str) -> list[tuple[float, float]]:
 
 def drawing(plan, lang: str) -> Drawing:
     """The `plan` group of the plan's SVG sheet (`draw.svg`) as primitives, with its box."""
-    root = ET.fromstring(svg(plan, lang=lang).encode("utf-8"))
+    root = ET.fromstring(svg(plan, lang=lang, notes=False).encode("utf-8"))
     group = next(g for g in root.iter(f"{_NS}g") if g.get("id") == "plan")
     lines, polylines, polygons, dots, texts = [], [], [], [], []
     xs, ys = [], []
@@ -115,10 +111,14 @@ def drawing(plan, lang: str) -> Drawing:
         elif tag == "polyline":
             p = _pts(el.get("points"))
             polylines.append((p, float(el.get("stroke-width")), el.get("stroke")))
+            xs += [a for a, _ in p]
+            ys += [b for _, b in p]
         elif tag == "path":                      # an arrowhead, its tip first: of the line before it
             p = _pts(el.get("d"))
             owner = lines[-1][7] if lines and "arc" not in el.get("class", "") else ""
             polygons.append((p, el.get("fill", "#000"), owner))
+            xs += [a for a, _ in p]
+            ys += [b for _, b in p]
         elif tag == "circle":
             x, y, r = (float(el.get(k)) for k in ("cx", "cy", "r"))
             dots.append((x, y, r))
@@ -135,9 +135,6 @@ def drawing(plan, lang: str) -> Drawing:
             texts.append((x, y, tuple(runs)))
             xs += [x, x + w]
             ys += [y - 0.95 * size, y + low + 0.3 * size]
-        for p in ([] if tag not in ("polyline", "path") else _pts(el.get("points") or el.get("d"))):
-            xs.append(p[0])
-            ys.append(p[1])
     scales = "; ".join(scale_text(s, lang) for s in scales_of(plan))
     box = (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
     return Drawing(plan.kind, (title_of(plan, lang), f"{text('scales', lang)}: {scales}"), tuple(lines),
@@ -313,13 +310,18 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
             out.append(drawn[key])
         return out
 
+    tried: dict[tuple | None, tuple] = {}
+
     def attempt(given: Mapping[str, float] | None):
-        plans = build(mech, at=at, scales=given)
-        ds = drawings(plans, lang)
-        places = layout(ds)
-        fit = all(p.page == 0 for p in places) and all(
-            all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
-        return plans, ds, places, fit
+        key = None if given is None else tuple(sorted(given.items()))
+        if key not in tried:                     # the searches below come back to scales tried before
+            plans = build(mech, at=at, scales=given)
+            ds = drawings(plans, lang)
+            places = layout(ds)
+            fit = all(p.page == 0 for p in places) and all(
+                all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
+            tried[key] = plans, ds, places, fit
+        return tried[key]
 
     plans, ds, places, fit = attempt(None)
     rule = dict(plans.scales)
@@ -361,31 +363,34 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     return OneSheet(plans, lang, tuple(ds), tuple(places), MappingProxyType(rule), MappingProxyType(reference))
 
 
-def pages(sheet: OneSheet, title: str):
-    """The A3 sheets of `sheet` (`one_sheet`: one, unless its plans fit none) as matplotlib
-    Figures. Each page's axes fill it: 1 data unit = 1 mm, y down. The title block: `title`, the
-    note that every plan is true to scale, the scales coarser than the texts' rule
-    (`OneSheet.coarsened`) and, where the plans take more than one sheet, its number. Lines and
-    arrowheads carry gid "<plan kind>/<segment>" ("/<segment>^" for an arrowhead, its tip
-    first), so that a test can measure them."""
-    from matplotlib.figure import Figure
-    from matplotlib.patches import Circle, Polygon
+@dataclass(frozen=True)
+class Page:
+    """One A3 sheet of `pages` as primitives in its mm from the top left (y down).
+    lines: (x0, y0, x1, y1, width, dash (on, off mm; () solid), colour, gid); polylines: (points,
+    width); polygons: (points, colour, gid) (arrowheads, tip first); dots: (x, y, r); texts: (x,
+    baseline y, text, size, weight). A plan's line carries gid "<plan kind>/<segment>", its
+    arrowhead "<plan kind>/<segment>^", so that a test can find them."""
+    lines: tuple
+    polylines: tuple
+    polygons: tuple
+    dots: tuple
+    texts: tuple
 
+
+def pages(sheet: OneSheet, title: str) -> list[Page]:
+    """The A3 sheets of `sheet` (`one_sheet`: one, unless its plans fit none): the frame, the title
+    block (`title`, the note that every plan is true to scale, the scales coarser than the texts'
+    rule (`OneSheet.coarsened`) and, where the plans take more than one sheet, its number) and each
+    plan's drawing with its heading where `layout` placed it, 1 mm of the drawing = 1 mm of the page."""
     lang, drawings, places = sheet.lang, sheet.drawings, sheet.places
     n = max(p.page for p in places) + 1
-    W, H = SHEET_MM
-    figs = []
-    for k in range(n):
-        fig = Figure(figsize=(W / 25.4, H / 25.4))
-        ax = fig.add_axes((0, 0, 1, 1))
-        ax.set_xlim(0, W)
-        ax.set_ylim(H, 0)
-        ax.set_axis_off()
+    parts = [([], [], [], [], []) for _ in range(n)]           # lines, polylines, polygons, dots, texts
+    tb = TITLE_BLOCK
+    for k, (lines, polylines, polygons, dots, texts) in enumerate(parts):
         x0, y0, x1, y1 = 20.0, 5.0, 415.0, 292.0
-        ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], color="k", lw=0.7 * _PT)
-        tb = TITLE_BLOCK
-        ax.plot([tb[0], tb[0], tb[2]], [tb[3], tb[1], tb[1]], color="k", lw=0.5 * _PT)
-        ax.text(24, 10, title, fontsize=4.0 * _PT, va="baseline", weight="bold")
+        polylines.append((((x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)), 0.7, "#000"))
+        polylines.append((((tb[0], tb[3]), (tb[0], tb[1]), (tb[2], tb[1])), 0.5, "#000"))
+        texts.append((24.0, 10.0, title, 4.0, "bold"))
         notes = [text("pack.a3_true", lang)]
         if n > 1:
             notes += [text("pack.a3_page", lang, k=k + 1, n=n), text("pack.a3_more", lang, n=n)]
@@ -397,34 +402,39 @@ def pages(sheet: OneSheet, title: str):
         rows += [(ln, 2.8, "normal") for s in notes for ln in _lines(s, 2.8, tb[2] - tb[0] - 6)]
         y = tb[1] + 5.5
         for s, size, weight in rows:
-            ax.text(tb[0] + 3, y, s, fontsize=size * _PT, va="baseline", weight=weight)
+            texts.append((tb[0] + 3, y, s, size, weight))
             y += 1.45 * size
-        figs.append((fig, ax))
     for d, p in zip(drawings, places):
-        ax = figs[p.page][1]
-        X = lambda x: x + p.dx                                         # noqa: E731
-        Y = lambda y: y + p.dy                                         # noqa: E731
-        y = Y(d.box[1]) - _size(d)[2]
+        lines, polylines, polygons, dots, texts = parts[p.page]
+        dx, dy = p.dx, p.dy
+        y = d.box[1] + dy - _size(d)[2]
         for line, size, weight in _heading(d):
             y += 1.3 * size
-            ax.text(X(d.box[0]), y - 0.3 * size, line, fontsize=size * _PT, va="baseline", weight=weight)
-        for pts, width, colour in d.polylines:
-            ax.plot([X(a) for a, _ in pts], [Y(b) for _, b in pts], color=colour, lw=width * _PT,
-                    solid_capstyle="round")
-        for a0, b0, a1, b1, width, dash, colour, name in d.lines:
-            ls = (0, tuple(float(v) * _PT / (width * _PT) for v in dash.split(","))) if dash else "-"
-            (ln,) = ax.plot([X(a0), X(a1)], [Y(b0), Y(b1)], color=colour, lw=width * _PT, ls=ls,
-                            solid_capstyle="round")
-            ln.set_gid(f"{d.kind}/{name}")
-        for pts, colour, owner in d.polygons:
-            poly = Polygon([(X(a), Y(b)) for a, b in pts], closed=True, facecolor=colour, edgecolor="none")
-            poly.set_gid(f"{d.kind}/{owner}^")
-            ax.add_patch(poly)
-        for a, b, r in d.dots:
-            ax.add_patch(Circle((X(a), Y(b)), r, facecolor="k", edgecolor="none"))
+            texts.append((d.box[0] + dx, y - 0.3 * size, line, size, weight))
+        polylines += [(tuple((a + dx, b + dy) for a, b in pts), width, colour) for pts, width, colour in d.polylines]
+        lines += [(a0 + dx, b0 + dy, a1 + dx, b1 + dy, width, tuple(float(v) for v in dash.split(",")) if dash else (),
+                   colour, f"{d.kind}/{name}") for a0, b0, a1, b1, width, dash, colour, name in d.lines]
+        polygons += [(tuple((a + dx, b + dy) for a, b in pts), colour, f"{d.kind}/{owner}^")
+                     for pts, colour, owner in d.polygons]
+        dots += [(a + dx, b + dy, r) for a, b, r in d.dots]
         for a, b, runs in d.texts:
-            x = X(a)
+            x = a + dx
             for s, size, low in runs:
-                ax.text(x, Y(b) + low, s, fontsize=size * _PT, va="baseline", ha="left")
+                texts.append((x, b + dy + low, s, size, "normal"))
                 x += _width(s, size)
-    return [f for f, _ in figs]
+    return [Page(*(tuple(part) for part in page)) for page in parts]
+
+
+def draw_page(pdf, page: Page) -> None:
+    """`page` onto a new A3 page of `pdf` (`pdf.Canvas`)."""
+    pdf.page(SHEET_MM)
+    for pts, width, colour in page.polylines:
+        pdf.polyline(pts, width, colour)
+    for x0, y0, x1, y1, width, dash, colour, _ in page.lines:
+        pdf.line(x0, y0, x1, y1, width, colour, dash, round_cap=not dash)
+    for pts, colour, _ in page.polygons:
+        pdf.polygon(pts, colour)
+    for x, y, r in page.dots:
+        pdf.dot(x, y, r)
+    for x, y, s, size, weight in page.texts:
+        pdf.text(x, y, s, size, bold=weight == "bold")

@@ -22,19 +22,17 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
   the A3 sheet) is drawn at those scales.
 
 Both documents are one list of blocks (headings, paragraphs, tables, the drawing area), rendered
-twice: to PDF by matplotlib's PDF backend (pure Python, already the plans' Figure library; TrueType
-DejaVu Sans embedded as Type 42 with its Unicode map, so pdftotext reads the Cyrillic back) and to
-HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
+twice: to PDF by reportlab (`.pdf`: DejaVu Sans embedded as a TrueType subset with its Unicode
+map, so pdftotext reads the Cyrillic back) and to HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
 May use: `build` of this package, `.a3`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `model.lettering`,
-`kinetostat._io`; matplotlib inside the PDF writers only. Never the harness, nor `kinetostat.variants` (the variant
+`.pdf`, `kinetostat._io`. Never matplotlib, never the harness, nor `kinetostat.variants` (the variant
 is passed in and says its task, title and letters).
 """
 from __future__ import annotations
 
 import math
 import textwrap
-from contextlib import contextmanager
 from dataclasses import dataclass
 from html import escape
 from pathlib import Path
@@ -45,6 +43,7 @@ import numpy as np
 from .._io import write_bytes, write_text
 from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
+from .pdf import ASCENT, Canvas
 from ..model.lettering import lettering
 from .worksheet import CSS, Worksheet, analyses, html_document, worksheet_cycle
 
@@ -308,23 +307,6 @@ _PRINT_A3 = """@page{size:420mm 297mm;margin:0}
 
 # ============================================================================ PDF
 
-@contextmanager
-def _rc():
-    """matplotlib's settings of the PDFs (TrueType fonts, DejaVu Sans, no mathtext), and fontTools'
-    note on DejaVu's font timestamps, which every subset prints, kept quiet meanwhile."""
-    import logging
-
-    import matplotlib
-    log = logging.getLogger("fontTools.ttLib.tables._h_e_a_d")
-    level = log.level
-    log.setLevel(logging.ERROR)
-    try:
-        with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": "DejaVu Sans", "text.parse_math": False}):
-            yield
-    finally:
-        log.setLevel(level)
-
-
 def _wrap(s: str, width_mm: float, size: float) -> list[str]:
     """`s` in lines of about `width_mm` at `size` pt (DejaVu Sans: about 0.57 em a character)."""
     chars = max(int(width_mm / (0.57 * size * _PT)), 4)
@@ -332,42 +314,30 @@ def _wrap(s: str, width_mm: float, size: float) -> list[str]:
 
 
 class _Flow:
-    """Blocks laid out top to bottom on A4 portrait pages (mm from the top left)."""
+    """Blocks laid out top to bottom on A4 portrait pages of `pdf` (`pdf.Canvas`, mm from the top left)."""
 
     def __init__(self, pdf):
-        self.pdf, self.fig, self.y, self.lines = pdf, None, 0.0, []
+        self.pdf, self.size, self.y = pdf, None, 0.0
         self.x0, self.width = _MARGIN[0], A4[0] - _MARGIN[0] - _MARGIN[1]
 
     def page(self, size=A4) -> None:
-        from matplotlib.figure import Figure
-        self.close()
-        self.fig, self.size, self.y = Figure(figsize=(size[0] / 25.4, size[1] / 25.4)), size, _MARGIN[2]
-        self.lines: list = []
-
-    def close(self) -> None:
-        """The page's lines as one collection, the page saved."""
-        if self.fig is not None:
-            from matplotlib.collections import LineCollection
-            W, H = self.size
-            for lw in sorted(set(w for _, w in self.lines)):
-                segs = [[(x0 / W, 1 - y0 / H), (x1 / W, 1 - y1 / H)] for (x0, y0, x1, y1), w in self.lines if w == lw]
-                self.fig.add_artist(LineCollection(segs, lw=lw, color="k", transform=self.fig.transFigure))
-            self.pdf.savefig(self.fig)
-            self.fig, self.lines = None, []
+        self.pdf.page(size)
+        self.size, self.y = size, _MARGIN[2]
 
     def room(self, h: float) -> bool:
         """A new page unless `h` mm fit below; True when a page was started."""
-        if self.fig is None or self.size != A4 or self.y + h > A4[1] - _MARGIN[3]:
+        if self.size != A4 or self.y + h > A4[1] - _MARGIN[3]:
             self.page()
             return True
         return False
 
-    def text(self, x: float, y: float, s: str, size: float, **kw) -> None:
-        W, H = self.size
-        self.fig.text(x / W, 1 - y / H, s, fontsize=size, va="top", **kw)
+    def text(self, x: float, y: float, s: str, size: float, right: bool = False) -> None:
+        """`s` at `size` pt, the top of its line at y (mm)."""
+        self.pdf.text(x, y + ASCENT * size * _PT, s, size * _PT, right=right)
 
     def line(self, x0: float, y0: float, x1: float, y1: float, lw: float = 0.5) -> None:
-        self.lines.append(((x0, y0, x1, y1), lw))
+        """A line `lw` pt wide (mm)."""
+        self.pdf.line(x0, y0, x1, y1, lw * _PT)
 
     def paragraph(self, s: str, size: float, after: float = 2.0) -> None:
         lh = size * _PT * 1.35
@@ -392,8 +362,7 @@ class _Flow:
             for i, (lines, w) in enumerate(zip(wrapped, widths)):
                 for k, ln in enumerate(lines):
                     right = i in t.numeric and not bold
-                    self.text(x + (w - pad if right else pad), self.y + pad + k * lh, ln, size,
-                              ha="right" if right else "left")
+                    self.text(x + (w - pad if right else pad), self.y + pad + k * lh, ln, size, right=right)
                 self.line(x, self.y, x, self.y + h)
                 x += w
             self.line(x, self.y, x, self.y + h)
@@ -416,47 +385,35 @@ class _Flow:
         self.text(25, 7, text_area, 8)
         for k, s in enumerate(lines):             # the title (two lines), then rows of 10 mm to fill in
             y = 249 if k == 0 else 250 + 10 * k + 1
-            self.text(233, y, "\n".join(_wrap(s, 178, 9)), 9)
+            for j, ln in enumerate(_wrap(s, 178, 9)):
+                self.text(233, y + j * 1.2 * 9 * _PT, ln, 9)
             if k:
                 self.line(230, y - 1.5, 415, y - 1.5, 0.3)
 
 
-@contextmanager
-def _pdf_pages(title: str):
-    """A PDF written into a buffer (`PdfPages`, metadata `title`) in the PDFs' settings (`_rc`):
-    yields (pages, buffer)."""
-    import io
-
-    from matplotlib.backends.backend_pdf import PdfPages
-    buf = io.BytesIO()
-    with _rc(), PdfPages(buf, metadata={"Title": title, "Creator": "kinetostat"}) as pdf:
-        yield pdf, buf
-
-
 def _pdf(blocks, title: str) -> bytes:
     """The blocks as PDF (A4 portrait, the drawing area on A3 landscape)."""
-    with _pdf_pages(title) as (pdf, buf):
-        flow = _Flow(pdf)
-        for kind, x in blocks:
-            if kind == "h1":
-                flow.paragraph(x, 13, after=3)
-            elif kind == "h2":
-                flow.room(20)
-                flow.paragraph(x, 10.5, after=1.5)
-            elif kind == "p":
-                flow.paragraph(x, 9)
-            elif kind == "table":
-                flow.table(x)
-            else:
-                flow.area(*x)
-        flow.close()
-    return buf.getvalue()
+    pdf = Canvas(title)
+    flow = _Flow(pdf)
+    for kind, x in blocks:
+        if kind == "h1":
+            flow.paragraph(x, 13, after=3)
+        elif kind == "h2":
+            flow.room(20)
+            flow.paragraph(x, 10.5, after=1.5)
+        elif kind == "p":
+            flow.paragraph(x, 9)
+        elif kind == "table":
+            flow.table(x)
+        else:
+            flow.area(*x)
+    return pdf.getvalue()
 
 
 def _plans_pdf(a3, title: str) -> bytes:
-    """All the plans true to scale on one A3 landscape sheet (`a3.pages`)."""
-    from .a3 import pages
-    with _pdf_pages(title) as (pdf, buf):
-        for fig in pages(a3, title):
-            pdf.savefig(fig)
-    return buf.getvalue()
+    """All the plans true to scale on one A3 landscape sheet (`a3.pages`, drawn by `a3.draw_page`)."""
+    from .a3 import draw_page, pages
+    pdf = Canvas(title)
+    for page in pages(a3, title):
+        draw_page(pdf, page)
+    return pdf.getvalue()
