@@ -194,9 +194,9 @@ def _near(items: np.ndarray, region: np.ndarray) -> np.ndarray:
     lo, hi = np.minimum(items[..., :2], items[..., 2:]), np.maximum(items[..., :2], items[..., 2:])
     near = (lo[..., 0] <= region[:, None, 2]) & (hi[..., 0] >= region[:, None, 0]) \
         & (lo[..., 1] <= region[:, None, 3]) & (hi[..., 1] >= region[:, None, 1])
+    if len(items) == 1:
+        return items[:, near[0]]
     m = int(near.sum(axis=1).max(initial=0))
-    if m == 0:
-        return np.empty((len(items), 0, 4))
     idx = np.argsort(~near, axis=1, kind="stable")[:, :m]
     out = np.take_along_axis(items, idx[..., None], axis=1)
     return np.where(np.take_along_axis(near, idx, axis=1)[..., None], out, np.nan)
@@ -212,32 +212,33 @@ class Placer:
     def __init__(self, n: int, bounds: tuple[float, float, float, float]):
         self.n = n
         self.bounds = bounds
-        self._hard: list[np.ndarray] = []              # each (N, 4) or (1, 4), grown by PAD
-        self._soft: list[np.ndarray] = []              # each (N, 4) or (1, 4)
-        self._stacked: dict[str, np.ndarray] = {}
+        self._hard: list[np.ndarray] = []              # each (N, S, 4), grown by PAD
+        self._soft: list[np.ndarray] = []              # each (N, S, 4)
+        self._stacked: dict[str, tuple[int, np.ndarray]] = {}     # parts stacked, and their stack
 
     def block(self, box) -> None:
         """Hard obstacles at every angle: boxes (4,), (R, 4) or (R, S, 4), R = N or 1 (the same at
         every angle); NaN where absent."""
         self._hard.append(self._rows(box) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD]))
-        self._stacked.pop("hard", None)
 
     def line(self, seg) -> None:
         """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent."""
         self._soft.append(self._rows(seg))
-        self._stacked.pop("soft", None)
 
     def _rows(self, a) -> np.ndarray:
         a = np.asarray(a, dtype=float)
-        return a.reshape(1, 1, 4) if a.ndim == 1 else a[:, None] if a.ndim == 2 else a
+        return np.broadcast_to(a.reshape(1, 1, 4) if a.ndim == 1 else a[:, None] if a.ndim == 2 else a,
+                               (self.n,) + ((1,) if a.ndim < 3 else a.shape[1:2]) + (4,))
 
     def _stack(self, key: str) -> np.ndarray:
-        """Every hard obstacle (grown by PAD) or every line, at every angle (N, H, 4)."""
-        if key not in self._stacked:
-            parts = self._hard if key == "hard" else self._soft
-            self._stacked[key] = (np.concatenate([np.broadcast_to(p, (self.n,) + p.shape[1:]) for p in parts], axis=1)
-                                  if parts else np.empty((self.n, 0, 4)))
-        return self._stacked[key]
+        """Every hard obstacle (grown by PAD) or every line, at every angle (N, H, 4): the parts
+        added since the last call appended."""
+        parts = self._hard if key == "hard" else self._soft
+        done, stacked = self._stacked.get(key, (0, np.empty((self.n, 0, 4))))
+        if done < len(parts):
+            stacked = np.concatenate([stacked, *parts[done:]], axis=1)
+            self._stacked[key] = (len(parts), stacked)
+        return stacked
 
     def place(self, names: tuple[str, ...], variant: np.ndarray, size: float, anchor: np.ndarray,
               along: np.ndarray | None = None) -> Placed:
@@ -297,25 +298,24 @@ class Placer:
         cost = np.full((n, K), np.inf)
         best = np.full(n, np.inf)
         hard, soft = self._stack("hard"), self._stack("soft")
+        slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         for start in range(0, K, _BATCH):
-            rows = np.nonzero(rest[:, start] <= best + SLACK)[0]
+            rows = np.nonzero(rest[:, start] <= best + slack)[0]
             if not len(rows):
                 break
             idx = order[start:start + _BATCH]
-            b = boxes[rows][:, idx]                                         # (n', B, 4)
-            c = base[rows][:, idx]
-            region = np.concatenate([np.nanmin(np.where(np.isfinite(c)[..., None], b, np.nan)[..., :2], axis=1),
-                                     np.nanmax(np.where(np.isfinite(c)[..., None], b, np.nan)[..., 2:], axis=1)],
-                                    axis=1) if np.isfinite(c).any() else None
-            if region is None:
-                continue
+            b = boxes[rows[:, None], idx]                                   # (n', B, 4)
+            c = base[rows[:, None], idx]
+            free = np.isfinite(c)[..., None]
+            region = np.concatenate([np.where(free, b[..., :2], np.inf).min(axis=1),
+                                     np.where(free, b[..., 2:], -np.inf).max(axis=1)], axis=1)
             ob = _near(hard[rows], region)
             if ob.shape[1]:
                 c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
             ln = _near(soft[rows], region)
             if ln.shape[1]:
                 c = c + LINE_COST * _clipped(ln[:, None], b[:, :, None]).sum(axis=2)
-            cost[rows[:, None], idx[None, :]] = c
+            cost[rows[:, None], idx] = c
             best[rows] = np.minimum(best[rows], c.min(axis=1))
         ok = cost <= best[:, None] + SLACK
         k = np.where(np.isfinite(base).any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
