@@ -172,34 +172,38 @@ def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
-    """Length (mm) of each segment (x0, y0, x1, y1) inside each box (broadcast, last axis 4):
-    the segment clipped to the box (Liang-Barsky); 0 where either is NaN."""
+    """Length (mm) of each segment (x0, y0, x1, y1) strictly inside each box (broadcast, last axis
+    4): the segment clipped to the box (Liang-Barsky; a segment parallel to a side divides by a
+    signed zero: +-inf inside the slab or out of it, NaN on its edge); 0 where either is NaN."""
     p, d = seg[..., :2], seg[..., 2:] - seg[..., :2]
-    lo_b, hi_b = box[..., :2], box[..., 2:]
     with np.errstate(divide="ignore", invalid="ignore"):
-        t0, t1 = (lo_b - p) / d, (hi_b - p) / d
-        flat = d == 0                                       # parallel to a side: inside the slab or not
-        inside = (p > lo_b) & (p < hi_b)
-        lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(t0, t1))
-        hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(t0, t1))
-        t_in = np.maximum(np.maximum(lo[..., 0], lo[..., 1]), 0.0)
-        t_out = np.minimum(np.minimum(hi[..., 0], hi[..., 1]), 1.0)
+        t0, t1 = (box[..., :2] - p) / d, (box[..., 2:] - p) / d
+        t_in = np.maximum(np.minimum(t0, t1).max(axis=-1), 0.0)
+        t_out = np.minimum(np.maximum(t0, t1).min(axis=-1), 1.0)
         length = (t_out - t_in) * np.hypot(d[..., 0], d[..., 1])
     return np.where(length > 0, length, 0.0)
 
 
-def _near(items: np.ndarray, region: np.ndarray) -> np.ndarray:
-    """Of `items` (N, H, 4) (boxes, or segments by their bounding boxes), at each angle those whose
-    box meets `region` (N, 4), packed (N, m, 4), NaN-padded: m the most at any angle."""
-    lo, hi = np.minimum(items[..., :2], items[..., 2:]), np.maximum(items[..., :2], items[..., 2:])
-    near = (lo[..., 0] <= region[:, None, 2]) & (hi[..., 0] >= region[:, None, 0]) \
-        & (lo[..., 1] <= region[:, None, 3]) & (hi[..., 1] >= region[:, None, 1])
+def _bounds(items: np.ndarray) -> np.ndarray:
+    """Bounding boxes (..., 4) of boxes or segments (..., 4)."""
+    return np.concatenate([np.minimum(items[..., :2], items[..., 2:]), np.maximum(items[..., :2], items[..., 2:])],
+                          axis=-1)
+
+
+def _near(items: np.ndarray, bb: np.ndarray, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Of `items` (N, H, 4) (boxes, or segments) with their bounding boxes `bb`, at each angle
+    those whose box meets `region` (N, 4), packed (N, m, 4), NaN-padded (m the most at any
+    angle), and their bounding boxes."""
+    near = (bb[..., 0] <= region[:, None, 2]) & (bb[..., 2] >= region[:, None, 0]) \
+        & (bb[..., 1] <= region[:, None, 3]) & (bb[..., 3] >= region[:, None, 1])
     if len(items) == 1:
-        return items[:, near[0]]
-    m = int(near.sum(axis=1).max(initial=0))
-    idx = np.argsort(~near, axis=1, kind="stable")[:, :m]
-    out = np.take_along_axis(items, idx[..., None], axis=1)
-    return np.where(np.take_along_axis(near, idx, axis=1)[..., None], out, np.nan)
+        return items[:, near[0]], bb[:, near[0]]
+    rank = np.cumsum(near, axis=1) - 1
+    r, j = np.nonzero(near)
+    out = np.full((2, len(items), int(rank[:, -1].max(initial=-1)) + 1, 4), np.nan)
+    out[0, r, rank[r, j]] = items[r, j]
+    out[1, r, rank[r, j]] = bb[r, j]
+    return out[0], out[1]
 
 
 class Placer:
@@ -213,7 +217,7 @@ class Placer:
         self.n = n
         self.bounds = bounds
         self._hard: list[np.ndarray] = []              # each (N, S, 4), grown by PAD
-        self._soft: list[np.ndarray] = []              # each (N, S, 4)
+        self._soft: list[np.ndarray] = []              # each (N, S, 8): lines, their bounding boxes
         self._stacked: dict[str, tuple[int, np.ndarray]] = {}     # parts stacked, and their stack
 
     def block(self, box) -> None:
@@ -223,7 +227,8 @@ class Placer:
 
     def line(self, seg) -> None:
         """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent."""
-        self._soft.append(self._rows(seg))
+        rows = self._rows(seg)
+        self._soft.append(np.concatenate([rows, _bounds(rows)], axis=-1))
 
     def _rows(self, a) -> np.ndarray:
         a = np.asarray(a, dtype=float)
@@ -231,10 +236,10 @@ class Placer:
                                (self.n,) + ((1,) if a.ndim < 3 else a.shape[1:2]) + (4,))
 
     def _stack(self, key: str) -> np.ndarray:
-        """Every hard obstacle (grown by PAD) or every line, at every angle (N, H, 4): the parts
-        added since the last call appended."""
+        """Every hard obstacle (grown by PAD) (N, H, 4), or every line and its bounding box
+        (N, H, 8), at every angle: the parts added since the last call appended."""
         parts = self._hard if key == "hard" else self._soft
-        done, stacked = self._stacked.get(key, (0, np.empty((self.n, 0, 4))))
+        done, stacked = self._stacked.get(key, (0, np.empty((self.n, 0, 4 if key == "hard" else 8))))
         if done < len(parts):
             stacked = np.concatenate([stacked, *parts[done:]], axis=1)
             self._stacked[key] = (len(parts), stacked)
@@ -298,6 +303,7 @@ class Placer:
         cost = np.full((n, K), np.inf)
         best = np.full(n, np.inf)
         hard, soft = self._stack("hard"), self._stack("soft")
+        soft, soft_bb = soft[..., :4], soft[..., 4:]
         slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         for start in range(0, K, _BATCH):
             rows = np.nonzero(rest[:, start] <= best + slack)[0]
@@ -309,12 +315,17 @@ class Placer:
             free = np.isfinite(c)[..., None]
             region = np.concatenate([np.where(free, b[..., :2], np.inf).min(axis=1),
                                      np.where(free, b[..., 2:], -np.inf).max(axis=1)], axis=1)
-            ob = _near(hard[rows], region)
+            ob, _ = _near(hard[rows], hard[rows], region)
             if ob.shape[1]:
                 c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
-            ln = _near(soft[rows], region)
-            if ln.shape[1]:
-                c = c + LINE_COST * _clipped(ln[:, None], b[:, :, None]).sum(axis=2)
+            ln, bb = _near(soft[rows], soft_bb[rows], region)
+            if ln.shape[1]:                             # the lines clipped to the free boxes they may cross
+                r, j = np.nonzero(np.isfinite(c))
+                fb, lb = b[r, j][:, None], bb[r]
+                f, m = np.nonzero((lb[..., 0] < fb[..., 2]) & (lb[..., 2] > fb[..., 0])
+                                  & (lb[..., 1] < fb[..., 3]) & (lb[..., 3] > fb[..., 1]))
+                covered = np.bincount(f, _clipped(ln[r[f], m], fb[f, 0]), len(r))
+                c[r, j] += LINE_COST * covered
             cost[rows[:, None], idx] = c
             best[rows] = np.minimum(best[rows], c.min(axis=1))
         ok = cost <= best[:, None] + SLACK
