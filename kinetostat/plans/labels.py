@@ -291,6 +291,19 @@ class Placer:
         self.block(box)
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
+    @staticmethod
+    def _covered(b: np.ndarray, which: np.ndarray, ln: np.ndarray, bb: np.ndarray) -> np.ndarray:
+        """LINE_COST times the length of the lines `ln` (n', m, 4) (bounding boxes `bb`) inside
+        each box b (n', B, 4) where `which` (n', B), else 0: each line clipped only to the boxes
+        its bounds meet."""
+        r, j = np.nonzero(which)
+        fb, lb = b[r, j][:, None], bb[r]
+        f, m = np.nonzero((lb[..., 0] < fb[..., 2]) & (lb[..., 2] > fb[..., 0])
+                          & (lb[..., 1] < fb[..., 3]) & (lb[..., 3] > fb[..., 1]))
+        out = np.zeros(which.shape)
+        out[r, j] = LINE_COST * np.bincount(f, _clipped(ln[r[f], m], fb[f, 0]), len(r))
+        return out
+
     def _choose(self, boxes: np.ndarray, base: np.ndarray) -> np.ndarray:
         """The candidate (N,) taken at each angle (-1: none, the anchor NaN): free candidates'
         costs found cheapest first at every angle until none left can come within SLACK of the
@@ -319,13 +332,16 @@ class Placer:
             if ob.shape[1]:
                 c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
             ln, bb = _near(soft[rows], soft_bb[rows], region)
-            if ln.shape[1]:                             # the lines clipped to the free boxes they may cross
-                r, j = np.nonzero(np.isfinite(c))
-                fb, lb = b[r, j][:, None], bb[r]
-                f, m = np.nonzero((lb[..., 0] < fb[..., 2]) & (lb[..., 2] > fb[..., 0])
-                                  & (lb[..., 1] < fb[..., 3]) & (lb[..., 3] > fb[..., 1]))
-                covered = np.bincount(f, _clipped(ln[r[f], m], fb[f, 0]), len(r))
-                c[r, j] += LINE_COST * covered
+            if ln.shape[1]:
+                first = np.argmin(c, axis=1)[:, None]                   # the cheapest free: its lines first
+                at_first = np.take_along_axis(c, first, axis=1) + self._covered(
+                    np.take_along_axis(b, first[..., None], axis=1), np.isfinite(np.take_along_axis(c, first, axis=1)),
+                    ln, bb)
+                np.put_along_axis(c, first, at_first, axis=1)
+                bound = np.minimum(best[rows], at_first[:, 0]) + slack  # none dearer can be within slack of the best
+                rest_free = np.isfinite(c) & (c <= bound[:, None]) & (np.arange(c.shape[1]) != first)
+                c = np.where(np.isfinite(c) & ~rest_free & (np.arange(c.shape[1]) != first), np.inf, c)
+                c += self._covered(b, rest_free, ln, bb)
             cost[rows[:, None], idx] = c
             best[rows] = np.minimum(best[rows], c.min(axis=1))
         ok = cost <= best[:, None] + SLACK
