@@ -129,9 +129,10 @@ def _numbered(plan: Plan, name: str) -> bool:
     return base != name and base in plan.points
 
 
-def _polygon_sides(plan: Plan) -> list[Segment]:
-    """A force plan's sides in the order drawn (its vector equation), else []."""
-    names = set(plan.equation)
+def _polygon_sides(plan: Plan | PlanCycle) -> list[Segment]:
+    """A force plan's sides (its vector equation's; of a cycle whose order changes with the angle,
+    those of any angle), else []."""
+    names = {n for e in plan.equation for n in ((e,) if isinstance(e, str) else e)}
     return [s for s in plan.segments if s.name in names]
 
 
@@ -488,7 +489,8 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
     for s in cycle.segments:
         za, zb = cycle.points[s.start], cycle.points[s.end]
         a, b = at(za), at(zb)
-        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) \
+            & ~(bool(s.unit) & np.isnan(np.asarray(s.value, dtype=float)))   # a quantity NaN: not drawn there
         if not ok.any():
             continue
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
@@ -560,9 +562,11 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
             lead = owner[:, j] == j
             if not lead.any():
                 continue
-            rows, variant = np.unique(owner == j, axis=0, return_inverse=True)
+            rows, inverse = np.unique((owner == j)[lead], axis=0, return_inverse=True)
+            variant = np.zeros(len(lead), dtype=int)
+            variant[lead] = inverse.reshape(-1)
             texts = tuple(" ≡ ".join(group[m][0] for m in np.nonzero(row)[0]) for row in rows)
-            labels.append(_Name(texts, variant.reshape(-1), _where(lead, p), None,
+            labels.append(_Name(texts, variant, _where(lead, p), None,
                                 _NUMBERED_MM if numbered else _POINT_MM, "label"))
     return dots, labels
 

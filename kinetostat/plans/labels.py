@@ -200,7 +200,7 @@ def _near(items: np.ndarray, bb: np.ndarray, region: np.ndarray) -> tuple[np.nda
         return items[:, near[0]], bb[:, near[0]]
     rank = np.cumsum(near, axis=1) - 1
     r, j = np.nonzero(near)
-    out = np.full((2, len(items), int(rank[:, -1].max(initial=-1)) + 1, 4), np.nan)
+    out = np.full((2, len(items), int(near.sum(axis=1).max(initial=0)), 4), np.nan)
     out[0, r, rank[r, j]] = items[r, j]
     out[1, r, rank[r, j]] = bb[r, j]
     return out[0], out[1]
