@@ -4,11 +4,17 @@ title and its scales, and beside it the notes: legend, the results the sheet fin
 plan's vector equation and every drawn segment with its length and value), and a matplotlib
 Figure for notebooks and the reports' PNGs.
 
+One renderer: `drawing(cycle)` computes every element of a plan's sheet at all N angles of a
+`PlanCycle` at once, as arrays (`core.Drawing`: one place of the plan on the sheet for the whole
+cycle, the title's φ a text with a variant per angle); `Drawing.svg(i)` writes the sheet of
+angle i; `svg(plan)`, the sheet of one angle, is `drawing` of the cycle of one, written, with
+its notes.
+
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
 results (vectors, the design position) thick, construction thin; a vector shorter than 1 mm at
 its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a polygon whose sides must
 close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
-clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
+(for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
 
@@ -19,6 +25,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -390,19 +397,51 @@ def _arrowhead(a: np.ndarray, b: np.ndarray, length: np.ndarray | float,
     return pts, box, b - u * (0.6 * h)[:, None]
 
 
-def _on_sheet(z: np.ndarray, tx: float, ty: float) -> np.ndarray:
-    """Plan points (..., complex, mm, y up) on the sheet (..., 2) (mm, y down); NaN where not finite."""
-    xy = np.stack([z.real + tx, ty - z.imag], axis=-1)
+def _on_sheet(z: np.ndarray, tx, ty) -> np.ndarray:
+    """Plan points (N, complex, mm, y up) or paths (N or 1, K) on the sheet (..., 2) (mm, y down),
+    moved by (tx, ty) (scalars, or (N,) one each angle); NaN where not finite."""
+    if np.ndim(tx) and z.ndim == 2:
+        tx, ty = tx[:, None], ty[:, None]
+    xy = np.stack(np.broadcast_arrays(z.real + tx, ty - z.imag), axis=-1)
     return np.where(np.isfinite(xy).all(axis=-1, keepdims=True), xy, np.nan)
 
 
-def _cycle_extent(cycle: PlanCycle) -> tuple[float, float, float, float]:
-    """(x0, y0, x1, y1) of the cycle's finite points and paths at every angle, mm (`extent` over the angles)."""
-    z = np.concatenate([np.ravel(v) for v in (*cycle.points.values(), *cycle.paths.values())] or [np.zeros(0, complex)])
-    z = z[np.isfinite(z.real) & np.isfinite(z.imag)]
-    if not len(z):
+def _extents(cycle: PlanCycle) -> np.ndarray:
+    """(x0, y0, x1, y1) of the finite points and paths at each angle, mm (N, 4) (`extent` of each
+    angle; NaN where none)."""
+    parts = [np.asarray(v)[:, None] for v in cycle.points.values()]
+    parts += [np.broadcast_to(v, (cycle.n, v.shape[1])) for v in cycle.paths.values()]
+    z = np.concatenate(parts, axis=1) if parts else np.zeros((cycle.n, 0), complex)
+    fin = np.isfinite(z.real) & np.isfinite(z.imag)
+    x, y = np.where(fin, z.real, np.nan), np.where(fin, z.imag, np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)           # an angle with nothing finite: NaN
+        return np.column_stack([np.nanmin(x, axis=1), np.nanmin(y, axis=1), np.nanmax(x, axis=1),
+                                np.nanmax(y, axis=1)]) if z.shape[1] else np.full((cycle.n, 4), np.nan)
+
+
+def _union(ext: np.ndarray) -> tuple[float, float, float, float]:
+    """The extent over every angle (the cycle's `extent`), (0, 0, 0, 0) where nothing is finite."""
+    if not np.isfinite(ext).any():
         return 0.0, 0.0, 0.0, 0.0
-    return float(z.real.min()), float(z.imag.min()), float(z.real.max()), float(z.imag.max())
+    return (float(np.nanmin(ext[:, 0])), float(np.nanmin(ext[:, 1])), float(np.nanmax(ext[:, 2])),
+            float(np.nanmax(ext[:, 3])))
+
+
+def _shifts(ext: np.ndarray, area: tuple[float, float, float, float], tx: float, ty: float):
+    """The plan's place on the sheet at each angle: (tx, ty) of the whole cycle, moved at an angle
+    only as far as brings that angle's extent inside the area (MIN_DRAWN_MM in from its sides;
+    centred where wider): scalars where it moves at no angle, else (N,) each."""
+    lo = np.array(area[:2]) + MIN_DRAWN_MM
+    hi = np.array(area[2:]) - MIN_DRAWN_MM
+    s0 = np.column_stack([ext[:, 0] + tx, ty - ext[:, 3]])          # each angle's box on the sheet
+    s1 = np.column_stack([ext[:, 2] + tx, ty - ext[:, 1]])
+    move = np.where(s1 - s0 > hi - lo, (lo + hi) / 2 - (s0 + s1) / 2,
+                    np.where(s0 < lo, lo - s0, np.where(s1 > hi, hi - s1, 0.0)))
+    move = np.nan_to_num(move)
+    if not move.any():
+        return tx, ty
+    return tx + move[:, 0], ty + move[:, 1]
 
 
 def _where(mask: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -575,14 +614,15 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where `notes`."""
     _lang(lang)
     tiny = _tiny(cycle)
-    box = _cycle_extent(cycle)
+    ext = _extents(cycle)
+    box = _union(ext)
     lines = np.array([len(x) for x in cycle.notes] if cycle.notes else [0] * cycle.n) \
         + sum((v != _AS_IS).astype(int) for v in tiny.values())
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
     plan = cycle.at(i)
     block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, _tiny_at(tiny, i), box, draw=notes)
     x0, y0, x1, y1 = box
-    tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
+    tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
     def at(z: np.ndarray) -> np.ndarray:
         return _on_sheet(z, tx, ty)
@@ -616,8 +656,9 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
 
 def drawing(cycle: PlanCycle, lang: str = "en", mechanism: str = "", contract: bool = False) -> Drawing:
     """The plan's A3 sheet at each angle of the cycle, true to scale (1 user unit = 1 mm), as
-    arrays (`Drawing`): one place of the plan on the sheet for the whole cycle (centred in the room
-    its notes leave at the angle with the most of them, over its extent at every angle), every
+    arrays (`Drawing`): one place of the plan on the sheet for the whole cycle (its extent over
+    every angle centred in the room its notes leave at the angle with the most of them; moved at an
+    angle only as far as keeps that angle's plan in the room, where the cycle's is larger), every
     element at every angle, labels placed for the cycle at once (`labels.Placer`); the notes left
     out, their room kept (the page's tables hold them). `contract`: every segment's element carries
     data-plan, data-segment and its drawn length (data-length-mm, as in segments.csv; a negligible
