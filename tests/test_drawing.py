@@ -168,17 +168,19 @@ def test_the_numeric_check_finds_a_planted_clash(ice_cycle):
 
 def test_labels_keep_their_place_from_angle_to_angle():
     """A label keeps one place beside its point over the angles where that place is free: on the
-    ICE's velocity plan every 5 deg, most labels keep their offset between neighbouring angles."""
-    cycle = stacked(kinetostat.load("ice_crank_slider"), np.arange(0.0, 60.0, 5.0))["velocity"]
-    d = drawing(cycle, "uk")
+    ICE's velocity and acceleration plans every 5 deg, at least 90 % of the points' labels keep
+    their offset between neighbouring angles (each angle's best place alone: 85 %)."""
+    cycles = stacked(kinetostat.load("ice_crank_slider"), np.arange(0.0, 60.0, 5.0))
     kept = []
-    for e in d.elements:
-        if e.tag == "text" and e.attrs.get("class") == "label":
-            name = re.sub("<[^>]+>", "", e.texts[0])
-            anchor = cycle.points["pi" if name == "π" else name.split(" ")[0]]
-            off = e.xy[:, 0] - np.column_stack([anchor.real, -anchor.imag])
-            kept += list(np.hypot(*np.diff(off, axis=0).T) < 1e-6)
-    assert len(kept) > 20 and np.mean(kept) >= 0.9, np.mean(kept)
+    for kind in ("velocity", "acceleration"):
+        cycle = cycles[kind]
+        for e in drawing(cycle, "uk").elements:
+            if e.tag == "text" and e.attrs.get("class") == "label":
+                name = re.sub("<[^>]+>", "", e.texts[0]).split(" ")[0]
+                anchor = cycle.points["pi" if name == "π" else name]
+                off = e.xy[:, 0] - np.column_stack([anchor.real, -anchor.imag])
+                kept += list(np.hypot(*np.diff(off, axis=0).T) < 1e-6)
+    assert len(kept) > 80 and np.mean(kept) >= 0.9, np.mean(kept)
 
 
 def test_text_widths_are_dejavu_sans_advances():
