@@ -332,19 +332,11 @@ class Placer:
             if ob.shape[1]:
                 c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
             ln, bb = _near(soft[rows], soft_bb[rows], region)
-            if ln.shape[1]:
-                first = np.argmin(c, axis=1)[:, None]                   # the cheapest free: its lines first
-                at_first = np.take_along_axis(c, first, axis=1) + self._covered(
-                    np.take_along_axis(b, first[..., None], axis=1), np.isfinite(np.take_along_axis(c, first, axis=1)),
-                    ln, bb)
-                np.put_along_axis(c, first, at_first, axis=1)
-                bound = np.minimum(best[rows], at_first[:, 0]) + slack  # none dearer can be within slack of the best
-                rest_free = np.isfinite(c) & (c <= bound[:, None]) & (np.arange(c.shape[1]) != first)
-                c = np.where(np.isfinite(c) & ~rest_free & (np.arange(c.shape[1]) != first), np.inf, c)
-                c += self._covered(b, rest_free, ln, bb)
+            if ln.shape[1]:                             # the lines each free box covers
+                c += self._covered(b, np.isfinite(c), ln, bb)
             cost[rows[:, None], idx] = c
             best[rows] = np.minimum(best[rows], c.min(axis=1))
-        ok = cost <= best[:, None] + SLACK
+        ok = cost <= best[:, None] + slack
         k = np.where(np.isfinite(base).any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
         todo = np.isfinite(best)
         while todo.any():
