@@ -402,8 +402,7 @@ def _on_sheet(z: np.ndarray, tx, ty) -> np.ndarray:
     moved by (tx, ty) (scalars, or (N,) one each angle); NaN where not finite."""
     if np.ndim(tx) and z.ndim == 2:
         tx, ty = tx[:, None], ty[:, None]
-    x, y = z.real + tx, ty - z.imag
-    xy = np.stack(np.broadcast_arrays(x, y) if np.ndim(tx) else (x, y), axis=-1)
+    xy = np.stack([z.real + tx, ty - z.imag], axis=-1)
     return np.where(np.isfinite(xy).all(axis=-1, keepdims=True), xy, np.nan)
 
 
