@@ -20,7 +20,7 @@ from typing import Mapping
 import numpy as np
 
 __all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent",
-           "ELEMENTS", "fixed"]
+           "extent_cycle", "ELEMENTS", "fixed"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -70,7 +70,7 @@ class Result:
     symbol: str
     value: float         # in a PlanCycle: an (N,) array over its angles
     unit: str
-    how: str = ""
+    how: str = ""        # in a PlanCycle: one key, or (N,) keys where it changes with the angle
 
 
 @dataclass(frozen=True)
@@ -135,6 +135,25 @@ def extent(plan: Plan) -> tuple[float, float, float, float]:
     return min(z.real for z in zs), min(z.imag for z in zs), max(z.real for z in zs), max(z.imag for z in zs)
 
 
+def extent_cycle(cycle: "PlanCycle") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(x0, y0, x1, y1), each (N,) mm: `extent` of the plan at every angle of the cycle (its finite
+    points and paths; 0 where none is finite)."""
+    n = cycle.n
+    cols = [v.reshape(n, 1) for v in cycle.points.values()]
+    cols += [np.broadcast_to(v, (n, v.shape[1])) for v in cycle.paths.values()]
+    if not cols:
+        return tuple(np.zeros(n) for _ in range(4))
+    z = np.concatenate(cols, axis=1)
+    ok = np.isfinite(z.real) & np.isfinite(z.imag)
+    some = ok.any(axis=1)
+    out = []
+    for part, lo in ((z.real, True), (z.imag, True), (z.real, False), (z.imag, False)):
+        v = (np.min(part, axis=1, where=ok, initial=np.inf) if lo else np.max(part, axis=1, where=ok, initial=-np.inf))
+        out.append(np.where(some, v, 0.0))
+    x0, y0, x1, y1 = out
+    return x0, y0, x1, y1
+
+
 def _one(x, i: int) -> float:
     return float(np.asarray(x).reshape(-1)[i if np.size(x) > 1 else 0])
 
@@ -148,7 +167,10 @@ class PlanCycle:
     Arrays, each with the leading angle axis N: `phi_deg` (N,) deg; `points[name]` (N,) complex,
     mm on the sheet (x right, y up); each segment's `value` and each result's `value` (N,) SI;
     `paths[name]` (N, K) complex mm, or (1, K) where the path is the same at every angle;
-    `accuracy`: (digits left (N,), the count under which a sheet states it) or None."""
+    `accuracy`: (digits left (N,), the count under which a sheet states it) or None.
+    A segment with a unit whose value is NaN at an angle is not drawn there (`drawn`); `equation`
+    the side names at every angle, or N such tuples where the order changes with the angle (a
+    triad's); a result's `how` one key, or N keys."""
     kind: str
     titles: tuple[str, ...]                # (N,) the title at each angle
     scale: Scale
@@ -209,11 +231,19 @@ class PlanCycle:
             acc = (float(self.accuracy[0][i]), self.accuracy[1])
         return Plan(self.kind, self.titles[i], self.scale, float(self.phi_deg[i]),
                     {k: complex(v[i]) for k, v in self.points.items()},
-                    tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale) for s in self.segments),
+                    tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale)
+                          for s in self.segments if self.drawn(s)[i]),
                     {k: tuple(map(complex, v[i if len(v) > 1 else 0])) for k, v in self.paths.items()},
                     self.notes[i] if self.notes else (),
-                    tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how) for r in self.results),
-                    self.equation, acc)
+                    tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how if isinstance(r.how, str) else r.how[i])
+                          for r in self.results),
+                    self.equation if not self.equation or isinstance(self.equation[0], str) else self.equation[i], acc)
+
+    def drawn(self, s: Segment) -> np.ndarray:
+        """(N,) bool: the angles segment s is drawn at: all, but where a quantity's value (a
+        segment with a unit) is NaN: an element that exists at other angles only (a triad's
+        polygon in another order, an arm of a force that is zero there)."""
+        return np.broadcast_to(~(bool(s.unit) & np.isnan(np.asarray(s.value, dtype=float))), (self.n,))
 
     def __repr__(self) -> str:
         return (f"PlanCycle({self.kind!r}, {self.n} angles, {self.scale}, points={len(self.points)}, "
