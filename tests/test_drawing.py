@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import html
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -20,16 +21,24 @@ from kinetostat.plans.core import ELEMENTS, Drawing, Element, PlanCycle, fixed
 from kinetostat.plans.draw import drawing, svg
 from kinetostat.plans.labels import ASCENT, DESCENT, Placer, text_width
 
+import kinetostat.plans as P
 import sheet_browser
 from conftest import MODELS
-from stacked_cycle import stacked
 
 ANGLES = (0.0, 30.0, 150.0, 250.0)          # 0: the ICE's dead centre (negligible vectors, R12t)
 
 
+def cycles(mech, angles) -> dict[str, PlanCycle]:
+    """Every plan of `mech` at `angles` (deg) from one analysis, at the cycle's scales."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = kinetostat.analyze(mech, phi_deg=np.asarray(angles, dtype=float))
+        return P.build_cycle(mech, res, P.cycle_scales(mech, res=res))
+
+
 @pytest.fixture(scope="module")
 def ice_cycle():
-    return stacked(kinetostat.load("ice_crank_slider"), ANGLES)
+    return cycles(kinetostat.load("ice_crank_slider"), ANGLES)
 
 
 # ----------------------------------------------------------------------------- writing an angle
@@ -170,10 +179,10 @@ def test_labels_keep_their_place_from_angle_to_angle():
     """A label keeps one place beside its point over the angles where that place is free: on the
     ICE's velocity and acceleration plans every 5 deg, at least 90 % of the points' labels keep
     their offset between neighbouring angles (each angle's best place alone: 85 %)."""
-    cycles = stacked(kinetostat.load("ice_crank_slider"), np.arange(0.0, 60.0, 5.0))
+    built = cycles(kinetostat.load("ice_crank_slider"), np.arange(0.0, 60.0, 5.0))
     kept = []
     for kind in ("velocity", "acceleration"):
-        cycle = cycles[kind]
+        cycle = built[kind]
         for e in drawing(cycle, "uk").elements:
             if e.tag == "text" and e.attrs.get("class") == "label":
                 name = re.sub("<[^>]+>", "", e.texts[0]).split(" ")[0]
@@ -246,11 +255,8 @@ def test_cycle_sheets_do_not_overprint_in_chromium(page, ice_cycle):
 def test_every_model_over_24_angles_in_chromium(page, path):
     """Every bundled model, every plan, a cycle of 24 angles (every 15 deg), each angle's sheet
     measured in Chromium: no label over a label or an arrowhead."""
-    mech = kinetostat.load(path)
-    res = kinetostat.analyze(mech, phi_deg=np.arange(0.0, 360.0, 15.0))
-    angles = [float(a) for a, s in zip(res.phi_deg, res.singular) if not s]
-    for kind, cycle in stacked(mech, angles).items():
+    for kind, cycle in cycles(kinetostat.load(path), np.arange(0.0, 360.0, 15.0)).items():
         d = drawing(cycle, "uk")
         for i in range(d.n):
-            assert not clashes(d, i), (path.stem, kind, angles[i], clashes(d, i)[:5])
+            assert not clashes(d, i), (path.stem, kind, float(d.phi_deg[i]), clashes(d, i)[:5])
         _browser_check(page, d, range(d.n))

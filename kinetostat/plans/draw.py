@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
-from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent
+from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, label_parts, text_width
 
@@ -407,17 +407,12 @@ def _on_sheet(z: np.ndarray, tx, ty) -> np.ndarray:
 
 
 def _extents(cycle: PlanCycle) -> np.ndarray:
-    """(x0, y0, x1, y1) of the finite points and paths at each angle, mm (N, 4) (`extent` of each
-    angle; NaN where none)."""
-    parts = [np.asarray(v)[:, None] for v in cycle.points.values()]
-    parts += [np.broadcast_to(v, (cycle.n, v.shape[1])) for v in cycle.paths.values()]
-    z = np.concatenate(parts, axis=1) if parts else np.zeros((cycle.n, 0), complex)
-    fin = np.isfinite(z.real) & np.isfinite(z.imag)
-    x, y = np.where(fin, z.real, np.nan), np.where(fin, z.imag, np.nan)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)           # an angle with nothing finite: NaN
-        return np.column_stack([np.nanmin(x, axis=1), np.nanmin(y, axis=1), np.nanmax(x, axis=1),
-                                np.nanmax(y, axis=1)]) if z.shape[1] else np.full((cycle.n, 4), np.nan)
+    """`extent_cycle` as rows (N, 4), NaN at an angle where nothing is finite (drawn)."""
+    ext = np.column_stack(extent_cycle(cycle))
+    some = np.zeros(cycle.n, dtype=bool)
+    for v in (*cycle.points.values(), *cycle.paths.values()):
+        some |= (np.isfinite(v.real) & np.isfinite(v.imag)).reshape(len(v), -1).any(axis=1)
+    return np.where(some[:, None], ext, np.nan)
 
 
 def _union(ext: np.ndarray) -> tuple[float, float, float, float]:
@@ -528,8 +523,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
     for s in cycle.segments:
         za, zb = cycle.points[s.start], cycle.points[s.end]
         a, b = at(za), at(zb)
-        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) \
-            & ~(bool(s.unit) & np.isnan(np.asarray(s.value, dtype=float)))   # a quantity NaN: not drawn there
+        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) & cycle.drawn(s)
         if not ok.any():
             continue
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
