@@ -425,10 +425,9 @@ def _union(ext: np.ndarray) -> tuple[float, float, float, float]:
 
 def _shifts(ext: np.ndarray, area: tuple[float, float, float, float], tx: float, ty: float):
     """The plan's place on the sheet at each angle: (tx, ty) of the whole cycle, moved at an angle
-    only as far as brings that angle's extent inside the area (MIN_DRAWN_MM in from its sides;
-    centred where wider): scalars where it moves at no angle, else (N,) each."""
-    lo = np.array(area[:2]) + MIN_DRAWN_MM
-    hi = np.array(area[2:]) - MIN_DRAWN_MM
+    only as far as brings that angle's extent inside the area (centred where wider): scalars where
+    it moves at no angle, else (N,) each."""
+    lo, hi = np.array(area[:2]), np.array(area[2:])
     s0 = np.column_stack([ext[:, 0] + tx, ty - ext[:, 3]])          # each angle's box on the sheet
     s1 = np.column_stack([ext[:, 2] + tx, ty - ext[:, 1]])
     move = np.where(s1 - s0 > hi - lo, (lo + hi) / 2 - (s0 + s1) / 2,

@@ -216,33 +216,41 @@ class Placer:
     def __init__(self, n: int, bounds: tuple[float, float, float, float]):
         self.n = n
         self.bounds = bounds
-        self._hard: list[np.ndarray] = []              # each (N, S, 4), grown by PAD
-        self._soft: list[np.ndarray] = []              # each (N, S, 8): lines, their bounding boxes
-        self._stacked: dict[str, tuple[int, np.ndarray]] = {}     # parts stacked, and their stack
+        # ("hard", still) -> boxes grown by PAD (R, S, 4); ("soft", still) -> lines and their bounding
+        # boxes (R, S, 8); R = 1 where still (the same at every angle), else N
+        self._parts: dict[tuple[str, bool], list[np.ndarray]] = {}
+        self._stacked: dict[tuple[str, bool], tuple[int, np.ndarray]] = {}     # parts stacked, their stack
 
     def block(self, box) -> None:
         """Hard obstacles at every angle: boxes (4,), (R, 4) or (R, S, 4), R = N or 1 (the same at
         every angle); NaN where absent."""
-        self._hard.append(self._rows(box) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD]))
+        self._add("hard", self._rows(box) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD]))
 
     def line(self, seg) -> None:
         """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent."""
         rows = self._rows(seg)
-        self._soft.append(np.concatenate([rows, _bounds(rows)], axis=-1))
+        self._add("soft", np.concatenate([rows, _bounds(rows)], axis=-1))
 
     def _rows(self, a) -> np.ndarray:
+        """Obstacles as (R, S, 4): R = 1 where the same at every angle (given so, or found so)."""
         a = np.asarray(a, dtype=float)
-        return np.broadcast_to(a.reshape(1, 1, 4) if a.ndim == 1 else a[:, None] if a.ndim == 2 else a,
-                               (self.n,) + ((1,) if a.ndim < 3 else a.shape[1:2]) + (4,))
+        a = a.reshape(1, 1, 4) if a.ndim == 1 else a[:, None] if a.ndim == 2 else a
+        return a[:1] if len(a) > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape), equal_nan=True) else a
 
-    def _stack(self, key: str) -> np.ndarray:
-        """Every hard obstacle (grown by PAD) (N, H, 4), or every line and its bounding box
-        (N, H, 8), at every angle: the parts added since the last call appended."""
-        parts = self._hard if key == "hard" else self._soft
-        done, stacked = self._stacked.get(key, (0, np.empty((self.n, 0, 4 if key == "hard" else 8))))
+    def _add(self, key: str, part: np.ndarray) -> None:
+        self._parts.setdefault((key, len(part) == 1), []).append(part)
+
+    def _stack(self, key: str, still: bool) -> np.ndarray:
+        """The hard obstacles (grown by PAD) (R, H, 4), or the lines and their bounding boxes
+        (R, H, 8), the same at every angle (still: R = 1) or not (R = N): those added since the
+        last call appended."""
+        parts = self._parts.get((key, still), [])
+        rows = 1 if still else self.n
+        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8))))
         if done < len(parts):
-            stacked = np.concatenate([stacked, *parts[done:]], axis=1)
-            self._stacked[key] = (len(parts), stacked)
+            stacked = np.concatenate([stacked, *(np.broadcast_to(p, (rows,) + p.shape[1:]) for p in parts[done:])],
+                                     axis=1)
+            self._stacked[key, still] = (len(parts), stacked)
         return stacked
 
     def place(self, names: tuple[str, ...], variant: np.ndarray, size: float, anchor: np.ndarray,
@@ -291,6 +299,23 @@ class Placer:
         self.block(box)
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
+    @classmethod
+    def _costs(cls, b: np.ndarray, c: np.ndarray, hard: np.ndarray, soft: np.ndarray) -> np.ndarray:
+        """Costs c (n', B) of boxes b (n', B, 4): inf where a box meets a hard obstacle (n', H, 4),
+        plus LINE_COST per mm of the lines (n', L, 8: with their bounding boxes) inside it."""
+        free = np.isfinite(c)
+        if not free.any():
+            return c
+        region = np.concatenate([np.where(free[..., None], b[..., :2], np.inf).min(axis=1),
+                                 np.where(free[..., None], b[..., 2:], -np.inf).max(axis=1)], axis=1)
+        ob, _ = _near(hard, hard, region)
+        if ob.shape[1]:
+            c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
+        ln, bb = _near(soft[..., :4], soft[..., 4:], region)
+        if ln.shape[1]:                             # the lines each free box covers
+            c = c + cls._covered(b, np.isfinite(c), ln, bb)
+        return c
+
     @staticmethod
     def _covered(b: np.ndarray, which: np.ndarray, ln: np.ndarray, bb: np.ndarray) -> np.ndarray:
         """LINE_COST times the length of the lines `ln` (n', m, 4) (bounding boxes `bb`) inside
@@ -315,8 +340,8 @@ class Placer:
         rest = np.minimum.accumulate(ordered[:, ::-1], axis=1)[:, ::-1]   # least base from j on
         cost = np.full((n, K), np.inf)
         best = np.full(n, np.inf)
-        hard, soft = self._stack("hard"), self._stack("soft")
-        soft, soft_bb = soft[..., :4], soft[..., 4:]
+        still = np.array_equal(boxes, np.broadcast_to(boxes[:1], boxes.shape), equal_nan=True) \
+            and np.array_equal(base, np.broadcast_to(base[:1], base.shape))   # the same candidates at every angle
         slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         for start in range(0, K, _BATCH):
             rows = np.nonzero(rest[:, start] <= best + slack)[0]
@@ -325,15 +350,13 @@ class Placer:
             idx = order[start:start + _BATCH]
             b = boxes[rows[:, None], idx]                                   # (n', B, 4)
             c = base[rows[:, None], idx]
-            free = np.isfinite(c)[..., None]
-            region = np.concatenate([np.where(free, b[..., :2], np.inf).min(axis=1),
-                                     np.where(free, b[..., 2:], -np.inf).max(axis=1)], axis=1)
-            ob, _ = _near(hard[rows], hard[rows], region)
-            if ob.shape[1]:
-                c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
-            ln, bb = _near(soft[rows], soft_bb[rows], region)
-            if ln.shape[1]:                             # the lines each free box covers
-                c += self._covered(b, np.isfinite(c), ln, bb)
+            if still:                                                       # the still obstacles once
+                c = np.broadcast_to(self._costs(b[:1], c[:1], self._stack("hard", True), self._stack("soft", True)),
+                                    c.shape)
+            else:
+                c = self._costs(b, c, *(np.broadcast_to(a, (len(rows),) + a.shape[1:])
+                                        for a in (self._stack("hard", True), self._stack("soft", True))))
+            c = self._costs(b, c, self._stack("hard", False)[rows], self._stack("soft", False)[rows])
             cost[rows[:, None], idx] = c
             best[rows] = np.minimum(best[rows], c.min(axis=1))
         ok = cost <= best[:, None] + slack
