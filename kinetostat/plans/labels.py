@@ -305,7 +305,7 @@ class Placer:
         """Costs c (n', B) of boxes b (n', B, 4): inf where a box meets a hard obstacle (n', H, 4),
         plus LINE_COST per mm of the lines (n', L, 8: with their bounding boxes) inside it."""
         free = np.isfinite(c)
-        if not free.any():
+        if not free.any() or not (hard.shape[1] or soft.shape[1]):
             return c
         region = np.concatenate([np.where(free[..., None], b[..., :2], np.inf).min(axis=1),
                                  np.where(free[..., None], b[..., 2:], -np.inf).max(axis=1)], axis=1)
