@@ -1,6 +1,7 @@
-// The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes the
-// sheets and values stored as templates and second differences (gzip, base64), builds the sheet
-// of the angle chosen, steps through the force plans, checks typed lengths. No network, no library.
+// The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
+// sheet's arrays and the values stored as second differences (gzip, base64), writes the sheet of
+// the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
+// lengths. No network, no library.
 "use strict";
 (async () => {
   const D = JSON.parse(document.getElementById("page-data").textContent);
@@ -26,13 +27,6 @@
       if (b[i] & 128) { m *= 128; } else { out.push(v % 2 ? -(v + 1) / 2 : v / 2); v = 0; m = 1; }
     }
     return out;
-  }
-  function fmt(n, f) {                            // a number as the sheet wrote it
-    if (f === "") return String(n);
-    if (f === "L") return String(n / 1e10);       // page.py LENGTH_Q = 1e-10 mm
-    const d = +f.slice(1);
-    const s = String(Math.abs(n)).padStart(d + 1, "0");
-    return (n < 0 ? "-" : "") + s.slice(0, s.length - d) + f[0] + s.slice(s.length - d);
   }
   function local(x, digits) {                     // `digits` significant digits, as i18n.num writes them
     if (!isFinite(x)) return "—";
@@ -104,33 +98,58 @@
 
   // ------------------------------------------------------------------ the sheets of every angle
   const meta = JSON.parse(new TextDecoder().decode(await bytes("meta")));
-  const kinds = [];
-  for (let k = 0; k < meta.kinds.length; k++) {
-    const K = meta.kinds[k], nums = varints(await bytes("k" + k)), frames = K.frames.map(() => null);
-    const slots = K.keys.map((deltas) => {      // template -> (series -> its slot): page.py _encode_split
-      const m = new Map();
-      let key = -1;
-      deltas.forEach((d, i) => { key += d; m.set(key, i); });
-      return m;
-    });
-    K.frames.forEach((tid, f) => { if (tid >= 0) frames[f] = new Array(slots[tid].size); });
-    let nk = 0;
-    slots.forEach((m) => m.forEach((_, key) => { nk = Math.max(nk, key + 1); }));
-    let p = 0;
-    for (let key = 0; key < nk; key++) {           // series by series, the frames that have it in order
-      let a = 0, b = 0, j = 0;
-      K.frames.forEach((tid, f) => {
-        const i = tid < 0 ? undefined : slots[tid].get(key);
-        if (i === undefined) return;
-        const d = nums[p++], v = j >= 2 ? d + 2 * b - a : j === 1 ? d + b : d;
-        a = b; b = v; j++;
-        frames[f][i] = v;
-      });
+  const nf = D.frames.length, lengthQ = Math.round(1 / D.lengthq);
+  function undiff(nums, p, n) {                 // n values from their second differences at nums[p]
+    const out = new Array(n);
+    for (let j = 0; j < n; j++) {
+      const d = nums[p + j];
+      out[j] = j >= 2 ? d + 2 * out[j - 1] - out[j - 2] : j === 1 ? d + out[0] : d;
     }
-    const templates = K.templates.map((ix) => ix.map((i) => K.lines[i]).join("\n").split("\0"));   // page.py _lines
-    kinds.push({kind: K.kind, templates, tids: K.frames, frames});
+    return out;
   }
-  const rows = D.rows, ncol = rows.length, nf = D.frames.length;
+  function decimals(n) {                         // an integer of 10^-D.coord mm as Drawing.svg writes it
+    const s = String(Math.abs(n)).padStart(D.coord + 1, "0"), cut = s.length - D.coord;
+    return (n < 0 ? "-" : "") + s.slice(0, cut) + (D.coord ? "." + s.slice(cut) : "");
+  }
+  const kinds = [];
+  for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
+    const K = meta.kinds[k], nums = varints(await bytes("k" + k));
+    let p = 0;
+    const take = (n) => { const v = undiff(nums, p, n); p += n; return v; };
+    const elements = K.elements.map((E) => {
+      const attrs = E.attrs.map(([a, v]) => ` ${a}="${v}"`).join("");
+      const el = {tag: E.tag, attrs, title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows};
+      el.drawn = take(nf);
+      el.variant = E.texts.length > 1 ? take(nf) : null;
+      el.xy = [];
+      for (let c = 0; c < 2 * E.m; c++) el.xy.push(take(E.rows));
+      el.len = E.len ? take(nf) : null;
+      return el;
+    });
+    kinds.push({kind: K.kind, static: K.static, elements});
+  }
+  function coords(el, i) {                       // the element's placing attributes at angle i
+    const r = el.rows === 1 ? 0 : i, x = (c) => decimals(el.xy[c][r]);
+    const pt = (j) => x(2 * j) + "," + x(2 * j + 1), m = el.xy.length / 2;
+    switch (el.tag) {
+      case "line": return ` x1="${x(0)}" y1="${x(1)}" x2="${x(2)}" y2="${x(3)}"`;
+      case "circle": return ` cx="${x(0)}" cy="${x(1)}"`;
+      case "text": return ` x="${x(0)}" y="${x(1)}"`;
+      case "polyline": return ` points="${[...Array(m).keys()].map(pt).join(" ")}"`;
+      default: return ` d="M${[...Array(m).keys()].map(pt).join(" L")} z"`;     // a closed path
+    }
+  }
+  function element(el, i) {                      // as core.py Drawing.svg writes one element
+    if (!el.drawn[i]) return "";
+    const len = el.len ? ` data-length-mm="${String(el.len[i] / lengthQ)}"` : "";
+    const body = (el.tag === "text" ? el.texts[el.variant ? el.variant[i] : 0] : "") + el.title;
+    return `<${el.tag}${coords(el, i)}${el.attrs}${len}` + (body ? `>${body}</${el.tag}>` : "/>") + "\n";
+  }
+  function sheet(K, i) {                          // as core.py Drawing.svg(i)
+    return K.static + K.elements.map((el) => element(el, i)).join("") + "</g>\n</svg>\n";
+  }
+  window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
+  const rows = D.rows, ncol = rows.length, singular = new Set(D.singular);
   const vals = varints(await bytes("values"));
   const values = D.frames.map(() => new Array(ncol));
   for (let c = 0; c < ncol; c++) {                 // column by column: page.py _columns
@@ -142,7 +161,6 @@
       values[f][c] = vals[c * nf + f] ? NaN : e < 0 ? n / 10 ** -e : n * 10 ** e;
     }
   }
-
   const sheets = $("sheets");
   sheets.textContent = "";
   const boxes = kinds.map((K) => {
@@ -171,11 +189,8 @@
   function render(f) {
     frame = f;
     kinds.forEach((K, k) => {
-      const a = K.frames[f];
-      if (!a) { boxes[k].textContent = D.ui.singular; return; }
-      const t = K.templates[K.tids[f]], out = [t[0]];
-      for (let i = 0; i < a.length; i++) out.push(fmt(a[i], t[2 * i + 1]), t[2 * i + 2]);
-      boxes[k].innerHTML = out.join("").replace(/<\/svg>\s*$/, D.scalebar + "</svg>");
+      if (singular.has(f)) { boxes[k].textContent = D.ui.singular; return; }
+      boxes[k].innerHTML = sheet(K, f).replace(/^<\?xml[^>]*>\s*/, "").replace(/<\/svg>\s*$/, D.scalebar + "</svg>");
     });
     values[f].forEach((v, c) => {
       cells[c].dataset.value = isFinite(v) ? String(v) : "";
@@ -274,14 +289,14 @@
   const slider = $("phi");
   function frameOf(deg) {                        // the frame of the nearest angle on the slider
     let best = 0;
-    for (let f = 0; f < nf - 1; f++) if (Math.abs(D.frames[f] - deg) < Math.abs(D.frames[best] - deg)) best = f;
+    for (let f = 0; f < D.slider; f++) if (Math.abs(D.frames[f] - deg) < Math.abs(D.frames[best] - deg)) best = f;
     return best;
   }
   slider.addEventListener("input", () => render(frameOf(+slider.value)));
-  $("design").addEventListener("click", () => { slider.value = Math.round(D.design) % 360; render(nf - 1); });
+  $("design").addEventListener("click", () => { slider.value = Math.round(D.design) % 360; render(D.slider); });
   $("next").addEventListener("click", () => { step = (step + 1) % meta.steps.length; highlight(); });
   $("prev").addEventListener("click", () => { step = step <= 0 ? meta.steps.length - 1 : step - 1; highlight(); });
   slider.value = Math.round(D.design) % 360;
-  render(nf - 1);
+  render(D.slider);
   document.body.dataset.ready = "1";
 })();
