@@ -411,3 +411,70 @@ def test_variant_all_writes_a_page_per_code_linked_from_its_index(tmp_path, monk
     assert '<html lang="uk">' in html and f'"at": {float(phi1)!r}' in html
     for index in ("index.md", "index.html"):
         assert "task1_479/page.html" in (tmp_path / index).read_text(encoding="utf-8")
+
+
+def _script_page(drawings, n: int) -> str:
+    """A page of the hand-made `drawings` (Drawing's, n angles) and no values: the key page's
+    script on the elements it looks for (page.py `_html`)."""
+    import base64
+    import gzip
+    import json
+    from importlib import resources
+
+    import numpy as np
+
+    import kinetostat.plans.page as pg
+    kinds, blobs = [], {}
+    for k, d in enumerate(drawings):
+        meta, numbers = pg.encode_drawing(d)
+        kinds.append(meta)
+        blobs[f"k{k}"] = pg._b64gz(numbers)
+    blobs["meta"] = pg._b64gz(json.dumps({"kinds": kinds, "steps": []}).encode())
+    blobs["values"] = pg._b64gz(pg._columns(np.zeros((n, 0)))[1])
+    blobs["check"] = base64.b64encode(pg._obscure(gzip.compress(b'{"items": [], "M": []}'))).decode()
+    data = {"student": False, "frames": list(range(n)), "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
+            "lengthq": pg.LENGTH_Q, "rows": [], "exps": [], "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
+            "mm": "mm", "tiny": 1.0, "tol": 5.0}
+    script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
+    return ('<!DOCTYPE html><html><head><meta charset="utf-8"><style id="page-size"></style></head><body>'
+            '<input type="range" id="phi" min="0" max="359"><output id="phi-value"></output><button id="design"></button>'
+            '<button id="prev"></button><button id="next"></button><output id="step"></output>'
+            '<select id="paper"><option>A3</option><option>A4</option></select><p id="equation"></p>'
+            '<section id="sheets"></section><table id="value-table"></table>'
+            + "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
+            + f'<script id="page-data" type="application/json">{json.dumps(data)}</script><script>{script}</script></body></html>')
+
+
+def test_script_writes_a_hand_made_drawing_at_each_angle(chromium, tmp_path):
+    """A Drawing made by hand (a segment with the contract's attributes, drawn at angles 0 and 2
+    only; a fixed polyline; an arrowhead; a point; a label with two texts) written by the page's
+    script at each angle: every element's coordinates to COORD_DECIMALS, a negative one, a length
+    to LENGTH_Q, a label's text and a segment left out where its points are NaN."""
+    import numpy as np
+
+    from kinetostat.plans.core import Drawing, Element
+    nan = np.nan
+    line = Element("line", [[[10.004, 20.0], [30.5, 40.25]], [[nan, nan], [1, 2]], [[12.0, 21.0], [-3.126, 45.0]]],
+                   {"stroke": "#000", "data-plan": "velocity", "data-segment": "p-b"}, "p-b",
+                   length_mm=np.array([54.123456789, nan, 3.5]))
+    arrow = Element("path", [[[1, 1], [2, 2], [3, 1]]] * 3, {"class": "arrowhead", "fill": "#000"})
+    path = Element("polyline", [[[0, 0], [1.5, 2], [3, 0]]], {"fill": "none"})
+    dot = Element("circle", [[[5, 5]], [[6, 6]], [[7.777, 7]]], {"r": "0.6", "fill": "#000"})
+    label = Element("text", [[[8, 9]], [[8.5, 9]], [[9, 9]]], {"font-size": "3.50"},
+                    texts=("B", 'A<tspan dy="0.70">2</tspan>'), variant=np.array([0, 1, 0]))
+    d = Drawing("velocity", np.array([0.0, 1.0, 2.0]), '<svg><g id="plan">\n', (line, arrow, path, dot, label))
+    f = tmp_path / "hand.html"
+    f.write_text(_script_page([d], 3), encoding="utf-8")
+    pg = _open(chromium, f)
+    got = [pg.evaluate("i => window.sheetSvg(0, i)", i) for i in range(3)]
+    pg.close()
+    assert got[0] == ('<svg><g id="plan">\n'
+                      '<line x1="10.00" y1="20.00" x2="30.50" y2="40.25" stroke="#000" data-plan="velocity" data-segment="p-b" '
+                      'data-length-mm="54.1234568"><title>p-b</title></line>\n'
+                      '<path d="M1.00,1.00 L2.00,2.00 L3.00,1.00 z" class="arrowhead" fill="#000"/>\n'
+                      '<polyline points="0.00,0.00 1.50,2.00 3.00,0.00" fill="none"/>\n'
+                      '<circle cx="5.00" cy="5.00" r="0.6" fill="#000"/>\n'
+                      '<text x="8.00" y="9.00" font-size="3.50">B</text>\n</g>\n</svg>\n')
+    assert "<line" not in got[1] and '<text x="8.50" y="9.00" font-size="3.50">A<tspan dy="0.70">2</tspan></text>' in got[1]
+    assert '<line x1="12.00" y1="21.00" x2="-3.13" y2="45.00"' in got[2] and 'data-length-mm="3.5"' in got[2]
+    assert '<circle cx="7.78" cy="7.00"' in got[2] and "<polyline points=\"0.00,0.00 1.50,2.00 3.00,0.00\"" in got[2]

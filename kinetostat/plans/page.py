@@ -130,9 +130,9 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
         rows = xy.shape[0]
         drawn = np.isfinite(xy).all(axis=(1, 2))
         drawn = np.broadcast_to(drawn, (n,)) if rows == 1 else drawn
-        series.append(drawn.astype(np.int64))
+        series.append(_second_differences(drawn.astype(np.int64)))
         if len(e.texts) > 1:
-            series.append(np.asarray(e.variant, dtype=np.int64).reshape(n))
+            series.append(_second_differences(np.asarray(e.variant, dtype=np.int64).reshape(n)))
         held = _held(xy, np.isfinite(xy).all(axis=(1, 2)))
         series.append(_second_differences(_scaled(held, COORD_DECIMALS).reshape(rows, -1)).T.ravel())
         if e.length_mm is not None:
