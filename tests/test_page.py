@@ -424,6 +424,7 @@ def _script_page(drawings, n: int) -> str:
     import numpy as np
 
     import kinetostat.plans.page as pg
+    from kinetostat.plans.core import ELEMENTS
     kinds, blobs = [], {}
     for k, d in enumerate(drawings):
         meta, numbers = pg.encode_drawing(d)
@@ -433,7 +434,7 @@ def _script_page(drawings, n: int) -> str:
     blobs["values"] = pg._b64gz(pg._columns(np.zeros((n, 0)))[1])
     blobs["check"] = base64.b64encode(pg._obscure(gzip.compress(b'{"items": [], "M": []}'))).decode()
     data = {"student": False, "frames": list(range(n)), "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
-            "lengthq": pg.LENGTH_Q, "rows": [], "exps": [], "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
+            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "rows": [], "exps": [], "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
     return ('<!DOCTYPE html><html><head><meta charset="utf-8"><style id="page-size"></style></head><body>'
@@ -452,7 +453,7 @@ def test_script_writes_a_hand_made_drawing_at_each_angle(chromium, tmp_path):
     to LENGTH_Q, a label's text and a segment left out where its points are NaN."""
     import numpy as np
 
-    from kinetostat.plans.core import Drawing, Element
+    from kinetostat.plans.core import ELEMENTS, Drawing, Element
     nan = np.nan
     line = Element("line", [[[10.004, 20.0], [30.5, 40.25]], [[nan, nan], [1, 2]], [[12.0, 21.0], [-3.126, 45.0]]],
                    {"stroke": "#000", "data-plan": "velocity", "data-segment": "p-b"}, "p-b",
@@ -462,19 +463,27 @@ def test_script_writes_a_hand_made_drawing_at_each_angle(chromium, tmp_path):
     dot = Element("circle", [[[5, 5]], [[6, 6]], [[7.777, 7]]], {"r": "0.6", "fill": "#000"})
     label = Element("text", [[[8, 9]], [[8.5, 9]], [[9, 9]]], {"font-size": "3.50"},
                     texts=("B", 'A<tspan dy="0.70">2</tspan>'), variant=np.array([0, 1, 0]))
-    d = Drawing("velocity", np.array([0.0, 1.0, 2.0]), '<svg><g id="plan">\n', (line, arrow, path, dot, label))
+    hole = Element("polyline", [[[0, 0], [nan, nan], [1, 1], [2, 0]], [[0, 1], [1, 1], [2, 1], [nan, nan]],
+                                [[nan, nan], [nan, nan], [1, 1], [nan, nan]]], {"stroke": "#1f5fa8"})
+    negligible = Element("g", np.zeros((1, 0, 2)), {"class": "negligible", "data-plan": "velocity", "data-segment": "G2"},
+                         length_mm=np.array([0.04, 0.05, 0.0]))
+    d = Drawing("velocity", np.array([0.0, 1.0, 2.0]), '<?xml version="1.0"?>\n<svg><g id="plan">\n' + ELEMENTS + "</g>\n</svg>\n",
+                (line, arrow, path, dot, label, hole, negligible))
     f = tmp_path / "hand.html"
     f.write_text(_script_page([d], 3), encoding="utf-8")
     pg = _open(chromium, f)
     got = [pg.evaluate("i => window.sheetSvg(0, i)", i) for i in range(3)]
     pg.close()
-    assert got[0] == ('<svg><g id="plan">\n'
-                      '<line x1="10.00" y1="20.00" x2="30.50" y2="40.25" stroke="#000" data-plan="velocity" data-segment="p-b" '
-                      'data-length-mm="54.1234568"><title>p-b</title></line>\n'
-                      '<path d="M1.00,1.00 L2.00,2.00 L3.00,1.00 z" class="arrowhead" fill="#000"/>\n'
-                      '<polyline points="0.00,0.00 1.50,2.00 3.00,0.00" fill="none"/>\n'
-                      '<circle cx="5.00" cy="5.00" r="0.6" fill="#000"/>\n'
-                      '<text x="8.00" y="9.00" font-size="3.50">B</text>\n</g>\n</svg>\n')
-    assert "<line" not in got[1] and '<text x="8.50" y="9.00" font-size="3.50">A<tspan dy="0.70">2</tspan></text>' in got[1]
-    assert '<line x1="12.00" y1="21.00" x2="-3.13" y2="45.00"' in got[2] and 'data-length-mm="3.5"' in got[2]
-    assert '<circle cx="7.78" cy="7.00"' in got[2] and "<polyline points=\"0.00,0.00 1.50,2.00 3.00,0.00\"" in got[2]
+    assert got == [d.svg(i) for i in range(3)]
+    assert got[0] == ('<?xml version="1.0"?>\n<svg><g id="plan">\n'
+                      '<line x1="10.004" y1="20.000" x2="30.500" y2="40.250" stroke="#000" data-plan="velocity" data-segment="p-b" '
+                      'data-length-mm="54.123456789"><title>p-b</title></line>\n'
+                      '<path d="M1.000,1.000 L2.000,2.000 L3.000,1.000 z" class="arrowhead" fill="#000"></path>\n'
+                      '<polyline points="0.000,0.000 1.500,2.000 3.000,0.000" fill="none"></polyline>\n'
+                      '<circle cx="5.000" cy="5.000" r="0.6" fill="#000"></circle>\n'
+                      '<text x="8.000" y="9.000" font-size="3.50">B</text>\n'
+                      '<polyline points="0.000,0.000 1.000,1.000 2.000,0.000" stroke="#1f5fa8"></polyline>\n'
+                      '<g class="negligible" data-plan="velocity" data-segment="G2" data-length-mm="0.040000000"></g>\n</g>\n</svg>\n')
+    assert "<line" not in got[1] and '<text x="8.500" y="9.000" font-size="3.50">A<tspan dy="0.70">2</tspan></text>' in got[1]
+    assert '<line x1="12.000" y1="21.000" x2="-3.126" y2="45.000"' in got[2] and 'data-length-mm="3.500000000"' in got[2]
+    assert 'points="0.000,1.000 1.000,1.000 2.000,1.000"' in got[1] and got[2].count("<polyline") == 1

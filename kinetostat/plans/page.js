@@ -98,7 +98,7 @@
 
   // ------------------------------------------------------------------ the sheets of every angle
   const meta = JSON.parse(new TextDecoder().decode(await bytes("meta")));
-  const nf = D.frames.length, lengthQ = Math.round(1 / D.lengthq);
+  const nf = D.frames.length;
   function undiff(nums, p, n) {                 // n values from their second differences at nums[p]
     const out = new Array(n);
     for (let j = 0; j < n; j++) {
@@ -107,9 +107,9 @@
     }
     return out;
   }
-  function decimals(n) {                         // an integer of 10^-D.coord mm as Drawing.svg writes it
-    const s = String(Math.abs(n)).padStart(D.coord + 1, "0"), cut = s.length - D.coord;
-    return (n < 0 ? "-" : "") + s.slice(0, cut) + (D.coord ? "." + s.slice(cut) : "");
+  function fixed(q, digits) {                    // core.py fixed: q / 10^digits with `digits` decimals
+    const s = String(Math.abs(q)).padStart(digits + 1, "0"), cut = s.length - digits;
+    return (q < 0 ? "-" : "") + s.slice(0, cut) + "." + s.slice(cut);
   }
   const kinds = [];
   for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
@@ -117,36 +117,32 @@
     let p = 0;
     const take = (n) => { const v = undiff(nums, p, n); p += n; return v; };
     const elements = K.elements.map((E) => {
-      const attrs = E.attrs.map(([a, v]) => ` ${a}="${v}"`).join("");
-      const el = {tag: E.tag, attrs, title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows};
-      el.drawn = take(nf);
-      el.variant = E.texts.length > 1 ? take(nf) : null;
-      el.xy = [];
-      for (let c = 0; c < 2 * E.m; c++) el.xy.push(take(E.rows));
-      el.len = E.len ? take(nf) : null;
+      const el = {tag: E.tag, attrs: E.attrs.map(([a, v]) => ` ${a}="${v}"`).join(""),
+                  title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows, m: E.m};
+      el.drawn = take(E.rows);
+      el.variant = E.variants ? take(E.variants) : [0];
+      el.finite = E.holes ? [...Array(E.m)].map(() => take(E.rows)) : null;
+      el.xy = [...Array(2 * E.m)].map(() => take(E.rows));
+      el.len = E.len ? take(E.len) : null;
       return el;
     });
     kinds.push({kind: K.kind, static: K.static, elements});
   }
-  function coords(el, i) {                       // the element's placing attributes at angle i
-    const r = el.rows === 1 ? 0 : i, x = (c) => decimals(el.xy[c][r]);
-    const pt = (j) => x(2 * j) + "," + x(2 * j + 1), m = el.xy.length / 2;
-    switch (el.tag) {
-      case "line": return ` x1="${x(0)}" y1="${x(1)}" x2="${x(2)}" y2="${x(3)}"`;
-      case "circle": return ` cx="${x(0)}" cy="${x(1)}"`;
-      case "text": return ` x="${x(0)}" y="${x(1)}"`;
-      case "polyline": return ` points="${[...Array(m).keys()].map(pt).join(" ")}"`;
-      default: return ` d="M${[...Array(m).keys()].map(pt).join(" L")} z"`;     // a closed path
-    }
+  const at = (a, i) => a[a.length > 1 ? i : 0];
+  function element(el, i) {                      // core.py Element.svg(i)
+    const r = el.rows > 1 ? i : 0;
+    if (!el.drawn[r]) return "";
+    const x = (c) => fixed(el.xy[c][r], D.coord);
+    const pts = [...Array(el.m).keys()].filter((j) => !el.finite || el.finite[j][r]).map((j) => x(2 * j) + "," + x(2 * j + 1));
+    let head = {line: () => ` x1="${x(0)}" y1="${x(1)}" x2="${x(2)}" y2="${x(3)}"`, circle: () => ` cx="${x(0)}" cy="${x(1)}"`,
+                text: () => ` x="${x(0)}" y="${x(1)}"`, polyline: () => ` points="${pts.join(" ")}"`,
+                path: () => ` d="M${pts.join(" L")} z"`}[el.tag];
+    head = (head ? head() : "") + el.attrs + (el.len ? ` data-length-mm="${fixed(at(el.len, i), D.lengthd)}"` : "");
+    const body = el.title + (el.tag === "text" ? el.texts[at(el.variant, i)] : "");
+    return `<${el.tag}${head}>${body}</${el.tag}>\n`;
   }
-  function element(el, i) {                      // as core.py Drawing.svg writes one element
-    if (!el.drawn[i]) return "";
-    const len = el.len ? ` data-length-mm="${String(el.len[i] / lengthQ)}"` : "";
-    const body = (el.tag === "text" ? el.texts[el.variant ? el.variant[i] : 0] : "") + el.title;
-    return `<${el.tag}${coords(el, i)}${el.attrs}${len}` + (body ? `>${body}</${el.tag}>` : "/>") + "\n";
-  }
-  function sheet(K, i) {                          // as core.py Drawing.svg(i)
-    return K.static + K.elements.map((el) => element(el, i)).join("") + "</g>\n</svg>\n";
+  function sheet(K, i) {                          // core.py Drawing.svg(i)
+    return K.static.replace(D.elements, () => K.elements.map((el) => element(el, i)).join(""));
   }
   window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
   const rows = D.rows, ncol = rows.length, singular = new Set(D.singular);

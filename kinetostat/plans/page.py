@@ -17,13 +17,13 @@ A page is drawn anew every time: nothing is cached.
 
 Small: each sheet's arrays (`encode_drawing`): the elements' markup once (tag, attributes,
 tooltip, the texts a label takes), and as integers, element by element over the angles, whether it
-is drawn, which text it shows, its coordinates in units of the decimals `Drawing.svg` writes
-(COORD_DECIMALS) and a segment's length in LENGTH_Q, each series as second differences over the
-angle, zigzag varints, deflated (gzip) and base64-encoded. The page's script (vanilla JavaScript,
+is drawn, which text it shows, its coordinates and a segment's length as `Element.svg` rounds them
+(COORD_DECIMALS, LENGTH_DECIMALS), each series as second differences over the angle, zigzag
+varints, deflated (gzip) and base64-encoded. The page's script (vanilla JavaScript,
 the browser's own DecompressionStream) decodes them once and writes the sheet of the angle chosen
 as `Drawing.svg` writes it.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
-`data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to LENGTH_Q); every value cell
+`data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to 1e-9 mm); every value cell
 `data-symbol`, `data-value`; `body[data-ready]`.
 
 May use: the plans (`build_cycle`, `cycle_scales`, `fixed_positions`, `core`, `draw`, `forces`,
@@ -47,21 +47,19 @@ import numpy as np
 
 from .._io import write_text
 from .._text import script_json
-from .core import Drawing
+from .core import ELEMENTS, Drawing
 from .draw import TINY_MM, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 
-__all__ = ["page", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_Q"]
+__all__ = ["page", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
 
 #: The angles of the slider, deg (the design position is one more frame).
 PAGE_ANGLES = tuple(float(a) for a in range(360))
 #: The texts' rule for the two balancing moments (crank and lever), %.
 TOLERANCE_PCT = 5.0
-#: Decimals of a sheet's coordinates (mm) as `Drawing.svg` writes them: the page keeps them so.
-COORD_DECIMALS = 2
-#: Resolution of a segment's length in the page (its data-length-mm), mm: within 1e-6 mm of
-#: segments.csv, as the contract says.
-LENGTH_Q = 1e-7
+#: Decimals of a sheet's coordinates (mm) and of a segment's length (data-length-mm) as
+#: `Element.svg` writes them (each rint(10^d x), `core.fixed`): the page keeps them so.
+COORD_DECIMALS, LENGTH_DECIMALS = 3, 9
 
 # ============================================================================ the numbers, small
 
@@ -102,44 +100,45 @@ def _held(x: np.ndarray, drawn: np.ndarray) -> np.ndarray:
     return x[idx]
 
 
-def _scaled(xy: np.ndarray, decimals: int) -> np.ndarray:
-    """Coordinates as integers of 10^-decimals mm, each as Python's format(x, f".{decimals}f")
-    writes it (correctly rounded: the few within 1e-6 of a tie formatted one by one)."""
-    f = 10.0 ** decimals
-    t = xy * f
-    n = np.rint(t)
-    near = np.flatnonzero(np.abs(np.abs(t - np.floor(t)) - 0.5) < 1e-6)
-    flat = n.reshape(-1)
-    for k in near:
-        flat[k] = int(format(float(xy.reshape(-1)[k]), f".{decimals}f").replace(".", ""))
-    return n.astype(np.int64)
+def _ints(x: np.ndarray, decimals: int) -> np.ndarray:
+    """`x` as `Element.svg` rounds it: rint(10^decimals x), int64 (NaN as 0)."""
+    return np.rint(np.where(np.isfinite(x), x, 0.0) * 10.0 ** decimals).astype(np.int64)
 
 
 def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
     """A sheet's arrays as (meta, numbers): `meta` = {"kind", "static", "elements": [{"tag",
     "attrs" [[name, value]...], "title", "texts", "m" points, "rows" (1: the same at every angle),
-    "len" (has a length)}]}; `numbers`, element by element: where it is drawn (N of 0/1), its
-    text's index at each angle (with more than one text), its coordinates (rows x m x 2, as
-    integers of 10^-COORD_DECIMALS mm, the rows where it is not drawn holding the last drawn),
-    its length (N, integers of LENGTH_Q mm); every series as second differences over the angle,
-    as zigzag varints."""
-    n = len(d.phi_deg)
+    "holes" (a polyline with points left out), "len" (has lengths)}]}; `numbers`, element by
+    element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each angle
+    (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
+    coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
+    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm); every series as second
+    differences over the angle, as zigzag varints."""
     meta, series = [], []
+
+    def put(a) -> None:
+        series.append(_second_differences(np.asarray(a, dtype=np.int64)))
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
-        rows = xy.shape[0]
-        drawn = np.isfinite(xy).all(axis=(1, 2))
-        drawn = np.broadcast_to(drawn, (n,)) if rows == 1 else drawn
-        series.append(_second_differences(drawn.astype(np.int64)))
+        rows, m = xy.shape[0], xy.shape[1]
+        drawn = np.asarray(e.drawn()).reshape(rows)
+        finite = np.isfinite(xy).all(axis=2)
+        holes = e.tag == "polyline" and not finite[drawn].all()
+        put(drawn)
         if len(e.texts) > 1:
-            series.append(_second_differences(np.asarray(e.variant, dtype=np.int64).reshape(n)))
-        held = _held(xy, np.isfinite(xy).all(axis=(1, 2)))
-        series.append(_second_differences(_scaled(held, COORD_DECIMALS).reshape(rows, -1)).T.ravel())
+            put(np.asarray(e.variant).reshape(-1))
+        if holes:
+            for k in range(m):
+                put(finite[:, k])
+        held = _held(np.where(finite[..., None], xy, np.nan), drawn) if m else xy
+        for c in range(2 * m):
+            put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS))
         if e.length_mm is not None:
-            L = np.asarray(e.length_mm, dtype=float)
-            series.append(_second_differences(np.rint(np.where(np.isfinite(L), L, 0.0) / LENGTH_Q).astype(np.int64)))
+            put(_ints(np.asarray(e.length_mm, dtype=float).reshape(-1), LENGTH_DECIMALS))
         meta.append({"tag": e.tag, "attrs": [[k, v] for k, v in e.attrs.items()], "title": e.title,
-                     "texts": list(e.texts), "m": xy.shape[1], "rows": rows, "len": e.length_mm is not None})
+                     "texts": list(e.texts), "m": m, "rows": rows, "holes": holes,
+                     "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
+                     "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))})
     return ({"kind": d.kind, "static": d.static, "elements": meta},
             _varints(np.concatenate(series)) if series else b"")
 
@@ -330,7 +329,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang),
-                  "coord": COORD_DECIMALS, "lengthq": LENGTH_Q}
+                  "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS}
     blobs: dict[str, str] = {}
     records = sheet.at(i_at).records()
     if not student:
