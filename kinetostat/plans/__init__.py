@@ -29,8 +29,8 @@ from .._io import write_text
 from .._text import csv_cell
 from ..kinematics import DIGITS_WARN
 from ..tables import FLOAT_FORMAT, by_unit, rounded
-from .core import SEGMENT_COLUMNS, Plan, Scale, Segment, extent
-from .draw import figure, fits, svg
+from .core import SEGMENT_COLUMNS, Plan, PlanCycle, Scale, Segment, extent, extent_cycle
+from .draw import ROOM_MM, figure, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
 from ..model.lettering import lettering
 from .mechanism import mechanism_plan
@@ -38,39 +38,111 @@ from .kinematic import FixedPositions, acceleration_plan, fixed_positions, posit
 from .lever import lever_plan
 from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
 
-__all__ = ["build", "Plans", "BUILDERS", "Plan", "Scale", "Segment", "SEGMENT_COLUMNS", "svg", "figure",
-           "choose_scales", "starting_position", "fixed_positions", "plan_file_name", "CycleScales", "cycle_scales"]
+__all__ = ["build", "build_cycle", "Plans", "BUILDERS", "Plan", "PlanCycle", "Scale", "Segment", "SEGMENT_COLUMNS", "svg",
+           "figure", "choose_scales", "starting_position", "fixed_positions", "plan_file_name", "CycleScales",
+           "cycle_scales", "fits"]
+
+
+def _shim_stack(plans: list[Plan | None], phi) -> PlanCycle:
+    """TEMPORARY (until the force plans' builders are vectorised): the one-angle plans of one kind
+    at the angles `phi` (None where not built) stacked into a PlanCycle: every point, segment and
+    path any angle has, NaN (segments: not `drawn`) where an angle lacks it, at the coarsest scale
+    of the angles'."""
+    import numpy as np
+    made = [p for p in plans if p is not None]
+    first = made[0]
+    n = len(plans)
+    point_names = list(dict.fromkeys(k for p in made for k in p.points))
+    def keyed(p: Plan) -> dict:            # a name drawn twice (a guide of two links) kept twice
+        seen: dict[str, int] = {}
+        return {(s.name, seen.setdefault(s.name, 0), seen.__setitem__(s.name, seen[s.name] + 1))[:2]: s
+                for s in p.segments}
+    segs_at = [keyed(p) if p is not None else {} for p in plans]
+    seg_names = list(dict.fromkeys(k for d in segs_at for k in d))
+    path_names = list(dict.fromkeys(k for p in made for k in p.paths))
+    points = {k: np.array([p.points.get(k, np.nan) if p is not None else np.nan for p in plans], complex)
+              for k in point_names}
+    segments = []
+    for name in seg_names:
+        have = [d.get(name) for d in segs_at]
+        s = next(x for x in have if x is not None)
+        scales = [x.scale for x in have if x is not None and x.scale is not None]
+        drawn = np.array([x is not None for x in have])
+        segments.append(Segment(s.name, s.start, s.end, np.array([x.value if x else np.nan for x in have], float),
+                                s.unit, s.kind, max(scales, key=lambda c: c.value) if scales else None,
+                                None if drawn.all() else drawn))
+    width = {k: max(len(p.paths[k]) for p in made if k in p.paths) for k in path_names}
+    paths = {k: np.array([list(p.paths[k]) + [np.nan] * (width[k] - len(p.paths[k]))
+                          if p is not None and k in p.paths else [np.nan] * width[k] for p in plans], complex)
+             for k in path_names}
+    symbols = list(dict.fromkeys(r.symbol for p in made for r in p.results))
+    results = tuple(replace(next(r for p in made for r in p.results if r.symbol == sym), value=
+        np.array([next((r.value for r in p.results if r.symbol == sym), np.nan) if p is not None else np.nan
+                  for p in plans])) for sym in symbols) if symbols else ()
+    return PlanCycle(first.kind, tuple(p.title if p is not None else "" for p in plans),
+                     max((p.scale for p in made), key=lambda c: c.value), phi, points, tuple(segments), paths,
+                     tuple(p.notes if p is not None else () for p in plans) if any(p.notes for p in made) else (),
+                     results, first.equation)
+
+
+def _shim_cycle(builder: Callable) -> Callable:
+    """TEMPORARY (until the force plans' builders take N angles): builder(mech, res, *args), a
+    one-angle builder of a Plan or a list of Plans, made a builder of PlanCycles at every angle of
+    `res` by building it at each non-singular angle in turn (the only loop over the angles here)."""
+    def at_every_angle(mech, res, *args):
+        made = [None if res.singular[i] else builder(mech, res.take([i]), *args) for i in range(len(res.phi_deg))]
+        some = next(m for m in made if m is not None)
+        if isinstance(some, (list, tuple)):
+            return [_shim_stack([None if m is None else m[j] for m in made], res.phi_deg) for j in range(len(some))]
+        return _shim_stack(made, res.phi_deg)
+    return at_every_angle
+
+
+_group_plans, _force_plans, _crank_plan, _lever_plan = map(_shim_cycle, (group_plans, force_plans, crank_plan, lever_plan))
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
-#: Plan or list of Plans).
+#: PlanCycle or list of PlanCycles at the angles of `res`).
 BUILDERS: tuple[tuple[str, Callable], ...] = (
     ("mechanism", mechanism_plan),
     ("positions", positions_plan),
     ("velocity", velocity_plan),
     ("acceleration", acceleration_plan),
-    ("groups", lambda mech, res, sc: _fitted(lambda mu: group_plans(mech, res, mu), sc["mu_l"])),
-    ("forces", lambda mech, res, sc: _fitted(lambda mu: force_plans(mech, res, mu), sc["mu_F"])),
+    ("groups", lambda mech, res, sc: _fitted(lambda mu: _group_plans(mech, res, mu), sc["mu_l"])),
+    ("forces", lambda mech, res, sc: _fitted(lambda mu: _force_plans(mech, res, mu), sc["mu_F"])),
     ("crank", lambda mech, res, sc: _crank(mech, res, sc)),
-    ("lever", lambda mech, res, sc: _fitted(lambda mu: lever_plan(mech, res, mu), sc["mu_v"])),
+    ("lever", lambda mech, res, sc: _fitted(lambda mu: _lever_plan(mech, res, mu), sc["mu_v"])),
 )
-def _crank(mech, res, sc) -> list[Plan]:
+
+
+def _crank(mech, res, sc) -> list[PlanCycle]:
     """The initial link at the plans' mu_l (its arms in mm as the worksheet gives them), its forces
-    at a mu_F of its own (`forces.crank_plan`'s), made coarser while the plan overflows its sheet."""
+    at a mu_F of its own (`forces.crank_plan`'s, for the largest reaction at the angles of `res`),
+    made coarser while the plan overflows its sheet."""
     import numpy as np
-    mu_F = force_scale(np.hypot(*res.forces.R[0].T), CRANK_FORCE_MM)
-    return _fitted(lambda mu: crank_plan(mech, res, sc["mu_l"], mu), mu_F)
+    R = np.hypot(*np.moveaxis(res.forces.R[~np.asarray(res.singular, bool)], -1, 0)).ravel()
+    mu_F = force_scale(R[np.isfinite(R)], CRANK_FORCE_MM)
+    return _fitted(lambda mu: _crank_plan(mech, res, sc["mu_l"], mu), mu_F)
 
 
-def _fitted(make: Callable, mu: Scale) -> list[Plan]:
-    """make(mu) -> a Plan or Plans, made again at the next coarser round scale while one of them
-    overflows its sheet (`draw.fits`: a group's reaction far out on its guide, a polygon longer than its
-    largest force, a lever whose forces reach beyond the velocity plan): the sheet states the
-    scale it is drawn at. A few tries at most; the last is kept."""
+def fits(cycle: PlanCycle):
+    """(N,): by how much the plan exceeds the room of its sheet (`draw.ROOM_MM`) at each angle of
+    the cycle: <= 1 where it fits (`draw.fits` angle by angle)."""
+    import numpy as np
+    x0, y0, x1, y1 = extent_cycle(cycle)
+    return np.min([np.maximum((x1 - x0) / w, (y1 - y0) / h) for w, h in ROOM_MM], axis=0)
+
+
+def _fitted(make: Callable, mu: Scale) -> list[PlanCycle]:
+    """make(mu) -> a PlanCycle or a list of them, made again at the next coarser round scale while
+    one of them overflows its sheet at some angle (`fits`: a group's reaction far out on its guide,
+    a polygon longer than its largest force, a lever whose forces reach beyond the velocity plan):
+    the sheet states the scale it is drawn at. A few tries at most; the last is kept."""
+    import numpy as np
     value = mu.value
     for _ in range(4):
         made = make(Scale(mu.symbol, value, mu.unit))
         plans = list(made) if isinstance(made, (list, tuple)) else [made]
-        factor = max(fits(p) for p in plans)
+        factor = max(float(np.max(fits(p), initial=0.0)) for p in plans)
         if factor <= 1:
             break
         value = coarser(value, factor)
@@ -91,47 +163,54 @@ class CycleScales:
         """BUILDERS' steps that draw at these scales."""
         group = {k.partition(":")[2]: s for k, s in self.forces_on.items() if k.startswith("group:")}
         kind = {k.partition(":")[0]: s for k, s in self.plan.items()}
-        return {"groups": lambda mech, res, sc: group_plans(mech, res, kind["group"], group),
-                "forces": lambda mech, res, sc: force_plans(mech, res, kind["forces"]),
-                "crank": lambda mech, res, sc: crank_plan(mech, res, self.plan["crank"], self.forces_on["crank"]),
-                "lever": lambda mech, res, sc: lever_plan(mech, res, self.plan["lever"], self.forces_on["lever"])}
+        return {"groups": lambda mech, res, sc: _group_plans(mech, res, kind["group"], group),
+                "forces": lambda mech, res, sc: _force_plans(mech, res, kind["forces"]),
+                "crank": lambda mech, res, sc: _crank_plan(mech, res, self.plan["crank"], self.forces_on["crank"]),
+                "lever": lambda mech, res, sc: _lever_plan(mech, res, self.plan["lever"], self.forces_on["lever"])}
 
 
-def cycle_scales(mech, step_deg: float = 5.0) -> CycleScales:
+#: The plans whose scale the cycle fixes beyond the base scales (`CycleScales.plan`).
+_FITTED = ("groups", "forces", "crank", "lever")
+
+
+def cycle_angles(mech, step_deg: float = 5.0):
+    """The angles `cycle_scales` samples, deg: 0, step_deg, ... below 360 and the design position."""
+    import numpy as np
+    if not (isinstance(step_deg, (int, float)) and 0 < step_deg <= 360):
+        raise ValueError(f"step_deg: expected a step in (0, 360] deg, got {step_deg!r}")
+    return np.array([*np.arange(0.0, 360.0, step_deg), float(getattr(mech.drive, "design_deg", 30.0))])
+
+
+def cycle_scales(mech, step_deg: float = 5.0, res=None) -> CycleScales:
     """The scales of `mech`'s plans fixed for the cycle: each the coarsest the texts' rule (and the
     fitting of each plan to its sheet) chooses at the angles 0, step_deg, ... and the design
-    position, so that every plan fits its sheet at every angle (a peak between two angles 5 deg
-    apart exceeds the sampled one by under 0.4 % of a cosine; the round scales leave more room).
-    Singular positions are left out."""
+    position (`cycle_angles`), or at the angles of `res` where given, so that every plan fits its
+    sheet at every angle (a peak between two angles 5 deg apart exceeds the sampled one by under
+    0.4 % of a cosine; the round scales leave more room). One analysis (none where `res` is
+    given), one build of the plans at every angle at the base scales, each plan's scale then
+    made coarser while it overflows its sheet at some angle. Singular positions are left out."""
     import warnings
 
     import numpy as np
-    base: dict[str, Scale] = {}
-    plan: dict[str, Scale] = {}
-    forces_on: dict[str, Scale] = {}
 
-    def coarsest(into: dict, key: str, s: Scale) -> None:
-        if key not in into or s.value > into[key].value:
-            into[key] = s
-    angles = [*np.arange(0.0, 360.0, step_deg), float(getattr(mech.drive, "design_deg", 30.0))]
-    start = starting_position(mech)             # the plan of positions' position 0: found once
+    from ..solve import analyze
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for at in angles:
-            try:
-                p = build(mech, at=float(at), starting_deg=start)
-            except ValueError:                     # a singular position: no plans there
-                continue
-            for key, s in p.scales.items():
-                coarsest(base, key, s)
-            for kind, pl in p.items():
-                if kind.partition(":")[0] in ("group", "forces", "crank", "lever"):
-                    coarsest(plan, kind, pl.scale)
-                    for s in pl.segments:
-                        if s.scale is not None and s.scale.symbol == "mu_F":
-                            coarsest(forces_on, kind, s.scale)
-    if not base:
-        raise ValueError(f"{mech.name}: no crank angle where the plans can be drawn")
+        if res is None:
+            res = analyze(mech, phi_deg=cycle_angles(mech, step_deg), friction="first")
+        keep = ~np.asarray(res.singular, bool) & (res.omega(1) != 0)
+        if not keep.any():
+            raise ValueError(f"{mech.name}: no crank angle where the plans can be drawn")
+        drawn = res.take(np.flatnonzero(keep))
+        base = choose_scales(mech, drawn, cycle=res)
+        steps = dict(BUILDERS)
+        plans = [p for name in _FITTED for p in steps[name](mech, drawn, base)]
+    plan: dict[str, Scale] = {p.kind: p.scale for p in plans}
+    forces_on: dict[str, Scale] = {}
+    for p in plans:
+        on = [s.scale for s in p.segments if s.scale is not None and s.scale.symbol == "mu_F"]
+        if on:
+            forces_on[p.kind] = max(on, key=lambda c: c.value)
     group = max((s for k, s in plan.items() if k.startswith("group:")), key=lambda s: s.value, default=None)
     forces = max((s for k, s in plan.items() if k.startswith("forces:")), key=lambda s: s.value, default=None)
     plan.update({k: group for k in plan if k.startswith("group:")})      # one mu_l for the group plans,
@@ -139,13 +218,68 @@ def cycle_scales(mech, step_deg: float = 5.0) -> CycleScales:
     return CycleScales(MappingProxyType(base), MappingProxyType(plan), MappingProxyType(forces_on))
 
 
-def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions | None) -> Plan:
-    """The plan of positions at mu_l; where the other branch's dashed mark alone would run off the
-    sheet (a slider's other branch below the crank), the mark left out and noted (the scale rule
-    keeps the crank at the length the text asks)."""
+def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions | None) -> PlanCycle:
+    """The plan of positions at mu_l; at the angles where the other branch's dashed mark alone
+    would run off the sheet (a slider's other branch below the crank), the mark left out and
+    noted (the scale rule keeps the crank at the length the text asks)."""
     fixed = fixed or fixed_positions(mech, sc["mu_l"], starting_deg)
     plan = positions_plan(mech, res, sc, starting_deg, fixed=fixed)
-    return plan if fits(plan) <= 1 else positions_plan(mech, res, sc, starting_deg, other_branch=False, fixed=fixed)
+    fit = fits(plan) <= 1
+    return plan if fit.all() else positions_plan(mech, res, sc, starting_deg, other_branch=fit, fixed=fixed)
+
+
+def _blank(cycle: PlanCycle, where) -> PlanCycle:
+    """The cycle with every point, path, segment value and result NaN at the angles `where` (N,)
+    bool (singular positions: nothing drawn there)."""
+    import numpy as np
+    if not where.any():
+        return cycle
+
+    def nan(v):
+        v = np.asarray(v)
+        return np.where(where.reshape((-1,) + (1,) * (v.ndim - 1)), np.nan, v) if len(v) == len(where) else v
+    return replace(cycle, points={k: nan(v) for k, v in cycle.points.items()},
+                   paths={k: nan(np.broadcast_to(v, (len(where), v.shape[1]))) for k, v in cycle.paths.items()},
+                   segments=tuple(replace(s, value=nan(np.broadcast_to(s.value, where.shape))) for s in cycle.segments),
+                   results=tuple(replace(r, value=nan(np.broadcast_to(r.value, where.shape))) for r in cycle.results))
+
+
+def _cycles(mech, res, sc: Mapping[str, Scale], chosen: list[str], steps: Mapping[str, Callable]) -> list[PlanCycle]:
+    """Every chosen plan at every angle of `res` (BUILDERS' order) drawn at `sc` by `steps`, each
+    stating the accuracy at its angles, NaN at singular positions."""
+    import numpy as np
+    cycles: list[PlanCycle] = []
+    for name, _ in BUILDERS:
+        if name in chosen:
+            made = steps[name](mech, res, sc)
+            cycles.extend(made if isinstance(made, (list, tuple)) else [made])
+    digits = np.asarray(res.digits, float)
+    if (digits < DIGITS_WARN).any():                 # each sheet states the accuracy at its angle
+        cycles = [replace(p, accuracy=(digits, DIGITS_WARN)) for p in cycles]
+    singular = np.asarray(res.singular, bool)
+    return [_blank(p, singular) for p in cycles]
+
+
+def _chosen(only: Iterable[str] | None) -> list[str]:
+    """The names of BUILDERS asked for (default all); ValueError naming an unknown one."""
+    names = [n for n, _ in BUILDERS]
+    chosen = list(names if only is None else only)
+    unknown = [n for n in chosen if n not in names]
+    if unknown:
+        raise ValueError(f"unknown plan {unknown[0]!r}: expected one of {', '.join(names)}")
+    return chosen
+
+
+def build_cycle(mech, res, fixed: CycleScales, positions: FixedPositions | None = None,
+                only: Iterable[str] | None = None) -> dict[str, PlanCycle]:
+    """Every plan of `mech` (`only`: names of BUILDERS, default all) at every angle of `res` (an
+    Analysis of `mech`, N angles) at the cycle's fixed scales `fixed` (`cycle_scales`), as
+    PlanCycles: kind -> PlanCycle, kinds as in `build`. At a singular position of `res` every
+    point and value is NaN (nothing drawn). `positions`: the plan of positions' 12 positions and
+    paths (`fixed_positions` of `mech` at fixed.base["mu_l"]; made here where not given)."""
+    steps = dict(BUILDERS) | fixed.builders()
+    steps["positions"] = partial(_positions, starting_deg=None if positions is None else positions.start, fixed=positions)
+    return {p.kind: p for p in _cycles(mech, res, dict(fixed.base), _chosen(only), steps)}
 
 
 class Plans(Mapping):
@@ -242,11 +376,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
         at = getattr(mech.drive, "design_deg", 30.0)
     if isinstance(at, bool) or not isinstance(at, (int, float)) or not math.isfinite(at):
         raise ValueError(f"at: expected a finite crank angle in degrees, got {at!r}")
-    names = [n for n, _ in BUILDERS]
-    chosen = list(names if only is None else only)
-    unknown = [n for n in chosen if n not in names]
-    if unknown:
-        raise ValueError(f"unknown plan {unknown[0]!r}: expected one of {', '.join(names)}")
+    chosen = _chosen(only)
     if friction not in ("first", "reactions"):
         raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
     res = analyze(mech, phi_deg=[float(at)], friction=friction)    # default: the graphical method's frictionless reactions
@@ -262,13 +392,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     sc = dict(fixed.base) if fixed is not None else choose_scales(mech, res, scales)
     steps = dict(BUILDERS) | (fixed.builders() if fixed is not None else {})
     steps["positions"] = partial(_positions, starting_deg=starting_deg, fixed=positions)
-    plans: list[Plan] = []
-    for name in names:
-        if name in chosen:
-            made = steps[name](mech, res, sc)
-            plans.extend(made if isinstance(made, (list, tuple)) else [made])
-    if res.digits[0] < DIGITS_WARN:                 # each sheet states the accuracy at this angle
-        plans = [replace(p, accuracy=(float(res.digits[0]), DIGITS_WARN)) for p in plans]
+    plans = [p.at(0) for p in _cycles(mech, res, sc, chosen, steps)]
     for p in plans:
         x0, y0, x1, y1 = extent(p)
         ends = [r[c] for r in p.rows() for c in ("x0_mm", "y0_mm", "x1_mm", "y1_mm")]

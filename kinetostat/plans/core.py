@@ -19,7 +19,7 @@ from typing import Mapping
 
 import numpy as np
 
-__all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent"]
+__all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent", "extent_cycle"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -58,6 +58,9 @@ class Segment:
     kind: str = "vector"
     scale: Scale | None = None   # a segment drawn at another scale than its plan's (the loads on a
                                  # group plan, at a force scale); None: the plan's scale
+    drawn: np.ndarray | None = None   # in a PlanCycle: (N,) bool, the angles where the segment is part
+                                      # of the plan (a triad's construction through S changes leashes
+                                      # over the cycle); None: at every angle
     # In a PlanCycle, `value` is an (N,) array over its angles.
 
 
@@ -134,6 +137,25 @@ def extent(plan: Plan) -> tuple[float, float, float, float]:
     return min(z.real for z in zs), min(z.imag for z in zs), max(z.real for z in zs), max(z.imag for z in zs)
 
 
+def extent_cycle(cycle: "PlanCycle") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(x0, y0, x1, y1), each (N,) mm: `extent` of the plan at every angle of the cycle (its finite
+    points and paths; 0 where none is finite)."""
+    n = cycle.n
+    cols = [v.reshape(n, 1) for v in cycle.points.values()]
+    cols += [np.broadcast_to(v, (n, v.shape[1])) for v in cycle.paths.values()]
+    if not cols:
+        return tuple(np.zeros(n) for _ in range(4))
+    z = np.concatenate(cols, axis=1)
+    ok = np.isfinite(z.real) & np.isfinite(z.imag)
+    some = ok.any(axis=1)
+    out = []
+    for part, lo in ((z.real, True), (z.imag, True), (z.real, False), (z.imag, False)):
+        v = (np.min(part, axis=1, where=ok, initial=np.inf) if lo else np.max(part, axis=1, where=ok, initial=-np.inf))
+        out.append(np.where(some, v, 0.0))
+    x0, y0, x1, y1 = out
+    return x0, y0, x1, y1
+
+
 def _one(x, i: int) -> float:
     return float(np.asarray(x).reshape(-1)[i if np.size(x) > 1 else 0])
 
@@ -208,7 +230,8 @@ class PlanCycle:
             acc = (float(self.accuracy[0][i]), self.accuracy[1])
         return Plan(self.kind, self.titles[i], self.scale, float(self.phi_deg[i]),
                     {k: complex(v[i]) for k, v in self.points.items()},
-                    tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale) for s in self.segments),
+                    tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale)
+                          for s in self.segments if s.drawn is None or s.drawn[i]),
                     {k: tuple(map(complex, v[i if len(v) > 1 else 0])) for k, v in self.paths.items()},
                     self.notes[i] if self.notes else (),
                     tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how) for r in self.results),

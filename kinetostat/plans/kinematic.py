@@ -27,9 +27,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import Plan, Scale, Segment
+from .core import PlanCycle, Scale, Segment
 
-__all__ = ["positions_plan", "fixed_positions", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
+__all__ = ["positions_plan", "fixed_positions", "other_branches", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
 
 #: Positions of the plan of positions: every 30 deg.
@@ -38,20 +38,27 @@ N_POSITIONS = 12
 PATH_STEPS = 180
 
 
-def _at(res) -> float:
-    if len(res.phi_deg) != 1:
-        raise ValueError(f"a plan is drawn at one crank angle; the analysis holds {len(res.phi_deg)}")
-    if res.singular[0]:
-        raise ValueError(f"the mechanism is at a singular position at {res.phi_deg[0]:g} deg "
-                         f"(velocities and accelerations undefined); draw the plans at another angle")
-    return float(res.phi_deg[0])
+def _titles(text: str, res) -> tuple[str, ...]:
+    """`text` with `{at:g}` filled at each angle of `res`: the N titles of a cycle."""
+    return tuple(text.format(at=float(a)) for a in res.phi_deg)
+
+
+def _ok(res) -> np.ndarray:
+    """(N,) True at the angles where the plans are drawn (not at a singular position)."""
+    return ~np.asarray(res.singular, bool)
+
+
+def _any(values, res) -> bool:
+    """Whether an element whose existence `values` (N,) decide is drawn at some angle of `res`
+    (`values` != 0 at a non-singular angle): such an element is in the plan at every angle."""
+    return bool(np.any((np.asarray(values) != 0) & _ok(res)))
 
 
 # ----------------------------------------------------------------------------- points of the plans
 
 class _Point(NamedTuple):
     link: int
-    local: complex      # local coordinates on `link`, m
+    local: complex | np.ndarray     # local coordinates on `link`, m; (N,) where it moves on the link
 
 
 @dataclass(frozen=True)
@@ -79,7 +86,8 @@ def _moving_p_pairs(mech):
 def plan_point_names(mech, res=None) -> dict[str, _Point]:
     """The points of the velocity and acceleration plans: plan name -> (link, local coordinates),
     in the order the texts draw them (crank, then group by group). Needs `res` (one angle) for
-    the coincident points of a guide, which move along it."""
+    the coincident points of a guide, which move along it: their local coordinates (N,) over
+    the angles of `res`)."""
     frame = mech.links[0].points
     split = {p.point for p in _moving_p_pairs(mech)}
     out: dict[str, _Point] = {}
@@ -95,8 +103,7 @@ def plan_point_names(mech, res=None) -> dict[str, _Point]:
     if res is not None:
         for p in _moving_p_pairs(mech):
             g = p.links[0]
-            X = complex(*res.position(p.point)[0])
-            out[f"{p.point.lower()}{g}"] = _Point(g, (X - res.kin.origin_z[0, g]) / res.kin.rot[0, g])
+            out[f"{p.point.lower()}{g}"] = _Point(g, (_z(res, p.point) - res.kin.origin_z[:, g]) / res.kin.rot[:, g])
     return out
 
 
@@ -123,10 +130,17 @@ def _slidings(mech, pole: str) -> list[_Sliding]:
     return out
 
 
+def _point_motion(kin, k: int, local) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position, velocity, acceleration (each (N,) complex) of the point of link k at `local`
+    (complex, or (N,) complex where it moves on the link): `Kinematics.point_z`'s formula."""
+    r = local * kin.rot[:, k]
+    w, e = kin.omega[:, k], kin.eps[:, k]
+    return kin.origin_z[:, k] + r, kin.v_z[:, k] + 1j * w * r, kin.a_z[:, k] + (1j * e - w**2) * r
+
+
 def _motion(res, pts: dict[str, _Point]):
-    """name -> (position, velocity, acceleration) complex at the analysis's one angle."""
-    return {n: tuple(complex(z[0]) for z in res.kin.point_z(p.link, (p.local.real, p.local.imag)))
-            for n, p in pts.items()}
+    """name -> (position, velocity, acceleration), each (N,) complex over the angles of `res`."""
+    return {n: _point_motion(res.kin, p.link, p.local) for n, p in pts.items()}
 
 
 def _floating_joints(mech, names: dict[str, _Point]) -> list[tuple[int, list[str]]]:
@@ -147,45 +161,57 @@ def _floating_joints(mech, names: dict[str, _Point]) -> list[tuple[int, list[str
     return out
 
 
-def _rel(a: str, b: str, value: float, unit: str) -> Segment:
-    return Segment(f"{a}-{b}", a, b, float(value), unit)
+def _rel(a: str, b: str, value, unit: str) -> Segment:
+    return Segment(f"{a}-{b}", a, b, np.asarray(value, dtype=float), unit)
 
 
-def velocity_plan(mech, res, scales: dict[str, Scale]) -> Plan:
-    """The velocity plan (seed 002 fig. 1.7): pole p, p-x for every point, the relative
-    velocities of each floating link's joints (a-b), the sliding velocities of blocks on moving
-    guides (a1-a3), like points by similarity (s2 on ab), and a triad's special point s (v_S
-    from the outer pins of the two leashes through S, e.g. a-s, e-s): all at mu_v."""
-    at = _at(res)
+def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
+    """The velocity plan (seed 002 fig. 1.7) at every angle of `res`: pole p, p-x for every
+    point, the relative velocities of each floating link's joints (a-b), the sliding velocities
+    of blocks on moving guides (a1-a3), like points by similarity (s2 on ab), and a triad's
+    special point s (v_S from the outer pins of the two leashes through S, e.g. a-s, e-s): all at
+    mu_v."""
     mu = scales["mu_v"]
     pts = plan_point_names(mech, res)
     mo = _motion(res, pts)
-    points = {"p": 0j, **{n: m[1] / mu.value for n, m in mo.items()}}
-    segs = [Segment(f"p-{n}", "p", n, abs(m[1]), "m/s") for n, m in mo.items()]
+    points = {"p": np.zeros(len(res.phi_deg), complex), **{n: m[1] / mu.value for n, m in mo.items()}}
+    segs = [Segment(f"p-{n}", "p", n, np.abs(m[1]), "m/s") for n, m in mo.items()]
     for _, joints in _floating_joints(mech, pts):
-        segs += [_rel(a, b, abs(mo[b][1] - mo[a][1]), "m/s") for i, a in enumerate(joints) for b in joints[i + 1:]]
+        segs += [_rel(a, b, np.abs(mo[b][1] - mo[a][1]), "m/s") for i, a in enumerate(joints) for b in joints[i + 1:]]
     for s in _slidings(mech, "p"):
-        segs.append(_rel(s.start, s.end, abs(res.kin.v_slide[0, s.pair.index]), "m/s"))
+        segs.append(_rel(s.start, s.end, np.abs(res.kin.v_slide[:, s.pair.index]), "m/s"))
     for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
-        vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
+        vS = _point_motion(res.kin, b, local)[1]
         points[name] = vS / mu.value
-        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, abs(vS - (mo[r][1] if r else 0j)), "m/s") for r in refs]
-    return Plan("velocity", f"Velocity plan at phi = {at:g} deg", mu, at, points, tuple(segs))
+        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, np.abs(vS - (mo[r][1] if r else 0j)), "m/s", drawn=on)
+                 for r, on in refs]
+    return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points, tuple(segs))
 
 
-def _special(mech, res, pts: dict) -> list[tuple[str, int, complex, list[str]]]:
+def _special(mech, res, pts: dict) -> list[tuple[str, int, np.ndarray, list[tuple[str, np.ndarray | None]]]]:
     """Per triad: the plan name of Assur's special point S (a point of the base link), the base,
-    S's local coordinates on it, and the plan names of the references of the two leashes through
-    S (their outer pins; "" for a point of the frame, at the pole)."""
-    from ..kinematics import special_point_z, special_sides
+    S's local coordinates on it (N,), and the references of the leashes through S: (the plan name
+    of the leash's outer pin, "" for a point of the frame at the pole; the angles (N,) bool where
+    its axis passes through S, None: at every angle). S lies on two of the three leashes' axes
+    (`kinematics.special_sides`), which two may change over the cycle; the references are in the
+    solver's order at the first angle."""
+    from ..kinematics import leash_axes
+    from ..triad import special_point
     out = []
     for n, g in enumerate(g for g in mech.structure.groups if g.klass == 3):
         name = "s" if n == 0 else f"s{n + 1}'"
         name = name if name not in pts else f"{name}'"
         b = g.links[0]
-        S = complex(special_point_z(mech, res.kin, g)[0])
-        local = (S - res.kin.origin_z[0, b]) / res.kin.rot[0, b]
-        refs = [_name_of(mech, o.point) if o.kind == "R" else "" for _, o, _, _ in special_sides(mech, res.kin, g)[:2]]
+        S, _, k = special_point(*(v for axis in leash_axes(mech, res.kin, g) for v in axis))
+        local = (S - res.kin.origin_z[:, b]) / res.kin.rot[:, b]
+        first = int(k[0]) if np.isfinite(k[0]) else 0
+        refs = []
+        for j in ((first + 1) % 3, (first + 2) % 3, first):        # the sides in the solver's order
+            on = (k != j) | ~_ok(res)
+            if j == first and not np.any(on & _ok(res)):
+                continue
+            _, o, _, _ = g.sides[j]
+            refs.append((_name_of(mech, o.point) if o.kind == "R" else "", None if on.all() else on))
         out.append((name, b, local, refs))
     return out
 
@@ -207,18 +233,19 @@ def _normals(mech, g):
     return []                # PRP, RPP: no link of the group turns about a pin of its own
 
 
-def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
-    """The acceleration plan (seed 002 fig. 1.8, seed 000 sec. 6.3): pole pi; the crank pin
-    (normal and tangential parts when the crank accelerates); per group the normal `r-n<k>` and
-    tangential `n<k>-q` parts of each turning link, the Coriolis `-k` and relative `k-` parts of
-    a block on a moving guide; pi-x for every point, the relative accelerations of each floating
-    link's joints (a-b), like points by similarity, and a triad's special point s with its
-    construction from the outer pins of the two leashes through S (e.g. a-s): all at mu_a."""
-    at = _at(res)
+def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
+    """The acceleration plan (seed 002 fig. 1.8, seed 000 sec. 6.3) at every angle of `res`: pole
+    pi; the crank pin (normal and tangential parts where the crank accelerates at some angle); per
+    group the normal `r-n<k>` and tangential `n<k>-q` parts of each turning link, the Coriolis
+    `-k` and relative `k-` parts of a block on a moving guide (where the guide turns at some
+    angle; at an angle where it does not, the Coriolis part has zero length); pi-x for every
+    point, the relative accelerations of each floating link's joints (a-b), like points by
+    similarity, and a triad's special point s with its construction from the outer pins of the
+    two leashes through S (e.g. a-s): all at mu_a."""
     mu = scales["mu_a"]
     pts = plan_point_names(mech, res)
     mo = _motion(res, pts)
-    points = {"pi": 0j, **{n: m[2] / mu.value for n, m in mo.items()}}
+    points = {"pi": np.zeros(len(res.phi_deg), complex), **{n: m[2] / mu.value for n, m in mo.items()}}
     segs: list[Segment] = []
     unit = "m/s^2"
 
@@ -226,43 +253,44 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> Plan:
         ref = _name_of(mech, ref_point) if ref_point in mech.point_names else ref_point
         start = ref or "pi"
         r_ref, a_ref = (mo[ref][0], mo[ref][2]) if ref else (complex(*mech.links[0].points[ref_point]), 0j)
-        w, e = res.kin.omega[0, k], res.kin.eps[0, k]
-        l = abs(mo[q][0] - r_ref)
+        w, e = res.kin.omega[:, k], res.kin.eps[:, k]
+        l = np.abs(mo[q][0] - r_ref)
         n = f"n{k}"
         points[n] = (a_ref - w * w * (mo[q][0] - r_ref)) / mu.value
-        segs.extend([Segment(f"{start}-{n}", start, n, float(w * w * l), unit), Segment(f"{n}-{q}", n, q, float(abs(e) * l), unit)])
+        segs.extend([Segment(f"{start}-{n}", start, n, w * w * l, unit), Segment(f"{n}-{q}", n, q, np.abs(e) * l, unit)])
 
     d = mech.drive
-    if res.kin.eps[0, d.link] != 0:
+    if _any(res.kin.eps[:, d.link], res):
         split(d.link, d.pivot, _name_of(mech, d.point))
     for g in mech.structure.groups:
         for k, ref_point, q in _normals(mech, g):
             split(k, ref_point, q if q in pts else _name_of(mech, q))
     slidings = _slidings(mech, "pi")
-    turning = [s for s in slidings if res.kin.omega[0, s.pair.links[0]] != 0]
+    turning = [s for s in slidings if _any(res.kin.omega[:, s.pair.links[0]], res)]
     for s in slidings:
         p = s.pair
         guide = p.links[0]
-        w = res.kin.omega[0, guide]
-        v_r, a_r = res.kin.v_slide[0, p.index], res.kin.a_slide[0, p.index]
+        w = res.kin.omega[:, guide]
+        v_r, a_r = res.kin.v_slide[:, p.index], res.kin.a_slide[:, p.index]
         if s in turning:
-            dw = complex(*p.direction) * res.kin.rot[0, guide]
+            dw = complex(*p.direction) * res.kin.rot[:, guide]
             cor = 2j * w * v_r * dw                      # slider's acceleration = guide point's + cor + a_r d
             kname = "k" if len(turning) == 1 else f"k{turning.index(s) + 1}"
             points[kname] = points[s.start] + (cor if s.from_guide else -cor) / mu.value
-            segs += [Segment(f"{s.start}-{kname}", s.start, kname, float(2 * abs(w * v_r)), unit),
-                     Segment(f"{kname}-{s.end}", kname, s.end, float(abs(a_r)), unit)]
+            segs += [Segment(f"{s.start}-{kname}", s.start, kname, 2 * np.abs(w * v_r), unit),
+                     Segment(f"{kname}-{s.end}", kname, s.end, np.abs(a_r), unit)]
         else:
-            segs.append(_rel(s.start, s.end, abs(a_r), unit))
-    segs += [Segment(f"pi-{n}", "pi", n, abs(m[2]), unit) for n, m in mo.items()]
+            segs.append(_rel(s.start, s.end, np.abs(a_r), unit))
+    segs += [Segment(f"pi-{n}", "pi", n, np.abs(m[2]), unit) for n, m in mo.items()]
     for name, b, local, refs in _special(mech, res, pts):        # a_S = a_1 + a_S1 = a_2 + a_S2
-        aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
+        aS = _point_motion(res.kin, b, local)[2]
         points[name] = aS / mu.value
-        segs.append(Segment(f"pi-{name}", "pi", name, abs(aS), unit))
-        segs += [Segment(f"{r}-{name}", r, name, abs(aS - mo[r][2]), unit) for r in refs if r]
+        segs.append(Segment(f"pi-{name}", "pi", name, np.abs(aS), unit))
+        segs += [Segment(f"{r}-{name}", r, name, np.abs(aS - mo[r][2]), unit, drawn=on) for r, on in refs if r]
     for _, joints in _floating_joints(mech, pts):
-        segs += [_rel(a, b, abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
-    return Plan("acceleration", f"Acceleration plan at phi = {at:g} deg", mu, at, points, tuple(segs))
+        segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
+    return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,
+                     points, tuple(segs))
 
 
 # ----------------------------------------------------------------------------- plan of positions
@@ -368,60 +396,92 @@ def _outline(mech, k: int) -> list[str]:
     return pts
 
 
-def _draw_position(mech, res, idx: int, label: int | None, mu: float, points: dict, segs: list) -> None:
-    """Points and links of the mechanism at res's angle number idx, named for position `label`."""
+def _draw_position(mech, res, idx, label: int | None, mu: float, points: dict, segs: list) -> None:
+    """Points and links of the mechanism at res's angle number idx (an int; a slice: the (N,)
+    angles it takes), named for position `label`."""
     moving, name = _position_names(mech)
     for n, xy in mech.links[0].points.items():
         points[n] = complex(*xy) / mu
     for n in moving:
-        points[name(n, label)] = complex(*res.position(n)[idx]) / mu
+        points[name(n, label)] = _z(res, n)[idx] / mu
     for link in mech.links[1:]:
         outline = _outline(mech, link.id)
         for i, a in enumerate(outline):
             for b in outline[i + 1:]:
                 za, zb = points[name(a, label)], points[name(b, label)]
                 segs.append(Segment(f"{name(a, label)}-{name(b, label)}", name(a, label), name(b, label),
-                                    abs(zb - za) * mu, "m", "link" if label is None else "position"))
+                                    np.abs(zb - za) * mu, "m", "link" if label is None else "position"))
 
 
-def _branch_marks(mech, at: float, res, mu: float, points: dict, segs: list, dashed: bool = True) -> list[str]:
-    """Mark each group's assembly branch: a note, and the other branch's inner joint drawn dashed
-    (primed name) where it lies elsewhere (with `dashed` False only noted: it runs off the sheet)."""
-    from ..solve import analyze
+def other_branches(mech, res) -> dict:
+    """Per group with two assembly branches (`mech.branches`): the analysis of the mechanism with
+    that group's other branch at the angles of `res`, one solve for all of them, and the angles
+    (N,) bool where it assembles; None where it assembles at none."""
     from ..errors import AssemblyError
-    notes = []
+    from ..solve import analyze
+    out = {}
+    for key, b in mech.branches.items():
+        other = replace(mech, branches={**mech.branches, key: -b})
+        phi = np.asarray(res.phi_deg, float)
+        where = np.ones(len(phi), bool)
+        for _ in range(2):                 # the angles where it fails left out, once
+            try:
+                out[key] = (analyze(other, phi_deg=phi[where]), where)
+                break
+            except AssemblyError as exc:
+                where &= ~np.isin(np.round(phi, 9), exc.phi_deg)
+                if not where.any():
+                    break
+            except (ValueError, KeyError):
+                break
+    return out
+
+
+def _branch_marks(mech, res, mu: float, points: dict, segs: list, dashed=True) -> list[list[str]]:
+    """Mark each group's assembly branch at every angle of `res`: a note per angle, and the other
+    branch's inner joint drawn dashed (primed name) where it lies elsewhere (NaN at the angles
+    where it does not; with `dashed` False, (N,) bool False at an angle, only noted there: it runs
+    off the sheet). The other branch is analysed once for all angles (`other_branches`)."""
+    from ..kinematics import assembly_modes
+    n_at = len(res.phi_deg)
+    dashed = np.broadcast_to(np.asarray(dashed, bool), (n_at,))
+    notes: list[list[str]] = [[] for _ in range(n_at)]
+    alts = other_branches(mech, res) if mech.branches else {}
     for g in mech.structure.groups:
         key = frozenset(g.links)
         if g.klass == 3:
-            from ..kinematics import assembly_modes
             count = next(len(am.O) for am in assembly_modes(mech) if am.group == g.label)
-            notes.append(f"{g.label} III3: the mode the model draws at the design position ({count} modes there)")
+            for lines in notes:
+                lines.append(f"{g.label} III3: the mode the model draws at the design position ({count} modes there)")
             continue
         if key not in mech.branches:
-            notes.append(f"{g.label} {g.kind}: one assembly")
+            for lines in notes:
+                lines.append(f"{g.label} {g.kind}: one assembly")
             continue
         b = mech.branches[key]
         q = g.pairs[1].point
         text = f"{g.label} {g.kind}: branch {b:+d} drawn"
-        try:
-            alt = analyze(replace(mech, branches={**mech.branches, key: -b}), phi_deg=[at])
-            zq = complex(*alt.position(q)[0])
-        except (AssemblyError, ValueError, KeyError):
-            notes.append(text + " (the other branch does not assemble here)")
-            continue
-        if not np.isfinite(zq) or abs(zq - complex(*res.position(q)[0])) <= 1e-9 * mech.size:
-            notes.append(text + " (the other branch looks the same here)")
-            continue
+        zq = np.full(n_at, np.nan + 0j)
+        assembles = np.zeros(n_at, bool)
+        if key in alts:
+            alt, assembles = alts[key]
+            zq[assembles] = _z(alt, q)
+        here = _z(res, q)
+        same = ~(np.isfinite(zq) & (np.abs(zq - here) > 1e-9 * mech.size))
+        drawn = assembles & ~same & dashed
         qp = f"{q}'"
-        if not dashed:
-            notes.append(text + f" (the other branch {qp} off the sheet at this scale)")
+        for i, lines in enumerate(notes):
+            lines.append(text + (" (the other branch does not assemble here)" if not assembles[i] else
+                                 " (the other branch looks the same here)" if same[i] else
+                                 f" (the other branch {qp} off the sheet at this scale)" if not dashed[i] else
+                                 f"; dashed to {qp}: the other branch"))
+        if not drawn.any():
             continue
-        points[qp] = zq / mu
+        points[qp] = np.where(drawn, zq / mu, np.nan)
         for p in (g.pairs[0], g.pairs[2]):
             n = p.point if p.kind == "R" else None
             if n is not None:
-                segs.append(Segment(f"{n}-{qp}", n, qp, float("nan"), "", "line"))
-        notes.append(text + f"; dashed to {qp}: the other branch")
+                segs.append(Segment(f"{n}-{qp}", n, qp, np.full(n_at, np.nan), "", "line"))
     return notes
 
 
@@ -458,14 +518,14 @@ def fixed_positions(mech, mu: Scale, starting_deg: float | None = None) -> Fixed
 
 
 def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | None = None,
-                   other_branch: bool = True, fixed: FixedPositions | None = None) -> Plan:
-    """The plan of positions (seed 002 fig. 1.5): 12 positions every 30 deg in the drive's sense
-    from the starting position (found by `starting_position` unless given), the design position
-    of `res` (plain names), the paths of every centre of mass and the assembly branch of each
-    group (notes; the other branch dashed, unless `other_branch` is False): all at mu_l. Link segments' values are the exact
-    distances between their points, m. `fixed`: the 12 positions and the paths made already
-    (`fixed_positions` of this `mech` at mu_l, from `starting_deg` where it is given)."""
-    at = float(res.phi_deg[0])
+                   other_branch: bool | np.ndarray = True, fixed: FixedPositions | None = None) -> PlanCycle:
+    """The plan of positions (seed 002 fig. 1.5) at every angle of `res`: 12 positions every 30 deg
+    in the drive's sense from the starting position (found by `starting_position` unless given),
+    the design position at each angle of `res` (plain names), the paths of every centre of mass
+    and the assembly branch of each group (notes; the other branch dashed, except where
+    `other_branch` (a bool, or (N,) bool per angle) is False): all at mu_l. Link segments' values
+    are the exact distances between their points, m. `fixed`: the 12 positions and the paths made
+    already (`fixed_positions` of this `mech` at mu_l, from `starting_deg` where it is given)."""
     mu = scales["mu_l"]
     if fixed is None:
         fixed = fixed_positions(mech, mu, starting_deg)
@@ -475,9 +535,9 @@ def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | No
         raise ValueError(f"fixed: positions from {fixed.start:g} deg, not from starting_deg = {starting_deg:g} deg")
     points = dict(fixed.points)
     segs = list(fixed.segments)
-    _draw_position(mech, res, 0, None, mu.value, points, segs)
-    notes = [f"position 0 at phi = {fixed.start:.6g} deg (crank and rod in line), then every 30 deg; "
-             f"design position phi = {at:g} deg drawn with plain letters"]
-    notes += _branch_marks(mech, at, res, mu.value, points, segs, other_branch)
-    return Plan("positions", f"Plan of positions, design position phi = {at:g} deg", mu, at, points,
-                tuple(segs), fixed.paths, tuple(notes))
+    _draw_position(mech, res, slice(None), None, mu.value, points, segs)
+    marks = _branch_marks(mech, res, mu.value, points, segs, other_branch)
+    notes = [(f"position 0 at phi = {fixed.start:.6g} deg (crank and rod in line), then every 30 deg; "
+              f"design position phi = {float(at):g} deg drawn with plain letters", *m) for at, m in zip(res.phi_deg, marks)]
+    return PlanCycle("positions", _titles("Plan of positions, design position phi = {at:g} deg", res), mu,
+                     res.phi_deg, points, tuple(segs), fixed.paths, tuple(notes))

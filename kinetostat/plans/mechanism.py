@@ -3,19 +3,21 @@
 as a small circle, a slider as a block on its guide), the centres of mass, and the senses of
 every link's angular velocity ω and acceleration ε as arcs with an arrowhead.
 
-The drawing's marks are `Plan.paths` (sheet mm) named by what they are: "pin A", "block B",
+Built at every angle of an analysis at once (`PlanCycle`: points (N,), marks (N, K)).
+The drawing's marks are `PlanCycle.paths` (sheet mm) named by what they are: "pin A", "block B",
 "support O", "hatch ..", "com S2", and "ω2", "ε2" for the senses; `draw` draws each by its name.
 
-May use: numpy, `core`, `forces` (the links drawn at mu_l). Never matplotlib.
+May use: numpy, `core`, `kinematic` (which angles draw), `kinetostat.model.lettering` (link numbers).
+Never matplotlib.
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
-from .core import Plan, Scale, Segment
-from .forces import _link_drawing, _world
+from ..model.lettering import link_number
+from .core import PlanCycle, Scale, Segment
+from .kinematic import _any, _ok, _titles
 
 __all__ = ["mechanism_plan", "PIN_MM", "BLOCK_MM", "ARC_MM"]
 
@@ -23,62 +25,113 @@ __all__ = ["mechanism_plan", "PIN_MM", "BLOCK_MM", "ARC_MM"]
 PIN_MM, BLOCK_MM, ARC_MM = 1.2, (10.0, 6.0), (7.0, 10.0)
 
 
-def _circle(c: complex, r: float, n: int = 16) -> tuple[complex, ...]:
-    return tuple(c + r * np.exp(2j * np.pi * np.arange(n + 1) / n))
+def _circle(c: np.ndarray, r: float, n: int = 16) -> np.ndarray:
+    """(N, n + 1) complex: a circle of radius r around each centre c (N,)."""
+    return c[:, None] + r * np.exp(2j * np.pi * np.arange(n + 1) / n)
 
 
-def _hatch(a: complex, b: complex, side: complex, name: str, paths: dict) -> None:
-    """The frame's hatching: the line a-b and short strokes every 2 mm on its `side` (a unit)."""
-    paths[f"{name}"] = (a, b)
-    L = abs(b - a)
-    u = (b - a) / L if L else 1.0
-    for n, t in enumerate(np.arange(1.0, min(L, 100.0), 2.0)):      # a frame's stretch: at most 50 strokes
+def _hatch(a: np.ndarray, b: np.ndarray, side, name: str, paths: dict) -> None:
+    """The frame's hatching: the line a-b (each (N,)) and short strokes every 2 mm on its `side`
+    (a unit, or (N,) units), as many at every angle as the stretch's length at the first."""
+    paths[f"{name}"] = np.stack([a, b], axis=1)
+    L = np.abs(b - a)
+    u = np.where(L != 0, (b - a) / np.where(L != 0, L, 1.0), 1.0)
+    for n, t in enumerate(np.arange(1.0, min(float(L[0]), 100.0), 2.0)):      # a frame's stretch: at most 50 strokes
         p = a + t * u
-        paths[f"{name} {n}"] = (p, p + 2.0 * side - 1.5 * u)
+        paths[f"{name} {n}"] = np.stack([p, p + 2.0 * side - 1.5 * u], axis=1)
 
 
-def _arc(c: complex, r: float, sense: float) -> tuple[complex, ...]:
-    """A 240-degree arc around c, from the upper left, in the sense's direction (ccw for +)."""
+def _arc(c: np.ndarray, r: float, sense: np.ndarray) -> np.ndarray:
+    """(N, 25): a 240-degree arc around each c, from the upper left, in the sense's direction
+    (ccw for +)."""
     t = np.linspace(0.0, np.radians(240.0), 25)
-    return tuple(c + r * np.exp(1j * (np.radians(150.0) + sense * t)))
+    return c[:, None] + r * np.exp(1j * (np.radians(150.0) + sense[:, None] * t))
+
+
+def _world(res, k: int, name: str) -> np.ndarray:
+    """(N,) complex, m: the point `name` of link k at every angle of `res`."""
+    return res.kin.position_z(k, res.mech.links[k].points[name])
+
+
+def _link_drawing(mech, res, k: int, pts: dict, segs: list, mu_l: Scale) -> None:
+    """Link k at mu_l at every angle: its points, a segment between every two of its joints, and
+    the guides of its prismatic pairs (80 mm construction lines through the block's point)."""
+    joints = [p.point for p in mech.pairs if k in p.links and p.point in mech.links[k].points]
+    joints += [p.guide for p in mech.pairs if p.links[0] == k and p.guide in mech.links[k].points]
+    names = list(dict.fromkeys(joints)) or list(mech.links[k].points)[:1]
+    for name in mech.links[k].points:
+        pts[name] = _world(res, k, name) / mu_l.value
+    for a in range(len(names)):
+        for b in range(a + 1, len(names)):
+            A, B = names[a], names[b]
+            segs.append(Segment(f"{A}{B}", A, B, np.abs(pts[B] - pts[A]) * mu_l.value, "m", "link"))
+    for p in mech.pairs:
+        if p.kind == "P" and k in p.links:
+            X = _world(res, p.links[1], p.point) / mu_l.value
+            d = complex(*p.direction) * res.kin.rot[:, p.links[0]]
+            name = f"guide P({link_number(mech, p.links[0])},{link_number(mech, p.links[1])})"     # the text's numbers
+            pts[f"{name}:from"], pts[f"{name}:to"] = X - 40 * d, X + 40 * d
+            segs.append(Segment(name, f"{name}:from", f"{name}:to", np.full(len(X), np.nan), "", "line"))
 
 
 def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
     """Link k drawn through all its points: along each slot it carries, from end to end of what
     runs in it (O2-S3 on to B), and every point not on a drawn line joined to the nearest drawn
-    point (B-S5-T of a ram)."""
-    drawn = {n for s in segs if s.kind == "link" for n in (s.start, s.end)} & set(mech.links[k].points)
+    point on the sheet (B-S5-T of a ram; distances within 1e-9 of each other tie, broken by
+    name: a point midway between two pins joins the first by name at every angle), angle by
+    angle: a join made at some angles only is `drawn` there."""
+    n_at = len(res.phi_deg)
+    names = list(mech.links[k].points)
+    on_line = {n for s in segs if s.kind == "link" for n in (s.start, s.end)}
+    drawn = {n: np.full(n_at, n in on_line) for n in names}
     for p in mech.pairs:
         if p.kind != "P" or p.links[0] != k or p.guide not in mech.links[k].points:
             continue
         G = pts[p.guide]
-        d = complex(*p.direction) * complex(res.kin.rot[0, k])
-        on = {n: ((pts[n] - G) * d.conjugate()).real for n in mech.links[k].points}
+        d = complex(*p.direction) * res.kin.rot[:, k]
+        on = {n: ((pts[n] - G) * d.conjugate()).real for n in names}
         on[p.point] = ((_world(res, p.links[1], p.point) / mu.value - G) * d.conjugate()).real
-        lo, hi = min(on.values()), max(on.values())
+        along = np.stack(list(on.values()))
+        lo, hi = along.min(axis=0), along.max(axis=0)
         name = f"slot {k} {p.point}"
         pts[f"{name}:from"], pts[f"{name}:to"] = G + lo * d, G + hi * d
         segs.append(Segment(name, f"{name}:from", f"{name}:to", (hi - lo) * mu.value, "m", "link"))
-        drawn |= {n for n in mech.links[k].points if abs(((pts[n] - G) * d.conjugate()).imag) < 1e-6}
-    rest = [n for n in mech.links[k].points if n not in drawn]
-    if not drawn and rest:
-        drawn.add(rest.pop(0))
-    while rest:                                   # the nearest point not yet drawn, joined to the drawing
-        a, b = min(((a, b) for a in rest for b in drawn),          # ties by name: the same sheet every run
-                   key=lambda ab: (abs(pts[ab[0]] - pts[ab[1]]), ab))
-        segs.append(Segment(f"{b}{a}", b, a, abs(pts[a] - pts[b]) * mu.value, "m", "link"))
-        drawn.add(a)
-        rest.remove(a)
+        for n in names:
+            drawn[n] = drawn[n] | (np.abs(((pts[n] - G) * d.conjugate()).imag) < 1e-6)
+    done = np.stack([drawn[n] for n in names], axis=1)                 # (N, points)
+    if not names:
+        return
+    first = ~done.any(axis=1)                   # nothing drawn yet: the first point is
+    done[first, 0] = True
+    pairs = sorted(((a, b) for a in range(len(names)) for b in range(len(names)) if a != b),
+                   key=lambda ab: (names[ab[0]], names[ab[1]]))           # ties by name
+    A, B = np.array([a for a, _ in pairs], int), np.array([b for _, b in pairs], int)
+    z = np.stack([pts[n] for n in names], axis=1)
+    dist = np.abs(z[:, A] - z[:, B])                                    # (N, pairs)
+    joins: dict[tuple[int, int], np.ndarray] = {}
+    while not done.all():                       # the nearest point not yet drawn, joined to the drawing
+        free = ~done[:, A] & done[:, B]
+        key = np.where(free, dist, np.inf)
+        near = free & (key <= key.min(axis=1, keepdims=True) * (1 + 1e-9))      # ties to rounding: by name
+        best = np.where(free.any(axis=1), np.argmax(near, axis=1), -1)
+        for j in np.unique(best[best >= 0]):
+            at = best == j
+            joins[pairs[j]] = joins.get(pairs[j], np.zeros(n_at, bool)) | at
+            done[at, A[j]] = True
+    for (a, b), at in joins.items():
+        na, nb = names[a], names[b]
+        segs.append(Segment(f"{nb}{na}", nb, na, np.abs(pts[na] - pts[nb]) * mu.value, "m", "link",
+                            drawn=None if at.all() else at))
 
 
-def mechanism_plan(mech, res, scales: dict[str, Scale]) -> Plan:
-    """The mechanism at the analysis's angle at mu_l: links, frame supports and guides hatched,
-    pins and blocks, centres of mass, and the arcs of ω_k and ε_k of every turning link."""
+def mechanism_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
+    """The mechanism at every angle of `res` at mu_l: links, frame supports and guides hatched,
+    pins and blocks, centres of mass, and the arcs of ω_k and ε_k of every link turning at some
+    angle (not drawn, NaN, at an angle where that one is zero)."""
     mu = scales["mu_l"]
-    at = float(res.phi_deg[0])
-    pts: dict[str, complex] = {}
+    pts: dict[str, np.ndarray] = {}
     segs: list = []
-    paths: dict[str, tuple[complex, ...]] = {}
+    paths: dict[str, np.ndarray] = {}
     for k in range(1, mech.n_links):
         _link_drawing(mech, res, k, pts, segs, mu)
         _link_lines(mech, res, k, pts, segs, mu)
@@ -90,16 +143,16 @@ def mechanism_plan(mech, res, scales: dict[str, Scale]) -> Plan:
             paths[f"pin {p.point}"] = _circle(X, PIN_MM)
             if 0 in p.links:
                 base = X - 5.0j
-                paths[f"support {p.point}"] = (X, base - 3.0, base + 3.0, X)
+                paths[f"support {p.point}"] = np.stack([X, base - 3.0, base + 3.0, X], axis=1)
                 _hatch(base - 4.0, base + 4.0, -1j, f"hatch {p.point}", paths)
             continue
-        d = complex(*p.direction) * complex(res.kin.rot[0, p.links[0]])
+        d = complex(*p.direction) * res.kin.rot[:, p.links[0]]
         n = 1j * d
         S = _world(res, p.links[1], p.point) / mu.value
         (l, w) = BLOCK_MM
-        paths[f"block {p.point}"] = tuple(S + z for z in (l / 2 * d + w / 2 * n, -l / 2 * d + w / 2 * n,
-                                                        -l / 2 * d - w / 2 * n, l / 2 * d - w / 2 * n,
-                                                        l / 2 * d + w / 2 * n))
+        paths[f"block {p.point}"] = np.stack([S + z for z in (l / 2 * d + w / 2 * n, -l / 2 * d + w / 2 * n,
+                                                              -l / 2 * d - w / 2 * n, l / 2 * d - w / 2 * n,
+                                                              l / 2 * d + w / 2 * n)], axis=1)
         if 0 in p.links:                         # the frame's guide: hatched on one side, along the block
             for s in (1.0, -1.0):
                 a, b = S - 14.0 * d + s * (w / 2 + 0.5) * n, S + 14.0 * d + s * (w / 2 + 0.5) * n
@@ -108,14 +161,15 @@ def mechanism_plan(mech, res, scales: dict[str, Scale]) -> Plan:
         link = mech.links[k]
         if link.com and link.com in pts:
             paths[f"com {link.com}"] = _circle(pts[link.com], 1.6, 12)
-        w, e = float(res.kin.omega[0, k]), float(res.kin.eps[0, k])
-        if w == 0 and e == 0:
+        w, e = res.kin.omega[:, k], res.kin.eps[:, k]
+        turns = {f"ω{k}": (w, ARC_MM[0]), f"ε{k}": (e, ARC_MM[1])}
+        turns = {name: v for name, v in turns.items() if _any(v[0], res)}
+        if not turns:
             continue                              # a translating link turns not
         joints = [s for s in segs if s.kind == "link" and s.start in link.points]
         c = pts[joints[0].start] if k == mech.drive.link else (
             (pts[joints[0].start] + pts[joints[0].end]) / 2 if joints else pts[next(iter(link.points))])
-        if w:
-            paths[f"ω{k}"] = _arc(c, ARC_MM[0], math.copysign(1.0, w))
-        if e:
-            paths[f"ε{k}"] = _arc(c, ARC_MM[1], math.copysign(1.0, e))
-    return Plan("mechanism", f"Mechanism at phi = {at:g} deg", mu, at, pts, tuple(segs), paths)
+        for name, (v, r) in turns.items():
+            arc = _arc(c, r, np.sign(v))
+            paths[name] = np.where((v != 0)[:, None], arc, np.nan)
+    return PlanCycle("mechanism", _titles("Mechanism at phi = {at:g} deg", res), mu, res.phi_deg, pts, tuple(segs), paths)

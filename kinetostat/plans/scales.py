@@ -22,7 +22,8 @@ digits (l_OA = 0.036 m: 0.001 m/mm, OA = 36 mm, as the example).
           drawn 100..200 mm: the texts give the force plan a sheet of its own (seed 002 draws
           its 9651 N gas force 193 mm long at mu_F = 50 N/mm).
 
-May use: numpy, `kinetostat.solve` (the exact results), `.core`.
+May use: numpy, `kinetostat.solve` (the exact results; analysed here only where `choose_scales`
+is not given the cycle of positions), `.core`.
 """
 from __future__ import annotations
 
@@ -136,58 +137,82 @@ def check_given(given: Mapping[str, float] | None) -> dict[str, float]:
     return out
 
 
-def _extent(z: np.ndarray) -> tuple[float, float]:
-    z = np.asarray(z)[np.isfinite(z)]
-    if not len(z):
-        return (0.0, 0.0)
-    return (float(np.ptp(z.real)), float(np.ptp(z.imag)))
+def _extent(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(width, height) of the finite points of z (N, M) at each angle, each (N,); 0 where none."""
+    z = np.asarray(z)
+    ok = np.isfinite(z)
+    some = ok.any(axis=1)
+
+    def ptp(v: np.ndarray) -> np.ndarray:
+        hi = np.max(v, axis=1, where=ok, initial=-np.inf)
+        return np.where(some, hi - np.min(v, axis=1, where=ok, initial=np.inf), 0.0)
+    return ptp(z.real), ptp(z.imag)
+
+
+def _per_angle(mech, res) -> dict[str, np.ndarray]:
+    """The quantity each scale draws at its recommended length (TARGET_MM), SI, (N,) at every
+    angle of `res` (see `references`)."""
+    d = mech.drive
+    crank = mech.links[d.link].points
+    n = len(res.phi_deg)
+    forces = np.concatenate([np.hypot(*np.moveaxis(a, -1, 0)).reshape(n, -1)
+                             for a in (res.forces.R, res.F_applied, res.F_i)], axis=1)
+    return {"mu_l": np.full(n, math.dist(crank[d.pivot], crank[d.point])),
+            "mu_v": np.hypot(*res.velocity(d.point).T),
+            "mu_a": np.hypot(*res.acceleration(d.point).T),
+            "mu_F": np.nanmax(forces, axis=1, initial=0.0)}
 
 
 def references(mech, res) -> dict[str, float]:
-    """The quantity each scale draws at its recommended length (TARGET_MM), SI, at the first angle
-    of `res`: mu_l the crank l_OA (m), mu_v |v_A| (m/s), mu_a |a_A| (m/s^2) of the crank pin,
-    mu_F the largest force (a reaction, an applied load or an inertia force; N)."""
-    d = mech.drive
-    crank = mech.links[d.link].points
-    forces = np.concatenate([np.hypot(*np.moveaxis(a[0], -1, 0)).ravel()
-                             for a in (res.forces.R, res.F_applied, res.F_i)])
-    return {"mu_l": math.dist(crank[d.pivot], crank[d.point]),
-            "mu_v": float(np.hypot(*res.velocity(d.point)[0])),
-            "mu_a": float(np.hypot(*res.acceleration(d.point)[0])),
-            "mu_F": float(np.nanmax(forces, initial=0.0))}
+    """The quantity each scale draws at its recommended length (TARGET_MM), SI, the largest over
+    the angles of `res`: mu_l the crank l_OA (m), mu_v |v_A| (m/s), mu_a |a_A| (m/s^2) of the
+    crank pin, mu_F the largest force (a reaction, an applied load or an inertia force; N)."""
+    return {k: float(np.max(v)) for k, v in _per_angle(mech, res).items()}
 
 
 def choose_scales(mech, res, given: Mapping[str, float] | None = None,
                   cycle=None) -> dict[str, Scale]:
-    """Scales mu_l, mu_v, mu_a, mu_F for the plans of `res` (an Analysis at one crank angle):
-    the given ones as given, the others by the texts' rule (module docstring). `cycle`: an
-    Analysis over the cycle whose positions the plan of positions must fit (default: 72 steps)."""
-    from ..solve import analyze
+    """Scales mu_l, mu_v, mu_a, mu_F for the plans of `res` (an Analysis at one crank angle or
+    more): the given ones as given, the others by the texts' rule (module docstring), each the
+    coarsest it chooses at the angles of `res` that are not singular. `cycle`: an Analysis over
+    the cycle whose positions the plan of positions must fit (default: 72 steps, analysed here)."""
     given = check_given(given)
-    ref = references(mech, res)
     if cycle is None:
+        from ..solve import analyze
         cycle = analyze(mech, steps=72, friction="first")      # positions only
+    ok = ~np.asarray(res.singular, bool)
+    if not ok.any():
+        ok[:] = True
+    ref = {k: v[ok] for k, v in _per_angle(mech, res).items()}
+    n = int(ok.sum())
     pos = np.concatenate([cycle.kin.point_z(k, p)[0] for k, link in enumerate(mech.links) if k
                           for p in link.points.values()] + [np.array([complex(*p) for p in mech.links[0].points.values()])])
-    vel = np.array([0j] + [complex(*res.velocity(n)[0]) for n in mech.point_names])
-    acc = np.array([0j] + [complex(*res.acceleration(n)[0]) for n in mech.point_names])
-    reference = {"mu_l": (ref["mu_l"], _extent(pos)), "mu_v": (ref["mu_v"], _extent(vel)),
-                 "mu_a": (ref["mu_a"], _extent(acc)), "mu_F": (ref["mu_F"], (0.0, 0.0))}
+    names = mech.point_names
+    vel = np.stack([np.zeros(n, complex)] + [_z(res.velocity(m)[ok]) for m in names], axis=1)
+    acc = np.stack([np.zeros(n, complex)] + [_z(res.acceleration(m)[ok]) for m in names], axis=1)
+    pos_extent = tuple(float(e[0]) for e in _extent(pos[None, :]))
+    extent = {"mu_l": (np.full(n, pos_extent[0]), np.full(n, pos_extent[1])), "mu_v": _extent(vel),
+              "mu_a": _extent(acc), "mu_F": (np.zeros(n), np.zeros(n))}
     out = {}
     for key, unit in SCALE_UNITS.items():
+        reference, (width, height) = ref[key], extent[key]
         if key in given:
             value = given[key]
-            size = max(reference[key][0], *reference[key][1]) / value
+            size = max(float(np.max(reference)), float(np.max(width)), float(np.max(height))) / value
             if not size <= MAX_EXTENT_MM:
                 raise ScaleError(f"{key}={value:g} {unit} would draw the {PLAN_OF[key]} plan "
                                  f"{f'{size:.3g} mm' if size < math.inf else 'beyond 1e308 mm'} across (at most {MAX_EXTENT_MM:g} mm); use a larger scale")
-        elif key == "mu_l" and ref["mu_l"] > 0:
-            value = length_scale(ref["mu_l"])
-            ext = reference[key][1]
-            factor = max(ext[0] / value / FIT_MM[0], ext[1] / value / FIT_MM[1])
+        elif key == "mu_l" and ref["mu_l"][0] > 0:
+            value = length_scale(float(ref["mu_l"][0]))
+            factor = max(pos_extent[0] / value / FIT_MM[0], pos_extent[1] / value / FIT_MM[1])
             if factor > 1:                   # the positions would not fit the sheet: coarser
                 value = coarser(value, factor)
-        else:
-            value = round_scale(reference[key][0], *TARGET_MM[key], extent=reference[key][1])
+        else:                                # the coarsest of the angles' (a scalar rule, angle by angle)
+            value = max(round_scale(float(r), *TARGET_MM[key], extent=(float(w), float(h)))
+                        for r, w, h in set(zip(reference, width, height)))
         out[key] = Scale(key, value, unit)
     return out
+
+
+def _z(xy: np.ndarray) -> np.ndarray:
+    return xy[:, 0] + 1j * xy[:, 1]
