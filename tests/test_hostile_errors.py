@@ -211,8 +211,10 @@ def test_a_scale_that_draws_beyond_a_sheet_is_refused(scale, message, tmp_path, 
 
 
 def test_the_drawings_loops_are_bounded_by_a_sheet():
-    """What a plan near MAX_EXTENT_MM draws: the frame's hatching and the labels' samples along a
-    line are capped (counted), whatever the length handed to them; a zero-length stretch is no error."""
+    """What a plan near MAX_EXTENT_MM draws: the frame's hatching is capped (counted), whatever the
+    length handed to it; a zero-length stretch is no error; the labels' placer clips a line to each
+    candidate box (no samples along it), so a line 1e12 mm long costs what a short one does."""
+    import numpy as np
     from kinetostat.plans.labels import Placer
     from kinetostat.plans.mechanism import _hatch
     paths: dict = {}
@@ -221,12 +223,11 @@ def test_the_drawings_loops_are_bounded_by_a_sheet():
     paths.clear()
     _hatch(1e19 + 0j, 1e19 + 0j, 1j, "h", paths)       # both ends one float at 1e19 mm
     assert len(paths) == 1
-    placer = Placer((0.0, 0.0, 420.0, 297.0))
-    placer.line(0.0, 0.0, 1e12, 0.0)
-    placer.line(0.0, 0.0, 7.0, 0.0)
-    s = placer._samples()
-    assert len(s) == 10_000 + 11                        # the first line capped, the second every 0.7 mm
-    assert s[[0, 9_999, 10_000, -1]].tolist() == [[0.0, 0.0], [1e12, 0.0], [0.0, 0.0], [7.0, 0.0]]
+    placer = Placer(1, (0.0, 0.0, 420.0, 297.0))
+    placer.line([0.0, 100.0, 1e12, 100.0])
+    placer.line([50.0, 100.0, 50.0, 100.0])
+    box = placer.place(("A",), np.zeros(1, dtype=int), 3.5, np.array([[50.0, 100.0]])).box[0]
+    assert box[3] <= 100.0 or box[1] >= 100.0          # beside the line, not over it
 
 
 # ============================================================================ 8. accuracy near singular positions

@@ -19,7 +19,8 @@ from typing import Mapping
 
 import numpy as np
 
-__all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent", "extent_cycle"]
+__all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent",
+           "extent_cycle", "ELEMENTS", "fixed"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -242,17 +243,29 @@ class PlanCycle:
                 f"segments={len(self.segments)})")
 
 
+#: Where a Drawing's `static` markup takes the elements of an angle (`Drawing.svg`).
+ELEMENTS = "<!--elements-->\n"
+
+
+def fixed(q: int, digits: int) -> str:
+    """The integer q / 10**digits written with `digits` decimals, exactly ('-' only below zero)."""
+    whole, frac = divmod(abs(int(q)), 10 ** digits)
+    return f"{'-' if q < 0 else ''}{whole}.{frac:0{digits}d}"
+
+
 @dataclass(frozen=True, eq=False)
 class Element:
     """One element of a drawn sheet over N angles, in sheet millimetres (x right, y down: SVG's
     user units), ready to write at any angle i. `tag`: "line" (xy[i] = its two ends), "path" (a
     closed polygon through xy[i]: an arrowhead), "polyline" (through xy[i]), "circle" (centre
     xy[i, 0]; its "r" in attrs), "text" (a label or a line of text: anchor xy[i, 0]; its markup
-    `texts[variant[i]]`, tspans placed relative to it). `xy` (N, M, 2) float, or (1, M, 2) where the
-    same at every angle; a NaN at angle i: the element is not drawn there. `attrs`: attributes the
-    same at every angle (stroke, class, data-plan, data-segment, ...); `title`: its tooltip, or "".
+    `texts[variant[i]]`, tspans placed relative to it), "g" (an empty group, no coordinates: a
+    negligible vector's place in the page contract). `xy` (N, M, 2) float, or (1, M, 2) where the
+    same at every angle; a NaN at angle i: the element is not drawn there (a polyline: through its
+    finite points, drawn where at least two). `attrs`: attributes the same at every angle (stroke,
+    class, data-plan, data-segment, ...) and `title`, its tooltip or "": markup, escaped already.
     `length_mm` (N,): a segment's drawn length at its scale (the page contract's data-length-mm),
-    or None."""
+    or None. `svg(i)` writes it (see `Drawing`)."""
     tag: str
     xy: np.ndarray
     attrs: Mapping[str, str] = field(default_factory=dict)
@@ -266,14 +279,70 @@ class Element:
         object.__setattr__(self, "attrs", MappingProxyType(dict(self.attrs)))
         object.__setattr__(self, "texts", tuple(self.texts))
 
+    def drawn(self) -> np.ndarray:
+        """Whether the element is drawn at each angle, (N,) or (1,)."""
+        fin = np.isfinite(self.xy).all(axis=2)
+        return fin.sum(axis=1) >= 2 if self.tag == "polyline" else fin.all(axis=1)
+
+    def svg(self, i: int) -> str:
+        """The element at angle i as SVG ("" where not drawn there): `<tag` + its coordinates,
+        each q = rint(1000 x) written with 3 decimals (`fixed`) + ` k="v"` for each of attrs in
+        order + ` data-length-mm="..."` (rint(1e9 L), 9 decimals) where it has lengths + `>` +
+        `<title>title</title>` where it has one + a text's markup + `</tag>`. Coordinates: line
+        x1 y1 x2 y2; circle cx cy; text x y; polyline points="x,y x,y ..." (its finite points);
+        path d="Mx,y Lx,y ... z"; g none."""
+        xy = self.xy[i if len(self.xy) > 1 else 0]
+        if self.tag == "polyline":
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            if len(xy) < 2:
+                return ""
+        elif not np.isfinite(xy).all():
+            return ""
+        q = np.rint(xy * 1000.0).astype(np.int64).tolist()
+        c = [[fixed(v, 3) for v in p] for p in q]
+        if self.tag == "line":
+            head = f' x1="{c[0][0]}" y1="{c[0][1]}" x2="{c[1][0]}" y2="{c[1][1]}"'
+        elif self.tag == "circle":
+            head = f' cx="{c[0][0]}" cy="{c[0][1]}"'
+        elif self.tag == "text":
+            head = f' x="{c[0][0]}" y="{c[0][1]}"'
+        elif self.tag == "polyline":
+            head = ' points="' + " ".join(f"{x},{y}" for x, y in c) + '"'
+        elif self.tag == "path":
+            head = ' d="M' + " L".join(f"{x},{y}" for x, y in c) + ' z"'
+        else:
+            head = ""
+        head += "".join(f' {k}="{v}"' for k, v in self.attrs.items())
+        if self.length_mm is not None:
+            L = self.length_mm[i if len(self.length_mm) > 1 else 0]
+            head += f' data-length-mm="{fixed(int(np.rint(L * 1e9)), 9)}"'
+        body = f"<title>{self.title}</title>" if self.title else ""
+        if self.tag == "text":
+            body += self.texts[int(self.variant[i if len(self.variant) > 1 else 0])]
+        return f"<{self.tag}{head}>{body}</{self.tag}>"
+
 
 @dataclass(frozen=True, eq=False)
 class Drawing:
-    """A plan's sheet at N angles as arrays (`draw.drawing`): `static` the SVG markup the same at
-    every angle (the sheet's frame, the parts of the title block that do not change), then
-    `elements` in the order drawn. `svg(i)` in Python and the page's script in a browser write the
-    same sheet of angle i from these arrays."""
+    """A plan's sheet at N angles as arrays (`draw.drawing`): `static` the SVG document the same
+    at every angle (the XML declaration, the <svg> root, the sheet's frame, the parts of the title
+    block that do not change) holding `ELEMENTS` once, where `elements`, in the order drawn, go.
+    `svg(i)` in Python and the page's script in a browser write the same sheet of angle i from
+    these arrays: `static` with ELEMENTS replaced by each element's `Element.svg(i)` + "\n"
+    (those drawn there)."""
     kind: str
     phi_deg: np.ndarray                    # (N,) deg
     static: str
     elements: tuple[Element, ...]
+
+    @property
+    def n(self) -> int:
+        """The number of angles."""
+        return len(self.phi_deg)
+
+    def svg(self, i: int) -> str:
+        """The whole SVG document of angle i (0 <= i < n)."""
+        if not -self.n <= i < self.n:
+            raise IndexError(f"{self.kind}: angle index {i} out of range for {self.n} angles")
+        body = "".join(s + "\n" for s in (e.svg(i) for e in self.elements) if s)
+        return self.static.replace(ELEMENTS, body, 1)

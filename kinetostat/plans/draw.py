@@ -19,13 +19,16 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import dataclass
+
+import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
-from .core import Plan, Segment, extent
+from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
-from .labels import ASCENT, MIN_TEXT_MM, Placer, label_parts, label_svg, merge_coincident, text_width
+from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, label_parts, text_width
 
-__all__ = ["svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
+__all__ = ["drawing", "svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
 
 #: The sheet: A3 landscape, mm.
@@ -70,11 +73,7 @@ def _lang(lang: str) -> int:
 
 def title_of(plan: Plan, lang: str = "en") -> str:
     """The plan's title in `lang`, with its crank angle."""
-    base, _, rest = plan.kind.partition(":")
-    name = text(f"plan.{base}", lang) if f"plan.{base}" in MESSAGES else plan.title
-    if rest:
-        name += " " + rest.replace(",", "-")
-    return f"{name}, φ = {num(plan.phi_deg, lang, 6)}°"
+    return f"{_plan_name(plan.kind, plan.title, lang)}, φ = {num(plan.phi_deg, lang, 6)}°"
 
 
 def scale_text(plan_or_scale, lang: str = "en") -> str:
@@ -172,11 +171,18 @@ def _rich(s: str, size: float) -> str:
     return "".join(out)
 
 
+def _text_element(x: float, y: float, texts: list[str], variant, size: float, anchor: str = "start",
+                  weight: str = "normal", ident: str = "", cls: str = "note") -> Element:
+    """A line of text (its variants over the angles: notes marked as `_rich` letters them) at (x, y)."""
+    attrs = {"class": cls, **({"id": ident} if ident else {}), "font-size": f"{size:.2f}", "text-anchor": anchor,
+             "font-weight": weight}
+    return Element("text", np.array([[[x, y]]]), attrs, texts=tuple(_rich(s, size) for s in texts),
+                   variant=np.asarray(variant, dtype=int))
+
+
 def _t(x: float, y: float, s: str, size: float, anchor: str = "start", weight: str = "normal",
        ident: str = "", cls: str = "note") -> str:
-    attrs = f' id="{ident}"' if ident else ""
-    return (f'<text class="{cls}"{attrs} x="{x:.2f}" y="{y:.2f}" font-size="{size:.2f}" text-anchor="{anchor}" '
-            f'font-weight="{weight}">{_rich(s, size)}</text>')
+    return _text_element(x, y, [s], [0], size, anchor, weight, ident, cls).svg(0)
 
 
 def _wrap(s: str, size: float, width: float) -> list[str]:
@@ -197,30 +203,47 @@ def _fit(s: str, size: float, width: float, least: float = MIN_TEXT_MM) -> float
     return max(least, min(size, size * width / max(text_width(_plain(s), size), 1e-9)))
 
 
-def _tiny(plan: Plan) -> dict[str, str]:
-    """Vectors under TINY_MM at their scale: name -> how drawn ("out" of scale at MIN_DRAWN_MM: a
-    load at a scale of its own; "negligible": a polygon's side or a plan's vector, not laid off)."""
+#: How a vector under TINY_MM is drawn at an angle (`_tiny`): as it is, out of scale, negligible.
+_AS_IS, _OUT, _NEGLIGIBLE = 0, 1, 2
+
+
+def _tiny(cycle: PlanCycle) -> dict[str, np.ndarray]:
+    """Vectors under TINY_MM at their scale at some angle: name -> how drawn at each angle (N,)
+    (_OUT of scale at MIN_DRAWN_MM: a load at a scale of its own; _NEGLIGIBLE: a polygon's side
+    or a plan's vector, not laid off; _AS_IS where not tiny or not drawn)."""
     how = {}
-    for s in _drawable(plan):
-        if s.kind == "vector" and abs(plan.points[s.end] - plan.points[s.start]) < TINY_MM:
-            out = s.scale is not None and abs(plan.points[s.end] - plan.points[s.start]) > ZERO_MM
-            how[s.name] = "out" if out else "negligible"
+    for s in cycle.segments:
+        if s.kind != "vector":
+            continue
+        L = cycle.length_mm(s.name)
+        tiny = L < TINY_MM
+        if tiny.any():
+            out = (s.scale is not None) & (L > ZERO_MM)
+            how[s.name] = np.where(tiny, np.where(out, _OUT, _NEGLIGIBLE), _AS_IS)
     return how
 
 
-def _collinear(plan: Plan, s: Segment, tiny: dict[str, str]) -> bool:
-    """Whether a vector drawn out of scale would lie on another vector of the plan: one from the
-    same point (within 0.5 mm) in the same direction (within 5 degrees)."""
-    a = plan.points[s.start]
-    d = plan.points[s.end] - a
-    for o in _drawable(plan):
-        if o.kind != "vector" or o.name == s.name or o.name in tiny:
+def _tiny_at(tiny: dict[str, np.ndarray], i: int) -> dict[str, str]:
+    """The tiny vectors of angle i: name -> "out" or "negligible" (the notes' words)."""
+    return {k: "out" if v[i] == _OUT else "negligible" for k, v in tiny.items() if v[i] != _AS_IS}
+
+
+def _collinear(cycle: PlanCycle, s: Segment, tiny: dict[str, np.ndarray]) -> np.ndarray:
+    """At each angle (N,), whether a vector drawn out of scale would lie on another vector of the
+    plan: one from the same point (within 0.5 mm) in the same direction (within 5 degrees), drawn
+    as it is there."""
+    a = cycle.points[s.start]
+    d = cycle.points[s.end] - a
+    out = np.zeros(cycle.n, dtype=bool)
+    for o in cycle.segments:
+        if o.kind != "vector" or o.name == s.name:
             continue
-        e = plan.points[o.end] - plan.points[o.start]
+        e = cycle.points[o.end] - cycle.points[o.start]
         turn = e * d.conjugate()
-        if abs(plan.points[o.start] - a) < 0.5 and abs(e) > 0 and abs(math.atan2(turn.imag, turn.real)) < math.radians(5.0):
-            return True
-    return False
+        as_is = tiny[o.name] == _AS_IS if o.name in tiny else True
+        out |= as_is & (np.abs(cycle.points[o.start] - a) < 0.5) & (np.abs(e) > 0) \
+            & (np.abs(np.angle(turn)) < math.radians(5.0))
+    return out
 
 
 def _result_line(plan: Plan, lang: str) -> list[str]:
@@ -303,12 +326,13 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0))
 
 
-def _layout(plan: Plan, lang: str, tiny: dict[str, str],
+def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float, float, float],
             draw: bool = True) -> tuple[list[str], tuple[float, float, float, float]]:
-    """The notes (SVG where `draw`) and the drawing area: notes below where the plan fits above
-    them, else in a column at its left where it fits beside them, else below with a note that it
-    does not fit (fitting: with MIN_DRAWN_MM to spare on every side, for a vector drawn out of scale)."""
-    x0, y0, x1, y1 = extent(plan)
+    """The notes of `plan` (SVG where `draw`) and the drawing area for a drawing of extent `box`:
+    notes below where it fits above them, else in a column at its left where it fits beside them,
+    else below with a note that it does not fit (fitting: with MIN_DRAWN_MM to spare on every
+    side, for a vector drawn out of scale)."""
+    x0, y0, x1, y1 = box
     for left in (False, True):
         notes, area = _notes_block(plan, lang, tiny, left, draw=draw)
         if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
@@ -317,153 +341,290 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str],
     return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw)
 
 
-def _title_block(plan: Plan, lang: str, mechanism: str) -> list[str]:
+def _variants(strings: list[str]) -> tuple[list[str], np.ndarray]:
+    """Per-angle strings as (the distinct ones, in order of first use; each angle's index (N,))."""
+    index: dict[str, int] = {}
+    variant = np.array([index.setdefault(s, len(index)) for s in strings], dtype=int)
+    return list(index), variant
+
+
+def _plan_name(kind: str, title: str, lang: str) -> str:
+    """A plan's name in `lang` (its title where the catalogue has none), with its group: 'Plan of group 2-3'."""
+    base, _, rest = kind.partition(":")
+    name = text(f"plan.{base}", lang) if f"plan.{base}" in MESSAGES else title
+    return name + (" " + rest.replace(",", "-") if rest else "")
+
+
+def _title_block(cycle: PlanCycle, lang: str, mechanism: str) -> list[Element]:
+    """The title block's texts over the angles (the title and the angle line change with φ)."""
     x0, y0, x1, y1 = _TITLE_BLOCK
     w = x1 - x0 - 6
-    title = title_of(plan, lang)
-    scales = scales_of(plan)
+    phi = [num(p, lang, 6) for p in cycle.phi_deg.tolist()]
+    titles, tv = _variants([f"{_plan_name(cycle.kind, t, lang)}, φ = {p}°" for t, p in zip(cycle.titles, phi)])
+    angles, av = _variants([f"{text('angle', lang)} φ = {p}°" for p in phi])
+    scales = scales_of(cycle)
     sc = f"{text('scale' if len(scales) == 1 else 'scales', lang)}: " + "; ".join(scale_text(s, lang) for s in scales)
-    angle = f"{text('angle', lang)} φ = {num(plan.phi_deg, lang, 6)}°"
-    return [f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
-            f'stroke="#000" stroke-width="0.5"/>',
-            f'<line x1="{x0}" y1="{y0 + 12}" x2="{x1}" y2="{y0 + 12}" stroke="#000" stroke-width="0.25"/>',
-            f'<line x1="{x0}" y1="{y0 + 24}" x2="{x1}" y2="{y0 + 24}" stroke="#000" stroke-width="0.25"/>',
-            _t(x0 + 3, y0 + 8, title, _fit(title, 5.0, w), weight="bold", cls="title"),
-            _t(x0 + 3, y0 + 19.5, sc, _fit(sc, 4.5, w), ident="scale", cls="title"),
-            _t(x0 + 3, y0 + 30, mechanism, _fit(mechanism, 3.0, w), ident="mechanism", cls="title"),
-            _t(x0 + 3, y0 + 36, angle, 3.0, cls="title"),
-            _t(x0 + 3, y0 + 42, text("sheet", lang), MIN_TEXT_MM, cls="title"),
-            "</g>"]
+    return [_text_element(x0 + 3, y0 + 8, titles, tv, min(_fit(t, 5.0, w) for t in titles), weight="bold", cls="title"),
+            _text_element(x0 + 3, y0 + 19.5, [sc], [0], _fit(sc, 4.5, w), ident="scale", cls="title"),
+            _text_element(x0 + 3, y0 + 30, [mechanism], [0], _fit(mechanism, 3.0, w), ident="mechanism", cls="title"),
+            _text_element(x0 + 3, y0 + 36, angles, av, 3.0, cls="title"),
+            _text_element(x0 + 3, y0 + 42, [text("sheet", lang)], [0], MIN_TEXT_MM, cls="title")]
 
 
-def _arrowhead(a: tuple[float, float], b: tuple[float, float], length: float,
-               arc: bool = False, colour: str = "#000") -> tuple[str, tuple, tuple]:
-    """An arrowhead filled with its line's `colour`, its tip at b pointing from a: (svg path, its
-    box, the line's new end); on an arc (a sense, a couple) ARC_HEAD_MM long whatever the chord a-b."""
-    L = math.hypot(b[0] - a[0], b[1] - a[1])
-    ux, uy = (b[0] - a[0]) / L, (b[1] - a[1]) / L
-    h = ARC_HEAD_MM if arc else min(ARROW_MM[0], max(0.3 * L, 0.8), length)
-    hw = max(0.3, ARROW_MM[1] * h / ARROW_MM[0] * 1.0)
-    bx, by = b[0] - ux * h, b[1] - uy * h
-    pts = [(b[0], b[1]), (bx - uy * hw, by + ux * hw), (bx + uy * hw, by - ux * hw)]
-    d = "M" + " L".join(f"{x:.3f},{y:.3f}" for x, y in pts) + " z"
-    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
-    return (f'<path class="arrowhead{" arc" if arc else ""}" d="{d}" fill="{colour}"/>', (min(xs), min(ys), max(xs), max(ys)),
-            (b[0] - ux * 0.6 * h, b[1] - uy * 0.6 * h))
+def _arrowhead(a: np.ndarray, b: np.ndarray, length: np.ndarray | float,
+               arc: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Arrowheads, tips at b (N, 2) pointing from a: (their corners (N, 3, 2), tip first; their
+    boxes (N, 4); the lines' new ends (N, 2)); on an arc (a sense, a couple) ARC_HEAD_MM long
+    whatever the chord a-b, else at most ARROW_MM, 0.3 of the line and `length`."""
+    d = b - a
+    L = np.hypot(d[:, 0], d[:, 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = d / L[:, None]
+    h = np.full(len(L), ARC_HEAD_MM) if arc else np.minimum(np.minimum(ARROW_MM[0], np.maximum(0.3 * L, 0.8)), length)
+    hw = np.maximum(0.3, ARROW_MM[1] * h / ARROW_MM[0])
+    back = b - u * h[:, None]
+    side = np.column_stack([-u[:, 1], u[:, 0]]) * hw[:, None]
+    pts = np.stack([b, back + side, back - side], axis=1)
+    box = np.concatenate([pts.min(axis=1), pts.max(axis=1)], axis=1)
+    return pts, box, b - u * (0.6 * h)[:, None]
+
+
+def _on_sheet(z: np.ndarray, tx: float, ty: float) -> np.ndarray:
+    """Plan points (..., complex, mm, y up) on the sheet (..., 2) (mm, y down); NaN where not finite."""
+    xy = np.stack([z.real + tx, ty - z.imag], axis=-1)
+    return np.where(np.isfinite(xy).all(axis=-1, keepdims=True), xy, np.nan)
+
+
+def _cycle_extent(cycle: PlanCycle) -> tuple[float, float, float, float]:
+    """(x0, y0, x1, y1) of the cycle's finite points and paths at every angle, mm (`extent` over the angles)."""
+    z = np.concatenate([np.ravel(v) for v in (*cycle.points.values(), *cycle.paths.values())] or [np.zeros(0, complex)])
+    z = z[np.isfinite(z.real) & np.isfinite(z.imag)]
+    if not len(z):
+        return 0.0, 0.0, 0.0, 0.0
+    return float(z.real.min()), float(z.imag.min()), float(z.real.max()), float(z.imag.max())
+
+
+def _where(mask: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """xy (N, ..., 2) where mask (N,), else NaN."""
+    return np.where(mask.reshape(-1, *([1] * (xy.ndim - 1))), xy, np.nan)
+
+
+def _packed(xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A polyline's finite points first, in order (R, K, 2), and how many at each angle (R,)."""
+    fin = np.isfinite(xy).all(axis=2)
+    idx = np.argsort(~fin, axis=1, kind="stable")
+    return np.take_along_axis(xy, idx[..., None], axis=1), fin.sum(axis=1)
+
+
+def _lines(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Segments (..., 4) from a to b (..., 2)."""
+    return np.concatenate([a, b], axis=-1)
+
+
+@dataclass(frozen=True)
+class _Name:
+    """A label to place: its text at each angle (`texts[variant]`), anchor (N, 2), the segment's
+    other end (N, 2) or None, size and class."""
+    texts: tuple[str, ...]
+    variant: np.ndarray
+    anchor: np.ndarray
+    along: np.ndarray | None
+    size: float
+    cls: str
+
+
+def _labels(placer: Placer, names: list[_Name]) -> list[Element]:
+    """Each label placed at every angle (in order), as its text and its leader."""
+    out = []
+    for nm in names:
+        pl = placer.place(nm.texts, nm.variant, nm.size, nm.anchor, nm.along)
+        out.append(Element("text", pl.xy[:, None], {"class": nm.cls, "font-size": f"{nm.size:.2f}"},
+                           texts=tuple(label_markup(t, nm.size) for t in nm.texts), variant=nm.variant))
+        if np.isfinite(pl.leader).any():
+            out.append(Element("line", pl.leader.reshape(-1, 2, 2), {"class": "leader", "stroke": "#777",
+                                                                       "stroke-width": "0.13"}))
+    return out
+
+
+def _paths(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
+           names: list[_Name]) -> list[Element]:
+    """The plan's polylines (a rotation's sense, a couple: with an arrowhead at the arc's end and
+    its name), their lines given to the placer."""
+    out = []
+    n = cycle.n
+    for name, path in cycle.paths.items():
+        xy = at(path)                                           # (N or 1, K, 2)
+        pts, count = _packed(xy)
+        if not (count >= 2).any():
+            continue
+        width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
+        tip = text(name, lang) if name in MESSAGES else name if name[:1] in "ωεM" else ""   # no English tooltip
+        attrs = {"fill": "none", "stroke": colour, "stroke-width": f"{width}"}
+        if contract:
+            attrs.update({"data-plan": escape(cycle.kind), "data-path": escape(name)})
+        out.append(Element("polyline", xy, attrs, title=escape(tip)))
+        placer.line(_lines(pts[:, :-1], pts[:, 1:]))
+        if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
+            drawn = count >= 2
+            r = np.arange(len(pts))
+            last, prev = pts[r, np.maximum(count - 1, 0)], pts[r, np.maximum(count - 2, 0)]
+            head, box, _ = _arrowhead(prev, last, ARC_HEAD_MM, arc=True)
+            out.append(Element("path", _where(drawn, head), {"class": "arrowhead arc", "fill": colour}))
+            placer.block(_where(drawn, box))
+            mid = _where(drawn, pts[r, count // 2])
+            names.append(_Name((name,), np.zeros(n, dtype=int), np.broadcast_to(mid, (n, 2)), None, _NAME_MM, "name"))
+    return out
+
+
+def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, np.ndarray], placer: Placer,
+              names: list[_Name]) -> list[Element]:
+    """Every segment drawn where its ends are finite: its line (out of scale where tiny, a
+    negligible one not at all: an empty <g> in the contract), a vector's arrowhead; its name
+    where the texts letter it, and where negligible; obstacles given to the placer."""
+    out = []
+    n = cycle.n
+    sides = {s.name for s in _polygon_sides(cycle)} or None        # a polygon: every side and chord named
+    zero = np.zeros(n, dtype=int)
+    for s in cycle.segments:
+        za, zb = cycle.points[s.start], cycle.points[s.end]
+        a, b = at(za), at(zb)
+        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+        if not ok.any():
+            continue
+        width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
+        label = escape(segment_label(s, lang))
+        Lz = np.abs(zb - za)
+        L = Lz.copy()
+        how = np.where(ok, tiny.get(s.name, zero), _AS_IS)
+        out_ = how == _OUT
+        if out_.any():
+            with np.errstate(invalid="ignore", divide="ignore"):
+                u = (b - a) / L[:, None]
+            side = _where(out_ & _collinear(cycle, s, tiny), np.column_stack([-u[:, 1], u[:, 0]]) * SIDE_MM)
+            shift = np.nan_to_num(side)                          # beside the load it would hide under (G3* along F_p)
+            a = a + shift
+            b = np.where(out_[:, None], a + u * MIN_DRAWN_MM, b)
+            L = np.where(out_, MIN_DRAWN_MM, L)
+        neg = how == _NEGLIGIBLE
+        data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name)} if contract else {}
+        if contract and neg.any():
+            out.append(Element("g", _where(neg, a)[:, None], {"class": "negligible", **data}, length_mm=Lz))
+        drawn = ok & ~neg
+        if s.kind == "vector":
+            head, box, end = _arrowhead(a, b, L)
+            placer.block(_where(drawn, box))
+        else:
+            end = b
+            placer.block(_where(drawn, np.concatenate([b - 0.5, b + 0.5], axis=1)))     # a line's end
+        attrs = {"stroke": colour, "stroke-width": f"{width}", **({"stroke-dasharray": dash} if dash else {}), **data}
+        for code, title in ((_AS_IS, label), (_OUT, label + "*")):
+            lit = drawn & (how == code)
+            if lit.any():
+                out.append(Element("line", _where(lit, np.stack([a, end], axis=1)), attrs, title=title,
+                                   length_mm=Lz if contract else None))
+        if s.kind == "vector":
+            out.append(Element("path", _where(drawn, head), {"class": "arrowhead", "fill": colour}))
+        placer.line(_where(drawn, _lines(a, b)))
+        named = s.kind != "link" and (not labelled(s.end) or (sides is not None and s.kind == "vector")
+                                      or s.kind == "arm")
+        lettered = neg | (drawn & named)
+        if lettered.any():
+            names.append(_Name((segment_label(s, lang), segment_label(s, lang) + "*"), out_.astype(int),
+                               _where(lettered, a), _where(drawn & named, b), _NAME_MM, "name"))
+    return out
+
+
+def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_Name]]:
+    """The lettered points' dots and their labels (the design position's first, then the numbered
+    ones of a plan of positions), coincident points lettered once ('B1 ≡ B11')."""
+    small = cycle.kind == "positions"
+    dots, groups = [], {False: [], True: []}
+    for name, z in cycle.points.items():
+        if not labelled(name):
+            continue
+        xy = at(z)
+        if not np.isfinite(xy).all(axis=1).any():
+            continue
+        numbered = small and _numbered(cycle, name)
+        r = 0.4 if numbered else 0.6
+        dots.append(Element("circle", xy[:, None], {"r": f"{r}", "fill": "#000"}))
+        placer.block(np.concatenate([xy - r, xy + r], axis=1))
+        groups[numbered].append((name, xy))
+    labels = []
+    for numbered, group in groups.items():
+        if not group:
+            continue
+        xy = np.stack([p for _, p in group], axis=1)          # (N, M, 2)
+        owner = coincident(xy)
+        for j, (name, p) in enumerate(group):
+            lead = owner[:, j] == j
+            if not lead.any():
+                continue
+            rows, variant = np.unique(owner == j, axis=0, return_inverse=True)
+            texts = tuple(" ≡ ".join(group[m][0] for m in np.nonzero(row)[0]) for row in rows)
+            labels.append(_Name(texts, variant.reshape(-1), _where(lead, p), None,
+                                _NUMBERED_MM if numbered else _POINT_MM, "label"))
+    return dots, labels
+
+
+def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: bool) -> Drawing:
+    """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where `notes`."""
+    _lang(lang)
+    tiny = _tiny(cycle)
+    box = _cycle_extent(cycle)
+    lines = np.array([len(x) for x in cycle.notes] if cycle.notes else [0] * cycle.n) \
+        + sum((v != _AS_IS).astype(int) for v in tiny.values())
+    i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
+    plan = cycle.at(i)
+    block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, _tiny_at(tiny, i), box, draw=notes)
+    x0, y0, x1, y1 = box
+    tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
+
+    def at(z: np.ndarray) -> np.ndarray:
+        return _on_sheet(z, tx, ty)
+
+    placer = Placer(cycle.n, (ax0 - 4.0, _FRAME[1] + 1, _FRAME[2] - 1, min(ay1 + 4.0, _TITLE_BLOCK[1]) - 0.5))
+    placer.block(_TITLE_BLOCK)
+    names: list[_Name] = []
+    elements = _paths(cycle, lang, contract, at, placer, names)
+    elements += _segments(cycle, lang, contract, at, tiny, placer, names)
+    dots, points = _points(cycle, at, placer)
+    elements += dots + _labels(placer, points + names)
+    title = _title_block(cycle, lang, mechanism)
+    W, H = SHEET_MM
+    x0, y0, x1, y1 = _TITLE_BLOCK
+    static = ['<?xml version="1.0" encoding="UTF-8"?>',
+              f'<svg xmlns="http://www.w3.org/2000/svg" width="{W:g}mm" height="{H:g}mm" viewBox="0 0 {W:g} {H:g}" '
+              f'font-family="DejaVu Sans, Arial, sans-serif">',
+              f'<title>{escape(_plan_name(cycle.kind, cycle.titles[0], lang))}, {escape(scale_text(cycle.scale, lang))}</title>',
+              f'<rect x="0" y="0" width="{W:g}" height="{H:g}" fill="#fff"/>',
+              f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
+              f'fill="none" stroke="#000" stroke-width="0.7"/>',
+              '<g id="plan" stroke-linecap="round">', ELEMENTS.rstrip("\n"), "</g>",
+              f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
+              f'stroke="#000" stroke-width="0.5"/>',
+              f'<line x1="{x0}" y1="{y0 + 12}" x2="{x1}" y2="{y0 + 12}" stroke="#000" stroke-width="0.25"/>',
+              f'<line x1="{x0}" y1="{y0 + 24}" x2="{x1}" y2="{y0 + 24}" stroke="#000" stroke-width="0.25"/>',
+              *(t.svg(0) for t in title if len(t.texts) == 1), "</g>", *block, "</svg>"]
+    return Drawing(cycle.kind, cycle.phi_deg, "\n".join(static) + "\n",
+                   tuple(t for t in title if len(t.texts) > 1) + tuple(elements))
+
+
+def drawing(cycle: PlanCycle, lang: str = "en", mechanism: str = "", contract: bool = False) -> Drawing:
+    """The plan's A3 sheet at each angle of the cycle, true to scale (1 user unit = 1 mm), as
+    arrays (`Drawing`): one place of the plan on the sheet for the whole cycle (centred in the room
+    its notes leave at the angle with the most of them, over its extent at every angle), every
+    element at every angle, labels placed for the cycle at once (`labels.Placer`); the notes left
+    out, their room kept (the page's tables hold them). `contract`: every segment's element carries
+    data-plan, data-segment and its drawn length (data-length-mm, as in segments.csv; a negligible
+    vector, not drawn, an empty <g>): the interactive page's contract (`page`)."""
+    return _sheet(cycle, lang, mechanism, contract, notes=False)
 
 
 def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = False, notes: bool = True) -> str:
-    """The plan on an A3 landscape sheet, true to scale (1 user unit = 1 mm), as SVG text.
-    `contract`: every segment's element carries data-plan, data-segment and data-length-mm (its
-    length at the scale, as in segments.csv; a negligible vector, not drawn, an empty <g>): the
-    interactive page's contract (`page`). `notes`: False leaves the notes out, their room kept
-    (the plan drawn where it is with them; the page's tables hold them)."""
-    _lang(lang)
-    tiny = _tiny(plan)
-    x0, y0, x1, y1 = extent(plan)
-    block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, tiny, draw=notes)
-    tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
-
-    def P(z: complex) -> tuple[float, float]:
-        return z.real + tx, ty - z.imag
-
-    W, H = SHEET_MM
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<svg xmlns="http://www.w3.org/2000/svg" width="{W:g}mm" height="{H:g}mm" viewBox="0 0 {W:g} {H:g}" '
-           f'font-family="DejaVu Sans, Arial, sans-serif">',
-           f'<title>{escape(title_of(plan, lang))}, {escape(scale_text(plan, lang))}</title>',
-           f'<rect x="0" y="0" width="{W:g}" height="{H:g}" fill="#fff"/>',
-           f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
-           f'fill="none" stroke="#000" stroke-width="0.7"/>',
-           '<g id="plan" stroke-linecap="round">']
-    placer = Placer((ax0 - 4.0, _FRAME[1] + 1, _FRAME[2] - 1, min(ay1 + 4.0, _TITLE_BLOCK[1]) - 0.5))
-    placer.block(_TITLE_BLOCK)
-    named: list[tuple[str, tuple[float, float], tuple[float, float] | None]] = []   # (label, anchor, along)
-    for name, path in plan.paths.items():
-        xy = [P(z) for z in path if _finite(z)]
-        if len(xy) < 2:
-            continue
-        width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
-        pts = " ".join(f"{a:.3f},{b:.3f}" for a, b in xy)
-        tip = text(name, lang) if name in MESSAGES else name if name[:1] in "ωεM" else ""   # no English tooltip
-        ident = f' data-plan="{escape(plan.kind)}" data-path="{escape(name)}"' if contract else ""
-        out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="{width}"{ident}>'
-                   + (f'<title>{escape(tip)}</title>' if tip else "") + '</polyline>')
-        for (a, b), (c, d) in zip(xy, xy[1:]):
-            placer.line(a, b, c, d)
-        if name[:1] in "ωεM":                 # a rotation's sense, a couple: an arrowhead at the arc's end, its name
-            head, box, _ = _arrowhead(xy[-2], xy[-1], ARC_HEAD_MM, arc=True, colour=colour)
-            out.append(head)
-            placer.block(box)
-            named.append((name, xy[len(xy) // 2], None))
-    sides = {s.name for s in _polygon_sides(plan)} or None        # a polygon: every side and chord named
-    for s in _drawable(plan):
-        a, b = P(plan.points[s.start]), P(plan.points[s.end])
-        width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
-        L = math.hypot(b[0] - a[0], b[1] - a[1])
-        label = segment_label(s, lang)
-        data = (f' data-plan="{escape(plan.kind)}" data-segment="{escape(s.name)}" '
-                f'data-length-mm="{float(abs(plan.points[s.end] - plan.points[s.start]))!r}"') if contract else ""
-        if s.name in tiny:
-            if tiny[s.name] == "negligible":
-                named.append((label, a, None))
-                if contract:
-                    out.append(f'<g class="negligible"{data}/>')
-                continue
-            b = (a[0] + (b[0] - a[0]) / L * MIN_DRAWN_MM, a[1] + (b[1] - a[1]) / L * MIN_DRAWN_MM)
-            L, label = MIN_DRAWN_MM, label + "*"
-            if _collinear(plan, s, tiny):              # beside the load it would hide under (G3* along F_p)
-                nx, ny = -(b[1] - a[1]) / L * SIDE_MM, (b[0] - a[0]) / L * SIDE_MM
-                a, b = (a[0] + nx, a[1] + ny), (b[0] + nx, b[1] + ny)
-        end = b
-        if s.kind == "vector":
-            head, box, end = _arrowhead(a, b, L, colour=colour)
-            placer.block(box)
-        else:
-            placer.block((b[0] - 0.5, b[1] - 0.5, b[0] + 0.5, b[1] + 0.5))      # a line's end
-        attrs = f' stroke-dasharray="{dash}"' if dash else ""
-        out.append(f'<line x1="{a[0]:.3f}" y1="{a[1]:.3f}" x2="{end[0]:.3f}" y2="{end[1]:.3f}" stroke="{colour}" '
-                   f'stroke-width="{width}"{attrs}{data}><title>{escape(label)}</title></line>')
-        if s.kind == "vector":
-            out.append(head)
-        placer.line(a[0], a[1], b[0], b[1])
-        if s.kind != "link" and (not labelled(s.end) or (sides is not None and s.kind == "vector") or s.kind == "arm"):
-            named.append((label, a, b))
-    small = plan.kind == "positions"
-    dots = []
-    for name, z in plan.points.items():
-        if not _finite(z) or not labelled(name):
-            continue
-        a, b = P(z)
-        numbered = small and _numbered(plan, name)
-        r = 0.4 if numbered else 0.6
-        out.append(f'<circle cx="{a:.3f}" cy="{b:.3f}" r="{r}" fill="#000"/>')
-        placer.block((a - r, b - r, a + r, b + r))
-        dots.append((numbered, name, a, b))
-    labels = []
-    for numbered in (False, True):        # the design position's letters first, then the numbered ones
-        group = [(n, a, b) for k, n, a, b in dots if k == numbered]
-        for name, a, b in merge_coincident(group):
-            pl = placer.place(name, _NUMBERED_MM if numbered else _POINT_MM, a, b)
-            labels.append(label_svg(pl.x, pl.y, pl.name, pl.size))
-            if pl.leader:
-                labels.append(_leader(pl.leader))
-    for name, a, along in named:
-        pl = placer.place(name, _NAME_MM, a[0], a[1], along)
-        labels.append(label_svg(pl.x, pl.y, pl.name, pl.size, cls="name"))
-        if pl.leader:
-            labels.append(_leader(pl.leader))
-    out += labels
-    out.append("</g>")
-    out += _title_block(plan, lang, mechanism)
-    out += block
-    out.append("</svg>")
-    return "\n".join(out) + "\n"
-
-
-def _leader(seg: tuple[float, float, float, float]) -> str:
-    a, b, c, d = seg
-    return f'<line class="leader" x1="{a:.2f}" y1="{b:.2f}" x2="{c:.2f}" y2="{d:.2f}" stroke="#777" stroke-width="0.13"/>'
+    """The plan on an A3 landscape sheet, as SVG text: the one-angle `drawing` of the plan,
+    written (`Drawing.svg`), with the notes block where `notes` (False: left out, their room kept)."""
+    return _sheet(PlanCycle.of(plan), lang, mechanism, contract, notes).svg(0)
 
 
 # ----------------------------------------------------------------------------- matplotlib

@@ -1,57 +1,59 @@
-"""Lettering on a sheet: the size of a text as the browser sets it (DejaVu Sans), the SVG of a
-point's letter with its subscript, and a placer that puts each label beside its point or vector
-where it overprints no other label, arrowhead, point or line end, as a draughtsman would.
+"""Lettering on a sheet over N crank angles: the width of a text as DejaVu Sans sets it (its
+advance widths, `dejavu`), a point's letter with its subscript as SVG markup, coincident points
+lettered once, and a placer that puts each label beside its point or vector at every angle at
+once where it overprints no other label, arrowhead or point, as a draughtsman would.
 
-Sheet coordinates: mm, x right, y down (SVG user units). A box is (x0, y0, x1, y1).
+Sheet coordinates: mm, x right, y down (SVG user units). A box is (x0, y0, x1, y1); boxes,
+anchors and segments are arrays with a leading angle axis N, NaN where absent at an angle.
 
-The placer is greedy: labels in the order given (points first, then names of vectors), each at
-the candidate position of least cost (distance from its anchor, lines crossed) among those that
-overlap nothing placed before; far from its anchor a label gets a thin leader line. Coincident
-points are lettered once, "B1 ≡ B11" (`merge_coincident`).
+The placer takes labels in the order given (points first, then names of vectors) and, for all
+angles at once, each label's candidate places about its anchor (rings of 16 directions, or
+beside its segment): a candidate's cost is its distance from the anchor plus the length of drawn
+lines it covers (each line clipped to the box, exactly); a candidate over a hard obstacle
+(arrowhead, point, line end, a label placed before) or outside the bounds is not free. At every
+angle the least cost is found (candidates tested lazily, cheapest first, until none left can
+beat it); then the label keeps one place where it may: the candidate within `SLACK` of the best
+at the most angles is taken at all of them, and so on for the angles left. A label that had to
+move far gets a thin leader line from its anchor.
 
-May use: numpy, the standard library, `kinetostat._text` (XML-safe text).
+May use: numpy, the standard library, `.dejavu`, `kinetostat._text` (XML-safe text).
 """
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
+from .dejavu import ADVANCES, EM
 
-__all__ = ["text_width", "text_box", "label_parts", "label_svg", "label_width", "Placer", "Placed",
-           "merge_coincident", "MIN_TEXT_MM", "ASCENT", "DESCENT"]
+__all__ = ["text_width", "label_parts", "label_markup", "label_width", "label_height", "coincident", "Placer",
+           "Placed", "MIN_TEXT_MM", "ASCENT", "DESCENT"]
 
 #: Smallest text on a sheet, mm (the texts' standard lettering: 2.5 mm and up).
 MIN_TEXT_MM = 2.5
 #: DejaVu Sans ascent and descent, em: the box getBBox gives a text.
 ASCENT, DESCENT = 0.93, 0.24
-_NARROW = set("iljtfrI.,:;'′|!()[] -")
-_WIDE = set("mwMWЖШЩЮжшщюΣ≡→")
+#: A character DejaVu Sans lacks (set by the browser in another font): this wide, em.
+_UNKNOWN_EM = 1.0
+
+
+@lru_cache(maxsize=None)
+def _advance(ch: str) -> float:
+    """Advance width of one character, em (DejaVu Sans; _UNKNOWN_EM where it has no glyph)."""
+    code = ord(ch)
+    for start, adv in ADVANCES.items():
+        if start <= code < start + len(adv) and adv[code - start]:
+            return adv[code - start] / EM
+    return _UNKNOWN_EM
 
 
 def text_width(s: str, size: float) -> float:
-    """Advance width of `s` at font size `size` (mm), DejaVu Sans, slightly generous."""
-    w = 0.0
-    for ch in s:
-        if ch in _NARROW:
-            w += 0.36
-        elif ch in _WIDE:
-            w += 0.98
-        elif ch.isupper():
-            w += 0.76
-        else:
-            w += 0.65
-    return w * size
-
-
-def text_box(x: float, y: float, s: str, size: float, anchor: str = "start") -> tuple[float, float, float, float]:
-    """Box of a one-line text at baseline (x, y)."""
-    w = text_width(s, size)
-    x0 = x - (w if anchor == "end" else w / 2 if anchor == "middle" else 0.0)
-    return x0, y - ASCENT * size, x0 + w, y + DESCENT * size
+    """Advance width of `s` at font size `size` (mm), DejaVu Sans (no kerning: at least the width
+    the browser sets)."""
+    return sum(map(_advance, s)) * size
 
 
 _LABEL = re.compile(r"^([^\d_']*)([\d_]*)('*)$")
@@ -77,7 +79,7 @@ def _sub(size: float) -> float:
 
 
 def label_width(name: str, size: float) -> float:
-    """Width of a lettered name (several names joined by ' ≡ ' allowed)."""
+    """Width of a lettered name (several names joined by ' ≡ ' allowed), mm."""
     w = 0.0
     for k, part in enumerate(name.split(" ≡ ")):
         head, sub, primes = label_parts(part)
@@ -95,10 +97,10 @@ def label_height(name: str, size: float) -> tuple[float, float]:
     return ASCENT * size, below
 
 
-def label_svg(x: float, y: float, name: str, size: float, cls: str = "label") -> str:
-    """A lettered name at baseline (x, y): letters, subscript (a smaller tspan below), primes;
-    coincident names joined by ' ≡ '."""
-    out = [f'<text class="{cls}" x="{x:.2f}" y="{y:.2f}" font-size="{size:.2f}">']
+def label_markup(name: str, size: float) -> str:
+    """The content of a lettered name's <text> at font size `size`: letters, subscript (a smaller
+    tspan below), primes; coincident names joined by ' ≡ '."""
+    out = []
     low = 0.0                                     # how far below the baseline the last tspan sits
     for k, part in enumerate(name.split(" ≡ ")):
         head, sub, primes = label_parts(part)
@@ -110,21 +112,21 @@ def label_svg(x: float, y: float, name: str, size: float, cls: str = "label") ->
             attrs += f' dy="{dy:.2f}"' if dy else ""
             out.append(f"<tspan{attrs}>{escape(piece)}</tspan>")
             low += dy
-    return "".join(out) + "</text>"
+    return "".join(out)
 
 
-def merge_coincident(points: list[tuple[str, float, float]], tol: float = 0.5) -> list[tuple[str, float, float]]:
-    """Points (name, x, y) within `tol` mm of one another lettered once: 'B1 ≡ B11' (names in
-    the order given), at the first point."""
-    out: list[list] = []
-    for name, x, y in points:
-        for group in out:
-            if math.hypot(group[1] - x, group[2] - y) <= tol:
-                group[0].append(name)
-                break
-        else:
-            out.append([[name], x, y])
-    return [(" ≡ ".join(names), x, y) for names, x, y in out]
+def coincident(xy: np.ndarray, tol: float = 0.5) -> np.ndarray:
+    """Points lettered once where they coincide: xy (N, M, 2) -> owner (N, M) int, at each angle
+    the index of the point whose label names point m ('B1 ≡ B11' at B1): the first point, in the
+    order given, within `tol` mm of it that names itself; -1 where m is not finite."""
+    n, m = xy.shape[:2]
+    owner = np.full((n, m), -1)
+    for j in range(m):                          # over points, every angle at once
+        near = (owner[:, :j] == np.arange(j)) & (np.hypot(*(xy[:, :j] - xy[:, j:j + 1]).transpose(2, 0, 1)) <= tol)
+        first = near.argmax(axis=1) if j else np.zeros(n, dtype=int)
+        fin = np.isfinite(xy[:, j]).all(axis=1)
+        owner[:, j] = np.where(near.any(axis=1), first, np.where(fin, j, -1))
+    return owner
 
 
 def _constant(a: np.ndarray) -> np.ndarray:
@@ -138,161 +140,192 @@ _DIRS = _constant(np.column_stack([np.cos(np.radians(np.arange(0, 360, 22.5) + 4
                                    -np.sin(np.radians(np.arange(0, 360, 22.5) + 45.0))]))
 _ABS_DIRS = _constant(np.abs(_DIRS))
 _REACH = _constant(_ABS_DIRS.max(axis=0))      # a label's half size times this: how far its box reaches
-_RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0])[:, None, None])
-_RING_COST = _constant(1.2 * _RINGS[:, :, 0] + np.where(_DIRS[:, 1] > 0, 0.3, 0.0))
+_RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0]))
+_RING_COST = _constant((1.2 * _RINGS[:, None] + np.where(_DIRS[:, 1] > 0, 0.3, 0.0)).reshape(-1))
 #: Beside a segment: at these fractions T of its length, on either side S, at these clearances R
-#: (mm), each (42, 1); the cost's part for leaving the middle, 6 |T - 0.5| (times min(L, 20) / 20).
-_ALONG = tuple(_constant(g.reshape(-1, 1)) for g in np.meshgrid(
+#: (mm), each (42,); the cost's part for leaving the middle, 6 |T - 0.5| (times min(L, 20) / 20).
+_ALONG = tuple(_constant(g.reshape(-1)) for g in np.meshgrid(
     (0.5, 0.38, 0.62, 0.25, 0.75, 0.15, 0.85), (1.0, -1.0), (0.6, 1.5, 3.0), indexing="ij"))
-_ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0][:, 0] - 0.5))
+_ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
+#: A label keeps one place over the angles where that place costs at most this more than the best.
+SLACK = 1.5
+#: The cost of covering a drawn line, per mm of it inside the label's box.
+LINE_COST = 0.6 / 0.7
+#: Candidates tested at once (cheapest first).
+_BATCH = 48
+#: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
+LEADER_MM = 6.0
 
 
 @dataclass(frozen=True)
 class Placed:
-    """A placed label: baseline start (x, y), its box, and a leader from its anchor if far."""
-    name: str
-    x: float
-    y: float
-    size: float
-    box: tuple[float, float, float, float]
-    leader: tuple[float, float, float, float] | None
+    """A label placed at N angles: baseline start `xy` (N, 2), its `box` (N, 4) and a leader
+    (N, 4) from its anchor to the box where far (else NaN); NaN where it is not placed."""
+    xy: np.ndarray
+    box: np.ndarray
+    leader: np.ndarray
+
+
+def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Whether boxes a and b overlap (broadcast, last axis 4); False where either is NaN."""
+    return (a[..., 0] < b[..., 2]) & (a[..., 2] > b[..., 0]) & (a[..., 1] < b[..., 3]) & (a[..., 3] > b[..., 1])
+
+
+def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """Length (mm) of each segment (x0, y0, x1, y1) inside each box (broadcast, last axis 4):
+    the segment clipped to the box (Liang-Barsky); 0 where either is NaN."""
+    p, d = seg[..., :2], seg[..., 2:] - seg[..., :2]
+    lo_b, hi_b = box[..., :2], box[..., 2:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0, t1 = (lo_b - p) / d, (hi_b - p) / d
+        flat = d == 0                                       # parallel to a side: inside the slab or not
+        inside = (p > lo_b) & (p < hi_b)
+        lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(t0, t1))
+        hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(t0, t1))
+        t_in = np.maximum(np.maximum(lo[..., 0], lo[..., 1]), 0.0)
+        t_out = np.minimum(np.minimum(hi[..., 0], hi[..., 1]), 1.0)
+        length = (t_out - t_in) * np.hypot(d[..., 0], d[..., 1])
+    return np.where(length > 0, length, 0.0)
+
+
+def _near(items: np.ndarray, region: np.ndarray) -> np.ndarray:
+    """Of `items` (N, H, 4) (boxes, or segments by their bounding boxes), at each angle those whose
+    box meets `region` (N, 4), packed (N, m, 4), NaN-padded: m the most at any angle."""
+    lo, hi = np.minimum(items[..., :2], items[..., 2:]), np.maximum(items[..., :2], items[..., 2:])
+    near = (lo[..., 0] <= region[:, None, 2]) & (hi[..., 0] >= region[:, None, 0]) \
+        & (lo[..., 1] <= region[:, None, 3]) & (hi[..., 1] >= region[:, None, 1])
+    if len(items) == 1:
+        return items[:, near[0]]
+    m = int(near.sum(axis=1).max(initial=0))
+    idx = np.argsort(~near, axis=1, kind="stable")[:, :m]
+    out = np.take_along_axis(items, idx[..., None], axis=1)
+    return np.where(np.take_along_axis(near, idx, axis=1)[..., None], out, np.nan)
 
 
 class Placer:
-    """Places labels inside `bounds` (a box) so that none overlaps another, an obstacle box
-    (arrowheads, points, line ends, the title block) or leaves the bounds; lines (soft
-    obstacles) are crossed as little as may be."""
+    """Places labels at N angles inside `bounds` (a box) so that none overlaps another, a hard
+    obstacle (arrowheads, points, line ends, the title block) or leaves the bounds; drawn lines
+    (soft obstacles) are covered as little as may be."""
 
     PAD = 0.35        # clearance between a label and anything else, mm
 
-    def __init__(self, bounds: tuple[float, float, float, float]):
+    def __init__(self, n: int, bounds: tuple[float, float, float, float]):
+        self.n = n
         self.bounds = bounds
-        self._boxes: list[tuple[float, float, float, float]] = []
-        self._padded = np.empty((0, 4))                 # the first len(_padded) boxes, grown by PAD
-        self._lines: list[tuple[float, float, float, float]] = []
-        self._all_samples: np.ndarray | None = None    # the lines' samples, made once per change
-        self._by_x: tuple[np.ndarray, np.ndarray] | None = None     # and sorted by x
-        self.placed: list[Placed] = []
+        self._hard: list[np.ndarray] = []              # each (N, S, 4), grown by PAD
+        self._soft: list[np.ndarray] = []              # each (N, S, 4)
+        self._stacked: dict[str, tuple[int, np.ndarray]] = {}     # parts stacked, and their stack
 
     def block(self, box) -> None:
-        """A hard obstacle: nothing is placed over it."""
-        self._boxes.append(tuple(float(v) for v in box))
+        """Hard obstacles at every angle: boxes (4,), (R, 4) or (R, S, 4), R = N or 1 (the same at
+        every angle); NaN where absent."""
+        self._hard.append(self._rows(box) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD]))
 
-    def _obstacles(self) -> np.ndarray:
-        """Every hard obstacle's box grown by PAD on each side (N, 4); the boxes added since the
-        last call appended."""
-        if len(self._padded) < len(self._boxes):
-            new = np.asarray(self._boxes[len(self._padded):]) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD])
-            self._padded = np.concatenate([self._padded, new])
-        return self._padded
+    def line(self, seg) -> None:
+        """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent."""
+        self._soft.append(self._rows(seg))
 
-    def line(self, x0: float, y0: float, x1: float, y1: float) -> None:
-        """A soft obstacle: a drawn line, sampled every 0.7 mm (`_samples`)."""
-        self._lines.append((x0, y0, x1, y1))
-        self._all_samples = self._by_x = None
+    def _rows(self, a) -> np.ndarray:
+        a = np.asarray(a, dtype=float)
+        return np.broadcast_to(a.reshape(1, 1, 4) if a.ndim == 1 else a[:, None] if a.ndim == 2 else a,
+                               (self.n,) + ((1,) if a.ndim < 3 else a.shape[1:2]) + (4,))
 
-    def _samples(self) -> np.ndarray:
-        """Every line's samples (M, 2), all lines at once: n = 1 + length / 0.7 mm (2 at least, a
-        sheet's length at most) points from end to end, each line as np.linspace(0, 1, n) puts them."""
-        if self._all_samples is None:
-            x0, y0, x1, y1 = np.asarray(self._lines, float).reshape(-1, 4).T
-            n = np.minimum(np.maximum(2.0, np.hypot(x1 - x0, y1 - y0) / 0.7 + 1), 1e4).astype(int)
-            start = np.cumsum(n) - n                     # each line's first sample
-            line = np.repeat(np.arange(len(n)), n)
-            t = (np.arange(n.sum()) - start[line]) * (1.0 / (n - 1))[line]
-            t[start + n - 1] = 1.0
-            self._all_samples = np.column_stack([x0[line] + t * (x1 - x0)[line], y0[line] + t * (y1 - y0)[line]])
-        return self._all_samples
+    def _stack(self, key: str) -> np.ndarray:
+        """Every hard obstacle (grown by PAD) or every line, at every angle (N, H, 4): the parts
+        added since the last call appended."""
+        parts = self._hard if key == "hard" else self._soft
+        done, stacked = self._stacked.get(key, (0, np.empty((self.n, 0, 4))))
+        if done < len(parts):
+            stacked = np.concatenate([stacked, *parts[done:]], axis=1)
+            self._stacked[key] = (len(parts), stacked)
+        return stacked
 
-    def _samples_by_x(self) -> tuple[np.ndarray, np.ndarray]:
-        """`_samples` sorted by x, and their x: the samples over an x range are a slice."""
-        if self._by_x is None:
-            s = self._samples()
-            s = s[np.argsort(s[:, 0])]
-            self._by_x = s, np.ascontiguousarray(s[:, 0])
-        return self._by_x
-
-    def _best(self, boxes: np.ndarray, base: np.ndarray) -> int:
-        """Index of the candidate box (K, 4) of least cost: `base` plus 0.6 per line sample inside
-        it; inf where it overlaps a hard obstacle or leaves the bounds; the first of equal costs;
-        0 where none is free. The candidates inside the bounds are tested in batches in order of
-        `base`, against the obstacles and samples near the batch, until the next base exceeds the
-        best cost found (a count only adds): the same choice as testing all."""
+    def place(self, names: tuple[str, ...], variant: np.ndarray, size: float, anchor: np.ndarray,
+              along: np.ndarray | None = None) -> Placed:
+        """Place at each angle the name `names[variant[i]]` beside the point `anchor` (N, 2), or,
+        where `along` (N, 2) is finite, beside the segment from anchor to along. Not placed where
+        the anchor is NaN."""
+        n = self.n
+        widths = np.array([label_width(s, size) for s in names])
+        heights = np.array([label_height(s, size) for s in names])
+        w, (up, down) = widths[variant], heights[variant].T
+        half = np.column_stack([w / 2, (up + down) / 2])                 # (N, 2)
+        A = np.asarray(anchor, dtype=float)
+        cands, base = [], []
+        if along is None:
+            along = np.full((n, 2), np.nan)
+        d = along - A
+        L = np.hypot(d[:, 0], d[:, 1])
+        has = np.isfinite(L)
+        beside = has & (L > 1e-9)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = d / L[:, None]
+        nrm = np.column_stack([-u[:, 1], u[:, 0]])
+        T, S, R = _ALONG
+        clear = R[None, :] + (np.abs(nrm) * half).sum(axis=1)[:, None]    # (N, 42)
+        cands.append(A[:, None] + T[None, :, None] * d[:, None] + S[None, :, None] * nrm[:, None] * clear[..., None])
+        base.append(np.where(beside[:, None], R[None, :] + _ALONG_OFF[None, :] * np.minimum(L, 20.0)[:, None] / 20.0,
+                             np.inf))
+        C = np.where(has[:, None], A + d / 2, A)                          # rings about the segment's middle
+        ring = _RINGS[None, :, None] + (half @ _ABS_DIRS.T)[:, None, :]   # (N, 12, 16)
+        cands.append((C[:, None, None] + _DIRS[None, None] * ring[..., None]).reshape(n, -1, 2))
+        base.append(_RING_COST[None, :] + np.where(has, 2.0, 0.0)[:, None])
+        centres = np.concatenate(cands, axis=1)                           # (N, K, 2)
+        boxes = np.concatenate([centres - half[:, None], centres + half[:, None]], axis=2)
         bx0, by0, bx1, by1 = self.bounds
-        out = ((boxes[:, :2] < (bx0, by0)) | (boxes[:, 2:] > (bx1, by1))).any(axis=1)
-        cost = np.where(out, np.inf, base.astype(float))
-        order = np.lexsort((np.arange(len(cost)), cost))
-        ob = self._obstacles()
-        o0, o1, o2, o3 = ob.T
-        s_all, xs = self._samples_by_x() if self._lines else (None, None)
-        best, k_best = math.inf, 0
-        for start in range(0, len(order), 32):
-            idx = order[start:start + 32]
-            first = float(cost[idx[0]])
-            if first == math.inf or first > best:
+        outside = (boxes[..., 0] < bx0) | (boxes[..., 1] < by0) | (boxes[..., 2] > bx1) | (boxes[..., 3] > by1)
+        base = np.where(outside, np.inf, np.concatenate(base, axis=1))
+        base[~np.isfinite(A).all(axis=1)] = np.inf
+        k = self._choose(boxes, base)
+        at = np.arange(n)
+        box = np.where((k >= 0)[:, None], boxes[at, np.maximum(k, 0)], np.nan)
+        centre = (box[:, :2] + box[:, 2:]) / 2
+        far = np.hypot(*(centre - C).T) - half @ _REACH > LEADER_MM
+        foot = np.clip(C, box[:, :2], box[:, 2:])
+        leader = np.where(far[:, None], np.concatenate([C, foot], axis=1), np.nan)
+        self.block(box)
+        return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
+
+    def _choose(self, boxes: np.ndarray, base: np.ndarray) -> np.ndarray:
+        """The candidate (N,) taken at each angle (-1: none, the anchor NaN): free candidates'
+        costs found cheapest first at every angle until none left can come within SLACK of the
+        best; then the candidate within SLACK of the best at the most angles is taken there, and
+        so on; where none is free, the cheapest (nowhere free: the test tells)."""
+        n, K = base.shape
+        order = np.argsort(np.where(np.isfinite(base), base, 1e9).mean(axis=0), kind="stable")
+        ordered = base[:, order]
+        rest = np.minimum.accumulate(ordered[:, ::-1], axis=1)[:, ::-1]   # least base from j on
+        cost = np.full((n, K), np.inf)
+        best = np.full(n, np.inf)
+        hard, soft = self._stack("hard"), self._stack("soft")
+        slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
+        for start in range(0, K, _BATCH):
+            rows = np.nonzero(rest[:, start] <= best + slack)[0]
+            if not len(rows):
                 break
-            c, b = cost[idx], boxes[idx]
-            (lo0, lo1), (hi0, hi1) = b[:, :2].min(axis=0).tolist(), b[:, 2:].max(axis=0).tolist()
-            near = ob[(o2 > lo0) & (o0 < hi0) & (o3 > lo1) & (o1 < hi1)]
-            keep = c <= best                            # free and not already beaten
-            if len(near):
-                keep &= ~((b[:, None, 0] < near[None, :, 2]) & (b[:, None, 2] > near[None, :, 0])
-                          & (b[:, None, 1] < near[None, :, 3]) & (b[:, None, 3] > near[None, :, 1])).any(axis=1)
-            if not keep.any():
-                continue
-            idx, c, b = idx[keep], c[keep], b[keep]
-            if s_all is not None:                       # the samples strictly inside some box left
-                (lo0, lo1), (hi0, hi1) = b[:, :2].min(axis=0).tolist(), b[:, 2:].max(axis=0).tolist()
-                s = s_all[xs.searchsorted(lo0, "right"):xs.searchsorted(hi0, "left")]
-                y = s[:, 1]
-                s = s[(y > lo1) & (y < hi1)]
-                if len(s):
-                    inside = ((s[None, :, 0] > b[:, None, 0]) & (s[None, :, 0] < b[:, None, 2])
-                              & (s[None, :, 1] > b[:, None, 1]) & (s[None, :, 1] < b[:, None, 3]))
-                    c = c + 0.6 * inside.sum(axis=1)
-            least = c.min()
-            k = int(idx[c == least].min())
-            if least < best or (least == best and k < k_best):
-                best, k_best = float(least), k
-        return k_best
-
-    def _boxes_at(self, centres: np.ndarray, w: float, up: float, down: float) -> np.ndarray:
-        """Boxes of a label whose box centre is at each of `centres` (K, 2)."""
-        half = (w / 2, (up + down) / 2)
-        return np.concatenate([centres - half, centres + half], axis=1)
-
-    def place(self, name: str, size: float, ax: float, ay: float,
-              along: tuple[float, float] | None = None) -> Placed:
-        """Place `name` beside point (ax, ay), or beside the segment from (ax, ay) to `along`."""
-        w = label_width(name, size)
-        up, down = label_height(name, size)
-        half = np.array([w / 2, (up + down) / 2])
-        A = np.array([ax, ay])
-        cands, base = [], []                        # blocks of candidate centres (K, 2) and costs (K,)
-        if along is not None:
-            d = np.array([along[0] - ax, along[1] - ay])
-            L = float(np.hypot(*d))
-            if L > 1e-9:
-                u = d / L
-                nrm = np.array([-u[1], u[0]])
-                T, S, R = _ALONG
-                cands.append(A + T * d + S * nrm * (R + abs(nrm) @ half))
-                base.append(R[:, 0] + _ALONG_OFF * min(L, 20.0) / 20.0)
-            ax, ay = (ax + along[0]) / 2, (ay + along[1]) / 2
-            A = np.array([ax, ay])
-        cands.append((A + _DIRS * (_RINGS + (_ABS_DIRS @ half)[:, None])).reshape(-1, 2))
-        base.append((_RING_COST + (2.0 if along is not None else 0.0)).reshape(-1))
-        cands_a = np.concatenate(cands)
-        boxes = self._boxes_at(cands_a, w, up, down)
-        k = self._best(boxes, np.concatenate(base))    # nowhere free: 0, the nearest place (the test tells)
-        x0, y0, x1, y1 = boxes[k]
-        box = (float(x0), float(y0), float(x1), float(y1))
-        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
-        leader = None
-        if math.hypot(cx - ax, cy - ay) - float(_REACH @ half) > 6.0:
-            qx, qy = min(max(ax, x0), x1), min(max(ay, y0), y1)
-            leader = (ax, ay, float(qx), float(qy))
-        pl = Placed(name, float(x0), float(y0 + up), size, box, leader)
-        self.placed.append(pl)
-        self._boxes.append(box)
-        return pl
+            idx = order[start:start + _BATCH]
+            b = boxes[rows[:, None], idx]                                   # (n', B, 4)
+            c = base[rows[:, None], idx]
+            free = np.isfinite(c)[..., None]
+            region = np.concatenate([np.where(free, b[..., :2], np.inf).min(axis=1),
+                                     np.where(free, b[..., 2:], -np.inf).max(axis=1)], axis=1)
+            ob = _near(hard[rows], region)
+            if ob.shape[1]:
+                c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
+            ln = _near(soft[rows], region)
+            if ln.shape[1]:
+                c = c + LINE_COST * _clipped(ln[:, None], b[:, :, None]).sum(axis=2)
+            cost[rows[:, None], idx] = c
+            best[rows] = np.minimum(best[rows], c.min(axis=1))
+        ok = cost <= best[:, None] + SLACK
+        k = np.where(np.isfinite(base).any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
+        todo = np.isfinite(best)
+        while todo.any():
+            hit = ok & todo[:, None]
+            count = hit.sum(axis=0)
+            total = np.where(hit, cost, 0.0).sum(axis=0)
+            j = np.lexsort((order.argsort(), total, -count))[0]          # most angles, then least cost
+            sel = hit[:, j]
+            k[sel] = j
+            todo &= ~sel
+        return k
