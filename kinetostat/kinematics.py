@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 __all__ = ["Kinematics", "kinematics", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
            "kinematic_size", "kinematic_deviation", "group_scales", "solve_checked", "guard",
            "a_priori_error", "relative_change", "digits", "assemble", "AssemblyModes", "assembly_modes", "leash_axes",
-           "MODES_CLOSE", "triad_warnings", "special_point_z", "special_sides", "tracks"]
+           "MODES_CLOSE", "triad_warnings", "special_point_z", "special_index", "special_sides", "tracks"]
 
 #: Above this condition number of a group's plan the accuracy is measured by a second solve on
 #: perturbed inputs. Below it the error is bounded by the measured law (reports/stability.md):
@@ -214,10 +214,16 @@ def special_point_z(mech: "Mechanism", kin: Kinematics, g) -> np.ndarray:
     return _special(mech, kin, g)[0]
 
 
+def special_index(mech: "Mechanism", kin: Kinematics, g) -> np.ndarray:
+    """(N,) int: per angle the index k (0, 1, 2) of `Triad.sides` whose leash closes triad g about
+    S (`triad.special_point`); the solver's order there is sides k+1, k+2, k (`special_sides`)."""
+    return _special(mech, kin, g)[1].astype(int)
+
+
 def special_sides(mech: "Mechanism", kin: Kinematics, g, at: int = 0) -> tuple:
     """Triad g's sides (`Triad.sides`) at angle index `at` in the solver's order there: the two
     leashes whose axes meet in S, then the one whose arm about S closes the group."""
-    k = int(_special(mech, kin.take([at]), g)[1][0])
+    k = int(special_index(mech, kin.take([at]), g)[0])
     return tuple(g.sides[(k + i) % 3] for i in (1, 2, 0))
 
 

@@ -73,7 +73,7 @@ class Result:
     symbol: str
     value: float         # in a PlanCycle: an (N,) array over its angles
     unit: str
-    how: str = ""
+    how: str = ""        # in a PlanCycle: one key, or (N,) keys where it changes with the angle
 
 
 @dataclass(frozen=True)
@@ -170,7 +170,10 @@ class PlanCycle:
     Arrays, each with the leading angle axis N: `phi_deg` (N,) deg; `points[name]` (N,) complex,
     mm on the sheet (x right, y up); each segment's `value` and each result's `value` (N,) SI;
     `paths[name]` (N, K) complex mm, or (1, K) where the path is the same at every angle;
-    `accuracy`: (digits left (N,), the count under which a sheet states it) or None."""
+    `accuracy`: (digits left (N,), the count under which a sheet states it) or None.
+    A segment with a unit whose value is NaN at an angle is not drawn there (`drawn`); `equation`
+    the side names at every angle, or N such tuples where the order changes with the angle (a
+    triad's); a result's `how` one key, or N keys."""
     kind: str
     titles: tuple[str, ...]                # (N,) the title at each angle
     scale: Scale
@@ -232,11 +235,18 @@ class PlanCycle:
         return Plan(self.kind, self.titles[i], self.scale, float(self.phi_deg[i]),
                     {k: complex(v[i]) for k, v in self.points.items()},
                     tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale)
-                          for s in self.segments if s.drawn is None or s.drawn[i]),
+                          for s in self.segments if (s.drawn is None or s.drawn[i]) and self.drawn(s)[i]),
                     {k: tuple(map(complex, v[i if len(v) > 1 else 0])) for k, v in self.paths.items()},
                     self.notes[i] if self.notes else (),
-                    tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how) for r in self.results),
-                    self.equation, acc)
+                    tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how if isinstance(r.how, str) else r.how[i])
+                          for r in self.results),
+                    self.equation if not self.equation or isinstance(self.equation[0], str) else self.equation[i], acc)
+
+    def drawn(self, s: Segment) -> np.ndarray:
+        """(N,) bool: the angles segment s is drawn at: all, but where a quantity's value (a
+        segment with a unit) is NaN: an element that exists at other angles only (a triad's
+        polygon in another order, an arm of a force that is zero there)."""
+        return np.broadcast_to(~(bool(s.unit) & np.isnan(np.asarray(s.value, dtype=float))), (self.n,))
 
     def __repr__(self) -> str:
         return (f"PlanCycle({self.kind!r}, {self.n} angles, {self.scale}, points={len(self.points)}, "

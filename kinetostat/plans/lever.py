@@ -1,6 +1,7 @@
 """Zhukovsky's rigid lever drawn (seed 000 sec. 8, seed 002 sec. 1.2.3, fig. 1.12): the velocity
 plan turned by 90 deg with every load at its like point, the arms about the pole and the
-balancing force F'_bal at the crank pin's image; and the check of M_bal by both routes.
+balancing force F'_bal at the crank pin's image, as a `PlanCycle` at the N angles of an
+analysis at once (as `forces` builds its plans); and the check of M_bal by both routes.
 
 The plan is turned by 90 deg counter-clockwise (each image is i v / mu_v) and the forces keep
 their true directions. Seed 002 keeps the plan and turns the forces by 90 deg clockwise instead:
@@ -19,8 +20,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .core import Plan, Result, Scale, Segment
-from .forces import _scale, _single, arm_name, force_scale, link_couples, link_loads
+from .core import Plan, PlanCycle, Result, Scale, Segment
+from .forces import _abs, _cycle, _dot, _drawable, _over, _scale, _unit, arm_name, force_scale, link_couples, link_loads
 from ..model.lettering import lettering
 
 if TYPE_CHECKING:
@@ -54,116 +55,135 @@ def _image(mech: "Mechanism", res: "Analysis", k: int, name: str, mu_v: Scale, p
            local: tuple[float, float] | None = None) -> str:
     """Name of the like point of point `name` of link k (at `local`, default the link's point of
     that name) on the turned plan: lower case, with the link's number where another link's point
-    of that name moves otherwise. Added to pts."""
-    v = complex(res.kin.velocity_z(k, mech.links[k].points[name] if local is None else local)[0])
-    z = 1j * v / mu_v.value
+    of that name moves otherwise at any of the angles. Added to pts ((N,) complex, mm)."""
+    v = np.asarray(res.kin.velocity_z(k, mech.links[k].points[name] if local is None else local), dtype=complex)
+    z = _over(1j * v, mu_v.value)
     key = name.lower()
-    if key in pts and abs(pts[key] - z) > 1e-9 * max(1.0, abs(z)):
+    if key in pts and (_abs(pts[key] - z) > 1e-9 * np.maximum(1.0, _abs(z))).any():
         key = f"{key}{k}"
     pts[key] = z
     return key
 
 
-def lever_plan(mech: "Mechanism", res: "Analysis", mu_v, mu_F: Scale | None = None) -> Plan:
-    """Zhukovsky's lever at mu_v: pole p, the image of every point of the moving links (turned by
-    90 deg counter-clockwise), the vectors p-x and the links' images (a-b, values in m/s), every
-    force at its like point (its value in N, drawn at a round force scale of its own; couples as
-    two forces "M_i2/l (a)", "M_i2/l (b)"), the arms h_.. about the pole (value: the arm's
-    drawn length in mm, as the texts keep it: `NATURAL`), and the balancing force F'_bal (the model's
-    lettering: F'_зр) at the crank pin's image, across p-a, whose moment about the pole cancels
-    the loads'. Its results: F'_bal, M'_bal, M_bal by the force plans and their difference δ
-    against the texts' 5 % (TOLERANCE_PCT). `mu_F`: the forces' scale (default: chosen at this angle)."""
-    _single(res)
+def lever_plan(mech: "Mechanism", res: "Analysis", mu_v, mu_F: Scale | None = None) -> PlanCycle:
+    """Zhukovsky's lever at mu_v at the N angles of `res`: pole p, the image of every point of the
+    moving links (turned by 90 deg counter-clockwise), the vectors p-x and the links' images (a-b,
+    values in m/s), every force at its like point (its value in N, drawn at a round force scale of
+    its own; couples as two forces "M_i2/l (a)", "M_i2/l (b)"), the arms h_.. about the pole
+    (value: the arm's drawn length in mm, as the texts keep it: `NATURAL`), and the balancing
+    force F'_bal (the model's lettering: F'_зр) at the crank pin's image, across p-a, whose moment
+    about the pole cancels the loads'. Its results: F'_bal, M'_bal, M_bal by the force plans and
+    their difference δ against the texts' 5 % (TOLERANCE_PCT). `mu_F`: the forces' scale
+    (default: chosen for the largest force over the angles). An element that exists at some
+    angles only (an image off the pole, a couple, an arm) is NaN at the others."""
+    _drawable(res)
     mu_v = _scale(mu_v, "mu_v", "m/(s mm)")
-    pts: dict[str, complex] = {"p": 0j}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return _lever_plan(mech, res, mu_v, mu_F)
+
+
+def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | None) -> PlanCycle:
+    n = len(res.phi_deg)
+    pts: dict[str, np.ndarray] = {"p": np.zeros(n, dtype=complex)}
     segs: list[Segment] = []
-    forces: list[tuple[str, str, complex]] = []     # (name, image point, force N)
+    forces: list[tuple[str, str, np.ndarray]] = []     # (name, image point, force N (N,))
     for k in range(1, mech.n_links):
         link = mech.links[k]
         images = [_image(mech, res, k, name, mu_v, pts) for name in link.points]
         for name, img in zip(link.points, images):
-            if abs(pts[img]) > 0 and f"p-{img}" not in {s.name for s in segs}:
-                segs.append(Segment(f"p-{img}", "p", img, abs(pts[img]) * mu_v.value, "m/s"))
+            off = _abs(pts[img]) > 0
+            if off.any() and f"p-{img}" not in {s.name for s in segs}:
+                segs.append(Segment(f"p-{img}", "p", img, np.where(off, _abs(pts[img]) * mu_v.value, np.nan), "m/s"))
         joints = list(dict.fromkeys(p.point for p in mech.pairs if k in p.links and p.point in link.points))
-        for n, a in enumerate(joints):
-            for b in joints[n + 1:]:
+        for m, a in enumerate(joints):
+            for b in joints[m + 1:]:
                 ia, ib = images[list(link.points).index(a)], images[list(link.points).index(b)]
-                if abs(pts[ia]) and abs(pts[ib]):      # a link pivoted on the frame: its image is p-x
-                    segs.append(Segment(f"{ia}-{ib}", ia, ib, abs(pts[ib] - pts[ia]) * mu_v.value, "m/s", "link"))
+                off = (_abs(pts[ia]) > 0) & (_abs(pts[ib]) > 0)    # a link pivoted on the frame: its image is p-x
+                if off.any():
+                    segs.append(Segment(f"{ia}-{ib}", ia, ib, np.where(off, _abs(pts[ib] - pts[ia]) * mu_v.value, np.nan),
+                                        "m/s", "link"))
         for ld in link_loads(mech, res, k):
             forces.append((ld.name, images[list(link.points).index(ld.at)], ld.force))
         for c in link_couples(mech, res, k):
-            if c.moment == 0:
+            acts = c.moment != 0
+            if not acts.any():
                 continue
             (a, la), (b, lb) = _couple_ends(mech, k)
-            A, B = (complex(res.kin.position_z(k, q)[0]) for q in (la, lb))
-            F = c.moment / abs(A - B) ** 2 * 1j * (A - B)       # F at A, -F at B: (A - B) x F = M
+            A, B = (np.asarray(res.kin.position_z(k, q), dtype=complex) for q in (la, lb))
+            F = np.where(acts, c.moment / _abs(A - B) ** 2 * 1j * (A - B), np.nan)   # F at A, -F at B: (A - B) x F = M
             for name, local, f in ((a, la, F), (b, lb, -F)):
                 forces.append((f"{c.name}/l ({name.lower()})", _image(mech, res, k, name, mu_v, pts, local), f))
-    total = sum(_moment(pts[at], F) for _, at, F in forces)
+    total = sum(np.where(np.isnan(F), 0.0, _moment(pts[at], F)) for _, at, F in forces)   # a couple acts where not NaN
     crank_pin = _image(mech, res, mech.drive.link, mech.drive.point, mu_v, pts)
-    pa = pts[crank_pin]
-    F_bal = _across(pa, -total)
+    F_bal = _across(pts[crank_pin], -total)
     L = lettering(mech)
     F_name = L.lever(L.F_bal)
     forces.append((F_name, crank_pin, F_bal))
     mu_F = mu_F or force_scale([F for _, _, F in forces])
     for name, at, F in forces:
         start = f"{name}:from"
-        pts[start], pts[f"{name}:to"] = pts[at], pts[at] + F / mu_F.value
-        segs.append(Segment(name, start, f"{name}:to", abs(F), "N", "vector", mu_F))
-        if name != F_name and abs(F) > 0 and abs(pts[at]) > 0:
-            u = F / abs(F)
-            foot = pts[at] - (pts[at] * u.conjugate()).real * u
+        pts[start], pts[f"{name}:to"] = pts[at], pts[at] + _over(F, mu_F.value)
+        segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
+        has = (_abs(F) > 0) & (_abs(pts[at]) > 0)
+        if name != F_name and has.any():
+            u = _unit(F)
+            foot = np.where(has, pts[at] - _dot(pts[at], u) * u, np.nan)
             pts[f"{arm_name(name)}:foot"] = foot
-            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", abs(foot) * NATURAL.value, "mm", "arm",
+            segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", _abs(foot) * NATURAL.value, "mm", "arm",
                                 NATURAL))
-    omega1 = float(res.omega(mech.drive.link)[0])
-    M_lever = float(total) * mu_v.value / omega1
-    M_forces = float(res.balancing_moment[0])
-    delta = (M_lever - M_forces) / M_lever * 100 if M_lever else 0.0
-    results = (Result(F_name, abs(F_bal), "N", "by lever"), Result(L.lever(L.M_bal), M_lever, "N m", "by lever"),
+    omega1 = np.asarray(res.omega(mech.drive.link), dtype=float)
+    M_lever = total * mu_v.value / omega1
+    M_forces = np.asarray(res.balancing_moment, dtype=float)
+    delta = np.where(M_lever != 0, (M_lever - M_forces) / np.where(M_lever != 0, M_lever, 1.0) * 100, 0.0)
+    within = tuple("within 5" if abs(d) <= TOLERANCE_PCT else "beyond 5" for d in delta.tolist())
+    results = (Result(F_name, _abs(F_bal), "N", "by lever"), Result(L.lever(L.M_bal), M_lever, "N m", "by lever"),
                Result(L.M_bal, M_forces, "N m", "by force plans"),
-               Result("δ", delta, "%", "within 5" if abs(delta) <= TOLERANCE_PCT else "beyond 5"))
-    return Plan("lever", f"Zhukovsky's lever (velocity plan turned by 90 deg ccw): {F_name} = {abs(F_bal):.6g} N "
-                f"at {crank_pin}, {L.lever(L.M_bal)} = {M_lever:.6g} N m; forces drawn at {mu_F}",
-                mu_v, float(res.phi_deg[0]), pts, tuple(segs), results=results)
+               Result("δ", delta, "%", within[0] if len(set(within)) == 1 else within))
+    titles = [f"Zhukovsky's lever (velocity plan turned by 90 deg ccw): {F_name} = {f:.6g} N "
+              f"at {crank_pin}, {L.lever(L.M_bal)} = {m:.6g} N m; forces drawn at {mu_F}"
+              for f, m in zip(_abs(F_bal).tolist(), M_lever.tolist())]
+    return _cycle("lever", titles, mu_v, res, pts, segs, results=results)
 
 
-def _moment(r: complex, F: complex) -> float:
-    """z-moment of force F at r about the origin (N mm for r in mm)."""
-    return (r.conjugate() * F).imag
+def _moment(r, F):
+    """z-moment of force F at r about the origin (N mm for r in mm); scalars or arrays."""
+    return np.real(r) * np.imag(F) - np.imag(r) * np.real(F)
 
 
-def _across(pa: complex, moment: float) -> complex:
-    """The force across pa at the end of pa whose moment about the pole is `moment`."""
-    if pa == 0:
-        return 0j
-    return moment / abs(pa) * 1j * pa / abs(pa)
+def _across(pa: np.ndarray, moment: np.ndarray) -> np.ndarray:
+    """The force across pa at the end of pa whose moment about the pole is `moment` (0 where pa = 0)."""
+    a = _abs(pa)
+    return np.where(a > 0, _over(moment / np.where(a > 0, a, 1.0) * 1j * pa, np.where(a > 0, a, 1.0)), 0j)
 
 
-def pole_moment(plan: Plan, without: tuple[str, ...] | None = None) -> float:
+def pole_moment(plan: Plan | PlanCycle, without: tuple[str, ...] | None = None):
     """Sum of the moments about the pole p of the lever's forces (segments in N), N mm, read off
     the plan's own points: each force along its drawn segment, at its start; `without` the
-    forces left out (default: the balancing force, the last one drawn)."""
+    forces left out (default: the balancing force, the last one drawn). A float for a Plan, (N,)
+    for a PlanCycle (a force not drawn at an angle counts nothing there)."""
     if without is None:
         without = tuple(s.name for s in plan.segments if s.unit == "N")[-1:]
     total = 0.0
     for s in plan.segments:
         if s.unit == "N" and s.name not in without:
-            d = plan.points[s.end] - plan.points[s.start]
-            if abs(d):
-                total += _moment(plan.points[s.start] - plan.points["p"], d / abs(d) * s.value)
-    return total
+            d = np.asarray(plan.points[s.end] - plan.points[s.start])
+            a = _abs(d)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                term = np.where(a > 0, _moment(plan.points[s.start] - plan.points["p"], _over(d, np.where(a > 0, a, 1.0)) * s.value), 0.0)
+            total = total + np.nan_to_num(term)
+    return float(total) if isinstance(plan, Plan) else np.broadcast_to(total, (plan.n,)).copy()
 
 
 def lever_check(mech: "Mechanism", res: "Analysis", mu_v=0.2) -> dict:
-    """M_bal by both routes (seed 002: 102.74 N m by the force plans, 102.97 by the lever, 0.22 %):
-    `M_bal_forces` from the group-by-group solution, `M_bal_lever` = the lever's moment about the
-    pole x mu_v / omega_1, `F_bal_lever` = F'_bal (N) at the crank pin, with |M_bal_lever| =
-    F'_bal l_OA, and `difference_pct` = (M_lever - M_forces) / M_lever x 100 as seed 002 writes it.
-    mu_v only sets the drawing; the results do not depend on it."""
-    plan = lever_plan(mech, res, mu_v)
+    """M_bal by both routes at the one angle of `res` (seed 002: 102.74 N m by the force plans,
+    102.97 by the lever, 0.22 %): `M_bal_forces` from the group-by-group solution, `M_bal_lever`
+    = the lever's moment about the pole x mu_v / omega_1, `F_bal_lever` = F'_bal (N) at the crank
+    pin, with |M_bal_lever| = F'_bal l_OA, and `difference_pct` = (M_lever - M_forces) / M_lever x
+    100 as seed 002 writes it. mu_v only sets the drawing; the results do not depend on it."""
+    if len(res.phi_deg) != 1:
+        raise ValueError(f"lever_check: analyse at one crank angle, e.g. analyze(mech, phi_deg=[30]); "
+                         f"got {len(res.phi_deg)} angles")
+    plan = lever_plan(mech, res, mu_v).at(0)
     mu = plan.scale.value
     omega1 = float(res.omega(mech.drive.link)[0])
     M_lever = float(pole_moment(plan)) * mu / omega1
