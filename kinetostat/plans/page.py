@@ -163,6 +163,24 @@ def _b64gz(data: bytes) -> str:
 
 # ============================================================================ what the page holds
 
+def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict:
+    """A moment equation about point M of `plan` as the page's script writes it at each angle
+    (page.js `momentText`): the unknown [segment, arm, M at the arm's end?] (R^τ with its link, the
+    lever's F'_bal with p-a), each force drawn with its arm h_.. about M ([force, arm, False]), each
+    couple's arc (M_i/μ_l); the script takes the signs and the arms (mm) from the sheet drawn."""
+    from .forces import arm_name
+    segs = {s.name: s for s in plan.segments}
+    terms = [[n, arm_name(n), False] for n in names if n in segs and arm_name(n) in segs]
+    out = {"terms": terms, "couples": [c for c in couples if c in plan.paths]}
+    if unknown is not None:
+        X = plan.points[segs[unknown].start]              # where the unknown acts: the arm is M to there
+        arm = next((x for x in plan.segments if x.kind in ("link", "vector") and x.name != unknown and M in (x.start, x.end)
+                    and abs(plan.points[x.end if x.start == M else x.start] - X) < 1e-6), None)
+        if arm is not None:
+            out["unknown"] = [unknown, arm.name, arm.end == M]
+    return out
+
+
 def _steps(mech, res, plans, lang: str) -> list[dict]:
     """The force analysis in the texts' order, one vector a step: per Assur group from the last
     attached, the unknowns found from moment equations (a dyad's R^τ from ΣM about the inner
@@ -270,7 +288,7 @@ def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[f
 
 def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
     """The data a student starts from: ω1, ε1, g, each moving link's lengths, mass and moment of
-    inertia, the applied forces at this angle (symbol, value, unit)."""
+    inertia, the applied forces at the angle of `res` (one angle) (symbol, value, unit)."""
     from .forces import _applied
     d = mech.drive
     rows = [("φ", num(float(res.phi_deg[0]), lang, 6), "°"), ("ω1", num(abs(d.omega), lang, 6), unit("rad/s", lang)),
@@ -286,7 +304,7 @@ def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
         if link.I_S:
             rows.append((f"I_S{k}", num(link.I_S, lang, 6), unit("kg m^2", lang)))
         for ld in _applied(mech, res, k):
-            rows.append((ld.name, num(abs(ld.force), lang, 6), unit("N", lang)))
+            rows.append((ld.name, num(abs(complex(np.ravel(ld.force)[0])), lang, 6), unit("N", lang)))
     return rows
 
 
@@ -299,7 +317,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     default PAGE_ANGLES); `fixed`: the plans' scales (default `cycle_scales` of the page's one
     analysis). ValueError where `at` is a singular position."""
     from ..solve import analyze
-    from . import build_cycle, cycle_scales, fixed_positions
+    from . import build_cycle, cycle_scales
     from .draw import drawing
     from .worksheet import worksheet_cycle
     from ..model.lettering import lettering
@@ -312,9 +330,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = analyze(mech, phi_deg=phi)
-        fixed = fixed or cycle_scales(mech, res)
-        positions = fixed_positions(mech, fixed.base["mu_l"])
-        cycles = build_cycle(mech, res, fixed, positions)
+        fixed = fixed or cycle_scales(mech, res=res)
+        cycles = build_cycle(mech, res, fixed)
         sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
