@@ -220,10 +220,10 @@
   }
   function a4Title(svg, x0, y0, cut) {           // A4 cuts the title block off: one line at the top instead
     const NS = "http://www.w3.org/2000/svg", g = document.createElementNS(NS, "g"), t = document.createElementNS(NS, "text");
-    const mech = svg.querySelector("#mechanism"), title = svg.querySelector("title");
+    const line = ["#mechanism", 'text.title[font-weight="bold"]', "#scale"].map((q) => svg.querySelector(q));   // name, plan and φ, scale
     g.id = "a4-title";
     t.setAttribute("x", x0 + 12); t.setAttribute("y", y0 + 6); t.setAttribute("font-size", "2.8");
-    t.textContent = (mech ? mech.textContent + " — " : "") + (title ? title.textContent : "");
+    t.textContent = line.filter((e) => e).map((e) => e.textContent).join(" — ");
     if (cut) {                                   // a second line, red
       const w = document.createElementNS(NS, "tspan");
       w.setAttribute("fill", "#b01515"); w.setAttribute("x", x0 + 12); w.setAttribute("dy", "3.6");
