@@ -1,5 +1,5 @@
 // The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
-// sheet's arrays and the values stored as second differences (gzip, base64), writes the sheet of
+// sheet's arrays and the values stored as differences over the angle (gzip, base64), writes the sheet of
 // the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
 // lengths. No network, no library.
 "use strict";
@@ -99,12 +99,9 @@
   // ------------------------------------------------------------------ the sheets of every angle
   const meta = JSON.parse(new TextDecoder().decode(await bytes("meta")));
   const nf = D.frames.length;
-  function undiff(nums, p, n) {                 // n values from their second differences at nums[p]
-    const out = new Array(n);
-    for (let j = 0; j < n; j++) {
-      const d = nums[p + j];
-      out[j] = j >= 2 ? d + 2 * out[j - 1] - out[j - 2] : j === 1 ? d + out[0] : d;
-    }
+  function series(nums, p, n) {                 // page.py _series at nums[p]: its order k, then n values
+    const out = nums.slice(p + 1, p + 1 + n);
+    for (let k = nums[p]; k > 0; k--) for (let j = 1; j < n; j++) out[j] += out[j - 1];
     return out;
   }
   function fixed(q, digits) {                    // core.py fixed: q / 10^digits with `digits` decimals
@@ -115,7 +112,7 @@
   for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
     const K = meta.kinds[k], nums = varints(await bytes("k" + k));
     let p = 0;
-    const take = (n) => { const v = undiff(nums, p, n); p += n; return v; };
+    const take = (n) => { const v = series(nums, p, n); p += n + 1; return v; };
     const elements = K.elements.map((E) => {
       const el = {tag: E.tag, attrs: E.attrs.map(([a, v]) => ` ${a}="${v}"`).join(""),
                   title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows, m: E.m};
@@ -146,16 +143,11 @@
   }
   window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
   const rows = D.rows, ncol = rows.length, singular = new Set(D.singular);
-  const vals = varints(await bytes("values"));
-  const values = D.frames.map(() => new Array(ncol));
-  for (let c = 0; c < ncol; c++) {                 // column by column: page.py _columns
-    let a = 0, b = 0;
-    const e = D.exps[c];
-    for (let f = 0; f < nf; f++) {
-      const d = vals[nf * ncol + c * nf + f], n = f >= 2 ? d + 2 * b - a : f === 1 ? d + b : d;
-      a = b; b = n;
-      values[f][c] = vals[c * nf + f] ? NaN : e < 0 ? n / 10 ** -e : n * 10 ** e;
-    }
+  const vals = varints(await bytes("values")), values = D.frames.map(() => new Array(ncol));
+  for (let c = 0, p = 0; c < ncol; c++) {          // column by column: page.py _columns
+    const none = series(vals, p, nf), n = series(vals, p + nf + 1, nf), e = D.exps[c];
+    p += 2 * (nf + 1);
+    for (let f = 0; f < nf; f++) values[f][c] = none[f] ? NaN : e < 0 ? n[f] / 10 ** -e : n[f] * 10 ** e;
   }
   const sheets = $("sheets");
   sheets.textContent = "";

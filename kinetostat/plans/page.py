@@ -18,8 +18,8 @@ A page is drawn anew every time: nothing is cached.
 Small: each sheet's arrays (`encode_drawing`): the elements' markup once (tag, attributes,
 tooltip, the texts a label takes), and as integers, element by element over the angles, whether it
 is drawn, which text it shows, its coordinates and a segment's length as `Element.svg` rounds them
-(COORD_DECIMALS, LENGTH_DECIMALS), each series as second differences over the angle, zigzag
-varints, deflated (gzip) and base64-encoded. The page's script (vanilla JavaScript,
+(COORD_DECIMALS, LENGTH_DECIMALS), each series as differences over the angle of the order that
+suits it, zigzag varints, deflated (gzip) and base64-encoded. The page's script (vanilla JavaScript,
 the browser's own DecompressionStream) decodes them once and writes the sheet of the angle chosen
 as `Drawing.svg` writes it.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
@@ -80,13 +80,22 @@ def _varints(values: np.ndarray) -> bytes:
     return out.tobytes()
 
 
-def _second_differences(a: np.ndarray) -> np.ndarray:
-    """Second differences of int64 rows along axis 0 (the first row as it is, the second as its
-    first difference): a smooth function of the angle becomes a few small numbers."""
-    d = a.copy()
-    d[1:] -= a[:-1]
-    d[2:] -= a[1:-1] - a[:-2]
-    return d
+#: Highest order of differences a series is stored as (`_series`).
+MAX_ORDER = 4
+
+
+def _series(a: np.ndarray) -> np.ndarray:
+    """An int64 series as its order k (0..MAX_ORDER) followed by its k-th differences, each
+    difference keeping the first value (a - [0, a[:-1]]): the order whose differences are
+    smallest (a sum of their bits), so that a smooth function of the angle becomes a few small
+    numbers; the page's script takes k prefix sums."""
+    best, d = None, np.asarray(a, dtype=np.int64).ravel()
+    for k in range(MAX_ORDER + 1):
+        cost = float(np.log2(1.0 + np.abs(d)).sum())
+        if best is None or cost < best[0]:
+            best = (cost, k, d)
+        d = d - np.concatenate([[0], d[:-1]])
+    return np.concatenate([[best[1]], best[2]])
 
 
 def _held(x: np.ndarray, drawn: np.ndarray) -> np.ndarray:
@@ -112,12 +121,12 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
     element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each angle
     (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
-    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm); every series as second
-    differences over the angle, as zigzag varints."""
+    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm); every series as
+    differences of the order that suits it (`_series`), as zigzag varints."""
     meta, series = [], []
 
     def put(a) -> None:
-        series.append(_second_differences(np.asarray(a, dtype=np.int64)))
+        series.append(_series(a))
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
         rows, m = xy.shape[0], xy.shape[1]
@@ -145,16 +154,16 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
 
 def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
     """Columns of values over frames (NaN: none): each column's exponent e (12 significant digits
-    of its largest |value|), and column by column the NaN mask (1: none), then column by column the
-    second differences over the frames of round(v / 10^e) (NaN as 0)."""
+    of its largest |value|), and column by column its NaN mask (1: none) and round(v / 10^e) (NaN
+    as 0), each a `_series`, as zigzag varints."""
     exps = []
     for col in values.T:
         top = np.nanmax(np.abs(col)) if np.isfinite(col).any() else 0.0
         exps.append(int(math.floor(math.log10(top))) - 11 if top > 0 else 0)
-    scaled = np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)
-    d = _second_differences(np.rint(scaled).astype(np.int64))
+    scaled = np.rint(np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)).astype(np.int64)
     mask = (~np.isfinite(values)).astype(np.int64)
-    return exps, _varints(np.concatenate([mask.T.ravel(), d.T.ravel()]))
+    parts = [_series(x) for c in range(values.shape[1]) for x in (mask[:, c], scaled[:, c])]
+    return exps, _varints(np.concatenate(parts)) if parts else b""
 
 
 def _b64gz(data: bytes) -> str:
