@@ -112,7 +112,13 @@
   for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
     const K = meta.kinds[k], nums = varints(await bytes("k" + k));
     let p = 0;
-    const take = (n) => { const v = series(nums, p, n); p += n + 1; return v; };
+    const made = [];                             // the sheet's series in order: one may repeat an earlier
+    const take = (n) => {
+      const v = nums[p] < 0 ? made[-1 - nums[p]] : series(nums, p, n);
+      p += nums[p] < 0 ? 1 : n + 1;
+      made.push(v);
+      return v;
+    };
     const elements = K.elements.map((E) => {
       const el = {tag: E.tag, attrs: E.attrs.map(([a, v]) => ` ${a}="${v}"`).join(""),
                   title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows, m: E.m};

@@ -122,11 +122,15 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
     (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
     holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm); every series as
-    differences of the order that suits it (`_series`), as zigzag varints."""
-    meta, series = [], []
+    differences of the order that suits it (`_series`), or, where an earlier series of the sheet
+    is the same (a line's end and its point), -1 - that series' index; as zigzag varints."""
+    meta, series, seen = [], [], {}
 
     def put(a) -> None:
-        series.append(_series(a))
+        a = np.asarray(a, dtype=np.int64).ravel()
+        key = a.tobytes()
+        series.append(np.array([-1 - seen[key]]) if key in seen else _series(a))
+        seen.setdefault(key, len(series) - 1)
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
         rows, m = xy.shape[0], xy.shape[1]
