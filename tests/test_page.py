@@ -423,7 +423,6 @@ def test_variant_all_writes_a_page_per_code_linked_from_its_index(tmp_path, monk
 def _script_page(drawings, n: int) -> str:
     """A page of the hand-made `drawings` (Drawing's, n angles) and no values: the key page's
     script on the elements it looks for (page.py `_html`)."""
-    import base64
     import gzip
     import json
     from importlib import resources
@@ -436,10 +435,10 @@ def _script_page(drawings, n: int) -> str:
     for k, d in enumerate(drawings):
         meta, numbers = pg.encode_drawing(d)
         kinds.append(meta)
-        blobs[f"k{k}"] = pg._b64gz(numbers)
-    blobs["meta"] = pg._b64gz(json.dumps({"kinds": kinds, "steps": []}).encode())
-    blobs["values"] = pg._b64gz(pg._columns(np.zeros((n, 0)))[1])
-    blobs["check"] = base64.b64encode(pg._obscure(gzip.compress(b'{"items": [], "M": []}'))).decode()
+        blobs[f"k{k}"] = pg._packed(numbers)
+    blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "steps": []}).encode())
+    blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[1])
+    blobs["check"] = pg._text85(pg._obscure(gzip.compress(b'{"items": [], "M": []}')))
     data = {"student": False, "frames": list(range(n)), "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
             "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "rows": [], "exps": [], "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}

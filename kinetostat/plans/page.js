@@ -1,5 +1,5 @@
 // The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
-// sheet's arrays and the values stored as differences over the angle (gzip, base64), writes the sheet of
+// sheet's arrays and the values stored as differences over the angle (gzip, 5 characters per 4 bytes), writes the sheet of
 // the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
 // lengths. No network, no library.
 "use strict";
@@ -7,8 +7,18 @@
   const D = JSON.parse(document.getElementById("page-data").textContent);
   const $ = (id) => document.getElementById(id);
 
+  function bytes85(s) {                         // page.py _text85: 5 digits (DIGITS85) per 4 bytes
+    const digit = (i) => { const c = i < s.length ? s.charCodeAt(i) : 118; return c - (c > 60 ? 34 : 33); };
+    const pad = (5 - s.length % 5) % 5, out = new Uint8Array((s.length + pad) / 5 * 4);
+    for (let i = 0, o = 0; i < s.length; i += 5, o += 4) {
+      let w = 0;
+      for (let k = 0; k < 5; k++) w = w * 85 + digit(i + k);
+      for (let b = 3; b >= 0; b--) { out[o + b] = w % 256; w = Math.floor(w / 256); }
+    }
+    return out.subarray(0, out.length - pad);
+  }
   async function bytes(id, xor) {
-    const bin = Uint8Array.from(atob($("blob-" + id).textContent), (c) => c.charCodeAt(0));
+    const bin = bytes85($("blob-" + id).textContent);
     if (xor) {                                   // page.py's _obscure: xorshift32, seed 27
       let x = 27;
       for (let i = 0; i < bin.length; i++) {
