@@ -587,17 +587,17 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     from .model.lettering import with_aliases
     from .plans.a3 import one_sheet
     from .plans.pack import pack
-    from .plans.worksheet import worksheet
+    from .plans.worksheet import analyses, worksheet_cycle
     from .tables import csv_text
     out = Path(out_dir)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
-    at = analyze(mech, phi_deg=[phi1])
+    at, other = analyses(mech, [phi1])                                # phi1 once: every file below from it
     res = analyze(mech, steps=steps)
-    a3 = one_sheet(mech, phi1, lang) if teacher_pack else None      # the scales of every file below
+    a3 = one_sheet(mech, phi1, lang, res=at) if teacher_pack else None      # the scales of every file below
     plans = a3.plans if a3 else build_plans(mech, at=phi1)
-    sheet = worksheet(mech, phi1, mu_l=plans.scales["mu_l"].value, lang=lang)
-    teacher = pack(v, lang, a3=a3) if teacher_pack else None
+    sheet = worksheet_cycle(mech, at, plans.scales["mu_l"].value, lang, other).at(0)
+    teacher = pack(v, lang, a3=a3, analysis=(at, other)) if teacher_pack else None
     with unit(out, root) as tmp:
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
         files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])

@@ -68,6 +68,27 @@ def test_reproducible_with_a_fixed_seed():
     assert not np.array_equal(a.samples["M_bal"], c.samples["M_bal"])
 
 
+def test_the_callers_analysis_is_drawn(monkeypatch):
+    """simulate(res=...) draws from the caller's analysis at its angle, the solver not called
+    again: the same samples as the study that analyses at its entry; an analysis at another
+    angle, of more than one angle or with friction in the reactions: ValueError naming res."""
+    import kinetostat.plans.drawing_error as D
+    import kinetostat.plans.worksheet as W
+    mech = kinetostat.load("ice_crank_slider")
+    alone = simulate(mech, at=60.0, n=50, seed=4)
+    res = kinetostat.analyze(mech, phi_deg=[60.0])
+    for module in (D, W):
+        monkeypatch.setattr(module, "analyze", lambda *a, **k: pytest.fail("analyze called"))
+    given = simulate(mech, n=50, seed=4, res=res)
+    assert given.phi_deg == 60.0 and given.scales == alone.scales and given.exact == alone.exact
+    assert all(np.array_equal(given.samples[k], alone.samples[k]) for k in alone.samples)
+    monkeypatch.undo()
+    for bad, at in ((res, 30.0), (kinetostat.analyze(mech, phi_deg=[60.0, 90.0]), None),
+                    (kinetostat.analyze(mech, phi_deg=[60.0], friction="reactions"), None)):
+        with pytest.raises(ValueError, match="res: expected the frictionless analysis"):
+            simulate(mech, at, n=2, res=bad)
+
+
 def test_seed_002_scales_and_spread():
     """Seed 002's own scales are the default choice (mu_l: OA 36 mm at 0.001, as the worked example);
     the published V_B lies inside the spread."""

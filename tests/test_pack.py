@@ -17,6 +17,7 @@ import kinetostat
 from kinetostat import variants
 from kinetostat.plans import pack as P
 from kinetostat.plans.drawing_error import simulate
+from kinetostat.plans.worksheet import worksheet
 from kinetostat.plans.i18n import num, words_en
 from kinetostat.plans.scales import choose_scales
 
@@ -298,7 +299,7 @@ def test_plans_html_prints_each_sheet_on_one_a3_page_at_true_size(uk_479, tmp_pa
 def test_a_zero_vector_has_no_direction():
     """Task 2, 479 at 90 deg: V_BA is 0 (printed so); the key gives it no angle, a non-zero vector keeps its own."""
     v = variants.variant(2, "479")
-    rec = {r["key"]: r for r in P.worksheet(v.mechanism(), float(v.values["phi1"]), lang="uk").records()}
+    rec = {r["key"]: r for r in worksheet(v.mechanism(), float(v.values["phi1"]), lang="uk").records()}
     assert num(rec["V_BA"]["value"], "uk") == "0" and rec["V_BA"]["direction"] == ""
     assert rec["V_B"]["value"] > 1 and rec["V_B"]["direction"].startswith("під кутом")
 
@@ -314,3 +315,17 @@ def test_the_figure_of_a_plan_holds_every_vector(pack_uk):
         for z in (plan.points[s.start], plan.points[s.end]):
             assert x0 <= z.real <= x1 and y0 <= z.imag <= y1, s.name
     assert len([t for t in ax.texts if t.arrow_patch is not None]) == 2          # R21, R41
+
+
+def test_the_pack_is_built_from_the_callers_analysis(monkeypatch, pack_uk):
+    """Given the analyses at phi1 and the A3 sheet (as `variants.write_key` gives them), the pack's
+    worksheet, bands and key are built from them, the solver not called again; the same key."""
+    import kinetostat.plans.drawing_error as D
+    import kinetostat.plans.worksheet as W
+    from kinetostat.plans.worksheet import analyses
+    v = variants.variant(1, "479")
+    pair = analyses(v.mechanism(), [float(v.values["phi1"])])
+    for module in (D, W):
+        monkeypatch.setattr(module, "analyze", lambda *a, **k: pytest.fail("analyze called"))
+    again = P.pack(v, lang="uk", a3=pack_uk.a3, analysis=pair)
+    assert again.key == pack_uk.key and again.bands == pack_uk.bands

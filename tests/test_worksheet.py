@@ -1,5 +1,6 @@
 """The worksheet (issue 12, item 3): seed 002's published values at 30 deg, every value against
-`analyze`, the senses by the text's own rule, every bundled model without NaN, the outputs."""
+`analyze`, the senses by the text's own rule, every bundled model without NaN, the outputs; the
+worksheet of a cycle (`worksheet_cycle`, one analysis at N angles) is the one-angle worksheet at each."""
 from __future__ import annotations
 
 import json
@@ -9,7 +10,8 @@ import numpy as np
 import pytest
 
 import kinetostat
-from kinetostat.plans.worksheet import worksheet
+from conftest import EVERY_KIND, MODELS, sampled
+from kinetostat.plans.worksheet import analyses, worksheet, worksheet_cycle
 
 # seed 002 sec. 1.2.2-1.2.3 at phi = 30 deg (drawn and measured: the text rounds)
 SEED_002 = {"V_B": 10.94, "V_BA": 14.92, "V_S2": 12.2, "omega_2": 135.6, "a_A": 7994.38, "a_B": 8311,
@@ -120,3 +122,66 @@ def test_a_rod_at_rest_has_no_sense():
     at_rest, moving = worksheet(mech, 90.0), worksheet(mech, 60.0)
     assert 0 < at_rest.value("omega_2") < 1e-12 * w1 and at_rest.row("omega_2").direction == ""
     assert moving.value("omega_2") > 0.1 and moving.row("omega_2").direction in ("cw", "ccw")
+
+
+def _close(a: float, b: float, scale: float) -> bool:
+    return (math.isnan(a) and math.isnan(b)) or abs(a - b) <= 1e-12 * max(abs(a), abs(b), scale)
+
+
+@pytest.mark.parametrize("friction", ["first", "reactions"])
+@pytest.mark.parametrize("path", sampled(MODELS, EVERY_KIND + ("triad_slider",)))     # a triad: its S by angle
+def test_the_cycle_is_the_one_angle_worksheet_at_every_angle(path, friction):
+    """One analysis at 24 angles, the rows built as arrays: at each angle the same rows (keys,
+    symbols, units, notes), values to 1e-12 of the largest of their unit over the cycle (of 100 %; δ not where both balancing moments are rounding), directions to 1e-9 deg,
+    as `worksheet(mech, at)`; `.values` holds them, NaN where a row is not written."""
+    mech = kinetostat.load(path)
+    if friction == "reactions" and mech.friction is None:
+        pytest.skip("no [friction]")
+    angles = np.arange(0.0, 360.0, 15.0)
+    res, other = analyses(mech, angles, friction)
+    cyc = worksheet_cycle(mech, res, 0.002, "uk", other)
+    assert cyc.values.shape == (24, len(cyc.rows)) and cyc.n == 24
+    largest = {"%": 100.0}                # δ: the lever's and the groups' M_зр agree to rounding
+    for r, col in zip(cyc.rows, np.abs(cyc.values).T):
+        largest[r.unit] = max(largest.get(r.unit, 0.0), float(np.nanmax(col, initial=0.0)))
+    for i, at in enumerate(angles):
+        one, got = worksheet(mech, float(at), mu_l=0.002, lang="uk", friction=friction), cyc.at(i)
+        assert (got.mechanism, got.phi_deg, got.mu_l, got.digits) == (one.mechanism, one.phi_deg, one.mu_l, one.digits)
+        assert [(r.section, r.key, r.symbol, r.unit, r.note) for r in got.rows] == \
+            [(r.section, r.key, r.symbol, r.unit, r.note) for r in one.rows], at
+        column = dict(zip(cyc.keys, cyc.values[i]))
+        dead = abs(one.value("M_bal_lever")) <= 1e-9 * largest["N m"]     # δ = 0/0: a ratio of rounding
+        for r, g in zip(one.rows, got.rows):
+            assert (dead and r.key == "delta_pct") or _close(g.value, r.value, largest[r.unit]) and _close(column[r.key], r.value, largest[r.unit]), \
+                (at, r, g)
+            if r.direction.startswith("angle:"):
+                assert g.direction.startswith("angle:") and abs(float(g.direction[6:]) - float(r.direction[6:])) < 1e-9
+            else:
+                assert g.direction == r.direction, (at, r, g)
+        written = {r.key for r in one.rows}
+        assert all(math.isnan(v) for k, v in column.items() if k not in written)
+
+
+def test_the_cycle_analyses_nothing(monkeypatch):
+    """worksheet_cycle builds from the analyses it is given (the friction rows included): the
+    solver is not called again."""
+    import kinetostat.plans.worksheet as W
+    mech = kinetostat.load("ice_crank_slider")                  # has [friction]
+    res, other = analyses(mech, [30.0, 60.0])
+    monkeypatch.setattr(W, "analyze", lambda *a, **k: pytest.fail("analyze called"))
+    cyc = worksheet_cycle(mech, res, 0.001, friction_res=other)
+    assert cyc.at(1).value("M_bal_friction") == pytest.approx(float(other.balancing_moment[1]), rel=1e-12)
+
+
+def test_the_friction_rows_come_from_the_other_mode():
+    """A model with [friction]: its friction rows with the analysis in the other mode at the same
+    angles, none without it; the wrong mode or other angles: ValueError naming friction_res."""
+    mech = kinetostat.load("ice_crank_slider")
+    res, other = analyses(mech, [30.0])
+    assert worksheet_cycle(mech, res, 0.001, friction_res=other).at(0).section("friction")
+    assert not worksheet_cycle(mech, res, 0.001).at(0).section("friction")
+    for bad in (res, analyses(mech, [31.0])[1]):               # the same mode, other angles
+        with pytest.raises(ValueError, match="friction_res: .*friction='reactions'"):
+            worksheet_cycle(mech, res, 0.001, friction_res=bad)
+    with pytest.raises(ValueError, match="mu_l"):
+        worksheet_cycle(mech, res, float("nan"), friction_res=other)

@@ -284,7 +284,7 @@ class OneSheet:
                 if s.value > self.rule[k].value * (1 + 1e-9)]
 
 
-def one_sheet(mech, at: float, lang: str) -> OneSheet:
+def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     """The plans of `mech` at crank angle `at` (deg), drawn in `lang`, at the texts' scales where
     they all fit one A3 sheet (`layout`) in every language of LANGS (so that a variant's scales do
     not depend on the language of its pack), else with scales chosen together for that sheet: the
@@ -294,11 +294,13 @@ def one_sheet(mech, at: float, lang: str) -> OneSheet:
     while they still fit. The same `kinetostat.plans.build` that every sheet of the plans uses,
     with these scales given; each try a build, the drawings of the plans whose scales changed
     (in each language) and their layouts. Where no scale within _TRIES steps fits them, the last
-    try is kept (more than one sheet)."""
-    from ..solve import analyze
+    try is kept (more than one sheet). `res`: the caller's frictionless analysis of `mech` at
+    [at] for the references of the scales (default: made here, once)."""
     from . import build
     from .scales import LENGTH_MANTISSAS, next_coarser, references
-    res = analyze(mech, phi_deg=[float(at)])
+    if res is None:
+        from ..solve import analyze
+        res = analyze(mech, phi_deg=[float(at)])
     reference = references(mech, res)
     drawn: dict[tuple, Drawing] = {}
 

@@ -57,7 +57,11 @@ class Scales:
 
 def default_scales(mech: Mechanism, at: float | None = None) -> Scales:
     """The scales the plans are drawn at (`scales.choose_scales`: as Logvinenko, Nadtoka 2021 choose them)."""
-    res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at], friction="first")   # drawn: frictionless
+    return _scales(mech, analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at], friction="first"))
+
+
+def _scales(mech: Mechanism, res: Analysis) -> Scales:
+    """The texts' scales of the plans of `res` (one angle; drawn: frictionless)."""
     sc = choose_scales(mech, res)
     return Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, sc["mu_F"].value)
 
@@ -464,19 +468,26 @@ def draws_forces(mech: Mechanism) -> bool:
 
 
 def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length_mm: float = 0.25,
-             angle_deg: float = 0.25, scales: Scales | None = None, seed: int = 0) -> DrawnSolution:
+             angle_deg: float = 0.25, scales: Scales | None = None, seed: int = 0,
+             res: Analysis | None = None) -> DrawnSolution:
     """`n` drawn solutions of `mech` at crank angle `at` (deg; default its design position),
     each act of drawing wrong by up to ±length_mm (lengths, arms, readings) and ±angle_deg
-    (directions), at `scales` (default: the texts' choice). Reproducible for a given seed."""
-    from .worksheet import worksheet
+    (directions), at `scales` (default: the texts' choice). `res`: the caller's frictionless
+    analysis of `mech` at the one angle `at` (`analyze(mech, phi_deg=[at])`; default: made here,
+    once). Reproducible for a given seed."""
+    from .worksheet import worksheet_cycle
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise ValueError(f"n: expected a positive number of samples, got {n!r}")
     for name, v in (("length_mm", length_mm), ("angle_deg", angle_deg)):
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
             raise ValueError(f"{name}: expected a finite precision >= 0, got {v!r}")
-    at = mech.drive.design_deg if at is None else float(at)
-    sc = scales or default_scales(mech, at)
-    res = analyze(mech, phi_deg=[at], friction="first")
+    if res is None:
+        res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else float(at)], friction="first")
+    elif len(res.phi_deg) != 1 or res.friction is not None or (at is not None and float(at) != res.phi_deg[0]):
+        raise ValueError(f"res: expected the frictionless analysis of {mech.name!r} at the one angle "
+                         f"{'at' if at is None else f'{float(at):g} deg'} (analyze(mech, phi_deg=[at])), got {res}")
+    at = float(res.phi_deg[0])
+    sc = scales or _scales(mech, res)
     dr = _Drafter(int(n), float(length_mm), float(angle_deg), seed)
     pl = _Plans(res, sc, dr)
     pl.kinematics()
@@ -486,7 +497,7 @@ def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length
         M = pl.crank(pl.forces_of_groups(forces, couples), forces, couples)
         ML = pl.lever(forces, couples)
         pl.put("delta_pct", (ML - M) / ML * 100.0, "%")
-    ws = worksheet(mech, at=at, mu_l=sc.mu_l)
+    ws = worksheet_cycle(mech, res, sc.mu_l).at(0)
     exact = {}
     for key in pl.out:
         try:

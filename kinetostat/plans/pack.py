@@ -46,7 +46,7 @@ from .._io import write_bytes, write_text
 from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 from ..model.lettering import lettering
-from .worksheet import CSS, Worksheet, html_document, worksheet
+from .worksheet import CSS, Worksheet, analyses, html_document, worksheet_cycle
 
 __all__ = ["Pack", "pack", "BAND", "BAND_DRAWS", "PACK_FILES"]
 
@@ -112,25 +112,27 @@ class Pack:
 
 # ============================================================================ content
 
-def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS) -> Pack:
+def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -> Pack:
     """The pack of variant `v` (`variants.Variant`) in `lang` at its design position, every part
     at the scales that put the plans on one A3 sheet (`a3`: `a3.one_sheet` in `lang`, when chosen
-    already); `draws`: Monte Carlo draws of the bands."""
+    already); `draws`: Monte Carlo draws of the bands; `analysis`: the caller's analyses of the
+    variant at [phi1] (`worksheet.analyses`), from which every part is built (default: made here, once)."""
     from .a3 import one_sheet
     from .drawing_error import Scales, simulate
     check_lang(lang)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
-    a3 = a3 or one_sheet(mech, phi1, lang)
+    res, other = analysis or analyses(mech, [phi1])
+    a3 = a3 or one_sheet(mech, phi1, lang, res=res)
     plans = a3.plans
     sc = plans.scales
-    ws = worksheet(mech, phi1, mu_l=sc["mu_l"].value, lang=lang)
+    ws = worksheet_cycle(mech, res, sc["mu_l"].value, lang, other).at(0)
     L = lettering(mech)
     spec, name = v.spec, v.title(lang)
     title = text("pack.task", lang, task=v.task, code=v.code or "—",
                  title=name[0].upper() + name[1:] if lang == "en" else name)
-    drawn = simulate(mech, at=phi1, n=draws, seed=0,
-                     scales=Scales(*(sc[k].value for k in ("mu_l", "mu_v", "mu_a", "mu_F"))))
+    drawn = simulate(mech, n=draws, seed=0, scales=Scales(*(sc[k].value for k in ("mu_l", "mu_v", "mu_a", "mu_F"))),
+                     res=res)
     bands = {k: tuple(float(x) for x in np.percentile(s, BAND)) for k, s in drawn.samples.items()}
     data = Table((text("pack.letter", lang), text("pack.parameter", lang), text("ws.head.symbol", lang),
                   text("ws.head.value", lang), text("ws.head.unit", lang)),
