@@ -280,12 +280,13 @@ def _steps(mech, res, plans, lang: str) -> list[dict]:
     return out
 
 
-def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[float, float]], dict[str, tuple[float, float]]]:
+def _bands(mech, res, plans, fixed) -> tuple[dict[tuple[str, str], tuple[float, float]], dict[str, tuple[float, float]]]:
     """The bands a careful drawing lands in (5-95 % of `drawing_error.simulate` at the page's
     scales): (1) of each segment (mm) whose value is a value of the worksheet (matched by value and
     unit: the study reads the worksheet's values), that value's band at the segment's scale; (2) of
     the two balancing moments, signed (N m): "M_bal" from the force plans, "M_bal_lever" from the
-    lever. None where the study does not draw the mechanism's groups (PRP, RPP, triads)."""
+    lever. None where the study does not draw the mechanism's groups (PRP, RPP, triads). `res`:
+    the analysis at the angle of `plans` alone."""
     from .drawing_error import Scales, simulate
     from .pack import BAND, BAND_DRAWS
     sc = fixed.base
@@ -293,7 +294,7 @@ def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            drawn = simulate(mech, at=at, n=BAND_DRAWS, seed=0,
+            drawn = simulate(mech, at=float(res.phi_deg[0]), n=BAND_DRAWS, seed=0, res=res,
                              scales=Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, mu_F))
         except NotImplementedError:            # a group kind the study does not draw: no bands
             return {}, {}
@@ -346,10 +347,9 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     (and of a student's page; default the design position); `angles`: the slider's frames (deg;
     default PAGE_ANGLES); `fixed`: the plans' scales (default `cycle_scales` of the page's one
     analysis). ValueError where `at` is a singular position."""
-    from ..solve import analyze
     from . import build_cycle, cycle_scales
     from .draw import drawing
-    from .worksheet import worksheet_cycle
+    from .worksheet import analyses, worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
     design = float(getattr(mech.drive, "design_deg", 30.0))
@@ -359,16 +359,16 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     i_at = phi.index(at)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = analyze(mech, phi_deg=phi)
+        res, other = analyses(mech, phi)           # the graphical method's; the other friction mode's rows
         fixed = fixed or cycle_scales(mech, res=res)
         cycles = build_cycle(mech, res, fixed)
-        sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang)
+        sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=other)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
     name = lettering(mech).name(lang, mech.name)
     check = {kind: c.at(i_at) for kind, c in cycles.items()}
     one = res.take(np.array([i_at]))
-    bands, moment_bands = _bands(mech, check, fixed, at)
+    bands, moment_bands = _bands(mech, one, check, fixed)
     data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": phi,
                   "slider": len(frames) - 1, "tol": TOLERANCE_PCT,
                   "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
