@@ -8,6 +8,7 @@ with `-m slow` the whole page of `kinetostat page` against `kinetostat plans --c
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import math
 import re
@@ -375,7 +376,9 @@ def test_shaper_check_and_values_in_ukrainian():
 
 def test_report_draws_its_page_every_time(tmp_path, monkeypatch, cli):
     """`kinetostat report` writes and links each model's page by default, drawn anew every time:
-    a page.html planted in the model's folder is replaced; --no-page removes the earlier page.
+    a page.html planted in the model's folder is replaced, even one sealed as the removed cache
+    accepted a page (its own key kept, the SHA-256 of its bytes on its last line); --no-page
+    removes the earlier page.
     (A page of two angles at scales sampled every 90 deg: quick.)"""
     import kinetostat.plans.page as pg
     monkeypatch.setattr(pg, "PAGE_ANGLES", (0.0, 150.0))
@@ -394,8 +397,9 @@ def test_report_draws_its_page_every_time(tmp_path, monkeypatch, cli):
     assert ", page drawn  ->" in report() and "](page.html)" in md.read_text(encoding="utf-8")
     assert "[page](ice_crank_slider/page.html)" in (out / "index.md").read_text(encoding="utf-8")
     first = html.read_bytes()
-    planted = first.replace(b"</body>", b"<p>planted</p></body>")
-    html.write_bytes(planted)
+    body = re.sub(rb"<!-- kinetostat-page-sha256 \w+ -->\n$", b"", first).replace(b"</body>", b"<p>planted</p></body>")
+    planted = body + b"<!-- kinetostat-page-sha256 " + hashlib.sha256(body).hexdigest().encode() + b" -->\n"
+    html.write_bytes(planted)                      # sealed as the removed page cache accepted a page as its own
     assert ", page drawn  ->" in report() and html.read_bytes() == first           # replaced, not kept
     report("--no-page")
     assert not html.exists() and "page.html" not in md.read_text(encoding="utf-8")        # none, none linked
