@@ -26,10 +26,11 @@ The page contract (the README): `<input type="range" id="phi">`; every segment's
 `data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to 1e-9 mm); every value cell
 `data-symbol`, `data-value`; `body[data-ready]`.
 
-May use: the plans (`build_cycle`, `cycle_scales`, `fixed_positions`, `core`, `draw`, `forces`,
-`worksheet`, `drawing_error`, `i18n`, `lettering`), the solver, `_io`, `kinetostat._text`
-(`script_json`: the data block's JSON), numpy, the standard library. Never matplotlib, never the
-harness.
+May use: the plans (`build_cycle`, `cycle_scales`, `core`, `draw`, `forces`, `worksheet`
+(`analyses`, `worksheet_cycle`), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
+`kinetostat._text` (`script_json`: the data block's JSON), numpy, the standard library. Never
+matplotlib, never the harness; the solver only through `worksheet.analyses` (the page's one
+analysis).
 """
 from __future__ import annotations
 
