@@ -35,7 +35,7 @@ SEED_002 = [
 def _plans(mech, res, mu_F=MU_F):
     plans = group_plans(mech, res, MU_L) + force_plans(mech, res, mu_F) + [crank_plan(mech, res, MU_L, mu_F),
                                                                              lever_plan(mech, res, MU_V)]
-    return {p.kind: p for p in plans}
+    return {p.kind: p.at(0) for p in plans}           # one angle: the cycle's N = 1 plans
 
 
 @pytest.mark.parametrize("kind, name, text_mm", SEED_002)
@@ -160,6 +160,6 @@ def test_every_model(analysed, path, n):
 def test_bad_input(ice):
     mech, res = ice
     with pytest.raises(ValueError, match="one crank angle"):
-        force_plans(mech, kinetostat.analyze(mech, phi_deg=[10.0, 20.0]), MU_F)
+        lever_check(mech, kinetostat.analyze(mech, phi_deg=[10.0, 20.0]), MU_V)
     with pytest.raises(ValueError, match="mu_F"):
         force_plans(mech, res, -1.0)

@@ -43,7 +43,8 @@ def test_seed_002_scales_chosen_by_the_rule():
 def _exact_values(mech, res, plans):
     """What each vector of the velocity and acceleration plans must measure, from analyze alone."""
     exp = {}
-    names = P.kinematic.plan_point_names(mech, res)
+    names = {n: pt._replace(local=complex(np.ravel(pt.local)[0]))       # a guide's point: (N,) local coordinates
+             for n, pt in P.kinematic.plan_point_names(mech, res).items()}
     for n, pt in names.items():
         r, v, a = (complex(z[0]) for z in res.kin.point_z(pt.link, (pt.local.real, pt.local.imag)))
         exp[("velocity", f"p-{n}")] = abs(v)

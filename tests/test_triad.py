@@ -204,24 +204,24 @@ def test_the_plans_draw_s_and_the_force_polygon_in_the_texts_order(mech):
     res = kinetostat.analyze(mech, phi_deg=[60.0])
     g = mech.structure.groups[0]
     sc = choose_scales(mech, res)
-    v = kinematic.velocity_plan(mech, res, sc)
+    v = kinematic.velocity_plan(mech, res, sc).at(0)          # the cycle of one angle
     S = special_point_z(mech, res.kin, g)[0]
     b = g.links[0]
     local = (S - res.kin.origin_z[0, b]) / res.kin.rot[0, b]
     vS = complex(res.kin.point_z(b, (local.real, local.imag))[1][0])
     assert abs(v.points["s"] * sc["mu_v"].value - vS) <= 1e-12 * abs(vS)
     assert {s.name for s in v.segments} >= {"a-s", "p-s"}
-    acc = kinematic.acceleration_plan(mech, res, sc)
+    acc = kinematic.acceleration_plan(mech, res, sc).at(0)
     aS = complex(res.kin.point_z(b, (local.real, local.imag))[2][0])
     a_A = complex(res.kin.point_z(1, tuple(mech.links[1].points["A"]))[2][0])
     seg = acc.segment("a-s")
     assert abs(seg.value - abs(aS - a_A)) <= 1e-12 * abs(aS)                     # a_S = a_A + a_SA
     assert abs(abs(acc.points["s"] - acc.points["a"]) * sc["mu_a"].value - seg.value) <= 1e-12 * abs(aS)
-    (gp,) = forces.group_plans(mech, res, sc["mu_l"])
+    (gp,) = (p.at(0) for p in forces.group_plans(mech, res, sc["mu_l"]))
     assert abs(gp.points["S"] * sc["mu_l"].value - S) <= 1e-12
     assert any(s.name.endswith("(S)") for s in gp.segments)
     mu_F = forces.default_mu_F(mech, res)
-    (fp,) = forces.force_plans(mech, res, mu_F)
+    (fp,) = (p.at(0) for p in forces.force_plans(mech, res, mu_F))
     eq = fp.equation
     (l1, _, _, a1), (l2, _, _, a2), (l3, _, _, a3) = kinetostat.kinematics.special_sides(mech, res.kin, g)
     best = {"RRR": (5, 2), "RRP": (2, 4)}[g.kind] if g.inner == "RRR" else (2, 4)     # S: the best-met axes

@@ -8,7 +8,9 @@
     >>> fig = kinetostat.plans.figure(plans["acceleration"], lang="uk")   # a matplotlib Figure
     >>> plans.write("out", lang="en")                       # one SVG sheet per plan + segments.csv
 
-`build` -> `Plans`, a frozen mapping kind -> `Plan` (`core`); scales by the texts' rule or given
+`build` -> `Plans`, a frozen mapping kind -> `Plan` (`core`), the N = 1 case of `build_cycle`
+(every plan at the N angles of one analysis, `PlanCycle`s at the cycle's scales, `cycle_scales`);
+scales by the texts' rule or given
 (`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
 there and only when a figure is drawn).
 
@@ -34,71 +36,14 @@ from .draw import ROOM_MM, figure, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
 from ..model.lettering import lettering
 from .mechanism import mechanism_plan
-from .kinematic import FixedPositions, acceleration_plan, fixed_positions, positions_plan, starting_position, velocity_plan
+from .kinematic import FixedPositions, acceleration_plan, assembled, fixed_positions, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
 from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
 
 __all__ = ["build", "build_cycle", "Plans", "BUILDERS", "Plan", "PlanCycle", "Scale", "Segment", "SEGMENT_COLUMNS", "svg",
            "figure", "choose_scales", "starting_position", "fixed_positions", "plan_file_name", "CycleScales",
-           "cycle_scales", "fits"]
+           "cycle_scales", "fits_cycle"]
 
-
-def _shim_stack(plans: list[Plan | None], phi) -> PlanCycle:
-    """TEMPORARY (until the force plans' builders are vectorised): the one-angle plans of one kind
-    at the angles `phi` (None where not built) stacked into a PlanCycle: every point, segment and
-    path any angle has, NaN (segments: not `drawn`) where an angle lacks it, at the coarsest scale
-    of the angles'."""
-    import numpy as np
-    made = [p for p in plans if p is not None]
-    first = made[0]
-    n = len(plans)
-    point_names = list(dict.fromkeys(k for p in made for k in p.points))
-    def keyed(p: Plan) -> dict:            # a name drawn twice (a guide of two links) kept twice
-        seen: dict[str, int] = {}
-        return {(s.name, seen.setdefault(s.name, 0), seen.__setitem__(s.name, seen[s.name] + 1))[:2]: s
-                for s in p.segments}
-    segs_at = [keyed(p) if p is not None else {} for p in plans]
-    seg_names = list(dict.fromkeys(k for d in segs_at for k in d))
-    path_names = list(dict.fromkeys(k for p in made for k in p.paths))
-    points = {k: np.array([p.points.get(k, np.nan) if p is not None else np.nan for p in plans], complex)
-              for k in point_names}
-    segments = []
-    for name in seg_names:
-        have = [d.get(name) for d in segs_at]
-        s = next(x for x in have if x is not None)
-        scales = [x.scale for x in have if x is not None and x.scale is not None]
-        drawn = np.array([x is not None for x in have])
-        segments.append(Segment(s.name, s.start, s.end, np.array([x.value if x else np.nan for x in have], float),
-                                s.unit, s.kind, max(scales, key=lambda c: c.value) if scales else None,
-                                None if drawn.all() else drawn))
-    width = {k: max(len(p.paths[k]) for p in made if k in p.paths) for k in path_names}
-    paths = {k: np.array([list(p.paths[k]) + [np.nan] * (width[k] - len(p.paths[k]))
-                          if p is not None and k in p.paths else [np.nan] * width[k] for p in plans], complex)
-             for k in path_names}
-    symbols = list(dict.fromkeys(r.symbol for p in made for r in p.results))
-    results = tuple(replace(next(r for p in made for r in p.results if r.symbol == sym), value=
-        np.array([next((r.value for r in p.results if r.symbol == sym), np.nan) if p is not None else np.nan
-                  for p in plans])) for sym in symbols) if symbols else ()
-    return PlanCycle(first.kind, tuple(p.title if p is not None else "" for p in plans),
-                     max((p.scale for p in made), key=lambda c: c.value), phi, points, tuple(segments), paths,
-                     tuple(p.notes if p is not None else () for p in plans) if any(p.notes for p in made) else (),
-                     results, first.equation)
-
-
-def _shim_cycle(builder: Callable) -> Callable:
-    """TEMPORARY (until the force plans' builders take N angles): builder(mech, res, *args), a
-    one-angle builder of a Plan or a list of Plans, made a builder of PlanCycles at every angle of
-    `res` by building it at each non-singular angle in turn (the only loop over the angles here)."""
-    def at_every_angle(mech, res, *args):
-        made = [None if res.singular[i] else builder(mech, res.take([i]), *args) for i in range(len(res.phi_deg))]
-        some = next(m for m in made if m is not None)
-        if isinstance(some, (list, tuple)):
-            return [_shim_stack([None if m is None else m[j] for m in made], res.phi_deg) for j in range(len(some))]
-        return _shim_stack(made, res.phi_deg)
-    return at_every_angle
-
-
-_group_plans, _force_plans, _crank_plan, _lever_plan = map(_shim_cycle, (group_plans, force_plans, crank_plan, lever_plan))
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
 #: PlanCycle or list of PlanCycles at the angles of `res`).
@@ -107,10 +52,10 @@ BUILDERS: tuple[tuple[str, Callable], ...] = (
     ("positions", positions_plan),
     ("velocity", velocity_plan),
     ("acceleration", acceleration_plan),
-    ("groups", lambda mech, res, sc: _fitted(lambda mu: _group_plans(mech, res, mu), sc["mu_l"])),
-    ("forces", lambda mech, res, sc: _fitted(lambda mu: _force_plans(mech, res, mu), sc["mu_F"])),
+    ("groups", lambda mech, res, sc: _fitted(lambda mu: group_plans(mech, res, mu), sc["mu_l"])),
+    ("forces", lambda mech, res, sc: _fitted(lambda mu: force_plans(mech, res, mu), sc["mu_F"])),
     ("crank", lambda mech, res, sc: _crank(mech, res, sc)),
-    ("lever", lambda mech, res, sc: _fitted(lambda mu: _lever_plan(mech, res, mu), sc["mu_v"])),
+    ("lever", lambda mech, res, sc: _fitted(lambda mu: lever_plan(mech, res, mu), sc["mu_v"])),
 )
 
 
@@ -119,12 +64,11 @@ def _crank(mech, res, sc) -> list[PlanCycle]:
     at a mu_F of its own (`forces.crank_plan`'s, for the largest reaction at the angles of `res`),
     made coarser while the plan overflows its sheet."""
     import numpy as np
-    R = np.hypot(*np.moveaxis(res.forces.R[~np.asarray(res.singular, bool)], -1, 0)).ravel()
-    mu_F = force_scale(R[np.isfinite(R)], CRANK_FORCE_MM)
-    return _fitted(lambda mu: _crank_plan(mech, res, sc["mu_l"], mu), mu_F)
+    mu_F = force_scale([np.hypot(res.forces.R[..., 0], res.forces.R[..., 1])], CRANK_FORCE_MM)
+    return _fitted(lambda mu: crank_plan(mech, res, sc["mu_l"], mu), mu_F)
 
 
-def fits(cycle: PlanCycle):
+def fits_cycle(cycle: PlanCycle):
     """(N,): by how much the plan exceeds the room of its sheet (`draw.ROOM_MM`) at each angle of
     the cycle: <= 1 where it fits (`draw.fits` angle by angle)."""
     import numpy as np
@@ -134,7 +78,7 @@ def fits(cycle: PlanCycle):
 
 def _fitted(make: Callable, mu: Scale) -> list[PlanCycle]:
     """make(mu) -> a PlanCycle or a list of them, made again at the next coarser round scale while
-    one of them overflows its sheet at some angle (`fits`: a group's reaction far out on its guide,
+    one of them overflows its sheet at some angle (`fits_cycle`: a group's reaction far out on its guide,
     a polygon longer than its largest force, a lever whose forces reach beyond the velocity plan):
     the sheet states the scale it is drawn at. A few tries at most; the last is kept."""
     import numpy as np
@@ -142,7 +86,7 @@ def _fitted(make: Callable, mu: Scale) -> list[PlanCycle]:
     for _ in range(4):
         made = make(Scale(mu.symbol, value, mu.unit))
         plans = list(made) if isinstance(made, (list, tuple)) else [made]
-        factor = max(float(np.max(fits(p), initial=0.0)) for p in plans)
+        factor = max(float(np.max(fits_cycle(p), initial=0.0)) for p in plans)
         if factor <= 1:
             break
         value = coarser(value, factor)
@@ -163,10 +107,10 @@ class CycleScales:
         """BUILDERS' steps that draw at these scales."""
         group = {k.partition(":")[2]: s for k, s in self.forces_on.items() if k.startswith("group:")}
         kind = {k.partition(":")[0]: s for k, s in self.plan.items()}
-        return {"groups": lambda mech, res, sc: _group_plans(mech, res, kind["group"], group),
-                "forces": lambda mech, res, sc: _force_plans(mech, res, kind["forces"]),
-                "crank": lambda mech, res, sc: _crank_plan(mech, res, self.plan["crank"], self.forces_on["crank"]),
-                "lever": lambda mech, res, sc: _lever_plan(mech, res, self.plan["lever"], self.forces_on["lever"])}
+        return {"groups": lambda mech, res, sc: group_plans(mech, res, kind["group"], group),
+                "forces": lambda mech, res, sc: force_plans(mech, res, kind["forces"]),
+                "crank": lambda mech, res, sc: crank_plan(mech, res, self.plan["crank"], self.forces_on["crank"]),
+                "lever": lambda mech, res, sc: lever_plan(mech, res, self.plan["lever"], self.forces_on["lever"])}
 
 
 #: The plans whose scale the cycle fixes beyond the base scales (`CycleScales.plan`).
@@ -188,17 +132,17 @@ def cycle_scales(mech, step_deg: float = 5.0, res=None) -> CycleScales:
     sheet at every angle (a peak between two angles 5 deg apart exceeds the sampled one by under
     0.4 % of a cosine; the round scales leave more room). One analysis (none where `res` is
     given), one build of the plans at every angle at the base scales, each plan's scale then
-    made coarser while it overflows its sheet at some angle. Singular positions are left out."""
+    made coarser while it overflows its sheet at some angle. Singular positions and angles where
+    the linkage does not assemble are left out."""
     import warnings
 
     import numpy as np
 
-    from ..solve import analyze
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        if res is None:
-            res = analyze(mech, phi_deg=cycle_angles(mech, step_deg), friction="first")
-        keep = ~np.asarray(res.singular, bool) & (res.omega(1) != 0)
+        if res is None:                             # where the linkage does not assemble: no plans
+            res = assembled(mech, cycle_angles(mech, step_deg), friction="first")[0]
+        keep = np.zeros(0, bool) if res is None else ~np.asarray(res.singular, bool) & (res.omega(1) != 0)
         if not keep.any():
             raise ValueError(f"{mech.name}: no crank angle where the plans can be drawn")
         drawn = res.take(np.flatnonzero(keep))
@@ -224,7 +168,7 @@ def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions 
     noted (the scale rule keeps the crank at the length the text asks)."""
     fixed = fixed or fixed_positions(mech, sc["mu_l"], starting_deg)
     plan = positions_plan(mech, res, sc, starting_deg, fixed=fixed)
-    fit = fits(plan) <= 1
+    fit = fits_cycle(plan) <= 1
     return plan if fit.all() else positions_plan(mech, res, sc, starting_deg, other_branch=fit, fixed=fixed)
 
 

@@ -59,9 +59,6 @@ class Segment:
     kind: str = "vector"
     scale: Scale | None = None   # a segment drawn at another scale than its plan's (the loads on a
                                  # group plan, at a force scale); None: the plan's scale
-    drawn: np.ndarray | None = None   # in a PlanCycle: (N,) bool, the angles where the segment is part
-                                      # of the plan (a triad's construction through S changes leashes
-                                      # over the cycle); None: at every angle
     # In a PlanCycle, `value` is an (N,) array over its angles.
 
 
@@ -235,7 +232,7 @@ class PlanCycle:
         return Plan(self.kind, self.titles[i], self.scale, float(self.phi_deg[i]),
                     {k: complex(v[i]) for k, v in self.points.items()},
                     tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale)
-                          for s in self.segments if (s.drawn is None or s.drawn[i]) and self.drawn(s)[i]),
+                          for s in self.segments if self.drawn(s)[i]),
                     {k: tuple(map(complex, v[i if len(v) > 1 else 0])) for k, v in self.paths.items()},
                     self.notes[i] if self.notes else (),
                     tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how if isinstance(r.how, str) else r.how[i])

@@ -364,7 +364,7 @@ def _foot(X: np.ndarray, F: np.ndarray, M: np.ndarray) -> np.ndarray:
 def _arrow(segs: list, pts: dict, name: str, X: np.ndarray, F: np.ndarray, mu_l: Scale, mu_F: Scale) -> None:
     """A force F (N) at world point X (m), each (N,), drawn at mu_F from X/mu_l."""
     start = f"{name}:from"
-    pts[start] = _over(X, mu_l.value)
+    pts[start] = np.where(np.isnan(F), np.nan, _over(X, mu_l.value))      # a force NaN where it is not drawn
     pts[f"{name}:to"] = pts[start] + _over(F, mu_F.value)
     segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
 
@@ -644,7 +644,7 @@ def _resultant(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: list
         return
     S, K = _world(res, k, link.com), np.where(has, _z(il.point), np.nan)
     _arrow(segs, pts, f"F_i{k}(h)", K, np.where(has, F, np.nan), mu_l, mu_F)
-    pts[f"z_{k}:S"] = _over(S, mu_l.value)
+    pts[f"z_{k}:S"] = np.where(has, _over(S, mu_l.value), np.nan)
     segs.append(Segment(f"z_{k}", f"z_{k}:S", f"F_i{k}(h):from", np.where(has, il.h, np.nan), "m", "arm"))
 
 
@@ -656,7 +656,8 @@ def _offset(mech: "Mechanism", res: "Analysis", p, pts: dict, segs: list, mu_l: 
         return
     X = _world(res, p.links[1], p.point)
     name = "x_" + reaction_name(mech, *p.links)[1:]
-    pts[f"{name}:from"], pts[f"{name}:to"] = _over(X, mu_l.value), (X + x * _guide(res, p)) / mu_l.value   # rounded as before
+    pts[f"{name}:from"] = np.where(np.isnan(x), np.nan, _over(X, mu_l.value))
+    pts[f"{name}:to"] = (X + x * _guide(res, p)) / mu_l.value   # rounded as before
     segs.append(Segment(name, f"{name}:from", f"{name}:to", _abs(x), "m", "arm"))
 
 

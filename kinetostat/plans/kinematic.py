@@ -15,7 +15,12 @@ crank pin `a1` in a slotted-link group, the guide's point `b3` when the guide is
 `k2`, ... when a plan has several. The plan of positions names each position's points with the
 position number (`A3`, `S2_3` where the name ends in a digit) and the design position's plain.
 
-May use: numpy, `kinetostat.solve` (the exact results: never re-solved here), `.core`.
+Every plan is built for the N angles of one analysis at once (`core.PlanCycle`); an element that
+exists at some angles only is NaN (not drawn) at the others.
+
+May use: numpy, `kinetostat.solve` (the exact results: the plans' own analysis is never re-solved;
+solved here once each: the cycle of positions, the starting position, the other assembly branch
+at the angles drawn), `kinetostat.kinematics` (Assur's special point), `.core`.
 """
 from __future__ import annotations
 
@@ -29,13 +34,15 @@ import numpy as np
 
 from .core import PlanCycle, Scale, Segment
 
-__all__ = ["positions_plan", "fixed_positions", "other_branches", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
+__all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
 
 #: Positions of the plan of positions: every 30 deg.
 N_POSITIONS = 12
 #: Crank angles sampled for the path of a centre of mass.
 PATH_STEPS = 180
+#: Angles a round of the search for the starting position analyses at once.
+SECTIONS = 63
 
 
 def _titles(text: str, res) -> tuple[str, ...]:
@@ -46,6 +53,12 @@ def _titles(text: str, res) -> tuple[str, ...]:
 def _ok(res) -> np.ndarray:
     """(N,) True at the angles where the plans are drawn (not at a singular position)."""
     return ~np.asarray(res.singular, bool)
+
+
+def _where(on: np.ndarray | None, value: np.ndarray) -> np.ndarray:
+    """A segment's value at the angles `on` (N,) bool (None: all), NaN at the others: the segment
+    is not drawn there (`PlanCycle.drawn`)."""
+    return value if on is None else np.where(on, value, np.nan)
 
 
 def _any(values, res) -> bool:
@@ -183,7 +196,7 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
         vS = _point_motion(res.kin, b, local)[1]
         points[name] = vS / mu.value
-        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, np.abs(vS - (mo[r][1] if r else 0j)), "m/s", drawn=on)
+        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s")
                  for r, on in refs]
     return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points, tuple(segs))
 
@@ -192,19 +205,19 @@ def _special(mech, res, pts: dict) -> list[tuple[str, int, np.ndarray, list[tupl
     """Per triad: the plan name of Assur's special point S (a point of the base link), the base,
     S's local coordinates on it (N,), and the references of the leashes through S: (the plan name
     of the leash's outer pin, "" for a point of the frame at the pole; the angles (N,) bool where
-    its axis passes through S, None: at every angle). S lies on two of the three leashes' axes
+    its axis passes through S, None: at every angle; its segment NaN, not drawn, at the others).
+    S lies on two of the three leashes' axes
     (`kinematics.special_sides`), which two may change over the cycle; the references are in the
     solver's order at the first angle."""
-    from ..kinematics import leash_axes
-    from ..triad import special_point
+    from ..kinematics import special_index, special_point_z
     out = []
     for n, g in enumerate(g for g in mech.structure.groups if g.klass == 3):
         name = "s" if n == 0 else f"s{n + 1}'"
         name = name if name not in pts else f"{name}'"
         b = g.links[0]
-        S, _, k = special_point(*(v for axis in leash_axes(mech, res.kin, g) for v in axis))
+        S, k = special_point_z(mech, res.kin, g), special_index(mech, res.kin, g)
         local = (S - res.kin.origin_z[:, b]) / res.kin.rot[:, b]
-        first = int(k[0]) if np.isfinite(k[0]) else 0
+        first = int(k[0]) % 3
         refs = []
         for j in ((first + 1) % 3, (first + 2) % 3, first):        # the sides in the solver's order
             on = (k != j) | ~_ok(res)
@@ -235,10 +248,10 @@ def _normals(mech, g):
 
 def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     """The acceleration plan (seed 002 fig. 1.8, seed 000 sec. 6.3) at every angle of `res`: pole
-    pi; the crank pin (normal and tangential parts where the crank accelerates at some angle); per
+    pi; the crank pin (normal and tangential parts at the angles where the crank accelerates); per
     group the normal `r-n<k>` and tangential `n<k>-q` parts of each turning link, the Coriolis
-    `-k` and relative `k-` parts of a block on a moving guide (where the guide turns at some
-    angle; at an angle where it does not, the Coriolis part has zero length); pi-x for every
+    `-k` and relative `k-` parts of a block on a moving guide at the angles where the guide turns
+    (where it stands still: the relative part alone, NaN, not drawn, elsewhere); pi-x for every
     point, the relative accelerations of each floating link's joints (a-b), like points by
     similarity, and a triad's special point s with its construction from the outer pins of the
     two leashes through S (e.g. a-s): all at mu_a."""
@@ -249,7 +262,9 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     segs: list[Segment] = []
     unit = "m/s^2"
 
-    def split(k: int, ref_point: str, q: str) -> None:
+    def split(k: int, ref_point: str, q: str, where: np.ndarray | None = None) -> None:
+        """The normal and tangential parts of q relative to the reference point (at the angles
+        `where` only: NaN, not drawn, at the others)."""
         ref = _name_of(mech, ref_point) if ref_point in mech.point_names else ref_point
         start = ref or "pi"
         r_ref, a_ref = (mo[ref][0], mo[ref][2]) if ref else (complex(*mech.links[0].points[ref_point]), 0j)
@@ -257,11 +272,14 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         l = np.abs(mo[q][0] - r_ref)
         n = f"n{k}"
         points[n] = (a_ref - w * w * (mo[q][0] - r_ref)) / mu.value
+        if where is not None:
+            points[n] = np.where(where, points[n], np.nan)
         segs.extend([Segment(f"{start}-{n}", start, n, w * w * l, unit), Segment(f"{n}-{q}", n, q, np.abs(e) * l, unit)])
 
     d = mech.drive
-    if _any(res.kin.eps[:, d.link], res):
-        split(d.link, d.pivot, _name_of(mech, d.point))
+    eps = res.kin.eps[:, d.link]
+    if _any(eps, res):                  # the crank pin's parts where the crank accelerates
+        split(d.link, d.pivot, _name_of(mech, d.point), eps != 0)
     for g in mech.structure.groups:
         for k, ref_point, q in _normals(mech, g):
             split(k, ref_point, q if q in pts else _name_of(mech, q))
@@ -272,13 +290,15 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         guide = p.links[0]
         w = res.kin.omega[:, guide]
         v_r, a_r = res.kin.v_slide[:, p.index], res.kin.a_slide[:, p.index]
-        if s in turning:
+        if s in turning:                 # where the guide stands still: no Coriolis part, k not drawn
             dw = complex(*p.direction) * res.kin.rot[:, guide]
             cor = 2j * w * v_r * dw                      # slider's acceleration = guide point's + cor + a_r d
             kname = "k" if len(turning) == 1 else f"k{turning.index(s) + 1}"
-            points[kname] = points[s.start] + (cor if s.from_guide else -cor) / mu.value
+            points[kname] = np.where(w != 0, points[s.start] + (cor if s.from_guide else -cor) / mu.value, np.nan)
             segs += [Segment(f"{s.start}-{kname}", s.start, kname, 2 * np.abs(w * v_r), unit),
                      Segment(f"{kname}-{s.end}", kname, s.end, np.abs(a_r), unit)]
+            if not np.all(w != 0):
+                segs.append(Segment(f"{s.start}-{s.end}", s.start, s.end, _where(w == 0, np.abs(a_r)), unit))
         else:
             segs.append(_rel(s.start, s.end, np.abs(a_r), unit))
     segs += [Segment(f"pi-{n}", "pi", n, np.abs(m[2]), unit) for n, m in mo.items()]
@@ -286,7 +306,7 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         aS = _point_motion(res.kin, b, local)[2]
         points[name] = aS / mu.value
         segs.append(Segment(f"pi-{name}", "pi", name, np.abs(aS), unit))
-        segs += [Segment(f"{r}-{name}", r, name, np.abs(aS - mo[r][2]), unit, drawn=on) for r, on in refs if r]
+        segs += [Segment(f"{r}-{name}", r, name, _where(on, np.abs(aS - mo[r][2])), unit) for r, on in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
     return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,
@@ -336,7 +356,8 @@ def starting_position(mech, steps: int = 720) -> float:
     """The texts' starting position (seed 002: crank and rod stretched in one line), crank angle
     in deg in [0, 360): the first dead centre of the first group driven by a link turning about
     a frame pin that has one (module docstring of `_dead_centre_functions`), found by a scan of
-    `steps` angles and bisection to ~1e-13 deg. 0 (the model's reference) when there is none."""
+    `steps` angles, then its bracket cut in SECTIONS + 1 parts by one analysis a round, to the
+    resolution of a float (~1e-14 deg). 0 (the model's reference) when there is none."""
     from ..solve import analyze
     phi = np.arange(steps) * 360.0 / steps
     cyc = analyze(mech, phi_deg=phi)
@@ -350,16 +371,19 @@ def starting_position(mech, steps: int = 720) -> float:
         if val[i] == 0:
             return float(phi[i])
         lo, hi, flo = phi[i], phi[i] + 360.0 / steps, val[i]
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            fm = f(analyze(mech, phi_deg=[mid]))[0][0]
-            if fm == 0 or mid in (lo, hi):
+        for _ in range(16):                 # each round: SECTIONS angles in one analysis
+            inner = np.unique(lo + (hi - lo) * np.arange(1, SECTIONS + 1) / (SECTIONS + 1))
+            inner = inner[(inner > lo) & (inner < hi)]
+            if not len(inner):
                 break
-            if np.sign(fm) == np.sign(flo):
-                lo, flo = mid, fm
-            else:
-                hi = mid
-        return float(mid % 360.0)
+            fm = f(analyze(mech, phi_deg=inner))[0]
+            if np.any(fm == 0):
+                return float(inner[np.argmax(fm == 0)] % 360.0)
+            changed = np.flatnonzero(np.sign(fm) != np.sign(flo))
+            j = int(changed[0]) if len(changed) else len(inner)
+            lo, flo = (inner[j - 1], fm[j - 1]) if j else (lo, flo)
+            hi = inner[j] if j < len(inner) else hi
+        return float(0.5 * (lo + hi) % 360.0)
     return 0.0
 
 
@@ -413,27 +437,36 @@ def _draw_position(mech, res, idx, label: int | None, mu: float, points: dict, s
                                     np.abs(zb - za) * mu, "m", "link" if label is None else "position"))
 
 
-def other_branches(mech, res) -> dict:
-    """Per group with two assembly branches (`mech.branches`): the analysis of the mechanism with
-    that group's other branch at the angles of `res`, one solve for all of them, and the angles
-    (N,) bool where it assembles; None where it assembles at none."""
+def assembled(mech, phi_deg, **options):
+    """(the analysis of `mech` at the angles `phi_deg` where it assembles, those angles (N,) bool):
+    one solve, and one more without the angles an AssemblyError named; (None, all False) where it
+    does not assemble at the rest either (or the model is refused: a ValueError). `options`: of
+    `analyze`."""
     from ..errors import AssemblyError
     from ..solve import analyze
+    phi = np.asarray(phi_deg, float)
+    where = np.ones(len(phi), bool)
+    for _ in range(2):
+        try:
+            return analyze(mech, phi_deg=phi[where], **options), where
+        except AssemblyError as exc:
+            where = where & ~np.isin(np.round(phi, 9), exc.phi_deg)
+            if not where.any():
+                break
+        except (ValueError, KeyError):
+            break
+    return None, np.zeros(len(phi), bool)
+
+
+def other_branches(mech, res) -> dict:
+    """Per group with two assembly branches (`mech.branches`): (the analysis of the mechanism with
+    that group's other branch at the angles of `res` where it assembles, those angles (N,) bool),
+    one solve for all of them (`assembled`); left out where it assembles at none."""
     out = {}
     for key, b in mech.branches.items():
-        other = replace(mech, branches={**mech.branches, key: -b})
-        phi = np.asarray(res.phi_deg, float)
-        where = np.ones(len(phi), bool)
-        for _ in range(2):                 # the angles where it fails left out, once
-            try:
-                out[key] = (analyze(other, phi_deg=phi[where]), where)
-                break
-            except AssemblyError as exc:
-                where &= ~np.isin(np.round(phi, 9), exc.phi_deg)
-                if not where.any():
-                    break
-            except (ValueError, KeyError):
-                break
+        alt, where = assembled(replace(mech, branches={**mech.branches, key: -b}), res.phi_deg)
+        if alt is not None:
+            out[key] = (alt, where)
     return out
 
 

@@ -122,7 +122,8 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
     mu_F = mu_F or force_scale([F for _, _, F in forces])
     for name, at, F in forces:
         start = f"{name}:from"
-        pts[start], pts[f"{name}:to"] = pts[at], pts[at] + _over(F, mu_F.value)
+        pts[start] = np.where(np.isnan(F), np.nan, pts[at])               # a couple's force NaN where it acts not
+        pts[f"{name}:to"] = pts[start] + _over(F, mu_F.value)
         segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
         has = (_abs(F) > 0) & (_abs(pts[at]) > 0)
         if name != F_name and has.any():

@@ -7,7 +7,7 @@ Built at every angle of an analysis at once (`PlanCycle`: points (N,), marks (N,
 The drawing's marks are `PlanCycle.paths` (sheet mm) named by what they are: "pin A", "block B",
 "support O", "hatch ..", "com S2", and "ω2", "ε2" for the senses; `draw` draws each by its name.
 
-May use: numpy, `core`, `kinematic` (which angles draw), `kinetostat.model.lettering` (link numbers).
+May use: numpy, `core`, `forces` (the links drawn at mu_l), `kinematic` (which angles draw).
 Never matplotlib.
 """
 from __future__ import annotations
@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model.lettering import link_number
 from .core import PlanCycle, Scale, Segment
+from .forces import _link_drawing, _world
 from .kinematic import _any, _ok, _titles
 
 __all__ = ["mechanism_plan", "PIN_MM", "BLOCK_MM", "ARC_MM"]
@@ -48,38 +48,12 @@ def _arc(c: np.ndarray, r: float, sense: np.ndarray) -> np.ndarray:
     return c[:, None] + r * np.exp(1j * (np.radians(150.0) + sense[:, None] * t))
 
 
-def _world(res, k: int, name: str) -> np.ndarray:
-    """(N,) complex, m: the point `name` of link k at every angle of `res`."""
-    return res.kin.position_z(k, res.mech.links[k].points[name])
-
-
-def _link_drawing(mech, res, k: int, pts: dict, segs: list, mu_l: Scale) -> None:
-    """Link k at mu_l at every angle: its points, a segment between every two of its joints, and
-    the guides of its prismatic pairs (80 mm construction lines through the block's point)."""
-    joints = [p.point for p in mech.pairs if k in p.links and p.point in mech.links[k].points]
-    joints += [p.guide for p in mech.pairs if p.links[0] == k and p.guide in mech.links[k].points]
-    names = list(dict.fromkeys(joints)) or list(mech.links[k].points)[:1]
-    for name in mech.links[k].points:
-        pts[name] = _world(res, k, name) / mu_l.value
-    for a in range(len(names)):
-        for b in range(a + 1, len(names)):
-            A, B = names[a], names[b]
-            segs.append(Segment(f"{A}{B}", A, B, np.abs(pts[B] - pts[A]) * mu_l.value, "m", "link"))
-    for p in mech.pairs:
-        if p.kind == "P" and k in p.links:
-            X = _world(res, p.links[1], p.point) / mu_l.value
-            d = complex(*p.direction) * res.kin.rot[:, p.links[0]]
-            name = f"guide P({link_number(mech, p.links[0])},{link_number(mech, p.links[1])})"     # the text's numbers
-            pts[f"{name}:from"], pts[f"{name}:to"] = X - 40 * d, X + 40 * d
-            segs.append(Segment(name, f"{name}:from", f"{name}:to", np.full(len(X), np.nan), "", "line"))
-
-
 def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
     """Link k drawn through all its points: along each slot it carries, from end to end of what
     runs in it (O2-S3 on to B), and every point not on a drawn line joined to the nearest drawn
     point on the sheet (B-S5-T of a ram; distances within 1e-9 of each other tie, broken by
     name: a point midway between two pins joins the first by name at every angle), angle by
-    angle: a join made at some angles only is `drawn` there."""
+    angle: a join made at some angles only is NaN, not drawn, at the others."""
     n_at = len(res.phi_deg)
     names = list(mech.links[k].points)
     on_line = {n for s in segs if s.kind == "link" for n in (s.start, s.end)}
@@ -120,8 +94,7 @@ def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
             done[at, A[j]] = True
     for (a, b), at in joins.items():
         na, nb = names[a], names[b]
-        segs.append(Segment(f"{nb}{na}", nb, na, np.abs(pts[na] - pts[nb]) * mu.value, "m", "link",
-                            drawn=None if at.all() else at))
+        segs.append(Segment(f"{nb}{na}", nb, na, np.where(at, np.abs(pts[na] - pts[nb]) * mu.value, np.nan), "m", "link"))
 
 
 def mechanism_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:

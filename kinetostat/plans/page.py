@@ -336,7 +336,7 @@ def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
         if link.I_S:
             rows.append((f"I_S{k}", num(link.I_S, lang, 6), unit("kg m^2", lang)))
         for ld in _applied(mech, res, k):
-            rows.append((ld.name, num(abs(complex(np.ravel(ld.force)[0])), lang, 6), unit("N", lang)))
+            rows.append((ld.name, num(abs(ld.force[0]), lang, 6), unit("N", lang)))
     return rows
 
 
