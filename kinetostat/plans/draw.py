@@ -4,11 +4,17 @@ title and its scales, and beside it the notes: legend, the results the sheet fin
 plan's vector equation and every drawn segment with its length and value), and a matplotlib
 Figure for notebooks and the reports' PNGs.
 
+One renderer: `drawing(cycle)` computes every element of a plan's sheet at all N angles of a
+`PlanCycle` at once, as arrays (`core.Drawing`: one place of the plan on the sheet for the whole
+cycle, the title's φ a text with a variant per angle); `Drawing.svg(i)` writes the sheet of
+angle i; `svg(plan)`, the sheet of one angle, is `drawing` of the cycle of one, written, with
+its notes.
+
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
 results (vectors, the design position) thick, construction thin; a vector shorter than 1 mm at
 its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a polygon whose sides must
 close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
-clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
+(for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
 
@@ -19,12 +25,13 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
-from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent
+from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, label_parts, text_width
 
@@ -129,9 +136,10 @@ def _numbered(plan: Plan, name: str) -> bool:
     return base != name and base in plan.points
 
 
-def _polygon_sides(plan: Plan) -> list[Segment]:
-    """A force plan's sides in the order drawn (its vector equation), else []."""
-    names = set(plan.equation)
+def _polygon_sides(plan: Plan | PlanCycle) -> list[Segment]:
+    """A force plan's sides (its vector equation's; of a cycle whose order changes with the angle,
+    those of any angle), else []."""
+    names = {n for e in plan.equation for n in ((e,) if isinstance(e, str) else e)}
     return [s for s in plan.segments if s.name in names]
 
 
@@ -389,19 +397,45 @@ def _arrowhead(a: np.ndarray, b: np.ndarray, length: np.ndarray | float,
     return pts, box, b - u * (0.6 * h)[:, None]
 
 
-def _on_sheet(z: np.ndarray, tx: float, ty: float) -> np.ndarray:
-    """Plan points (..., complex, mm, y up) on the sheet (..., 2) (mm, y down); NaN where not finite."""
+def _on_sheet(z: np.ndarray, tx, ty) -> np.ndarray:
+    """Plan points (N, complex, mm, y up) or paths (N or 1, K) on the sheet (..., 2) (mm, y down),
+    moved by (tx, ty) (scalars, or (N,) one each angle); NaN where not finite."""
+    if np.ndim(tx) and z.ndim == 2:
+        tx, ty = tx[:, None], ty[:, None]
     xy = np.stack([z.real + tx, ty - z.imag], axis=-1)
     return np.where(np.isfinite(xy).all(axis=-1, keepdims=True), xy, np.nan)
 
 
-def _cycle_extent(cycle: PlanCycle) -> tuple[float, float, float, float]:
-    """(x0, y0, x1, y1) of the cycle's finite points and paths at every angle, mm (`extent` over the angles)."""
-    z = np.concatenate([np.ravel(v) for v in (*cycle.points.values(), *cycle.paths.values())] or [np.zeros(0, complex)])
-    z = z[np.isfinite(z.real) & np.isfinite(z.imag)]
-    if not len(z):
+def _extents(cycle: PlanCycle) -> np.ndarray:
+    """`extent_cycle` as rows (N, 4), NaN at an angle where nothing is finite (drawn)."""
+    ext = np.column_stack(extent_cycle(cycle))
+    some = np.zeros(cycle.n, dtype=bool)
+    for v in (*cycle.points.values(), *cycle.paths.values()):
+        some |= (np.isfinite(v.real) & np.isfinite(v.imag)).reshape(len(v), -1).any(axis=1)
+    return np.where(some[:, None], ext, np.nan)
+
+
+def _union(ext: np.ndarray) -> tuple[float, float, float, float]:
+    """The extent over every angle (the cycle's `extent`), (0, 0, 0, 0) where nothing is finite."""
+    if not np.isfinite(ext).any():
         return 0.0, 0.0, 0.0, 0.0
-    return float(z.real.min()), float(z.imag.min()), float(z.real.max()), float(z.imag.max())
+    return (float(np.nanmin(ext[:, 0])), float(np.nanmin(ext[:, 1])), float(np.nanmax(ext[:, 2])),
+            float(np.nanmax(ext[:, 3])))
+
+
+def _shifts(ext: np.ndarray, area: tuple[float, float, float, float], tx: float, ty: float):
+    """The plan's place on the sheet at each angle: (tx, ty) of the whole cycle, moved at an angle
+    only as far as brings that angle's extent inside the area (centred where wider): scalars where
+    it moves at no angle, else (N,) each."""
+    lo, hi = np.array(area[:2]), np.array(area[2:])
+    s0 = np.column_stack([ext[:, 0] + tx, ty - ext[:, 3]])          # each angle's box on the sheet
+    s1 = np.column_stack([ext[:, 2] + tx, ty - ext[:, 1]])
+    move = np.where(s1 - s0 > hi - lo, (lo + hi) / 2 - (s0 + s1) / 2,
+                    np.where(s0 < lo, lo - s0, np.where(s1 > hi, hi - s1, 0.0)))
+    move = np.nan_to_num(move)
+    if not move.any():
+        return tx, ty
+    return tx + move[:, 0], ty + move[:, 1]
 
 
 def _where(mask: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -488,7 +522,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
     for s in cycle.segments:
         za, zb = cycle.points[s.start], cycle.points[s.end]
         a, b = at(za), at(zb)
-        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) & cycle.drawn(s)
         if not ok.any():
             continue
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
@@ -560,9 +594,11 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
             lead = owner[:, j] == j
             if not lead.any():
                 continue
-            rows, variant = np.unique(owner == j, axis=0, return_inverse=True)
+            rows, inverse = np.unique((owner == j)[lead], axis=0, return_inverse=True)
+            variant = np.zeros(len(lead), dtype=int)
+            variant[lead] = inverse.reshape(-1)
             texts = tuple(" ≡ ".join(group[m][0] for m in np.nonzero(row)[0]) for row in rows)
-            labels.append(_Name(texts, variant.reshape(-1), _where(lead, p), None,
+            labels.append(_Name(texts, variant, _where(lead, p), None,
                                 _NUMBERED_MM if numbered else _POINT_MM, "label"))
     return dots, labels
 
@@ -571,14 +607,15 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where `notes`."""
     _lang(lang)
     tiny = _tiny(cycle)
-    box = _cycle_extent(cycle)
+    ext = _extents(cycle)
+    box = _union(ext)
     lines = np.array([len(x) for x in cycle.notes] if cycle.notes else [0] * cycle.n) \
         + sum((v != _AS_IS).astype(int) for v in tiny.values())
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
     plan = cycle.at(i)
     block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, _tiny_at(tiny, i), box, draw=notes)
     x0, y0, x1, y1 = box
-    tx, ty = (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2
+    tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
     def at(z: np.ndarray) -> np.ndarray:
         return _on_sheet(z, tx, ty)
@@ -612,8 +649,9 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
 
 def drawing(cycle: PlanCycle, lang: str = "en", mechanism: str = "", contract: bool = False) -> Drawing:
     """The plan's A3 sheet at each angle of the cycle, true to scale (1 user unit = 1 mm), as
-    arrays (`Drawing`): one place of the plan on the sheet for the whole cycle (centred in the room
-    its notes leave at the angle with the most of them, over its extent at every angle), every
+    arrays (`Drawing`): one place of the plan on the sheet for the whole cycle (its extent over
+    every angle centred in the room its notes leave at the angle with the most of them; moved at an
+    angle only as far as keeps that angle's plan in the room, where the cycle's is larger), every
     element at every angle, labels placed for the cycle at once (`labels.Placer`); the notes left
     out, their room kept (the page's tables hold them). `contract`: every segment's element carries
     data-plan, data-segment and its drawn length (data-length-mm, as in segments.csv; a negligible

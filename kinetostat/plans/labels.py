@@ -13,8 +13,9 @@ lines it covers (each line clipped to the box, exactly); a candidate over a hard
 (arrowhead, point, line end, a label placed before) or outside the bounds is not free. At every
 angle the least cost is found (candidates tested lazily, cheapest first, until none left can
 beat it); then the label keeps one place where it may: the candidate within `SLACK` of the best
-at the most angles is taken at all of them, and so on for the angles left. A label that had to
-move far gets a thin leader line from its anchor.
+at the most angles is taken at all of them, and so on for the angles left. Obstacles and
+candidates the same at every angle are tested once for the cycle. A label that had to move far
+gets a thin leader line from its anchor.
 
 May use: numpy, the standard library, `.dejavu`, `kinetostat._text` (XML-safe text).
 """
@@ -172,34 +173,38 @@ def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
-    """Length (mm) of each segment (x0, y0, x1, y1) inside each box (broadcast, last axis 4):
-    the segment clipped to the box (Liang-Barsky); 0 where either is NaN."""
+    """Length (mm) of each segment (x0, y0, x1, y1) strictly inside each box (broadcast, last axis
+    4): the segment clipped to the box (Liang-Barsky; a segment parallel to a side divides by a
+    signed zero: +-inf inside the slab or out of it, NaN on its edge); 0 where either is NaN."""
     p, d = seg[..., :2], seg[..., 2:] - seg[..., :2]
-    lo_b, hi_b = box[..., :2], box[..., 2:]
     with np.errstate(divide="ignore", invalid="ignore"):
-        t0, t1 = (lo_b - p) / d, (hi_b - p) / d
-        flat = d == 0                                       # parallel to a side: inside the slab or not
-        inside = (p > lo_b) & (p < hi_b)
-        lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(t0, t1))
-        hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(t0, t1))
-        t_in = np.maximum(np.maximum(lo[..., 0], lo[..., 1]), 0.0)
-        t_out = np.minimum(np.minimum(hi[..., 0], hi[..., 1]), 1.0)
+        t0, t1 = (box[..., :2] - p) / d, (box[..., 2:] - p) / d
+        t_in = np.maximum(np.minimum(t0, t1).max(axis=-1), 0.0)
+        t_out = np.minimum(np.maximum(t0, t1).min(axis=-1), 1.0)
         length = (t_out - t_in) * np.hypot(d[..., 0], d[..., 1])
     return np.where(length > 0, length, 0.0)
 
 
-def _near(items: np.ndarray, region: np.ndarray) -> np.ndarray:
-    """Of `items` (N, H, 4) (boxes, or segments by their bounding boxes), at each angle those whose
-    box meets `region` (N, 4), packed (N, m, 4), NaN-padded: m the most at any angle."""
-    lo, hi = np.minimum(items[..., :2], items[..., 2:]), np.maximum(items[..., :2], items[..., 2:])
-    near = (lo[..., 0] <= region[:, None, 2]) & (hi[..., 0] >= region[:, None, 0]) \
-        & (lo[..., 1] <= region[:, None, 3]) & (hi[..., 1] >= region[:, None, 1])
+def _bounds(items: np.ndarray) -> np.ndarray:
+    """Bounding boxes (..., 4) of boxes or segments (..., 4)."""
+    return np.concatenate([np.minimum(items[..., :2], items[..., 2:]), np.maximum(items[..., :2], items[..., 2:])],
+                          axis=-1)
+
+
+def _near(items: np.ndarray, bb: np.ndarray, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Of `items` (N, H, 4) (boxes, or segments) with their bounding boxes `bb`, at each angle
+    those whose box meets `region` (N, 4), packed (N, m, 4), NaN-padded (m the most at any
+    angle), and their bounding boxes."""
+    near = (bb[..., 0] <= region[:, None, 2]) & (bb[..., 2] >= region[:, None, 0]) \
+        & (bb[..., 1] <= region[:, None, 3]) & (bb[..., 3] >= region[:, None, 1])
     if len(items) == 1:
-        return items[:, near[0]]
-    m = int(near.sum(axis=1).max(initial=0))
-    idx = np.argsort(~near, axis=1, kind="stable")[:, :m]
-    out = np.take_along_axis(items, idx[..., None], axis=1)
-    return np.where(np.take_along_axis(near, idx, axis=1)[..., None], out, np.nan)
+        return items[:, near[0]], bb[:, near[0]]
+    rank = np.cumsum(near, axis=1) - 1
+    r, j = np.nonzero(near)
+    out = np.full((2, len(items), int(near.sum(axis=1).max(initial=0)), 4), np.nan)
+    out[0, r, rank[r, j]] = items[r, j]
+    out[1, r, rank[r, j]] = bb[r, j]
+    return out[0], out[1]
 
 
 class Placer:
@@ -212,32 +217,41 @@ class Placer:
     def __init__(self, n: int, bounds: tuple[float, float, float, float]):
         self.n = n
         self.bounds = bounds
-        self._hard: list[np.ndarray] = []              # each (N, S, 4), grown by PAD
-        self._soft: list[np.ndarray] = []              # each (N, S, 4)
-        self._stacked: dict[str, tuple[int, np.ndarray]] = {}     # parts stacked, and their stack
+        # ("hard", still) -> boxes grown by PAD (R, S, 4); ("soft", still) -> lines and their bounding
+        # boxes (R, S, 8); R = 1 where still (the same at every angle), else N
+        self._parts: dict[tuple[str, bool], list[np.ndarray]] = {}
+        self._stacked: dict[tuple[str, bool], tuple[int, np.ndarray]] = {}     # parts stacked, their stack
 
     def block(self, box) -> None:
         """Hard obstacles at every angle: boxes (4,), (R, 4) or (R, S, 4), R = N or 1 (the same at
         every angle); NaN where absent."""
-        self._hard.append(self._rows(box) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD]))
+        self._add("hard", self._rows(box) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD]))
 
     def line(self, seg) -> None:
         """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent."""
-        self._soft.append(self._rows(seg))
+        rows = self._rows(seg)
+        self._add("soft", np.concatenate([rows, _bounds(rows)], axis=-1))
 
     def _rows(self, a) -> np.ndarray:
+        """Obstacles as (R, S, 4): R = 1 where the same at every angle (given so, or found so)."""
         a = np.asarray(a, dtype=float)
-        return np.broadcast_to(a.reshape(1, 1, 4) if a.ndim == 1 else a[:, None] if a.ndim == 2 else a,
-                               (self.n,) + ((1,) if a.ndim < 3 else a.shape[1:2]) + (4,))
+        a = a.reshape(1, 1, 4) if a.ndim == 1 else a[:, None] if a.ndim == 2 else a
+        return a[:1] if len(a) > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape), equal_nan=True) else a
 
-    def _stack(self, key: str) -> np.ndarray:
-        """Every hard obstacle (grown by PAD) or every line, at every angle (N, H, 4): the parts
-        added since the last call appended."""
-        parts = self._hard if key == "hard" else self._soft
-        done, stacked = self._stacked.get(key, (0, np.empty((self.n, 0, 4))))
+    def _add(self, key: str, part: np.ndarray) -> None:
+        self._parts.setdefault((key, len(part) == 1), []).append(part)
+
+    def _stack(self, key: str, still: bool) -> np.ndarray:
+        """The hard obstacles (grown by PAD) (R, H, 4), or the lines and their bounding boxes
+        (R, H, 8), the same at every angle (still: R = 1) or not (R = N): those added since the
+        last call appended."""
+        parts = self._parts.get((key, still), [])
+        rows = 1 if still else self.n
+        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8))))
         if done < len(parts):
-            stacked = np.concatenate([stacked, *parts[done:]], axis=1)
-            self._stacked[key] = (len(parts), stacked)
+            stacked = np.concatenate([stacked, *(np.broadcast_to(p, (rows,) + p.shape[1:]) for p in parts[done:])],
+                                     axis=1)
+            self._stacked[key, still] = (len(parts), stacked)
         return stacked
 
     def place(self, names: tuple[str, ...], variant: np.ndarray, size: float, anchor: np.ndarray,
@@ -286,6 +300,36 @@ class Placer:
         self.block(box)
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
+    @classmethod
+    def _costs(cls, b: np.ndarray, c: np.ndarray, hard: np.ndarray, soft: np.ndarray) -> np.ndarray:
+        """Costs c (n', B) of boxes b (n', B, 4): inf where a box meets a hard obstacle (n', H, 4),
+        plus LINE_COST per mm of the lines (n', L, 8: with their bounding boxes) inside it."""
+        free = np.isfinite(c)
+        if not free.any() or not (hard.shape[1] or soft.shape[1]):
+            return c
+        region = np.concatenate([np.where(free[..., None], b[..., :2], np.inf).min(axis=1),
+                                 np.where(free[..., None], b[..., 2:], -np.inf).max(axis=1)], axis=1)
+        ob, _ = _near(hard, hard, region)
+        if ob.shape[1]:
+            c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
+        ln, bb = _near(soft[..., :4], soft[..., 4:], region)
+        if ln.shape[1]:                             # the lines each free box covers
+            c = c + cls._covered(b, np.isfinite(c), ln, bb)
+        return c
+
+    @staticmethod
+    def _covered(b: np.ndarray, which: np.ndarray, ln: np.ndarray, bb: np.ndarray) -> np.ndarray:
+        """LINE_COST times the length of the lines `ln` (n', m, 4) (bounding boxes `bb`) inside
+        each box b (n', B, 4) where `which` (n', B), else 0: each line clipped only to the boxes
+        its bounds meet."""
+        r, j = np.nonzero(which)
+        fb, lb = b[r, j][:, None], bb[r]
+        f, m = np.nonzero((lb[..., 0] < fb[..., 2]) & (lb[..., 2] > fb[..., 0])
+                          & (lb[..., 1] < fb[..., 3]) & (lb[..., 3] > fb[..., 1]))
+        out = np.zeros(which.shape)
+        out[r, j] = LINE_COST * np.bincount(f, _clipped(ln[r[f], m], fb[f, 0]), len(r))
+        return out
+
     def _choose(self, boxes: np.ndarray, base: np.ndarray) -> np.ndarray:
         """The candidate (N,) taken at each angle (-1: none, the anchor NaN): free candidates'
         costs found cheapest first at every angle until none left can come within SLACK of the
@@ -297,7 +341,8 @@ class Placer:
         rest = np.minimum.accumulate(ordered[:, ::-1], axis=1)[:, ::-1]   # least base from j on
         cost = np.full((n, K), np.inf)
         best = np.full(n, np.inf)
-        hard, soft = self._stack("hard"), self._stack("soft")
+        still = np.array_equal(boxes, np.broadcast_to(boxes[:1], boxes.shape), equal_nan=True) \
+            and np.array_equal(base, np.broadcast_to(base[:1], base.shape))   # the same candidates at every angle
         slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         for start in range(0, K, _BATCH):
             rows = np.nonzero(rest[:, start] <= best + slack)[0]
@@ -306,18 +351,16 @@ class Placer:
             idx = order[start:start + _BATCH]
             b = boxes[rows[:, None], idx]                                   # (n', B, 4)
             c = base[rows[:, None], idx]
-            free = np.isfinite(c)[..., None]
-            region = np.concatenate([np.where(free, b[..., :2], np.inf).min(axis=1),
-                                     np.where(free, b[..., 2:], -np.inf).max(axis=1)], axis=1)
-            ob = _near(hard[rows], region)
-            if ob.shape[1]:
-                c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
-            ln = _near(soft[rows], region)
-            if ln.shape[1]:
-                c = c + LINE_COST * _clipped(ln[:, None], b[:, :, None]).sum(axis=2)
+            if still:                                                       # the still obstacles once
+                c = np.broadcast_to(self._costs(b[:1], c[:1], self._stack("hard", True), self._stack("soft", True)),
+                                    c.shape)
+            else:
+                c = self._costs(b, c, *(np.broadcast_to(a, (len(rows),) + a.shape[1:])
+                                        for a in (self._stack("hard", True), self._stack("soft", True))))
+            c = self._costs(b, c, self._stack("hard", False)[rows], self._stack("soft", False)[rows])
             cost[rows[:, None], idx] = c
             best[rows] = np.minimum(best[rows], c.min(axis=1))
-        ok = cost <= best[:, None] + SLACK
+        ok = cost <= best[:, None] + slack
         k = np.where(np.isfinite(base).any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
         todo = np.isfinite(best)
         while todo.any():
