@@ -1,4 +1,4 @@
-"""Hostile reads and waits (issue 35, class 3): an input or an earlier output is read only where it
+"""Hostile reads and waits (issue 35, class 3): an input is read only where it
 is a regular file of bounded size (a FIFO never blocks, /dev/zero is never read, also through a
 link); the step summary is appended to a regular file only; a Dask scheduler that accepts and never
 answers times out; a table's list is limited to MAX_TABLE_POINTS."""
@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import os
 import socket
-import stat
 import sys
 import threading
 from pathlib import Path
@@ -34,25 +33,6 @@ def _zero_link(tmp_path: Path, name: str) -> Path:
 def test_a_model_linked_to_dev_zero_is_refused_as_a_device(tmp_path):
     exc = within(lambda: kinetostat.load(_zero_link(tmp_path, "model.toml")))
     assert isinstance(exc, ModelError) and "a device, not a regular file" in str(exc), exc
-
-
-@pytest.mark.parametrize("kind", ["fifo", "dev-zero link", "too large"])
-def test_an_earlier_page_that_is_no_regular_file_is_not_read_and_the_page_is_drawn(kind, tmp_path, monkeypatch):
-    from kinetostat.plans import page as page_module
-    earlier = tmp_path / "page.html"
-    if kind == "fifo":
-        os.mkfifo(earlier)                   # read_bytes() would wait for a writer for ever
-    elif kind == "dev-zero link":
-        earlier = _zero_link(tmp_path, "page.html")
-    else:
-        with open(earlier, "wb") as f:       # sparse: nothing on disk
-            f.truncate(page_module.MAX_PAGE_BYTES + 1)
-    assert within(lambda: page_module.key_of(earlier)) is None
-    monkeypatch.setattr(page_module, "page", lambda *a, **k: "<p>drawn</p>")       # no real drawing
-    out = tmp_path / "new.html"
-    got = within(lambda: page_module.write_page(kinetostat.load("ice_crank_slider"), out, reuse=earlier))
-    assert got == out and out.read_text(encoding="utf-8") == "<p>drawn</p>"
-    assert kind != "fifo" or stat.S_ISFIFO(os.lstat(earlier).st_mode)
 
 
 @pytest.mark.parametrize("reader", [False, True], ids=["no reader", "a reader"])

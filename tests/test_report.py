@@ -338,7 +338,7 @@ def test_report_cli_errors_become_one_line(tmp_path, monkeypatch, capsys):
     from kinetostat import cli
     from kinetostat import report
 
-    def broken(run, out, folder=None, page=False, friction="first", reuse=None):
+    def broken(run, out, folder=None, page=False, friction="first"):
         raise RuntimeError("plotting failed\nsecond line")
     monkeypatch.setattr(report, "write_report", broken)
     code = cli.main(["report", str(ICE), "--out", str(tmp_path), "--steps", "12", "--engines", "pinocchio",

@@ -151,9 +151,8 @@ def build_parser() -> argparse.ArgumentParser:
     _friction_option(r, "of the report's plans and worksheet (default first, the graphical method's; the friction "
                         "section shows both either way)")
     r.add_argument("--page", action=argparse.BooleanOptionalAction, default=True,
-                   help="each model's interactive page, page.html, linked (default; --no-page: none). A page "
-                        "is drawn anew, about 15-40 s of CPU a model, only where OUT/<model>/page.html is not "
-                        "already the same page: the same model, the same code (docs: The interactive page)")
+                   help="each model's interactive page, page.html, drawn anew and linked (default; --no-page: "
+                        "none; docs: The interactive page)")
     r.set_defaults(func=cmd_report)
 
     pl = sub.add_parser("plans", help="draw the plans of the graphical method (SVG sheets, segments.csv)",

@@ -29,13 +29,12 @@ log = logging.getLogger(__name__)
 def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = True,
                 friction: str = "first") -> dict:
     """One model's report: load, analyse (or take both from `_PREPARED`), run the routes, write
-    `out/<folder>/` (with `page`, its page.html kept where it is the same page; without, an
-    earlier page.html removed). Returns {"summary", "warnings", "seconds", "page": "kept", "drawn" or
+    `out/<folder>/` (with `page`, its page.html drawn; without, an
+    earlier page.html removed). Returns {"summary", "warnings", "seconds", "page": "drawn" or
     None} or {"error"} (one line); raises only KeyboardInterrupt."""
     from ..report import run_validation, write_report
     t0 = time.perf_counter()
     try:
-        from ..plans.page import key_of
         from ..solve import analyze
         if path in _PREPARED:
             mech, res, secs = _PREPARED[path]
@@ -49,9 +48,8 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
         run = run_validation(mech, engines, steps, res=res, path=path)
         run.solver_seconds = secs
         earlier = Path(out) / folder / "page.html"
-        before = key_of(earlier) if page else None
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
-            summary = write_report(run, tmp, folder, page=page, friction=friction, reuse=earlier.parent)
+            summary = write_report(run, tmp, folder, page=page, friction=friction)
         notes = list(run.warnings)
         if not page and (earlier.is_file() or earlier.is_symlink()):
             try:
@@ -63,8 +61,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
     except Exception as exc:                  # noqa: BLE001 -- one model's fault is its error line
         msg = str(exc).strip().splitlines()
         return {"error": f"{type(exc).__name__}: {msg[0] if msg else ''}".rstrip(": ")}
-    page_state = None if not page else "kept" if before is not None and key_of(earlier) == before else "drawn"
-    return {"summary": summary, "warnings": notes, "seconds": time.perf_counter() - t0, "page": page_state}
+    return {"summary": summary, "warnings": notes, "seconds": time.perf_counter() - t0, "page": "drawn" if page else None}
 
 
 def _worker_init(verbosity: int = NORMAL) -> None:

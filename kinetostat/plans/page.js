@@ -1,13 +1,24 @@
-// The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes the
-// sheets and values stored as templates and second differences (gzip, base64), builds the sheet
-// of the angle chosen, steps through the force plans, checks typed lengths. No network, no library.
+// The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
+// sheet's arrays and the values stored as differences over the angle (gzip, 5 characters per 4 bytes), writes the sheet of
+// the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
+// lengths. No network, no library.
 "use strict";
 (async () => {
   const D = JSON.parse(document.getElementById("page-data").textContent);
   const $ = (id) => document.getElementById(id);
 
+  function bytes85(s) {                         // page.py _text85: 5 digits (DIGITS85) per 4 bytes
+    const digit = (i) => { const c = i < s.length ? s.charCodeAt(i) : 118; return c - (c > 60 ? 34 : 33); };
+    const pad = (5 - s.length % 5) % 5, out = new Uint8Array((s.length + pad) / 5 * 4);
+    for (let i = 0, o = 0; i < s.length; i += 5, o += 4) {
+      let w = 0;
+      for (let k = 0; k < 5; k++) w = w * 85 + digit(i + k);
+      for (let b = 3; b >= 0; b--) { out[o + b] = w % 256; w = Math.floor(w / 256); }
+    }
+    return out.subarray(0, out.length - pad);
+  }
   async function bytes(id, xor) {
-    const bin = Uint8Array.from(atob($("blob-" + id).textContent), (c) => c.charCodeAt(0));
+    const bin = bytes85($("blob-" + id).textContent);
     if (xor) {                                   // page.py's _obscure: xorshift32, seed 27
       let x = 27;
       for (let i = 0; i < bin.length; i++) {
@@ -26,13 +37,6 @@
       if (b[i] & 128) { m *= 128; } else { out.push(v % 2 ? -(v + 1) / 2 : v / 2); v = 0; m = 1; }
     }
     return out;
-  }
-  function fmt(n, f) {                            // a number as the sheet wrote it
-    if (f === "") return String(n);
-    if (f === "L") return String(n / 1e10);       // page.py LENGTH_Q = 1e-10 mm
-    const d = +f.slice(1);
-    const s = String(Math.abs(n)).padStart(d + 1, "0");
-    return (n < 0 ? "-" : "") + s.slice(0, s.length - d) + f[0] + s.slice(s.length - d);
   }
   function local(x, digits) {                     // `digits` significant digits, as i18n.num writes them
     if (!isFinite(x)) return "—";
@@ -104,45 +108,63 @@
 
   // ------------------------------------------------------------------ the sheets of every angle
   const meta = JSON.parse(new TextDecoder().decode(await bytes("meta")));
+  const nf = D.frames.length;
+  function series(nums, p, n) {                 // page.py _series at nums[p]: its order k, then n values
+    const out = nums.slice(p + 1, p + 1 + n);
+    for (let k = nums[p]; k > 0; k--) for (let j = 1; j < n; j++) out[j] += out[j - 1];
+    return out;
+  }
+  function fixed(q, digits) {                    // core.py fixed: q / 10^digits with `digits` decimals
+    const s = String(Math.abs(q)).padStart(digits + 1, "0"), cut = s.length - digits;
+    return (q < 0 ? "-" : "") + s.slice(0, cut) + "." + s.slice(cut);
+  }
   const kinds = [];
-  for (let k = 0; k < meta.kinds.length; k++) {
-    const K = meta.kinds[k], nums = varints(await bytes("k" + k)), frames = K.frames.map(() => null);
-    const slots = K.keys.map((deltas) => {      // template -> (series -> its slot): page.py _encode_split
-      const m = new Map();
-      let key = -1;
-      deltas.forEach((d, i) => { key += d; m.set(key, i); });
-      return m;
-    });
-    K.frames.forEach((tid, f) => { if (tid >= 0) frames[f] = new Array(slots[tid].size); });
-    let nk = 0;
-    slots.forEach((m) => m.forEach((_, key) => { nk = Math.max(nk, key + 1); }));
+  for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
+    const K = meta.kinds[k], nums = varints(await bytes("k" + k));
     let p = 0;
-    for (let key = 0; key < nk; key++) {           // series by series, the frames that have it in order
-      let a = 0, b = 0, j = 0;
-      K.frames.forEach((tid, f) => {
-        const i = tid < 0 ? undefined : slots[tid].get(key);
-        if (i === undefined) return;
-        const d = nums[p++], v = j >= 2 ? d + 2 * b - a : j === 1 ? d + b : d;
-        a = b; b = v; j++;
-        frames[f][i] = v;
-      });
-    }
-    const templates = K.templates.map((ix) => ix.map((i) => K.lines[i]).join("\n").split("\0"));   // page.py _lines
-    kinds.push({kind: K.kind, templates, tids: K.frames, frames});
+    const made = [];                             // the sheet's series in order: one may repeat an earlier
+    const take = (n) => {
+      const v = nums[p] < 0 ? made[-1 - nums[p]] : series(nums, p, n);
+      p += nums[p] < 0 ? 1 : n + 1;
+      made.push(v);
+      return v;
+    };
+    const elements = K.elements.map((E) => {
+      const el = {tag: E.tag, attrs: E.attrs.map(([a, v]) => ` ${a}="${v}"`).join(""),
+                  title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows, m: E.m};
+      el.drawn = take(E.rows);
+      el.variant = E.variants ? take(E.variants) : [0];
+      el.finite = E.holes ? [...Array(E.m)].map(() => take(E.rows)) : null;
+      el.xy = [...Array(2 * E.m)].map(() => take(E.rows));
+      el.len = E.len ? take(E.len) : null;
+      return el;
+    });
+    kinds.push({kind: K.kind, static: K.static, elements});
   }
-  const rows = D.rows, ncol = rows.length, nf = D.frames.length;
-  const vals = varints(await bytes("values"));
-  const values = D.frames.map(() => new Array(ncol));
-  for (let c = 0; c < ncol; c++) {                 // column by column: page.py _columns
-    let a = 0, b = 0;
-    const e = D.exps[c];
-    for (let f = 0; f < nf; f++) {
-      const d = vals[nf * ncol + c * nf + f], n = f >= 2 ? d + 2 * b - a : f === 1 ? d + b : d;
-      a = b; b = n;
-      values[f][c] = vals[c * nf + f] ? NaN : e < 0 ? n / 10 ** -e : n * 10 ** e;
-    }
+  const at = (a, i) => a[a.length > 1 ? i : 0];
+  function element(el, i) {                      // core.py Element.svg(i)
+    const r = el.rows > 1 ? i : 0;
+    if (!el.drawn[r]) return "";
+    const x = (c) => fixed(el.xy[c][r], D.coord);
+    const pts = [...Array(el.m).keys()].filter((j) => !el.finite || el.finite[j][r]).map((j) => x(2 * j) + "," + x(2 * j + 1));
+    let head = {line: () => ` x1="${x(0)}" y1="${x(1)}" x2="${x(2)}" y2="${x(3)}"`, circle: () => ` cx="${x(0)}" cy="${x(1)}"`,
+                text: () => ` x="${x(0)}" y="${x(1)}"`, polyline: () => ` points="${pts.join(" ")}"`,
+                path: () => ` d="M${pts.join(" L")} z"`}[el.tag];
+    head = (head ? head() : "") + el.attrs + (el.len ? ` data-length-mm="${fixed(at(el.len, i), D.lengthd)}"` : "");
+    const body = el.title + (el.tag === "text" ? el.texts[at(el.variant, i)] : "");
+    return `<${el.tag}${head}>${body}</${el.tag}>\n`;
   }
-
+  function sheet(K, i) {                          // core.py Drawing.svg(i)
+    return K.static.replace(D.elements, () => K.elements.map((el) => element(el, i)).join(""));
+  }
+  window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
+  const rows = D.rows, ncol = rows.length, singular = new Set(D.singular);
+  const vals = varints(await bytes("values")), values = D.frames.map(() => new Array(ncol));
+  for (let c = 0, p = 0; c < ncol; c++) {          // column by column: page.py _columns
+    const none = series(vals, p, nf), n = series(vals, p + nf + 1, nf), e = D.exps[c];
+    p += 2 * (nf + 1);
+    for (let f = 0; f < nf; f++) values[f][c] = none[f] ? NaN : e < 0 ? n[f] / 10 ** -e : n[f] * 10 ** e;
+  }
   const sheets = $("sheets");
   sheets.textContent = "";
   const boxes = kinds.map((K) => {
@@ -171,11 +193,8 @@
   function render(f) {
     frame = f;
     kinds.forEach((K, k) => {
-      const a = K.frames[f];
-      if (!a) { boxes[k].textContent = D.ui.singular; return; }
-      const t = K.templates[K.tids[f]], out = [t[0]];
-      for (let i = 0; i < a.length; i++) out.push(fmt(a[i], t[2 * i + 1]), t[2 * i + 2]);
-      boxes[k].innerHTML = out.join("").replace(/<\/svg>\s*$/, D.scalebar + "</svg>");
+      if (singular.has(f)) { boxes[k].textContent = D.ui.singular; return; }
+      boxes[k].innerHTML = sheet(K, f).replace(/^<\?xml[^>]*>\s*/, "").replace(/<\/svg>\s*$/, D.scalebar + "</svg>");
     });
     values[f].forEach((v, c) => {
       cells[c].dataset.value = isFinite(v) ? String(v) : "";
@@ -209,10 +228,10 @@
   }
   function a4Title(svg, x0, y0, cut) {           // A4 cuts the title block off: one line at the top instead
     const NS = "http://www.w3.org/2000/svg", g = document.createElementNS(NS, "g"), t = document.createElementNS(NS, "text");
-    const mech = svg.querySelector("#mechanism"), title = svg.querySelector("title");
+    const line = ["#mechanism", 'text.title[font-weight="bold"]', "#scale"].map((q) => svg.querySelector(q));   // name, plan and φ, scale
     g.id = "a4-title";
     t.setAttribute("x", x0 + 12); t.setAttribute("y", y0 + 6); t.setAttribute("font-size", "2.8");
-    t.textContent = (mech ? mech.textContent + " — " : "") + (title ? title.textContent : "");
+    t.textContent = line.filter((e) => e).map((e) => e.textContent).join(" — ");
     if (cut) {                                   // a second line, red
       const w = document.createElementNS(NS, "tspan");
       w.setAttribute("fill", "#b01515"); w.setAttribute("x", x0 + 12); w.setAttribute("dy", "3.6");
@@ -274,14 +293,14 @@
   const slider = $("phi");
   function frameOf(deg) {                        // the frame of the nearest angle on the slider
     let best = 0;
-    for (let f = 0; f < nf - 1; f++) if (Math.abs(D.frames[f] - deg) < Math.abs(D.frames[best] - deg)) best = f;
+    for (let f = 0; f < D.slider; f++) if (Math.abs(D.frames[f] - deg) < Math.abs(D.frames[best] - deg)) best = f;
     return best;
   }
   slider.addEventListener("input", () => render(frameOf(+slider.value)));
-  $("design").addEventListener("click", () => { slider.value = Math.round(D.design) % 360; render(nf - 1); });
+  $("design").addEventListener("click", () => { slider.value = Math.round(D.design) % 360; render(D.slider); });
   $("next").addEventListener("click", () => { step = (step + 1) % meta.steps.length; highlight(); });
   $("prev").addEventListener("click", () => { step = step <= 0 ? meta.steps.length - 1 : step - 1; highlight(); });
   slider.value = Math.round(D.design) % 360;
-  render(nf - 1);
+  render(D.slider);
   document.body.dataset.ready = "1";
 })();

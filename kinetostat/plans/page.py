@@ -6,247 +6,193 @@ student's measured lengths, and print at true scale.
     >>> from kinetostat.plans.page import page
     >>> html = page(kinetostat.load("ice_crank_slider"), lang="uk")      # doctest: +SKIP
 
-Key mode (default): the sheets of `kinetostat plans` (`draw.svg`, the same lettering and label
-placement) at every whole degree and the design position, every scale fixed for the whole cycle
-(`cycle_scales`), the plan of positions' 12 positions and paths made once for all of them
-(`fixed_positions`), drawn without the sheets' notes (`svg(notes=False)`: the page's tables take
-their place); the worksheet's values; "Next step". Student mode (`student=True`): no answer in
-the page: the data, the empty tables, an A3 sheet with a millimetre grid at true scale, and the
-check of typed lengths.
+Key mode (default): one analysis at every whole degree, the design position and the check's
+angle; from it each plan of the cycle (`build_cycle`, every scale fixed for the whole cycle:
+`cycle_scales`; the plan of positions' 12 positions and paths made once: `fixed_positions`) and
+its sheet over all the angles as arrays (`draw.drawing`, with the page contract, without the
+sheets' notes: the page's tables take their place); the worksheet's values of every angle
+(`worksheet_cycle`); "Next step". Student mode (`student=True`): no answer in the page: the data,
+the empty tables, an A3 sheet with a millimetre grid at true scale, and the check of typed lengths.
+A page is drawn anew every time: nothing is cached.
 
-Small: the sheets of all angles are cut into templates (the markup, a few per plan) and numbers
-(`_split`, one regex pass a sheet), each plan's templates stored as a table of their distinct
-lines (`_lines`); the numbers of each template slot are stored as second
-differences over the angle (the drawing's coordinates at 0.1 mm, each segment's length and each
-value to 12 significant digits), as zigzag varints, gzip-compressed and base64-encoded; the
-page's script (vanilla JavaScript, the browser's own DecompressionStream) decodes them once and
-builds the sheet of the angle chosen.
+Small: each sheet's arrays (`encode_drawing`): the elements' markup once (tag, attributes,
+tooltip, the texts a label takes), and as integers, element by element over the angles, whether it
+is drawn, which text it shows, its coordinates and a segment's length as `Element.svg` rounds them
+(COORD_DECIMALS, LENGTH_DECIMALS), each series as differences over the angle of the order that
+suits it, zigzag varints, deflated (gzip) and written as text, 5 characters per 4 bytes (`_text85`). The page's script (vanilla JavaScript,
+the browser's own DecompressionStream) decodes them once and writes the sheet of the angle chosen
+as `Drawing.svg` writes it.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
-`data-plan`, `data-segment`, `data-length-mm` as in segments.csv; every value cell `data-symbol`,
-`data-value`.
+`data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to 1e-9 mm); every value cell
+`data-symbol`, `data-value`; `body[data-ready]`.
 
-May use: the plans (`build`, `cycle_scales`, `draw`, `forces`, `worksheet`, `drawing_error`,
-`i18n`, `lettering`), the solver, `kinetostat._text` (`script_json`: the data block's JSON),
-numpy, the standard library. Never matplotlib, never the harness.
+May use: the plans (`build_cycle`, `cycle_scales`, `core`, `draw`, `forces`, `worksheet`
+(`analyses`, `worksheet_cycle`), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
+`kinetostat._text` (`script_json`: the data block's JSON), numpy, the standard library. Never
+matplotlib, never the harness; the solver only through `worksheet.analyses` (the page's one
+analysis).
 """
 from __future__ import annotations
 
-import base64
 import gzip
-import hashlib
 import json
 import math
-import multiprocessing
-import os
-import re
 import warnings
-from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, fields, is_dataclass
-from collections.abc import Mapping, Sequence
-from functools import cache, partial
+from collections.abc import Sequence
 from html import escape
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
-from .._io import read_regular, write_bytes, write_text
+from .._io import write_text
 from .._text import script_json
-from .draw import TINY_MM, segment_label, svg, title_of
+from .core import ELEMENTS, Drawing
+from .draw import TINY_MM, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 
-__all__ = ["page", "write_page", "page_key", "key_of", "code_files", "encode", "PAGE_ANGLES", "TOLERANCE_PCT", "KEY_META"]
+__all__ = ["page", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
 
 #: The angles of the slider, deg (the design position is one more frame).
 PAGE_ANGLES = tuple(float(a) for a in range(360))
 #: The texts' rule for the two balancing moments (crank and lever), %.
 TOLERANCE_PCT = 5.0
-#: Resolution of a segment's length in the page, mm (its data-length-mm): 12 significant digits
-#: of a 100 mm segment, as segments.csv.
-LENGTH_Q = 1e-10
-_NUM = re.compile(r"(-?)(\d+)(?:([.,])(\d+))?")
-#: The attributes that place a drawing's elements (mm), and their decimals in the page.
-COORDINATES = frozenset({"x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "dx", "dy", "points", "d"})
-COORD_DECIMALS = 1
-#: A tag, or (between tags) a number: `_NUM`'s groups after the tag's.
-_PIECE = re.compile(r"(<[^>]*>)|" + _NUM.pattern)
-_COORD_FORMAT = f"\x00.{COORD_DECIMALS}\x00"
-_ATTR = re.compile(r'([\w:-]+)="([^"]*)"')
+#: Decimals of a sheet's coordinates (mm) and of a segment's length (data-length-mm) as
+#: `Element.svg` writes them (each rint(10^d x), `core.fixed`): the page keeps them so.
+COORD_DECIMALS, LENGTH_DECIMALS = 3, 9
 
 # ============================================================================ the numbers, small
 
-@dataclass(frozen=True)
-class Encoded:
-    """Sheets cut into templates and numbers (`encode`): `templates[t]` alternates literal text and
-    a number's format ("" integer, ".2" two decimals after a point, ",1" after a comma, "L" a
-    length at LENGTH_Q); `keys[t]` the series of each of its slots (`_slot_keys`), as differences
-    from the slot before (the first from -1); `frames[f]` the template of each frame (-1: none);
-    `data` the numbers, series by series, each the second differences over the frames it is in."""
-    templates: tuple[tuple[str, ...], ...]
-    keys: tuple[tuple[int, ...], ...]
-    frames: tuple[int, ...]
-    data: bytes
-
-
-_IDENT = re.compile(r'data-(?:segment|path)="([^"]*)"')
-
-
-def _slot_keys(template: tuple[str, ...]) -> list[tuple]:
-    """What each number of a template is, the same in every template that has it: the element it
-    is in (its data-segment or data-path; a label's text; else "after" the last element that had
-    one), the element's text up to the number, and how many slots before had that key. A label
-    or an arrowhead that comes or goes between angles then shifts no other series."""
-    s = "\x00".join(template[0::2])
-    out, seen, last = [], {}, ""
-    for m in re.finditer("\x00", s):
-        p = m.start()
-        a, b = s.rfind("<", 0, p), s.find(">", p)
-        tag = s[a:b]
-        ident = _IDENT.search(tag)
-        if ident:
-            who = last = ident.group(1)
-        elif tag.startswith("<text"):
-            who = last = "text:" + re.sub(r"<[^>]*>|\x00", "", s[b + 1:s.find("</text>", b)])
-        else:
-            who = ("after", last)
-        key = (who, s[a:p])
-        seen[key] = seen.get(key, -1) + 1
-        out.append((*key, seen[key]))
-    return out
-
-
-def _split(sheet: str) -> tuple[tuple[str, ...], list[int]]:
-    """A sheet as (template, numbers): data-length-mm as integers of LENGTH_Q; a drawing's
-    coordinates (COORDINATES' attributes) rounded to COORD_DECIMALS (0.1 mm: finer than a ruler
-    reads); every other number (a stroke's width, a font's size, a number in a text) as written;
-    a zero-padded number ("000" of a colour) kept as text. One pass of `re.sub` over the sheet,
-    each number replaced by its format between two NULs (which XML cannot hold), then split there."""
-    nums: list[int] = []
-    push = nums.append
-
-    def as_written(m: re.Match) -> str:                  # of `_NUM` or of `_PIECE`
-        sign, whole, sep, frac = m.groups()[-4:]
-        if len(whole) > 1 and whole[0] == "0":
-            return m[0]
-        if frac:
-            n = int(whole + frac)
-            push(-n if sign else n)
-            return f"\x00{sep}{len(frac)}\x00"
-        push(-int(whole) if sign else int(whole))
-        return "\x00\x00"
-
-    def coordinate(m: re.Match) -> str:
-        sign, whole, sep, frac = m.groups()
-        if not frac or len(frac) <= COORD_DECIMALS or sep != ".":     # "217,69": two integers of a list
-            return as_written(m)
-        if len(whole) > 1 and whole[0] == "0":
-            return m[0]
-        cut = 10 ** (len(frac) - COORD_DECIMALS)
-        n = (int(whole + frac) + cut // 2) // cut
-        push(-n if sign else n)
-        return _COORD_FORMAT
-
-    def attribute(m: re.Match) -> str:
-        name, value = m.groups()
-        if name == "data-length-mm":
-            push(round(float(value) / LENGTH_Q))
-            return 'data-length-mm="\x00L\x00"'
-        return f'{name}="{_NUM.sub(coordinate if name in COORDINATES else as_written, value)}"'
-
-    def piece(m: re.Match) -> str:                       # a tag: its attributes; else a number in a text
-        return _ATTR.sub(attribute, m[0]) if m[1] else as_written(m)
-
-    return tuple(_PIECE.sub(piece, sheet).split("\x00")), nums
-
-
 def _varints(values: np.ndarray) -> bytes:
-    """Zigzag LEB128 varints of int64 values (|v| < 2^53)."""
-    z = np.where(values >= 0, 2 * values, -2 * values - 1).astype(np.uint64)
-    out = bytearray()
-    for v in z.tolist():
-        while v >= 128:
-            out.append((v & 127) | 128)
-            v >>= 7
-        out.append(v)
-    return bytes(out)
+    """Zigzag LEB128 varints of int64 values (|v| < 2^53), vectorised."""
+    v = np.asarray(values, dtype=np.int64).ravel()
+    z = np.where(v >= 0, 2 * v, -2 * v - 1).astype(np.uint64)
+    size = np.ones(len(z), dtype=np.int64)
+    for k in range(1, 8):
+        size += z >= np.uint64(1 << (7 * k))
+    at = np.cumsum(size) - size
+    out = np.zeros(int(size.sum()), dtype=np.uint8)
+    for k in range(int(size.max(initial=1))):
+        has = size > k
+        byte = (z[has] >> np.uint64(7 * k)) & np.uint64(127)
+        more = (size[has] > k + 1).astype(np.uint64) << np.uint64(7)
+        out[at[has] + k] = (byte | more).astype(np.uint8)
+    return out.tobytes()
 
 
-def _second_differences(a: np.ndarray) -> np.ndarray:
-    """Second differences of int64 rows along axis 0 (the first row as it is, the second as its
-    first difference): a smooth function of the angle becomes a few small numbers."""
-    d = a.copy()
-    d[1:] -= a[:-1]
-    d[2:] -= a[1:-1] - a[:-2]
-    return d
+#: Highest order of differences a series is stored as (`_series`).
+MAX_ORDER = 4
 
 
-def encode(sheets: list[str | None]) -> Encoded:
-    """Sheets of one plan at successive angles (None: not drawn there) as templates and, template
-    by template, slot by slot, the second differences of the slot's numbers over the frames that
-    use that template."""
-    return _encode_split([None if s is None else _split(s) for s in sheets])
+def _series(a: np.ndarray) -> np.ndarray:
+    """An int64 series as its order k (0..MAX_ORDER) followed by its k-th differences, each
+    difference keeping the first value (a - [0, a[:-1]]): the order whose differences are
+    smallest (a sum of their bits), so that a smooth function of the angle becomes a few small
+    numbers; the page's script takes k prefix sums."""
+    best, d = None, np.asarray(a, dtype=np.int64).ravel()
+    for k in range(MAX_ORDER + 1):
+        cost = float(np.log2(1.0 + np.abs(d)).sum())
+        if best is None or cost < best[0]:
+            best = (cost, k, d)
+        d = d - np.concatenate([[0], d[:-1]])
+    return np.concatenate([[best[1]], best[2]])
 
 
-def _encode_split(split: list[tuple[tuple[str, ...], list[int]] | None]) -> Encoded:
-    """`encode` of sheets already `_split`."""
-    templates: dict[tuple[str, ...], int] = {}
-    keys: dict[tuple, int] = {}
-    slots: list[list[int]] = []
-    frames: list[int] = []
-    series: dict[int, list[int]] = {}
-    for one in split:
-        if one is None:
-            frames.append(-1)
-            continue
-        t, nums = one
-        tid = templates.get(t)
-        if tid is None:
-            tid = templates[t] = len(templates)
-            slots.append([keys.setdefault(k, len(keys)) for k in _slot_keys(t)])
-        frames.append(tid)
-        for k, v in zip(slots[tid], nums):
-            series.setdefault(k, []).append(v)
-    data = b"".join(_varints(_second_differences(np.array(series[k], dtype=np.int64))) for k in range(len(keys)))
-    deltas = tuple(tuple(np.diff([-1, *ks]).tolist()) for ks in slots)
-    return Encoded(tuple(templates), deltas, tuple(frames), data)
+def _held(x: np.ndarray, drawn: np.ndarray) -> np.ndarray:
+    """`x` (N, ...) with each row where not `drawn` the last drawn row before it (the first drawn
+    before the first): a series that pauses instead of jumping, zeros where never drawn."""
+    if not drawn.any():
+        return np.zeros_like(x)
+    idx = np.where(drawn, np.arange(len(drawn)), -1)
+    idx = np.maximum.accumulate(idx)
+    idx[idx < 0] = int(np.argmax(drawn))
+    return x[idx]
+
+
+def _ints(x: np.ndarray, decimals: int) -> np.ndarray:
+    """`x` as `Element.svg` rounds it: rint(10^decimals x), int64 (NaN as 0)."""
+    return np.rint(np.where(np.isfinite(x), x, 0.0) * 10.0 ** decimals).astype(np.int64)
+
+
+def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
+    """A sheet's arrays as (meta, numbers): `meta` = {"kind", "static", "elements": [{"tag",
+    "attrs" [[name, value]...], "title", "texts", "m" points, "rows" (1: the same at every angle),
+    "holes" (a polyline with points left out), "len" (has lengths)}]}; `numbers`, element by
+    element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each angle
+    (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
+    coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
+    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm); every series as
+    differences of the order that suits it (`_series`), or, where an earlier series of the sheet
+    is the same (a line's end and its point), -1 - that series' index; as zigzag varints."""
+    meta, series, seen = [], [], {}
+
+    def put(a) -> None:
+        a = np.asarray(a, dtype=np.int64).ravel()
+        key = a.tobytes()
+        series.append(np.array([-1 - seen[key]]) if key in seen else _series(a))
+        seen.setdefault(key, len(series) - 1)
+    for e in d.elements:
+        xy = np.asarray(e.xy, dtype=float)
+        rows, m = xy.shape[0], xy.shape[1]
+        drawn = np.asarray(e.drawn()).reshape(rows)
+        finite = np.isfinite(xy).all(axis=2)
+        holes = e.tag == "polyline" and not finite[drawn].all()
+        put(drawn)
+        if len(e.texts) > 1:
+            put(np.asarray(e.variant).reshape(-1))
+        if holes:
+            for k in range(m):
+                put(finite[:, k])
+        held = _held(np.where(finite[..., None], xy, np.nan), drawn) if m else xy
+        for c in range(2 * m):
+            put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS))
+        if e.length_mm is not None:
+            put(_ints(np.asarray(e.length_mm, dtype=float).reshape(-1), LENGTH_DECIMALS))
+        meta.append({"tag": e.tag, "attrs": [[k, v] for k, v in e.attrs.items()], "title": e.title,
+                     "texts": list(e.texts), "m": m, "rows": rows, "holes": holes,
+                     "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
+                     "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))})
+    return ({"kind": d.kind, "static": d.static, "elements": meta},
+            _varints(np.concatenate(series)) if series else b"")
 
 
 def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
     """Columns of values over frames (NaN: none): each column's exponent e (12 significant digits
-    of its largest |value|), and column by column the NaN mask (1: none), then column by column the
-    second differences over the frames of round(v / 10^e) (NaN as 0)."""
+    of its largest |value|), and column by column its NaN mask (1: none) and round(v / 10^e) (NaN
+    as 0), each a `_series`, as zigzag varints."""
     exps = []
     for col in values.T:
         top = np.nanmax(np.abs(col)) if np.isfinite(col).any() else 0.0
         exps.append(int(math.floor(math.log10(top))) - 11 if top > 0 else 0)
-    scaled = np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)
-    d = _second_differences(np.rint(scaled).astype(np.int64))
+    scaled = np.rint(np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)).astype(np.int64)
     mask = (~np.isfinite(values)).astype(np.int64)
-    return exps, _varints(np.concatenate([mask.T.ravel(), d.T.ravel()]))
+    parts = [_series(x) for c in range(values.shape[1]) for x in (mask[:, c], scaled[:, c])]
+    return exps, _varints(np.concatenate(parts)) if parts else b""
 
 
-def _lines(templates: tuple[tuple[str, ...], ...]) -> tuple[list[str], list[list[int]]]:
-    """Templates as one table of their distinct lines and each template as its lines' indices (a
-    template joined by NUL, split at newlines; the page's script joins and splits back): the
-    templates of one plan differ by a few lines (a leader, a label, a vector drawn or not), and
-    gzip's 32 kB window would not reach the template before a large one."""
-    table: dict[str, int] = {}
-    rows = [[table.setdefault(line, len(table)) for line in "\0".join(t).split("\n")] for t in templates]
-    return list(table), rows
+#: The 85 digits of a blob's text (`_text85`): ASCII 33-118 but "<", so that nothing in a blob
+#: ends or opens an element of the page.
+DIGITS85 = bytes(c for c in range(33, 119) if c != ord("<"))
 
 
-def _b64gz(data: bytes) -> str:
-    return base64.b64encode(gzip.compress(data, 9, mtime=0)).decode("ascii")
+def _text85(data: bytes) -> str:
+    """`data` as text, Ascii85's way with DIGITS85: each 4 bytes (big-endian) as 5 digits, the last
+    k < 4 bytes as k + 1 (25 % longer than the bytes, base64 33 %)."""
+    pad = -len(data) % 4
+    words = np.frombuffer(data + b"\0" * pad, dtype=">u4").astype(np.int64)
+    digits = np.empty((len(words), 5), dtype=np.int64)
+    for k in range(4, -1, -1):
+        words, digits[:, k] = np.divmod(words, 85)
+    out = np.frombuffer(DIGITS85, dtype=np.uint8)[digits].tobytes()
+    return out[:len(out) - pad].decode("ascii")
+
+
+def _packed(data: bytes) -> str:
+    """`data` deflated (gzip) as text (`_text85`): a blob of the page."""
+    return _text85(gzip.compress(data, 9, mtime=0))
 
 
 # ============================================================================ what the page holds
-
-def _sheets_of(plans, lang: str, name: str) -> dict[str, str]:
-    """The page's sheets of one angle: `draw.svg` with the contract, without the notes (the page's
-    tables hold them) and the XML declaration."""
-    return {kind: svg(p, lang=lang, mechanism=name, contract=True, notes=False).split("?>", 1)[-1].lstrip()
-            for kind, p in plans.items()}
-
 
 def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict:
     """A moment equation about point M of `plan` as the page's script writes it at each angle
@@ -266,75 +212,18 @@ def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict
     return out
 
 
-def _plans_at(mech, positions, fixed, a: float):
-    """The plans at `a` deg at the page's scales, the plan of positions on its 12 positions and
-    paths made once (`fixed_positions`); None at a singular position."""
-    from . import build
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        try:
-            return build(mech, at=a, fixed=fixed, positions=positions)
-        except ValueError:                     # a singular position
-            return None
-
-
-def _frame(mech, positions, fixed, lang: str, name: str, a: float) -> tuple[dict, dict | None, list | None]:
-    """One frame of the slider: each plan's sheet `_split` (kind -> (template, numbers)), the
-    worksheet's values (key -> value) and its records; ({}, None, None) at a singular position."""
-    from .worksheet import worksheet
-    plans = _plans_at(mech, positions, fixed, a)
-    if plans is None:
-        return {}, None, None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ws = worksheet(mech, a, mu_l=fixed.base["mu_l"].value, lang=lang)
-    return ({k: _split(v) for k, v in _sheets_of(plans, lang, name).items()},
-            {r.key: r.value for r in ws.rows}, ws.records())
-
-
-#: Frames per page below which they are drawn in this process (a test's few angles).
-PARALLEL_FROM = 24
-
-
-_WORK = None                   # the function a forked worker applies (`_map`): inherited, not pickled
-
-
-def _work(item):
-    return _WORK(item)
-
-
-def _map(fn, items: list) -> list:
-    """`fn` over `items` in order, on every core this process may use (forked workers, which
-    inherit `fn` and what it holds: a mechanism is not picklable) when there are PARALLEL_FROM
-    items or more, else here."""
-    global _WORK
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    if cores < 2 or len(items) < PARALLEL_FROM or "fork" not in multiprocessing.get_all_start_methods():
-        return list(map(fn, items))
-    _WORK, n = fn, min(cores, 8)
-    try:
-        with ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("fork")) as ex:
-            return list(ex.map(_work, items, chunksize=max(1, len(items) // (4 * n))))
-    finally:
-        _WORK = None
-
-
-def _steps(mech, plans, lang: str) -> list[dict]:
+def _steps(mech, res, plans, lang: str) -> list[dict]:
     """The force analysis in the texts' order, one vector a step: per Assur group from the last
     attached, the unknowns found from moment equations (a dyad's R^τ from ΣM about the inner
     joint, its terms R^τ·l + Σ±F·h ± M_i/μ_l = 0; a triad's R^τ of each leash about its inner pin,
     then R^n of the leash whose axis is off Assur's point S from the group's moment about S), the
     polygon's sides in the order drawn, the inner reactions; then the initial link's loads and M_bal (M_bal + μ_l Σ±F·h =
     0); then the lever's loads and F'_bal·pa + Σ±F·h = 0. A step with "moment" has its equation's
-    terms written by the page's script from the sheet of the angle shown."""
-    from ..solve import analyze
+    terms written by the page's script from the sheet of the angle shown. `res`: the analysis at
+    the angle of `plans` (one angle)."""
     from .forces import _carried, _group_label, _later, _moment_equations, link_couples, link_loads, reaction_name
     from ..model.lettering import lettering
     L = lettering(mech)
-    any_plan = next(iter(plans.values()))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        res = analyze(mech, phi_deg=[any_plan.phi_deg])
     out = []
     for g in reversed(mech.structure.groups):
         label = _group_label(g)
@@ -392,12 +281,13 @@ def _steps(mech, plans, lang: str) -> list[dict]:
     return out
 
 
-def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[float, float]], dict[str, tuple[float, float]]]:
+def _bands(mech, res, plans, fixed) -> tuple[dict[tuple[str, str], tuple[float, float]], dict[str, tuple[float, float]]]:
     """The bands a careful drawing lands in (5-95 % of `drawing_error.simulate` at the page's
     scales): (1) of each segment (mm) whose value is a value of the worksheet (matched by value and
     unit: the study reads the worksheet's values), that value's band at the segment's scale; (2) of
     the two balancing moments, signed (N m): "M_bal" from the force plans, "M_bal_lever" from the
-    lever. None where the study does not draw the mechanism's groups (PRP, RPP, triads)."""
+    lever. None where the study does not draw the mechanism's groups (PRP, RPP, triads). `res`:
+    the analysis at the angle of `plans` alone."""
     from .drawing_error import Scales, simulate
     from .pack import BAND, BAND_DRAWS
     sc = fixed.base
@@ -405,7 +295,7 @@ def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            drawn = simulate(mech, at=at, n=BAND_DRAWS, seed=0,
+            drawn = simulate(mech, at=float(res.phi_deg[0]), n=BAND_DRAWS, seed=0, res=res,
                              scales=Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, mu_F))
         except NotImplementedError:            # a group kind the study does not draw: no bands
             return {}, {}
@@ -430,7 +320,7 @@ def _bands(mech, plans, fixed, at: float) -> tuple[dict[tuple[str, str], tuple[f
 
 def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
     """The data a student starts from: ω1, ε1, g, each moving link's lengths, mass and moment of
-    inertia, the applied forces at this angle (symbol, value, unit)."""
+    inertia, the applied forces at the angle of `res` (one angle) (symbol, value, unit)."""
     from .forces import _applied
     d = mech.drive
     rows = [("φ", num(float(res.phi_deg[0]), lang, 6), "°"), ("ω1", num(abs(d.omega), lang, 6), unit("rad/s", lang)),
@@ -456,57 +346,54 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
          angles: Sequence[float] | None = None, fixed=None) -> str:
     """The interactive page of `mech` in `lang` (module docstring). `at`: the angle of the check
     (and of a student's page; default the design position); `angles`: the slider's frames (deg;
-    default PAGE_ANGLES);
-    `fixed`: the plans' scales (default `cycle_scales(mech)`)."""
-    from ..solve import analyze
-    from . import cycle_scales, fixed_positions
+    default PAGE_ANGLES); `fixed`: the plans' scales (default `cycle_scales` of the page's one
+    analysis). ValueError where `at` is a singular position."""
+    from . import build_cycle, cycle_scales
+    from .draw import drawing
+    from .worksheet import analyses, worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
-    key = page_key(mech, lang, student, at, angles, fixed)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
-    fixed = fixed or cycle_scales(mech)
-    positions = fixed_positions(mech, fixed.base["mu_l"])
-    name = lettering(mech).name(lang, mech.name)
     frames = [at] if student else [*map(float, PAGE_ANGLES if angles is None else angles), design]
-
-    plans_at = partial(_plans_at, mech, positions, fixed)
-    check = plans_at(at)
-    if check is None:
+    phi = frames if at in frames else [*frames, at]
+    i_at = phi.index(at)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res, other = analyses(mech, phi)           # the graphical method's; the other friction mode's rows
+        fixed = fixed or cycle_scales(mech, res=res)
+        cycles = build_cycle(mech, res, fixed)
+        sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=other)
+    if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
-    bands, moment_bands = _bands(mech, check, fixed, at)
-    data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": frames,
-                  "tol": TOLERANCE_PCT, "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
+    name = lettering(mech).name(lang, mech.name)
+    check = {kind: c.at(i_at) for kind, c in cycles.items()}
+    one = res.take(np.array([i_at]))
+    bands, moment_bands = _bands(mech, one, check, fixed)
+    data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": phi,
+                  "slider": len(frames) - 1, "tol": TOLERANCE_PCT,
+                  "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
                   | {"negligible": text("page.negligible", lang, tiny=num(TINY_MM, lang))}, "tiny": TINY_MM,
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
-                  "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang)}
+                  "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang),
+                  "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS}
     blobs: dict[str, str] = {}
+    records = sheet.at(i_at).records()
     if not student:
-        per_kind: dict[str, list] = {k: [] for k in check}
-        values, rows = [], None
-        for split, got, records in _map(partial(_frame, mech, positions, fixed, lang, name), frames):
-            for kind in per_kind:
-                per_kind[kind].append(split.get(kind))
-            if got is not None:
-                rows = rows or records
-                values.append([got.get(r["key"], math.nan) for r in rows])
-            else:
-                values.append(None)
-        width = len(rows)
-        table = np.array([v if v is not None else [math.nan] * width for v in values], dtype=float)
-        exps, vbytes = _columns(table)
         kinds = []
-        for kind, sheets in per_kind.items():
-            enc = _encode_split(sheets)
-            lines, templates = _lines(enc.templates)
-            kinds.append({"kind": kind, "lines": lines, "templates": templates, "keys": enc.keys, "frames": enc.frames})
-            blobs[f"k{len(kinds) - 1}"] = _b64gz(enc.data)
-        blobs["values"] = _b64gz(vbytes)
-        data.update(kinds=kinds, rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
-                                        "section": r["section"]} for r in rows], exps=exps,
-                    steps=_steps(mech, check, lang))
-        blobs["meta"] = _b64gz(json.dumps({"kinds": data.pop("kinds"), "steps": data.pop("steps")},
+        for kind, cycle in cycles.items():
+            meta, numbers = encode_drawing(drawing(cycle, lang, name, contract=True))
+            kinds.append(meta)
+            blobs[f"k{len(kinds) - 1}"] = _packed(numbers)
+        values = np.array(sheet.values, dtype=float)
+        values[np.asarray(res.singular)] = math.nan
+        exps, vbytes = _columns(values)
+        blobs["values"] = _packed(vbytes)
+        data.update(singular=np.flatnonzero(res.singular).tolist(), exps=exps,
+                    rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
+                           "section": r["section"]} for r in records])
+        blobs["meta"] = _packed(json.dumps({"kinds": kinds, "steps": _steps(mech, one, check, lang)},
                                           ensure_ascii=False).encode())
     items = []
     for kind, plan in check.items():
@@ -520,26 +407,19 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
                     for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
     results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
-    blobs["check"] = base64.b64encode(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(),
-                                                             9, mtime=0))).decode("ascii")
-    res = analyze(mech, phi_deg=[at])
-    blank = _blank_tables(mech, at, fixed, lang) if student else ""
-    return _sealed(_html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, res, lang), items, results, blank, key))
+    blobs["check"] = _text85(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(), 9, mtime=0)))
+    blank = _blank_tables(records, lang) if student else ""
+    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), items, results, blank)
 
 
-def _blank_tables(mech, at: float, fixed, lang: str) -> str:
-    """The worksheet's tables with their values and senses left blank, section by section
-    (velocities, accelerations, reactions, M_bal), as the teacher's pack has them (`pack`)."""
-    from .worksheet import worksheet
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ws = worksheet(mech, at, mu_l=fixed.base["mu_l"].value, lang=lang)
-    recs = ws.records()
+def _blank_tables(records: list[dict], lang: str) -> str:
+    """The worksheet's tables (its `records`) with their values and senses left blank, section by
+    section (velocities, accelerations, reactions, M_bal), as the teacher's pack has them (`pack`)."""
     head = "".join(f"<th>{escape(text(f'ws.head.{k}', lang))}</th>" for k in ("symbol", "value", "unit", "direction"))
     out = [f'<section id="worksheet"><h2>{escape(text("pack.fill", lang))}</h2>']
-    for section in dict.fromkeys(r["section"] for r in recs):
+    for section in dict.fromkeys(r["section"] for r in records):
         rows = "".join(f'<tr><td>{escape(_symbol(r["symbol"], lang))}</td><td class="blank"></td>'
-                       f'<td>{escape(r["unit"])}</td><td class="blank"></td></tr>' for r in recs if r["section"] == section)
+                       f'<td>{escape(r["unit"])}</td><td class="blank"></td></tr>' for r in records if r["section"] == section)
         out.append(f'<h3>{escape(section)}</h3><table class="fill"><tr>{head}</tr>{rows}</table>')
     return "".join(out) + "</section>"
 
@@ -563,7 +443,7 @@ def _obscure(data: bytes) -> bytes:
 
 
 def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
-          data_rows, items, results, blank: str = "", key: str | None = None) -> str:
+          data_rows, items, results, blank: str = "") -> str:
     from .draw import scale_text
     title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
     scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
@@ -614,7 +494,6 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     payload = script_json(data)                 # no name in it (`</script>`, `<!--<script>`) ends its element
     blob_tags = "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
     return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
-            + (f'<meta name="{KEY_META}" content="{key}">' if key else "") +
             f'<meta http-equiv="Content-Security-Policy" content="default-src \'none\'; style-src \'unsafe-inline\'; '
             f'script-src \'unsafe-inline\'; img-src data:">'
             f'<title>{escape(title)}</title><style>{_CSS}</style><style id="page-size">@page{{size:A3 landscape;margin:0}}</style>'
@@ -682,179 +561,8 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
 """
 
 
-def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None,
-               reuse: str | Path | None = None) -> Path:
-    """The page of `mech` (`page`) written to `out` atomically; returns its path. `reuse`: an
-    earlier page (e.g. the one `out` replaces); where it is whole and its key (`key_of`) equals
-    this page's (`page_key`), its bytes are written instead of drawing the page again."""
+def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None) -> Path:
+    """The page of `mech` (`page`), drawn anew, written to `out` atomically; returns its path."""
     path = Path(out)
-    key = page_key(mech, lang, student, at)
-    earlier = _earlier_page(reuse) if key is not None and reuse is not None else None
-    if earlier is not None and _key_in(earlier) == key:
-        write_bytes(path, earlier)
-    else:
-        write_text(path, page(mech, lang=lang, student=student, at=at))
+    write_text(path, page(mech, lang=lang, student=student, at=at))
     return path
-
-
-# ============================================================================ what a page is drawn from
-
-#: The name of the meta element that holds a page's key (`page_key`).
-KEY_META = "kinetostat-page"
-_KEY = re.compile(rb'<meta name="' + KEY_META.encode() + rb'" content="([0-9a-f]{64})">')
-#: A page's last line: the SHA-256 of every byte before it (`_sealed`, `key_of`).
-_SEAL = re.compile(rb"<!-- kinetostat-page-sha256 ([0-9a-f]{64}) -->\n\Z")
-
-
-def page_key(mech, lang: str = "en", student: bool = False, at: float | None = None,
-             angles: Sequence[float] | None = None, fixed=None) -> str | None:
-    """What the page `page(mech, lang, student, at, angles, fixed)` is drawn from, as a SHA-256
-    hex digest: every field of the mechanism but where its file lies (its `path`, and that path
-    wherever a text holds it, as a drive's `source` does), the arguments, and
-    the code that draws it (`code_files`). Equal keys: the same page. The libraries' versions are
-    left out by choice, so that a checkout's committed pages stay current on another machine: a
-    page drawn with other versions of numpy or Python is kept. None where the mechanism holds
-    something other than numbers, text, arrays and containers of them (no key: never reused)."""
-    h = hashlib.sha256(_code_digest())
-    try:
-        _feed(h, (lang, student, at, tuple(map(float, PAGE_ANGLES if angles is None else angles)), fixed))
-        _feed(h, mech, skip=("path", "structure", "_derived"), where=mech.path)
-    except TypeError:
-        return None
-    return h.hexdigest()
-
-
-#: Largest earlier page read (`key_of`, `write_page(reuse=)`), bytes: the bundled models' pages
-#: are below 1 MB; a larger file is not read, and the page is drawn again.
-MAX_PAGE_BYTES = 64 * 2**20
-
-
-def _earlier_page(path: str | Path) -> bytes | None:
-    """The bytes of the earlier page at `path`: a regular file of at most MAX_PAGE_BYTES
-    (`read_regular`: a FIFO or /dev/zero there is not read); None otherwise."""
-    try:
-        return read_regular(path, MAX_PAGE_BYTES)
-    except OSError:
-        return None
-
-
-def key_of(path: str | Path) -> str | None:
-    """The key of the page written at `path` (its KEY_META element); None where there is no file,
-    no regular file of at most MAX_PAGE_BYTES, no key, or the page is not whole (its last line, the
-    SHA-256 of the bytes before it, missing or not theirs: a page cut short or edited)."""
-    data = _earlier_page(path)
-    return None if data is None else _key_in(data)
-
-
-def _key_in(data: bytes) -> str | None:
-    """The key of the page `data` (`key_of`)."""
-    seal = _SEAL.search(data)
-    if seal is None or hashlib.sha256(data[:seal.start()]).hexdigest().encode() != seal.group(1):
-        return None
-    m = _KEY.search(data, 0, 4096)
-    return m.group(1).decode() if m else None
-
-
-def _sealed(html: str) -> str:
-    """`html` with its seal: a last line holding the SHA-256 of its UTF-8 bytes."""
-    return f"{html}<!-- kinetostat-page-sha256 {hashlib.sha256(html.encode()).hexdigest()} -->\n"
-
-
-@cache
-def _code_digest() -> bytes:
-    """SHA-256 of the code a page is drawn by (`code_files`), each file by its path relative to the
-    package and its bytes, in order."""
-    root = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for f in code_files():
-        h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
-    return h.digest()
-
-
-def code_files() -> list[Path]:
-    """The files of the code a page is drawn by, sorted: this module and every module of the
-    package it imports, directly or through others, at module level or inside a function (read
-    from their source, with each package's __init__), and the .js and .json files in their
-    folders (regular files, not hidden, not an editor's lock). An edit to another module (the
-    command line, the reports) leaves a page's key as it is."""
-    root = Path(__file__).resolve().parents[1]
-    todo, seen = [Path(__file__).resolve()], set()
-    while todo:
-        f = todo.pop()
-        if f not in seen:
-            seen.add(f)
-            todo += _imported(f, root)
-    data = {g for f in seen for g in f.parent.iterdir()
-            if g.suffix in (".js", ".json") and g.name[0] not in ".#" and g.is_file() and not g.is_symlink()}
-    return sorted(seen | data)
-
-
-#: An import statement at the start of a line: `from X import names` (X relative or absolute;
-#: names in parentheses over lines, with comments) or `import names`, at any indentation; one in a
-#: docstring counts too. Not seen: an import after `;` or continued by a backslash (a test checks
-#: the package's sources against Python's parser).
-_IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n#;]*)|import[ \t]+([^\n#;]*))", re.M)
-
-
-def _imported(f: Path, root: Path) -> list[Path]:
-    """The package's modules the module `f` imports (relative or absolute; of `from X import a`, X
-    and a submodule a), each with the __init__ of every package on its way."""
-    package = [*f.parent.relative_to(root.parent).parts]          # e.g. ["kinetostat", "plans"]
-    out = []
-
-    def add(parts: list[str]) -> None:
-        if not parts or parts[0] != root.name:
-            return
-        for n in range(1, len(parts) + 1):
-            p = root.parent.joinpath(*parts[:n])
-            out.extend(g for g in (p / "__init__.py", p.with_suffix(".py")) if g.is_file())
-    names = lambda text: [a.split()[0] for a in re.sub(r"#[^\n]*", "", text).strip("() \t\n").split(",") if a.strip()]
-    for m in _IMPORT.finditer(f.read_text(encoding="utf-8")):
-        source, what, plain = m.groups()
-        if plain is not None:
-            for name in names(plain):
-                add(name.split("."))
-            continue
-        level = len(source) - len(source.lstrip("."))
-        base = (package[:len(package) - level + 1] if level else []) + [x for x in source.lstrip(".").split(".") if x]
-        add(base)
-        for name in names(what):
-            add(base + [name])
-    return out
-
-
-def _feed(h, x, skip: tuple[str, ...] = (), where: str | None = None) -> None:
-    """Feed `x` to the hash `h` unambiguously: its type, then its value (a float exactly, a text
-    with the path `where` in it made a placeholder, an array by dtype, shape and bytes, a
-    dataclass field by field but `skip`, a mapping item by item); TypeError for anything else (a
-    function, an object of its own)."""
-    if isinstance(x, str) and where:
-        x = x.replace(where, "\0model file\0")
-    if x is None or isinstance(x, (bool, int, float, complex, str)):
-        h.update(f"{type(x).__name__}:{x!r};".encode())
-    elif isinstance(x, np.generic):
-        _feed(h, x.item(), where=where)
-    elif isinstance(x, np.ndarray):
-        h.update(f"ndarray:{x.dtype.str}:{x.shape};".encode() + np.ascontiguousarray(x).tobytes())
-    elif is_dataclass(x) and not isinstance(x, type):
-        h.update(f"{type(x).__qualname__}{{".encode())
-        for f in fields(x):
-            if f.name not in skip:
-                h.update(f.name.encode() + b"=")
-                _feed(h, getattr(x, f.name), where=where)
-        h.update(b"}")
-    elif isinstance(x, Mapping):
-        h.update(f"map:{len(x)}{{".encode())
-        for k, v in x.items():
-            _feed(h, k, where=where)
-            _feed(h, v, where=where)
-        h.update(b"}")
-    elif isinstance(x, (tuple, list)):
-        h.update(f"{type(x).__name__}:{len(x)}(".encode())
-        for v in x:
-            _feed(h, v, where=where)
-        h.update(b")")
-    elif isinstance(x, (frozenset, set)):
-        _feed(h, sorted(x, key=repr), where=where)
-    else:
-        raise TypeError(f"cannot key a {type(x).__qualname__}")

@@ -14,14 +14,13 @@ per model folder of the rerun (one holding a summary.json):
   table is rounded: `kinetostat.tables.rounded`); an angle as the shortest turn, a reaction's
   angle weighed by the reaction (|R| times the turn in rad, against the force's tolerance); text
   and flags equal;
-- page.html: the same key (the same model, the same code: `plans.page.key_of`);
-- the figures (.svg, .png): present, not compared (drawn from the numbers above);
+- the figures (.svg, .png) and page.html: present, not compared (drawn from the numbers above);
 - every other text file (Markdown, HTML, segments.csv, worksheet.csv) and the folder's own
   index.md/index.html: equal line by line but for the versions after "made with", the numbers in
   e-notation (the error figures, checked in summary.json) and a relative 1e-9 in other numbers
   (12 printed digits).
 
-May use: numpy, `_io` (bounded reads of regular files), `kinetostat.tables` (reading the CSV), `kinetostat.plans.page` (a page's key), the
+May use: numpy, `_io` (bounded reads of regular files), `kinetostat.tables` (reading the CSV), the
 document's ROUNDING and the harness's tolerances (imported inside `compare_reports`).
 """
 from __future__ import annotations
@@ -226,11 +225,7 @@ def _compared(model: str, name: str, fresh: Path, old: Path) -> Iterator[Differe
         yield from _json(model, json.loads(_read(fresh)), json.loads(_read(old)))
     elif name == "cycle.csv":
         yield from _cycle(model, fresh, old)
-    elif name == "page.html":
-        from ..plans.page import key_of
-        if key_of(fresh) != key_of(old):
-            yield Difference(model, name, "key", "", str(key_of(fresh)), str(key_of(old)), "equal")
-    elif not name.endswith(FIGURES):
+    elif not name.endswith(FIGURES) and name != "page.html":
         yield from _text(model, name, fresh, old)
 
 

@@ -280,12 +280,10 @@ def _published_section(doc: Doc, m: Mechanism, published: Sequence[PublishedChec
                "within"], rows, "lllrrlrrl")
 
 
-def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction: str = "first",
-                   reuse: Path | None = None) -> list[Path]:
+def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction: str = "first") -> list[Path]:
     """The plans of the graphical method at the model's design position (`kinetostat.plans`),
     one picture each, with their segments.csv and the worksheet beside them, and with `page` the
-    interactive page (`plans.page`, page.html) linked, `reuse`/page.html kept where it is the same
-    page (`write_page`); `friction`: the method they are drawn with (`plans.build`); returns the files."""
+    interactive page (`plans.page`, page.html, drawn anew) linked; `friction`: the method they are drawn with (`plans.build`); returns the files."""
     from ..plans import build, plan_file_name, svg
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
@@ -310,7 +308,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
     files = []
     if page:
         from ..plans.page import write_page
-        files.append(write_page(m, d / "page.html", reuse=None if reuse is None else Path(reuse) / "page.html"))
+        files.append(write_page(m, d / "page.html"))
         doc.p("[The interactive page](page.html): every plan at every degree of the crank at scales fixed for "
               "the cycle, the values, the force plans step by step, a check of measured lengths (one offline file"
               + ("; the graphical method's first approximation: reactions without friction" if m.friction is not None else "")
@@ -482,14 +480,13 @@ def _tolerance(run: ModelRun, route: str):
 
 
 def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool = False,
-                 friction: str = "first", reuse: Path | None = None) -> dict[str, Any]:
+                 friction: str = "first") -> dict[str, Any]:
     """Write `out/<folder>/` for one model (default folder: `run.stem`); returns the summary
     also saved as summary.json.
 
     `folder` is a name of ASCII letters, digits, '_' and '-' (`kinetostat._io.safe_name`), and
     the folder must resolve to a place inside `out` (ValueError otherwise); `page`: also the
-    model's interactive page, page.html, linked from the plans' section (`reuse`: the folder of an
-    earlier report, whose page.html is kept where it is the same page: `plans.page.write_page`);
+    model's interactive page, page.html, linked from the plans' section (`plans.page.write_page`);
     `friction`: the method
     of the plans and worksheet ("first": the graphical method's; "reactions": with friction in the
     reactions, a model with [friction] only). Every file is
@@ -603,7 +600,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
     _published_section(doc, m, published)
-    plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first", reuse)
+    plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first")
     log.debug("%s: plans and worksheet, %d files%s", folder, len(plan_files),
               ", page.html" if any(p.name == "page.html" for p in plan_files) else "")
 
