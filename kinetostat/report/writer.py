@@ -15,7 +15,6 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
-from ..solve import analyze
 from ..model import Mechanism, model_text
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
@@ -404,18 +403,20 @@ def _figure(value: Callable[[], float], why: str) -> str:
     return esc(f"undefined: {why}") if why else _fmt(value())
 
 
-def _friction_section(doc: Doc, m: Mechanism, res) -> None:
+def _friction_section(doc: Doc, run: ModelRun) -> None:
     """With [friction]: the exact solution with friction in the reactions beside the first
-    approximation of the course text (`res`, the cycle the engines checked): M_bal at the design
-    position, the energy lost per pair, the efficiency, the self-locking zones, the checks."""
+    approximation of the course text (`run.res`, the cycle the engines checked): M_bal at the design
+    position, the energy lost per pair, the efficiency, the self-locking zones, the checks; the
+    analyses the run's (`ModelRun.at`)."""
+    m, res = run.mech, run.res
     if m.friction is None or not len(res.phi_deg):
         return
     from ..errors import SelfLockingWarning
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SelfLockingWarning)
-        ex = analyze(m, phi_deg=res.phi_deg, friction="reactions")
-        at = analyze(m, phi_deg=[m.drive.design_deg], friction="reactions")
-        first = analyze(m, phi_deg=[m.drive.design_deg], friction="first")
+        ex = run.at(res.phi_deg, friction="reactions")
+        at = run.at([m.drive.design_deg], friction="reactions")
+        first = run.at([m.drive.design_deg], friction="first")
     M = esc(quantity_name(m, "M_bal"))
     doc.h(2, "Friction in the reactions")
     doc.p("The course text on friction computes the losses *in the first approximation*: the frictionless reactions "
@@ -508,7 +509,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     inside(out, d)
     published = run.published
     pic_deg = m.drive.design_deg
-    at = analyze(m, phi_deg=[pic_deg])
+    at = run.at([pic_deg])
     machine = m.drive.kind == "machine"
     with plain_text():
         images = {
@@ -570,7 +571,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
                for p in m.pairs], "lrrrr")
 
     _three_routes_section(doc, m, res)
-    _friction_section(doc, m, res)
+    _friction_section(doc, run)
     _study_section(doc, m)
 
     doc.h(2, "Errors against the engines")
