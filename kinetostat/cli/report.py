@@ -1,4 +1,6 @@
-"""`report`: the per-mechanism error reports, in worker processes (`--jobs`), most work first.
+"""`report`: the per-mechanism error reports, in worker processes (`--jobs`), most work first; its
+first line (what it will do) as soon as the options are checked, then each model's progress
+(engine routes, figures, plans and page) as each part is done, logged at INFO.
 
 May use: `.common`, `kinetostat._forecast` (the estimated time), the solver, `kinetostat.report` and the harness (imported inside the command).
 """
@@ -46,7 +48,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
                 t1 = time.perf_counter()
                 res = analyze(mech, steps=steps)
                 secs = time.perf_counter() - t1
-        run = run_validation(mech, engines, steps, res=res, path=path)
+        run = run_validation(mech, engines, steps, res=res, path=path, level=logging.INFO)
         run.solver_seconds = secs
         earlier = Path(out) / folder / "page.html"
         before = key_of(earlier) if page else None
@@ -130,6 +132,9 @@ def cmd_report(args) -> int:
     out = _writable_dir(args.out, "--out")
     earlier = _earlier_reports(args.check, out) if args.check is not None else None
     paths = args.models or bundled_models()
+    jobs, cores = args.jobs or os.cpu_count() or 1, os.cpu_count() or 1
+    log.info(one_line(f"report: {len(paths)} model(s) into {out}: routes lever, {', '.join(engines)}; "
+                      f"{'pages' if args.page else 'no pages'}; {min(jobs, len(paths))} at a time"))
     prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
     _PREPARED.clear()
     _PREPARED.update({str(p): (mech, res, secs) for p, mech, res, secs in prepared})
@@ -138,7 +143,6 @@ def cmd_report(args) -> int:
     t0 = time.perf_counter()
     summaries: dict[int, dict] = {}
     n_fail, n_err = 0, 0
-    jobs, cores = args.jobs or os.cpu_count() or 1, os.cpu_count() or 1
     eta = Forecast(log, len(order), "model(s)", parallel=jobs,
                    faster=([f"--jobs {cores}"] if jobs < cores else []) + (["--no-page"] if args.page else [])
                    + (["--engines none"] if engines != ["reference"] else []))

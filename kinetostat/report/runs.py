@@ -182,7 +182,8 @@ def _record(caught, where: str, out: list[str]) -> None:
 
 
 def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, res: Analysis | None = None,
-                   path: str | Path | None = None, on_route: Callable[[str], None] | None = None) -> ModelRun:
+                   path: str | Path | None = None, on_route: Callable[[str], None] | None = None,
+                   level: int = logging.DEBUG) -> ModelRun:
     """Check `res` (default: `analyze(mech, steps=steps)`) by the internal lever identity (route
     LEVER_ROUTE, always), against every route in `engines`, and against the model's published
     values (an exception there is the error of route "published").
@@ -190,7 +191,8 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
     Each route runs in its own `compare(..., engines=[route], res=res)` call; an exception of a
     route is recorded in `errors` (that route fails) and the other routes still run. Warnings
     raised meanwhile are collected, one line each, in `warnings`. `on_route(route)` is called
-    after each route (progress bars); each route's verdict and time is logged (DEBUG).
+    after each route (progress bars); each route's verdict and time is logged at `level`
+    (DEBUG: the -v line of `validate`; the report command's progress: INFO).
     """
     from kinetostat_validation.compare import LEVER, TOLERANCES, compare, lever_row
 
@@ -232,7 +234,7 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
         if route in TOLERANCES:
             run.tolerances[route] = TOLERANCES[route]
         _record(caught, f"{route}: ", run.warnings)
-        log.debug("%s: route %s %s (%.1f s)", run.stem, route, run.status(route), run.seconds[route])
+        log.log(level, "%s: route %s %s (%.1f s)", run.stem, route, run.status(route), run.seconds[route])
         if on_route is not None:
             on_route(route)
     return run

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import time
 import warnings
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -289,6 +290,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
     doc.h(2, PLANS_HEADING)
+    t0 = time.perf_counter()
     try:
         with warnings.catch_warnings():         # the cycle's warnings are reported below
             warnings.simplefilter("ignore")
@@ -321,6 +323,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
         files.append(path)
     write_text(d / "segments.csv", plans.segments_csv())
     sheet.to_csv(d / "worksheet.csv")
+    log.info("%s: plans, worksheet%s (%.1f s)", d.name, " and page" if page else "", time.perf_counter() - t0)
     return files + [d / "segments.csv", d / "worksheet.csv"]
 
 
@@ -498,7 +501,9 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     file depends only on the model, the routes and the steps (and the libraries' versions): no
     dates and no run times (printed by the command line only). A rerun reproduces the numbers
     within their tolerances, not byte for byte: errors at rounding level differ in their last
-    digits from machine to machine (`kinetostat.report.compare_reports` checks a rerun).
+    digits from machine to machine (`kinetostat.report.compare_reports` checks a rerun). Its
+    progress is logged (INFO) as each part is done: the figures, cycle.csv with the tables, then
+    the plans with their worksheet and page, each with its time.
     """
     m, res = run.mech, run.res
     folder = run.stem if folder is None else folder
@@ -511,6 +516,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     pic_deg = m.drive.design_deg
     at = run.at([pic_deg])
     machine = m.drive.kind == "machine"
+    t0 = time.perf_counter()
     with plain_text():
         images = {
             "mechanism": plot_mechanism(at, res, d / "mechanism.svg"),
@@ -520,7 +526,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
             "errors": plot_errors(run, d / "errors.svg"),
             "hodographs": plot_hodographs(run, d / "hodographs.svg"),
         }
-    log.debug("%s: figures %s", folder, ", ".join(images))
+    log.info("%s: figures %s (%.1f s)", folder, ", ".join(images), time.perf_counter() - t0)
+    t0 = time.perf_counter()
     with atomic(d / "cycle.csv") as f:
         write_csv(res.to_frame(), f)
 
@@ -573,6 +580,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     _three_routes_section(doc, m, res)
     _friction_section(doc, run)
     _study_section(doc, m)
+    log.info("%s: cycle.csv and the tables (%.1f s)", folder, time.perf_counter() - t0)
 
     doc.h(2, "Errors against the engines")
     doc.p("Per route and quantity: max |engine − kinetostat| over the cycle (absolute) and the crank angle "
