@@ -56,15 +56,17 @@ def test_quiet_report_prints_nothing_and_verbose_shows_its_progress(cli, tmp_pat
 
 
 def test_report_says_what_it_will_do_first_then_each_part_of_a_model(tmp_path, monkeypatch, capsys):
-    """The first line as soon as the options are checked, before any model is loaded; then, at the
+    """The first line once the options and models are checked, before the first model's report (an
+    input error is the one line it prints: test_cli); then, at the
     default verbosity, each model's parts as they are done (its routes, figures, tables, plans),
     each with its time (-q: none of them, test_quiet_report_prints_nothing_...)."""
     from kinetostat import cli
     from kinetostat.cli import report
     sketch_plots(monkeypatch)
     before_models = []
-    prepare = report._prepare
-    monkeypatch.setattr(report, "_prepare", lambda *a: (before_models.append(capsys.readouterr().err), prepare(*a))[1])
+    reports = report._report_results
+    monkeypatch.setattr(report, "_report_results",
+                        lambda *a: (before_models.append(capsys.readouterr().err), reports(*a))[1])
     quick = ["--engines", "none", "--no-page", "--steps", "8", "--jobs", "1", "--no-progress", "--out", str(tmp_path)]
     assert cli.main(["report", str(FOUR_BAR_MODEL), *quick]) == 0
     assert before_models == [f"report: 1 model(s) into {tmp_path}: routes lever, reference; no pages; 1 at a time\n"]

@@ -1,6 +1,7 @@
 """`report`: the per-mechanism error reports, in worker processes (`--jobs`), most work first; its
-first line (what it will do) as soon as the options are checked, then each model's progress
-(engine routes, figures, plans and page) as each part is done, logged at INFO.
+first line (what it will do) once the options and models are checked, before any model's report,
+then each model's progress (engine routes, figures, tables, plans and page) as each part is done,
+logged at INFO.
 
 May use: `.common`, `kinetostat._forecast` (the estimated time), the solver, `kinetostat.report` and the harness (imported inside the command).
 """
@@ -132,10 +133,10 @@ def cmd_report(args) -> int:
     out = _writable_dir(args.out, "--out")
     earlier = _earlier_reports(args.check, out) if args.check is not None else None
     paths = args.models or bundled_models()
+    prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
     jobs, cores = args.jobs or os.cpu_count() or 1, os.cpu_count() or 1
     log.info(one_line(f"report: {len(paths)} model(s) into {out}: routes lever, {', '.join(engines)}; "
                       f"{'pages' if args.page else 'no pages'}; {min(jobs, len(paths))} at a time"))
-    prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
     _PREPARED.clear()
     _PREPARED.update({str(p): (mech, res, secs) for p, mech, res, secs in prepared})
     order = [p for p, *_ in prepared]
