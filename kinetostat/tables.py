@@ -133,7 +133,9 @@ def write_csv(df, f: IO[str]) -> None:
         return ["" if na else text(v) for v, na in zip(col.tolist(), col.isna().tolist())]
     w = csv.writer(f, lineterminator="\n")
     w.writerow(header(df))
-    cols = [col for _, col in rounded(df).items()]
+    table = rounded(df)
+    table.attrs = {}           # pandas deep-copies `attrs` into every column and every slice of one
+    cols = [col for _, col in table.items()]
     for start in range(0, len(df), CSV_CHUNK):
         w.writerows(zip(*(cells(col.iloc[start:start + CSV_CHUNK]) for col in cols)))
 

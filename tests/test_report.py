@@ -42,6 +42,25 @@ def _report(out: Path, *args: str) -> subprocess.CompletedProcess:
 REPORT_ARGS = (str(ICE), str(SHAPER), "--steps", "36", "--engines", "pinocchio", "mujoco", "--no-progress", "--no-page")
 
 
+#: (model, angles, first angle, friction method) of each analysis the report package asked for
+#: while `ice_report` was written (`_count_report_analyses`).
+REPORT_ANALYSES: list[tuple] = []
+
+
+def _count_report_analyses(mp: pytest.MonkeyPatch) -> None:
+    """Each `analyze` called from the report package (`kinetostat.report.*`) recorded in
+    REPORT_ANALYSES (by the numpy path `analyze` takes at a report's few angles)."""
+    import kinetostat.solve
+    exact = kinetostat.solve.exact
+
+    def counted(mech, phi_deg, friction="first"):
+        if sys._getframe(2).f_globals["__name__"].startswith("kinetostat.report"):   # analyze's caller
+            REPORT_ANALYSES.append((Path(mech.path).stem, len(phi_deg), float(phi_deg[0]), friction))
+        return exact(mech, phi_deg, friction)
+    REPORT_ANALYSES.clear()
+    mp.setattr(kinetostat.solve, "exact", counted)
+
+
 @pytest.fixture(scope="module")
 def ice_report(tmp_path_factory) -> Path:
     """Two reports written by `kinetostat report` in this process (plots sketched,
@@ -55,6 +74,7 @@ def ice_report(tmp_path_factory) -> Path:
     out = io.StringIO()
     with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out):
         sketch_plots(mp)
+        _count_report_analyses(mp)
         assert cli.main(["report", *REPORT_ARGS, "--out", str(folder), "--jobs", "1"]) == 0
     assert "ice_crank_slider" in out.getvalue() and "slotted_link_shaper" in out.getvalue() and "PASS" in out.getvalue()
     return folder
@@ -524,3 +544,14 @@ def test_figures_keep_every_coordinate_to_a_hundredth_of_a_point_in_fewer_bytes(
                                    [float(v) for v in re.findall(r"-?\d+\.?\d*", a)], atol=0.005 + 1e-12)
     assert paths.sub("", small) == paths.sub("", svg)
     assert "font-family: 'DejaVu Sans', sans-serif;" in small and "Bitstream" not in small
+
+
+
+def test_a_report_analyses_each_set_of_angles_once(ice_report):
+    """The report's parts at the same angles and friction method share one analysis (`ModelRun.at`):
+    the ICE (published values at 30°, its design position; [friction]) is analysed by the report
+    package once at 30° frictionless, once at 30° and once over the cycle with friction in the
+    reactions, the shaper (no friction) once at 30°; the cycle itself is the run's `res`, never
+    analysed again. (The plans, drawn by `kinetostat.plans` from their own analysis, are not counted.)"""
+    assert sorted(REPORT_ANALYSES) == [("ice_crank_slider", 1, 30.0, "first"), ("ice_crank_slider", 1, 30.0, "reactions"),
+                                       ("ice_crank_slider", 36, 0.0, "reactions"), ("slotted_link_shaper", 1, 30.0, "first")]

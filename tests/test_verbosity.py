@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import logging
 import os
+import re
 
 import pytest
 
@@ -54,6 +55,28 @@ def test_quiet_report_prints_nothing_and_verbose_shows_its_progress(cli, tmp_pat
     assert [type(h) for h in package.handlers] == [logging.NullHandler]
 
 
+def test_report_says_what_it_will_do_first_then_each_part_of_a_model(tmp_path, monkeypatch, capsys):
+    """The first line once the options and models are checked, before the first model's report (an
+    input error is the one line it prints: test_cli); then, at the
+    default verbosity, each model's parts as they are done (its routes, figures, tables, plans),
+    each with its time (-q: none of them, test_quiet_report_prints_nothing_...)."""
+    from kinetostat import cli
+    from kinetostat.cli import report
+    sketch_plots(monkeypatch)
+    before_models = []
+    reports = report._report_results
+    monkeypatch.setattr(report, "_report_results",
+                        lambda *a: (before_models.append(capsys.readouterr().err), reports(*a))[1])
+    quick = ["--engines", "none", "--no-page", "--steps", "8", "--jobs", "1", "--no-progress", "--out", str(tmp_path)]
+    assert cli.main(["report", str(FOUR_BAR_MODEL), *quick]) == 0
+    assert before_models == [f"report: 1 model(s) into {tmp_path}: routes lever, reference; no pages; 1 at a time\n"]
+    err = capsys.readouterr().err.splitlines()
+    parts = ["chain_unit_four_bar: route reference PASS (", "chain_unit_four_bar: figures mechanism, moment, ",
+             "chain_unit_four_bar: cycle.csv and the tables (", "chain_unit_four_bar: plans, worksheet ("]
+    assert [next((i for i, s in enumerate(err) if s.startswith(p)), None) for p in parts] == list(range(4)), err
+    assert all(re.search(r"\(\d+\.\d s\)$", s) for s in err[:4]), err
+
+
 def test_a_long_report_says_its_time_and_what_is_faster(cli, tmp_path, monkeypatch, clock):
     """Each model's report made up (an error line): the forecast after the first, with the options
     that apply (--jobs while fewer than the cores, --no-page with pages, --engines none with engines)."""
@@ -64,10 +87,12 @@ def test_a_long_report_says_its_time_and_what_is_faster(cli, tmp_path, monkeypat
     models = [FOUR_BAR_MODEL] * 3
     r = cli("report", *models, "--steps", "8", "--jobs", "2", "--engines", "pymunk", "--out", tmp_path)
     assert [s for s in r.stderr.splitlines() if not s.startswith("kinetostat: error: ")] == [
+        f"report: 3 model(s) into {tmp_path}: routes lever, pymunk; pages; 2 at a time",
         "about 2 min for the remaining 2 model(s) (2 min for the first, 2 at a time); faster: --jobs 4 / --no-page "
         "/ --engines none"]
     r = cli("report", *models * 2, "--steps", "8", "--no-page", "--engines", "none", "--out", tmp_path)
     assert [s for s in r.stderr.splitlines() if not s.startswith("kinetostat: error: ")] == [       # 4 started
+        f"report: 6 model(s) into {tmp_path}: routes lever, reference; no pages; 4 at a time",
         "about 2 min for the remaining 5 model(s) (2 min for the first, 4 at a time)"]
     r = cli("-q", "report", *models, "--steps", "8", "--out", tmp_path)
     assert "about" not in r.stderr and r.stderr.count("kinetostat: error: ") == 3
@@ -99,7 +124,9 @@ def test_validate_and_variant_all_say_their_time(cli, tmp_path, monkeypatch, clo
     assert r.returncode == 0 and r.stderr == "about 2 min for the remaining 1 model(s) (2 min for the first)\n"
     monkeypatch.setattr("kinetostat.variants.codes", lambda: ["479"])            # one code of each task
     r = cli("variant", "--all", "--no-pack", "--out", tmp_path)
-    assert r.returncode == 0 and r.stderr == "about 4 min for the remaining 2 variant(s) (2 min for the first); faster: one TASK\n"
+    assert r.returncode == 0 and r.stderr == (f"variant --all: 3 code(s) of task(s) 1, 2, 3 into {tmp_path}, no pack\n"
+                                              "about 4 min for the remaining 2 variant(s) (2 min for the first); "
+                                              "faster: one TASK\n")
 
 
 def test_a_forecast_at_the_first_items_pace(caplog, clock, monkeypatch):

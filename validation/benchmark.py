@@ -3,6 +3,7 @@
     python -m kinetostat_validation.benchmark              # full study: writes ./reports/benchmark.{md,csv,png}
     python -m kinetostat_validation.benchmark --out DIR    # ... into DIR instead
     python -m kinetostat_validation.benchmark --quick      # fewer repeats and settings, prints only
+    python -m kinetostat_validation.benchmark --drawing-budgets   # only the drawing layer's budgets, printed
 
 Every route runs over the same full cycle (360 angles) and is timed as the median of repeated
 runs in one process; its error is the worst peak-relative error over the driving moment and
@@ -25,6 +26,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import os
 import statistics
 import time
 import warnings
@@ -449,18 +451,28 @@ def _n_models() -> int:
     return len(kinetostat.examples.names())
 
 
-def _report_run(folder: str, models: tuple[str, ...] = ()) -> tuple[float, float]:
-    """One `kinetostat report --jobs 2` of `models` (default every bundled one) into `folder`, in a
-    fresh process: (CPU s of the command and its workers, user + sys from getrusage of the
-    waited-for children; wall s)."""
+def _child_run(args: list[str]) -> tuple[float, float, str]:
+    """`args` run by this Python in a fresh process: (CPU s of it and every process it waited
+    for, user + sys from getrusage of the waited-for children; wall s; its stdout)."""
     import resource
     import subprocess
     import sys
     r0, w0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-    subprocess.run([sys.executable, "-m", "kinetostat", "report", *models, "--jobs", "2", "--no-progress",
-                    "--out", folder], check=True, capture_output=True)
+    out = subprocess.run([sys.executable, *args], check=True, capture_output=True, text=True).stdout
     w, r1 = time.perf_counter() - w0, resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, w
+    return r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, w, out
+
+
+def _command_run(*args: str) -> tuple[float, float]:
+    """One `kinetostat ARGS` in a fresh process: (CPU s of the command and its workers; wall s)."""
+    cpu, wall, _ = _child_run(["-m", "kinetostat", *args])
+    return cpu, wall
+
+
+def _report_run(folder: str, models: tuple[str, ...] = (), *options: str) -> tuple[float, float]:
+    """One `kinetostat report --jobs 2` of `models` (default every bundled one) into `folder`, with
+    `options`, in a fresh process: (CPU s of the command and its workers; wall s)."""
+    return _command_run("report", *models, "--jobs", "2", "--no-progress", "--out", folder, *options)
 
 
 def main_job(runs: int = 3) -> dict:
@@ -511,6 +523,120 @@ def main_job_lines(mj: dict) -> list[str]:
                   row(f"after (this run), the models of {b['commit']}, pages kept", r)]
     return lines + [row("after (this run), every bundled model, pages kept", kept),
                     row("after (this run), every bundled model, pages drawn", mj["drawn"])]
+
+
+#: The drawing layer's budgets (issue 34), each a limit on what `drawing_budgets` measures: a page
+#: of 361 frames over `kinetostat plans MODEL --at 30` (CPU, 1), `plans MODEL --at A` beyond
+#: loading the model (CPU s), the main job with pages over --no-page (CPU, 1) and its wall time
+#: (s, every bundled model), `variant TASK CODE` with its pack (CPU s), a page's size (bytes).
+PAGE_OVER_PLANS, PLANS_CPU, PAGES_OVER_NO_PAGE, MAIN_JOB_WALL, VARIANT_CPU, PAGE_BYTES = 3.0, 0.3, 1.3, 15.0, 1.5, 300_000
+#: The models of the page budget: the ICE and the largest bundled model (6 links, 7 pairs, a
+#: class-III group: the most plans, and the largest page before issue 34, 827 kB).
+PAGE_MODELS = ("ice_crank_slider", "triad_six_bar")
+#: The angle of the plans budget, deg, and the variants timed (one code of each task).
+PLANS_AT, VARIANTS = 30.0, (("1", "479"), ("2", "479"), ("3", "479"))
+#: Run in a fresh process by `_plans_beyond_load`: the model loaded, then CPU s of `kinetostat
+#: plans` on it (its first call: the plans' imports included) and of a second call, one a line.
+_PLANS_CHILD = """
+import sys, time, kinetostat
+from kinetostat.cli import main
+model, at, out = sys.argv[1:]
+kinetostat.load(model)
+for n in (1, 2):
+    t = time.process_time()
+    assert main(["-q", "plans", model, "--at", at, "--out", f"{out}/{n}"]) == 0
+    print(time.process_time() - t)
+"""
+
+
+def _load_1min() -> float:
+    """The machine's load average over the last minute (NaN where the system does not say)."""
+    return os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan
+
+
+def _budget(name: str, measured: float, limit: float, unit: str, cpu: float, wall: float, load: tuple) -> dict:
+    """One row of `drawing_budgets`, printed as it is measured."""
+    row = dict(name=name, measured=measured, limit=limit, unit=unit, cpu=cpu, wall=wall, load=load)
+    print("budget: " + _budget_line(row)[2:-2].replace(" | ", "; "), flush=True)
+    return row
+
+
+def _plans_beyond_load(model: str, folder: Path) -> tuple[float, float, float]:
+    """CPU s of `kinetostat plans MODEL --at PLANS_AT` in a process that has loaded the model
+    already: its first call (the plans' imports included) and a second; and the process's wall s."""
+    _, wall, out = _child_run(["-c", _PLANS_CHILD, model, f"{PLANS_AT:g}", str(folder)])
+    first, second = map(float, out.split())
+    return first, second, wall
+
+
+def drawing_budgets(main_job: bool = True) -> list[dict]:
+    """Every budget of the drawing layer (issue 34) measured in fresh processes, in one run, each
+    with its CPU s (user + sys of the processes), wall s and the 1-minute load average before and
+    after: (a) a page of 361 frames (`kinetostat page`) over `kinetostat plans MODEL --at 30` for
+    PAGE_MODELS, CPU; (b) `plans MODEL --at 30` beyond loading the model, CPU s; (c) with
+    `main_job`, `kinetostat report` of every bundled model (--jobs 2) into an empty folder with
+    pages over the same into another with --no-page, CPU, and its wall s; (d) `variant TASK CODE`
+    with its pack, CPU s, for VARIANTS; (e) each model's page.html of (c), bytes. Rows as
+    `_budget` makes them, for `budget_lines`."""
+    import tempfile
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="kinetostat-budgets-") as tmp:
+        tmp = Path(tmp)
+        for model in PAGE_MODELS:
+            load = _load_1min()
+            page = _command_run("page", model, "--out", str(tmp / f"{model}.html"), "-q")
+            plans = _command_run("plans", model, "--at", f"{PLANS_AT:g}", "--out", str(tmp / model), "-q")
+            rows.append(_budget(f"(a) page of 361 frames / plans --at {PLANS_AT:g}, CPU, {model}",
+                                page[0] / plans[0], PAGE_OVER_PLANS, "x", page[0], page[1], (load, _load_1min())))
+            load = _load_1min()
+            first, second, wall = _plans_beyond_load(model, tmp / f"{model}-loaded")
+            rows.append(_budget(f"(b) plans --at {PLANS_AT:g} beyond loading the model, CPU, {model} (a second "
+                                f"call in the same process: {second:.2f} s)", first, PLANS_CPU, "s", first, wall,
+                                (load, _load_1min())))
+        if main_job:
+            load = _load_1min()
+            drawn = _report_run(str(tmp / "pages"))
+            none = _report_run(str(tmp / "no-page"), (), "--no-page")
+            after = _load_1min()
+            rows.append(_budget("(c) main job into an empty folder, pages / --no-page, CPU", drawn[0] / none[0],
+                                PAGES_OVER_NO_PAGE, "x", drawn[0], drawn[1], (load, after)))
+            rows.append(_budget(f"(c) main job into an empty folder with pages, wall, {_n_models()} models", drawn[1],
+                                MAIN_JOB_WALL, "s", drawn[0], drawn[1], (load, after)))
+            for page in sorted((tmp / "pages").glob("*/page.html")):
+                rows.append(_budget(f"(e) page size, {page.parent.name}", page.stat().st_size / 1e3,
+                                    PAGE_BYTES / 1e3, "kB", math.nan, math.nan, (after, after)))
+        for task, code in VARIANTS:
+            load = _load_1min()
+            cpu, wall = _command_run("variant", task, code, "--out", str(tmp / f"task{task}_{code}"), "-q")
+            rows.append(_budget(f"(d) variant {task} {code} with its pack, CPU", cpu, VARIANT_CPU, "s", cpu, wall,
+                                (load, _load_1min())))
+    return rows
+
+
+def _budget_line(r: dict) -> str:
+    """A row of `drawing_budgets` as a line of the table of `budget_lines`."""
+    num = lambda x, f: "-" if math.isnan(x) else format(x, f)
+    ratio = r["measured"] / r["limit"]
+    return (f"| {r['name']} | {r['measured']:.3g} {r['unit']} | {r['limit']:g} {r['unit']} | {ratio:.2f} | "
+            f"{'pass' if ratio <= 1 else '**FAIL**'} | {num(r['cpu'], '.2f')} | {num(r['wall'], '.2f')} | "
+            f"{r['load'][0]:.2f} / {r['load'][1]:.2f} |")
+
+
+def budget_lines(rows: list[dict]) -> list[str]:
+    """The section "Drawing budgets" (`drawing_budgets`): one table, budget against measure."""
+    return ["## Drawing budgets", "",
+            "The drawing layer's budgets (issue 34), each measured in fresh processes in this run: CPU = user + sys "
+            "of the command and every process it waited for (`resource.getrusage(RUSAGE_CHILDREN)`); ratio = "
+            "measured / budget, pass where it is at most 1; load = the machine's 1-minute load average before / "
+            "after the measure (a shared machine: read CPU time). (a) `kinetostat page MODEL` (361 frames) over "
+            f"`kinetostat plans MODEL --at {PLANS_AT:g}`, both with the interpreter's start and imports; (b) the "
+            "plans command's CPU in a process that has loaded the model (its first call, with the plans' own "
+            "imports); (c) `kinetostat report --jobs 2` of every bundled model into an empty folder, with pages "
+            "and with `--no-page`; (d) `kinetostat variant TASK CODE` (its teacher's pack included); (e) each "
+            "page.html of (c). Regenerate this section alone with "
+            "`python -m kinetostat_validation.benchmark --drawing-budgets` (printed only).", "",
+            "| budget | measured | limit | ratio | result | CPU s | wall s | load before / after |",
+            "|---|---|---|---|---|---|---|---|"] + [_budget_line(r) for r in rows]
 
 
 def speed_lines(sp: dict) -> list[str]:
@@ -717,14 +843,19 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['cpu_min']:.3f} / {r['cpu_median']:.3f} | "
                      f"{r['wall_min']:.3f} / {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + crossover_lines(kernels["crossover"]) + [""] + main_job_lines(kernels["main_job"])
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + crossover_lines(kernels["crossover"]) + [""] + main_job_lines(kernels["main_job"]) + [""] + budget_lines(kernels["budgets"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
 def main(argv: list[str] | None = None) -> None:
     ap = parser("benchmark", __doc__)
     ap.add_argument("--quick", action="store_true", help="fewer repeats and settings; print only")
+    ap.add_argument("--drawing-budgets", action="store_true",
+                    help="only the section 'Drawing budgets' (issue 34's budgets of the drawing layer); print only")
     args = ap.parse_args(argv)
+    if args.drawing_budgets:
+        print("\n".join(budget_lines(drawing_budgets())))
+        return
     if not args.quick:
         require_plots(ap)
     from .kernels import cpu_info
@@ -749,6 +880,7 @@ def main(argv: list[str] | None = None) -> None:
     rows = study(models, args.quick)
     if not args.quick:
         kern["main_job"] = main_job()
+        kern["budgets"] = drawing_budgets()
         kern["machine"] = (machine, cpu_info())
         write_report(rows, kin_rows, thr, kern, args.out)
         print(f"wrote {args.out / 'benchmark.md'}")

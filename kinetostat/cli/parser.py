@@ -30,8 +30,9 @@ def _verbosity_options(parser: argparse.ArgumentParser, default) -> None:
                    help="errors only on stderr: no progress bar, information line or warning; no line saying "
                         "which files were written; results (tables, --out -) still go to stdout")
     g.add_argument("-v", "--verbose", dest="verbosity", action="store_const", const=VERBOSE, default=default,
-                   help="also the progress lines on stderr: per model its analysis, each engine route, the "
-                        "figures and plans of a report, each variant, each chunk of a sweep")
+                   help="also the progress lines on stderr: per model its analysis, each engine route of "
+                        "validate, each variant, each chunk of a sweep (report says its first line and each "
+                        "model's routes, figures, tables and plans without -v)")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -122,6 +122,10 @@ def cmd_variant(args) -> int:
     teacher_pack = not args.no_pack
     default = "task_variants" if args.all else jobs[0].name
     out = _writable_dir(args.out or default, "--out")
+    if args.all:                                    # the first line of a long job, before its first key
+        pack = "with the teacher's pack" if teacher_pack else "no pack"
+        log.info(one_line(f"variant --all: {len(jobs)} code(s) of task(s) {', '.join(map(str, tasks))} into {out}, "
+                          f"{pack}{', pages' if args.page else ''}"))
     t0 = time.perf_counter()
     keys = []
     eta = Forecast(log, len(jobs), "variant(s)", faster=(["--no-pack"] if teacher_pack else [])

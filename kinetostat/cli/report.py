@@ -1,4 +1,7 @@
-"""`report`: the per-mechanism error reports, in worker processes (`--jobs`), most work first.
+"""`report`: the per-mechanism error reports, in worker processes (`--jobs`), most work first; its
+first line (what it will do) once the options and models are checked, before any model's report,
+then each model's progress (engine routes, figures, tables, plans and page) as each part is done,
+logged at INFO.
 
 May use: `.common`, `kinetostat._forecast` (the estimated time), the solver, `kinetostat.report` and the harness (imported inside the command).
 """
@@ -45,7 +48,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
                 t1 = time.perf_counter()
                 res = analyze(mech, steps=steps)
                 secs = time.perf_counter() - t1
-        run = run_validation(mech, engines, steps, res=res, path=path)
+        run = run_validation(mech, engines, steps, res=res, path=path, level=logging.INFO)
         run.solver_seconds = secs
         earlier = Path(out) / folder / "page.html"
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
@@ -128,6 +131,9 @@ def cmd_report(args) -> int:
     earlier = _earlier_reports(args.check, out) if args.check is not None else None
     paths = args.models or bundled_models()
     prepared = _prepare(paths, args.steps)     # input errors stop the command before any route runs
+    jobs, cores = args.jobs or os.cpu_count() or 1, os.cpu_count() or 1
+    log.info(one_line(f"report: {len(paths)} model(s) into {out}: routes lever, {', '.join(engines)}; "
+                      f"{'pages' if args.page else 'no pages'}; {min(jobs, len(paths))} at a time"))
     _PREPARED.clear()
     _PREPARED.update({str(p): (mech, res, secs) for p, mech, res, secs in prepared})
     order = [p for p, *_ in prepared]
@@ -135,7 +141,6 @@ def cmd_report(args) -> int:
     t0 = time.perf_counter()
     summaries: dict[int, dict] = {}
     n_fail, n_err = 0, 0
-    jobs, cores = args.jobs or os.cpu_count() or 1, os.cpu_count() or 1
     eta = Forecast(log, len(order), "model(s)", parallel=jobs,
                    faster=([f"--jobs {cores}"] if jobs < cores else []) + (["--no-page"] if args.page else [])
                    + (["--engines none"] if engines != ["reference"] else []))

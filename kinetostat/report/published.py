@@ -4,6 +4,7 @@ May use: numpy, the solver (solve, analysis, model). Never matplotlib, the harne
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Callable
@@ -78,13 +79,11 @@ def exact_value(res: Analysis, p: Published) -> tuple[float, float]:
     return (at if p.reduce == "angle_of_max" else float(mag[k])), at
 
 
-def published_rows(mech: Mechanism) -> list[PublishedCheck]:
-    """Every `[[published]]` value of `mech` beside the exact one (empty if it has none); the
-    solver runs once per distinct set of angles."""
-    cache: dict[tuple[float, ...], Analysis] = {}
-    out = []
-    for p in mech.published:
-        if p.angles not in cache:
-            cache[p.angles] = analyze(mech, phi_deg=list(p.angles))
-        out.append(PublishedCheck(p, *exact_value(cache[p.angles], p)))
-    return out
+def published_rows(mech: Mechanism, at: Callable[[tuple[float, ...]], Analysis] | None = None) -> list[PublishedCheck]:
+    """Every `[[published]]` value of `mech` beside the exact one (empty if it has none); `at(angles)`:
+    the analysis at a published value's angles (deg), by the model's friction method (a report
+    run's `ModelRun.at`, shared with the report's other parts); default: the solver run once per
+    distinct set of angles."""
+    if at is None:
+        at = functools.cache(lambda angles: analyze(mech, phi_deg=list(angles)))
+    return [PublishedCheck(p, *exact_value(at(p.angles), p)) for p in mech.published]

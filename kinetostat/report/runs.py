@@ -16,7 +16,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from .._io import safe_name
-from ..analysis import Analysis
+from ..analysis import Analysis, friction_method
 from ..solve import analyze
 from ..model import Mechanism
 from .published import PublishedCheck, published_rows
@@ -114,6 +114,18 @@ class ModelRun:
     tolerances: dict = field(default_factory=dict)      # route -> Tolerance
     solver_seconds: float = 0.0                         # wall time of analyze() over the cycle
     published: list[PublishedCheck] = field(default_factory=list)   # the model's published values
+    analyses: dict = field(default_factory=dict)        # (angles, friction method) -> Analysis (`at`)
+
+    def at(self, phi_deg: Sequence[float], friction: str | None = None) -> Analysis:
+        """The model's analysis at the crank angles `phi_deg` (deg) by the friction method
+        `friction` (`analyze`'s; None: the model's), made once in a run: the parts of a report at
+        the same angles and method (figures, friction section, published values) share it, and
+        `res` stands for its own angles and method. The analysis' warnings are raised by the call
+        that makes it."""
+        key = (tuple(float(x) for x in phi_deg), friction_method(self.mech, friction) if self.mech.friction else "none")
+        if key not in self.analyses:
+            self.analyses[key] = analyze(self.mech, phi_deg=list(key[0]), friction=friction)
+        return self.analyses[key]
 
     @property
     def stem(self) -> str:
@@ -170,7 +182,8 @@ def _record(caught, where: str, out: list[str]) -> None:
 
 
 def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, res: Analysis | None = None,
-                   path: str | Path | None = None, on_route: Callable[[str], None] | None = None) -> ModelRun:
+                   path: str | Path | None = None, on_route: Callable[[str], None] | None = None,
+                   level: int = logging.DEBUG) -> ModelRun:
     """Check `res` (default: `analyze(mech, steps=steps)`) by the internal lever identity (route
     LEVER_ROUTE, always), against every route in `engines`, and against the model's published
     values (an exception there is the error of route "published").
@@ -178,7 +191,8 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
     Each route runs in its own `compare(..., engines=[route], res=res)` call; an exception of a
     route is recorded in `errors` (that route fails) and the other routes still run. Warnings
     raised meanwhile are collected, one line each, in `warnings`. `on_route(route)` is called
-    after each route (progress bars); each route's verdict and time is logged (DEBUG).
+    after each route (progress bars); each route's verdict and time is logged at `level`
+    (DEBUG: the -v line of `validate`; the report command's progress: INFO).
     """
     from kinetostat_validation.compare import LEVER, TOLERANCES, compare, lever_row
 
@@ -190,13 +204,14 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
             run.res = analyze(mech, steps=steps, friction="first")   # the engines' frictionless reactions
             run.solver_seconds = time.perf_counter() - t0
         _record(caught, "", run.warnings)
+    run.analyses[(tuple(float(x) for x in run.res.phi_deg), run.res.friction_method)] = run.res
     run.rows.append(lever_row(run.res))
     run.tolerances[LEVER] = TOLERANCES[LEVER]
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            run.published = published_rows(mech)
+            run.published = published_rows(mech, run.at)
         except Exception as exc:              # e.g. a published angle where the linkage does not assemble
             run.errors[PUBLISHED_ROUTE] = _one_line(exc)
     if mech.published:
@@ -219,7 +234,7 @@ def run_validation(mech: Mechanism, engines: Sequence[str], steps: int = 360, re
         if route in TOLERANCES:
             run.tolerances[route] = TOLERANCES[route]
         _record(caught, f"{route}: ", run.warnings)
-        log.debug("%s: route %s %s (%.1f s)", run.stem, route, run.status(route), run.seconds[route])
+        log.log(level, "%s: route %s %s (%.1f s)", run.stem, route, run.status(route), run.seconds[route])
         if on_route is not None:
             on_route(route)
     return run

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import time
 import warnings
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -15,7 +16,6 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
-from ..solve import analyze
 from ..model import Mechanism, model_text
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
@@ -288,6 +288,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
     doc.h(2, PLANS_HEADING)
+    t0 = time.perf_counter()
     try:
         with warnings.catch_warnings():         # the cycle's warnings are reported below
             warnings.simplefilter("ignore")
@@ -320,6 +321,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
         files.append(path)
     write_text(d / "segments.csv", plans.segments_csv())
     sheet.to_csv(d / "worksheet.csv")
+    log.info("%s: plans, worksheet%s (%.1f s)", d.name, " and page" if page else "", time.perf_counter() - t0)
     return files + [d / "segments.csv", d / "worksheet.csv"]
 
 
@@ -402,18 +404,20 @@ def _figure(value: Callable[[], float], why: str) -> str:
     return esc(f"undefined: {why}") if why else _fmt(value())
 
 
-def _friction_section(doc: Doc, m: Mechanism, res) -> None:
+def _friction_section(doc: Doc, run: ModelRun) -> None:
     """With [friction]: the exact solution with friction in the reactions beside the first
-    approximation of the course text (`res`, the cycle the engines checked): M_bal at the design
-    position, the energy lost per pair, the efficiency, the self-locking zones, the checks."""
+    approximation of the course text (`run.res`, the cycle the engines checked): M_bal at the design
+    position, the energy lost per pair, the efficiency, the self-locking zones, the checks; the
+    analyses the run's (`ModelRun.at`)."""
+    m, res = run.mech, run.res
     if m.friction is None or not len(res.phi_deg):
         return
     from ..errors import SelfLockingWarning
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SelfLockingWarning)
-        ex = analyze(m, phi_deg=res.phi_deg, friction="reactions")
-        at = analyze(m, phi_deg=[m.drive.design_deg], friction="reactions")
-        first = analyze(m, phi_deg=[m.drive.design_deg], friction="first")
+        ex = run.at(res.phi_deg, friction="reactions")
+        at = run.at([m.drive.design_deg], friction="reactions")
+        first = run.at([m.drive.design_deg], friction="first")
     M = esc(quantity_name(m, "M_bal"))
     doc.h(2, "Friction in the reactions")
     doc.p("The course text on friction computes the losses *in the first approximation*: the frictionless reactions "
@@ -494,7 +498,9 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     file depends only on the model, the routes and the steps (and the libraries' versions): no
     dates and no run times (printed by the command line only). A rerun reproduces the numbers
     within their tolerances, not byte for byte: errors at rounding level differ in their last
-    digits from machine to machine (`kinetostat.report.compare_reports` checks a rerun).
+    digits from machine to machine (`kinetostat.report.compare_reports` checks a rerun). Its
+    progress is logged (INFO) as each part is done: the figures, cycle.csv with the tables, then
+    the plans with their worksheet and page, each with its time.
     """
     m, res = run.mech, run.res
     folder = run.stem if folder is None else folder
@@ -505,8 +511,9 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     inside(out, d)
     published = run.published
     pic_deg = m.drive.design_deg
-    at = analyze(m, phi_deg=[pic_deg])
+    at = run.at([pic_deg])
     machine = m.drive.kind == "machine"
+    t0 = time.perf_counter()
     with plain_text():
         images = {
             "mechanism": plot_mechanism(at, res, d / "mechanism.svg"),
@@ -516,7 +523,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
             "errors": plot_errors(run, d / "errors.svg"),
             "hodographs": plot_hodographs(run, d / "hodographs.svg"),
         }
-    log.debug("%s: figures %s", folder, ", ".join(images))
+    log.info("%s: figures %s (%.1f s)", folder, ", ".join(images), time.perf_counter() - t0)
+    t0 = time.perf_counter()
     with atomic(d / "cycle.csv") as f:
         write_csv(res.to_frame(), f)
 
@@ -567,8 +575,9 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
                for p in m.pairs], "lrrrr")
 
     _three_routes_section(doc, m, res)
-    _friction_section(doc, m, res)
+    _friction_section(doc, run)
     _study_section(doc, m)
+    log.info("%s: cycle.csv and the tables (%.1f s)", folder, time.perf_counter() - t0)
 
     doc.h(2, "Errors against the engines")
     doc.p("Per route and quantity: max |engine − kinetostat| over the cycle (absolute) and the crank angle "
