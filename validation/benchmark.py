@@ -476,53 +476,45 @@ def _report_run(folder: str, models: tuple[str, ...] = (), *options: str) -> tup
 
 
 def main_job(runs: int = 3) -> dict:
-    """`kinetostat report` (--jobs 2, the default on 2 cores) in fresh processes, all into one
-    temporary folder: first every bundled model into the empty folder (each page drawn), then
-    `runs` times every bundled model and `runs` times the models of each MAIN_JOB_BEFORE entry
-    (each page kept: the folder holds the same page, as a checkout's reports/ does). Returns
-    {"drawn", "kept", "same"}: CPU and wall s of each run, the load before and after, the models."""
+    """`kinetostat report` (--jobs 2, the default on 2 cores) in fresh processes, each into a new
+    empty folder (every page drawn: a page is drawn every time): `runs` times every bundled model,
+    and `runs` times the models of each MAIN_JOB_BEFORE entry. Returns {"all", "same"}: CPU and
+    wall s of each run, the load before and after, the models."""
     import tempfile
     from .kernels import cpu_info
     n = _n_models()
 
-    def measured(folder: str, models: tuple[str, ...], times: int, what: str) -> dict:
+    def measured(models: tuple[str, ...], times: int) -> dict:
         load, cpu, wall = [cpu_info()["load"]], [], []
         for _ in range(times):
-            c, w = _report_run(folder, models)
+            with tempfile.TemporaryDirectory(prefix="kinetostat-report-") as folder:
+                c, w = _report_run(folder, models)
             cpu.append(c)
             wall.append(w)
-            print(f"main job: kinetostat report, {len(models) or n} models, pages {what}: {c:.1f} s CPU, {w:.1f} s wall",
-                  flush=True)
+            print(f"main job: kinetostat report, {len(models) or n} models: {c:.1f} s CPU, {w:.1f} s wall", flush=True)
         return dict(cpu=cpu, wall=wall, load=load + [cpu_info()["load"]], n=len(models) or n)
 
-    with tempfile.TemporaryDirectory(prefix="kinetostat-report-") as folder:
-        drawn = measured(folder, (), 1, "drawn")
-        kept = measured(folder, (), runs, "kept")
-        same = [measured(folder, b["models"], runs, "kept") for b in MAIN_JOB_BEFORE]
-    return dict(drawn=drawn, kept=kept, same=same)
+    every = measured((), runs)
+    return dict(all=every, same=[measured(b["models"], runs) for b in MAIN_JOB_BEFORE])
 
 
 def main_job_lines(mj: dict) -> list[str]:
     """The report's section on `kinetostat report` (`main_job`)."""
     row = lambda name, r: (f"| {name} | {r['n']} | {len(r['cpu'])} | {min(r['cpu']):.1f} / {statistics.median(r['cpu']):.1f} | "
                            f"{min(r['wall']):.1f} / {statistics.median(r['wall']):.1f} |")
-    kept = mj["kept"]
+    every = mj["all"]
     lines = ["## The main job: `kinetostat report` for every bundled model", "",
              "`kinetostat report --jobs 2` (per model: the solver, 5 engine routes, the 40-digit reference, "
-             "plots, plans, the interactive page, HTML), in a fresh process per run; CPU = user + sys of the "
-             "command and its two workers. Target: <= 10 s wall on this 2-core machine for every bundled "
-             "model. A model's interactive page is drawn only where the folder does not already hold the same "
-             "page (`plans.page.page_key`): \"pages kept\" is the folder of an earlier run with the same code and "
-             "models, as the committed reports/ are for a checkout; \"pages drawn\" an empty folder, or any "
-             "change to the code a page is drawn by (`plans.page.code_files`). Before: each commit below on its own models (no pages then), "
-             f"measured on this machine at the load average given. After: this run; load average "
-             f"{mj['drawn']['load'][0]} before the first run and {kept['load'][1]} after the kept runs.", "",
+             "plots, plans, the interactive page, HTML), in a fresh process per run, into an empty folder "
+             "(a page is drawn every time); CPU = user + sys of the command and its two workers. Before: each "
+             "commit below on its own models (no pages then), measured on this machine at the load average "
+             f"given. After: this run; load average {every['load'][0]} before the first run and "
+             f"{every['load'][1]} after.", "",
              "| the main job | models | runs | CPU s min / median | wall s min / median |", "|---|---|---|---|---|"]
     for b, r in zip(MAIN_JOB_BEFORE, mj["same"]):
         lines += [row(f"before ({b['commit']}, load {b['load']})", dict(b, n=len(b["models"]))),
-                  row(f"after (this run), the models of {b['commit']}, pages kept", r)]
-    return lines + [row("after (this run), every bundled model, pages kept", kept),
-                    row("after (this run), every bundled model, pages drawn", mj["drawn"])]
+                  row(f"after (this run), the models of {b['commit']}", r)]
+    return lines + [row("after (this run), every bundled model", every)]
 
 
 #: The drawing layer's budgets (issue 34), each a limit on what `drawing_budgets` measures: a page

@@ -250,6 +250,10 @@ class PlanCycle:
                 f"segments={len(self.segments)})")
 
 
+#: The decimals the interactive page writes a sheet with (`Drawing.svg`'s coord, length): its
+#: coordinates to 0.1 mm (a third of a pencil line, a third of a screen pixel at 96 dpi) and a
+#: segment's data-length-mm to 1e-6 mm (the page contract: segments.csv's length to 1e-6 mm, 5e-7 at most off).
+PAGE_DECIMALS = (1, 6)
 #: Where a Drawing's `static` markup takes the elements of an angle (`Drawing.svg`).
 ELEMENTS = "<!--elements-->\n"
 
@@ -291,10 +295,10 @@ class Element:
         fin = np.isfinite(self.xy).all(axis=2)
         return fin.sum(axis=1) >= 2 if self.tag == "polyline" else fin.all(axis=1)
 
-    def svg(self, i: int) -> str:
+    def svg(self, i: int, coord: int = 3, length: int = 9) -> str:
         """The element at angle i as SVG ("" where not drawn there): `<tag` + its coordinates,
-        each q = rint(1000 x) written with 3 decimals (`fixed`) + ` k="v"` for each of attrs in
-        order + ` data-length-mm="..."` (rint(1e9 L), 9 decimals) where it has lengths + `>` +
+        each q = rint(10^coord x) written with `coord` decimals (`fixed`) + ` k="v"` for each of
+        attrs in order + ` data-length-mm="..."` (rint(10^length L), `length` decimals) where it has lengths + `>` +
         `<title>title</title>` where it has one + a text's markup + `</tag>`. Coordinates: line
         x1 y1 x2 y2; circle cx cy; text x y; polyline points="x,y x,y ..." (its finite points);
         path d="Mx,y Lx,y ... z"; g none."""
@@ -305,8 +309,8 @@ class Element:
                 return ""
         elif not np.isfinite(xy).all():
             return ""
-        q = np.rint(xy * 1000.0).astype(np.int64).tolist()
-        c = [[fixed(v, 3) for v in p] for p in q]
+        q = np.rint(xy * 10.0 ** coord).astype(np.int64).tolist()
+        c = [[fixed(v, coord) for v in p] for p in q]
         if self.tag == "line":
             head = f' x1="{c[0][0]}" y1="{c[0][1]}" x2="{c[1][0]}" y2="{c[1][1]}"'
         elif self.tag == "circle":
@@ -322,7 +326,7 @@ class Element:
         head += "".join(f' {k}="{v}"' for k, v in self.attrs.items())
         if self.length_mm is not None:
             L = self.length_mm[i if len(self.length_mm) > 1 else 0]
-            head += f' data-length-mm="{fixed(int(np.rint(L * 1e9)), 9)}"'
+            head += f' data-length-mm="{fixed(int(np.rint(L * 10.0 ** length)), length)}"'
         body = f"<title>{self.title}</title>" if self.title else ""
         if self.tag == "text":
             body += self.texts[int(self.variant[i if len(self.variant) > 1 else 0])]
@@ -336,7 +340,8 @@ class Drawing:
     block that do not change) holding `ELEMENTS` once, where `elements`, in the order drawn, go.
     `svg(i)` in Python and the page's script in a browser write the same sheet of angle i from
     these arrays: `static` with ELEMENTS replaced by each element's `Element.svg(i)` + "\n"
-    (those drawn there)."""
+    (those drawn there). A sheet's file writes coordinates to 0.001 mm and lengths to 1e-9 mm;
+    the page to PAGE_DECIMALS."""
     kind: str
     phi_deg: np.ndarray                    # (N,) deg
     static: str
@@ -347,9 +352,10 @@ class Drawing:
         """The number of angles."""
         return len(self.phi_deg)
 
-    def svg(self, i: int) -> str:
-        """The whole SVG document of angle i (0 <= i < n)."""
+    def svg(self, i: int, coord: int = 3, length: int = 9) -> str:
+        """The whole SVG document of angle i (0 <= i < n), coordinates (mm) with `coord`
+        decimals and lengths (mm) with `length` (`Element.svg`)."""
         if not -self.n <= i < self.n:
             raise IndexError(f"{self.kind}: angle index {i} out of range for {self.n} angles")
-        body = "".join(s + "\n" for s in (e.svg(i) for e in self.elements) if s)
+        body = "".join(s + "\n" for s in (e.svg(i, coord, length) for e in self.elements) if s)
         return self.static.replace(ELEMENTS, body, 1)

@@ -47,7 +47,7 @@ import numpy as np
 
 from .._io import write_text
 from .._text import script_json
-from .core import ELEMENTS, Drawing
+from .core import ELEMENTS, PAGE_DECIMALS, Drawing
 from .draw import TINY_MM, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 
@@ -57,9 +57,12 @@ __all__ = ["page", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT
 PAGE_ANGLES = tuple(float(a) for a in range(360))
 #: The texts' rule for the two balancing moments (crank and lever), %.
 TOLERANCE_PCT = 5.0
-#: Decimals of a sheet's coordinates (mm) and of a segment's length (data-length-mm) as
-#: `Element.svg` writes them (each rint(10^d x), `core.fixed`): the page keeps them so.
-COORD_DECIMALS, LENGTH_DECIMALS = 3, 9
+#: Decimals of a sheet's coordinates (mm) and of a segment's length (data-length-mm) in the page
+#: (`core.PAGE_DECIMALS`; each rint(10^d x), `core.fixed`, as `Drawing.svg(i, *PAGE_DECIMALS)`).
+COORD_DECIMALS, LENGTH_DECIMALS = PAGE_DECIMALS
+#: Significant digits of the worksheet's values in the page (of each value's largest |value| over
+#: the cycle): the tables show 4; the files (worksheet.csv, cycle.csv) hold 12.
+VALUE_DIGITS = 9
 
 # ============================================================================ the numbers, small
 
@@ -121,7 +124,8 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
     element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each angle
     (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
-    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm); every series as
+    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not
+    drawn or NaN); every series as
     differences of the order that suits it (`_series`), or, where an earlier series of the sheet
     is the same (a line's end and its point), -1 - that series' index; as zigzag varints."""
     meta, series, seen = [], [], {}
@@ -147,7 +151,9 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
         for c in range(2 * m):
             put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS))
         if e.length_mm is not None:
-            put(_ints(np.asarray(e.length_mm, dtype=float).reshape(-1), LENGTH_DECIMALS))
+            L = np.asarray(e.length_mm, dtype=float).reshape(-1)
+            shown = np.isfinite(L) & (drawn if len(L) == rows else True)
+            put(_ints(_held(L, shown), LENGTH_DECIMALS))
         meta.append({"tag": e.tag, "attrs": [[k, v] for k, v in e.attrs.items()], "title": e.title,
                      "texts": list(e.texts), "m": m, "rows": rows, "holes": holes,
                      "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
@@ -157,13 +163,13 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
 
 
 def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
-    """Columns of values over frames (NaN: none): each column's exponent e (12 significant digits
+    """Columns of values over frames (NaN: none): each column's exponent e (VALUE_DIGITS significant digits
     of its largest |value|), and column by column its NaN mask (1: none) and round(v / 10^e) (NaN
     as 0), each a `_series`, as zigzag varints."""
     exps = []
     for col in values.T:
         top = np.nanmax(np.abs(col)) if np.isfinite(col).any() else 0.0
-        exps.append(int(math.floor(math.log10(top))) - 11 if top > 0 else 0)
+        exps.append(int(math.floor(math.log10(top))) - (VALUE_DIGITS - 1) if top > 0 else 0)
     scaled = np.rint(np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)).astype(np.int64)
     mask = (~np.isfinite(values)).astype(np.int64)
     parts = [_series(x) for c in range(values.shape[1]) for x in (mask[:, c], scaled[:, c])]
