@@ -153,8 +153,9 @@ _ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
 SLACK = 1.5
 #: The cost of covering a drawn line, per mm of it inside the label's box.
 LINE_COST = 0.6 / 0.7
-#: Candidates tested at once (cheapest first): a few, then more while angles are left to place.
-_BATCHES = (16, 16, 32, 64, 128)
+#: Candidates tested at once (cheapest first): at first at least this many, or as many as make
+#: _BATCH_CELLS candidates over the angles (one angle: all at once), twice as many from the third batch on.
+_BATCH, _BATCH_CELLS = 16, 4096
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
 
@@ -171,11 +172,6 @@ class Placed:
 def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Whether boxes a and b overlap (broadcast, last axis 4); False where either is NaN."""
     return (a[..., 0] < b[..., 2]) & (a[..., 2] > b[..., 0]) & (a[..., 1] < b[..., 3]) & (a[..., 3] > b[..., 1])
-
-
-def _inside(p: np.ndarray, box: np.ndarray) -> np.ndarray:
-    """Whether points p (..., 2) lie strictly inside boxes (broadcast, last axis 4); False where NaN."""
-    return (p[..., 0] > box[..., 0]) & (p[..., 0] < box[..., 2]) & (p[..., 1] > box[..., 1]) & (p[..., 1] < box[..., 3])
 
 
 def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
@@ -275,24 +271,26 @@ class Placer:
         clear = R[None, :] + (np.abs(nrm) * half).sum(axis=1)[:, None]    # (N, 42)
         C = np.where(has[:, None], A + d / 2, A)                          # rings about the segment's middle
         ring = (_RINGS[:, None] + (half @ _ABS_DIRS.T)[:, None, :]).reshape(n, -1)      # (N, 192)
-        centres = np.empty((n, len(T) + ring.shape[1], 2))                # (N, K, 2): beside, then the rings
+        K = len(T) + ring.shape[1]
+        xy = np.empty((2, n, K))                                          # candidates' centres: beside, then the rings
         for axis in (0, 1):
-            centres[:, :len(T), axis] = A[:, axis, None] + T * d[:, axis, None] + S * nrm[:, axis, None] * clear
-            centres[:, len(T):, axis] = C[:, axis, None] + _RING_DIRS[:, axis] * ring
-        base = np.empty((n, centres.shape[1]))
+            xy[axis, :, :len(T)] = A[:, axis, None] + T * d[:, axis, None] + S * nrm[:, axis, None] * clear
+            xy[axis, :, len(T):] = C[:, axis, None] + _RING_DIRS[:, axis] * ring
+        base = np.empty((n, K))
         base[:, :len(T)] = np.where(beside[:, None], R + _ALONG_OFF * np.minimum(L, 20.0)[:, None] / 20.0, np.inf)
         base[:, len(T):] = _RING_COST + np.where(has, 2.0, 0.0)[:, None]
         bx0, by0, bx1, by1 = self.bounds
         with np.errstate(invalid="ignore"):
-            x, y = centres[..., 0], centres[..., 1]
+            x, y = xy
             outside = (x < bx0 + half[:, :1]) | (y < by0 + half[:, 1:]) | (x > bx1 - half[:, :1]) | (y > by1 - half[:, 1:])
         base[outside | ~np.isfinite(A).all(axis=1)[:, None]] = np.inf
+        xy = np.where(np.isfinite(xy), xy, C.T[:, :, None])               # no centre beside no segment: never free
         still = bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
-        k = self._choose(centres, half, base, still)
+        k = self._choose(xy, half.T, base, still)
         at = np.arange(n)
-        c = np.where((k >= 0)[:, None], centres[at, np.maximum(k, 0)], np.nan)
+        c = np.where((k >= 0)[:, None], xy[:, at, np.maximum(k, 0)].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
         far = np.hypot(*(c - C).T) - half @ _REACH > LEADER_MM
         foot = np.clip(C, box[:, :2], box[:, 2:])
@@ -300,39 +298,46 @@ class Placer:
         self.block(box)
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
-    def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: bool) -> np.ndarray:
-        """Costs c (n', B) of the boxes centred at p (n', B, 2), half size h (n', 1, 2), at the angles
+    def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: tuple[bool, ...]) -> np.ndarray:
+        """Costs c (n', B) of the boxes centred at p (2, n', B), half size h (2, n'), at the angles
         `rows`: inf where a box meets a hard obstacle, plus LINE_COST per mm of the lines inside
-        it; of the obstacles the same at every angle (`still`) or of those that move."""
+        it; of the obstacles the same at every angle (`still` holds True) and of those that move
+        (False)."""
         free = np.isfinite(c)
         if not free.any():
             return c
-        region = np.concatenate([np.fmin.reduce(p, axis=1) - h[:, 0], np.fmax.reduce(p, axis=1) + h[:, 0]], axis=1)
-        hard = self._stack("hard", still)
-        r, j = _meets(hard if still else hard[rows], region)
-        if len(r):                                  # a box over an obstacle: its centre inside the obstacle grown by h
-            grown = hard[0 if still else rows[r], j] + np.concatenate([-h[r], h[r]], axis=2)[:, 0]    # (pairs, 4)
-            hit = _inside(p[r], grown[:, None])                                                        # (pairs, B)
-            starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
-            blocked = np.zeros(c.shape, dtype=bool)
-            blocked[r[starts]] = np.logical_or.reduceat(hit, starts, axis=0)
-            c = np.where(blocked, np.inf, c)
-            free = ~blocked & free
-        soft = self._stack("soft", still)
-        r, j = _meets(soft[..., 4:] if still else soft[rows, :, 4:], region)
-        if len(r):                                  # the lines each free box covers
-            ln = soft[0 if still else rows[r], j]                                                     # (pairs, 8)
-            f, q = np.nonzero(free[r] & _inside(p[r], (ln[:, 4:] + np.concatenate([-h[r], h[r]], axis=2)[:, 0])[:, None]))
-            hr = h[r[f], 0]
-            centre = p[r[f], q]
-            covered = np.bincount(r[f] * c.shape[1] + q, _clipped(ln[f, :4], np.concatenate([centre - hr, centre + hr], axis=1)),
-                                  c.size)
-            c = c + LINE_COST * covered.reshape(c.shape)
+        (px, py), (hx, hy) = p, h
+        region = np.column_stack([px.min(axis=1) - hx, py.min(axis=1) - hy, px.max(axis=1) + hx, py.max(axis=1) + hy])
+        blocked = np.zeros(c.shape, dtype=bool)
+        pairs = []
+        for key in ("hard", "soft"):
+            for fixed in still:
+                items = self._stack(key, fixed)
+                if not items.shape[1]:
+                    continue
+                r, j = _meets(items[..., -4:] if fixed else items[rows, :, -4:], region)
+                if not len(r):
+                    continue
+                items = items[0 if fixed else rows[r], j]                  # (pairs, 4 or 8)
+                X, Y, w, v = px[r], py[r], hx[r], hy[r]                    # a box over it: its centre inside it grown by h
+                inside = (X > (items[:, -4] - w)[:, None]) & (X < (items[:, -2] + w)[:, None]) \
+                    & (Y > (items[:, -3] - v)[:, None]) & (Y < (items[:, -1] + v)[:, None])     # (pairs, B)
+                if key == "hard":
+                    starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
+                    blocked[r[starts]] |= np.logical_or.reduceat(inside, starts, axis=0)
+                else:
+                    f, q = np.nonzero(inside & ~blocked[r] & free[r])
+                    pairs.append((r[f], q, items[f, :4]))
+        c = np.where(blocked, np.inf, c)
+        for r, q, ln in pairs:                                             # the lines each free box covers
+            x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
+            box = np.column_stack([x - w, y - v, x + w, y + v])
+            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln, box), c.size).reshape(c.shape)
         return c
 
     def _choose(self, centres: np.ndarray, half: np.ndarray, base: np.ndarray, still: bool) -> np.ndarray:
         """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of those centred at
-        `centres` (N, K, 2), half size `half` (N, 2), least costs `base` (N, K); `still`: the same
+        `centres` (2, N, K), half size `half` (2, N), least costs `base` (N, K); `still`: the same
         candidates at every angle. Free candidates' costs found cheapest first at every angle
         until none left can come within SLACK of the best; then the candidate within SLACK of the
         best at the most angles is taken there, and so on; where none is free, the cheapest
@@ -344,26 +349,25 @@ class Placer:
         best = np.full(n, np.inf)
         slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         tested = []
-        start = 0
-        for size in _BATCHES:
-            if start >= K:
-                break
+        start, size = 0, max(_BATCH, _BATCH_CELLS // n)
+        while start < K:
             rows = np.flatnonzero(np.isfinite(rest[:, start]) & (rest[:, start] <= best + slack))
             if not len(rows):
                 break
             idx = order[start:start + size]
             c = ordered[rows, start:start + size]
-            first = rows[:1] if still else rows                            # still: the still obstacles once
-            p, h = centres[first[:, None], idx], half[first, None]
-            c = np.broadcast_to(self._costs(p, h, c[:len(first)], first, True), c.shape)
-            if still:
-                p, h = np.broadcast_to(p, c.shape + (2,)), np.broadcast_to(h, (len(rows), 1, 2))
-            c = self._costs(p, h, c, rows, False)
+            if still:                                                       # the still obstacles once
+                p, h = centres[:, :1, idx], half[:, :1]
+                c = self._costs(p, h, c[:1], rows[:1], (True,))
+                c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
+                                np.broadcast_to(c, (len(rows), len(idx))), rows, (False,))
+            else:
+                c = self._costs(centres[:, rows[:, None], idx], half[:, rows], c, rows, (True, False))
             cost = np.full((n, len(idx)), np.inf)
             cost[rows] = c
             tested.append(cost)
             best[rows] = np.minimum(best[rows], c.min(axis=1))
-            start += size
+            start, size = start + size, size * (2 if len(tested) > 1 else 1)
         cost = np.concatenate(tested, axis=1) if tested else np.full((n, 0), np.inf)    # of order[:start]
         ok = cost <= best[:, None] + slack
         k = np.where(np.isfinite(base).any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
