@@ -232,7 +232,7 @@ class Placer:
         return a[:1] if len(a) > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape), equal_nan=True) else a
 
     def _add(self, key: str, part: np.ndarray) -> None:
-        self._parts.setdefault((key, len(part) == 1), []).append(part)
+        self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32))
 
     def _stack(self, key: str, still: bool) -> np.ndarray:
         """The hard obstacles (grown by PAD) (R, H, 4), or the lines and their bounding boxes
@@ -240,7 +240,7 @@ class Placer:
         last call appended."""
         parts = self._parts.get((key, still), [])
         rows = 1 if still else self.n
-        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8))))
+        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8), dtype=np.float32)))
         if done < len(parts):
             stacked = np.concatenate([stacked, *(np.broadcast_to(p, (rows,) + p.shape[1:]) for p in parts[done:])],
                                      axis=1)
@@ -288,7 +288,7 @@ class Placer:
         still = bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
-        k = self._choose(xy, half.T, base, still)
+        k = self._choose(xy.astype(np.float32), half.T.astype(np.float32), base, still)
         at = np.arange(n)
         c = np.where((k >= 0)[:, None], xy[:, at, np.maximum(k, 0)].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
