@@ -155,7 +155,7 @@ SLACK = 1.5
 LINE_COST = 0.6 / 0.7
 #: Candidates tested at once (cheapest first): at first at least this many, or as many as make
 #: _BATCH_CELLS candidates over the angles (one angle: all at once), twice as many from the third batch on.
-_BATCH, _BATCH_CELLS = 16, 4096
+_BATCH, _BATCH_CELLS = 32, 4096
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
 
@@ -178,12 +178,13 @@ def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
     """Length (mm) of each segment (x0, y0, x1, y1) strictly inside each box (broadcast, last axis
     4): the segment clipped to the box (Liang-Barsky; a segment parallel to a side divides by a
     signed zero: +-inf inside the slab or out of it, NaN on its edge); 0 where either is NaN."""
-    p, d = seg[..., :2], seg[..., 2:] - seg[..., :2]
+    x, y = seg[..., 0], seg[..., 1]
+    dx, dy = seg[..., 2] - x, seg[..., 3] - y
     with np.errstate(divide="ignore", invalid="ignore"):
-        t0, t1 = (box[..., :2] - p) / d, (box[..., 2:] - p) / d
-        t_in = np.maximum(np.minimum(t0, t1).max(axis=-1), 0.0)
-        t_out = np.minimum(np.maximum(t0, t1).min(axis=-1), 1.0)
-        length = (t_out - t_in) * np.hypot(d[..., 0], d[..., 1])
+        tx0, tx1, ty0, ty1 = (box[..., 0] - x) / dx, (box[..., 2] - x) / dx, (box[..., 1] - y) / dy, (box[..., 3] - y) / dy
+        t_in = np.maximum(np.maximum(np.minimum(tx0, tx1), np.minimum(ty0, ty1)), 0.0)
+        t_out = np.minimum(np.minimum(np.maximum(tx0, tx1), np.maximum(ty0, ty1)), 1.0)
+        length = (t_out - t_in) * np.hypot(dx, dy)
     return np.where(length > 0, length, 0.0)
 
 
@@ -343,7 +344,10 @@ class Placer:
         best at the most angles is taken there, and so on; where none is free, the cheapest
         (nowhere free: the test tells)."""
         n, K = base.shape
-        order = np.argsort(np.where(np.isfinite(base), base, 1e9).mean(axis=0), kind="stable")
+        fin = np.isfinite(base)
+        with np.errstate(invalid="ignore"):                                # by the mean where finite; nowhere: last
+            typical = np.where(fin, base, 0.0).sum(axis=0) / fin.sum(axis=0)
+        order = np.argsort(np.where(np.isnan(typical), np.inf, typical), kind="stable")
         ordered = base[:, order]
         rest = np.minimum.accumulate(ordered[:, ::-1], axis=1)[:, ::-1]   # least base from j on
         best = np.full(n, np.inf)
@@ -369,15 +373,17 @@ class Placer:
             best[rows] = np.minimum(best[rows], c.min(axis=1))
             start, size = start + size, size * (2 if len(tested) > 1 else 1)
         cost = np.concatenate(tested, axis=1) if tested else np.full((n, 0), np.inf)    # of order[:start]
-        ok = cost <= best[:, None] + slack
-        k = np.where(np.isfinite(base).any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
+        ok = (cost <= best[:, None] + slack) & np.isfinite(cost)
+        cols = np.flatnonzero(ok.any(axis=0))                              # within SLACK somewhere
+        ok = ok[:, cols]
+        within = np.where(ok, cost[:, cols], 0.0)
+        k = np.where(fin.any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
         todo = np.isfinite(best)
         while todo.any():
-            hit = ok & todo[:, None]
-            count = hit.sum(axis=0)
-            total = np.where(hit, cost, 0.0).sum(axis=0)
-            j = np.lexsort((np.arange(len(count)), total, -count))[0]    # most angles, then least cost, then order
-            sel = hit[:, j]
-            k[sel] = order[j]
+            left = todo.astype(float)
+            count, total = left @ ok, left @ within                        # over the angles left
+            j = np.lexsort((np.arange(len(cols)), total, -count))[0]     # most angles, then least cost, then order
+            sel = ok[:, j] & todo
+            k[sel] = order[cols[j]]
             todo &= ~sel
         return k
