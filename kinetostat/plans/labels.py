@@ -304,31 +304,29 @@ class Placer:
         `rows`: inf where a box meets a hard obstacle, plus LINE_COST per mm of the lines inside
         it; of the obstacles the same at every angle (`still` holds True) and of those that move
         (False)."""
+        stacks = [(key, fixed, items) for key in ("hard", "soft") for fixed in still
+                  for items in (self._stack(key, fixed),) if items.shape[1]]
         free = np.isfinite(c)
-        if not free.any():
+        if not stacks or not free.any():
             return c
         (px, py), (hx, hy) = p, h
         region = np.column_stack([px.min(axis=1) - hx, py.min(axis=1) - hy, px.max(axis=1) + hx, py.max(axis=1) + hy])
         blocked = np.zeros(c.shape, dtype=bool)
         pairs = []
-        for key in ("hard", "soft"):
-            for fixed in still:
-                items = self._stack(key, fixed)
-                if not items.shape[1]:
-                    continue
-                r, j = _meets(items[..., -4:] if fixed else items[rows, :, -4:], region)
-                if not len(r):
-                    continue
-                items = items[0 if fixed else rows[r], j]                  # (pairs, 4 or 8)
-                X, Y, w, v = px[r], py[r], hx[r], hy[r]                    # a box over it: its centre inside it grown by h
-                inside = (X > (items[:, -4] - w)[:, None]) & (X < (items[:, -2] + w)[:, None]) \
-                    & (Y > (items[:, -3] - v)[:, None]) & (Y < (items[:, -1] + v)[:, None])     # (pairs, B)
-                if key == "hard":
-                    starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
-                    blocked[r[starts]] |= np.logical_or.reduceat(inside, starts, axis=0)
-                else:
-                    f, q = np.nonzero(inside & ~blocked[r] & free[r])
-                    pairs.append((r[f], q, items[f, :4]))
+        for key, fixed, items in stacks:                                   # the hard ones first
+            r, j = _meets(items[..., -4:] if fixed else items[rows, :, -4:], region)
+            if not len(r):
+                continue
+            items = items[0 if fixed else rows[r], j]                     # (pairs, 4 or 8)
+            X, Y, w, v = px[r], py[r], hx[r], hy[r]                       # a box over it: its centre inside it grown by h
+            inside = (X > (items[:, -4] - w)[:, None]) & (X < (items[:, -2] + w)[:, None]) \
+                & (Y > (items[:, -3] - v)[:, None]) & (Y < (items[:, -1] + v)[:, None])         # (pairs, B)
+            if key == "hard":
+                starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
+                blocked[r[starts]] |= np.logical_or.reduceat(inside, starts, axis=0)
+            else:
+                f, q = np.nonzero(inside & ~blocked[r] & free[r])
+                pairs.append((r[f], q, items[f, :4]))
         c = np.where(blocked, np.inf, c)
         for r, q, ln in pairs:                                             # the lines each free box covers
             x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
