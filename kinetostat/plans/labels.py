@@ -337,8 +337,9 @@ class Placer:
     def _choose(self, centres: np.ndarray, half: np.ndarray, base: np.ndarray, still: bool) -> np.ndarray:
         """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of those centred at
         `centres` (2, N, K), half size `half` (2, N), least costs `base` (N, K); `still`: the same
-        candidates at every angle. Free candidates' costs found cheapest first at every angle
-        until none left can come within SLACK of the best; then the candidate within SLACK of the
+        candidates at every angle. Free candidates' costs found in batches, in the order of their
+        mean base where finite, at every angle until none left there can come within SLACK of the
+        best; then the candidate within SLACK of the
         best at the most angles is taken there, and so on; where none is free, the cheapest
         (nowhere free: the test tells)."""
         n, K = base.shape
