@@ -153,9 +153,9 @@ _ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
 SLACK = 1.5
 #: The cost of covering a drawn line, per mm of it inside the label's box.
 LINE_COST = 0.6 / 0.7
-#: Candidates tested at once (cheapest first): at first at least this many (three rings), or as many as make
-#: _BATCH_CELLS candidates over the angles (one angle: all at once), twice as many from the third batch on.
-_BATCH, _BATCH_CELLS = 48, 4096
+#: Candidates tested at once (cheapest first): this many (a point label's three nearest rings),
+#: twice as many from the third batch on.
+_BATCH = 48
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
 
@@ -352,7 +352,7 @@ class Placer:
         best = np.full(n, np.inf)
         slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         tested = []
-        start, size = 0, max(_BATCH, _BATCH_CELLS // n)
+        start, size = 0, _BATCH
         while start < K:
             rows = np.flatnonzero(np.isfinite(rest[:, start]) & (rest[:, start] <= best + slack))
             if not len(rows):
