@@ -348,13 +348,13 @@ class Placer:
             typical = np.where(fin, base, 0.0).sum(axis=0) / fin.sum(axis=0)
         order = np.argsort(np.where(np.isnan(typical), np.inf, typical), kind="stable")
         ordered = base[:, order]
-        rest = np.minimum.accumulate(ordered[:, ::-1], axis=1)[:, ::-1]   # least base from j on
         best = np.full(n, np.inf)
         slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         tested = []
         start, size = 0, _BATCH
         while start < K:
-            rows = np.flatnonzero(np.isfinite(rest[:, start]) & (rest[:, start] <= best + slack))
+            rest = ordered[:, start:].min(axis=1)                          # the least base left
+            rows = np.flatnonzero(np.isfinite(rest) & (rest <= best + slack))
             if not len(rows):
                 break
             idx = order[start:start + size]
