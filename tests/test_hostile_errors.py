@@ -211,17 +211,20 @@ def test_a_scale_that_draws_beyond_a_sheet_is_refused(scale, message, tmp_path, 
 
 
 def test_the_drawings_loops_are_bounded_by_a_sheet():
-    """What a plan near MAX_EXTENT_MM draws: the frame's hatching is capped (counted), whatever the
-    length handed to it; a zero-length stretch is no error; the labels' placer clips a line to each
-    candidate box (no samples along it), so a line 1e12 mm long costs what a short one does."""
+    """What a plan near MAX_EXTENT_MM draws: the frame's hatching (its ends (N,) over the angles)
+    is capped at 50 strokes, as many at every angle as the stretch's length at the first gives,
+    whatever the length handed to it; a zero-length stretch is no error; the labels' placer clips a
+    line to each candidate box (no samples along it), so a line 1e12 mm long costs what a short
+    one does."""
     import numpy as np
     from kinetostat.plans.labels import Placer
     from kinetostat.plans.mechanism import _hatch
     paths: dict = {}
-    _hatch(0j, 1e12 + 0j, 1j, "h", paths)
+    _hatch(np.array([0j, 0j]), np.array([1e12 + 0j, 3.0 + 0j]), 1j, "h", paths)
     assert len(paths) == 1 + 50                         # the line and its strokes every 2 mm over 100 mm
+    assert all(v.shape == (2, 2) for v in paths.values())      # each at both angles
     paths.clear()
-    _hatch(1e19 + 0j, 1e19 + 0j, 1j, "h", paths)       # both ends one float at 1e19 mm
+    _hatch(np.array([1e19 + 0j]), np.array([1e19 + 0j]), 1j, "h", paths)       # both ends one float at 1e19 mm
     assert len(paths) == 1
     placer = Placer(1, (0.0, 0.0, 420.0, 297.0))
     placer.line([0.0, 100.0, 1e12, 100.0])

@@ -568,6 +568,16 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
     return out
 
 
+def _distinct_rows(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """np.unique(mask, axis=0, return_inverse=True) of a bool array (R, M), by the rows' bytes (the
+    same sorted rows; the structured-dtype sort of np.unique costs milliseconds a call)."""
+    keys = [row.tobytes() for row in np.ascontiguousarray(mask)]
+    distinct = sorted(set(keys))
+    index = {k: i for i, k in enumerate(distinct)}
+    rows = np.frombuffer(b"".join(distinct), dtype=bool).reshape(len(distinct), mask.shape[1])
+    return rows, np.array([index[k] for k in keys], dtype=int)
+
+
 def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_Name]]:
     """The lettered points' dots and their labels (the design position's first, then the numbered
     ones of a plan of positions), coincident points lettered once ('B1 ≡ B11')."""
@@ -594,9 +604,9 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
             lead = owner[:, j] == j
             if not lead.any():
                 continue
-            rows, inverse = np.unique((owner == j)[lead], axis=0, return_inverse=True)
+            rows, inverse = _distinct_rows((owner == j)[lead])
             variant = np.zeros(len(lead), dtype=int)
-            variant[lead] = inverse.reshape(-1)
+            variant[lead] = inverse
             texts = tuple(" ≡ ".join(group[m][0] for m in np.nonzero(row)[0]) for row in rows)
             labels.append(_Name(texts, variant, _where(lead, p), None,
                                 _NUMBERED_MM if numbered else _POINT_MM, "label"))

@@ -142,6 +142,7 @@ _DIRS = _constant(np.column_stack([np.cos(np.radians(np.arange(0, 360, 22.5) + 4
 _ABS_DIRS = _constant(np.abs(_DIRS))
 _REACH = _constant(_ABS_DIRS.max(axis=0))      # a label's half size times this: how far its box reaches
 _RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0]))
+_RING_DIRS = _constant(np.tile(_DIRS, (len(_RINGS), 1)))       # each ring candidate's direction, ring by ring
 _RING_COST = _constant((1.2 * _RINGS[:, None] + np.where(_DIRS[:, 1] > 0, 0.3, 0.0)).reshape(-1))
 #: Beside a segment: at these fractions T of its length, on either side S, at these clearances R
 #: (mm), each (42,); the cost's part for leaving the middle, 6 |T - 0.5| (times min(L, 20) / 20).
@@ -152,7 +153,8 @@ _ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
 SLACK = 1.5
 #: The cost of covering a drawn line, per mm of it inside the label's box.
 LINE_COST = 0.6 / 0.7
-#: Candidates tested at once (cheapest first).
+#: Candidates tested at once (cheapest first): this many (a point label's three nearest rings),
+#: twice as many from the third batch on.
 _BATCH = 48
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
@@ -176,12 +178,13 @@ def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
     """Length (mm) of each segment (x0, y0, x1, y1) strictly inside each box (broadcast, last axis
     4): the segment clipped to the box (Liang-Barsky; a segment parallel to a side divides by a
     signed zero: +-inf inside the slab or out of it, NaN on its edge); 0 where either is NaN."""
-    p, d = seg[..., :2], seg[..., 2:] - seg[..., :2]
+    x, y = seg[..., 0], seg[..., 1]
+    dx, dy = seg[..., 2] - x, seg[..., 3] - y
     with np.errstate(divide="ignore", invalid="ignore"):
-        t0, t1 = (box[..., :2] - p) / d, (box[..., 2:] - p) / d
-        t_in = np.maximum(np.minimum(t0, t1).max(axis=-1), 0.0)
-        t_out = np.minimum(np.maximum(t0, t1).min(axis=-1), 1.0)
-        length = (t_out - t_in) * np.hypot(d[..., 0], d[..., 1])
+        tx0, tx1, ty0, ty1 = (box[..., 0] - x) / dx, (box[..., 2] - x) / dx, (box[..., 1] - y) / dy, (box[..., 3] - y) / dy
+        t_in = np.maximum(np.maximum(np.minimum(tx0, tx1), np.minimum(ty0, ty1)), 0.0)
+        t_out = np.minimum(np.minimum(np.maximum(tx0, tx1), np.maximum(ty0, ty1)), 1.0)
+        length = (t_out - t_in) * np.hypot(dx, dy)
     return np.where(length > 0, length, 0.0)
 
 
@@ -191,20 +194,11 @@ def _bounds(items: np.ndarray) -> np.ndarray:
                           axis=-1)
 
 
-def _near(items: np.ndarray, bb: np.ndarray, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Of `items` (N, H, 4) (boxes, or segments) with their bounding boxes `bb`, at each angle
-    those whose box meets `region` (N, 4), packed (N, m, 4), NaN-padded (m the most at any
-    angle), and their bounding boxes."""
-    near = (bb[..., 0] <= region[:, None, 2]) & (bb[..., 2] >= region[:, None, 0]) \
-        & (bb[..., 1] <= region[:, None, 3]) & (bb[..., 3] >= region[:, None, 1])
-    if len(items) == 1:
-        return items[:, near[0]], bb[:, near[0]]
-    rank = np.cumsum(near, axis=1) - 1
-    r, j = np.nonzero(near)
-    out = np.full((2, len(items), int(near.sum(axis=1).max(initial=0)), 4), np.nan)
-    out[0, r, rank[r, j]] = items[r, j]
-    out[1, r, rank[r, j]] = bb[r, j]
-    return out[0], out[1]
+def _meets(bb: np.ndarray, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(row, item) of the items whose bounding boxes `bb` (R, H, 4) (R = 1: the same at every row)
+    meet `region` (n', 4), row by row."""
+    return np.nonzero((bb[..., 0] <= region[:, None, 2]) & (bb[..., 2] >= region[:, None, 0])
+                      & (bb[..., 1] <= region[:, None, 3]) & (bb[..., 3] >= region[:, None, 1]))
 
 
 class Placer:
@@ -239,7 +233,7 @@ class Placer:
         return a[:1] if len(a) > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape), equal_nan=True) else a
 
     def _add(self, key: str, part: np.ndarray) -> None:
-        self._parts.setdefault((key, len(part) == 1), []).append(part)
+        self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32))
 
     def _stack(self, key: str, still: bool) -> np.ndarray:
         """The hard obstacles (grown by PAD) (R, H, 4), or the lines and their bounding boxes
@@ -247,7 +241,7 @@ class Placer:
         last call appended."""
         parts = self._parts.get((key, still), [])
         rows = 1 if still else self.n
-        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8))))
+        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8), dtype=np.float32)))
         if done < len(parts):
             stacked = np.concatenate([stacked, *(np.broadcast_to(p, (rows,) + p.shape[1:]) for p in parts[done:])],
                                      axis=1)
@@ -265,7 +259,6 @@ class Placer:
         w, (up, down) = widths[variant], heights[variant].T
         half = np.column_stack([w / 2, (up + down) / 2])                 # (N, 2)
         A = np.asarray(anchor, dtype=float)
-        cands, base = [], []
         if along is None:
             along = np.full((n, 2), np.nan)
         d = along - A
@@ -277,98 +270,119 @@ class Placer:
         nrm = np.column_stack([-u[:, 1], u[:, 0]])
         T, S, R = _ALONG
         clear = R[None, :] + (np.abs(nrm) * half).sum(axis=1)[:, None]    # (N, 42)
-        cands.append(A[:, None] + T[None, :, None] * d[:, None] + S[None, :, None] * nrm[:, None] * clear[..., None])
-        base.append(np.where(beside[:, None], R[None, :] + _ALONG_OFF[None, :] * np.minimum(L, 20.0)[:, None] / 20.0,
-                             np.inf))
         C = np.where(has[:, None], A + d / 2, A)                          # rings about the segment's middle
-        ring = _RINGS[None, :, None] + (half @ _ABS_DIRS.T)[:, None, :]   # (N, 12, 16)
-        cands.append((C[:, None, None] + _DIRS[None, None] * ring[..., None]).reshape(n, -1, 2))
-        base.append(_RING_COST[None, :] + np.where(has, 2.0, 0.0)[:, None])
-        centres = np.concatenate(cands, axis=1)                           # (N, K, 2)
-        boxes = np.concatenate([centres - half[:, None], centres + half[:, None]], axis=2)
+        ring = (_RINGS[:, None] + (half @ _ABS_DIRS.T)[:, None, :]).reshape(n, -1)      # (N, 192)
+        K = len(T) + ring.shape[1]
+        xy = np.empty((2, n, K))                                          # candidates' centres: beside, then the rings
+        for axis in (0, 1):
+            xy[axis, :, :len(T)] = A[:, axis, None] + T * d[:, axis, None] + S * nrm[:, axis, None] * clear
+            xy[axis, :, len(T):] = C[:, axis, None] + _RING_DIRS[:, axis] * ring
+        base = np.empty((n, K))
+        base[:, :len(T)] = np.where(beside[:, None], R + _ALONG_OFF * np.minimum(L, 20.0)[:, None] / 20.0, np.inf)
+        base[:, len(T):] = _RING_COST + np.where(has, 2.0, 0.0)[:, None]
         bx0, by0, bx1, by1 = self.bounds
-        outside = (boxes[..., 0] < bx0) | (boxes[..., 1] < by0) | (boxes[..., 2] > bx1) | (boxes[..., 3] > by1)
-        base = np.where(outside, np.inf, np.concatenate(base, axis=1))
-        base[~np.isfinite(A).all(axis=1)] = np.inf
-        k = self._choose(boxes, base)
+        with np.errstate(invalid="ignore"):
+            x, y = xy
+            outside = (x < bx0 + half[:, :1]) | (y < by0 + half[:, 1:]) | (x > bx1 - half[:, :1]) | (y > by1 - half[:, 1:])
+        base[outside | ~np.isfinite(A).all(axis=1)[:, None]] = np.inf
+        xy = np.where(np.isfinite(xy), xy, C.T[:, :, None])               # no centre beside no segment: never free
+        still = bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
+                     and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
+                     and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
+        k = self._choose(xy.astype(np.float32), half.T.astype(np.float32), base, still)
         at = np.arange(n)
-        box = np.where((k >= 0)[:, None], boxes[at, np.maximum(k, 0)], np.nan)
-        centre = (box[:, :2] + box[:, 2:]) / 2
-        far = np.hypot(*(centre - C).T) - half @ _REACH > LEADER_MM
+        c = np.where((k >= 0)[:, None], xy[:, at, np.maximum(k, 0)].T, np.nan)
+        box = np.concatenate([c - half, c + half], axis=1)
+        far = np.hypot(*(c - C).T) - half @ _REACH > LEADER_MM
         foot = np.clip(C, box[:, :2], box[:, 2:])
         leader = np.where(far[:, None], np.concatenate([C, foot], axis=1), np.nan)
         self.block(box)
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
-    @classmethod
-    def _costs(cls, b: np.ndarray, c: np.ndarray, hard: np.ndarray, soft: np.ndarray) -> np.ndarray:
-        """Costs c (n', B) of boxes b (n', B, 4): inf where a box meets a hard obstacle (n', H, 4),
-        plus LINE_COST per mm of the lines (n', L, 8: with their bounding boxes) inside it."""
+    def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: tuple[bool, ...]) -> np.ndarray:
+        """Costs c (n', B) of the boxes centred at p (2, n', B), half size h (2, n'), at the angles
+        `rows`: inf where a box meets a hard obstacle, plus LINE_COST per mm of the lines inside
+        it; of the obstacles the same at every angle (`still` holds True) and of those that move
+        (False)."""
+        stacks = [(key, fixed, items) for key in ("hard", "soft") for fixed in still
+                  for items in (self._stack(key, fixed),) if items.shape[1]]
         free = np.isfinite(c)
-        if not free.any() or not (hard.shape[1] or soft.shape[1]):
+        if not stacks or not free.any():
             return c
-        region = np.concatenate([np.where(free[..., None], b[..., :2], np.inf).min(axis=1),
-                                 np.where(free[..., None], b[..., 2:], -np.inf).max(axis=1)], axis=1)
-        ob, _ = _near(hard, hard, region)
-        if ob.shape[1]:
-            c = np.where(_overlap(b[:, :, None], ob[:, None]).any(axis=2), np.inf, c)
-        ln, bb = _near(soft[..., :4], soft[..., 4:], region)
-        if ln.shape[1]:                             # the lines each free box covers
-            c = c + cls._covered(b, np.isfinite(c), ln, bb)
+        (px, py), (hx, hy) = p, h
+        region = np.column_stack([px.min(axis=1) - hx, py.min(axis=1) - hy, px.max(axis=1) + hx, py.max(axis=1) + hy])
+        blocked = np.zeros(c.shape, dtype=bool)
+        pairs = []
+        for key, fixed, items in stacks:                                   # the hard ones first
+            r, j = _meets(items[..., -4:] if fixed else items[rows, :, -4:], region)
+            if not len(r):
+                continue
+            items = items[0 if fixed else rows[r], j]                     # (pairs, 4 or 8)
+            X, Y, w, v = px[r], py[r], hx[r], hy[r]                       # a box over it: its centre inside it grown by h
+            inside = (X > (items[:, -4] - w)[:, None]) & (X < (items[:, -2] + w)[:, None]) \
+                & (Y > (items[:, -3] - v)[:, None]) & (Y < (items[:, -1] + v)[:, None])         # (pairs, B)
+            if key == "hard":
+                starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
+                blocked[r[starts]] |= np.logical_or.reduceat(inside, starts, axis=0)
+            else:
+                f, q = np.nonzero(inside & ~blocked[r] & free[r])
+                pairs.append((r[f], q, items[f, :4]))
+        c = np.where(blocked, np.inf, c)
+        for r, q, ln in pairs:                                             # the lines each free box covers
+            x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
+            box = np.column_stack([x - w, y - v, x + w, y + v])
+            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln, box), c.size).reshape(c.shape)
         return c
 
-    @staticmethod
-    def _covered(b: np.ndarray, which: np.ndarray, ln: np.ndarray, bb: np.ndarray) -> np.ndarray:
-        """LINE_COST times the length of the lines `ln` (n', m, 4) (bounding boxes `bb`) inside
-        each box b (n', B, 4) where `which` (n', B), else 0: each line clipped only to the boxes
-        its bounds meet."""
-        r, j = np.nonzero(which)
-        fb, lb = b[r, j][:, None], bb[r]
-        f, m = np.nonzero((lb[..., 0] < fb[..., 2]) & (lb[..., 2] > fb[..., 0])
-                          & (lb[..., 1] < fb[..., 3]) & (lb[..., 3] > fb[..., 1]))
-        out = np.zeros(which.shape)
-        out[r, j] = LINE_COST * np.bincount(f, _clipped(ln[r[f], m], fb[f, 0]), len(r))
-        return out
-
-    def _choose(self, boxes: np.ndarray, base: np.ndarray) -> np.ndarray:
-        """The candidate (N,) taken at each angle (-1: none, the anchor NaN): free candidates'
-        costs found cheapest first at every angle until none left can come within SLACK of the
-        best; then the candidate within SLACK of the best at the most angles is taken there, and
-        so on; where none is free, the cheapest (nowhere free: the test tells)."""
+    def _choose(self, centres: np.ndarray, half: np.ndarray, base: np.ndarray, still: bool) -> np.ndarray:
+        """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of those centred at
+        `centres` (2, N, K), half size `half` (2, N), least costs `base` (N, K); `still`: the same
+        candidates at every angle. Free candidates' costs found in batches, in the order of their
+        mean base where finite, at every angle until none left there can come within SLACK of the
+        best; then the candidate within SLACK of the
+        best at the most angles is taken there, and so on; where none is free, the cheapest
+        (nowhere free: the test tells)."""
         n, K = base.shape
-        order = np.argsort(np.where(np.isfinite(base), base, 1e9).mean(axis=0), kind="stable")
+        fin = np.isfinite(base)
+        with np.errstate(invalid="ignore"):                                # by the mean where finite; nowhere: last
+            typical = np.where(fin, base, 0.0).sum(axis=0) / fin.sum(axis=0)
+        order = np.argsort(np.where(np.isnan(typical), np.inf, typical), kind="stable")
         ordered = base[:, order]
-        rest = np.minimum.accumulate(ordered[:, ::-1], axis=1)[:, ::-1]   # least base from j on
-        cost = np.full((n, K), np.inf)
         best = np.full(n, np.inf)
-        still = np.array_equal(boxes, np.broadcast_to(boxes[:1], boxes.shape), equal_nan=True) \
-            and np.array_equal(base, np.broadcast_to(base[:1], base.shape))   # the same candidates at every angle
         slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
-        for start in range(0, K, _BATCH):
-            rows = np.nonzero(rest[:, start] <= best + slack)[0]
+        tested = []
+        start, size = 0, _BATCH
+        while start < K:
+            rest = ordered[:, start:].min(axis=1)                          # the least base left
+            rows = np.flatnonzero(np.isfinite(rest) & (rest <= best + slack))
             if not len(rows):
                 break
-            idx = order[start:start + _BATCH]
-            b = boxes[rows[:, None], idx]                                   # (n', B, 4)
-            c = base[rows[:, None], idx]
+            idx = order[start:start + size]
+            c = ordered[rows, start:start + size]
             if still:                                                       # the still obstacles once
-                c = np.broadcast_to(self._costs(b[:1], c[:1], self._stack("hard", True), self._stack("soft", True)),
-                                    c.shape)
+                p, h = centres[:, :1, idx], half[:, :1]
+                c = self._costs(p, h, c[:1], rows[:1], (True,))
+                c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
+                                np.broadcast_to(c, (len(rows), len(idx))), rows, (False,))
             else:
-                c = self._costs(b, c, *(np.broadcast_to(a, (len(rows),) + a.shape[1:])
-                                        for a in (self._stack("hard", True), self._stack("soft", True))))
-            c = self._costs(b, c, self._stack("hard", False)[rows], self._stack("soft", False)[rows])
-            cost[rows[:, None], idx] = c
+                c = self._costs(centres[:, rows[:, None], idx], half[:, rows], c, rows, (True, False))
+            cost = np.full((n, len(idx)), np.inf)
+            cost[rows] = c
+            tested.append(cost)
             best[rows] = np.minimum(best[rows], c.min(axis=1))
-        ok = cost <= best[:, None] + slack
-        k = np.where(np.isfinite(base).any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
+            start, size = start + size, size * (2 if len(tested) > 1 else 1)
+        cost = np.concatenate(tested, axis=1) if tested else np.full((n, 0), np.inf)    # of order[:start]
+        ok = (cost <= best[:, None] + slack) & np.isfinite(cost)
+        cols = np.flatnonzero(ok.any(axis=0))                              # within SLACK somewhere
+        ok = ok[:, cols]
+        within = np.where(ok, cost[:, cols], 0.0)
+        k = np.where(fin.any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
         todo = np.isfinite(best)
         while todo.any():
-            hit = ok & todo[:, None]
-            count = hit.sum(axis=0)
-            total = np.where(hit, cost, 0.0).sum(axis=0)
-            j = np.lexsort((order.argsort(), total, -count))[0]          # most angles, then least cost
-            sel = hit[:, j]
-            k[sel] = j
+            left = todo.astype(float)
+            count, total = left @ ok, left @ within                        # over the angles left
+            j = np.lexsort((np.arange(len(cols)), total, -count))[0]     # most angles, then least cost, then order
+            sel = ok[:, j] & todo
+            k[sel] = order[cols[j]]
             todo &= ~sel
         return k
