@@ -1,5 +1,5 @@
 """Sheets in a real browser: Debian's headless Chromium driven by Playwright measures every text's
-and arrowhead's box (getBBox, in the SVG's millimetres) and reports the overlaps a reader would
+arrowhead's and point's box (getBBox, in the SVG's millimetres) and reports the overlaps a reader would
 see. Used by tests/test_sheet_layout.py; as a script (`python tests/sheet_browser.py OUT file.svg
 ...`) it writes PNG screenshots of sheets.
 
@@ -15,13 +15,13 @@ from pathlib import Path
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
         "--disable-component-update", "--no-first-run"]
 
-#: Boxes of every text and arrowhead, in SVG user units (mm: the sheets use no transforms), with their text.
+#: Boxes of every text, arrowhead and point (a dot of the plan), in SVG user units (mm: the sheets
+#: use no transforms), with their text.
 _MEASURE = """() => {
   const out = [];
-  for (const el of document.querySelectorAll('text, path.arrowhead')) {
-    const b = el.getBBox();
-    out.push({tag: el.tagName === 'text' ? 'text' : 'arrow', text: el.textContent,
-              box: [b.x, b.y, b.x + b.width, b.y + b.height]});
+  for (const el of document.querySelectorAll('text, path.arrowhead, #plan circle')) {
+    const b = el.getBBox(), tag = {text: 'text', circle: 'point'}[el.tagName] || 'arrow';
+    out.push({tag, text: el.textContent, box: [b.x, b.y, b.x + b.width, b.y + b.height]});
   }
   return out;
 }"""
@@ -53,7 +53,9 @@ def chromium():
 
 
 def measure(page, svg_text: str) -> list[dict]:
-    """Boxes (x0, y0, x1, y1, mm) of every text and arrowhead of an SVG sheet."""
+    """Boxes (x0, y0, x1, y1, mm) of every text, arrowhead and point of an SVG sheet, set at its
+    own size (A3, 1 mm = 3.78 px): the drawing's, not a screen's zoom (a sheet shrunk to a column
+    sets its 3.5 mm letters at 4 px, where the browser's hinting widens them)."""
     page.set_content(svg_text.split("?>", 1)[-1])
     return page.evaluate(_MEASURE)
 
@@ -63,17 +65,18 @@ def _overlap(a, b, tol: float) -> bool:
 
 
 def overlaps(items: list[dict], tol: float = 0.05) -> list[str]:
-    """Pairs of texts that overlap, and texts under an arrowhead (by more than `tol` mm)."""
+    """Pairs of texts that overlap, and texts over an arrowhead or a point (by more than `tol` mm)."""
     texts = [i for i in items if i["tag"] == "text" and i["text"].strip()]
-    arrows = [i for i in items if i["tag"] == "arrow"]
+    marks = [i for i in items if i["tag"] in ("arrow", "point")]
     bad = []
     for n, a in enumerate(texts):
         for b in texts[n + 1:]:
             if _overlap(a["box"], b["box"], tol):
                 bad.append(f"text {a['text']!r} over text {b['text']!r}")
-        for b in arrows:
+        for b in marks:
             if _overlap(a["box"], b["box"], tol):
-                bad.append(f"text {a['text']!r} under an arrowhead at {[round(v, 1) for v in b['box']]}")
+                what = "an arrowhead" if b["tag"] == "arrow" else "a point"
+                bad.append(f"text {a['text']!r} over {what} at {[round(v, 1) for v in b['box']]}")
     return bad
 
 

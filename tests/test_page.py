@@ -501,25 +501,22 @@ def test_script_writes_a_hand_made_drawing_at_each_angle(chromium, tmp_path):
     assert 'points="0.0,1.0 1.0,1.0 2.0,1.0"' in got[1] and got[2].count("<polyline") == 1
 
 
-#: Boxes (mm) of each sheet's texts, arrowheads and points, per sheet, in the page as shown.
-_BOXES = """() => [...document.querySelectorAll('.sheet svg')].map(svg => [svg.closest('.sheet').dataset.kind,
-  [...svg.querySelectorAll('#plan text, #plan path.arrowhead, #plan circle')].map(el => {
-    const b = el.getBBox(), tag = el.tagName === 'text' ? 'text' : el.tagName === 'circle' ? 'point' : 'arrow';
-    return {tag, text: el.textContent, box: [b.x, b.y, b.x + b.width, b.y + b.height]};
-  })])"""
+#: Each sheet of the page as its script wrote it: (kind, the SVG).
+_SHEETS = """() => [...document.querySelectorAll('.sheet')].map(s => [s.dataset.kind, s.querySelector('svg').outerHTML])"""
 
 
 def _page_overlaps(chromium, path, angles) -> list[str]:
-    """Every label over another label, an arrowhead or a point (`sheet_browser.overlaps`, a
-    point counted as an arrowhead) on each sheet of the page at `path`, at each of `angles`."""
-    pg = _open(chromium, path)
+    """Every label over another label, an arrowhead or a point (`sheet_browser.overlaps`) on each
+    sheet the page's script writes at each of `angles`, each sheet set at its own size in Chromium
+    (`sheet_browser.measure`)."""
+    pg, sheet = _open(chromium, path), chromium.new_page()
     bad = []
     for at in angles:
         _slide(pg, at)
-        for kind, items in pg.evaluate(_BOXES):
-            items = [dict(i, tag="arrow") if i["tag"] == "point" else i for i in items]
-            bad += [f"{at:g} deg, {kind}: {b}" for b in sheet_browser.overlaps(items)]
+        for kind, svg in pg.evaluate(_SHEETS):
+            bad += [f"{at:g} deg, {kind}: {b}" for b in sheet_browser.overlaps(sheet_browser.measure(sheet, svg))]
     pg.close()
+    sheet.close()
     return bad
 
 

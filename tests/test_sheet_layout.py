@@ -1,6 +1,6 @@
 """The sheets as a reader sees them, measured in a real browser (issue 20): Debian's headless
 Chromium, driven by Playwright, gives every text's and arrowhead's box (getBBox, mm); no two
-texts overlap and no text lies under an arrowhead. By default a sample (the ICE at its design
+texts overlap and no text lies over an arrowhead or a point. By default a sample (the ICE at its design
 position, seed 002's variant 1/479 at 150 deg); with `-m slow` every bundled model at its design
 position and three other angles, and 30 random variants of each seed 002 task.
 
@@ -217,16 +217,21 @@ def test_notes_letter_names_as_the_drawing(ice_plans):
 
 
 def test_the_overlap_check_finds_a_planted_overlap(page, ice_plans):
-    """Negative control: a label planted on another label, and one under an arrowhead, are reported."""
+    """Negative control: a label planted on another label, one over an arrowhead and one over a
+    point are reported."""
     mech, plans = ice_plans
     sheet = svg(plans["group:2,3"], lang="uk")
     assert _check(page, {"clean": sheet}) > 10
     label = re.search(r'<text x="([-0-9.]+)" y="([-0-9.]+)" class="label"', sheet)
     head = re.search(r'<path d="M([-0-9.]+),([-0-9.]+) [^"]*" class="arrowhead"', sheet)
+    dot = re.search(r'<circle cx="([-0-9.]+)" cy="([-0-9.]+)"', sheet)
     planted = sheet.replace('<g id="title-block">',
                             f'<text x="{label.group(1)}" y="{label.group(2)}" font-size="3">QQ</text>'
                             f'<text x="{float(head.group(1)) - 1:.2f}" y="{float(head.group(2)) + 1:.2f}" '
-                            f'font-size="3">WW</text><g id="title-block">', 1)
+                            f'font-size="3">WW</text>'
+                            f'<text x="{float(dot.group(1)) - 1:.2f}" y="{float(dot.group(2)) + 1:.2f}" '
+                            f'font-size="3">PP</text><g id="title-block">', 1)
     bad = sheet_browser.overlaps(sheet_browser.measure(page, planted))
     assert any("'QQ' over text" in b or "over text 'QQ'" in b for b in bad), bad
-    assert any("'WW' under an arrowhead" in b for b in bad), bad
+    assert any("'WW' over an arrowhead" in b for b in bad), bad
+    assert any("'PP' over a point" in b for b in bad), bad
