@@ -191,9 +191,11 @@ def test_the_pages_shell_commands_parse(page):
 
 
 #: Commands of the bash blocks that make or test the checkout (a venv, an editable install, its
-#: test suite, the docs' build), not examples of use: not run from an empty folder.
+#: test suite, the docs' build, a rerun checked against its committed reports/), not examples of
+#: use: not run from an empty folder.
 CHECKOUT = {"python3 -m venv .venv", "python -m pip install -e '.[all]'", "python -m pytest -q",
-            "python -m pytest -m slow", "python -m sphinx -W -b html docs docs/_build/html"}
+            "python -m pytest -m slow", "python -m sphinx -W -b html docs docs/_build/html",
+            "kinetostat report --out rerun --check reports"}
 #: Examples not run even with -m slow: (command, why).
 NOT_RUN = {"kinetostat variant 2 --all --out keys": "every code of task 2, about 1000 keys: hours"}
 #: Examples run by default (a second each); every other one is slow.
