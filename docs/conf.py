@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).parent / "_ext"))   # cli_reference: the p
 
 project = "kinetostat"
 author = "kinetostat contributors"
-copyright = "kinetostat contributors, MIT licence"
+copyright = "kinetostat contributors, MIT licence (the bundled DejaVu Sans: Bitstream Vera licence)"
 release = version = kinetostat.__version__
 
 extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinxarg.ext"]

@@ -47,7 +47,7 @@ def test_quiet_report_prints_nothing_and_verbose_shows_its_progress(cli, tmp_pat
     assert r.returncode == 0 and "chain_unit_four_bar        PASS" in r.stdout and "report: 1 mechanism(s)" in r.stdout
     for line in ("chain_unit_four_bar.toml: loaded and analysed over 8 positions in ",
                  "chain_unit_four_bar: route reference PASS (", "chain_unit_four_bar: figures mechanism, moment, ",
-                 "chain_unit_four_bar: plans and worksheet, "):
+                 "chain_unit_four_bar: plans, worksheet ("):
         assert any(s.startswith(line) for s in r.stderr.splitlines()), (line, r.stderr)
     # the library's logger as it was after the command: its NullHandler alone, its level unset
     package = logging.getLogger("kinetostat")

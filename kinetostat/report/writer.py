@@ -610,8 +610,6 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
 
     _published_section(doc, m, published)
     plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first")
-    log.debug("%s: plans and worksheet, %d files%s", folder, len(plan_files),
-              ", page.html" if any(p.name == "page.html" for p in plan_files) else "")
 
     sing = int(np.sum(res.singular))
     if run.warnings or sing:
