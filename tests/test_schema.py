@@ -9,7 +9,9 @@ import io
 import json
 import re
 import shutil
+import os
 import subprocess
+import sys
 import tomllib
 from pathlib import Path
 
@@ -310,12 +312,16 @@ def test_no_table_of_the_json_schema_refuses_unknown_keys_as_a_whole():
     assert not any(o.get("additionalProperties") is False for o in objects(describe.json_schema()))
 
 
-@pytest.mark.skipif(shutil.which("taplo") is None, reason="taplo (pip install taplo) not on PATH")
+#: taplo (the TOML editors' validator; the test extra installs it beside this interpreter), or None.
+TAPLO = shutil.which("taplo", path=os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")]))
+
+
+@pytest.mark.skipif(TAPLO is None, reason="taplo (pip install taplo) not beside this Python nor on PATH")
 def test_taplo_reports_one_misspelt_key_once(tmp_path):
     """The editors' validator itself: one error, on the key's line."""
     model = tmp_path / "m.toml"
     model.write_text(four_bar(MISSPELT[0][0]), encoding="utf-8")
-    r = subprocess.run(["taplo", "check", "--schema", describe.SCHEMA_FILE.as_uri(), str(model)],
+    r = subprocess.run([TAPLO, "check", "--schema", describe.SCHEMA_FILE.as_uri(), str(model)],
                        capture_output=True, text=True, timeout=60)
     errors = [line for line in (r.stdout + r.stderr).splitlines() if line.startswith("error")]
     assert r.returncode != 0 and len(errors) == 1, r.stdout + r.stderr
