@@ -334,8 +334,10 @@ def _assembled(data: dict, steps: int = 120):
         mech = kinetostat.from_dict(data)
     except kinetostat.ModelWarning as exc:
         # a drawn two-group chain may just pass the 20 m plausibility bound of a single linkage
-        # (the warning "drawn in millimetres?"): not a mechanism the strategies mean to draw
-        if "the largest link spans" in str(exc):
+        # (the warning "drawn in millimetres?"), or a link drawn under a millimetre keep its drawn
+        # moment of inertia (the warning on a radius of gyration over 100 spans: "is it in kg m^2?"):
+        # not mechanisms the strategies mean to draw
+        if "the largest link spans" in str(exc) or "radius of gyration" in str(exc):
             return None
         raise
     except kinetostat.ModelError as exc:
