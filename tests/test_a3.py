@@ -119,18 +119,27 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
 def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
     """Task 2 / 479 (its search comes back to scales tried before): `one_sheet` builds the plans of
     each choice of scales once (was: 9 builds for 8 choices) and draws each plan once a language
-    at its scales; the same sheet as `_one` (no state kept between calls)."""
+    at its scales; every build after the rule's is given the plan of positions' 12 positions at
+    its μ_l, made once per μ_l (was: made again in each build); the same sheet as `_one` (no
+    state kept between calls)."""
     import kinetostat.plans as KP
-    built, drawn = [], []
+    built, drawn, positions = [], [], []
     build, drawing = KP.build, A3.drawing
-    monkeypatch.setattr(KP, "build", lambda mech, at, scales=None: built.append(
-        None if scales is None else tuple(sorted(scales.items()))) or build(mech, at=at, scales=scales))
+
+    def counted(mech, at, scales=None, **kw):
+        built.append(None if scales is None else tuple(sorted(scales.items())))
+        positions.append(kw.get("positions"))
+        return build(mech, at=at, scales=scales, **kw)
+    monkeypatch.setattr(KP, "build", counted)
     monkeypatch.setattr(A3, "drawing", lambda plan, lang: drawn.append(
         (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or drawing(plan, lang))
     v = variants.variant(2, "479")
     one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
     assert len(built) == len(set(built)) >= 5
     assert len(drawn) == len(set(drawn)) and {lang for lang, _, _ in drawn} == {"en", "uk", "ru"}
+    given = positions[1:]
+    assert all(p is not None and p.mu.value == dict(b)["mu_l"] for p, b in zip(given, built[1:]))
+    assert len({id(p) for p in given}) == len({p.mu.value for p in given}) < len(given)
     assert one.places == _one(2, "479").places and one.drawings == _one(2, "479").drawings
 
 

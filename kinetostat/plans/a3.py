@@ -14,8 +14,8 @@ step coarser first, μ_l only where they cannot make room; the title block and t
 scale made coarser than the rule, and why. Where no choice fits them, further sheets take the
 rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
-May use: the standard library, `build` of this package, `.core`, `.draw`, `.i18n`, `.labels`,
-`.scales`, `.pdf`, `kinetostat.solve`. Never matplotlib.
+May use: the standard library, `build` of this package, `.core`, `.draw`, `.i18n`, `.kinematic`,
+`.labels`, `.scales`, `.pdf`, `kinetostat.solve`. Never matplotlib.
 """
 from __future__ import annotations
 
@@ -289,12 +289,14 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     coarser (`scales.next_coarser`) while its reference stays FLOOR_MM long, then μ_l (its GOST
     2.302 series, LENGTH_MANTISSAS), until they fit; then each scale of FIRST back one step finer
     while they still fit. The same `kinetostat.plans.build` that every sheet of the plans uses,
-    with these scales given; each try a build, the drawings of the plans whose scales changed
-    (in each language) and their layouts. Where no scale within _TRIES steps fits them, the last
+    with these scales given; each try a build (the plan of positions' 12 positions made once per
+    μ_l, `kinematic.fixed_positions`), the drawings of the plans whose scales changed (in each
+    language) and their layouts. Where no scale within _TRIES steps fits them, the last
     try is kept (more than one sheet). `res`: the caller's frictionless analysis of `mech` at
     [at] for the references of the scales (default: made here, once)."""
     from . import build
-    from .scales import LENGTH_MANTISSAS, next_coarser, references
+    from .kinematic import fixed_positions, starting_position
+    from .scales import LENGTH_MANTISSAS, SCALE_UNITS, next_coarser, references
     if res is None:
         from ..solve import analyze
         res = analyze(mech, phi_deg=[float(at)])
@@ -310,12 +312,25 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
             out.append(drawn[key])
         return out
 
+    fixed: dict[float, Any] = {}
+
+    def positions(mu_l: float):
+        """The plan of positions' 12 positions and paths at μ_l (m/mm), made once per μ_l."""
+        if mu_l not in fixed:
+            start = next(iter(fixed.values())).start if fixed else starting_position(mech)
+            fixed[mu_l] = fixed_positions(mech, Scale("mu_l", mu_l, SCALE_UNITS["mu_l"]), start)
+        return fixed[mu_l]
+
     tried: dict[tuple | None, tuple] = {}
 
     def attempt(given: Mapping[str, float] | None):
         key = None if given is None else tuple(sorted(given.items()))
         if key not in tried:                     # the searches below come back to scales tried before
-            plans = build(mech, at=at, scales=given)
+            if given is None:                    # the texts' rule: its μ_l is not known before
+                plans = build(mech, at=at)
+            else:
+                pos = positions(given["mu_l"])
+                plans = build(mech, at=at, scales=given, starting_deg=pos.start, positions=pos)
             ds = drawings(plans, lang)
             places = layout(ds)
             fit = all(p.page == 0 for p in places) and all(
