@@ -69,7 +69,7 @@ def test_model_strings_are_text_in_every_report_file(tmp_path, cli, others):
                data["drive"]["point"], *[t["name"] for t in data["link"]], *data["frame"],
                *[p for t in data["link"] for p in t["points"]], data["load"][0]["name"], data["spring"][0]["name"],
                *[data["published"][0][k] for k in ("symbol", "meaning", "source", "accuracy")]]
-    own = {"cycle.csv", "summary.json", "segments.csv", "worksheet.csv", "../index.md", "injection/index.md",
+    own = {"cycle.csv.gz", "summary.json", "segments.csv", "worksheet.csv", "../index.md", "injection/index.md",
            "ice_crank_slider/index.md"}
     for md in (out / "injection" / "index.md", out / "index.md"):
         tokens = _tokens(md.read_text(encoding="utf-8"))
@@ -128,7 +128,7 @@ def test_report_folders_stay_inside_out_and_never_overwrite_each_other(tmp_path,
     folders = sorted(p.name for p in out.iterdir() if p.is_dir())
     assert folders == ["model", "name", "same", "same-2", "x_javascript_y"]
     for f in folders:
-        assert (out / f / "index.md").stat().st_size > 1000 and (out / f / "cycle.csv").stat().st_size > 100
+        assert (out / f / "index.md").stat().st_size > 1000 and (out / f / "cycle.csv.gz").stat().st_size > 100
     index = (out / "index.md").read_text(encoding="utf-8")
     assert all(f"({f}/index.md)" in index for f in folders)
     assert "\\\\udcff" in (out / "name" / "index.md").read_text(encoding="utf-8")    # the file name, escaped

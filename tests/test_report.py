@@ -3,6 +3,7 @@ comparison with the seeds' published values, and the check of a rerun against ea
 from __future__ import annotations
 
 import contextlib
+import gzip
 import io
 import json
 import multiprocessing
@@ -17,6 +18,7 @@ import pytest
 
 import kinetostat
 import kinetostat.report
+import kinetostat.tables
 from conftest import FOUR_BAR, MODELS, ROOT, sketch_plots
 from kinetostat import cli
 from kinetostat.report import published_rows, run_validation, write_index, write_report
@@ -113,11 +115,13 @@ def test_a_rerun_writes_the_same_text_files(tmp_path, sketched_plots):
 
 def test_report_files(ice_report):
     d = ice_report / "ice_crank_slider"
-    for name in ["index.md", "index.html", "cycle.csv", "summary.json", *FIGURES]:
+    for name in ["index.md", "index.html", "cycle.csv.gz", "summary.json", *FIGURES]:
         assert (d / name).is_file(), name
     for fig in FIGURES:
         assert b"<svg" in (d / fig).read_bytes()[:400], fig     # sketched; real ones: -m slow
-    cycle = read_csv(d / "cycle.csv")
+    cycle = read_csv(d / "cycle.csv.gz")        # gzip, read as it is; the same table as to_frame's CSV
+    res = kinetostat.analyze(kinetostat.load(ICE), steps=36)
+    assert gzip.decompress((d / "cycle.csv.gz").read_bytes()).decode() == kinetostat.tables.csv_text(res.to_frame())
     assert len(cycle) == 36 and {"phi_deg", "M_bal", "M_lever", "R_0_1"} <= set(cycle.columns)
     assert cycle.attrs["units"]["R_0_1"] == "N" and cycle.attrs["units"]["M_bal"] == "N m"
     summary = json.loads((d / "summary.json").read_text())
@@ -221,7 +225,7 @@ def test_report_html_is_markdown_it_rendering(ice_report):
     assert "data:" not in html and "<svg" not in html
     assert html.count("<img ") == len(FIGURES) + len(plans) and len(html) < 100_000
     assert '<div class="scroll"><table>' in html and 'class="pass"' in html
-    assert 'href="../index.html"' in html and 'href="cycle.csv"' in html
+    assert 'href="../index.html"' in html and 'href="cycle.csv.gz"' in html
     # the body is markdown-it's rendering of the Markdown file (tables as it renders them)
     cell = MarkdownIt("commonmark").enable("table").render("| a |\n|---:|\n| **PASS** |\n")
     assert '<td style="text-align:right"><strong>PASS</strong></td>' in cell
@@ -449,13 +453,13 @@ def test_the_check_passes_a_rerun_and_names_only_a_number_beyond_its_tolerance(t
     from kinetostat.report import compare_reports
     b, a = _rerun(four_bar_runs, tmp_path)
     assert compare_reports(b, a) == []
-    cycle = b / "four_bar" / "cycle.csv"
+    cycle = b / "four_bar" / "cycle.csv.gz"
     df = pd.read_csv(cycle)
     force = max(df[c].abs().max() for c in df.columns if c.endswith(" [N]"))
     moment = max(df[c].abs().max() for c in df.columns if c.endswith(" [N m]"))
     df.loc[3, "R_0_1 [N]"] += 1e-9 * force
     df.loc[5, "M_bal [N m]"] += 3e-12 * moment
-    df.to_csv(cycle, index=False, float_format="%.17g")
+    df.to_csv(cycle, index=False, float_format="%.17g")         # gzip, by the name's suffix
     summary = b / "four_bar" / "summary.json"
     data = json.loads(summary.read_text())
     assert 0 < data["routes"]["lever"]["worst"] < 1e-13
@@ -467,11 +471,11 @@ def test_the_check_passes_a_rerun_and_names_only_a_number_beyond_its_tolerance(t
     index.write_text(text.replace(figure, "9.99e-15 †"))
     diffs = compare_reports(b, a)
     phi = float(df.loc[3, "phi_deg [deg]"])
-    assert [(d.model, d.file, d.what, d.where) for d in diffs] == [("four_bar", "cycle.csv", "R_0_1 [N]", f"φ = {phi:g}°")]
-    was = float(pd.read_csv(a / "four_bar" / "cycle.csv").loc[3, "R_0_1 [N]"])
+    assert [(d.model, d.file, d.what, d.where) for d in diffs] == [("four_bar", "cycle.csv.gz", "R_0_1 [N]", f"φ = {phi:g}°")]
+    was = float(pd.read_csv(a / "four_bar" / "cycle.csv.gz").loc[3, "R_0_1 [N]"])
     assert float(diffs[0].committed) == pytest.approx(was, rel=1e-11)
     assert float(diffs[0].fresh) == pytest.approx(was + 1e-9 * force, rel=1e-11)
-    assert str(diffs[0]).startswith("four_bar/cycle.csv: R_0_1 [N] at φ = ") and f"1e-11 of the N scale {force:.6g} N" in str(diffs[0])
+    assert str(diffs[0]).startswith("four_bar/cycle.csv.gz: R_0_1 [N] at φ = ") and f"1e-11 of the N scale {force:.6g} N" in str(diffs[0])
 
 
 def test_the_check_names_a_changed_verdict_a_missing_file_and_a_changed_line(tmp_path, four_bar_runs):
@@ -489,6 +493,25 @@ def test_the_check_names_a_changed_verdict_a_missing_file_and_a_changed_line(tmp
     assert ("worksheet.csv", "file", "absent", "present") in found
     assert any(f == "index.md" and w == "text" and "figures" in a and "data" in b for f, w, a, b in found)
     assert len(found) == 3 + 1       # and the table of contents' line naming the same heading
+
+
+def test_the_check_names_a_cycle_table_that_is_not_gzip_cut_short_or_a_bomb(tmp_path, four_bar_runs, monkeypatch):
+    """The rerun's cycle.csv.gz is read decompressed within MAX_REPORT_BYTES: a file that is not
+    gzip, one cut short, and one that inflates beyond the limit (a 'zip bomb') are each named as
+    not read, never inflated into memory whole."""
+    from kinetostat.report import compare_reports, rerun
+    b, a = _rerun(four_bar_runs, tmp_path)
+    cycle = b / "four_bar" / "cycle.csv.gz"
+    whole = cycle.read_bytes()
+    limit = 4 * max(f.stat().st_size for f in b.rglob("*") if f.is_file())     # a bomb of a test's size
+    monkeypatch.setattr(rerun, "MAX_REPORT_BYTES", limit)
+    assert compare_reports(b, a) == []
+    for data, why in ((b"phi_deg [deg]\n0\n", "not gzip"), (whole[:len(whole) // 2], "cut short"),
+                      (gzip.compress(b"0" * (limit + 1)), "bytes decompressed")):
+        cycle.write_bytes(data)
+        diffs = compare_reports(b, a)
+        assert [(d.file, d.what) for d in diffs] == [("cycle.csv.gz", "file")], diffs
+        assert why in diffs[0].committed and "a regular file" == diffs[0].tolerance, diffs[0]
 
 
 def test_report_check_refuses_its_own_output_folder_and_a_missing_one(tmp_path, capsys):

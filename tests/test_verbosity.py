@@ -72,7 +72,7 @@ def test_report_says_what_it_will_do_first_then_each_part_of_a_model(tmp_path, m
     assert before_models == [f"report: 1 model(s) into {tmp_path}: routes lever, reference; no pages; 1 at a time\n"]
     err = capsys.readouterr().err.splitlines()
     parts = ["chain_unit_four_bar: route reference PASS (", "chain_unit_four_bar: figures mechanism, moment, ",
-             "chain_unit_four_bar: cycle.csv and the tables (", "chain_unit_four_bar: plans, worksheet ("]
+             "chain_unit_four_bar: cycle.csv.gz and the tables (", "chain_unit_four_bar: plans, worksheet ("]
     assert [next((i for i, s in enumerate(err) if s.startswith(p)), None) for p in parts] == list(range(4)), err
     assert all(re.search(r"\(\d+\.\d s\)$", s) for s in err[:4]), err
 

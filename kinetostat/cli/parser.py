@@ -123,7 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Write OUT/<model>/index.md and index.html (its figures linked, files beside it) per MODEL "
                                    "(default: all bundled models) with the mechanism's data, its picture, "
                                    "plots over the cycle, error tables per engine route, the seeds' published "
-                                   "values where known, cycle.csv, the plans at the design position and the "
+                                   "values where known, cycle.csv.gz, the plans at the design position and the "
                                    "interactive page; plus OUT/index.md and OUT/index.html. "
                                    "The files carry no dates or run times (printed here only); a rerun "
                                    "reproduces the numbers within their tolerances, not byte for byte (errors "

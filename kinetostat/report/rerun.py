@@ -9,19 +9,20 @@ per model folder of the rerun (one holding a summary.json):
 - summary.json: equal, but each route's `worst` error within the route's stated `tolerance` (two
   errors both below ROUNDING, at rounding level, agree) and `published.worst_percent` within one
   unit of its last printed digit;
-- cycle.csv: the same columns, units and rows; each value within TOLERANCES["reference"] (the
-  solver's stated accuracy, 1e-11) of its unit's scale (the largest |value| of that unit, as the
-  table is rounded: `kinetostat.tables.rounded`); an angle as the shortest turn, a reaction's
-  angle weighed by the reaction (|R| times the turn in rad, against the force's tolerance); text
-  and flags equal;
+- cycle.csv.gz (`writer.CYCLE_FILE`, read decompressed): the same columns, units and rows; each
+  value within TOLERANCES["reference"] (the solver's stated accuracy, 1e-11) of its unit's scale
+  (the largest |value| of that unit, as the table is rounded: `kinetostat.tables.rounded`); an
+  angle as the shortest turn, a reaction's angle weighed by the reaction (|R| times the turn in
+  rad, against the force's tolerance); text and flags equal;
 - the figures (.svg, .png) and page.html: present, not compared (drawn from the numbers above);
 - every other text file (Markdown, HTML, segments.csv, worksheet.csv) and the folder's own
   index.md/index.html: equal line by line but for the versions after "made with", the numbers in
   e-notation (the error figures, checked in summary.json) and a relative 1e-9 in other numbers
   (12 printed digits).
 
-May use: numpy, `_io` (bounded reads of regular files), `kinetostat.tables` (reading the CSV), the
-document's ROUNDING and the harness's tolerances (imported inside `compare_reports`).
+May use: numpy, zlib, `_io` (bounded reads of regular files), `kinetostat.tables` (reading the CSV),
+the writer's CYCLE_FILE, the document's ROUNDING and the harness's tolerances (imported inside
+`compare_reports`).
 """
 from __future__ import annotations
 
@@ -29,6 +30,7 @@ import io
 import json
 import math
 import re
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator
@@ -37,6 +39,7 @@ import numpy as np
 
 from .._io import read_regular
 from .document import ROUNDING
+from .writer import CYCLE_FILE
 
 #: Relative difference allowed in a number of a text file that is not in e-notation (12 digits printed).
 TEXT_RTOL = 1e-9
@@ -125,16 +128,16 @@ def _scales(df) -> dict[str, float]:
 
 
 def _cycle(model: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]:
-    """The differences of two cycle.csv files (the rules of the module's docstring)."""
+    """The differences of two cycle tables (CYCLE_FILE) (the rules of the module's docstring)."""
     from kinetostat.tables import read_csv
     from kinetostat_validation.compare import TOLERANCES
 
     rtol = TOLERANCES["reference"].peak_relative
-    new, old = (read_csv(io.StringIO(_read(p))) for p in (fresh_path, old_path))
+    new, old = (read_csv(io.StringIO(_read_gzip(p))) for p in (fresh_path, old_path))
     head = [f"{c} [{new.attrs['units'][c]}]" for c in new.columns]
     was = [f"{c} [{old.attrs['units'][c]}]" for c in old.columns]
     if head != was or len(new) != len(old):
-        yield Difference(model, "cycle.csv", "columns and rows", "", f"{len(head)} columns x {len(new)} rows",
+        yield Difference(model, CYCLE_FILE, "columns and rows", "", f"{len(head)} columns x {len(new)} rows",
                          f"{len(was)} columns x {len(old)} rows" + ("" if head == was else
                          f"; first differing column: {next((b for a, b in zip(head + [''], was + ['']) if a != b), '')!r}"),
                          "equal")
@@ -147,7 +150,7 @@ def _cycle(model: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]
             bad = np.flatnonzero(a.astype(str).to_numpy() != b.astype(str).to_numpy())
             if bad.size:
                 k = int(bad[0])
-                yield Difference(model, "cycle.csv", c, f"φ = {phi[k]:g}°", str(a.iloc[k]), str(b.iloc[k]), "equal")
+                yield Difference(model, CYCLE_FILE, c, f"φ = {phi[k]:g}°", str(a.iloc[k]), str(b.iloc[k]), "equal")
             continue
         x, y = a.to_numpy(dtype=float), b.to_numpy(dtype=float)
         unit = units[c]
@@ -165,7 +168,7 @@ def _cycle(model: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]
         d = np.where(np.isnan(d), np.inf, d)
         if d.size and float(d.max()) > tol:
             k = int(np.argmax(d))
-            yield Difference(model, "cycle.csv", f"{c} [{unit}]", f"φ = {phi[k]:g}°", f"{x[k]:.12g}", f"{y[k]:.12g}", said)
+            yield Difference(model, CYCLE_FILE, f"{c} [{unit}]", f"φ = {phi[k]:g}°", f"{x[k]:.12g}", f"{y[k]:.12g}", said)
 
 
 def _normal(line: str) -> str:
@@ -212,6 +215,21 @@ def _read(path: Path) -> str:
     return read_regular(path, MAX_REPORT_BYTES).decode("utf-8", "replace")
 
 
+def _read_gzip(path: Path) -> str:
+    """The text of the gzip-compressed report file `path`, at most MAX_REPORT_BYTES both as read
+    and as decompressed (OSError else: a file cut short, not gzip, or a bomb)."""
+    inflate = zlib.decompressobj(wbits=16 + zlib.MAX_WBITS)
+    try:
+        data = inflate.decompress(read_regular(path, MAX_REPORT_BYTES), MAX_REPORT_BYTES)
+    except zlib.error as exc:
+        raise OSError(0, f"not gzip ({exc})", str(path)) from None
+    if inflate.unconsumed_tail:
+        raise OSError(0, f"more than {MAX_REPORT_BYTES} bytes decompressed", str(path))
+    if not inflate.eof:
+        raise OSError(0, "cut short", str(path))
+    return data.decode("utf-8", "replace")
+
+
 def _file(model: str, name: str, fresh: Path, old: Path) -> Iterator[Difference]:
     try:
         yield from _compared(model, name, fresh, old)
@@ -223,7 +241,7 @@ def _file(model: str, name: str, fresh: Path, old: Path) -> Iterator[Difference]
 def _compared(model: str, name: str, fresh: Path, old: Path) -> Iterator[Difference]:
     if name == "summary.json":
         yield from _json(model, json.loads(_read(fresh)), json.loads(_read(old)))
-    elif name == "cycle.csv":
+    elif name == CYCLE_FILE:
         yield from _cycle(model, fresh, old)
     elif not name.endswith(FIGURES) and name != "page.html":
         yield from _text(model, name, fresh, old)
