@@ -96,19 +96,57 @@ def plain_text() -> Iterator[None]:
         yield
 
 
-#: The coordinates in matplotlib's SVG (six decimals of a point): a path's data (one command a
-#: line), a text's or a marker's place and its transform; and a number in them.
-_COORDINATES = re.compile(r'( (?:d|x|y|transform)=")([^"]*)')
+#: In matplotlib's SVG: a path's data (absolute M, L, Q, C and z commands, six decimals of a
+#: point), a text's or a marker's place and transform (`_compact`); a number in those.
+_PATH_DATA = re.compile(r' d="([^"]*)"')
+_PLACES = re.compile(r'( (?:x|y|transform)=")([^"]*)')
 _COORDINATE = re.compile(r"-?\d+\.\d+")
+#: coordinate pairs after each command of a path
+_PAIRS = {"M": 1, "L": 1, "Q": 2, "C": 3}
+
+
+def _hundredths(n: int) -> str:
+    """n hundredths of a point, the SVG's shortest way: 0, 12, .5, -3.07."""
+    whole, part = divmod(abs(n), 100)
+    text = (str(whole) if whole else "") + (f".{part:02d}".rstrip("0") if part else "")
+    return ("-" + text if n < 0 else text) or "0"
+
+
+def _relative(d: str) -> str:
+    """matplotlib's path data as relative commands (m, l, q, c; a repeated command's letter
+    left out) on coordinates rounded to 0.01 pt: the same outline, each point given as the step
+    from the one before (rounded first, so the steps add up to the rounded points exactly)."""
+    tokens = d.split()
+    out: list[str] = []
+    x0 = y0 = sx = sy = 0          # the current point and the subpath's start, 0.01 pt
+    last, i = "", 0
+    while i < len(tokens):
+        cmd = tokens[i]
+        i += 1
+        if cmd not in _PAIRS:       # z: back to the subpath's start
+            out.append(cmd.lower())
+            x0, y0, last = sx, sy, "z"
+            continue
+        n = 2 * _PAIRS[cmd]
+        xy = [round(float(t) * 100) for t in tokens[i:i + n]]
+        i += n
+        steps = " ".join(_hundredths(v - (y0 if k % 2 else x0)) for k, v in enumerate(xy))
+        letter = cmd.lower()
+        out.append((letter if letter != last or letter == "m" else " ") + steps)
+        x0, y0, last = xy[-2], xy[-1], letter
+        if letter == "m":
+            sx, sy = x0, y0
+    return "".join(out).replace(" -", "-")
 
 
 def _compact(svg: str) -> str:
     """matplotlib's SVG with every coordinate to 0.01 pt (a hundredth of a point, far below any
-    screen's pixel or printer's dot) and a path's commands on one line: the figures drawn the
-    same in fewer bytes."""
+    screen's pixel or printer's dot), a path's data as relative steps (`_relative`): the figures
+    drawn the same in fewer bytes."""
     def point(m: re.Match) -> str:
         return f"{round(float(m[0]), 2) + 0.0:.2f}".rstrip("0").rstrip(".")
-    return _COORDINATES.sub(lambda m: m[1] + _COORDINATE.sub(point, " ".join(m[2].split())), svg)
+    svg = _PATH_DATA.sub(lambda m: f' d="{_relative(m[1])}"', svg)
+    return _PLACES.sub(lambda m: m[1] + _COORDINATE.sub(point, " ".join(m[2].split())), svg)
 
 
 def _save(fig, path: Path) -> Path:
@@ -178,29 +216,36 @@ def _ticks(lo: float, hi: float, log: bool, loc=None) -> list[float]:
 def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = None, ylabel_pt: float = _LABEL_PT,
           xnumbers: bool = True) -> None:
     """ax's two axes drawn light, after its data and limits are set: `x`, `y` are tick locators
-    (`_ticks`; labels `_names`); the ticks within the view are drawn as one grid line collection
-    and a text per label, the axis labels as texts, in place of matplotlib's own axes, which make
+    (`_ticks`; labels `_names`); the ticks within the view are drawn as one grid line (one path
+    for both axes' grids) and a text per label, the axis labels as texts, in place of matplotlib's own axes, which make
     five artists per tick (half of these figures' drawing time). No tick marks: the grid carries
     the ticks. `xnumbers` False: the x grid without its labels (a panel above another on the same x)."""
-    from matplotlib.collections import LineCollection
+    from matplotlib.lines import Line2D
     from matplotlib.transforms import offset_copy
     ax.apply_aspect()
     widest = 0
+    grid: list[tuple[float, float]] = []          # the grid's segments in axes coordinates, NaN between
     for axis, loc in ((ax.xaxis, x), (ax.yaxis, y)):
         along_x = axis is ax.xaxis
         log = axis.get_scale() == "log"
-        ticks = _ticks(*sorted(axis.get_view_interval()), log, loc)
+        view = axis.get_view_interval()
+        ticks = _ticks(*sorted(view), log, loc)
         names = _names(ticks, log)
-        ax.add_collection(LineCollection([[(t, 0), (t, 1)] if along_x else [(0, t), (1, t)] for t in ticks],
-                                         colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
-                                         transform=ax.get_xaxis_transform() if along_x else ax.get_yaxis_transform()),
-                          autolim=False)
+        f = np.log10 if log else float
+        for t in ticks:
+            a = float((f(t) - f(view[0])) / (f(view[1]) - f(view[0])))
+            grid += [(a, 0.0), (a, 1.0)] if along_x else [(0.0, a), (1.0, a)]
+            grid.append((math.nan, math.nan))
         if along_x and not xnumbers:
             continue
         trans, va, ha = (ax.get_xaxis_text1_transform if along_x else ax.get_yaxis_text1_transform)(_PAD_PT)
         for t, name in zip(ticks, names):
             ax.text(*((t, 0) if along_x else (0, t)), name, transform=trans, va=va, ha=ha, fontsize=_TICK_PT)
         widest = 0 if along_x else max(map(len, names), default=0)
+    if grid:
+        gx, gy = zip(*grid)
+        ax.add_artist(Line2D(gx, gy, transform=ax.transAxes, color="#b0b0b0", alpha=0.3, lw=0.8,
+                             solid_capstyle="butt", zorder=0.5))
     ax.set_xlim(ax.get_xlim())                      # frozen: nothing added later moves the grid
     ax.set_ylim(ax.get_ylim())
     ax.xaxis.set_visible(False)
@@ -211,6 +256,13 @@ def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = No
     if ylabel:
         ax.text(0, 0.5, ylabel, transform=offset_copy(ax.transAxes, ax.figure, x=-(_PAD_PT + 0.64 * _TICK_PT * widest + 4),
                                                       units="points"), ha="right", va="center", rotation=90, fontsize=ylabel_pt)
+
+
+def _hline(ax, y: float, **style) -> Any:
+    """A line across ax at height y (data), as `axhline` draws it (y in the data limits) but as two
+    points: `axhline` gives a log axis' line 100 points."""
+    h, = ax.plot([0, 1], [y, y], transform=ax.get_yaxis_transform(), **style)
+    return h
 
 
 def _phi_axes(ax, label: bool = True, step: int = 90, y=None, ylabel: str | None = None, ylabel_pt: float = _LABEL_PT,
@@ -444,7 +496,7 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
     for n, (route, er) in enumerate(run.results.items()):
         col, ls = _style(route, n)
         ax.plot(*_closed(er.phi_deg, er.M_drive), **_line(er, res, col, ls, 1.6), label=f"{route} ({er.route})")
-    ax.axhline(0, color="0.3", lw=0.6)
+    _hline(ax, 0, color="0.3", lw=0.6)
     kind = "moment of the drive on the crank about +z"
     ax.set_title(f"{m.name}\nbalancing moment ({kind}) over the cycle", fontsize=10, y=1.0)
     ax.legend(fontsize=8, loc="best")
@@ -495,6 +547,12 @@ def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, 
     return out
 
 
+#: The error curves (`plot_errors`): drawn below the tolerance lines (z 2), all of a panel one
+#: after another, so that they make one picture of `_RASTER_DPI` in the SVG: at rounding level
+#: they are noise, 360 points a route whose every point as a vector made 200 kB a figure.
+_ERRORS_Z, _RASTER_DPI = 1.9, 200
+
+
 def plot_errors(run: ModelRun, path: Path) -> Path:
     from matplotlib.ticker import FixedLocator
     res, m = run.res, run.mech
@@ -502,27 +560,28 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
     ncols = _legend_cols(2 * len(run.results), 4)
     fig, axes, cols = _panels(len(qs), f"{m.name}\nerror of each engine route against kinetostat (log scale; "
                                        f"dashed: the route's tolerance × the cycle's peak)", 2 * len(run.results), ncols)
+    fig.set_dpi(80)
     curves = {route: _error_curves(res, er) for route, er in run.results.items()}
     handles = {}
     for n_ax, (ax, q) in enumerate(zip(axes, qs)):
         unit = "N·m" if q == "M_drive" else "N"
         any_drawn = False
+        ax.set_yscale("log")
         for n, route in enumerate(run.results):
             col, ls = _style(route, n)
             phi, err, peak = curves[route][q]
             e = np.where(err > 0, err, np.nan)
             if np.any(np.isfinite(e)):
-                h, = ax.semilogy(*_closed(phi, e), **_line(run.results[route], res, col, "-", 1.3))
+                h, = ax.plot(*_closed(phi, e), **_line(run.results[route], res, col, "-", 1.3),
+                             zorder=_ERRORS_Z)
                 handles[f"{route}: |engine − kinetostat|"] = h
                 any_drawn = True
             tol = run.tolerances.get(route)
             if tol is not None and peak > 0:
-                h = ax.axhline(tol.peak_relative * peak, color=col, ls="--", lw=1)
-                handles[f"{route}: tolerance × peak"] = h
+                handles[f"{route}: tolerance × peak"] = _hline(ax, tol.peak_relative * peak, color=col, ls="--", lw=1)
         if not any_drawn:
             ax.text(0.5, 0.5, "no differences to draw\n(no engine results, or exactly equal)",
                     transform=ax.transAxes, ha="center", va="center", fontsize=8, color="0.4")
-            ax.set_yscale("log")
         title = f"{quantity_name(m, q)}: balancing moment" if q == "M_drive" else \
             pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
         ax.set_title(_wrap(title), fontsize=9, y=1.0)
@@ -532,6 +591,32 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
         ax.set_visible(False)
     _legend(fig, handles, ncols)
     return _save(fig, path)
+
+
+def _offset(ax, x_pt: float, y_pt: float):
+    """ax's data coordinates shifted by x_pt, y_pt points (a label beside a point)."""
+    from matplotlib.transforms import offset_copy
+    return offset_copy(ax.transData, ax.figure, x_pt, y_pt, units="points")
+
+
+def _arrows(ax, tips: np.ndarray, color: str, lw: float, head_pt: tuple[float, float] = (4.0, 2.0)) -> None:
+    """Arrows from the origin to each of `tips` (data, n x 2) as `annotate`'s "-|>" draws them
+    (a filled head `head_pt` long and half wide, points), as one line of shafts and one collection of
+    heads instead of an artist each. After ax's limits are fixed (`_axes`): the heads are shaped
+    in points."""
+    from matplotlib.collections import PolyCollection
+    if not len(tips):
+        return
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    k = np.array([ax.bbox.width / (x1 - x0), ax.bbox.height / (y1 - y0)]) * 72 / ax.figure.dpi   # pt per unit
+    v = tips * k
+    u = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    n = u @ np.array([[0.0, 1.0], [-1.0, 0.0]])
+    base = v - head_pt[0] * u
+    heads = np.stack([v, base + head_pt[1] * n, base - head_pt[1] * n], axis=1) / k
+    shafts = np.concatenate([np.zeros_like(base)[:, None], (base / k)[:, None], np.full_like(base, np.nan)[:, None]], 1)
+    ax.plot(*shafts.reshape(-1, 2).T, color=color, lw=lw, zorder=3)
+    ax.add_collection(PolyCollection(heads, facecolors=color, edgecolors=color, linewidths=lw, zorder=3), autolim=False)
 
 
 def plot_hodographs(run: ModelRun, path: Path) -> Path:
@@ -560,21 +645,22 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
         ax.plot(0, 0, marker="+", ms=12, color="black")
         mag = np.linalg.norm(R, axis=-1)
         fin = np.isfinite(mag)
+        if fin.any():
+            i = int(np.nanargmax(mag))
+            ax.plot(*R[i], marker="o", ms=6, color="tab:red", ls="none")
+            ax.text(*R[i], f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", transform=_offset(ax, 6, -14), fontsize=7,
+                    color="tab:red")
+        ax.set_aspect("equal", adjustable="datalim")
+        _axes(ax, _nice(4), _nice(5), "R_x, N", "R_y, N")     # 4 on x: room for "−4000" on a narrow panel
         # rays at every 30 deg of the cycle, labelled with the angle
+        rays = []
         for a in range(0, 360, 30):
             i = int(np.argmin(np.abs(((phi - a) + 180) % 360 - 180)))
             if abs(((phi[i] - a) + 180) % 360 - 180) > 2.5 or not fin[i] or mag[i] < 0.12 * np.nanmax(mag):
                 continue      # short rays near the origin would only clutter the labels
-            ax.annotate("", xy=R[i], xytext=(0, 0),
-                        arrowprops=dict(arrowstyle="-|>", color="0.6", lw=0.7, shrinkA=0, shrinkB=0))
-            ax.annotate(f"{phi[i]:.0f}°", R[i], xytext=(3, 3), textcoords="offset points", fontsize=7, color="0.25")
-        if fin.any():
-            i = int(np.nanargmax(mag))
-            h, = ax.plot(*R[i], marker="o", ms=6, color="tab:red", ls="none")
-            ax.annotate(f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", R[i], xytext=(6, -14), textcoords="offset points",
-                        fontsize=7, color="tab:red")
-        ax.set_aspect("equal", adjustable="datalim")
-        _axes(ax, _nice(4), _nice(5), "R_x, N", "R_y, N")     # 4 on x: room for "−4000" on a narrow panel
+            rays.append(R[i])
+            ax.text(*R[i], f"{phi[i]:.0f}°", transform=_offset(ax, 3, 3), fontsize=7, color="0.25")
+        _arrows(ax, np.reshape(rays, (-1, 2)), color="0.6", lw=0.7)
         ax.set_title(_wrap(f"{pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
     for ax in axes[len(pairs):]:
         ax.set_visible(False)
@@ -593,7 +679,7 @@ def plot_balancing_force(res: Analysis, path: Path) -> Path:
     ax.plot(*_closed(phi, np.linalg.norm(F, axis=-1)), color="black", lw=2.4, label=quantity_name(m, "|F_bal|"))
     ax.plot(*_closed(phi, F[:, 0]), color="tab:blue", lw=1.4, ls="--", label=quantity_name(m, "F_bal,x"))
     ax.plot(*_closed(phi, F[:, 1]), color="tab:orange", lw=1.4, ls=(0, (2, 2)), label=quantity_name(m, "F_bal,y"))
-    ax.axhline(0, color="0.3", lw=0.6)
+    _hline(ax, 0, color="0.3", lw=0.6)
     ax.set_title(f"{m.name}\nbalancing force of the pinion on the crank's wheel (pitch point, line of action)",
                  fontsize=10, y=1.0)
     ax.legend(fontsize=8, loc="best")
