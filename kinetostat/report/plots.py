@@ -422,10 +422,9 @@ def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
             for sgn in (-1, 1):
                 r0, r1 = a + sgn * 0.6 * blk_w * n, b + sgn * 0.6 * blk_w * n
                 ax.plot([r0[0], r1[0]], [r0[1], r1[1]], color="0.3", lw=1.4, zorder=2)
-                for t in np.linspace(0.04, 0.96, 12):
-                    q = r0 + t * (r1 - r0)
-                    e = q + sgn * 0.3 * blk_w * n + 0.3 * blk_w * d
-                    ax.plot([q[0], e[0]], [q[1], e[1]], color="0.5", lw=0.7, zorder=2)
+                q = r0 + np.linspace(0.04, 0.96, 12)[:, None] * (r1 - r0)      # 12 hatches: one line, NaN between
+                e = q + sgn * 0.3 * blk_w * n + 0.3 * blk_w * d
+                ax.plot(*np.stack([q, e, np.full_like(q, np.nan)], 1).reshape(-1, 2).T, color="0.5", lw=0.7, zorder=2)
         else:        # a guide on a moving link: the slot, drawn in that link's colour
             ax.plot([a[0], b[0]], [a[1], b[1]], color=colors[g], lw=2.5, alpha=0.8, zorder=2)
             for sgn in (-1, 1):
