@@ -232,18 +232,15 @@ def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = No
     from matplotlib.transforms import offset_copy
     ax.apply_aspect()
     widest = 0
-    grid: list[tuple[float, float]] = []          # the grid's segments in axes coordinates, NaN between
+    grid: list[tuple[float, float]] = []          # the grid's lines in data coordinates, NaN between
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
     for axis, loc in ((ax.xaxis, x), (ax.yaxis, y)):
         along_x = axis is ax.xaxis
         log = axis.get_scale() == "log"
-        view = axis.get_view_interval()
-        ticks = _ticks(*sorted(view), log, loc)
+        ticks = _ticks(*sorted(axis.get_view_interval()), log, loc)
         names = _names(ticks, log)
-        f = np.log10 if log else float
         for t in ticks:
-            a = float((f(t) - f(view[0])) / (f(view[1]) - f(view[0])))
-            grid += [(a, 0.0), (a, 1.0)] if along_x else [(0.0, a), (1.0, a)]
-            grid.append((math.nan, math.nan))
+            grid += [(t, y0), (t, y1), (math.nan, math.nan)] if along_x else [(x0, t), (x1, t), (math.nan, math.nan)]
         if along_x and not xnumbers:
             continue
         trans, va, ha = (ax.get_xaxis_text1_transform if along_x else ax.get_yaxis_text1_transform)(_PAD_PT)
@@ -251,8 +248,8 @@ def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = No
             ax.text(*((t, 0) if along_x else (0, t)), name, transform=trans, va=va, ha=ha, fontsize=_TICK_PT)
         widest = 0 if along_x else max(map(len, names), default=0)
     if grid:              # a collection (not a line): a legend's "best" place does not avoid it
-        ax.add_collection(LineCollection([grid], colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
-                                         transform=ax.transAxes), autolim=False)
+        ax.add_collection(LineCollection([grid], colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5),
+                          autolim=False)
     ax.spines[:].set_visible(False)                 # the frame as one rectangle in place of four spines
     ax.add_artist(Rectangle((0, 0), 1, 1, transform=ax.transAxes, fill=False, edgecolor="black", lw=0.8,
                             joinstyle="miter", zorder=2.5, clip_on=False))
