@@ -56,7 +56,7 @@ _TITLE_CHARS = int(_CELL_W * _CHARS_PER_INCH_10PT * 10 / 9)
 
 
 def _panels(n: int, title: str, n_legend: int, ncols_legend: int, cell_h: float = _CELL_H):
-    """Figure, its axes (a rows x cols grid for n panels, flat) and cols: the title on top
+    """Figure, its n axes (in a rows x cols grid, row by row) and cols: the title on top
     (wrapped to the width), room for a legend of n_legend entries in ncols_legend columns below."""
     rows, cols = _grid(n)
     w = _LEFT + _RIGHT + cols * _CELL_W + (cols - 1) * _GAP_W
@@ -67,7 +67,8 @@ def _panels(n: int, title: str, n_legend: int, ncols_legend: int, cell_h: float 
     fig = _figure(w, h, _LEFT, _RIGHT, top, bottom)
     fig.subplots_adjust(wspace=_GAP_W / _CELL_W, hspace=_GAP_H / cell_h)
     fig.suptitle(lines, fontsize=10, y=1 - 0.1 / h, va="top")
-    return fig, fig.subplots(rows, cols, squeeze=False).ravel(), cols
+    grid = fig.add_gridspec(rows, cols)
+    return fig, [fig.add_subplot(grid[i // cols, i % cols]) for i in range(n)], cols     # no axes for an empty cell
 
 
 def _legend(fig, handles: dict, ncols: int) -> None:
@@ -529,8 +530,6 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
         ax.set_title(_wrap(f"{pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
         ax.set_ylim(bottom=0)
         _phi_axes(ax, label=n_ax + cols >= len(m.pairs), y=_nice(4), ylabel="|R|, N")
-    for ax in axes[len(m.pairs):]:
-        ax.set_visible(False)
     _legend(fig, handles, ncols)
     return _save(fig, path)
 
@@ -593,8 +592,6 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
         ax.set_title(_wrap(title), fontsize=9, y=1.0)
         _phi_axes(ax, label=n_ax + cols >= len(qs), ylabel=f"|error|, {unit}",
                   y=None if ax.get_lines() else FixedLocator([]))     # nothing drawn: no scale to read
-    for ax in axes[len(qs):]:
-        ax.set_visible(False)
     _legend(fig, handles, ncols)
     return _save(fig, path)
 
@@ -668,8 +665,6 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
             ax.text(*R[i], f"{phi[i]:.0f}°", transform=_offset(ax, 3, 3), fontsize=7, color="0.25")
         _arrows(ax, np.reshape(rays, (-1, 2)), color="0.6", lw=0.7)
         ax.set_title(_wrap(f"{pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
-    for ax in axes[len(pairs):]:
-        ax.set_visible(False)
     _legend(fig, handles, ncols)
     return _save(fig, path)
 
