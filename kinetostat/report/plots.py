@@ -225,9 +225,9 @@ def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = No
           xnumbers: bool = True) -> None:
     """ax's two axes drawn light, after its data and limits are set: `x`, `y` are tick locators
     (`_ticks`; labels `_names`); the ticks within the view are drawn as one grid path (both
-    axes' grids), a text per label and the frame as one rectangle, the axis labels as texts, in place of matplotlib's own axes, which make
-    five artists per tick (half of these figures' drawing time). No tick marks: the grid carries
-    the ticks. `xnumbers` False: the x grid without its labels (a panel above another on the same x)."""
+    axes' grids), a text per label, the axis labels as texts and the frame as one rectangle, in
+    place of matplotlib's own axes, which make five artists per tick (half of these figures'
+    drawing time) and four spines. No tick marks: the grid carries the ticks. `xnumbers` False: the x grid without its labels (a panel above another on the same x)."""
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Rectangle
     from matplotlib.transforms import offset_copy
@@ -552,12 +552,6 @@ def _error_curves(res: Analysis, er) -> dict[str, tuple[np.ndarray, np.ndarray, 
     return out
 
 
-#: The error curves (`plot_errors`): drawn below the tolerance lines (z 2), all of a panel one
-#: after another, so that they make one picture of `_RASTER_DPI` in the SVG: at rounding level
-#: they are noise, 360 points a route whose every point as a vector made 200 kB a figure.
-_ERRORS_Z, _RASTER_DPI = 1.9, 200
-
-
 def plot_errors(run: ModelRun, path: Path) -> Path:
     from matplotlib.ticker import FixedLocator
     res, m = run.res, run.mech
@@ -565,7 +559,6 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
     ncols = _legend_cols(2 * len(run.results), 4)
     fig, axes, cols = _panels(len(qs), f"{m.name}\nerror of each engine route against kinetostat (log scale; "
                                        f"dashed: the route's tolerance × the cycle's peak)", 2 * len(run.results), ncols)
-    fig.set_dpi(80)
     curves = {route: _error_curves(res, er) for route, er in run.results.items()}
     handles = {}
     for n_ax, (ax, q) in enumerate(zip(axes, qs)):
@@ -577,8 +570,7 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
             phi, err, peak = curves[route][q]
             e = np.where(err > 0, err, np.nan)
             if np.any(np.isfinite(e)):
-                h, = ax.plot(*_closed(phi, e), **_line(run.results[route], res, col, "-", 1.3),
-                             zorder=_ERRORS_Z)
+                h, = ax.plot(*_closed(phi, e), **_line(run.results[route], res, col, "-", 1.3))
                 handles[f"{route}: |engine − kinetostat|"] = h
                 any_drawn = True
             tol = run.tolerances.get(route)
