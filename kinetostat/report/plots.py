@@ -227,7 +227,8 @@ def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = No
     (`_ticks`; labels `_names`); the ticks within the view are drawn as one grid path (both
     axes' grids), a text per label, the axis labels as texts and the frame as one rectangle, in
     place of matplotlib's own axes, which make five artists per tick (half of these figures'
-    drawing time) and four spines. No tick marks: the grid carries the ticks. `xnumbers` False: the x grid without its labels (a panel above another on the same x)."""
+    drawing time) and four spines. No tick marks: the grid carries the ticks. `xnumbers` False:
+    the x grid without its labels (a panel above another on the same x)."""
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Rectangle
     from matplotlib.transforms import offset_copy
