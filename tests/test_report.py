@@ -312,9 +312,12 @@ def test_the_light_axes_label_ticks_that_read_back_as_the_ticks(lo, hi, log):
     _axes(ax, xnumbers=False)                                        # its texts: the y labels only
     ys = ax.texts
     values = [float(t.get_text().replace("−", "-")) for t in ys]
-    grid = ax.collections[-1].get_segments()
+    grid = ax.collections[-1].get_paths()[0].vertices                # one path: its lines NaN apart
+    lines = [grid[i:i + 2] for i in range(0, len(grid), 3)]
+    assert np.isnan(grid[2::3]).all() and len(lines) * 3 == len(grid)
+    across = [a[1] for a, b in lines if a[1] == b[1]]                # the y grid: horizontal lines
     assert len(ys) >= 2 and len(set(t.get_text() for t in ys)) == len(ys)
-    np.testing.assert_allclose(values, [seg[0][1] for seg in grid], rtol=1e-12 if log else 0, atol=0 if log else 1e-12 * (hi - lo))
+    np.testing.assert_allclose(values, across, rtol=1e-12 if log else 0, atol=0 if log else 1e-12 * (hi - lo))
     assert all(lo <= v <= hi for v in values)
 
 
@@ -542,31 +545,70 @@ def test_report_check_says_a_rerun_reproduces_or_prints_each_difference(tmp_path
     assert "check: 1 difference(s)" in out
 
 
-def test_figures_keep_every_coordinate_to_a_hundredth_of_a_point_in_fewer_bytes():
-    """`plots._compact`: the same paths, texts and markers (commands, and coordinates to 0.005 pt)
-    in under 70 % of matplotlib's bytes of coordinates; everything else untouched, the texts'
-    font named once (DejaVu Sans, `plain_text`)."""
+def _outline(d: str, relative: bool) -> list[tuple]:
+    """An SVG path's data as absolute commands with their points: (letter, x, y, ...) each, "z"
+    alone; relative data (m, l, c, q: steps from the current point, a repeated letter left out)
+    summed back."""
+    out: list[tuple] = []
+    here = start = np.zeros(2)
+    for cmd, numbers in re.findall(r"([MLCQZmlcqz])([^MLCQZmlcqz]*)", d):
+        if cmd in "zZ":
+            out.append(("z",))
+            here = start
+            continue
+        v = np.array([float(x) for x in re.findall(r"-?(?:\d+\.?\d*|\.\d+)", numbers)]).reshape(-1, 2)
+        k = {"m": 1, "l": 1, "q": 2, "c": 3}[cmd.lower()]
+        for i in range(0, len(v), k):                                  # a letter left out: the command again
+            pts = here + v[i:i + k] if relative else v[i:i + k]
+            out.append(("L" if cmd in "mM" and i else cmd.upper(), *pts.ravel()))
+            here = pts[-1]
+            if cmd in "mM" and not i:
+                start = here
+    return out
+
+
+def test_figures_keep_every_coordinate_to_a_tenth_of_a_point_in_fewer_bytes():
+    """`plots._compact`: the same paths (commands, and points to 0.05 pt: relative steps of 0.1 pt
+    that add up to the rounded points), texts and markers (places to 0.005 pt) in under half of
+    matplotlib's bytes of coordinates; everything else untouched but a text's rotation by 0° and
+    the texts' font, named once in the style sheet (DejaVu Sans, `plain_text`)."""
     from matplotlib.backends.backend_svg import FigureCanvasSVG
     from matplotlib.figure import Figure
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path
     from kinetostat.report.plots import _compact, plain_text
     with plain_text():
         fig = Figure(figsize=(4, 3))
         x = np.linspace(0, 2 * np.pi, 361)
         wiggle = np.random.default_rng(1).normal(size=x.size)         # kept by matplotlib's path simplification
-        fig.add_subplot().plot(x, np.sin(x) + 0.1 * wiggle, x, 1e-3 * wiggle)
+        ax = fig.add_subplot()
+        ax.plot(x, np.sin(x) + 0.1 * wiggle, x, 1e-3 * wiggle)
+        ax.plot(x[::40], np.cos(x[::40]), "o")                          # markers: C commands, then z
+        ax.add_patch(PathPatch(Path.make_compound_path(Path.unit_rectangle(), Path.unit_circle())))   # z, then m
         buf = io.StringIO()
         FigureCanvasSVG(fig).print_svg(buf, metadata={"Date": None, "Creator": None})
     svg = buf.getvalue()
     small = _compact(svg)
-    paths = re.compile(r' (?:d|x|y|transform)="([^"]*)"')
-    before, after = paths.findall(svg), paths.findall(small)
-    assert len(before) == len(after) > 2 and sum(map(len, after)) < 0.7 * sum(map(len, before))
+    data, places = re.compile(r' d="([^"]*)"'), re.compile(r' (?:x|y|transform)="([^"]*)"')
+    before, after = data.findall(svg), data.findall(small)
+    assert len(before) == len(after) > 2 and sum(map(len, after)) < 0.5 * sum(map(len, before))
+    assert any("C" in d for d in before) and any("z" in d for d in before)
     for a, b in zip(before, after):
-        assert re.sub(r"[-\d.]+", "#", " ".join(a.split())) == re.sub(r"[-\d.]+", "#", b)     # the same commands
+        wide, short = _outline(a, relative=False), _outline(b, relative=True)
+        assert [c[0] for c in wide] == [c[0] for c in short]                    # the same commands
+        np.testing.assert_allclose(np.concatenate([c[1:] for c in short]), np.concatenate([c[1:] for c in wide]),
+                                   atol=0.05 + 1e-9)
+    unrotated = re.sub(r' transform="rotate\(-?0 [-\d. ]+\)"', "", svg)
+    before, after = places.findall(unrotated), places.findall(small)
+    assert len(before) == len(after) > 2 and len(unrotated) < len(svg)
+    for a, b in zip(before, after):
+        assert re.sub(r"[-\d.]+", "#", " ".join(a.split())) == re.sub(r"[-\d.]+", "#", b)
         np.testing.assert_allclose([float(v) for v in re.findall(r"-?\d+\.?\d*", b)],
                                    [float(v) for v in re.findall(r"-?\d+\.?\d*", a)], atol=0.005 + 1e-12)
-    assert paths.sub("", small) == paths.sub("", svg)
-    assert "font-family: 'DejaVu Sans', sans-serif;" in small and "Bitstream" not in small
+    font = "font-family: 'DejaVu Sans', sans-serif"
+    rest = lambda text: places.sub("", data.sub("", text)).replace(font + "; ", "").replace("; " + font, "")
+    assert rest(small) == rest(unrotated).replace("<style type=\"text/css\">*{", "<style type=\"text/css\">text{%s}*{" % font)
+    assert small.count(font) == 1 and svg.count(font) > 5 and "Bitstream" not in small
 
 
 

@@ -56,7 +56,7 @@ _TITLE_CHARS = int(_CELL_W * _CHARS_PER_INCH_10PT * 10 / 9)
 
 
 def _panels(n: int, title: str, n_legend: int, ncols_legend: int, cell_h: float = _CELL_H):
-    """Figure, its axes (a rows x cols grid for n panels, flat) and cols: the title on top
+    """Figure, its n axes (in a rows x cols grid, row by row) and cols: the title on top
     (wrapped to the width), room for a legend of n_legend entries in ncols_legend columns below."""
     rows, cols = _grid(n)
     w = _LEFT + _RIGHT + cols * _CELL_W + (cols - 1) * _GAP_W
@@ -67,7 +67,8 @@ def _panels(n: int, title: str, n_legend: int, ncols_legend: int, cell_h: float 
     fig = _figure(w, h, _LEFT, _RIGHT, top, bottom)
     fig.subplots_adjust(wspace=_GAP_W / _CELL_W, hspace=_GAP_H / cell_h)
     fig.suptitle(lines, fontsize=10, y=1 - 0.1 / h, va="top")
-    return fig, fig.subplots(rows, cols, squeeze=False).ravel(), cols
+    grid = fig.add_gridspec(rows, cols)
+    return fig, [fig.add_subplot(grid[i // cols, i % cols]) for i in range(n)], cols     # no axes for an empty cell
 
 
 def _legend(fig, handles: dict, ncols: int) -> None:
@@ -96,19 +97,64 @@ def plain_text() -> Iterator[None]:
         yield
 
 
-#: The coordinates in matplotlib's SVG (six decimals of a point): a path's data (one command a
-#: line), a text's or a marker's place and its transform; and a number in them.
-_COORDINATES = re.compile(r'( (?:d|x|y|transform)=")([^"]*)')
+#: In matplotlib's SVG: a path's data (absolute M, L, Q, C and z commands, six decimals of a
+#: point), a text's or a marker's place and transform (`_compact`); a number in those.
+_PATH_DATA = re.compile(r' d="([^"]*)"')
+_PLACES = re.compile(r'( (?:x|y|transform)=")([^"]*)')
 _COORDINATE = re.compile(r"-?\d+\.\d+")
+#: every text's font (`plain_text`), given once for all texts in the SVG's style sheet
+_FONT = "font-family: 'DejaVu Sans', sans-serif"
+_NO_ROTATION = re.compile(r' transform="rotate\(-?0 [-\d. ]+\)"')
+#: coordinate pairs after each command of a path
+_PAIRS = {"M": 1, "L": 1, "Q": 2, "C": 3}
+
+
+def _tenths(n: int) -> str:
+    """n tenths of a point, the SVG's shortest way: 0, 12, .5, -3.7."""
+    whole, part = divmod(abs(n), 10)
+    text = (str(whole) if whole else "") + (f".{part}" if part else "")
+    return ("-" + text if n < 0 else text) or "0"
+
+
+def _relative(d: str) -> str:
+    """matplotlib's path data as relative commands (m, l, q, c; a repeated command's letter
+    left out) on coordinates rounded to 0.1 pt (0.035 mm: a fraction of a screen's pixel even at
+    400 %): the same outline, each point given as the step from the one before (rounded first,
+    so the steps add up to the rounded points exactly)."""
+    tokens = d.split()
+    out: list[str] = []
+    x0 = y0 = sx = sy = 0          # the current point and the subpath's start, 0.1 pt
+    last, i = "", 0
+    while i < len(tokens):
+        cmd = tokens[i]
+        i += 1
+        if cmd not in _PAIRS:       # z: back to the subpath's start
+            out.append(cmd.lower())
+            x0, y0, last = sx, sy, "z"
+            continue
+        n = 2 * _PAIRS[cmd]
+        xy = [round(float(t) * 10) for t in tokens[i:i + n]]
+        i += n
+        steps = " ".join(_tenths(v - (y0 if k % 2 else x0)) for k, v in enumerate(xy))
+        letter = cmd.lower()
+        out.append((letter if letter != last or letter == "m" else " ") + steps)
+        x0, y0, last = xy[-2], xy[-1], letter
+        if letter == "m":
+            sx, sy = x0, y0
+    return "".join(out).replace(" -", "-")
 
 
 def _compact(svg: str) -> str:
-    """matplotlib's SVG with every coordinate to 0.01 pt (a hundredth of a point, far below any
-    screen's pixel or printer's dot) and a path's commands on one line: the figures drawn the
-    same in fewer bytes."""
+    """matplotlib's SVG with a text's or a marker's place to 0.01 pt, a path's data as relative
+    steps of 0.1 pt (`_relative`), a text's rotation by 0° left out, the texts' font named once
+    (`_FONT`): the figures drawn the same in fewer bytes."""
     def point(m: re.Match) -> str:
         return f"{round(float(m[0]), 2) + 0.0:.2f}".rstrip("0").rstrip(".")
-    return _COORDINATES.sub(lambda m: m[1] + _COORDINATE.sub(point, " ".join(m[2].split())), svg)
+    svg = _PATH_DATA.sub(lambda m: f' d="{_relative(m[1])}"', svg)
+    svg = _NO_ROTATION.sub("", svg)
+    svg = svg.replace(_FONT + "; ", "").replace("; " + _FONT, "").replace('<style type="text/css">*{',
+                                                                         '<style type="text/css">text{%s}*{' % _FONT, 1)
+    return _PLACES.sub(lambda m: m[1] + _COORDINATE.sub(point, " ".join(m[2].split())), svg)
 
 
 def _save(fig, path: Path) -> Path:
@@ -178,29 +224,37 @@ def _ticks(lo: float, hi: float, log: bool, loc=None) -> list[float]:
 def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = None, ylabel_pt: float = _LABEL_PT,
           xnumbers: bool = True) -> None:
     """ax's two axes drawn light, after its data and limits are set: `x`, `y` are tick locators
-    (`_ticks`; labels `_names`); the ticks within the view are drawn as one grid line collection
-    and a text per label, the axis labels as texts, in place of matplotlib's own axes, which make
-    five artists per tick (half of these figures' drawing time). No tick marks: the grid carries
-    the ticks. `xnumbers` False: the x grid without its labels (a panel above another on the same x)."""
+    (`_ticks`; labels `_names`); the ticks within the view are drawn as one grid path (both
+    axes' grids), a text per label, the axis labels as texts and the frame as one rectangle, in
+    place of matplotlib's own axes, which make five artists per tick (half of these figures'
+    drawing time) and four spines. No tick marks: the grid carries the ticks. `xnumbers` False:
+    the x grid without its labels (a panel above another on the same x)."""
     from matplotlib.collections import LineCollection
+    from matplotlib.patches import Rectangle
     from matplotlib.transforms import offset_copy
     ax.apply_aspect()
     widest = 0
+    grid: list[tuple[float, float]] = []          # the grid's lines in data coordinates, NaN between
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
     for axis, loc in ((ax.xaxis, x), (ax.yaxis, y)):
         along_x = axis is ax.xaxis
         log = axis.get_scale() == "log"
         ticks = _ticks(*sorted(axis.get_view_interval()), log, loc)
         names = _names(ticks, log)
-        ax.add_collection(LineCollection([[(t, 0), (t, 1)] if along_x else [(0, t), (1, t)] for t in ticks],
-                                         colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5,
-                                         transform=ax.get_xaxis_transform() if along_x else ax.get_yaxis_transform()),
-                          autolim=False)
+        for t in ticks:
+            grid += [(t, y0), (t, y1), (math.nan, math.nan)] if along_x else [(x0, t), (x1, t), (math.nan, math.nan)]
         if along_x and not xnumbers:
             continue
         trans, va, ha = (ax.get_xaxis_text1_transform if along_x else ax.get_yaxis_text1_transform)(_PAD_PT)
         for t, name in zip(ticks, names):
             ax.text(*((t, 0) if along_x else (0, t)), name, transform=trans, va=va, ha=ha, fontsize=_TICK_PT)
         widest = 0 if along_x else max(map(len, names), default=0)
+    if grid:              # a collection (not a line): a legend's "best" place does not avoid it
+        ax.add_collection(LineCollection([grid], colors="#b0b0b0", alpha=0.3, linewidths=0.8, zorder=0.5),
+                          autolim=False)
+    ax.spines[:].set_visible(False)                 # the frame as one rectangle in place of four spines
+    ax.add_artist(Rectangle((0, 0), 1, 1, transform=ax.transAxes, fill=False, edgecolor="black", lw=0.8,
+                            joinstyle="miter", zorder=2.5, clip_on=False))
     ax.set_xlim(ax.get_xlim())                      # frozen: nothing added later moves the grid
     ax.set_ylim(ax.get_ylim())
     ax.xaxis.set_visible(False)
@@ -211,6 +265,13 @@ def _axes(ax, x=None, y=None, xlabel: str | None = None, ylabel: str | None = No
     if ylabel:
         ax.text(0, 0.5, ylabel, transform=offset_copy(ax.transAxes, ax.figure, x=-(_PAD_PT + 0.64 * _TICK_PT * widest + 4),
                                                       units="points"), ha="right", va="center", rotation=90, fontsize=ylabel_pt)
+
+
+def _hline(ax, y: float, **style) -> Any:
+    """A line across ax at height y (data), as `axhline` draws it (y in the data limits) but as two
+    points: `axhline` gives a log axis' line 100 points."""
+    h, = ax.plot([0, 1], [y, y], transform=ax.get_yaxis_transform(), **style)
+    return h
 
 
 def _phi_axes(ax, label: bool = True, step: int = 90, y=None, ylabel: str | None = None, ylabel_pt: float = _LABEL_PT,
@@ -360,10 +421,9 @@ def plot_mechanism(res: Analysis, cycle: Analysis, path: Path) -> Path:
             for sgn in (-1, 1):
                 r0, r1 = a + sgn * 0.6 * blk_w * n, b + sgn * 0.6 * blk_w * n
                 ax.plot([r0[0], r1[0]], [r0[1], r1[1]], color="0.3", lw=1.4, zorder=2)
-                for t in np.linspace(0.04, 0.96, 12):
-                    q = r0 + t * (r1 - r0)
-                    e = q + sgn * 0.3 * blk_w * n + 0.3 * blk_w * d
-                    ax.plot([q[0], e[0]], [q[1], e[1]], color="0.5", lw=0.7, zorder=2)
+                q = r0 + np.linspace(0.04, 0.96, 12)[:, None] * (r1 - r0)      # 12 hatches: one line, NaN between
+                e = q + sgn * 0.3 * blk_w * n + 0.3 * blk_w * d
+                ax.plot(*np.stack([q, e, np.full_like(q, np.nan)], 1).reshape(-1, 2).T, color="0.5", lw=0.7, zorder=2)
         else:        # a guide on a moving link: the slot, drawn in that link's colour
             ax.plot([a[0], b[0]], [a[1], b[1]], color=colors[g], lw=2.5, alpha=0.8, zorder=2)
             for sgn in (-1, 1):
@@ -444,7 +504,7 @@ def plot_moment(run: ModelRun, path: Path) -> Path:
     for n, (route, er) in enumerate(run.results.items()):
         col, ls = _style(route, n)
         ax.plot(*_closed(er.phi_deg, er.M_drive), **_line(er, res, col, ls, 1.6), label=f"{route} ({er.route})")
-    ax.axhline(0, color="0.3", lw=0.6)
+    _hline(ax, 0, color="0.3", lw=0.6)
     kind = "moment of the drive on the crank about +z"
     ax.set_title(f"{m.name}\nbalancing moment ({kind}) over the cycle", fontsize=10, y=1.0)
     ax.legend(fontsize=8, loc="best")
@@ -471,8 +531,6 @@ def plot_reactions(run: ModelRun, path: Path) -> Path:
         ax.set_title(_wrap(f"{pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
         ax.set_ylim(bottom=0)
         _phi_axes(ax, label=n_ax + cols >= len(m.pairs), y=_nice(4), ylabel="|R|, N")
-    for ax in axes[len(m.pairs):]:
-        ax.set_visible(False)
     _legend(fig, handles, ncols)
     return _save(fig, path)
 
@@ -507,31 +565,54 @@ def plot_errors(run: ModelRun, path: Path) -> Path:
     for n_ax, (ax, q) in enumerate(zip(axes, qs)):
         unit = "N·m" if q == "M_drive" else "N"
         any_drawn = False
+        ax.set_yscale("log")
         for n, route in enumerate(run.results):
             col, ls = _style(route, n)
             phi, err, peak = curves[route][q]
             e = np.where(err > 0, err, np.nan)
             if np.any(np.isfinite(e)):
-                h, = ax.semilogy(*_closed(phi, e), **_line(run.results[route], res, col, "-", 1.3))
+                h, = ax.plot(*_closed(phi, e), **_line(run.results[route], res, col, "-", 1.3))
                 handles[f"{route}: |engine − kinetostat|"] = h
                 any_drawn = True
             tol = run.tolerances.get(route)
             if tol is not None and peak > 0:
-                h = ax.axhline(tol.peak_relative * peak, color=col, ls="--", lw=1)
-                handles[f"{route}: tolerance × peak"] = h
+                handles[f"{route}: tolerance × peak"] = _hline(ax, tol.peak_relative * peak, color=col, ls="--", lw=1)
         if not any_drawn:
             ax.text(0.5, 0.5, "no differences to draw\n(no engine results, or exactly equal)",
                     transform=ax.transAxes, ha="center", va="center", fontsize=8, color="0.4")
-            ax.set_yscale("log")
         title = f"{quantity_name(m, q)}: balancing moment" if q == "M_drive" else \
             pair_name(m, m.pair_between(*map(int, q[2:-1].split(","))))
         ax.set_title(_wrap(title), fontsize=9, y=1.0)
         _phi_axes(ax, label=n_ax + cols >= len(qs), ylabel=f"|error|, {unit}",
                   y=None if ax.get_lines() else FixedLocator([]))     # nothing drawn: no scale to read
-    for ax in axes[len(qs):]:
-        ax.set_visible(False)
     _legend(fig, handles, ncols)
     return _save(fig, path)
+
+
+def _offset(ax, x_pt: float, y_pt: float):
+    """ax's data coordinates shifted by x_pt, y_pt points (a label beside a point)."""
+    from matplotlib.transforms import offset_copy
+    return offset_copy(ax.transData, ax.figure, x_pt, y_pt, units="points")
+
+
+def _arrows(ax, tips: np.ndarray, color: str, lw: float, head_pt: tuple[float, float] = (4.0, 2.0)) -> None:
+    """Arrows from the origin to each of `tips` (data, n x 2) as `annotate`'s "-|>" draws them
+    (a filled head `head_pt` long and half wide, points), as one line of shafts and one collection of
+    heads instead of an artist each. After ax's limits are fixed (`_axes`): the heads are shaped
+    in points."""
+    from matplotlib.collections import PolyCollection
+    if not len(tips):
+        return
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    k = np.array([ax.bbox.width / (x1 - x0), ax.bbox.height / (y1 - y0)]) * 72 / ax.figure.dpi   # pt per unit
+    v = tips * k
+    u = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    n = u @ np.array([[0.0, 1.0], [-1.0, 0.0]])
+    base = v - head_pt[0] * u
+    heads = np.stack([v, base + head_pt[1] * n, base - head_pt[1] * n], axis=1) / k
+    shafts = np.concatenate([np.zeros_like(base)[:, None], (base / k)[:, None], np.full_like(base, np.nan)[:, None]], 1)
+    ax.plot(*shafts.reshape(-1, 2).T, color=color, lw=lw, zorder=3)
+    ax.add_collection(PolyCollection(heads, facecolors=color, edgecolors=color, linewidths=lw, zorder=3), autolim=False)
 
 
 def plot_hodographs(run: ModelRun, path: Path) -> Path:
@@ -560,24 +641,23 @@ def plot_hodographs(run: ModelRun, path: Path) -> Path:
         ax.plot(0, 0, marker="+", ms=12, color="black")
         mag = np.linalg.norm(R, axis=-1)
         fin = np.isfinite(mag)
+        if fin.any():
+            i = int(np.nanargmax(mag))
+            ax.plot(*R[i], marker="o", ms=6, color="tab:red", ls="none")
+            ax.text(*R[i], f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", transform=_offset(ax, 6, -14), fontsize=7,
+                    color="tab:red")
+        ax.set_aspect("equal", adjustable="datalim")
+        _axes(ax, _nice(4), _nice(5), "R_x, N", "R_y, N")     # 4 on x: room for "−4000" on a narrow panel
         # rays at every 30 deg of the cycle, labelled with the angle
+        rays = []
         for a in range(0, 360, 30):
             i = int(np.argmin(np.abs(((phi - a) + 180) % 360 - 180)))
             if abs(((phi[i] - a) + 180) % 360 - 180) > 2.5 or not fin[i] or mag[i] < 0.12 * np.nanmax(mag):
                 continue      # short rays near the origin would only clutter the labels
-            ax.annotate("", xy=R[i], xytext=(0, 0),
-                        arrowprops=dict(arrowstyle="-|>", color="0.6", lw=0.7, shrinkA=0, shrinkB=0))
-            ax.annotate(f"{phi[i]:.0f}°", R[i], xytext=(3, 3), textcoords="offset points", fontsize=7, color="0.25")
-        if fin.any():
-            i = int(np.nanargmax(mag))
-            h, = ax.plot(*R[i], marker="o", ms=6, color="tab:red", ls="none")
-            ax.annotate(f"max {mag[i]:.4g} N\nat {phi[i]:.4g}°", R[i], xytext=(6, -14), textcoords="offset points",
-                        fontsize=7, color="tab:red")
-        ax.set_aspect("equal", adjustable="datalim")
-        _axes(ax, _nice(4), _nice(5), "R_x, N", "R_y, N")     # 4 on x: room for "−4000" on a narrow panel
+            rays.append(R[i])
+            ax.text(*R[i], f"{phi[i]:.0f}°", transform=_offset(ax, 3, 3), fontsize=7, color="0.25")
+        _arrows(ax, np.reshape(rays, (-1, 2)), color="0.6", lw=0.7)
         ax.set_title(_wrap(f"{pair_name(m, p)}: {_link_name(m, p.links[0])} on {_link_name(m, p.links[1])}"), fontsize=9, y=1.0)
-    for ax in axes[len(pairs):]:
-        ax.set_visible(False)
     _legend(fig, handles, ncols)
     return _save(fig, path)
 
@@ -593,7 +673,7 @@ def plot_balancing_force(res: Analysis, path: Path) -> Path:
     ax.plot(*_closed(phi, np.linalg.norm(F, axis=-1)), color="black", lw=2.4, label=quantity_name(m, "|F_bal|"))
     ax.plot(*_closed(phi, F[:, 0]), color="tab:blue", lw=1.4, ls="--", label=quantity_name(m, "F_bal,x"))
     ax.plot(*_closed(phi, F[:, 1]), color="tab:orange", lw=1.4, ls=(0, (2, 2)), label=quantity_name(m, "F_bal,y"))
-    ax.axhline(0, color="0.3", lw=0.6)
+    _hline(ax, 0, color="0.3", lw=0.6)
     ax.set_title(f"{m.name}\nbalancing force of the pinion on the crank's wheel (pitch point, line of action)",
                  fontsize=10, y=1.0)
     ax.legend(fontsize=8, loc="best")
