@@ -8,10 +8,11 @@ May use: the standard library only.
 from __future__ import annotations
 
 import re
-import xml.etree.ElementTree as ET
 import json
-from typing import Any
-from xml.sax.saxutils import escape
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import xml.etree.ElementTree as ET
 
 __all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "workflow_command_text",
            "script_json", "visible", "one_line"]
@@ -39,6 +40,9 @@ def xml_safe(s: str) -> str:
 
 #: A text `xml_escape` leaves as it is: no & < > ", no control character, surrogate or non-character.
 _XML_PLAIN = re.compile("[^&<>\"\x00-\x1f\ud800-\udfff\ufffe\uffff]*")
+#: `xml_escape`'s entities and character references (`xml.sax.saxutils` imports urllib.request, http, email, ssl).
+_XML_ENTITIES = str.maketrans({"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "\n": "&#10;", "\r": "&#13;",
+                               "\t": "&#9;"})
 
 
 def xml_escape(s: str) -> str:
@@ -47,7 +51,7 @@ def xml_escape(s: str) -> str:
     as "\\x.."."""
     if _XML_PLAIN.fullmatch(s):                    # most names and labels: nothing to do
         return s
-    return escape(xml_safe(s), {'"': "&quot;", "\n": "&#10;", "\r": "&#13;", "\t": "&#9;"})
+    return xml_safe(s).translate(_XML_ENTITIES)
 
 
 def xml_clean_tree(root: ET.Element) -> ET.Element:

@@ -141,6 +141,23 @@ def test_the_solver_imports_nothing_of_the_harness_engines_or_reports():
     assert r.stdout.strip() == "[]"
 
 
+def test_the_plans_and_variants_are_imported_when_first_used():
+    code = ("import sys, kinetostat\n"
+            f"kinetostat.analyze(kinetostat.load({str(ICE)!r}), steps=36)\n"
+            "print(sorted(m for m in sys.modules if m.startswith(('kinetostat.plans', 'kinetostat.variants',"
+            " 'urllib.request', 'pandas'))))\n"
+            "print(kinetostat.plans.build.__module__, kinetostat.examples.__name__, kinetostat.variants.__name__)\n"
+            "print(sorted(set(kinetostat.__all__) - set(dir(kinetostat))))\n"
+            "from kinetostat import *\n"
+            "print(plans.__name__)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT / "tests", timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == ["[]", "kinetostat.plans kinetostat.examples kinetostat.variants", "[]",
+                                     "kinetostat.plans"]
+    with pytest.raises(AttributeError, match="no attribute 'plan'"):
+        kinetostat.plan
+
+
 def _imports(module: str) -> set[str]:
     tree = ast.parse((ROOT / "kinetostat" / f"{module}.py").read_text(encoding="utf-8"))
     out = set()
