@@ -30,7 +30,7 @@ from ..kinematics import DIGITS_WARN, leash_axes, special_point_z, special_index
 from .._io import write_text
 from .._text import csv_cell, markdown_text
 from ..model import Mechanism
-from ..tables import FLOAT_FORMAT, by_unit, plain
+from ..tables import by_unit, plain, rows_csv
 from .i18n import ZERO, accuracy, check_lang, num, phrase, text, unit
 from ..model.lettering import lettering
 from .scales import choose_scales
@@ -127,15 +127,13 @@ class Worksheet:
         """Write the rows as CSV, each value to 12 significant digits of the largest |value| of its
         unit (`kinetostat.tables.by_unit`), no cell read as a formula (atomic: a temporary file in the same folder, then replaced).
         Near a singular position the first row states the accuracy (key "digits")."""
-        import pandas as pd
-        df = self.frame()
-        df["value"] = by_unit(df["value"], df["unit"])
+        recs = self.records()
+        values = by_unit([r["value"] for r in recs], [r["unit"] for r in recs])
+        rows = [[v if c == "value" else r[c] for c in COLUMNS] for r, v in zip(recs, values)]
         if self.digits < DIGITS_WARN:          # the accuracy first: section "Accuracy", key "digits", the line as note
             head, _, note = accuracy(self.digits, DIGITS_WARN, self.lang, markdown=False).partition(": ")
-            df = pd.concat([pd.DataFrame([{"section": head, "key": "digits", "symbol": "digits",
-                                           "value": round(self.digits, 1), "unit": "", "direction": "",
-                                           "note": note}]), df], ignore_index=True)
-        write_text(path, df.map(csv_cell).to_csv(index=False, float_format=FLOAT_FORMAT))
+            rows.insert(0, [head, "digits", "digits", round(self.digits, 1), "", "", note])
+        write_text(path, rows_csv(COLUMNS, ([csv_cell(x) for x in row] for row in rows)))
 
     def to_json(self, path: str | Path) -> None:
         """Write the rows as a JSON list of objects, values as in `to_csv`, NaN as null (atomic)."""
