@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import xml.etree.ElementTree as ET
 
-__all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "html_text", "workflow_command_text",
-           "script_json", "visible", "one_line"]
+__all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "html_text",
+           "workflow_command_text", "script_json", "visible", "one_line"]
 
 #: Characters XML 1.0 cannot hold, even as a character reference.
 _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")

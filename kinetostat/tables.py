@@ -1,8 +1,8 @@
 """The tables a user gets (`analyze --out`, a report's cycle.csv, sweep tables, a variant's
 cycle.csv; segments.csv and the worksheets: rows rounded by `rounded_columns` and `by_unit`,
-written by `rows_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON or Parquet of a pandas DataFrame whose `attrs["units"]`
-gives each column's unit, with the units in every format and the numbers of the text formats
-to the digits that mean something.
+written by `rows_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON
+or Parquet of a pandas DataFrame whose `attrs["units"]` gives each column's unit, with the units
+in every format and the numbers of the text formats to the digits that mean something.
 
 - CSV: the header names each column with its unit, `R_0_1 [N]` (a text column: its bare name);
   `read_csv` reads such a file back with bare names and `attrs["units"]`.
@@ -30,8 +30,8 @@ from typing import IO, Any, Iterable
 
 import numpy as np
 
-__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "rounded_columns", "by_unit", "cell_text", "rows_csv", "value", "error", "header", "write_csv", "csv_text", "plain",
-           "json_document", "write_json", "write_parquet", "read_csv"]
+__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "rounded_columns", "by_unit", "cell_text", "rows_csv", "value", "error",
+           "header", "write_csv", "csv_text", "plain", "json_document", "write_json", "write_parquet", "read_csv"]
 
 #: Significant digits of a value in a text output, counted on its unit's largest |value|.
 DIGITS = 12
@@ -158,12 +158,12 @@ def cell_text(x: Any) -> str:
     return str(x)
 
 
-def rows_csv(header: Iterable[str], rows: Iterable[Iterable[Any]]) -> str:
-    """CSV text of `header` and `rows` (each a row's cells, `cell_text`), lines ending "\\n",
-    quoted where the csv module must: the text `write_csv` writes of a frame, without pandas."""
+def rows_csv(names: Iterable[str], rows: Iterable[Iterable[Any]]) -> str:
+    """CSV text of the header `names` and `rows` (each a row's cells, `cell_text`), lines ending
+    "\\n", quoted where the csv module must: the text `write_csv` writes of a frame, without pandas."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(header)
+    w.writerow(names)
     w.writerows([cell_text(x) for x in row] for row in rows)
     return buf.getvalue()
 

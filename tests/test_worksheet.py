@@ -99,7 +99,8 @@ def test_outputs(ice_sheet, tmp_path):
 
 HOSTILE = ["*a*", "_b_", "x_y", "__init__", "[l](u)", "a | b", "\\", "\\|", "~~s~~", "`c`", "&amp; <i>", '"q" \'s\'',
            "\u00a0 edge \u3000", "\u2028line\u2029", "\ufefffeff", "tab\there", "nl\nhere", "\x00\x1b[2J", "# h", "> q",
-           "- li", "1. li", "---", "    code", "<https://a.b>", "&#65; &copy;", "\\*", "  ", "", "😀 μ_l²_x", "a  b"]
+           "- li", "1. li", "---", "    code", "<https://a.b>", "&#65; &copy;", "\\*", "  ", "", "😀 μ_l²_x",
+           "a  b"]
 
 
 @functools.cache
@@ -124,7 +125,8 @@ def test_the_html_is_the_markdown_as_commonmark_renders_it(ice_sheet):
     controls, edge spaces)."""
     from dataclasses import replace
     from kinetostat.plans.worksheet import Row
-    rows = tuple(Row("kinematics" if i % 3 else "inertia", f"k{i}", h, float(i), h, h, h) for i, h in enumerate(HOSTILE))
+    rows = tuple(Row("kinematics" if i % 3 else "inertia", f"k{i}", h, float(i), h, h, h)
+                 for i, h in enumerate(HOSTILE))
     for lang in ("en", "uk", "ru"):
         sheet = replace(ice_sheet, lang=lang)
         assert sheet.html() == _commonmark(sheet)

@@ -98,7 +98,7 @@ class Worksheet:
         df.attrs.update(mechanism=self.mechanism, phi_deg=self.phi_deg, mu_l=self.mu_l)
         return df
 
-    def _tables(self) -> tuple[str, list[str], list[tuple[str, list[tuple[str, ...]]]]]:
+    def _body(self) -> tuple[str, list[str], list[tuple[str, list[tuple[str, ...]]]]]:
         """What the Markdown and the HTML show under the title, in the worksheet's language: the
         scale line, the tables' header, and one table per run of rows of one section: (section,
         its rows' cells: symbol, value as the language writes it, unit, direction, note)."""
@@ -114,7 +114,7 @@ class Worksheet:
         """The worksheet as Markdown: a title, then one table per section (numbers as the
         worksheet's language writes them); near a singular position, the digits left."""
         lang = self.lang
-        scale, head, tables = self._tables()
+        scale, head, tables = self._body()
         out = [f"# {text('ws.title', lang, name=markdown_text(self.mechanism), phi=num(self.phi_deg, lang, 6))}", "",
                scale]
         if self.digits < DIGITS_WARN:
@@ -129,7 +129,7 @@ class Worksheet:
         tables writes it (every text escaped, `_text.html_text`), written here directly."""
         lang = self.lang
         title = text("ws.title", lang, name=self.mechanism, phi=num(self.phi_deg, lang, 6))
-        scale, head, tables = self._tables()
+        scale, head, tables = self._body()
         out = [f"<h1>{html_text(title)}</h1>", f"<p>{html_text(scale)}</p>"]
         if self.digits < DIGITS_WARN:        # the Markdown's bold lead: "**Accuracy:** ..."
             lead, _, line = accuracy(self.digits, DIGITS_WARN, lang, markdown=False).partition(": ")
