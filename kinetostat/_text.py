@@ -1,20 +1,21 @@
 """Text from a model file (names, notes, expressions) made safe for each place it is written, one
 function per place: XML (MJCF, URDF, SVG, JUnit), CSV cells opened by spreadsheets, Markdown (also
-GitHub's step summary), GitHub Actions' workflow commands, JSON inside an HTML <script> element,
-and the terminal.
+GitHub's step summary) and the HTML a CommonMark renderer makes of it, GitHub Actions' workflow
+commands, JSON inside an HTML <script> element, and the terminal.
 
 May use: the standard library only.
 """
 from __future__ import annotations
 
 import re
-import xml.etree.ElementTree as ET
 import json
-from typing import Any
-from xml.sax.saxutils import escape
+from typing import TYPE_CHECKING, Any
 
-__all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "workflow_command_text",
-           "script_json", "visible", "one_line"]
+if TYPE_CHECKING:
+    import xml.etree.ElementTree as ET
+
+__all__ = ["xml_safe", "xml_escape", "xml_clean_tree", "csv_cell", "markdown_text", "html_text",
+           "workflow_command_text", "script_json", "visible", "one_line"]
 
 #: Characters XML 1.0 cannot hold, even as a character reference.
 _NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
@@ -39,6 +40,9 @@ def xml_safe(s: str) -> str:
 
 #: A text `xml_escape` leaves as it is: no & < > ", no control character, surrogate or non-character.
 _XML_PLAIN = re.compile("[^&<>\"\x00-\x1f\ud800-\udfff\ufffe\uffff]*")
+#: `xml_escape`'s entities and character references (`xml.sax.saxutils` imports urllib.request, http, email, ssl).
+_XML_ENTITIES = str.maketrans({"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "\n": "&#10;", "\r": "&#13;",
+                               "\t": "&#9;"})
 
 
 def xml_escape(s: str) -> str:
@@ -47,7 +51,7 @@ def xml_escape(s: str) -> str:
     as "\\x.."."""
     if _XML_PLAIN.fullmatch(s):                    # most names and labels: nothing to do
         return s
-    return escape(xml_safe(s), {'"': "&quot;", "\n": "&#10;", "\r": "&#13;", "\t": "&#9;"})
+    return xml_safe(s).translate(_XML_ENTITIES)
 
 
 def xml_clean_tree(root: ET.Element) -> ET.Element:
@@ -75,6 +79,20 @@ def markdown_text(s: str) -> str:
     controls visible, one line."""
     s = _MARKDOWN.sub(r"\\\1", one_line(s))
     return s.replace("&", "&amp;").replace("<", "&lt;")
+
+
+#: The whitespace CommonMark trims from the edges of a heading, a paragraph or a table cell (Unicode
+#: Zs, U+2028, U+2029; the controls `one_line` writes visibly).
+_MARKDOWN_TRIM = " \u00a0\u1680" + "".join(map(chr, range(0x2000, 0x200b))) + "\u2028\u2029\u202f\u205f\u3000"
+#: The characters a CommonMark renderer writes as entities in HTML text (not ').
+_HTML_ENTITIES = str.maketrans({"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;"})
+
+
+def html_text(s: str) -> str:
+    """`s` as the text of an HTML heading, paragraph or table cell, as a CommonMark renderer
+    writes `markdown_text(s)` standing alone there: controls visible, one line, the edges'
+    whitespace trimmed, & < > " as entities."""
+    return one_line(s).strip(_MARKDOWN_TRIM).translate(_HTML_ENTITIES)
 
 
 def workflow_command_text(s: str, prop: bool = False) -> str:

@@ -1,7 +1,8 @@
 """The tables a user gets (`analyze --out`, a report's cycle.csv, sweep tables, a variant's
-cycle.csv; segments.csv and the worksheets round with `rounded` and `value`), written one way: CSV, JSON or Parquet of a pandas DataFrame whose `attrs["units"]`
-gives each column's unit, with the units in every format and the numbers of the text formats
-to the digits that mean something.
+cycle.csv; segments.csv and the worksheets: rows rounded by `rounded_columns` and `by_unit`,
+written by `rows_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON
+or Parquet of a pandas DataFrame whose `attrs["units"]` gives each column's unit, with the units
+in every format and the numbers of the text formats to the digits that mean something.
 
 - CSV: the header names each column with its unit, `R_0_1 [N]` (a text column: its bare name);
   `read_csv` reads such a file back with bare names and `attrs["units"]`.
@@ -29,8 +30,8 @@ from typing import IO, Any, Iterable
 
 import numpy as np
 
-__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "by_unit", "value", "error", "header", "write_csv", "csv_text", "plain",
-           "json_document", "write_json", "write_parquet", "read_csv"]
+__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "rounded_columns", "by_unit", "cell_text", "rows_csv", "value", "error",
+           "header", "write_csv", "csv_text", "plain", "json_document", "write_json", "write_parquet", "read_csv"]
 
 #: Significant digits of a value in a text output, counted on its unit's largest |value|.
 DIGITS = 12
@@ -100,17 +101,24 @@ def rounded(df, units: dict[str, str] | None = None):
     units = df.attrs.get("units", {}) if units is None else units
     attrs, df = dict(df.attrs), df.copy(deep=False)
     df.attrs = {}              # pandas deep-copies `attrs` into every column `items` hands out
-    cols = {name: col.to_numpy(dtype=float) for name, col in df.items() if col.dtype.kind == "f"}
-    scale: dict[str, float] = {}
-    for name in cols:
-        key = units.get(name) or ("column", name)
-        scale[key] = max(scale.get(key, 0.0), _peak(cols[name]))
+    cols = rounded_columns({name: col.to_numpy(dtype=float) for name, col in df.items() if col.dtype.kind == "f"},
+                           units)
     # built from df.items() (type(df): pandas is passed in): indexing a wide frame by name, and
     # setting each column back, cost most of a report's CSV writing
-    out = type(df)({name: _column_rounded(cols[name], scale[units.get(name) or ("column", name)])
-                    if name in cols else col for name, col in df.items()}, index=df.index)
+    out = type(df)({name: cols.get(name, col) for name, col in df.items()}, index=df.index)
     out.attrs = attrs
     return out
+
+
+def rounded_columns(cols: dict[str, np.ndarray], units: dict[str, str]) -> dict[str, np.ndarray]:
+    """Float columns (name -> array) each rounded to `DIGITS` significant digits of its unit's
+    scale: the largest |value| among the columns of the same unit (`units`; a column with no unit:
+    its own largest |value|), as `rounded` rounds a frame's."""
+    scale: dict[Any, float] = {}
+    for name, col in cols.items():
+        key = units.get(name) or ("column", name)
+        scale[key] = max(scale.get(key, 0.0), _peak(col))
+    return {name: _column_rounded(col, scale[units.get(name) or ("column", name)]) for name, col in cols.items()}
 
 
 def header(df) -> list[str]:
@@ -138,6 +146,26 @@ def write_csv(df, f: IO[str]) -> None:
     cols = [col for _, col in table.items()]
     for start in range(0, len(df), CSV_CHUNK):
         w.writerows(zip(*(cells(col.iloc[start:start + CSV_CHUNK]) for col in cols)))
+
+
+def cell_text(x: Any) -> str:
+    """One cell as `write_csv` writes it: a float `FLOAT_FORMAT`, a missing one (None, NaN) empty,
+    other cells `str`."""
+    if x is None:
+        return ""
+    if isinstance(x, (float, np.floating)):
+        return "" if math.isnan(x) else FLOAT_FORMAT % x
+    return str(x)
+
+
+def rows_csv(names: Iterable[str], rows: Iterable[Iterable[Any]]) -> str:
+    """CSV text of the header `names` and `rows` (each a row's cells, `cell_text`), lines ending
+    "\\n", quoted where the csv module must: the text `write_csv` writes of a frame, without pandas."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(names)
+    w.writerows([cell_text(x) for x in row] for row in rows)
+    return buf.getvalue()
 
 
 def csv_text(df) -> str:

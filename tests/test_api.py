@@ -141,6 +141,35 @@ def test_the_solver_imports_nothing_of_the_harness_engines_or_reports():
     assert r.stdout.strip() == "[]"
 
 
+def test_the_plans_and_variants_are_imported_when_first_used():
+    code = ("import sys, kinetostat\n"
+            f"kinetostat.analyze(kinetostat.load({str(ICE)!r}), steps=36)\n"
+            "print(sorted(m for m in sys.modules if m.startswith(('kinetostat.plans', 'kinetostat.variants',"
+            " 'urllib.request', 'pandas'))))\n"
+            "print(kinetostat.plans.build.__module__, kinetostat.examples.__name__, kinetostat.variants.__name__)\n"
+            "print(sorted(set(kinetostat.__all__) - set(dir(kinetostat))))\n"
+            "from kinetostat import *\n"
+            "print(plans.__name__)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT / "tests", timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == ["[]", "kinetostat.plans kinetostat.examples kinetostat.variants", "[]",
+                                     "kinetostat.plans"]
+    with pytest.raises(AttributeError, match="no attribute 'plan'"):
+        kinetostat.plan
+
+
+def test_the_plans_command_imports_no_pandas_markdown_it_or_matplotlib(tmp_path):
+    """`kinetostat plans` writes its sheets, segments.csv and the worksheet (CSV, HTML) without
+    pandas (0.6 s to import) or markdown-it-py: the budget of a plan (issue 34 (b))."""
+    code = ("import sys\nfrom kinetostat.cli import main\n"
+            f"assert main(['-q', 'plans', {str(ICE)!r}, '--at', '30', '--out', {str(tmp_path / 'p')!r}]) == 0\n"
+            "print(sorted({m.split('.')[0] for m in sys.modules} & {'pandas', 'markdown_it', 'matplotlib'}))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT / "tests", timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "[]"
+    assert {"segments.csv", "worksheet.csv", "worksheet.html"} <= {p.name for p in (tmp_path / "p").iterdir()}
+
+
 def _imports(module: str) -> set[str]:
     tree = ast.parse((ROOT / "kinetostat" / f"{module}.py").read_text(encoding="utf-8"))
     out = set()

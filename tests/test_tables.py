@@ -112,6 +112,18 @@ def test_write_csv_writes_what_pandas_to_csv_writes():
     assert "x [m],n [1]" in want and ',,,,2\n' in want          # the NA row: every missing cell empty
 
 
+def test_rows_csv_writes_what_pandas_to_csv_writes():
+    """segments.csv and the worksheet's CSV are written without pandas (`rows_csv`): each cell as
+    pandas' to_csv(float_format=FLOAT_FORMAT) writes it: floats with NaN and inf, None, text with
+    a comma, a quote and a newline, a formula led by a quote, integers, booleans."""
+    cols = {"x": [0.1, np.nan, np.inf, -1.5e-7, 30.0, 1 / 3],
+            "why": ['a, "b"', None, "line\nbreak", "", "plain", "'=1"], "k": [1, 2, 3, 4, 5, -6],
+            "ok": [True, False] * 3}
+    want = pd.DataFrame(cols).to_csv(index=False, lineterminator="\n", float_format=tables.FLOAT_FORMAT)
+    assert tables.rows_csv(cols, zip(*cols.values())) == want
+    assert tables.rows_csv(cols, []) == "x,why,k,ok\n"
+
+
 def test_a_column_named_twice_is_refused():
     df = pd.DataFrame([[1.0, 2.0]], columns=["phi_deg", "phi_deg"])
     with pytest.raises(ValueError, match="column 'phi_deg' twice"):

@@ -3,6 +3,7 @@
 worksheet of a cycle (`worksheet_cycle`, one analysis at N angles) is the one-angle worksheet at each."""
 from __future__ import annotations
 
+import functools
 import json
 import math
 
@@ -94,6 +95,48 @@ def test_outputs(ice_sheet, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["w.csv", "w.json"]     # no temporary left
     uk = worksheet(kinetostat.load("ice_crank_slider"), lang="uk")
     assert "за годинниковою стрілкою" in uk.markdown() and "Реакції" in uk.markdown()
+
+
+HOSTILE = ["*a*", "_b_", "x_y", "__init__", "[l](u)", "a | b", "\\", "\\|", "~~s~~", "`c`", "&amp; <i>", '"q" \'s\'',
+           "\u00a0 edge \u3000", "\u2028line\u2029", "\ufefffeff", "tab\there", "nl\nhere", "\x00\x1b[2J", "# h", "> q",
+           "- li", "1. li", "---", "    code", "<https://a.b>", "&#65; &copy;", "\\*", "  ", "", "😀 μ_l²_x",
+           "a  b"]
+
+
+@functools.cache
+def _markdown_it():
+    from markdown_it import MarkdownIt
+    return MarkdownIt("commonmark", {"html": False}).enable("table")
+
+
+def _commonmark(sheet) -> str:
+    """The page as markdown-it-py renders the sheet's Markdown (CommonMark with tables, no raw HTML)."""
+    from kinetostat.plans.worksheet import html_document
+    from kinetostat.plans.i18n import num, text
+    body = _markdown_it().render(sheet.markdown())
+    return html_document(text("ws.title", sheet.lang, name=sheet.mechanism, phi=num(sheet.phi_deg, sheet.lang, 6)),
+                         body, sheet.lang)
+
+
+def test_the_html_is_the_markdown_as_commonmark_renders_it(ice_sheet):
+    """worksheet.html is written without a Markdown renderer: it is markdown-it-py's page of
+    worksheet.md in every language, with the accuracy line, sections that come back (a triad's
+    a_S amid its velocities), and hostile names, symbols, units and notes (Markdown, HTML,
+    controls, edge spaces)."""
+    from dataclasses import replace
+    from kinetostat.plans.worksheet import Row
+    rows = tuple(Row("kinematics" if i % 3 else "inertia", f"k{i}", h, float(i), h, h, h)
+                 for i, h in enumerate(HOSTILE))
+    for lang in ("en", "uk", "ru"):
+        sheet = replace(ice_sheet, lang=lang)
+        assert sheet.html() == _commonmark(sheet)
+        near = replace(sheet, digits=3.25)
+        assert near.html() == _commonmark(near) and "<strong>" in near.html()
+    hostile = replace(ice_sheet, rows=rows)
+    assert hostile.html() == _commonmark(hostile)
+    for h in HOSTILE:
+        titled = replace(ice_sheet, mechanism=f"{h} mechanism {h}", rows=())
+        assert titled.html() == _commonmark(titled), h
 
 
 def test_bad_options():

@@ -15,7 +15,7 @@ scales by the texts' rule or given
 there and only when a figure is drawn).
 
 May use: numpy, the solver (`kinetostat.solve`, `kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`, `tables`;
-pandas only inside `Plans.segments_frame` and `Plans.segments_csv`; never the harness or
+pandas only inside `Plans.segments_frame`; never the harness or
 `kinetostat.report`.
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ from typing import Callable, Iterable
 from .._io import write_text
 from .._text import csv_cell
 from ..kinematics import DIGITS_WARN
-from ..tables import FLOAT_FORMAT, by_unit, rounded
+from ..tables import by_unit, rounded_columns, rows_csv
 from .core import SEGMENT_COLUMNS, Plan, PlanCycle, Scale, Segment, extent, extent_cycle
 from .draw import ROOM_MM, figure, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
@@ -268,13 +268,16 @@ class Plans(Mapping):
 
     def segments_csv(self) -> str:
         """segments.csv, plain numbers: the drawing's coordinates and lengths to 12 significant
-        digits of their largest |value| (all in mm; `kinetostat.tables.rounded`), each value to
+        digits of their largest |value| (all in mm; `kinetostat.tables.rounded_columns`), each value to
         12 significant digits of the largest |value| of its unit (`kinetostat.tables.by_unit`); no text cell a spreadsheet reads as a formula."""
-        df = self.segments_frame()
-        out = rounded(df, units={c: "mm" for c in df.columns if c.endswith("_mm")})
-        out["value"] = by_unit(df["value"], df["unit"])
-        out = out.map(csv_cell)                               # no text cell read as a formula
-        return out.to_csv(index=False, lineterminator="\n", float_format=FLOAT_FORMAT)
+        import numpy as np
+        rows = self.rows()
+        mm = [c for c in SEGMENT_COLUMNS if c.endswith("_mm")]
+        cols: dict[str, list] = {c: [r[c] for r in rows] for c in SEGMENT_COLUMNS}
+        cols |= {c: v.tolist() for c, v in rounded_columns({c: np.array(cols[c], float) for c in mm},
+                                                           dict.fromkeys(mm, "mm")).items()}
+        cols["value"] = by_unit(cols["value"], cols["unit"])
+        return rows_csv(SEGMENT_COLUMNS, zip(*(map(csv_cell, cols[c]) for c in SEGMENT_COLUMNS)))  # no formula cell
 
     def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
         """Write one SVG sheet per plan (`plan_file_name`) in `lang` ("en", "uk", "ru"; the

@@ -9,8 +9,8 @@ accelerations), the inertia loads and the applied loads, the reactions group by 
 last group attached back to the crank, the crank, Zhukovsky's lever and the difference of the two
 balancing moments. Outputs: Markdown, HTML, a pandas frame, CSV and JSON (written atomically).
 
-May use: the solver (`solve`, `analysis`, `applied`, `model`), `_io`, `_text` (safe cells), numpy; pandas and markdown-it-py inside the
-output methods only. Never matplotlib, never the harness.
+May use: the solver (`solve`, `analysis`, `applied`, `model`), `_io`, `_text` (safe cells), numpy; pandas inside
+`Worksheet.frame` only. Never matplotlib, never the harness.
 """
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ import json
 import warnings
 import math
 from dataclasses import dataclass
+from itertools import groupby
 from pathlib import Path
 
 import numpy as np
@@ -28,9 +29,9 @@ from ..applied import load_magnitude
 from ..errors import SelfLockingWarning
 from ..kinematics import DIGITS_WARN, leash_axes, special_point_z, special_index
 from .._io import write_text
-from .._text import csv_cell, markdown_text
+from .._text import csv_cell, html_text, markdown_text
 from ..model import Mechanism
-from ..tables import FLOAT_FORMAT, by_unit, plain
+from ..tables import by_unit, plain, rows_csv
 from .i18n import ZERO, accuracy, check_lang, num, phrase, text, unit
 from ..model.lettering import lettering
 from .scales import choose_scales
@@ -97,45 +98,62 @@ class Worksheet:
         df.attrs.update(mechanism=self.mechanism, phi_deg=self.phi_deg, mu_l=self.mu_l)
         return df
 
+    def _body(self) -> tuple[str, list[str], list[tuple[str, list[tuple[str, ...]]]]]:
+        """What the Markdown and the HTML show under the title, in the worksheet's language: the
+        scale line, the tables' header, and one table per run of rows of one section: (section,
+        its rows' cells: symbol, value as the language writes it, unit, direction, note)."""
+        lang = self.lang
+        scale = f"{text('scale', lang)} μ_l = {num(self.mu_l, lang, 6)} {unit('m/mm', lang)}"
+        head = [text(f"ws.head.{c}", lang) for c in ("symbol", "value", "unit", "direction", "note")]
+        tables = [(section, [tuple(str(c) for c in (r["symbol"], num(r["value"], lang, 6), r["unit"], r["direction"],
+                                                    r["note"])) for r in recs])
+                  for section, recs in groupby(self.records(), key=lambda r: r["section"])]
+        return scale, head, tables
+
     def markdown(self) -> str:
         """The worksheet as Markdown: a title, then one table per section (numbers as the
         worksheet's language writes them); near a singular position, the digits left."""
         lang = self.lang
+        scale, head, tables = self._body()
         out = [f"# {text('ws.title', lang, name=markdown_text(self.mechanism), phi=num(self.phi_deg, lang, 6))}", "",
-               f"{text('scale', lang)} μ_l = {num(self.mu_l, lang, 6)} {unit('m/mm', lang)}"]
+               scale]
         if self.digits < DIGITS_WARN:
             out += ["", accuracy(self.digits, DIGITS_WARN, lang)]
-        section = None
-        head = [text(f"ws.head.{c}", lang) for c in ("symbol", "value", "unit", "direction", "note")]
-        for rec in self.records():
-            if rec["section"] != section:
-                section = rec["section"]
-                out += ["", f"## {section}", "", "| " + " | ".join(head) + " |", "|---|---:|---|---|---|"]
-            cells = (rec["symbol"], num(rec["value"], lang, 6), rec["unit"], rec["direction"], rec["note"])
-            out.append("| " + " | ".join(markdown_text(str(c)) for c in cells) + " |")
+        for section, rows in tables:
+            out += ["", f"## {section}", "", "| " + " | ".join(head) + " |", "|---|---:|---|---|---|"]
+            out += ["| " + " | ".join(map(markdown_text, cells)) + " |" for cells in rows]
         return "\n".join(out) + "\n"
 
     def html(self) -> str:
-        """A standalone HTML page (`html_document`): the Markdown rendered (CommonMark with tables;
-        raw HTML is not passed through)."""
-        from markdown_it import MarkdownIt
-        body = MarkdownIt("commonmark", {"html": False}).enable("table").render(self.markdown())
-        return html_document(text("ws.title", self.lang, name=self.mechanism, phi=num(self.phi_deg, self.lang, 6)),
-                             body, self.lang)
+        """A standalone HTML page (`html_document`): the Markdown as a CommonMark renderer with
+        tables writes it (every text escaped, `_text.html_text`), written here directly."""
+        lang = self.lang
+        title = text("ws.title", lang, name=self.mechanism, phi=num(self.phi_deg, lang, 6))
+        scale, head, tables = self._body()
+        out = [f"<h1>{html_text(title)}</h1>", f"<p>{html_text(scale)}</p>"]
+        if self.digits < DIGITS_WARN:        # the Markdown's bold lead: "**Accuracy:** ..."
+            lead, _, line = accuracy(self.digits, DIGITS_WARN, lang, markdown=False).partition(": ")
+            out.append(f"<p><strong>{html_text(lead)}:</strong> {html_text(line)}</p>")
+        align = ("", ' style="text-align:right"', "", "", "")          # the value column: right
+        for section, rows in tables:
+            out += [f"<h2>{html_text(section)}</h2>", "<table>", "<thead>", "<tr>",
+                    *(f"<th{a}>{html_text(c)}</th>" for a, c in zip(align, head)), "</tr>", "</thead>", "<tbody>"]
+            for cells in rows:
+                out += ["<tr>", *(f"<td{a}>{html_text(c)}</td>" for a, c in zip(align, cells)), "</tr>"]
+            out += ["</tbody>", "</table>"]
+        return html_document(title, "\n".join(out) + "\n", lang)
 
     def to_csv(self, path: str | Path) -> None:
         """Write the rows as CSV, each value to 12 significant digits of the largest |value| of its
         unit (`kinetostat.tables.by_unit`), no cell read as a formula (atomic: a temporary file in the same folder, then replaced).
         Near a singular position the first row states the accuracy (key "digits")."""
-        import pandas as pd
-        df = self.frame()
-        df["value"] = by_unit(df["value"], df["unit"])
+        recs = self.records()
+        values = by_unit([r["value"] for r in recs], [r["unit"] for r in recs])
+        rows = [[v if c == "value" else r[c] for c in COLUMNS] for r, v in zip(recs, values)]
         if self.digits < DIGITS_WARN:          # the accuracy first: section "Accuracy", key "digits", the line as note
             head, _, note = accuracy(self.digits, DIGITS_WARN, self.lang, markdown=False).partition(": ")
-            df = pd.concat([pd.DataFrame([{"section": head, "key": "digits", "symbol": "digits",
-                                           "value": round(self.digits, 1), "unit": "", "direction": "",
-                                           "note": note}]), df], ignore_index=True)
-        write_text(path, df.map(csv_cell).to_csv(index=False, float_format=FLOAT_FORMAT))
+            rows.insert(0, [head, "digits", "digits", round(self.digits, 1), "", "", note])
+        write_text(path, rows_csv(COLUMNS, ([csv_cell(x) for x in row] for row in rows)))
 
     def to_json(self, path: str | Path) -> None:
         """Write the rows as a JSON list of objects, values as in `to_csv`, NaN as null (atomic)."""
