@@ -28,7 +28,6 @@ from functools import lru_cache
 import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
-from . import label_kernel
 from .dejavu import ADVANCES, EM
 
 __all__ = ["text_width", "label_parts", "label_markup", "label_width", "label_height", "coincident", "Placer",
@@ -157,9 +156,6 @@ LINE_COST = 0.6 / 0.7
 #: Candidates tested at once (cheapest first): this many (a point label's three nearest rings),
 #: twice as many from the third batch on.
 _BATCH = 48
-#: From this many angles a label's costs are found by the compiled kernel (`label_kernel`);
-#: fewer by numpy (importing numba costs more than placing a one-angle sheet's labels).
-COMPILED_MIN = 16
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
 
@@ -338,12 +334,22 @@ class Placer:
             c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln, box), c.size).reshape(c.shape)
         return c
 
-    def _batched_costs(self, centres: np.ndarray, half: np.ndarray, order: np.ndarray, ordered: np.ndarray,
-                       still: bool, slack: float) -> tuple[np.ndarray, np.ndarray]:
-        """The costs (N, K') of the candidates order[:K'] (`_choose`'s arguments; `ordered`: the base
-        costs in that order) and the least (N,), in batches by numpy: inf where not tested."""
-        n, K = ordered.shape
+    def _choose(self, centres: np.ndarray, half: np.ndarray, base: np.ndarray, still: bool) -> np.ndarray:
+        """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of those centred at
+        `centres` (2, N, K), half size `half` (2, N), least costs `base` (N, K); `still`: the same
+        candidates at every angle. Free candidates' costs found in batches, in the order of their
+        mean base where finite, at every angle until none left there can come within SLACK of the
+        best; then the candidate within SLACK of the
+        best at the most angles is taken there, and so on; where none is free, the cheapest
+        (nowhere free: the test tells)."""
+        n, K = base.shape
+        fin = np.isfinite(base)
+        with np.errstate(invalid="ignore"):                                # by the mean where finite; nowhere: last
+            typical = np.where(fin, base, 0.0).sum(axis=0) / fin.sum(axis=0)
+        order = np.argsort(np.where(np.isnan(typical), np.inf, typical), kind="stable")
+        ordered = base[:, order]
         best = np.full(n, np.inf)
+        slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
         tested = []
         start, size = 0, _BATCH
         while start < K:
@@ -365,39 +371,7 @@ class Placer:
             tested.append(cost)
             best[rows] = np.minimum(best[rows], c.min(axis=1))
             start, size = start + size, size * (2 if len(tested) > 1 else 1)
-        return (np.concatenate(tested, axis=1) if tested else np.full((n, 0), np.inf)), best
-
-    def _compiled_costs(self, centres: np.ndarray, half: np.ndarray, ordered: np.ndarray,
-                        slack: float) -> tuple[np.ndarray, np.ndarray]:
-        """The costs (N, K) of the candidates centred at `centres` (2, N, K) in the order to test them
-        (base costs `ordered`) and the least (N,), by the compiled kernel: inf where not tested."""
-        cost, best = np.empty(ordered.shape), np.empty(len(ordered))
-        hard, soft = self._stack("hard", True)[0], self._stack("soft", True)[0]
-        flat = np.ascontiguousarray                                       # one compiled signature
-        label_kernel.kernel()(flat(centres[0]), flat(centres[1]), flat(half[0]), flat(half[1]), ordered, flat(hard),
-                              self._stack("hard", False), flat(soft), self._stack("soft", False), LINE_COST, slack, _BATCH,
-                              cost, best)
-        return cost, best
-
-    def _choose(self, centres: np.ndarray, half: np.ndarray, base: np.ndarray, still: bool) -> np.ndarray:
-        """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of those centred at
-        `centres` (2, N, K), half size `half` (2, N), least costs `base` (N, K); `still`: the same
-        candidates at every angle. Free candidates' costs found in batches, in the order of their
-        mean base where finite, at every angle until none left there can come within SLACK of the
-        best; then the candidate within SLACK of the
-        best at the most angles is taken there, and so on; where none is free, the cheapest
-        (nowhere free: the test tells)."""
-        n, K = base.shape
-        fin = np.isfinite(base)
-        with np.errstate(invalid="ignore"):                                # by the mean where finite; nowhere: last
-            typical = np.where(fin, base, 0.0).sum(axis=0) / fin.sum(axis=0)
-        order = np.argsort(np.where(np.isnan(typical), np.inf, typical), kind="stable")
-        ordered = base[:, order]
-        slack = SLACK if n > 1 else 0.0                                    # one angle: nothing to keep
-        if n >= COMPILED_MIN:
-            cost, best = self._compiled_costs(centres[:, :, order], half, ordered, slack)
-        else:
-            cost, best = self._batched_costs(centres, half, order, ordered, still, slack)
+        cost = np.concatenate(tested, axis=1) if tested else np.full((n, 0), np.inf)    # of order[:start]
         ok = (cost <= best[:, None] + slack) & np.isfinite(cost)
         cols = np.flatnonzero(ok.any(axis=0))                              # within SLACK somewhere
         ok = ok[:, cols]
