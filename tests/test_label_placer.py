@@ -26,6 +26,17 @@ def _lines(rng, shape, span=60.0):
     return seg
 
 
+def _over(box, other):
+    """Whether boxes overlap (broadcast, last axis 4; strict: touching is clear)."""
+    return (box[..., 0] < other[..., 2]) & (box[..., 2] > other[..., 0]) & (box[..., 1] < other[..., 3]) \
+        & (box[..., 3] > other[..., 1])
+
+
+def _grown(boxes):
+    """Boxes grown by the placer's clearance."""
+    return boxes + np.array([-Placer.PAD, -Placer.PAD, Placer.PAD, Placer.PAD])
+
+
 def _scene(seed: int, n: int):
     """A placer with hard obstacles and lines, still and moving (some absent: NaN), and the
     same obstacles as plain arrays for the reference: hard (n, H, 4) grown by PAD, lines (n, S, 4)."""
@@ -39,8 +50,7 @@ def _scene(seed: int, n: int):
     placer.block(moving_hard)
     placer.line(still_lines[None])
     placer.line(moving_lines)
-    hard = np.concatenate([np.broadcast_to(still_hard, (n, 5, 4)), moving_hard], axis=1) \
-        + np.array([-Placer.PAD, -Placer.PAD, Placer.PAD, Placer.PAD])
+    hard = _grown(np.concatenate([np.broadcast_to(still_hard, (n, 5, 4)), moving_hard], axis=1))
     lines = np.concatenate([np.broadcast_to(still_lines, (n, 12, 4)), moving_lines], axis=1)
     return rng, placer, hard, lines
 
@@ -58,8 +68,7 @@ def _reference_choice(centres, half, base, hard, lines, slack):
                 continue
             c = centres[:, i, k].astype(float)
             box = np.r_[c - half[:, i], c + half[:, i]]
-            over = (box[0] < hard[i, :, 2]) & (box[2] > hard[i, :, 0]) & (box[1] < hard[i, :, 3]) & (box[3] > hard[i, :, 1])
-            if not over.any():
+            if not _over(box, hard[i]).any():
                 cost[i, k] = base[i, k] + LINE_COST * _clipped(lines[i], box).sum()
     fin = np.isfinite(base)
     typical = np.array([base[fin[:, k], k].mean() if fin[:, k].any() else np.inf for k in range(K)])
@@ -93,7 +102,7 @@ def test_lazy_costs_choose_what_testing_every_candidate_chooses(seed, still):
     near = np.broadcast_to(anchor, (n, 2)) + rng.uniform(-1.0, 1.0, (n, 2))
     blocker = np.concatenate([near, near], axis=1) + rng.uniform(1.0, 7.0, (n, 1)) * np.array([-1, -1, 1, 1])
     placer.block(blocker)                                     # the first rings taken at some angles: later batches
-    hard = np.concatenate([hard, blocker[:, None] + np.array([-Placer.PAD, -Placer.PAD, Placer.PAD, Placer.PAD])], axis=1)
+    hard = np.concatenate([hard, _grown(blocker[:, None])], axis=1)
     base[rng.random(base.shape) < 0.1] = np.inf
     centres, base = np.broadcast_to(centres, (2, n, K)), np.broadcast_to(base, (n, K))
     half = np.broadcast_to(rng.uniform(0.8, 3.0, (2, 1)), (2, n)).astype(np.float32)
@@ -116,9 +125,7 @@ def test_no_label_is_placed_over_a_hard_obstacle(seed):
         box = placer.place(("B" + "1" * j, "C"), rng.integers(0, 2, n), 3.5, anchor, along).box
         assert np.isfinite(box).all()
         assert (box[:, :2] >= 0.0).all() and (box[:, 2:] <= 60.0).all()
-        for other in [hard, *(b[:, None] + np.array([-Placer.PAD, -Placer.PAD, Placer.PAD, Placer.PAD])
-                              for b in placed)]:
-            over = (box[:, None, 0] < other[..., 2]) & (box[:, None, 2] > other[..., 0]) \
-                & (box[:, None, 1] < other[..., 3]) & (box[:, None, 3] > other[..., 1])
+        for other in [hard, *(_grown(b[:, None]) for b in placed)]:
+            over = _over(box[:, None], other)
             assert not over.any(), (j, np.argwhere(over))
         placed.append(box)
