@@ -1,0 +1,131 @@
+"""The label placer against a brute-force reference on small random scenes: its lazy costs
+(batches, the obstacles the same at every angle tested once, SLACK) choose the places that
+testing every candidate against every obstacle chooses, and no label is placed over a hard
+obstacle or another label."""
+import numpy as np
+import pytest
+
+from kinetostat.plans.labels import LINE_COST, SLACK, Placer, _clipped
+
+
+def _boxes(rng, shape, size=4.0, span=60.0):
+    """Random boxes (..., 4) in [0, span], sides up to `size`."""
+    xy = rng.uniform(0.0, span, shape + (2,))
+    return np.concatenate([xy, xy + rng.uniform(0.2, size, shape + (2,))], axis=-1)
+
+
+def _lines(rng, shape, span=60.0):
+    """Random segments (..., 4): oblique, some horizontal or vertical, some a point."""
+    seg = rng.uniform(0.0, span, shape + (4,))
+    flat = rng.random(shape) < 0.2
+    seg[flat, 3] = seg[flat, 1]                               # horizontal
+    upright = rng.random(shape) < 0.2
+    seg[upright, 2] = seg[upright, 0]                         # vertical
+    dot = rng.random(shape) < 0.05
+    seg[dot, 2:] = seg[dot, :2]
+    return seg
+
+
+def _over(box, other):
+    """Whether boxes overlap (broadcast, last axis 4; strict: touching is clear)."""
+    return (box[..., 0] < other[..., 2]) & (box[..., 2] > other[..., 0]) & (box[..., 1] < other[..., 3]) \
+        & (box[..., 3] > other[..., 1])
+
+
+def _grown(boxes):
+    """Boxes grown by the placer's clearance."""
+    return boxes + np.array([-Placer.PAD, -Placer.PAD, Placer.PAD, Placer.PAD])
+
+
+def _scene(seed: int, n: int):
+    """A placer with hard obstacles and lines, still and moving (some absent: NaN), and the
+    same obstacles as plain arrays for the reference: hard (n, H, 4) grown by PAD, lines (n, S, 4)."""
+    rng = np.random.default_rng(seed)
+    placer = Placer(n, (0.0, 0.0, 60.0, 60.0))
+    still_hard, moving_hard = _boxes(rng, (5,)), _boxes(rng, (n, 4))
+    still_lines, moving_lines = _lines(rng, (12,)), _lines(rng, (n, 8))
+    moving_hard[rng.random((n, 4)) < 0.2] = np.nan
+    moving_lines[rng.random((n, 8)) < 0.2] = np.nan
+    placer.block(still_hard[None])                           # (1, S, 4): the same at every angle
+    placer.block(moving_hard)
+    placer.line(still_lines[None])
+    placer.line(moving_lines)
+    hard = _grown(np.concatenate([np.broadcast_to(still_hard, (n, 5, 4)), moving_hard], axis=1))
+    lines = np.concatenate([np.broadcast_to(still_lines, (n, 12, 4)), moving_lines], axis=1)
+    return rng, placer, hard, lines
+
+
+def _reference_choice(centres, half, base, hard, lines, slack):
+    """Every candidate's cost at every angle (inf: not free, or over a hard obstacle; else its
+    base plus LINE_COST per mm of the lines inside its box), then the rule: at each angle the
+    candidates within `slack` of the least; the one of them at the most angles left (then the
+    least cost over them, then the first by mean finite base) taken there, and so on."""
+    n, K = base.shape
+    cost = np.full((n, K), np.inf)
+    for i in range(n):
+        for k in range(K):
+            if not np.isfinite(base[i, k]):
+                continue
+            c = centres[:, i, k].astype(float)
+            box = np.r_[c - half[:, i], c + half[:, i]]
+            if not _over(box, hard[i]).any():
+                cost[i, k] = base[i, k] + LINE_COST * _clipped(lines[i], box).sum()
+    fin = np.isfinite(base)
+    typical = np.array([base[fin[:, k], k].mean() if fin[:, k].any() else np.inf for k in range(K)])
+    rank = np.argsort(typical, kind="stable")                 # a candidate's place in the order
+    best = cost.min(axis=1)
+    ok = np.isfinite(cost) & (cost <= best[:, None] + slack)
+    chosen = np.where(fin.any(axis=1), rank[np.argmax(np.isfinite(base[:, rank]), axis=1)], -1)
+    todo = np.isfinite(best)
+    while todo.any():
+        key = [(-(ok[:, k] & todo).sum(), cost[ok[:, k] & todo, k].sum(), int(np.flatnonzero(rank == k)[0]), k)
+               for k in range(K) if (ok[:, k] & todo).any()]
+        k = min(key)[-1]
+        chosen[ok[:, k] & todo] = k
+        todo &= ~ok[:, k]
+    return chosen
+
+
+@pytest.mark.parametrize("still", [False, True], ids=["moving", "still"])
+@pytest.mark.parametrize("seed", range(4))
+def test_lazy_costs_choose_what_testing_every_candidate_chooses(seed, still):
+    """Random anchors among random obstacles, candidates on rings about them (n = 7 angles,
+    160 candidates: more than the first batches; a few not free; still: the same candidates at
+    every angle): the placer's choice is the brute-force reference's."""
+    n, K = 7, 160
+    rng, placer, hard, lines = _scene(seed, n)
+    anchor = rng.uniform(10.0, 50.0, (1 if still else n, 2))
+    reach = np.repeat(np.linspace(0.5, 8.0, K // 16), 16) + rng.uniform(0.0, 0.5, (len(anchor), K))
+    turn = np.radians(np.tile(np.arange(0.0, 360.0, 22.5), K // 16))
+    centres = (anchor.T[:, :, None] + reach * np.array([np.cos(turn), np.sin(turn)])[:, None]).astype(np.float32)
+    base = 1.2 * reach
+    near = np.broadcast_to(anchor, (n, 2)) + rng.uniform(-1.0, 1.0, (n, 2))
+    blocker = np.concatenate([near, near], axis=1) + rng.uniform(1.0, 7.0, (n, 1)) * np.array([-1, -1, 1, 1])
+    placer.block(blocker)                                     # the first rings taken at some angles: later batches
+    hard = np.concatenate([hard, _grown(blocker[:, None])], axis=1)
+    base[rng.random(base.shape) < 0.1] = np.inf
+    centres, base = np.broadcast_to(centres, (2, n, K)), np.broadcast_to(base, (n, K))
+    half = np.broadcast_to(rng.uniform(0.8, 3.0, (2, 1)), (2, n)).astype(np.float32)
+    got = placer._choose(centres, half, base, still)
+    want = _reference_choice(centres, half, base, hard, lines, SLACK)
+    assert np.array_equal(got, want), (got, want)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_no_label_is_placed_over_a_hard_obstacle(seed):
+    """Eight labels, still and moving, some beside a segment, among random obstacles (n = 6
+    angles): at every angle each box lies in the bounds, off every hard obstacle (grown by the
+    clearance) and off every label placed before it."""
+    n = 6
+    rng, placer, hard, _ = _scene(seed, n)
+    placed = []
+    for j in range(8):
+        anchor = np.broadcast_to(rng.uniform(10.0, 50.0, 2), (n, 2)) if j % 3 == 0 else rng.uniform(10.0, 50.0, (n, 2))
+        along = anchor + rng.uniform(-15.0, 15.0, (n, 2)) if j % 2 else None
+        box = placer.place(("B" + "1" * j, "C"), rng.integers(0, 2, n), 3.5, anchor, along).box
+        assert np.isfinite(box).all()
+        assert (box[:, :2] >= 0.0).all() and (box[:, 2:] <= 60.0).all()
+        for other in [hard, *(_grown(b[:, None]) for b in placed)]:
+            over = _over(box[:, None], other)
+            assert not over.any(), (j, np.argwhere(over))
+        placed.append(box)
