@@ -1,11 +1,12 @@
 """The label placer against a brute-force reference on small random scenes: its lazy costs
 (batches, the obstacles the same at every angle tested once, SLACK) choose the places that
-testing every candidate against every obstacle chooses, and no label is placed over a hard
-obstacle or another label."""
+testing every candidate against every obstacle chooses; over many angles a label keeps the
+place of a searched neighbouring angle where that place is free (STRIDE); and no label is
+placed over a hard obstacle or another label."""
 import numpy as np
 import pytest
 
-from kinetostat.plans.labels import LINE_COST, SLACK, Placer, _clipped
+from kinetostat.plans.labels import LINE_COST, SLACK, STRIDE, Placer, _clipped
 
 
 def _boxes(rng, shape, size=4.0, span=60.0):
@@ -55,11 +56,9 @@ def _scene(seed: int, n: int):
     return rng, placer, hard, lines
 
 
-def _reference_choice(centres, half, base, hard, lines, slack):
-    """Every candidate's cost at every angle (inf: not free, or over a hard obstacle; else its
-    base plus LINE_COST per mm of the lines inside its box), then the rule: at each angle the
-    candidates within `slack` of the least; the one of them at the most angles left (then the
-    least cost over them, then the first by mean finite base) taken there, and so on."""
+def _reference_costs(centres, half, base, hard, lines):
+    """Every candidate's cost at every angle: inf where not free (its base inf, or over a hard
+    obstacle), else its base plus LINE_COST per mm of the lines inside its box."""
     n, K = base.shape
     cost = np.full((n, K), np.inf)
     for i in range(n):
@@ -70,6 +69,15 @@ def _reference_choice(centres, half, base, hard, lines, slack):
             box = np.r_[c - half[:, i], c + half[:, i]]
             if not _over(box, hard[i]).any():
                 cost[i, k] = base[i, k] + LINE_COST * _clipped(lines[i], box).sum()
+    return cost
+
+
+def _reference_choice(centres, half, base, hard, lines, slack):
+    """`_reference_costs`, then the rule: at each angle the candidates within `slack` of the
+    least; the one of them at the most angles left (then the least cost over them, then the
+    first by mean finite base) taken there, and so on."""
+    n, K = base.shape
+    cost = _reference_costs(centres, half, base, hard, lines)
     fin = np.isfinite(base)
     typical = np.array([base[fin[:, k], k].mean() if fin[:, k].any() else np.inf for k in range(K)])
     rank = np.argsort(typical, kind="stable")                 # a candidate's place in the order
@@ -106,17 +114,72 @@ def test_lazy_costs_choose_what_testing_every_candidate_chooses(seed, still):
     base[rng.random(base.shape) < 0.1] = np.inf
     centres, base = np.broadcast_to(centres, (2, n, K)), np.broadcast_to(base, (n, K))
     half = np.broadcast_to(rng.uniform(0.8, 3.0, (2, 1)), (2, n)).astype(np.float32)
-    got = placer._choose(centres, half, base, still)
+    got = placer._choose(_geometry(centres, base), K, half, still)
     want = _reference_choice(centres, half, base, hard, lines, SLACK)
     assert np.array_equal(got, want), (got, want)
+
+
+def _geometry(centres, base):
+    """The placer's candidates as given arrays: centres (2, N, K), least costs (N, K)."""
+    return lambda rows, cols: (centres[:, rows[:, None], cols], base[rows[:, None], cols])
+
+
+def _scene_of_candidates(seed: int, n: int, K: int):
+    """A scene (`_scene`) with a moving anchor among blockers and K candidates on rings about it."""
+    rng, placer, hard, lines = _scene(seed, n)
+    anchor = rng.uniform(10.0, 50.0, 2) + np.cumsum(rng.uniform(-0.6, 0.6, (n, 2)), axis=0)    # a point moving on
+    reach = np.repeat(np.linspace(0.5, 8.0, K // 16), 16)
+    turn = np.radians(np.tile(np.arange(0.0, 360.0, 22.5), K // 16))
+    centres = (anchor.T[:, :, None] + reach * np.array([np.cos(turn), np.sin(turn)])[:, None]).astype(np.float32)
+    blocker = np.concatenate([anchor, anchor], axis=1) + rng.uniform(0.5, 4.0, (n, 1)) * np.array([-1, -1, 1, 1]) \
+        + rng.uniform(-3.0, 3.0, (n, 1)) * np.array([1, 0, 1, 0])
+    placer.block(blocker)
+    hard = np.concatenate([hard, _grown(blocker[:, None])], axis=1)
+    base = np.broadcast_to(1.2 * reach, (n, K)).copy()
+    half = np.broadcast_to(rng.uniform(0.8, 3.0, (2, 1)), (2, n)).astype(np.float32)
+    return placer, centres, half, base, hard, lines
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_over_many_angles_a_label_keeps_a_searched_neighbours_place_where_it_is_free(seed):
+    """n = 40 angles (>= 2 STRIDE): at every STRIDE-th angle and the last the brute-force
+    reference's choice over those angles alone; at an angle between, the place chosen at the
+    searched angle before it where free there, else the one after it where free, else the
+    reference's choice over the angles left; and at every angle a free place."""
+    n, K = 40, 96
+    placer, centres, half, base, hard, lines = _scene_of_candidates(seed, n, K)
+    got = placer._choose(_geometry(centres, base), K, half, False)
+    sample = np.unique(np.r_[np.arange(0, n, STRIDE), n - 1])
+    pick = lambda rows: _reference_choice(centres[:, rows], half[:, rows], base[rows], hard[rows], lines[rows], SLACK)
+    want = np.full(n, -1)
+    want[sample] = pick(sample)
+    free = np.isfinite(_reference_costs(centres, half, base, hard, lines))
+    left = []
+    for i in np.setdiff1d(np.arange(n), sample):
+        j = np.searchsorted(sample, i)
+        keep = [k for k in (want[sample[j - 1]], want[sample[j]]) if k >= 0 and free[i, k]]
+        if keep:
+            want[i] = keep[0]
+        else:
+            left.append(i)
+    if left:
+        want[left] = pick(np.array(left))
+    assert np.array_equal(got, want), np.flatnonzero(got != want)
+    assert free[np.arange(n), got].all()
+    assert len(left) and (want[sample][1:] != want[sample][:-1]).any()      # the scene moves a label, and searches again
 
 
 @pytest.mark.parametrize("seed", range(4))
 def test_no_label_is_placed_over_a_hard_obstacle(seed):
     """Eight labels, still and moving, some beside a segment, among random obstacles (n = 6
-    angles): at every angle each box lies in the bounds, off every hard obstacle (grown by the
-    clearance) and off every label placed before it."""
-    n = 6
+    angles, and n = 30 where the places are searched at every STRIDE-th angle): at every angle
+    each box lies in the bounds, off every hard obstacle (grown by the clearance) and off every
+    label placed before it."""
+    for n in (6, 30):
+        _labels_clear(seed, n)
+
+
+def _labels_clear(seed: int, n: int) -> None:
     rng, placer, hard, _ = _scene(seed, n)
     placed = []
     for j in range(8):

@@ -24,6 +24,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Callable
 
 import numpy as np
 
@@ -149,6 +150,13 @@ _RING_COST = _constant((1.2 * _RINGS[:, None] + np.where(_DIRS[:, 1] > 0, 0.3, 0
 _ALONG = tuple(_constant(g.reshape(-1)) for g in np.meshgrid(
     (0.5, 0.38, 0.62, 0.25, 0.75, 0.15, 0.85), (1.0, -1.0), (0.6, 1.5, 3.0), indexing="ij"))
 _ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
+#: Every candidate, beside the segment (the first 42), then on the rings (192): ring or not, and
+#: T, S, R and the cost's part for leaving the middle (0 on a ring); direction, ring, cost (0 beside).
+_CAND_RING = _constant(np.r_[np.zeros(len(_ALONG_OFF), bool), np.ones(len(_RING_COST), bool)])
+_CAND_T, _CAND_S, _CAND_R, _CAND_OFF = (_constant(np.r_[a, np.zeros(len(_RING_COST))]) for a in (*_ALONG, _ALONG_OFF))
+_CAND_DIR = _constant(np.r_[np.zeros((len(_ALONG_OFF), 2)), _RING_DIRS])
+_CAND_RAD = _constant(np.r_[np.zeros(len(_ALONG_OFF)), np.repeat(_RINGS, len(_DIRS))])
+_CAND_COST = _constant(np.r_[np.zeros(len(_ALONG_OFF)), _RING_COST])
 #: A label keeps one place over the angles where that place costs at most this more than the best.
 SLACK = 1.5
 #: The cost of covering a drawn line, per mm of it inside the label's box.
@@ -156,6 +164,9 @@ LINE_COST = 0.6 / 0.7
 #: Candidates tested at once (cheapest first): this many (a point label's three nearest rings),
 #: twice as many from the third batch on.
 _BATCH = 48
+#: Over many angles a label's places are searched at every STRIDE-th angle; the angles between
+#: keep a neighbour's place where it is free (`Placer._choose`).
+STRIDE = 4
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
 
@@ -268,30 +279,38 @@ class Placer:
         with np.errstate(invalid="ignore", divide="ignore"):
             u = d / L[:, None]
         nrm = np.column_stack([-u[:, 1], u[:, 0]])
-        T, S, R = _ALONG
-        clear = R[None, :] + (np.abs(nrm) * half).sum(axis=1)[:, None]    # (N, 42)
         C = np.where(has[:, None], A + d / 2, A)                          # rings about the segment's middle
-        ring = (_RINGS[:, None] + (half @ _ABS_DIRS.T)[:, None, :]).reshape(n, -1)      # (N, 192)
-        K = len(T) + ring.shape[1]
-        xy = np.empty((2, n, K))                                          # candidates' centres: beside, then the rings
-        for axis in (0, 1):
-            xy[axis, :, :len(T)] = A[:, axis, None] + T * d[:, axis, None] + S * nrm[:, axis, None] * clear
-            xy[axis, :, len(T):] = C[:, axis, None] + _RING_DIRS[:, axis] * ring
-        base = np.empty((n, K))
-        base[:, :len(T)] = np.where(beside[:, None], R + _ALONG_OFF * np.minimum(L, 20.0)[:, None] / 20.0, np.inf)
-        base[:, len(T):] = _RING_COST + np.where(has, 2.0, 0.0)[:, None]
+        fixed = np.isfinite(A).all(axis=1)
         bx0, by0, bx1, by1 = self.bounds
-        with np.errstate(invalid="ignore"):
-            x, y = xy
-            outside = (x < bx0 + half[:, :1]) | (y < by0 + half[:, 1:]) | (x > bx1 - half[:, :1]) | (y > by1 - half[:, 1:])
-        base[outside | ~np.isfinite(A).all(axis=1)[:, None]] = np.inf
-        xy = np.where(np.isfinite(xy), xy, C.T[:, :, None])               # no centre beside no segment: never free
+
+        def geometry(rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            """Centres (2, r, m) and least costs (r, m) of the candidates `cols` (r, m), or (1, m)
+            at every angle, at the angles `rows` (r,): beside the segment (`_ALONG`), then on the
+            rings (`_RINGS`)."""
+            h, n_r, c_r = half[rows][:, :, None], nrm[rows][:, :, None], C[rows][:, :, None]      # (r, 2, 1)
+            clear = _CAND_R[cols] + (np.abs(n_r[:, 0]) * h[:, 0] + np.abs(n_r[:, 1]) * h[:, 1])      # (r, m)
+            beside_xy = A[rows][:, :, None] + _CAND_T[cols][:, None] * d[rows][:, :, None] \
+                + _CAND_S[cols][:, None] * n_r * clear[:, None]
+            dirs = np.moveaxis(_CAND_DIR[cols], -1, 1)                                           # (r, 2, m)
+            reach = _CAND_RAD[cols] + (h[:, 0] * np.abs(dirs[:, 0]) + h[:, 1] * np.abs(dirs[:, 1]))
+            ring = _CAND_RING[cols]
+            xy = np.where(ring[:, None], c_r + dirs * reach[:, None], beside_xy)
+            base = np.where(ring, _CAND_COST[cols] + np.where(has[rows], 2.0, 0.0)[:, None],
+                            np.where(beside[rows][:, None],
+                                     _CAND_R[cols] + _CAND_OFF[cols] * np.minimum(L[rows], 20.0)[:, None] / 20.0, np.inf))
+            x, y, hx, hy = xy[:, 0], xy[:, 1], h[:, 0], h[:, 1]
+            outside = (x < bx0 + hx) | (y < by0 + hy) | (x > bx1 - hx) | (y > by1 - hy)
+            base = np.where(outside | ~fixed[rows][:, None], np.inf, base)
+            xy = np.where(np.isfinite(xy), xy, c_r)                       # no centre beside no segment: never free
+            return np.moveaxis(xy, 1, 0), base
+
         still = bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
-        k = self._choose(xy.astype(np.float32), half.T.astype(np.float32), base, still)
-        at = np.arange(n)
-        c = np.where((k >= 0)[:, None], xy[:, at, np.maximum(k, 0)].T, np.nan)
+        with np.errstate(invalid="ignore"):
+            k = self._choose(geometry, len(_CAND_RING), half.T.astype(np.float32), still)
+            xy, _ = geometry(np.arange(n), np.maximum(k, 0)[:, None])
+        c = np.where((k >= 0)[:, None], xy[:, :, 0].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
         far = np.hypot(*(c - C).T) - half @ _REACH > LEADER_MM
         foot = np.clip(C, box[:, :2], box[:, 2:])
@@ -299,12 +318,13 @@ class Placer:
         self.block(box)
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
-    def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: tuple[bool, ...]) -> np.ndarray:
+    def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: tuple[bool, ...],
+               kinds: tuple[str, ...] = ("hard", "soft")) -> np.ndarray:
         """Costs c (n', B) of the boxes centred at p (2, n', B), half size h (2, n'), at the angles
         `rows`: inf where a box meets a hard obstacle, plus LINE_COST per mm of the lines inside
         it; of the obstacles the same at every angle (`still` holds True) and of those that move
-        (False)."""
-        stacks = [(key, fixed, items) for key in ("hard", "soft") for fixed in still
+        (False); `kinds` ("hard",): whether free only, the lines not costed."""
+        stacks = [(key, fixed, items) for key in kinds for fixed in still
                   for items in (self._stack(key, fixed),) if items.shape[1]]
         free = np.isfinite(c)
         if not stacks or not free.any():
@@ -334,15 +354,45 @@ class Placer:
             c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln, box), c.size).reshape(c.shape)
         return c
 
-    def _choose(self, centres: np.ndarray, half: np.ndarray, base: np.ndarray, still: bool) -> np.ndarray:
-        """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of those centred at
-        `centres` (2, N, K), half size `half` (2, N), least costs `base` (N, K); `still`: the same
-        candidates at every angle. Free candidates' costs found in batches, in the order of their
-        mean base where finite, at every angle until none left there can come within SLACK of the
-        best; then the candidate within SLACK of the
-        best at the most angles is taken there, and so on; where none is free, the cheapest
-        (nowhere free: the test tells)."""
-        n, K = base.shape
+    def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool) -> np.ndarray:
+        """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of the K candidates
+        `geometry(rows, cols)` gives (their centres (2, r, m) and least costs (r, m) at the angles
+        `rows` (r,), candidates `cols` (r, m) or (1, m)), half size `half` (2, N); `still`: the same
+        candidates at every angle. Over many angles (N >= 2 STRIDE) a label keeps its place from
+        angle to angle unless it must move: the places are searched (`_search`) at every STRIDE-th
+        angle (and the last); an angle between keeps the place of the searched angle before it,
+        else of the one after it, where that place is free there (off every hard obstacle and in
+        the bounds); the angles where neither is are searched."""
+        n = self.n
+        if n < 2 * STRIDE:
+            return self._search(geometry, K, half, still, np.arange(n))
+        k = np.full(n, -1)
+        sample = np.unique(np.r_[np.arange(0, n, STRIDE), n - 1])
+        k[sample] = self._search(geometry, K, half, still, sample)
+        between = np.setdiff1d(np.arange(n), sample)
+        tried = np.full(n, -1)
+        for after in (0, 1):                                        # the searched angle before, then after
+            guess = k[sample[np.searchsorted(sample, between) - 1 + after]]
+            new = (guess >= 0) & (guess != tried[between])
+            rows, cand = between[new], guess[new]
+            tried[rows] = cand
+            xy, base = geometry(rows, cand[:, None])
+            free = np.isfinite(self._costs(xy.astype(np.float32), half[:, rows], base, rows, (True, False), ("hard",))[:, 0])
+            k[rows[free]] = cand[free]
+            between = np.setdiff1d(between, rows[free])
+        if len(between):
+            k[between] = self._search(geometry, K, half, still, between)
+        return k
+
+    def _search(self, geometry: Callable, K: int, half: np.ndarray, still: bool, at: np.ndarray) -> np.ndarray:
+        """The candidate (len(at),) taken at each of the angles `at` (indices; -1: none), as
+        `_choose`'s arguments give them. Free candidates' costs found in batches, in the order of
+        their mean base where finite, at every angle until none left there can come within SLACK of
+        the best; then the candidate within SLACK of the best at the most angles is taken there,
+        and so on; where none is free, the cheapest (nowhere free: the test tells)."""
+        centres, base = geometry(at, np.arange(K)[None])
+        centres = centres.astype(np.float32)
+        n = len(at)
         fin = np.isfinite(base)
         with np.errstate(invalid="ignore"):                                # by the mean where finite; nowhere: last
             typical = np.where(fin, base, 0.0).sum(axis=0) / fin.sum(axis=0)
@@ -354,22 +404,23 @@ class Placer:
         start, size = 0, _BATCH
         while start < K:
             rest = ordered[:, start:].min(axis=1)                          # the least base left
-            rows = np.flatnonzero(np.isfinite(rest) & (rest <= best + slack))
-            if not len(rows):
+            local = np.flatnonzero(np.isfinite(rest) & (rest <= best + slack))
+            if not len(local):
                 break
+            rows = at[local]
             idx = order[start:start + size]
-            c = ordered[rows, start:start + size]
+            c = ordered[local, start:start + size]
             if still:                                                       # the still obstacles once
-                p, h = centres[:, :1, idx], half[:, :1]
+                p, h = centres[:, :1, idx], half[:, rows[:1]]
                 c = self._costs(p, h, c[:1], rows[:1], (True,))
                 c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
                                 np.broadcast_to(c, (len(rows), len(idx))), rows, (False,))
             else:
-                c = self._costs(centres[:, rows[:, None], idx], half[:, rows], c, rows, (True, False))
+                c = self._costs(centres[:, local[:, None], idx], half[:, rows], c, rows, (True, False))
             cost = np.full((n, len(idx)), np.inf)
-            cost[rows] = c
+            cost[local] = c
             tested.append(cost)
-            best[rows] = np.minimum(best[rows], c.min(axis=1))
+            best[local] = np.minimum(best[local], c.min(axis=1))
             start, size = start + size, size * (2 if len(tested) > 1 else 1)
         cost = np.concatenate(tested, axis=1) if tested else np.full((n, 0), np.inf)    # of order[:start]
         ok = (cost <= best[:, None] + slack) & np.isfinite(cost)
