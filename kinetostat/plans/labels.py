@@ -166,7 +166,7 @@ LINE_COST = 0.6 / 0.7
 _BATCH = 48
 #: Over many angles a label's places are searched at every STRIDE-th angle; the angles between
 #: keep a neighbour's place where it is free (`Placer._choose`).
-STRIDE = 4
+STRIDE = 8
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
 
