@@ -439,21 +439,21 @@ def _script_page(drawings, n: int) -> str:
     from kinetostat.plans.core import ELEMENTS
     kinds, blobs = [], {}
     for k, d in enumerate(drawings):
-        meta, numbers = pg.encode_drawing(d)
+        meta, numbers, _ = pg.encode_drawing(d)
         kinds.append(meta)
         blobs[f"k{k}"] = pg._packed(numbers)
     blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "steps": []}).encode())
-    blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[1])
+    blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[2])
     blobs["check"] = pg._text85(pg._obscure(gzip.compress(b'{"items": [], "M": []}')))
     data = {"student": False, "frames": list(range(n)), "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
-            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "rows": [], "exps": [], "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
+            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "rows": [], "exps": [], "sources": [], "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
     return ('<!DOCTYPE html><html><head><meta charset="utf-8"><style id="page-size"></style></head><body>'
             '<input type="range" id="phi" min="0" max="359"><output id="phi-value"></output><button id="design"></button>'
             '<button id="prev"></button><button id="next"></button><output id="step"></output>'
             '<select id="paper"><option>A3</option><option>A4</option></select><p id="equation"></p>'
-            '<section id="sheets"></section><table id="value-table"></table>'
+            '<section id="sheets"></section><table id="value-table"></table><table id="check-table"><tr></tr></table>'
             + "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
             + f'<script id="page-data" type="application/json">{json.dumps(data)}</script><script>{script}</script></body></html>')
 

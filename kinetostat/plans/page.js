@@ -63,6 +63,19 @@
     return (d >= 0 ? "+" : "") + local(d, 3) + (unit ? " " + unit : "") + " (" + pct1(100 * d / exact) + ")";
   }
   function band(b) { return b ? local(b[0], 3) + " … " + local(b[1], 3) : "—"; }
+  let last = $("check-table").rows[0];         // the items' rows (page.py _html writes the moments' rows)
+  check.items.forEach((it, n) => {
+    const tr = document.createElement("tr"), input = document.createElement("input");
+    tr.dataset.item = n;
+    Object.assign(input, {type: "text", inputMode: "decimal", className: "measured", size: 7});
+    Object.assign(input.dataset, {plan: it.plan, segment: it.segment});
+    [it.title, it.label, input, "exact num", "band num", "verdict"].forEach((x, c) => {
+      const td = tr.insertCell();
+      if (c === 2) td.appendChild(x); else if (c < 2) td.textContent = x; else td.className = x;
+    });
+    last.after(tr);
+    last = tr;
+  });
   document.querySelectorAll("tr[data-item]").forEach((tr) => {
     const it = check.items[+tr.dataset.item];
     if (!D.student) {
@@ -118,7 +131,9 @@
     const s = String(Math.abs(q)).padStart(digits + 1, "0"), cut = s.length - digits;
     return (q < 0 ? "-" : "") + s.slice(0, cut) + "." + s.slice(cut);
   }
-  const kinds = [];
+  // An earlier length series times f, as page.py _scaled: the part of a series stored less it.
+  const plus = (rest, source, f) => rest.map((r, j) => r + Math.floor(source[j] * f + 0.5));
+  const kinds = [], lengths = [];                // lengths: every length series of the page, in order
   for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
     const K = meta.kinds[k], nums = varints(await bytes("k" + k));
     let p = 0;
@@ -137,6 +152,8 @@
       el.finite = E.holes ? [...Array(E.m)].map(() => take(E.rows)) : null;
       el.xy = [...Array(2 * E.m)].map(() => take(E.rows));
       el.len = E.len ? take(E.len) : null;
+      if (E.from) el.len = plus(el.len, lengths[E.from[0]], E.from[1]);
+      if (el.len) lengths.push(el.len);
       return el;
     });
     kinds.push({kind: K.kind, static: K.static, elements});
@@ -161,7 +178,8 @@
   const rows = D.rows, ncol = rows.length, singular = new Set(D.singular);
   const vals = varints(await bytes("values")), values = D.frames.map(() => new Array(ncol));
   for (let c = 0, p = 0; c < ncol; c++) {          // column by column: page.py _columns
-    const none = series(vals, p, nf), n = series(vals, p + nf + 1, nf), e = D.exps[c];
+    const none = series(vals, p, nf), rest = series(vals, p + nf + 1, nf), e = D.exps[c], src = D.sources[c];
+    const n = src ? plus(rest, lengths[src[0]], src[1]) : rest;
     p += 2 * (nf + 1);
     for (let f = 0; f < nf; f++) values[f][c] = none[f] ? NaN : e < 0 ? n[f] / 10 ** -e : n[f] * 10 ** e;
   }

@@ -92,13 +92,59 @@ def _series(a: np.ndarray) -> np.ndarray:
     difference keeping the first value (a - [0, a[:-1]]): the order whose differences are
     smallest (a sum of their bits), so that a smooth function of the angle becomes a few small
     numbers; the page's script takes k prefix sums."""
-    best, d = None, np.asarray(a, dtype=np.int64).ravel()
-    for k in range(MAX_ORDER + 1):
-        cost = float(np.log2(1.0 + np.abs(d)).sum())
-        if best is None or cost < best[0]:
-            best = (cost, k, d)
-        d = d - np.concatenate([[0], d[:-1]])
-    return np.concatenate([[best[1]], best[2]])
+    return _serieses([a])[0]
+
+
+def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """`_series` of each of `arrays`, those of one length at once."""
+    out: list[np.ndarray] = [np.empty(0, dtype=np.int64)] * len(arrays)
+    by_size: dict[int, list[int]] = {}
+    for i, a in enumerate(arrays):
+        by_size.setdefault(np.size(a), []).append(i)
+    for idx in by_size.values():
+        d = [np.stack([np.asarray(arrays[i], dtype=np.int64).ravel() for i in idx])]
+        for _ in range(MAX_ORDER):
+            d.append(np.diff(d[-1], axis=1, prepend=0))
+        diffs = np.stack(d)                                       # (order, series, angle)
+        order = np.argmin(np.log2(1.0 + np.abs(diffs)).sum(axis=2), axis=0)
+        for j, i in enumerate(idx):
+            out[i] = np.concatenate([[order[j]], diffs[order[j], j]])
+    return out
+
+
+def _cost(d: np.ndarray) -> float:
+    """What a series of integers costs as varints, roughly: the sum of their bits."""
+    return float(np.log2(1.0 + np.abs(d)).sum())
+
+
+def _scaled(source: np.ndarray, f: float) -> np.ndarray:
+    """floor(f source + 0.5), int64: what the page's script computes from an earlier series
+    (page.js `plus`; one product and one sum in doubles, the same in both)."""
+    return np.floor(source.astype(np.float64) * f + 0.5).astype(np.int64)
+
+
+def _proportional(q: np.ndarray, sources: Sequence[np.ndarray]) -> tuple[int, float] | None:
+    """The earlier series (`sources`, int64) of which `q` is most nearly a multiple, (its index, the
+    factor f), where q - `_scaled`(source, f) costs less than q (`_series`); None where none does
+    (no source as long as q and positive at every angle). A segment drawn on two plans at two
+    scales (a velocity on its plan and on the lever), a value the length of its vector times the
+    plan's scale: their remainders are a few units of the last digit."""
+    q = np.asarray(q, dtype=np.int64)
+    same = [g for g, s in enumerate(sources) if len(s) == len(q)]
+    on = q > 0
+    if len(q) < 2 or not same or on.sum() < 2:
+        return None
+    stack = np.stack([sources[g] for g in same])
+    positive = stack.min(axis=1) > 0
+    if not positive.any():
+        return None
+    picks = np.asarray(same)[positive]
+    ratio = q[on] / stack[positive][:, on].astype(np.float64)
+    g = int(np.argmin(np.ptp(ratio, axis=1) / ratio.mean(axis=1)))
+    f = float(np.median(ratio[g]))
+    if _cost(_series(q - _scaled(sources[picks[g]], f))[1:]) < _cost(_series(q)[1:]):
+        return int(picks[g]), f
+    return None
 
 
 def _held(x: np.ndarray, drawn: np.ndarray) -> np.ndarray:
@@ -117,23 +163,25 @@ def _ints(x: np.ndarray, decimals: int) -> np.ndarray:
     return np.rint(np.where(np.isfinite(x), x, 0.0) * 10.0 ** decimals).astype(np.int64)
 
 
-def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
-    """A sheet's arrays as (meta, numbers): `meta` = {"kind", "static", "elements": [{"tag",
+def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict, bytes, list[np.ndarray]]:
+    """A sheet's arrays as (meta, numbers, lengths): `meta` = {"kind", "static", "elements": [{"tag",
     "attrs" [[name, value]...], "title", "texts", "m" points, "rows" (1: the same at every angle),
-    "holes" (a polyline with points left out), "len" (has lengths)}]}; `numbers`, element by
-    element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each angle
-    (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
+    "holes" (a polyline with points left out), "len" (has lengths), "from" (where its lengths are
+    stored less a multiple of an earlier series: [index, factor], `_proportional`)}]}; `numbers`,
+    element by element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each
+    angle (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
-    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not
-    drawn or NaN); every series as
-    differences of the order that suits it (`_series`), or, where an earlier series of the sheet
-    is the same (a line's end and its point), -1 - that series' index; as zigzag varints."""
-    meta, series, seen = [], [], {}
+    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not drawn
+    or NaN; less `_scaled`(earlier[index], factor) where "from"); every series as differences of
+    the order that suits it (`_series`), or, where an earlier series of the sheet is the same (a
+    line's end and its point), -1 - that series' index; as zigzag varints. `earlier`: the length
+    series of the sheets before it on the page, in order; `lengths`: this sheet's, in order."""
+    meta, series, seen, lengths = [], [], {}, []
 
     def put(a) -> None:
         a = np.asarray(a, dtype=np.int64).ravel()
         key = a.tobytes()
-        series.append(np.array([-1 - seen[key]]) if key in seen else _series(a))
+        series.append(-1 - seen[key] if key in seen else a)
         seen.setdefault(key, len(series) - 1)
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
@@ -150,30 +198,44 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
         held = _held(np.where(finite[..., None], xy, np.nan), drawn) if m else xy
         for c in range(2 * m):
             put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS))
+        source = None
         if e.length_mm is not None:
             L = np.asarray(e.length_mm, dtype=float).reshape(-1)
             shown = np.isfinite(L) & (drawn if len(L) == rows else True)
-            put(_ints(_held(L, shown), LENGTH_DECIMALS))
+            q, pool = _ints(_held(L, shown), LENGTH_DECIMALS), [*earlier, *lengths]
+            source = _proportional(q, pool)
+            put(q if source is None else q - _scaled(pool[source[0]], source[1]))
+            lengths.append(q)
         meta.append({"tag": e.tag, "attrs": [[k, v] for k, v in e.attrs.items()], "title": e.title,
                      "texts": list(e.texts), "m": m, "rows": rows, "holes": holes,
                      "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
-                     "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))})
+                     "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))}
+                    | ({"from": list(source)} if source else {}))
+    new = iter(_serieses([a for a in series if not isinstance(a, int)]))
+    series = [np.array([a]) if isinstance(a, int) else next(new) for a in series]
     return ({"kind": d.kind, "static": d.static, "elements": meta},
-            _varints(np.concatenate(series)) if series else b"")
+            _varints(np.concatenate(series)) if series else b"", lengths)
 
 
-def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
+def _columns(values: np.ndarray, lengths: Sequence[np.ndarray] = ()) -> tuple[list[int], list, bytes]:
     """Columns of values over frames (NaN: none): each column's exponent e (VALUE_DIGITS significant digits
-    of its largest |value|), and column by column its NaN mask (1: none) and round(v / 10^e) (NaN
-    as 0), each a `_series`, as zigzag varints."""
+    of its largest |value|), where a column is stored less a multiple of one of the page's `lengths`
+    ([index, factor] or 0, `_proportional`: a value is its vector's length times the plan's scale), and
+    column by column its NaN mask (1: none) and round(v / 10^e) (NaN as 0) less that multiple, each a
+    `_series`, as zigzag varints."""
     exps = []
     for col in values.T:
         top = np.nanmax(np.abs(col)) if np.isfinite(col).any() else 0.0
         exps.append(int(math.floor(math.log10(top))) - (VALUE_DIGITS - 1) if top > 0 else 0)
     scaled = np.rint(np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)).astype(np.int64)
     mask = (~np.isfinite(values)).astype(np.int64)
-    parts = [_series(x) for c in range(values.shape[1]) for x in (mask[:, c], scaled[:, c])]
-    return exps, _varints(np.concatenate(parts)) if parts else b""
+    sources, parts = [], []
+    for c in range(values.shape[1]):
+        source = _proportional(scaled[:, c], lengths)
+        sources.append(list(source) if source else 0)
+        rest = scaled[:, c] if source is None else scaled[:, c] - _scaled(lengths[source[0]], source[1])
+        parts += [mask[:, c], rest]
+    return exps, sources, _varints(np.concatenate(_serieses(parts))) if parts else b""
 
 
 #: The 85 digits of a blob's text (`_text85`): ASCII 33-118 but "<", so that nothing in a blob
@@ -387,16 +449,17 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     blobs: dict[str, str] = {}
     records = sheet.at(i_at).records()
     if not student:
-        kinds = []
+        kinds, lengths = [], []
         for kind, cycle in cycles.items():
-            meta, numbers = encode_drawing(drawing(cycle, lang, name, contract=True))
+            meta, numbers, more = encode_drawing(drawing(cycle, lang, name, contract=True), lengths)
             kinds.append(meta)
+            lengths += more
             blobs[f"k{len(kinds) - 1}"] = _packed(numbers)
         values = np.array(sheet.values, dtype=float)
         values[np.asarray(res.singular)] = math.nan
-        exps, vbytes = _columns(values)
+        exps, sources, vbytes = _columns(values, lengths)
         blobs["values"] = _packed(vbytes)
-        data.update(singular=np.flatnonzero(res.singular).tolist(), exps=exps,
+        data.update(singular=np.flatnonzero(res.singular).tolist(), exps=exps, sources=sources,
                     rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
                            "section": r["section"]} for r in records])
         blobs["meta"] = _packed(json.dumps({"kinds": kinds, "steps": _steps(mech, one, check, lang)},
@@ -415,7 +478,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
     blobs["check"] = _text85(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(), 9, mtime=0)))
     blank = _blank_tables(records, lang) if student else ""
-    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), items, results, blank)
+    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), results, blank)
 
 
 def _blank_tables(records: list[dict], lang: str) -> str:
@@ -449,7 +512,7 @@ def _obscure(data: bytes) -> bytes:
 
 
 def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
-          data_rows, items, results, blank: str = "") -> str:
+          data_rows, results, blank: str = "") -> str:
     from .draw import scale_text
     title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
     scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
@@ -459,12 +522,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     head = "".join(f"<th>{escape(h)}</th>" for h in ("", "", ""))
     data_table = "".join(f'<tr><td>{escape(s)}</td><td class="num">{escape(v)}</td><td>{escape(u)}</td></tr>'
                          for s, v, u in data_rows)
-    check_rows = []
-    for n, it in enumerate(items):
-        check_rows.append(f'<tr data-item="{n}"><td>{escape(it["title"])}</td><td>{escape(it["label"])}</td>'
-                          f'<td><input type="text" inputmode="decimal" class="measured" data-plan="{escape(it["plan"])}" '
-                          f'data-segment="{escape(it["segment"])}" size="7"></td>'
-                          f'<td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
+    check_rows = []                             # the items' rows: the script writes them from the check's blob
     for n, (symbol, _, _) in enumerate(results):
         check_rows.append(f'<tr data-moment="{n}"><td></td><td>{escape(symbol)}, {escape(unit("N m", lang))}</td>'
                           f'<td><input type="text" inputmode="decimal" class="moment" data-symbol="{escape(symbol)}" '
@@ -475,7 +533,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                           f'{num(TOLERANCE_PCT, lang)} %</td><td class="verdict"></td></tr>')
     phi = num(data["at"], lang, 6)
     check = (f'<section id="check"><h2>{escape(text("page.check", lang))}</h2><p>{escape(text("page.check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
-             f'<table><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
+             f'<table id="check-table"><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
              + "</tr>" + "".join(check_rows) + "</table></section>")
     if student:
         body = (f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><p>{escape(text("page.scales", lang))}: {escape(scales)}</p>'
