@@ -124,7 +124,19 @@
   const nf = D.frames.length;
   function series(nums, p, n) {                 // page.py _series at nums[p]: its order k, then n values
     const out = nums.slice(p + 1, p + 1 + n);
+    if (nums[p] > D.maxorder) return unjump(out);
     for (let k = nums[p]; k > 0; k--) for (let j = 1; j < n; j++) out[j] += out[j - 1];
+    return out;
+  }
+  function unjump(v) {                           // page.py _jumps, taken back
+    const J = D.jump, out = [v[0]];
+    let s = 0, excess = 0, before = 0;
+    for (let t = 1; t < v.length; t++) {
+      const r = Math.abs(v[t]) <= J ? v[t] : (v[t] > 0 ? v[t] - J - 1 : v[t] + J + 1) - excess, d = s + r;
+      if (t >= 2 && Math.abs(d - before) > J) excess = d - s; else s = d;
+      before = d;
+      out.push(out[t - 1] + d);
+    }
     return out;
   }
   function fixed(q, digits) {                    // core.py fixed: q / 10^digits with `digits` decimals
@@ -137,16 +149,19 @@
   for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
     const K = meta.kinds[k], nums = varints(await bytes("k" + k));
     let p = 0;
-    const made = [];                             // the sheet's series in order: one may repeat an earlier
+    const made = [];                             // the sheet's series in order: one may repeat an earlier, or move it
     const take = (n) => {
-      const v = nums[p] < 0 ? made[-1 - nums[p]] : series(nums, p, n);
-      p += nums[p] < 0 ? 1 : n + 1;
+      let v;
+      if (nums[p] >= 0) { v = series(nums, p, n); p += n + 1; }
+      else if ((-1 - nums[p]) % 2 === 0) { v = made[(-1 - nums[p]) / 2]; p += 1; }
+      else { const c = nums[p + 1]; v = made[(-2 - nums[p]) / 2].map((x) => x + c); p += 2; }
       made.push(v);
       return v;
     };
     const elements = K.elements.map((E) => {
       const el = {tag: E.tag, attrs: E.attrs.map(([a, v]) => ` ${a}="${v}"`).join(""),
-                  title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows, m: E.m};
+                  title: E.title ? `<title>${E.title}</title>` : "", rows: E.rows, m: E.m,
+                  texts: Array.isArray(E.texts) ? E.texts : meta.mids[E.texts.mids].map((t) => E.texts.pre + t + E.texts.suf)};
       el.drawn = take(E.rows);
       el.variant = E.variants ? take(E.variants) : [0];
       el.finite = E.holes ? [...Array(E.m)].map(() => take(E.rows)) : null;
@@ -175,10 +190,10 @@
     return K.static.replace(D.elements, () => K.elements.map((el) => element(el, i)).join(""));
   }
   window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
-  const rows = D.rows, ncol = rows.length, singular = new Set(D.singular);
+  const rows = meta.rows, ncol = rows.length, singular = new Set(D.singular);
   const vals = varints(await bytes("values")), values = D.frames.map(() => new Array(ncol));
   for (let c = 0, p = 0; c < ncol; c++) {          // column by column: page.py _columns
-    const none = series(vals, p, nf), rest = series(vals, p + nf + 1, nf), e = D.exps[c], src = D.sources[c];
+    const none = series(vals, p, nf), rest = series(vals, p + nf + 1, nf), e = meta.exps[c], src = meta.sources[c];
     const n = src ? plus(rest, lengths[src[0]], src[1]) : rest;
     p += 2 * (nf + 1);
     for (let f = 0; f < nf; f++) values[f][c] = none[f] ? NaN : e < 0 ? n[f] / 10 ** -e : n[f] * 10 ** e;

@@ -37,6 +37,7 @@ from __future__ import annotations
 import gzip
 import json
 import math
+import os
 import warnings
 from collections.abc import Sequence
 from html import escape
@@ -83,16 +84,48 @@ def _varints(values: np.ndarray) -> bytes:
     return out.tobytes()
 
 
-#: Highest order of differences a series is stored as (`_series`).
+#: Highest order of differences a series is stored as (`_series`); MAX_ORDER + 1: as `_jumps`.
 MAX_ORDER = 4
+#: A step of a series whose slope changes by more than this (units of its last digit) is a jump
+#: (`_jumps`: a label moved to another place).
+JUMP = 3
 
 
 def _series(a: np.ndarray) -> np.ndarray:
     """An int64 series as its order k (0..MAX_ORDER) followed by its k-th differences, each
-    difference keeping the first value (a - [0, a[:-1]]): the order whose differences are
-    smallest (a sum of their bits), so that a smooth function of the angle becomes a few small
-    numbers; the page's script takes k prefix sums."""
+    difference keeping the first value (a - [0, a[:-1]]), or as MAX_ORDER + 1 followed by
+    `_jumps`: the one whose numbers are smallest (a sum of their bits), so that a smooth function
+    of the angle becomes a few small numbers; the page's script takes k prefix sums."""
     return _serieses([a])[0]
+
+
+def _last(mask: np.ndarray) -> np.ndarray:
+    """Along each row of `mask` (m, n), the index of the last True at or before each column (-1: none)."""
+    return np.maximum.accumulate(np.where(mask, np.arange(mask.shape[1]), -1), axis=1)
+
+
+def _jumps(x: np.ndarray) -> np.ndarray:
+    """Rows of int64 series (m, n) as their first value and, step by step, the step d less the
+    slope s (the last step that was not a jump, 0 at first): a label moving with its point costs
+    the rounding's few units; a step is a jump where it differs from the step before by more than
+    JUMP, stored as r = d - s where |r| <= JUMP, else as (r + e) ± (JUMP + 1), e the last jump's
+    excess over its slope (0 before any): a label back at its earlier place costs a few units
+    too (page.js `unjump` takes it back)."""
+    m, n = x.shape
+    rows, d = np.arange(m)[:, None], np.zeros_like(x)
+    d[:, 1:] = np.diff(x, axis=1)
+    jump = np.zeros((m, n), dtype=bool)
+    jump[:, 2:] = np.abs(d[:, 2:] - d[:, 1:-1]) > JUMP
+    steady, jumped = _last(~jump & (np.arange(n) >= 1)), _last(jump)
+    s = np.zeros_like(x)
+    s[:, 1:] = np.where(steady[:, :-1] >= 1, d[rows, np.maximum(steady[:, :-1], 0)], 0)
+    excess = np.zeros_like(x)
+    excess[:, 1:] = np.where(jumped[:, :-1] >= 0, (d - s)[rows, np.maximum(jumped[:, :-1], 0)], 0)
+    r = d - s
+    w = r + excess
+    out = np.where(np.abs(r) <= JUMP, r, np.where(w >= 0, w + JUMP + 1, w - JUMP - 1))
+    out[:, 0] = x[:, 0]
+    return out
 
 
 def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
@@ -105,6 +138,7 @@ def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
         d = [np.stack([np.asarray(arrays[i], dtype=np.int64).ravel() for i in idx])]
         for _ in range(MAX_ORDER):
             d.append(np.diff(d[-1], axis=1, prepend=0))
+        d.append(_jumps(d[0]))
         diffs = np.stack(d)                                       # (order, series, angle)
         order = np.argmin(np.log2(1.0 + np.abs(diffs)).sum(axis=2), axis=0)
         for j, i in enumerate(idx):
@@ -173,16 +207,26 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
     holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not drawn
     or NaN; less `_scaled`(earlier[index], factor) where "from"); every series as differences of
-    the order that suits it (`_series`), or, where an earlier series of the sheet is the same (a
-    line's end and its point), -1 - that series' index; as zigzag varints. `earlier`: the length
+    the order that suits it (`_series`), or, where an earlier series j of the sheet is the same (a
+    line's end and its point), -1 - 2j, or where it is j plus a constant c (a point's label),
+    -2 - 2j and c; as zigzag varints. `earlier`: the length
     series of the sheets before it on the page, in order; `lengths`: this sheet's, in order."""
-    meta, series, seen, lengths = [], [], {}, []
+    meta, series, seen, shapes, lengths = [], [], {}, {}, []
 
     def put(a) -> None:
         a = np.asarray(a, dtype=np.int64).ravel()
-        key = a.tobytes()
-        series.append(-1 - seen[key] if key in seen else a)
+        key, shape = a.tobytes(), (a - a[0]).tobytes()
+        if key in seen:
+            series.append((-1 - 2 * seen[key],))
+        elif shape in shapes:
+            j = shapes[shape]
+            series.append((-2 - 2 * j, int(a[0] - raw[j][0])))
+        else:
+            series.append(a)
+        raw.append(a)
         seen.setdefault(key, len(series) - 1)
+        shapes.setdefault(shape, len(series) - 1)
+    raw: list[np.ndarray] = []
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
         rows, m = xy.shape[0], xy.shape[1]
@@ -211,10 +255,33 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
                      "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
                      "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))}
                     | ({"from": list(source)} if source else {}))
-    new = iter(_serieses([a for a in series if not isinstance(a, int)]))
-    series = [np.array([a]) if isinstance(a, int) else next(new) for a in series]
+    new = iter(_serieses([a for a in series if not isinstance(a, tuple)]))
+    series = [np.array(a) if isinstance(a, tuple) else next(new) for a in series]
     return ({"kind": d.kind, "static": d.static, "elements": meta},
             _varints(np.concatenate(series)) if series else b"", lengths)
+
+
+def _shared_texts(kinds: Sequence[dict]) -> tuple[list[dict], list[list[str]]]:
+    """The sheets' `meta` (`encode_drawing`) with each element's texts of more than two (a title
+    with φ at every angle) as {"pre", "suf", "mids"}: the texts' common start and end and the index
+    of their middles in `mids`, the page's lists of middles, each once (the angles, alike on every
+    sheet)."""
+    mids: list[list[str]] = []
+    out = []
+    for K in kinds:
+        elements = []
+        for E in K["elements"]:
+            texts = E["texts"]
+            if len(texts) > 2:
+                pre = os.path.commonprefix(texts)
+                suf = os.path.commonprefix([t[len(pre):][::-1] for t in texts])[::-1]
+                middle = [t[len(pre):len(t) - len(suf)] for t in texts]
+                if middle not in mids:
+                    mids.append(middle)
+                E = {**E, "texts": {"pre": pre, "suf": suf, "mids": mids.index(middle)}}
+            elements.append(E)
+        out.append({**K, "elements": elements})
+    return out, mids
 
 
 def _columns(values: np.ndarray, lengths: Sequence[np.ndarray] = ()) -> tuple[list[int], list, bytes]:
@@ -438,14 +505,15 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     check = {kind: c.at(i_at) for kind, c in cycles.items()}
     one = res.take(np.array([i_at]))
     bands, moment_bands = _bands(mech, one, check, fixed)
-    data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": phi,
+    data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": [int(a) if a.is_integer() else a for a in phi],
                   "slider": len(frames) - 1, "tol": TOLERANCE_PCT,
                   "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
                   | {"negligible": text("page.negligible", lang, tiny=num(TINY_MM, lang))}, "tiny": TINY_MM,
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang),
-                  "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS}
+                  "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS,
+                  "maxorder": MAX_ORDER, "jump": JUMP}
     blobs: dict[str, str] = {}
     records = sheet.at(i_at).records()
     if not student:
@@ -459,11 +527,12 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         values[np.asarray(res.singular)] = math.nan
         exps, sources, vbytes = _columns(values, lengths)
         blobs["values"] = _packed(vbytes)
-        data.update(singular=np.flatnonzero(res.singular).tolist(), exps=exps, sources=sources,
-                    rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
-                           "section": r["section"]} for r in records])
-        blobs["meta"] = _packed(json.dumps({"kinds": kinds, "steps": _steps(mech, one, check, lang)},
-                                          ensure_ascii=False).encode())
+        data.update(singular=np.flatnonzero(res.singular).tolist())
+        rows = [{"symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"], "section": r["section"]}
+                for r in records]
+        kinds, mids = _shared_texts(kinds)
+        blobs["meta"] = _packed(json.dumps({"kinds": kinds, "mids": mids, "steps": _steps(mech, one, check, lang),
+                                            "rows": rows, "exps": exps, "sources": sources}, ensure_ascii=False).encode())
     items = []
     for kind, plan in check.items():
         for s in plan.segments:
