@@ -129,11 +129,11 @@
     return out;
   }
   function unjump(v) {                           // page.py _jumps, taken back
-    const J = D.jump, out = [v[0]];
-    let s = 0, excess = 0, before = 0;
+    const out = [v[0]];
+    let s = 0, before = 0;
     for (let t = 1; t < v.length; t++) {
-      const r = Math.abs(v[t]) <= J ? v[t] : (v[t] > 0 ? v[t] - J - 1 : v[t] + J + 1) - excess, d = s + r;
-      if (t >= 2 && Math.abs(d - before) > J) excess = d - s; else s = d;
+      const d = s + v[t];
+      if (t < 2 || Math.abs(d - before) <= D.jump) s = d;
       before = d;
       out.push(out[t - 1] + d);
     }

@@ -105,25 +105,20 @@ def _last(mask: np.ndarray) -> np.ndarray:
 
 
 def _jumps(x: np.ndarray) -> np.ndarray:
-    """Rows of int64 series (m, n) as their first value and, step by step, the step d less the
-    slope s (the last step that was not a jump, 0 at first): a label moving with its point costs
-    the rounding's few units; a step is a jump where it differs from the step before by more than
-    JUMP, stored as r = d - s where |r| <= JUMP, else as (r + e) ± (JUMP + 1), e the last jump's
-    excess over its slope (0 before any): a label back at its earlier place costs a few units
-    too (page.js `unjump` takes it back)."""
+    """Rows of int64 series (m, n) as their first value and, step by step, the step less the
+    slope: the last step that was not a jump (0 at first), a jump a step that differs from the
+    step before by more than JUMP. A label moving with its point costs the rounding's few units,
+    and a jump to another place and back one number each (page.js `unjump` takes it back)."""
     m, n = x.shape
-    rows, d = np.arange(m)[:, None], np.zeros_like(x)
+    d = np.zeros_like(x)
     d[:, 1:] = np.diff(x, axis=1)
-    jump = np.zeros((m, n), dtype=bool)
-    jump[:, 2:] = np.abs(d[:, 2:] - d[:, 1:-1]) > JUMP
-    steady, jumped = _last(~jump & (np.arange(n) >= 1)), _last(jump)
+    steady = np.ones((m, n), dtype=bool)
+    steady[:, 0] = False
+    steady[:, 2:] = np.abs(d[:, 2:] - d[:, 1:-1]) <= JUMP
+    last = _last(steady)
     s = np.zeros_like(x)
-    s[:, 1:] = np.where(steady[:, :-1] >= 1, d[rows, np.maximum(steady[:, :-1], 0)], 0)
-    excess = np.zeros_like(x)
-    excess[:, 1:] = np.where(jumped[:, :-1] >= 0, (d - s)[rows, np.maximum(jumped[:, :-1], 0)], 0)
-    r = d - s
-    w = r + excess
-    out = np.where(np.abs(r) <= JUMP, r, np.where(w >= 0, w + JUMP + 1, w - JUMP - 1))
+    s[:, 1:] = np.where(last[:, :-1] >= 1, d[np.arange(m)[:, None], np.maximum(last[:, :-1], 0)], 0)
+    out = d - s
     out[:, 0] = x[:, 0]
     return out
 
