@@ -448,7 +448,7 @@ def _script_page(drawings, n: int) -> str:
     blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[2])
     blobs["check"] = pg._text85(pg._obscure(gzip.compress(b'{"items": [], "M": []}')))
     data = {"student": False, "frames": list(range(n)), "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
-            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
+            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "smooth": pg.SMOOTH.tolist(), "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
     return ('<!DOCTYPE html><html><head><meta charset="utf-8"><style id="page-size"></style></head><body>'
@@ -503,10 +503,10 @@ def test_script_writes_a_hand_made_drawing_at_each_angle(chromium, tmp_path):
     assert 'points="0.0,1.0 1.0,1.0 2.0,1.0"' in got[1] and got[2].count("<polyline") == 1
 
 
-def test_script_writes_jumps_moved_series_scaled_lengths_and_shared_texts(chromium, tmp_path):
+def test_script_writes_jumps_smooth_lengths_moved_series_scaled_lengths_and_shared_texts(chromium, tmp_path):
     """Over 60 angles, a sheet whose series the page stores in its shorter forms, written by the
     page's script exactly as `Drawing.svg`: a label that jumps between two places and back as it
-    moves (`_jumps`), a point that is another moved by a constant (a reference and the constant),
+    moves (`_jumps`), a length to 1e-6 mm on its least-squares polynomial (`_smooth`), a point that is another moved by a constant (a reference and the constant),
     a segment's length half another's on an earlier sheet plus a little (`_proportional`: "from"),
     a title with φ at every angle (`_shared_texts`)."""
     import numpy as np
@@ -518,7 +518,7 @@ def test_script_writes_jumps_moved_series_scaled_lengths_and_shared_texts(chromi
     centre = np.stack([100 + 30 * np.cos(t), 100 + 20 * np.sin(t)], axis=1)
     side = np.where((np.arange(n) // 7) % 2 == 0, 4.0, -3.5)
     label_xy = centre + np.stack([side, np.full(n, 2.0)], axis=1)
-    L = 50 + 10 * np.sin(t)
+    L = 50 + 10 * np.sin(4 * t)
     root = '<?xml version="1.0"?>\n<svg><g id="plan">\n' + ELEMENTS + "</g>\n</svg>\n"
     seg = lambda name, length: Element("line", np.stack([centre, centre + 5], axis=1), {"data-plan": "p", "data-segment": name},
                                        length_mm=length)
@@ -530,6 +530,7 @@ def test_script_writes_jumps_moved_series_scaled_lengths_and_shared_texts(chromi
         Element("text", np.full((n, 1, 2), 5.0), {"class": "title"}, texts=tuple(f"Lever, φ = {k}°" for k in range(n)),
                 variant=np.arange(n))))
     assert pg._series(pg._ints(label_xy[:, 0], pg.COORD_DECIMALS))[0] == pg.MAX_ORDER + 1
+    assert pg._series(pg._ints(L, pg.LENGTH_DECIMALS))[0] == pg.MAX_ORDER + 2
     metas = pg.encode_drawing(second, pg.encode_drawing(first)[2])[0]["elements"]
     assert metas[0]["from"][0] == 0 and pg._shared_texts([{"elements": metas}])[0][0]["elements"][-1]["texts"]["pre"] == "Lever, φ = "
     f = tmp_path / "stored.html"

@@ -124,8 +124,26 @@
   const nf = D.frames.length;
   function series(nums, p, n) {                 // page.py _series at nums[p]: its order k, then n values
     const out = nums.slice(p + 1, p + 1 + n);
-    if (nums[p] > D.maxorder) return unjump(out);
+    if (nums[p] === D.maxorder + 1) return unjump(out);
+    if (nums[p] === D.maxorder + 2) return unsmooth(out);
     for (let k = nums[p]; k > 0; k--) for (let j = 1; j < n; j++) out[j] += out[j - 1];
+    return out;
+  }
+  function unsmooth(v) {                         // page.py _smooth, taken back
+    const C = D.smooth, K = C.length, out = [];
+    let fit = 0, line = 0;                       // the two predictions of the value before
+    for (let i = 0; i < v.length; i++) {
+      const nextLine = i === 0 ? 0 : i === 1 ? out[0] : 2 * out[i - 1] - out[i - 2];
+      let nextFit = nextLine;
+      if (i >= K) {
+        let acc = 0;
+        for (let k = 0; k < K; k++) acc = acc + C[k] * out[i - K + k];
+        nextFit = Math.floor(acc + 0.5);
+      }
+      const better = i >= K + 1 && Math.abs(out[i - 1] - fit) <= Math.abs(out[i - 1] - line);
+      out.push(v[i] + (better ? nextFit : nextLine));
+      fit = nextFit; line = nextLine;
+    }
     return out;
   }
   function unjump(v) {                           // page.py _jumps, taken back

@@ -38,6 +38,7 @@ import gzip
 import json
 import math
 import os
+import re
 import warnings
 from collections.abc import Sequence
 from html import escape
@@ -84,8 +85,14 @@ def _varints(values: np.ndarray) -> bytes:
     return out.tobytes()
 
 
-#: Highest order of differences a series is stored as (`_series`); MAX_ORDER + 1: as `_jumps`.
+#: Highest order of differences a series is stored as (`_series`); MAX_ORDER + 1: as `_jumps`;
+#: MAX_ORDER + 2: as `_smooth`.
 MAX_ORDER = 4
+#: `_smooth`'s weights: of the last 24 values, the one next on the least-squares polynomial of
+#: degree 8 through them.
+SMOOTH = np.linalg.pinv(np.vander(np.arange(-24.0, 0.0), 9))[-1]
+#: The smallest series (units of its last digit) `_smooth` is tried on: lengths and values.
+SMOOTH_FROM = 10 ** 5
 #: A step of a series whose slope changes by more than this (units of its last digit) is a jump
 #: (`_jumps`: a label moved to another place).
 JUMP = 3
@@ -94,7 +101,7 @@ JUMP = 3
 def _series(a: np.ndarray) -> np.ndarray:
     """An int64 series as its order k (0..MAX_ORDER) followed by its k-th differences, each
     difference keeping the first value (a - [0, a[:-1]]), or as MAX_ORDER + 1 followed by
-    `_jumps`: the one whose numbers are smallest (a sum of their bits), so that a smooth function
+    `_jumps`, or (SMOOTH_FROM units or more) as MAX_ORDER + 2 followed by `_smooth`: the one whose numbers are smallest (a sum of their bits), so that a smooth function
     of the angle becomes a few small numbers; the page's script takes k prefix sums."""
     return _serieses([a])[0]
 
@@ -123,6 +130,29 @@ def _jumps(x: np.ndarray) -> np.ndarray:
     return out
 
 
+def _smooth(x: np.ndarray) -> np.ndarray:
+    """Rows of int64 series (m, n) as each value less its prediction: floor(p + 0.5) of p = SMOOTH
+    · the last len(SMOOTH) values (summed in order: page.js `unsmooth` the same in doubles) where
+    that predicted the value before at least as well as 2 x[i-1] - x[i-2] did, else the latter
+    (x[0] before the second, 0 before the first): a length to 1e-6 mm, smooth over the angles but
+    for a kink here and there, costs a unit or two a value."""
+    m, n = x.shape
+    K = len(SMOOTH)
+    line = np.zeros_like(x)
+    line[:, 1:2] = x[:, :1]
+    line[:, 2:] = 2 * x[:, 1:-1] - x[:, :-2]
+    if n <= K + 1:
+        return x - line
+    acc = np.zeros((m, n - K))
+    for k in range(K):
+        acc = acc + SMOOTH[k] * x[:, k:n - K + k]
+    fit = line.copy()
+    fit[:, K:] = np.floor(acc + 0.5).astype(np.int64)
+    better = np.zeros((m, n), dtype=bool)
+    better[:, K + 1:] = np.abs(x - fit)[:, K:-1] <= np.abs(x - line)[:, K:-1]
+    return x - np.where(better, fit, line)
+
+
 def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
     """`_series` of each of `arrays`, those of one length at once."""
     out: list[np.ndarray] = [np.empty(0, dtype=np.int64)] * len(arrays)
@@ -134,8 +164,14 @@ def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
         for _ in range(MAX_ORDER):
             d.append(np.diff(d[-1], axis=1, prepend=0))
         d.append(_jumps(d[0]))
+        large = np.abs(d[0]).max(axis=1) >= SMOOTH_FROM
+        d.append(d[0].copy())
+        if large.any():
+            d[-1][large] = _smooth(d[0][large])
         diffs = np.stack(d)                                       # (order, series, angle)
-        order = np.argmin(np.log2(1.0 + np.abs(diffs)).sum(axis=2), axis=0)
+        costs = np.log2(1.0 + np.abs(diffs)).sum(axis=2)
+        costs[-1, ~large] = np.inf
+        order = np.argmin(costs, axis=0)
         for j, i in enumerate(idx):
             out[i] = np.concatenate([[order[j]], diffs[order[j], j]])
     return out
@@ -508,7 +544,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang),
                   "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS,
-                  "maxorder": MAX_ORDER, "jump": JUMP}
+                  "maxorder": MAX_ORDER, "jump": JUMP, "smooth": SMOOTH.tolist()}
     blobs: dict[str, str] = {}
     records = sheet.at(i_at).records()
     if not student:
@@ -618,7 +654,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                 f'<section id="values"><h2>{escape(text("page.values", lang))}</h2><table id="value-table"></table></section>'
                 f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><table>{data_table}</table></section>'
                 + check)
-    script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
+    script = _bare(resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8"))
     payload = script_json(data)                 # no name in it (`</script>`, `<!--<script>`) ends its element
     blob_tags = "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
     return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
@@ -628,6 +664,13 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
             f'</head><body>'
             f'<h1>{escape(title)}</h1>{body}{blob_tags}'
             f'<script id="page-data" type="application/json">{payload}</script><script>{script}</script></body></html>\n')
+
+
+def _bare(script: str) -> str:
+    """The page's script without its comments (a line's own, or after code and two spaces) and
+    indentation: what the browser runs, line for line."""
+    lines = (re.sub(r"\s{2,}// .*$", "", line).strip() for line in script.splitlines())
+    return "\n".join(line for line in lines if line and not line.startswith("//"))
 
 
 def _plan_name(kind: str, lang: str) -> str:
