@@ -188,28 +188,36 @@ def _scaled(source: np.ndarray, f: float) -> np.ndarray:
     return np.floor(source.astype(np.float64) * f + 0.5).astype(np.int64)
 
 
-def _proportional(q: np.ndarray, sources: Sequence[np.ndarray]) -> tuple[int, float] | None:
-    """The earlier series (`sources`, int64) of which `q` is most nearly a multiple, (its index, the
-    factor f), where q - `_scaled`(source, f) costs less than q (`_series`); None where none does
-    (no source as long as q and positive at every angle). A segment drawn on two plans at two
-    scales (a velocity on its plan and on the lever), a value the length of its vector times the
-    plan's scale: their remainders are a few units of the last digit."""
-    q = np.asarray(q, dtype=np.int64)
-    same = [g for g, s in enumerate(sources) if len(s) == len(q)]
-    on = q > 0
-    if len(q) < 2 or not same or on.sum() < 2:
-        return None
-    stack = np.stack([sources[g] for g in same])
-    positive = stack.min(axis=1) > 0
-    if not positive.any():
-        return None
-    picks = np.asarray(same)[positive]
-    ratio = q[on] / stack[positive][:, on].astype(np.float64)
-    g = int(np.argmin(np.ptp(ratio, axis=1) / ratio.mean(axis=1)))
-    f = float(np.median(ratio[g]))
-    if _cost(_series(q - _scaled(sources[picks[g]], f))[1:]) < _cost(_series(q)[1:]):
-        return int(picks[g]), f
-    return None
+def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
+                   limits: Sequence[int]) -> list[tuple[int, float] | None]:
+    """For each series qs[i] (int64), the series of pool[:limits[i]] of which it is most nearly a
+    multiple, (its index, the factor f), where q - `_scaled`(source, f) costs less than q
+    (`_series`); None where none does (no source as long as q and, where q > 0, positive). A
+    segment drawn on two plans at two scales (a velocity on its plan and on the lever), a value
+    the length of its vector times the plan's scale: their remainders are a few units of the last
+    digit."""
+    by_size: dict[int, list[int]] = {}
+    for g, s in enumerate(pool):
+        by_size.setdefault(len(s), []).append(g)
+    stacks = {n: (np.asarray(gs), np.stack([pool[g] for g in gs]).astype(np.float64)) for n, gs in by_size.items()}
+    picks: list[tuple[int, int, float]] = []                     # (i, g, f)
+    for i, q in enumerate(qs):
+        on = q > 0
+        if len(q) < 2 or on.sum() < 2 or len(q) not in stacks:
+            continue
+        index, stack = stacks[len(q)]
+        usable = (index < limits[i]) & (stack.min(axis=1) >= 0)
+        usable[usable] = stack[usable][:, on].min(axis=1) > 0
+        if usable.any():
+            ratio = q[on] / stack[usable][:, on]
+            g = int(np.argmin(np.ptp(ratio, axis=1) / ratio.mean(axis=1)))
+            picks.append((i, int(index[usable][g]), float(np.median(ratio[g]))))
+    coded = _serieses([x for i, g, f in picks for x in (qs[i] - _scaled(pool[g], f), qs[i])])
+    out: list[tuple[int, float] | None] = [None] * len(qs)
+    for n, (i, g, f) in enumerate(picks):
+        if _cost(coded[2 * n][1:]) < _cost(coded[2 * n + 1][1:]):
+            out[i] = (g, f)
+    return out
 
 
 def _held(x: np.ndarray, drawn: np.ndarray) -> np.ndarray:
@@ -228,6 +236,13 @@ def _ints(x: np.ndarray, decimals: int) -> np.ndarray:
     return np.rint(np.where(np.isfinite(x), x, 0.0) * 10.0 ** decimals).astype(np.int64)
 
 
+def _shown(e) -> np.ndarray:
+    """Where element `e`'s length is shown: finite, and the element drawn (lengths one a row)."""
+    L = np.asarray(e.length_mm, dtype=float).reshape(-1)
+    drawn = np.asarray(e.drawn()).reshape(-1)
+    return np.isfinite(L) & (drawn if len(L) == len(drawn) else True)
+
+
 def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict, bytes, list[np.ndarray]]:
     """A sheet's arrays as (meta, numbers, lengths): `meta` = {"kind", "static", "elements": [{"tag",
     "attrs" [[name, value]...], "title", "texts", "m" points, "rows" (1: the same at every angle),
@@ -242,7 +257,12 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     line's end and its point), -1 - 2j, or where it is j plus a constant c (a point's label),
     -2 - 2j and c; as zigzag varints. `earlier`: the length
     series of the sheets before it on the page, in order; `lengths`: this sheet's, in order."""
-    meta, series, seen, shapes, lengths = [], [], {}, {}, []
+    meta, series, seen, shapes = [], [], {}, {}
+    lengths = [_ints(_held(np.asarray(e.length_mm, dtype=float).reshape(-1), _shown(e)), LENGTH_DECIMALS)
+               for e in d.elements if e.length_mm is not None]
+    pool = [*earlier, *lengths]
+    sources = iter(_proportionals(lengths, pool, range(len(earlier), len(pool))))
+    own = iter(lengths)
 
     def put(a) -> None:
         a = np.asarray(a, dtype=np.int64).ravel()
@@ -275,12 +295,8 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
             put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS))
         source = None
         if e.length_mm is not None:
-            L = np.asarray(e.length_mm, dtype=float).reshape(-1)
-            shown = np.isfinite(L) & (drawn if len(L) == rows else True)
-            q, pool = _ints(_held(L, shown), LENGTH_DECIMALS), [*earlier, *lengths]
-            source = _proportional(q, pool)
+            q, source = next(own), next(sources)
             put(q if source is None else q - _scaled(pool[source[0]], source[1]))
-            lengths.append(q)
         meta.append({"tag": e.tag, "attrs": [[k, v] for k, v in e.attrs.items()], "title": e.title,
                      "texts": list(e.texts), "m": m, "rows": rows, "holes": holes,
                      "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
@@ -328,8 +344,7 @@ def _columns(values: np.ndarray, lengths: Sequence[np.ndarray] = ()) -> tuple[li
     scaled = np.rint(np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)).astype(np.int64)
     mask = (~np.isfinite(values)).astype(np.int64)
     sources, parts = [], []
-    for c in range(values.shape[1]):
-        source = _proportional(scaled[:, c], lengths)
+    for c, source in enumerate(_proportionals(list(scaled.T), lengths, [len(lengths)] * values.shape[1])):
         sources.append(list(source) if source else 0)
         rest = scaled[:, c] if source is None else scaled[:, c] - _scaled(lengths[source[0]], source[1])
         parts += [mask[:, c], rest]
