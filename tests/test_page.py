@@ -444,10 +444,10 @@ def _script_page(drawings, n: int) -> str:
         lengths += more
         blobs[f"k{k}"] = pg._packed(numbers)
     kinds, mids = pg._shared_texts(kinds)
-    blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "mids": mids, "steps": [], "rows": [], "exps": [], "sources": []}).encode())
+    blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "mids": mids, "steps": [], "rows": [], "exps": [], "sources": [], "frames": list(range(n))}).encode())
     blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[2])
     blobs["check"] = pg._text85(pg._obscure(gzip.compress(b'{"items": [], "M": []}')))
-    data = {"student": False, "frames": list(range(n)), "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
+    data = {"student": False, "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
             "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "smooth": pg.SMOOTH.tolist(), "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")

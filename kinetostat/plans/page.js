@@ -121,7 +121,7 @@
 
   // ------------------------------------------------------------------ the sheets of every angle
   const meta = JSON.parse(new TextDecoder().decode(await bytes("meta")));
-  const nf = D.frames.length;
+  const frames = meta.frames, nf = frames.length;
   function series(nums, p, n) {                 // page.py _series at nums[p]: its order k, then n values
     const out = nums.slice(p + 1, p + 1 + n);
     if (nums[p] === D.maxorder + 1) return unjump(out);
@@ -209,7 +209,7 @@
   }
   window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
   const rows = meta.rows, ncol = rows.length, singular = new Set(D.singular);
-  const vals = varints(await bytes("values")), values = D.frames.map(() => new Array(ncol));
+  const vals = varints(await bytes("values")), values = frames.map(() => new Array(ncol));
   for (let c = 0, p = 0; c < ncol; c++) {          // column by column: page.py _columns
     const none = series(vals, p, nf), rest = series(vals, p + nf + 1, nf), e = meta.exps[c], src = meta.sources[c];
     const n = src ? plus(rest, lengths[src[0]], src[1]) : rest;
@@ -251,7 +251,7 @@
       cells[c].dataset.value = isFinite(v) ? String(v) : "";
       cells[c].textContent = local(v, 4);
     });
-    $("phi-value").textContent = local(D.frames[f], 6);
+    $("phi-value").textContent = local(frames[f], 6);
     paper();
     highlight();
   }
@@ -344,7 +344,7 @@
   const slider = $("phi");
   function frameOf(deg) {                        // the frame of the nearest angle on the slider
     let best = 0;
-    for (let f = 0; f < D.slider; f++) if (Math.abs(D.frames[f] - deg) < Math.abs(D.frames[best] - deg)) best = f;
+    for (let f = 0; f < D.slider; f++) if (Math.abs(frames[f] - deg) < Math.abs(frames[best] - deg)) best = f;
     return best;
   }
   slider.addEventListener("input", () => render(frameOf(+slider.value)));

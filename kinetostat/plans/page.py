@@ -16,12 +16,18 @@ the empty tables, an A3 sheet with a millimetre grid at true scale, and the chec
 A page is drawn anew every time: nothing is cached.
 
 Small: each sheet's arrays (`encode_drawing`): the elements' markup once (tag, attributes,
-tooltip, the texts a label takes), and as integers, element by element over the angles, whether it
+tooltip, the texts a label takes; texts with φ at every angle as their common start and end and
+the angles once: `_shared_texts`), and as integers, element by element over the angles, whether it
 is drawn, which text it shows, its coordinates and a segment's length as `Element.svg` rounds them
 (COORD_DECIMALS, LENGTH_DECIMALS), each series as differences over the angle of the order that
-suits it, zigzag varints, deflated (gzip) and written as text, 5 characters per 4 bytes (`_text85`). The page's script (vanilla JavaScript,
-the browser's own DecompressionStream) decodes them once and writes the sheet of the angle chosen
-as `Drawing.svg` writes it.
+suits it, as its jumps (`_jumps`: a label), as its least-squares prediction's misses (`_smooth`: a
+length), as an earlier series of the sheet (moved by a constant), or less a multiple of an earlier
+length (`_proportionals`: a velocity on its plan and on the lever; a value of the worksheet, its
+vector's length times the scale), zigzag varints, deflated (gzip) and written as text, 5
+characters per 4 bytes (`_text85`); the worksheet's rows and the check's items in the blobs too.
+The page's script (vanilla JavaScript, the browser's own DecompressionStream; without its comments,
+`_bare`) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
+`Drawing.svg` writes it.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
 `data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to 1e-9 mm); every value cell
 `data-symbol`, `data-value`; `body[data-ready]`.
@@ -211,7 +217,7 @@ def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
         if usable.any():
             ratio = q[on] / stack[usable][:, on]
             g = int(np.argmin(np.ptp(ratio, axis=1) / ratio.mean(axis=1)))
-            picks.append((i, int(index[usable][g]), float(np.median(ratio[g]))))
+            picks.append((i, int(index[usable][g]), float(f"{np.median(ratio[g]):.10g}")))   # 10 digits: the page's JSON short
     coded = _serieses([x for i, g, f in picks for x in (qs[i] - _scaled(pool[g], f), qs[i])])
     out: list[tuple[int, float] | None] = [None] * len(qs)
     for n, (i, g, f) in enumerate(picks):
@@ -551,7 +557,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     check = {kind: c.at(i_at) for kind, c in cycles.items()}
     one = res.take(np.array([i_at]))
     bands, moment_bands = _bands(mech, one, check, fixed)
-    data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": [int(a) if a.is_integer() else a for a in phi],
+    data: dict = {"lang": lang, "student": student, "design": design, "at": at,
                   "slider": len(frames) - 1, "tol": TOLERANCE_PCT,
                   "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
                   | {"negligible": text("page.negligible", lang, tiny=num(TINY_MM, lang))}, "tiny": TINY_MM,
@@ -578,7 +584,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                 for r in records]
         kinds, mids = _shared_texts(kinds)
         blobs["meta"] = _packed(json.dumps({"kinds": kinds, "mids": mids, "steps": _steps(mech, one, check, lang),
-                                            "rows": rows, "exps": exps, "sources": sources}, ensure_ascii=False).encode())
+                                            "rows": rows, "exps": exps, "sources": sources,
+                                            "frames": [int(a) if a.is_integer() else a for a in phi]}, ensure_ascii=False).encode())
     items = []
     for kind, plan in check.items():
         for s in plan.segments:
