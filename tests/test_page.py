@@ -429,7 +429,6 @@ def test_variant_all_writes_a_page_per_code_linked_from_its_index(tmp_path, monk
 def _script_page(drawings, n: int) -> str:
     """A page of the hand-made `drawings` (Drawing's, n angles) and no values: the key page's
     script on the elements it looks for (page.py `_html`)."""
-    import gzip
     import json
     from importlib import resources
 
@@ -446,7 +445,7 @@ def _script_page(drawings, n: int) -> str:
     kinds, mids = pg._shared_texts(kinds)
     blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "mids": mids, "steps": [], "rows": [], "exps": [], "sources": [], "frames": list(range(n))}).encode())
     blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[2])
-    blobs["check"] = pg._text85(pg._obscure(gzip.compress(b'{"items": [], "M": []}')))
+    blobs["check"] = pg._text85(pg._obscure(pg._deflated(b'{"items": [], "M": []}')))
     data = {"student": False, "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
             "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "smooth": pg.SMOOTH.tolist(), "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}

@@ -1,5 +1,5 @@
 // The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
-// sheet's arrays and the values stored as differences over the angle (gzip, 5 characters per 4 bytes), writes the sheet of
+// sheet's arrays and the values stored as differences over the angle (deflated, 5 characters per 4 bytes), writes the sheet of
 // the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
 // lengths. No network, no library.
 "use strict";
@@ -26,7 +26,7 @@
         bin[i] ^= x & 255;
       }
     }
-    const stream = new Blob([bin]).stream().pipeThrough(new DecompressionStream("gzip"));
+    const stream = new Blob([bin]).stream().pipeThrough(new DecompressionStream("deflate-raw"));
     return new Uint8Array(await new Response(stream).arrayBuffer());
   }
   function varints(b) {                          // zigzag LEB128, exact below 2^53

@@ -23,7 +23,7 @@ is drawn, which text it shows, its coordinates and a segment's length as `Elemen
 suits it, as its jumps (`_jumps`: a label), as its least-squares prediction's misses (`_smooth`: a
 length), as an earlier series of the sheet (moved by a constant), or less a multiple of an earlier
 length (`_proportionals`: a velocity on its plan and on the lever; a value of the worksheet, its
-vector's length times the scale), zigzag varints, deflated (gzip) and written as text, 5
+vector's length times the scale), zigzag varints, deflated and written as text, 5
 characters per 4 bytes (`_text85`); the worksheet's rows and the check's items in the blobs too.
 The page's script (vanilla JavaScript, the browser's own DecompressionStream; without its comments,
 `_bare`) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
@@ -40,12 +40,12 @@ analysis).
 """
 from __future__ import annotations
 
-import gzip
 import json
 import math
 import os
 import re
 import warnings
+import zlib
 from collections.abc import Sequence
 from html import escape
 from importlib import resources
@@ -375,8 +375,14 @@ def _text85(data: bytes) -> str:
 
 
 def _packed(data: bytes) -> str:
-    """`data` deflated (gzip) as text (`_text85`): a blob of the page."""
-    return _text85(gzip.compress(data, 9, mtime=0))
+    """`data` deflated as text (`_text85`): a blob of the page."""
+    return _text85(_deflated(data))
+
+
+def _deflated(data: bytes) -> bytes:
+    """`data` deflated, raw (no wrapper: the script's DecompressionStream("deflate-raw"))."""
+    z = zlib.compressobj(9, zlib.DEFLATED, -15)
+    return z.compress(data) + z.flush()
 
 
 # ============================================================================ what the page holds
@@ -585,7 +591,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         kinds, mids = _shared_texts(kinds)
         blobs["meta"] = _packed(json.dumps({"kinds": kinds, "mids": mids, "steps": _steps(mech, one, check, lang),
                                             "rows": rows, "exps": exps, "sources": sources,
-                                            "frames": [int(a) if a.is_integer() else a for a in phi]}, ensure_ascii=False).encode())
+                                            "frames": [int(a) if a.is_integer() else a for a in phi]},
+                                           ensure_ascii=False, separators=(",", ":")).encode())
     items = []
     for kind, plan in check.items():
         for s in plan.segments:
@@ -598,7 +605,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
                     for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
     results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
-    blobs["check"] = _text85(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(), 9, mtime=0)))
+    blobs["check"] = _text85(_obscure(_deflated(json.dumps({"items": items, "M": results}, separators=(",", ":")).encode())))
     blank = _blank_tables(records, lang) if student else ""
     return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), results, blank)
 
