@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import re
+import zlib
 from html.parser import HTMLParser
 
 import pytest
@@ -13,7 +14,7 @@ import pytest
 import kinetostat
 import kinetostat.plans as P
 from conftest import four_bar
-from kinetostat.plans.page import page
+from kinetostat.plans.page import DIGITS85, page
 
 M_BAL, POINT = "<!--<script>", "</script>"
 #: Point B of the four-bar named POINT (a pair's point: its velocity and acceleration rows name it).
@@ -57,8 +58,19 @@ def test_a_name_cannot_end_or_extend_the_data_block(hostile_page):
     (data,) = [text for i, text in parser.scripts if i == "page-data"]
     # what would end the element early, or (after "<!--") make its "</script>" not end it (HTML, script data)
     assert not re.search(r"<!--|</?script", data, re.IGNORECASE), data[:200]
-    symbols = [r["symbol"] for r in json.loads(data)["rows"]]
-    assert M_BAL in symbols and f"V_{POINT}" in symbols        # the names, as they were
+    (meta,) = [text for i, text in parser.scripts if i == "blob-meta"]
+    symbols = [r["symbol"] for r in json.loads(_unpacked(meta))["rows"]]
+    assert M_BAL in symbols and f"V_{POINT}" in symbols        # the names, as they were, in the page's blob
+
+
+def _unpacked(blob: str) -> bytes:
+    """A blob of the page (page.py `_packed`) back as its bytes: 5 digits (DIGITS85) per 4 bytes, inflated."""
+    digits = [DIGITS85.index(c) for c in blob.encode("ascii")]
+    pad = -len(digits) % 5
+    digits += [84] * pad
+    words = [sum(d * 85 ** (4 - k) for k, d in enumerate(digits[i:i + 5])) for i in range(0, len(digits), 5)]
+    data = b"".join(w.to_bytes(4, "big") for w in words)
+    return zlib.decompress(data[:len(data) - pad], -15)
 
 
 def test_the_page_gets_ready_in_a_browser(hostile_page, chromium):

@@ -429,7 +429,6 @@ def test_variant_all_writes_a_page_per_code_linked_from_its_index(tmp_path, monk
 def _script_page(drawings, n: int) -> str:
     """A page of the hand-made `drawings` (Drawing's, n angles) and no values: the key page's
     script on the elements it looks for (page.py `_html`)."""
-    import gzip
     import json
     from importlib import resources
 
@@ -437,23 +436,25 @@ def _script_page(drawings, n: int) -> str:
 
     import kinetostat.plans.page as pg
     from kinetostat.plans.core import ELEMENTS
-    kinds, blobs = [], {}
+    kinds, blobs, lengths = [], {}, []
     for k, d in enumerate(drawings):
-        meta, numbers = pg.encode_drawing(d)
+        meta, numbers, more = pg.encode_drawing(d, lengths)
         kinds.append(meta)
+        lengths += more
         blobs[f"k{k}"] = pg._packed(numbers)
-    blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "steps": []}).encode())
-    blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[1])
-    blobs["check"] = pg._text85(pg._obscure(gzip.compress(b'{"items": [], "M": []}')))
-    data = {"student": False, "frames": list(range(n)), "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
-            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "rows": [], "exps": [], "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
+    kinds, mids = pg._shared_texts(kinds)
+    blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "mids": mids, "steps": [], "rows": [], "exps": [], "sources": [], "frames": list(range(n))}).encode())
+    blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[2])
+    blobs["check"] = pg._text85(pg._obscure(pg._deflated(b'{"items": [], "M": []}')))
+    data = {"student": False, "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
+            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "smooth": pg.SMOOTH.tolist(), "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
     return ('<!DOCTYPE html><html><head><meta charset="utf-8"><style id="page-size"></style></head><body>'
             '<input type="range" id="phi" min="0" max="359"><output id="phi-value"></output><button id="design"></button>'
             '<button id="prev"></button><button id="next"></button><output id="step"></output>'
             '<select id="paper"><option>A3</option><option>A4</option></select><p id="equation"></p>'
-            '<section id="sheets"></section><table id="value-table"></table>'
+            '<section id="sheets"></section><table id="value-table"></table><table id="check-table"><tr></tr></table>'
             + "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
             + f'<script id="page-data" type="application/json">{json.dumps(data)}</script><script>{script}</script></body></html>')
 
@@ -499,6 +500,44 @@ def test_script_writes_a_hand_made_drawing_at_each_angle(chromium, tmp_path):
     assert "<line" not in got[1] and '<text x="8.5" y="9.0" font-size="3.50">A<tspan dy="0.70">2</tspan></text>' in got[1]
     assert '<line x1="12.0" y1="21.0" x2="-3.1" y2="45.0"' in got[2] and 'data-length-mm="3.500000"' in got[2]
     assert 'points="0.0,1.0 1.0,1.0 2.0,1.0"' in got[1] and got[2].count("<polyline") == 1
+
+
+def test_script_writes_jumps_smooth_lengths_moved_series_scaled_lengths_and_shared_texts(chromium, tmp_path):
+    """Over 60 angles, a sheet whose series the page stores in its shorter forms, written by the
+    page's script exactly as `Drawing.svg`: a label that jumps between two places and back as it
+    moves (`_jumps`), a length to 1e-6 mm on its least-squares polynomial (`_smooth`), a point that is another moved by a constant (a reference and the constant),
+    a segment's length half another's on an earlier sheet plus a little (`_proportional`: "from"),
+    a title with φ at every angle (`_shared_texts`)."""
+    import numpy as np
+
+    import kinetostat.plans.page as pg
+    from kinetostat.plans.core import ELEMENTS, Drawing, Element
+    n = 60
+    t = np.radians(np.arange(n) * 1.0)
+    centre = np.stack([100 + 30 * np.cos(t), 100 + 20 * np.sin(t)], axis=1)
+    side = np.where((np.arange(n) // 7) % 2 == 0, 4.0, -3.5)
+    label_xy = centre + np.stack([side, np.full(n, 2.0)], axis=1)
+    L = 50 + 10 * np.sin(4 * t)
+    root = '<?xml version="1.0"?>\n<svg><g id="plan">\n' + ELEMENTS + "</g>\n</svg>\n"
+    seg = lambda name, length: Element("line", np.stack([centre, centre + 5], axis=1), {"data-plan": "p", "data-segment": name},
+                                       length_mm=length)
+    first = Drawing("velocity", np.arange(n, dtype=float), root, (seg("a", L),))
+    second = Drawing("lever", np.arange(n, dtype=float), root, (
+        seg("b", L / 2 + 1e-6 * (np.arange(n) % 3)),
+        Element("circle", centre[:, None], {"r": "0.6"}), Element("circle", centre[:, None] + [12.3, -4.5], {"r": "0.6"}),
+        Element("text", label_xy[:, None], {"class": "name"}, texts=("B",), variant=np.zeros(1, dtype=int)),
+        Element("text", np.full((n, 1, 2), 5.0), {"class": "title"}, texts=tuple(f"Lever, φ = {k}°" for k in range(n)),
+                variant=np.arange(n))))
+    assert pg._series(pg._ints(label_xy[:, 0], pg.COORD_DECIMALS))[0] == pg.MAX_ORDER + 1
+    assert pg._series(pg._ints(L, pg.LENGTH_DECIMALS))[0] == pg.MAX_ORDER + 2
+    metas = pg.encode_drawing(second, pg.encode_drawing(first)[2])[0]["elements"]
+    assert metas[0]["from"][0] == 0 and pg._shared_texts([{"elements": metas}])[0][0]["elements"][-1]["texts"]["pre"] == "Lever, φ = "
+    f = tmp_path / "stored.html"
+    f.write_text(_script_page([first, second], n), encoding="utf-8")
+    page = _open(chromium, f)
+    got = [[page.evaluate("([k, i]) => window.sheetSvg(k, i)", [k, i]) for i in range(n)] for k in range(2)]
+    page.close()
+    assert got == [[d.svg(i, *PAGE_DECIMALS) for i in range(n)] for d in (first, second)]
 
 
 #: Each sheet of the page as its script wrote it: (kind, the SVG).

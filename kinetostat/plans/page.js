@@ -1,5 +1,5 @@
 // The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
-// sheet's arrays and the values stored as differences over the angle (gzip, 5 characters per 4 bytes), writes the sheet of
+// sheet's arrays and the values stored as differences over the angle (deflated, 5 characters per 4 bytes), writes the sheet of
 // the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
 // lengths. No network, no library.
 "use strict";
@@ -26,7 +26,7 @@
         bin[i] ^= x & 255;
       }
     }
-    const stream = new Blob([bin]).stream().pipeThrough(new DecompressionStream("gzip"));
+    const stream = new Blob([bin]).stream().pipeThrough(new DecompressionStream("deflate-raw"));
     return new Uint8Array(await new Response(stream).arrayBuffer());
   }
   function varints(b) {                          // zigzag LEB128, exact below 2^53
@@ -63,6 +63,19 @@
     return (d >= 0 ? "+" : "") + local(d, 3) + (unit ? " " + unit : "") + " (" + pct1(100 * d / exact) + ")";
   }
   function band(b) { return b ? local(b[0], 3) + " … " + local(b[1], 3) : "—"; }
+  let last = $("check-table").rows[0];         // the items' rows (page.py _html writes the moments' rows)
+  check.items.forEach((it, n) => {
+    const tr = document.createElement("tr"), input = document.createElement("input");
+    tr.dataset.item = n;
+    Object.assign(input, {type: "text", inputMode: "decimal", className: "measured", size: 7});
+    Object.assign(input.dataset, {plan: it.plan, segment: it.segment});
+    [it.title, it.label, input, "exact num", "band num", "verdict"].forEach((x, c) => {
+      const td = tr.insertCell();
+      if (c === 2) td.appendChild(x); else if (c < 2) td.textContent = x; else td.className = x;
+    });
+    last.after(tr);
+    last = tr;
+  });
   document.querySelectorAll("tr[data-item]").forEach((tr) => {
     const it = check.items[+tr.dataset.item];
     if (!D.student) {
@@ -108,35 +121,72 @@
 
   // ------------------------------------------------------------------ the sheets of every angle
   const meta = JSON.parse(new TextDecoder().decode(await bytes("meta")));
-  const nf = D.frames.length;
+  const frames = meta.frames, nf = frames.length;
   function series(nums, p, n) {                 // page.py _series at nums[p]: its order k, then n values
     const out = nums.slice(p + 1, p + 1 + n);
+    if (nums[p] === D.maxorder + 1) return unjump(out);
+    if (nums[p] === D.maxorder + 2) return unsmooth(out);
     for (let k = nums[p]; k > 0; k--) for (let j = 1; j < n; j++) out[j] += out[j - 1];
+    return out;
+  }
+  function unsmooth(v) {                         // page.py _smooth, taken back
+    const C = D.smooth, K = C.length, out = [];
+    let fit = 0, line = 0;                       // the two predictions of the value before
+    for (let i = 0; i < v.length; i++) {
+      const nextLine = i === 0 ? 0 : i === 1 ? out[0] : 2 * out[i - 1] - out[i - 2];
+      let nextFit = nextLine;
+      if (i >= K) {
+        let acc = 0;
+        for (let k = 0; k < K; k++) acc = acc + C[k] * out[i - K + k];
+        nextFit = Math.floor(acc + 0.5);
+      }
+      const better = i >= K + 1 && Math.abs(out[i - 1] - fit) <= Math.abs(out[i - 1] - line);
+      out.push(v[i] + (better ? nextFit : nextLine));
+      fit = nextFit; line = nextLine;
+    }
+    return out;
+  }
+  function unjump(v) {                           // page.py _jumps, taken back
+    const out = [v[0]];
+    let s = 0, before = 0;
+    for (let t = 1; t < v.length; t++) {
+      const d = s + v[t];
+      if (t < 2 || Math.abs(d - before) <= D.jump) s = d;
+      before = d;
+      out.push(out[t - 1] + d);
+    }
     return out;
   }
   function fixed(q, digits) {                    // core.py fixed: q / 10^digits with `digits` decimals
     const s = String(Math.abs(q)).padStart(digits + 1, "0"), cut = s.length - digits;
     return (q < 0 ? "-" : "") + s.slice(0, cut) + "." + s.slice(cut);
   }
-  const kinds = [];
+  // An earlier length series times f, as page.py _scaled: the part of a series stored less it.
+  const plus = (rest, source, f) => rest.map((r, j) => r + Math.floor(source[j] * f + 0.5));
+  const kinds = [], lengths = [];                // lengths: every length series of the page, in order
   for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
     const K = meta.kinds[k], nums = varints(await bytes("k" + k));
     let p = 0;
-    const made = [];                             // the sheet's series in order: one may repeat an earlier
+    const made = [];                             // the sheet's series in order: one may repeat an earlier, or move it
     const take = (n) => {
-      const v = nums[p] < 0 ? made[-1 - nums[p]] : series(nums, p, n);
-      p += nums[p] < 0 ? 1 : n + 1;
+      let v;
+      if (nums[p] >= 0) { v = series(nums, p, n); p += n + 1; }
+      else if ((-1 - nums[p]) % 2 === 0) { v = made[(-1 - nums[p]) / 2]; p += 1; }
+      else { const c = nums[p + 1]; v = made[(-2 - nums[p]) / 2].map((x) => x + c); p += 2; }
       made.push(v);
       return v;
     };
     const elements = K.elements.map((E) => {
       const el = {tag: E.tag, attrs: E.attrs.map(([a, v]) => ` ${a}="${v}"`).join(""),
-                  title: E.title ? `<title>${E.title}</title>` : "", texts: E.texts, rows: E.rows, m: E.m};
+                  title: E.title ? `<title>${E.title}</title>` : "", rows: E.rows, m: E.m,
+                  texts: Array.isArray(E.texts) ? E.texts : meta.mids[E.texts.mids].map((t) => E.texts.pre + t + E.texts.suf)};
       el.drawn = take(E.rows);
       el.variant = E.variants ? take(E.variants) : [0];
       el.finite = E.holes ? [...Array(E.m)].map(() => take(E.rows)) : null;
       el.xy = [...Array(2 * E.m)].map(() => take(E.rows));
       el.len = E.len ? take(E.len) : null;
+      if (E.from) el.len = plus(el.len, lengths[E.from[0]], E.from[1]);
+      if (el.len) lengths.push(el.len);
       return el;
     });
     kinds.push({kind: K.kind, static: K.static, elements});
@@ -158,10 +208,11 @@
     return K.static.replace(D.elements, () => K.elements.map((el) => element(el, i)).join(""));
   }
   window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
-  const rows = D.rows, ncol = rows.length, singular = new Set(D.singular);
-  const vals = varints(await bytes("values")), values = D.frames.map(() => new Array(ncol));
+  const rows = meta.rows, ncol = rows.length, singular = new Set(D.singular);
+  const vals = varints(await bytes("values")), values = frames.map(() => new Array(ncol));
   for (let c = 0, p = 0; c < ncol; c++) {          // column by column: page.py _columns
-    const none = series(vals, p, nf), n = series(vals, p + nf + 1, nf), e = D.exps[c];
+    const none = series(vals, p, nf), rest = series(vals, p + nf + 1, nf), e = meta.exps[c], src = meta.sources[c];
+    const n = src ? plus(rest, lengths[src[0]], src[1]) : rest;
     p += 2 * (nf + 1);
     for (let f = 0; f < nf; f++) values[f][c] = none[f] ? NaN : e < 0 ? n[f] / 10 ** -e : n[f] * 10 ** e;
   }
@@ -200,7 +251,7 @@
       cells[c].dataset.value = isFinite(v) ? String(v) : "";
       cells[c].textContent = local(v, 4);
     });
-    $("phi-value").textContent = local(D.frames[f], 6);
+    $("phi-value").textContent = local(frames[f], 6);
     paper();
     highlight();
   }
@@ -293,7 +344,7 @@
   const slider = $("phi");
   function frameOf(deg) {                        // the frame of the nearest angle on the slider
     let best = 0;
-    for (let f = 0; f < D.slider; f++) if (Math.abs(D.frames[f] - deg) < Math.abs(D.frames[best] - deg)) best = f;
+    for (let f = 0; f < D.slider; f++) if (Math.abs(frames[f] - deg) < Math.abs(frames[best] - deg)) best = f;
     return best;
   }
   slider.addEventListener("input", () => render(frameOf(+slider.value)));

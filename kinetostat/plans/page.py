@@ -16,12 +16,18 @@ the empty tables, an A3 sheet with a millimetre grid at true scale, and the chec
 A page is drawn anew every time: nothing is cached.
 
 Small: each sheet's arrays (`encode_drawing`): the elements' markup once (tag, attributes,
-tooltip, the texts a label takes), and as integers, element by element over the angles, whether it
+tooltip, the texts a label takes; texts with φ at every angle as their common start and end and
+the angles once: `_shared_texts`), and as integers, element by element over the angles, whether it
 is drawn, which text it shows, its coordinates and a segment's length as `Element.svg` rounds them
 (COORD_DECIMALS, LENGTH_DECIMALS), each series as differences over the angle of the order that
-suits it, zigzag varints, deflated (gzip) and written as text, 5 characters per 4 bytes (`_text85`). The page's script (vanilla JavaScript,
-the browser's own DecompressionStream) decodes them once and writes the sheet of the angle chosen
-as `Drawing.svg` writes it.
+suits it, as its jumps (`_jumps`: a label), as its least-squares prediction's misses (`_smooth`: a
+length), as an earlier series of the sheet (moved by a constant), or less a multiple of an earlier
+length (`_proportionals`: a velocity on its plan and on the lever; a value of the worksheet, its
+vector's length times the scale), zigzag varints, deflated and written as text, 5
+characters per 4 bytes (`_text85`); the worksheet's rows and the check's items in the blobs too.
+The page's script (vanilla JavaScript, the browser's own DecompressionStream; without its comments,
+`_bare`) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
+`Drawing.svg` writes it.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
 `data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to 1e-9 mm); every value cell
 `data-symbol`, `data-value`; `body[data-ready]`.
@@ -34,10 +40,12 @@ analysis).
 """
 from __future__ import annotations
 
-import gzip
 import json
 import math
+import os
+import re
 import warnings
+import zlib
 from collections.abc import Sequence
 from html import escape
 from importlib import resources
@@ -83,22 +91,139 @@ def _varints(values: np.ndarray) -> bytes:
     return out.tobytes()
 
 
-#: Highest order of differences a series is stored as (`_series`).
+#: Highest order of differences a series is stored as (`_series`); MAX_ORDER + 1: as `_jumps`;
+#: MAX_ORDER + 2: as `_smooth`.
 MAX_ORDER = 4
+#: `_smooth`'s weights: of the last 24 values, the one next on the least-squares polynomial of
+#: degree 8 through them.
+SMOOTH = np.linalg.pinv(np.vander(np.arange(-24.0, 0.0), 9))[-1]
+#: The smallest series (units of its last digit) `_smooth` is tried on: lengths and values.
+SMOOTH_FROM = 10 ** 5
+#: A step of a series whose slope changes by more than this (units of its last digit) is a jump
+#: (`_jumps`: a label moved to another place).
+JUMP = 3
 
 
 def _series(a: np.ndarray) -> np.ndarray:
     """An int64 series as its order k (0..MAX_ORDER) followed by its k-th differences, each
-    difference keeping the first value (a - [0, a[:-1]]): the order whose differences are
-    smallest (a sum of their bits), so that a smooth function of the angle becomes a few small
-    numbers; the page's script takes k prefix sums."""
-    best, d = None, np.asarray(a, dtype=np.int64).ravel()
-    for k in range(MAX_ORDER + 1):
-        cost = float(np.log2(1.0 + np.abs(d)).sum())
-        if best is None or cost < best[0]:
-            best = (cost, k, d)
-        d = d - np.concatenate([[0], d[:-1]])
-    return np.concatenate([[best[1]], best[2]])
+    difference keeping the first value (a - [0, a[:-1]]), or as MAX_ORDER + 1 followed by
+    `_jumps`, or (SMOOTH_FROM units or more) as MAX_ORDER + 2 followed by `_smooth`: the one whose numbers are smallest (a sum of their bits), so that a smooth function
+    of the angle becomes a few small numbers; the page's script takes k prefix sums."""
+    return _serieses([a])[0]
+
+
+def _last(mask: np.ndarray) -> np.ndarray:
+    """Along each row of `mask` (m, n), the index of the last True at or before each column (-1: none)."""
+    return np.maximum.accumulate(np.where(mask, np.arange(mask.shape[1]), -1), axis=1)
+
+
+def _jumps(x: np.ndarray) -> np.ndarray:
+    """Rows of int64 series (m, n) as their first value and, step by step, the step less the
+    slope: the last step that was not a jump (0 at first), a jump a step that differs from the
+    step before by more than JUMP. A label moving with its point costs the rounding's few units,
+    and a jump to another place and back one number each (page.js `unjump` takes it back)."""
+    m, n = x.shape
+    d = np.zeros_like(x)
+    d[:, 1:] = np.diff(x, axis=1)
+    steady = np.ones((m, n), dtype=bool)
+    steady[:, 0] = False
+    steady[:, 2:] = np.abs(d[:, 2:] - d[:, 1:-1]) <= JUMP
+    last = _last(steady)
+    s = np.zeros_like(x)
+    s[:, 1:] = np.where(last[:, :-1] >= 1, d[np.arange(m)[:, None], np.maximum(last[:, :-1], 0)], 0)
+    out = d - s
+    out[:, 0] = x[:, 0]
+    return out
+
+
+def _smooth(x: np.ndarray) -> np.ndarray:
+    """Rows of int64 series (m, n) as each value less its prediction: floor(p + 0.5) of p = SMOOTH
+    · the last len(SMOOTH) values (summed in order: page.js `unsmooth` the same in doubles) where
+    that predicted the value before at least as well as 2 x[i-1] - x[i-2] did, else the latter
+    (x[0] before the second, 0 before the first): a length to 1e-6 mm, smooth over the angles but
+    for a kink here and there, costs a unit or two a value."""
+    m, n = x.shape
+    K = len(SMOOTH)
+    line = np.zeros_like(x)
+    line[:, 1:2] = x[:, :1]
+    line[:, 2:] = 2 * x[:, 1:-1] - x[:, :-2]
+    if n <= K + 1:
+        return x - line
+    acc = np.zeros((m, n - K))
+    for k in range(K):
+        acc = acc + SMOOTH[k] * x[:, k:n - K + k]
+    fit = line.copy()
+    fit[:, K:] = np.floor(acc + 0.5).astype(np.int64)
+    better = np.zeros((m, n), dtype=bool)
+    better[:, K + 1:] = np.abs(x - fit)[:, K:-1] <= np.abs(x - line)[:, K:-1]
+    return x - np.where(better, fit, line)
+
+
+def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """`_series` of each of `arrays`, those of one length at once."""
+    out: list[np.ndarray] = [np.empty(0, dtype=np.int64)] * len(arrays)
+    by_size: dict[int, list[int]] = {}
+    for i, a in enumerate(arrays):
+        by_size.setdefault(np.size(a), []).append(i)
+    for idx in by_size.values():
+        d = [np.stack([np.asarray(arrays[i], dtype=np.int64).ravel() for i in idx])]
+        for _ in range(MAX_ORDER):
+            d.append(np.diff(d[-1], axis=1, prepend=0))
+        d.append(_jumps(d[0]))
+        large = np.abs(d[0]).max(axis=1) >= SMOOTH_FROM
+        d.append(d[0].copy())
+        if large.any():
+            d[-1][large] = _smooth(d[0][large])
+        diffs = np.stack(d)                                       # (order, series, angle)
+        costs = np.log2(1.0 + np.abs(diffs)).sum(axis=2)
+        costs[-1, ~large] = np.inf
+        order = np.argmin(costs, axis=0)
+        for j, i in enumerate(idx):
+            out[i] = np.concatenate([[order[j]], diffs[order[j], j]])
+    return out
+
+
+def _cost(d: np.ndarray) -> float:
+    """What a series of integers costs as varints, roughly: the sum of their bits."""
+    return float(np.log2(1.0 + np.abs(d)).sum())
+
+
+def _scaled(source: np.ndarray, f: float) -> np.ndarray:
+    """floor(f source + 0.5), int64: what the page's script computes from an earlier series
+    (page.js `plus`; one product and one sum in doubles, the same in both)."""
+    return np.floor(source.astype(np.float64) * f + 0.5).astype(np.int64)
+
+
+def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
+                   limits: Sequence[int]) -> list[tuple[int, float] | None]:
+    """For each series qs[i] (int64), the series of pool[:limits[i]] of which it is most nearly a
+    multiple, (its index, the factor f), where q - `_scaled`(source, f) costs less than q
+    (`_series`); None where none does (no source as long as q and, where q > 0, positive). A
+    segment drawn on two plans at two scales (a velocity on its plan and on the lever), a value
+    the length of its vector times the plan's scale: their remainders are a few units of the last
+    digit."""
+    by_size: dict[int, list[int]] = {}
+    for g, s in enumerate(pool):
+        by_size.setdefault(len(s), []).append(g)
+    stacks = {n: (np.asarray(gs), np.stack([pool[g] for g in gs]).astype(np.float64)) for n, gs in by_size.items()}
+    picks: list[tuple[int, int, float]] = []                     # (i, g, f)
+    for i, q in enumerate(qs):
+        on = q > 0
+        if len(q) < 2 or on.sum() < 2 or len(q) not in stacks:
+            continue
+        index, stack = stacks[len(q)]
+        usable = (index < limits[i]) & (stack.min(axis=1) >= 0)
+        usable[usable] = stack[usable][:, on].min(axis=1) > 0
+        if usable.any():
+            ratio = q[on] / stack[usable][:, on]
+            g = int(np.argmin(np.ptp(ratio, axis=1) / ratio.mean(axis=1)))
+            picks.append((i, int(index[usable][g]), float(f"{np.median(ratio[g]):.10g}")))   # 10 digits: the page's JSON short
+    coded = _serieses([x for i, g, f in picks for x in (qs[i] - _scaled(pool[g], f), qs[i])])
+    out: list[tuple[int, float] | None] = [None] * len(qs)
+    for n, (i, g, f) in enumerate(picks):
+        if _cost(coded[2 * n][1:]) < _cost(coded[2 * n + 1][1:]):
+            out[i] = (g, f)
+    return out
 
 
 def _held(x: np.ndarray, drawn: np.ndarray) -> np.ndarray:
@@ -117,24 +242,48 @@ def _ints(x: np.ndarray, decimals: int) -> np.ndarray:
     return np.rint(np.where(np.isfinite(x), x, 0.0) * 10.0 ** decimals).astype(np.int64)
 
 
-def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
-    """A sheet's arrays as (meta, numbers): `meta` = {"kind", "static", "elements": [{"tag",
+def _shown(e) -> np.ndarray:
+    """Where element `e`'s length is shown: finite, and the element drawn (lengths one a row)."""
+    L = np.asarray(e.length_mm, dtype=float).reshape(-1)
+    drawn = np.asarray(e.drawn()).reshape(-1)
+    return np.isfinite(L) & (drawn if len(L) == len(drawn) else True)
+
+
+def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict, bytes, list[np.ndarray]]:
+    """A sheet's arrays as (meta, numbers, lengths): `meta` = {"kind", "static", "elements": [{"tag",
     "attrs" [[name, value]...], "title", "texts", "m" points, "rows" (1: the same at every angle),
-    "holes" (a polyline with points left out), "len" (has lengths)}]}; `numbers`, element by
-    element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each angle
-    (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
+    "holes" (a polyline with points left out), "len" (has lengths), "from" (where its lengths are
+    stored less a multiple of an earlier series: [index, factor], `_proportional`)}]}; `numbers`,
+    element by element: where it is drawn (rows of 0/1, `Element.drawn`), its text's index at each
+    angle (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
-    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not
-    drawn or NaN); every series as
-    differences of the order that suits it (`_series`), or, where an earlier series of the sheet
-    is the same (a line's end and its point), -1 - that series' index; as zigzag varints."""
-    meta, series, seen = [], [], {}
+    holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not drawn
+    or NaN; less `_scaled`(earlier[index], factor) where "from"); every series as differences of
+    the order that suits it (`_series`), or, where an earlier series j of the sheet is the same (a
+    line's end and its point), -1 - 2j, or where it is j plus a constant c (a point's label),
+    -2 - 2j and c; as zigzag varints. `earlier`: the length
+    series of the sheets before it on the page, in order; `lengths`: this sheet's, in order."""
+    meta, series, seen, shapes = [], [], {}, {}
+    lengths = [_ints(_held(np.asarray(e.length_mm, dtype=float).reshape(-1), _shown(e)), LENGTH_DECIMALS)
+               for e in d.elements if e.length_mm is not None]
+    pool = [*earlier, *lengths]
+    sources = iter(_proportionals(lengths, pool, range(len(earlier), len(pool))))
+    own = iter(lengths)
 
     def put(a) -> None:
         a = np.asarray(a, dtype=np.int64).ravel()
-        key = a.tobytes()
-        series.append(np.array([-1 - seen[key]]) if key in seen else _series(a))
+        key, shape = a.tobytes(), (a - a[0]).tobytes()
+        if key in seen:
+            series.append((-1 - 2 * seen[key],))
+        elif shape in shapes:
+            j = shapes[shape]
+            series.append((-2 - 2 * j, int(a[0] - raw[j][0])))
+        else:
+            series.append(a)
+        raw.append(a)
         seen.setdefault(key, len(series) - 1)
+        shapes.setdefault(shape, len(series) - 1)
+    raw: list[np.ndarray] = []
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
         rows, m = xy.shape[0], xy.shape[1]
@@ -150,30 +299,62 @@ def encode_drawing(d: Drawing) -> tuple[dict, bytes]:
         held = _held(np.where(finite[..., None], xy, np.nan), drawn) if m else xy
         for c in range(2 * m):
             put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS))
+        source = None
         if e.length_mm is not None:
-            L = np.asarray(e.length_mm, dtype=float).reshape(-1)
-            shown = np.isfinite(L) & (drawn if len(L) == rows else True)
-            put(_ints(_held(L, shown), LENGTH_DECIMALS))
+            q, source = next(own), next(sources)
+            put(q if source is None else q - _scaled(pool[source[0]], source[1]))
         meta.append({"tag": e.tag, "attrs": [[k, v] for k, v in e.attrs.items()], "title": e.title,
                      "texts": list(e.texts), "m": m, "rows": rows, "holes": holes,
                      "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
-                     "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))})
+                     "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))}
+                    | ({"from": list(source)} if source else {}))
+    new = iter(_serieses([a for a in series if not isinstance(a, tuple)]))
+    series = [np.array(a) if isinstance(a, tuple) else next(new) for a in series]
     return ({"kind": d.kind, "static": d.static, "elements": meta},
-            _varints(np.concatenate(series)) if series else b"")
+            _varints(np.concatenate(series)) if series else b"", lengths)
 
 
-def _columns(values: np.ndarray) -> tuple[list[int], bytes]:
+def _shared_texts(kinds: Sequence[dict]) -> tuple[list[dict], list[list[str]]]:
+    """The sheets' `meta` (`encode_drawing`) with each element's texts of more than two (a title
+    with φ at every angle) as {"pre", "suf", "mids"}: the texts' common start and end and the index
+    of their middles in `mids`, the page's lists of middles, each once (the angles, alike on every
+    sheet)."""
+    mids: list[list[str]] = []
+    out = []
+    for K in kinds:
+        elements = []
+        for E in K["elements"]:
+            texts = E["texts"]
+            if len(texts) > 2:
+                pre = os.path.commonprefix(texts)
+                suf = os.path.commonprefix([t[len(pre):][::-1] for t in texts])[::-1]
+                middle = [t[len(pre):len(t) - len(suf)] for t in texts]
+                if middle not in mids:
+                    mids.append(middle)
+                E = {**E, "texts": {"pre": pre, "suf": suf, "mids": mids.index(middle)}}
+            elements.append(E)
+        out.append({**K, "elements": elements})
+    return out, mids
+
+
+def _columns(values: np.ndarray, lengths: Sequence[np.ndarray] = ()) -> tuple[list[int], list, bytes]:
     """Columns of values over frames (NaN: none): each column's exponent e (VALUE_DIGITS significant digits
-    of its largest |value|), and column by column its NaN mask (1: none) and round(v / 10^e) (NaN
-    as 0), each a `_series`, as zigzag varints."""
+    of its largest |value|), where a column is stored less a multiple of one of the page's `lengths`
+    ([index, factor] or 0, `_proportional`: a value is its vector's length times the plan's scale), and
+    column by column its NaN mask (1: none) and round(v / 10^e) (NaN as 0) less that multiple, each a
+    `_series`, as zigzag varints."""
     exps = []
     for col in values.T:
         top = np.nanmax(np.abs(col)) if np.isfinite(col).any() else 0.0
         exps.append(int(math.floor(math.log10(top))) - (VALUE_DIGITS - 1) if top > 0 else 0)
     scaled = np.rint(np.where(np.isfinite(values), values, 0.0) / 10.0 ** np.array(exps, dtype=float)).astype(np.int64)
     mask = (~np.isfinite(values)).astype(np.int64)
-    parts = [_series(x) for c in range(values.shape[1]) for x in (mask[:, c], scaled[:, c])]
-    return exps, _varints(np.concatenate(parts)) if parts else b""
+    sources, parts = [], []
+    for c, source in enumerate(_proportionals(list(scaled.T), lengths, [len(lengths)] * values.shape[1])):
+        sources.append(list(source) if source else 0)
+        rest = scaled[:, c] if source is None else scaled[:, c] - _scaled(lengths[source[0]], source[1])
+        parts += [mask[:, c], rest]
+    return exps, sources, _varints(np.concatenate(_serieses(parts))) if parts else b""
 
 
 #: The 85 digits of a blob's text (`_text85`): ASCII 33-118 but "<", so that nothing in a blob
@@ -194,8 +375,14 @@ def _text85(data: bytes) -> str:
 
 
 def _packed(data: bytes) -> str:
-    """`data` deflated (gzip) as text (`_text85`): a blob of the page."""
-    return _text85(gzip.compress(data, 9, mtime=0))
+    """`data` deflated as text (`_text85`): a blob of the page."""
+    return _text85(_deflated(data))
+
+
+def _deflated(data: bytes) -> bytes:
+    """`data` deflated, raw (no wrapper: the script's DecompressionStream("deflate-raw"))."""
+    z = zlib.compressobj(9, zlib.DEFLATED, -15)
+    return z.compress(data) + z.flush()
 
 
 # ============================================================================ what the page holds
@@ -376,31 +563,36 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     check = {kind: c.at(i_at) for kind, c in cycles.items()}
     one = res.take(np.array([i_at]))
     bands, moment_bands = _bands(mech, one, check, fixed)
-    data: dict = {"lang": lang, "student": student, "design": design, "at": at, "frames": phi,
+    data: dict = {"lang": lang, "student": student, "design": design, "at": at,
                   "slider": len(frames) - 1, "tol": TOLERANCE_PCT,
                   "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
                   | {"negligible": text("page.negligible", lang, tiny=num(TINY_MM, lang))}, "tiny": TINY_MM,
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang),
-                  "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS}
+                  "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS,
+                  "maxorder": MAX_ORDER, "jump": JUMP, "smooth": SMOOTH.tolist()}
     blobs: dict[str, str] = {}
     records = sheet.at(i_at).records()
     if not student:
-        kinds = []
+        kinds, lengths = [], []
         for kind, cycle in cycles.items():
-            meta, numbers = encode_drawing(drawing(cycle, lang, name, contract=True))
+            meta, numbers, more = encode_drawing(drawing(cycle, lang, name, contract=True), lengths)
             kinds.append(meta)
+            lengths += more
             blobs[f"k{len(kinds) - 1}"] = _packed(numbers)
         values = np.array(sheet.values, dtype=float)
         values[np.asarray(res.singular)] = math.nan
-        exps, vbytes = _columns(values)
+        exps, sources, vbytes = _columns(values, lengths)
         blobs["values"] = _packed(vbytes)
-        data.update(singular=np.flatnonzero(res.singular).tolist(), exps=exps,
-                    rows=[{"key": r["key"], "symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"],
-                           "section": r["section"]} for r in records])
-        blobs["meta"] = _packed(json.dumps({"kinds": kinds, "steps": _steps(mech, one, check, lang)},
-                                          ensure_ascii=False).encode())
+        data.update(singular=np.flatnonzero(res.singular).tolist())
+        rows = [{"symbol": r["symbol"], "shown": _symbol(r["symbol"], lang), "unit": r["unit"], "section": r["section"]}
+                for r in records]
+        kinds, mids = _shared_texts(kinds)
+        blobs["meta"] = _packed(json.dumps({"kinds": kinds, "mids": mids, "steps": _steps(mech, one, check, lang),
+                                            "rows": rows, "exps": exps, "sources": sources,
+                                            "frames": [int(a) if a.is_integer() else a for a in phi]},
+                                           ensure_ascii=False, separators=(",", ":")).encode())
     items = []
     for kind, plan in check.items():
         for s in plan.segments:
@@ -413,9 +605,9 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
                     for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
     results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
-    blobs["check"] = _text85(_obscure(gzip.compress(json.dumps({"items": items, "M": results}).encode(), 9, mtime=0)))
+    blobs["check"] = _text85(_obscure(_deflated(json.dumps({"items": items, "M": results}, separators=(",", ":")).encode())))
     blank = _blank_tables(records, lang) if student else ""
-    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), items, results, blank)
+    return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), results, blank)
 
 
 def _blank_tables(records: list[dict], lang: str) -> str:
@@ -449,7 +641,7 @@ def _obscure(data: bytes) -> bytes:
 
 
 def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str, str], fixed,
-          data_rows, items, results, blank: str = "") -> str:
+          data_rows, results, blank: str = "") -> str:
     from .draw import scale_text
     title = f"{name}: {text('page.student' if student else 'page.key', lang)}"
     scales = "; ".join([scale_text(s, lang) for s in fixed.base.values()]
@@ -459,12 +651,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     head = "".join(f"<th>{escape(h)}</th>" for h in ("", "", ""))
     data_table = "".join(f'<tr><td>{escape(s)}</td><td class="num">{escape(v)}</td><td>{escape(u)}</td></tr>'
                          for s, v, u in data_rows)
-    check_rows = []
-    for n, it in enumerate(items):
-        check_rows.append(f'<tr data-item="{n}"><td>{escape(it["title"])}</td><td>{escape(it["label"])}</td>'
-                          f'<td><input type="text" inputmode="decimal" class="measured" data-plan="{escape(it["plan"])}" '
-                          f'data-segment="{escape(it["segment"])}" size="7"></td>'
-                          f'<td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
+    check_rows = []                             # the items' rows: the script writes them from the check's blob
     for n, (symbol, _, _) in enumerate(results):
         check_rows.append(f'<tr data-moment="{n}"><td></td><td>{escape(symbol)}, {escape(unit("N m", lang))}</td>'
                           f'<td><input type="text" inputmode="decimal" class="moment" data-symbol="{escape(symbol)}" '
@@ -475,7 +662,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                           f'{num(TOLERANCE_PCT, lang)} %</td><td class="verdict"></td></tr>')
     phi = num(data["at"], lang, 6)
     check = (f'<section id="check"><h2>{escape(text("page.check", lang))}</h2><p>{escape(text("page.check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
-             f'<table><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
+             f'<table id="check-table"><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
              + "</tr>" + "".join(check_rows) + "</table></section>")
     if student:
         body = (f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><p>{escape(text("page.scales", lang))}: {escape(scales)}</p>'
@@ -496,7 +683,7 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                 f'<section id="values"><h2>{escape(text("page.values", lang))}</h2><table id="value-table"></table></section>'
                 f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><table>{data_table}</table></section>'
                 + check)
-    script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
+    script = _bare(resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8"))
     payload = script_json(data)                 # no name in it (`</script>`, `<!--<script>`) ends its element
     blob_tags = "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
     return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
@@ -506,6 +693,13 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
             f'</head><body>'
             f'<h1>{escape(title)}</h1>{body}{blob_tags}'
             f'<script id="page-data" type="application/json">{payload}</script><script>{script}</script></body></html>\n')
+
+
+def _bare(script: str) -> str:
+    """The page's script without its comments (a line's own, or after code and two spaces) and
+    indentation: what the browser runs, line for line."""
+    lines = (re.sub(r"\s{2,}// .*$", "", line).strip() for line in script.splitlines())
+    return "\n".join(line for line in lines if line and not line.startswith("//"))
 
 
 def _plan_name(kind: str, lang: str) -> str:
