@@ -528,8 +528,8 @@ def test_script_writes_jumps_smooth_lengths_moved_series_scaled_lengths_and_shar
         Element("text", label_xy[:, None], {"class": "name"}, texts=("B",), variant=np.zeros(1, dtype=int)),
         Element("text", np.full((n, 1, 2), 5.0), {"class": "title"}, texts=tuple(f"Lever, φ = {k}°" for k in range(n)),
                 variant=np.arange(n))))
-    assert pg._series(pg._ints(label_xy[:, 0], pg.COORD_DECIMALS))[0] == pg.MAX_ORDER + 1
-    assert pg._series(pg._ints(L, pg.LENGTH_DECIMALS))[0] == pg.MAX_ORDER + 2
+    assert pg._serieses([pg._ints(label_xy[:, 0], pg.COORD_DECIMALS)])[0][0] == pg.MAX_ORDER + 1
+    assert pg._serieses([pg._ints(L, pg.LENGTH_DECIMALS)])[0][0] == pg.MAX_ORDER + 2
     metas = pg.encode_drawing(second, pg.encode_drawing(first)[2])[0]["elements"]
     assert metas[0]["from"][0] == 0 and pg._shared_texts([{"elements": metas}])[0][0]["elements"][-1]["texts"]["pre"] == "Lever, φ = "
     f = tmp_path / "stored.html"

@@ -91,7 +91,7 @@ def _varints(values: np.ndarray) -> bytes:
     return out.tobytes()
 
 
-#: Highest order of differences a series is stored as (`_series`); MAX_ORDER + 1: as `_jumps`;
+#: Highest order of differences a series is stored as (`_serieses`); MAX_ORDER + 1: as `_jumps`;
 #: MAX_ORDER + 2: as `_smooth`.
 MAX_ORDER = 4
 #: `_smooth`'s weights: of the last 24 values, the one next on the least-squares polynomial of
@@ -102,14 +102,6 @@ SMOOTH_FROM = 10 ** 5
 #: A step of a series whose slope changes by more than this (units of its last digit) is a jump
 #: (`_jumps`: a label moved to another place).
 JUMP = 3
-
-
-def _series(a: np.ndarray) -> np.ndarray:
-    """An int64 series as its order k (0..MAX_ORDER) followed by its k-th differences, each
-    difference keeping the first value (a - [0, a[:-1]]), or as MAX_ORDER + 1 followed by
-    `_jumps`, or (SMOOTH_FROM units or more) as MAX_ORDER + 2 followed by `_smooth`: the one whose numbers are smallest (a sum of their bits), so that a smooth function
-    of the angle becomes a few small numbers; the page's script takes k prefix sums."""
-    return _serieses([a])[0]
 
 
 def _last(mask: np.ndarray) -> np.ndarray:
@@ -160,7 +152,12 @@ def _smooth(x: np.ndarray) -> np.ndarray:
 
 
 def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
-    """`_series` of each of `arrays`, those of one length at once."""
+    """Each of `arrays` (int64 series) as its order k (0..MAX_ORDER) followed by its k-th
+    differences, each difference keeping the first value (a - [0, a[:-1]]), or as MAX_ORDER + 1
+    followed by `_jumps`, or (SMOOTH_FROM units or more) as MAX_ORDER + 2 followed by `_smooth`:
+    the one whose numbers are smallest (a sum of their bits), so that a smooth function of the
+    angle becomes a few small numbers; the page's script takes k prefix sums. Those of one length
+    at once."""
     out: list[np.ndarray] = [np.empty(0, dtype=np.int64)] * len(arrays)
     by_size: dict[int, list[int]] = {}
     for i, a in enumerate(arrays):
@@ -198,7 +195,7 @@ def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
                    limits: Sequence[int]) -> list[tuple[int, float] | None]:
     """For each series qs[i] (int64), the series of pool[:limits[i]] of which it is most nearly a
     multiple, (its index, the factor f), where q - `_scaled`(source, f) costs less than q
-    (`_series`); None where none does (no source as long as q and, where q > 0, positive). A
+    (`_serieses`); None where none does (no source as long as q and, where q > 0, positive). A
     segment drawn on two plans at two scales (a velocity on its plan and on the lever), a value
     the length of its vector times the plan's scale: their remainders are a few units of the last
     digit."""
@@ -259,7 +256,7 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
     holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not drawn
     or NaN; less `_scaled`(earlier[index], factor) where "from"); every series as differences of
-    the order that suits it (`_series`), or, where an earlier series j of the sheet is the same (a
+    the order that suits it (`_serieses`), or, where an earlier series j of the sheet is the same (a
     line's end and its point), -1 - 2j, or where it is j plus a constant c (a point's label),
     -2 - 2j and c; as zigzag varints. `earlier`: the length
     series of the sheets before it on the page, in order; `lengths`: this sheet's, in order."""
@@ -342,7 +339,7 @@ def _columns(values: np.ndarray, lengths: Sequence[np.ndarray] = ()) -> tuple[li
     of its largest |value|), where a column is stored less a multiple of one of the page's `lengths`
     ([index, factor] or 0, `_proportional`: a value is its vector's length times the plan's scale), and
     column by column its NaN mask (1: none) and round(v / 10^e) (NaN as 0) less that multiple, each a
-    `_series`, as zigzag varints."""
+    `_serieses`, as zigzag varints."""
     exps = []
     for col in values.T:
         top = np.nanmax(np.abs(col)) if np.isfinite(col).any() else 0.0
