@@ -163,6 +163,18 @@ def test_labels_are_clear_at_every_angle(ice_cycle):
             assert not clashes(d, i), (kind, ANGLES[i], clashes(d, i)[:5])
 
 
+def test_a_crowded_label_beyond_the_room_finds_a_place_at_every_angle_of_a_page():
+    """The rotating slotted link's lever over a page's 361 angles (labels searched at every
+    STRIDE-th angle, kept between): near 285 deg its F_i5 and F_КО hang below the room, where
+    only far rings are free; with rings out to 45 mm no place was free there and F_i5 lay over b
+    (14 angles); rings out to 80 mm: no label over another, an arrowhead or a point anywhere."""
+    mech = kinetostat.load("rotating_slotted_link")
+    lever = cycles(mech, np.arange(0.0, 361.0))["lever"]
+    d = drawing(lever, "en")
+    bad = {i: clashes(d, i) for i in range(d.n)}
+    assert not {i: b for i, b in bad.items() if b}
+
+
 def test_the_numeric_check_finds_a_planted_clash(ice_cycle):
     """Negative control: a label moved onto another label at one angle is reported there only."""
     d = drawing(ice_cycle["velocity"], "uk")

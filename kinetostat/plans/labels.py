@@ -137,12 +137,13 @@ def _constant(a: np.ndarray) -> np.ndarray:
 
 
 #: The candidate places of a label about its anchor: 16 directions (unit vectors, y down) from
-#: 45 deg, on rings of these clearances (mm), at a cost of 1.2 per mm, 0.3 more below the anchor.
+#: 45 deg, on rings of these clearances (mm), at a cost of 1.2 per mm, 0.3 more below the anchor
+#: (the far rings for a label whose anchor lies at the edge of the room or beyond it).
 _DIRS = _constant(np.column_stack([np.cos(np.radians(np.arange(0, 360, 22.5) + 45.0)),
                                    -np.sin(np.radians(np.arange(0, 360, 22.5) + 45.0))]))
 _ABS_DIRS = _constant(np.abs(_DIRS))
 _REACH = _constant(_ABS_DIRS.max(axis=0))      # a label's half size times this: how far its box reaches
-_RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0]))
+_RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0, 60.0, 80.0]))
 _RING_DIRS = _constant(np.tile(_DIRS, (len(_RINGS), 1)))       # each ring candidate's direction, ring by ring
 _RING_COST = _constant((1.2 * _RINGS[:, None] + np.where(_DIRS[:, 1] > 0, 0.3, 0.0)).reshape(-1))
 #: Beside a segment: at these fractions T of its length, on either side S, at these clearances R
@@ -150,7 +151,7 @@ _RING_COST = _constant((1.2 * _RINGS[:, None] + np.where(_DIRS[:, 1] > 0, 0.3, 0
 _ALONG = tuple(_constant(g.reshape(-1)) for g in np.meshgrid(
     (0.5, 0.38, 0.62, 0.25, 0.75, 0.15, 0.85), (1.0, -1.0), (0.6, 1.5, 3.0), indexing="ij"))
 _ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
-#: Every candidate, beside the segment (the first 42), then on the rings (192): ring or not, and
+#: Every candidate, beside the segment (the first 42), then on the rings (224): ring or not, and
 #: T, S, R and the cost's part for leaving the middle (0 on a ring); direction, ring, cost (0 beside).
 _CAND_RING = _constant(np.r_[np.zeros(len(_ALONG_OFF), bool), np.ones(len(_RING_COST), bool)])
 _CAND_T, _CAND_S, _CAND_R, _CAND_OFF = (_constant(np.r_[a, np.zeros(len(_RING_COST))]) for a in (*_ALONG, _ALONG_OFF))
