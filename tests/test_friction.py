@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 import kinetostat
 from conftest import EVERY_KIND, sampled
-from kinetostat.errors import SelfLockingWarning
+from kinetostat.errors import ModelWarning, SelfLockingWarning
 from kinetostat.friction import MAX_PASSES, NEWTON_STEPS, RATE_TOL, relative_rate
 from test_properties import KINDS, _SETTINGS, dead_centres, valid
 
@@ -238,7 +238,8 @@ def test_every_self_locking_angle_is_named_with_its_reason_and_never_a_silent_nu
     self-locking angle with its reason. No equilibrium: M_bal NaN. Wedged (friction gain >= 1):
     M_bal is an equilibrium (the lever and the power balance hold there to rounding) but not the
     only one, so eta is NaN. eta <= 0: the equilibrium value, eta a number <= 0."""
-    mech = with_friction(ICE, f=3.5, radius=0.001)
+    with pytest.warns(ModelWarning, match="friction.f: 3.5 is a friction angle of 74.1 deg"):     # the model check
+        mech = with_friction(ICE, f=3.5, radius=0.001)
     with pytest.warns(SelfLockingWarning, match=r"self-locking with friction in the reactions at \d+ angle") as w:
         res = kinetostat.analyze(mech, steps=72, friction="reactions")
     msg = w[0].message
