@@ -481,6 +481,24 @@ def test_the_check_passes_a_rerun_and_names_only_a_number_beyond_its_tolerance(t
     assert str(diffs[0]).startswith("four_bar/cycle.csv.gz: R_0_1 [N] at φ = ") and f"1e-11 of the N scale {force:.6g} N" in str(diffs[0])
 
 
+def test_the_check_leaves_out_the_index_studies_and_still_reads_the_lines_after_them(tmp_path, four_bar_runs):
+    """The committed folder holds a study (its index lists it under "Studies"), a rerun into an
+    empty folder does not: no difference. A word changed after that section is still named, at
+    the rerun's line."""
+    import shutil
+    from kinetostat.report import compare_reports
+    b, _ = _rerun(four_bar_runs, tmp_path)
+    a = Path(shutil.copytree(four_bar_runs / "a", tmp_path / "a"))
+    (a / "stability.md").write_text("# Stability\n")
+    write_index(a, [json.loads((a / "four_bar" / "summary.json").read_text())])
+    assert "## Studies" in (a / "index.md").read_text() and 'id="studies"' in (a / "index.html").read_text()
+    assert compare_reports(b, a) == []
+    text = (b / "index.md").read_text().splitlines()
+    n = next(i for i, line in enumerate(text, 1) if line == "The works the reports cite.")
+    (b / "index.md").write_text("\n".join(text).replace("The works the reports cite.", "The works cited.") + "\n")
+    assert [(d.file, d.what, d.where) for d in compare_reports(b, a)] == [("index.md", "text", f"line {n}")]
+
+
 def test_the_check_names_a_changed_verdict_a_missing_file_and_a_changed_line(tmp_path, four_bar_runs):
     """Beyond numbers: a route's status, a file only one side has, a word of the Markdown."""
     from kinetostat.report import compare_reports

@@ -16,9 +16,10 @@ per model folder of the rerun (one holding a summary.json):
   rad, against the force's tolerance); text and flags equal;
 - the figures (.svg, .png) and page.html: present, not compared (drawn from the numbers above);
 - every other text file (Markdown, HTML, segments.csv, worksheet.csv) and the folder's own
-  index.md/index.html: equal line by line but for the versions after "made with", the numbers in
-  e-notation (the error figures, checked in summary.json) and a relative 1e-9 in other numbers
-  (12 printed digits).
+  index.md/index.html (but for its Studies section, listed where the studies' files are in the
+  folder; line numbers of the rerun): equal line by line but for the versions after "made
+  with", the numbers in e-notation (the error figures, checked in summary.json) and a relative
+  1e-9 in other numbers (12 printed digits).
 
 May use: numpy, zlib, `_io` (bounded reads of regular files), `kinetostat.tables` (reading the CSV),
 the writer's CYCLE_FILE, the document's ROUNDING and the harness's tolerances (imported inside
@@ -200,9 +201,26 @@ def _excerpt(s: str, other: str, width: int = 60) -> str:
     return repr(("…" if lo else "") + s[lo:lo + width] + ("…" if lo + width < len(s) else ""))
 
 
+#: The first line of the folder index's Studies section (Markdown, HTML) and of the section after it.
+_STUDIES, _SECTION = re.compile(r'^(## Studies|<h2 id="studies">)'), re.compile(r"^(## |<h2[ >])")
+
+
+def _without_studies(lines: list[str]) -> list[tuple[int, str]]:
+    """(line number, line) of an index but for its Studies section: the studies are runs of their
+    own, listed where their files are in the folder, not part of what `report` reruns."""
+    out, inside = [], False
+    for n, line in enumerate(lines, 1):
+        inside = bool(_STUDIES.match(line)) or (inside and not _SECTION.match(line))
+        if not inside:
+            out.append((n, line))
+    return out
+
+
 def _text(model: str, name: str, fresh_path: Path, old_path: Path) -> Iterator[Difference]:
-    new, old = _read(fresh_path).splitlines(), _read(old_path).splitlines()
-    found = [d for n, (a, b) in enumerate(zip(new, old), 1) if (d := _line(model, name, n, a, b)) is not None]
+    new, old = (list(enumerate(_read(p).splitlines(), 1)) for p in (fresh_path, old_path))
+    if not model:                                  # the folder's own index
+        new, old = _without_studies([t for _, t in new]), _without_studies([t for _, t in old])
+    found = [d for (n, a), (_, b) in zip(new, old) if (d := _line(model, name, n, a, b)) is not None]
     yield from found[:TEXT_LIMIT]
     if len(found) > TEXT_LIMIT:
         yield Difference(model, name, "text", "", f"{len(found) - TEXT_LIMIT} more lines differ", "", "equal")
