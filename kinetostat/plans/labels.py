@@ -13,9 +13,11 @@ lines it covers (each line clipped to the box, exactly); a candidate over a hard
 (arrowhead, point, line end, a label placed before) or outside the bounds is not free. At every
 angle the least cost is found (candidates tested lazily, cheapest first, until none left can
 beat it); then the label keeps one place where it may: the candidate within `SLACK` of the best
-at the most angles is taken at all of them, and so on for the angles left. Obstacles and
-candidates the same at every angle are tested once for the cycle. A label that had to move far
-gets a thin leader line from its anchor.
+at the most angles is taken at all of them, and so on for the angles left. Over a page's many
+angles this search runs at every `STRIDE`-th angle; an angle between keeps a searched
+neighbour's place where that is free, and only the angles where neither is are searched.
+Obstacles and candidates the same at every angle are tested once for the cycle. A label that
+had to move far gets a thin leader line from its anchor.
 
 May use: numpy, the standard library, `.dejavu`, `kinetostat._text` (XML-safe text).
 """
