@@ -60,7 +60,7 @@ def measure(page, svg_text: str) -> list[dict]:
     return page.evaluate(_MEASURE)
 
 
-def _overlap(a, b, tol: float) -> bool:
+def overlap(a, b, tol: float) -> bool:
     return a[0] < b[2] - tol and b[0] < a[2] - tol and a[1] < b[3] - tol and b[1] < a[3] - tol
 
 
@@ -71,10 +71,10 @@ def overlaps(items: list[dict], tol: float = 0.05) -> list[str]:
     bad = []
     for n, a in enumerate(texts):
         for b in texts[n + 1:]:
-            if _overlap(a["box"], b["box"], tol):
+            if overlap(a["box"], b["box"], tol):
                 bad.append(f"text {a['text']!r} over text {b['text']!r}")
         for b in marks:
-            if _overlap(a["box"], b["box"], tol):
+            if overlap(a["box"], b["box"], tol):
                 what = "an arrowhead" if b["tag"] == "arrow" else "a point"
                 bad.append(f"text {a['text']!r} over {what} at {[round(v, 1) for v in b['box']]}")
     return bad

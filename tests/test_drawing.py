@@ -129,10 +129,6 @@ def _box(markup: str, x: float, y: float, size: float) -> tuple[float, float, fl
     return x, y - ASCENT * size, x + w, y + below
 
 
-def _overlap(a, b, tol: float) -> bool:
-    return a[0] < b[2] - tol and b[0] < a[2] - tol and a[1] < b[3] - tol and b[1] < a[3] - tol
-
-
 def clashes(d: Drawing, i: int, tol: float = 0.05) -> list[str]:
     """Labels of angle i over another label, an arrowhead or a point (by more than `tol` mm)."""
     labels, hard = [], []
@@ -150,8 +146,8 @@ def clashes(d: Drawing, i: int, tol: float = 0.05) -> list[str]:
             hard.append(("point", (xy[0, 0] - r, xy[0, 1] - r, xy[0, 0] + r, xy[0, 1] + r)))
     bad = []
     for k, (name, box) in enumerate(labels):
-        bad += [f"{name!r} over {other!r}" for other, b in labels[k + 1:] if _overlap(box, b, tol)]
-        bad += [f"{name!r} over a {what}" for what, b in hard if _overlap(box, b, tol)]
+        bad += [f"{name!r} over {other!r}" for other, b in labels[k + 1:] if sheet_browser.overlap(box, b, tol)]
+        bad += [f"{name!r} over a {what}" for what, b in hard if sheet_browser.overlap(box, b, tol)]
     return bad
 
 

@@ -183,11 +183,6 @@ class Placed:
     leader: np.ndarray
 
 
-def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Whether boxes a and b overlap (broadcast, last axis 4); False where either is NaN."""
-    return (a[..., 0] < b[..., 2]) & (a[..., 2] > b[..., 0]) & (a[..., 1] < b[..., 3]) & (a[..., 3] > b[..., 1])
-
-
 def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
     """Length (mm) of each segment (x0, y0, x1, y1) strictly inside each box (broadcast, last axis
     4): the segment clipped to the box (Liang-Barsky; a segment parallel to a side divides by a
