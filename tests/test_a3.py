@@ -21,6 +21,7 @@ from kinetostat.plans import a3 as A3
 from kinetostat.plans import pack as P
 from kinetostat.plans.drawing_error import Scales, simulate
 from kinetostat.plans.draw import scale_text
+from kinetostat.plans.i18n import text
 from kinetostat.plans.scales import LENGTH_MANTISSAS, ROUND_MANTISSAS, next_coarser
 
 needs_poppler = pytest.mark.skipif(shutil.which("pdftotext") is None, reason="poppler's pdftotext not installed")
@@ -43,7 +44,7 @@ def _check_sheet(one: A3.OneSheet) -> None:
         x0, y0 = d.box[0] + p.dx, d.box[1] + p.dy - top
         x1, y1 = x0 + w, y0 + h
         assert A3.AREA[0] - 1e-9 <= x0 and x1 <= A3.AREA[2] + 1e-9 and A3.AREA[1] - 1e-9 <= y0 and y1 <= A3.AREA[3] + 1e-9, d.kind
-        assert x1 <= A3.TITLE_BLOCK[0] or y1 <= A3.TITLE_BLOCK[1], d.kind
+        assert x1 <= A3.TITLE_BLOCK[0] or y1 <= A3.TITLE_BLOCK[1] - A3.NOTES_MM, d.kind
         for kind, b in boxes:
             assert x1 <= b[0] or b[2] <= x0 or y1 <= b[1] or b[3] <= y0, (d.kind, kind)
         boxes.append((d.kind, (x0, y0, x1, y1)))
@@ -144,20 +145,25 @@ def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
 
 
 def test_the_packer_counts_its_work():
-    """The packer tries RULES x ORDERS at most, each placing every plan once per page it tries."""
-    one = _one(1, "479")
-    calls = []
-    place = A3._place
+    """The layout tries the texts' order by each of READING, each placing every plan once at most;
+    then (task 2 / 479: it does not fit) packs by RULES x (the texts' order and ORDERS) at most,
+    each placing every plan once per page it tries."""
+    one = _one(2, "479")
+    calls = {"_place": [], "_place_after": []}
+    saved = {k: getattr(A3, k) for k in calls}
 
-    def counted(*a):
-        calls.append(1)
-        return place(*a)
+    def counted(k):
+        return lambda *a: calls[k].append(1) or saved[k](*a)
     try:
-        A3._place = counted
+        for k in calls:
+            setattr(A3, k, counted(k))
         A3.layout(list(one.drawings))
     finally:
-        A3._place = place
-    assert 0 < len(calls) <= len(A3.RULES) * len(A3.ORDERS) * len(one.drawings) * 2
+        for k, f in saved.items():
+            setattr(A3, k, f)
+    n = len(one.drawings)
+    assert 0 < len(calls["_place_after"]) <= len(A3.READING) * n
+    assert 0 < len(calls["_place"]) <= len(A3.RULES) * (1 + len(A3.ORDERS)) * n * 2
 
 
 def _pdf_lines(pdf: bytes) -> list[tuple[float, float, float, float]]:
@@ -271,3 +277,115 @@ def test_every_variant_fits_one_sheet(task, hundred):
     for code in variants.codes()[100 * hundred:100 * (hundred + 1)]:
         v = variants.variant(task, code)
         _check_sheet(A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "uk"))
+
+
+def _boxes(one: A3.OneSheet) -> dict[str, tuple[float, float, float, float]]:
+    """Each plan's box on the page (drawing with its heading), mm."""
+    out = {}
+    for d, p in zip(one.drawings, one.places):
+        w, h, top = A3._size(d)
+        x0, y0 = d.box[0] + p.dx, d.box[1] + p.dy - top
+        out[d.kind] = (x0, y0, x0 + w, y0 + h)
+    return out
+
+
+def _reads_after(b, a) -> bool:
+    return b[0] >= a[2] - 1e-6 or b[1] >= a[3] - 1e-6
+
+
+def test_the_plans_read_in_the_texts_order():
+    """Task 1 / 479 (was: the force polygon top left, the velocity plan at the bottom, packed):
+    seed 002's figures 1.5-1.12 in turn, each plan right of or below every plan before it: the
+    plan of positions top left, the mechanism, velocities, accelerations, the group plan, its force
+    polygon, the crank, the lever; the boxes apart and clear of the title block and its notes."""
+    one = _one(1, "479", "uk")
+    _check_sheet(one)
+    b = _boxes(one)
+    texts = ["positions", "mechanism", "velocity", "acceleration", "group:2,3", "forces:2,3", "crank", "lever"]
+    assert sorted(b) == sorted(texts)
+    assert b["positions"][:2] == pytest.approx((A3.AREA[0], A3.AREA[1]))            # top left
+    for i, later in enumerate(texts):
+        for before in texts[:i]:
+            assert _reads_after(b[later], b[before]), (later, before)
+    assert b["forces:2,3"][0] >= b["positions"][2] and b["lever"][0] >= b["crank"][2]
+    (page,) = A3.pages(one, "t")
+    assert text("a3.packed", "uk") not in {s for _, _, s, _, _ in page.texts}
+
+
+def test_the_texts_order_puts_the_last_attached_group_first():
+    """Seed 000: the force analysis starts at the last attached group (4-5), each group's plan
+    before its force polygon; the crank and the lever after them; unknown kinds last."""
+    kinds = ["lever", "forces:2,3", "group:2,3", "forces:4,5", "group:4,5", "crank", "acceleration", "velocity",
+             "mechanism", "positions", "detail"]
+    assert sorted(kinds, key=A3.texts_rank) == ["positions", "mechanism", "velocity", "acceleration", "group:4,5",
+                                                "forces:4,5", "group:2,3", "forces:2,3", "crank", "lever", "detail"]
+
+
+def test_a_sheet_packed_out_of_the_texts_order_says_so():
+    """Task 2 / 479's ten plans do not fit in the texts' order: packed (one sheet, apart) and the
+    notes above the title block say so."""
+    one = _one(2, "479")
+    _check_sheet(one)
+    b = _boxes(one)
+    assert not A3.in_texts_order(list(b), list(b.values()))
+    (page,) = A3.pages(one, "t")
+    notes = " ".join(s for x, y, s, size, _ in page.texts if x == A3.TITLE_BLOCK[0] + 1.0 and size == 2.5)
+    assert "Packed to fit: in the texts' order the plans do not fit this sheet" in notes
+
+
+def _in_cell(page: A3.Page, cell: tuple) -> list[str]:
+    """The texts whose start lies in `cell` (x0, y0, x1, y1 mm from the title block's top left)."""
+    bx, by = A3.TITLE_BLOCK[:2]
+    return [s for x, y, s, _, _ in page.texts if bx + cell[0] < x < bx + cell[2] and by + cell[1] < y < by + cell[3]]
+
+
+def test_the_title_block_of_gost_2_104():
+    """Bottom right, 185 x 55 mm (GOST 2.104 form 1): its roles, headers and graphs named in the
+    sheet's language; the designation the sheet's title, the name the mechanism's; the scale μ_l =
+    0.0015 m/mm as 1:1,5; sheet 1 of 1; the names, signatures and dates blank for the student and
+    the teacher; the notes above it within its width, clear of the plans."""
+    one = _one(1, "479", "uk")
+    (page,) = A3.pages(one, "Плани механізму: Завдання 1")
+    rules = [ln for ln in page.lines if ln[7] == "title-block"]
+    xs, ys = [v for ln in rules for v in ln[0:4:2]], [v for ln in rules for v in ln[1:4:2]]
+    assert (min(xs), min(ys), max(xs), max(ys)) == pytest.approx((230.0, 237.0, 415.0, 292.0))
+    assert (max(xs) - min(xs), max(ys) - min(ys)) == pytest.approx((185.0, 55.0))
+    cell = {"Зм.": (0, 20, 7, 25), "Арк.": (7, 20, 17, 25), "№ докум.": (17, 20, 40, 25), "Підпис": (40, 20, 55, 25),
+            "Дата": (55, 20, 65, 25), "Розроб.": (0, 25, 17, 30), "Перев.": (0, 30, 17, 35), "Т.контр.": (0, 35, 17, 40),
+            "Н.контр.": (0, 45, 17, 50), "Затв.": (0, 50, 17, 55), "Літ.": (135, 15, 150, 20), "Маса": (150, 15, 167, 20),
+            "Масштаб": (167, 15, 185, 20), "Аркуш": (135, 35, 155, 40), "Аркушів": (155, 35, 185, 40)}
+    for label, box in cell.items():
+        assert label in _in_cell(page, box), label
+    assert _in_cell(page, (167, 20, 185, 35)) == ["1:1,5"]
+    assert _in_cell(page, (135, 35, 155, 40)) == ["Аркуш", "1"] and _in_cell(page, (155, 35, 185, 40)) == ["Аркушів", "1"]
+    assert " ".join(_in_cell(page, (65, 0, 185, 15))) == "Плани механізму: Завдання 1"
+    assert " ".join(_in_cell(page, (65, 15, 135, 40))).startswith("Кривошипно-повзунний механізм двотактного ДВЗ")
+    assert _in_cell(page, (17, 0, 65, 20)) == [] and _in_cell(page, (17, 25, 65, 55)) == []      # for the hand
+    tb = A3.TITLE_BLOCK
+    notes = [(x, y, s, size) for x, y, s, size, _ in page.texts if x == tb[0] + 1.0 and y < tb[1]]
+    assert notes and all(tb[1] - A3.NOTES_MM < y < tb[1] and A3._width(s, size) <= tb[2] - tb[0] for x, y, s, size in notes)
+    for x0, y0, x1, y1 in _boxes(one).values():
+        assert x1 <= tb[0] or y1 <= tb[1] - A3.NOTES_MM
+
+
+@pytest.mark.parametrize("mu_l, lang, ratio", [(0.0015, "uk", "1:1,5"), (0.0015, "en", "1:1.5"), (0.001, "en", "1:1"),
+                                               (0.004, "ru", "1:4"), (0.0005, "en", "2:1"), (0.0012, "uk", "1:1,2")])
+def test_mu_l_as_gost_writes_a_scale(mu_l, lang, ratio):
+    """1 mm drawn is μ_l x 1000 mm of the mechanism: 0.0015 m/mm is a reduction 1:1.5 (not 1:15)."""
+    assert A3.scale_ratio(mu_l, lang) == ratio
+
+
+def test_the_notes_state_the_scales_and_their_departures():
+    """Task 1 / 479 at the rule: every scale, μ_l with its ratio; OA (32 mm) within 30-36 mm is no
+    departure, πa (92.9 mm) beyond 70-90 mm is. Task 2 / 479 made coarser: OA 19.0 mm (l_OA /
+    μ_l, measured on its mechanism plan) is stated with the recommended range."""
+    one = _one(1, "479", "en")
+    notes = A3.notes(one, True, "en")
+    assert notes[1] == "Scales: μ_l = 0.0015 m/mm (1:1.5); μ_v = 0.25 m/(s·mm); μ_a = 100 m/(s²·mm); μ_F = 40 N/mm"
+    pi_a = one.reference["mu_a"] / 100.0
+    (departs,) = [s for s in notes if s.startswith("Outside the guide's recommended lengths: ")]
+    assert f"πa {pi_a:.1f} mm (70–90)" in departs and "OA" not in departs and pi_a > 90
+    two = _one(2, "479")
+    oa = two.plans["mechanism"].length_mm("OA")
+    (departs,) = [s for s in A3.notes(two, False, "en") if s.startswith("Outside")]
+    assert f"OA {oa:.1f} mm (30–36)" in departs and round(oa) == 19

@@ -7,8 +7,13 @@ points and every label where `labels.Placer` put it clear of the others): the `p
 that sheet is read back (`drawing`), placed on the page (`pages`) and drawn into the PDF in
 millimetres (`draw_page`, `.pdf`). The
 plans' extents (drawing, labels and a heading: title, then every scale the plan is drawn at) are
-packed inside the frame, clear of the title block, never turned (`layout`: maximal rectangles,
-several rules and orders). Where the plans at the texts' scales do not fit one sheet, `one_sheet`
+placed inside the frame, clear of the title block and the notes above it, never turned
+(`layout`): in the texts' order (`texts_rank`: positions, mechanism, velocities, accelerations,
+each group's plan and force polygon, the initial link, the lever; each right of or below every
+plan before it) where that fits, else packed (maximal rectangles, several rules and orders) and
+the notes say so. The title block is GOST 2.104's form 1 (185 x 55 mm: roles, designation, name,
+μ_l as its ratio, sheet and sheets; names and signatures left blank); the notes state the scales
+and each one whose reference is drawn outside the guide's recommended length. Where the plans at the texts' scales do not fit one sheet, `one_sheet`
 chooses the variant's scales together for it: velocity, acceleration and force scales a round
 step coarser first, μ_l only where they cannot make room; the title block and the key name each
 scale made coarser than the rule, and why. Where no choice fits them, further sheets take the
@@ -38,8 +43,12 @@ _NS = "{http://www.w3.org/2000/svg}"
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
 #: (left 20 mm for binding, 5 mm elsewhere) below the sheet's title line.
 AREA = (24.0, 13.0, 411.0, 288.0)
-#: The title block, bottom right (as `draw`'s sheets), mm.
-TITLE_BLOCK = (230.0, 247.0, 415.0, 292.0)
+#: The main title block of GOST 2.104 (form 1, 185 x 55 mm), bottom right, mm.
+TITLE_BLOCK = (230.0, 237.0, 415.0, 292.0)
+#: The notes above the title block (its width; GOST 2.316 puts a drawing's text there): the
+#: scales, their departures from the guide's, the order of the plans; their height, mm.
+NOTES_MM = 20.0
+_NOTE_STEP = 3.1                            # between the notes' lines (2.5 mm type), mm
 #: A plan's heading above its drawing (its title, 3.5 mm, then its scales, 3 mm) is broken into
 #: lines no wider than the drawing, or than this where the drawing is narrower, mm.
 MIN_HEADING_MM = 50.0
@@ -166,9 +175,9 @@ def _size(d: Drawing) -> tuple[float, float, float]:
 
 def _free(G: float) -> list[tuple[float, float, float, float]]:
     """The free rectangles of an empty page for boxes grown by the gap G (right and bottom): AREA
-    above the title block, and AREA left of it (both maximal; they overlap)."""
+    above the notes over the title block, and AREA left of them (both maximal; they overlap)."""
     x0, y0, x1, y1 = AREA
-    return [(x0, y0, x1 + G, TITLE_BLOCK[1] - 2 + G), (x0, y0, TITLE_BLOCK[0] - 2 + G, y1 + G)]
+    return [(x0, y0, x1 + G, TITLE_BLOCK[1] - NOTES_MM - 2 + G), (x0, y0, TITLE_BLOCK[0] - 2 + G, y1 + G)]
 
 
 #: The rules of `_place`, each a key of a free rectangle's corner (x, y, x1, y1) for a box w x h
@@ -177,18 +186,41 @@ def _free(G: float) -> list[tuple[float, float, float, float]]:
 #: area left), then highest.
 RULES = (lambda x, y, x1, y1, w, h: (y + h, x), lambda x, y, x1, y1, w, h: (x + w, y),
          lambda x, y, x1, y1, w, h: ((x1 - x) * (y1 - y) - w * h, y, x))
+#: The rules of the texts' order (`_place_after`), each a key of a box's top left corner (x, y):
+#: by rows (highest, then leftmost), by columns (leftmost, then highest).
+READING = (lambda x, y: (y, x), lambda x, y: (x, y))
+#: The plans in the order of the texts (seed 002 sec. 1.2, figs 1.5-1.12): the plan of positions,
+#: the mechanism at the design position, velocities, accelerations; then each group's plan and its
+#: force polygon, the last attached group first (the force analysis starts there: seed 000); the
+#: initial link; the lever. A kind not named here goes last, in the order given.
+TEXTS_ORDER = ("positions", "mechanism", "velocity", "acceleration", "group", "forces", "crank", "lever")
 
 
-def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float] | None:
-    """Where a box w x h goes among the free rectangles (maximal rectangles): at the top left
-    corner of one it fits, the least by `rule` (RULES); None where it fits none. The free
-    rectangles are split around the box and those inside another dropped (in place)."""
-    spots = [(rule(fx, fy, fx1, fy1, w, h), fx, fy) for fx, fy, fx1, fy1 in free
-             if fx + w <= fx1 + 1e-9 and fy + h <= fy1 + 1e-9]
-    if not spots:
-        return None
-    _, x, y = min(spots)
-    bx0, by0, bx1, by1 = x, y, x + w, y + h
+def texts_rank(kind: str) -> tuple:
+    """Sort key of a plan kind in TEXTS_ORDER ("group:4,5" before "group:2,3", each group's plan
+    before its force polygon)."""
+    base, _, links = kind.partition(":")
+    if base in ("group", "forces"):
+        first = int(links.split(",")[0]) if links.split(",")[0].isdigit() else 0
+        return (TEXTS_ORDER.index("group"), -first, base == "forces")
+    return (TEXTS_ORDER.index(base) if base in TEXTS_ORDER else len(TEXTS_ORDER), 0, False)
+
+
+def _after(box: tuple, before: tuple) -> bool:
+    """Whether `box` (x0, y0, x1, y1) reads after `before`: right of it or below it."""
+    return box[0] >= before[2] - 1e-9 or box[1] >= before[3] - 1e-9
+
+
+def in_texts_order(kinds: list[str], boxes: list[tuple]) -> bool:
+    """Whether the boxes (x0, y0, x1, y1, each a plan's with its heading) read in the texts' order
+    (`texts_rank`): each right of or below every plan before it."""
+    ranked = sorted(zip(kinds, boxes), key=lambda kb: texts_rank(kb[0]))
+    return all(_after(b, a) for i, (_, b) in enumerate(ranked) for _, a in ranked[:i])
+
+
+def _split(free: list, box: tuple) -> None:
+    """The free rectangles split around `box` (x0, y0, x1, y1), those inside another dropped (in place)."""
+    bx0, by0, bx1, by1 = box
     out = []
     for r in free:
         fx0, fy0, fx1, fy1 = r
@@ -200,11 +232,43 @@ def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float]
     free[:] = [r for i, r in enumerate(out) if not any(
         j != i and q[0] <= r[0] and q[1] <= r[1] and r[2] <= q[2] and r[3] <= q[3] and (q != r or j < i)
         for j, q in enumerate(out))]
+
+
+def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float] | None:
+    """Where a box w x h goes among the free rectangles (maximal rectangles): at the top left
+    corner of one it fits, the least by `rule` (RULES); None where it fits none. The free
+    rectangles are split around the box (`_split`)."""
+    spots = [(rule(fx, fy, fx1, fy1, w, h), fx, fy) for fx, fy, fx1, fy1 in free
+             if fx + w <= fx1 + 1e-9 and fy + h <= fy1 + 1e-9]
+    if not spots:
+        return None
+    _, x, y = min(spots)
+    _split(free, (x, y, x + w, y + h))
     return x, y
 
 
-#: The orders `layout` tries, each a key of a (width, height) to sort by descending: height, width,
-#: area, longer side.
+def _place_after(free: list, w: float, h: float, placed: list, rule) -> tuple[float, float] | None:
+    """Where a box w x h goes inside one free rectangle, right of or below every box `placed`
+    (grown by the gap, `_after`): of the corners made by a free rectangle's edges and the placed
+    boxes' right and bottom edges, the least by `rule` (READING); None where none is free. The free
+    rectangles are split around it."""
+    spots = []
+    for fx, fy, fx1, fy1 in free:
+        for x in {fx, *(b[2] for b in placed if fx < b[2] <= fx1 - w + 1e-9)}:
+            for y in {fy, *(b[3] for b in placed if fy < b[3] <= fy1 - h + 1e-9)}:
+                box = (x, y, x + w, y + h)
+                if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and all(_after(box, b) for b in placed):
+                    spots.append((rule(x, y), x, y))
+    if not spots:
+        return None
+    _, x, y = min(spots)
+    _split(free, (x, y, x + w, y + h))
+    placed.append((x, y, x + w, y + h))
+    return x, y
+
+
+#: The orders the packing tries (where the texts' order does not fit), each a key of a (width,
+#: height) to sort by descending: height, width, area, longer side.
 ORDERS = (lambda w, h: h, lambda w, h: w, lambda w, h: w * h, lambda w, h: max(w, h))
 
 
@@ -227,16 +291,32 @@ def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule) -> di
     return out
 
 
+def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule) -> dict[int, tuple[int, float, float]] | None:
+    """Each box (in `order`, the texts') at (0, x, y) on one page, each right of or below every
+    box before it (`_place_after` by `rule`); None where one does not fit."""
+    free, placed, out = _free(_GAP), [], {}
+    for i in order:
+        spot = _place_after(free, sizes[i][0] + _GAP, sizes[i][1] + _GAP, placed, rule)
+        if spot is None:
+            return None
+        out[i] = (0, *spot)
+    return out
+
+
 def layout(drawings: list[Drawing]) -> list[Placement]:
-    """The drawings (heading above each) packed into AREA, clear of the title block and _GAP
-    apart, never turned: maximal rectangles (`_place`) by each of the RULES, the drawings taken in
-    each of the ORDERS (ties by their order here); the first packing on one page is kept, else the
-    one on the fewest pages. A drawing that fits no page's room goes onto a further page."""
+    """The drawings (heading above each) on A3 pages inside AREA, clear of the title block and
+    the notes above it, _GAP apart, never turned. In the texts' order (`texts_rank`: each plan
+    right of or below every plan before it; `_in_order` by rows, then by columns) where that fits
+    one page; else packed (maximal rectangles, `_place`, by each of the RULES, the drawings taken
+    in the texts' order, then in each of the ORDERS; the first packing on one page kept, else the
+    one on the fewest pages; `in_texts_order` tells which). A drawing that fits no page's room
+    goes onto a further page."""
     sizes = [_size(d) for d in drawings]
-    best = None
-    for rule in RULES:
-        for key in ORDERS:
-            order = sorted(range(len(drawings)), key=lambda i: (-key(*sizes[i][:2]), i))
+    texts = sorted(range(len(drawings)), key=lambda i: (texts_rank(drawings[i].kind), i))
+    best = next(((1, spots) for rule in READING if (spots := _in_order(sizes, texts, rule)) is not None), None)
+    orders = [texts] + [sorted(range(len(drawings)), key=lambda i: (-key(*sizes[i][:2]), i)) for key in ORDERS]
+    for rule in RULES if best is None else ():
+        for order in orders:
             spots = _pack(sizes, order, rule)
             n = 1 + max((k for k, _, _ in spots.values()), default=0)
             if best is None or n < best[0]:
@@ -392,33 +472,140 @@ class Page:
     texts: tuple
 
 
+#: The cells of the title block (GOST 2.104 form 1), mm from its top left (x0, y0, x1, y1): the
+#: changes' header row and the signature rows (each a role, a name, a signature, a date), the
+#: designation (graph 2), the name (1), the material (3), the letter (4), mass (5), scale (6),
+#: sheet and sheets (7, 8) and the organisation (9), each with its header where it has one.
+TB_ROWS = (0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0)
+TB_HEAD = (("rev", (0, 20, 7, 25)), ("sheet_no", (7, 20, 17, 25)), ("doc", (17, 20, 40, 25)),
+           ("sign", (40, 20, 55, 25)), ("date", (55, 20, 65, 25)))
+TB_ROLES = (("drawn", 25.0), ("checked", 30.0), ("tech", 35.0), ("", 40.0), ("norm", 45.0), ("approved", 50.0))
+TB_CELLS = {"designation": (65, 0, 185, 15), "name": (65, 15, 135, 40), "material": (65, 40, 135, 55),
+            "letter": (135, 15, 150, 20), "mass": (150, 15, 167, 20), "scale": (167, 15, 185, 20),
+            "letter_value": (135, 20, 150, 35), "mass_value": (150, 20, 167, 35), "scale_value": (167, 20, 185, 35),
+            "sheet": (135, 35, 155, 40), "sheets": (155, 35, 185, 40), "organisation": (135, 40, 185, 55)}
+_TB_THICK, _TB_THIN = 0.5, 0.25            # the block's outline and graphs; the rows of the left part, mm
+
+
+def scale_ratio(mu_l: float, lang: str) -> str:
+    """μ_l (m/mm) as GOST 2.302 writes a scale of the drawing: 1:1,5 for 0.0015 m/mm (1 mm drawn =
+    1.5 mm of the mechanism), 2:1 for 0.0005."""
+    mm = mu_l * 1000.0
+    return f"1:{num(mm, lang, 6)}" if mm >= 1 - 1e-9 else f"{num(1 / mm, lang, 6)}:1"
+
+
+def _fit(s: str, width: float, size: float = 3.5, weight: str = "normal") -> float:
+    """`size` (mm), made smaller down to 2.5 where `s` is wider than `width` (mm)."""
+    return max(2.5, min(size, size * width / max(_width(s, size, weight), 1e-9)))
+
+
+def _title_block(lines: list, texts: list, cells: Mapping[str, str], lang: str) -> None:
+    """The title block (TITLE_BLOCK, TB_CELLS) and its texts: the headers in `lang`, and the lines
+    of each cell of `cells` (cell name -> its text, broken to its width, `_cell_lines`)."""
+    bx, by = TITLE_BLOCK[:2]
+
+    def rule(x0, y0, x1, y1, width):
+        lines.append((bx + x0, by + y0, bx + x1, by + y1, width, (), "#000", "title-block"))
+    for x0, y0, x1, y1 in ((0, 0, 185, 0), (0, 0, 0, 55), (65, 0, 65, 55), (135, 15, 135, 55), (65, 15, 185, 15),
+                           (135, 20, 185, 20), (135, 35, 185, 35), (135, 40, 185, 40), (65, 40, 135, 40),
+                           (0, 20, 65, 20), (0, 25, 65, 25), (7, 0, 7, 25), (17, 0, 17, 55), (40, 0, 40, 55),
+                           (55, 0, 55, 55), (150, 15, 150, 35), (167, 15, 167, 35), (155, 35, 155, 40)):
+        rule(x0, y0, x1, y1, _TB_THICK)
+    for y in TB_ROWS[1:-1]:
+        if y not in (20.0, 25.0):
+            rule(0, y, 65, y, _TB_THIN)
+    for x in (140.0, 145.0):
+        rule(x, 20, x, 35, _TB_THIN)
+    heads = [(text(f"tb.{k}", lang), box) for k, box in TB_HEAD]
+    heads += [(text(f"tb.{k}", lang), (0, y, 17, y + 5)) for k, y in TB_ROLES if k]
+    heads += [(text(f"tb.{k}", lang), TB_CELLS[k]) for k in ("letter", "mass", "scale", "sheet", "sheets")]
+    for s, (x0, y0, x1, y1) in heads:
+        texts.append((bx + x0 + 0.8, by + y1 - 1.2, s, _fit(s, x1 - x0 - 1.6, 3.0), "normal"))
+    for k, value in cells.items():
+        x0, y0, x1, y1 = TB_CELLS[k]
+        if k in ("sheet", "sheets"):                             # the number after its header
+            x0 += _width(text(f"tb.{k}", lang), _fit(text(f"tb.{k}", lang), x1 - x0 - 1.6, 3.0)) + 2.0
+        weight = "bold" if k in ("designation", "name") else "normal"
+        size, rows = _cell_lines(value, x1 - x0 - 2.0, y1 - y0, weight)
+        step = 1.3 * size
+        y = (y0 + y1) / 2 - step * (len(rows) - 1) / 2 + 0.35 * size
+        for r in rows:
+            texts.append((bx + x0 + 1.0, by + y, r, size, weight))
+            y += step
+
+
+def _cell_lines(s: str, width: float, height: float, weight: str) -> tuple[float, list[str]]:
+    """(size, lines) of `s` in a cell width x height (mm): the largest size of 3.5, 3, 2.5 mm at
+    which its lines (`_lines`) fit the cell's height, else 2.5 mm."""
+    for size in (3.5, 3.0, 2.5):
+        rows = _lines(s, size, width, weight)
+        if len(rows) * 1.3 * size <= height - 1.0 and all(_width(r, size, weight) <= width for r in rows):
+            break
+    return size, rows
+
+
+def notes(sheet: OneSheet, in_order: bool, lang: str) -> list[str]:
+    """The notes above the title block: every plan true to scale; the scales of the sheet (μ_l
+    also as GOST 2.302's ratio); each scale whose reference (`scales.REFERENCE_NAMES`) is drawn
+    outside the guide's recommended length (`scales.TARGET_MM`), with that length, and each scale
+    coarser than the texts' rule (`OneSheet.coarsened`); where the plans are packed, not in the
+    texts' order, that."""
+    from .scales import REFERENCE_NAMES, TARGET_MM
+    sc = sheet.plans.scales
+    used = "; ".join(scale_text(s, lang) + (f" ({scale_ratio(s.value, lang)})" if k == "mu_l" else "")
+                     for k, s in sc.items())
+    out = [text("pack.a3_true", lang), f"{text('pack.scales', lang)}: {used}"]
+    departs = []
+    for k, s in sc.items():
+        lo, hi = TARGET_MM[k]
+        mm = sheet.reference[k] / s.value
+        if not lo - 0.05 <= mm <= hi + 0.05:
+            departs.append(text("a3.depart_one", lang, mm=num(mm, lang, decimals=1),
+                                ref=REFERENCE_NAMES.get(k) or text("pack.largest_force", lang),
+                                lo=num(lo, lang), hi=num(hi, lang)))
+    if departs:
+        out.append(text("a3.departs", lang, items="; ".join(departs)))
+    if sheet.coarsened():
+        out.append(text("pack.a3_coarser", lang, scales="; ".join(
+            text("pack.instead", lang, scale=scale_text(s, lang), rule=num(r.value, lang, 6))
+            for r, s, _ in sheet.coarsened())))
+    if not in_order:
+        out.append(text("a3.packed", lang))
+    return out
+
+
 def pages(sheet: OneSheet, title: str) -> list[Page]:
-    """The A3 sheets of `sheet` (`one_sheet`: one, unless its plans fit none): the frame, the title
-    block (`title`, the note that every plan is true to scale, the scales coarser than the texts'
-    rule (`OneSheet.coarsened`) and, where the plans take more than one sheet, its number) and each
-    plan's drawing with its heading where `layout` placed it, 1 mm of the drawing = 1 mm of the page."""
+    """The A3 sheets of `sheet` (`one_sheet`: one, unless its plans fit none): the frame, the
+    title line, the notes (`notes`, and where the plans take more than one sheet, that) above the
+    title block of GOST 2.104 (`_title_block`: `title` as the designation, the mechanism's name and
+    the crank angle as the name, μ_l as its ratio, the sheet's number and count; the names,
+    signatures and dates left blank for the student and the teacher) and each plan's drawing with
+    its heading where `layout` placed it, 1 mm of the drawing = 1 mm of the page."""
+    from ..model.lettering import lettering
     lang, drawings, places = sheet.lang, sheet.drawings, sheet.places
     n = max(p.page for p in places) + 1
+    boxes = []
+    for d, p in zip(drawings, places):
+        w, h, top = _size(d)
+        boxes.append((d.box[0] + p.dx, d.box[1] + p.dy - top, d.box[0] + p.dx + w, d.box[1] + p.dy - top + h))
+    ordered = n == 1 and in_texts_order([d.kind for d in drawings], boxes)
+    mech = sheet.plans.mech
+    name = lettering(mech).name(lang, mech.name)
     parts = [([], [], [], [], []) for _ in range(n)]           # lines, polylines, polygons, dots, texts
     tb = TITLE_BLOCK
     for k, (lines, polylines, polygons, dots, texts) in enumerate(parts):
         x0, y0, x1, y1 = 20.0, 5.0, 415.0, 292.0
         polylines.append((((x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)), 0.7, "#000"))
-        polylines.append((((tb[0], tb[3]), (tb[0], tb[1]), (tb[2], tb[1])), 0.5, "#000"))
         texts.append((24.0, 10.0, title, 4.0, "bold"))
-        notes = [text("pack.a3_true", lang)]
-        if n > 1:
-            notes += [text("pack.a3_page", lang, k=k + 1, n=n), text("pack.a3_more", lang, n=n)]
-        if sheet.coarsened():
-            notes.append(text("pack.a3_coarser", lang, scales="; ".join(
-                text("pack.instead", lang, scale=scale_text(s, lang), rule=num(r.value, lang, 6))
-                for r, s, _ in sheet.coarsened())))
-        rows = [(ln, 3.5, "bold") for ln in _lines(title, 3.5, tb[2] - tb[0] - 6, "bold")]
-        rows += [(ln, 2.8, "normal") for s in notes for ln in _lines(s, 2.8, tb[2] - tb[0] - 6)]
-        y = tb[1] + 5.5
-        for s, size, weight in rows:
-            texts.append((tb[0] + 3, y, s, size, weight))
-            y += 1.45 * size
+        rows = notes(sheet, ordered, lang) + ([text("pack.a3_more", lang, n=n)] if n > 1 else [])
+        rows = [ln for s in rows for ln in _lines(s, 2.5, tb[2] - tb[0] - 2)]
+        y = tb[1] - 1.5 - _NOTE_STEP * (len(rows) - 1)
+        for s in rows:
+            texts.append((tb[0] + 1.0, y, s, 2.5, "normal"))
+            y += _NOTE_STEP
+        _title_block(lines, texts, {
+            "designation": title, "name": f"{name}, φ = {num(sheet.plans.at, lang, 6)}°",
+            "scale_value": scale_ratio(sheet.plans.scales["mu_l"].value, lang), "sheet": str(k + 1), "sheets": str(n)}, lang)
     for d, p in zip(drawings, places):
         lines, polylines, polygons, dots, texts = parts[p.page]
         dx, dy = p.dx, p.dy

@@ -44,6 +44,7 @@ from .._io import write_bytes, write_text
 from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 from .pdf import ASCENT, Canvas
+from .scales import REFERENCE_NAMES as _REFERENCE
 from ..model.lettering import lettering
 from .worksheet import CSS, Worksheet, analyses, html_document, worksheet_cycle
 
@@ -55,8 +56,6 @@ BAND = (5.0, 95.0)
 BAND_DRAWS = 400
 #: The files `Pack.write` writes.
 PACK_FILES = ("sheet.pdf", "key.pdf", "plans_a3.pdf", "sheet.html", "key.html", "plans.html")
-#: Reference length each scale draws (the texts' rule, `scales`): symbol -> the segment it draws.
-_REFERENCE = {"mu_l": "OA", "mu_v": "pa", "mu_a": "πa"}
 
 A4, A3 = (210.0, 297.0), (420.0, 297.0)
 _MARGIN = (20.0, 10.0, 12.0, 12.0)        # left (binding), right, top, bottom, mm

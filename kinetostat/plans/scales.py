@@ -35,7 +35,7 @@ import numpy as np
 from .core import Scale
 
 __all__ = ["choose_scales", "references", "round_scale", "length_scale", "coarser", "next_coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
-           "LENGTH_MANTISSAS", "FIT_MM", "MAX_EXTENT_MM", "PLAN_OF"]
+           "LENGTH_MANTISSAS", "REFERENCE_NAMES", "FIT_MM", "MAX_EXTENT_MM", "PLAN_OF"]
 
 #: Unit of each scale, per millimetre drawn.
 SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F": "N/mm"}
@@ -51,6 +51,9 @@ FIT_MM = (380.0, 220.0)
 #: The largest extent a plan may have on its sheet, mm: a given scale that draws a plan larger is
 #: refused (a sheet 100 m long is a typing error, and its drawing would take unbounded memory).
 MAX_EXTENT_MM = 1e5
+#: The name of the quantity each scale draws at its recommended length (mu_F: the largest force,
+#: no one name).
+REFERENCE_NAMES = {"mu_l": "OA", "mu_v": "pa", "mu_a": "πa"}
 #: The plan that each scale draws first (named when that scale is refused).
 PLAN_OF = {"mu_l": "mechanism", "mu_v": "velocity", "mu_a": "acceleration", "mu_F": "forces"}
 
