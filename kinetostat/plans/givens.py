@@ -160,12 +160,18 @@ def _columns(head: tuple[str, ...], rows: tuple[tuple[str, ...], ...], n: int):
 def model_data(mech, rows_given: set[str], lang: str, g: float) -> tuple[tuple[tuple[str, ...], ...], frozenset[str]]:
     """Rows (parameter, symbol, value, unit) of the model's data that the task's table leaves out
     (`rows_given`: the table's row keys): the crank's weight, every moving link's moment of
-    inertia about its centre of mass where the table gives none, and the drive's gear pair (the
-    crank's wheel carries F_зр); values to 6 digits. With the numbers printed."""
+    inertia about its centre of mass where the table gives none, each cylinder's axis (through
+    O, its direction towards the piston), and the drive's gear pair (the crank's wheel carries
+    F_зр); values to 6 digits. With the numbers printed."""
     rows = [(text("pack.g_crank", lang), "G_1", num(mech.links[1].mass * g, lang, 6), unit("N", lang))]
     for link in mech.links[1:]:
         if link.I_S > 0 and f"I_S{link.id}" not in rows_given:
             rows.append((text("pack.i_link", lang, k=link.id), f"I_S{link.id}", num(link.I_S, lang, 6), unit("kg m^2", lang)))
+    for pair in mech.pairs:
+        if pair.kind == "P" and 0 in pair.links:
+            k = pair.links[1] if pair.links[0] == 0 else pair.links[0]
+            angle = math.degrees(math.atan2(pair.direction[1], pair.direction[0]))
+            rows.append((text("pack.cylinder", lang, k=k), f"β_{k}", num(angle, lang, 6), unit("deg", lang)))
     gear = mech.drive.gear
     if gear is not None:
         e = math.degrees(math.atan2(gear.centre_direction[1], gear.centre_direction[0]))
