@@ -50,16 +50,10 @@ class Diagram:
     lang: str
 
     @property
-    def y_range(self) -> tuple[float, float]:
-        """The lowest and highest y drawn (0 always on the plot)."""
-        ys = [y for _, c in self.curves for y in c] + [0.0]
-        return min(ys), max(ys)
-
-    @property
     def size(self) -> tuple[float, float]:
         """Width and height of the whole figure, mm."""
-        lo, hi = self.y_range
-        return _LEFT + max(self.x_ticks) / self.mu_x + 12.0, _TOP + (hi - lo) / self.mu_y + _BOTTOM
+        return (_LEFT + max(self.x_ticks) / self.mu_x + 12.0,
+                _TOP + (max(self.y_ticks) - min(self.y_ticks)) / self.mu_y + _BOTTOM)
 
 
 def _ticks(lo: float, hi: float, step: float) -> tuple[float, ...]:
@@ -189,29 +183,46 @@ def model_data(mech, rows_given: set[str], lang: str, g: float) -> tuple[tuple[t
 def layout(d: Diagram):
     """The diagram's primitives in mm from its top left: lines (x0, y0, x1, y1, width, dashed),
     paths (points, width), dots (x, y, r) and texts (x, y baseline, text, right-aligned)."""
-    lo, hi = d.y_range
-    y_lo = min(min(d.y_ticks), lo)
+    y_lo, y_hi = min(d.y_ticks), max(d.y_ticks)                            # the ticks span the curves
     X = lambda x: _LEFT + x / d.mu_x                                        # noqa: E731
-    Y = lambda y: _TOP + (hi - y) / d.mu_y + max(0.0, (max(d.y_ticks) - hi) / d.mu_y)   # noqa: E731
+    Y = lambda y: _TOP + (y_hi - y) / d.mu_y                                # noqa: E731
     x_end = X(max(d.x_ticks))
     lines, paths, dots, texts = [], [], [], []
-    lines += [(X(0), Y(0), x_end + 6, Y(0), 0.35, False), (X(0), Y(y_lo), X(0), Y(max(d.y_ticks)) - 5, 0.35, False)]
+    lines += [(X(0), Y(0), x_end + 6, Y(0), 0.35, False), (X(0), Y(y_lo), X(0), Y(y_hi) - 5, 0.35, False)]
     for x in d.x_ticks:
         lines.append((X(x), Y(0), X(x), Y(0) + 1.2, 0.25, False))
         texts.append((X(x) - 1.0, Y(y_lo) + 5.0, num(x, d.lang, 6), False))
     for y in d.y_ticks:
         lines.append((X(0) - 1.2, Y(y), X(0), Y(y), 0.25, False))
         texts.append((X(0) - 2.0, Y(y) + _SIZE / 2 - 0.3, num(y, d.lang, 6), True))
-    texts += [(x_end + 5.0, Y(0) + 1.0, d.x_name, False), (X(0) + 2.0, Y(max(d.y_ticks)) - 2.5, d.y_name, False),
+    texts += [(x_end + 5.0, Y(0) + 1.0, d.x_name, False), (X(0) + 2.0, Y(y_hi) - 2.5, d.y_name, False),
               (x_end + 6, _TOP - 3.0, d.scales, True)]
     for xs, ys in d.curves:
         paths.append(([(X(x), Y(y)) for x, y in zip(xs, ys)], 0.5))
-    for x, y, label in d.marks:
+    for x, y, _ in d.marks:
         dots.append((X(x), Y(y), 0.9))
         lines += [(X(x), Y(y), X(x), Y(0), 0.2, True), (X(x), Y(y), X(0), Y(y), 0.2, True)]
-        right = X(x) > (X(0) + x_end) / 2
-        texts.append((X(x) + (-1.8 if right else 1.8), Y(y) - 4.0 if Y(y) > _TOP + 8 else Y(y) + 5.0, label, right))
+    segments = [pair for pts, _ in paths for pair in zip(pts, pts[1:])] + [((a, b), (c, e)) for a, b, c, e, *_ in lines]
+    drawn = [q for a, b in segments for q in np.linspace(a, b, 2 + int(math.dist(a, b) / 0.5))]    # every 0.5 mm
+    for x, y, label in d.marks:
+        texts.append(_place(X(x), Y(y), label, drawn, (X(0), _TOP, x_end, Y(y_lo))))
     return lines, paths, dots, texts
+
+
+def _place(x: float, y: float, label: str, drawn, bounds) -> tuple[float, float, str, bool]:
+    """The mark's label beside its point (x, y), mm: of the four corners around it, the one inside
+    `bounds` (x0, y0, x1, y1) whose box covers the fewest of the curves' `drawn` points."""
+    width = len(label) * 0.6 * _SIZE
+
+    def cost(right: bool, above: bool) -> tuple[float, float]:
+        bx = x - 1.8 - width if right else x + 1.8
+        by = y - 1.5 - _SIZE if above else y + 1.5
+        inside = sum(bx <= px <= bx + width and by - 0.5 <= py <= by + _SIZE + 0.5 for px, py in drawn)
+        out = max(bounds[0] - bx, bx + width - bounds[2], 0.0) + max(bounds[1] - by, 0.0)
+        return out, inside
+
+    right, above = min(((r, a) for r in (False, True) for a in (True, False)), key=lambda c: cost(*c))
+    return x + (-1.8 if right else 1.8), y - 1.5 if above else y + 1.5 + _SIZE, label, right
 
 
 def draw_pdf(pdf, x0: float, y0: float, d: Diagram) -> None:
