@@ -20,7 +20,8 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Load, Mechanism
 
-__all__ = ["applied_wrenches", "com_motion", "inertia_loads", "load_magnitude", "point_forces", "PointForce", "applied_moment"]
+__all__ = ["applied_wrenches", "com_motion", "inertia_loads", "load_magnitude", "point_forces", "PointForce", "applied_moment",
+           "travel", "forward_stroke"]
 
 
 def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
@@ -164,8 +165,25 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
         xp, vp = mech.memo(("periodic", id(t)), lambda: (   # the diagram (rad) over [-4 pi, 4 pi]: fmod lands inside
             np.concatenate([np.radians(t.x) + 2 * np.pi * n for n in (-2, -1, 0, 1)]), t.scale * np.tile(t.value, 4)))
         return np.interp(np.fmod(kin.phi, 2 * np.pi), xp, vp)
+    xs, fwd, ret = mech.memo(("diagram", id(t)), lambda: (   # scaled once: np.interp converts tuples per call
+        np.asarray(t.x), t.scale * np.asarray(t.value),
+        None if t.value_return is None else t.scale * np.asarray(t.value_return)))
+    s = travel(mech, kin, ld, X)
+    return np.interp(s, xs, fwd) if ret is None else np.where(forward_stroke(mech, kin, ld, V), np.interp(s, xs, fwd),
+                                                              np.interp(s, xs, ret))
+
+
+def _travel_axis(ld: "Load") -> complex:
+    """The world axis a travel table's stroke is measured along (its own, else the load's direction)."""
+    return complex(*(ld.table.axis if ld.table.axis is not None else ld.direction))
+
+
+def travel(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarray | None = None) -> np.ndarray:
+    """The travel of load `ld`'s point (a travel table's) from the table's origin at every angle,
+    as a fraction of the stroke (0..1): where the diagram is read. X: the point's complex
+    position, if the caller has it already. ModelError where the point does not move along the axis."""
     p = mech.links[ld.link].points[ld.point]
-    axis = complex(*(t.axis if t.axis is not None else ld.direction))
+    axis = _travel_axis(ld)
     if X is None:
         X = kin.position_z(ld.link, p)
     lo, hi = mech.memo(("stroke", ld.link, tuple(p), axis), lambda: _stroke(mech, ld.link, p, axis))
@@ -173,16 +191,16 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
         n = mech.loads.index(ld)
         raise ModelError([f"load[{n}].table: a travel diagram needs a moving point, but {ld.point!r} of link "
                           f"{ld.link} travels {hi - lo:.3g} m along the axis over the cycle"], source=mech.path or "model")
-    xs, fwd, ret = mech.memo(("diagram", id(t)), lambda: (   # scaled once: np.interp converts tuples per call
-        np.asarray(t.x), t.scale * np.asarray(t.value),
-        None if t.value_return is None else t.scale * np.asarray(t.value_return)))
     s = dot_z(X, axis)
-    travel = (hi - s) / (hi - lo) if t.origin == "max" else (s - lo) / (hi - lo)
-    if ret is None:
-        return np.interp(travel, xs, fwd)
-    v = dot_z(kin.velocity_z(ld.link, p) if V is None else V, axis)
-    forward = v <= 0 if t.origin == "max" else v >= 0
-    return np.where(forward, np.interp(travel, xs, fwd), np.interp(travel, xs, ret))
+    return (hi - s) / (hi - lo) if ld.table.origin == "max" else (s - lo) / (hi - lo)
+
+
+def forward_stroke(mech: "Mechanism", kin: "Kinematics", ld: "Load", V: np.ndarray | None = None) -> np.ndarray:
+    """Whether load `ld`'s point (a travel table's) moves away from the table's origin at every
+    angle: the diagram's `value` holds there, its `value_return` elsewhere. V: the point's complex
+    velocity, if the caller has it already."""
+    v = dot_z(kin.velocity_z(ld.link, mech.links[ld.link].points[ld.point]) if V is None else V, _travel_axis(ld))
+    return v <= 0 if ld.table.origin == "max" else v >= 0
 
 
 def _stroke(mech: "Mechanism", k: int, p, axis: complex) -> tuple[float, float]:

@@ -7,8 +7,11 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
     >>> paths = p.write("out/task1_479")                            # doctest: +SKIP
 
 - `sheet.pdf` / `sheet.html`: the task in the text's words, the variant's data (table 1.1-1.3 rows
-  with their letters), the worksheet's tables with their values left blank, and an A3 drawing
-  area with a title block. No answer: no value, scale or length the key gives.
+  with their letters), what the task needs beyond the table (`givens`: each pressure diagram drawn
+  at stated scales with p at φ1 marked, and its points; the crank's weight, the links' inertia,
+  the gear pair; where the plans' scales were chosen for one A3 sheet, the scales to draw at), the
+  worksheet's tables with their values left blank, and an A3 drawing area with a title block. No
+  answer: no value or length the key gives, beyond those data.
 - `key.pdf` / `key.html`: every worksheet value with its unit and sense, and the band a careful
   drawing lands in (the 5-95 % range of `drawing_error.simulate`, BAND_DRAWS draws, seeded); the
   scales μ_l, μ_v, μ_a, μ_F with the reference length each draws, and every scale each plan is
@@ -21,11 +24,11 @@ A3 sheet with all the plans, as PDF and as standalone HTML.
   part of the pack (the key's scales, segment lengths and bands, the SVG sheets, the worksheet,
   the A3 sheet) is drawn at those scales.
 
-Both documents are one list of blocks (headings, paragraphs, tables, the drawing area), rendered
+Both documents are one list of blocks (headings, paragraphs, tables, figures, the drawing area), rendered
 twice: to PDF by reportlab (`.pdf`: DejaVu Sans embedded as a TrueType subset with its Unicode
 map, so pdftotext reads the Cyrillic back) and to HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
-May use: `build` of this package, `.a3`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `model.lettering`,
+May use: `build` of this package, `.a3`, `.givens`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `model.lettering`,
 `.pdf`, `kinetostat._io`. Never matplotlib, never the harness, nor `kinetostat.variants` (the variant
 is passed in and says its task, title and letters).
 """
@@ -76,7 +79,7 @@ class Table:
 @dataclass(frozen=True)
 class Pack:
     """The pack of one variant in `lang`: the blocks of the sheet and of the key (("h1"|"h2"|"p",
-    text), ("table", Table), ("area", title-block lines)), the plans on their one A3 sheet
+    text), ("table", Table), ("figure", `givens.Diagram`), ("area", title-block lines)), the plans on their one A3 sheet
     (`a3`: `a3.OneSheet`), the numbers of the key as printed (`answers`) and the bands
     (worksheet key -> (low, high), SI)."""
     name: str
@@ -140,6 +143,7 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
              ("h2", text("pack.data", lang, table=spec.table)), ("table", data)]
     if v.code:
         sheet.append(("p", "  ".join(f"{ch} = {d}" for ch, d in v.letters.items())))
+    given_here = _givens(sheet, mech, res, v, a3, lang, L)
     key = [("h1", f"{text('pack.key', lang)}. {title}")]          # scales, values and bands, δ, segments
     answers: set[str] = set()
     key += [("h2", text("pack.scales", lang)), ("table", _scales_table(mech, ws, sc, lang, answers))]
@@ -187,9 +191,32 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
     key += [("h2", text("pack.segments", lang)), ("table", _segments_table(plans, lang, answers))]
     sheet.append(("area", (text("pack.area", lang), (title, *(f"{text(k, lang)}: " for k in
                                                                ("pack.student", "pack.group", "pack.checked"))))))
-    given = {num(v.values[r.key], lang, 6) for r in spec.rows}
+    given = {num(v.values[r.key], lang, 6) for r in spec.rows} | given_here
     answers = {a for a in answers if a not in given and a not in ("0", "—")}
     return Pack(v.name, lang, title, tuple(sheet), tuple(key), a3, frozenset(answers), bands)
+
+
+def _givens(sheet: list, mech, res, v, a3, lang: str, L) -> set[str]:
+    """Append to `sheet` what the task needs beyond its table (`givens`): each pressure diagram
+    drawn with p at φ1 marked and its points, the model's further data (the crank, the links'
+    inertia, the gear pair), and, where `a3` chose scales coarser than the texts' rule, the scales
+    of every plan to draw at. Returns the numbers these print (data, not answers)."""
+    from .givens import diagrams, model_data
+    printed: set[str] = set()
+    for g in diagrams(mech, res, float(v.values["d"]), lang, L):
+        sheet += [("h2", g.heading), ("figure", g.diagram), ("p", g.note),
+                  ("table", Table(g.head, g.rows, g.widths, frozenset(range(len(g.head)))))]
+        printed |= g.printed
+    rows, numbers = model_data(mech, {r.key for r in v.spec.rows}, lang, float(mech.g))
+    sheet += [("h2", text("pack.model_data", lang)),
+              ("table", Table((text("pack.parameter", lang), text("ws.head.symbol", lang), text("ws.head.value", lang),
+                               text("ws.head.unit", lang)), rows, (0.57, 0.14, 0.16, 0.13), frozenset({2})))]
+    printed |= numbers
+    if a3.coarsened():
+        scales: set[str] = set()
+        sheet += [("h2", text("pack.use_scales", lang)), ("table", _plan_scales_table(a3.plans, lang, scales))]
+        printed |= scales
+    return printed
 
 
 def _scales_table(mech, ws: Worksheet, scales, lang: str, answers: set[str]) -> Table:
@@ -277,6 +304,9 @@ def _html(blocks) -> str:
                     cells.append(f"<td{cls}>{escape(c)}</td>")
                 out.append("<tr>" + "".join(cells) + "</tr>")
             out.append("</table>")
+        elif kind == "figure":
+            from .givens import svg
+            out.append(f'<figure class="diagram">{svg(x)}</figure>')
         else:                                   # the drawing area with its title block
             out.append(f'<div class="area">{escape(x[0])}<div class="titleblock">' + "<br>".join(escape(s) for s in x[1])
                        + "</div></div>")
@@ -374,6 +404,14 @@ class _Flow:
             draw(row, blank=t.blank)
         self.y += 3.0
 
+    def figure(self, diagram) -> None:
+        """A diagram (`givens.Diagram`) at its true scales, below the text so far."""
+        from .givens import draw_pdf
+        h = diagram.size[1]
+        self.room(h)
+        draw_pdf(self.pdf, self.x0, self.y, diagram)
+        self.y += h + 2.0
+
     def area(self, text_area: str, lines) -> None:
         """An A3 landscape page: the frame, the drawing area (`text_area` at its top left), the
         title block (bottom right: `lines`)."""
@@ -404,6 +442,8 @@ def _pdf(blocks, title: str) -> bytes:
             flow.paragraph(x, 9)
         elif kind == "table":
             flow.table(x)
+        elif kind == "figure":
+            flow.figure(x)
         else:
             flow.area(*x)
     return pdf.getvalue()
