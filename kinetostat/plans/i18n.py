@@ -273,14 +273,14 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                         "{scales}"),
     "pack.instead": ("{scale} (rule: {rule})", "{scale} (за правилом {rule})", "{scale} (по правилу {rule})"),
     "pack.coarsened": ("Scales coarser than the text's rule, so that all the plans fit one A3 sheet (every length and "
-                       "band in this key is at them): {scales}. Give the students these scales with their sheet: drawn "
-                       "at the rule's, their lengths would match none of this key's.",
+                       "band in this key is at them): {scales}. The students' sheet gives them: drawn at the rule's, "
+                       "their lengths would match none of this key's.",
                        "Масштаби дрібніші, ніж за правилом посібника, щоб усі плани вмістилися на одному аркуші А3 "
-                       "(усі довжини й межі цього ключа — у них): {scales}. Дайте студентам ці масштаби разом з аркушем "
-                       "завдання: у масштабах за правилом їхні довжини не збіжуться з жодною довжиною цього ключа.",
+                       "(усі довжини й межі цього ключа — у них): {scales}. Аркуш завдання студента їх подає: у масштабах "
+                       "за правилом їхні довжини не збіжуться з жодною довжиною цього ключа.",
                        "Масштабы мельче, чем по правилу пособия, чтобы все планы поместились на одном листе А3 "
-                       "(все длины и границы этого ключа — в них): {scales}. Дайте студентам эти масштабы вместе с "
-                       "листом задания: в масштабах по правилу их длины не совпадут ни с одной длиной этого ключа."),
+                       "(все длины и границы этого ключа — в них): {scales}. Лист задания студента их приводит: в масштабах "
+                       "по правилу их длины не совпадут ни с одной длиной этого ключа."),
     "pack.coarsened_within": ("{scale} instead of the rule's {rule}, {ref} drawn {mm} mm (still within the recommended "
                               "{lo}–{hi} mm)",
                               "{scale} замість {rule} за правилом, {ref} має {mm} мм (у межах рекомендованих {lo}–{hi} мм)",
