@@ -63,34 +63,60 @@
     return (d >= 0 ? "+" : "") + local(d, 3) + (unit ? " " + unit : "") + " (" + pct1(100 * d / exact) + ")";
   }
   function band(b) { return b ? local(b[0], 3) + " … " + local(b[1], 3) : "—"; }
+  // The scales the student drew at: one input per scale of the check's lengths (page.py _check_scale),
+  // this page's own to start with; a length is judged at its own, its exact length and band times
+  // the page's scale over his (the quantity it stands for against the exact one and its band).
+  const scales = check.scales.map(([name, mu, u], k) => {
+    const tr = $("scale-table").insertRow(), input = document.createElement("input"), note = document.createElement("td");
+    Object.assign(input, {type: "text", inputMode: "decimal", className: "scale", size: 9, value: local(mu, 6)});
+    input.dataset.scale = k;
+    tr.insertCell().textContent = name;
+    tr.insertCell().appendChild(input);
+    tr.insertCell().textContent = u;
+    note.className = "verdict";
+    tr.appendChild(note);
+    return {name, mu, input, note};
+  });
+  function scale(k) {                            // the student's scale k, or NaN (the input's note says why)
+    const S = scales[k], s = S.input.value.trim(), x = Number(s.replace(",", "."));
+    const ok = s !== "" && isFinite(x) && x > 0;
+    mark(S.note, ok ? undefined : false, D.ui.bad_scale.replace("{mu}", S.name));
+    return ok ? x : NaN;
+  }
   let last = $("check-table").rows[0];         // the items' rows (page.py _html writes the moments' rows)
   check.items.forEach((it, n) => {
     const tr = document.createElement("tr"), input = document.createElement("input");
     tr.dataset.item = n;
     Object.assign(input, {type: "text", inputMode: "decimal", className: "measured", size: 7});
-    Object.assign(input.dataset, {plan: it.plan, segment: it.segment});
-    [it.title, it.label, input, "exact num", "band num", "verdict"].forEach((x, c) => {
+    Object.assign(input.dataset, {plan: it.plan, segment: it.segment, scale: it.s});
+    [it.title, it.label, input, "quantity num", "exact num", "band num", "verdict"].forEach((x, c) => {
       const td = tr.insertCell();
       if (c === 2) td.appendChild(x); else if (c < 2) td.textContent = x; else td.className = x;
     });
     last.after(tr);
     last = tr;
   });
-  document.querySelectorAll("tr[data-item]").forEach((tr) => {
-    const it = check.items[+tr.dataset.item];
+  function judge(tr) {                           // an item's row at the student's scale
+    const it = check.items[+tr.dataset.item], mu = scale(it.s), r = scales[it.s].mu / mu;
+    const b = it.band && isFinite(r) ? it.band.map((x) => x * r) : null, cell = tr.querySelector(".verdict");
     if (!D.student) {
-      tr.querySelector(".exact").textContent = local(it.exact, 4);
-      tr.querySelector(".band").textContent = band(it.band);
+      tr.querySelector(".exact").textContent = local(it.exact * r, 4);
+      tr.querySelector(".band").textContent = band(b);
     } else if (!it.band) {
       tr.querySelector(".band").textContent = "—";
     }
-    tr.querySelector("input").addEventListener("input", (e) => {
-      const typed = parse(e.target.value), cell = tr.querySelector(".verdict");
-      if (!isFinite(typed)) return mark(cell);
-      const ok = it.band ? it.band[0] <= typed && typed <= it.band[1] : null;
-      mark(cell, ok, dev(typed, it.exact, D.mm) + (ok === null ? "" : " — " + D.ui[ok ? "in_band" : "out_band"]));
-    });
-  });
+    const typed = parse(tr.querySelector("input").value), q = tr.querySelector(".quantity");
+    q.textContent = isFinite(typed) && isFinite(mu) && it.u ? local(typed * mu, 4) + " " + it.u : "";
+    if (!isFinite(typed)) return mark(cell);
+    if (!isFinite(mu)) return mark(cell, null, D.ui.bad_scale.replace("{mu}", scales[it.s].name));
+    const ok = b ? b[0] <= typed && typed <= b[1] : null;
+    mark(cell, ok, dev(typed, it.exact * r, D.mm) + (ok === null ? "" : " — " + D.ui[ok ? "in_band" : "out_band"]));
+  }
+  const itemRows = [...document.querySelectorAll("tr[data-item]")];
+  itemRows.forEach((tr) => { judge(tr); tr.querySelector("input").addEventListener("input", () => judge(tr)); });
+  scales.forEach((S, k) => S.input.addEventListener("input", () => itemRows.forEach((tr) => {
+    if (check.items[+tr.dataset.item].s === k) judge(tr);
+  })));
   // The two balancing moments (signed, N m): each against its band and sense; then the texts' rule
   // on the student's own two, δ = (M' − M)/M' · 100 %, judged on δ as shown (0.1 %).
   const moments = [...document.querySelectorAll("tr[data-moment]")];
