@@ -1,6 +1,6 @@
 """The interactive page of a mechanism (issue 27): one self-contained, offline HTML file with an
 angle slider over every plan, the force plans stepped through in the texts' order, a check of a
-student's measured lengths, and print at true scale.
+student's measured lengths at the scales he drew at, and print at true scale.
 
     >>> import kinetostat
     >>> from kinetostat.plans.page import page
@@ -68,8 +68,8 @@ TOLERANCE_PCT = 5.0
 #: Decimals of a sheet's coordinates (mm) and of a segment's length (data-length-mm) in the page
 #: (`core.PAGE_DECIMALS`; each rint(10^d x), `core.fixed`, as `Drawing.svg(i, *PAGE_DECIMALS)`).
 COORD_DECIMALS, LENGTH_DECIMALS = PAGE_DECIMALS
-#: Decimals of the check's bands (mm; the 5-95 % of the drawing-error study's draws).
-BAND_DECIMALS = 3
+#: Decimals of the check's exact lengths and bands (mm; a drawing is read to 0.1 mm).
+CHECK_DECIMALS = 4
 #: Significant digits of the worksheet's values in the page (of each value's largest |value| over
 #: the cycle): the tables show 4; the files (worksheet.csv, cycle.csv) hold 12.
 VALUE_DIGITS = 9
@@ -599,9 +599,10 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                 continue
             lo_hi = bands.get((kind, s.name))
             mu, mu_name = _check_scale(kind, plan, s, fixed.base, lang)
-            item = {"plan": kind, "segment": s.name, "title": title_of(plan, lang).split(",")[0],
-                    "label": segment_label(s, lang), "exact": round(plan.length_mm(s.name), LENGTH_DECIMALS),
-                    "band": [round(x, BAND_DECIMALS) for x in lo_hi] if lo_hi else None}
+            item = {"plan": kind, "segment": s.name, "exact": round(plan.length_mm(s.name), CHECK_DECIMALS),
+                    "band": [round(x, CHECK_DECIMALS) for x in lo_hi] if lo_hi else None}
+            if segment_label(s, lang) != s.name:             # else the row shows the segment's name
+                item["label"] = segment_label(s, lang)
             if mu is (s.scale or plan.scale) and s.unit:    # the length stands for a quantity at mu
                 item["u"] = unit(s.unit, lang)
             items.append(item)
@@ -613,8 +614,9 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
                     for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
     results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
-    blobs["check"] = _text85(_obscure(_deflated(json.dumps({"items": items, "M": results, "scales": scales},
-                                                           separators=(",", ":")).encode())))
+    answers = {"items": items, "M": results, "scales": scales,
+               "titles": {kind: title_of(plan, lang).split(",")[0] for kind, plan in check.items()}}
+    blobs["check"] = _text85(_obscure(_deflated(json.dumps(answers, separators=(",", ":")).encode())))
     blank = _blank_tables(records, lang) if student else ""
     return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), results, blank)
 
