@@ -624,17 +624,19 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
 def _check_scale(kind: str, plan, s, base, lang: str):
     """The scale a check item's length is judged at (a Scale: the segment's own, else its plan's; a
     lever's arm, kept in mm, at the lever's μ_v, as it grows with the lever) and the name of the
-    student's input for it: the symbol where it is a base scale (μ_F), else the plan's name with it
-    (a force on a group plan, a plan drawn coarser), and the segment's where the segment has a scale
-    of its plan's kind of its own (a friction detail drawn enlarged)."""
+    student's input for it, as the page's line of scales names it: the symbol where it is a base
+    scale (μ_F); else the plan's name with it (a plan drawn coarser), with "(F)" (the loads on a
+    group plan, the crank, the lever), or with the segment's (a friction detail drawn enlarged)."""
     own = s.scale or plan.scale
     mu = own if own.symbol.startswith("mu_") else plan.scale
     symbol = mu.symbol.replace("mu_", "μ_")
     if base.get(mu.symbol) == mu:
         return mu, symbol
-    if s.scale is not None and s.scale.symbol == plan.scale.symbol:
-        return mu, f"{_plan_name(kind, lang)}, {segment_label(s, lang)}: {symbol}"
-    return mu, f"{_plan_name(kind, lang)}: {symbol}"
+    if mu == plan.scale:
+        return mu, f"{_plan_name(kind, lang)}: {symbol}"
+    if mu.symbol != plan.scale.symbol:
+        return mu, f"{_plan_name(kind, lang)} (F): {symbol}"
+    return mu, f"{_plan_name(kind, lang)}, {segment_label(s, lang)}: {symbol}"
 
 
 def _blank_tables(records: list[dict], lang: str) -> str:
