@@ -1,7 +1,7 @@
 """The interactive page (issue 27) in a real browser: Debian's headless Chromium driven by Playwright
 (tests/sheet_browser.py; a fresh profile per launch). The slider's sheets carry every segment's
 length as segments.csv has it; "Next step" follows seed 002's order of the force analysis; the
-student's page holds no answer and judges typed lengths; the print's 100 mm bar measures 100 mm
+student's page holds no answer and judges typed lengths at the scales typed; the print's 100 mm bar measures 100 mm
 in the PDF; the pages make no request. By default the ICE (seed 002) on a page of three angles;
 with `-m slow` the whole page of `kinetostat page` against `kinetostat plans --cycle-scales`.
 """
@@ -195,8 +195,9 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
     answers = {a for a in answers if "," in a}              # with decimals: not a bare small integer
     requests: list[str] = []
     pg = _open(chromium, student, requests)
-    shown = pg.text_content("body")
-    assert not [a for a in answers if re.search(rf"(?<![\d,]){re.escape(a)}(?!\d)", html + shown)]
+    shown = pg.inner_text("body")                           # the text shown (no script)
+    plain = re.sub(r'<script type="application/octet-stream"[^>]*>[^<]*</script>', "", html)   # the blobs: base85
+    assert not [a for a in answers if re.search(rf"(?<![\d,]){re.escape(a)}(?!\d)", plain + shown)]
     assert pg.eval_on_selector_all("td.exact", "es => es.every(e => e.textContent === '')")
 
     def verdict(selector: str, typed: str) -> str:
@@ -233,6 +234,91 @@ def test_student_page_holds_no_answer_and_judges_typed_lengths(chromium, ice):
                                     ".map(e => e.getBBox().x + e.getBBox().width)")
     assert len(right) == 2 and max(right) < 415.0, right
     assert requests == [student.as_uri()], requests
+    pg.close()
+
+
+#: Seed 002 sec. 1.2 (the ICE at 30 deg): the guide's scales and the lengths it measured at them, mm.
+GUIDE_SCALES = {"velocity": "0,2", "acceleration": "100", "forces:2,3": "50"}
+GUIDE_MM = {("velocity", "p-b"): 54.7, ("velocity", "a-b"): 74.6, ("velocity", "p-s2"): 61.0,
+            ("acceleration", "pi-b"): 83.11, ("acceleration", "pi-s2"): 78.75, ("acceleration", "n2-b"): 37.16,
+            ("acceleration", "a-n2"): 20.23,
+            ("forces:2,3", "R12"): 63.44, ("forces:2,3", "R43"): 15.61, ("forces:2,3", "R32"): 129.62}
+
+
+def _item(plan: str, segment: str) -> str:
+    return f'input.measured[data-plan="{plan}"][data-segment="{segment}"]'
+
+
+#: Types each [item's selector, length, scale or null] as a student would (an input event each): the
+#: scale into the input of the item's scale (data-scale) where given, then the length; the item
+#: rows' [data-verdict, verdict text, quantity shown, the scale row's note] after each.
+_TYPE = """rows => rows.map(([sel, typed, scale]) => {
+  const e = document.querySelector(sel), type = (i, v) => { i.value = v; i.dispatchEvent(new Event('input')); };
+  const mu = document.querySelector(`input.scale[data-scale="${e.dataset.scale}"]`);
+  if (scale !== null) type(mu, scale);
+  type(e, typed);
+  const tr = e.closest('tr'), v = tr.querySelector('.verdict');
+  return [v.dataset.verdict || '', v.textContent, tr.querySelector('.quantity').textContent,
+          mu.closest('tr').querySelector('.verdict').textContent];
+})"""
+
+
+def _judged(pg, *rows: tuple[str, str, str, str | None]) -> list[tuple[str, str, str, str]]:
+    """(plan, segment, typed, scale or None) each typed in turn (`_TYPE`): what each row then shows."""
+    return [tuple(x) for x in pg.evaluate(_TYPE, [[_item(p, s), t, mu] for p, s, t, mu in rows])]
+
+
+def test_check_judges_the_guides_lengths_at_the_guides_scales(chromium, ice):
+    """Before, the check assumed the page's scales: seed 002's R12 = 63,44 mm, drawn at μ_F = 50 N/mm,
+    read "+99 %, outside the band" on a page at μ_F = 100. Now the student types the scales he drew
+    at, and every length the guide measured (sec. 1.2: the velocity, acceleration and force plans) at
+    the guide's scales is in the band, its quantity shown (R12 = 63,44 · 50 = 3172 N, the guide's);
+    a wrong length at those scales is not; a scale of 0, below 0 or not a number is named, never NaN."""
+    mech, fixed, key, student = ice
+    assert fixed.plan["forces:2,3"].value != 50.0           # the page's own scale is not the guide's
+    pg = _open(chromium, student)
+    R12 = ("forces:2,3", "R12", "63,44")
+    assert _judged(pg, (*R12, None))[0][0] == "bad"                      # at the page's scale (before)
+    got = _judged(pg, *[(p, s, num(mm, "uk", 6), GUIDE_SCALES[p]) for (p, s), mm in GUIDE_MM.items()])
+    assert [g[0] for g in got] == ["ok"] * len(GUIDE_MM), list(zip(GUIDE_MM, got))
+    shown = {k: g[2] for k, g in zip(GUIDE_MM, got)}
+    assert (shown[("forces:2,3", "R12")], shown[("forces:2,3", "R32")], shown[("velocity", "p-b")]) \
+        == ("3172 Н", "6481 Н", "10,94 м/с")                          # the guide's R12, R32, V_B
+    # wrong at the guide's scales: 2 mm too long on the force plan (100 N), 1 mm on the velocity plan
+    got = _judged(pg, ("forces:2,3", "R12", "65,44", None), ("velocity", "p-b", "55,7", None))
+    assert [g[0] for g in got] == ["bad", "bad"], got
+    # a scale that is not a number above 0: named on its own row and on the rows at it, never NaN
+    said = "μ_F: введіть число, більше за 0"
+    for bad in ("0", "-50", "п'ятдесят", ""):
+        assert _judged(pg, (*R12, bad)) == [("none", said, "", said)], bad
+        assert "NaN" not in pg.text_content("#check")
+    assert _judged(pg, (*R12, "50")) == [("ok", _judged(pg, (*R12, None))[0][1], "3172 Н", "")]    # and back
+    pg.close()
+    # the key: the exact length and band at the scale typed (twice the page's at half its μ_F)
+    pg = _open(chromium, key)
+    exact = float(pg.get_attribute('svg [data-plan="forces:2,3"][data-segment="R12"]', "data-length-mm"))   # at 30°
+    _judged(pg, (*R12, num(fixed.plan["forces:2,3"].value / 2, "uk", 6)))
+    assert pg.eval_on_selector(_item("forces:2,3", "R12"), "e => e.closest('tr').querySelector('.exact').textContent") \
+        == num(2 * exact, "uk", 4)
+    pg.close()
+
+
+def test_check_judges_variant_1_479_at_the_keys_scale(chromium, tmp_path):
+    """Variant 1/479 at φ1 = 150°: its key (`kinetostat variant 1 479`, key.pdf) draws the force plan
+    at μ_F = 40 N/mm, R12n 174,6 mm; its page (`variant --page`: the cycle's scales, μ_F = 100) marked
+    that +150 %. At μ_F = 40 it is in the band; 180 mm is not. (The cycle's scales sampled every 30°.)"""
+    from kinetostat import variants
+    mech = variants.variant(1, "479").mechanism()
+    f = tmp_path / "student.html"
+    f.write_text(make_page(mech, lang="uk", student=True, at=150.0, fixed=P.cycle_scales(mech, step_deg=30.0)),
+                 encoding="utf-8")
+    pg = _open(chromium, f)
+    k = pg.get_attribute(_item("forces:2,3", "R12n"), "data-scale")
+    assert pg.input_value(f'input.scale[data-scale="{k}"]') != "40"
+    got = _judged(pg, ("forces:2,3", "R12n", "174,6", None), ("forces:2,3", "R12n", "174,6", "40"),
+                  ("forces:2,3", "R12n", "180", None))
+    assert [g[0] for g in got] == ["bad", "ok", "bad"], got              # at the page's scale (before); at 40
+    assert got[1][2] == "6984 Н"                                         # the key: R12n = 6982 N
     pg.close()
 
 
@@ -445,7 +531,7 @@ def _script_page(drawings, n: int) -> str:
     kinds, mids = pg._shared_texts(kinds)
     blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "mids": mids, "steps": [], "rows": [], "exps": [], "sources": [], "frames": list(range(n))}).encode())
     blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[2])
-    blobs["check"] = pg._text85(pg._obscure(pg._deflated(b'{"items": [], "M": []}')))
+    blobs["check"] = pg._text85(pg._obscure(pg._deflated(b'{"items": [], "M": [], "scales": [], "titles": {}}')))
     data = {"student": False, "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
             "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "smooth": pg.SMOOTH.tolist(), "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}

@@ -384,6 +384,14 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "page.plan": ("Plan", "План", "План"),
     "page.segment": ("Segment", "Відрізок", "Отрезок"),
     "page.measured": ("Measured", "Виміряно", "Измерено"),
+    "page.quantity": ("At your scale", "У вашому масштабі", "В вашем масштабе"),
+    "page.your_scales": ("The scales you drew at (each length is judged at its own: the quantity it stands for "
+                         "against the exact one; this page's scales to start with):",
+                         "Масштаби, у яких ви креслили (кожну довжину оцінено у її масштабі: величину, яку "
+                         "вона зображує, проти точної; спершу — масштаби цієї сторінки):",
+                         "Масштабы, в которых вы чертили (каждая длина оценена в её масштабе: величина, которую "
+                         "она изображает, против точной; сначала — масштабы этой страницы):"),
+    "page.bad_scale": ("{mu}: type a number above 0", "{mu}: введіть число, більше за 0", "{mu}: введите число больше 0"),
     "page.exact": ("Exact", "Точно", "Точно"),
     "page.band": ("Band", "Смуга", "Полоса"),
     "page.verdict": ("Verdict", "Висновок", "Вывод"),

@@ -1,7 +1,7 @@
 // The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
 // sheet's arrays and the values stored as differences over the angle (deflated, 5 characters per 4 bytes), writes the sheet of
 // the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
-// lengths. No network, no library.
+// lengths at the typed scales. No network, no library.
 "use strict";
 (async () => {
   const D = JSON.parse(document.getElementById("page-data").textContent);
@@ -63,34 +63,57 @@
     return (d >= 0 ? "+" : "") + local(d, 3) + (unit ? " " + unit : "") + " (" + pct1(100 * d / exact) + ")";
   }
   function band(b) { return b ? local(b[0], 3) + " … " + local(b[1], 3) : "—"; }
-  let last = $("check-table").rows[0];         // the items' rows (page.py _html writes the moments' rows)
-  check.items.forEach((it, n) => {
-    const tr = document.createElement("tr"), input = document.createElement("input");
-    tr.dataset.item = n;
-    Object.assign(input, {type: "text", inputMode: "decimal", className: "measured", size: 7});
-    Object.assign(input.dataset, {plan: it.plan, segment: it.segment});
-    [it.title, it.label, input, "exact num", "band num", "verdict"].forEach((x, c) => {
-      const td = tr.insertCell();
-      if (c === 2) td.appendChild(x); else if (c < 2) td.textContent = x; else td.className = x;
-    });
-    last.after(tr);
-    last = tr;
+  function row(tr, texts, box, classes) {        // a row of the check: its texts, an input, empty cells of `classes`
+    texts.forEach((t) => { tr.insertCell().textContent = t; });
+    tr.insertCell().appendChild(box);
+    classes.forEach((c) => { tr.insertCell().className = c; });
+    return tr;
+  }
+  function box(className, size, data) {          // a text input for a number
+    const e = document.createElement("input");
+    Object.assign(e, {type: "text", inputMode: "decimal", className, size});
+    Object.assign(e.dataset, data);
+    return e;
+  }
+  // The scales the student drew at: one input per scale of the check's lengths (page.py _check_scale),
+  // this page's own to start with; a length is judged at its own, its exact length and band times
+  // the page's scale over his (the quantity it stands for against the exact one and its band).
+  const scales = check.scales.map(([name, mu, u], k) => {
+    const input = Object.assign(box("scale", 9, {scale: k}), {value: local(mu, 6)});
+    const tr = row($("scale-table").insertRow(), [name + ", " + u], input, ["verdict"]);
+    return {mu, input, note: tr.cells[2], bad: D.ui.bad_scale.replace("{mu}", name)};
   });
-  document.querySelectorAll("tr[data-item]").forEach((tr) => {
-    const it = check.items[+tr.dataset.item];
+  function scale(k) {                            // the student's scale k, or NaN (its row says why)
+    const S = scales[k], s = S.input.value.trim(), x = Number(s.replace(",", ".")), ok = s !== "" && x > 0 && isFinite(x);
+    mark(S.note, ok ? undefined : false, S.bad);
+    return ok ? x : NaN;
+  }
+  let last = $("check-table").rows[0];         // the items' rows (page.py _html writes the moments' rows)
+  const items = check.items.map((it, n) => {
+    const tr = row(document.createElement("tr"), [check.titles[it.plan], it.label || it.segment],
+                   box("measured", 7, {plan: it.plan, segment: it.segment, scale: it.s}), ["quantity num", "exact num", "band num", "verdict"]);
+    tr.dataset.item = n;
+    last.after(tr);
+    return (last = tr);
+  });
+  function judge(tr) {                           // an item's row at the student's scale
+    const it = check.items[+tr.dataset.item], mu = scale(it.s), r = scales[it.s].mu / mu;
+    const b = it.band && isFinite(r) ? it.band.map((x) => x * r) : null, cell = tr.querySelector(".verdict");
     if (!D.student) {
-      tr.querySelector(".exact").textContent = local(it.exact, 4);
-      tr.querySelector(".band").textContent = band(it.band);
+      tr.querySelector(".exact").textContent = local(it.exact * r, 4);
+      tr.querySelector(".band").textContent = band(b);
     } else if (!it.band) {
       tr.querySelector(".band").textContent = "—";
     }
-    tr.querySelector("input").addEventListener("input", (e) => {
-      const typed = parse(e.target.value), cell = tr.querySelector(".verdict");
-      if (!isFinite(typed)) return mark(cell);
-      const ok = it.band ? it.band[0] <= typed && typed <= it.band[1] : null;
-      mark(cell, ok, dev(typed, it.exact, D.mm) + (ok === null ? "" : " — " + D.ui[ok ? "in_band" : "out_band"]));
-    });
-  });
+    const typed = parse(tr.querySelector("input").value);
+    tr.querySelector(".quantity").textContent = isFinite(typed * mu) && it.u ? local(typed * mu, 4) + " " + it.u : "";
+    if (!isFinite(typed)) return mark(cell);
+    if (!isFinite(mu)) return mark(cell, null, scales[it.s].bad);
+    const ok = b ? b[0] <= typed && typed <= b[1] : null;
+    mark(cell, ok, dev(typed, it.exact * r, D.mm) + (ok === null ? "" : " — " + D.ui[ok ? "in_band" : "out_band"]));
+  }
+  items.forEach((tr) => { judge(tr); tr.querySelector("input").addEventListener("input", () => judge(tr)); });
+  scales.forEach((S) => S.input.addEventListener("input", () => items.forEach(judge)));
   // The two balancing moments (signed, N m): each against its band and sense; then the texts' rule
   // on the student's own two, δ = (M' − M)/M' · 100 %, judged on δ as shown (0.1 %).
   const moments = [...document.querySelectorAll("tr[data-moment]")];

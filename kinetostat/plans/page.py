@@ -1,6 +1,6 @@
 """The interactive page of a mechanism (issue 27): one self-contained, offline HTML file with an
 angle slider over every plan, the force plans stepped through in the texts' order, a check of a
-student's measured lengths, and print at true scale.
+student's measured lengths at the scales he drew at, and print at true scale.
 
     >>> import kinetostat
     >>> from kinetostat.plans.page import page
@@ -68,6 +68,8 @@ TOLERANCE_PCT = 5.0
 #: Decimals of a sheet's coordinates (mm) and of a segment's length (data-length-mm) in the page
 #: (`core.PAGE_DECIMALS`; each rint(10^d x), `core.fixed`, as `Drawing.svg(i, *PAGE_DECIMALS)`).
 COORD_DECIMALS, LENGTH_DECIMALS = PAGE_DECIMALS
+#: Decimals of the check's exact lengths and bands (mm; a drawing is read to 0.1 mm).
+CHECK_DECIMALS = 4
 #: Significant digits of the worksheet's values in the page (of each value's largest |value| over
 #: the cycle): the tables show 4; the files (worksheet.csv, cycle.csv) hold 12.
 VALUE_DIGITS = 9
@@ -562,7 +564,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     bands, moment_bands = _bands(mech, one, check, fixed)
     data: dict = {"lang": lang, "student": student, "design": design, "at": at,
                   "slider": len(frames) - 1, "tol": TOLERANCE_PCT,
-                  "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both")}
+                  "ui": {k: text(f"page.{k}", lang) for k in ("in_band", "out_band", "singular", "a4_cut", "sense", "both", "bad_scale")}
                   | {"negligible": text("page.negligible", lang, tiny=num(TINY_MM, lang))}, "tiny": TINY_MM,
                   "rule_ok": text("page.rule_ok", lang, tol=num(TOLERANCE_PCT, lang)),
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
@@ -590,21 +592,51 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                                             "rows": rows, "exps": exps, "sources": sources,
                                             "frames": [int(a) if a.is_integer() else a for a in phi]},
                                            ensure_ascii=False, separators=(",", ":")).encode())
-    items = []
+    items, keys = [], []                      # keys: each item's scale (its input's name, value, unit)
     for kind, plan in check.items():
         for s in plan.segments:
             if s.kind in ("position", "line") or not math.isfinite(plan.length_mm(s.name)):
                 continue
             lo_hi = bands.get((kind, s.name))
-            items.append({"plan": kind, "segment": s.name, "title": title_of(plan, lang).split(",")[0],
-                          "label": segment_label(s, lang), "exact": plan.length_mm(s.name),
-                          "band": list(lo_hi) if lo_hi else None})
+            mu, mu_name = _check_scale(kind, plan, s, fixed.base, lang)
+            item = {"plan": kind, "segment": s.name, "exact": round(plan.length_mm(s.name), CHECK_DECIMALS),
+                    "band": [round(x, CHECK_DECIMALS) for x in lo_hi] if lo_hi else None}
+            if segment_label(s, lang) != s.name:             # else the row shows the segment's name
+                item["label"] = segment_label(s, lang)
+            if mu is (s.scale or plan.scale) and s.unit:    # the length stands for a quantity at mu
+                item["u"] = unit(s.unit, lang)
+            items.append(item)
+            keys.append((mu_name, mu.value, unit(mu.unit, lang)))
+    rank = {mu.symbol.replace("mu_", "μ_"): n for n, mu in enumerate(fixed.base.values())}
+    scales = sorted(set(keys), key=lambda k: (rank.get(k[0], len(rank)), keys.index(k)))   # the base ones first
+    for item, key in zip(items, keys):
+        item["s"] = scales.index(key)
     results = list({r.symbol: (r.symbol, r.value) for kind in ("lever", "crank") if kind in check
                     for r in check[kind].results if r.unit == "N m"}.values())[::-1]    # M_bal (crank), M'_bal
     results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
-    blobs["check"] = _text85(_obscure(_deflated(json.dumps({"items": items, "M": results}, separators=(",", ":")).encode())))
+    answers = {"items": items, "M": results, "scales": scales,
+               "titles": {kind: title_of(plan, lang).split(",")[0] for kind, plan in check.items()}}
+    blobs["check"] = _text85(_obscure(_deflated(json.dumps(answers, separators=(",", ":")).encode())))
     blank = _blank_tables(records, lang) if student else ""
     return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), results, blank)
+
+
+def _check_scale(kind: str, plan, s, base, lang: str):
+    """The scale a check item's length is judged at (a Scale: the segment's own, else its plan's; a
+    lever's arm, kept in mm, at the lever's μ_v, as it grows with the lever) and the name of the
+    student's input for it, as the page's line of scales names it: the symbol where it is a base
+    scale (μ_F); else the plan's name with it (a plan drawn coarser), with "(F)" (the loads on a
+    group plan, the crank, the lever), or with the segment's (a friction detail drawn enlarged)."""
+    own = s.scale or plan.scale
+    mu = own if own.symbol.startswith("mu_") else plan.scale
+    symbol = mu.symbol.replace("mu_", "μ_")
+    if base.get(mu.symbol) == mu:
+        return mu, symbol
+    if mu == plan.scale:
+        return mu, f"{_plan_name(kind, lang)}: {symbol}"
+    if mu.symbol != plan.scale.symbol:
+        return mu, f"{_plan_name(kind, lang)} (F): {symbol}"
+    return mu, f"{_plan_name(kind, lang)}, {segment_label(s, lang)}: {symbol}"
 
 
 def _blank_tables(records: list[dict], lang: str) -> str:
@@ -652,14 +684,16 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
     for n, (symbol, _, _) in enumerate(results):
         check_rows.append(f'<tr data-moment="{n}"><td></td><td>{escape(symbol)}, {escape(unit("N m", lang))}</td>'
                           f'<td><input type="text" inputmode="decimal" class="moment" data-symbol="{escape(symbol)}" '
-                          f'size="7"></td><td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
+                          f'size="7"></td><td></td><td class="exact num"></td><td class="band num"></td><td class="verdict"></td></tr>')
     if len(results) == 2:
         check_rows.append(f'<tr id="delta"><td></td><td>δ = ({escape(results[1][0])} − {escape(results[0][0])}) / '
-                          f'{escape(results[1][0])} · 100 %</td><td></td><td></td><td class="num">|δ| ≤ '
+                          f'{escape(results[1][0])} · 100 %</td><td></td><td></td><td></td><td class="num">|δ| ≤ '
                           f'{num(TOLERANCE_PCT, lang)} %</td><td class="verdict"></td></tr>')
     phi = num(data["at"], lang, 6)
     check = (f'<section id="check"><h2>{escape(text("page.check", lang))}</h2><p>{escape(text("page.check_note", lang, phi=phi, tol=num(TOLERANCE_PCT, lang)))}</p>'
-             f'<table id="check-table"><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>" for k in ("plan", "segment", "measured", "exact", "band", "verdict"))
+             f'<p>{escape(text("page.your_scales", lang))}</p><table id="scale-table"></table>'
+             f'<table id="check-table"><tr>' + "".join(f"<th>{escape(text('page.' + k, lang))}</th>"
+                                                      for k in ("plan", "segment", "measured", "quantity", "exact", "band", "verdict"))
              + "</tr>" + "".join(check_rows) + "</table></section>")
     if student:
         body = (f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><p>{escape(text("page.scales", lang))}: {escape(scales)}</p>'
