@@ -71,7 +71,10 @@ def fits(plan: Plan) -> float:
 
 #: How each kind of segment is drawn: stroke width (mm), dash pattern, colour.
 _STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
-          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33")}
+          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33"),
+          "alternative": (0.35, "3,1.5", "#000"), "extension": (0.35, "3,1.5", "#000")}
+#: The kinds drawn as arrows: a vector, and one drawn as the alternative of others (F_i2(h), dashed).
+_ARROWS = ("vector", "alternative")
 
 
 def _lang(lang: str) -> int:
@@ -221,7 +224,7 @@ def _tiny(cycle: PlanCycle) -> dict[str, np.ndarray]:
     or a plan's vector, not laid off; _AS_IS where not tiny or not drawn)."""
     how = {}
     for s in cycle.segments:
-        if s.kind != "vector":
+        if s.kind not in _ARROWS:
             continue
         L = cycle.length_mm(s.name)
         tiny = L < TINY_MM
@@ -244,7 +247,7 @@ def _collinear(cycle: PlanCycle, s: Segment, tiny: dict[str, np.ndarray]) -> np.
     d = cycle.points[s.end] - a
     out = np.zeros(cycle.n, dtype=bool)
     for o in cycle.segments:
-        if o.kind != "vector" or o.name == s.name:
+        if o.kind not in _ARROWS or o.name == s.name:
             continue
         e = cycle.points[o.end] - cycle.points[o.start]
         turn = e * d.conjugate()
@@ -290,7 +293,7 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
     sides = plan.kind.startswith("forces:")
     out = []
     for s in plan.segments:
-        if s.kind not in ("vector", "arm") or not math.isfinite(s.value):
+        if s.kind not in (*_ARROWS, "arm") or not math.isfinite(s.value):
             continue
         L = num(plan.length_mm(s.name), lang, decimals=2)
         value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
@@ -544,7 +547,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         if contract and neg.any():
             out.append(Element("g", _where(neg, a)[:, None], {"class": "negligible", **data}, length_mm=Lz))
         drawn = ok & ~neg
-        if s.kind == "vector":
+        if s.kind in _ARROWS:
             head, box, end = _arrowhead(a, b, L)
             placer.block(_where(drawn, box))
         else:
@@ -556,11 +559,11 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
             if lit.any():
                 out.append(Element("line", _where(lit, np.stack([a, end], axis=1)), attrs, title=title,
                                    length_mm=Lz if contract else None))
-        if s.kind == "vector":
+        if s.kind in _ARROWS:
             out.append(Element("path", _where(drawn, head), {"class": "arrowhead", "fill": colour}))
         placer.line(_where(drawn, _lines(a, b)))
-        named = s.kind != "link" and (not labelled(s.end) or (sides is not None and s.kind == "vector")
-                                      or s.kind == "arm")
+        named = s.kind not in ("link", "extension") and (not labelled(s.end) or (sides is not None and s.kind == "vector")
+                                                         or s.kind == "arm")
         lettered = neg | (drawn & named)
         if lettered.any():
             names.append(_Name((segment_label(s, lang), segment_label(s, lang) + "*"), out_.astype(int),
@@ -707,7 +710,7 @@ def figure(plan: Plan, lang: str = "en", ax=None):
     for s in _drawable(plan):
         a, b = plan.points[s.start], plan.points[s.end]
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
-        if s.kind == "vector":
+        if s.kind in _ARROWS:
             if abs(b - a) >= 0.05:
                 ax.annotate("", xy=(b.real, b.imag), xytext=(a.real, a.imag),
                             arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.0, shrinkA=0, shrinkB=0))
