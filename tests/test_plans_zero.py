@@ -139,9 +139,13 @@ def test_shaper_R05_off_the_ram_warns_at_those_angles_and_is_drawn_where_it_acts
     assert not any("outside link" in n for n in plan.at(on).notes)
 
 
-def test_crank_plan_notes_a_zero_M_i1_where_the_crank_turns_evenly():
-    """The crank turns at constant ω1 (ε1 = 0): where the model gives it an I_S, M_i1 is not drawn."""
-    mech = _model("ice_crank_slider")
+def test_crank_plan_leaves_out_the_evenly_turning_cranks_zero_F_i1_and_M_i1():
+    """The furnace loader's crank turns at constant ω1 (ε1 = 0) about its centre of mass O1: its
+    F_i1 = -m a_O1 and M_i1 = -I_S ε1 are zero, not drawn, and named in a note."""
+    mech = _model("furnace_loader_six_bar")
     res = kinetostat.analyze(mech, phi_deg=[30.0])
+    assert mech.links[1].com == mech.drive.pivot and mech.links[1].I_S > 0 and res.kin.eps[0, 1] == 0.0
     plan = crank_plan(mech, res, MU_L).at(0)
-    assert "M_i1" not in {k for k, v in plan.paths.items() if np.isfinite(v).any()}
+    assert not np.isfinite(np.asarray(plan.paths["M_i1"])).any()
+    assert "F_i1" not in {s.name for s in plan.segments} and plan.segment("G1").value > 0
+    assert "F_i1 = 0, M_i1 = 0 (at this angle): not drawn" in plan.notes
