@@ -164,6 +164,16 @@ def _runs(name: str) -> list[tuple[str, bool]]:
     return [(t, k == 1) for part in parts for k, t in enumerate(label_parts(part)) if t]
 
 
+#: A symbol in a plan's note: ω2, M_i5, F_i2(h), R05, ρ12 (letters, a digit, an optional (h)), or a
+#: side of a plan between two points, p-b, pi-b, n2-b (short point names).
+_SYMBOL = re.compile(r"(?<![\w\x01-])([A-Za-zωεπρ]+_?[A-Za-z]*\d+(?:\([a-z]\))?|[a-z]{1,2}\d*-[a-z]{1,2}\d*)(?![\w(-])")
+
+
+def _symbols(note: str) -> str:
+    """A plan's note with its symbols marked (`_n`): lettered as the drawing letters them."""
+    return _SYMBOL.sub(lambda m: _n(m.group(1)), note)
+
+
 def _plain(s: str) -> str:
     """A note as read, without the names' marks (for its width)."""
     return _NAMED.sub(lambda m: "".join(t for t, _ in _runs(m.group(1))), s)
@@ -271,7 +281,7 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
     """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors."""
     base = plan.kind.partition(":")[0]
     lines = [text(f"legend.{base}", lang)] if f"legend.{base}" in MESSAGES else []
-    lines += [phrase(n, lang) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
+    lines += [_symbols(phrase(n, lang)) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
     lines += _result_line(plan, lang)
     if plan.equation:
         lines.append(f"{text('equation', lang)}: " + " + ".join(map(_n, plan.equation)) + " = 0")

@@ -499,8 +499,7 @@ def _links_and_loads(mech: "Mechanism", res: "Analysis", loads: dict[int, list[L
     for x in loads:
         zeros.update(_zeros(mech, res, x))
         for ld in loads[x]:
-            F = np.where(zeros[ld.name][0], np.nan, ld.force) if ld.name in zeros else ld.force
-            _arrow(segs, pts, ld.name, ld.point, F, mu_l, mu_F)
+            _load_arrow(segs, pts, ld, zeros, mu_l, mu_F)
         _couples(mech, res, x, _couple_centre(mech, res, x), 8.0, zeros, paths, mu_l)
         replaces.append(_resultant(mech, res, x, pts, segs, mu_l, mu_F))
     notes = zero_notes(zeros, len(res.phi_deg))
@@ -522,6 +521,15 @@ def _zeros(mech: "Mechanism", res: "Analysis", k: int) -> dict[str, tuple[np.nda
     return out
 
 
+def _load_arrow(segs: list, pts: dict, ld: Load, zeros: dict[str, tuple[np.ndarray, str]], mu_l: Scale,
+                mu_F: Scale) -> None:
+    """Load `ld` as an arrow (`_arrow`), NaN where it is zero (`zeros`); one zero at every angle not
+    drawn at all."""
+    zero = zeros[ld.name][0] if ld.name in zeros else np.zeros(len(ld.force), dtype=bool)
+    if not zero.all():
+        _arrow(segs, pts, ld.name, ld.point, np.where(zero, np.nan, ld.force), mu_l, mu_F)
+
+
 def _couple_centre(mech: "Mechanism", res: "Analysis", k: int) -> np.ndarray:
     """(N,) complex world m: where link k's couples are drawn, its centre of mass (its origin)."""
     link = mech.links[k]
@@ -530,10 +538,12 @@ def _couple_centre(mech: "Mechanism", res: "Analysis", k: int) -> np.ndarray:
 
 def _couples(mech: "Mechanism", res: "Analysis", k: int, at: np.ndarray, radius_mm: float,
              zeros: dict[str, tuple[np.ndarray, str]], paths: dict, mu_l: Scale) -> None:
-    """Link k's couples as arcs of `radius_mm` about `at` (world m), NaN where zero (`zeros`)."""
+    """Link k's couples as arcs of `radius_mm` about `at` (world m), NaN where zero (`zeros`);
+    one zero at every angle not drawn at all."""
     for c in link_couples(mech, res, k):
-        arc = _couple_path(_over(at, mu_l.value), c.moment, radius_mm)
-        paths[c.name] = np.where(zeros[c.name][0][:, None], np.nan, arc)
+        zero = zeros[c.name][0]
+        if not zero.all():
+            paths[c.name] = np.where(zero[:, None], np.nan, _couple_path(_over(at, mu_l.value), c.moment, radius_mm))
 
 
 def _leash_parts(mech: "Mechanism", res: "Analysis", side) -> _Parts:
@@ -882,8 +892,7 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
     on_crank = _carried(mech, res, 1, set(range(2, mech.n_links))) + link_loads(mech, res, 1)
     zeros = _zeros(mech, res, 1)
     for ld in on_crank:
-        _arrow(segs, pts, ld.name, ld.point, np.where(zeros[ld.name][0], np.nan, ld.force) if ld.name in zeros
-               else ld.force, mu_l, mu_F)
+        _load_arrow(segs, pts, ld, zeros, mu_l, mu_F)
     for ld in on_crank:
         _arm(mech, segs, pts, arm_name(ld.name), O, dr.pivot, ld.point, ld.force, mu_l)
     _couples(mech, res, 1, O, 6.0, zeros, paths, mu_l)

@@ -207,12 +207,12 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
 def _collapsed(segs: list[Segment], n: int) -> tuple[tuple[str, ...], ...]:
     """Each of n angles' notes naming the special position where a side of a velocity or an
     acceleration plan collapses to a point (its value zero, `zero.zero_of`, against the plan's
-    largest there): 'special position: p-b = 0 (b ≡ p), the plan collapses there'."""
+    largest there): 'special position: p-b = 0, the plan collapses there' (b on the pole)."""
     vals = np.stack([np.broadcast_to(np.asarray(s.value, dtype=float), (n,)) for s in segs])
     with np.errstate(invalid="ignore"):
         ref = np.max(np.where(np.isfinite(vals), vals, 0.0), axis=0)
         zero = zero_of(vals, ref) & (ref > 0)
-    return tuple(tuple(f"special position: {s.name} = 0 ({s.end} ≡ {s.start}), the plan collapses there"
+    return tuple(tuple(f"special position: {s.name} = 0, the plan collapses there"
                        for s, z in zip(segs, zero[:, i]) if z) for i in range(n))
 
 
