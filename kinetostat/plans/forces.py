@@ -26,8 +26,15 @@ with these reactions.
 Forces on a group plan or the crank plan are drawn at a force scale of their own, stated on each
 segment (`Segment.scale`); arms, links and offsets at the plan's mu_l.
 
+Only what acts is drawn: an inertia force or couple zero at an angle (`zero`: M_i of a link that
+translates is none at all) is NaN there, and the plan's note of that angle names it; F_i<k>(h),
+which replaces F_i<k> and M_i<k>, is drawn as their alternative (kind "alternative", dashed) with a
+note; a prismatic pair's normal force whose offset x falls outside its slider link is drawn where
+it acts, the link's line drawn on to it (kind "extension"), with a note and a ModelWarning.
+
 May use: numpy, the solver's public results (`Analysis`, `Mechanism`), `kinetostat.applied`
-(load magnitudes) and `core`. Never matplotlib, never the harness.
+(load magnitudes), `kinetostat.errors` (the warning), `core` and `zero`. Never matplotlib, never
+the harness.
 """
 from __future__ import annotations
 
