@@ -156,3 +156,14 @@ def test_crank_plan_leaves_out_the_evenly_turning_cranks_zero_F_i1_and_M_i1():
     assert "M_i1" not in plan.paths
     assert "F_i1" not in {s.name for s in plan.segments} and plan.segment("G1").value > 0
     assert "F_i1 = 0, M_i1 = 0 (at this angle): not drawn" in plan.notes
+
+
+def test_a_side_within_a_translating_link_is_no_special_position():
+    """The scotch yoke's a3-y joins two points of the yoke, which translates: zero at every angle,
+    not a special position; at 90 deg its a1-a3 (the block's sliding) is, the crank pin at the
+    top of its stroke."""
+    mech = _model("scotch_yoke")
+    res = kinetostat.analyze(mech, phi_deg=[30.0, 90.0])
+    vel = velocity_plan(mech, res, {"mu_v": MU_V})
+    assert vel.at(0).segment("a3-y").value == 0.0 and vel.at(0).notes == ()
+    assert vel.at(1).notes == ("special position: a1-a3 = 0, the plan collapses there",)
