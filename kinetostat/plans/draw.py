@@ -12,9 +12,9 @@ its notes.
 
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
 results (vectors, the design position) thick, construction thin, an alternative (F_i2(h)) and a
-link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a vector shorter than 1 mm at
-its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a polygon whose sides must
-close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
+link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a
+vector shorter than 1 mm at its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a
+polygon whose sides must close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
 (for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
