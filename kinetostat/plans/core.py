@@ -47,7 +47,9 @@ class Segment:
     |value| = drawn length x scale for a vector or an arm drawn at the plan's scale; `kind` says how
     it is drawn: "vector" (an arrow), "link" (a link of the mechanism), "position" (a link at one
     of the other positions of the plan of positions, drawn thin), "arm" (a moment arm),
-    "line" (a construction line: a direction, a path). A segment whose quantity is not at the plan's
+    "line" (a construction line: a direction, a path), "alternative" (an arrow that replaces others
+    drawn: F_i2(h) for F_i2 and M_i2, dashed), "extension" (a link's line drawn on, dashed, to a
+    force acting off it). A segment whose quantity is not at the plan's
     scale (a link of a lever, a path) has `value` NaN and unit "", unless it names its own `scale`
     (a force drawn on a group plan: |value| = drawn length x segment.scale).
     """

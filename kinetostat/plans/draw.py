@@ -11,9 +11,10 @@ angle i; `svg(plan)`, the sheet of one angle, is `drawing` of the cycle of one, 
 its notes.
 
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
-results (vectors, the design position) thick, construction thin; a vector shorter than 1 mm at
-its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a polygon whose sides must
-close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
+results (vectors, the design position) thick, construction thin, an alternative (F_i2(h)) and a
+link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a
+vector shorter than 1 mm at its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a
+polygon whose sides must close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
 (for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
@@ -71,7 +72,10 @@ def fits(plan: Plan) -> float:
 
 #: How each kind of segment is drawn: stroke width (mm), dash pattern, colour.
 _STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
-          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33")}
+          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33"),
+          "alternative": (0.35, "3,1.5", "#000"), "extension": (0.35, "3,1.5", "#000")}
+#: The kinds drawn as arrows: a vector, and one drawn as the alternative of others (F_i2(h), dashed).
+_ARROWS = ("vector", "alternative")
 
 
 def _lang(lang: str) -> int:
@@ -161,6 +165,16 @@ def _runs(name: str) -> list[tuple[str, bool]]:
     return [(t, k == 1) for part in parts for k, t in enumerate(label_parts(part)) if t]
 
 
+#: A symbol in a plan's note: ω2, M_i5, F_i2(h), R05, ρ12 (letters, a digit, an optional (h)), or a
+#: side of a plan between two points, p-b, pi-b, n2-b (short point names).
+_SYMBOL = re.compile(r"(?<![\w\x01-])([A-Za-zωεπρ]+_?[A-Za-z]*\d+(?:\([a-z]\))?|[a-z]{1,2}\d*-[a-z]{1,2}\d*)(?![\w(-])")
+
+
+def _symbols(note: str) -> str:
+    """A plan's note with its symbols marked (`_n`): lettered as the drawing letters them."""
+    return _SYMBOL.sub(lambda m: _n(m.group(1)), note)
+
+
 def _plain(s: str) -> str:
     """A note as read, without the names' marks (for its width)."""
     return _NAMED.sub(lambda m: "".join(t for t, _ in _runs(m.group(1))), s)
@@ -221,7 +235,7 @@ def _tiny(cycle: PlanCycle) -> dict[str, np.ndarray]:
     or a plan's vector, not laid off; _AS_IS where not tiny or not drawn)."""
     how = {}
     for s in cycle.segments:
-        if s.kind != "vector":
+        if s.kind not in _ARROWS:
             continue
         L = cycle.length_mm(s.name)
         tiny = L < TINY_MM
@@ -244,7 +258,7 @@ def _collinear(cycle: PlanCycle, s: Segment, tiny: dict[str, np.ndarray]) -> np.
     d = cycle.points[s.end] - a
     out = np.zeros(cycle.n, dtype=bool)
     for o in cycle.segments:
-        if o.kind != "vector" or o.name == s.name:
+        if o.kind not in _ARROWS or o.name == s.name:
             continue
         e = cycle.points[o.end] - cycle.points[o.start]
         turn = e * d.conjugate()
@@ -268,7 +282,7 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
     """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors."""
     base = plan.kind.partition(":")[0]
     lines = [text(f"legend.{base}", lang)] if f"legend.{base}" in MESSAGES else []
-    lines += [phrase(n, lang) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
+    lines += [_symbols(phrase(n, lang)) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
     lines += _result_line(plan, lang)
     if plan.equation:
         lines.append(f"{text('equation', lang)}: " + " + ".join(map(_n, plan.equation)) + " = 0")
@@ -290,7 +304,7 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
     sides = plan.kind.startswith("forces:")
     out = []
     for s in plan.segments:
-        if s.kind not in ("vector", "arm") or not math.isfinite(s.value):
+        if s.kind not in (*_ARROWS, "arm") or not math.isfinite(s.value):
             continue
         L = num(plan.length_mm(s.name), lang, decimals=2)
         value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
@@ -544,7 +558,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         if contract and neg.any():
             out.append(Element("g", _where(neg, a)[:, None], {"class": "negligible", **data}, length_mm=Lz))
         drawn = ok & ~neg
-        if s.kind == "vector":
+        if s.kind in _ARROWS:
             head, box, end = _arrowhead(a, b, L)
             placer.block(_where(drawn, box))
         else:
@@ -556,11 +570,11 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
             if lit.any():
                 out.append(Element("line", _where(lit, np.stack([a, end], axis=1)), attrs, title=title,
                                    length_mm=Lz if contract else None))
-        if s.kind == "vector":
+        if s.kind in _ARROWS:
             out.append(Element("path", _where(drawn, head), {"class": "arrowhead", "fill": colour}))
         placer.line(_where(drawn, _lines(a, b)))
-        named = s.kind != "link" and (not labelled(s.end) or (sides is not None and s.kind == "vector")
-                                      or s.kind == "arm")
+        named = s.kind not in ("link", "extension") and (not labelled(s.end) or (sides is not None and s.kind == "vector")
+                                                         or s.kind == "arm")
         lettered = neg | (drawn & named)
         if lettered.any():
             names.append(_Name((segment_label(s, lang), segment_label(s, lang) + "*"), out_.astype(int),
@@ -707,7 +721,7 @@ def figure(plan: Plan, lang: str = "en", ax=None):
     for s in _drawable(plan):
         a, b = plan.points[s.start], plan.points[s.end]
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
-        if s.kind == "vector":
+        if s.kind in _ARROWS:
             if abs(b - a) >= 0.05:
                 ax.annotate("", xy=(b.real, b.imag), xytext=(a.real, a.imag),
                             arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.0, shrinkA=0, shrinkB=0))

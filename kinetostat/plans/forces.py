@@ -26,13 +26,21 @@ with these reactions.
 Forces on a group plan or the crank plan are drawn at a force scale of their own, stated on each
 segment (`Segment.scale`); arms, links and offsets at the plan's mu_l.
 
+Only what acts is drawn: an inertia force or couple zero at an angle (`zero`: M_i of a link that
+translates is none at all) is NaN there, and the plan's note of that angle names it; F_i<k>(h),
+which replaces F_i<k> and M_i<k>, is drawn as their alternative (kind "alternative", dashed) with a
+note; a prismatic pair's normal force whose offset x falls outside its slider link is drawn where
+it acts, the link's line drawn on to it (kind "extension"), with a note and a ModelWarning.
+
 May use: numpy, the solver's public results (`Analysis`, `Mechanism`), `kinetostat.applied`
-(load magnitudes) and `core`. Never matplotlib, never the harness.
+(load magnitudes), `kinetostat.errors` (the warning), `core` and `zero`. Never matplotlib, never
+the harness.
 """
 from __future__ import annotations
 
 import math
 import string
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -42,6 +50,8 @@ from ..applied import applied_moment, point_forces
 from .core import PlanCycle, Result, Scale, Segment
 from ..model.lettering import lettering, link_number, reaction_name
 from .scales import round_scale
+from ..errors import ModelWarning, _angle_list
+from .zero import ZERO_REL, translates, zero_eps, zero_inertia_force, zero_notes, zero_of
 
 if TYPE_CHECKING:
     from ..analysis import Analysis
@@ -159,9 +169,10 @@ def link_loads(mech: "Mechanism", res: "Analysis", k: int) -> list[Load]:
 
 
 def link_couples(mech: "Mechanism", res: "Analysis", k: int) -> list[Couple]:
-    """The moments on moving link k: inertia main moment M_i<k>, applied moments M<k>."""
+    """The moments on moving link k: inertia main moment M_i<k> (none on a link that translates,
+    `zero.translates`), applied moments M<k>."""
     out = []
-    if mech.links[k].I_S:
+    if mech.links[k].I_S and not translates(mech, k):
         out.append(Couple(f"M_i{k}", k, np.asarray(res.inertia(k).moment, dtype=float)))
     moments = [ld for ld in mech.loads if ld.link == k and ld.kind == "moment"]
     for n, ld in enumerate(moments):
@@ -361,12 +372,14 @@ def _foot(X: np.ndarray, F: np.ndarray, M: np.ndarray) -> np.ndarray:
     return X + _dot(M - X, u) * u
 
 
-def _arrow(segs: list, pts: dict, name: str, X: np.ndarray, F: np.ndarray, mu_l: Scale, mu_F: Scale) -> None:
-    """A force F (N) at world point X (m), each (N,), drawn at mu_F from X/mu_l."""
+def _arrow(segs: list, pts: dict, name: str, X: np.ndarray, F: np.ndarray, mu_l: Scale, mu_F: Scale,
+           kind: str = "vector") -> None:
+    """A force F (N) at world point X (m), each (N,), drawn at mu_F from X/mu_l (`kind`
+    "alternative": one that replaces others drawn, dashed)."""
     start = f"{name}:from"
     pts[start] = np.where(np.isnan(F), np.nan, _over(X, mu_l.value))      # a force NaN where it is not drawn
     pts[f"{name}:to"] = pts[start] + _over(F, mu_F.value)
-    segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
+    segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", kind, mu_F))
 
 
 def _has_arm(mech: "Mechanism", F: np.ndarray, X: np.ndarray, M: np.ndarray) -> np.ndarray:
@@ -459,7 +472,7 @@ def _dyad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: S
     pts: dict[str, np.ndarray] = {}
     segs: list[Segment] = []
     paths: dict[str, np.ndarray] = {}
-    _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_g)
+    drawn_notes = _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_g)
     for o in outer:
         w = o.whole
         if o.normal is None:
@@ -469,7 +482,7 @@ def _dyad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: S
             _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_g)
     for p in (g.pairs[0], g.pairs[1], g.pairs[2]):
         if p.kind == "P":
-            _offset(mech, res, p, pts, segs, mu_l)
+            drawn_notes = [a + b for a, b in zip(drawn_notes, _offset(mech, res, p, pts, segs, mu_l))]
     for links, M_name in _moment_equations(g):
         M = _world(res, next(x for x in links[::-1] if M_name in mech.links[x].points), M_name)
         for x in links:
@@ -478,23 +491,66 @@ def _dyad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: S
     notes = _friction_circles(mech, res, g.pairs, pts, segs, paths, mu_l)
     return _cycle(f"group:{_group_label(g)}", f"Group {_group_label(g)} ({g.kind}): loads and reactions"
                   + (" with friction" if res.friction is not None else "") + f"; forces drawn at {mu_g}",
-                  mu_l, res, pts, segs, paths, notes)
+                  mu_l, res, pts, segs, paths, [tuple(notes) + z for z in drawn_notes])
 
 
 def _links_and_loads(mech: "Mechanism", res: "Analysis", loads: dict[int, list[Load]], pts: dict, segs: list,
-                     paths: dict, mu_l: Scale, mu_F: Scale) -> None:
-    """The links of a group (the keys of `loads`) at mu_l, their loads at mu_F, the inertia
-    moments as arcs and the single inertia resultants."""
+                     paths: dict, mu_l: Scale, mu_F: Scale) -> list[tuple[str, ...]]:
+    """The links of a group (the keys of `loads`) at mu_l, their loads at mu_F, the moments as
+    arcs and the single inertia resultants; an inertia force or a couple not drawn where it is
+    zero (`_zeros`). Returns each angle's notes: what is zero there, what F_i(h) replaces."""
     for x in loads:
         _link_drawing(mech, res, x, pts, segs, mu_l)
+    zeros: dict[str, tuple[np.ndarray, str]] = {}
+    replaces = []
     for x in loads:
+        zeros.update(_zeros(mech, res, x))
         for ld in loads[x]:
-            _arrow(segs, pts, ld.name, ld.point, ld.force, mu_l, mu_F)
-        for c in link_couples(mech, res, x):
-            link = mech.links[x]
-            S = _world(res, x, link.com) if link.com else res.kin.origin_z[:, x]
-            paths[c.name] = _couple_path(_over(S, mu_l.value), c.moment, 8.0)
-        _resultant(mech, res, x, pts, segs, mu_l, mu_F)
+            _load_arrow(segs, pts, ld, zeros, mu_l, mu_F)
+        _couples(mech, res, x, _couple_centre(mech, res, x), 8.0, zeros, paths, mu_l)
+        replaces.append(_resultant(mech, res, x, pts, segs, mu_l, mu_F))
+    notes = zero_notes(zeros, len(res.phi_deg))
+    return [z + tuple(r[i] for r in replaces if r[i]) for i, z in enumerate(notes)]
+
+
+def _zeros(mech: "Mechanism", res: "Analysis", k: int) -> dict[str, tuple[np.ndarray, str]]:
+    """Link k's inertia force and couples where zero (`zero`): name -> ((N,) bool, why: "" at
+    the angle, "link k translates" where M_i<k> is zero by the link's motion)."""
+    link, out = mech.links[k], {}
+    if link.com is not None and link.mass:
+        out[f"F_i{k}"] = (zero_inertia_force(mech, res, k) & ~res.singular, "")
+    if link.I_S:
+        out[f"M_i{k}"] = (zero_eps(mech, res, k) & ~res.singular, f"link {k} translates" if translates(mech, k) else "")
+    for c in link_couples(mech, res, k):
+        if c.name not in out:                     # an applied moment: against its largest over the angles
+            big = np.nanmax(np.abs(c.moment)) if np.isfinite(c.moment).any() else 0.0
+            out[c.name] = (zero_of(c.moment, big) & ~res.singular, "")
+    return out
+
+
+def _load_arrow(segs: list, pts: dict, ld: Load, zeros: dict[str, tuple[np.ndarray, str]], mu_l: Scale,
+                mu_F: Scale) -> None:
+    """Load `ld` as an arrow (`_arrow`), NaN where it is zero (`zeros`); one zero at every angle not
+    drawn at all."""
+    zero = zeros[ld.name][0] if ld.name in zeros else np.zeros(len(ld.force), dtype=bool)
+    if not zero.all():
+        _arrow(segs, pts, ld.name, ld.point, np.where(zero, np.nan, ld.force), mu_l, mu_F)
+
+
+def _couple_centre(mech: "Mechanism", res: "Analysis", k: int) -> np.ndarray:
+    """(N,) complex world m: where link k's couples are drawn, its centre of mass (its origin)."""
+    link = mech.links[k]
+    return _world(res, k, link.com) if link.com else res.kin.origin_z[:, k]
+
+
+def _couples(mech: "Mechanism", res: "Analysis", k: int, at: np.ndarray, radius_mm: float,
+             zeros: dict[str, tuple[np.ndarray, str]], paths: dict, mu_l: Scale) -> None:
+    """Link k's couples as arcs of `radius_mm` about `at` (world m), NaN where zero (`zeros`);
+    one zero at every angle not drawn at all."""
+    for c in link_couples(mech, res, k):
+        zero = zeros[c.name][0]
+        if not zero.all():
+            paths[c.name] = np.where(zero[:, None], np.nan, _couple_path(_over(at, mu_l.value), c.moment, radius_mm))
 
 
 def _leash_parts(mech: "Mechanism", res: "Analysis", side) -> _Parts:
@@ -574,14 +630,14 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
     pts: dict[str, np.ndarray] = {}
     segs: list[Segment] = []
     paths: dict[str, np.ndarray] = {}
-    _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_F)
+    notes = _links_and_loads(mech, res, loads, pts, segs, paths, mu_l, mu_F)
     S_name, S = _special_point(mech, res, g)
     pts[S_name] = _over(S, mu_l.value)
     for (ell, outer, inner, _), o in zip(g.sides, parts):
         w = o.whole
         if o.normal is None:
             _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_F)
-            _offset(mech, res, outer, pts, segs, mu_l)
+            notes = [a + b for a, b in zip(notes, _offset(mech, res, outer, pts, segs, mu_l))]
         else:
             _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_F)
             _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_F)
@@ -600,7 +656,7 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
         for ld in loads[x]:
             _arm(mech, segs, pts, f"{arm_name(ld.name)}({S_name})", S, S_name, ld.point, ld.force, mu_l)
     return _cycle(f"group:{_group_label(g)}", f"Group {g.label} (III3, Assur's point {S_name}): loads and reactions; "
-                  f"forces drawn at {mu_F}", mu_l, res, pts, segs, paths)
+                  f"forces drawn at {mu_F}", mu_l, res, pts, segs, paths, notes)
 
 
 def _triad_polygon(mech: "Mechanism", res: "Analysis", g, sides) -> tuple[list[tuple[str, np.ndarray]], list, list]:
@@ -630,35 +686,79 @@ def _triad_polygon(mech: "Mechanism", res: "Analysis", g, sides) -> tuple[list[t
     return seq, spans, whole
 
 
-def _resultant(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: list, mu_l: Scale, mu_F: Scale) -> None:
+def _resultant(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: list, mu_l: Scale,
+               mu_F: Scale) -> list[str]:
     """The single inertia resultant F_i<k>(h) of a link with both a main vector and a main
-    moment, at z = h/mu_l from S on the side whose moment opposes eps (seed 000 sec. 4), and z;
-    at the angles where it has both (NaN at the others), if at any."""
+    moment (neither zero, `zero`), at z = h/mu_l from S on the side whose moment opposes eps
+    (seed 000 sec. 4), and z; at the angles where it has both (NaN at the others), if at any.
+    It replaces F_i<k> and M_i<k>, which are drawn too: it is drawn as an alternative (kind
+    "alternative": dashed), and each angle's note (N strings, "" where not drawn) says so."""
+    n = len(res.phi_deg)
     link = mech.links[k]
-    if link.com is None or not link.mass:
-        return
+    if link.com is None or not link.mass or not link.I_S or translates(mech, k):
+        return [""] * n
     il = res.inertia(k)
-    F, M = _z(il.force), np.asarray(il.moment)
-    has = (F != 0) & (M != 0)
+    F = _z(il.force)
+    has = ~zero_inertia_force(mech, res, k) & ~zero_eps(mech, res, k) & ~res.singular
     if not has.any():
-        return
+        return [""] * n
     S, K = _world(res, k, link.com), np.where(has, _z(il.point), np.nan)
-    _arrow(segs, pts, f"F_i{k}(h)", K, np.where(has, F, np.nan), mu_l, mu_F)
+    _arrow(segs, pts, f"F_i{k}(h)", K, np.where(has, F, np.nan), mu_l, mu_F, "alternative")
     pts[f"z_{k}:S"] = np.where(has, _over(S, mu_l.value), np.nan)
     segs.append(Segment(f"z_{k}", f"z_{k}:S", f"F_i{k}(h):from", np.where(has, il.h, np.nan), "m", "arm"))
+    return [f"F_i{k}(h) (dashed) replaces F_i{k} and M_i{k}: one or the other acts, not both" if h else ""
+            for h in has.tolist()]
 
 
-def _offset(mech: "Mechanism", res: "Analysis", p, pts: dict, segs: list, mu_l: Scale) -> None:
+def _offset(mech: "Mechanism", res: "Analysis", p, pts: dict, segs: list, mu_l: Scale) -> list[tuple[str, ...]]:
     """The offset x of prismatic pair p's normal force from its slider point, along the guide,
-    where it is defined, if at any angle (NaN at the others)."""
+    where it is defined, if at any angle (NaN at the others). Where it falls outside the slider
+    link (`_off_link`): the link's line drawn on to it (kind "extension", dashed), a
+    ModelWarning naming the pair and the angles, and each angle's note (N tuples) saying so."""
+    n = len(res.phi_deg)
     x = res.reaction_offset(*p.links)
     if np.isnan(x).all():
-        return
-    X = _world(res, p.links[1], p.point)
-    name = "x_" + reaction_name(mech, *p.links)[1:]
+        return [()] * n
+    X, d = _world(res, p.links[1], p.point), _guide(res, p)
+    R = reaction_name(mech, *p.links)
+    name = "x_" + R[1:]
     pts[f"{name}:from"] = np.where(np.isnan(x), np.nan, _over(X, mu_l.value))
-    pts[f"{name}:to"] = (X + x * _guide(res, p)) / mu_l.value   # rounded as before
+    pts[f"{name}:to"] = (X + x * d) / mu_l.value   # rounded as before
     segs.append(Segment(name, f"{name}:from", f"{name}:to", _abs(x), "m", "arm"))
+    lo, hi = _span(mech, res, p)
+    off = _off_link(mech, x, lo, hi)
+    if not off.any():
+        return [()] * n
+    q = link_number(mech, p.links[1])
+    pts[f"{name}:edge"] = np.where(off, _over(X + np.clip(x, lo, hi) * d, mu_l.value), np.nan)
+    segs.append(Segment(f"link {q} extended to {R}", f"{name}:edge", f"{name}:to", np.where(off, _abs(x - np.clip(x, lo, hi)), np.nan),
+                        "m", "extension"))
+    pair = f"P({link_number(mech, p.links[0])},{q})"
+    warnings.warn(ModelWarning(
+        f"pair {pair}: the normal force {R} acts {np.nanmax(np.abs(x[off])):.4g} m from {p.point} at most, outside link {q} "
+        f"(its points span {np.nanmin(lo[off]):.4g} .. {np.nanmax(hi[off]):.4g} m along the guide) at phi = "
+        f"{_angle_list(np.round(res.phi_deg[off], 9))}: "
+        f"the link is shorter than the model's loads need, or its points do not reach its ends"), stacklevel=3)
+    return [(f"{R} acts {abs(v):.4g} m from {p.point}, outside link {q} ({a:.4g} .. {b:.4g} m along the guide): "
+             f"the link's line drawn on to it, dashed",) if o else ()
+            for v, a, b, o in zip(x.tolist(), lo.tolist(), hi.tolist(), off.tolist())]
+
+
+def _span(mech: "Mechanism", res: "Analysis", p) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) each, m: the least and the greatest of prismatic pair p's slider link's points along
+    the guide, from its slider point."""
+    k = p.links[1]
+    X, d = _world(res, k, p.point), _guide(res, p)
+    along = np.stack([_dot(_world(res, k, name) - X, d) for name in mech.links[k].points])
+    return along.min(axis=0), along.max(axis=0)
+
+
+def _off_link(mech: "Mechanism", x: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(N,) bool: where offset x (m) lies outside [lo, hi] by more than ZERO_REL of the mechanism's
+    size, on a link that has a length along the guide (a slider drawn as one point has none)."""
+    tol = ZERO_REL * mech.size
+    with np.errstate(invalid="ignore"):
+        return (hi - lo > tol) & ((x < lo - tol) | (x > hi + tol))
 
 
 def _polygon(mech: "Mechanism", res: "Analysis", g: "AssurGroup") -> tuple[list[tuple[str, np.ndarray]], int, int]:
@@ -797,12 +897,12 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
     _link_drawing(mech, res, 1, pts, segs, mu_l)
     O = _world(res, 1, dr.pivot)
     on_crank = _carried(mech, res, 1, set(range(2, mech.n_links))) + link_loads(mech, res, 1)
+    zeros = _zeros(mech, res, 1)
     for ld in on_crank:
-        _arrow(segs, pts, ld.name, ld.point, ld.force, mu_l, mu_F)
+        _load_arrow(segs, pts, ld, zeros, mu_l, mu_F)
     for ld in on_crank:
         _arm(mech, segs, pts, arm_name(ld.name), O, dr.pivot, ld.point, ld.force, mu_l)
-    for c in link_couples(mech, res, 1):
-        paths[c.name] = _couple_path(_over(O, mu_l.value), c.moment, 6.0)
+    _couples(mech, res, 1, O, 6.0, zeros, paths, mu_l)
     R01 = _reaction_load(mech, res, 0, 1)
     _arrow(segs, pts, R01.name, R01.point, R01.force, mu_l, mu_F)
     M_bal = np.asarray(res.balancing_moment, dtype=float)
@@ -834,7 +934,7 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
         results = (Result(L.M_bal, M_bal, "N m", "M = sum"),)
     notes = _friction_circles(mech, res, [p for p in mech.pairs if dr.link in p.links], pts, segs, paths, mu_l)
     return _cycle("crank", [f"{t}; forces drawn at {mu_F}" for t in titles], mu_l, res, pts, segs, paths,
-                  notes=notes, results=results)
+                  notes=[tuple(notes) + z for z in zero_notes(zeros, len(res.phi_deg))], results=results)
 
 
 def _line_of_action(gear, M: np.ndarray) -> np.ndarray:

@@ -440,6 +440,20 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
 #: The English phrases of the generated notes (positions, branches) and their translations,
 #: longest first where one contains another.
 PHRASES: tuple[tuple[str, str, str], ...] = (
+    # what is not drawn (plans.zero), alternatives, special positions, forces off their link
+    (" (dashed) replaces ", " (штрихова) замінює ", " (штриховая) заменяет "),
+    (": one or the other acts, not both", ": діє одне або інше, не обидва", ": действует одно или другое, не оба"),
+    (" and M_i", " і M_i", " и M_i"),
+    (" (at this angle): not drawn", " (у цьому положенні): не показано", " (в этом положении): не показано"),
+    (" translates): not drawn", " рухається поступально): не показано", " движется поступательно): не показано"),
+    ("special position:", "особливе положення:", "особое положение:"),
+    (", the plan collapses there", ", план тут вироджується", ", план здесь вырождается"),
+    (" outside link ", " поза ланкою ", " вне звена "),
+    (" m along the guide): the link's line drawn on to it, dashed", " м уздовж напрямної): лінію ланки продовжено до неї штрихом",
+     " м вдоль направляющей): линия звена продолжена до неё штрихом"),
+    (" acts ", " діє на відстані ", " действует на расстоянии "),
+    (" m from ", " м від ", " м от "),
+    ("(link ", "(ланка ", "(звено "),
     ("(crank and rod in line), then every 30 deg", "(кривошип і шатун на одній прямій), далі через 30°",
      "(кривошип и шатун на одной прямой), далее через 30°"),
     ("drawn with plain letters", "позначене літерами без індексу", "обозначено буквами без индекса"),

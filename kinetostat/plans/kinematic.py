@@ -20,7 +20,8 @@ exists at some angles only is NaN (not drawn) at the others.
 
 May use: numpy, `kinetostat.solve` (the exact results: the plans' own analysis is never re-solved;
 solved here once each: the cycle of positions, the starting position, the other assembly branch
-at the angles drawn), `kinetostat.kinematics` (Assur's special point), `.core`.
+at the angles drawn), `kinetostat.kinematics` (Assur's special point), `.core`, `.zero` (a plan's
+side that collapses).
 """
 from __future__ import annotations
 
@@ -33,6 +34,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .core import PlanCycle, Scale, Segment
+from .zero import translates, zero_of
 
 __all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
@@ -198,7 +200,26 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         points[name] = vS / mu.value
         segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s")
                  for r, on in refs]
-    return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points, tuple(segs))
+    return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points, tuple(segs),
+                     notes=_collapsed(mech, pts, segs, len(res.phi_deg)))
+
+
+def _collapsed(mech, pts: dict[str, _Point], segs: list[Segment], n: int) -> tuple[tuple[str, ...], ...]:
+    """Each of n angles' notes naming the special position where a side of a velocity or an
+    acceleration plan collapses to a point (its value zero, `zero.zero_of`, against the plan's
+    largest there): 'special position: p-b = 0, the plan collapses there' (b on the pole). A
+    side between two points of a link that translates (`zero.translates`) is zero at every
+    angle: no special position."""
+    still = {n for n, q in pts.items() if translates(mech, q.link)}
+    segs = [s for s in segs if not (s.start in still and s.end in still)]
+    if not segs:
+        return ((),) * n
+    vals = np.stack([np.broadcast_to(np.asarray(s.value, dtype=float), (n,)) for s in segs])
+    with np.errstate(invalid="ignore"):
+        ref = np.max(np.where(np.isfinite(vals), vals, 0.0), axis=0)
+        zero = zero_of(vals, ref) & (ref > 0)
+    return tuple(tuple(f"special position: {s.name} = 0, the plan collapses there"
+                       for s, z in zip(segs, zero[:, i]) if z) for i in range(n))
 
 
 def _special(mech, res, pts: dict) -> list[tuple[str, int, np.ndarray, list[tuple[str, np.ndarray | None]]]]:
@@ -310,7 +331,7 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
     return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,
-                     points, tuple(segs))
+                     points, tuple(segs), notes=_collapsed(mech, pts, segs, len(res.phi_deg)))
 
 
 # ----------------------------------------------------------------------------- plan of positions

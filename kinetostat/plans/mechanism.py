@@ -1,13 +1,15 @@
 """The mechanism at its design position, drawn as seed 002 fig. 1.6 draws it: the links to scale
 (mu_l), the frame hatched under its pins and along its guides, the pairs drawn as pairs (a pin
 as a small circle, a slider as a block on its guide), the centres of mass, and the senses of
-every link's angular velocity ω and acceleration ε as arcs with an arrowhead.
+every link's angular velocity ω and acceleration ε as arcs with an arrowhead, about the link; a
+zero ω or ε not drawn, and named in a note.
 
 Built at every angle of an analysis at once (`PlanCycle`: points (N,), marks (N, K)).
 The drawing's marks are `PlanCycle.paths` (sheet mm) named by what they are: "pin A", "block B",
 "support O", "hatch ..", "com S2", and "ω2", "ε2" for the senses; `draw` draws each by its name.
 
-May use: numpy, `core`, `forces` (the links drawn at mu_l), `kinematic` (which angles draw).
+May use: numpy, `core`, `forces` (the links drawn at mu_l), `kinematic` (which angles draw), `zero`
+(which ω, ε are zero).
 Never matplotlib.
 """
 from __future__ import annotations
@@ -17,7 +19,8 @@ import numpy as np
 
 from .core import PlanCycle, Scale, Segment
 from .forces import _link_drawing, _world
-from .kinematic import _any, _ok, _titles
+from .kinematic import _ok, _titles
+from .zero import translates, zero_eps, zero_notes, zero_omega
 
 __all__ = ["mechanism_plan", "PIN_MM", "BLOCK_MM", "ARC_MM"]
 
@@ -99,8 +102,9 @@ def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
 
 def mechanism_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     """The mechanism at every angle of `res` at mu_l: links, frame supports and guides hatched,
-    pins and blocks, centres of mass, and the arcs of ω_k and ε_k of every link turning at some
-    angle (not drawn, NaN, at an angle where that one is zero)."""
+    pins and blocks, centres of mass, and the arcs of ω_k and ε_k of every link that does not
+    translate, about the link (`_arc_centre`); an arc not drawn (NaN) at an angle where its
+    quantity is zero (`zero`), and a note there says so."""
     mu = scales["mu_l"]
     pts: dict[str, np.ndarray] = {}
     segs: list = []
@@ -130,19 +134,33 @@ def mechanism_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
             for s in (1.0, -1.0):
                 a, b = S - 14.0 * d + s * (w / 2 + 0.5) * n, S + 14.0 * d + s * (w / 2 + 0.5) * n
                 _hatch(a, b, s * n, f"hatch {p.point}{'+' if s > 0 else '-'}", paths)
+    zeros: dict[str, tuple[np.ndarray, str]] = {}
     for k in range(1, mech.n_links):
         link = mech.links[k]
         if link.com and link.com in pts:
             paths[f"com {link.com}"] = _circle(pts[link.com], 1.6, 12)
-        w, e = res.kin.omega[:, k], res.kin.eps[:, k]
-        turns = {f"ω{k}": (w, ARC_MM[0]), f"ε{k}": (e, ARC_MM[1])}
-        turns = {name: v for name, v in turns.items() if _any(v[0], res)}
-        if not turns:
-            continue                              # a translating link turns not
-        joints = [s for s in segs if s.kind == "link" and s.start in link.points]
-        c = pts[joints[0].start] if k == mech.drive.link else (
-            (pts[joints[0].start] + pts[joints[0].end]) / 2 if joints else pts[next(iter(link.points))])
-        for name, (v, r) in turns.items():
-            arc = _arc(c, r, np.sign(v))
-            paths[name] = np.where((v != 0)[:, None], arc, np.nan)
+        if translates(mech, k):
+            continue                              # a translating link turns not: no arcs, nothing to note
+        turns = {f"ω{k}": (res.kin.omega[:, k], zero_omega(mech, res, k), ARC_MM[0]),
+                 f"ε{k}": (res.kin.eps[:, k], zero_eps(mech, res, k), ARC_MM[1])}
+        c = _arc_centre(mech, k, pts)
+        for name, (v, zero, r) in turns.items():
+            zeros[name] = (zero & _ok(res), "")
+            if (~zero & _ok(res)).any():
+                paths[name] = np.where(zero[:, None], np.nan, _arc(c, r, np.sign(v)))
+    return PlanCycle("mechanism", _titles("Mechanism at phi = {at:g} deg", res), mu, res.phi_deg, pts, tuple(segs), paths,
+                     tuple(zero_notes(zeros, len(res.phi_deg))))
+
+
+def _arc_centre(mech, k: int, pts: dict) -> np.ndarray:
+    """(N,) sheet mm: where link k's ω and ε arcs are drawn, about the link itself: the crank's
+    about its pivot, another link's midway between its first two joints (its only joint, or its
+    first point, where it has fewer)."""
+    if k == mech.drive.link:
+        return pts[mech.drive.pivot]
+    link = mech.links[k]
+    joints = list(dict.fromkeys(p.point for p in mech.pairs if k in p.links and p.point in link.points))
+    if len(joints) >= 2:
+        return (pts[joints[0]] + pts[joints[1]]) / 2
+    return pts[joints[0] if joints else next(iter(link.points))]
     return PlanCycle("mechanism", _titles("Mechanism at phi = {at:g} deg", res), mu, res.phi_deg, pts, tuple(segs), paths)
