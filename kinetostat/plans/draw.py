@@ -13,7 +13,8 @@ its notes.
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
 results (vectors, the design position) thick, construction thin; a vector shorter than 1 mm at
 its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a polygon whose sides must
-close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
+close, lettered at its point and noted as negligible; the lever's arms as dimension lines with
+their mm (`_dimensions`); every letter placed by `labels.Placer`
 (for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
@@ -590,9 +591,10 @@ def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
     line from the pole to the foot on its force's line, with an arrowhead at both ends (on a
     sheet, the force's line carried on to the foot as a thin construction line); arms that
     coincide at an angle (the loads at b of a slider, all across p-b) drawn and lettered once,
-    'h_Fi3 ≡ h_G3 ≡ h_Fp = 54,60'; the value (mm, as drawn) on a sheet, the names only on the
-    page (`contract`: its step equations give the lengths), whose arrowheads are the line's
-    markers (`_DIMENSION_MARKER`: no coordinates per angle). Obstacles given to the placer."""
+    their loads in one subscript, 'h_G3,Fi3,Fp = 54,60'; the value (mm, as drawn) on a sheet,
+    the names only on the page (`contract`: its step equations give the lengths), whose
+    arrowheads are the line's markers (`_DIMENSION_MARKER`: no coordinates per angle).
+    Obstacles given to the placer."""
     arms = [s for s in cycle.segments if _dimension(cycle, s)]
     if not arms:
         return []
@@ -608,24 +610,24 @@ def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
         ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) & cycle.drawn(s)
         if not ok.any():
             continue
-        data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name),
-                "marker-start": "url(#dimension)", "marker-end": "url(#dimension)"} if contract else {}
-        out.append(Element("line", _where(ok, np.stack([a, b], axis=1)), {"stroke": colour, "stroke-width": f"{width}", **data},
-                           title=escape(segment_label(s, lang)), length_mm=mm[j] if contract else None))
-        lead = ok & (owner[:, j] == j)
-        placer.line(_where(ok, _lines(a, b)))
         if not contract:                          # the force's line carried to the foot (an extension line)
             c = at(cycle.points[forces[s.name].start])
             far = ok & (np.hypot(*(b - c).T) > 0.5)
             out.append(Element("line", _where(far, np.stack([c, b], axis=1)),
                                {"stroke": ext_colour, "stroke-width": f"{ext_width}", "stroke-dasharray": ext_dash}))
             placer.line(_where(far, _lines(c, b)))
+        data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name),
+                "marker-start": "url(#dimension)", "marker-end": "url(#dimension)"} if contract else {}
+        out.append(Element("line", _where(ok, np.stack([a, b], axis=1)), {"stroke": colour, "stroke-width": f"{width}", **data},
+                           title=escape(segment_label(s, lang)), length_mm=mm[j] if contract else None))
+        lead = ok & (owner[:, j] == j)
+        placer.line(_where(ok, _lines(a, b)))
         for tail, tip in ((a, b), (b, a)):
             head, box, _ = _arrowhead(tail, tip, DIMENSION_ARROW_MM)
             if not contract:
                 out.append(Element("path", _where(lead, head), {"class": "arrowhead dimension", "fill": colour}))
             placer.block(_where(ok, box))
-        strings = [" ≡ ".join(segment_label(arms[m], lang) for m in np.nonzero(owner[i] == j)[0])
+        strings = ["h_" + ",".join(arms[m].name[2:] for m in np.nonzero(owner[i] == j)[0])     # h_G3,Fi3,Fp
                    + ("" if contract else f" = {num(mm[j][i], lang, decimals=2)}") if lead[i] else ""
                    for i in range(cycle.n)]
         texts, variant = _variants(strings)
