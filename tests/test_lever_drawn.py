@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import kinetostat
+from kinetostat import variants
 from kinetostat.plans.core import Scale
 from kinetostat.plans.draw import svg
 from kinetostat.plans.forces import arm_name, crank_plan, group_plans
@@ -151,3 +152,15 @@ def test_lever_sheet_says_what_is_turned_and_dimensions_its_arms(lang):
     assert len(at_b) == 1 and "G3" in at_b[0] and "Fi3" in at_b[0], lettered
     dec = "," if lang != "en" else "."
     assert any(t.startswith("hFi2 = 37" + dec) for t in lettered), lettered     # seed 002: h_Fi2 = 37.67 mm
+
+
+def test_no_arm_where_the_force_line_meets_the_pole():
+    """Variant 2/479 at 90 deg (the crank square to the cylinders: teach-09's pile-up at p): the
+    weights G2..G5 turned lie on their points' lines through p, so they have no arm and none is
+    drawn at p; every arm drawn is longer than rounding, and their moments still close."""
+    mech = variants.variant(2, "479").mechanism()
+    res, lever = _lever(mech, [90.0])
+    plan = lever.at(0)
+    arms = {s.name: plan.length_mm(s.name) for s in plan.segments if s.kind == "arm"}
+    assert not {f"h_G{k}" for k in range(2, 6)} & set(arms), arms
+    assert min(arms.values()) > 1.0 and len(arms) == 10
