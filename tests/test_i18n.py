@@ -69,8 +69,8 @@ def _words(path) -> str:
     return re.sub(r"`[^`]*`|\]\([^)]*\)", " ", raw)
 
 
-#: A Latin word standing alone (not part of a symbol such as R43, h_G2, a^Cor, P(3,4), x_B) ...
-_LATIN = re.compile(r"(?<![\w^'’\\])[A-Za-z]{2,}(?![\w^'’(\\])")
+#: A Latin word standing alone (not part of a symbol such as R43, h_G2, a^Cor, P(3,4), x_B, h_G3,Fp) ...
+_LATIN = re.compile(r"(?<![\w^'’\\,])[A-Za-z]{2,}(?![\w^'’(\\])")
 #: ... that is a letter name and not English: the Assur groups' kinds (RRP), a segment (ab, pa), cos.
 _SYMBOLS = re.compile(r"[RP]{3}|[A-Z]{2}|[a-z]{2}|sin|cos|tan")
 

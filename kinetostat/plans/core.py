@@ -78,7 +78,7 @@ class Result:
 @dataclass(frozen=True)
 class Plan:
     """A plan of the method at one crank angle: points on the sheet (mm, x right, y up, the world's
-    orientation unless the plan says otherwise, e.g. the lever turned by 90 deg), its segments,
+    orientation unless the plan says otherwise, e.g. the lever's forces turned by 90 deg), its segments,
     and its scale. `kind` is one of "positions", "velocity", "acceleration", "group:<i,j>",
     "forces:<i,j>", "crank", "lever" (the `plan` column of segments.csv)."""
     kind: str

@@ -14,13 +14,14 @@ Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), d
 results (vectors, the design position) thick, construction thin, an alternative (F_i2(h)) and a
 link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a
 vector shorter than 1 mm at its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a
-polygon whose sides must close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
+polygon whose sides must close, lettered at its point and noted as negligible; the lever's arms as
+dimension lines with their mm (`_dimensions`); every letter placed by `labels.Placer`
 (for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
 
-May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `kinetostat._text` (XML-safe
-text); matplotlib only inside `figure`.
+May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `.forces` (an arm's name),
+`kinetostat._text` (XML-safe text); matplotlib only inside `figure`.
 """
 from __future__ import annotations
 
@@ -33,6 +34,7 @@ import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
+from .forces import arm_name
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, label_parts, text_width
 
@@ -72,10 +74,19 @@ def fits(plan: Plan) -> float:
 
 #: How each kind of segment is drawn: stroke width (mm), dash pattern, colour.
 _STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
-          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33"),
+          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33"), "dimension": (0.25, "", "#a33"),
           "alternative": (0.35, "3,1.5", "#000"), "extension": (0.35, "3,1.5", "#000")}
 #: The kinds drawn as arrows: a vector, and one drawn as the alternative of others (F_i2(h), dashed).
 _ARROWS = ("vector", "alternative")
+#: A dimension line's arrowheads (the lever's arms), mm: the drafting size of a thin line's arrow.
+DIMENSION_ARROW_MM = 2.5
+_DIM_HALF = ARROW_MM[1] * DIMENSION_ARROW_MM / ARROW_MM[0]
+#: The page's dimension arrowhead: an SVG marker at both ends of the line (no coordinates per angle).
+_DIMENSION_MARKER = (f'<defs><marker id="dimension" markerUnits="userSpaceOnUse" orient="auto-start-reverse" '
+                     f'markerWidth="{DIMENSION_ARROW_MM:g}" markerHeight="{2 * _DIM_HALF:g}" '
+                     f'viewBox="0 0 {DIMENSION_ARROW_MM:g} {2 * _DIM_HALF:g}" refX="{DIMENSION_ARROW_MM:g}" '
+                     f'refY="{_DIM_HALF:g}"><path d="M{DIMENSION_ARROW_MM:g},{_DIM_HALF:g} L0,0 L0,{2 * _DIM_HALF:g} z" '
+                     f'fill="{_STYLE["dimension"][2]}"/></marker></defs>')
 
 
 def _lang(lang: str) -> int:
@@ -294,7 +305,7 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
             lines.append(f"{_n(s.name)}{mark} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
                          f"{text(key, lang, length=num(L, lang, decimals=2))}")
     if plan.kind == "lever":
-        lines.append(text("arms natural", lang))
+        lines += [text("lever turned", lang), text("arms natural", lang)]
     return lines
 
 
@@ -534,6 +545,8 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
     sides = {s.name for s in _polygon_sides(cycle)} or None        # a polygon: every side and chord named
     zero = np.zeros(n, dtype=int)
     for s in cycle.segments:
+        if _dimension(cycle, s):
+            continue
         za, zb = cycle.points[s.start], cycle.points[s.end]
         a, b = at(za), at(zb)
         ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) & cycle.drawn(s)
@@ -579,6 +592,60 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         if lettered.any():
             names.append(_Name((segment_label(s, lang), segment_label(s, lang) + "*"), out_.astype(int),
                                _where(lettered, a), _where(drawn & named, b), _NAME_MM, "name"))
+    return out
+
+
+def _dimension(cycle: PlanCycle, s: Segment) -> bool:
+    """Whether `s` is drawn as a dimension line (`_dimensions`): an arm on the lever."""
+    return cycle.kind == "lever" and s.kind == "arm"
+
+
+def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer, names: list[_Name]) -> list[Element]:
+    """The lever's arms as dimension lines (seed 002 fig. 1.12: h_Fi2 = 37.67 mm): each a thin
+    line from the pole to the foot on its force's line, with an arrowhead at both ends (on a
+    sheet, the force's line carried on to the foot as a thin construction line); arms that
+    coincide at an angle (the loads at b of a slider, all across p-b) drawn and lettered once,
+    their loads in one subscript, 'h_G3,Fi3,Fp = 54,60'; the value (mm, as drawn) on a sheet,
+    the names only on the page (`contract`: its step equations give the lengths), whose
+    arrowheads are the line's markers (`_DIMENSION_MARKER`: no coordinates per angle).
+    Obstacles given to the placer."""
+    arms = [s for s in cycle.segments if _dimension(cycle, s)]
+    if not arms:
+        return []
+    width, dash, colour = _STYLE["dimension"]
+    ext_width, ext_dash, ext_colour = _STYLE["line"]
+    forces = {arm_name(f.name): f for f in cycle.segments if f.unit == "N"}
+    starts = [at(cycle.points[s.start]) for s in arms]
+    ends = [at(cycle.points[s.end]) for s in arms]
+    owner = coincident(np.stack(ends, axis=1))                     # (N, M): the arm lettered for each
+    mm = [cycle.length_mm(s.name) for s in arms]
+    out = []
+    for j, (s, a, b) in enumerate(zip(arms, starts, ends)):
+        ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) & cycle.drawn(s)
+        if not ok.any():
+            continue
+        if not contract:                          # the force's line carried to the foot (an extension line)
+            c = at(cycle.points[forces[s.name].start])
+            far = ok & (np.hypot(*(b - c).T) > 0.5)
+            out.append(Element("line", _where(far, np.stack([c, b], axis=1)),
+                               {"stroke": ext_colour, "stroke-width": f"{ext_width}", "stroke-dasharray": ext_dash}))
+            placer.line(_where(far, _lines(c, b)))
+        data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name),
+                "marker-start": "url(#dimension)", "marker-end": "url(#dimension)"} if contract else {}
+        out.append(Element("line", _where(ok, np.stack([a, b], axis=1)), {"stroke": colour, "stroke-width": f"{width}", **data},
+                           title=escape(segment_label(s, lang)), length_mm=mm[j] if contract else None))
+        lead = ok & (owner[:, j] == j)
+        placer.line(_where(ok, _lines(a, b)))
+        for tail, tip in ((a, b), (b, a)):
+            head, box, _ = _arrowhead(tail, tip, DIMENSION_ARROW_MM)
+            if not contract:
+                out.append(Element("path", _where(lead, head), {"class": "arrowhead dimension", "fill": colour}))
+            placer.block(_where(ok, box))
+        strings = ["h_" + ",".join(arms[m].name[2:] for m in np.nonzero(owner[i] == j)[0])     # h_G3,Fi3,Fp
+                   + ("" if contract else f" = {num(mm[j][i], lang, decimals=2)}") if lead[i] else ""
+                   for i in range(cycle.n)]
+        texts, variant = _variants(strings)
+        names.append(_Name(tuple(texts), variant, _where(lead, a), _where(lead, b), _NAME_MM, "name"))
     return out
 
 
@@ -648,7 +715,10 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     placer.block(_TITLE_BLOCK)
     names: list[_Name] = []
     elements = _paths(cycle, lang, contract, at, placer, names)
+    dimensions: list[_Name] = []
+    elements += _dimensions(cycle, lang, contract, at, placer, dimensions)       # under the vectors, lettered after
     elements += _segments(cycle, lang, contract, at, tiny, placer, names)
+    names += dimensions
     dots, points = _points(cycle, at, placer)
     elements += dots + _labels(placer, points + names)
     title = _title_block(cycle, lang, mechanism)
@@ -661,6 +731,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
               f'<rect x="0" y="0" width="{W:g}" height="{H:g}" fill="#fff"/>',
               f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
               f'fill="none" stroke="#000" stroke-width="0.7"/>',
+              *([_DIMENSION_MARKER] if contract and any(_dimension(cycle, s) for s in cycle.segments) else []),
               '<g id="plan" stroke-linecap="round">', ELEMENTS.rstrip("\n"), "</g>",
               f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
               f'stroke="#000" stroke-width="0.5"/>',

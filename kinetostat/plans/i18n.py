@@ -56,6 +56,12 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                    "пренебрежимо мала: {length} мм в масштабе, не откладывается"),
     "arms natural": ("arms h measured on the drawing, mm", "плечі h виміряно на кресленні, мм",
                      "плечи h измерены на чертеже, мм"),
+    "lever turned": ("the velocity plan is not turned: every force is turned by 90° clockwise and carried to the "
+                     "like point of the plan; arms h are dimension lines from the pole p to the forces' lines",
+                     "план швидкостей не повернуто: кожну силу повернуто на 90° за годинниковою стрілкою й "
+                     "перенесено в однойменну точку плану; плечі h — розмірні лінії від полюса p до ліній дії сил",
+                     "план скоростей не повёрнут: каждая сила повёрнута на 90° по часовой стрелке и перенесена в "
+                     "одноимённую точку плана; плечи h — размерные линии от полюса p до линий действия сил"),
     "within 5": ("within the texts' 5 %", "у межах допустимих 5 %", "в пределах допустимых 5 %"),
     "beyond 5": ("beyond the texts' 5 %", "перевищує допустимі 5 %", "превышает допустимые 5 %"),
     "by force plans": ("by the force plans", "за планами сил", "по планам сил"),

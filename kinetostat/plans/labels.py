@@ -82,33 +82,41 @@ def _sub(size: float) -> float:
     return max(MIN_TEXT_MM, 0.75 * size)
 
 
+#: Where a label joins names: coincident ones (' ≡ '), a name and its value (' = ': an arm's mm).
+_JOIN = re.compile(r"( [≡=] )")
+
+
+def _joined(name: str) -> list[tuple[str, str]]:
+    """A label as (joint before, name) pairs: 'h_G3 ≡ h_Fp = 54,6' -> ('', 'h_G3'), (' ≡ ', 'h_Fp'), (' = ', '54,6')."""
+    pieces = _JOIN.split(name)
+    return list(zip([""] + pieces[1::2], pieces[0::2]))
+
+
 def label_width(name: str, size: float) -> float:
-    """Width of a lettered name (several names joined by ' ≡ ' allowed), mm."""
+    """Width of a lettered name (several names joined by ' ≡ ', a value after ' = ' allowed), mm."""
     w = 0.0
-    for k, part in enumerate(name.split(" ≡ ")):
+    for joint, part in _joined(name):
         head, sub, primes = label_parts(part)
-        w += text_width(head, size) + text_width(sub, _sub(size)) + text_width(primes, size)
-        if k:
-            w += text_width(" ≡ ", size)
+        w += text_width(joint, size) + text_width(head, size) + text_width(sub, _sub(size)) + text_width(primes, size)
     return w
 
 
 def label_height(name: str, size: float) -> tuple[float, float]:
     """(above, below) the baseline of a lettered name, mm."""
     below = DESCENT * size
-    if any(label_parts(p)[1] for p in name.split(" ≡ ")):
+    if any(label_parts(p)[1] for _, p in _joined(name)):
         below = max(below, 0.3 * size + DESCENT * _sub(size))
     return ASCENT * size, below
 
 
 def label_markup(name: str, size: float) -> str:
     """The content of a lettered name's <text> at font size `size`: letters, subscript (a smaller
-    tspan below), primes; coincident names joined by ' ≡ '."""
+    tspan below), primes; coincident names joined by ' ≡ ', a value after ' = '."""
     out = []
     low = 0.0                                     # how far below the baseline the last tspan sits
-    for k, part in enumerate(name.split(" ≡ ")):
+    for joint, part in _joined(name):
         head, sub, primes = label_parts(part)
-        for piece, dy, small in (((" ≡ " if k else ""), -low, False), (head, 0.0, False),
+        for piece, dy, small in ((joint, -low, False), (head, 0.0, False),
                                  (sub, 0.3 * size, True), (primes, -0.3 * size if sub else 0.0, False)):
             if not piece:
                 continue

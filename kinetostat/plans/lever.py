@@ -1,13 +1,14 @@
-"""Zhukovsky's rigid lever drawn (seed 000 sec. 8, seed 002 sec. 1.2.3, fig. 1.12): the velocity
-plan turned by 90 deg with every load at its like point, the arms about the pole and the
-balancing force F'_bal at the crank pin's image, as a `PlanCycle` at the N angles of an
-analysis at once (as `forces` builds its plans); and the check of M_bal by both routes.
+"""Zhukovsky's rigid lever drawn (seed 002 sec. 1.2.3, fig. 1.12; seed 000 sec. 8): the velocity
+plan as it is, every load turned by 90 deg clockwise at its like point (TURN), the arms about the
+pole and the balancing force F'_bal at the crank pin's image, across p-a, as a `PlanCycle` at the
+N angles of an analysis at once (as `forces` builds its plans); and the check of M_bal by both
+routes.
 
-The plan is turned by 90 deg counter-clockwise (each image is i v / mu_v) and the forces keep
-their true directions. Seed 002 keeps the plan and turns the forces by 90 deg clockwise instead:
-the same figure turned as a whole, with the same arms and moments. The moment about the pole of
-a force F at the image of a point of velocity v is then -(F . v) / mu_v, minus its power over
-mu_v, so that sum(moments) mu_v / omega_1 = M_bal (the balancing moment on the crank).
+Seed 002 keeps the plan and turns the forces by 90 deg clockwise, as drawn here; seed 000 turns the
+plan by 90 deg and keeps the forces: the same figure turned as a whole, with the same arms and
+moments. The moment about the pole of a force F turned at the image of a point of velocity v is
+-(F . v) / mu_v, minus its power over mu_v, so that sum(moments) mu_v / omega_1 = M_bal (the
+balancing moment on the crank).
 
 An inertia main moment M_i (and an applied moment) is replaced, as seed 002 does, by a couple of
 forces M_i / l_AB at the ends a, b of the link's image, across the link AB on the mechanism.
@@ -28,12 +29,14 @@ if TYPE_CHECKING:
     from ..analysis import Analysis
     from ..model import Mechanism
 
-__all__ = ["lever_plan", "lever_check", "pole_moment", "NATURAL", "TOLERANCE_PCT"]
+__all__ = ["lever_plan", "lever_check", "pole_moment", "NATURAL", "TOLERANCE_PCT", "TURN"]
 
 #: The arms on the lever are measured on the drawing and kept in mm (seed 002: h_Fi2 = 37.67 mm).
 NATURAL = Scale("natural", 1.0, "mm/mm")
 #: The texts' rule: the two balancing moments may differ by 5 % (seed 002, line 468).
 TOLERANCE_PCT = 5.0
+#: How a load is turned onto the lever: by 90 deg clockwise (F -> -i F), as seed 002 turns them.
+TURN = -1j
 
 
 def _couple_ends(mech: "Mechanism", k: int) -> list[tuple[str, tuple[float, float]]]:
@@ -54,10 +57,10 @@ def _couple_ends(mech: "Mechanism", k: int) -> list[tuple[str, tuple[float, floa
 def _image(mech: "Mechanism", res: "Analysis", k: int, name: str, mu_v: Scale, pts: dict,
            local: tuple[float, float] | None = None) -> str:
     """Name of the like point of point `name` of link k (at `local`, default the link's point of
-    that name) on the turned plan: lower case, with the link's number where another link's point
+    that name) on the velocity plan: lower case, with the link's number where another link's point
     of that name moves otherwise at any of the angles. Added to pts ((N,) complex, mm)."""
     v = np.asarray(res.kin.velocity_z(k, mech.links[k].points[name] if local is None else local), dtype=complex)
-    z = _over(1j * v, mu_v.value)
+    z = _over(v, mu_v.value)
     key = name.lower()
     if key in pts and (_abs(pts[key] - z) > 1e-9 * np.maximum(1.0, _abs(z))).any():
         key = f"{key}{k}"
@@ -67,11 +70,12 @@ def _image(mech: "Mechanism", res: "Analysis", k: int, name: str, mu_v: Scale, p
 
 def lever_plan(mech: "Mechanism", res: "Analysis", mu_v, mu_F: Scale | None = None) -> PlanCycle:
     """Zhukovsky's lever at mu_v at the N angles of `res`: pole p, the image of every point of the
-    moving links (turned by 90 deg counter-clockwise), the vectors p-x and the links' images (a-b,
-    values in m/s), every force at its like point (its value in N, drawn at a round force scale of
-    its own; couples as two forces "M_i2/l (a)", "M_i2/l (b)"), the arms h_.. about the pole
-    (value: the arm's drawn length in mm, as the texts keep it: `NATURAL`), and the balancing
-    force F'_bal (the model's lettering: F'_зр) at the crank pin's image, across p-a, whose moment
+    moving links (the velocity plan, not turned), the vectors p-x and the links' images (a-b,
+    values in m/s), every force turned by 90 deg clockwise (`TURN`) at its like point (its value
+    in N, drawn at a round force scale of its own; couples as two forces "M_i2/l (a)",
+    "M_i2/l (b)"), the arms h_.. about the pole to the turned force's line where not zero (value:
+    the arm's drawn length in mm, as the texts keep it: `NATURAL`), and the balancing force
+    F'_bal (the model's lettering: F'_зр) at the crank pin's image, across p-a, whose moment
     about the pole cancels the loads'. Its results: F'_bal, M'_bal, M_bal by the force plans and
     their difference δ against the texts' 5 % (TOLERANCE_PCT). `mu_F`: the forces' scale
     (default: chosen for the largest force over the angles). An element that exists at some
@@ -86,7 +90,7 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
     n = len(res.phi_deg)
     pts: dict[str, np.ndarray] = {"p": np.zeros(n, dtype=complex)}
     segs: list[Segment] = []
-    forces: list[tuple[str, str, np.ndarray]] = []     # (name, image point, force N (N,))
+    forces: list[tuple[str, str, np.ndarray]] = []     # (name, image point, force turned N (N,))
     for k in range(1, mech.n_links):
         link = mech.links[k]
         images = [_image(mech, res, k, name, mu_v, pts) for name in link.points]
@@ -103,7 +107,7 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
                     segs.append(Segment(f"{ia}-{ib}", ia, ib, np.where(off, _abs(pts[ib] - pts[ia]) * mu_v.value, np.nan),
                                         "m/s", "link"))
         for ld in link_loads(mech, res, k):
-            forces.append((ld.name, images[list(link.points).index(ld.at)], ld.force))
+            forces.append((ld.name, images[list(link.points).index(ld.at)], TURN * ld.force))
         for c in link_couples(mech, res, k):
             acts = c.moment != 0
             if not acts.any():
@@ -112,7 +116,7 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
             A, B = (np.asarray(res.kin.position_z(k, q), dtype=complex) for q in (la, lb))
             F = np.where(acts, c.moment / _abs(A - B) ** 2 * 1j * (A - B), np.nan)   # F at A, -F at B: (A - B) x F = M
             for name, local, f in ((a, la, F), (b, lb, -F)):
-                forces.append((f"{c.name}/l ({name.lower()})", _image(mech, res, k, name, mu_v, pts, local), f))
+                forces.append((f"{c.name}/l ({name.lower()})", _image(mech, res, k, name, mu_v, pts, local), TURN * f))
     total = sum(np.where(np.isnan(F), 0.0, _moment(pts[at], F)) for _, at, F in forces)   # a couple acts where not NaN
     crank_pin = _image(mech, res, mech.drive.link, mech.drive.point, mu_v, pts)
     F_bal = _across(pts[crank_pin], -total)
@@ -125,10 +129,11 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
         pts[start] = np.where(np.isnan(F), np.nan, pts[at])               # a couple's force NaN where it acts not
         pts[f"{name}:to"] = pts[start] + _over(F, mu_F.value)
         segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
-        has = (_abs(F) > 0) & (_abs(pts[at]) > 0)
+        u = _unit(F)
+        foot = pts[at] - _dot(pts[at], u) * u
+        has = (_abs(F) > 0) & (_abs(foot) > 1e-9 * _abs(pts[at]))      # a line through the pole has no arm
         if name != F_name and has.any():
-            u = _unit(F)
-            foot = np.where(has, pts[at] - _dot(pts[at], u) * u, np.nan)
+            foot = np.where(has, foot, np.nan)
             pts[f"{arm_name(name)}:foot"] = foot
             segs.append(Segment(arm_name(name), "p", f"{arm_name(name)}:foot", _abs(foot) * NATURAL.value, "mm", "arm",
                                 NATURAL))
@@ -140,7 +145,7 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
     results = (Result(F_name, _abs(F_bal), "N", "by lever"), Result(L.lever(L.M_bal), M_lever, "N m", "by lever"),
                Result(L.M_bal, M_forces, "N m", "by force plans"),
                Result("δ", delta, "%", within[0] if len(set(within)) == 1 else within))
-    titles = [f"Zhukovsky's lever (velocity plan turned by 90 deg ccw): {F_name} = {f:.6g} N "
+    titles = [f"Zhukovsky's lever (forces turned by 90 deg cw): {F_name} = {f:.6g} N "
               f"at {crank_pin}, {L.lever(L.M_bal)} = {m:.6g} N m; forces drawn at {mu_F}"
               for f, m in zip(_abs(F_bal).tolist(), M_lever.tolist())]
     return _cycle("lever", titles, mu_v, res, pts, segs, results=results)
