@@ -33,7 +33,8 @@ import numpy as np
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
-from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, label_parts, text_width
+from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, markup, text_width
+from .symbols import SUB, SUP, mark, plain, runs, text_runs
 
 __all__ = ["drawing", "svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
@@ -54,8 +55,10 @@ TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
 ZERO_MM = 1e-9
 #: A vector drawn out of scale along another vector from the same point is drawn this far beside it, mm.
 SIDE_MM = 1.8
-_POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
-_LINE_STEP = 3.6                             # line spacing of the notes, mm (room for a subscript)
+#: Font sizes of the points' letters, the vectors' names, the numbered positions' letters and the
+#: notes, mm: none under MIN_TEXT_MM (capitals 2.5 mm, GOST 2.304).
+_POINT_MM = _NAME_MM = _NUMBERED_MM = _NOTE_MM = MIN_TEXT_MM
+_LINE_STEP = 5.1                             # line spacing of the notes, mm (room for a sub- and superscript)
 _LEFT_NOTES_MM = 120.0                       # width of the notes beside a tall plan, mm
 
 #: Room a plan has on its sheet (width, height), mm: above notes of a few lines, or beside a
@@ -149,34 +152,13 @@ def _n(name: str) -> str:
     """A name in a note, marked to be lettered as the drawing letters it (πa, F with subscript i2;
     of 'M_i2/l (a)' its first word)."""
     head, sep, tail = name.partition(" ")
-    return f"\x01{head}\x02{sep}{tail}"
-
-
-_NAMED = re.compile("\x01([^\x02]*)\x02")
-
-
-def _runs(name: str) -> list[tuple[str, bool]]:
-    """A name as (text, subscript?) runs, by `label_parts`; a segment 'pi-a' as its points' letters: πa."""
-    parts = name.split("-") if re.fullmatch(r"[^-\s]+-[^-\s]+", name) else [name]
-    return [(t, k == 1) for part in parts for k, t in enumerate(label_parts(part)) if t]
-
-
-def _plain(s: str) -> str:
-    """A note as read, without the names' marks (for its width)."""
-    return _NAMED.sub(lambda m: "".join(t for t, _ in _runs(m.group(1))), s)
+    return f"{mark(head)}{sep}{tail}"
 
 
 def _rich(s: str, size: float) -> str:
-    """A note's SVG content: text escaped, marked names with their subscripts lowered 0.2 of the size
-    (the same size: no note text under 2.5 mm)."""
-    out, low = [], 0.0
-    for k, piece in enumerate(_NAMED.split(s)):
-        runs = _runs(piece) if k % 2 else [(piece, False)]
-        for t, sub in runs:
-            dy = (0.2 * size if sub else 0.0) - low
-            out.append(f'<tspan dy="{dy:.2f}">{escape(t)}</tspan>' if dy else escape(t))
-            low += dy
-    return "".join(out)
+    """A note's SVG content: text escaped, its symbols (marked names, words with _ or ^) with their
+    sub- and superscripts (`symbols.text_runs`, `labels.markup`)."""
+    return markup(text_runs(s), size)
 
 
 def _text_element(x: float, y: float, texts: list[str], variant, size: float, anchor: str = "start",
@@ -198,7 +180,7 @@ def _wrap(s: str, size: float, width: float) -> list[str]:
     out, line = [], ""
     for word in s.split(" "):
         trial = f"{line} {word}" if line else word
-        if line and text_width(_plain(trial), size) > width:
+        if line and text_width(plain(trial), size) > width:
             out.append(line)
             line = word
         else:
@@ -208,7 +190,7 @@ def _wrap(s: str, size: float, width: float) -> list[str]:
 
 def _fit(s: str, size: float, width: float, least: float = MIN_TEXT_MM) -> float:
     """The font size, at most `size` and at least `least`, at which `s` fits `width` mm."""
-    return max(least, min(size, size * width / max(text_width(_plain(s), size), 1e-9)))
+    return max(least, min(size, size * width / max(text_width(plain(s), size), 1e-9)))
 
 
 #: How a vector under TINY_MM is drawn at an angle (`_tiny`): as it is, out of scale, negligible.
@@ -314,7 +296,7 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     if nofit:
         lines.append(text("nofit", lang))
     rows = [w for r in _table_rows(plan, lang) for w in (_wrap(r, _NOTE_MM, width) if left else [r])]
-    col_w = max((text_width(_plain(r), _NOTE_MM) for r in rows), default=0.0) + 4.0
+    col_w = max((text_width(plain(r), _NOTE_MM) for r in rows), default=0.0) + 4.0
     cols = 1 if left or not rows else max(1, int(width // col_w))
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
@@ -374,8 +356,8 @@ def _title_block(cycle: PlanCycle, lang: str, mechanism: str) -> list[Element]:
     sc = f"{text('scale' if len(scales) == 1 else 'scales', lang)}: " + "; ".join(scale_text(s, lang) for s in scales)
     return [_text_element(x0 + 3, y0 + 8, titles, tv, min(_fit(t, 5.0, w) for t in titles), weight="bold", cls="title"),
             _text_element(x0 + 3, y0 + 19.5, [sc], [0], _fit(sc, 4.5, w), ident="scale", cls="title"),
-            _text_element(x0 + 3, y0 + 30, [mechanism], [0], _fit(mechanism, 3.0, w), ident="mechanism", cls="title"),
-            _text_element(x0 + 3, y0 + 36, angles, av, 3.0, cls="title"),
+            _text_element(x0 + 3, y0 + 30, [mechanism], [0], _fit(mechanism, MIN_TEXT_MM, w), ident="mechanism", cls="title"),
+            _text_element(x0 + 3, y0 + 36, angles, av, MIN_TEXT_MM, cls="title"),
             _text_element(x0 + 3, y0 + 42, [text("sheet", lang)], [0], MIN_TEXT_MM, cls="title")]
 
 
@@ -678,13 +660,17 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = Fals
 # ----------------------------------------------------------------------------- matplotlib
 
 def _tex(name: str) -> str:
-    """A point name as mathtext (letters with a subscript), or as it is where it is anything
-    else: `figure` then draws it with mathtext off (a model's point may be named anything)."""
-    head, sub, primes = label_parts(name)
-    if not re.fullmatch(r"[A-Za-zπ]+", head):
+    """A point name as mathtext (letters with their sub- and superscripts, `symbols.runs`), or as it
+    is where it is anything else: `figure` then draws it with mathtext off (a model's point may be
+    named anything)."""
+    rs = runs(name)
+    if not re.fullmatch(r"[A-Za-zπ]+′*", rs[0][0]) or any(re.search(r"[\\{}$^_#%&~\s]", t) for t, _ in rs):
         return name
-    head = r"\pi" if head == "π" else re.sub(r"([\\{}_^$#%&~])", r"\\\1", head)
-    return f"${head}" + (f"_{{{sub}}}" if sub else "") + ("'" * len(primes)) + "$"
+    out = []
+    for t, level in rs:
+        t = t.replace("π", r"\pi ").replace("′", "'")
+        out.append(t if not level else f"{'_' if level == SUB else '^'}{{{t}}}")
+    return "$" + "".join(out) + "$"
 
 
 def figure(plan: Plan, lang: str = "en", ax=None):
