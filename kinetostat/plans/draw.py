@@ -18,8 +18,8 @@ close, lettered at its point and noted as negligible; every letter placed by `la
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
 
-May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `kinetostat._text` (XML-safe
-text); matplotlib only inside `figure`.
+May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `.symbols`, `kinetostat._text` (XML-safe
+text), `kinetostat.model.lettering` (a symbol in the sheet's language); matplotlib only inside `figure`.
 """
 from __future__ import annotations
 
@@ -34,7 +34,8 @@ from .._text import xml_escape as escape     # also control characters, which XM
 from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, markup, text_width
-from .symbols import SUB, SUP, mark, plain, runs, text_runs
+from .symbols import SUB, mark, plain, runs, text_runs
+from ..model.lettering import in_lang
 
 __all__ = ["drawing", "svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
@@ -107,12 +108,12 @@ def labelled(name: str) -> bool:
 
 def segment_label(s: Segment, lang: str) -> str:
     """A segment's name as the sheet letters it (a guide or a line of action in `lang`)."""
-    if s.name.startswith("guide "):
-        return f"{text('guide', lang)} {s.name[6:]}"
+    if s.name.startswith("guide "):                 # "guide P(4,3)": the guide of the sliding pair 4-3
+        return text("guide", lang, pair=re.sub(r"^P\((\d+),(\d+)\)$", r"\1-\2", s.name[6:]))
     if s.name.startswith("slot "):                  # mechanism.py: "slot <link> <point>"
         k, P = s.name[5:].split(" ", 1)
         return text("slot", lang, k=k, P=P)
-    return text(s.name, lang) if s.name in MESSAGES else s.name
+    return text(s.name, lang) if s.name in MESSAGES else in_lang(s.name, lang)
 
 
 # ----------------------------------------------------------------------------- geometry shared by both
@@ -148,10 +149,10 @@ def _polygon_sides(plan: Plan | PlanCycle) -> list[Segment]:
 
 # ----------------------------------------------------------------------------- SVG
 
-def _n(name: str) -> str:
+def _n(name: str, lang: str) -> str:
     """A name in a note, marked to be lettered as the drawing letters it (πa, F with subscript i2;
-    of 'M_i2/l (a)' its first word)."""
-    head, sep, tail = name.partition(" ")
+    of 'M_i2/l (a)' its first word), in `lang`'s letters (`lettering.in_lang`)."""
+    head, sep, tail = in_lang(name, lang).partition(" ")
     return f"{mark(head)}{sep}{tail}"
 
 
@@ -241,7 +242,7 @@ def _result_line(plan: Plan, lang: str) -> list[str]:
         return []
     parts = []
     for r in plan.results:
-        part = f"{_n(r.symbol)} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
+        part = f"{_n(r.symbol, lang)} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
         parts.append(part + (f" ({text(r.how, lang)})" if r.how else ""))
     return [f"{text('results', lang)}: " + "; ".join(parts)]
 
@@ -253,13 +254,13 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
     lines += [phrase(n, lang) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
     lines += _result_line(plan, lang)
     if plan.equation:
-        lines.append(f"{text('equation', lang)}: " + " + ".join(map(_n, plan.equation)) + " = 0")
+        lines.append(f"{text('equation', lang)}: " + " + ".join(_n(e, lang) for e in plan.equation) + " = 0")
     for s in _drawable(plan):
         if s.name in tiny:
             L = abs(plan.points[s.end] - plan.points[s.start])
             key = "out of scale" if tiny[s.name] == "out" else "negligible"
-            mark = "*" if tiny[s.name] == "out" else ""
-            lines.append(f"{_n(s.name)}{mark} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
+            star = "*" if tiny[s.name] == "out" else ""
+            lines.append(f"{_n(s.name, lang)}{star} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
                          f"{text(key, lang, length=num(L, lang, decimals=2))}")
     if plan.kind == "lever":
         lines.append(text("arms natural", lang))
@@ -277,11 +278,11 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
         L = num(plan.length_mm(s.name), lang, decimals=2)
         value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
         if sides:
-            out.append(f"{text('segment', lang)} {_n(s.start + '-' + s.end)} = {L} {mm} → {_n(s.name)} = {value}")
+            out.append(f"{text('segment', lang)} {_n(s.start + '-' + s.end, lang)} = {L} {mm} → {_n(s.name, lang)} = {value}")
         elif s.unit == "mm":                      # a length kept as drawn (the lever's arms): once
-            out.append(f"{_n(s.name)} = {L} {mm}")
+            out.append(f"{_n(s.name, lang)} = {L} {mm}")
         else:
-            out.append(f"{_n(s.name)}: {L} {mm} → {value}")
+            out.append(f"{_n(s.name, lang)}: {L} {mm} → {value}")
     return out
 
 
@@ -488,7 +489,8 @@ def _paths(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
             out.append(Element("path", _where(drawn, head), {"class": "arrowhead arc", "fill": colour}))
             placer.block(_where(drawn, box))
             mid = _where(drawn, pts[r, count // 2])
-            names.append(_Name((name,), np.zeros(n, dtype=int), np.broadcast_to(mid, (n, 2)), None, _NAME_MM, "name"))
+            names.append(_Name((in_lang(name, lang),), np.zeros(n, dtype=int), np.broadcast_to(mid, (n, 2)), None,
+                               _NAME_MM, "name"))
     return out
 
 
