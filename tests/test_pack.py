@@ -76,7 +76,7 @@ def test_the_key_holds_the_answers_and_their_bands(uk_479):
     mech = variants.variant(1, "479").mechanism()
     M = kinetostat.analyze(mech, phi_deg=[150.0]).balancing_moment[0]
     assert "Mзр" in key and num(M, "uk", 4) in key                                   # 99,6 N m, exact solver
-    for mu, value in (("μl", "0,0015"), ("μv", "0,5"), ("μa", "100"), ("μF", "40")):      # μ with its subscript; μ_v a step coarser than the rule (the lettering at 3.5 mm)
+    for mu, value in (("μl", "0,0015"), ("μv", "0,25"), ("μa", "100"), ("μF", "40")):      # μ with its subscript
         assert re.search(rf"{mu} (\S+ )?{value} ", flat), mu         # pdftotext may read a header cell between
     assert "OA = 32 мм" in flat                                                        # the crank at 30..35 mm
     # the polygon's sides at mu_F = 40 N/mm: R12 = 7009 N is 175,2 mm, the scale beside it

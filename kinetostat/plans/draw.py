@@ -108,7 +108,7 @@ def labelled(name: str) -> bool:
 
 def segment_label(s: Segment, lang: str) -> str:
     """A segment's name as the sheet letters it (a guide or a line of action in `lang`)."""
-    if s.name.startswith("guide "):                 # "guide P(4,3)": the guide of the sliding pair 4-3
+    if s.name.startswith("guide "):                 # "guide P(4,3)": the guide of the sliding pair 4-3, "напрямна 4-3"
         return text("guide", lang, pair=re.sub(r"^P\((\d+),(\d+)\)$", r"\1-\2", s.name[6:]))
     if s.name.startswith("slot "):                  # mechanism.py: "slot <link> <point>"
         k, P = s.name[5:].split(" ", 1)

@@ -82,8 +82,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "legend.mechanism": ("ω: angular velocity, ε: angular acceleration (senses); S: centres of mass",
                          "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
-    "guide": ("guide of the sliding pair {pair}", "напрямна поступальної пари {pair}",
-              "направляющая поступательной пары {pair}"),
+    "guide": ("guide {pair}", "напрямна {pair}", "направляющая {pair}"),      # of the sliding pair: its links
     "slot": ("slot of link {k} ({P})", "паз ланки {k} ({P})", "паз звена {k} ({P})"),
     "coriolis": ("Cor", "к", "к"),          # the superscript of the Coriolis acceleration: a^Cor, a^к
     "line of action": ("line of action", "лінія зачеплення", "линия зацепления"),
