@@ -34,7 +34,8 @@ ROOT = Path(__file__).resolve().parents[1]
     ("S2_3", (("S", 0), ("2,3", SUB))),
     ("pi-a", (("πa", 0),)),
     ("n2-b", (("n", 0), ("2", SUB), ("b", 0))),
-    ("B3B4", (("B3B4", 0),)),                                       # letters after the digits: a name as it is
+    ("B3B4", (("B3B4", 0),)),
+    ("l_AB/l_OA", (("l", 0), ("AB", SUB), ("/l", 0), ("OA", SUB))),      # a ratio of two symbols                                       # letters after the digits: a name as it is
 ])
 def test_a_symbol_splits_into_base_subscript_and_superscript(name, want):
     assert runs(name) == want

@@ -9,7 +9,7 @@ A symbol as the project writes it: letters, then a subscript (digits, R12; or af
 μ_l), a superscript (after "^", a^n; a reaction's component letter after its digits, R12t), in
 any order; primes after the letters (M'_зр); a pair's indices "(4,3)" belong to the script before
 them (V_rel(4,3)); "*" (drawn out of scale) and anything after the symbol (F_i2(h), M_i2/l (a))
-are set as they are. "pi" is π; a segment "pi-a" is its two points' symbols (πa).
+are set as they are, its own symbols with "_" or "^" as such (l_AB/l_OA). "pi" is π; a segment "pi-a" is its two points' symbols (πa).
 
 In a text, a symbol is a name marked by `mark` (\\x01name\\x02) or any word with "_" or "^" in it
 (μ_l = 0.001 m/mm, δ = (M'_зр - M_зр) / M'_зр): `text_runs` splits a text so.
@@ -70,7 +70,7 @@ def runs(name: str) -> tuple[tuple[str, int], ...]:
     if body[pos:pos + 1].isalnum():                # letters after its digits (B3B4): a name, as it is
         return ((name, 0),)
     rest = body[pos:] + ("*" if star else "")
-    return _merge(tuple(out) + (((rest, 0),) if rest else ()))
+    return _merge(tuple(out) + text_runs(rest))                  # l_AB/l_OA: the rest may hold symbols too
 
 
 def _merge(rs: tuple[tuple[str, int], ...]) -> tuple[tuple[str, int], ...]:
