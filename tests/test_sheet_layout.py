@@ -155,8 +155,8 @@ def test_mechanism_sheet_draws_every_link(path):
     assert len(guides) == len(set(guides)), (path.stem, guides)
     names = ["".join(t.itertext()) for t in ET.fromstring(svg(plan).encode()).iter(f"{_NS}text")
              if t.get("class") == "name"]
-    for g in guides:
-        assert names.count(g) == 1, (path.stem, g, names)
+    for g in guides:                                  # "guide P(4,3)" lettered "guide 4-3"
+        assert names.count(re.sub(r"P\((\d+),(\d+)\)", r"\1-\2", g)) == 1, (path.stem, g, names)
 
 
 _HEAD = re.compile(r'<path d="M([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) z" class="arrowhead( arc)?"')
