@@ -80,7 +80,7 @@ def test_the_key_holds_the_answers_and_their_bands(uk_479):
         assert re.search(rf"{mu} (\S+ )?{value} ", flat), mu         # pdftotext may read a header cell between
     assert "OA = 32 мм" in flat                                                        # the crank at 30..35 mm
     # the polygon's sides at mu_F = 40 N/mm: R12 = 7009 N is 175,2 mm, the scale beside it
-    assert re.search(r"R12 175,2 μ_F = 40 Н/мм 7009 Н", flat)
+    assert re.search(r"R12 175,2 μF = 40 Н/мм 7009 Н", flat)                          # μ_F: F set below
     # a band per drawn value: the 5-95 % of the seeded study, printed
     sol = simulate(mech, at=150.0, n=P.BAND_DRAWS, seed=0)
     lo, hi = np.percentile(sol.samples["M_bal"], P.BAND)
