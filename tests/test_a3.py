@@ -229,7 +229,7 @@ def test_the_sheet_names_the_coarsened_scales(task2_pdf):
     page = " ".join(subprocess.run(["pdftotext", str(task2_pdf), "-"], capture_output=True,
                                    text=True, check=True).stdout.split())
     assert "Scales coarser than the text's rule, so that all the plans fit this one sheet" in page
-    assert "μ_l = 0.002 m/mm (rule: 0.0012)" in page
+    assert "μl = 0.002 m/mm (rule: 0.0012)" in page                                   # μ_l: l set below
 
 
 def test_the_bands_are_drawn_at_the_one_sheets_scales(task2_pack):
@@ -242,6 +242,7 @@ def test_the_bands_are_drawn_at_the_one_sheets_scales(task2_pack):
     for k, (lo, hi) in p.bands.items():
         assert (lo, hi) == pytest.approx(tuple(np.percentile(drawn.samples[k], P.BAND))), k
     scales = next(x for kind, x in p.key if kind == "table" and x.rows[0][0] == "μ_l")
+    # μ_v, μ_a coarser than the rule's: GOST 2.304's 3.5 mm lettering, the title block and the lever's arms take room
     assert {r[0]: r[1] for r in scales.rows} == {"μ_l": "0.002", "μ_v": "0.4", "μ_a": "200", "μ_F": "100"}
 
 

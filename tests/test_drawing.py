@@ -119,14 +119,15 @@ def test_one_angle_sheet_is_the_cycle_of_one(ice_cycle):
 # ----------------------------------------------------------------------------- labels
 
 def _box(markup: str, x: float, y: float, size: float) -> tuple[float, float, float, float]:
-    """A label's box from its markup at baseline (x, y): DejaVu Sans widths of its tspans."""
-    w, below = 0.0, DESCENT * size
+    """A label's box from its markup at baseline (x, y): DejaVu Sans widths of its tspans, each at
+    its own size and its baseline moved by its dy (a sub- or superscript)."""
+    w, shift, top, below = 0.0, 0.0, -ASCENT * size, DESCENT * size
     for attrs, piece in re.findall(r"<tspan([^>]*)>([^<]*)</tspan>", markup):
         s = float(re.search(r'font-size="([0-9.]+)"', attrs).group(1)) if "font-size" in attrs else size
+        shift += float(re.search(r'dy="(-?[0-9.]+)"', attrs).group(1)) if "dy=" in attrs else 0.0
         w += text_width(html.unescape(piece), s)
-        if s < size:
-            below = max(below, 0.3 * size + DESCENT * s)
-    return x, y - ASCENT * size, x + w, y + below
+        top, below = min(top, shift - ASCENT * s), max(below, shift + DESCENT * s)
+    return x, y + top, x + w, y + below
 
 
 def clashes(d: Drawing, i: int, tol: float = 0.05) -> list[str]:

@@ -65,7 +65,7 @@ def _words(path) -> str:
     if path.suffix in (".svg", ".html"):
         raw = re.sub(r"(?s)<style>.*?</style>|<code>[^<]*</code>", " ", raw)      # CSS, file names
         raw = re.sub(r'(</tspan>)?<tspan[^>]*dy="\d[^"]*">', "_", raw)     # a lettered subscript: h_Fp, as written
-        raw = re.sub(r"<[^>]+>", " ", re.sub(r"</?tspan[^>]*>", "", raw))
+        raw = re.sub(r"<[^>]+>", " ", re.sub(r"</?tspan[^>]*>", "", raw)).replace("′", "'")    # a prime as typed
     return re.sub(r"`[^`]*`|\]\([^)]*\)", " ", raw)
 
 

@@ -155,8 +155,8 @@ def test_mechanism_sheet_draws_every_link(path):
     assert len(guides) == len(set(guides)), (path.stem, guides)
     names = ["".join(t.itertext()) for t in ET.fromstring(svg(plan).encode()).iter(f"{_NS}text")
              if t.get("class") == "name"]
-    for g in guides:
-        assert names.count(g) == 1, (path.stem, g, names)
+    for g in guides:                                  # "guide P(4,3)" lettered "guide 4-3"
+        assert names.count(re.sub(r"P\((\d+),(\d+)\)", r"\1-\2", g)) == 1, (path.stem, g, names)
 
 
 _HEAD = re.compile(r'<path d="M([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) L([-0-9.]+),([-0-9.]+) z" class="arrowhead( arc)?"')
@@ -204,7 +204,8 @@ def test_a_dead_centre_notes_its_zero_loads_negligible():
 
 
 def test_notes_letter_names_as_the_drawing(ice_plans):
-    """The notes write πa, F with subscript i2, h with subscript Fi2 (as the drawing letters them),
+    """The notes write πa, F with subscript i2, h with subscript Fi2 (as the drawing letters them: a
+    script 0.75 of the size, dropped 0.22 of it),
     never the raw 'pi-a', 'F_i2', 'h_Fi2'; the lever's arms stay in mm (seed 002: h_Fi2 = 37.67 mm)."""
     mech, plans = ice_plans
     for kind in ("acceleration", "group:2,3", "forces:2,3", "lever", "crank"):
@@ -212,7 +213,8 @@ def test_notes_letter_names_as_the_drawing(ice_plans):
         words = re.sub(r"<[^>]+>", "", notes)
         assert "_" not in words and "pi-" not in words, (kind, words)
     notes = svg(plans["lever"], lang="uk").split('<g id="notes">')[1]
-    assert re.search(r'>h<tspan dy="0\.50">Fi2</tspan><tspan dy="-0\.50"> = 37,\d\d мм</tspan>', notes), notes
+    assert re.search(r'<tspan>h</tspan><tspan font-size="2\.62" dy="0\.77">Fi2</tspan><tspan dy="-0\.77"> = 37,\d\d мм</tspan>',
+                     notes), notes
     assert "πa" in svg(plans["acceleration"], lang="uk")
 
 

@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, Mapping
 if TYPE_CHECKING:
     from .mechanism import Mechanism
 
-__all__ = ["Lettering", "lettering", "link_number", "reaction_name", "pair_name", "with_aliases", "DEFAULT"]
+__all__ = ["Lettering", "lettering", "link_number", "reaction_name", "pair_name", "with_aliases", "in_lang", "DEFAULT",
+           "EN_SUBSCRIPTS"]
 
 
 @dataclass(frozen=True)
@@ -51,6 +52,19 @@ class Lettering:
 
 
 DEFAULT = Lettering()
+
+#: The texts' Cyrillic subscripts as English writes them: зр (зрівноважувальний), ур
+#: (уравновешивающий): bal, balancing; КО (корисний опір): ur, useful resistance.
+EN_SUBSCRIPTS = MappingProxyType({"зр": "bal", "ур": "bal", "КО": "ur"})
+_CYRILLIC = re.compile(r"[\u0400-\u04ff]+")
+
+
+def in_lang(symbol: str, lang: str) -> str:
+    """A symbol as a text in `lang` writes it: in English the texts' Cyrillic subscripts in
+    EN_SUBSCRIPTS (M_зр -> M_bal, F_КО -> F_ur); in Ukrainian and Russian as the model letters it."""
+    if lang != "en":
+        return symbol
+    return _CYRILLIC.sub(lambda m: EN_SUBSCRIPTS.get(m.group(), m.group()), symbol)
 
 
 def _published_frame(mech: "Mechanism") -> int:

@@ -20,8 +20,9 @@ dimension lines with their mm (`_dimensions`); every letter placed by `labels.Pl
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
 
-May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `.forces` (an arm's name),
-`kinetostat._text` (XML-safe text); matplotlib only inside `figure`.
+May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `.symbols`, `.forces` (an arm's
+name), `kinetostat._text` (XML-safe text), `kinetostat.model.lettering` (a symbol in the sheet's
+language); matplotlib only inside `figure`.
 """
 from __future__ import annotations
 
@@ -36,7 +37,9 @@ from .._text import xml_escape as escape     # also control characters, which XM
 from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
 from .forces import arm_name
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
-from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, label_parts, text_width
+from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, markup, text_width
+from .symbols import SUB, mark, plain, runs, text_runs
+from ..model.lettering import in_lang
 
 __all__ = ["drawing", "svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
@@ -57,8 +60,10 @@ TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
 ZERO_MM = 1e-9
 #: A vector drawn out of scale along another vector from the same point is drawn this far beside it, mm.
 SIDE_MM = 1.8
-_POINT_MM, _NAME_MM, _NUMBERED_MM, _NOTE_MM = 3.5, 3.0, 2.5, 2.5
-_LINE_STEP = 3.6                             # line spacing of the notes, mm (room for a subscript)
+#: Font sizes of the points' letters, the vectors' names, the numbered positions' letters and the
+#: notes, mm: none under MIN_TEXT_MM (capitals 2.5 mm, GOST 2.304).
+_POINT_MM = _NAME_MM = _NUMBERED_MM = _NOTE_MM = MIN_TEXT_MM
+_LINE_STEP = 5.1                             # line spacing of the notes, mm (room for a sub- and superscript)
 _LEFT_NOTES_MM = 120.0                       # width of the notes beside a tall plan, mm
 
 #: Room a plan has on its sheet (width, height), mm: above notes of a few lines, or beside a
@@ -119,12 +124,12 @@ def labelled(name: str) -> bool:
 
 def segment_label(s: Segment, lang: str) -> str:
     """A segment's name as the sheet letters it (a guide or a line of action in `lang`)."""
-    if s.name.startswith("guide "):
-        return f"{text('guide', lang)} {s.name[6:]}"
+    if s.name.startswith("guide "):                 # "guide P(4,3)": the guide of the sliding pair 4-3, "напрямна 4-3"
+        return text("guide", lang, pair=re.sub(r"^P\((\d+),(\d+)\)$", r"\1-\2", s.name[6:]))
     if s.name.startswith("slot "):                  # mechanism.py: "slot <link> <point>"
         k, P = s.name[5:].split(" ", 1)
         return text("slot", lang, k=k, P=P)
-    return text(s.name, lang) if s.name in MESSAGES else s.name
+    return text(s.name, lang) if s.name in MESSAGES else in_lang(s.name, lang)
 
 
 # ----------------------------------------------------------------------------- geometry shared by both
@@ -160,20 +165,11 @@ def _polygon_sides(plan: Plan | PlanCycle) -> list[Segment]:
 
 # ----------------------------------------------------------------------------- SVG
 
-def _n(name: str) -> str:
+def _n(name: str, lang: str) -> str:
     """A name in a note, marked to be lettered as the drawing letters it (πa, F with subscript i2;
-    of 'M_i2/l (a)' its first word)."""
-    head, sep, tail = name.partition(" ")
-    return f"\x01{head}\x02{sep}{tail}"
-
-
-_NAMED = re.compile("\x01([^\x02]*)\x02")
-
-
-def _runs(name: str) -> list[tuple[str, bool]]:
-    """A name as (text, subscript?) runs, by `label_parts`; a segment 'pi-a' as its points' letters: πa."""
-    parts = name.split("-") if re.fullmatch(r"[^-\s]+-[^-\s]+", name) else [name]
-    return [(t, k == 1) for part in parts for k, t in enumerate(label_parts(part)) if t]
+    of 'M_i2/l (a)' its first word), in `lang`'s letters (`lettering.in_lang`)."""
+    head, sep, tail = in_lang(name, lang).partition(" ")
+    return f"{mark(head)}{sep}{tail}"
 
 
 #: A symbol in a plan's note: ω2, M_i5, F_i2(h), R05, ρ12 (letters, a digit, an optional (h)), or a
@@ -181,27 +177,15 @@ def _runs(name: str) -> list[tuple[str, bool]]:
 _SYMBOL = re.compile(r"(?<![\w\x01-])([A-Za-zωεπρ]+_?[A-Za-z]*\d+(?:\([a-z]\))?|[a-z]{1,2}\d*-[a-z]{1,2}\d*)(?![\w(-])")
 
 
-def _symbols(note: str) -> str:
+def _symbols(note: str, lang: str) -> str:
     """A plan's note with its symbols marked (`_n`): lettered as the drawing letters them."""
-    return _SYMBOL.sub(lambda m: _n(m.group(1)), note)
-
-
-def _plain(s: str) -> str:
-    """A note as read, without the names' marks (for its width)."""
-    return _NAMED.sub(lambda m: "".join(t for t, _ in _runs(m.group(1))), s)
+    return _SYMBOL.sub(lambda m: _n(m.group(1), lang), note)
 
 
 def _rich(s: str, size: float) -> str:
-    """A note's SVG content: text escaped, marked names with their subscripts lowered 0.2 of the size
-    (the same size: no note text under 2.5 mm)."""
-    out, low = [], 0.0
-    for k, piece in enumerate(_NAMED.split(s)):
-        runs = _runs(piece) if k % 2 else [(piece, False)]
-        for t, sub in runs:
-            dy = (0.2 * size if sub else 0.0) - low
-            out.append(f'<tspan dy="{dy:.2f}">{escape(t)}</tspan>' if dy else escape(t))
-            low += dy
-    return "".join(out)
+    """A note's SVG content: text escaped, its symbols (marked names, words with _ or ^) with their
+    sub- and superscripts (`symbols.text_runs`, `labels.markup`)."""
+    return markup(text_runs(s), size)
 
 
 def _text_element(x: float, y: float, texts: list[str], variant, size: float, anchor: str = "start",
@@ -223,7 +207,7 @@ def _wrap(s: str, size: float, width: float) -> list[str]:
     out, line = [], ""
     for word in s.split(" "):
         trial = f"{line} {word}" if line else word
-        if line and text_width(_plain(trial), size) > width:
+        if line and text_width(plain(trial), size) > width:
             out.append(line)
             line = word
         else:
@@ -233,7 +217,7 @@ def _wrap(s: str, size: float, width: float) -> list[str]:
 
 def _fit(s: str, size: float, width: float, least: float = MIN_TEXT_MM) -> float:
     """The font size, at most `size` and at least `least`, at which `s` fits `width` mm."""
-    return max(least, min(size, size * width / max(text_width(_plain(s), size), 1e-9)))
+    return max(least, min(size, size * width / max(text_width(plain(s), size), 1e-9)))
 
 
 #: How a vector under TINY_MM is drawn at an angle (`_tiny`): as it is, out of scale, negligible.
@@ -284,7 +268,7 @@ def _result_line(plan: Plan, lang: str) -> list[str]:
         return []
     parts = []
     for r in plan.results:
-        part = f"{_n(r.symbol)} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
+        part = f"{_n(r.symbol, lang)} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
         parts.append(part + (f" ({text(r.how, lang)})" if r.how else ""))
     return [f"{text('results', lang)}: " + "; ".join(parts)]
 
@@ -293,16 +277,16 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
     """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors."""
     base = plan.kind.partition(":")[0]
     lines = [text(f"legend.{base}", lang)] if f"legend.{base}" in MESSAGES else []
-    lines += [_symbols(phrase(n, lang)) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
+    lines += [_symbols(phrase(n, lang), lang) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
     lines += _result_line(plan, lang)
     if plan.equation:
-        lines.append(f"{text('equation', lang)}: " + " + ".join(map(_n, plan.equation)) + " = 0")
+        lines.append(f"{text('equation', lang)}: " + " + ".join(_n(e, lang) for e in plan.equation) + " = 0")
     for s in _drawable(plan):
         if s.name in tiny:
             L = abs(plan.points[s.end] - plan.points[s.start])
             key = "out of scale" if tiny[s.name] == "out" else "negligible"
-            mark = "*" if tiny[s.name] == "out" else ""
-            lines.append(f"{_n(s.name)}{mark} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
+            star = "*" if tiny[s.name] == "out" else ""
+            lines.append(f"{_n(s.name, lang)}{star} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
                          f"{text(key, lang, length=num(L, lang, decimals=2))}")
     if plan.kind == "lever":
         lines += [text("lever turned", lang), text("arms natural", lang)]
@@ -320,11 +304,11 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
         L = num(plan.length_mm(s.name), lang, decimals=2)
         value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
         if sides:
-            out.append(f"{text('segment', lang)} {_n(s.start + '-' + s.end)} = {L} {mm} → {_n(s.name)} = {value}")
+            out.append(f"{text('segment', lang)} {_n(s.start + '-' + s.end, lang)} = {L} {mm} → {_n(s.name, lang)} = {value}")
         elif s.unit == "mm":                      # a length kept as drawn (the lever's arms): once
-            out.append(f"{_n(s.name)} = {L} {mm}")
+            out.append(f"{_n(s.name, lang)} = {L} {mm}")
         else:
-            out.append(f"{_n(s.name)}: {L} {mm} → {value}")
+            out.append(f"{_n(s.name, lang)}: {L} {mm} → {value}")
     return out
 
 
@@ -339,7 +323,7 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     if nofit:
         lines.append(text("nofit", lang))
     rows = [w for r in _table_rows(plan, lang) for w in (_wrap(r, _NOTE_MM, width) if left else [r])]
-    col_w = max((text_width(_plain(r), _NOTE_MM) for r in rows), default=0.0) + 4.0
+    col_w = max((text_width(plain(r), _NOTE_MM) for r in rows), default=0.0) + 4.0
     cols = 1 if left or not rows else max(1, int(width // col_w))
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
@@ -399,8 +383,8 @@ def _title_block(cycle: PlanCycle, lang: str, mechanism: str) -> list[Element]:
     sc = f"{text('scale' if len(scales) == 1 else 'scales', lang)}: " + "; ".join(scale_text(s, lang) for s in scales)
     return [_text_element(x0 + 3, y0 + 8, titles, tv, min(_fit(t, 5.0, w) for t in titles), weight="bold", cls="title"),
             _text_element(x0 + 3, y0 + 19.5, [sc], [0], _fit(sc, 4.5, w), ident="scale", cls="title"),
-            _text_element(x0 + 3, y0 + 30, [mechanism], [0], _fit(mechanism, 3.0, w), ident="mechanism", cls="title"),
-            _text_element(x0 + 3, y0 + 36, angles, av, 3.0, cls="title"),
+            _text_element(x0 + 3, y0 + 30, [mechanism], [0], _fit(mechanism, MIN_TEXT_MM, w), ident="mechanism", cls="title"),
+            _text_element(x0 + 3, y0 + 36, angles, av, MIN_TEXT_MM, cls="title"),
             _text_element(x0 + 3, y0 + 42, [text("sheet", lang)], [0], MIN_TEXT_MM, cls="title")]
 
 
@@ -531,7 +515,8 @@ def _paths(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
             out.append(Element("path", _where(drawn, head), {"class": "arrowhead arc", "fill": colour}))
             placer.block(_where(drawn, box))
             mid = _where(drawn, pts[r, count // 2])
-            names.append(_Name((name,), np.zeros(n, dtype=int), np.broadcast_to(mid, (n, 2)), None, _NAME_MM, "name"))
+            names.append(_Name((in_lang(name, lang),), np.zeros(n, dtype=int), np.broadcast_to(mid, (n, 2)), None,
+                               _NAME_MM, "name"))
     return out
 
 
@@ -763,13 +748,17 @@ def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = Fals
 # ----------------------------------------------------------------------------- matplotlib
 
 def _tex(name: str) -> str:
-    """A point name as mathtext (letters with a subscript), or as it is where it is anything
-    else: `figure` then draws it with mathtext off (a model's point may be named anything)."""
-    head, sub, primes = label_parts(name)
-    if not re.fullmatch(r"[A-Za-zπ]+", head):
+    """A point name as mathtext (letters with their sub- and superscripts, `symbols.runs`), or as it
+    is where it is anything else: `figure` then draws it with mathtext off (a model's point may be
+    named anything)."""
+    rs = runs(name)
+    if not re.fullmatch(r"[A-Za-zπ]+′*", rs[0][0]) or any(re.search(r"[\\{}$^_#%&~\s]", t) for t, _ in rs):
         return name
-    head = r"\pi" if head == "π" else re.sub(r"([\\{}_^$#%&~])", r"\\\1", head)
-    return f"${head}" + (f"_{{{sub}}}" if sub else "") + ("'" * len(primes)) + "$"
+    out = []
+    for t, level in rs:
+        t = t.replace("π", r"\pi ").replace("′", "'")
+        out.append(t if not level else f"{'_' if level == SUB else '^'}{{{t}}}")
+    return "$" + "".join(out) + "$"
 
 
 def figure(plan: Plan, lang: str = "en", ax=None):

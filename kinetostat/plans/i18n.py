@@ -10,7 +10,7 @@ numbers and units as each language writes them (decimal comma in uk and ru, Н·
 generated English notes of the plans (branches, positions) phrase by phrase; `words_en()` is the
 English side the tests look for in uk and ru output.
 
-May use: the standard library and numpy only.
+May use: the standard library, numpy and `kinetostat.structure` (the kinds of the dyads).
 """
 from __future__ import annotations
 
@@ -19,8 +19,10 @@ import re
 
 import numpy as np
 
+from ..structure import GROUP_KINDS
+
 __all__ = ["LANGS", "MESSAGES", "PHRASES", "UNITS", "check_lang", "text", "plural", "PLURALS", "num", "unit", "phrase",
-           "words_en", "accuracy", "ZERO"]
+           "words_en", "accuracy", "group_name", "ZERO"]
 
 LANGS = ("en", "uk", "ru")
 #: A magnitude below this (SI) is printed as 0: the solver's rounding noise, never a value.
@@ -86,7 +88,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "legend.mechanism": ("ω: angular velocity, ε: angular acceleration (senses); S: centres of mass",
                          "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
-    "guide": ("guide", "напрямна", "направляющая"),
+    "guide": ("guide {pair}", "напрямна {pair}", "направляющая {pair}"),      # of the sliding pair: its links
     "slot": ("slot of link {k} ({P})", "паз ланки {k} ({P})", "паз звена {k} ({P})"),
     "coriolis": ("Cor", "к", "к"),          # the superscript of the Coriolis acceleration: a^Cor, a^к
     "line of action": ("line of action", "лінія зачеплення", "линия зацепления"),
@@ -95,6 +97,10 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "pitch circle of the pinion": ("pitch circle of the pinion", "початкове коло шестерні",
                                    "начальная окружность шестерни"),
     "mm": ("mm", "мм", "мм"),
+    "group.kind": ("group {links} (class {klass}, kind {n})", "група {links} ({klass}-го класу {n}-го виду)",
+                   "группа {links} ({klass}-го класса {n}-го вида)"),
+    "group.class": ("group {links} (class {klass})", "група {links} ({klass}-го класу)", "группа {links} ({klass}-го класса)"),
+    "group.kinds_12": ("of class 2, kinds 1 (RRR) and 2 (RRP)", "2-го класу 1-го і 2-го виду", "2-го класса 1-го и 2-го вида"),
     # the index of the answer keys
     "ix.title": ("Logvinenko, Nadtoka 2021: answer keys of the task variants", "Логвіненко, Надтока 2021: відповіді до варіантів завдань",
                  "Логвиненко, Надтока 2021: ответы к вариантам заданий"),
@@ -460,6 +466,9 @@ PHRASES: tuple[tuple[str, str, str], ...] = (
     (" acts ", " діє на відстані ", " действует на расстоянии "),
     (" m from ", " м від ", " м от "),
     ("(link ", "(ланка ", "(звено "),
+    (": the mode the model draws at the design position (", ": складання, накреслене в розрахунковому положенні "
+     "(усього складань: ", ": сборка, начерченная в расчётном положении (всего сборок: "),
+    (" modes there)", ")", ")"),
     ("(crank and rod in line), then every 30 deg", "(кривошип і шатун на одній прямій), далі через 30°",
      "(кривошип и шатун на одной прямой), далее через 30°"),
     ("drawn with plain letters", "позначене літерами без індексу", "обозначено буквами без индекса"),
@@ -586,11 +595,28 @@ def accuracy(digits: float, minimum: int, lang: str, markdown: bool = True) -> s
     return line if markdown else line.replace("**", "")
 
 
+#: An Assur group as the generated notes name it: its class in Roman numerals, links, kind ("II(2,3) RRP",
+#: "III(2,3,4,5) III3").
+_GROUP = re.compile(r"\b(II|III)\((\d+(?:,\d+)*)\) ([RP]{3}|III\d)\b")
+def group_name(label: str, kind: str, lang: str) -> str:
+    """An Assur group in `lang`'s words: "II(2,3)", "RRP" -> "група 2-3 (2-го класу 2-го виду)"; in
+    English its label and kind as the structure names them."""
+    klass = {"II": 2, "III": 3}.get(label.partition("(")[0], 0)
+    links = label.partition("(")[2].rstrip(")").replace(",", "-")
+    if check_lang(lang) == 0:
+        return f"{label} {kind}"
+    if kind in GROUP_KINDS:
+        return text("group.kind", lang, links=links, klass=klass, n=GROUP_KINDS[kind])
+    return text("group.class", lang, links=links, klass=klass)
+
+
 def phrase(note: str, lang: str) -> str:
-    """A generated English note in `lang`, phrase by phrase (PHRASES); its numbers as `lang` writes them."""
+    """A generated English note in `lang`, phrase by phrase (PHRASES), its groups in words
+    (`group_name`); its numbers as `lang` writes them."""
     i = check_lang(lang)
     if not i:
         return note
+    note = _GROUP.sub(lambda m: group_name(f"{m.group(1)}({m.group(2)})", m.group(3), lang), note)
     for p in PHRASES:
         note = note.replace(p[0], p[i])
     return re.sub(r"(?<=\d)\.(?=\d)", ",", note)

@@ -1,5 +1,6 @@
 """Lettering on a sheet over N crank angles: the width of a text as DejaVu Sans sets it (its
-advance widths, `dejavu`), a point's letter with its subscript as SVG markup, coincident points
+advance widths, `dejavu`), a symbol with its sub- and superscripts as SVG markup (split as
+`symbols.runs` splits it), coincident points
 lettered once, and a placer that puts each label beside its point or vector at every angle at
 once where it overprints no other label, arrowhead or point, as a draughtsman would.
 
@@ -19,7 +20,7 @@ neighbour's place where that is free, and only the angles where neither is are s
 Obstacles and candidates the same at every angle are tested once for the cycle. A label that
 had to move far gets a thin leader line from its anchor.
 
-May use: numpy, the standard library, `.dejavu`, `kinetostat._text` (XML-safe text).
+May use: numpy, the standard library, `.dejavu`, `.symbols`, `kinetostat._text` (XML-safe text).
 """
 from __future__ import annotations
 
@@ -32,12 +33,18 @@ import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
 from .dejavu import ADVANCES, EM
+from .symbols import SCRIPT, SUB, SUB_DROP, SUP, SUP_RISE, runs
 
-__all__ = ["text_width", "label_parts", "label_markup", "label_width", "label_height", "coincident", "Placer",
-           "Placed", "MIN_TEXT_MM", "ASCENT", "DESCENT"]
+__all__ = ["text_width", "markup", "label_markup", "label_width", "label_height", "coincident", "Placer",
+           "Placed", "MIN_TEXT_MM", "MIN_SCRIPT_MM", "CAP", "ASCENT", "DESCENT"]
 
-#: Smallest text on a sheet, mm (the texts' standard lettering: 2.5 mm and up).
-MIN_TEXT_MM = 2.5
+#: DejaVu Sans' capital height, em (its "H": 1493 / 2048).
+CAP = 0.729
+#: Smallest text on a sheet, font size in mm: its capitals 2.55 mm high, GOST 2.304's smallest
+#: size 2.5 (a size is the capitals' height).
+MIN_TEXT_MM = 3.5
+#: Smallest sub- or superscript, font size in mm: capitals 1.8 mm, GOST 2.304's size for indices.
+MIN_SCRIPT_MM = 2.5
 #: DejaVu Sans ascent and descent, em: the box getBBox gives a text.
 ASCENT, DESCENT = 0.93, 0.24
 #: A character DejaVu Sans lacks (set by the browser in another font): this wide, em.
@@ -60,26 +67,13 @@ def text_width(s: str, size: float) -> float:
     return sum(map(_advance, s)) * size
 
 
-_LABEL = re.compile(r"^([^\d_']*)([\d_]*)('*)$")
+def _script(size: float) -> float:
+    """Font size of a sub- or superscript of a symbol set at `size`, mm."""
+    return max(MIN_SCRIPT_MM, SCRIPT * size)
 
 
-def label_parts(name: str) -> tuple[str, str, str]:
-    """A point name as (letters, subscript, primes): 's2' -> ('s', '2', ''), 'S2_3' -> ('S', '2,3', ''),
-    'pi' -> ('π', '', ''), "B'" -> ('B', '', '′'); 'R12t' -> ('R', '12', 't') is not split this
-    way: a name with letters after its digits is written as it is; 'F_i2' -> ('F', 'i2', '')."""
-    if name == "pi":
-        return "π", "", ""
-    m = _LABEL.match(name)
-    if (not m or not m.group(1)) and "_" in name.strip("_"):
-        head, _, sub = name.partition("_")
-        return head, sub, ""
-    if not m or not m.group(1):
-        return name, "", ""
-    return m.group(1), m.group(2).strip("_").replace("_", ","), "′" * len(m.group(3))
-
-
-def _sub(size: float) -> float:
-    return max(MIN_TEXT_MM, 0.75 * size)
+def _run_size(level: int, size: float) -> float:
+    return _script(size) if level else size
 
 
 #: Where a label joins names: coincident ones (' ≡ '), a name and its value (' = ': an arm's mm).
@@ -92,39 +86,48 @@ def _joined(name: str) -> list[tuple[str, str]]:
     return list(zip([""] + pieces[1::2], pieces[0::2]))
 
 
-def label_width(name: str, size: float) -> float:
-    """Width of a lettered name (several names joined by ' ≡ ', a value after ' = ' allowed), mm."""
-    w = 0.0
+def _label_runs(name: str) -> tuple[tuple[str, int], ...]:
+    """A label's (text, level) runs: each name's by `symbols.runs`, the joints between them, a
+    value after ' = ' as it is."""
+    rs: list[tuple[str, int]] = []
     for joint, part in _joined(name):
-        head, sub, primes = label_parts(part)
-        w += text_width(joint, size) + text_width(head, size) + text_width(sub, _sub(size)) + text_width(primes, size)
-    return w
+        rs += ([(joint, 0)] if joint else []) + ([(part, 0)] if joint == " = " else list(runs(part)))
+    return tuple(rs)
+
+
+def label_width(name: str, size: float) -> float:
+    """Width of a lettered name (several names joined by ' ≡ ', a value after ' = ' allowed) as
+    `label_markup` sets it, mm."""
+    return sum(text_width(t, _run_size(level, size)) for t, level in _label_runs(name))
 
 
 def label_height(name: str, size: float) -> tuple[float, float]:
-    """(above, below) the baseline of a lettered name, mm."""
-    below = DESCENT * size
-    if any(label_parts(p)[1] for _, p in _joined(name)):
-        below = max(below, 0.3 * size + DESCENT * _sub(size))
-    return ASCENT * size, below
+    """(above, below) the baseline of a lettered name as `label_markup` sets it, mm."""
+    levels = {level for _, level in _label_runs(name)}
+    above, below = ASCENT * size, DESCENT * size
+    if SUP in levels:
+        above = max(above, SUP_RISE * size + ASCENT * _script(size))
+    if SUB in levels:
+        below = max(below, SUB_DROP * size + DESCENT * _script(size))
+    return above, below
+
+
+def markup(rs: tuple[tuple[str, int], ...], size: float) -> str:
+    """SVG content of (text, level) runs (`symbols`) in a <text> of font size `size`: a script a
+    smaller tspan, dropped SUB_DROP or raised SUP_RISE of the size; the baseline back after it."""
+    out, shift = [], 0.0                          # how far the last tspan sits from the baseline, down
+    for t, level in rs:
+        dy = {0: 0.0, SUB: SUB_DROP * size, SUP: -SUP_RISE * size}[level] - shift
+        attrs = (f' font-size="{_script(size):.2f}"' if level else "") + (f' dy="{dy:.2f}"' if abs(dy) > 1e-9 else "")
+        out.append(f"<tspan{attrs}>{escape(t)}</tspan>")
+        shift += dy
+    return "".join(out)
 
 
 def label_markup(name: str, size: float) -> str:
-    """The content of a lettered name's <text> at font size `size`: letters, subscript (a smaller
-    tspan below), primes; coincident names joined by ' ≡ ', a value after ' = '."""
-    out = []
-    low = 0.0                                     # how far below the baseline the last tspan sits
-    for joint, part in _joined(name):
-        head, sub, primes = label_parts(part)
-        for piece, dy, small in ((joint, -low, False), (head, 0.0, False),
-                                 (sub, 0.3 * size, True), (primes, -0.3 * size if sub else 0.0, False)):
-            if not piece:
-                continue
-            attrs = f' font-size="{_sub(size):.2f}"' if small else ""
-            attrs += f' dy="{dy:.2f}"' if dy else ""
-            out.append(f"<tspan{attrs}>{escape(piece)}</tspan>")
-            low += dy
-    return "".join(out)
+    """The content of a lettered name's <text> at font size `size`: each symbol's runs (`symbols.runs`:
+    base, subscript, superscript) by `markup`; coincident names joined by ' ≡ ', a value after ' = '."""
+    return markup(_label_runs(name), size)
 
 
 def coincident(xy: np.ndarray, tol: float = 0.5) -> np.ndarray:
@@ -153,7 +156,7 @@ _DIRS = _constant(np.column_stack([np.cos(np.radians(np.arange(0, 360, 22.5) + 4
                                    -np.sin(np.radians(np.arange(0, 360, 22.5) + 45.0))]))
 _ABS_DIRS = _constant(np.abs(_DIRS))
 _REACH = _constant(_ABS_DIRS.max(axis=0))      # a label's half size times this: how far its box reaches
-_RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0, 60.0, 80.0]))
+_RINGS = _constant(np.array([0.5, 1.2, 2.2, 3.5, 5.0, 7.0, 10.0, 14.0, 19.0, 25.0, 33.0, 45.0, 60.0, 80.0, 105.0, 135.0]))
 _RING_DIRS = _constant(np.tile(_DIRS, (len(_RINGS), 1)))       # each ring candidate's direction, ring by ring
 _RING_COST = _constant((1.2 * _RINGS[:, None] + np.where(_DIRS[:, 1] > 0, 0.3, 0.0)).reshape(-1))
 #: Beside a segment: at these fractions T of its length, on either side S, at these clearances R

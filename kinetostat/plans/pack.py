@@ -29,7 +29,7 @@ twice: to PDF by reportlab (`.pdf`: DejaVu Sans embedded as a TrueType subset wi
 map, so pdftotext reads the Cyrillic back) and to HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
 May use: `build` of this package, `.a3`, `.givens`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `model.lettering`,
-`.pdf`, `kinetostat._io`. Never matplotlib, never the harness, nor `kinetostat.variants` (the variant
+`.pdf`, `.symbols`, `kinetostat._io`. Never matplotlib, never the harness, nor `kinetostat.variants` (the variant
 is passed in and says its task, title and letters).
 """
 from __future__ import annotations
@@ -48,6 +48,7 @@ from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 from .pdf import ASCENT, Canvas
 from .scales import REFERENCE_NAMES as _REFERENCE
+from .symbols import html, mark
 from ..model.lettering import lettering
 from .worksheet import CSS, Worksheet, analyses, html_document, worksheet_cycle
 
@@ -68,12 +69,18 @@ _PT = 25.4 / 72.0                          # mm per point
 @dataclass(frozen=True)
 class Table:
     """A table block: header cells, rows of cells, column widths (fractions of the text width),
-    the columns of numbers (right-aligned) and the blank columns (to fill in by hand)."""
+    the columns of numbers (right-aligned), the blank columns (to fill in by hand) and the columns
+    of symbols (lettered with their sub- and superscripts: `symbols.runs`)."""
     head: tuple[str, ...]
     rows: tuple[tuple[str, ...], ...]
     widths: tuple[float, ...]
     numeric: frozenset[int] = frozenset()
     blank: frozenset[int] = frozenset()
+    symbols: frozenset[int] = frozenset()
+
+    def cell(self, row: tuple[str, ...], i: int) -> str:
+        """Cell i of `row` as written: a symbol marked (`symbols.mark`)."""
+        return mark(row[i]) if i in self.symbols and row[i] else row[i]
 
 
 @dataclass(frozen=True)
@@ -138,7 +145,8 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
     data = Table((text("pack.letter", lang), text("pack.parameter", lang), text("ws.head.symbol", lang),
                   text("ws.head.value", lang), text("ws.head.unit", lang)),
                  tuple((r.letter, text(f"row.{r.key}", lang), r.symbol, num(v.values[r.key], lang, 6),
-                        unit(r.unit, lang)) for r in spec.rows), (0.07, 0.5, 0.18, 0.13, 0.12), frozenset({3}))
+                        unit(r.unit, lang)) for r in spec.rows), (0.07, 0.5, 0.18, 0.13, 0.12), frozenset({3}),
+                 symbols=frozenset({2}))
     sheet = [("h1", title), ("p", text("pack.statement", lang, M=L.M_bal)), ("p", text("pack.assume", lang)),
              ("h2", text("pack.data", lang, table=spec.table)), ("table", data)]
     if v.code:
@@ -159,7 +167,7 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
         sheet.append(("table", Table((text("ws.head.symbol", lang), text("ws.head.value", lang),
                                       text("ws.head.unit", lang), text("ws.head.direction", lang)),
                                      tuple((ws.rows[i].symbol, "", recs[i]["unit"], "") for i in idx),
-                                     (0.2, 0.25, 0.2, 0.35), blank=frozenset({1, 3}))))
+                                     (0.2, 0.25, 0.2, 0.35), blank=frozenset({1, 3}), symbols=frozenset({0}))))
         krows = []
         for i in idx:
             r = ws.rows[i]
@@ -176,13 +184,13 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
         key += [("h2", recs[idx[0]]["section"]),
                 ("table", Table((text("ws.head.symbol", lang), text("ws.head.value", lang), text("ws.head.unit", lang),
                                  text("ws.head.direction", lang), text("pack.band", lang)), tuple(krows),
-                                (0.14, 0.15, 0.12, 0.3, 0.29), frozenset({1, 4})))]
+                                (0.14, 0.15, 0.12, 0.3, 0.29), frozenset({1, 4}), symbols=frozenset({0})))]
     key.append(("p", text("pack.band_note", lang, lo=num(BAND[0], lang), hi=num(BAND[1], lang), n=draws,
                           mm=num(drawn.length_mm, lang), deg=num(drawn.angle_deg, lang))))
     if outside:
         key.append(("p", text("pack.band_outside", lang)))
     if not drawn.forces_drawn:
-        key.append(("p", text("pack.band_partial", lang, M=L.M_bal, kinds="RRR, RRP")))
+        key.append(("p", text("pack.band_partial", lang, M=L.M_bal, kinds=text("group.kinds_12", lang))))
     delta = text("pack.delta", lang, M=L.M_bal, ML=L.lever(L.M_bal), delta=num(ws.value("delta_pct"), lang, decimals=2))
     if "delta_pct" in bands:            # the study draws the force plans of RRR and RRP (frame guide) groups only
         lo, hi = (num(x, lang, decimals=2) for x in bands["delta_pct"])
@@ -275,7 +283,8 @@ def _segments_table(plans, lang: str, answers: set[str]) -> Table:
             rows.append((title_of(plan, lang), segment_label(s, lang), num(length, lang, decimals=1), scale, value))
             answers.add(num(length, lang, decimals=1))
     return Table((text("pack.plan", lang), text("segment", lang), text("pack.length", lang), text("scale", lang),
-                  text("ws.head.value", lang)), tuple(rows), (0.3, 0.14, 0.12, 0.24, 0.2), frozenset({2, 4}))
+                  text("ws.head.value", lang)), tuple(rows), (0.3, 0.14, 0.12, 0.24, 0.2), frozenset({2, 4}),
+                 symbols=frozenset({1}))
 
 
 def _reference_mm(mech, ws: Worksheet, scale) -> float:
@@ -290,18 +299,19 @@ def _reference_mm(mech, ws: Worksheet, scale) -> float:
 # ============================================================================ HTML
 
 def _html(blocks) -> str:
-    """The blocks as the body of an HTML page (every text escaped)."""
+    """The blocks as the body of an HTML page (every text escaped, its symbols' scripts in <sub> and
+    <sup>: `symbols.html`)."""
     out = []
     for kind, x in blocks:
         if kind in ("h1", "h2", "p"):
-            out.append(f"<{kind}>{escape(x)}</{kind}>")
+            out.append(f"<{kind}>{html(x)}</{kind}>")
         elif kind == "table":
-            out.append("<table>\n<tr>" + "".join(f"<th>{escape(h)}</th>" for h in x.head) + "</tr>")
+            out.append("<table>\n<tr>" + "".join(f"<th>{html(h)}</th>" for h in x.head) + "</tr>")
             for row in x.rows:
                 cells = []
-                for i, c in enumerate(row):
+                for i in range(len(row)):
                     cls = ' class="blank"' if i in x.blank else ' class="num"' if i in x.numeric else ""
-                    cells.append(f"<td{cls}>{escape(c)}</td>")
+                    cells.append(f"<td{cls}>{html(x.cell(row, i))}</td>")
                 out.append("<tr>" + "".join(cells) + "</tr>")
             out.append("</table>")
         elif kind == "figure":
@@ -383,7 +393,7 @@ class _Flow:
         widths = [w * self.width for w in t.widths]
 
         def draw(row, bold=False, blank=()):
-            wrapped = [_wrap(c, w - 2 * pad, size) for c, w in zip(row, widths)]
+            wrapped = [_wrap(c if bold else t.cell(row, i), w - 2 * pad, size) for i, (c, w) in enumerate(zip(row, widths))]
             h = max(len(c) for c in wrapped) * lh + 2 * pad + (2.5 if blank else 0)
             if self.room(h) and not bold:
                 draw(t.head, bold=True)

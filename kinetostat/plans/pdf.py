@@ -8,13 +8,18 @@ punctuation, arrows and mathematical operators by fontTools:
 `pyftsubset DejaVuSans.ttf --unicodes=U+0020-024F,U+0300-036F,U+0370-052F,U+2000-22FF,U+25A0-25FF
 --no-hinting --layout-features='' --name-IDs='*' --name-languages='*'` (the same for the bold).
 
-May use: reportlab, the standard library. Never matplotlib.
+A symbol in a text (`symbols`: μ_l, a^n_BA, R12t where marked) is set with its sub- and superscripts
+at a smaller size and a rise (the text operators Tf and Ts), as the sheets set them.
+
+May use: reportlab, the standard library, `.symbols`. Never matplotlib.
 """
 from __future__ import annotations
 
 import io
 from functools import lru_cache
 from pathlib import Path
+
+from .symbols import SCRIPT, SUB, SUB_DROP, SUP, SUP_RISE, text_runs
 
 __all__ = ["Canvas", "text_width", "FONT", "BOLD", "PT", "ASCENT"]
 
@@ -35,12 +40,20 @@ def _registered() -> None:
         pdfmetrics.registerFont(TTFont(name, str(_FONTS / f"{name}.ttf")))
 
 
+def _runs(s: str, size_mm: float) -> tuple[tuple[str, float, float], ...]:
+    """`s` as (text, font size mm, rise mm) runs: its symbols' sub- and superscripts (`symbols.text_runs`)
+    SCRIPT of the size, dropped SUB_DROP or raised SUP_RISE of it."""
+    rise = {0: 0.0, SUB: -SUB_DROP * size_mm, SUP: SUP_RISE * size_mm}
+    return tuple((t, SCRIPT * size_mm if level else size_mm, rise[level]) for t, level in text_runs(s))
+
+
 @lru_cache(maxsize=8192)
 def text_width(s: str, size_mm: float, bold: bool = False) -> float:
-    """Advance width of `s` (mm) at `size_mm`, DejaVu Sans (bold), as the PDF sets it."""
+    """Advance width of `s` (mm) at `size_mm`, DejaVu Sans (bold), as the PDF sets it (its symbols'
+    scripts smaller: `Canvas.text`)."""
     from reportlab.pdfbase.pdfmetrics import stringWidth
     _registered()
-    return stringWidth(s, BOLD if bold else FONT, size_mm)
+    return sum(stringWidth(t, BOLD if bold else FONT, size) for t, size, _ in _runs(s, size_mm))
 
 
 @lru_cache(maxsize=64)
@@ -121,11 +134,26 @@ class Canvas:
         self._c.circle(*self._xy(x, y), r * PT, stroke=0, fill=1)
 
     def text(self, x: float, y: float, s: str, size_mm: float, bold: bool = False, right: bool = False) -> None:
-        """`s` with its baseline at y, starting (`right`: ending) at x, `size_mm` high (em), black."""
+        """`s` with its baseline at y, starting (`right`: ending) at x, `size_mm` high (em), black; its
+        symbols' sub- and superscripts (`symbols.text_runs`) smaller, below or above the baseline."""
         c = self._c
+        font = BOLD if bold else FONT
         self._set("fill", (0.0, 0.0, 0.0), c.setFillColorRGB)
-        self._set("font", (BOLD if bold else FONT, size_mm * PT), c.setFont)
-        (c.drawRightString if right else c.drawString)(*self._xy(x, y), s)
+        self._set("font", (font, size_mm * PT), c.setFont)
+        if right:
+            x -= text_width(s, size_mm, bold)
+        runs = _runs(s, size_mm)
+        if len(runs) <= 1 and not any(rise for _, _, rise in runs):
+            c.drawString(*self._xy(x, y), runs[0][0] if runs else "")
+            return
+        t = c.beginText(*self._xy(x, y))
+        for piece, size, rise in runs:
+            t.setFont(font, size * PT)
+            t.setRise(rise * PT)
+            t.textOut(piece)
+        t.setFont(font, size_mm * PT)
+        t.setRise(0)
+        c.drawText(t)
 
     def getvalue(self) -> bytes:
         """The PDF, its last page closed."""

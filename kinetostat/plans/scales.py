@@ -12,7 +12,8 @@ The plan of positions follows the text's own words (sec. 1.2.2): "the crank's le
 (30..35 mm recommended); then mu_l = l_OA / OA", and its worked example takes OA = 36 mm for the
 round mu_l = 0.001. So OA is chosen "about 30..35 mm", 30..36 mm (the example's own practice), and
 mu_l follows from it, as round as that allows (`length_scale`): a GOST 2.302 value
-(LENGTH_MANTISSAS, with 1:15 and 1:75) where one lands OA in the range, else two significant
+(LENGTH_MANTISSAS, with the mantissas 1.5 and 7.5 of 1:15 and 1:75; mu_l = 0.0015 m/mm is a
+drawing at 1:1.5) where one lands OA in the range, else two significant
 digits (l_OA = 0.036 m: 0.001 m/mm, OA = 36 mm, as the example).
 
     mu_l: the crank O-A drawn 30..36 mm;
@@ -41,7 +42,7 @@ __all__ = ["choose_scales", "references", "round_scale", "length_scale", "coarse
 SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F": "N/mm"}
 #: Mantissas of a round scale.
 ROUND_MANTISSAS = (1.0, 2.0, 2.5, 4.0, 5.0)
-#: Mantissas of the plan of positions' scale mu_l: ROUND_MANTISSAS and GOST 2.302's 1:15 and 1:75.
+#: Mantissas of the plan of positions' scale mu_l: ROUND_MANTISSAS and those of GOST 2.302's 1:15 and 1:75.
 LENGTH_MANTISSAS = (1.0, 1.5, 2.0, 2.5, 4.0, 5.0, 7.5)
 #: Recommended drawn length of each scale's reference quantity, mm.
 TARGET_MM = {"mu_l": (30.0, 36.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (100.0, 200.0)}
