@@ -584,11 +584,11 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     (default: itself), ValueError otherwise."""
     from .solve import analyze
     from .plans import build as build_plans
-    from .model.lettering import with_aliases
+    from .model.lettering import with_alias_columns
     from .plans.a3 import one_sheet
     from .plans.pack import pack
     from .plans.worksheet import analyses, worksheet_cycle
-    from .tables import csv_text
+    from .tables import columns_csv
     out = Path(out_dir)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
@@ -602,7 +602,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
         files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
         if cycle_csv:
-            files.append(write_text(tmp / "cycle.csv", csv_text(with_aliases(res.to_frame(), mech))))
+            files.append(write_text(tmp / "cycle.csv", columns_csv(*with_alias_columns(*res.columns(), mech))))
         if page:
             from .plans.page import write_page
             files.append(write_page(mech, tmp / "page.html", lang=lang, at=phi1))
