@@ -600,7 +600,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     teacher = pack(v, lang, a3=a3, analysis=(at, other)) if teacher_pack else None
     with unit(out, root) as tmp:
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
-        files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
+        files += plans.write(tmp, lang=lang, sheets=a3.sheets if a3 else None) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
         if cycle_csv:
             files.append(write_text(tmp / "cycle.csv", columns_csv(*with_alias_columns(*res.columns(), mech))))
         if page:
