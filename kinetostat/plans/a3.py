@@ -322,26 +322,33 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
         res = analyze(mech, phi_deg=[float(at)])
     reference = references(mech, res)
     drawn: dict[tuple, Drawing] = {}            # (language, kind, its scales) -> its drawing
-    alike: dict[tuple, Drawing] = {}            # (kind, its scales, `language_part`) -> a drawing of it
+    native: dict[tuple, list[str]] = {}         # (kind, its scales) -> the languages it was drawn in
+    parts: dict[tuple, tuple] = {}              # (language, kind, its scales) -> `language_part`
     sheets: dict[tuple, Any] = {}               # (kind, its scales) -> its sheet in `lang`, as Plans.write writes it
+
+    def part(plan, lg: str, at_scales: tuple) -> tuple:
+        if (lg, *at_scales) not in parts:
+            parts[(lg, *at_scales)] = language_part(plan, lg)
+        return parts[(lg, *at_scales)]
 
     def drawings(plans, lg: str) -> list[Drawing]:
         """The plans' drawings in `lg`, each drawn once for all the languages its plan group is
-        the same in (`draw.language_part`; its heading in `lg`); in `lang` with the notes and the
-        mechanism's name (`Plans.write`'s sheet)."""
+        the same in (`draw.language_part`, found where a language drawn before may be one; its
+        heading in `lg`); in `lang` with the notes and the mechanism's name (`Plans.write`'s sheet)."""
         out = []
         for k in plans:
             plan = plans[k]
             at_scales = (k, *(s.value for s in scales_of(plan)))
             if (lg, *at_scales) not in drawn:
-                part = (*at_scales, language_part(plan, lg))
-                if part in alike:
-                    drawn[(lg, *at_scales)] = replace(alike[part], heading=_heading_of(plan, lg))
+                alike = [o for o in native.get(at_scales, []) if part(plan, o, at_scales) == part(plan, lg, at_scales)]
+                if alike:
+                    drawn[(lg, *at_scales)] = replace(drawn[(alike[0], *at_scales)], heading=_heading_of(plan, lg))
                 else:
                     one = sheet(plan, lg, plans.mechanism_name(lg), notes=lg == lang)
                     if lg == lang:
                         sheets[at_scales] = one
-                    drawn[(lg, *at_scales)] = alike[part] = _read(one, plan, lg)
+                    native.setdefault(at_scales, []).append(lg)
+                    drawn[(lg, *at_scales)] = _read(one, plan, lg)
             out.append(drawn[(lg, *at_scales)])
         return out
 
