@@ -90,7 +90,7 @@ def _lines(s: str, size_mm: float, width_mm: float, weight: str = "normal") -> l
 
 def _xml_text(markup: str) -> str:
     """The text of escaped character data (a title, a tspan's content), as an XML reader reads it."""
-    return ET.fromstring(f"<t>{markup}</t>").text or "" if "&" in markup else markup
+    return (ET.fromstring(f"<t>{markup}</t>").text or "") if "&" in markup else markup
 
 
 def _runs(markup: str, size: float) -> tuple[tuple[str, float, float], ...]:
@@ -137,7 +137,10 @@ def _read(sheet, plan, lang: str) -> Drawing:
             (x, y), size = p[0], float(a["font-size"])
             runs = _runs(el.texts[int(el.variant[0])], size)
             texts.append((x, y, runs))
-            xs += [x, x + sum(_width(t, s) for t, s, _ in runs)]
+            w = 0.0
+            for t, s, _ in runs:                 # the runs' advances added in order
+                w += _width(t, s)
+            xs += [x, x + w]
             ys += [y - 0.95 * size, y + (runs[-1][2] if runs else 0.0) + 0.3 * size]
             continue
         xs += [x for x, _ in p]
