@@ -578,8 +578,9 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML), and with
     `page` the interactive page (page.html, `plans.page`: the key mode, the check at phi1). With the
     pack, the plans, worksheet and pack are drawn at the scales that put all the plans on its one
-    A3 sheet (`plans.a3.one_sheet`, chosen once here); without it, at the texts' rule (page.html
-    keeps its own scales, fixed over the cycle). The files
+    A3 sheet (`plans.a3.one_sheet`, chosen once here; the plans' SVG sheets are those it drew,
+    `OneSheet.sheets`); without it, at the texts' rule (page.html keeps its own scales, fixed over
+    the cycle). cycle.csv is written without pandas (`Analysis.columns`, `tables.columns_csv`). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
     from .solve import analyze
