@@ -2,8 +2,8 @@
 that computes it (`exact`); `kinetostat.solve.analyze` chooses between it and the compiled path.
 
 May use: model (with `model.lettering`: the pairs' names a warning gives), groups, kinematics,
-kinetostatics, applied, planar, friction, errors; pandas only inside `to_frame`, xarray (an optional
-extra) only inside `to_xarray`.
+kinetostatics, applied, planar, friction, errors; pandas only inside `to_frame` (`columns`: its
+table without pandas), xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
 
@@ -620,7 +620,19 @@ class Analysis:
 
     # -- table
     def to_frame(self):
-        """The whole analysis as a pandas DataFrame, one row per crank angle.
+        """The whole analysis as a pandas DataFrame, one row per crank angle: the columns of
+        `columns`. `df.attrs["units"]` maps every column to its unit ("1": dimensionless, "bool": a
+        flag); `df.attrs["frame"]` states the frame and sign conventions; `df.attrs["mechanism"]` the
+        model's name."""
+        import pandas as pd
+        cols, units = self.columns()
+        df = pd.DataFrame(cols)
+        df.attrs.update(mechanism=self.mech.name, units=units, frame=FRAME_NOTE)
+        return df
+
+    def columns(self) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+        """The whole analysis as columns over the crank angles (name -> (N,) array) and each
+        column's unit (name -> unit; "1": dimensionless, "bool": a flag), in `to_frame`'s order.
 
         Columns (unit in brackets): phi_deg [deg]; for every point P x_P, y_P [m], vx_P, vy_P
         [m/s], ax_P, ay_P [m/s^2]; for every moving link k theta_k [rad], omega_k [rad/s], eps_k
@@ -638,14 +650,9 @@ class Analysis:
         a revolute pair, friction force on the slider along the guide [N] in a prismatic one) and
         M_bal_0 [N m] (the frictionless balancing moment) and passes [1] (the most friction passes
         of a group at that angle, `FrictionSolution.passes`); cond_<group> [1] per Assur group;
-        singular [bool].
-
-        `df.attrs["units"]` maps every column to its unit ("1": dimensionless, "bool": a flag);
-        `df.attrs["frame"]` states the frame and sign conventions; `df.attrs["mechanism"]` the
-        model's name. Vectors are in the world frame (x right, y up, gravity along -y), moments
+        singular [bool]. Vectors are in the world frame (x right, y up, gravity along -y), moments
         and angles about +z.
         """
-        import pandas as pd
         m = self.mech
         cols: dict[str, np.ndarray] = {}
         units: dict[str, str] = {}
@@ -702,9 +709,7 @@ class Analysis:
             put("bool", self_locking=self.self_locking)
         put("1", **{f"cond_{g.label}": self.cond[:, n] for n, g in enumerate(m.structure.groups)})
         put("bool", singular=self.singular)
-        df = pd.DataFrame(cols)
-        df.attrs.update(mechanism=m.name, units=units, frame=FRAME_NOTE)
-        return df
+        return cols, units
 
     # -- labelled arrays
     def to_xarray(self):

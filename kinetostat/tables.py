@@ -1,5 +1,5 @@
-"""The tables a user gets (`analyze --out`, a report's cycle.csv, sweep tables, a variant's
-cycle.csv; segments.csv and the worksheets: rows rounded by `rounded_columns` and `by_unit`,
+"""The tables a user gets (`analyze --out`, a report's cycle.csv, sweep tables; segments.csv,
+the worksheets and a variant's cycle.csv: rows rounded by `rounded_columns` and `by_unit`,
 written by `rows_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON
 or Parquet of a pandas DataFrame whose `attrs["units"]` gives each column's unit, with the units
 in every format and the numbers of the text formats to the digits that mean something.
@@ -30,7 +30,7 @@ from typing import IO, Any, Iterable
 
 import numpy as np
 
-__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "rounded_columns", "by_unit", "cell_text", "rows_csv", "value", "error",
+__all__ = ["DIGITS", "ERROR_DIGITS", "rounded", "rounded_columns", "by_unit", "cell_text", "rows_csv", "columns_csv", "value", "error",
            "header", "write_csv", "csv_text", "plain", "json_document", "write_json", "write_parquet", "read_csv"]
 
 #: Significant digits of a value in a text output, counted on its unit's largest |value|.
@@ -123,8 +123,12 @@ def rounded_columns(cols: dict[str, np.ndarray], units: dict[str, str]) -> dict[
 
 def header(df) -> list[str]:
     """The CSV header of `df`: each column as `name [unit]` (`attrs["units"]`), text columns bare."""
-    units = df.attrs.get("units", {})
-    return [name if units.get(name, "") in _NO_UNIT else f"{name} [{units[name]}]" for name in df.columns]
+    return _named(df.columns, df.attrs.get("units", {}))
+
+
+def _named(names: Iterable[str], units: dict[str, str]) -> list[str]:
+    """Each column's name in a CSV header: `name [unit]`, a text column bare."""
+    return [name if units.get(name, "") in _NO_UNIT else f"{name} [{units[name]}]" for name in names]
 
 
 #: Rows of a CSV formatted at a time (`write_csv`): the text of all rows at once took 7 kB a row.
@@ -166,6 +170,15 @@ def rows_csv(names: Iterable[str], rows: Iterable[Iterable[Any]]) -> str:
     w.writerow(names)
     w.writerows([cell_text(x) for x in row] for row in rows)
     return buf.getvalue()
+
+
+def columns_csv(cols: dict[str, np.ndarray], units: dict[str, str]) -> str:
+    """Columns (name -> (N,) array) with their units as CSV text without pandas: the text
+    `write_csv` writes of the frame of these columns with these `attrs["units"]` (float columns
+    `rounded_columns`, cells `cell_text`)."""
+    floats = rounded_columns({k: v for k, v in cols.items() if v.dtype.kind == "f"}, units)
+    table = [floats.get(k, v).tolist() for k, v in cols.items()]
+    return rows_csv(_named(cols, units), zip(*table))
 
 
 def csv_text(df) -> str:

@@ -578,17 +578,18 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     `teacher_pack` the teacher's pack (`plans.pack`: sheet.pdf, key.pdf, plans_a3.pdf and their HTML), and with
     `page` the interactive page (page.html, `plans.page`: the key mode, the check at phi1). With the
     pack, the plans, worksheet and pack are drawn at the scales that put all the plans on its one
-    A3 sheet (`plans.a3.one_sheet`, chosen once here); without it, at the texts' rule (page.html
-    keeps its own scales, fixed over the cycle). The files
+    A3 sheet (`plans.a3.one_sheet`, chosen once here; the plans' SVG sheets are those it drew,
+    `OneSheet.sheets`); without it, at the texts' rule (page.html keeps its own scales, fixed over
+    the cycle). cycle.csv is written without pandas (`Analysis.columns`, `tables.columns_csv`). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
     from .solve import analyze
     from .plans import build as build_plans
-    from .model.lettering import with_aliases
+    from .model.lettering import with_alias_columns
     from .plans.a3 import one_sheet
     from .plans.pack import pack
     from .plans.worksheet import analyses, worksheet_cycle
-    from .tables import csv_text
+    from .tables import columns_csv
     out = Path(out_dir)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
@@ -600,9 +601,9 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     teacher = pack(v, lang, a3=a3, analysis=(at, other)) if teacher_pack else None
     with unit(out, root) as tmp:
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
-        files += plans.write(tmp, lang=lang) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
+        files += plans.write(tmp, lang=lang, sheets=a3.sheets if a3 else None) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
         if cycle_csv:
-            files.append(write_text(tmp / "cycle.csv", csv_text(with_aliases(res.to_frame(), mech))))
+            files.append(write_text(tmp / "cycle.csv", columns_csv(*with_alias_columns(*res.columns(), mech))))
         if page:
             from .plans.page import write_page
             files.append(write_page(mech, tmp / "page.html", lang=lang, at=phi1))

@@ -119,29 +119,63 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
 
 def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
     """Task 2 / 479 (its search comes back to scales tried before): `one_sheet` builds the plans of
-    each choice of scales once (was: 9 builds for 8 choices) and draws each plan once a language
-    at its scales; every build after the rule's is given the plan of positions' 12 positions at
-    its μ_l, made once per μ_l (was: made again in each build); the same sheet as `_one` (no
-    state kept between calls)."""
+    each choice of scales once (was: 9 builds for 8 choices) and draws each plan once at its
+    scales for all the languages that draw it alike (`draw.language_part`: was once a language:
+    the velocity plan, lettered the same in all three, drawn three times; a group plan, whose
+    guide is lettered in each language, is drawn again in the others); every build after the
+    rule's is given the plan of positions' 12 positions at its μ_l, made once per μ_l (was: made
+    again in each build); the same sheet as `_one` (no state kept between calls)."""
     import kinetostat.plans as KP
     built, drawn, positions = [], [], []
-    build, drawing = KP.build, A3.drawing
+    build, sheet = KP.build, A3.sheet
 
     def counted(mech, at, scales=None, **kw):
         built.append(None if scales is None else tuple(sorted(scales.items())))
         positions.append(kw.get("positions"))
         return build(mech, at=at, scales=scales, **kw)
     monkeypatch.setattr(KP, "build", counted)
-    monkeypatch.setattr(A3, "drawing", lambda plan, lang: drawn.append(
-        (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or drawing(plan, lang))
+    monkeypatch.setattr(A3, "sheet", lambda plan, lang, *a, **kw: drawn.append(
+        (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or sheet(plan, lang, *a, **kw))
     v = variants.variant(2, "479")
     one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
     assert len(built) == len(set(built)) >= 5
     assert len(drawn) == len(set(drawn)) and {lang for lang, _, _ in drawn} == {"en", "uk", "ru"}
+    again = {kind for lang, kind, _ in drawn if lang != "en"}
+    assert "group:2,3" in again and "velocity" not in again
     given = positions[1:]
     assert all(p is not None and p.mu.value == dict(b)["mu_l"] for p, b in zip(given, built[1:]))
     assert len({id(p) for p in given}) == len({p.mu.value for p in given}) < len(given)
     assert one.places == _one(2, "479").places and one.drawings == _one(2, "479").drawings
+
+
+def test_a_plans_drawing_is_its_sheets_plan_group_as_written():
+    """`drawing` reads the plan group of the plan's sheet from its elements (no SVG text written and
+    parsed back): the same lines (ends to 0.001 mm, as the SVG writes them; each named by its
+    tooltip, a guide in the sheet's language), arrowheads, points and labels (their tspans) as the
+    plan group of the sheet's SVG."""
+    import xml.etree.ElementTree as ET
+    from kinetostat.plans.draw import svg
+    ns = "{http://www.w3.org/2000/svg}"
+    plan = _one(1, "479").plans["group:2,3"]
+    d = A3.drawing(plan, "uk")
+    group = next(g for g in ET.fromstring(svg(plan, "uk", notes=False)).iter(f"{ns}g") if g.get("id") == "plan")
+    lines = [(*(float(el.get(k)) for k in ("x1", "y1", "x2", "y2")), el.findtext(f"{ns}title") or "")
+             for el in group.iter(f"{ns}line")]
+    assert [(*ln[:4], ln[7]) for ln in d.lines] == lines and any(ln[4] == "напрямна P(4,3)" for ln in lines)
+    assert [(x, y, tuple(r[0] for r in runs)) for x, y, runs in d.texts] == [
+        (float(el.get("x")), float(el.get("y")), tuple(t.text for t in el.iter(f"{ns}tspan")))
+        for el in group.iter(f"{ns}text")]
+    assert len(d.polygons) == len(group.findall(f"{ns}path")) and len(d.dots) == len(group.findall(f"{ns}circle"))
+
+
+def test_the_plans_sheets_are_the_one_sheets_drawn_ones(tmp_path):
+    """The key's plans are written from the sheets `one_sheet` drew in its language (`OneSheet.sheets`,
+    not drawn again): the same files as `Plans.write` draws them, title block and notes included."""
+    one = _one(1, "479", "uk")
+    shared = one.plans.write(tmp_path / "shared", "uk", sheets=one.sheets)
+    drawn = one.plans.write(tmp_path / "drawn", "uk")
+    assert len(shared) == len(one.plans) + 1
+    assert [p.read_bytes() for p in shared] == [p.read_bytes() for p in drawn]
 
 
 def test_the_packer_counts_its_work():

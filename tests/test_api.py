@@ -170,6 +170,18 @@ def test_the_plans_command_imports_no_pandas_markdown_it_or_matplotlib(tmp_path)
     assert {"segments.csv", "worksheet.csv", "worksheet.html"} <= {p.name for p in (tmp_path / "p").iterdir()}
 
 
+def test_the_variant_command_imports_no_pandas(tmp_path):
+    """`kinetostat variant` writes its cycle.csv without pandas (`Analysis.columns`, `tables.columns_csv`):
+    0.6 s of the budget of a variant (issue 34 (d))."""
+    code = ("import sys\nfrom kinetostat.cli import main\n"
+            f"assert main(['variant', '1', '479', '-q', '--no-pack', '--out', {str(tmp_path / 'v')!r}]) == 0\n"
+            "print(sorted({m.split('.')[0] for m in sys.modules} & {'pandas', 'matplotlib'}))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT / "tests", timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[-1] == "[]"            # after the variant's summary
+    assert (tmp_path / "v" / "cycle.csv").read_text(encoding="utf-8").startswith("phi_deg [deg],x_O [m]")
+
+
 def _imports(module: str) -> set[str]:
     tree = ast.parse((ROOT / "kinetostat" / f"{module}.py").read_text(encoding="utf-8"))
     out = set()

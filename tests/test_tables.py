@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import json
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -122,6 +123,24 @@ def test_rows_csv_writes_what_pandas_to_csv_writes():
     want = pd.DataFrame(cols).to_csv(index=False, lineterminator="\n", float_format=tables.FLOAT_FORMAT)
     assert tables.rows_csv(cols, zip(*cols.values())) == want
     assert tables.rows_csv(cols, []) == "x,why,k,ok\n"
+
+
+def test_a_variants_cycle_csv_is_the_frames_csv_without_pandas():
+    """A variant's cycle.csv is written from `Analysis.columns` (`columns_csv`, no pandas): the
+    bytes `csv_text` writes of `to_frame` with the text's names (`with_aliases`), for a model with
+    friction in the reactions (Pfr_, eta, the bool self_locking, the integer passes) and a variant
+    whose frame is lettered 4 (R_4_1 after R_0_1, M_зр after M_bal)."""
+    from kinetostat.model.lettering import with_alias_columns, with_aliases
+    ice = kinetostat.load(Path(__file__).resolve().parents[1] / "models" / "ice_crank_slider.toml")
+    variant = kinetostat.variants.variant(1, "479").mechanism()
+    for mech, friction in ((variant, "first"), (ice, "reactions")):
+        with warnings.catch_warnings():             # the ICE self-locks with friction at its dead centres
+            warnings.simplefilter("ignore", kinetostat.errors.SelfLockingWarning)
+            res = kinetostat.analyze(mech, steps=24, friction=friction)
+        text = tables.columns_csv(*with_alias_columns(*res.columns(), mech))
+        assert text == tables.csv_text(with_aliases(res.to_frame(), mech))
+    assert {"R_4_1 [N]", "M_зр [N m]"} <= set(tables.columns_csv(*with_alias_columns(
+        *kinetostat.analyze(variant, steps=2).columns(), variant)).splitlines()[0].split(","))
 
 
 def test_a_column_named_twice_is_refused():

@@ -15,13 +15,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Any, Iterable, Mapping
 
 if TYPE_CHECKING:
     from .mechanism import Mechanism
 
-__all__ = ["Lettering", "lettering", "link_number", "reaction_name", "pair_name", "with_aliases", "in_lang", "DEFAULT",
-           "EN_SUBSCRIPTS"]
+__all__ = ["Lettering", "lettering", "link_number", "reaction_name", "pair_name", "aliases", "with_alias_columns",
+           "with_aliases", "in_lang", "DEFAULT", "EN_SUBSCRIPTS"]
 
 
 @dataclass(frozen=True)
@@ -108,22 +108,39 @@ def pair_name(mech: "Mechanism", p) -> str:
     return f"{reaction_name(mech, *p.links)} {where}"
 
 
-def with_aliases(df, mech: "Mechanism"):
-    """The analysis frame `df` (`Analysis.to_frame`) with the text's names added as copies of
-    their columns, after them: R_4_3 for R_0_3 where the frame is lettered 4 (and Rx_, Ry_,
-    angle_R_, x_ likewise), M_зр for M_bal, M'_зр for M_lever, F_зр for F_bal. Units carried."""
+def aliases(columns: Iterable[str], mech: "Mechanism") -> dict[str, str]:
+    """The text's names of the analysis table's `columns` (`Analysis.columns`), alias -> column:
+    R_4_3 for R_0_3 where the frame is lettered 4 (and Rx_, Ry_, angle_R_, x_ likewise), M_зр for
+    M_bal, M'_зр for M_lever, F_зр for F_bal."""
     L = lettering(mech)
-    units = dict(df.attrs.get("units", {}))
+    columns = list(columns)
     alias: dict[str, str] = {}
     if L.frame:
-        for col in df.columns:
+        for col in columns:
             m = re.fullmatch(r"(Rx|Ry|R|angle_R|x|m|vs|as)_(\d+)_(\d+)", col)
             if m and "0" in m.group(2, 3):
                 i, j = (L.frame if g == "0" else g for g in m.group(2, 3))
                 alias[f"{m.group(1)}_{i}_{j}"] = col
     for symbol, col in ((L.M_bal, "M_bal"), (L.lever(L.M_bal), "M_lever"), (L.F_bal, "F_bal")):
-        if symbol != col and col in df.columns and symbol not in df.columns:
+        if symbol != col and col in columns and symbol not in columns:
             alias[symbol] = col
+    return alias
+
+
+def with_alias_columns(cols: Mapping[str, Any], units: Mapping[str, str], mech: "Mechanism"
+                       ) -> tuple[dict[str, Any], dict[str, str]]:
+    """The analysis table's columns (`Analysis.columns`: name -> array, name -> unit) with the
+    text's names (`aliases`) added as copies of their columns, after them: as `with_aliases` a frame."""
+    alias = aliases(cols, mech)
+    return ({**cols, **{a: cols[c] for a, c in alias.items()}},
+            {**units, **{a: units.get(c, "") for a, c in alias.items()}})
+
+
+def with_aliases(df, mech: "Mechanism"):
+    """The analysis frame `df` (`Analysis.to_frame`) with the text's names (`aliases`) added as
+    copies of their columns, after them. Units carried."""
+    units = dict(df.attrs.get("units", {}))
+    alias = aliases(df.columns, mech)
     out = df.assign(**{a: df[c] for a, c in alias.items()})
     out.attrs.update(df.attrs, units=units | {a: units.get(c, "") for a, c in alias.items()})
     return out

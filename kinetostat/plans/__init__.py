@@ -25,14 +25,14 @@ from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 from types import MappingProxyType
-from typing import Callable, Iterable
+from typing import Any, Callable, Iterable
 
 from .._io import write_text
 from .._text import csv_cell
 from ..kinematics import DIGITS_WARN
 from ..tables import by_unit, rounded_columns, rows_csv
 from .core import SEGMENT_COLUMNS, Plan, PlanCycle, Scale, Segment, extent, extent_cycle
-from .draw import ROOM_MM, figure, svg
+from .draw import ROOM_MM, figure, sheet, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
 from ..model.lettering import lettering
 from .mechanism import mechanism_plan
@@ -279,17 +279,24 @@ class Plans(Mapping):
         cols["value"] = by_unit(cols["value"], cols["unit"])
         return rows_csv(SEGMENT_COLUMNS, zip(*(map(csv_cell, cols[c]) for c in SEGMENT_COLUMNS)))  # no formula cell
 
-    def write(self, out_dir: str | Path, lang: str = "en") -> list[Path]:
+    def mechanism_name(self, lang: str = "en") -> str:
+        """The mechanism as the plans' sheets name it in `lang` (the model's lettering)."""
+        return lettering(self.mech).name(lang, self.mech.name)
+
+    def write(self, out_dir: str | Path, lang: str = "en", sheets: Mapping[str, Any] | None = None) -> list[Path]:
         """Write one SVG sheet per plan (`plan_file_name`) in `lang` ("en", "uk", "ru"; the
-        mechanism named as the model's lettering names it in `lang`) and segments.csv into
-        `out_dir` (created), each atomically; returns the paths written."""
+        mechanism named as `mechanism_name`) and segments.csv into `out_dir` (created), each
+        atomically; returns the paths written. `sheets`: kind -> that plan's sheet drawn already
+        in `lang` (`draw.sheet` with the notes and the mechanism's name: `a3.OneSheet.sheets`),
+        written as it is."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
-        name = lettering(self.mech).name(lang, self.mech.name)
+        sheets = sheets or {}
         for plan in self._plans.values():
             path = out / plan_file_name(plan)
-            write_text(path, svg(plan, lang=lang, mechanism=name))
+            drawn = sheets[plan.kind] if plan.kind in sheets else sheet(plan, lang=lang, mechanism=self.mechanism_name(lang))
+            write_text(path, drawn.svg(0))
             written.append(path)
         write_text(out / "segments.csv", self.segments_csv())
         return written + [out / "segments.csv"]

@@ -2,10 +2,10 @@
 drawing = 1 mm on paper, at the scales its heading states), as seed 002 (Logvinenko, Nadtoka
 2021, appendix B) puts them.
 
-Each plan is drawn exactly as its own SVG sheet draws it (`draw.svg`: its lines, arrowheads,
+Each plan is drawn exactly as its own SVG sheet draws it (`draw.sheet`: its lines, arrowheads,
 points and every label where `labels.Placer` put it clear of the others): the `plan` group of
-that sheet is read back (`drawing`), placed on the page (`pages`) and drawn into the PDF in
-millimetres (`draw_page`, `.pdf`). The
+that sheet is read from its elements, as its SVG writes them (`drawing`), placed on the page
+(`pages`) and drawn into the PDF in millimetres (`draw_page`, `.pdf`). The
 plans' extents (drawing, labels and a heading: title, then every scale the plan is drawn at) are
 placed inside the frame, clear of the title block and the notes above it, never turned
 (`layout`): in the texts' order (`texts_rank`: positions, mechanism, velocities, accelerations,
@@ -19,19 +19,20 @@ step coarser first, μ_l only where they cannot make room; the title block and t
 scale made coarser than the rule, and why. Where no choice fits them, further sheets take the
 rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
-May use: the standard library, `build` of this package, `.core`, `.draw`, `.i18n`, `.kinematic`,
+May use: the standard library, numpy, `build` of this package, `.core`, `.draw`, `.i18n`, `.kinematic`,
 `.labels`, `.scales`, `.pdf`, `kinetostat.solve`. Never matplotlib.
 """
 from __future__ import annotations
 
-import re
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any, Mapping
 
+import numpy as np
+
 from .core import Scale
-from .draw import SHEET_MM, scale_text, scales_of, svg, title_of
+from .draw import SHEET_MM, language_part, scale_text, scales_of, sheet, title_of
 from .i18n import LANGS, num, text
 from .pdf import text_width
 from .scales import TARGET_MM
@@ -39,7 +40,6 @@ from .scales import TARGET_MM
 __all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
            "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM"]
 
-_NS = "{http://www.w3.org/2000/svg}"
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
 #: (left 20 mm for binding, 5 mm elsewhere) below the sheet's title line.
 AREA = (24.0, 13.0, 411.0, 288.0)
@@ -97,57 +97,77 @@ def _lines(s: str, size_mm: float, width_mm: float, weight: str = "normal") -> l
     return out + [line]
 
 
-def _pts(s: str) -> list[tuple[float, float]]:
-    nums = [float(v) for v in re.findall(r"-?\d+(?:\.\d+)?", s)]
-    return list(zip(nums[::2], nums[1::2]))
+def _xml_text(markup: str) -> str:
+    """The text of escaped character data (a title, a tspan's content), as an XML reader reads it."""
+    return (ET.fromstring(f"<t>{markup}</t>").text or "") if "&" in markup else markup
 
 
-def drawing(plan, lang: str) -> Drawing:
-    """The `plan` group of the plan's SVG sheet (`draw.svg`) as primitives, with its box."""
-    root = ET.fromstring(svg(plan, lang=lang, notes=False).encode("utf-8"))
-    group = next(g for g in root.iter(f"{_NS}g") if g.get("id") == "plan")
+def _runs(markup: str, size: float) -> tuple[tuple[str, float, float], ...]:
+    """A label's runs (text, size mm, how far below the baseline, mm) from its tspans' markup
+    (`labels.label_markup`) at font size `size`."""
+    runs, low = [], 0.0
+    for t in ET.fromstring(f"<t>{markup}</t>").iter("tspan"):
+        low += float(t.get("dy", "0"))
+        runs.append((t.text or "", float(t.get("font-size", size)), low))
+    return tuple(runs)
+
+
+def _read(sheet, plan, lang: str) -> Drawing:
+    """The plan group of a plan's one-angle sheet (`draw.sheet`: its elements, in the order its SVG
+    writes them, coordinates to 0.001 mm as it writes them) as primitives, with its box."""
     lines, polylines, polygons, dots, texts = [], [], [], [], []
     xs, ys = [], []
-    for el in group:
-        tag = el.tag[len(_NS):]
-        if tag == "line":
-            x0, y0, x1, y1 = (float(el.get(k)) for k in ("x1", "y1", "x2", "y2"))
-            title = el.find(f"{_NS}title")
-            lines.append((x0, y0, x1, y1, float(el.get("stroke-width", "0.13")), el.get("stroke-dasharray", ""),
-                          el.get("stroke", "#000"), title.text if title is not None else ""))
-            xs += [x0, x1]
-            ys += [y0, y1]
-        elif tag == "polyline":
-            p = _pts(el.get("points"))
-            polylines.append((p, float(el.get("stroke-width")), el.get("stroke")))
-            xs += [a for a, _ in p]
-            ys += [b for _, b in p]
-        elif tag == "path":                      # an arrowhead, its tip first: of the line before it
-            p = _pts(el.get("d"))
-            owner = lines[-1][7] if lines and "arc" not in el.get("class", "") else ""
-            polygons.append((p, el.get("fill", "#000"), owner))
-            xs += [a for a, _ in p]
-            ys += [b for _, b in p]
-        elif tag == "circle":
-            x, y, r = (float(el.get(k)) for k in ("cx", "cy", "r"))
+    for el in sheet.elements:
+        xy = el.xy[0]
+        if el.tag == "polyline":
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            if len(xy) < 2:
+                continue
+        elif el.tag == "g" or not np.isfinite(xy).all():
+            continue
+        p = [(x, y) for x, y in (np.rint(xy * 1000.0) / 1000.0 + 0.0).tolist()]     # as written: 0.001 mm
+        a = el.attrs
+        if el.tag == "line":
+            (x0, y0), (x1, y1) = p
+            lines.append((x0, y0, x1, y1, float(a.get("stroke-width", "0.13")), a.get("stroke-dasharray", ""),
+                          a.get("stroke", "#000"), _xml_text(el.title)))
+        elif el.tag == "polyline":
+            polylines.append((p, float(a["stroke-width"]), a["stroke"]))
+        elif el.tag == "path":                   # an arrowhead, its tip first: of the line before it
+            owner = lines[-1][7] if lines and "arc" not in a.get("class", "") else ""
+            polygons.append((p, a.get("fill", "#000"), owner))
+        elif el.tag == "circle":
+            (x, y), r = p[0], float(a["r"])
             dots.append((x, y, r))
             xs += [x - r, x + r]
             ys += [y - r, y + r]
-        elif tag == "text":
-            x, y, size = float(el.get("x")), float(el.get("y")), float(el.get("font-size"))
-            runs, w, low = [], 0.0, 0.0
-            for t in el.iter(f"{_NS}tspan"):
-                s = float(t.get("font-size", size))
-                low += float(t.get("dy", "0"))
-                runs.append((t.text or "", s, low))
-                w += _width(t.text or "", s)
-            texts.append((x, y, tuple(runs)))
+            continue
+        elif el.tag == "text":
+            (x, y), size = p[0], float(a["font-size"])
+            runs = _runs(el.texts[int(el.variant[0])], size)
+            texts.append((x, y, runs))
+            w = 0.0
+            for t, s, _ in runs:                 # the runs' advances added in order
+                w += _width(t, s)
             xs += [x, x + w]
-            ys += [y - 0.95 * size, y + low + 0.3 * size]
-    scales = "; ".join(scale_text(s, lang) for s in scales_of(plan))
+            ys += [y - 0.95 * size, y + (runs[-1][2] if runs else 0.0) + 0.3 * size]
+            continue
+        xs += [x for x, _ in p]
+        ys += [y for _, y in p]
     box = (min(xs), min(ys), max(xs), max(ys)) if xs else (0.0, 0.0, 0.0, 0.0)
-    return Drawing(plan.kind, (title_of(plan, lang), f"{text('scales', lang)}: {scales}"), tuple(lines),
-                   tuple(polylines), tuple(polygons), tuple(dots), tuple(texts), box)
+    return Drawing(plan.kind, _heading_of(plan, lang), tuple(lines), tuple(polylines), tuple(polygons), tuple(dots),
+                   tuple(texts), box)
+
+
+def _heading_of(plan, lang: str) -> tuple[str, str]:
+    """A plan's heading in `lang`: its title, and every scale it is drawn at."""
+    scales = "; ".join(scale_text(s, lang) for s in scales_of(plan))
+    return title_of(plan, lang), f"{text('scales', lang)}: {scales}"
+
+
+def drawing(plan, lang: str, mechanism: str = "") -> Drawing:
+    """The `plan` group of the plan's sheet (`draw.sheet`) as primitives, with its box."""
+    return _read(sheet(plan, lang, mechanism), plan, lang)
 
 
 def _heading(d: Drawing) -> list[tuple[str, float, str]]:
@@ -346,13 +366,15 @@ class OneSheet:
     """The plans of a variant at the scales that put them all on one A3 sheet (`one_sheet`):
     `plans` (`kinetostat.plans.Plans`), their drawings in `lang` and placements (`layout`), the
     scales the texts' rule chose (`rule`: symbol -> Scale) and the quantity each scale draws
-    (`reference`, SI: `scales.references`)."""
+    (`reference`, SI: `scales.references`), and each plan's sheet in `lang` (`sheets`: kind ->
+    `draw.sheet` with its notes, as `Plans.write` writes it: drawn once for both)."""
     plans: Any
     lang: str
     drawings: tuple[Drawing, ...]
     places: tuple[Placement, ...]
     rule: Mapping[str, Scale]
     reference: Mapping[str, float]
+    sheets: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     def coarsened(self) -> list[tuple[Scale, Scale, float]]:
         """The scales made coarser than the rule's to fit one sheet: (rule's, chosen, the
@@ -371,7 +393,8 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     while they still fit. The same `kinetostat.plans.build` that every sheet of the plans uses,
     with these scales given; each try a build (the plan of positions' 12 positions made once per
     μ_l, `kinematic.fixed_positions`), the drawings of the plans whose scales changed (in each
-    language) and their layouts. Where no scale within _TRIES steps fits them, the last
+    language; drawn once for the languages whose letters and notes' room are the same,
+    `draw.language_part`) and their layouts. Where no scale within _TRIES steps fits them, the last
     try is kept (more than one sheet). `res`: the caller's frictionless analysis of `mech` at
     [at] for the references of the scales (default: made here, once)."""
     from . import build
@@ -381,15 +404,35 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
         from ..solve import analyze
         res = analyze(mech, phi_deg=[float(at)])
     reference = references(mech, res)
-    drawn: dict[tuple, Drawing] = {}
+    drawn: dict[tuple, Drawing] = {}            # (language, kind, its scales) -> its drawing
+    native: dict[tuple, list[str]] = {}         # (kind, its scales) -> the languages it was drawn in
+    parts: dict[tuple, tuple] = {}              # (language, kind, its scales) -> `language_part`
+    sheets: dict[tuple, Any] = {}               # (kind, its scales) -> its sheet in `lang`, as Plans.write writes it
+
+    def part(plan, lg: str, at_scales: tuple) -> tuple:
+        if (lg, *at_scales) not in parts:
+            parts[(lg, *at_scales)] = language_part(plan, lg)
+        return parts[(lg, *at_scales)]
 
     def drawings(plans, lg: str) -> list[Drawing]:
+        """The plans' drawings in `lg`, each drawn once for all the languages its plan group is
+        the same in (`draw.language_part`, found where a language drawn before may be one; its
+        heading in `lg`); in `lang` with the notes and the mechanism's name (`Plans.write`'s sheet)."""
         out = []
         for k in plans:
-            key = (lg, k, *(s.value for s in scales_of(plans[k])))
-            if key not in drawn:
-                drawn[key] = drawing(plans[k], lg)
-            out.append(drawn[key])
+            plan = plans[k]
+            at_scales = (k, *(s.value for s in scales_of(plan)))
+            if (lg, *at_scales) not in drawn:
+                alike = [o for o in native.get(at_scales, []) if part(plan, o, at_scales) == part(plan, lg, at_scales)]
+                if alike:
+                    drawn[(lg, *at_scales)] = replace(drawn[(alike[0], *at_scales)], heading=_heading_of(plan, lg))
+                else:
+                    one = sheet(plan, lg, plans.mechanism_name(lg), notes=lg == lang)
+                    if lg == lang:
+                        sheets[at_scales] = one
+                    native.setdefault(at_scales, []).append(lg)
+                    drawn[(lg, *at_scales)] = _read(one, plan, lg)
+            out.append(drawn[(lg, *at_scales)])
         return out
 
     fixed: dict[float, Any] = {}
@@ -455,7 +498,8 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
                 break
             given[k] = steps[k].pop()
             plans, ds, places, fit = trial
-    return OneSheet(plans, lang, tuple(ds), tuple(places), MappingProxyType(rule), MappingProxyType(reference))
+    return OneSheet(plans, lang, tuple(ds), tuple(places), MappingProxyType(rule), MappingProxyType(reference),
+                    MappingProxyType({k: sheets[(k, *(s.value for s in scales_of(plans[k])))] for k in plans}))
 
 
 @dataclass(frozen=True)

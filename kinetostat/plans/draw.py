@@ -7,8 +7,8 @@ Figure for notebooks and the reports' PNGs.
 One renderer: `drawing(cycle)` computes every element of a plan's sheet at all N angles of a
 `PlanCycle` at once, as arrays (`core.Drawing`: one place of the plan on the sheet for the whole
 cycle, the title's φ a text with a variant per angle); `Drawing.svg(i)` writes the sheet of
-angle i; `svg(plan)`, the sheet of one angle, is `drawing` of the cycle of one, written, with
-its notes.
+angle i; `sheet(plan)`, the sheet of one angle, is `drawing` of the cycle of one, with its
+notes, and `svg(plan)` that sheet written.
 
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
 results (vectors, the design position) thick, construction thin, an alternative (F_i2(h)) and a
@@ -41,7 +41,7 @@ from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, marku
 from .symbols import SUB, mark, plain, runs, text_runs
 from ..model.lettering import in_lang
 
-__all__ = ["drawing", "svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
+__all__ = ["drawing", "sheet", "svg", "language_part", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
            "ROOM_MM"]
 
 #: The sheet: A3 landscape, mm.
@@ -679,17 +679,33 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
     return dots, labels
 
 
-def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: bool) -> Drawing:
-    """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where `notes`."""
-    _lang(lang)
+def _room(cycle: PlanCycle, lang: str, notes: bool):
+    """The notes block (SVG where `notes`, of the angle with the most lines of them) and the
+    drawing area they leave, with what they were found from: (block, area, tiny, extents, box)."""
     tiny = _tiny(cycle)
     ext = _extents(cycle)
     box = _union(ext)
     lines = np.array([len(x) for x in cycle.notes] if cycle.notes else [0] * cycle.n) \
         + sum((v != _AS_IS).astype(int) for v in tiny.values())
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
-    plan = cycle.at(i)
-    block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, _tiny_at(tiny, i), box, draw=notes)
+    block, area = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, draw=notes)
+    return block, area, tiny, ext, box
+
+
+def language_part(plan: Plan, lang: str) -> tuple:
+    """All that the plan's drawing in `lang` (every element of its sheet's plan group and each
+    label's place: `sheet`) takes from the language: the drawing area its notes leave and the
+    letters of its segments and paths. Two languages with the same part draw the same plan group."""
+    _lang(lang)
+    area = _room(PlanCycle.of(plan), lang, notes=False)[1]
+    return (area, tuple(segment_label(s, lang) for s in plan.segments),
+            tuple(text(name, lang) for name in plan.paths if name in MESSAGES))
+
+
+def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: bool) -> Drawing:
+    """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where `notes`."""
+    _lang(lang)
+    block, (ax0, ay0, ax1, ay1), tiny, ext, box = _room(cycle, lang, notes)
     x0, y0, x1, y1 = box
     tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
@@ -739,10 +755,15 @@ def drawing(cycle: PlanCycle, lang: str = "en", mechanism: str = "", contract: b
     return _sheet(cycle, lang, mechanism, contract, notes=False)
 
 
+def sheet(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = False, notes: bool = True) -> Drawing:
+    """The plan on an A3 landscape sheet as arrays: the one-angle `drawing` of the plan, with the
+    notes block where `notes` (False: left out, their room kept); `svg` writes it."""
+    return _sheet(PlanCycle.of(plan), lang, mechanism, contract, notes)
+
+
 def svg(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = False, notes: bool = True) -> str:
-    """The plan on an A3 landscape sheet, as SVG text: the one-angle `drawing` of the plan,
-    written (`Drawing.svg`), with the notes block where `notes` (False: left out, their room kept)."""
-    return _sheet(PlanCycle.of(plan), lang, mechanism, contract, notes).svg(0)
+    """The plan on an A3 landscape sheet, as SVG text: its `sheet`, written (`Drawing.svg`)."""
+    return sheet(plan, lang, mechanism, contract, notes).svg(0)
 
 
 # ----------------------------------------------------------------------------- matplotlib
