@@ -161,7 +161,7 @@ def test_a_plans_drawing_is_its_sheets_plan_group_as_written():
     group = next(g for g in ET.fromstring(svg(plan, "uk", notes=False)).iter(f"{ns}g") if g.get("id") == "plan")
     lines = [(*(float(el.get(k)) for k in ("x1", "y1", "x2", "y2")), el.findtext(f"{ns}title") or "")
              for el in group.iter(f"{ns}line")]
-    assert [(*ln[:4], ln[7]) for ln in d.lines] == lines and any(ln[4] == "напрямна P(4,3)" for ln in lines)
+    assert [(*ln[:4], ln[7]) for ln in d.lines] == lines and any(ln[4] == "напрямна 4-3" for ln in lines)
     assert [(x, y, tuple(r[0] for r in runs)) for x, y, runs in d.texts] == [
         (float(el.get("x")), float(el.get("y")), tuple(t.text for t in el.iter(f"{ns}tspan")))
         for el in group.iter(f"{ns}text")]
