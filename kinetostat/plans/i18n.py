@@ -54,6 +54,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "negligible": ("negligible: {length} mm at the scale, not laid off",
                    "нехтовно мала: {length} мм у масштабі, не відкладається",
                    "пренебрежимо мала: {length} мм в масштабе, не откладывается"),
+    "out of scale, page": ("drawn out of scale", "показано поза масштабом", "показано вне масштаба"),
+    "negligible, page": ("negligible, not laid off", "нехтовно мала, не відкладається", "пренебрежимо мала, не откладывается"),
     "arms natural": ("arms h measured on the drawing, mm", "плечі h виміряно на кресленні, мм",
                      "плечи h измерены на чертеже, мм"),
     "within 5": ("within the texts' 5 %", "у межах допустимих 5 %", "в пределах допустимых 5 %"),
