@@ -764,7 +764,7 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
   #controls{position:static;border:0;order:0}#controls>label[for=phi],#scales{display:block}
   #data{order:1}#values,#worksheet{order:2}
   #data table,#value-table{display:block;columns:4;column-gap:8mm}
-  #data tr,#value-table tr{display:flex;break-inside:avoid}#data td,#value-table td,#value-table th{flex:1}
+  #data tr,#value-table tr{display:flex;break-inside:avoid}#data td,#value-table td,#value-table th{flex:1;white-space:nowrap}
   #sheets,#grid{order:3;display:block;break-before:page}#grid h2{display:none}
   .sheet{border:0;margin:0;break-after:page}
   .sheet svg{width:420mm;height:297mm;max-width:none}
