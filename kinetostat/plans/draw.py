@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -360,14 +360,31 @@ def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
                  where: tuple[float, float, float]) -> list[Element]:
     """The notes of every angle (`_note_lines` without amounts: the results and the tiny vectors'
     numbers change with every angle, the page's values table holds them) as lines of text at
-    `where` (x, first baseline, width; `_notes_block`), as many as fit above the frame's bottom, line k showing the k-th line of each angle's notes where it
-    has one: each line's texts once and an index per angle."""
+    `where` (x, first baseline, width; `_notes_block`), as many as fit above the frame's bottom:
+    line k shows the k-th line of each angle's notes where it has one (its texts once, an index
+    per angle). Each distinct make-up of notes (the plan's notes, tiny vectors, accuracy,
+    equation) read and wrapped once, of the plan cut to its tiny vectors."""
     x, y, width = where
     room = int((_FRAME[3] - 1.5 - (y - ASCENT * _NOTE_MM)) // _LINE_STEP)
+    segments = tuple(s for s in cycle.segments if s.name in tiny)       # all of its drawing the notes read
+    light = replace(cycle, points={k: cycle.points[k] for s in segments for k in (s.start, s.end)},
+                    segments=segments, paths={}, results=())
+    wrapped: dict[str, list[str]] = {}
+    known: dict[tuple, list[str]] = {}                 # what an angle's notes are made of -> its lines
+    drawn = np.array([light.drawn(s) for s in segments], dtype=bool).reshape(len(segments), cycle.n)
     per_angle = []
     for j in range(cycle.n):
-        per_angle.append([w for n in _note_lines(cycle.at(j), lang, _tiny_at(tiny, j), amounts=False)
-                          for w in _wrap(n, _NOTE_MM, width)][:room])
+        acc = None if cycle.accuracy is None else float(cycle.accuracy[0][j])
+        key = (cycle.notes[j] if cycle.notes else (), tuple(_tiny_at(tiny, j).items()),
+               tuple(drawn[:, j]), acc if acc is not None and acc < cycle.accuracy[1] else None,
+               cycle.equation[j] if cycle.equation and not isinstance(cycle.equation[0], str) else ())
+        if key not in known:
+            notes = _note_lines(light.at(j), lang, _tiny_at(tiny, j), amounts=False)
+            for n in notes:
+                if n not in wrapped:
+                    wrapped[n] = _wrap(n, _NOTE_MM, width)
+            known[key] = [w for n in notes for w in wrapped[n]][:room]
+        per_angle.append(known[key])
     out = []
     for k in range(max(map(len, per_angle), default=0)):
         has = np.array([k < len(lines) for lines in per_angle])
