@@ -9,8 +9,8 @@ student's measured lengths, and print at true scale.
 Key mode (default): one analysis at every whole degree, the design position and the check's
 angle; from it each plan of the cycle (`build_cycle`, every scale fixed for the whole cycle:
 `cycle_scales`; the plan of positions' 12 positions and paths made once: `fixed_positions`) and
-its sheet over all the angles as arrays (`draw.drawing`, with the page contract, without the
-sheets' notes: the page's tables take their place); the worksheet's values of every angle
+its sheet over all the angles as arrays (`draw.drawing`, with the page contract and each angle's
+notes but their numbers: the page's values table holds them); the worksheet's values of every angle
 (`worksheet_cycle`); "Next step". Student mode (`student=True`): no answer in the page: the data,
 the empty tables, an A3 sheet with a millimetre grid at true scale, and the check of typed lengths.
 A page is drawn anew every time: nothing is cached.
@@ -26,11 +26,14 @@ length (`_proportionals`: a velocity on its plan and on the lever; a value of th
 vector's length times the scale), zigzag varints, deflated and written as text, 5
 characters per 4 bytes (`_text85`); the worksheet's rows and the check's items in the blobs too.
 The page's script (vanilla JavaScript, the browser's own DecompressionStream; without its comments,
-`_bare`) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
+`_bare`; deflated in blob "js", `_UNPACK` runs it) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
 `Drawing.svg` writes it.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
 `data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to 1e-9 mm); every value cell
 `data-symbol`, `data-value`; `body[data-ready]`.
+Print (`_CSS`): a first page with the title, the angle, the scales, the data and (key) the values
+of that angle, or (student) the tables to fill in; then each sheet a page at true scale, A3 or (key,
+A4 chosen) A4 around the plan with the title line and the notes on top (page.js `a4Title`).
 
 May use: the plans (`build_cycle`, `cycle_scales`, `core`, `draw`, `forces`, `worksheet`
 (`analyses`, `worksheet_cycle`), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
