@@ -324,17 +324,16 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
     top = _AREA[1] if left else _FRAME[3] - 1.5 - height
-    out = []
+    out, where = [], (x0, top + ASCENT * _NOTE_MM, width)
     if draw:
         out.append('<g id="notes">')
-        y = top + ASCENT * _NOTE_MM
+        y = where[1]
         for line in lines:
             out.append(_t(x0, y, line, _NOTE_MM))
             y += _LINE_STEP
         for k, r in enumerate(rows):
             out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
         out.append("</g>")
-    where = (x0, top + ASCENT * _NOTE_MM, width)
     if left:
         return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None, where
     return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0)), where
