@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import html
 import io
 import math
 import re
@@ -322,23 +323,36 @@ def test_check_judges_variant_1_479_at_the_keys_scale(chromium, tmp_path):
     pg.close()
 
 
-def _bar_mm(pdf) -> tuple[tuple[float, float], dict[str, float], int]:
-    """(page size in pt, the bar's labels 0, 50, 100 -> their centres' y in mm, the number of
-    pages) of a PDF's first page (pdftotext -bbox); the bar's labels are the words left of 20 mm."""
+def _bars_mm(pdf) -> tuple[set[tuple[float, float]], list[dict[str, float]], int]:
+    """(the pages' sizes in pt, on each page with the 100 mm bar its labels 0, 50, 100 -> their
+    centres' y in mm, the number of pages) of a PDF (pdftotext -bbox); the bar's labels are the
+    words "0", "50", "100" left of 20 mm."""
     box = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
-    first = box.split("</page>")[0]
-    size = re.search(r'<page width="([\d.]+)" height="([\d.]+)"', first)
-    words = re.findall(r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="([\d.]+)">([^<]*)</word>', first)
-    x_bar = min(float(w[0]) for w in words if w[4] == "100")
-    y = {w[4]: (float(w[1]) + float(w[3])) / 2 * 25.4 / 72 for w in words
-         if abs(float(w[0]) - x_bar) < 20 and w[4] in ("0", "50", "100")}
-    return (float(size[1]), float(size[2])), y, box.count("<page ")
+    sizes, bars = set(), []
+    for page in box.split("</page>")[:-1]:
+        size = re.search(r'<page width="([\d.]+)" height="([\d.]+)"', page)
+        sizes.add((float(size[1]), float(size[2])))
+        words = re.findall(r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="([\d.]+)">([^<]*)</word>', page)
+        y = {w[4]: (float(w[1]) + float(w[3])) / 2 * 25.4 / 72 for w in words
+             if float(w[0]) * 25.4 / 72 < 20.0 and w[4] in ("0", "50", "100")}
+        if y:
+            bars.append(y)
+    return sizes, bars, box.count("<page ")
+
+
+def _printed(pg, pdf) -> list[str]:
+    """The page printed to `pdf` as Chromium prints it (the page's own @page size), each printed
+    page's text (pdftotext -raw: in the order drawn)."""
+    pg.pdf(path=str(pdf), prefer_css_page_size=True, print_background=True)
+    raw = subprocess.run(["pdftotext", "-raw", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
+    return raw.split("\f")[:-1]
 
 
 def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
-    """Printed to PDF, each sheet is a page at true scale, A3 landscape (the whole sheet) or, with
-    A4 chosen, A4 landscape (the 297 x 210 mm around the plan): the 100 mm bar's labels 0 and 100
-    lie 100 mm apart (pdftotext -bbox: the labels' centres)."""
+    """Printed to PDF, a first page of data, then each sheet a page at true scale, A3 landscape
+    (the whole sheet) or, with A4 chosen, A4 landscape (the 297 x 210 mm around the plan): on
+    every sheet the 100 mm bar's labels 0 and 100 lie 100 mm apart (pdftotext -bbox: the labels'
+    centres)."""
     if shutil.which("pdftotext") is None:
         pytest.skip("no pdftotext (apt-get install poppler-utils)")
     mech, fixed, key, _ = ice
@@ -349,20 +363,73 @@ def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):
     pg.emulate_media(media="print")
     assert pg.evaluate(lit) != "rgb(208, 28, 28)"
     pg.emulate_media(media="no-override")
+    sheets = len(_build(mech, 30.0, fixed))
     for paper, (w, h) in (("A3", (420, 297)), ("A4", (297, 210))):
         pg.select_option("#paper", paper)
         pdf = tmp_path / f"{paper}.pdf"
         pg.pdf(path=str(pdf), prefer_css_page_size=True, print_background=True)
-        size, y, pages = _bar_mm(pdf)
-        assert size == pytest.approx((w / 25.4 * 72, h / 25.4 * 72), abs=1.0), paper   # Chromium: whole px
-        assert y["100"] - y["0"] == pytest.approx(100.0, abs=0.2), paper
-        assert y["50"] - y["0"] == pytest.approx(50.0, abs=0.2), paper
-        assert pages == len(_build(mech, 30.0, fixed)), paper
+        sizes, bars, pages = _bars_mm(pdf)
+        assert len(sizes) == 1 and sizes.pop() == pytest.approx((w / 25.4 * 72, h / 25.4 * 72), abs=1.0), paper   # Chromium: whole px
+        assert len(bars) == sheets and pages == sheets + 1, (paper, len(bars), pages)  # the data's page first
+        for y in bars:
+            assert y["100"] - y["0"] == pytest.approx(100.0, abs=0.2), paper
+            assert y["50"] - y["0"] == pytest.approx(50.0, abs=0.2), paper
         words = subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
-        titled = [p for p in words.split("\f") if "φ = 30°" in p and "ДВЗ" in p]
-        assert len(titled) == pages, (paper, pages, len(titled))   # A3: the title block; A4: the line on top
+        titled = [p for p in words.split("\f") if "φ = 30°" in p and "ДВЗ" in p and "мм" in p]
+        assert len(titled) == sheets, (paper, sheets, len(titled))   # A3: the title block; A4: the line on top
         if paper == "A4":                                   # the positions plan is taller than A4: said on it
             assert sum("обрізаний" in p for p in titled) >= 1
+    pg.close()
+
+
+def _bare_text(s: str) -> str:
+    """Text without its markup and whitespace: a line of a sheet as pdftotext reads it, whatever the
+    line breaks and the subscripts' runs."""
+    return re.sub(r"\s+", "", html.unescape(re.sub(r"<[^>]+>", "", s)))
+
+
+def test_print_keeps_title_data_scales_and_notes(chromium, ice, tmp_path):
+    """Printed (A3 and A4), the key page's first page holds the title, the angle, the scales, every
+    data row and every value of the angle shown; each sheet's page holds the notes of the plan's
+    own SVG sheet (`kinetostat plans --at 30`) but the numbers the values table holds (results,
+    segments' lengths, a tiny vector's value and length: its name and how drawn); the student's
+    page prints its title, scales and data too. Before: print hid all of them."""
+    if shutil.which("pdftotext") is None:
+        pytest.skip("no pdftotext (apt-get install poppler-utils)")
+    from kinetostat.model.lettering import lettering
+    from kinetostat.plans import draw
+    mech, fixed, key, student = ice
+    name = lettering(mech).name("uk", mech.name)
+    want = {}                                           # kind -> the notes of its own sheet, markup-free
+    for kind, plan in _build(mech, 30.0, fixed).items():
+        svg = P.svg(plan, "uk", name)
+        sheet = _bare_text(svg[svg.index('<g id="notes">'):])
+        notes = [_bare_text(draw._plain(n)) for n in draw._note_lines(plan, "uk", draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0))]
+        assert all(n in sheet for n in notes), kind     # the notes as the sheet draws them, unwrapped
+        tiny = [re.match(r"(.*?)(\*?)=.*ммумасштабі", n) for n in notes]
+        want[kind] = [n for n, m in zip(notes, tiny) if not m and not n.startswith("Результати")] \
+            + [m[1] + m[2] + (":показанопозамасштабом" if m[2] else ":нехтовномала") for m in tiny if m]
+    assert any("G2*:" in x for v in want.values() for x in v)   # the ICE's G2*, G3*: out of scale
+    data = [(r[0], r[1]) for r in make_page.__globals__["_data_rows"](mech, _one(mech, None), "uk")]
+    pg = _open(chromium, key)
+    rows = pg.eval_on_selector_all("#value-table td.num", "es => es.map(e => [e.dataset.symbol, e.textContent])")
+    for paper in ("A3", "A4"):
+        pg.select_option("#paper", paper)
+        first, *sheets = _printed(pg, tmp_path / f"{paper}.pdf")
+        flat = _bare_text(first)
+        assert _bare_text(name) in flat and "Куткривошипаφ:30°" in flat and "μ_F=400Н/мм" in flat, first[:300]
+        for symbol, value in data + [(s, v) for s, v in rows]:
+            assert _bare_text(symbol + value) in flat, (paper, symbol, value)
+        assert len(sheets) == len(want)
+        for (kind, lines), page in zip(want.items(), sheets):
+            missing = [x for x in lines if x not in _bare_text(page)]
+            assert not missing, (paper, kind, missing)
+    pg.close()
+    pg = _open(chromium, student)
+    first = _bare_text("".join(_printed(pg, tmp_path / "student.pdf")[:-1]))
+    assert _bare_text(name) in first and "Масштаби" in first and "μ_l=0,001м/мм" in first
+    for symbol, value in data:
+        assert _bare_text(symbol + value) in first, symbol
     pg.close()
 
 
@@ -682,7 +749,7 @@ def test_script_writes_every_sheet_as_drawing_svg(chromium, ice):
     cycles = P.build_cycle(mech, res, fixed, P.fixed_positions(mech, fixed.base["mu_l"]))
     pg = _open(chromium, key)
     for k, cycle in enumerate(cycles.values()):
-        d = drawing(cycle, "uk", lettering(mech).name("uk", mech.name), contract=True)
+        d = drawing(cycle, "uk", lettering(mech).name("uk", mech.name), contract=True, notes=True)
         for i in range(len(phi)):
             assert pg.evaluate("([k, i]) => window.sheetSvg(k, i)", [k, i]) == d.svg(i, *PAGE_DECIMALS), (cycle.kind, phi[i])
     pg.close()

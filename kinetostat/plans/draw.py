@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -273,12 +273,14 @@ def _result_line(plan: Plan, lang: str) -> list[str]:
     return [f"{text('results', lang)}: " + "; ".join(parts)]
 
 
-def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
-    """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors."""
+def _note_lines(plan: Plan, lang: str, tiny: dict[str, str], amounts: bool = True) -> list[str]:
+    """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors;
+    where not `amounts`, without the results and the tiny vectors' values and lengths (the page's
+    notes: its values table holds them)."""
     base = plan.kind.partition(":")[0]
     lines = [text(f"legend.{base}", lang)] if f"legend.{base}" in MESSAGES else []
     lines += [_symbols(phrase(n, lang), lang) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
-    lines += _result_line(plan, lang)
+    lines += _result_line(plan, lang) if amounts else []
     if plan.equation:
         lines.append(f"{text('equation', lang)}: " + " + ".join(_n(e, lang) for e in plan.equation) + " = 0")
     for s in _drawable(plan):
@@ -286,6 +288,9 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str]) -> list[str]:
             L = abs(plan.points[s.end] - plan.points[s.start])
             key = "out of scale" if tiny[s.name] == "out" else "negligible"
             star = "*" if tiny[s.name] == "out" else ""
+            if not amounts:
+                lines.append(f"{_n(s.name, lang)}{star}: {text(key + ', page', lang)}")
+                continue
             lines.append(f"{_n(s.name, lang)}{star} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
                          f"{text(key, lang, length=num(L, lang, decimals=2))}")
     if plan.kind == "lever":
@@ -313,10 +318,10 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
 
 
 def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit: bool = False,
-                 draw: bool = True) -> tuple[list[str], tuple[float, float, float, float]]:
-    """SVG of the notes (none where not `draw`) and the drawing area they leave: below the plan
+                 draw: bool = True) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
+    """SVG of the notes (none where not `draw`), the drawing area they leave: below the plan
     (bottom left, from the frame's bottom up, beside the title block) or, for a tall plan, in a
-    column at its left."""
+    column at its left, and where the notes' lines go (x, first baseline, width; mm)."""
     x0 = _FRAME[0] + 3
     width = _LEFT_NOTES_MM if left else _TITLE_BLOCK[0] - 3 - x0
     lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
@@ -328,10 +333,10 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
     top = _AREA[1] if left else _FRAME[3] - 1.5 - height
-    out = []
+    out, where = [], (x0, top + ASCENT * _NOTE_MM, width)
     if draw:
         out.append('<g id="notes">')
-        y = top + ASCENT * _NOTE_MM
+        y = where[1]
         for line in lines:
             out.append(_t(x0, y, line, _NOTE_MM))
             y += _LINE_STEP
@@ -339,23 +344,62 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
             out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
         out.append("</g>")
     if left:
-        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None
-    return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0))
+        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None, where
+    return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0)), where
 
 
 def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float, float, float],
-            draw: bool = True) -> tuple[list[str], tuple[float, float, float, float]]:
-    """The notes of `plan` (SVG where `draw`) and the drawing area for a drawing of extent `box`:
+            draw: bool = True) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
+    """The notes of `plan` (SVG where `draw`), the drawing area for a drawing of extent `box` and
+    where the notes' lines go (`_notes_block`):
     notes below where it fits above them, else in a column at its left where it fits beside them,
     else below with a note that it does not fit (fitting: with MIN_DRAWN_MM to spare on every
     side, for a vector drawn out of scale)."""
     x0, y0, x1, y1 = box
     for left in (False, True):
-        notes, area = _notes_block(plan, lang, tiny, left, draw=draw)
+        notes, area, where = _notes_block(plan, lang, tiny, left, draw=draw)
         if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
                 and y1 - y0 + 2 * MIN_DRAWN_MM <= area[3] - area[1]:      # room for a vector drawn out of scale
-            return notes, area
+            return notes, area, where
     return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw)
+
+
+def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
+                 where: tuple[float, float, float]) -> list[Element]:
+    """The notes of every angle (`_note_lines` without amounts: the results and the tiny vectors'
+    numbers change with every angle, the page's values table holds them) as lines of text at
+    `where` (x, first baseline, width; `_notes_block`), as many as fit above the frame's bottom:
+    line k shows the k-th line of each angle's notes where it has one (its texts once, an index
+    per angle). Each distinct make-up of notes (the plan's notes, tiny vectors, accuracy,
+    equation) read and wrapped once, of the plan cut to its tiny vectors."""
+    x, y, width = where
+    room = int((_FRAME[3] - 1.5 - (y - ASCENT * _NOTE_MM)) // _LINE_STEP)
+    segments = tuple(s for s in cycle.segments if s.name in tiny)       # all of its drawing the notes read
+    light = replace(cycle, points={k: cycle.points[k] for s in segments for k in (s.start, s.end)},
+                    segments=segments, paths={}, results=())
+    wrapped: dict[str, list[str]] = {}
+    known: dict[tuple, list[str]] = {}                 # what an angle's notes are made of -> its lines
+    drawn = np.array([light.drawn(s) for s in segments], dtype=bool).reshape(len(segments), cycle.n)
+    per_angle = []
+    for j in range(cycle.n):
+        acc = None if cycle.accuracy is None else float(cycle.accuracy[0][j])
+        key = (cycle.notes[j] if cycle.notes else (), tuple(_tiny_at(tiny, j).items()),
+               tuple(drawn[:, j]), acc if acc is not None and acc < cycle.accuracy[1] else None,
+               cycle.equation[j] if cycle.equation and not isinstance(cycle.equation[0], str) else ())
+        if key not in known:
+            notes = _note_lines(light.at(j), lang, _tiny_at(tiny, j), amounts=False)
+            for n in notes:
+                if n not in wrapped:
+                    wrapped[n] = _wrap(n, _NOTE_MM, width)
+            known[key] = [w for n in notes for w in wrapped[n]][:room]
+        per_angle.append(known[key])
+    out = []
+    for k in range(max(map(len, per_angle), default=0)):
+        has = np.array([k < len(lines) for lines in per_angle])
+        texts, variant = _variants([lines[k] if k < len(lines) else "" for lines in per_angle])
+        e = _text_element(x, y + k * _LINE_STEP, texts, variant, _NOTE_MM, cls="note")
+        out.append(Element("text", np.where(has[:, None, None], e.xy, np.nan), e.attrs, texts=e.texts, variant=e.variant))
+    return out
 
 
 def _variants(strings: list[str]) -> tuple[list[str], np.ndarray]:
@@ -680,16 +724,17 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
 
 
 def _room(cycle: PlanCycle, lang: str, notes: bool):
-    """The notes block (SVG where `notes`, of the angle with the most lines of them) and the
-    drawing area they leave, with what they were found from: (block, area, tiny, extents, box)."""
+    """The notes block (SVG where `notes`, of the angle with the most lines of them), the drawing
+    area they leave and where the notes go, with what they were found from: (block, area, where,
+    tiny, extents, box)."""
     tiny = _tiny(cycle)
     ext = _extents(cycle)
     box = _union(ext)
     lines = np.array([len(x) for x in cycle.notes] if cycle.notes else [0] * cycle.n) \
         + sum((v != _AS_IS).astype(int) for v in tiny.values())
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
-    block, area = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, draw=notes)
-    return block, area, tiny, ext, box
+    block, area, where = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, draw=notes)
+    return block, area, where, tiny, ext, box
 
 
 def language_part(plan: Plan, lang: str) -> tuple:
@@ -702,10 +747,11 @@ def language_part(plan: Plan, lang: str) -> tuple:
             tuple(text(name, lang) for name in plan.paths if name in MESSAGES))
 
 
-def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: bool) -> Drawing:
-    """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where `notes`."""
+def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: bool, cycle_notes: bool = False) -> Drawing:
+    """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where
+    `notes`, the notes of every angle (`_cycle_notes`) where `cycle_notes`."""
     _lang(lang)
-    block, (ax0, ay0, ax1, ay1), tiny, ext, box = _room(cycle, lang, notes)
+    block, (ax0, ay0, ax1, ay1), where, tiny, ext, box = _room(cycle, lang, notes)
     x0, y0, x1, y1 = box
     tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
@@ -722,6 +768,8 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     names += dimensions
     dots, points = _points(cycle, at, placer)
     elements += dots + _labels(placer, points + names)
+    if cycle_notes:
+        elements += _cycle_notes(cycle, lang, tiny, where)
     title = _title_block(cycle, lang, mechanism)
     W, H = SHEET_MM
     x0, y0, x1, y1 = _TITLE_BLOCK
@@ -743,16 +791,18 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
                    tuple(t for t in title if len(t.texts) > 1) + tuple(elements))
 
 
-def drawing(cycle: PlanCycle, lang: str = "en", mechanism: str = "", contract: bool = False) -> Drawing:
+def drawing(cycle: PlanCycle, lang: str = "en", mechanism: str = "", contract: bool = False,
+            notes: bool = False) -> Drawing:
     """The plan's A3 sheet at each angle of the cycle, true to scale (1 user unit = 1 mm), as
     arrays (`Drawing`): one place of the plan on the sheet for the whole cycle (its extent over
     every angle centred in the room its notes leave at the angle with the most of them; moved at an
     angle only as far as keeps that angle's plan in the room, where the cycle's is larger), every
     element at every angle, labels placed for the cycle at once (`labels.Placer`); the notes left
-    out, their room kept (the page's tables hold them). `contract`: every segment's element carries
+    out, their room kept, or where `notes` each angle's notes but its results and its segments'
+    lengths (`_cycle_notes`: the page's values table holds those). `contract`: every segment's element carries
     data-plan, data-segment and its drawn length (data-length-mm, as in segments.csv; a negligible
     vector, not drawn, an empty <g>): the interactive page's contract (`page`)."""
-    return _sheet(cycle, lang, mechanism, contract, notes=False)
+    return _sheet(cycle, lang, mechanism, contract, notes=False, cycle_notes=notes)
 
 
 def sheet(plan: Plan, lang: str = "en", mechanism: str = "", contract: bool = False, notes: bool = True) -> Drawing:

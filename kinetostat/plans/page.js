@@ -285,22 +285,26 @@
     boxes.forEach((box) => {
       const svg = box.querySelector("svg"), plan = svg && svg.querySelector("#plan");
       if (!plan) return;
-      const bar = svg.querySelector("#scalebar"), old = svg.querySelector("#a4-title");
+      const bar = svg.querySelector("#scalebar"), old = svg.querySelector("#a4-title"), notes = [...svg.querySelectorAll("text.note")];
       if (old) old.remove();
+      notes.forEach((t) => t.removeAttribute("transform"));
       if (!a4) {
         svg.setAttribute("viewBox", "0 0 420 297"); svg.setAttribute("width", "420mm"); svg.setAttribute("height", "297mm");
         bar.removeAttribute("transform"); delete box.dataset.a4; return;
       }
+      notes.forEach((t) => { t.style.display = "none"; });      // the crop: around the plan, not its notes
       const b = plan.getBBox(), clamp = (x, hi) => Math.min(Math.max(x, 0), hi);
+      notes.forEach((t) => { t.style.display = ""; });
       const x0 = clamp(b.x + b.width / 2 - 148.5, 123), y0 = clamp(b.y + b.height / 2 - 105, 87);
       svg.setAttribute("viewBox", `${x0} ${y0} 297 210`); svg.setAttribute("width", "297mm"); svg.setAttribute("height", "210mm");
       bar.setAttribute("transform", `translate(${x0 - 8} ${y0 - 30})`);   // the bar 8 mm in, 10 mm down
       const cut = b.width > 280 || b.height > 195;
       if (cut) box.dataset.a4 = D.ui.a4_cut; else delete box.dataset.a4;
-      svg.appendChild(a4Title(svg, x0, y0, cut));
+      a4Title(svg, x0, y0, cut, notes);
     });
   }
-  function a4Title(svg, x0, y0, cut) {           // A4 cuts the title block off: one line at the top instead
+  // A4 cuts the title block and the notes off: at the top instead, the title line and under it the notes, on white
+  function a4Title(svg, x0, y0, cut, notes) {
     const NS = "http://www.w3.org/2000/svg", g = document.createElementNS(NS, "g"), t = document.createElementNS(NS, "text");
     const line = ["#mechanism", 'text.title[font-weight="bold"]', "#scale"].map((q) => svg.querySelector(q));   // name, plan and φ, scale
     g.id = "a4-title";
@@ -313,10 +317,20 @@
       t.appendChild(w);
     }
     const r = document.createElementNS(NS, "rect");
-    r.setAttribute("x", x0 + 11); r.setAttribute("y", y0 + 2); r.setAttribute("height", cut ? 9 : 5.5); r.setAttribute("fill", "#fff");
+    r.setAttribute("x", x0 + 11); r.setAttribute("y", y0 + 2); r.setAttribute("fill", "#fff");
     g.append(r, t);
     svg.appendChild(g);
-    r.setAttribute("width", t.getComputedTextLength() + 2);
+    let width = t.getComputedTextLength(), bottom = y0 + (cut ? 11 : 7.5);
+    if (notes.length) {                          // the notes' block moved under the title line
+      const x = +notes[0].getAttribute("x"), y = +notes[0].getAttribute("y");
+      notes.forEach((n) => {
+        n.setAttribute("transform", `translate(${x0 + 12 - x} ${bottom + 2 - y})`);
+        width = Math.max(width, n.getComputedTextLength());
+        svg.appendChild(n);                      // over the white
+      });
+      bottom = Math.max(...notes.map((n) => n.getBBox().y + n.getBBox().height)) + bottom + 2 - y;
+    }
+    r.setAttribute("height", bottom - y0 - 2); r.setAttribute("width", width + 2);
     return g;
   }
   $("paper").addEventListener("change", paper);

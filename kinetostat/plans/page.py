@@ -9,8 +9,8 @@ student's measured lengths at the scales he drew at, and print at true scale.
 Key mode (default): one analysis at every whole degree, the design position and the check's
 angle; from it each plan of the cycle (`build_cycle`, every scale fixed for the whole cycle:
 `cycle_scales`; the plan of positions' 12 positions and paths made once: `fixed_positions`) and
-its sheet over all the angles as arrays (`draw.drawing`, with the page contract, without the
-sheets' notes: the page's tables take their place); the worksheet's values of every angle
+its sheet over all the angles as arrays (`draw.drawing`, with the page contract and each angle's
+notes but their numbers: the page's values table holds them); the worksheet's values of every angle
 (`worksheet_cycle`); "Next step". Student mode (`student=True`): no answer in the page: the data,
 the empty tables, an A3 sheet with a millimetre grid at true scale, and the check of typed lengths.
 A page is drawn anew every time: nothing is cached.
@@ -26,11 +26,14 @@ length (`_proportionals`: a velocity on its plan and on the lever; a value of th
 vector's length times the scale), zigzag varints, deflated and written as text, 5
 characters per 4 bytes (`_text85`); the worksheet's rows and the check's items in the blobs too.
 The page's script (vanilla JavaScript, the browser's own DecompressionStream; without its comments,
-`_bare`) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
+`_bare`; deflated in blob "js", `_UNPACK` runs it) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
 `Drawing.svg` writes it.
 The page contract (the README): `<input type="range" id="phi">`; every segment's element
 `data-plan`, `data-segment`, `data-length-mm` as in segments.csv (to 1e-9 mm); every value cell
 `data-symbol`, `data-value`; `body[data-ready]`.
+Print (`_CSS`): a first page with the title, the angle, the scales, the data and (key) the values
+of that angle, or (student) the tables to fill in; then each sheet a page at true scale, A3 or (key,
+A4 chosen) A4 around the plan with the title line and the notes on top (page.js `a4Title`).
 
 May use: the plans (`build_cycle`, `cycle_scales`, `core`, `draw`, `forces`, `worksheet`
 (`analyses`, `worksheet_cycle`), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
@@ -40,6 +43,7 @@ analysis).
 """
 from __future__ import annotations
 
+import base64
 import json
 import math
 import os
@@ -576,7 +580,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     if not student:
         kinds, lengths = [], []
         for kind, cycle in cycles.items():
-            meta, numbers, more = encode_drawing(drawing(cycle, lang, name, contract=True), lengths)
+            meta, numbers, more = encode_drawing(drawing(cycle, lang, name, contract=True, notes=True), lengths)
             kinds.append(meta)
             lengths += more
             blobs[f"k{len(kinds) - 1}"] = _packed(numbers)
@@ -709,12 +713,13 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
                 f'<button id="next" type="button">{escape(text("page.next", lang))}</button> '
                 f'<output id="step"></output> <label>{escape(text("page.paper", lang))}: <select id="paper"><option>A3</option>'
                 f'<option>A4</option></select></label><p id="equation"></p><p class="hint">{escape(text("page.print", lang))}</p>'
-                f'<p>{escape(text("page.scales", lang))}: {escape(scales)}</p></section>'
+                f'<p id="scales">{escape(text("page.scales", lang))}: {escape(scales)}</p></section>'
                 f'<section id="sheets"><p id="status">{escape(text("page.loading", lang))}</p></section>'
                 f'<section id="values"><h2>{escape(text("page.values", lang))}</h2><table id="value-table"></table></section>'
                 f'<section id="data"><h2>{escape(text("page.data", lang))}</h2><table>{data_table}</table></section>'
                 + check)
     script = _bare(resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8"))
+    blobs = {**blobs, "js": base64.b64encode(_deflated(script.encode())).decode("ascii")}   # `_UNPACK` runs it
     payload = script_json(data)                 # no name in it (`</script>`, `<!--<script>`) ends its element
     blob_tags = "".join(f'<script type="application/octet-stream" id="blob-{k}">{v}</script>' for k, v in blobs.items())
     return (f'<!DOCTYPE html>\n<html lang="{lang}"><head><meta charset="utf-8">'
@@ -723,7 +728,14 @@ def _html(mech, name: str, lang: str, student: bool, data: dict, blobs: dict[str
             f'<title>{escape(title)}</title><style>{_CSS}</style><style id="page-size">@page{{size:A3 landscape;margin:0}}</style>'
             f'</head><body>'
             f'<h1>{escape(title)}</h1>{body}{blob_tags}'
-            f'<script id="page-data" type="application/json">{payload}</script><script>{script}</script></body></html>\n')
+            f'<script id="page-data" type="application/json">{payload}</script><script>{_UNPACK}</script></body></html>\n')
+
+
+#: The page's one script as written: the page's script (blob "js": deflated, base64; a third the
+#: size of its text: the page's budget) inflated and run.
+_UNPACK = ('(async()=>{const b=Uint8Array.from(atob(document.getElementById("blob-js").textContent),c=>c.charCodeAt(0)),'
+           's=document.createElement("script");s.textContent=await new Response(new Blob([b]).stream()'
+           '.pipeThrough(new DecompressionStream("deflate-raw"))).text();document.body.append(s)})();')
 
 
 def _bare(script: str) -> str:
@@ -784,8 +796,14 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
 .sheet[data-a4]::before{content:attr(data-a4);color:#b01515}
 .verdict.ok{color:#176317}.verdict.bad{color:#b01515}
 @media print{
-  body{margin:0}h1,h2,#controls,#values,#data,#check,.hint,#status{display:none}
-  #sheets{display:block}.sheet{border:0;margin:0;page-break-after:always;break-after:page}
+  body{margin:0;display:flex;flex-direction:column}#check,#status,#controls>*{display:none}
+  h1,#controls,#data,#values,#worksheet{padding:0 10mm 0 25mm;font-size:9pt}
+  #controls{position:static;border:0;order:0}#controls>label[for=phi],#scales{display:block}
+  #data{order:1}#values,#worksheet{order:2}
+  #data table,#value-table{display:block;columns:4;column-gap:8mm}
+  #data tr,#value-table tr{display:flex;break-inside:avoid}#data td,#value-table td,#value-table th{flex:1;white-space:nowrap}
+  #sheets,#grid{order:3;display:block;break-before:page}#grid h2{display:none}
+  .sheet{border:0;margin:0;break-after:page}
   .sheet svg{width:420mm;height:297mm;max-width:none}
   [data-paper="A4"] .sheet svg{width:297mm;height:210mm}.sheet::before{display:none}
 }
