@@ -157,7 +157,8 @@ _ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
 #: T, S, R and the cost's part for leaving the middle (0 on a ring); direction, ring, cost (0 beside).
 _CAND_RING = _constant(np.r_[np.zeros(len(_ALONG_OFF), bool), np.ones(len(_RING_COST), bool)])
 _CAND_T, _CAND_S, _CAND_R, _CAND_OFF = (_constant(np.r_[a, np.zeros(len(_RING_COST))]) for a in (*_ALONG, _ALONG_OFF))
-_CAND_DIR = _constant(np.r_[np.zeros((len(_ALONG_OFF), 2)), _RING_DIRS])
+_CAND_DIR_T = _constant(np.r_[np.zeros((len(_ALONG_OFF), 2)), _RING_DIRS].T.copy())     # (2, K)
+_CAND_ABS_DIR_T = _constant(np.abs(_CAND_DIR_T))
 _CAND_RAD = _constant(np.r_[np.zeros(len(_ALONG_OFF)), np.repeat(_RINGS, len(_DIRS))])
 _CAND_COST = _constant(np.r_[np.zeros(len(_ALONG_OFF)), _RING_COST])
 #: A label keeps one place over the angles where that place costs at most this more than the best.
@@ -187,10 +188,11 @@ def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
     """Length (mm) of each segment (x0, y0, x1, y1) strictly inside each box (broadcast, last axis
     4): the segment clipped to the box (Liang-Barsky; a segment parallel to a side divides by a
     signed zero: +-inf inside the slab or out of it, NaN on its edge); 0 where either is NaN."""
-    x, y = seg[..., 0], seg[..., 1]
-    dx, dy = seg[..., 2] - x, seg[..., 3] - y
+    x, y, x1, y1 = np.moveaxis(seg, -1, 0)
+    box = np.moveaxis(box, -1, 0)
+    dx, dy = x1 - x, y1 - y
     with np.errstate(divide="ignore", invalid="ignore"):
-        tx0, tx1, ty0, ty1 = (box[..., 0] - x) / dx, (box[..., 2] - x) / dx, (box[..., 1] - y) / dy, (box[..., 3] - y) / dy
+        tx0, tx1, ty0, ty1 = (box[0] - x) / dx, (box[2] - x) / dx, (box[1] - y) / dy, (box[3] - y) / dy
         t_in = np.maximum(np.maximum(np.minimum(tx0, tx1), np.minimum(ty0, ty1)), 0.0)
         t_out = np.minimum(np.minimum(np.maximum(tx0, tx1), np.maximum(ty0, ty1)), 1.0)
         length = (t_out - t_in) * np.hypot(dx, dy)
@@ -203,11 +205,34 @@ def _bounds(items: np.ndarray) -> np.ndarray:
                           axis=-1)
 
 
-def _meets(bb: np.ndarray, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(row, item) of the items whose bounding boxes `bb` (R, H, 4) (R = 1: the same at every row)
-    meet `region` (n', 4), row by row."""
-    return np.nonzero((bb[..., 0] <= region[:, None, 2]) & (bb[..., 2] >= region[:, None, 0])
-                      & (bb[..., 1] <= region[:, None, 3]) & (bb[..., 3] >= region[:, None, 1]))
+def _meets(bb: np.ndarray, region: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """(row, item) of the items whose bounding boxes `bb` (4, R, H) (x0, y0, x1, y1; R = 1: the
+    same at every row) meet `region` (x0, y0, x1, y1, each (n', 1)), row by row."""
+    x0, y0, x1, y1 = region
+    hit = bb[0] <= x1
+    hit &= bb[2] >= x0
+    hit &= bb[1] <= y1
+    hit &= bb[3] >= y0
+    return _nonzero(hit)
+
+
+def _nonzero(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """np.nonzero of a 2-D bool array, the same (row, column) in the same order (row by row), by
+    its flat indices (np.nonzero of a 2-D array takes several times longer)."""
+    return np.divmod(np.flatnonzero(mask), mask.shape[1])
+
+
+def _any_by_row(inside: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Of the rows of `inside` (pairs, B) bool, taken `counts` (n',) at a time in order, whether any
+    is True, column by column (n', B) (no rows: False); the columns' bytes ORed a word at a time."""
+    word = next(w for w in (8, 4, 2, 1) if inside.shape[1] % w == 0)
+    starts = np.cumsum(counts) - counts
+    some = counts > 0
+    out = np.zeros((len(counts), inside.shape[1]), dtype=bool)
+    if some.any():
+        out[some] = np.bitwise_or.reduceat(np.ascontiguousarray(inside).view(f"u{word}"), starts[some],
+                                           axis=0).view(bool)
+    return out
 
 
 class Placer:
@@ -220,8 +245,9 @@ class Placer:
     def __init__(self, n: int, bounds: tuple[float, float, float, float]):
         self.n = n
         self.bounds = bounds
-        # ("hard", still) -> boxes grown by PAD (R, S, 4); ("soft", still) -> lines and their bounding
-        # boxes (R, S, 8); R = 1 where still (the same at every angle), else N
+        # ("hard", still) -> boxes grown by PAD (4, R, S); ("soft", still) -> lines and their bounding
+        # boxes (8, R, S), float32, coordinate by coordinate; R = 1 where still (the same at every
+        # angle), else N
         self._parts: dict[tuple[str, bool], list[np.ndarray]] = {}
         self._stacked: dict[tuple[str, bool], tuple[int, np.ndarray]] = {}     # parts stacked, their stack
 
@@ -242,18 +268,19 @@ class Placer:
         return a[:1] if len(a) > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape), equal_nan=True) else a
 
     def _add(self, key: str, part: np.ndarray) -> None:
-        self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32))
+        self._parts.setdefault((key, len(part) == 1), []).append(np.moveaxis(part.astype(np.float32), -1, 0))
 
     def _stack(self, key: str, still: bool) -> np.ndarray:
-        """The hard obstacles (grown by PAD) (R, H, 4), or the lines and their bounding boxes
-        (R, H, 8), the same at every angle (still: R = 1) or not (R = N): those added since the
+        """The hard obstacles (grown by PAD) (4, R, H), or the lines and their bounding boxes
+        (8, R, H), the same at every angle (still: R = 1) or not (R = N): those added since the
         last call appended."""
         parts = self._parts.get((key, still), [])
-        rows = 1 if still else self.n
-        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8), dtype=np.float32)))
-        if done < len(parts):
-            stacked = np.concatenate([stacked, *(np.broadcast_to(p, (rows,) + p.shape[1:]) for p in parts[done:])],
-                                     axis=1)
+        done, stacked = self._stacked.get((key, still), (0, None))
+        if done < len(parts) or stacked is None:
+            rows = 1 if still else self.n
+            stacked = np.concatenate([np.empty((4 if key == "hard" else 8, rows, 0), dtype=np.float32) if stacked is None
+                                      else stacked, *(np.broadcast_to(p, p.shape[:1] + (rows,) + p.shape[2:])
+                                                      for p in parts[done:])], axis=2)
             self._stacked[key, still] = (len(parts), stacked)
         return stacked
 
@@ -278,29 +305,37 @@ class Placer:
             u = d / L[:, None]
         nrm = np.column_stack([-u[:, 1], u[:, 0]])
         C = np.where(has[:, None], A + d / 2, A)                          # rings about the segment's middle
+        CT = np.ascontiguousarray(C.T)                                    # (2, N)
         fixed = np.isfinite(A).all(axis=1)
         bx0, by0, bx1, by1 = self.bounds
+        # each text's ring candidates about the centre (2, texts, K); 0 beside the segment
+        hv = np.column_stack([widths / 2, heights.sum(axis=1) / 2])
+        ring_off = _CAND_DIR_T[:, None] * (_CAND_RAD + (hv[:, :1] * _CAND_ABS_DIR_T[0] + hv[:, 1:] * _CAND_ABS_DIR_T[1]))
+        ring_extra = np.where(has, 2.0, 0.0)
 
         def geometry(rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             """Centres (2, r, m) and least costs (r, m) of the candidates `cols` (r, m), or (1, m)
-            at every angle, at the angles `rows` (r,): beside the segment (`_ALONG`), then on the
-            rings (`_RINGS`)."""
-            h, n_r, c_r = half[rows][:, :, None], nrm[rows][:, :, None], C[rows][:, :, None]      # (r, 2, 1)
-            clear = _CAND_R[cols] + (np.abs(n_r[:, 0]) * h[:, 0] + np.abs(n_r[:, 1]) * h[:, 1])      # (r, m)
-            beside_xy = A[rows][:, :, None] + _CAND_T[cols][:, None] * d[rows][:, :, None] \
-                + _CAND_S[cols][:, None] * n_r * clear[:, None]
-            dirs = np.moveaxis(_CAND_DIR[cols], -1, 1)                                           # (r, 2, m)
-            reach = _CAND_RAD[cols] + (h[:, 0] * np.abs(dirs[:, 0]) + h[:, 1] * np.abs(dirs[:, 1]))
+            at every angle, at the angles `rows` (r,): beside the segment (`_ALONG`; a label with
+            no segment: none, their centre the anchor's), then on the rings (`_RINGS`)."""
+            hx, hy = half[rows, :1], half[rows, 1:]                                               # (r, 1)
+            xy = CT[:, rows, None] + ring_off[:, variant[rows][:, None], cols]                    # (2, r, m)
             ring = _CAND_RING[cols]
-            xy = np.where(ring[:, None], c_r + dirs * reach[:, None], beside_xy)
-            base = np.where(ring, _CAND_COST[cols] + np.where(has[rows], 2.0, 0.0)[:, None],
-                            np.where(beside[rows][:, None],
-                                     _CAND_R[cols] + _CAND_OFF[cols] * np.minimum(L[rows], 20.0)[:, None] / 20.0, np.inf))
-            x, y, hx, hy = xy[:, 0], xy[:, 1], h[:, 0], h[:, 1]
+            base = np.where(ring, _CAND_COST[cols] + ring_extra[rows, None], np.inf)
+            some = ~ring.all(axis=0)                                          # the columns beside the segment somewhere
+            if has.any() and some.any():
+                k, r_ring = cols[:, some], ring[:, some]
+                n_r = nrm[rows][:, :, None]
+                clear = _CAND_R[k] + (np.abs(n_r[:, 0]) * hx + np.abs(n_r[:, 1]) * hy)           # (r, m')
+                at = A[rows][:, :, None] + _CAND_T[k][:, None] * d[rows][:, :, None] \
+                    + _CAND_S[k][:, None] * n_r * clear[:, None]                                   # (r, 2, m')
+                at = np.where(np.isfinite(at), at, C[rows][:, :, None])       # no centre beside no segment: never free
+                xy[:, :, some] = np.where(r_ring, xy[:, :, some], np.moveaxis(at, 1, 0))
+                base[:, some] = np.where(r_ring | ~beside[rows][:, None], base[:, some],
+                                         _CAND_R[k] + _CAND_OFF[k] * np.minimum(L[rows], 20.0)[:, None] / 20.0)
+            x, y = xy
             outside = (x < bx0 + hx) | (y < by0 + hy) | (x > bx1 - hx) | (y > by1 - hy)
-            base = np.where(outside | ~fixed[rows][:, None], np.inf, base)
-            xy = np.where(np.isfinite(xy), xy, c_r)                       # no centre beside no segment: never free
-            return np.moveaxis(xy, 1, 0), base
+            base[outside | ~fixed[rows][:, None]] = np.inf
+            return xy, base
 
         still = bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
@@ -323,33 +358,37 @@ class Placer:
         it; of the obstacles the same at every angle (`still` holds True) and of those that move
         (False); `kinds` ("hard",): whether free only, the lines not costed."""
         stacks = [(key, fixed, items) for key in kinds for fixed in still
-                  for items in (self._stack(key, fixed),) if items.shape[1]]
+                  for items in (self._stack(key, fixed),) if items.shape[2]]
         free = np.isfinite(c)
         if not stacks or not free.any():
             return c
         (px, py), (hx, hy) = p, h
-        region = np.column_stack([px.min(axis=1) - hx, py.min(axis=1) - hy, px.max(axis=1) + hx, py.max(axis=1) + hy])
+        region = ((px.min(axis=1) - hx)[:, None], (py.min(axis=1) - hy)[:, None],
+                  (px.max(axis=1) + hx)[:, None], (py.max(axis=1) + hy)[:, None])
         blocked = np.zeros(c.shape, dtype=bool)
         pairs = []
         for key, fixed, items in stacks:                                   # the hard ones first
-            r, j = _meets(items[..., -4:] if fixed else items[rows, :, -4:], region)
+            r, j = _meets(items[-4:] if fixed else items[-4:, rows], region)
             if not len(r):
                 continue
-            items = items[0 if fixed else rows[r], j]                     # (pairs, 4 or 8)
-            X, Y, w, v = px[r], py[r], hx[r], hy[r]                       # a box over it: its centre inside it grown by h
-            inside = (X > (items[:, -4] - w)[:, None]) & (X < (items[:, -2] + w)[:, None]) \
-                & (Y > (items[:, -3] - v)[:, None]) & (Y < (items[:, -1] + v)[:, None])         # (pairs, B)
+            items = items[:, 0, j] if fixed else items[:, rows[r], j]     # (4 or 8, pairs)
+            counts = np.bincount(r, minlength=len(c))                     # r ascending: each row's pairs together
+            X, Y, w, v = (np.repeat(a, counts, axis=0) for a in (px, py, hx, hy))
+            inside = X > (items[-4] - w)[:, None]                         # a box over it: its centre inside it grown by h
+            inside &= X < (items[-2] + w)[:, None]
+            inside &= Y > (items[-3] - v)[:, None]
+            inside &= Y < (items[-1] + v)[:, None]                        # (pairs, B)
             if key == "hard":
-                starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
-                blocked[r[starts]] |= np.logical_or.reduceat(inside, starts, axis=0)
+                blocked |= _any_by_row(inside, counts)
             else:
-                f, q = np.nonzero(inside & ~blocked[r] & free[r])
-                pairs.append((r[f], q, items[f, :4]))
+                inside &= np.repeat(free & ~blocked, counts, axis=0)
+                f, q = _nonzero(inside)
+                pairs.append((r[f], q, items[:4, f]))
         c = np.where(blocked, np.inf, c)
         for r, q, ln in pairs:                                             # the lines each free box covers
             x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
-            box = np.column_stack([x - w, y - v, x + w, y + v])
-            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln, box), c.size).reshape(c.shape)
+            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln.T, np.stack([x - w, y - v, x + w, y + v], axis=-1)),
+                                            c.size).reshape(c.shape)
         return c
 
     def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool) -> np.ndarray:
