@@ -308,9 +308,10 @@ class Placer:
         CT = np.ascontiguousarray(C.T)                                    # (2, N)
         fixed = np.isfinite(A).all(axis=1)
         bx0, by0, bx1, by1 = self.bounds
-        # each text's ring candidates about the centre (2, texts, K); 0 beside the segment
+        # each text's ring candidates about the centre (2, texts x K); 0 beside the segment
         hv = np.column_stack([widths / 2, heights.sum(axis=1) / 2])
-        ring_off = _CAND_DIR_T[:, None] * (_CAND_RAD + (hv[:, :1] * _CAND_ABS_DIR_T[0] + hv[:, 1:] * _CAND_ABS_DIR_T[1]))
+        ring_off = (_CAND_DIR_T[:, None] * (_CAND_RAD + (hv[:, :1] * _CAND_ABS_DIR_T[0] + hv[:, 1:] * _CAND_ABS_DIR_T[1]))).reshape(2, -1)   # text by text
+        K = len(_CAND_RING)
         ring_extra = np.where(has, 2.0, 0.0)
 
         def geometry(rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -318,7 +319,7 @@ class Placer:
             at every angle, at the angles `rows` (r,): beside the segment (`_ALONG`; a label with
             no segment: none, their centre the anchor's), then on the rings (`_RINGS`)."""
             hx, hy = half[rows, :1], half[rows, 1:]                                               # (r, 1)
-            xy = CT[:, rows, None] + ring_off[:, variant[rows][:, None], cols]                    # (2, r, m)
+            xy = CT[:, rows, None] + np.take(ring_off, variant[rows][:, None] * K + cols, axis=1)  # (2, r, m)
             ring = _CAND_RING[cols]
             base = np.where(ring, _CAND_COST[cols] + ring_extra[rows, None], np.inf)
             some = ~ring.all(axis=0)                                          # the columns beside the segment somewhere
@@ -341,7 +342,7 @@ class Placer:
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
         with np.errstate(invalid="ignore"):
-            k = self._choose(geometry, len(_CAND_RING), half.T.astype(np.float32), still)
+            k = self._choose(geometry, K, half.T.astype(np.float32), still)
             xy, _ = geometry(np.arange(n), np.maximum(k, 0)[:, None])
         c = np.where((k >= 0)[:, None], xy[:, :, 0].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
@@ -368,10 +369,10 @@ class Placer:
         blocked = np.zeros(c.shape, dtype=bool)
         pairs = []
         for key, fixed, items in stacks:                                   # the hard ones first
-            r, j = _meets(items[-4:] if fixed else items[-4:, rows], region)
+            r, j = _meets(items[-4:] if fixed else np.take(items[-4:], rows, axis=1), region)
             if not len(r):
                 continue
-            items = items[:, 0, j] if fixed else items[:, rows[r], j]     # (4 or 8, pairs)
+            items = np.take(items.reshape(len(items), -1), j if fixed else rows[r] * items.shape[2] + j, axis=1)  # (4 or 8, pairs)
             counts = np.bincount(r, minlength=len(c))                     # r ascending: each row's pairs together
             X, Y, w, v = (np.repeat(a, counts, axis=0) for a in (px, py, hx, hy))
             inside = X > (items[-4] - w)[:, None]                         # a box over it: its centre inside it grown by h
@@ -383,7 +384,7 @@ class Placer:
             else:
                 inside &= np.repeat(free & ~blocked, counts, axis=0)
                 f, q = _nonzero(inside)
-                pairs.append((r[f], q, items[:4, f]))
+                pairs.append((r[f], q, np.take(items[:4], f, axis=1)))
         c = np.where(blocked, np.inf, c)
         for r, q, ln in pairs:                                             # the lines each free box covers
             x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
@@ -404,9 +405,11 @@ class Placer:
         if n < 2 * STRIDE:
             return self._search(geometry, K, half, still, np.arange(n))
         k = np.full(n, -1)
-        sample = np.unique(np.r_[np.arange(0, n, STRIDE), n - 1])
+        done = np.zeros(n, dtype=bool)                              # searched, or a neighbour's place kept
+        done[::STRIDE] = done[-1] = True
+        sample = np.flatnonzero(done)
         k[sample] = self._search(geometry, K, half, still, sample)
-        between = np.setdiff1d(np.arange(n), sample)
+        between = np.flatnonzero(~done)
         tried = np.full(n, -1)
         for after in (0, 1):                                        # the searched angle before, then after
             guess = k[sample[np.searchsorted(sample, between) - 1 + after]]
@@ -416,7 +419,8 @@ class Placer:
             xy, base = geometry(rows, cand[:, None])
             free = np.isfinite(self._costs(xy.astype(np.float32), half[:, rows], base, rows, (True, False), ("hard",))[:, 0])
             k[rows[free]] = cand[free]
-            between = np.setdiff1d(between, rows[free])
+            done[rows[free]] = True
+            between = np.flatnonzero(~done)
         if len(between):
             k[between] = self._search(geometry, K, half, still, between)
         return k
@@ -453,7 +457,8 @@ class Placer:
                 c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
                                 np.broadcast_to(c, (len(rows), len(idx))), rows, (False,))
             else:
-                c = self._costs(centres[:, local[:, None], idx], half[:, rows], c, rows, (True, False))
+                c = self._costs(np.take(centres.reshape(2, -1), local[:, None] * K + idx, axis=1), half[:, rows], c, rows,
+                                (True, False))
             cost = np.full((n, len(idx)), np.inf)
             cost[local] = c
             tested.append(cost)
