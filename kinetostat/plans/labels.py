@@ -410,17 +410,15 @@ class Placer:
         sample = np.flatnonzero(done)
         k[sample] = self._search(geometry, K, half, still, sample)
         between = np.flatnonzero(~done)
-        tried = np.full(n, -1)
-        for after in (0, 1):                                        # the searched angle before, then after
-            guess = k[sample[np.searchsorted(sample, between) - 1 + after]]
-            new = (guess >= 0) & (guess != tried[between])
-            rows, cand = between[new], guess[new]
-            tried[rows] = cand
-            xy, base = geometry(rows, cand[:, None])
-            free = np.isfinite(self._costs(xy.astype(np.float32), half[:, rows], base, rows, (True, False), ("hard",))[:, 0])
-            k[rows[free]] = cand[free]
-            done[rows[free]] = True
-            between = np.flatnonzero(~done)
+        at = np.searchsorted(sample, between)
+        guess = np.column_stack([k[sample[at - 1]], k[sample[at]]])    # the searched angle before, then after
+        xy, base = geometry(between, np.maximum(guess, 0))
+        free = np.isfinite(self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False), ("hard",)))
+        free &= guess >= 0
+        first = np.argmax(free, axis=1)
+        kept = free.any(axis=1)
+        k[between[kept]] = guess[kept, first[kept]]
+        between = between[~kept]
         if len(between):
             k[between] = self._search(geometry, K, half, still, between)
         return k
