@@ -278,9 +278,10 @@ class Placer:
         done, stacked = self._stacked.get((key, still), (0, None))
         if done < len(parts) or stacked is None:
             rows = 1 if still else self.n
-            stacked = np.concatenate([np.empty((4 if key == "hard" else 8, rows, 0), dtype=np.float32) if stacked is None
-                                      else stacked, *(np.broadcast_to(p, p.shape[:1] + (rows,) + p.shape[2:])
-                                                      for p in parts[done:])], axis=2)
+            if stacked is None:
+                stacked = np.empty((4 if key == "hard" else 8, rows, 0), dtype=np.float32)
+            stacked = np.concatenate([stacked, *(np.broadcast_to(p, p.shape[:1] + (rows,) + p.shape[2:])
+                                                 for p in parts[done:])], axis=2)
             self._stacked[key, still] = (len(parts), stacked)
         return stacked
 
@@ -310,7 +311,8 @@ class Placer:
         bx0, by0, bx1, by1 = self.bounds
         # each text's ring candidates about the centre (2, texts x K); 0 beside the segment
         hv = np.column_stack([widths / 2, heights.sum(axis=1) / 2])
-        ring_off = (_CAND_DIR_T[:, None] * (_CAND_RAD + (hv[:, :1] * _CAND_ABS_DIR_T[0] + hv[:, 1:] * _CAND_ABS_DIR_T[1]))).reshape(2, -1)   # text by text
+        reach = _CAND_RAD + (hv[:, :1] * _CAND_ABS_DIR_T[0] + hv[:, 1:] * _CAND_ABS_DIR_T[1])           # (texts, K)
+        ring_off = (_CAND_DIR_T[:, None] * reach).reshape(2, -1)
         K = len(_CAND_RING)
         ring_extra = np.where(has, 2.0, 0.0)
 
@@ -372,10 +374,11 @@ class Placer:
             r, j = _meets(items[-4:] if fixed else np.take(items[-4:], rows, axis=1), region)
             if not len(r):
                 continue
-            items = np.take(items.reshape(len(items), -1), j if fixed else rows[r] * items.shape[2] + j, axis=1)  # (4 or 8, pairs)
+            at = j if fixed else rows[r] * items.shape[2] + j
+            items = np.take(items.reshape(len(items), -1), at, axis=1)   # (4 or 8, pairs)
             counts = np.bincount(r, minlength=len(c))                     # r ascending: each row's pairs together
             X, Y, w, v = (np.repeat(a, counts, axis=0) for a in (px, py, hx, hy))
-            inside = X > (items[-4] - w)[:, None]                         # a box over it: its centre inside it grown by h
+            inside = X > (items[-4] - w)[:, None]                         # a box over it: its centre in it grown by h
             inside &= X < (items[-2] + w)[:, None]
             inside &= Y > (items[-3] - v)[:, None]
             inside &= Y < (items[-1] + v)[:, None]                        # (pairs, B)
@@ -388,8 +391,8 @@ class Placer:
         c = np.where(blocked, np.inf, c)
         for r, q, ln in pairs:                                             # the lines each free box covers
             x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
-            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln.T, np.stack([x - w, y - v, x + w, y + v], axis=-1)),
-                                            c.size).reshape(c.shape)
+            covered = _clipped(ln.T, np.stack([x - w, y - v, x + w, y + v], axis=-1))
+            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, covered, c.size).reshape(c.shape)
         return c
 
     def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool) -> np.ndarray:
@@ -413,7 +416,8 @@ class Placer:
         at = np.searchsorted(sample, between)
         guess = np.column_stack([k[sample[at - 1]], k[sample[at]]])    # the searched angle before, then after
         xy, base = geometry(between, np.maximum(guess, 0))
-        free = np.isfinite(self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False), ("hard",)))
+        free = np.isfinite(self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False),
+                                       ("hard",)))
         free &= guess >= 0
         first = np.argmax(free, axis=1)
         kept = free.any(axis=1)
@@ -455,8 +459,8 @@ class Placer:
                 c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
                                 np.broadcast_to(c, (len(rows), len(idx))), rows, (False,))
             else:
-                c = self._costs(np.take(centres.reshape(2, -1), local[:, None] * K + idx, axis=1), half[:, rows], c, rows,
-                                (True, False))
+                p = np.take(centres.reshape(2, -1), local[:, None] * K + idx, axis=1)    # (2, rows, batch)
+                c = self._costs(p, half[:, rows], c, rows, (True, False))
             cost = np.full((n, len(idx)), np.inf)
             cost[local] = c
             tested.append(cost)
