@@ -188,11 +188,10 @@ def _clipped(seg: np.ndarray, box: np.ndarray) -> np.ndarray:
     """Length (mm) of each segment (x0, y0, x1, y1) strictly inside each box (broadcast, last axis
     4): the segment clipped to the box (Liang-Barsky; a segment parallel to a side divides by a
     signed zero: +-inf inside the slab or out of it, NaN on its edge); 0 where either is NaN."""
-    x, y, x1, y1 = np.moveaxis(seg, -1, 0)
-    box = np.moveaxis(box, -1, 0)
-    dx, dy = x1 - x, y1 - y
+    x, y = seg[..., 0], seg[..., 1]
+    dx, dy = seg[..., 2] - x, seg[..., 3] - y
     with np.errstate(divide="ignore", invalid="ignore"):
-        tx0, tx1, ty0, ty1 = (box[0] - x) / dx, (box[2] - x) / dx, (box[1] - y) / dy, (box[3] - y) / dy
+        tx0, tx1, ty0, ty1 = (box[..., 0] - x) / dx, (box[..., 2] - x) / dx, (box[..., 1] - y) / dy, (box[..., 3] - y) / dy
         t_in = np.maximum(np.maximum(np.minimum(tx0, tx1), np.minimum(ty0, ty1)), 0.0)
         t_out = np.minimum(np.minimum(np.maximum(tx0, tx1), np.maximum(ty0, ty1)), 1.0)
         length = (t_out - t_in) * np.hypot(dx, dy)
@@ -268,7 +267,7 @@ class Placer:
         return a[:1] if len(a) > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape), equal_nan=True) else a
 
     def _add(self, key: str, part: np.ndarray) -> None:
-        self._parts.setdefault((key, len(part) == 1), []).append(np.moveaxis(part.astype(np.float32), -1, 0))
+        self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32).transpose(2, 0, 1))
 
     def _stack(self, key: str, still: bool) -> np.ndarray:
         """The hard obstacles (grown by PAD) (4, R, H), or the lines and their bounding boxes
