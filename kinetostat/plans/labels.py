@@ -452,7 +452,7 @@ class Placer:
             rows = at[local]
             idx = order[start:start + size]
             c = ordered[local, start:start + size]
-            if still:                                                       # the still obstacles once
+            if still and len(rows) > 1:                                     # the still obstacles once
                 p, h = centres[:, :1, idx], half[:, rows[:1]]
                 c = self._costs(p, h, c[:1], rows[:1], (True,))
                 c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
