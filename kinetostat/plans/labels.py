@@ -168,7 +168,8 @@ _ALONG_OFF = _constant(6.0 * np.abs(_ALONG[0] - 0.5))
 #: T, S, R and the cost's part for leaving the middle (0 on a ring); direction, ring, cost (0 beside).
 _CAND_RING = _constant(np.r_[np.zeros(len(_ALONG_OFF), bool), np.ones(len(_RING_COST), bool)])
 _CAND_T, _CAND_S, _CAND_R, _CAND_OFF = (_constant(np.r_[a, np.zeros(len(_RING_COST))]) for a in (*_ALONG, _ALONG_OFF))
-_CAND_DIR = _constant(np.r_[np.zeros((len(_ALONG_OFF), 2)), _RING_DIRS])
+_CAND_DIR_T = _constant(np.r_[np.zeros((len(_ALONG_OFF), 2)), _RING_DIRS].T.copy())     # (2, K)
+_CAND_ABS_DIR_T = _constant(np.abs(_CAND_DIR_T))
 _CAND_RAD = _constant(np.r_[np.zeros(len(_ALONG_OFF)), np.repeat(_RINGS, len(_DIRS))])
 _CAND_COST = _constant(np.r_[np.zeros(len(_ALONG_OFF)), _RING_COST])
 #: A label keeps one place over the angles where that place costs at most this more than the best.
@@ -214,11 +215,34 @@ def _bounds(items: np.ndarray) -> np.ndarray:
                           axis=-1)
 
 
-def _meets(bb: np.ndarray, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(row, item) of the items whose bounding boxes `bb` (R, H, 4) (R = 1: the same at every row)
-    meet `region` (n', 4), row by row."""
-    return np.nonzero((bb[..., 0] <= region[:, None, 2]) & (bb[..., 2] >= region[:, None, 0])
-                      & (bb[..., 1] <= region[:, None, 3]) & (bb[..., 3] >= region[:, None, 1]))
+def _meets(bb: np.ndarray, region: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """(row, item) of the items whose bounding boxes `bb` (4, R, H) (x0, y0, x1, y1; R = 1: the
+    same at every row) meet `region` (x0, y0, x1, y1, each (n', 1)), row by row."""
+    x0, y0, x1, y1 = region
+    hit = bb[0] <= x1
+    hit &= bb[2] >= x0
+    hit &= bb[1] <= y1
+    hit &= bb[3] >= y0
+    return _nonzero(hit)
+
+
+def _nonzero(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """np.nonzero of a 2-D bool array, the same (row, column) in the same order (row by row), by
+    its flat indices (np.nonzero of a 2-D array takes several times longer)."""
+    return np.divmod(np.flatnonzero(mask), mask.shape[1])
+
+
+def _any_by_row(inside: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Of the rows of `inside` (pairs, B) bool, taken `counts` (n',) at a time in order, whether any
+    is True, column by column (n', B) (no rows: False); the columns' bytes ORed a word at a time."""
+    word = next(w for w in (8, 4, 2, 1) if inside.shape[1] % w == 0)
+    starts = np.cumsum(counts) - counts
+    some = counts > 0
+    out = np.zeros((len(counts), inside.shape[1]), dtype=bool)
+    if some.any():
+        out[some] = np.bitwise_or.reduceat(np.ascontiguousarray(inside).view(f"u{word}"), starts[some],
+                                           axis=0).view(bool)
+    return out
 
 
 class Placer:
@@ -231,8 +255,9 @@ class Placer:
     def __init__(self, n: int, bounds: tuple[float, float, float, float]):
         self.n = n
         self.bounds = bounds
-        # ("hard", still) -> boxes grown by PAD (R, S, 4); ("soft", still) -> lines and their bounding
-        # boxes (R, S, 8); R = 1 where still (the same at every angle), else N
+        # ("hard", still) -> boxes grown by PAD (4, R, S); ("soft", still) -> lines and their bounding
+        # boxes (8, R, S), float32, coordinate by coordinate; R = 1 where still (the same at every
+        # angle), else N
         self._parts: dict[tuple[str, bool], list[np.ndarray]] = {}
         self._stacked: dict[tuple[str, bool], tuple[int, np.ndarray]] = {}     # parts stacked, their stack
 
@@ -253,18 +278,20 @@ class Placer:
         return a[:1] if len(a) > 1 and np.array_equal(a, np.broadcast_to(a[:1], a.shape), equal_nan=True) else a
 
     def _add(self, key: str, part: np.ndarray) -> None:
-        self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32))
+        self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32).transpose(2, 0, 1))
 
     def _stack(self, key: str, still: bool) -> np.ndarray:
-        """The hard obstacles (grown by PAD) (R, H, 4), or the lines and their bounding boxes
-        (R, H, 8), the same at every angle (still: R = 1) or not (R = N): those added since the
+        """The hard obstacles (grown by PAD) (4, R, H), or the lines and their bounding boxes
+        (8, R, H), the same at every angle (still: R = 1) or not (R = N): those added since the
         last call appended."""
         parts = self._parts.get((key, still), [])
-        rows = 1 if still else self.n
-        done, stacked = self._stacked.get((key, still), (0, np.empty((rows, 0, 4 if key == "hard" else 8), dtype=np.float32)))
-        if done < len(parts):
-            stacked = np.concatenate([stacked, *(np.broadcast_to(p, (rows,) + p.shape[1:]) for p in parts[done:])],
-                                     axis=1)
+        done, stacked = self._stacked.get((key, still), (0, None))
+        if done < len(parts) or stacked is None:
+            rows = 1 if still else self.n
+            if stacked is None:
+                stacked = np.empty((4 if key == "hard" else 8, rows, 0), dtype=np.float32)
+            stacked = np.concatenate([stacked, *(np.broadcast_to(p, p.shape[:1] + (rows,) + p.shape[2:])
+                                                 for p in parts[done:])], axis=2)
             self._stacked[key, still] = (len(parts), stacked)
         return stacked
 
@@ -289,35 +316,45 @@ class Placer:
             u = d / L[:, None]
         nrm = np.column_stack([-u[:, 1], u[:, 0]])
         C = np.where(has[:, None], A + d / 2, A)                          # rings about the segment's middle
+        CT = np.ascontiguousarray(C.T)                                    # (2, N)
         fixed = np.isfinite(A).all(axis=1)
         bx0, by0, bx1, by1 = self.bounds
+        # each text's ring candidates about the centre (2, texts x K); 0 beside the segment
+        hv = np.column_stack([widths / 2, heights.sum(axis=1) / 2])
+        reach = _CAND_RAD + (hv[:, :1] * _CAND_ABS_DIR_T[0] + hv[:, 1:] * _CAND_ABS_DIR_T[1])           # (texts, K)
+        ring_off = (_CAND_DIR_T[:, None] * reach).reshape(2, -1)
+        K = len(_CAND_RING)
+        ring_extra = np.where(has, 2.0, 0.0)
 
         def geometry(rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             """Centres (2, r, m) and least costs (r, m) of the candidates `cols` (r, m), or (1, m)
-            at every angle, at the angles `rows` (r,): beside the segment (`_ALONG`), then on the
-            rings (`_RINGS`)."""
-            h, n_r, c_r = half[rows][:, :, None], nrm[rows][:, :, None], C[rows][:, :, None]      # (r, 2, 1)
-            clear = _CAND_R[cols] + (np.abs(n_r[:, 0]) * h[:, 0] + np.abs(n_r[:, 1]) * h[:, 1])      # (r, m)
-            beside_xy = A[rows][:, :, None] + _CAND_T[cols][:, None] * d[rows][:, :, None] \
-                + _CAND_S[cols][:, None] * n_r * clear[:, None]
-            dirs = np.moveaxis(_CAND_DIR[cols], -1, 1)                                           # (r, 2, m)
-            reach = _CAND_RAD[cols] + (h[:, 0] * np.abs(dirs[:, 0]) + h[:, 1] * np.abs(dirs[:, 1]))
+            at every angle, at the angles `rows` (r,): beside the segment (`_ALONG`; a label with
+            no segment: none, their centre the anchor's), then on the rings (`_RINGS`)."""
+            hx, hy = half[rows, :1], half[rows, 1:]                                               # (r, 1)
+            xy = CT[:, rows, None] + np.take(ring_off, variant[rows][:, None] * K + cols, axis=1)  # (2, r, m)
             ring = _CAND_RING[cols]
-            xy = np.where(ring[:, None], c_r + dirs * reach[:, None], beside_xy)
-            base = np.where(ring, _CAND_COST[cols] + np.where(has[rows], 2.0, 0.0)[:, None],
-                            np.where(beside[rows][:, None],
-                                     _CAND_R[cols] + _CAND_OFF[cols] * np.minimum(L[rows], 20.0)[:, None] / 20.0, np.inf))
-            x, y, hx, hy = xy[:, 0], xy[:, 1], h[:, 0], h[:, 1]
+            base = np.where(ring, _CAND_COST[cols] + ring_extra[rows, None], np.inf)
+            some = ~ring.all(axis=0)                                          # the columns beside the segment somewhere
+            if has.any() and some.any():
+                k, r_ring = cols[:, some], ring[:, some]
+                n_r = nrm[rows][:, :, None]
+                clear = _CAND_R[k] + (np.abs(n_r[:, 0]) * hx + np.abs(n_r[:, 1]) * hy)           # (r, m')
+                at = A[rows][:, :, None] + _CAND_T[k][:, None] * d[rows][:, :, None] \
+                    + _CAND_S[k][:, None] * n_r * clear[:, None]                                   # (r, 2, m')
+                at = np.where(np.isfinite(at), at, C[rows][:, :, None])       # no centre beside no segment: never free
+                xy[:, :, some] = np.where(r_ring, xy[:, :, some], np.moveaxis(at, 1, 0))
+                base[:, some] = np.where(r_ring | ~beside[rows][:, None], base[:, some],
+                                         _CAND_R[k] + _CAND_OFF[k] * np.minimum(L[rows], 20.0)[:, None] / 20.0)
+            x, y = xy
             outside = (x < bx0 + hx) | (y < by0 + hy) | (x > bx1 - hx) | (y > by1 - hy)
-            base = np.where(outside | ~fixed[rows][:, None], np.inf, base)
-            xy = np.where(np.isfinite(xy), xy, c_r)                       # no centre beside no segment: never free
-            return np.moveaxis(xy, 1, 0), base
+            base[outside | ~fixed[rows][:, None]] = np.inf
+            return xy, base
 
         still = bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
         with np.errstate(invalid="ignore"):
-            k = self._choose(geometry, len(_CAND_RING), half.T.astype(np.float32), still)
+            k = self._choose(geometry, K, half.T.astype(np.float32), still)
             xy, _ = geometry(np.arange(n), np.maximum(k, 0)[:, None])
         c = np.where((k >= 0)[:, None], xy[:, :, 0].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
@@ -334,33 +371,38 @@ class Placer:
         it; of the obstacles the same at every angle (`still` holds True) and of those that move
         (False); `kinds` ("hard",): whether free only, the lines not costed."""
         stacks = [(key, fixed, items) for key in kinds for fixed in still
-                  for items in (self._stack(key, fixed),) if items.shape[1]]
+                  for items in (self._stack(key, fixed),) if items.shape[2]]
         free = np.isfinite(c)
         if not stacks or not free.any():
             return c
         (px, py), (hx, hy) = p, h
-        region = np.column_stack([px.min(axis=1) - hx, py.min(axis=1) - hy, px.max(axis=1) + hx, py.max(axis=1) + hy])
+        region = ((px.min(axis=1) - hx)[:, None], (py.min(axis=1) - hy)[:, None],
+                  (px.max(axis=1) + hx)[:, None], (py.max(axis=1) + hy)[:, None])
         blocked = np.zeros(c.shape, dtype=bool)
         pairs = []
         for key, fixed, items in stacks:                                   # the hard ones first
-            r, j = _meets(items[..., -4:] if fixed else items[rows, :, -4:], region)
+            r, j = _meets(items[-4:] if fixed else np.take(items[-4:], rows, axis=1), region)
             if not len(r):
                 continue
-            items = items[0 if fixed else rows[r], j]                     # (pairs, 4 or 8)
-            X, Y, w, v = px[r], py[r], hx[r], hy[r]                       # a box over it: its centre inside it grown by h
-            inside = (X > (items[:, -4] - w)[:, None]) & (X < (items[:, -2] + w)[:, None]) \
-                & (Y > (items[:, -3] - v)[:, None]) & (Y < (items[:, -1] + v)[:, None])         # (pairs, B)
+            at = j if fixed else rows[r] * items.shape[2] + j
+            items = np.take(items.reshape(len(items), -1), at, axis=1)   # (4 or 8, pairs)
+            counts = np.bincount(r, minlength=len(c))                     # r ascending: each row's pairs together
+            X, Y, w, v = (np.repeat(a, counts, axis=0) for a in (px, py, hx, hy))
+            inside = X > (items[-4] - w)[:, None]                         # a box over it: its centre in it grown by h
+            inside &= X < (items[-2] + w)[:, None]
+            inside &= Y > (items[-3] - v)[:, None]
+            inside &= Y < (items[-1] + v)[:, None]                        # (pairs, B)
             if key == "hard":
-                starts = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
-                blocked[r[starts]] |= np.logical_or.reduceat(inside, starts, axis=0)
+                blocked |= _any_by_row(inside, counts)
             else:
-                f, q = np.nonzero(inside & ~blocked[r] & free[r])
-                pairs.append((r[f], q, items[f, :4]))
+                inside &= np.repeat(free & ~blocked, counts, axis=0)
+                f, q = _nonzero(inside)
+                pairs.append((r[f], q, np.take(items[:4], f, axis=1)))
         c = np.where(blocked, np.inf, c)
         for r, q, ln in pairs:                                             # the lines each free box covers
             x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
-            box = np.column_stack([x - w, y - v, x + w, y + v])
-            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, _clipped(ln, box), c.size).reshape(c.shape)
+            covered = _clipped(ln.T, np.stack([x - w, y - v, x + w, y + v], axis=-1))
+            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, covered, c.size).reshape(c.shape)
         return c
 
     def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool) -> np.ndarray:
@@ -376,19 +418,21 @@ class Placer:
         if n < 2 * STRIDE:
             return self._search(geometry, K, half, still, np.arange(n))
         k = np.full(n, -1)
-        sample = np.unique(np.r_[np.arange(0, n, STRIDE), n - 1])
+        done = np.zeros(n, dtype=bool)                              # searched, or a neighbour's place kept
+        done[::STRIDE] = done[-1] = True
+        sample = np.flatnonzero(done)
         k[sample] = self._search(geometry, K, half, still, sample)
-        between = np.setdiff1d(np.arange(n), sample)
-        tried = np.full(n, -1)
-        for after in (0, 1):                                        # the searched angle before, then after
-            guess = k[sample[np.searchsorted(sample, between) - 1 + after]]
-            new = (guess >= 0) & (guess != tried[between])
-            rows, cand = between[new], guess[new]
-            tried[rows] = cand
-            xy, base = geometry(rows, cand[:, None])
-            free = np.isfinite(self._costs(xy.astype(np.float32), half[:, rows], base, rows, (True, False), ("hard",))[:, 0])
-            k[rows[free]] = cand[free]
-            between = np.setdiff1d(between, rows[free])
+        between = np.flatnonzero(~done)
+        at = np.searchsorted(sample, between)
+        guess = np.column_stack([k[sample[at - 1]], k[sample[at]]])    # the searched angle before, then after
+        xy, base = geometry(between, np.maximum(guess, 0))
+        free = np.isfinite(self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False),
+                                       ("hard",)))
+        free &= guess >= 0
+        first = np.argmax(free, axis=1)
+        kept = free.any(axis=1)
+        k[between[kept]] = guess[kept, first[kept]]
+        between = between[~kept]
         if len(between):
             k[between] = self._search(geometry, K, half, still, between)
         return k
@@ -419,13 +463,14 @@ class Placer:
             rows = at[local]
             idx = order[start:start + size]
             c = ordered[local, start:start + size]
-            if still:                                                       # the still obstacles once
+            if still and len(rows) > 1:                                     # the still obstacles once
                 p, h = centres[:, :1, idx], half[:, rows[:1]]
                 c = self._costs(p, h, c[:1], rows[:1], (True,))
                 c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
                                 np.broadcast_to(c, (len(rows), len(idx))), rows, (False,))
             else:
-                c = self._costs(centres[:, local[:, None], idx], half[:, rows], c, rows, (True, False))
+                p = np.take(centres.reshape(2, -1), local[:, None] * K + idx, axis=1)    # (2, rows, batch)
+                c = self._costs(p, half[:, rows], c, rows, (True, False))
             cost = np.full((n, len(idx)), np.inf)
             cost[local] = c
             tested.append(cost)

@@ -208,19 +208,21 @@ def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
     by_size: dict[int, list[int]] = {}
     for g, s in enumerate(pool):
         by_size.setdefault(len(s), []).append(g)
-    stacks = {n: (np.asarray(gs), np.stack([pool[g] for g in gs]).astype(np.float64)) for n, gs in by_size.items()}
+    stacks = {}
+    for n, gs in by_size.items():
+        stack = np.stack([pool[g] for g in gs]).astype(np.float64)
+        stacks[n] = (np.asarray(gs), stack, (stack.min(axis=1) >= 0), (stack <= 0).astype(np.float64))
     picks: list[tuple[int, int, float]] = []                     # (i, g, f)
     for i, q in enumerate(qs):
         on = q > 0
         if len(q) < 2 or on.sum() < 2 or len(q) not in stacks:
             continue
-        index, stack = stacks[len(q)]
-        usable = (index < limits[i]) & (stack.min(axis=1) >= 0)
-        usable[usable] = stack[usable][:, on].min(axis=1) > 0
-        if usable.any():
+        index, stack, nonneg, off = stacks[len(q)]
+        usable = np.flatnonzero((index < limits[i]) & nonneg & (off @ on == 0))     # positive wherever q is
+        if len(usable):
             ratio = q[on] / stack[usable][:, on]
-            g = int(np.argmin(np.ptp(ratio, axis=1) / ratio.mean(axis=1)))
-            picks.append((i, int(index[usable][g]), float(f"{np.median(ratio[g]):.10g}")))   # 10 digits: the page's JSON short
+            g = int(np.argmin((ratio.max(axis=1) - ratio.min(axis=1)) / ratio.mean(axis=1)))
+            picks.append((i, int(index[usable[g]]), float(f"{np.median(ratio[g]):.10g}")))   # 10 digits: the page's JSON short
     coded = _serieses([x for i, g, f in picks for x in (qs[i] - _scaled(pool[g], f), qs[i])])
     out: list[tuple[int, float] | None] = [None] * len(qs)
     for n, (i, g, f) in enumerate(picks):
