@@ -398,13 +398,14 @@ def test_print_keeps_title_data_scales_and_notes(chromium, ice, tmp_path):
         pytest.skip("no pdftotext (apt-get install poppler-utils)")
     from kinetostat.model.lettering import lettering
     from kinetostat.plans import draw
+    from kinetostat.plans.symbols import plain
     mech, fixed, key, student = ice
     name = lettering(mech).name("uk", mech.name)
     want = {}                                           # kind -> the notes of its own sheet, markup-free
     for kind, plan in _build(mech, 30.0, fixed).items():
         svg = P.svg(plan, "uk", name)
         sheet = _bare_text(svg[svg.index('<g id="notes">'):])
-        notes = [_bare_text(draw._plain(n)) for n in draw._note_lines(plan, "uk", draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0))]
+        notes = [_bare_text(plain(n)) for n in draw._note_lines(plan, "uk", draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0))]
         assert all(n in sheet for n in notes), kind     # the notes as the sheet draws them, unwrapped
         tiny = [re.match(r"(.*?)(\*?)=.*ммумасштабі", n) for n in notes]
         want[kind] = [n for n, m in zip(notes, tiny) if not m and not n.startswith("Результати")] \

@@ -373,7 +373,7 @@ def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
     per angle). Each distinct make-up of notes (the plan's notes, tiny vectors, accuracy,
     equation) read and wrapped once, of the plan cut to its tiny vectors."""
     x, y, width = where
-    room = int((_FRAME[3] - 1.5 - (y - ASCENT * _NOTE_MM)) // _LINE_STEP)
+    room = int((_FRAME[3] - 1.5 - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
     segments = tuple(s for s in cycle.segments if s.name in tiny)       # all of its drawing the notes read
     light = replace(cycle, points={k: cycle.points[k] for s in segments for k in (s.start, s.end)},
                     segments=segments, paths={}, results=())
