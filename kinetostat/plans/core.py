@@ -20,7 +20,7 @@ from typing import Mapping
 import numpy as np
 
 __all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent",
-           "extent_cycle", "ELEMENTS", "fixed", "construction"]
+           "extent_cycle", "ELEMENTS", "fixed", "construction", "UNMEASURED"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -65,6 +65,10 @@ class Segment:
     scale: Scale | None = None   # a segment drawn at another scale than its plan's (the loads on a
                                  # group plan, at a force scale); None: the plan's scale
     # In a PlanCycle, `value` is an (N,) array over its angles.
+
+
+#: Kinds of segment no one measures: a position's link, a line, a construction line, a mark.
+UNMEASURED = ("position", "line", "construction", "intersection")
 
 
 def construction(point: str, lines: list[tuple[str, str]]) -> list[Segment]:

@@ -556,6 +556,9 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         if s.kind in ("construction", "intersection"):
             element, spots[s.name] = _construction(s.kind, a, b, ok, attrs, label, placer)
             out.append(replace(element, length_mm=Lz if contract else None))
+            none = ok & ~np.asarray(element.drawn()).reshape(-1)       # a line of no direction (v_B = 0): not drawn
+            if contract and none.any():
+                out.append(Element("g", _where(none, a)[:, None], {"class": "negligible", **data}, length_mm=Lz))
             continue
         spots[s.name] = (a, b)
         L = Lz.copy()
