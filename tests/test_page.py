@@ -129,9 +129,12 @@ def test_slider_draws_every_segment_as_segments_csv(chromium, ice):
 
 
 def test_next_step_follows_the_texts_order(chromium, ice):
-    """Seed 002 (fig. 1.10): R12t from ΣM_B of the rod, then the polygon R12t + G2 + F_i2 + G3 +
-    F_i3 + F_p + R43 + R12n = 0 in that order, then the inner reaction R32, then the crank (R21 and
-    M_зр), then the lever; one vector highlighted at a time, on the plan it belongs to."""
+    """Seed 002 (figs. 1.7, 1.8, 1.10): the velocity plan (p-a, the line through a square to AB, the
+    vertical through p, b at their intersection) and the acceleration plan (pi-a, a-n2, the lines
+    through n2 and pi, b), each step with its number on the sheet; then R12t from ΣM_B of the rod,
+    the polygon R12t + G2 + F_i2 + G3 + F_i3 + F_p, the lines of R12n and R43 and their
+    intersection h, R43 + R12n = 0, then the inner reaction R32, then the crank (R21 and M_зр),
+    then the lever; one element highlighted at a time, on the plan it belongs to."""
     mech, fixed, key, _ = ice
     pg = _open(chromium, key)
     _slide(pg, 30)
@@ -139,15 +142,23 @@ def test_next_step_follows_the_texts_order(chromium, ice):
         document.getElementById('next').click();
         const s = document.getElementById('step').dataset, key = e => [e.plan, e.segment || e.path];
         return [key(s), [...document.querySelectorAll('.hl')].map(e => key(e.dataset)),
-                document.getElementById('equation').textContent];
-    })""", 14)
-    for step, lit, _ in steps:
-        assert lit == [step], (step, lit)            # one vector lit at a time: the step's
-    seen = [tuple(step) for step, _, _ in steps]
-    polygon = [("forces:2,3", n) for n in ("R12t", "G2", "F_i2", "G3", "F_i3", "F_p", "R43", "R12n")]
-    assert seen[:10] == [("group:2,3", "R12t"), *polygon, ("forces:2,3", "R32")]
-    assert seen[10] == ("crank", "R21") and ("crank", "M_зр") in seen[10:]
-    assert steps[0][2].startswith("R12t з ΣM_B(ланка 2) = 0") and "R32" in steps[9][2]
+                document.getElementById('equation').textContent, s.n];
+    })""", 26)
+    for step, lit, _, _ in steps:
+        assert lit == [step], (step, lit)            # one element lit at a time: the step's
+    seen = [tuple(step) for step, _, _, _ in steps]
+    kinematic = [("velocity", n) for n in ("p-a", "line a-b", "line p-b", "point b")] \
+        + [("acceleration", n) for n in ("pi-a", "a-n2", "line n2-b", "line pi-b", "point b")]
+    assert seen[:9] == kinematic
+    assert [n for *_, n in steps[:9]] == ["1", "2", "3", "4", "1", "2", "3", "4", "5"]      # as on the sheets
+    assert "перетині" in steps[3][2] and "a-b" in steps[1][2]
+    steps = [s[:3] for s in steps[9:]]
+    seen = seen[9:]
+    polygon = [("forces:2,3", n) for n in ("R12t", "G2", "F_i2", "G3", "F_i3", "F_p", "line R12n", "line R43",
+                                           "point h", "R43", "R12n")]
+    assert seen[:13] == [("group:2,3", "R12t"), *polygon, ("forces:2,3", "R32")]
+    assert seen[13] == ("crank", "R21") and ("crank", "M_зр") in seen[13:]
+    assert steps[0][2].startswith("R12t з ΣM_B(ланка 2) = 0") and "R32" in steps[12][2]
     assert "G2" in steps[2][2] and "нехтовно мала" in steps[2][2]          # 0,049 mm: said, not an empty light
     plans = _build(mech, 30.0, fixed)
     crank_M = next(e for (plan, seg), _, e in steps if seg == "M_зр")
@@ -437,7 +448,8 @@ def test_print_keeps_title_data_scales_and_notes(chromium, ice, tmp_path):
 @pytest.mark.parametrize("path", sampled(MODELS))
 def test_every_step_names_a_drawn_vector(path):
     """Each step of "Next step" lights a segment (or a couple's arc) its plan draws, every group's
-    polygon side once in the order of its equation, the groups from the last attached."""
+    polygon side once in the order of its equation (its construction lines between), the groups
+    from the last attached."""
     mech = kinetostat.load(path)
     plans = _build(mech, None, None)
     steps = _steps(mech, _one(mech, None), plans, "en")
@@ -446,7 +458,8 @@ def test_every_step_names_a_drawn_vector(path):
         assert (s["path"] in plan.paths) if "path" in s else any(x.name == s["segment"] for x in plan.segments), s
     for g in mech.structure.groups:
         label = _group_label(g)
-        sides = [s["segment"] for s in steps if s["plan"] == f"forces:{label}"]
+        sides = [s["segment"] for s in steps if s["plan"] == f"forces:{label}"
+                 and plans[s["plan"]].segment(s["segment"]).kind == "vector"]     # not its construction
         inner = 3 if g.klass == 3 else 1                 # a triad: the base's reaction on each leash
         assert sides[:-inner] == list(plans[f"forces:{label}"].equation)
         assert len(set(sides[-inner:])) == inner

@@ -20,7 +20,7 @@ from typing import Mapping
 import numpy as np
 
 __all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent",
-           "extent_cycle", "ELEMENTS", "fixed"]
+           "extent_cycle", "ELEMENTS", "fixed", "construction", "UNMEASURED"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -47,7 +47,10 @@ class Segment:
     |value| = drawn length x scale for a vector or an arm drawn at the plan's scale; `kind` says how
     it is drawn: "vector" (an arrow), "link" (a link of the mechanism), "position" (a link at one
     of the other positions of the plan of positions, drawn thin), "arm" (a moment arm),
-    "line" (a construction line: a direction, a path), "alternative" (an arrow that replaces others
+    "line" (a direction, a path), "construction" (a line of known direction drawn through the
+    known point `start` toward the point `end` that its intersection with another fixes, drawn
+    thin past both), "intersection" (the mark at `start` = `end` where construction lines meet),
+    "alternative" (an arrow that replaces others
     drawn: F_i2(h) for F_i2 and M_i2, dashed), "extension" (a link's line drawn on, dashed, to a
     force acting off it). A segment whose quantity is not at the plan's
     scale (a link of a lever, a path) has `value` NaN and unit "", unless it names its own `scale`
@@ -62,6 +65,19 @@ class Segment:
     scale: Scale | None = None   # a segment drawn at another scale than its plan's (the loads on a
                                  # group plan, at a force scale); None: the plan's scale
     # In a PlanCycle, `value` is an (N,) array over its angles.
+
+
+#: Kinds of segment no one measures: a position's link, a line, a construction line, a mark.
+UNMEASURED = ("position", "line", "construction", "intersection")
+
+
+def construction(point: str, lines: list[tuple[str, str]]) -> list[Segment]:
+    """The construction that fixes `point` (seed 002 sec. 1.2: "through a draw a line
+    perpendicular to AB, through p a vertical line; their intersection is b"): for each
+    (name, known point) of `lines` the line of known direction "line <name>" from the known point
+    toward `point`, then the intersection's mark "point <point>"; nothing at a scale."""
+    return [*(Segment(f"line {name}", known, point, math.nan, "", "construction") for name, known in lines),
+            Segment(f"point {point}", point, point, math.nan, "", "intersection")]
 
 
 @dataclass(frozen=True)
@@ -93,6 +109,8 @@ class Plan:
     equation: tuple[str, ...] = ()         # a force plan's vector equation: its sides' names in the order drawn
     accuracy: tuple[float, int] | None = None   # near a singular position: (digits left, fewer than this);
                                                 # the sheet states it (i18n.accuracy)
+    steps: tuple[str, ...] = ()            # the construction in the texts' order: segment names, numbered
+                                           # 1, 2, ... on the sheet and in the page's "next step"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "points", MappingProxyType(dict(self.points)))
@@ -100,6 +118,7 @@ class Plan:
         object.__setattr__(self, "notes", tuple(self.notes))
         object.__setattr__(self, "results", tuple(self.results))
         object.__setattr__(self, "equation", tuple(self.equation))
+        object.__setattr__(self, "steps", tuple(self.steps))
 
     def length_mm(self, name: str) -> float:
         """Drawn length of the segment `name`, mm."""
@@ -184,6 +203,7 @@ class PlanCycle:
     results: tuple[Result, ...] = ()
     equation: tuple[str, ...] = ()
     accuracy: tuple[np.ndarray, int] | None = None
+    steps: tuple[str, ...] = ()               # see Plan.steps: the same at every angle
 
     def __post_init__(self) -> None:
         phi = np.atleast_1d(np.asarray(self.phi_deg, dtype=float))
@@ -199,6 +219,7 @@ class PlanCycle:
         object.__setattr__(self, "notes", tuple(tuple(x) for x in self.notes))
         object.__setattr__(self, "results", tuple(self.results))
         object.__setattr__(self, "equation", tuple(self.equation))
+        object.__setattr__(self, "steps", tuple(self.steps))
 
     @property
     def n(self) -> int:
@@ -215,7 +236,7 @@ class PlanCycle:
                          for s in plan.segments),
                    {k: np.array([v], dtype=complex) for k, v in plan.paths.items()},
                    (plan.notes,), tuple(Result(r.symbol, np.array([r.value]), r.unit, r.how) for r in plan.results),
-                   plan.equation, acc)
+                   plan.equation, acc, plan.steps)
 
     def length_mm(self, name: str) -> np.ndarray:
         """Drawn length of the segment `name` at every angle, mm, (N,)."""
@@ -239,7 +260,8 @@ class PlanCycle:
                     self.notes[i] if self.notes else (),
                     tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how if isinstance(r.how, str) else r.how[i])
                           for r in self.results),
-                    self.equation if not self.equation or isinstance(self.equation[0], str) else self.equation[i], acc)
+                    self.equation if not self.equation or isinstance(self.equation[0], str) else self.equation[i], acc,
+                    self.steps)
 
     def drawn(self, s: Segment) -> np.ndarray:
         """(N,) bool: the angles segment s is drawn at: all, but where a quantity's value (a

@@ -58,6 +58,9 @@ TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
 #: A vector shorter than this (mm) is rounding noise of a zero (a load's arm at a dead centre): it
 #: has no direction to draw it out of scale in, and is noted as negligible.
 ZERO_MM = 1e-9
+#: A construction line is drawn this far past its known point and past the intersection, mm; the
+#: intersection is marked by a circle of this radius, mm.
+PAST_MM, MARK_MM = 12.0, 1.2
 #: A vector drawn out of scale along another vector from the same point is drawn this far beside it, mm.
 SIDE_MM = 1.8
 #: Font sizes of the points' letters, the vectors' names, the numbered positions' letters and the
@@ -81,6 +84,7 @@ def fits(plan: Plan) -> float:
 _STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
           "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33"), "dimension": (0.25, "", "#a33"),
           "alternative": (0.35, "3,1.5", "#000"), "extension": (0.35, "3,1.5", "#000")}
+_STYLE["construction"] = _STYLE["intersection"] = (0.25, "", "#000")     # ГОСТ 2.303's thin solid line
 #: The kinds drawn as arrows: a vector, and one drawn as the alternative of others (F_i2(h), dashed).
 _ARROWS = ("vector", "alternative")
 #: A dimension line's arrowheads (the lever's arms), mm: the drafting size of a thin line's arrow.
@@ -129,6 +133,10 @@ def segment_label(s: Segment, lang: str) -> str:
     if s.name.startswith("slot "):                  # mechanism.py: "slot <link> <point>"
         k, P = s.name[5:].split(" ", 1)
         return text("slot", lang, k=k, P=P)
+    if s.kind == "construction":                    # core.construction: "line <name>", "point <P>"
+        return text("construction.line", lang, name=in_lang(s.name[5:], lang), P=s.start)
+    if s.kind == "intersection":
+        return text("construction.point", lang, P=s.start)
     return text(s.name, lang) if s.name in MESSAGES else in_lang(s.name, lang)
 
 
@@ -573,6 +581,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
     n = cycle.n
     sides = {s.name for s in _polygon_sides(cycle)} or None        # a polygon: every side and chord named
     zero = np.zeros(n, dtype=int)
+    spots: dict[str, tuple[np.ndarray, np.ndarray | None]] = {}       # where each step's number goes
     for s in cycle.segments:
         if _dimension(cycle, s):
             continue
@@ -584,6 +593,16 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
         label = escape(segment_label(s, lang))
         Lz = np.abs(zb - za)
+        data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name)} if contract else {}
+        attrs = {"stroke": colour, "stroke-width": f"{width}", **({"stroke-dasharray": dash} if dash else {}), **data}
+        if s.kind in ("construction", "intersection"):
+            element, spots[s.name] = _construction(s.kind, a, b, ok, attrs, label, placer)
+            out.append(replace(element, length_mm=Lz if contract else None))
+            none = ok & ~np.asarray(element.drawn()).reshape(-1)       # a line of no direction (v_B = 0): not drawn
+            if contract and none.any():
+                out.append(Element("g", _where(none, a)[:, None], {"class": "negligible", **data}, length_mm=Lz))
+            continue
+        spots[s.name] = (a, b)
         L = Lz.copy()
         how = np.where(ok, tiny.get(s.name, zero), _AS_IS)
         out_ = how == _OUT
@@ -596,7 +615,6 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
             b = np.where(out_[:, None], a + u * MIN_DRAWN_MM, b)
             L = np.where(out_, MIN_DRAWN_MM, L)
         neg = how == _NEGLIGIBLE
-        data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name)} if contract else {}
         if contract and neg.any():
             out.append(Element("g", _where(neg, a)[:, None], {"class": "negligible", **data}, length_mm=Lz))
         drawn = ok & ~neg
@@ -606,7 +624,6 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         else:
             end = b
             placer.block(_where(drawn, np.concatenate([b - 0.5, b + 0.5], axis=1)))     # a line's end
-        attrs = {"stroke": colour, "stroke-width": f"{width}", **({"stroke-dasharray": dash} if dash else {}), **data}
         for code, title in ((_AS_IS, label), (_OUT, label + "*")):
             lit = drawn & (how == code)
             if lit.any():
@@ -621,6 +638,9 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         if lettered.any():
             names.append(_Name((segment_label(s, lang), segment_label(s, lang) + "*"), out_.astype(int),
                                _where(lettered, a), _where(drawn & named, b), _NAME_MM, "name"))
+    for k, name in enumerate(cycle.steps, 1):           # the construction's steps numbered: (1), (2), ...
+        if name in spots:
+            names.append(_Name((f"({k})",), zero, *spots[name], _NUMBERED_MM, "step"))
     return out
 
 
@@ -676,6 +696,24 @@ def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
         texts, variant = _variants(strings)
         names.append(_Name(tuple(texts), variant, _where(lead, a), _where(lead, b), _NAME_MM, "name"))
     return out
+
+
+def _construction(kind: str, a: np.ndarray, b: np.ndarray, ok: np.ndarray, attrs: dict, title: str,
+                  placer: Placer) -> tuple[Element, tuple[np.ndarray, None]]:
+    """A construction line from its known point a through the point b it fixes (N, 2), drawn
+    PAST_MM past both, or an intersection's mark at a (a circle MARK_MM across); given to the
+    placer; with where its step's number goes (past the line's end, beside the mark)."""
+    if kind == "intersection":
+        at = _where(ok, a)
+        placer.block(np.concatenate([at - MARK_MM, at + MARK_MM], axis=1))
+        return Element("circle", at[:, None], {"r": f"{MARK_MM}", "fill": "none", **attrs}, title=title), (at, None)
+    d = b - a
+    L = np.hypot(d[:, 0], d[:, 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = np.where((L > ZERO_MM)[:, None], d / L[:, None], np.nan)
+    ends = _where(ok, np.stack([a - PAST_MM * u, b + PAST_MM * u], axis=1))
+    placer.line(_lines(ends[:, 0], ends[:, 1]))
+    return Element("line", ends, attrs, title=title), (ends[:, 1], None)
 
 
 def _distinct_rows(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -47,7 +47,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..applied import applied_moment, point_forces
-from .core import PlanCycle, Result, Scale, Segment
+from .core import PlanCycle, Result, Scale, Segment, construction
 from ..model.lettering import lettering, link_number, reaction_name
 from .scales import round_scale
 from ..errors import ModelWarning, _angle_list
@@ -429,14 +429,15 @@ def _link_drawing(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: l
 
 
 def _cycle(kind: str, titles, scale: Scale, res: "Analysis", pts: dict, segs, paths=None, notes=(),
-           results=(), equation=()) -> PlanCycle:
+           results=(), equation=(), steps=()) -> PlanCycle:
     """A PlanCycle at the angles of `res`; `titles` one string for every angle or N strings;
     `notes` the lines at every angle (a list) or per angle (N tuples)."""
     n = len(res.phi_deg)
     titles = (titles,) * n if isinstance(titles, str) else tuple(titles)
     if notes and isinstance(notes[0], str):
         notes = (tuple(notes),) * n
-    return PlanCycle(kind, titles, scale, res.phi_deg, pts, tuple(segs), paths or {}, tuple(notes), results, equation)
+    return PlanCycle(kind, titles, scale, res.phi_deg, pts, tuple(segs), paths or {}, tuple(notes), results, equation,
+                     steps=steps)
 
 
 # -- the plans
@@ -797,7 +798,10 @@ def force_plans(mech: "Mechanism", res: "Analysis", mu_F) -> list[PlanCycle]:
     lettered a, b, c, ... from the start of the first known force, closed by the unknowns; the
     whole outer reactions (R12 = R12n + R12t, ...) as chords; and the internal reaction (R32: of
     link k on link j) from the polygon of link j, the chord from the end of j's loads to the
-    start of j's outer reaction. Each segment's value is the force's magnitude, N."""
+    start of j's outer reaction. Each segment's value is the force's magnitude, N. A dyad closed by
+    two unknowns of known direction (R12n, R43) shows their lines through the polygon's start and
+    the last known force's end, and the intersection that fixes both (`core.construction`); its
+    steps: the known forces, the lines, the intersection, the unknowns."""
     _drawable(res)
     mu_F = _scale(mu_F, "mu_F", "N/mm")
     plans = []
@@ -820,10 +824,16 @@ def _dyad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Plan
         first = len(seq) - 3
         segs.append(Segment(ok.whole.name, _vertex(first), _vertex(first + 2), _abs(ok.whole.force), "N"))
     segs.append(Segment(reaction_name(mech, k, j), _vertex(end_j), X, _abs(_z(res.reaction(k, j))), "N"))
+    equation = tuple(name for name, _ in seq)
+    steps = equation
+    if oj.normal is not None:      # closed by two unknowns of known direction (seed 002 fig. 1.10)
+        m = len(seq)
+        lines = construction(_vertex(m - 1), [(equation[-1], _vertex(0)), (equation[-2], _vertex(m - 2))])
+        segs += lines
+        steps = equation[:-2] + tuple(s.name for s in lines) + equation[-2:]
     return _cycle(f"forces:{_group_label(g)}", f"Force plan of group {_group_label(g)} ({g.kind}): "
-                  + " + ".join(name for name, _ in seq) + " = 0", mu_F, res, pts, segs,
-                  equation=tuple(name for name, _ in seq),
-                  notes=["the reactions with friction in the reactions"] if res.friction is not None else ())
+                  + " + ".join(equation) + " = 0", mu_F, res, pts, segs, equation=equation,
+                  notes=["the reactions with friction in the reactions"] if res.friction is not None else (), steps=steps)
 
 
 def _closed_polygon(seq: list[tuple[str, np.ndarray]], mu_F: Scale) -> tuple[dict, list]:

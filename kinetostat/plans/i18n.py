@@ -92,6 +92,8 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
     "guide": ("guide {pair}", "напрямна {pair}", "направляющая {pair}"),      # of the sliding pair: its links
     "slot": ("slot of link {k} ({P})", "паз ланки {k} ({P})", "паз звена {k} ({P})"),
+    "construction.line": ("line of {name} through {P}", "лінія {name} через {P}", "линия {name} через {P}"),
+    "construction.point": ("{P}: the intersection of the lines", "{P}: перетин ліній", "{P}: пересечение линий"),
     "coriolis": ("Cor", "к", "к"),          # the superscript of the Coriolis acceleration: a^Cor, a^к
     "line of action": ("line of action", "лінія зачеплення", "линия зацепления"),
     "pitch circle of the wheel": ("pitch circle of the wheel", "початкове коло колеса",
@@ -438,6 +440,11 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "page.tau_S": ("{R} from ΣM_{P}(group {k}) = 0", "{R} з ΣM_{P}(група {k}) = 0", "{R} из ΣM_{P}(группа {k}) = 0"),
     "page.side": ("polygon: {sum} (side {n} of {m})", "многокутник: {sum} (сторона {n} з {m})",
              "многоугольник: {sum} (сторона {n} из {m})"),
+    "page.vector": ("{plan}: {V}, known", "{plan}: {V}, відомий", "{plan}: {V}, известен"),
+    "page.line": ("{plan}: through {P} the line of {V}, of known direction", "{plan}: через {P} лінія {V} відомого напрямку",
+                  "{plan}: через {P} линия {V} известного направления"),
+    "page.point": ("{plan}: {P} at the intersection of the lines", "{plan}: {P} на перетині ліній",
+                   "{plan}: {P} на пересечении линий"),
     "page.inner": ("inner reaction {R}: ΣF(link {k}) = 0", "внутрішня реакція {R}: ΣF(ланка {k}) = 0",
               "внутренняя реакция {R}: ΣF(звено {k}) = 0"),
     "page.crank": ("initial link: {F}", "початкова ланка: {F}", "начальное звено: {F}"),

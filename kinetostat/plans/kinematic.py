@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import PlanCycle, Scale, Segment
+from .core import PlanCycle, Scale, Segment, construction
 from .zero import translates, zero_of
 
 __all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
@@ -200,8 +200,66 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         points[name] = vS / mu.value
         segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s")
                  for r, on in refs]
-    return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points, tuple(segs),
-                     notes=_collapsed(mech, pts, segs, len(res.phi_deg)))
+    lines, steps = _constructions(mech, segs, "p")
+    return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points,
+                     tuple(segs + lines), notes=_collapsed(mech, pts, segs, len(res.phi_deg)), steps=steps)
+
+
+def _found(mech, g) -> str:
+    """The plan name of the point a dyad's plan fixes: its inner joint (a block on a moving guide:
+    the guide's point under it, seed 000's a3)."""
+    p = g.pairs[1]
+    return _name_of(mech, p.point) if p.kind == "R" else f"{p.point.lower()}{p.links[0]}"
+
+
+def _component(name: str) -> bool:
+    """Whether a plan point is the end of a component (n2, k: not a point of a link)."""
+    return name[:1] in "nk" and name[1:].isdigit() or name == "k"
+
+
+def _constructions(mech, segs: list[Segment], pole: str) -> tuple[list[Segment], tuple[str, ...]]:
+    """The construction of a velocity or an acceleration plan (seed 002 sec. 1.2.2) and its steps
+    in the texts' order. Per dyad, the point q it fixes (`_found`) lies on two lines of known
+    direction: those of the vectors drawn to q from known points (v_BA from a and v_B from p; a^t_BA
+    from n2 and a_B from pi), less a whole relative vector split into components (a-b where
+    a-n2-b is drawn) and, where three remain, the one from the pole; each line through its known
+    point (`core.construction`), the one reached through more vectors first. The steps: per line
+    the vectors that reach its known point from the pole or a point fixed already (components
+    first: pi-a, a-n2), then the line; then the intersection.
+    A triad, or a dyad whose q is not fixed so, has no construction drawn."""
+    vectors = [s for s in segs if s.kind == "vector"]
+    out: list[Segment] = []
+    steps: list[str] = []
+    fixed = {pole}
+
+    def chain(x: str) -> list[str]:
+        """The vectors from the pole or a point fixed already to x, in the order drawn (components
+        first: pi-a, a-n2)."""
+        into = [s for s in vectors if s.end == x and s.start != x]
+        if x in fixed or not into:
+            return []
+        s = next((s for s in into if _component(s.start)), into[0])
+        return [*chain(s.start), s.name]
+
+    for g in mech.structure.groups:
+        if g.klass == 3:
+            continue
+        q = _found(mech, g)
+        into = [s for s in vectors if s.end == q and s.start != q]
+        starts = {s.start for s in into}
+        into = [s for s in into if not any(t.start == s.start and t.end in starts and _component(t.end) for t in vectors)]
+        if len(into) > 2:
+            into = [s for s in into if s.start != pole]
+        if len(into) != 2:
+            continue
+        into.sort(key=lambda s: (-len(chain(s.start)), s.start == pole))     # through the known link first
+        made = construction(q, [(s.name, s.start) for s in into])
+        for s, line in zip(into, made):
+            steps += [n for n in chain(s.start) if n not in steps] + [line.name]
+        steps.append(made[-1].name)
+        out += made
+        fixed |= {q, *(s.start for s in into)}
+    return out, tuple(steps)
 
 
 def _collapsed(mech, pts: dict[str, _Point], segs: list[Segment], n: int) -> tuple[tuple[str, ...], ...]:
@@ -330,8 +388,9 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         segs += [Segment(f"{r}-{name}", r, name, _where(on, np.abs(aS - mo[r][2])), unit) for r, on in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
+    lines, steps = _constructions(mech, segs, "pi")
     return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,
-                     points, tuple(segs), notes=_collapsed(mech, pts, segs, len(res.phi_deg)))
+                     points, tuple(segs + lines), notes=_collapsed(mech, pts, segs, len(res.phi_deg)), steps=steps)
 
 
 # ----------------------------------------------------------------------------- plan of positions

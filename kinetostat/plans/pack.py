@@ -28,8 +28,8 @@ Both documents are one list of blocks (headings, paragraphs, tables, figures, th
 twice: to PDF by reportlab (`.pdf`: DejaVu Sans embedded as a TrueType subset with its Unicode
 map, so pdftotext reads the Cyrillic back) and to HTML (`worksheet.html_document`). Every word comes from the catalogue (`i18n`).
 
-May use: `build` of this package, `.a3`, `.givens`, `.worksheet`, `.drawing_error`, `.draw`, `.i18n`, `model.lettering`,
-`.pdf`, `.symbols`, `kinetostat._io`. Never matplotlib, never the harness, nor `kinetostat.variants` (the variant
+May use: `build` of this package, `.a3`, `.givens`, `.worksheet`, `.drawing_error`, `.core`, `.draw`, `.i18n`,
+`model.lettering`, `.pdf`, `.symbols`, `kinetostat._io`. Never matplotlib, never the harness, nor `kinetostat.variants` (the variant
 is passed in and says its task, title and letters).
 """
 from __future__ import annotations
@@ -44,6 +44,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .._io import write_bytes, write_text
+from .core import UNMEASURED
 from .draw import scale_text, scales_of, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 from .pdf import ASCENT, Canvas
@@ -276,7 +277,7 @@ def _segments_table(plans, lang: str, answers: set[str]) -> Table:
         plan = plans[kind]
         for s in plan.segments:
             length = plan.length_mm(s.name)
-            if s.kind in ("position", "line") or not math.isfinite(length):
+            if s.kind in UNMEASURED or not math.isfinite(length):
                 continue
             value = "" if not math.isfinite(s.value) else f"{num(s.value, lang, 4)} {unit(s.unit, lang)}".strip()
             scale = scale_text(s.scale or plan.scale, lang) if s.unit != "mm" else ""    # an arm kept as drawn: none

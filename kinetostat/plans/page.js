@@ -1,6 +1,6 @@
 // The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
 // sheet's arrays and the values stored as differences over the angle (deflated, 5 characters per 4 bytes), writes the sheet of
-// the angle chosen as core.py's Drawing.svg writes it, steps through the force plans, checks typed
+// the angle chosen as core.py's Drawing.svg writes it, steps through the kinematic and force plans, checks typed
 // lengths at the typed scales. No network, no library.
 "use strict";
 (async () => {
@@ -345,7 +345,8 @@
     out.dataset.plan = s.plan;
     out.dataset.segment = s.segment || "";
     out.dataset.path = s.path || "";
-    out.textContent = `${step + 1}/${meta.steps.length}`;
+    out.dataset.n = s.n || "";                       // the step's number on its sheet: (n)
+    out.textContent = (s.n ? `(${s.n}) ` : "") + `${step + 1}/${meta.steps.length}`;
     const mm = el && el.dataset.lengthMm !== undefined ? +el.dataset.lengthMm : NaN;
     const len = isFinite(mm) ? ` — ${local(mm, 4)} ${D.mm}` + (mm < D.tiny ? `: ${D.ui.negligible}` : "") : "";
     $("equation").textContent = s.eq + (s.moment ? ": " + momentText(s.plan, s.moment) : "") + len;

@@ -59,7 +59,7 @@ import numpy as np
 
 from .._io import write_text
 from .._text import script_json
-from .core import ELEMENTS, PAGE_DECIMALS, Drawing
+from .core import ELEMENTS, PAGE_DECIMALS, UNMEASURED, Drawing
 from .draw import TINY_MM, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 
@@ -411,18 +411,21 @@ def _moment(plan, M: str, names, couples=(), unknown: str | None = None) -> dict
 
 
 def _steps(mech, res, plans, lang: str) -> list[dict]:
-    """The force analysis in the texts' order, one vector a step: per Assur group from the last
+    """The analysis in the texts' order, one element a step: the velocity and the acceleration
+    plans' construction (`Plan.steps`: the known vectors, the lines of known direction, their
+    intersection), then the force analysis: per Assur group from the last
     attached, the unknowns found from moment equations (a dyad's R^τ from ΣM about the inner
     joint, its terms R^τ·l + Σ±F·h ± M_i/μ_l = 0; a triad's R^τ of each leash about its inner pin,
     then R^n of the leash whose axis is off Assur's point S from the group's moment about S), the
     polygon's sides in the order drawn, the inner reactions; then the initial link's loads and M_bal (M_bal + μ_l Σ±F·h =
     0); then the lever's loads and F'_bal·pa + Σ±F·h = 0. A step with "moment" has its equation's
     terms written by the page's script from the sheet of the angle shown. `res`: the analysis at
-    the angle of `plans` (one angle)."""
+    the angle of `plans` (one angle). A step of a plan's `steps` has "n", its number on the sheet."""
     from .forces import _carried, _group_label, _later, _moment_equations, link_couples, link_loads, reaction_name
     from ..model.lettering import lettering
     L = lettering(mech)
-    out = []
+    out = [_construction_step(plans[kind], name, k, lang) for kind in ("velocity", "acceleration") if kind in plans
+           for k, name in enumerate(plans[kind].steps, 1)]
     for g in reversed(mech.structure.groups):
         label = _group_label(g)
         forces, group = plans.get(f"forces:{label}"), plans.get(f"group:{label}")
@@ -455,10 +458,13 @@ def _steps(mech, res, plans, lang: str) -> list[dict]:
                                              [c for x in on for c in couples[x]], unknown=R)
                 out.append(step)
         m = len(forces.equation)
-        for n, name in enumerate(forces.equation):
-            out.append({"plan": f"forces:{label}", "segment": name,
-                        "eq": text("page.side", lang, sum=" + ".join(forces.equation[:n + 1]) + (" = 0" if n + 1 == m else " + …"),
-                                  n=n + 1, m=m)})
+        for k, name in enumerate(forces.steps, 1):
+            if name in forces.equation:
+                n = forces.equation.index(name) + 1
+                eq = text("page.side", lang, sum=" + ".join(forces.equation[:n]) + (" = 0" if n == m else " + …"), n=n, m=m)
+                out.append({"plan": f"forces:{label}", "segment": name, "n": k, "eq": eq})
+            else:
+                out.append(_construction_step(forces, name, k, lang))
         for inner, k in inners:
             out.append({"plan": f"forces:{label}", "segment": inner, "eq": text("page.inner", lang, R=inner, k=k)})
     crank = plans.get("crank")
@@ -477,6 +483,20 @@ def _steps(mech, res, plans, lang: str) -> list[dict]:
         out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang)),
                     "moment": _moment(lever, "p", vectors, unknown=L.lever(L.F_bal))})
     return out
+
+
+def _construction_step(plan, name: str, n: int, lang: str) -> dict:
+    """Step `n` of a plan's construction (`Plan.steps`): a known vector, a line of known direction
+    through its known point, the intersection that fixes a point."""
+    s = plan.segment(name)
+    where = title_of(plan, lang).split(",")[0]
+    if s.kind == "construction":
+        eq = text("page.line", lang, plan=where, P=s.start, V=name[5:])
+    elif s.kind == "intersection":
+        eq = text("page.point", lang, plan=where, P=s.start)
+    else:
+        eq = text("page.vector", lang, plan=where, V=name)
+    return {"plan": plan.kind, "segment": name, "n": n, "eq": eq}
 
 
 def _bands(mech, res, plans, fixed) -> tuple[dict[tuple[str, str], tuple[float, float]], dict[str, tuple[float, float]]]:
@@ -601,7 +621,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     items, keys = [], []                      # keys: each item's scale (its input's name, value, unit)
     for kind, plan in check.items():
         for s in plan.segments:
-            if s.kind in ("position", "line") or not math.isfinite(plan.length_mm(s.name)):
+            if s.kind in UNMEASURED or not math.isfinite(plan.length_mm(s.name)):
                 continue
             lo_hi = bands.get((kind, s.name))
             mu, mu_name = _check_scale(kind, plan, s, fixed.base, lang)
