@@ -32,12 +32,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
-from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
+from .core import ELEMENTS, ROLES, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle, role_of
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, label_parts, text_width
 
-__all__ = ["drawing", "svg", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
-           "ROOM_MM"]
+__all__ = ["drawing", "svg", "figure", "title_of", "scale_text", "scales_of", "fits", "style", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
+           "ROOM_MM", "S_MM", "WEIGHT_MM"]
 
 #: The sheet: A3 landscape, mm.
 SHEET_MM = (420.0, 297.0)
@@ -70,12 +70,33 @@ def fits(plan: Plan) -> float:
     return min(max((x1 - x0) / w, (y1 - y0) / h) for w, h in ROOM_MM)
 
 
-#: How each kind of segment is drawn: stroke width (mm), dash pattern, colour.
-_STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
-          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33"),
-          "alternative": (0.35, "3,1.5", "#000"), "extension": (0.35, "3,1.5", "#000")}
+#: The solid thick main line of ГОСТ 2.303 (which allows S = 0.5-1.4 mm), mm.
+S_MM = 0.7
+#: A segment's line weight by its role (`core.role_of`), mm. The rule, after ГОСТ 2.303 (a solid
+#: thick main line S; thin lines, solid, dashed or dash-dotted, S/3-S/2) and seed 002 § 1.2 (a
+#: plan is drawn from the known vectors, the unknowns fixed by lines of known direction through
+#: the known points, the whole reaction the sum of its parts, figs 1.7-1.10): what a plan is drawn
+#: to find (a result: p-b, π-b, R12, R43, R32, F_зр) and the mechanism's links at S; what is laid
+#: off from the data (a given: p-a, G2, F_i2, F_p) at S/1.4 = 0.5 mm, the next pen of the
+#: drafting series 0.25-0.35-0.5-0.7, so that the result reads first; the parts of a vector sum
+#: (a component: a-b, a^n_BA, a^t_BA, R12n, R12t) at S/2; the lines of known direction (kinds
+#: "line", "construction") and the auxiliary lines (the other positions, arms, a link drawn on)
+#: at 0.25 mm, about S/3.
+WEIGHT_MM = {"result": S_MM, "link": S_MM, "given": 0.5, "component": S_MM / 2, "construction": 0.25,
+             "auxiliary": 0.25}
+#: How each kind of segment is drawn besides its weight: dash pattern, colour.
+_STYLE = {"vector": ("", "#000"), "link": ("", "#000"), "position": ("", "#555"),
+          "line": ("2,1.2", "#555"), "arm": ("4,1,1,1", "#a33"),
+          "alternative": ("3,1.5", "#000"), "extension": ("3,1.5", "#000")}
 #: The kinds drawn as arrows: a vector, and one drawn as the alternative of others (F_i2(h), dashed).
 _ARROWS = ("vector", "alternative")
+
+
+def style(s: Segment) -> tuple[float, str, str]:
+    """How segment s is drawn: stroke width (mm, by its role: `WEIGHT_MM`), dash pattern, colour
+    (by its kind: a kind not listed as a line)."""
+    dash, colour = _STYLE.get(s.kind, _STYLE["line"])
+    return WEIGHT_MM[role_of(s)], dash, colour
 
 
 def _lang(lang: str) -> int:
@@ -317,11 +338,52 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
     return out
 
 
+#: The legend's sample stroke and the gaps after it and after its words, mm.
+_SAMPLE_MM, _SAMPLE_GAP, _ENTRY_GAP = 7.0, 1.2, 3.5
+
+
+def _legend(cycle: PlanCycle, lang: str) -> tuple[list[str], tuple[float, float, float, float]]:
+    """The sheet's legend of line weights (`WEIGHT_MM`): a sample stroke of each role drawn on the
+    sheet, in the width of that role and the dash and colour of its first segment, with the
+    role's name and width, in rows at the frame's bottom left beside the title block: its SVG and
+    its box (x0, y0, x1, y1), mm (its top y0: the notes go above it)."""
+    first = {}
+    for s in cycle.segments:
+        if cycle.drawn(s).any():
+            first.setdefault(role_of(s), s)
+    x0, x1 = _FRAME[0] + 3, _TITLE_BLOCK[0] - 3
+    head = text("legend.lines", lang)
+    entries = [(first[r], f"{text(f'role.{r}', lang)} {num(WEIGHT_MM[r], lang, decimals=2)}") for r in ROLES if r in first]
+    rows, x, row = [], x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP, 0
+    for seg, words in entries:
+        w = _SAMPLE_MM + _SAMPLE_GAP + text_width(words, _NOTE_MM)
+        if x + w > x1 and x > x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP:
+            x, row = x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP, row + 1
+        rows.append((seg, words, x, row))
+        x += w + _ENTRY_GAP
+    n_rows = row + 1 if entries else 0
+    if not n_rows:
+        return [], (x0, _FRAME[3] - 1.5, x0, _FRAME[3] - 1.5)
+    y0 = _FRAME[3] - 1.5 - _LINE_STEP * n_rows
+    base = y0 + ASCENT * _NOTE_MM
+    out = ['<g id="legend">', _t(x0, base, head, _NOTE_MM)]
+    for seg, words, x, row in rows:
+        width, dash, colour = style(seg)
+        y = base + _LINE_STEP * row
+        dashed = f' stroke-dasharray="{dash}"' if dash else ""
+        out.append(f'<line class="legend" data-role="{role_of(seg)}" x1="{x:.2f}" y1="{y - 0.9:.2f}" '
+                   f'x2="{x + _SAMPLE_MM:.2f}" y2="{y - 0.9:.2f}" stroke="{colour}" stroke-width="{width}"{dashed}/>')
+        out.append(_t(x + _SAMPLE_MM + _SAMPLE_GAP, y, words, _NOTE_MM))
+    out.append("</g>")
+    right = max(x + _SAMPLE_MM + _SAMPLE_GAP + text_width(words, _NOTE_MM) for _, words, x, _ in rows)
+    return out, (x0, y0, right, _FRAME[3] - 1.5)
+
+
 def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit: bool = False,
-                 draw: bool = True) -> tuple[list[str], tuple[float, float, float, float]]:
+                 draw: bool = True, bottom: float = _FRAME[3] - 1.5) -> tuple[list[str], tuple[float, float, float, float]]:
     """SVG of the notes (none where not `draw`) and the drawing area they leave: below the plan
-    (bottom left, from the frame's bottom up, beside the title block) or, for a tall plan, in a
-    column at its left."""
+    (bottom left, from `bottom` up (the legend's top), beside the title block) or, for a tall
+    plan, in a column at its left."""
     x0 = _FRAME[0] + 3
     width = _LEFT_NOTES_MM if left else _TITLE_BLOCK[0] - 3 - x0
     lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
@@ -332,7 +394,7 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     cols = 1 if left or not rows else max(1, int(width // col_w))
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
-    top = _AREA[1] if left else _FRAME[3] - 1.5 - height
+    top = _AREA[1] if left else bottom - height
     out = []
     if draw:
         out.append('<g id="notes">')
@@ -344,23 +406,23 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
             out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
         out.append("</g>")
     if left:
-        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None
+        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < bottom else None
     return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0))
 
 
 def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float, float, float],
-            draw: bool = True) -> tuple[list[str], tuple[float, float, float, float]]:
+            draw: bool = True, bottom: float = _FRAME[3] - 1.5) -> tuple[list[str], tuple[float, float, float, float]]:
     """The notes of `plan` (SVG where `draw`) and the drawing area for a drawing of extent `box`:
     notes below where it fits above them, else in a column at its left where it fits beside them,
     else below with a note that it does not fit (fitting: with MIN_DRAWN_MM to spare on every
     side, for a vector drawn out of scale)."""
     x0, y0, x1, y1 = box
     for left in (False, True):
-        notes, area = _notes_block(plan, lang, tiny, left, draw=draw)
+        notes, area = _notes_block(plan, lang, tiny, left, draw=draw, bottom=bottom)
         if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
                 and y1 - y0 + 2 * MIN_DRAWN_MM <= area[3] - area[1]:      # room for a vector drawn out of scale
             return notes, area
-    return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw)
+    return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw, bottom=bottom)
 
 
 def _variants(strings: list[str]) -> tuple[list[str], np.ndarray]:
@@ -539,7 +601,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) & cycle.drawn(s)
         if not ok.any():
             continue
-        width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
+        width, dash, colour = style(s)
         label = escape(segment_label(s, lang))
         Lz = np.abs(zb - za)
         L = Lz.copy()
@@ -637,7 +699,8 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
         + sum((v != _AS_IS).astype(int) for v in tiny.values())
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
     plan = cycle.at(i)
-    block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, _tiny_at(tiny, i), box, draw=notes)
+    legend, key = _legend(cycle, lang)
+    block, (ax0, ay0, ax1, ay1) = _layout(plan, lang, _tiny_at(tiny, i), box, draw=notes, bottom=key[1])
     x0, y0, x1, y1 = box
     tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
@@ -646,6 +709,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
 
     placer = Placer(cycle.n, (ax0 - 4.0, _FRAME[1] + 1, _FRAME[2] - 1, min(ay1 + 4.0, _TITLE_BLOCK[1]) - 0.5))
     placer.block(_TITLE_BLOCK)
+    placer.block(key)
     names: list[_Name] = []
     elements = _paths(cycle, lang, contract, at, placer, names)
     elements += _segments(cycle, lang, contract, at, tiny, placer, names)
@@ -666,7 +730,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
               f'stroke="#000" stroke-width="0.5"/>',
               f'<line x1="{x0}" y1="{y0 + 12}" x2="{x1}" y2="{y0 + 12}" stroke="#000" stroke-width="0.25"/>',
               f'<line x1="{x0}" y1="{y0 + 24}" x2="{x1}" y2="{y0 + 24}" stroke="#000" stroke-width="0.25"/>',
-              *(t.svg(0) for t in title if len(t.texts) == 1), "</g>", *block, "</svg>"]
+              *(t.svg(0) for t in title if len(t.texts) == 1), "</g>", *legend, *block, "</svg>"]
     return Drawing(cycle.kind, cycle.phi_deg, "\n".join(static) + "\n",
                    tuple(t for t in title if len(t.texts) > 1) + tuple(elements))
 
@@ -720,7 +784,7 @@ def figure(plan: Plan, lang: str = "en", ax=None):
         ax.plot([z.real for z in zs], [z.imag for z in zs], color="#1f5fa8", lw=0.8)
     for s in _drawable(plan):
         a, b = plan.points[s.start], plan.points[s.end]
-        width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
+        width, dash, colour = style(s)
         if s.kind in _ARROWS:
             if abs(b - a) >= 0.05:
                 ax.annotate("", xy=(b.real, b.imag), xytext=(a.real, a.imag),

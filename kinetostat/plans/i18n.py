@@ -80,6 +80,13 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "legend.mechanism": ("ω: angular velocity, ε: angular acceleration (senses); S: centres of mass",
                          "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
+    "legend.lines": ("lines (GOST 2.303), mm:", "лінії (ГОСТ 2.303), мм:", "линии (ГОСТ 2.303), мм:"),
+    "role.result": ("result", "результат", "результат"),
+    "role.link": ("link", "ланка", "звено"),
+    "role.given": ("given", "задана", "заданная"),
+    "role.component": ("component", "складова", "составляющая"),
+    "role.construction": ("construction", "побудова", "построение"),
+    "role.auxiliary": ("auxiliary", "допоміжна", "вспомогательная"),
     "guide": ("guide", "напрямна", "направляющая"),
     "slot": ("slot of link {k} ({P})", "паз ланки {k} ({P})", "паз звена {k} ({P})"),
     "coriolis": ("Cor", "к", "к"),          # the superscript of the Coriolis acceleration: a^Cor, a^к
