@@ -80,7 +80,7 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "legend.mechanism": ("ω: angular velocity, ε: angular acceleration (senses); S: centres of mass",
                          "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
-    "legend.lines": ("lines (GOST 2.303), mm:", "лінії (ГОСТ 2.303), мм:", "линии (ГОСТ 2.303), мм:"),
+    "legend.lines": ("line widths, mm:", "товщина ліній, мм:", "толщина линий, мм:"),
     "role.result": ("result", "результат", "результат"),
     "role.link": ("link", "ланка", "звено"),
     "role.given": ("given", "задана", "заданная"),
