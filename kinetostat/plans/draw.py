@@ -11,8 +11,9 @@ angle i; `svg(plan)`, the sheet of one angle, is `drawing` of the cycle of one, 
 its notes.
 
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
-results (vectors, the design position) thick, construction thin, an alternative (F_i2(h)) and a
-link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a
+each segment as heavy as its role (`WEIGHT_MM`, after ГОСТ 2.303: results and links at S = 0.7 mm,
+givens 0.5, components S/2, construction 0.25), with a legend of the strokes at the bottom left of
+each sheet; an alternative (F_i2(h)) and a link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a
 vector shorter than 1 mm at its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a
 polygon whose sides must close, lettered at its point and noted as negligible; every letter placed by `labels.Placer`
 (for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
