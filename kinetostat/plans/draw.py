@@ -355,11 +355,12 @@ def _legend(cycle: PlanCycle, lang: str) -> tuple[list[str], tuple[float, float,
     x0, x1 = _FRAME[0] + 3, _TITLE_BLOCK[0] - 3
     head = text("legend.lines", lang)
     entries = [(first[r], f"{text(f'role.{r}', lang)} {num(WEIGHT_MM[r], lang, decimals=2)}") for r in ROLES if r in first]
-    rows, x, row = [], x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP, 0
+    start = x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP             # each row's first entry: after the head
+    rows, x, row = [], start, 0
     for seg, words in entries:
         w = _SAMPLE_MM + _SAMPLE_GAP + text_width(words, _NOTE_MM)
-        if x + w > x1 and x > x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP:
-            x, row = x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP, row + 1
+        if x + w > x1 and x > start:
+            x, row = start, row + 1
         rows.append((seg, words, x, row))
         x += w + _ENTRY_GAP
     n_rows = row + 1 if entries else 0
