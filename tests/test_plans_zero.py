@@ -109,7 +109,7 @@ def test_F_i2h_is_drawn_as_the_alternative_with_a_note():
     assert plan.length_mm("z_2") * MU_L.value == pytest.approx(abs(il.moment[0]) / math.hypot(*il.force[0]), rel=1e-9)
     assert "F_i2(h) (dashed) replaces F_i2 and M_i2: one or the other acts, not both" in plan.notes
     page = svg(plan, lang="uk")
-    assert re.search(r'<line [^>]*stroke-width="0.35" stroke-dasharray="3,1.5"><title>F_i2\(h\)</title>', page)
+    assert re.search(r'<line [^>]*stroke-width="0.5" stroke-dasharray="3,1.5"><title>F_i2\(h\)</title>', page)
     assert "Fi2(h) (штрихова) замінює Fi2 і Mi2" in _notes(page)
 
 

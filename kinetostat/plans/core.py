@@ -13,14 +13,14 @@ May use: numpy and the standard library. Never matplotlib at import time, never 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Mapping
 
 import numpy as np
 
-__all__ = ["Scale", "Segment", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS", "extent",
-           "extent_cycle", "ELEMENTS", "fixed", "construction", "UNMEASURED"]
+__all__ = ["Scale", "Segment", "ROLES", "role_of", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS",
+           "extent", "extent_cycle", "ELEMENTS", "fixed", "construction", "UNMEASURED"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -52,7 +52,8 @@ class Segment:
     thin past both), "intersection" (the mark at `start` = `end` where construction lines meet),
     "alternative" (an arrow that replaces others
     drawn: F_i2(h) for F_i2 and M_i2, dashed), "extension" (a link's line drawn on, dashed, to a
-    force acting off it). A segment whose quantity is not at the plan's
+    force acting off it). `role` says how heavy it is drawn (`ROLES`, `role_of`): "" takes
+    its kind's (`KIND_ROLES`). A segment whose quantity is not at the plan's
     scale (a link of a lever, a path) has `value` NaN and unit "", unless it names its own `scale`
     (a force drawn on a group plan: |value| = drawn length x segment.scale).
     """
@@ -64,7 +65,30 @@ class Segment:
     kind: str = "vector"
     scale: Scale | None = None   # a segment drawn at another scale than its plan's (the loads on a
                                  # group plan, at a force scale); None: the plan's scale
+    role: str = ""               # one of ROLES, or "": its kind's (KIND_ROLES)
     # In a PlanCycle, `value` is an (N,) array over its angles.
+
+    def __post_init__(self) -> None:
+        if self.role and self.role not in ROLES:
+            raise ValueError(f"segment {self.name!r}: role {self.role!r} is none of {', '.join(ROLES)}")
+
+
+#: A segment's role on its sheet, which sets its line weight (`draw.WEIGHT_MM`): "given" (known
+#: before the plan is drawn: a load, the driving link's velocity or acceleration), "component" (a
+#: part of a vector sum: a relative velocity, a normal, tangential or Coriolis part, R12n, R12t),
+#: "result" (what the plan is drawn to find: an absolute velocity or acceleration, a whole
+#: reaction, the balancing force), "construction" (a line of known direction), "link" (a link of
+#: the mechanism, of the lever), "auxiliary" (the other positions, arms, a link drawn on).
+ROLES = ("result", "link", "given", "component", "construction", "auxiliary")
+#: The role of a segment that states none, by its kind (a vector: a given, unless its plan says).
+KIND_ROLES = {"vector": "given", "alternative": "given", "link": "link", "line": "construction",
+              "construction": "construction", "intersection": "construction", "position": "auxiliary", "arm": "auxiliary",
+              "dimension": "auxiliary", "extension": "auxiliary"}
+
+
+def role_of(s: Segment) -> str:
+    """The segment's role (`ROLES`): its own, else its kind's (auxiliary for a kind not listed)."""
+    return s.role or KIND_ROLES.get(s.kind, "auxiliary")
 
 
 #: Kinds of segment no one measures: a position's link, a line, a construction line, a mark.
@@ -232,8 +256,7 @@ class PlanCycle:
         acc = None if plan.accuracy is None else (np.array([plan.accuracy[0]]), plan.accuracy[1])
         return cls(plan.kind, (plan.title,), plan.scale, np.array([plan.phi_deg]),
                    {k: np.array([v]) for k, v in plan.points.items()},
-                   tuple(Segment(s.name, s.start, s.end, np.array([s.value], dtype=float), s.unit, s.kind, s.scale)
-                         for s in plan.segments),
+                   tuple(replace(s, value=np.array([s.value], dtype=float)) for s in plan.segments),
                    {k: np.array([v], dtype=complex) for k, v in plan.paths.items()},
                    (plan.notes,), tuple(Result(r.symbol, np.array([r.value]), r.unit, r.how) for r in plan.results),
                    plan.equation, acc, plan.steps)
@@ -254,8 +277,7 @@ class PlanCycle:
             acc = (float(self.accuracy[0][i]), self.accuracy[1])
         return Plan(self.kind, self.titles[i], self.scale, float(self.phi_deg[i]),
                     {k: complex(v[i]) for k, v in self.points.items()},
-                    tuple(Segment(s.name, s.start, s.end, _one(s.value, i), s.unit, s.kind, s.scale)
-                          for s in self.segments if self.drawn(s)[i]),
+                    tuple(replace(s, value=_one(s.value, i)) for s in self.segments if self.drawn(s)[i]),
                     {k: tuple(map(complex, v[i if len(v) > 1 else 0])) for k, v in self.paths.items()},
                     self.notes[i] if self.notes else (),
                     tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how if isinstance(r.how, str) else r.how[i])

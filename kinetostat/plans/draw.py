@@ -11,8 +11,9 @@ angle i; `sheet(plan)`, the sheet of one angle, is `drawing` of the cycle of one
 notes, and `svg(plan)` that sheet written.
 
 Drafting as the texts draw: arrowheads 3.5 mm long (shorter on short vectors), drawn as paths;
-results (vectors, the design position) thick, construction thin, an alternative (F_i2(h)) and a
-link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a
+each segment as heavy as its role (`WEIGHT_MM`, after ГОСТ 2.303: results and links at S = 0.7 mm,
+givens 0.5, components S/2, construction 0.25), with a legend of the strokes at the bottom left of
+each sheet; an alternative (F_i2(h)) and a link drawn on to a force off it dashed; a plan's notes with their symbols lettered as drawn; a
 vector shorter than 1 mm at its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a
 polygon whose sides must close, lettered at its point and noted as negligible; the lever's arms as
 dimension lines with their mm (`_dimensions`); every letter placed by `labels.Placer`
@@ -34,15 +35,15 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
-from .core import ELEMENTS, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle
+from .core import ELEMENTS, ROLES, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle, role_of
 from .forces import arm_name
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
 from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, markup, text_width
 from .symbols import SUB, mark, plain, runs, text_runs
 from ..model.lettering import in_lang
 
-__all__ = ["drawing", "sheet", "svg", "language_part", "figure", "title_of", "scale_text", "scales_of", "fits", "LANGS", "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM",
-           "ROOM_MM"]
+__all__ = ["drawing", "sheet", "svg", "language_part", "figure", "title_of", "scale_text", "scales_of", "fits", "style", "LANGS",
+           "SHEET_MM", "MIN_DRAWN_MM", "ARROW_MM", "ARC_HEAD_MM", "ROOM_MM", "S_MM", "WEIGHT_MM"]
 
 #: The sheet: A3 landscape, mm.
 SHEET_MM = (420.0, 297.0)
@@ -80,11 +81,25 @@ def fits(plan: Plan) -> float:
     return min(max((x1 - x0) / w, (y1 - y0) / h) for w, h in ROOM_MM)
 
 
-#: How each kind of segment is drawn: stroke width (mm), dash pattern, colour.
-_STYLE = {"vector": (0.5, "", "#000"), "link": (0.7, "", "#000"), "position": (0.25, "", "#555"),
-          "line": (0.25, "2,1.2", "#555"), "arm": (0.25, "4,1,1,1", "#a33"), "dimension": (0.25, "", "#a33"),
-          "alternative": (0.35, "3,1.5", "#000"), "extension": (0.35, "3,1.5", "#000")}
-_STYLE["construction"] = _STYLE["intersection"] = (0.25, "", "#000")     # ГОСТ 2.303's thin solid line
+#: The solid thick main line of ГОСТ 2.303 (which allows S = 0.5-1.4 mm), mm.
+S_MM = 0.7
+#: A segment's line weight by its role (`core.role_of`), mm. The rule, after ГОСТ 2.303 (a solid
+#: thick main line S; thin lines, solid, dashed or dash-dotted, S/3-S/2) and seed 002 § 1.2 (a
+#: plan is drawn from the known vectors, the unknowns fixed by lines of known direction through
+#: the known points, the whole reaction the sum of its parts, figs 1.7-1.10): what a plan is drawn
+#: to find (a result: p-b, π-b, R12, R43, R32, F_зр) and the mechanism's links at S; what is laid
+#: off from the data (a given: p-a, G2, F_i2, F_p) at S/1.4 = 0.5 mm, the next pen of the
+#: drafting series 0.25-0.35-0.5-0.7, so that the result reads first; the parts of a vector sum
+#: (a component: a-b, a^n_BA, a^t_BA, R12n, R12t) at S/2; the lines of known direction (kinds
+#: "line", "construction") and the auxiliary lines (the other positions, arms, a link drawn on)
+#: at 0.25 mm, about S/3.
+WEIGHT_MM = {"result": S_MM, "link": S_MM, "given": 0.5, "component": S_MM / 2, "construction": 0.25,
+             "auxiliary": 0.25}
+#: How each kind of segment is drawn besides its weight: dash pattern, colour.
+_STYLE = {"vector": ("", "#000"), "link": ("", "#000"), "position": ("", "#555"),
+          "line": ("2,1.2", "#555"), "arm": ("4,1,1,1", "#a33"),
+          "alternative": ("3,1.5", "#000"), "extension": ("3,1.5", "#000"), "dimension": ("", "#a33"),
+          "construction": ("", "#000"), "intersection": ("", "#000")}
 #: The kinds drawn as arrows: a vector, and one drawn as the alternative of others (F_i2(h), dashed).
 _ARROWS = ("vector", "alternative")
 #: A dimension line's arrowheads (the lever's arms), mm: the drafting size of a thin line's arrow.
@@ -95,7 +110,14 @@ _DIMENSION_MARKER = (f'<defs><marker id="dimension" markerUnits="userSpaceOnUse"
                      f'markerWidth="{DIMENSION_ARROW_MM:g}" markerHeight="{2 * _DIM_HALF:g}" '
                      f'viewBox="0 0 {DIMENSION_ARROW_MM:g} {2 * _DIM_HALF:g}" refX="{DIMENSION_ARROW_MM:g}" '
                      f'refY="{_DIM_HALF:g}"><path d="M{DIMENSION_ARROW_MM:g},{_DIM_HALF:g} L0,0 L0,{2 * _DIM_HALF:g} z" '
-                     f'fill="{_STYLE["dimension"][2]}"/></marker></defs>')
+                     f'fill="{_STYLE["dimension"][1]}"/></marker></defs>')
+
+
+def style(s: Segment) -> tuple[float, str, str]:
+    """How segment s is drawn: stroke width (mm, by its role: `WEIGHT_MM`), dash pattern, colour
+    (by its kind: a kind not listed as a line)."""
+    dash, colour = _STYLE.get(s.kind, _STYLE["line"])
+    return WEIGHT_MM[role_of(s)], dash, colour
 
 
 def _lang(lang: str) -> int:
@@ -325,11 +347,54 @@ def _table_rows(plan: Plan, lang: str) -> list[str]:
     return out
 
 
+#: The legend's sample stroke and the gaps after it and after its words, mm.
+_SAMPLE_MM, _SAMPLE_GAP, _ENTRY_GAP = 7.0, 1.2, 3.5
+
+
+def _legend(cycle: PlanCycle, lang: str) -> tuple[list[str], tuple[float, float, float, float]]:
+    """The sheet's legend of line weights (`WEIGHT_MM`): a sample stroke of each role drawn on the
+    sheet, in the width of that role and the dash and colour of its first segment, with the
+    role's name and width, in rows at the frame's bottom left beside the title block: its SVG and
+    its box (x0, y0, x1, y1), mm (its top y0: the notes go above it)."""
+    first = {}
+    for s in cycle.segments:
+        if cycle.drawn(s).any():
+            first.setdefault(role_of(s), s)
+    x0, x1 = _FRAME[0] + 3, _TITLE_BLOCK[0] - 3
+    head = text("legend.lines", lang)
+    entries = [(first[r], f"{text(f'role.{r}', lang)} {num(WEIGHT_MM[r], lang, decimals=2)}") for r in ROLES if r in first]
+    start = x0 + text_width(head, _NOTE_MM) + _ENTRY_GAP             # each row's first entry: after the head
+    rows, x, row = [], start, 0
+    for seg, words in entries:
+        w = _SAMPLE_MM + _SAMPLE_GAP + text_width(words, _NOTE_MM)
+        if x + w > x1 and x > start:
+            x, row = start, row + 1
+        rows.append((seg, words, x, row))
+        x += w + _ENTRY_GAP
+    n_rows = row + 1 if entries else 0
+    if not n_rows:
+        return [], (x0, _FRAME[3] - 1.5, x0, _FRAME[3] - 1.5)
+    y0 = _FRAME[3] - 1.5 - _LINE_STEP * n_rows
+    base = y0 + ASCENT * _NOTE_MM
+    out = [f'<g id="legend" class="note" font-size="{_NOTE_MM:.2f}"><text x="{x0:.1f}" y="{base:.1f}">{escape(head)}</text>']
+    for seg, words, x, row in rows:
+        width, dash, colour = style(seg)
+        y = base + _LINE_STEP * row
+        dashed = f' stroke-dasharray="{dash}"' if dash else ""
+        out.append(f'<line data-role="{role_of(seg)}" x1="{x:.1f}" y1="{y - 0.9:.1f}" x2="{x + _SAMPLE_MM:.1f}" '
+                   f'y2="{y - 0.9:.1f}" stroke="{colour}" stroke-width="{width}"{dashed}/>'
+                   f'<text x="{x + _SAMPLE_MM + _SAMPLE_GAP:.1f}" y="{y:.1f}">{escape(words)}</text>')
+    out.append("</g>")
+    right = max(x + _SAMPLE_MM + _SAMPLE_GAP + text_width(words, _NOTE_MM) for _, words, x, _ in rows)
+    return out, (x0, y0, right, _FRAME[3] - 1.5)
+
+
 def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit: bool = False,
-                 draw: bool = True) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
+                 draw: bool = True, bottom: float = _FRAME[3] - 1.5
+                 ) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
     """SVG of the notes (none where not `draw`), the drawing area they leave: below the plan
-    (bottom left, from the frame's bottom up, beside the title block) or, for a tall plan, in a
-    column at its left, and where the notes' lines go (x, first baseline, width; mm)."""
+    (bottom left, from `bottom` up (the legend's top), beside the title block) or, for a tall
+    plan, in a column at its left, and where the notes' lines go (x, first baseline, width; mm)."""
     x0 = _FRAME[0] + 3
     width = _LEFT_NOTES_MM if left else _TITLE_BLOCK[0] - 3 - x0
     lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
@@ -340,7 +405,7 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     cols = 1 if left or not rows else max(1, int(width // col_w))
     per_col = -(-len(rows) // cols) if rows else 0
     height = _LINE_STEP * (len(lines) + per_col)
-    top = _AREA[1] if left else _FRAME[3] - 1.5 - height
+    top = _AREA[1] if left else bottom - height
     out, where = [], (x0, top + ASCENT * _NOTE_MM, width)
     if draw:
         out.append('<g id="notes">')
@@ -352,36 +417,37 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
             out.append(_t(x0 + col_w * (k // per_col), y + _LINE_STEP * (k % per_col), r, _NOTE_MM))
         out.append("</g>")
     if left:
-        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < _FRAME[3] else None, where
+        return out, (x0 + width + 4.0, _AREA[1], _AREA[2], _AREA[3]) if top + height < bottom else None, where
     return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0)), where
 
 
 def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float, float, float],
-            draw: bool = True) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
-    """The notes of `plan` (SVG where `draw`), the drawing area for a drawing of extent `box` and
-    where the notes' lines go (`_notes_block`):
+            draw: bool = True, bottom: float = _FRAME[3] - 1.5
+            ) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
+    """The notes of `plan` (SVG where `draw`, above `bottom`), the drawing area for a drawing of
+    extent `box` and where the notes' lines go (`_notes_block`):
     notes below where it fits above them, else in a column at its left where it fits beside them,
     else below with a note that it does not fit (fitting: with MIN_DRAWN_MM to spare on every
     side, for a vector drawn out of scale)."""
     x0, y0, x1, y1 = box
     for left in (False, True):
-        notes, area, where = _notes_block(plan, lang, tiny, left, draw=draw)
+        notes, area, where = _notes_block(plan, lang, tiny, left, draw=draw, bottom=bottom)
         if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
                 and y1 - y0 + 2 * MIN_DRAWN_MM <= area[3] - area[1]:      # room for a vector drawn out of scale
             return notes, area, where
-    return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw)
+    return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw, bottom=bottom)
 
 
 def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
-                 where: tuple[float, float, float]) -> list[Element]:
+                 where: tuple[float, float, float], bottom: float) -> list[Element]:
     """The notes of every angle (`_note_lines` without amounts: the results and the tiny vectors'
     numbers change with every angle, the page's values table holds them) as lines of text at
-    `where` (x, first baseline, width; `_notes_block`), as many as fit above the frame's bottom:
+    `where` (x, first baseline, width; `_notes_block`), as many as fit above `bottom` (the legend's top):
     line k shows the k-th line of each angle's notes where it has one (its texts once, an index
     per angle). Each distinct make-up of notes (the plan's notes, tiny vectors, accuracy,
     equation) read and wrapped once, of the plan cut to its tiny vectors."""
     x, y, width = where
-    room = int((_FRAME[3] - 1.5 - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
+    room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
     segments = tuple(s for s in cycle.segments if s.name in tiny)       # all of its drawing the notes read
     light = replace(cycle, points={k: cycle.points[k] for s in segments for k in (s.start, s.end)},
                     segments=segments, paths={}, results=())
@@ -590,7 +656,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1) & cycle.drawn(s)
         if not ok.any():
             continue
-        width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
+        width, dash, colour = style(s)
         label = escape(segment_label(s, lang))
         Lz = np.abs(zb - za)
         data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name)} if contract else {}
@@ -661,8 +727,8 @@ def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
     arms = [s for s in cycle.segments if _dimension(cycle, s)]
     if not arms:
         return []
-    width, dash, colour = _STYLE["dimension"]
-    ext_width, ext_dash, ext_colour = _STYLE["line"]
+    (dash, colour), width = _STYLE["dimension"], WEIGHT_MM["auxiliary"]
+    (ext_dash, ext_colour), ext_width = _STYLE["line"], WEIGHT_MM["construction"]
     forces = {arm_name(f.name): f for f in cycle.segments if f.unit == "N"}
     starts = [at(cycle.points[s.start]) for s in arms]
     ends = [at(cycle.points[s.end]) for s in arms]
@@ -763,16 +829,17 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
 
 def _room(cycle: PlanCycle, lang: str, notes: bool):
     """The notes block (SVG where `notes`, of the angle with the most lines of them), the drawing
-    area they leave and where the notes go, with what they were found from: (block, area, where,
-    tiny, extents, box)."""
+    area they leave and where the notes go, the legend of line weights (`_legend`: SVG, box), with
+    what they were found from: (block, area, where, legend, legend's box, tiny, extents, box)."""
     tiny = _tiny(cycle)
     ext = _extents(cycle)
     box = _union(ext)
     lines = np.array([len(x) for x in cycle.notes] if cycle.notes else [0] * cycle.n) \
         + sum((v != _AS_IS).astype(int) for v in tiny.values())
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
-    block, area, where = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, draw=notes)
-    return block, area, where, tiny, ext, box
+    legend, key = _legend(cycle, lang)
+    block, area, where = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, draw=notes, bottom=key[1])
+    return block, area, where, legend, key, tiny, ext, box
 
 
 def language_part(plan: Plan, lang: str) -> tuple:
@@ -789,7 +856,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where
     `notes`, the notes of every angle (`_cycle_notes`) where `cycle_notes`."""
     _lang(lang)
-    block, (ax0, ay0, ax1, ay1), where, tiny, ext, box = _room(cycle, lang, notes)
+    block, (ax0, ay0, ax1, ay1), where, legend, key, tiny, ext, box = _room(cycle, lang, notes)
     x0, y0, x1, y1 = box
     tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
@@ -798,6 +865,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
 
     placer = Placer(cycle.n, (ax0 - 4.0, _FRAME[1] + 1, _FRAME[2] - 1, min(ay1 + 4.0, _TITLE_BLOCK[1]) - 0.5))
     placer.block(_TITLE_BLOCK)
+    placer.block(key)
     names: list[_Name] = []
     elements = _paths(cycle, lang, contract, at, placer, names)
     dimensions: list[_Name] = []
@@ -807,7 +875,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     dots, points = _points(cycle, at, placer)
     elements += dots + _labels(placer, points + names)
     if cycle_notes:
-        elements += _cycle_notes(cycle, lang, tiny, where)
+        elements += _cycle_notes(cycle, lang, tiny, where, key[1])
     title = _title_block(cycle, lang, mechanism)
     W, H = SHEET_MM
     x0, y0, x1, y1 = _TITLE_BLOCK
@@ -824,7 +892,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
               f'stroke="#000" stroke-width="0.5"/>',
               f'<line x1="{x0}" y1="{y0 + 12}" x2="{x1}" y2="{y0 + 12}" stroke="#000" stroke-width="0.25"/>',
               f'<line x1="{x0}" y1="{y0 + 24}" x2="{x1}" y2="{y0 + 24}" stroke="#000" stroke-width="0.25"/>',
-              *(t.svg(0) for t in title if len(t.texts) == 1), "</g>", *block, "</svg>"]
+              *(t.svg(0) for t in title if len(t.texts) == 1), "</g>", *legend, *block, "</svg>"]
     return Drawing(cycle.kind, cycle.phi_deg, "\n".join(static) + "\n",
                    tuple(t for t in title if len(t.texts) > 1) + tuple(elements))
 
@@ -889,7 +957,7 @@ def figure(plan: Plan, lang: str = "en", ax=None):
         ax.plot([z.real for z in zs], [z.imag for z in zs], color="#1f5fa8", lw=0.8)
     for s in _drawable(plan):
         a, b = plan.points[s.start], plan.points[s.end]
-        width, dash, colour = _STYLE.get(s.kind, _STYLE["line"])
+        width, dash, colour = style(s)
         if s.kind in _ARROWS:
             if abs(b - a) >= 0.05:
                 ax.annotate("", xy=(b.real, b.imag), xytext=(a.real, a.imag),

@@ -41,7 +41,7 @@ from __future__ import annotations
 import math
 import string
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -373,13 +373,13 @@ def _foot(X: np.ndarray, F: np.ndarray, M: np.ndarray) -> np.ndarray:
 
 
 def _arrow(segs: list, pts: dict, name: str, X: np.ndarray, F: np.ndarray, mu_l: Scale, mu_F: Scale,
-           kind: str = "vector") -> None:
+           kind: str = "vector", role: str = "given") -> None:
     """A force F (N) at world point X (m), each (N,), drawn at mu_F from X/mu_l (`kind`
-    "alternative": one that replaces others drawn, dashed)."""
+    "alternative": one that replaces others drawn, dashed; `role`: `core.ROLES`, a load given)."""
     start = f"{name}:from"
     pts[start] = np.where(np.isnan(F), np.nan, _over(X, mu_l.value))      # a force NaN where it is not drawn
     pts[f"{name}:to"] = pts[start] + _over(F, mu_F.value)
-    segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", kind, mu_F))
+    segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", kind, mu_F, role))
 
 
 def _has_arm(mech: "Mechanism", F: np.ndarray, X: np.ndarray, M: np.ndarray) -> np.ndarray:
@@ -477,10 +477,10 @@ def _dyad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: S
     for o in outer:
         w = o.whole
         if o.normal is None:
-            _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_g)
+            _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_g, role="result")
         else:
-            _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_g)
-            _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_g)
+            _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_g, role="component")
+            _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_g, role="component")
     for p in (g.pairs[0], g.pairs[1], g.pairs[2]):
         if p.kind == "P":
             drawn_notes = [a + b for a, b in zip(drawn_notes, _offset(mech, res, p, pts, segs, mu_l))]
@@ -586,7 +586,7 @@ def _orders(mech: "Mechanism", res: "Analysis", g) -> list[tuple[tuple, np.ndarr
 
 def _masked(segs: list[Segment], where: np.ndarray) -> list[Segment]:
     """The segments with their values NaN off `where` (not drawn there)."""
-    return [Segment(s.name, s.start, s.end, np.where(where, s.value, np.nan), s.unit, s.kind, s.scale) for s in segs]
+    return [replace(s, value=np.where(where, s.value, np.nan)) for s in segs]
 
 
 def _merged(parts: list[tuple[np.ndarray, dict, list[Segment]]]) -> tuple[dict, list[Segment]]:
@@ -612,7 +612,7 @@ def _merged(parts: list[tuple[np.ndarray, dict, list[Segment]]]) -> tuple[dict, 
             else:
                 at = j
                 o = out[j]
-                out[j] = Segment(o.name, o.start, o.end, np.where(where, s.value, o.value), o.unit, o.kind, o.scale)
+                out[j] = replace(o, value=np.where(where, s.value, o.value))
     return pts, out
 
 
@@ -637,11 +637,11 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
     for (ell, outer, inner, _), o in zip(g.sides, parts):
         w = o.whole
         if o.normal is None:
-            _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_F)
+            _arrow(segs, pts, w.name, w.point, w.force, mu_l, mu_F, role="result")
             notes = [a + b for a, b in zip(notes, _offset(mech, res, outer, pts, segs, mu_l))]
         else:
-            _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_F)
-            _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_F)
+            _arrow(segs, pts, f"{w.name}n", w.point, o.normal, mu_l, mu_F, role="component")
+            _arrow(segs, pts, f"{w.name}t", w.point, o.tangential, mu_l, mu_F, role="component")
             X = _world(res, ell, inner.point)
             for ld in loads[ell] if inner.kind == "R" else ():
                 _arm(mech, segs, pts, arm_name(ld.name), X, inner.point, ld.point, ld.force, mu_l)
@@ -660,7 +660,7 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
                   f"forces drawn at {mu_F}", mu_l, res, pts, segs, paths, notes)
 
 
-def _triad_polygon(mech: "Mechanism", res: "Analysis", g, sides) -> tuple[list[tuple[str, np.ndarray]], list, list]:
+def _triad_polygon(mech: "Mechanism", res: "Analysis", g, sides) -> tuple[list[tuple[str, np.ndarray, str]], list, list]:
     """A triad's vector equation, its sides in the solver's order `sides`, in an order that keeps
     each leash's forces together, leashes 1 and 2 those through S and 3 the third
     (`kinematics.special_sides`): R..t of leash 2, its loads, the base's loads, R..n and R..t of
@@ -670,9 +670,9 @@ def _triad_polygon(mech: "Mechanism", res: "Analysis", g, sides) -> tuple[list[t
     other) and of its two reaction parts."""
     later = _later(mech, g)
     parts = [_leash_parts(mech, res, side) for side in sides]
-    loads = lambda x: [(ld.name, ld.force) for ld in link_loads(mech, res, x) + _carried(mech, res, x, later)]
-    t = lambda o: [] if o.normal is None else [(f"{o.whole.name}t", o.tangential)]
-    n = lambda o: [(o.whole.name, o.whole.force)] if o.normal is None else [(f"{o.whole.name}n", o.normal)]
+    loads = lambda x: [(ld.name, ld.force, "given") for ld in link_loads(mech, res, x) + _carried(mech, res, x, later)]
+    t = lambda o: [] if o.normal is None else [(f"{o.whole.name}t", o.tangential, "component")]
+    n = lambda o: [(o.whole.name, o.whole.force, "result")] if o.normal is None else [(f"{o.whole.name}n", o.normal, "component")]
     (l1, l2, l3), (o1, o2, o3) = [s[0] for s in sides], parts
     blocks = [t(o2) + loads(l2), loads(g.links[0]), n(o3) + t(o3) + loads(l3), loads(l1) + t(o1) + n(o1), n(o2)]
     seq = [f for b in blocks for f in b]
@@ -762,8 +762,9 @@ def _off_link(mech: "Mechanism", x: np.ndarray, lo: np.ndarray, hi: np.ndarray) 
         return (hi - lo > tol) & ((x < lo - tol) | (x > hi + tol))
 
 
-def _polygon(mech: "Mechanism", res: "Analysis", g: "AssurGroup") -> tuple[list[tuple[str, np.ndarray]], int, int]:
-    """The group's vector equation in the texts' order, as (name, force N (N,)): the known part of
+def _polygon(mech: "Mechanism", res: "Analysis", g: "AssurGroup") -> tuple[list[tuple[str, np.ndarray, str]], int, int]:
+    """The group's vector equation in the texts' order, as (name, force N (N,), role: a load
+    given, a reaction's part a component, a whole reaction found a result): the known part of
     j's outer reaction (R..t) or the whole of it, j's loads, k's loads, then k's outer reaction
     (R..t known, R..n unknown; or the normal force) and j's R..n closing it. Also the index of
     the last of j's loads (the internal reaction closes j's polygon there) and the index at
@@ -771,20 +772,20 @@ def _polygon(mech: "Mechanism", res: "Analysis", g: "AssurGroup") -> tuple[list[
     j, k = g.links
     later = _later(mech, g)
     oj, ok = _outer(mech, res, g, 0), _outer(mech, res, g, 1)
-    seq: list[tuple[str, np.ndarray]] = []
+    seq: list[tuple[str, np.ndarray, str]] = []
     if oj.normal is None:
-        seq.append((oj.whole.name, oj.whole.force))
+        seq.append((oj.whole.name, oj.whole.force, "result"))
     else:
-        seq.append((f"{oj.whole.name}t", oj.tangential))
-    seq += [(ld.name, ld.force) for ld in link_loads(mech, res, j) + _carried(mech, res, j, later)]
+        seq.append((f"{oj.whole.name}t", oj.tangential, "component"))
+    seq += [(ld.name, ld.force, "given") for ld in link_loads(mech, res, j) + _carried(mech, res, j, later)]
     end_j = len(seq)
-    seq += [(ld.name, ld.force) for ld in link_loads(mech, res, k) + _carried(mech, res, k, later)]
+    seq += [(ld.name, ld.force, "given") for ld in link_loads(mech, res, k) + _carried(mech, res, k, later)]
     if ok.normal is None:
-        seq.append((ok.whole.name, ok.whole.force))
+        seq.append((ok.whole.name, ok.whole.force, "result"))
     else:
-        seq += [(f"{ok.whole.name}t", ok.tangential), (f"{ok.whole.name}n", ok.normal)]
+        seq += [(f"{ok.whole.name}t", ok.tangential, "component"), (f"{ok.whole.name}n", ok.normal, "component")]
     if oj.normal is not None:
-        seq.append((f"{oj.whole.name}n", oj.normal))
+        seq.append((f"{oj.whole.name}n", oj.normal, "component"))
     return seq, end_j, 0 if oj.normal is None else len(seq) - 1
 
 
@@ -819,12 +820,12 @@ def _dyad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Plan
     oj, ok = _outer(mech, res, g, 0), _outer(mech, res, g, 1)
     X = _vertex(start_j)
     if oj.normal is not None:     # whole pin reactions as chords: R = R^n + R^tau
-        segs.append(Segment(oj.whole.name, X, _vertex(1), _abs(oj.whole.force), "N"))
+        segs.append(Segment(oj.whole.name, X, _vertex(1), _abs(oj.whole.force), "N", role="result"))
     if ok.normal is not None:
         first = len(seq) - 3
-        segs.append(Segment(ok.whole.name, _vertex(first), _vertex(first + 2), _abs(ok.whole.force), "N"))
-    segs.append(Segment(reaction_name(mech, k, j), _vertex(end_j), X, _abs(_z(res.reaction(k, j))), "N"))
-    equation = tuple(name for name, _ in seq)
+        segs.append(Segment(ok.whole.name, _vertex(first), _vertex(first + 2), _abs(ok.whole.force), "N", role="result"))
+    segs.append(Segment(reaction_name(mech, k, j), _vertex(end_j), X, _abs(_z(res.reaction(k, j))), "N", role="result"))
+    equation = tuple(name for name, *_ in seq)
     steps = equation
     if oj.normal is not None:      # closed by two unknowns of known direction (seed 002 fig. 1.10)
         m = len(seq)
@@ -836,16 +837,16 @@ def _dyad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Plan
                   notes=["the reactions with friction in the reactions"] if res.friction is not None else (), steps=steps)
 
 
-def _closed_polygon(seq: list[tuple[str, np.ndarray]], mu_F: Scale) -> tuple[dict, list]:
-    """The polygon of `seq` at mu_F: vertices a, b, c, ... from the start of the first force,
-    the last force ending at the first vertex."""
+def _closed_polygon(seq: list[tuple[str, np.ndarray, str]], mu_F: Scale) -> tuple[dict, list]:
+    """The polygon of `seq` (name, force, role) at mu_F: vertices a, b, c, ... from the start of
+    the first force, the last force ending at the first vertex."""
     pts = {_vertex(0): np.zeros(len(seq[0][1]), dtype=complex)}
     segs = []
-    for n, (name, F) in enumerate(seq):
+    for n, (name, F, role) in enumerate(seq):
         a, b = _vertex(n), _vertex((n + 1) % len(seq))
         if b not in pts:
             pts[b] = pts[a] + _over(F, mu_F.value)
-        segs.append(Segment(name, a, b, _abs(F), "N"))
+        segs.append(Segment(name, a, b, _abs(F), "N", role=role))
     return pts, segs
 
 
@@ -864,12 +865,12 @@ def _triad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Pla
         for (ell, _, _, known), w in zip(sides, whole):
             if w is not None:
                 segs.append(Segment(reaction_name(mech, known, ell), _vertex(w[0] % m), _vertex(w[1] % m),
-                                    _abs(_z(res.reaction(known, ell))), "N"))
+                                    _abs(_z(res.reaction(known, ell))), "N", role="result"))
         for (ell, _, _, _), (a, b) in zip(sides, spans):
             segs.append(Segment(reaction_name(mech, g.links[0], ell), _vertex(b % m), _vertex(a % m),
-                                _abs(_z(res.reaction(g.links[0], ell))), "N"))
+                                _abs(_z(res.reaction(g.links[0], ell))), "N", role="result"))
         parts.append((where, pts, _masked(segs, where)))
-        equations.append(tuple(name for name, _ in seq))
+        equations.append(tuple(name for name, *_ in seq))
     pts, segs = _merged(parts)
     which = np.argmax(np.stack([where for _, where in orders]), axis=0)      # each angle's order
     titles = [f"Force plan of group {g.label} (III3): " + " + ".join(equations[o]) + " = 0" for o in which.tolist()]
@@ -914,7 +915,7 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
         _arm(mech, segs, pts, arm_name(ld.name), O, dr.pivot, ld.point, ld.force, mu_l)
     _couples(mech, res, 1, O, 6.0, zeros, paths, mu_l)
     R01 = _reaction_load(mech, res, 0, 1)
-    _arrow(segs, pts, R01.name, R01.point, R01.force, mu_l, mu_F)
+    _arrow(segs, pts, R01.name, R01.point, R01.force, mu_l, mu_F, role="result")
     M_bal = np.asarray(res.balancing_moment, dtype=float)
     if dr.kind == "machine":
         gear = dr.gear
@@ -929,7 +930,7 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
         pts["line of action:from"], pts["line of action:to"] = pts["P"] - 40 * line, pts["P"] + 40 * line
         segs.append(Segment("line of action", "line of action:from", "line of action:to", np.full(len(P), np.nan),
                             "", "line"))
-        _arrow(segs, pts, L.F_bal, P, F_bal, mu_l, mu_F)
+        _arrow(segs, pts, L.F_bal, P, F_bal, mu_l, mu_F, role="result")
         foot = _foot(P, line, O)
         pts["r_b:foot"] = _over(foot, mu_l.value)
         segs.append(Segment("r_b", dr.pivot, "r_b:foot", _abs(foot - O), "m", "arm"))

@@ -91,6 +91,13 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
                          "ω: кутова швидкість, ε: кутове прискорення (напрямки); S: центри мас",
                          "ω: угловая скорость, ε: угловое ускорение (направления); S: центры масс"),
     "guide": ("guide {pair}", "напрямна {pair}", "направляющая {pair}"),      # of the sliding pair: its links
+    "legend.lines": ("line widths, mm:", "товщина ліній, мм:", "толщина линий, мм:"),
+    "role.result": ("result", "результат", "результат"),
+    "role.link": ("link", "ланка", "звено"),
+    "role.given": ("given", "задана", "заданная"),
+    "role.component": ("component", "складова", "составляющая"),
+    "role.construction": ("construction", "побудова", "построение"),
+    "role.auxiliary": ("auxiliary", "допоміжна", "вспомогательная"),
     "slot": ("slot of link {k} ({P})", "паз ланки {k} ({P})", "паз звена {k} ({P})"),
     "construction.line": ("line of {name} through {P}", "лінія {name} через {P}", "линия {name} через {P}"),
     "construction.point": ("{P}: the intersection of the lines", "{P}: перетин ліній", "{P}: пересечение линий"),

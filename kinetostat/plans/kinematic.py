@@ -177,7 +177,15 @@ def _floating_joints(mech, names: dict[str, _Point]) -> list[tuple[int, list[str
 
 
 def _rel(a: str, b: str, value, unit: str) -> Segment:
-    return Segment(f"{a}-{b}", a, b, np.asarray(value, dtype=float), unit)
+    """A relative vector a-b: a component of its plan's vector sums."""
+    return Segment(f"{a}-{b}", a, b, np.asarray(value, dtype=float), unit, role="component")
+
+
+def _absolute(mech, pts: dict[str, _Point], n: str, pole: str, value, unit: str) -> Segment:
+    """The absolute vector pole-n of point n: given on the driving link (known from its motion),
+    else a result the plan is drawn to find."""
+    role = "given" if pts[n].link == mech.drive.link else "result"
+    return Segment(f"{pole}-{n}", pole, n, np.asarray(value, dtype=float), unit, role=role)
 
 
 def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
@@ -190,7 +198,7 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     pts = plan_point_names(mech, res)
     mo = _motion(res, pts)
     points = {"p": np.zeros(len(res.phi_deg), complex), **{n: m[1] / mu.value for n, m in mo.items()}}
-    segs = [Segment(f"p-{n}", "p", n, np.abs(m[1]), "m/s") for n, m in mo.items()]
+    segs = [_absolute(mech, pts, n, "p", np.abs(m[1]), "m/s") for n, m in mo.items()]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][1] - mo[a][1]), "m/s") for i, a in enumerate(joints) for b in joints[i + 1:]]
     for s in _slidings(mech, "p"):
@@ -198,8 +206,8 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
         vS = _point_motion(res.kin, b, local)[1]
         points[name] = vS / mu.value
-        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s")
-                 for r, on in refs]
+        segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s",
+                         role="component" if r else "result") for r, on in refs]
     lines, steps = _constructions(mech, segs, "p")
     return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points,
                      tuple(segs + lines), notes=_collapsed(mech, pts, segs, len(res.phi_deg)), steps=steps)
@@ -353,7 +361,7 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         points[n] = (a_ref - w * w * (mo[q][0] - r_ref)) / mu.value
         if where is not None:
             points[n] = np.where(where, points[n], np.nan)
-        segs.extend([Segment(f"{start}-{n}", start, n, w * w * l, unit), Segment(f"{n}-{q}", n, q, np.abs(e) * l, unit)])
+        segs.extend([_rel(start, n, w * w * l, unit), _rel(n, q, np.abs(e) * l, unit)])
 
     d = mech.drive
     eps = res.kin.eps[:, d.link]
@@ -374,18 +382,17 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
             cor = 2j * w * v_r * dw                      # slider's acceleration = guide point's + cor + a_r d
             kname = "k" if len(turning) == 1 else f"k{turning.index(s) + 1}"
             points[kname] = np.where(w != 0, points[s.start] + (cor if s.from_guide else -cor) / mu.value, np.nan)
-            segs += [Segment(f"{s.start}-{kname}", s.start, kname, 2 * np.abs(w * v_r), unit),
-                     Segment(f"{kname}-{s.end}", kname, s.end, np.abs(a_r), unit)]
+            segs += [_rel(s.start, kname, 2 * np.abs(w * v_r), unit), _rel(kname, s.end, np.abs(a_r), unit)]
             if not np.all(w != 0):
-                segs.append(Segment(f"{s.start}-{s.end}", s.start, s.end, _where(w == 0, np.abs(a_r)), unit))
+                segs.append(_rel(s.start, s.end, _where(w == 0, np.abs(a_r)), unit))
         else:
             segs.append(_rel(s.start, s.end, np.abs(a_r), unit))
-    segs += [Segment(f"pi-{n}", "pi", n, np.abs(m[2]), unit) for n, m in mo.items()]
+    segs += [_absolute(mech, pts, n, "pi", np.abs(m[2]), unit) for n, m in mo.items()]
     for name, b, local, refs in _special(mech, res, pts):        # a_S = a_1 + a_S1 = a_2 + a_S2
         aS = _point_motion(res.kin, b, local)[2]
         points[name] = aS / mu.value
-        segs.append(Segment(f"pi-{name}", "pi", name, np.abs(aS), unit))
-        segs += [Segment(f"{r}-{name}", r, name, _where(on, np.abs(aS - mo[r][2])), unit) for r, on in refs if r]
+        segs.append(Segment(f"pi-{name}", "pi", name, np.abs(aS), unit, role="result"))
+        segs += [_rel(r, name, _where(on, np.abs(aS - mo[r][2])), unit) for r, on in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
     lines, steps = _constructions(mech, segs, "pi")

@@ -97,7 +97,8 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
         for name, img in zip(link.points, images):
             off = _abs(pts[img]) > 0
             if off.any() and f"p-{img}" not in {s.name for s in segs}:
-                segs.append(Segment(f"p-{img}", "p", img, np.where(off, _abs(pts[img]) * mu_v.value, np.nan), "m/s"))
+                segs.append(Segment(f"p-{img}", "p", img, np.where(off, _abs(pts[img]) * mu_v.value, np.nan), "m/s",
+                                    role="link"))       # the lever: a rigid body
         joints = list(dict.fromkeys(p.point for p in mech.pairs if k in p.links and p.point in link.points))
         for m, a in enumerate(joints):
             for b in joints[m + 1:]:
@@ -128,7 +129,7 @@ def _lever_plan(mech: "Mechanism", res: "Analysis", mu_v: Scale, mu_F: Scale | N
         start = f"{name}:from"
         pts[start] = np.where(np.isnan(F), np.nan, pts[at])               # a couple's force NaN where it acts not
         pts[f"{name}:to"] = pts[start] + _over(F, mu_F.value)
-        segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F))
+        segs.append(Segment(name, start, f"{name}:to", _abs(F), "N", "vector", mu_F, "result" if name == F_name else "given"))
         u = _unit(F)
         foot = pts[at] - _dot(pts[at], u) * u
         has = (_abs(F) > 0) & (_abs(foot) > 1e-9 * _abs(pts[at]))      # a line through the pole has no arm
