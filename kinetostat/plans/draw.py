@@ -376,14 +376,15 @@ def _legend(cycle: PlanCycle, lang: str) -> tuple[list[str], tuple[float, float,
         return [], (x0, _FRAME[3] - 1.5, x0, _FRAME[3] - 1.5)
     y0 = _FRAME[3] - 1.5 - _LINE_STEP * n_rows
     base = y0 + ASCENT * _NOTE_MM
-    out = [f'<g id="legend" class="note" font-size="{_NOTE_MM:.2f}"><text x="{x0:.1f}" y="{base:.1f}">{escape(head)}</text>']
+    size = f'font-size="{_NOTE_MM:.2f}"'
+    out = [f'<g id="legend" class="note"><text x="{x0:.1f}" y="{base:.1f}" {size}>{escape(head)}</text>']
     for seg, words, x, row in rows:
         width, dash, colour = style(seg)
         y = base + _LINE_STEP * row
         dashed = f' stroke-dasharray="{dash}"' if dash else ""
         out.append(f'<line data-role="{role_of(seg)}" x1="{x:.1f}" y1="{y - 0.9:.1f}" x2="{x + _SAMPLE_MM:.1f}" '
                    f'y2="{y - 0.9:.1f}" stroke="{colour}" stroke-width="{width}"{dashed}/>'
-                   f'<text x="{x + _SAMPLE_MM + _SAMPLE_GAP:.1f}" y="{y:.1f}">{escape(words)}</text>')
+                   f'<text x="{x + _SAMPLE_MM + _SAMPLE_GAP:.1f}" y="{y:.1f}" {size}>{escape(words)}</text>')
     out.append("</g>")
     right = max(x + _SAMPLE_MM + _SAMPLE_GAP + text_width(words, _NOTE_MM) for _, words, x, _ in rows)
     return out, (x0, y0, right, _FRAME[3] - 1.5)
