@@ -14,7 +14,7 @@ import pytest
 import kinetostat
 import kinetostat.plans as P
 from conftest import four_bar
-from kinetostat.plans.page import DIGITS85, page
+from kinetostat.plans.page import ILLEGAL7, page
 
 M_BAL, POINT = "<!--<script>", "</script>"
 #: Point B of the four-bar named POINT (a pair's point: its velocity and acceleration rows name it).
@@ -64,13 +64,18 @@ def test_a_name_cannot_end_or_extend_the_data_block(hostile_page):
 
 
 def _unpacked(blob: str) -> bytes:
-    """A blob of the page (page.py `_packed`) back as its bytes: 5 digits (DIGITS85) per 4 bytes, inflated."""
-    digits = [DIGITS85.index(c) for c in blob.encode("ascii")]
-    pad = -len(digits) % 5
-    digits += [84] * pad
-    words = [sum(d * 85 ** (4 - k) for k, d in enumerate(digits[i:i + 5])) for i in range(0, len(digits), 5)]
-    data = b"".join(w.to_bytes(4, "big") for w in words)
-    return zlib.decompress(data[:len(data) - pad], -15)
+    """A blob of the page (page.py `_packed`) back as its bytes: 7 bits a character (a character of
+    U+0100 and up: a group of ILLEGAL7 and, but for the last, the group after it), inflated."""
+    groups = []
+    for c in map(ord, blob):
+        if c < 256:
+            groups.append(c)
+            continue
+        k = (c - 256) >> 7
+        groups += [ILLEGAL7[k % 3]] + ([(c - 256) & 127] if k < 3 else [])
+    bits = "".join(format(g, "07b") for g in groups)
+    data = bytes(int(bits[i:i + 8], 2) for i in range(0, len(bits) // 8 * 8, 8))
+    return zlib.decompress(data, -15)
 
 
 def test_the_page_gets_ready_in_a_browser(hostile_page, chromium):

@@ -612,9 +612,9 @@ def _script_page(drawings, n: int) -> str:
     kinds, mids = pg._shared_texts(kinds)
     blobs["meta"] = pg._packed(json.dumps({"kinds": kinds, "mids": mids, "steps": [], "rows": [], "exps": [], "sources": [], "frames": list(range(n))}).encode())
     blobs["values"] = pg._packed(pg._columns(np.zeros((n, 0)))[2])
-    blobs["check"] = pg._text85(pg._obscure(pg._deflated(b'{"items": [], "M": [], "scales": [], "titles": {}}')))
+    blobs["check"] = pg._text7(pg._obscure(pg._deflated(b'{"items": [], "M": [], "scales": [], "titles": {}}')))
     data = {"student": False, "slider": n - 1, "design": 0.0, "coord": pg.COORD_DECIMALS,
-            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "smooth": pg.SMOOTH.tolist(), "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
+            "lengthd": pg.LENGTH_DECIMALS, "elements": ELEMENTS, "maxorder": pg.MAX_ORDER, "jump": pg.JUMP, "smooth": pg.SMOOTH.tolist(), "illegal7": list(pg.ILLEGAL7), "singular": [], "ui": {}, "decimal": ".", "scalebar": '<g id="scalebar"/>',
             "mm": "mm", "tiny": 1.0, "tol": 5.0}
     script = resources.files("kinetostat.plans").joinpath("page.js").read_text(encoding="utf-8")
     return ('<!DOCTYPE html><html><head><meta charset="utf-8"><style id="page-size"></style></head><body>'
@@ -767,3 +767,24 @@ def test_script_writes_every_sheet_as_drawing_svg(chromium, ice):
         for i in range(len(phi)):
             assert pg.evaluate("([k, i]) => window.sheetSvg(k, i)", [k, i]) == d.svg(i, *PAGE_DECIMALS), (cycle.kind, phi[i])
     pg.close()
+
+
+@pytest.mark.parametrize("data", [b"", b"\x00", b"\x00" * 9, bytes(range(256)) * 3, b"<\r\x00" * 40,
+                                  bytes([0b0011110, 0b0000000]), bytes([0x01, 0x80 | 0x3C]), bytes([0xFF] * 6 + [0x3C])],
+                         ids=["empty", "nul", "nuls", "all", "illegal", "nul-paired", "nul-last-alone", "lt-last-alone"])
+def test_a_blob_holds_7_bits_a_character_and_no_lt_cr_or_nul(data):
+    """A blob's text (`_text7`, read back as the test of the hostile page reads it, as page.js
+    does): the same bytes; no "<", CR or NUL in it; in UTF-8 at most 8/7 of the bytes and 2 bytes
+    more (was Ascii85: 5/4), whatever the data, an illegal group last or illegal groups in a row."""
+    import zlib
+    from kinetostat.plans import page as pg
+    from test_hostile_page import _unpacked
+    z = zlib.compressobj(9, zlib.DEFLATED, -15)
+    packed = z.compress(data) + z.flush()
+    text = pg._text7(packed)
+    assert not set(text) & {"<", "\r", "\x00"}
+    assert _unpacked(text) == data
+    assert len(text.encode()) <= len(packed) * 8 / 7 + 2
+    raw = pg._text7(data)                                     # the groups as they come, not deflated
+    groups = "".join(format(b, "08b") for b in data)
+    assert len(raw) <= -(-len(groups) // 7) and len(raw.encode()) <= len(data) * 8 / 7 + 2

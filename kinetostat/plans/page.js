@@ -1,5 +1,5 @@
 // The interactive page's script (kinetostat/plans/page.py writes it into the page): decodes each
-// sheet's arrays and the values stored as differences over the angle (deflated, 5 characters per 4 bytes), writes the sheet of
+// sheet's arrays and the values stored as differences over the angle (deflated, 7 bits a character), writes the sheet of
 // the angle chosen as core.py's Drawing.svg writes it, steps through the kinematic and force plans, checks typed
 // lengths at the typed scales. No network, no library.
 "use strict";
@@ -7,18 +7,25 @@
   const D = JSON.parse(document.getElementById("page-data").textContent);
   const $ = (id) => document.getElementById(id);
 
-  function bytes85(s) {                         // page.py _text85: 5 digits (DIGITS85) per 4 bytes
-    const digit = (i) => { const c = i < s.length ? s.charCodeAt(i) : 118; return c - (c > 60 ? 34 : 33); };
-    const pad = (5 - s.length % 5) % 5, out = new Uint8Array((s.length + pad) / 5 * 4);
-    for (let i = 0, o = 0; i < s.length; i += 5, o += 4) {
-      let w = 0;
-      for (let k = 0; k < 5; k++) w = w * 85 + digit(i + k);
-      for (let b = 3; b >= 0; b--) { out[o + b] = w % 256; w = Math.floor(w / 256); }
+  function bytes7(s) {                          // page.py _text7: 7 bits a character
+    const bad = D.illegal7, groups = [];
+    for (let i = 0; i < s.length; i++) {
+      const c = s.charCodeAt(i);
+      if (c < 256) { groups.push(c); continue; }
+      const k = (c - 256) >> 7;                  // an illegal group, and the next one where k < 3
+      groups.push(bad[k % 3]);
+      if (k < 3) groups.push((c - 256) & 127);
     }
-    return out.subarray(0, out.length - pad);
+    const out = new Uint8Array(Math.floor(groups.length * 7 / 8));
+    let acc = 0, held = 0, o = 0;
+    for (let i = 0; i < groups.length && o < out.length; i++) {
+      acc = (acc << 7) | groups[i]; held += 7;
+      if (held >= 8) { held -= 8; out[o++] = (acc >> held) & 255; acc &= (1 << held) - 1; }
+    }
+    return out;
   }
   async function bytes(id, xor) {
-    const bin = bytes85($("blob-" + id).textContent);
+    const bin = bytes7($("blob-" + id).textContent);
     if (xor) {                                   // page.py's _obscure: xorshift32, seed 27
       let x = 27;
       for (let i = 0; i < bin.length; i++) {

@@ -23,8 +23,8 @@ is drawn, which text it shows, its coordinates and a segment's length as `Elemen
 suits it, as its jumps (`_jumps`: a label), as its least-squares prediction's misses (`_smooth`: a
 length), as an earlier series of the sheet (moved by a constant), or less a multiple of an earlier
 length (`_proportionals`: a velocity on its plan and on the lever; a value of the worksheet, its
-vector's length times the scale), zigzag varints, deflated and written as text, 5
-characters per 4 bytes (`_text85`); the worksheet's rows and the check's items in the blobs too.
+vector's length times the scale), zigzag varints, deflated and written as text, 7 bits a
+character (`_text7`); the worksheet's rows and the check's items in the blobs too.
 The page's script (vanilla JavaScript, the browser's own DecompressionStream; without its comments,
 `_bare`; deflated in blob "js", `_UNPACK` runs it) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
 `Drawing.svg` writes it.
@@ -362,26 +362,37 @@ def _columns(values: np.ndarray, lengths: Sequence[np.ndarray] = ()) -> tuple[li
     return exps, sources, _varints(np.concatenate(_serieses(parts))) if parts else b""
 
 
-#: The 85 digits of a blob's text (`_text85`): ASCII 33-118 but "<", so that nothing in a blob
-#: ends or opens an element of the page.
-DIGITS85 = bytes(c for c in range(33, 119) if c != ord("<"))
+#: The 7-bit groups a blob's text (`_text7`) cannot hold as themselves: NUL (the HTML parser
+#: replaces it), CR (it reads CR as LF) and "<" (nothing in a blob ends or opens an element).
+ILLEGAL7 = (0, 13, 60)
 
 
-def _text85(data: bytes) -> str:
-    """`data` as text, Ascii85's way with DIGITS85: each 4 bytes (big-endian) as 5 digits, the last
-    k < 4 bytes as k + 1 (25 % longer than the bytes, base64 33 %)."""
-    pad = -len(data) % 4
-    words = np.frombuffer(data + b"\0" * pad, dtype=">u4").astype(np.int64)
-    digits = np.empty((len(words), 5), dtype=np.int64)
-    for k in range(4, -1, -1):
-        words, digits[:, k] = np.divmod(words, 85)
-    out = np.frombuffer(DIGITS85, dtype=np.uint8)[digits].tobytes()
-    return out[:len(out) - pad].decode("ascii")
+def _text7(data: bytes) -> str:
+    """`data` as text, 7 bits a character (14 % longer than the bytes; Ascii85 25 %, base64 33 %):
+    its bits, zero-padded to a whole group, in groups of 7, each group as the character of that
+    code; a group of ILLEGAL7 (the k-th) and the group after it as one character U+0100 + (k << 7 |
+    next), a last group of ILLEGAL7 as U+0100 + ((3 + k) << 7); in the page's UTF-8 a character of
+    U+0100 and up takes 2 bytes, as its 2 groups. Read back: the groups' bits, as many whole bytes
+    as they hold."""
+    bits = np.unpackbits(np.frombuffer(data, dtype=np.uint8))
+    bits = np.concatenate([bits, np.zeros(-len(bits) % 7, dtype=np.uint8)])
+    g = bits.reshape(-1, 7).astype(np.int64) @ (1 << np.arange(6, -1, -1))
+    codes, keep = g.copy(), np.ones(len(g), dtype=bool)
+    paired = -1                                  # the last group taken into a pair
+    for i in np.flatnonzero(np.isin(g, ILLEGAL7)):
+        if i <= paired:
+            continue
+        k = ILLEGAL7.index(int(g[i]))
+        if i + 1 < len(g):
+            codes[i], keep[i + 1], paired = 0x100 + (k << 7 | int(g[i + 1])), False, i + 1
+        else:
+            codes[i] = 0x100 + ((3 + k) << 7)
+    return codes[keep].astype("<u4").tobytes().decode("utf-32-le")
 
 
 def _packed(data: bytes) -> str:
-    """`data` deflated as text (`_text85`): a blob of the page."""
-    return _text85(_deflated(data))
+    """`data` deflated as text (`_text7`): a blob of the page."""
+    return _text7(_deflated(data))
 
 
 def _deflated(data: bytes) -> bytes:
@@ -596,7 +607,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
                   "rule_bad": text("page.rule_bad", lang, tol=num(TOLERANCE_PCT, lang)),
                   "decimal": "." if lang == "en" else ",", "scalebar": scale_bar(lang), "mm": unit("mm", lang),
                   "coord": COORD_DECIMALS, "lengthd": LENGTH_DECIMALS, "elements": ELEMENTS,
-                  "maxorder": MAX_ORDER, "jump": JUMP, "smooth": SMOOTH.tolist()}
+                  "maxorder": MAX_ORDER, "jump": JUMP, "smooth": SMOOTH.tolist(), "illegal7": list(ILLEGAL7)}
     blobs: dict[str, str] = {}
     records = sheet.at(i_at).records()
     if not student:
@@ -642,7 +653,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     results = [(sym, v, moment_bands.get(key)) for (sym, v), key in zip(results, ("M_bal", "M_bal_lever"))]
     answers = {"items": items, "M": results, "scales": scales,
                "titles": {kind: title_of(plan, lang).split(",")[0] for kind, plan in check.items()}}
-    blobs["check"] = _text85(_obscure(_deflated(json.dumps(answers, separators=(",", ":")).encode())))
+    blobs["check"] = _text7(_obscure(_deflated(json.dumps(answers, separators=(",", ":")).encode())))
     blank = _blank_tables(records, lang) if student else ""
     return _html(mech, name, lang, student, data, blobs, fixed, _data_rows(mech, one, lang), results, blank)
 
