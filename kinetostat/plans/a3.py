@@ -37,7 +37,7 @@ from .i18n import LANGS, num, text
 from .pdf import text_width
 from .scales import TARGET_MM
 
-__all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
+__all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "placed_in_order", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
            "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM"]
 
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
@@ -236,6 +236,16 @@ def in_texts_order(kinds: list[str], boxes: list[tuple]) -> bool:
     (`texts_rank`): each right of or below every plan before it."""
     ranked = sorted(zip(kinds, boxes), key=lambda kb: texts_rank(kb[0]))
     return all(_after(b, a) for i, (_, b) in enumerate(ranked) for _, a in ranked[:i])
+
+
+def placed_in_order(drawings: list[Drawing], places: list[Placement]) -> bool:
+    """Whether the drawings, placed (`layout`), are all on one page in the texts' order
+    (`in_texts_order` of their boxes with headings)."""
+    boxes = []
+    for d, p in zip(drawings, places):
+        w, h, top = _size(d)
+        boxes.append((d.box[0] + p.dx, d.box[1] + p.dy - top, d.box[0] + p.dx + w, d.box[1] + p.dy - top + h))
+    return all(p.page == 0 for p in places) and in_texts_order([d.kind for d in drawings], boxes)
 
 
 def _split(free: list, box: tuple) -> None:
@@ -447,6 +457,8 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     tried: dict[tuple | None, tuple] = {}
 
     def attempt(given: Mapping[str, float] | None):
+        """(plans, their drawings in `lang`, placements, on one page in every language, and in the
+        texts' order in every language) at the scales `given` (None: the texts' rule)."""
         key = None if given is None else tuple(sorted(given.items()))
         if key not in tried:                     # the searches below come back to scales tried before
             if given is None:                    # the texts' rule: its μ_l is not known before
@@ -456,48 +468,67 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
                 plans = build(mech, at=at, scales=given, starting_deg=pos.start, positions=pos)
             ds = drawings(plans, lang)
             places = layout(ds)
-            fit = all(p.page == 0 for p in places) and all(
-                all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
-            tried[key] = plans, ds, places, fit
+            fit, ordered = all(p.page == 0 for p in places), placed_in_order(ds, places)
+            for lg in LANGS:
+                if lg != lang and fit:
+                    other = drawings(plans, lg)
+                    there = layout(other)
+                    fit = all(p.page == 0 for p in there)
+                    ordered = ordered and fit and placed_in_order(other, there)
+            tried[key] = plans, ds, places, fit, fit and ordered
         return tried[key]
 
-    plans, ds, places, fit = attempt(None)
-    rule = dict(plans.scales)
-    given = {k: s.value for k, s in rule.items()}
+    rule = dict(attempt(None)[0].scales)
     coarsest = {}                                # each scale of FIRST as coarse as its floor allows
     for k in FIRST:
-        coarsest[k] = given[k]
+        coarsest[k] = rule[k].value
         while reference[k] / next_coarser(coarsest[k]) >= FLOOR_MM[k]:
             coarsest[k] = next_coarser(coarsest[k])
-    for _ in range(_TRIES):                      # μ_l: the finest at which they fit, the others at their floor
-        if fit or attempt({**given, **coarsest})[3]:
-            break
-        given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
-    steps: dict[str, list[float]] = {k: [] for k in FIRST}       # the values each scale of FIRST left
-    for _ in range(_TRIES):                      # the others from the rule's, the one with most room first
-        if fit:
-            break
-        room = dict.fromkeys(FIRST, 0.0)
-        for d in ds:
-            sym = plans[d.kind].scale.symbol
-            if sym in room:
-                w, h, _ = _size(d)
-                room[sym] += w * h
-        open_ = [k for k in FIRST if room[k] and given[k] < coarsest[k] * (1 - 1e-9)]
-        if open_:
-            k = max(open_, key=lambda k: (room[k], -FIRST.index(k)))
-            steps[k].append(given[k])
-            given[k] = next_coarser(given[k])
-        else:                                    # (only where the search above ran out of tries)
-            given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
-        plans, ds, places, fit = attempt(given)
-    for k in FIRST:                              # back towards the rule while they still fit
-        while fit and steps[k]:
-            trial = attempt({**given, k: steps[k][-1]})
-            if not trial[3]:
+
+    def search(good: int, mu_l: float = np.inf):
+        """The scales by the rule above at which the try's flag `good` holds (3: one sheet; 4: one
+        sheet in the texts' order), μ_l no coarser than `mu_l`; else the last try."""
+        trial = attempt(None)
+        given = {k: s.value for k, s in rule.items()}
+        for _ in range(_TRIES):                  # μ_l: the finest at which they fit, the others at their floor
+            if trial[good] or attempt({**given, **coarsest})[good] or given["mu_l"] >= mu_l * (1 - 1e-9):
                 break
-            given[k] = steps[k].pop()
-            plans, ds, places, fit = trial
+            given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
+        steps: dict[str, list[float]] = {k: [] for k in FIRST}   # the values each scale of FIRST left
+        for _ in range(_TRIES):                  # the others from the rule's, the one with most room first
+            if trial[good]:
+                break
+            plans, ds = trial[:2]
+            room = dict.fromkeys(FIRST, 0.0)
+            for d in ds:
+                sym = plans[d.kind].scale.symbol
+                if sym in room:
+                    w, h, _ = _size(d)
+                    room[sym] += w * h
+            open_ = [k for k in FIRST if room[k] and given[k] < coarsest[k] * (1 - 1e-9)]
+            if open_:
+                k = max(open_, key=lambda k: (room[k], -FIRST.index(k)))
+                steps[k].append(given[k])
+                given[k] = next_coarser(given[k])
+            elif given["mu_l"] < mu_l * (1 - 1e-9):  # (only where the search above ran out of tries)
+                given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
+            else:
+                break
+            trial = attempt(given)
+        for k in FIRST:                          # back towards the rule while they still fit
+            while trial[good] and steps[k]:
+                finer = attempt({**given, k: steps[k][-1]})
+                if not finer[good]:
+                    break
+                given[k] = steps[k].pop()
+                trial = finer
+        return trial
+
+    trial = search(3)
+    if trial[3] and not trial[4]:                # the texts' order bought with μ_v, μ_a, μ_F, not μ_l
+        ordered = search(4, trial[0].scales["mu_l"].value)
+        trial = ordered if ordered[4] else trial
+    plans, ds, places = trial[:3]
     return OneSheet(plans, lang, tuple(ds), tuple(places), MappingProxyType(rule), MappingProxyType(reference),
                     MappingProxyType({k: sheets[(k, *(s.value for s in scales_of(plans[k])))] for k in plans}))
 
@@ -628,11 +659,7 @@ def pages(sheet: OneSheet, title: str) -> list[Page]:
     from ..model.lettering import lettering
     lang, drawings, places = sheet.lang, sheet.drawings, sheet.places
     n = max(p.page for p in places) + 1
-    boxes = []
-    for d, p in zip(drawings, places):
-        w, h, top = _size(d)
-        boxes.append((d.box[0] + p.dx, d.box[1] + p.dy - top, d.box[0] + p.dx + w, d.box[1] + p.dy - top + h))
-    ordered = n == 1 and in_texts_order([d.kind for d in drawings], boxes)
+    ordered = placed_in_order(drawings, places)
     mech = sheet.plans.mech
     name = lettering(mech).name(lang, mech.name)
     parts = [([], [], [], [], []) for _ in range(n)]           # lines, polylines, polygons, dots, texts
