@@ -38,7 +38,7 @@ from .pdf import text_width
 from .scales import TARGET_MM
 
 __all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "placed_in_order", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
-           "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM"]
+           "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM", "IN_ORDER_TRIES"]
 
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
 #: (left 20 mm for binding, 5 mm elsewhere) below the sheet's title line.
@@ -52,7 +52,7 @@ _NOTE_STEP = 3.1                            # between the notes' lines (2.5 mm t
 #: A plan's heading above its drawing (its title, 3.5 mm, then its scales, 3 mm) is broken into
 #: lines no wider than the drawing, or than this where the drawing is narrower, mm.
 MIN_HEADING_MM = 50.0
-_GAP = 4.0                                  # between two drawings, mm
+_GAP = 3.0                                  # between two drawings, mm
 
 
 @dataclass(frozen=True)
@@ -277,24 +277,18 @@ def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float]
     return x, y
 
 
-def _place_after(free: list, w: float, h: float, placed: list, rule) -> tuple[float, float] | None:
-    """Where a box w x h goes inside one free rectangle, right of or below every box `placed`
-    (grown by the gap, `_after`): of the corners made by a free rectangle's edges and the placed
-    boxes' right and bottom edges, the least by `rule` (READING); None where none is free. The free
-    rectangles are split around it."""
-    spots = []
+def _place_after(free: list, w: float, h: float, placed: list, rule) -> list[tuple[float, float]]:
+    """Where a box w x h may go inside one free rectangle, right of or below every box `placed`
+    (grown by the gap, `_after`): the corners made by a free rectangle's edges and the placed
+    boxes' right and bottom edges, least by `rule` (READING) first; none where none is free."""
+    spots = set()
     for fx, fy, fx1, fy1 in free:
         for x in {fx, *(b[2] for b in placed if fx < b[2] <= fx1 - w + 1e-9)}:
             for y in {fy, *(b[3] for b in placed if fy < b[3] <= fy1 - h + 1e-9)}:
                 box = (x, y, x + w, y + h)
                 if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and all(_after(box, b) for b in placed):
-                    spots.append((rule(x, y), x, y))
-    if not spots:
-        return None
-    _, x, y = min(spots)
-    _split(free, (x, y, x + w, y + h))
-    placed.append((x, y, x + w, y + h))
-    return x, y
+                    spots.add((rule(x, y), x, y))
+    return [(x, y) for _, x, y in sorted(spots)]
 
 
 #: The orders the packing tries (where the texts' order does not fit), each a key of a (width,
@@ -321,16 +315,35 @@ def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule) -> di
     return out
 
 
+#: The most corners `_in_order` tries for one layout (its first tries are the greedy's: each box
+#: at the least corner by the rule; the others where a later box finds none).
+IN_ORDER_TRIES = 2000
+
+
 def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule) -> dict[int, tuple[int, float, float]] | None:
     """Each box (in `order`, the texts') at (0, x, y) on one page, each right of or below every
-    box before it (`_place_after` by `rule`); None where one does not fit."""
-    free, placed, out = _free(_GAP), [], {}
-    for i in order:
-        spot = _place_after(free, sizes[i][0] + _GAP, sizes[i][1] + _GAP, placed, rule)
-        if spot is None:
-            return None
-        out[i] = (0, *spot)
-    return out
+    box before it: at a corner of `_place_after` by `rule`, the next corner where the boxes after
+    it find no room (depth first, IN_ORDER_TRIES corners at most); None where none is found."""
+    left = IN_ORDER_TRIES
+    out: dict[int, tuple[int, float, float]] = {}
+
+    def fill(k: int, free: list, placed: list) -> bool:
+        nonlocal left
+        if k == len(order):
+            return True
+        i = order[k]
+        w, h = sizes[i][0] + _GAP, sizes[i][1] + _GAP
+        for x, y in _place_after(free, w, h, placed, rule):
+            left -= 1
+            if left < 0:
+                return False
+            rest = list(free)
+            _split(rest, (x, y, x + w, y + h))
+            if fill(k + 1, rest, [*placed, (x, y, x + w, y + h)]):
+                out[i] = (0, x, y)
+                return True
+        return False
+    return out if fill(0, _free(_GAP), []) else None
 
 
 def layout(drawings: list[Drawing]) -> list[Placement]:
