@@ -10,12 +10,13 @@ plans' extents (drawing, labels and a heading: title, then every scale the plan 
 placed inside the frame, clear of the title block and the notes above it, never turned
 (`layout`): in the texts' order (`texts_rank`: positions, mechanism, velocities, accelerations,
 each group's plan and force polygon, the initial link, the lever; each right of or below every
-plan before it) where that fits, else packed (maximal rectangles, several rules and orders) and
+plan before it; found depth first over the corners) where that fits, else packed (maximal rectangles, several rules and orders) and
 the notes say so. The title block is GOST 2.104's form 1 (185 x 55 mm: roles, designation, name,
 μ_l as its ratio, sheet and sheets; names and signatures left blank); the notes state the scales
 and each one whose reference is drawn outside the guide's recommended length. Where the plans at the texts' scales do not fit one sheet, `one_sheet`
 chooses the variant's scales together for it: velocity, acceleration and force scales a round
-step coarser first, μ_l only where they cannot make room; the title block and the key name each
+step coarser first, μ_l only where they cannot make room; where they fit only packed, the first
+three coarser (at that μ_l) until they fit in the texts' order, if they can; the title block and the key name each
 scale made coarser than the rule, and why. Where no choice fits them, further sheets take the
 rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
