@@ -76,11 +76,12 @@ def test_the_key_holds_the_answers_and_their_bands(uk_479):
     mech = variants.variant(1, "479").mechanism()
     M = kinetostat.analyze(mech, phi_deg=[150.0]).balancing_moment[0]
     assert "Mзр" in key and num(M, "uk", 4) in key                                   # 99,6 N m, exact solver
-    for mu, value in (("μl", "0,0015"), ("μv", "0,25"), ("μa", "100"), ("μF", "40")):      # μ with its subscript
+    # the A3 sheet's scales (in the texts' order only at μ_v = 0.4, μ_F = 50: tests/test_a3.py)
+    for mu, value in (("μl", "0,0015"), ("μv", "0,4"), ("μa", "100"), ("μF", "50")):      # μ with its subscript
         assert re.search(rf"{mu} (\S+ )?{value} ", flat), mu         # pdftotext may read a header cell between
     assert "OA = 32 мм" in flat                                                        # the crank at 30..35 mm
-    # the polygon's sides at mu_F = 40 N/mm: R12 = 7009 N is 175,2 mm, the scale beside it
-    assert re.search(r"R12 175,2 μF = 40 Н/мм 7009 Н", flat)                          # μ_F: F set below
+    # the polygon's sides at mu_F = 50 N/mm: R12 = 7009 N is 140,2 mm, the scale beside it
+    assert re.search(r"R12 140,2 μF = 50 Н/мм 7009 Н", flat)                          # μ_F: F set below
     # a band per drawn value: the 5-95 % of the seeded study, printed
     sol = simulate(mech, at=150.0, n=P.BAND_DRAWS, seed=0)
     lo, hi = np.percentile(sol.samples["M_bal"], P.BAND)
@@ -241,9 +242,10 @@ def test_the_a3_sheet_draws_every_plan_true_to_scale(pack_uk):
 @needs_poppler
 def test_the_a3_pdf_titles_each_plan_with_its_scales(uk_479):
     """Each panel heads its plan with every scale it is drawn at: the force scales of the group,
-    crank and lever plans appear on the sheet."""
+    crank and lever plans appear on the sheet (at the sheet's own scales, `one_sheet`)."""
     page = pdftext(uk_479 / "plans_a3.pdf")
-    plans = kinetostat.plans.build(variants.variant(1, "479").mechanism(), at=150.0)
+    from kinetostat.plans.a3 import one_sheet
+    plans = one_sheet(variants.variant(1, "479").mechanism(), 150.0, "uk").plans
     from kinetostat.plans.draw import scale_text, scales_of
     from kinetostat.plans.symbols import plain
     for kind in ("group:2,3", "crank", "lever"):

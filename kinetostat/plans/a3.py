@@ -10,12 +10,13 @@ plans' extents (drawing, labels and a heading: title, then every scale the plan 
 placed inside the frame, clear of the title block and the notes above it, never turned
 (`layout`): in the texts' order (`texts_rank`: positions, mechanism, velocities, accelerations,
 each group's plan and force polygon, the initial link, the lever; each right of or below every
-plan before it) where that fits, else packed (maximal rectangles, several rules and orders) and
+plan before it; found depth first over the corners) where that fits, else packed (maximal rectangles, several rules and orders) and
 the notes say so. The title block is GOST 2.104's form 1 (185 x 55 mm: roles, designation, name,
 μ_l as its ratio, sheet and sheets; names and signatures left blank); the notes state the scales
 and each one whose reference is drawn outside the guide's recommended length. Where the plans at the texts' scales do not fit one sheet, `one_sheet`
 chooses the variant's scales together for it: velocity, acceleration and force scales a round
-step coarser first, μ_l only where they cannot make room; the title block and the key name each
+step coarser first, μ_l only where they cannot make room; where they fit only packed, the first
+three coarser (at that μ_l) until they fit in the texts' order, if they can; the title block and the key name each
 scale made coarser than the rule, and why. Where no choice fits them, further sheets take the
 rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
@@ -37,8 +38,8 @@ from .i18n import LANGS, num, text
 from .pdf import text_width
 from .scales import TARGET_MM
 
-__all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
-           "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM"]
+__all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "placed_in_order", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
+           "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM", "IN_ORDER_TRIES"]
 
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
 #: (left 20 mm for binding, 5 mm elsewhere) below the sheet's title line.
@@ -52,7 +53,7 @@ _NOTE_STEP = 3.1                            # between the notes' lines (2.5 mm t
 #: A plan's heading above its drawing (its title, 3.5 mm, then its scales, 3 mm) is broken into
 #: lines no wider than the drawing, or than this where the drawing is narrower, mm.
 MIN_HEADING_MM = 50.0
-_GAP = 4.0                                  # between two drawings, mm
+_GAP = 3.0                                  # between two drawings, mm
 
 
 @dataclass(frozen=True)
@@ -238,6 +239,16 @@ def in_texts_order(kinds: list[str], boxes: list[tuple]) -> bool:
     return all(_after(b, a) for i, (_, b) in enumerate(ranked) for _, a in ranked[:i])
 
 
+def placed_in_order(drawings: list[Drawing], places: list[Placement]) -> bool:
+    """Whether the drawings, placed (`layout`), are all on one page in the texts' order
+    (`in_texts_order` of their boxes with headings)."""
+    boxes = []
+    for d, p in zip(drawings, places):
+        w, h, top = _size(d)
+        boxes.append((d.box[0] + p.dx, d.box[1] + p.dy - top, d.box[0] + p.dx + w, d.box[1] + p.dy - top + h))
+    return all(p.page == 0 for p in places) and in_texts_order([d.kind for d in drawings], boxes)
+
+
 def _split(free: list, box: tuple) -> None:
     """The free rectangles split around `box` (x0, y0, x1, y1), those inside another dropped (in place)."""
     bx0, by0, bx1, by1 = box
@@ -267,24 +278,18 @@ def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float]
     return x, y
 
 
-def _place_after(free: list, w: float, h: float, placed: list, rule) -> tuple[float, float] | None:
-    """Where a box w x h goes inside one free rectangle, right of or below every box `placed`
-    (grown by the gap, `_after`): of the corners made by a free rectangle's edges and the placed
-    boxes' right and bottom edges, the least by `rule` (READING); None where none is free. The free
-    rectangles are split around it."""
-    spots = []
+def _place_after(free: list, w: float, h: float, placed: list, rule) -> list[tuple[float, float]]:
+    """Where a box w x h may go inside one free rectangle, right of or below every box `placed`
+    (grown by the gap, `_after`): the corners made by a free rectangle's edges and the placed
+    boxes' right and bottom edges, least by `rule` (READING) first; none where none is free."""
+    spots = set()
     for fx, fy, fx1, fy1 in free:
         for x in {fx, *(b[2] for b in placed if fx < b[2] <= fx1 - w + 1e-9)}:
             for y in {fy, *(b[3] for b in placed if fy < b[3] <= fy1 - h + 1e-9)}:
                 box = (x, y, x + w, y + h)
                 if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and all(_after(box, b) for b in placed):
-                    spots.append((rule(x, y), x, y))
-    if not spots:
-        return None
-    _, x, y = min(spots)
-    _split(free, (x, y, x + w, y + h))
-    placed.append((x, y, x + w, y + h))
-    return x, y
+                    spots.add((rule(x, y), x, y))
+    return [(x, y) for _, x, y in sorted(spots)]
 
 
 #: The orders the packing tries (where the texts' order does not fit), each a key of a (width,
@@ -311,16 +316,35 @@ def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule) -> di
     return out
 
 
+#: The most corners `_in_order` tries for one layout (its first tries are the greedy's: each box
+#: at the least corner by the rule; the others where a later box finds none).
+IN_ORDER_TRIES = 2000
+
+
 def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule) -> dict[int, tuple[int, float, float]] | None:
     """Each box (in `order`, the texts') at (0, x, y) on one page, each right of or below every
-    box before it (`_place_after` by `rule`); None where one does not fit."""
-    free, placed, out = _free(_GAP), [], {}
-    for i in order:
-        spot = _place_after(free, sizes[i][0] + _GAP, sizes[i][1] + _GAP, placed, rule)
-        if spot is None:
-            return None
-        out[i] = (0, *spot)
-    return out
+    box before it: at a corner of `_place_after` by `rule`, the next corner where the boxes after
+    it find no room (depth first, IN_ORDER_TRIES corners at most); None where none is found."""
+    left = IN_ORDER_TRIES
+    out: dict[int, tuple[int, float, float]] = {}
+
+    def fill(k: int, free: list, placed: list) -> bool:
+        nonlocal left
+        if k == len(order):
+            return True
+        i = order[k]
+        w, h = sizes[i][0] + _GAP, sizes[i][1] + _GAP
+        for x, y in _place_after(free, w, h, placed, rule):
+            left -= 1
+            if left < 0:
+                return False
+            rest = list(free)
+            _split(rest, (x, y, x + w, y + h))
+            if fill(k + 1, rest, [*placed, (x, y, x + w, y + h)]):
+                out[i] = (0, x, y)
+                return True
+        return False
+    return out if fill(0, _free(_GAP), []) else None
 
 
 def layout(drawings: list[Drawing]) -> list[Placement]:
@@ -447,6 +471,8 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     tried: dict[tuple | None, tuple] = {}
 
     def attempt(given: Mapping[str, float] | None):
+        """(plans, their drawings in `lang`, placements, on one page in every language, and in the
+        texts' order in every language) at the scales `given` (None: the texts' rule)."""
         key = None if given is None else tuple(sorted(given.items()))
         if key not in tried:                     # the searches below come back to scales tried before
             if given is None:                    # the texts' rule: its μ_l is not known before
@@ -456,48 +482,67 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
                 plans = build(mech, at=at, scales=given, starting_deg=pos.start, positions=pos)
             ds = drawings(plans, lang)
             places = layout(ds)
-            fit = all(p.page == 0 for p in places) and all(
-                all(p.page == 0 for p in layout(drawings(plans, lg))) for lg in LANGS if lg != lang)
-            tried[key] = plans, ds, places, fit
+            fit, ordered = all(p.page == 0 for p in places), placed_in_order(ds, places)
+            for lg in LANGS:
+                if lg != lang and fit:
+                    other = drawings(plans, lg)
+                    there = layout(other)
+                    fit = all(p.page == 0 for p in there)
+                    ordered = ordered and fit and placed_in_order(other, there)
+            tried[key] = plans, ds, places, fit, fit and ordered
         return tried[key]
 
-    plans, ds, places, fit = attempt(None)
-    rule = dict(plans.scales)
-    given = {k: s.value for k, s in rule.items()}
+    rule = dict(attempt(None)[0].scales)
     coarsest = {}                                # each scale of FIRST as coarse as its floor allows
     for k in FIRST:
-        coarsest[k] = given[k]
+        coarsest[k] = rule[k].value
         while reference[k] / next_coarser(coarsest[k]) >= FLOOR_MM[k]:
             coarsest[k] = next_coarser(coarsest[k])
-    for _ in range(_TRIES):                      # μ_l: the finest at which they fit, the others at their floor
-        if fit or attempt({**given, **coarsest})[3]:
-            break
-        given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
-    steps: dict[str, list[float]] = {k: [] for k in FIRST}       # the values each scale of FIRST left
-    for _ in range(_TRIES):                      # the others from the rule's, the one with most room first
-        if fit:
-            break
-        room = dict.fromkeys(FIRST, 0.0)
-        for d in ds:
-            sym = plans[d.kind].scale.symbol
-            if sym in room:
-                w, h, _ = _size(d)
-                room[sym] += w * h
-        open_ = [k for k in FIRST if room[k] and given[k] < coarsest[k] * (1 - 1e-9)]
-        if open_:
-            k = max(open_, key=lambda k: (room[k], -FIRST.index(k)))
-            steps[k].append(given[k])
-            given[k] = next_coarser(given[k])
-        else:                                    # (only where the search above ran out of tries)
-            given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
-        plans, ds, places, fit = attempt(given)
-    for k in FIRST:                              # back towards the rule while they still fit
-        while fit and steps[k]:
-            trial = attempt({**given, k: steps[k][-1]})
-            if not trial[3]:
+
+    def search(good: int, mu_l: float = np.inf):
+        """The scales by the rule above at which the try's flag `good` holds (3: one sheet; 4: one
+        sheet in the texts' order), μ_l no coarser than `mu_l`; else the last try."""
+        trial = attempt(None)
+        given = {k: s.value for k, s in rule.items()}
+        for _ in range(_TRIES):                  # μ_l: the finest at which they fit, the others at their floor
+            if trial[good] or attempt({**given, **coarsest})[good] or given["mu_l"] >= mu_l * (1 - 1e-9):
                 break
-            given[k] = steps[k].pop()
-            plans, ds, places, fit = trial
+            given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
+        steps: dict[str, list[float]] = {k: [] for k in FIRST}   # the values each scale of FIRST left
+        for _ in range(_TRIES):                  # the others from the rule's, the one with most room first
+            if trial[good]:
+                break
+            plans, ds = trial[:2]
+            room = dict.fromkeys(FIRST, 0.0)
+            for d in ds:
+                sym = plans[d.kind].scale.symbol
+                if sym in room:
+                    w, h, _ = _size(d)
+                    room[sym] += w * h
+            open_ = [k for k in FIRST if room[k] and given[k] < coarsest[k] * (1 - 1e-9)]
+            if open_:
+                k = max(open_, key=lambda k: (room[k], -FIRST.index(k)))
+                steps[k].append(given[k])
+                given[k] = next_coarser(given[k])
+            elif given["mu_l"] < mu_l * (1 - 1e-9):  # (only where the search above ran out of tries)
+                given["mu_l"] = next_coarser(given["mu_l"], LENGTH_MANTISSAS)
+            else:
+                break
+            trial = attempt(given)
+        for k in FIRST:                          # back towards the rule while they still fit
+            while trial[good] and steps[k]:
+                finer = attempt({**given, k: steps[k][-1]})
+                if not finer[good]:
+                    break
+                given[k] = steps[k].pop()
+                trial = finer
+        return trial
+
+    trial = search(3)
+    if trial[3] and not trial[4]:                # the texts' order bought with μ_v, μ_a, μ_F, not μ_l
+        ordered = search(4, trial[0].scales["mu_l"].value)
+        trial = ordered if ordered[4] else trial
+    plans, ds, places = trial[:3]
     return OneSheet(plans, lang, tuple(ds), tuple(places), MappingProxyType(rule), MappingProxyType(reference),
                     MappingProxyType({k: sheets[(k, *(s.value for s in scales_of(plans[k])))] for k in plans}))
 
@@ -628,11 +673,7 @@ def pages(sheet: OneSheet, title: str) -> list[Page]:
     from ..model.lettering import lettering
     lang, drawings, places = sheet.lang, sheet.drawings, sheet.places
     n = max(p.page for p in places) + 1
-    boxes = []
-    for d, p in zip(drawings, places):
-        w, h, top = _size(d)
-        boxes.append((d.box[0] + p.dx, d.box[1] + p.dy - top, d.box[0] + p.dx + w, d.box[1] + p.dy - top + h))
-    ordered = n == 1 and in_texts_order([d.kind for d in drawings], boxes)
+    ordered = placed_in_order(drawings, places)
     mech = sheet.plans.mech
     name = lettering(mech).name(lang, mech.name)
     parts = [([], [], [], [], []) for _ in range(n)]           # lines, polylines, polygons, dots, texts
