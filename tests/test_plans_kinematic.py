@@ -100,7 +100,7 @@ def test_every_segment_is_the_exact_value(path):
         assert checked >= 4
         vel = plans["velocity"]
         for s in vel.segments:
-            if s.start != "p":          # a relative vector closes the triangle p-x, x-y, p-y
+            if s.start != "p" and s.unit:   # a relative vector closes the triangle p-x, x-y, p-y
                 pa, pb = vel.points[s.start], vel.points[s.end]
                 largest = max(abs(pa), abs(pb), abs(pb - pa))
                 rel = (s.value / vel.scale.value) * (pb - pa) / abs(pb - pa) if abs(pb - pa) else 0
