@@ -233,15 +233,17 @@ def _t(x: float, y: float, s: str, size: float, anchor: str = "start", weight: s
 
 
 def _wrap(s: str, size: float, width: float) -> list[str]:
-    """`s` broken at spaces into lines no wider than `width` mm at `size` (a longer word alone)."""
-    out, line = [], ""
+    """`s` broken at spaces into lines no wider than `width` mm at `size` (a longer word alone);
+    a line's width the sum of its words' and spaces' (a symbol's mark never holds a space)."""
+    out, line, used = [], "", 0.0
+    space = text_width(" ", size)
     for word in s.split(" "):
-        trial = f"{line} {word}" if line else word
-        if line and text_width(plain(trial), size) > width:
+        w = text_width(plain(word), size)
+        if line and used + space + w > width:
             out.append(line)
-            line = word
+            line, used = word, w
         else:
-            line = trial
+            line, used = (f"{line} {word}", used + space + w) if line else (word, w)
     return out + [line] if line else out
 
 

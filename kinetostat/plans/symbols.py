@@ -90,6 +90,7 @@ def mark(name: str) -> str:
     return f"{_OPEN}{name}{_CLOSE}"
 
 
+@lru_cache(maxsize=16384)
 def text_runs(s: str) -> tuple[tuple[str, int], ...]:
     """A text as (text, level) runs: its marked names and its words with "_" or "^" by `runs`, the
     rest on the baseline."""
