@@ -192,3 +192,15 @@ def _labels_clear(seed: int, n: int) -> None:
             over = _over(box[:, None], other)
             assert not over.any(), (j, np.argwhere(over))
         placed.append(box)
+
+
+def test_clear_tells_a_box_that_meets_a_hard_obstacle_at_its_angle():
+    """`Placer.clear` (the page's notes of every angle shown only where clear): a box over an
+    arrowhead at its angle is not clear, the same box at an angle where the arrowhead is elsewhere
+    is; a box 0.2 mm off it is clear (meeting counts, not the labels' PAD); NaN is not clear."""
+    pl = Placer(3, (0.0, 0.0, 100.0, 100.0))
+    pl.block(np.array([[10.0, 10.0, 12.0, 12.0], [50.0, 50.0, 52.0, 52.0], [10.0, 10.0, 12.0, 12.0]]))
+    over = np.array([11.0, 11.0, 20.0, 14.0])
+    assert pl.clear(np.array([over, over, [np.nan] * 4])).tolist() == [False, True, False]
+    beside = np.array([12.2, 10.0, 20.0, 12.0])
+    assert pl.clear(np.array([beside] * 3)).tolist() == [True, True, True]

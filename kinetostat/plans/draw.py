@@ -38,8 +38,8 @@ from .._text import xml_escape as escape     # also control characters, which XM
 from .core import ELEMENTS, ROLES, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle, role_of
 from .forces import arm_name
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
-from .labels import ASCENT, MIN_TEXT_MM, Placer, coincident, label_markup, markup, text_width
-from .symbols import SUB, mark, plain, runs, text_runs
+from .labels import ASCENT, DESCENT, MIN_TEXT_MM, Placer, coincident, label_markup, markup, text_width
+from .symbols import SUB, SUB_DROP, mark, plain, runs, text_runs
 from ..model.lettering import in_lang
 
 __all__ = ["drawing", "sheet", "svg", "language_part", "figure", "title_of", "scale_text", "scales_of", "fits", "style", "LANGS",
@@ -442,12 +442,13 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float
 
 
 def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
-                 where: tuple[float, float, float], bottom: float) -> list[Element]:
+                 where: tuple[float, float, float], bottom: float, placer: Placer) -> list[Element]:
     """The notes of every angle (`_note_lines` without amounts: the results and the tiny vectors'
     numbers change with every angle, the page's values table holds them) as lines of text at
     `where` (x, first baseline, width; `_notes_block`), as many as fit above `bottom` (the legend's top):
     line k shows the k-th line of each angle's notes where it has one (its texts once, an index
-    per angle). Each distinct make-up of notes (the plan's notes, tiny vectors, accuracy,
+    per angle) and where it is clear of the plan's arrowheads, points and letters (`placer`: the
+    plan of an angle may reach into the notes' room where the cycle's is larger than the room). Each distinct make-up of notes (the plan's notes, tiny vectors, accuracy,
     equation) read and wrapped once, of the plan cut to its tiny vectors."""
     x, y, width = where
     room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
@@ -472,9 +473,13 @@ def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
         per_angle.append(known[key])
     out = []
     for k in range(max(map(len, per_angle), default=0)):
-        has = np.array([k < len(lines) for lines in per_angle])
         texts, variant = _variants([lines[k] if k < len(lines) else "" for lines in per_angle])
-        e = _text_element(x, y + k * _LINE_STEP, texts, variant, _NOTE_MM, cls="note")
+        base = y + k * _LINE_STEP
+        w = np.array([text_width(plain(t), _NOTE_MM) for t in texts])[variant]
+        box = np.column_stack([np.full(cycle.n, x), np.full(cycle.n, base - ASCENT * _NOTE_MM), x + w,
+                               np.full(cycle.n, base + (SUB_DROP + DESCENT) * _NOTE_MM)])
+        has = np.array([k < len(lines) for lines in per_angle]) & placer.clear(box)
+        e = _text_element(x, base, texts, variant, _NOTE_MM, cls="note")
         out.append(Element("text", np.where(has[:, None, None], e.xy, np.nan), e.attrs, texts=e.texts, variant=e.variant))
     return out
 
@@ -878,7 +883,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     dots, points = _points(cycle, at, placer)
     elements += dots + _labels(placer, points + names)
     if cycle_notes:
-        elements += _cycle_notes(cycle, lang, tiny, where, key[1])
+        elements += _cycle_notes(cycle, lang, tiny, where, key[1], placer)
     title = _title_block(cycle, lang, mechanism)
     W, H = SHEET_MM
     x0, y0, x1, y1 = _TITLE_BLOCK

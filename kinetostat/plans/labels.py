@@ -364,6 +364,18 @@ class Placer:
         self.block(box)
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
+    def clear(self, box: np.ndarray) -> np.ndarray:
+        """Whether each box (N, 4) is clear of every hard obstacle (arrowheads, points, line ends,
+        labels placed) at its angle, (N,): meets none (not: keeps PAD from them, as a label placed
+        does); False where the box is NaN."""
+        box = np.asarray(box, dtype=float) + np.array([self.PAD, self.PAD, -self.PAD, -self.PAD])
+        ok = np.isfinite(box).all(axis=1)
+        centre = np.where(ok[:, None], (box[:, :2] + box[:, 2:]) / 2, 0.0)
+        half = np.where(ok[:, None], (box[:, 2:] - box[:, :2]) / 2, 0.0)
+        cost = self._costs(centre.T[:, :, None].astype(np.float32), half.T.astype(np.float32),
+                           np.where(ok, 0.0, np.inf)[:, None], np.arange(self.n), (True, False), ("hard",))
+        return np.isfinite(cost[:, 0])
+
     def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: tuple[bool, ...],
                kinds: tuple[str, ...] = ("hard", "soft")) -> np.ndarray:
         """Costs c (n', B) of the boxes centred at p (2, n', B), half size h (2, n'), at the angles
