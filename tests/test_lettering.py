@@ -163,3 +163,20 @@ def test_the_how_to_states_the_drawing_ratio_of_its_length_scale():
     assert pairs
     for mu, ratio in pairs:
         assert float(ratio) == pytest.approx(float(mu) * 1000.0)
+
+
+@pytest.mark.parametrize("name", ["Кривошипно-повзунний механізм ДВЗ",
+                                  "Двотактний ДВЗ з протилежними циліндрами транспортної силової установки "
+                                  "(Логвіненко, Надтока 2021, задача 2, варіант 479)"])
+def test_the_mechanisms_name_stays_inside_the_title_block(ice30, name):
+    """The title block (185 mm, its texts from 3 mm in): the mechanism's name, at 2.5 mm capitals
+    at least, in one line where it fits, else in two (was: one line at the least size, running
+    20 mm past the frame on task 2's sheets); every text of the block within it."""
+    sheet = svg(ice30["crank"], "uk", mechanism=name)
+    found = [(x, re.search(r'font-size="([0-9.]+)"', attrs).group(1), ident, body) for x, attrs, ident, body in
+             re.findall(r'<text x="([0-9.]+)"([^>]*id="(mechanism(?:-2)?)"[^>]*)>(.*?)</text>', sheet)]
+    assert [f[2] for f in found] == (["mechanism"] if len(name) < 60 else ["mechanism", "mechanism-2"]), found
+    assert " ".join(re.sub(r"<[^>]*>", "", f[3]) for f in found) == name
+    for x, size, _, body in found:
+        assert float(size) >= MIN_TEXT_MM
+        assert float(x) + text_width(re.sub(r"<[^>]*>", "", body), float(size)) <= 415.0 - 1.0       # the frame, less 1 mm

@@ -509,9 +509,21 @@ def _title_block(cycle: PlanCycle, lang: str, mechanism: str) -> list[Element]:
     sc = f"{text('scale' if len(scales) == 1 else 'scales', lang)}: " + "; ".join(scale_text(s, lang) for s in scales)
     return [_text_element(x0 + 3, y0 + 8, titles, tv, min(_fit(t, 5.0, w) for t in titles), weight="bold", cls="title"),
             _text_element(x0 + 3, y0 + 19.5, [sc], [0], _fit(sc, 4.5, w), ident="scale", cls="title"),
-            _text_element(x0 + 3, y0 + 30, [mechanism], [0], _fit(mechanism, MIN_TEXT_MM, w), ident="mechanism", cls="title"),
-            _text_element(x0 + 3, y0 + 36, angles, av, MIN_TEXT_MM, cls="title"),
+            *_mechanism_lines(mechanism, x0 + 3, y0, w),
+            _text_element(x0 + 3, y0 + 36.3, angles, av, MIN_TEXT_MM, cls="title"),
             _text_element(x0 + 3, y0 + 42, [text("sheet", lang)], [0], MIN_TEXT_MM, cls="title")]
+
+
+def _mechanism_lines(mechanism: str, x: float, y0: float, w: float) -> list[Element]:
+    """The mechanism's name in the title block (top `y0`, `w` mm wide): one line at y0 + 30 where it
+    fits at MIN_TEXT_MM (at most 3.5 mm), else broken in two lines at y0 + 27.9 and y0 + 31.9
+    (the second "mechanism-2"), each fit to the width, none under MIN_TEXT_MM."""
+    lines = _wrap(mechanism, MIN_TEXT_MM, w) if text_width(plain(mechanism), MIN_TEXT_MM) > w else [mechanism]
+    if len(lines) < 2:
+        return [_text_element(x, y0 + 30, [mechanism], [0], _fit(mechanism, MIN_TEXT_MM, w), ident="mechanism", cls="title")]
+    first, rest = lines[0], " ".join(lines[1:])
+    return [_text_element(x, y0 + 27.9, [first], [0], _fit(first, MIN_TEXT_MM, w), ident="mechanism", cls="title"),
+            _text_element(x, y0 + 31.9, [rest], [0], _fit(rest, MIN_TEXT_MM, w), ident="mechanism-2", cls="title")]
 
 
 def _arrowhead(a: np.ndarray, b: np.ndarray, length: np.ndarray | float,

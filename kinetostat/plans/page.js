@@ -313,7 +313,8 @@
   // A4 cuts the title block and the notes off: at the top instead, the title line and under it the notes, on white
   function a4Title(svg, x0, y0, cut, notes) {
     const NS = "http://www.w3.org/2000/svg", g = document.createElementNS(NS, "g"), t = document.createElementNS(NS, "text");
-    const line = ["#mechanism", 'text.title[font-weight="bold"]', "#scale"].map((q) => svg.querySelector(q));   // name, plan and φ, scale
+    const name = ["#mechanism", "#mechanism-2"].map((q) => svg.querySelector(q)).filter((e) => e);   // in one line or two
+    const line = [...(name.length ? [{textContent: name.map((e) => e.textContent).join(" ")}] : []), ...['text.title[font-weight="bold"]', "#scale"].map((q) => svg.querySelector(q))];   // name, plan and φ, scale
     g.id = "a4-title";
     t.setAttribute("x", x0 + 12); t.setAttribute("y", y0 + 6); t.setAttribute("font-size", "2.8");
     t.textContent = line.filter((e) => e).map((e) => e.textContent).join(" — ");
