@@ -8,8 +8,8 @@ the pack chose them.
 A diagram is laid out once (`layout`: lines, paths, dots and texts in mm from its top left) and
 drawn by both renderers: `draw_pdf` (a `pdf.Canvas`) and `svg` (the HTML sheet).
 
-May use: numpy, `kinetostat.applied` (where a load's diagram is read), `.i18n`, `.scales`. Never
-`kinetostat.variants`, matplotlib or the harness.
+May use: numpy, `kinetostat.applied` (where a load's diagram is read), `.i18n`, `.labels` (a
+text's width), `.scales`, `.symbols`. Never `kinetostat.variants`, matplotlib or the harness.
 """
 from __future__ import annotations
 
@@ -21,7 +21,9 @@ import numpy as np
 
 from ..applied import forward_stroke, load_magnitude, travel
 from .i18n import num, text, unit
+from .labels import text_width
 from .scales import coarser
+from .symbols import plain
 
 __all__ = ["Diagram", "Given", "diagrams", "model_data", "layout", "draw_pdf", "svg", "PLOT_MM", "MPA"]
 
@@ -203,7 +205,7 @@ def layout(d: Diagram):
         dots.append((X(x), Y(y), 0.9))
         lines += [(X(x), Y(y), X(x), Y(0), 0.2, True), (X(x), Y(y), X(0), Y(y), 0.2, True)]
     segments = [pair for pts, _ in paths for pair in zip(pts, pts[1:])] + [((a, b), (c, e)) for a, b, c, e, *_ in lines]
-    drawn = [q for a, b in segments for q in np.linspace(a, b, 2 + int(math.dist(a, b) / 0.5))]    # every 0.5 mm
+    drawn = np.concatenate([np.linspace(a, b, 2 + int(math.dist(a, b) / 0.5)) for a, b in segments])    # every 0.5 mm
     for x, y, label in d.marks:
         texts.append(_place(X(x), Y(y), label, drawn, (X(0), _TOP, x_end, Y(y_lo))))
     return lines, paths, dots, texts
@@ -211,13 +213,15 @@ def layout(d: Diagram):
 
 def _place(x: float, y: float, label: str, drawn, bounds) -> tuple[float, float, str, bool]:
     """The mark's label beside its point (x, y), mm: of the four corners around it, the one inside
-    `bounds` (x0, y0, x1, y1) whose box covers the fewest of the curves' `drawn` points."""
-    width = len(label) * 0.6 * _SIZE
+    `bounds` (x0, y0, x1, y1) whose box (the label's width as DejaVu Sans sets it) covers the fewest
+    of the curves' `drawn` points (K, 2)."""
+    width = text_width(plain(label), _SIZE)
+    px, py = drawn.T
 
     def cost(right: bool, above: bool) -> tuple[float, float]:
         bx = x - 1.8 - width if right else x + 1.8
         by = y - 1.5 - _SIZE if above else y + 1.5
-        inside = sum(bx <= px <= bx + width and by - 0.5 <= py <= by + _SIZE + 0.5 for px, py in drawn)
+        inside = int(np.count_nonzero((bx <= px) & (px <= bx + width) & (by - 0.5 <= py) & (py <= by + _SIZE + 0.5)))
         out = max(bounds[0] - bx, bx + width - bounds[2], 0.0) + max(bounds[1] - by, 0.0)
         return out, inside
 
