@@ -448,45 +448,51 @@ def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
     `where` (x, first baseline, width; `_notes_block`), as many as fit above `bottom` (the legend's top):
     line k shows the k-th line of each angle's notes where it has one (its texts once, an index
     per angle) and where it is clear of the plan's arrowheads, points and letters (`placer`: the
-    plan of an angle may reach into the notes' room where the cycle's is larger than the room). Each distinct make-up of notes (the plan's notes, tiny vectors, accuracy,
-    equation) read and wrapped once, of the plan cut to its tiny vectors."""
+    plan of an angle may reach into the notes' room where the cycle's is larger than the room).
+    The angles grouped by what their notes are made of (the plan's notes, tiny vectors, accuracy,
+    equation) in one pass; each group's notes read and wrapped once, of the plan cut to its tiny
+    vectors."""
     x, y, width = where
     room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
     segments = tuple(s for s in cycle.segments if s.name in tiny)       # all of its drawing the notes read
     light = replace(cycle, points={k: cycle.points[k] for s in segments for k in (s.start, s.end)},
                     segments=segments, paths={}, results=())
-    wrapped: dict[str, list[str]] = {}
-    known: dict[tuple, list[str]] = {}                 # what an angle's notes are made of -> its lines
     drawn = np.array([light.drawn(s) for s in segments], dtype=bool).reshape(len(segments), cycle.n)
-    per_angle = []
-    for j in range(cycle.n):
-        acc = None if cycle.accuracy is None else float(cycle.accuracy[0][j])
-        key = (cycle.notes[j] if cycle.notes else (), tuple(_tiny_at(tiny, j).items()),
-               tuple(drawn[:, j]), acc if acc is not None and acc < cycle.accuracy[1] else None,
-               cycle.equation[j] if cycle.equation and not isinstance(cycle.equation[0], str) else ())
-        if key not in known:
-            notes = _note_lines(light.at(j), lang, _tiny_at(tiny, j), amounts=False)
-            for n in notes:
-                if n not in wrapped:
-                    wrapped[n] = _wrap(n, _NOTE_MM, width)
-            known[key] = [w for n in notes for w in wrapped[n]][:room]
-        per_angle.append(known[key])
+    acc = np.full(cycle.n, -1.0) if cycle.accuracy is None else \
+        np.where(cycle.accuracy[0] < cycle.accuracy[1], cycle.accuracy[0], -1.0)     # stated where below the rule
+    per_angle_equation = cycle.equation and not isinstance(cycle.equation[0], str)
+    keys = np.column_stack([*tiny.values(), drawn.T, acc,                   # what an angle's notes are made of
+                            _variants(list(cycle.notes) if cycle.notes else [()] * cycle.n)[1],
+                            _variants(list(cycle.equation) if per_angle_equation else [()] * cycle.n)[1]])
+    _, first, inverse = np.unique(keys.astype(float), axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first)                          # the groups in the order of their first angle
+    first, inverse = first[order], np.argsort(order)[inverse.reshape(-1)]
+    wrapped: dict[str, list[str]] = {}
+    groups = []                                        # each make-up's lines, read and wrapped once
+    for j in first.tolist():
+        notes = _note_lines(light.at(j), lang, _tiny_at(tiny, j), amounts=False)
+        for n in notes:
+            if n not in wrapped:
+                wrapped[n] = _wrap(n, _NOTE_MM, width)
+        groups.append([w for n in notes for w in wrapped[n]][:room])
     out = []
-    for k in range(max(map(len, per_angle), default=0)):
-        texts, variant = _variants([lines[k] if k < len(lines) else "" for lines in per_angle])
+    for k in range(max(map(len, groups), default=0)):
+        texts, variant = _variants([lines[k] if k < len(lines) else "" for lines in groups])
+        variant = variant[inverse]
         base = y + k * _LINE_STEP
         w = np.array([text_width(plain(t), _NOTE_MM) for t in texts])[variant]
         box = np.column_stack([np.full(cycle.n, x), np.full(cycle.n, base - ASCENT * _NOTE_MM), x + w,
                                np.full(cycle.n, base + (SUB_DROP + DESCENT) * _NOTE_MM)])
-        has = np.array([k < len(lines) for lines in per_angle]) & placer.clear(box)
+        has = np.array([k < len(lines) for lines in groups])[inverse] & placer.clear(box)
         e = _text_element(x, base, texts, variant, _NOTE_MM, cls="note")
         out.append(Element("text", np.where(has[:, None, None], e.xy, np.nan), e.attrs, texts=e.texts, variant=e.variant))
     return out
 
 
-def _variants(strings: list[str]) -> tuple[list[str], np.ndarray]:
-    """Per-angle strings as (the distinct ones, in order of first use; each angle's index (N,))."""
-    index: dict[str, int] = {}
+def _variants(strings: list) -> tuple[list, np.ndarray]:
+    """Per-angle strings (or other hashables) as (the distinct ones, in order of first use; each
+    angle's index (N,))."""
+    index: dict = {}
     variant = np.array([index.setdefault(s, len(index)) for s in strings], dtype=int)
     return list(index), variant
 
