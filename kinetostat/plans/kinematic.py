@@ -34,7 +34,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .core import PlanCycle, Scale, Segment, construction
-from .zero import translates, zero_of
+from .zero import by_pattern, translates, zero_of
 
 __all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
@@ -284,8 +284,8 @@ def _collapsed(mech, pts: dict[str, _Point], segs: list[Segment], n: int) -> tup
     with np.errstate(invalid="ignore"):
         ref = np.max(np.where(np.isfinite(vals), vals, 0.0), axis=0)
         zero = zero_of(vals, ref) & (ref > 0)
-    return tuple(tuple(f"special position: {s.name} = 0, the plan collapses there"
-                       for s, z in zip(segs, zero[:, i]) if z) for i in range(n))
+    return tuple(by_pattern(zero, lambda row: tuple(f"special position: {s.name} = 0, the plan collapses there"
+                                                     for s, z in zip(segs, row) if z)))
 
 
 def _special(mech, res, pts: dict) -> list[tuple[str, int, np.ndarray, list[tuple[str, np.ndarray | None]]]]:

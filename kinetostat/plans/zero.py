@@ -22,7 +22,8 @@ if TYPE_CHECKING:
     from ..analysis import Analysis
     from ..model import Mechanism
 
-__all__ = ["ZERO_REL", "translates", "rates", "zero_omega", "zero_eps", "zero_inertia_force", "zero_of", "zero_notes"]
+__all__ = ["ZERO_REL", "translates", "rates", "zero_omega", "zero_eps", "zero_inertia_force", "zero_of", "zero_notes",
+           "by_pattern"]
 
 #: A quantity at most this fraction of its reference (`rates`) is zero: not drawn.
 ZERO_REL = 1e-9
@@ -72,14 +73,25 @@ def zero_inertia_force(mech: "Mechanism", res: "Analysis", k: int) -> np.ndarray
     return zero_of(np.hypot(F[:, 0], F[:, 1]), mech.links[k].mass * rates(res)[1] * mech.size)
 
 
+def by_pattern(where: np.ndarray, make) -> list:
+    """`make(row)` of each angle's column of `where` (Q, N) bool, made once for each distinct
+    column: a per-angle note from which quantities are zero there, without a loop over the angles."""
+    patterns, inverse = np.unique(np.asarray(where, dtype=bool).T, axis=0, return_inverse=True)
+    made = [make(p) for p in patterns]
+    return [made[i] for i in inverse.reshape(-1)]
+
+
 def zero_notes(zeros: dict[str, tuple[np.ndarray, str]], n: int) -> list[tuple[str, ...]]:
     """The notes of each of n angles on the quantities not drawn there: name -> ((N,) bool where
     zero, why: "" for "at this angle", else e.g. "link 5 translates"); one line per reason."""
-    out = []
-    for i in range(n):
+    if not zeros:
+        return [()] * n
+    items = list(zeros.items())
+
+    def notes(row: np.ndarray) -> tuple[str, ...]:
         by_why: dict[str, list[str]] = {}
-        for name, (where, why) in zeros.items():
-            if where[i]:
+        for (name, (_, why)), z in zip(items, row):
+            if z:
                 by_why.setdefault(why, []).append(f"{name} = 0")
-        out.append(tuple(f"{', '.join(names)} ({why or 'at this angle'}): not drawn" for why, names in by_why.items()))
-    return out
+        return tuple(f"{', '.join(names)} ({why or 'at this angle'}): not drawn" for why, names in by_why.items())
+    return by_pattern(np.stack([np.broadcast_to(where, (n,)) for where, _ in zeros.values()]), notes)
