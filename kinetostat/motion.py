@@ -126,6 +126,7 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
         change = float(np.abs(new.at(cycle.angles) - speed.at(cycle.angles)).max()) / level
         speed = new
         if not varying or change <= SPEED_TOL:
+            change = change if varying else 0.0     # the loads do not depend on the motion: exact at once
             break
         if passes >= MAX_PASSES:
             raise ValueError(f"law_of_motion: the speed-dependent loads' fixed point did not settle in {MAX_PASSES} "
