@@ -34,12 +34,9 @@ GAUSS_NODES = 4
 #: M(omega)) stops when omega changes by less than this, relative to omega_mean, between passes.
 SPEED_TOL = 1e-12
 #: A continuous extreme's angle is refined on the exact energy equation until it moves less than
-#: this, deg, or for at most REFINE_PASSES evaluations.
+#: this, deg, or for at most REFINE_PASSES solves (each one for all the extremes sought together).
 REFINE_DEG = 1e-9
-REFINE_PASSES = 8
-#: Passes of that fixed point before omega changes by less than this (relative) refine the
-#: extremes once only; the later passes to REFINE_DEG.
-ROUGH = 1e-6
+REFINE_PASSES = 12
 #: The most passes of that fixed point before a ValueError says it did not settle.
 MAX_PASSES = 200
 
@@ -95,7 +92,9 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
     crank-angle table. Speed-dependent loads and M(omega): a fixed point over the motion to
     SPEED_TOL (`passes`, `settled`), omega between the grid's angles by the periodic cubic Hermite
     through omega and d omega/d phi = eps/omega. omega_max and omega_min are the continuous
-    curve's: each extreme located on that Hermite and evaluated exactly there. Sizing for delta:
+    curve's: each extreme located on that Hermite, then refined on the exact energy equation, all
+    the extremes sought together, one solve per step (a pass of the fixed point starts from the
+    last pass's angles). Sizing for delta:
     Wittenbauer's tangents at the exact slopes omega_m^2 (1 +- delta/2)^2 / 2 give the exact
     smallest J (0 where the machine alone holds delta)."""
     if not isinstance(mech, Mechanism):
@@ -109,7 +108,7 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
         ld.kind == "damper" or ld.characteristic is not None for ld in mech.loads)
     n = cycle.n
     speed = _Speed(phi_deg, np.full(n, nominal), np.zeros(n), chars)
-    passes, red, change = 0, None, np.inf
+    passes, red, change, seeds = 0, None, np.inf, None
     while True:
         passes += 1
         if red is None or varying:
@@ -117,10 +116,10 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
             _check_work(mech, red, chars)
         M_drive, level, shift = (_characteristic_drive(chars, red, cycle, speed) if chars else
                                  (np.full(len(cycle.angles), -cycle.mean(red.M)), nominal, 0.0))
-        pieces = _Pieces(mech, cycle, red, M_drive, speed, shift,
-                         REFINE_PASSES if not varying or change <= ROUGH else 1)
-        J = J_fly if target is None else _sized(pieces, level, target)
-        T0, top, bottom = _level(pieces, J, level)
+        pieces = _Pieces(mech, cycle, red, M_drive, speed, shift)
+        J, tangents = (J_fly, None) if target is None else _sized(pieces, level, target, seeds)
+        T0, top, bottom, extremes = _level(pieces, J, level, tangents or seeds)
+        seeds = (np.concatenate([extremes[0]] + ([] if tangents is None else [tangents[0]])), None)
         omega = np.sqrt(np.maximum(2 * (T0 + pieces.A) / (J + red.J[:n]), 0.0))
         new = _Speed(phi_deg, omega, _eps(red, M_drive, omega, J, n) / omega, chars)
         change = float(np.abs(new.at(cycle.angles) - speed.at(cycle.angles)).max()) / level
@@ -292,14 +291,16 @@ def at_motion(mech: Mechanism, phi_deg: np.ndarray, omega: np.ndarray, domega: n
               J_flywheel: float) -> Mechanism:
     """`mech` driven by the law omega(phi) (the periodic cubic Hermite through omega and
     d omega/d phi at the uniform cycle `phi_deg`, rad/s and rad/s per rad), with a flywheel of
-    J_flywheel (kg m^2) on the crank about its axis (added to the crank's I_S)."""
+    J_flywheel (kg m^2) on the crank about its axis (added to the crank's I_S). Without a
+    flywheel it keeps a copy of `mech`'s derived data (programs, constants, tracks: the geometry's
+    and the masses', none reads the drive's speed), so that a solve at a motion compiles nothing."""
     law = SpeedLaw(tuple(map(float, phi_deg)), tuple(map(float, omega)), slope=tuple(map(float, domega)))
     drive = replace(mech.drive, law=law, omega=float(np.max(omega)), eps=float(np.abs(omega * domega).max()))
     links = mech.links
     if J_flywheel:
         crank = links[mech.drive.link]
         links = links[:crank.id] + (replace(crank, I_S=crank.I_S + J_flywheel),) + links[crank.id + 1:]
-    return replace(mech, drive=drive, links=links, _derived={})
+    return replace(mech, drive=drive, links=links, _derived={} if J_flywheel else dict(mech._derived))
 
 
 # ------------------------------------------------------------------------------ the motion
@@ -349,16 +350,17 @@ def _root(f, lo: float, step: float, why: str, tol: float = 0.0) -> float:
 
 class _Pieces:
     """The energy equation's terms at the grid (A, J_red and their slopes), and exactly at any
-    other angle: A by Gauss-Legendre from the grid angle below, cut at the table knots."""
+    other angles: A by Gauss-Legendre from the grid angle below, cut at the table knots, all the
+    angles asked for in one solve."""
 
     def __init__(self, mech: Mechanism, cycle: _Cycle, red: _Reduced, M_drive: np.ndarray, speed: _Speed,
-                 shift: float, refine: int):
+                 shift: float):
         n = cycle.n
-        self.refine = refine
         self.mech, self.cycle, self.red, self.speed, self.shift = mech, cycle, red, speed, shift
         self.M_drive = M_drive
         self.phi = cycle.angles[:n]
         self.A = cycle.work(red.M + M_drive)
+        self.A_end = float(cycle.integrals(red.M + M_drive).sum())     # A at 360 deg: the cycle's work
         self.J, self.dJ, self.dA = red.J[:n], red.dJ[:n], (red.M + M_drive)[:n]
 
     def drive_at(self, angles: np.ndarray) -> np.ndarray:
@@ -368,38 +370,45 @@ class _Pieces:
         w = self.speed.at(angles) + self.shift
         return sum((ld.characteristic(w) for ld in self.speed.chars), np.zeros_like(w))
 
+    def grid(self, i: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The terms (A, J_red, dJ_red, dA) at the grid angles of index `i` (0..n: n is 360 deg)."""
+        k = i % len(self.phi)
+        return np.where(i < len(self.phi), self.A[k], self.A_end), self.J[k], self.dJ[k], self.dA[k]
+
     def exact(self, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """A (J), J_red (kg m^2), dJ_red (kg m^2/rad) and dA = M_red + M_drive (N m) at the angles
-        `at` (deg, in [0, 360))."""
+        `at` (deg, in [0, 360)): one solve at them and at the Gauss nodes from the grid angle
+        below each (the knots between them cut the interval)."""
         if not len(at):
             return np.empty(0), np.empty(0), np.empty(0), np.empty(0)
         i = np.clip(np.searchsorted(self.phi, at, side="right") - 1, 0, len(self.phi) - 1)
+        a, knots = self.phi[i], self.cycle.knots
+        first = np.searchsorted(knots, a, side="right")
+        count = np.searchsorted(knots, at, side="left") - first
+        r = np.arange(count.max(initial=0))
+        cuts = np.where(r < count[:, None], knots[np.minimum(first[:, None] + r, len(knots) - 1)] if len(knots)
+                        else at[:, None], at[:, None])
+        edges = np.column_stack([a, cuts, at])             # (m, K + 2): padded with `at` (empty pieces)
+        lo, hi = edges[:, :-1, None], edges[:, 1:, None]
         x, w = np.polynomial.legendre.leggauss(GAUSS_NODES)
-        nodes, weights, owner = [], [], []
-        for q, (a, b) in enumerate(zip(self.phi[i], at)):       # the few points located, not the grid
-            cuts = self.cycle.knots[(self.cycle.knots > a) & (self.cycle.knots < b)]
-            edges = np.concatenate([[a], cuts, [b]])
-            lo, hi = edges[:-1], edges[1:]
-            nodes.append((0.5 * (lo + hi)[:, None] + 0.5 * (hi - lo)[:, None] * x).ravel())
-            weights.append((np.radians(0.5 * (hi - lo))[:, None] * w).ravel())
-            owner.append(np.full(nodes[-1].size, q))
-        nodes, weights, owner = np.concatenate(nodes), np.concatenate(weights), np.concatenate(owner)
-        red = _reduced(self.mech, np.concatenate([at, nodes]), self.speed)
+        nodes = (0.5 * (lo + hi) + 0.5 * (hi - lo) * x).reshape(len(at), -1)
+        weights = (np.radians(0.5 * (hi - lo)) * w).reshape(len(at), -1)
+        red = _reduced(self.mech, np.concatenate([at, nodes.ravel()]), self.speed)
         k = len(at)
-        f = red.M[k:] + self.drive_at(nodes)
-        return (self.A[i] + np.bincount(owner, weights * f, minlength=k), red.J[:k], red.dJ[:k],
-                red.M[:k] + self.drive_at(at))
+        f = (red.M[k:] + self.drive_at(nodes.ravel())).reshape(nodes.shape)
+        return self.A[i] + (weights * f).sum(axis=1), red.J[:k], red.dJ[:k], red.M[:k] + self.drive_at(at)
 
-    def locate(self, y: np.ndarray, dy: np.ndarray, most: int = 6) -> np.ndarray:
+    def locate(self, y: np.ndarray, dy: np.ndarray, most: int = 6) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The angles (deg) of the `most` largest local maxima of the periodic cubic Hermite
-        through the values `y` and slopes `dy` (per rad) at the grid, each inside its grid step."""
+        through the values `y` and slopes `dy` (per rad) at the grid, and the indices of the grid
+        angles a and a + 1 of the step each lies in (a + 1 = n: 360 deg)."""
         n, phi = len(y), self.phi
         peak = np.flatnonzero((y >= np.roll(y, 1)) & (y >= np.roll(y, -1)))
         peak = peak[np.argsort(-y[peak])][:most]
         a = np.where(dy[peak] > 0, peak, peak - 1) % n           # the step the maximum lies in
-        b = (a + 1) % n
-        h = np.radians(np.where(b > a, phi[b] - phi[a], phi[b] + 360.0 - phi[a]))
-        y0, y1, d0, d1 = y[a], y[b], dy[a] * h, dy[b] * h
+        b = a + 1
+        h = np.radians(np.where(b < n, phi[b % n], 360.0) - phi[a])
+        y0, y1, d0, d1 = y[a], y[b % n], dy[a] * h, dy[b % n] * h
         # h p'(s) = c2 s^2 + c1 s + c0 on s in [0, 1]
         c2, c1, c0 = 6 * (y0 - y1) + 3 * d0 + 3 * d1, -6 * (y0 - y1) - 4 * d0 - 2 * d1, d0
         with np.errstate(all="ignore"):
@@ -409,79 +418,141 @@ class _Pieces:
         h00, h10, h01, h11 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2, s * s * (3 - 2 * s), s * s * (s - 1)
         value = np.where(np.isnan(s), -np.inf, h00 * y0 + h10 * d0 + h01 * y1 + h11 * d1)
         best = np.nan_to_num(np.take_along_axis(s, np.argmax(value, axis=0)[None], 0)[0], nan=0.0)
-        return phi[a] + np.degrees(best * h), phi[a], phi[a] + np.degrees(h)
+        return phi[a] + np.degrees(best * h), a, b
 
-    def peaks(self, y: np.ndarray, dy: np.ndarray, slope, most: int = 6) -> tuple[np.ndarray, tuple]:
-        """The angles (deg) of the local maxima of a function of the energy equation's terms,
-        given at the grid as values `y` and slopes `dy`, and its terms exactly there (`exact`):
-        each located on the Hermite (`locate`), then by regula falsi (Illinois) on the exact slope
-        `slope(A, J_red, dJ_red, dA)` within its grid step, to REFINE_DEG."""
-        x, lo, hi = self.locate(y, dy, most)
-        g_lo, g_hi = np.ones_like(x), -np.ones_like(x)        # the slope's signs at the ends of a maximum
-        terms = self.exact(np.mod(x, 360.0))
-        for _ in range(self.refine):
-            g = slope(*terms)
-            up = g > 0
-            moved = x.copy()
-            lo, hi = np.where(up, x, lo), np.where(up, hi, x)
-            g_lo, g_hi = np.where(up, g, g_lo * np.where(up, 1.0, 0.5)), np.where(up, g_hi * 0.5, g)
-            with np.errstate(all="ignore"):
-                x = np.where(g == 0, x, lo + (hi - lo) * g_lo / (g_lo - g_hi))
-            x = np.where(np.isfinite(x), x, 0.5 * (lo + hi))
-            terms = self.exact(np.mod(x, 360.0))
-            if np.abs(x - moved).max(initial=0.0) <= REFINE_DEG:
-                break
-        return np.mod(x, 360.0), terms
 
-    def sup(self, k: float, sign: float) -> tuple[float, float]:
-        """The largest of sign (A - k J_red) over the continuous cycle, J, and its angle (deg):
-        the grid's, and each local maximum located (`locate`) and evaluated exactly."""
-        at, (A, J, _, _) = self.peaks(sign * (self.A - k * self.J), sign * (self.dA - k * self.dJ),
-                                      lambda A, J, dJ, dA: sign * (dA - k * dJ))
-        values = sign * np.concatenate([self.A - k * self.J, A - k * J])
+#: A function of the energy equation's terms to maximise: its values and slopes (per rad) at the
+#: grid, its exact slope as a function of the terms (A, J_red, dJ_red, dA) at any angles, and how
+#: many of its largest local maxima to refine.
+Objective = tuple
+
+
+def _refine(pieces: _Pieces, objectives: list, seeds: tuple | None = None, after=None) -> list[tuple]:
+    """The local maxima of every objective (`Objective`), each located on the grid's Hermite
+    (`locate`; or at a seed angle in its grid step: `seeds` = (angles, terms there or None)),
+    then all of them together by the secant on the exact slope, kept inside the step (else
+    regula falsi), to REFINE_DEG: one solve per step for all. `after(terms)` is called with the
+    terms at every candidate after each solve (a caller's parameters the slopes read).
+    Returns per objective (angles deg in [0, 360), terms there)."""
+    located = [pieces.locate(y, dy, most) for y, dy, _, most in objectives]
+    x = np.concatenate([np.asarray(p[0], float) for p in located])
+    a, b = (np.concatenate([p[k] for p in located]) for k in (1, 2))
+    owner = np.concatenate([np.full(len(p[0]), q) for q, p in enumerate(located)])
+    lo, hi = pieces.phi[a], np.where(b < len(pieces.phi), pieces.phi[b % len(pieces.phi)], 360.0)
+    T = None
+    if seeds is not None and len(seeds[0]):
+        s = np.asarray(seeds[0], float)
+        inside = (s[None, :] >= lo[:, None]) & (s[None, :] <= hi[:, None])
+        has = inside.any(axis=1)
+        which = np.argmax(inside, axis=1)
+        x = np.where(has, s[which], x)
+        if seeds[1] is not None and has.all():
+            T = tuple(t[which] for t in seeds[1])
+    T = pieces.exact(np.mod(x, 360.0)) if T is None else T
+    T_lo, T_hi = pieces.grid(a), pieces.grid(b)
+
+    def slope(terms) -> np.ndarray:
+        out = np.empty(len(owner))
+        for q, obj in enumerate(objectives):
+            m = owner == q
+            out[m] = obj[2](*(t[m] for t in terms))
+        return out
+
+    def pick(mask, t1, t2):
+        return tuple(np.where(mask, u, v) for u, v in zip(t1, t2))
+
+    prev = None
+    for _ in range(REFINE_PASSES):
+        if after is not None:
+            after(T)
+        g, g_lo, g_hi = slope(T), slope(T_lo), slope(T_hi)
+        up = g > 0                                  # a maximum: the slope falls through 0
+        lo, T_lo, g_lo = np.where(up, x, lo), pick(up, T, T_lo), np.where(up, g, g_lo)
+        hi, T_hi, g_hi = np.where(up, hi, x), pick(up, T_hi, T), np.where(up, g_hi, g)
+        other, g_other = (np.where(up, hi, lo), np.where(up, g_hi, g_lo)) if prev is None else (prev[0], slope(prev[1]))
+        with np.errstate(all="ignore"):
+            step = x - g * (x - other) / (g - g_other)
+            fall = lo + (hi - lo) * g_lo / (g_lo - g_hi)
+        step = np.where(np.isfinite(step) & (step > lo) & (step < hi), step,
+                        np.where(np.isfinite(fall), fall, 0.5 * (lo + hi)))
+        step = np.where(g == 0, x, step)
+        if np.abs(step - x).max(initial=0.0) <= REFINE_DEG:
+            break
+        prev = (x, T)
+        x, T = step, pieces.exact(np.mod(step, 360.0))
+    else:
+        if after is not None:
+            after(T)
+    x = np.mod(x, 360.0)
+    return [(x[owner == q], tuple(t[owner == q] for t in T)) for q in range(len(objectives))]
+
+
+def _sups(pieces: _Pieces, lines: list[tuple[float, float]], seeds: tuple | None = None) -> tuple[list, tuple]:
+    """For each (k, sign) of `lines`: the largest of sign (A - k J_red) over the continuous cycle
+    (J) and its angle (deg), the grid's and every local maximum refined (`_refine`, together);
+    and the refined angles with the terms there (seeds for later refinements)."""
+    found = _refine(pieces, [(sign * (pieces.A - k * pieces.J), sign * (pieces.dA - k * pieces.dJ),
+                              lambda A, J, dJ, dA, k=k, sign=sign: sign * (dA - k * dJ), 6) for k, sign in lines],
+                    seeds)
+    out = []
+    for (k, sign), (at, (A, J, _, _)) in zip(lines, found):
+        values = sign * np.concatenate([pieces.A - k * pieces.J, A - k * J])
         best = int(np.argmax(values))
-        return float(values[best]), float(np.concatenate([self.phi, at])[best])
+        out.append((float(values[best]), float(np.concatenate([pieces.phi, at])[best])))
+    angles = np.concatenate([at for at, _ in found])
+    return out, (angles, tuple(np.concatenate([t[j] for _, t in found]) for j in range(4)))
 
 
-def _sized(pieces: _Pieces, level: float, delta: float) -> float:
+def _sized(pieces: _Pieces, level: float, delta: float, seeds: tuple | None = None) -> tuple[float, tuple]:
     """The smallest J_flywheel (kg m^2) whose motion has (omega_max - omega_min)/level = delta at
     (omega_max + omega_min)/2 = level: Wittenbauer's tangents at the exact slopes k = omega^2/2,
-    J = (b_max - b_min) / (k_max - k_min); 0 where the machine alone holds delta."""
+    J = (b_max - b_min) / (k_max - k_min); 0 where the machine alone holds delta. With the
+    tangent points found (angles, terms: the extremes of omega for that J)."""
     k_max, k_min = 0.5 * (level * (1 + delta / 2)) ** 2, 0.5 * (level * (1 - delta / 2)) ** 2
-    b_max, b_min = pieces.sup(k_max, 1.0)[0], -pieces.sup(k_min, -1.0)[0]
-    return max((b_max - b_min) / (k_max - k_min), 0.0)
+    ((b_max, _), (minus_b_min, _)), found = _sups(pieces, [(k_max, 1.0), (k_min, -1.0)], seeds)
+    return max((b_max + minus_b_min) / (k_max - k_min), 0.0), found
 
 
-def _level(pieces: _Pieces, J: float, level: float) -> tuple[float, tuple[float, float], tuple[float, float]]:
-    """T0 (J) such that (omega_max + omega_min)/2 = level for the flywheel J, and the continuous
-    curve's (phi_deg, omega) at its largest and smallest omega; ValueError where the crank stops."""
+def _T0(pieces: _Pieces, J: float, level: float, A: np.ndarray, Jr: np.ndarray) -> float:
+    """The kinetic energy at phi_deg[0] (J) such that the omega at the angles of (A, Jr) has
+    (max + min)/2 = level; ValueError where the crank would stop."""
+    def miss(T0: float) -> float:
+        w2 = 2 * (T0 + A) / (J + Jr)
+        return 0.5 * (math.sqrt(w2.max()) + math.sqrt(max(w2.min(), 0.0))) - level
+    lo = float(-A.min())
+    if miss(lo) > 0:
+        raise ValueError(f"law_of_motion: flywheel: J_flywheel = {J:.6g} kg m^2 is too small for the machine to "
+                         f"run at omega_mean = {level:.6g} rad/s: the crank would stop (the cycle's work swing "
+                         f"{float(np.ptp(pieces.A)):.6g} J exceeds what the inertia stores); give a larger flywheel or delta")
+    return _root(miss, lo, 0.5 * level ** 2 * float((J + pieces.J).mean()), "no level of the kinetic energy gives omega_mean")
+
+
+def _level(pieces: _Pieces, J: float, level: float, seeds: tuple | None = None
+           ) -> tuple[float, tuple[float, float], tuple[float, float], tuple]:
+    """T0 (J) such that (omega_max + omega_min)/2 = level for the flywheel J, the continuous
+    curve's (phi_deg, omega) at its largest and smallest omega, and their angles and terms
+    (seeds); ValueError where the crank stops. The extremes are refined together with T0: after
+    each solve, T0 again over the grid and the candidates."""
     A, Jr = pieces.A, pieces.J
-    extra_A, extra_J, extra_phi = np.empty(0), np.empty(0), np.empty(0)
-    for _ in range(3):          # the grid, then twice with the extremes located at the last T0
-        cand_A, cand_J = np.concatenate([A, extra_A]), np.concatenate([Jr, extra_J])
+    T0 = [_T0(pieces, J, level, A, Jr)]
 
-        def miss(T0: float) -> float:
-            w2 = 2 * (T0 + cand_A) / (J + cand_J)
-            return 0.5 * (math.sqrt(w2.max()) + math.sqrt(max(w2.min(), 0.0))) - level
-        lo = float(-cand_A.min())
-        if miss(lo) > 0:
-            raise ValueError(f"law_of_motion: flywheel: J_flywheel = {J:.6g} kg m^2 is too small for the machine to "
-                             f"run at omega_mean = {level:.6g} rad/s: the crank would stop (the cycle's work swing "
-                             f"{float(np.ptp(A)):.6g} J exceeds what the inertia stores); give a larger flywheel or delta")
-        T0 = _root(miss, lo, 0.5 * level ** 2 * float((J + Jr).mean()), "no level of the kinetic energy gives omega_mean")
-        w = np.sqrt(np.maximum(2 * (T0 + A) / (J + Jr), 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dw = np.where(w > 0, (pieces.dA - 0.5 * pieces.dJ * w ** 2) / ((J + Jr) * w), 0.0)
-        def slope(sign: float):
-            return lambda A_, J_, dJ_, dA_: sign * (dA_ - dJ_ * (T0 + A_) / (J + J_))   # (J + J_red) omega omega'
-        top, t_terms = pieces.peaks(w, dw, slope(1.0), 2)
-        bottom, b_terms = pieces.peaks(-w, -dw, slope(-1.0), 2)
-        extra_phi = np.concatenate([top, bottom])
-        extra_A, extra_J = np.concatenate([t_terms[0], b_terms[0]]), np.concatenate([t_terms[1], b_terms[1]])
-    w_all = np.sqrt(np.maximum(2 * (T0 + np.concatenate([A, extra_A])) / (J + np.concatenate([Jr, extra_J])), 0.0))
-    phi_all = np.concatenate([pieces.phi, extra_phi])
-    top, bottom = int(np.argmax(w_all)), int(np.argmin(w_all))
-    return T0, (float(phi_all[top]), float(w_all[top])), (float(phi_all[bottom]), float(w_all[bottom]))
+    def after(T) -> None:
+        T0[0] = _T0(pieces, J, level, np.concatenate([A, T[0]]), np.concatenate([Jr, T[1]]))
+
+    w = np.sqrt(np.maximum(2 * (T0[0] + A) / (J + Jr), 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dw = np.where(w > 0, (pieces.dA - 0.5 * pieces.dJ * w ** 2) / ((J + Jr) * w), 0.0)
+
+    def slope(sign: float):       # (J + J_red) omega omega': the sign of omega's slope
+        return lambda A_, J_, dJ_, dA_: sign * (dA_ - dJ_ * (T0[0] + A_) / (J + J_))
+    (top, t_terms), (bottom, b_terms) = _refine(pieces, [(w, dw, slope(1.0), 2), (-w, -dw, slope(-1.0), 2)],
+                                                seeds, after)
+    extra_A, extra_J = np.concatenate([t_terms[0], b_terms[0]]), np.concatenate([t_terms[1], b_terms[1]])
+    w_all = np.sqrt(np.maximum(2 * (T0[0] + np.concatenate([A, extra_A])) / (J + np.concatenate([Jr, extra_J])), 0.0))
+    phi_all = np.concatenate([pieces.phi, top, bottom])
+    i, j = int(np.argmax(w_all)), int(np.argmin(w_all))
+    angles = np.concatenate([top, bottom])
+    return T0[0], (float(phi_all[i]), float(w_all[i])), (float(phi_all[j]), float(w_all[j])), (angles, None)
 
 
 def _result(mech: Mechanism, pieces: _Pieces, J: float, T0: float, top: tuple, bottom: tuple,
@@ -513,14 +584,12 @@ def _approximate(mech: Mechanism, pieces: _Pieces, mean: float, delta: float) ->
     "formula": Delta A_max / (delta omega_m^2) - mean J_red (J_red taken constant);
     "mertsalov": the swing of A - 0.5 (J_red - J_crank) omega_m^2 over delta omega_m^2, less J_crank
     (the crank's own reduced inertia J_crank, constant)."""
-    scale = delta * mean ** 2
-    b_max, b_min = pieces.sup(0.5 * mean ** 2 * (1 + delta), 1.0)[0], -pieces.sup(0.5 * mean ** 2 * (1 - delta), -1.0)[0]
-    swing = pieces.sup(0.0, 1.0)[0] + pieces.sup(0.0, -1.0)[0]
+    scale, k = delta * mean ** 2, 0.5 * mean ** 2
+    sups, _ = _sups(pieces, [(k * (1 + delta), 1.0), (k * (1 - delta), -1.0), (0.0, 1.0), (0.0, -1.0), (k, 1.0), (k, -1.0)])
+    b_max, minus_b_min, A_max, minus_A_min, I_max, minus_I_min = (value for value, _ in sups)
     crank = mech.links[mech.drive.link]
     u = kinematics(mech, np.zeros(1), unit_speed=True)
     J_crank = float(reduced_inertia(replace(mech, links=tuple(
         link if link.id == crank.id else replace(link, mass=0.0, I_S=0.0) for link in mech.links), _derived={}), u)[0][0])
-    k = 0.5 * mean ** 2
-    swing_I = pieces.sup(k, 1.0)[0] + pieces.sup(k, -1.0)[0]
-    return {"wittenbauer": (b_max - b_min) / scale, "formula": swing / scale - float(pieces.J.mean()),
-            "mertsalov": swing_I / scale - J_crank}
+    return {"wittenbauer": (b_max + minus_b_min) / scale, "formula": (A_max + minus_A_min) / scale - float(pieces.J.mean()),
+            "mertsalov": (I_max + minus_I_min) / scale - J_crank}

@@ -16,6 +16,7 @@ import pytest
 
 import kinetostat
 from kinetostat import ModelError
+from kinetostat.analysis import exact
 from conftest import ROOT, kinetic_energy
 from test_law_of_motion import CRANK_SLIDER, H_DEG, STENCIL
 
@@ -134,7 +135,6 @@ def ice():
     return mech, kinetostat.law_of_motion(mech, delta=0.02)
 
 
-@pytest.mark.slow      # ~9 s: the friction's fixed point refines its extremes by many small re-solves
 def test_ice_at_delta_002(ice):
     mech, mo = ice
     assert mo.delta == pytest.approx(0.02, rel=1e-10)
@@ -195,3 +195,17 @@ def test_analyze_refuses_another_mechanism_s_motion(crank):
     mo = kinetostat.law_of_motion(crank, delta=0.02, steps=12)
     with pytest.raises(ValueError, match="law: the Motion of another mechanism"):
         kinetostat.analyze(kinetostat.loads(CRANK_SLIDER), law=mo)
+
+
+def test_the_law_of_motion_costs_a_few_batched_solves(ice, monkeypatch):
+    """Every solve of a step (the grid with its Gauss nodes, or the candidates of all the
+    extremes sought at once) is one call: a pass of the friction's fixed point costs the grid's
+    solve and a few small ones, not one per extreme and refinement step."""
+    from kinetostat import motion
+    mech, ref = ice
+    calls = []
+    monkeypatch.setattr(motion, "exact", lambda m, phi_deg, *a: calls.append(len(phi_deg)) or exact(m, phi_deg, *a))
+    mo = kinetostat.law_of_motion(mech, delta=0.02)
+    assert mo.J_flywheel == pytest.approx(ref.J_flywheel, rel=1e-14)
+    assert calls.count(len(mo.phi_deg) * (1 + motion.GAUSS_NODES)) == mo.passes
+    assert len(calls) <= 5 * mo.passes + 5, calls
