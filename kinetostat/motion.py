@@ -20,7 +20,7 @@ from typing import Mapping
 import numpy as np
 
 from .analysis import Analysis, crank_angles, exact
-from .applied import applied_moment, com_motion
+from .applied import applied_moment, com_motion, travel_rates
 from .errors import ModelError, SelfLockingWarning, SingularPositionWarning
 from .kinematics import Kinematics, kinematics
 from .model import Flywheel, Mechanism, SpeedLaw
@@ -89,7 +89,7 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
     omega_mean is what the characteristic makes it, not the nominal), else a constant moment
     -mean(M_red) (an engine's consumer, a machine's motor) with omega_mean = the drive's omega.
     A(phi): Gauss-Legendre (GAUSS_NODES a piece) over each grid step, cut at the knots of a load's
-    crank-angle table. Speed-dependent loads and M(omega): a fixed point over the motion to
+    crank-angle table and where a travel table's point passes its knots or turns. Speed-dependent loads and M(omega): a fixed point over the motion to
     SPEED_TOL (`passes`, `settled`), omega between the grid's angles by the periodic cubic Hermite
     through omega and d omega/d phi = eps/omega. omega_max and omega_min are the continuous
     curve's: each extreme located on that Hermite, then refined on the exact energy equation, all
@@ -188,18 +188,19 @@ def _check_work(mech: Mechanism, red: "_Reduced", chars: tuple) -> None:
 @dataclass(frozen=True)
 class _Cycle:
     """The grid's angles, then the Gauss nodes of every piece of the work integral (pieces: the
-    grid's steps cut at the knots of a load's crank-angle table), deg, and the weights, rad."""
+    grid's steps cut at the knots of a load's crank-angle table and at `_travel_knots`), deg, and
+    the weights, rad."""
     n: int                    # grid angles (the first n of `angles`)
     angles: np.ndarray        # (n + P G,) deg
     weights: np.ndarray       # (P, G) rad
     step: np.ndarray          # (P,) the grid step each piece lies in
-    knots: np.ndarray         # the knots of the loads' crank-angle tables in [0, 360), deg
+    knots: np.ndarray         # those cuts in [0, 360), deg
 
     @classmethod
     def of(cls, mech: Mechanism, phi_deg: np.ndarray) -> "_Cycle":
         n = len(phi_deg)
         knots = np.concatenate([np.mod(np.asarray(ld.table.x, float), 360.0) for ld in mech.loads
-                                if ld.table is not None and ld.table.argument == "phi"] or [np.empty(0)])
+                                if ld.table is not None and ld.table.argument == "phi"] + [_travel_knots(mech)])
         edges = np.unique(np.concatenate([phi_deg, knots]))
         edges = edges[np.append(True, np.diff(edges) > 1e-9)]
         lo, hi = edges, np.append(edges[1:], 360.0)
@@ -221,6 +222,51 @@ class _Cycle:
     def work(self, f: np.ndarray) -> np.ndarray:
         """(n,) the integral of f from the first grid angle to each grid angle."""
         return np.concatenate([[0.0], np.cumsum(self.integrals(f))[:-1]])
+
+
+def _travel_knots(mech: Mechanism) -> np.ndarray:
+    """The crank angles (deg, in [0, 360)) where a travel table's point passes one of the table's
+    inner knots, or turns (a dead centre: the table's forward and return values meet there):
+    bracketed on a scan at every degree, then by Newton's method kept inside the brackets (else
+    bisection) on the exact travel and its derivatives, every bracket in one solve per step."""
+    loads = [ld for ld in mech.loads if ld.table is not None and ld.table.argument == "travel"]
+    if not loads:
+        return np.empty(0)
+    scan = np.radians(np.arange(361.0))
+    owner, level, turn, lo, hi = [], [], [], [], []
+    for q, ld in enumerate(loads):
+        s, ds, _ = travel_rates(mech, kinematics(mech, scan, unit_speed=True), ld)
+        for x, f, is_turn in [(x, s - x, False) for x in ld.table.x if 0.0 < x < 1.0] + [(0.0, ds, True)]:
+            at = np.flatnonzero((f[:-1] == 0) | (np.sign(f[:-1]) * np.sign(f[1:]) < 0))
+            owner += [q] * len(at)
+            level += [x] * len(at)
+            turn += [is_turn] * len(at)
+            lo, hi = lo + list(scan[at]), hi + list(scan[at + 1])
+    if not lo:
+        return np.empty(0)
+    owner, level, turn, lo, hi = map(np.asarray, (owner, level, turn, lo, hi))
+
+    def value(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        kin = kinematics(mech, phi, unit_speed=True)
+        f, df = np.empty(len(phi)), np.empty(len(phi))
+        for q, ld in enumerate(loads):
+            m = owner == q
+            s, ds, d2s = (r[m] for r in travel_rates(mech, kin, ld))
+            f[m], df[m] = np.where(turn[m], ds, s - level[m]), np.where(turn[m], d2s, ds)
+        return f, df
+    f_lo = value(lo)[0]
+    x = 0.5 * (lo + hi)
+    for _ in range(60):
+        f, df = value(x)
+        same = np.sign(f) == np.sign(f_lo)
+        lo, f_lo, hi = np.where(same, x, lo), np.where(same, f, f_lo), np.where(same, hi, x)
+        with np.errstate(all="ignore"):
+            step = x - f / df
+        step = np.where(f == 0, x, np.where(np.isfinite(step) & (step > lo) & (step < hi), step, 0.5 * (lo + hi)))
+        if np.abs(step - x).max() <= 1e-15 * 2 * np.pi:
+            break
+        x = step
+    return np.mod(np.degrees(x), 360.0)
 
 
 # ------------------------------------------------------------------------ reduced quantities
