@@ -86,11 +86,14 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
     each pair on the frictionless reactions of the analysis at omega(phi), eps(phi)): the drive
     supplies it, so analyze(mech, law=motion)'s balancing_moment_with_friction is M_drive.
     The drive: a characteristic moment M(omega) on the crank where the model gives one (then
-    omega_mean is what the characteristic makes it, not the nominal), else a constant moment
+    omega_mean is what the characteristic makes it, not the nominal: the periodic motion by
+    periodic shooting, Newton's method with the monodromy, `_shoot`), else a constant moment
     -mean(M_red) (an engine's consumer, a machine's motor) with omega_mean = the drive's omega.
     A(phi): Gauss-Legendre (GAUSS_NODES a piece) over each grid step, cut at the knots of a load's
-    crank-angle table and where a travel table's point passes its knots or turns. Speed-dependent loads and M(omega): a fixed point over the motion to
-    SPEED_TOL (`passes`, `settled`), omega between the grid's angles by the periodic cubic Hermite
+    crank-angle table and where a travel table's point passes its knots or turns. Speed-dependent
+    loads (friction, dampers, characteristics but the drive's), and the flywheel sized for delta
+    under a characteristic drive (by the secant): a fixed point over the motion to SPEED_TOL
+    (`passes`, `settled`), omega between the grid's angles by the periodic cubic Hermite
     through omega and d omega/d phi = eps/omega. omega_max and omega_min are the continuous
     curve's: each extreme located on that Hermite, then refined on the exact energy equation, all
     the extremes sought together, one solve per step (a pass of the fixed point starts from the
@@ -104,29 +107,45 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
     phi_deg = crank_angles(None, steps)
     cycle = _Cycle.of(mech, phi_deg)
     chars = _characteristics(mech)
-    varying = bool(chars) or mech.friction is not None or any(
-        ld.kind == "damper" or ld.characteristic is not None for ld in mech.loads)
+    loads_vary = mech.friction is not None or any(
+        ld.kind == "damper" or (ld.characteristic is not None and ld not in chars) for ld in mech.loads)
+    varying = loads_vary or bool(chars and target is not None)
     n = cycle.n
     speed = _Speed(phi_deg, np.full(n, nominal), np.zeros(n), chars)
-    passes, red, change, seeds = 0, None, np.inf, None
+    passes, red, change, seeds, last = 0, None, np.inf, None, None
+    J = J_fly if target is None else None          # None: sized in this pass
     while True:
         passes += 1
-        if red is None or varying:
+        if red is None or loads_vary:
             red = _reduced(mech, cycle.angles, speed)
             _check_work(mech, red, chars)
-        M_drive, level, shift = (_characteristic_drive(chars, red, cycle, speed) if chars else
-                                 (np.full(len(cycle.angles), -cycle.mean(red.M)), nominal, 0.0))
-        pieces = _Pieces(mech, cycle, red, M_drive, speed, shift)
-        J, tangents = (J_fly, None) if target is None else _sized(pieces, level, target, seeds)
-        T0, top, bottom, extremes = _level(pieces, J, level, tangents or seeds)
+        if chars and J is not None:                # the characteristic's periodic motion at this flywheel
+            M_drive, T0 = _shoot(mech, chars, red, cycle, J, nominal)
+            pieces = _Pieces(mech, cycle, red, M_drive, speed, _motion(phi_deg, cycle, red, M_drive, J, T0, chars))
+            T0, top, bottom, extremes = _level(pieces, J, None, seeds, fixed=T0)
+            level = 0.5 * (top[1] + bottom[1])
+            J_next, tangents = (J, None) if target is None else _sized(pieces, level, target, seeds)
+            if target is not None:                 # the secant on sized(J) - J = 0 through the last pass's
+                if last is not None and J_next - J != last[1] - last[0]:
+                    last, J_next = (J, J_next), max(J - (J_next - J) * (J - last[0]) / ((J_next - J) - (last[1] - last[0])), 0.0)
+                else:
+                    last = (J, J_next)
+        else:                                      # a constant drive (or a characteristic's first sizing)
+            M_drive = np.full(len(cycle.angles), -cycle.mean(red.M))
+            level = _balancing_speed(mech, chars, cycle.mean(red.M), nominal) if chars else nominal
+            pieces = _Pieces(mech, cycle, red, M_drive, speed)
+            J, tangents = (J, None) if target is None else _sized(pieces, level, target, seeds)
+            T0, top, bottom, extremes = _level(pieces, J, level, tangents or seeds)
+            J_next = J
         seeds = (np.concatenate([extremes[0]] + ([] if tangents is None else [tangents[0]])), None)
-        omega = np.sqrt(np.maximum(2 * (T0 + pieces.A) / (J + red.J[:n]), 0.0))
-        new = _Speed(phi_deg, omega, _eps(red, M_drive, omega, J, n) / omega, chars)
-        change = float(np.abs(new.at(cycle.angles) - speed.at(cycle.angles)).max()) / level
+        new = _motion(phi_deg, cycle, red, M_drive, J, T0, chars)
+        change = max(float(np.abs(new.at(cycle.angles) - speed.at(cycle.angles)).max()) / level,
+                     abs(J_next - J) / J if J else 0.0)
         speed = new
-        if not varying or change <= SPEED_TOL:
+        if not varying or (change <= SPEED_TOL and not (chars and pieces.driven is None)):
             change = change if varying else 0.0     # the loads do not depend on the motion: exact at once
             break
+        J = J_next
         if passes >= MAX_PASSES:
             raise ValueError(f"law_of_motion: the speed-dependent loads' fixed point did not settle in {MAX_PASSES} "
                              f"passes (the last changed omega by {change:.3g} of omega_mean)")
@@ -351,24 +370,115 @@ def at_motion(mech: Mechanism, phi_deg: np.ndarray, omega: np.ndarray, domega: n
 
 # ------------------------------------------------------------------------------ the motion
 
+def _motion(phi_deg: np.ndarray, cycle: _Cycle, red: _Reduced, M_drive: np.ndarray, J: float, T0: float,
+            chars: tuple) -> _Speed:
+    """The motion of the energy equation 0.5 (J + J_red) omega^2 = T0 + A(phi) at the grid."""
+    n = cycle.n
+    omega = np.sqrt(np.maximum(2 * (T0 + cycle.work(red.M + M_drive)) / (J + red.J[:n]), 0.0))
+    return _Speed(phi_deg, omega, _eps(red, M_drive, omega, J, n) / omega, chars)
+
+
 def _eps(red: _Reduced, M_drive: np.ndarray, omega: np.ndarray, J: float, n: int) -> np.ndarray:
     """eps = (M_red + M_drive - 0.5 dJ_red omega^2) / (J + J_red) at the first n angles, rad/s^2."""
     return (red.M[:n] + M_drive[:n] - 0.5 * red.dJ[:n] * omega ** 2) / (J + red.J[:n])
 
 
-def _characteristic_drive(chars: tuple, red: _Reduced, cycle: _Cycle, speed: _Speed) -> tuple[np.ndarray, float]:
-    """The characteristic drive's moment at the cycle's angles, N m, at the motion `speed` moved
-    by the constant c that closes the cycle's work (mean(M_red + M(omega + c)) = 0, a scalar root),
-    and the level (omega_max + omega_min)/2 that motion has, rad/s."""
-    w = speed.at(cycle.angles)
+def _characteristic_field(mech: Mechanism, chars: tuple) -> str:
+    """The model's fields of the drive's characteristics, as an error names them."""
+    return " + ".join(f"load[{mech.loads.index(ld)}].characteristic ({ld.name!r})" for ld in chars)
 
-    def closure(c: float) -> float:
-        return cycle.mean(red.M + sum((ld.characteristic(w + c) for ld in chars), np.zeros_like(w)))
-    c = _root(closure, -w.min(), float(w.max()) or 1.0, "the motor's characteristic M(omega): no steady speed "
-              "balances the cycle's work (M(omega) must fall as omega rises through the working speed)")
-    M = sum((ld.characteristic(w + c) for ld in chars), np.zeros_like(w))
-    g = w[:cycle.n] + c
-    return M, float(g.max() + g.min()) / 2, c
+
+def _collocation() -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre collocation's matrix a_ij = integral from 0 to c_i of the j-th Lagrange
+    polynomial through the nodes c (GAUSS_NODES, on [0, 1]), and its weights b."""
+    x, w = np.polynomial.legendre.leggauss(GAUSS_NODES)
+    c = 0.5 * (x + 1)
+    k = np.arange(GAUSS_NODES)
+    lagrange = np.linalg.inv(c[:, None] ** k[None, :])          # column j: the coefficients of the j-th
+    return (c[:, None] ** (k + 1) / (k + 1)) @ lagrange, 0.5 * w
+
+
+def _shoot(mech: Mechanism, chars: tuple, red: _Reduced, cycle: _Cycle, J: float, guess: float
+           ) -> tuple[np.ndarray, float]:
+    """The characteristic drive's periodic motion for the flywheel J: its moment M(omega) at the
+    cycle's angles (N m) and the kinetic energy T0 at phi_deg[0] (J).
+
+    The energy equation dE/dphi = M_red + M(omega), E = 0.5 (J + J_red) omega^2, is integrated
+    over each piece of the cycle by Gauss-Legendre collocation at the pieces' Gauss nodes (where
+    M_red and J_red are solved: order 2 GAUSS_NODES), and the periodic solution E(phi_0 + 2 pi) =
+    E(phi_0) found by Newton's method on every piece's start and stages at once: the linearised
+    step carries dE from piece to piece with each piece's multiplier m = dE_end/dE_start, and
+    closes the cycle with their product, the monodromy mu = dE(phi_0 + 2 pi)/dE(phi_0):
+    dE(phi_0) = mu S / (1 - mu), the shooting Newton step (S: the carried residuals). A stable
+    steady motion has mu < 1 (M(omega) falls as omega rises). Started from the constant speed
+    where M balances the cycle's mean load (searched upwards from `guess`, rad/s). ValueError
+    naming the characteristic where it cannot drive the load (the crank stops) or no periodic
+    motion settles."""
+    field = _characteristic_field(mech, chars)
+    n, (P, G) = cycle.n, cycle.weights.shape
+    h = cycle.weights.sum(axis=1)                         # (P,) rad
+    a, b = _collocation()
+    Jt = J + red.J[n:].reshape(P, G)
+    Mr = red.M[n:].reshape(P, G)
+
+    def drive(w: np.ndarray) -> np.ndarray:
+        return sum((ld.characteristic(w) for ld in chars), np.zeros_like(w))
+    load = cycle.mean(red.M)
+    w_c = _balancing_speed(mech, chars, load, guess)
+    f = Mr + drive(np.full((P, G), w_c))
+    start = np.concatenate([[0.0], np.cumsum(h * (f @ b))[:-1]])
+    E0 = 0.5 * float(Jt.mean()) * w_c ** 2 - float(start.mean())
+    E = E0 + start                                        # (P,) at the pieces' starts
+    K = E[:, None] + h[:, None] * (f @ a.T)               # (P, G) at their stages
+    scale = float(np.abs(K).max())
+    for _ in range(MAX_PASSES):
+        if not (K > 0).all() or not np.isfinite(K).all():
+            raise ValueError(f"law_of_motion: {field}: no periodic motion with J_flywheel = {J:.6g} kg m^2: the "
+                             f"crank stops (the cycle's work swing exceeds what the motor and the inertia keep up)")
+        w = np.sqrt(2 * K / Jt)
+        f = Mr + drive(w)
+        dw = 1e-7 * np.maximum(w, 1.0)
+        p = (drive(w + dw) - drive(w - dw)) / (2 * dw) / (Jt * w)          # d f / d E
+        R = K - E[:, None] - h[:, None] * (f @ a.T)
+        L = np.eye(G) - h[:, None, None] * a[None] * p[:, None, :]
+        u = np.linalg.solve(L, np.ones((P, G, 1)))[..., 0]
+        v = np.linalg.solve(L, -R[..., None])[..., 0]
+        m = 1 + h * ((b * p * u).sum(axis=1))
+        r = E + h * (f @ b) + h * (b * p * v).sum(axis=1) - np.roll(E, -1)
+        carried = np.concatenate([[1.0], np.cumprod(m)])
+        mu = carried[-1]
+        if not mu < 1:
+            raise ValueError(f"law_of_motion: {field}: M(omega) does not fall as omega rises through the working "
+                             f"speed (monodromy {mu:.6g} >= 1): no stable steady motion")
+        S = np.cumsum(r / carried[1:])
+        d0 = mu * S[-1] / (1 - mu)
+        dE = carried[:-1] * (d0 + np.concatenate([[0.0], S[:-1]]))
+        dK = u * dE[:, None] + v
+        t = 1.0
+        while not (K + t * dK > 0).all() and t > 1e-6:     # a step that would stop the crank: shortened
+            t *= 0.5
+        E, K = E + t * dE, K + t * dK
+        if t == 1.0 and max(np.abs(dE).max(), np.abs(dK).max()) <= 1e-14 * scale:
+            break
+    else:
+        raise ValueError(f"law_of_motion: {field}: Newton's method found no periodic motion in {MAX_PASSES} steps")
+    w_grid = np.sqrt(2 * E[np.searchsorted(cycle.step, np.arange(n))] / (J + red.J[:n]))
+    return np.concatenate([drive(w_grid), drive(np.sqrt(2 * K / Jt)).ravel()]), float(E[0])
+
+
+def _balancing_speed(mech: Mechanism, chars: tuple, load: float, guess: float) -> float:
+    """The constant speed (rad/s) at which the characteristic drive balances the cycle's mean
+    load moment `load` (N m, M_red's mean): M(omega) + load = 0, searched upwards from 0 in steps
+    from `guess`; ValueError naming the characteristic where M(0) cannot turn the crank."""
+    field = _characteristic_field(mech, chars)
+
+    def surplus(w: float) -> float:
+        return float(sum(ld.characteristic(np.array([w]))[0] for ld in chars)) + load
+    if not surplus(0.0) > 0:
+        raise ValueError(f"law_of_motion: {field}: M(0) = {surplus(0.0) - load:.6g} N m cannot drive the load "
+                         f"(its mean resisting moment {-load:.6g} N m): the crank stops")
+    return _root(surplus, 0.0, guess, f"{field}: no speed at which M(omega) balances the load's mean moment "
+                 f"{-load:.6g} N m")
 
 
 def _root(f, lo: float, step: float, why: str, tol: float = 0.0) -> float:
@@ -400,9 +510,9 @@ class _Pieces:
     angles asked for in one solve."""
 
     def __init__(self, mech: Mechanism, cycle: _Cycle, red: _Reduced, M_drive: np.ndarray, speed: _Speed,
-                 shift: float):
+                 driven: _Speed | None = None):
         n = cycle.n
-        self.mech, self.cycle, self.red, self.speed, self.shift = mech, cycle, red, speed, shift
+        self.mech, self.cycle, self.red, self.speed, self.driven = mech, cycle, red, speed, driven
         self.M_drive = M_drive
         self.phi = cycle.angles[:n]
         self.A = cycle.work(red.M + M_drive)
@@ -410,11 +520,9 @@ class _Pieces:
         self.J, self.dJ, self.dA = red.J[:n], red.dJ[:n], (red.M + M_drive)[:n]
 
     def drive_at(self, angles: np.ndarray) -> np.ndarray:
-        """M_drive at `angles` (deg): the constant, or M(omega + shift) of the characteristic."""
-        if not self.speed.chars:
-            return np.full(len(angles), self.M_drive[0])
-        w = self.speed.at(angles) + self.shift
-        return sum((ld.characteristic(w) for ld in self.speed.chars), np.zeros_like(w))
+        """M_drive at `angles` (deg): the constant, or the characteristic's M(omega) at the
+        motion `driven` it drives."""
+        return np.full(len(angles), self.M_drive[0]) if self.driven is None else self.driven.drive(angles)
 
     def grid(self, i: np.ndarray) -> tuple[np.ndarray, ...]:
         """The terms (A, J_red, dJ_red, dA) at the grid angles of index `i` (0..n: n is 360 deg)."""
@@ -573,17 +681,18 @@ def _T0(pieces: _Pieces, J: float, level: float, A: np.ndarray, Jr: np.ndarray) 
     return _root(miss, lo, 0.5 * level ** 2 * float((J + pieces.J).mean()), "no level of the kinetic energy gives omega_mean")
 
 
-def _level(pieces: _Pieces, J: float, level: float, seeds: tuple | None = None
+def _level(pieces: _Pieces, J: float, level: float | None, seeds: tuple | None = None, fixed: float | None = None
            ) -> tuple[float, tuple[float, float], tuple[float, float], tuple]:
-    """T0 (J) such that (omega_max + omega_min)/2 = level for the flywheel J, the continuous
-    curve's (phi_deg, omega) at its largest and smallest omega, and their angles and terms
-    (seeds); ValueError where the crank stops. The extremes are refined together with T0: after
-    each solve, T0 again over the grid and the candidates."""
+    """T0 (J) such that (omega_max + omega_min)/2 = level for the flywheel J (or the `fixed`
+    T0), the continuous curve's (phi_deg, omega) at its largest and smallest omega, and their
+    angles (seeds); ValueError where the crank stops. The extremes are refined together with
+    T0: after each solve, T0 again over the grid and the candidates."""
     A, Jr = pieces.A, pieces.J
-    T0 = [_T0(pieces, J, level, A, Jr)]
+    T0 = [_T0(pieces, J, level, A, Jr) if fixed is None else fixed]
 
     def after(T) -> None:
-        T0[0] = _T0(pieces, J, level, np.concatenate([A, T[0]]), np.concatenate([Jr, T[1]]))
+        if fixed is None:
+            T0[0] = _T0(pieces, J, level, np.concatenate([A, T[0]]), np.concatenate([Jr, T[1]]))
 
     w = np.sqrt(np.maximum(2 * (T0[0] + A) / (J + Jr), 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
