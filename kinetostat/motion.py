@@ -125,11 +125,8 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
             T0, top, bottom, extremes = _level(pieces, J, None, seeds, fixed=T0)
             level = 0.5 * (top[1] + bottom[1])
             J_next, tangents = (J, None) if target is None else _sized(pieces, level, target, seeds)
-            if target is not None:                 # the secant on sized(J) - J = 0 through the last pass's
-                if last is not None and J_next - J != last[1] - last[0]:
-                    last, J_next = (J, J_next), max(J - (J_next - J) * (J - last[0]) / ((J_next - J) - (last[1] - last[0])), 0.0)
-                else:
-                    last = (J, J_next)
+            if target is not None:
+                J_next, last = _secant(J, J_next, last), (J, J_next)
         else:                                      # a constant drive (or a characteristic's first sizing)
             M_drive = np.full(len(cycle.angles), -cycle.mean(red.M))
             level = _balancing_speed(mech, chars, cycle.mean(red.M), nominal) if chars else nominal
@@ -376,6 +373,15 @@ def _motion(phi_deg: np.ndarray, cycle: _Cycle, red: _Reduced, M_drive: np.ndarr
     n = cycle.n
     omega = np.sqrt(np.maximum(2 * (T0 + cycle.work(red.M + M_drive)) / (J + red.J[:n]), 0.0))
     return _Speed(phi_deg, omega, _eps(red, M_drive, omega, J, n) / omega, chars)
+
+
+def _secant(J: float, sized: float, last: tuple[float, float] | None) -> float:
+    """The next flywheel (kg m^2) of the fixed point J -> sized(J): the root of sized(J) - J by
+    the secant through this pass's (J, sized) and the last pass's, else `sized`."""
+    if last is None or sized - J == last[1] - last[0]:
+        return sized
+    g, g_last = sized - J, last[1] - last[0]
+    return max(J - g * (J - last[0]) / (g - g_last), 0.0)
 
 
 def _eps(red: _Reduced, M_drive: np.ndarray, omega: np.ndarray, J: float, n: int) -> np.ndarray:
