@@ -66,10 +66,14 @@ def summary_lines(motion, path: Path, delta=None, flywheel=None) -> list[str]:
 def cmd_motion(args) -> int:
     from .. import tables
     from ..model.lettering import lettering
-    from ..plans.motion_sheet import motion_sheet
+    from ..plans.motion_sheet import motion_sheet, no_drive
     path = Path(args.model)
     mech = _load(path)
     motion = _law(mech, path, delta=args.delta, flywheel=args.flywheel, steps=args.steps)
+    why = no_drive(motion)
+    if why:
+        raise CLIError(f"{path}: {why}; the law of motion sizes a flywheel against a drive's work "
+                       "(give the model a load that does work)")
     out = _writable_dir(args.out, "--out")     # after the law: a refused model leaves no folder behind
     lang = args.lang or lettering(mech).language or "en"
     lines = summary_lines(motion, path, args.delta, args.flywheel)

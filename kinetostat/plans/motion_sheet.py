@@ -32,7 +32,10 @@ from .scales import coarser, next_coarser
 from .symbols import text_runs
 from ..model.lettering import lettering
 
-__all__ = ["Panel", "MotionSheet", "motion_sheet", "work_parts"]
+__all__ = ["Panel", "MotionSheet", "motion_sheet", "work_parts", "no_drive", "NO_WORK"]
+
+#: The loads' work over a cycle below this share of 2 pi max |M_red|: no work, no drive to balance.
+NO_WORK = 1e-9
 
 _FRAME = (20.0, 5.0, 415.0, 292.0)
 _TB = (230.0, 237.0, 415.0, 292.0)                 # the title block (a3.TITLE_BLOCK)
@@ -113,6 +116,17 @@ def work_parts(motion) -> tuple[np.ndarray, np.ndarray]:
         m = np.append(m, m[0])
         return np.concatenate([[0.0], np.cumsum(0.5 * (m[1:] + m[:-1]) * np.diff(phi))])
     return integral(np.asarray(motion.M_drive, float)), integral(np.asarray(motion.M_red, float))
+
+
+def no_drive(motion) -> str:
+    """Why `motion` has no drive to balance ("" where it has one): the loads' work over a cycle
+    (2 pi mean M_red) is 0 to NO_WORK of 2 pi max |M_red| (gravity and conservative loads only)."""
+    M_red = np.asarray(motion.M_red, dtype=float)
+    work = float(np.mean(M_red)) * 2 * math.pi
+    if abs(work) <= NO_WORK * 2 * math.pi * float(np.max(np.abs(M_red), initial=0.0)):
+        return (f"the loads' work over a cycle is {work:.3g} J (gravity and conservative loads only): there is no "
+                "drive to balance")
+    return ""
 
 
 def _closed(a) -> np.ndarray:
@@ -208,9 +222,12 @@ def _clip(p: Panel, k: float, b: float) -> tuple[float, float, float, float] | N
     return float(p.X(t0)), float(p.Y(k * t0 + b)), float(p.X(t1)), float(p.Y(k * t1 + b))
 
 
-def _symbols(lang: str) -> dict[str, str]:
-    """The sheet's symbols in `lang` (the texts' letters: зв/пр reduced, р/дв drive)."""
-    return {k: text(f"motion.sym_{k}", lang) for k in ("M_red", "M_drive", "A_red", "A_drive", "J_red", "J_fly")}
+def _symbols(lang: str, kind: str) -> dict[str, str]:
+    """The sheet's symbols in `lang` (the texts' letters: зв/пр reduced; the drive's moment an
+    engine's consumer (сп/потр) or a working machine's motor (р/дв) by the drive's `kind`)."""
+    out = {k: text(f"motion.sym_{k}", lang) for k in ("M_red", "A_red", "J_red", "J_fly")}
+    drive = text(f"motion.sym_drive_{'engine' if kind == 'engine' else 'machine'}", lang)
+    return out | {"M_drive": f"M_{drive}", "A_drive": f"A_{drive}"}
 
 
 def _mu(sym: str, value: float, u: str, lang: str) -> str:
@@ -222,7 +239,7 @@ def motion_sheet(motion, lang: str = "en") -> MotionSheet:
     its title block."""
     mech = motion.mech
     name = lettering(mech).name(lang, mech.name)
-    S = _symbols(lang)
+    S = _symbols(lang, motion.mech.drive.kind)
     L = _Layout(lang)
     panels = {}
     phi = np.append(motion.phi_deg, motion.phi_deg[0] + 360.0)
@@ -339,7 +356,7 @@ def _notes(L: _Layout, motion, S: dict, ab_mm: float, mu_T: float) -> None:
         diff = (value - J_fly) / J_fly * 100.0 if J_fly > 0 else math.nan
         rows.append(text("motion.n_approx", lang, method=text(f"motion.m_{method}", lang) if f"motion.m_{method}" in MESSAGES else method,
                          J=S["J_fly"], value=num(value, lang, 6), unit=unit("kg m^2", lang),
-                         diff=num(diff, lang, decimals=2)))
+                         diff=num(round(diff, 2) + 0.0, lang, decimals=2)))
     y = _TB[1] + 5.0
     for s in rows:
         L.text(_FRAME[0] + 4.0, y, s)

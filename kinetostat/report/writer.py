@@ -46,8 +46,7 @@ MOTION_HEADING = "Law of motion"
 DEFAULT_DELTA = 0.02
 #: The angle of the section's M_bal at constant omega and at the true omega(phi), deg.
 MOTION_AT_DEG = 30.0
-#: The loads' work over a cycle below this share of the largest |M_red| x 2 pi: no work, no drive to balance.
-NO_WORK = 1e-9
+
 #: The project's studies, linked from the index where their files are in its folder.
 STUDIES = (("stability.md", "Stability: the solver's accuracy near singular positions"),
            ("drawing_error.md", "Drawing error: the spread of a careful drawing of the plans"),
@@ -492,16 +491,6 @@ def _law_choice(m: Mechanism, delta: float | None, flywheel: float | None) -> tu
     return {"delta": DEFAULT_DELTA}, f"the flywheel sized for δ = {DEFAULT_DELTA:g} by default (the model has no [flywheel])"
 
 
-def _no_work(motion) -> str:
-    """Why `motion` has no drive to balance ("" where it has one): the loads' work over a cycle is 0."""
-    M_red = np.asarray(motion.M_red)
-    work = float(np.mean(M_red)) * 2 * math.pi
-    if abs(work) <= NO_WORK * 2 * math.pi * float(np.max(np.abs(M_red), initial=0.0)):
-        return (f"the loads' work over a cycle is {work:.3g} J (gravity and conservative loads only): "
-                "no drive to balance")
-    return ""
-
-
 def _forward_dynamics_rows(m: Mechanism, motion) -> list[list[str]]:
     """The hook for the engines' check of the law (forward dynamics of the machine with its flywheel,
     MuJoCo and Pinocchio): its rows for the section's table. None are run in the report today."""
@@ -515,6 +504,7 @@ def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywhee
     (or whose law cannot be found) is skipped with a line saying why. Returns the Motion, or None."""
     from ..errors import AssemblyError, ModelError
     from ..motion import law_of_motion
+    from ..plans.motion_sheet import no_drive
     from ..solve import analyze
     m = run.mech
     doc.h(2, MOTION_HEADING)
@@ -524,7 +514,7 @@ def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywhee
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             motion = law_of_motion(m, **kwargs)
-            why = _no_work(motion)
+            why = no_drive(motion)
             if not why:
                 true = analyze(m, phi_deg=[MOTION_AT_DEG], law=motion)
                 const = run.at([MOTION_AT_DEG])
