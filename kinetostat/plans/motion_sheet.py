@@ -91,7 +91,7 @@ class MotionSheet:
         for x0, y0, x1, y1, width, dash, colour, gid in self.page.lines:
             d = f' stroke-dasharray="{" ".join(f"{v:g}" for v in dash)}"' if dash else ""
             g = f' data-gid="{xml_escape(gid)}"' if gid else ""
-            out.append(f'<line x1="{x0:.4f}" y1="{y0:.4f}" x2="{x1:.4f}" y2="{y1:.4f}" stroke="{colour}" '
+            out.append(f'<line x1="{x0:.6f}" y1="{y0:.6f}" x2="{x1:.6f}" y2="{y1:.6f}" stroke="{colour}" '
                        f'stroke-width="{width}"{d}{g}/>')
         for x, y, r in self.page.dots:
             out.append(f'<circle cx="{x:.3f}" cy="{y:.3f}" r="{r}"/>')
