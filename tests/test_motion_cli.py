@@ -39,7 +39,8 @@ def written(tmp_path_factory):
 def test_csv_is_the_apis_arrays_with_units(written, motion):
     with open(written / "motion.csv", encoding="utf-8") as f:
         rows = list(csv.reader(f))
-    assert rows[0] == [f"{k} [{u}]" for k, u in COLUMNS.items()]
+    assert rows[0] == ["phi_deg [deg]", "J_red [kg m^2]", "dJ_red [kg m^2/rad]", "M_red [N m]", "M_drive [N m]",
+                       "work [J]", "T [J]", "omega [rad/s]", "eps [rad/s^2]"]
     table = np.array(rows[1:], dtype=float)
     assert table.shape == (len(motion.phi_deg), len(COLUMNS))
     for j, key in enumerate(COLUMNS):
@@ -102,10 +103,10 @@ def test_hostile_options_one_line_nothing_written(cli, tmp_path, args, says):
 
 def test_model_without_work_to_balance_is_refused(cli, tmp_path):
     out = tmp_path / "out"
-    r = cli("motion", "triad_six_bar", "--delta", "0.02", "--out", out)     # gravity only: no work over a cycle
+    r = cli("motion", "chain_unit_four_bar", "--delta", "0.02", "--out", out)     # gravity only: no work over a cycle
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.count("\n") == 1
-    assert re.search(r"triad_six_bar: the loads' work over a cycle is \S+ J .*no drive to balance", r.stderr)
+    assert re.search(r"chain_unit_four_bar: the loads' work over a cycle is \S+ J .*no drive to balance", r.stderr)
     assert not out.exists()
 
 
@@ -124,3 +125,35 @@ def test_analyze_delta_gives_the_laws_balancing_moment(cli, tmp_path, motion):
         constant = kinetostat.analyze(mech, phi_deg=[30.0]).balancing_moment[0]
     assert M == pytest.approx(true, rel=1e-9)
     assert abs(true - constant) > 1e-3 * abs(constant)          # the true motion's M_bal is another number
+
+
+def _section(name: str, **law) -> str:
+    from kinetostat.report.document import Doc
+    from kinetostat.report.runs import ModelRun
+    from kinetostat.report.writer import _motion_section
+    mech = kinetostat.load(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = ModelRun(mech, kinetostat.analyze(mech, steps=360))
+        doc = Doc("t")
+        _motion_section(doc, run, **law)
+    return doc.markdown()
+
+
+def test_report_section_law_of_motion(motion):
+    from kinetostat.report.document import _fmt
+    md = _section(MODEL)
+    assert "with the flywheel sized for δ = 0.02 by default (the model has no \\[flywheel\\])" in md
+    assert f"| J_flywheel, kg·m² (exact) | {_fmt(motion.J_flywheel)} |" in md
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        true = kinetostat.analyze(motion.mech, phi_deg=[30.0], law=motion).balancing_moment[0]
+        constant = kinetostat.analyze(motion.mech, phi_deg=[30.0]).balancing_moment[0]
+    assert f"| M_bal, N·m | {_fmt(constant)} | {_fmt(true)} |" in md
+    assert f"flywheel J = 0.5 kg·m² given (--flywheel)" in _section(MODEL, flywheel=0.5)
+
+
+def test_report_section_skips_a_model_with_no_drive_to_balance():
+    md = _section("chain_unit_four_bar")
+    assert re.search(r"Skipped: the loads' work over a cycle is \S+ J \(gravity and conservative loads only\): "
+                     r"there is no drive to balance\.", md)

@@ -70,7 +70,7 @@ def cmd_motion(args) -> int:
     path = Path(args.model)
     mech = _load(path)
     motion = _law(mech, path, delta=args.delta, flywheel=args.flywheel, steps=args.steps)
-    why = no_drive(motion)
+    why = no_drive(motion.M_red)
     if why:
         raise CLIError(f"{path}: {why}; the law of motion sizes a flywheel against a drive's work "
                        "(give the model a load that does work)")

@@ -118,10 +118,11 @@ def work_parts(motion) -> tuple[np.ndarray, np.ndarray]:
     return integral(np.asarray(motion.M_drive, float)), integral(np.asarray(motion.M_red, float))
 
 
-def no_drive(motion) -> str:
-    """Why `motion` has no drive to balance ("" where it has one): the loads' work over a cycle
-    (2 pi mean M_red) is 0 to NO_WORK of 2 pi max |M_red| (gravity and conservative loads only)."""
-    M_red = np.asarray(motion.M_red, dtype=float)
+def no_drive(M_red) -> str:
+    """Why a machine whose loads' reduced moment over a uniform full cycle is `M_red` (N m) has no
+    drive to balance ("" where it has one): their work over the cycle (2 pi mean M_red) is 0 to
+    NO_WORK of 2 pi max |M_red| (gravity and conservative loads only)."""
+    M_red = np.asarray(M_red, dtype=float)
     work = float(np.mean(M_red)) * 2 * math.pi
     if abs(work) <= NO_WORK * 2 * math.pi * float(np.max(np.abs(M_red), initial=0.0)):
         return (f"the loads' work over a cycle is {work:.3g} J (gravity and conservative loads only): there is no "

@@ -510,16 +510,19 @@ def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywhee
     doc.h(2, MOTION_HEADING)
     kwargs, said = _law_choice(m, delta, flywheel)
     t0 = time.perf_counter()
+    motion = None
+    why = no_drive(-run.res.balancing_moment)      # at constant omega the inertia does no work over the cycle
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            motion = law_of_motion(m, **kwargs)
-            why = no_drive(motion)
+            if not why:
+                motion = law_of_motion(m, **kwargs)
+                why = no_drive(motion.M_red)
             if not why:
                 true = analyze(m, phi_deg=[MOTION_AT_DEG], law=motion)
                 const = run.at([MOTION_AT_DEG])
     except (ModelError, AssemblyError, ValueError) as exc:
-        motion, why = None, str(exc).strip().splitlines()[0]
+        why = str(exc).strip().splitlines()[0]
     log.info("%s: law of motion (%.3f s)", run.stem, time.perf_counter() - t0)
     if why:
         doc.p(f"Skipped: {esc(why)}.")
