@@ -149,7 +149,7 @@ def test_report_section_law_of_motion(motion):
         warnings.simplefilter("ignore")
         true = kinetostat.analyze(motion.mech, phi_deg=[30.0], law=motion).balancing_moment[0]
         constant = kinetostat.analyze(motion.mech, phi_deg=[30.0]).balancing_moment[0]
-    assert f"| M_bal, N·m | {_fmt(constant)} | {_fmt(true)} |" in md
+    assert f"| M_bal, N·m | {_fmt(constant)} | {_fmt(true)} |" in md          # the model's symbol (lettering)
     assert f"flywheel J = 0.5 kg·m² given (--flywheel)" in _section(MODEL, flywheel=0.5)
 
 

@@ -538,7 +538,7 @@ def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywhee
     doc.table(["quantity", "value", "from the exact"], rows, "lrr")
     s = m.drive.sense
     doc.table([f"at φ = {MOTION_AT_DEG:g}°", "constant ω", "true ω(φ)"],
-              [["M_bal, N·m", _fmt(const.balancing_moment[0]), _fmt(true.balancing_moment[0])],
+              [[f"{esc(quantity_name(m, 'M_bal'))}, N·m", _fmt(const.balancing_moment[0]), _fmt(true.balancing_moment[0])],
                ["ω₁, rad/s", _fmt(s * const.omega(1)[0]), _fmt(s * true.omega(1)[0])],
                ["ε₁, rad/s²", _fmt(s * const.eps(1)[0]), _fmt(s * true.eps(1)[0])]], "lrr")
     fd = _forward_dynamics_rows(m, motion)
