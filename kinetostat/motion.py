@@ -33,6 +33,13 @@ GAUSS_NODES = 4
 #: The fixed point over speed-dependent loads (friction, dampers, characteristics, a motor's
 #: M(omega)) stops when omega changes by less than this, relative to omega_mean, between passes.
 SPEED_TOL = 1e-12
+#: A continuous extreme's angle is refined on the exact energy equation until it moves less than
+#: this, deg, or for at most REFINE_PASSES evaluations.
+REFINE_DEG = 1e-9
+REFINE_PASSES = 8
+#: Passes of that fixed point before omega changes by less than this (relative) refine the
+#: extremes once only; the later passes to REFINE_DEG.
+ROUGH = 1e-6
 #: The most passes of that fixed point before a ValueError says it did not settle.
 MAX_PASSES = 200
 
@@ -102,7 +109,7 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
         ld.kind == "damper" or ld.characteristic is not None for ld in mech.loads)
     n = cycle.n
     speed = _Speed(phi_deg, np.full(n, nominal), np.zeros(n), chars)
-    passes, red = 0, None
+    passes, red, change = 0, None, np.inf
     while True:
         passes += 1
         if red is None or varying:
@@ -110,7 +117,8 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
             _check_work(mech, red, chars)
         M_drive, level, shift = (_characteristic_drive(chars, red, cycle, speed) if chars else
                                  (np.full(len(cycle.angles), -cycle.mean(red.M)), nominal, 0.0))
-        pieces = _Pieces(mech, cycle, red, M_drive, speed, shift)
+        pieces = _Pieces(mech, cycle, red, M_drive, speed, shift,
+                         REFINE_PASSES if not varying or change <= ROUGH else 1)
         J = J_fly if target is None else _sized(pieces, level, target)
         T0, top, bottom = _level(pieces, J, level)
         omega = np.sqrt(np.maximum(2 * (T0 + pieces.A) / (J + red.J[:n]), 0.0))
@@ -118,6 +126,7 @@ def law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float |
         change = float(np.abs(new.at(cycle.angles) - speed.at(cycle.angles)).max()) / level
         speed = new
         if not varying or change <= SPEED_TOL:
+            change = change if varying else 0.0     # the loads do not depend on the motion: exact at once
             break
         if passes >= MAX_PASSES:
             raise ValueError(f"law_of_motion: the speed-dependent loads' fixed point did not settle in {MAX_PASSES} "
@@ -343,8 +352,9 @@ class _Pieces:
     other angle: A by Gauss-Legendre from the grid angle below, cut at the table knots."""
 
     def __init__(self, mech: Mechanism, cycle: _Cycle, red: _Reduced, M_drive: np.ndarray, speed: _Speed,
-                 shift: float):
+                 shift: float, refine: int):
         n = cycle.n
+        self.refine = refine
         self.mech, self.cycle, self.red, self.speed, self.shift = mech, cycle, red, speed, shift
         self.M_drive = M_drive
         self.phi = cycle.angles[:n]
@@ -358,10 +368,11 @@ class _Pieces:
         w = self.speed.at(angles) + self.shift
         return sum((ld.characteristic(w) for ld in self.speed.chars), np.zeros_like(w))
 
-    def exact(self, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """A (J), J_red (kg m^2) and dJ_red (kg m^2/rad) at the angles `at` (deg, in [0, 360))."""
+    def exact(self, at: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """A (J), J_red (kg m^2), dJ_red (kg m^2/rad) and dA = M_red + M_drive (N m) at the angles
+        `at` (deg, in [0, 360))."""
         if not len(at):
-            return np.empty(0), np.empty(0), np.empty(0)
+            return np.empty(0), np.empty(0), np.empty(0), np.empty(0)
         i = np.clip(np.searchsorted(self.phi, at, side="right") - 1, 0, len(self.phi) - 1)
         x, w = np.polynomial.legendre.leggauss(GAUSS_NODES)
         nodes, weights, owner = [], [], []
@@ -376,7 +387,8 @@ class _Pieces:
         red = _reduced(self.mech, np.concatenate([at, nodes]), self.speed)
         k = len(at)
         f = red.M[k:] + self.drive_at(nodes)
-        return self.A[i] + np.bincount(owner, weights * f, minlength=k), red.J[:k], red.dJ[:k]
+        return (self.A[i] + np.bincount(owner, weights * f, minlength=k), red.J[:k], red.dJ[:k],
+                red.M[:k] + self.drive_at(at))
 
     def locate(self, y: np.ndarray, dy: np.ndarray, most: int = 6) -> np.ndarray:
         """The angles (deg) of the `most` largest local maxima of the periodic cubic Hermite
@@ -397,13 +409,35 @@ class _Pieces:
         h00, h10, h01, h11 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2, s * s * (3 - 2 * s), s * s * (s - 1)
         value = np.where(np.isnan(s), -np.inf, h00 * y0 + h10 * d0 + h01 * y1 + h11 * d1)
         best = np.nan_to_num(np.take_along_axis(s, np.argmax(value, axis=0)[None], 0)[0], nan=0.0)
-        return np.mod(phi[a] + np.degrees(best * h), 360.0)
+        return phi[a] + np.degrees(best * h), phi[a], phi[a] + np.degrees(h)
+
+    def peaks(self, y: np.ndarray, dy: np.ndarray, slope, most: int = 6) -> tuple[np.ndarray, tuple]:
+        """The angles (deg) of the local maxima of a function of the energy equation's terms,
+        given at the grid as values `y` and slopes `dy`, and its terms exactly there (`exact`):
+        each located on the Hermite (`locate`), then by regula falsi (Illinois) on the exact slope
+        `slope(A, J_red, dJ_red, dA)` within its grid step, to REFINE_DEG."""
+        x, lo, hi = self.locate(y, dy, most)
+        g_lo, g_hi = np.ones_like(x), -np.ones_like(x)        # the slope's signs at the ends of a maximum
+        terms = self.exact(np.mod(x, 360.0))
+        for _ in range(self.refine):
+            g = slope(*terms)
+            up = g > 0
+            moved = x.copy()
+            lo, hi = np.where(up, x, lo), np.where(up, hi, x)
+            g_lo, g_hi = np.where(up, g, g_lo * np.where(up, 1.0, 0.5)), np.where(up, g_hi * 0.5, g)
+            with np.errstate(all="ignore"):
+                x = np.where(g == 0, x, lo + (hi - lo) * g_lo / (g_lo - g_hi))
+            x = np.where(np.isfinite(x), x, 0.5 * (lo + hi))
+            terms = self.exact(np.mod(x, 360.0))
+            if np.abs(x - moved).max(initial=0.0) <= REFINE_DEG:
+                break
+        return np.mod(x, 360.0), terms
 
     def sup(self, k: float, sign: float) -> tuple[float, float]:
         """The largest of sign (A - k J_red) over the continuous cycle, J, and its angle (deg):
         the grid's, and each local maximum located (`locate`) and evaluated exactly."""
-        at = self.locate(sign * (self.A - k * self.J), sign * (self.dA - k * self.dJ))
-        A, J, _ = self.exact(at)
+        at, (A, J, _, _) = self.peaks(sign * (self.A - k * self.J), sign * (self.dA - k * self.dJ),
+                                      lambda A, J, dJ, dA: sign * (dA - k * dJ))
         values = sign * np.concatenate([self.A - k * self.J, A - k * J])
         best = int(np.argmax(values))
         return float(values[best]), float(np.concatenate([self.phi, at])[best])
@@ -438,8 +472,12 @@ def _level(pieces: _Pieces, J: float, level: float) -> tuple[float, tuple[float,
         w = np.sqrt(np.maximum(2 * (T0 + A) / (J + Jr), 0.0))
         with np.errstate(divide="ignore", invalid="ignore"):
             dw = np.where(w > 0, (pieces.dA - 0.5 * pieces.dJ * w ** 2) / ((J + Jr) * w), 0.0)
-        extra_phi = np.concatenate([pieces.locate(w, dw, 2), pieces.locate(-w, -dw, 2)])
-        extra_A, extra_J, _ = pieces.exact(extra_phi)
+        def slope(sign: float):
+            return lambda A_, J_, dJ_, dA_: sign * (dA_ - dJ_ * (T0 + A_) / (J + J_))   # (J + J_red) omega omega'
+        top, t_terms = pieces.peaks(w, dw, slope(1.0), 2)
+        bottom, b_terms = pieces.peaks(-w, -dw, slope(-1.0), 2)
+        extra_phi = np.concatenate([top, bottom])
+        extra_A, extra_J = np.concatenate([t_terms[0], b_terms[0]]), np.concatenate([t_terms[1], b_terms[1]])
     w_all = np.sqrt(np.maximum(2 * (T0 + np.concatenate([A, extra_A])) / (J + np.concatenate([Jr, extra_J])), 0.0))
     phi_all = np.concatenate([pieces.phi, extra_phi])
     top, bottom = int(np.argmax(w_all)), int(np.argmin(w_all))
