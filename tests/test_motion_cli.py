@@ -157,3 +157,17 @@ def test_report_section_skips_a_model_with_no_drive_to_balance():
     md = _section("chain_unit_four_bar")
     assert re.search(r"Skipped: the loads' work over a cycle is \S+ J \(gravity and conservative loads only\): "
                      r"there is no drive to balance\.", md)
+
+
+def test_plans_delta_draws_the_velocities_at_the_true_omega(cli, tmp_path, motion):
+    values = {}
+    for name, args in (("const", []), ("true", ["--delta", str(DELTA)])):
+        r = cli("plans", MODEL, "--at", "30", "--only", "velocity", "--out", tmp_path / name, *args)
+        assert r.returncode == 0, r.stderr
+        with open(tmp_path / name / "segments.csv", encoding="utf-8") as f:
+            values[name] = next(float(row["value"]) for row in csv.DictReader(f) if row["segment"] == "p-a1")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        omega = abs(kinetostat.analyze(motion.mech, phi_deg=[30.0], law=motion).omega(1)[0])
+    assert values["true"] / values["const"] == pytest.approx(omega / motion.mech.drive.omega, rel=1e-9)
+    assert abs(omega / motion.mech.drive.omega - 1) > 1e-4                 # the true speed differs at 30 deg
