@@ -193,7 +193,7 @@ def _panel(L: _Layout, key: str, cell: tuple[float, float, float, float], headin
         Y = float(p.Y(v))
         L.line(p.box[0] - 1.2, Y, p.box[0], Y, "construction")
         L.text(p.box[0] - 2.0, Y + 0.36 * _SIZE, num(v, L.lang, 6), right=True)
-    L.text(p.box[2] + 4.0, ax_y - 1.5, x_name, right=True)
+    L.names.append((x_name, (p.box[2] + 4.0, ax_y)))          # placed clear of the curves (`_place_names`)
     L.text(p.box[0] + 1.5, p.box[1] - 1.0, y_name)
     return p
 
