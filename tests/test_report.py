@@ -365,7 +365,7 @@ def test_report_cli_errors_become_one_line(tmp_path, monkeypatch, capsys):
     from kinetostat import cli
     from kinetostat import report
 
-    def broken(run, out, folder=None, page=False, friction="first"):
+    def broken(run, out, folder=None, page=False, friction="first", delta=None, flywheel=None):
         raise RuntimeError("plotting failed\nsecond line")
     monkeypatch.setattr(report, "write_report", broken)
     code = cli.main(["report", str(ICE), "--out", str(tmp_path), "--steps", "12", "--engines", "pinocchio",
@@ -634,7 +634,10 @@ def test_a_report_analyses_each_set_of_angles_once(ice_report):
     """The report's parts at the same angles and friction method share one analysis (`ModelRun.at`):
     the ICE (published values at 30°, its design position; [friction]) is analysed by the report
     package once at 30° frictionless, once at 30° and once over the cycle with friction in the
-    reactions, the shaper (no friction) once at 30°; the cycle itself is the run's `res`, never
-    analysed again. (The plans, drawn by `kinetostat.plans` from their own analysis, are not counted.)"""
-    assert sorted(REPORT_ANALYSES) == [("ice_crank_slider", 1, 30.0, "first"), ("ice_crank_slider", 1, 30.0, "reactions"),
-                                       ("ice_crank_slider", 36, 0.0, "reactions"), ("slotted_link_shaper", 1, 30.0, "first")]
+    reactions, the shaper (no friction) once at 30°; each once more at 30° at its true law of motion
+    (the law-of-motion section: another motion, another analysis); the cycle itself is the run's
+    `res`, never analysed again. (The plans, drawn by `kinetostat.plans` from their own analysis,
+    are not counted.)"""
+    assert sorted(REPORT_ANALYSES) == [("ice_crank_slider", 1, 30.0, "first"), ("ice_crank_slider", 1, 30.0, "first"),
+                                       ("ice_crank_slider", 1, 30.0, "reactions"), ("ice_crank_slider", 36, 0.0, "reactions"),
+                                       ("slotted_link_shaper", 1, 30.0, "first"), ("slotted_link_shaper", 1, 30.0, "first")]

@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from .._text import one_line
-from .common import CLIError, EXIT_OK, TABLE_SUFFIXES, _Out, _analyze, _done, _fmt, _lines, _load, _model_error_lines, _parquet_engine, _save, _turn, _warn, _writable_file, bundled_models
+from .common import CLIError, EXIT_OK, TABLE_SUFFIXES, _Out, _analyze, _done, _fmt, _law, _lines, _load, _model_error_lines, _parquet_engine, _save, _turn, _warn, _writable_file, bundled_models
 
 
 def _summary(res, path: Path) -> list[str]:
@@ -146,9 +146,16 @@ def cmd_analyze(args) -> int:
         _writable_file(out, "--out")
     path = Path(args.model)
     mech = _load(path)
+    law = None
+    if args.delta is not None or args.flywheel is not None:
+        law = _law(mech, path, delta=args.delta, flywheel=args.flywheel, steps=args.steps)
     res, _ = _analyze(mech, path, phi_deg=_turn(args.at, "--at"), steps=args.steps, friction=args.friction,
-                      out=out)
+                      out=out, law=law)
     lines = _summary(res, path)
+    if law is not None:
+        lines.insert(3, f"at the true law of motion (--{'delta' if args.delta is not None else 'flywheel'}): "
+                        f"omega_mean = {law.omega_mean:.6g} rad/s, delta = {law.delta:.6g}, "
+                        f"J_flywheel = {law.J_flywheel:.6g} kg m^2 on the crank shaft (see 'kinetostat motion')")
     if len(res.phi_deg) == 1:
         lines += _worksheet_lines(mech, float(res.phi_deg[0]))
     if out is not None:

@@ -1,7 +1,8 @@
 """What every command shares: exit codes, CLIError, output that does not break a progress bar,
 the verbosity (-q, -v: the package logger's level and its one stderr handler, `_logging`),
 interrupts, atomic saving (`_save`), warnings as one line, progress bars, the argument types,
-loading a model (`_load`), the analysis with its memory check (`_analyze`), writable outputs,
+loading a model (`_load`), the analysis with its memory check (`_analyze`), the law of motion
+(`_law`, --delta/--flywheel: `_coefficient`, `_inertia`), writable outputs,
 the engine routes (`_engines`) and the models prepared for them (`_prepare`).
 
 May use: every room of the solver; the harness only inside `_engines`.
@@ -482,10 +483,11 @@ def _check_memory(mech, steps: int, out: str | None = None) -> None:
                        f"available to this process; use fewer steps (at most about {int(free // per_angle):,})")
 
 
-def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | None = None, out: str | None = None):
+def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | None = None, out: str | None = None,
+             law=None):
     """analyze() with AssemblyError and ModelError as a CLIError, warnings printed one line each;
     `steps` that would not fit in memory (with `out`, the --out table's too) are refused before
-    anything is allocated."""
+    anything is allocated. `law` (`_law`): at that true motion, at its angles unless `phi_deg`."""
     from ..solve import analyze
     from ..errors import AssemblyError, ModelError
     if phi_deg is None:
@@ -494,7 +496,7 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | N
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            res = analyze(mech, phi_deg=phi_deg, steps=steps, friction=friction)
+            res = analyze(mech, phi_deg=phi_deg, steps=steps, friction=friction, law=law)
         except AssemblyError as exc:
             raise CLIError(f"{path}: {exc}") from None
         except ModelError as exc:       # faults that show only over the cycle (a travel diagram's stroke)
@@ -506,6 +508,48 @@ def _analyze(mech, path: Path, phi_deg=None, steps: int = 360, friction: str | N
             seen.add(text)
             _warn(f"{Path(path).name}: {text}")
     return res, time.perf_counter() - t0
+
+
+def _law(mech, path: Path, delta: float | None = None, flywheel: float | None = None, steps: int = 360):
+    """`kinetostat.law_of_motion` (--delta D, --flywheel J, or neither: the model's [flywheel])
+    with its faults as a CLIError naming the file, warnings printed one line each."""
+    from ..errors import AssemblyError, ModelError
+    from ..motion import law_of_motion
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            motion = law_of_motion(mech, delta=delta, flywheel=flywheel, steps=steps)
+        except ModelError as exc:
+            raise CLIError(lines=_model_error_lines(exc)) from None
+        except (AssemblyError, ValueError) as exc:
+            raise CLIError(f"{path}: {exc}") from None
+    for text in dict.fromkeys(str(w.message).splitlines()[0] for w in caught):
+        _warn(f"{Path(path).name}: {text}")
+    return motion
+
+
+def _coefficient(text: str) -> float:
+    """An argparse type: --delta, a coefficient of fluctuation 0 < D < 2."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not 0 < x < 2:
+        raise argparse.ArgumentTypeError(f"invalid coefficient of fluctuation {text!r}: expected 0 < D < 2 "
+                                         f"((omega_max - omega_min) / omega_mean), e.g. --delta 0.02")
+    return x
+
+
+def _inertia(text: str) -> float:
+    """An argparse type: --flywheel, a moment of inertia J >= 0, kg m^2."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (math.isfinite(x) and x >= 0):
+        raise argparse.ArgumentTypeError(f"invalid flywheel {text!r}: expected a moment of inertia >= 0 in "
+                                         f"kg m^2, e.g. --flywheel 0.5")
+    return x
 
 
 def _probe_file(folder: Path) -> IO:

@@ -8,7 +8,8 @@ from __future__ import annotations
 import argparse
 
 from .analyze import cmd_analyze, cmd_examples, cmd_export, cmd_schema, cmd_structure
-from .common import NORMAL, QUIET, VERBOSE, _Parser, _angle, _jobs, _positive, _steps
+from .common import NORMAL, QUIET, VERBOSE, _Parser, _angle, _coefficient, _inertia, _jobs, _positive, _steps
+from .motion import cmd_motion
 from .plans import _plan_names, _scale_item, cmd_page, cmd_plans, cmd_variant
 from .report import cmd_report
 from .sweep import _param, cmd_sweep
@@ -20,6 +21,18 @@ def _friction_option(parser: argparse.ArgumentParser, default: str) -> None:
     parser.add_argument("--friction", choices=["first", "reactions"], default=None,
                         help="a model with [friction]: 'first' (the first approximation: frictionless reactions) or "
                              f"'reactions' (friction in the reactions, exact); {default}")
+
+
+def _law_options(parser: argparse.ArgumentParser, what: str) -> None:
+    """--delta D | --flywheel J: `what` at the machine's true law of motion (`kinetostat motion`)."""
+    g = parser.add_mutually_exclusive_group()
+    g.add_argument("--delta", metavar="D", type=_coefficient,
+                   help=f"{what} at the true law of motion omega(phi), eps(phi) with the smallest flywheel on the crank "
+                        "shaft that holds the coefficient of fluctuation D = (omega_max - omega_min) / omega_mean, "
+                        "0 < D < 2 (see 'kinetostat motion')")
+    g.add_argument("--flywheel", metavar="J", type=_inertia,
+                   help=f"{what} at the true law of motion with a flywheel of moment of inertia J (kg m^2) on the "
+                        "crank shaft")
 
 
 def _verbosity_options(parser: argparse.ArgumentParser, default) -> None:
@@ -64,6 +77,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--steps", metavar="N", type=_steps, default=360,
                    help="N equal steps over a revolution (default 360)")
     _friction_option(a, "default: the model's friction.method, else first")
+    _law_options(a, "analyse")
     a.add_argument("--out", metavar="FILE",
                    help="write the full table: FILE.csv, FILE.parquet (needs pyarrow) or FILE.json "
                         "(records); '-' writes CSV to stdout and the summary to stderr")
@@ -151,6 +165,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "other text equal but for the libraries' versions")
     _friction_option(r, "of the report's plans and worksheet (default first, the graphical method's; the friction "
                         "section shows both either way)")
+    _law_options(r, "each model's report, analyses and plans")
     r.add_argument("--page", action=argparse.BooleanOptionalAction, default=True,
                    help="each model's interactive page, page.html, drawn anew and linked (default; --no-page: "
                         "none; docs: The interactive page)")
@@ -183,7 +198,29 @@ def build_parser() -> argparse.ArgumentParser:
     _friction_option(pl, "default first (the graphical method's frictionless reactions); reactions draws each "
                          "revolute pair's friction circle with its reaction tangent to it, the guides' reactions "
                          "leaning by arctg f, the force polygons closed by them, and the worksheet's reactions with friction")
+    _law_options(pl, "draw the plans")
     pl.set_defaults(func=cmd_plans)
+
+    mo = sub.add_parser("motion", help="the machine's law of motion: J_red, M_red, omega(phi), delta, the flywheel "
+                                       "(CSV, a sheet of diagrams, a summary)",
+                        description="Find MODEL's steady periodic law of motion (the dynamic analysis before "
+                                    "kinetostatics): the reduced moment of inertia J_red(phi), the reduced moment "
+                                    "of the loads M_red(phi) and the drive's M_drive, the work and Delta T, "
+                                    "omega(phi) and eps(phi) with omega_mean the drive's nominal speed, the "
+                                    "coefficient of fluctuation delta and the flywheel on the crank shaft (exact, "
+                                    "and by the texts' approximate methods). Writes into DIR, as one set: "
+                                    "motion.csv (every array, units in the header), motion.svg and motion.pdf (one "
+                                    "A3 sheet of diagrams at stated scales: the moments, the work, Delta T, J_red, "
+                                    "Wittenbauer's energy-mass curve with its tangents, omega(phi)) and "
+                                    "summary.txt (also printed). Without --delta or --flywheel: the model's "
+                                    "[flywheel], else no flywheel.")
+    mo.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
+    _law_options(mo, "the law of motion")
+    mo.add_argument("--steps", metavar="N", type=_steps, default=360, help="positions over the cycle (default 360)")
+    mo.add_argument("--lang", choices=("en", "uk", "ru"), default=None,
+                    help="language of the sheet (default: the model's [lettering] language, else en)")
+    mo.add_argument("--out", metavar="DIR", required=True, help="output directory (created)")
+    mo.set_defaults(func=cmd_motion)
 
     pg = sub.add_parser("page", help="the interactive page of a mechanism: one offline HTML file, an angle slider "
                                      "over every plan", description="Write one self-contained HTML file (no network): "

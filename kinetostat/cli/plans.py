@@ -17,7 +17,7 @@ from pathlib import Path
 from .._forecast import Forecast
 from .._io import unit
 from .._text import one_line
-from .common import (CLIError, EXIT_OK, _Out, _checkpoint, _close, _done, _lines, _load, _os_reason, _progress, _size,
+from .common import (CLIError, EXIT_OK, _Out, _checkpoint, _close, _done, _law, _lines, _load, _os_reason, _progress, _size,
                      _turn, _warn, _writable_dir, _writable_file)
 
 log = logging.getLogger(__name__)
@@ -59,6 +59,8 @@ def cmd_plans(args) -> int:
     from ..plans.scales import ScaleError
     path = Path(args.model)
     mech = _load(path)
+    law = _law(mech, path, delta=args.delta, flywheel=args.flywheel) \
+        if args.delta is not None or args.flywheel is not None else None
     args.lang = args.lang or lettering(mech).language or "en"
     out = _writable_dir(args.out, "--out")
     only = [n for group in (args.only or []) for n in group] or None
@@ -68,9 +70,9 @@ def cmd_plans(args) -> int:
             warnings.simplefilter("always")
             fixed = cycle_scales(mech) if args.cycle_scales else None          # the page's scales
             plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only,
-                          fixed=fixed, friction=args.friction or "first")
+                          fixed=fixed, friction=args.friction or "first", law=law)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang,
-                                                friction=args.friction or "first")
+                                                friction=args.friction or "first", law=law)
     except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
         raise CLIError(f"--scale {exc}") from None
     except ValueError as exc:

@@ -30,9 +30,9 @@ log = logging.getLogger(__name__)
 
 
 def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str, page: bool = True,
-                friction: str = "first") -> dict:
+                friction: str = "first", law: tuple = (None, None)) -> dict:
     """One model's report: load, analyse (or take both from `_PREPARED`), run the routes, write
-    `out/<folder>/` (with `page`, its page.html drawn; without, an
+    `out/<folder>/` (`law`: --delta, --flywheel; with `page`, its page.html drawn; without, an
     earlier page.html removed). Returns {"summary", "warnings", "seconds", "page": "drawn" or
     None} or {"error"} (one line); raises only KeyboardInterrupt."""
     from ..report import run_validation, write_report
@@ -52,7 +52,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
         run.solver_seconds = secs
         earlier = Path(out) / folder / "page.html"
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
-            summary = write_report(run, tmp, folder, page=page, friction=friction)
+            summary = write_report(run, tmp, folder, page=page, friction=friction, delta=law[0], flywheel=law[1])
         notes = list(run.warnings)
         if not page and (earlier.is_file() or earlier.is_symlink()):
             try:
@@ -91,21 +91,22 @@ def _report_cost(mech) -> int:
 
 
 def _report_results(paths: list[Path], folders: list[str], engines: list[str], steps: int, out: Path, jobs: int,
-                    costs: Sequence[int] = (), page: bool = True, friction: str = "first", verbosity: int = NORMAL):
+                    costs: Sequence[int] = (), page: bool = True, friction: str = "first", verbosity: int = NORMAL,
+                    law: tuple = (None, None)):
     """Yield (index into `paths`, result of _report_job) as each model finishes; `jobs` > 1 runs
     them in a process pool (only paths and names cross to the workers, so any start method
     works), the largest `costs` first, 1 in this process; the workers log at `verbosity`. Ctrl-C
     cancels the models not started and raises KeyboardInterrupt here."""
     if jobs == 1 or len(paths) == 1:
         for n, p in enumerate(paths):
-            yield n, _report_job(str(p), engines, steps, str(out), folders[n], page, friction)
+            yield n, _report_job(str(p), engines, steps, str(out), folders[n], page, friction, law)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(paths)), initializer=_worker_init,
                                initargs=(verbosity,))
     try:
         first = sorted(range(len(paths)), key=lambda n: -costs[n] if costs else 0)
-        futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n], page, friction): n
+        futures = {pool.submit(_report_job, str(paths[n]), engines, steps, str(out), folders[n], page, friction, law): n
                    for n in first}
         for f in as_completed(futures):
             try:
@@ -148,7 +149,7 @@ def cmd_report(args) -> int:
     try:
         for n, r in _report_results(order, folders, engines, args.steps, out, jobs,
                                     [_report_cost(mech) for _, mech, *_ in prepared], args.page,
-                                    args.friction or "first", args.verbosity):
+                                    args.friction or "first", args.verbosity, (args.delta, args.flywheel)):
             _checkpoint()
             path = order[n]
             bar.update()

@@ -310,7 +310,7 @@ def plan_file_name(plan: Plan, suffix: str = ".svg") -> str:
 def build(mech, at: float | None = None, scales: Mapping[str, float] | None = None,
           starting_deg: float | None = None, only: Iterable[str] | None = None,
           fixed: CycleScales | None = None, friction: str = "first",
-          positions: FixedPositions | None = None) -> Plans:
+          positions: FixedPositions | None = None, law=None) -> Plans:
     """The plans of `mech` at crank angle `at` (deg; default: the model's design position
     `drive.design_deg`). `scales`: any of mu_l [m/mm], mu_v [m/(s mm)], mu_a [m/(s^2 mm)],
     mu_F [N/mm] (the others chosen by the texts' rule, `choose_scales`); `starting_deg`: position
@@ -320,7 +320,9 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     "reactions" (a model with [friction]: the group plans, force polygons and crank plan with the
     reactions with friction, each revolute pair's friction circle drawn, `forces`). `positions`:
     the plan of positions' 12 positions and paths made once for many angles (`fixed_positions` of
-    `mech` at the mu_l drawn at; from `starting_deg` where it is given, else ValueError). ValueError for
+    `mech` at the mu_l drawn at; from `starting_deg` where it is given, else ValueError). `law`: at
+    that true law of motion (`kinetostat.law_of_motion`: omega and eps at `at`, the flywheel's
+    moment on the crank), not the model's drive. ValueError for
     a bad angle or name, or an angle with no equilibrium with friction; ScaleError (a ValueError)
     for a scale that would draw a plan beyond MAX_EXTENT_MM."""
     import math
@@ -333,7 +335,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     chosen = _chosen(only)
     if friction not in ("first", "reactions"):
         raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
-    res = analyze(mech, phi_deg=[float(at)], friction=friction)    # default: the graphical method's frictionless reactions
+    res = analyze(mech, phi_deg=[float(at)], friction=friction, law=law)    # default: the graphical method's frictionless reactions
     if res.friction is not None and not res.friction.solved[0]:
         raise ValueError(f"at {at:g} deg there is no equilibrium with friction in the reactions (self-locking): "
                          f"no plans of the forces to draw")

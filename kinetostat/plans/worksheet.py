@@ -630,16 +630,17 @@ def _point_of(res: Analysis, k: int, name: str) -> np.ndarray:
     return res.kin.v_origin[:, k] + res.omega(k)[:, None] * _across(r)
 
 
-def analyses(mech: Mechanism, phi_deg, friction: str = "first") -> tuple[Analysis, Analysis | None]:
+def analyses(mech: Mechanism, phi_deg, friction: str = "first", law=None) -> tuple[Analysis, Analysis | None]:
     """The analyses a worksheet of `mech` at the angles `phi_deg` (deg) is built from
     (`worksheet_cycle`): in the mode `friction` ("first": the graphical method's frictionless
     reactions, or "reactions"), and for a model with [friction] in the other mode too (its
-    friction rows), else None. Self-locking is not warned of: the sheet's rows state eta."""
+    friction rows), else None; at the true law of motion `law` (`kinetostat.law_of_motion`) where
+    given. Self-locking is not warned of: the sheet's rows state eta."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SelfLockingWarning)
-        res = analyze(mech, phi_deg=phi_deg, friction=friction)
+        res = analyze(mech, phi_deg=phi_deg, friction=friction, law=law)
         other = None if mech.friction is None else \
-            analyze(mech, phi_deg=phi_deg, friction="reactions" if friction == "first" else "first")
+            analyze(mech, phi_deg=phi_deg, friction="reactions" if friction == "first" else "first", law=law)
     return res, other
 
 
@@ -672,9 +673,9 @@ def worksheet_cycle(mech: Mechanism, res: Analysis, mu_l: float, lang: str = "en
 
 
 def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = None, lang: str = "en",
-              friction: str = "first") -> Worksheet:
+              friction: str = "first", law=None) -> Worksheet:
     """The worksheet of `mech` at crank angle `at` (deg; default the model's design position):
-    `worksheet_cycle` at the one angle.
+    `worksheet_cycle` at the one angle (at the true law of motion `law` where given: `analyses`).
 
     mu_l: the scale of the plan of positions, m/mm, for the arms and z in mm (default: the
     crank drawn 30-35 mm at a round scale, as seed 002 chooses it). lang: "en", "uk" or "ru"
@@ -690,7 +691,7 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
     if friction not in ("first", "reactions"):
         raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
-    res, other = analyses(mech, [float(at)], friction)
+    res, other = analyses(mech, [float(at)], friction, law)
     if mu_l is None:
         mu_l = choose_scales(mech, res)["mu_l"].value
     return worksheet_cycle(mech, res, float(mu_l), lang, other).at(0)

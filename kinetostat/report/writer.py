@@ -39,6 +39,14 @@ CYCLE_FILE = "cycle.csv.gz"
 MIN_REPORT_STEPS = 8
 #: The heading of a report's plans (the index links to it).
 PLANS_HEADING = "Plans of the graphical method"
+#: The heading of a report's law of motion (the index links to it).
+MOTION_HEADING = "Law of motion"
+#: The coefficient of fluctuation the law-of-motion section sizes the flywheel for where the model
+#: has no [flywheel] and the run gives no --delta or --flywheel.
+DEFAULT_DELTA = 0.02
+#: The angle of the section's M_bal at constant omega and at the true omega(phi), deg.
+MOTION_AT_DEG = 30.0
+
 #: The project's studies, linked from the index where their files are in its folder.
 STUDIES = (("stability.md", "Stability: the solver's accuracy near singular positions"),
            ("drawing_error.md", "Drawing error: the spread of a careful drawing of the plans"),
@@ -284,10 +292,12 @@ def _published_section(doc: Doc, m: Mechanism, published: Sequence[PublishedChec
                "within"], rows, "lllrrlrrl")
 
 
-def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction: str = "first") -> list[Path]:
+def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction: str = "first",
+                   law=None, law_said: str = "") -> list[Path]:
     """The plans of the graphical method at the model's design position (`kinetostat.plans`),
     one picture each, with their segments.csv and the worksheet beside them, and with `page` the
-    interactive page (`plans.page`, page.html, drawn anew) linked; `friction`: the method they are drawn with (`plans.build`); returns the files."""
+    interactive page (`plans.page`, page.html, drawn anew) linked; `friction`: the method they are drawn with (`plans.build`);
+    `law`: the plans and worksheet at that true law of motion (`law_said` says which); returns the files."""
     from ..plans import build, plan_file_name, svg
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
@@ -296,14 +306,16 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
     try:
         with warnings.catch_warnings():         # the cycle's warnings are reported below
             warnings.simplefilter("ignore")
-            plans = build(m, friction=friction)
-            sheet = worksheet(m, mu_l=plans.scales["mu_l"].value, friction=friction)
+            plans = build(m, friction=friction, law=law)
+            sheet = worksheet(m, mu_l=plans.scales["mu_l"].value, friction=friction, law=law)
     except ValueError as exc:
         doc.p(f"No plans at this position: {esc(str(exc))}")
         return []
     doc.p(f"The plans at φ = {at:g}° as the course texts draw them, from the exact solution"
           + (" with friction in the reactions (each revolute pair's friction circle drawn, its reaction tangent to it)"
-             if friction == "reactions" else "") + ", at the scales "
+             if friction == "reactions" else "")
+          + (f", at the true law of motion ({law_said}; the interactive page at the model's constant speed)"
+             if law is not None else "") + ", at the scales "
           + ", ".join(f"`{s}`" for s in plans.scales.values())
           + ": positions, velocities, accelerations, each Assur group with its loads and arms, the "
             "force polygons, the initial link and Zhukovsky's lever, each on an A3 sheet true to scale in mm "
@@ -465,6 +477,76 @@ def _friction_section(doc: Doc, run: ModelRun) -> None:
         _rounding_note(doc, checks)
 
 
+def _law_choice(m: Mechanism, delta: float | None, flywheel: float | None) -> tuple[dict, str]:
+    """law_of_motion's arguments for the report's section, and the words saying which flywheel:
+    --delta, --flywheel, the model's [flywheel], else DEFAULT_DELTA."""
+    if delta is not None:
+        return {"delta": delta}, f"the flywheel sized for δ = {delta:g} (--delta)"
+    if flywheel is not None:
+        return {"flywheel": flywheel}, f"the flywheel J = {flywheel:g} kg·m² given (--flywheel)"
+    fw = m.flywheel
+    if fw is not None:
+        return {}, ("the flywheel sized for the model's [flywheel] δ = " + f"{fw.delta:g}" if fw.J is None
+                    else f"the model's [flywheel] J = {fw.J:g} kg·m²")
+    return {"delta": DEFAULT_DELTA}, f"the flywheel sized for δ = {DEFAULT_DELTA:g} by default (the model has no [flywheel])"
+
+
+def _forward_dynamics_rows(m: Mechanism, motion) -> list[list[str]]:
+    """The hook for the engines' check of the law (forward dynamics of the machine with its flywheel,
+    MuJoCo and Pinocchio): its rows for the section's table. None are run in the report today."""
+    return []
+
+
+def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywheel: float | None = None):
+    """The machine's law of motion (`kinetostat.law_of_motion`) at the flywheel `_law_choice` picks:
+    omega_mean, delta, J_flywheel exact and by the texts' approximate methods, and M_bal at
+    MOTION_AT_DEG at constant omega beside the true omega(phi); a model with no drive to balance
+    (or whose law cannot be found) is skipped with a line saying why. Returns the Motion, or None."""
+    from ..errors import AssemblyError, ModelError
+    from ..motion import law_of_motion
+    from ..plans.motion_sheet import no_drive
+    from ..solve import analyze
+    m = run.mech
+    doc.h(2, MOTION_HEADING)
+    kwargs, said = _law_choice(m, delta, flywheel)
+    t0 = time.perf_counter()
+    motion = None
+    why = no_drive(-run.res.balancing_moment)      # at constant omega the inertia does no work over the cycle
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            if not why:
+                motion = law_of_motion(m, **kwargs)
+                why = no_drive(motion.M_red)
+            if not why:
+                true = analyze(m, phi_deg=[MOTION_AT_DEG], law=motion)
+                const = run.at([MOTION_AT_DEG])
+    except (ModelError, AssemblyError, ValueError) as exc:
+        why = str(exc).strip().splitlines()[0]
+    log.info("%s: law of motion (%.3f s)", run.stem, time.perf_counter() - t0)
+    if why:
+        doc.p(f"Skipped: {esc(why)}.")
+        return None
+    doc.p(f"The steady periodic motion of the machine (the dynamic analysis before kinetostatics, "
+          f"`kinetostat motion`), with {esc(said)}, over {len(motion.phi_deg)} positions; the drive: "
+          f"{esc(motion.drive)} (M_drive = {_fmt(float(np.mean(motion.M_drive)))} N·m on average).")
+    J = motion.J_flywheel
+    rows = [["ω_mean, rad/s", _fmt(motion.omega_mean), ""], ["δ, 1", _fmt(motion.delta), ""],
+            ["J_flywheel, kg·m² (exact)", _fmt(J), ""]]
+    rows += [[f"J_flywheel, kg·m² ({esc(k)})", _fmt(v), f"{(v - J) / J * 100:+.3g} %" if J > 0 else "-"]
+             for k, v in motion.approximate.items()]
+    doc.table(["quantity", "value", "from the exact"], rows, "lrr")
+    s = m.drive.sense
+    doc.table([f"at φ = {MOTION_AT_DEG:g}°", "constant ω", "true ω(φ)"],
+              [[f"{esc(quantity_name(m, 'M_bal'))}, N·m", _fmt(const.balancing_moment[0]), _fmt(true.balancing_moment[0])],
+               ["ω₁, rad/s", _fmt(s * const.omega(1)[0]), _fmt(s * true.omega(1)[0])],
+               ["ε₁, rad/s²", _fmt(s * const.eps(1)[0]), _fmt(s * true.eps(1)[0])]], "lrr")
+    fd = _forward_dynamics_rows(m, motion)
+    if fd:
+        doc.table(["engine", "max |Δω| / ω_mean", "energy balance"], fd, "lrr")
+    return motion
+
+
 def _error_rows(run: ModelRun) -> list[list[str]]:
     rows = []
     for r in run.rows:
@@ -488,7 +570,7 @@ def _tolerance(run: ModelRun, route: str):
 
 
 def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool = False,
-                 friction: str = "first") -> dict[str, Any]:
+                 friction: str = "first", delta: float | None = None, flywheel: float | None = None) -> dict[str, Any]:
     """Write `out/<folder>/` for one model (default folder: `run.stem`); returns the summary
     also saved as summary.json.
 
@@ -497,7 +579,8 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     model's interactive page, page.html, linked from the plans' section (`plans.page.write_page`);
     `friction`: the method
     of the plans and worksheet ("first": the graphical method's; "reactions": with friction in the
-    reactions, a model with [friction] only). Every file is
+    reactions, a model with [friction] only). `delta`, `flywheel`: the law-of-motion section's
+    flywheel (`_law_choice`), and the plans and worksheet at that true law of motion. Every file is
     written atomically: an interrupted or failed run leaves each earlier file as it was. Every
     file depends only on the model, the routes and the steps (and the libraries' versions): no
     dates and no run times (printed by the command line only). A rerun reproduces the numbers
@@ -580,6 +663,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
 
     _three_routes_section(doc, m, res)
     _friction_section(doc, run)
+    motion = _motion_section(doc, run, delta, flywheel)
     _study_section(doc, m)
     log.info("%s: cycle.csv.gz and the tables (%.1f s)", folder, time.perf_counter() - t0)
 
@@ -613,7 +697,9 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     doc.img(images["hodographs"], "Hodographs of the revolute pairs' reactions, N")
 
     _published_section(doc, m, published)
-    plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first")
+    asked = delta is not None or flywheel is not None
+    plan_files = _plans_section(doc, m, d, page, friction if m.friction is not None else "first",
+                                motion if asked else None, _law_choice(m, delta, flywheel)[1])
 
     sing = int(np.sum(res.singular))
     if run.warnings or sing:
