@@ -14,6 +14,7 @@ import pytest
 import kinetostat
 from kinetostat.cli import main
 from kinetostat.cli.motion import COLUMNS
+from conftest import ROOT
 from kinetostat.plans.i18n import num
 
 MODEL = "scotch_yoke"            # an engine whose law takes ~0.15 s
@@ -101,13 +102,17 @@ def test_hostile_options_one_line_nothing_written(cli, tmp_path, args, says):
     assert not out.exists()
 
 
-def test_model_without_work_to_balance_is_refused(cli, tmp_path):
+def test_model_without_work_to_balance_runs_free(cli, tmp_path):
+    """Gravity only: no work over a cycle, so no drive (M_drive = 0), but the weights still swing the
+    speed; the command writes the law with the summary saying so, the same delta as the API's."""
     out = tmp_path / "out"
-    r = cli("motion", "chain_unit_four_bar", "--delta", "0.02", "--out", out)     # gravity only: no work over a cycle
-    assert r.returncode == 2 and r.stdout == ""
-    assert r.stderr.count("\n") == 1
-    assert re.search(r"chain_unit_four_bar: the loads' work over a cycle is \S+ J .*no drive to balance", r.stderr)
-    assert not out.exists()
+    r = cli("motion", "chain_unit_four_bar", "--flywheel", "0.01", "--out", out)
+    assert r.returncode == 0, r.stderr
+    assert re.search(r"the loads' work over a cycle is \S+ J .*no drive to balance: M_drive = 0, the machine runs free",
+                     (out / "summary.txt").read_text(encoding="utf-8"))
+    m = kinetostat.law_of_motion(kinetostat.load(ROOT / "models" / "chain_unit_four_bar.toml"), flywheel=0.01)
+    assert np.max(np.abs(m.M_drive)) < 1e-9 * np.max(np.abs(m.M_red)) and m.delta > 0
+    assert f"delta = {m.delta:.6g}" in (out / "summary.txt").read_text(encoding="utf-8")
 
 
 def test_analyze_delta_gives_the_laws_balancing_moment(cli, tmp_path, motion):

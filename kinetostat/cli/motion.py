@@ -70,13 +70,12 @@ def cmd_motion(args) -> int:
     path = Path(args.model)
     mech = _load(path)
     motion = _law(mech, path, delta=args.delta, flywheel=args.flywheel, steps=args.steps)
-    why = no_drive(motion.M_red)
-    if why:
-        raise CLIError(f"{path}: {why}; the law of motion sizes a flywheel against a drive's work "
-                       "(give the model a load that does work)")
     out = _writable_dir(args.out, "--out")     # after the law: a refused model leaves no folder behind
     lang = args.lang or lettering(mech).language or "en"
     lines = summary_lines(motion, path, args.delta, args.flywheel)
+    why = no_drive(motion.M_red)
+    if why:                                    # gravity only: the machine runs free, its speed still swings
+        lines.append(f"{why}: M_drive = 0, the machine runs free")
     sheet = motion_sheet(motion, lang)
     names = ("motion.csv", "motion.svg", "motion.pdf", "summary.txt")
     try:
