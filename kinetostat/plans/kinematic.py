@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import PlanCycle, Scale, Segment, construction
+from .core import PlanCycle, Scale, Segment, alias, construction
 from .zero import by_pattern, translates, zero_of
 
 __all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
@@ -203,12 +203,15 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         segs += [_rel(a, b, np.abs(mo[b][1] - mo[a][1]), "m/s") for i, a in enumerate(joints) for b in joints[i + 1:]]
     for s in _slidings(mech, "p"):
         segs.append(_rel(s.start, s.end, np.abs(res.kin.v_slide[:, s.pair.index]), "m/s"))
-    for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
+    special = _special(mech, res, pts)
+    for name, b, local, refs in special:        # v_S = v_1 + v_S1 = v_2 + v_S2
         vS = _point_motion(res.kin, b, local)[1]
         points[name] = vS / mu.value
         segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s",
                          role="component" if r else "result") for r, on in refs]
-    lines, steps = _constructions(mech, segs, "p")
+    triads = _triad_lines(mech, res, "p", special)
+    _aliases(points, triads)
+    lines, steps = _constructions(mech, segs, "p", triads)
     return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points,
                      tuple(segs + lines), notes=_collapsed(mech, pts, segs, len(res.phi_deg)), steps=steps)
 
@@ -225,7 +228,7 @@ def _component(name: str) -> bool:
     return name[:1] in "nk" and name[1:].isdigit() or name == "k"
 
 
-def _constructions(mech, segs: list[Segment], pole: str) -> tuple[list[Segment], tuple[str, ...]]:
+def _constructions(mech, segs: list[Segment], pole: str, triads=()) -> tuple[list[Segment], tuple]:
     """The construction of a velocity or an acceleration plan (seed 002 sec. 1.2.2) and its steps
     in the texts' order. Per dyad, the point q it fixes (`_found`) lies on two lines of known
     direction: those of the vectors drawn to q from known points (v_BA from a and v_B from p; a^t_BA
@@ -234,21 +237,36 @@ def _constructions(mech, segs: list[Segment], pole: str) -> tuple[list[Segment],
     point (`core.construction`), the one reached through more vectors first. The steps: per line
     the vectors that reach its known point from the pole or a point fixed already (components
     first: pi-a, a-n2), then the line; then the intersection.
-    A triad, or a dyad whose q is not fixed so, has no construction drawn."""
+    `triads`: per triad, its construction in each order of its sides (`_triad_lines`): (angles
+    (N,) bool, order, [(point, [(line, known point), (line, known point)]), ...]), each drawn at
+    its angles (`core.construction`'s order); the steps then change with the angle (N tuples).
+    A dyad whose q is not fixed so has no construction drawn."""
     vectors = [s for s in segs if s.kind == "vector"]
     out: list[Segment] = []
     steps: list[str] = []
-    fixed = {pole}
 
-    def chain(x: str) -> list[str]:
+    def chain(x: str, fixed: set[str]) -> list[str]:
         """The vectors from the pole or a point fixed already to x, in the order drawn (components
         first: pi-a, a-n2)."""
         into = [s for s in vectors if s.end == x and s.start != x]
         if x in fixed or not into:
             return []
         s = next((s for s in into if _component(s.start)), into[0])
-        return [*chain(s.start), s.name]
+        return [*chain(s.start, fixed), s.name]
 
+    def made(q: str, lines: list[tuple[str, str]], fixed: set[str], order: str = "") -> list[str]:
+        """The construction of q (`core.construction`), through the known link first, added to
+        `out`; its steps; q and the known points added to `fixed`."""
+        lines = sorted(lines, key=lambda x: (-len(chain(x[1], fixed)), x[1] == pole))
+        drawn = construction(q, lines, order)
+        out.extend(drawn)
+        own: list[str] = []
+        for (_, known), line in zip(lines, drawn):
+            own += [n for n in chain(known, fixed) if n not in own] + [line.name]
+        fixed |= {q, *(known for _, known in lines)}
+        return own + [drawn[-1].name]
+
+    fixed = {pole}
     for g in mech.structure.groups:
         if g.klass == 3:
             continue
@@ -260,14 +278,67 @@ def _constructions(mech, segs: list[Segment], pole: str) -> tuple[list[Segment],
             into = [s for s in into if s.start != pole]
         if len(into) != 2:
             continue
-        into.sort(key=lambda s: (-len(chain(s.start)), s.start == pole))     # through the known link first
-        made = construction(q, [(s.name, s.start) for s in into])
-        for s, line in zip(into, made):
-            steps += [n for n in chain(s.start) if n not in steps] + [line.name]
-        steps.append(made[-1].name)
-        out += made
-        fixed |= {q, *(s.start for s in into)}
-    return out, tuple(steps)
+        steps += [n for n in made(q, [(s.name, s.start) for s in into], fixed) if n not in steps]
+    if not triads:
+        return out, tuple(steps)
+    n = len(triads[0][0][0])
+    at = [list(steps) for _ in range(n)]
+    for orders in triads:
+        for where, order, points in orders:
+            own: list[str] = []
+            known = set(fixed)
+            for q, lines in points:
+                own += made(q, lines, known, order)
+            for i in np.flatnonzero(where):
+                at[i] += own
+    return out, tuple(tuple(x) for x in at) if len({tuple(x) for x in at}) > 1 else tuple(at[0])
+
+
+def _triad_lines(mech, res, pole: str, special: list) -> list:
+    """Per triad (Artobolevsky 1988, the class-III group: "the special point S of Assur, where the
+    axes of two leashes meet, taken as a point of the base link"), its velocity plan's
+    construction in each order of its sides over the angles of `res` (`kinematics.special_index`
+    k: S on the axes of sides k+1 and k+2): (angles (N,) bool, the order's tag, [(point fixed,
+    [(line, known point), (line, known point)]) in the order drawn]): s on the lines of v_S - v_O
+    through the outer pins o of the two leashes through S (square to a two-pin leash's axis, along
+    a slider's guide or a rocking block's arm: the vectors o-s); the third leash's inner point q3
+    on the line of v_Q3 - v_S through s (square to S Q3) and of the leash's own vector o-q3; the
+    other two inner points each on the line of its velocity relative to q3 (square to Q3 Q) and of
+    its leash's vector (a line through s would run parallel to it). A triad whose leash's outer
+    prismatic pair is on a moving link, or whose inner one has its guide on the leash, is left
+    out (the lines above are not then of known direction through a point on the plan)."""
+    from ..kinematics import special_index
+    triads = [g for g in mech.structure.groups if g.klass == 3]
+    out = []
+    for g, (s_name, _, _, _) in zip(triads, special):
+        ends = []
+        for ell, o, i, _ in g.sides:
+            if (o.kind == "P" and 0 not in o.links) or (i.kind == "P" and i.links[0] != g.links[0]):
+                break
+            outer = (_name_of(mech, o.point) if o.kind == "R" else "") or pole
+            inner = _name_of(mech, i.point) if i.kind == "R" else f"{i.point.lower()}{i.links[0]}"
+            ends.append((outer, inner))
+        else:
+            k = special_index(mech, res.kin, g)
+            orders = []
+            for x in sorted(set(k[_ok(res)].tolist())):
+                (o1, q1), (o2, q2), (o3, q3) = (ends[(x + j) % 3] for j in (1, 2, 0))
+                orders.append((_ok(res) & (k == x), str(x + 1), [
+                    (s_name, [(f"{o1}-{s_name}", o1), (f"{o2}-{s_name}", o2)]),
+                    (q3, [(f"{s_name}-{q3}", s_name), (f"{o3}-{q3}", o3)]),
+                    (q1, [(f"{q3}-{q1}", q3), (f"{o1}-{q1}", o1)]),
+                    (q2, [(f"{q3}-{q2}", q3), (f"{o2}-{q2}", o2)])]))
+            out.append(orders)
+    return out
+
+
+def _aliases(points: dict, triads: list) -> None:
+    """Each triad construction's points in its order (`core.alias`): the point at its angles, NaN
+    at the others."""
+    for orders in triads:
+        for where, order, fixed in orders:
+            for q, _ in fixed:
+                points[alias(q, order)] = np.where(where, points[q], np.nan)
 
 
 def _collapsed(mech, pts: dict[str, _Point], segs: list[Segment], n: int) -> tuple[tuple[str, ...], ...]:

@@ -504,7 +504,7 @@ def _construction_step(plan, name: str, n: int, lang: str) -> dict:
     if s.kind == "construction":
         eq = text("page.line", lang, plan=where, P=s.start, V=name[5:])
     elif s.kind == "intersection":
-        eq = text("page.point", lang, plan=where, P=s.start)
+        eq = text("page.point", lang, plan=where, P=name[len("point "):])        # its mark's point: a triad's 'c:2'
     else:
         eq = text("page.vector", lang, plan=where, V=name)
     return {"plan": plan.kind, "segment": name, "n": n, "eq": eq}
