@@ -106,3 +106,119 @@ def test_sheet_numbers_the_steps_as_the_page_does(ice, kind):
         assert np.hypot(float(x2) - float(x1), float(y2) - float(y1)) > 2 * PAST_MM
     page = [(s["segment"], s["n"]) for s in _steps(mech, res, plans, "uk") if s["plan"] == kind and "n" in s]
     assert page == [(name, k) for k, name in enumerate(plan.steps, 1)]
+
+
+# ----------------------------------------------------------------------------- triads
+
+TRIADS = ("triad_six_bar", "triad_rocking_block", "triad_slider")
+#: Angles at which S lies on each pair of leashes the models take (`kinematics.special_index`).
+TRIAD_ANGLES = [30.0, 90.0, 150.0, 330.0]
+
+
+def _axes(mech, res, g, i: int) -> dict[int, tuple[complex, complex]]:
+    """Per leash of triad g at angle index i: (a point of its axis, its direction), world, from the
+    positions alone: a two-pin leash outer pin -> inner pin, a slider the normal to its frame
+    guide through its pin, a rocking block the normal to the base's arm through its frame pin."""
+    z = lambda n: complex(*res.position(n)[i])
+    out = {}
+    for ell, o, inner, _ in g.sides:
+        if inner.kind == "P":                    # the arm of the base: its direction turned with the base
+            b = g.links[0]
+            local = [complex(*xy) for xy in mech.links[b].points.values()][:2]
+            world = [z(n) for n in list(mech.links[b].points)[:2]]
+            out[ell] = (z(o.point), 1j * complex(*inner.direction) * (world[1] - world[0]) / (local[1] - local[0]))
+        elif o.kind == "P":
+            out[ell] = (z(inner.point), 1j * complex(*o.direction))
+        else:
+            out[ell] = (z(inner.point), z(inner.point) - z(o.point))
+    return out
+
+
+def _world(mech, res, g, name: str, i: int, S: complex) -> complex:
+    """A velocity plan point's model point, world (s: Assur's point S; f3: the base's point under F)."""
+    return S if name.rstrip(":0123456789") == "s" else complex(*res.position(name.split(":")[0].rstrip("0123456789").upper())[i])
+
+
+@pytest.fixture(scope="module", params=TRIADS)
+def triad(request):
+    from kinetostat.kinematics import special_point_z
+    mech = kinetostat.load(request.param)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = kinetostat.analyze(mech, phi_deg=TRIAD_ANGLES)
+        fixed = P.cycle_scales(mech, step_deg=120.0)
+        cycles = P.build_cycle(mech, res, fixed, only=["velocity", "forces"])
+    g = next(g for g in mech.structure.groups if g.klass == 3)
+    return mech, res, g, cycles, special_point_z(mech, res.kin, g)
+
+
+def _lines_meet(plan, lines: list[tuple[str, complex]], point: str) -> None:
+    """Each line (name, the exact direction) runs from its known point parallel to it; the lines
+    of those directions through the known points meet at the plan's point to 1e-9 mm; its mark is there."""
+    got = {s.name: s for s in plan.segments if s.kind in ("construction", "intersection") and np.isfinite(plan.points[s.end])}
+    ends = []
+    for name, d in lines:
+        s = got[f"line {name}"]
+        drawn = plan.points[s.end] - plan.points[s.start]
+        assert abs((drawn.conjugate() * d).imag) <= 1e-9 * abs(drawn) * abs(d), name
+        ends.append((plan.points[s.start], d))
+    assert abs(_meet(*ends[0], *ends[1]) - plan.points[point]) < 1e-9
+    assert plan.points[got[f"point {point}"].start] == plan.points[point]
+
+
+def test_triad_velocity_plan_through_assurs_point(triad):
+    """Artobolevsky's construction: s where the lines square to the axes of the two leashes
+    through S (through their outer pins' points) meet; the third leash's inner point on the line
+    square to S-Q through s and its leash's line; the other two on the lines square to the base's
+    sides from it and their leashes' lines. Every direction from the positions alone; the
+    intersections at the solver's velocities to 1e-9 mm; at angles where S lies on each pair."""
+    mech, res, g, cycles, S = triad
+    outer = {ell: (o.point.lower() if o.kind == "R" and 0 not in o.links else "p") for ell, o, _, _ in g.sides}
+    inner = {ell: (i.point.lower() + (str(i.links[0]) if i.kind == "P" else "")) for ell, _, i, _ in g.sides}
+    orders = set()
+    for i in range(len(TRIAD_ANGLES)):
+        v = cycles["velocity"].at(i)
+        axes = _axes(mech, res, g, i)
+        lines = [s for s in v.segments if s.kind == "construction" and np.isfinite(v.points[s.end])]
+        through_s = [ell for ell, (X, u) in axes.items() if abs(((S[i] - X).conjugate() * u).imag) < 1e-9 * abs(u)]
+        assert len(through_s) == 2
+        third = next(ell for ell in axes if ell not in through_s)
+        orders.add(third)
+        q3 = inner[third]
+        q1, q2 = (inner[ell] for ell in through_s)
+        expected = {"s": [(f"{outer[ell]}-s", 1j * axes[ell][1]) for ell in through_s],
+                    q3: [(f"s-{q3}", 1j * (_world(mech, res, g, q3, i, S[i]) - S[i])), (f"{outer[third]}-{q3}", 1j * axes[third][1])]}
+        for ell, q in zip(through_s, (q1, q2)):
+            expected[q] = [(f"{q3}-{q}", 1j * (_world(mech, res, g, q, i, S[i]) - _world(mech, res, g, q3, i, S[i]))),
+                           (f"{outer[ell]}-{q}", 1j * axes[ell][1])]
+        assert sorted(s.name for s in lines) == sorted(f"line {n}" for ls in expected.values() for n, _ in ls)
+        for q, ls in expected.items():
+            _lines_meet(v, ls, q)
+        assert [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q1}", f"point {q2}"] \
+            or [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q2}", f"point {q1}"]
+    assert len(orders) == 2
+
+
+def test_triad_force_polygon_closed_along_the_axes_through_S(triad):
+    """The polygon closed by R..n of the two leashes through S: their lines along those leashes'
+    axes (from the positions) through the polygon's start and the last known force's end, meeting
+    at the vertex the solver's reactions put there, to 1e-9 mm; the steps: the known sides, the
+    lines, the intersection, the two unknowns."""
+    mech, res, g, cycles, S = triad
+    cycle = next(c for k, c in cycles.items() if k.startswith("forces:"))
+    for i in range(len(TRIAD_ANGLES)):
+        f = cycle.at(i)
+        axes = _axes(mech, res, g, i)
+        last, before = f.equation[-1], f.equation[-2]
+        leash = lambda R: int(R[2])               # R<known><leash>n
+        _lines_meet(f, [(last, axes[leash(last)][1]), (before, axes[leash(before)][1])], f.segment(before).end)
+        assert f.steps == (*f.equation[:-2], f"line {last}", f"line {before}", f"point {f.segment(before).end}", before, last)
+
+
+def test_triad_sheet_numbers_every_step(triad):
+    """The one-angle sheets of a triad number each step (1)..(n) as `Plan.steps` lists them."""
+    mech, res, g, cycles, S = triad
+    for kind, cycle in cycles.items():
+        if kind in ("velocity",) or kind.startswith("forces:"):
+            plan = cycle.at(0)
+            assert sorted(_numbers(svg(plan, lang="uk"))) == list(range(1, len(plan.steps) + 1)), kind
