@@ -221,4 +221,4 @@ def test_triad_sheet_numbers_every_step(triad):
     for kind, cycle in cycles.items():
         if kind in ("velocity",) or kind.startswith("forces:"):
             plan = cycle.at(0)
-            assert sorted(_numbers(svg(plan, lang="uk"))) == list(range(1, len(plan.steps) + 1)), kind
+            assert len(plan.steps) >= 4 and sorted(_numbers(svg(plan, lang="uk"))) == list(range(1, len(plan.steps) + 1)), kind
