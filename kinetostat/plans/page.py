@@ -577,7 +577,7 @@ def _one_order(cycle):
     `core.alias`es: a ':' in the name), and then without steps: the page of every angle has no
     room for their lines within its 300 kB (triad_six_bar's would grow from 296 to 326 kB); the
     sheets of one angle (`kinetostat plans --at`) draw them."""
-    kept = tuple(s for s in cycle.segments if not (s.kind in UNMEASURED and ":" in s.end))
+    kept = tuple(s for s in cycle.segments if not (s.kind in ("construction", "intersection") and ":" in s.end))
     return cycle if len(kept) == len(cycle.segments) else replace(cycle, segments=kept, steps=())
 
 
