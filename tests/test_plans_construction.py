@@ -147,7 +147,7 @@ def triad(request):
         warnings.simplefilter("ignore")
         res = kinetostat.analyze(mech, phi_deg=TRIAD_ANGLES)
         fixed = P.cycle_scales(mech, step_deg=120.0)
-        cycles = P.build_cycle(mech, res, fixed, only=["velocity", "forces"])
+        cycles = P.build_cycle(mech, res, fixed, only=["velocity", "acceleration", "forces"])
     g = next(g for g in mech.structure.groups if g.klass == 3)
     return mech, res, g, cycles, special_point_z(mech, res.kin, g)
 
@@ -197,6 +197,59 @@ def test_triad_velocity_plan_through_assurs_point(triad):
         assert [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q1}", f"point {q2}"] \
             or [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q2}", f"point {q1}"]
     assert len(orders) == 2
+
+
+def test_triad_acceleration_plan_through_assurs_point(triad):
+    """Artobolevsky's a_S = a_O + a^n_QO + a^n_SQ + a^t (both tangential parts square to the
+    leash's axis through S; a slider's: a^n_SQ + a part along its guide): s where the lines of
+    those directions through the ends of the normal parts meet; Q3 from s (a^n_Q3S, square to
+    S Q3) and its leash (a^n_Q3O, square to its axis); the other two from Q3 likewise. Every
+    known point and direction from the positions, omega and the outer pins' accelerations alone;
+    the intersections at the solver's accelerations to 1e-9 mm. A rocking block (a leash on an
+    inner prismatic pair) has none."""
+    mech, res, g, cycles, S = triad
+    acc = cycles["acceleration"]
+    if any(i.kind == "P" for _, _, i, _ in g.sides):
+        assert not any(s.kind == "construction" for s in acc.segments) and acc.steps == ()
+        return
+    mu = acc.scale.value
+    base = g.links[0]
+    for i in range(len(TRIAD_ANGLES)):
+        a = acc.at(i)
+        z = lambda n: complex(*res.position(n)[i])
+        acc_of = lambda n: complex(*res.acceleration(n)[i]) / mu
+        w2 = res.omega(base)[i] ** 2
+        axes = _axes(mech, res, g, i)
+        leash = {}                 # leash -> (inner point, the end of its known parts (plan), the line's direction)
+        for ell, o, inner, _ in g.sides:
+            Q = z(inner.point)
+            if o.kind == "R":
+                leash[ell] = (inner.point, acc_of(o.point) - res.omega(ell)[i] ** 2 * (Q - z(o.point)) / mu, 1j * axes[ell][1])
+            else:
+                leash[ell] = (inner.point, 0j, complex(*o.direction))
+        through_s = [ell for ell, (X, u) in axes.items() if abs(((S[i] - X).conjugate() * u).imag) < 1e-9 * abs(u)]
+        third = next(ell for ell in axes if ell not in through_s)
+        ends = []
+        for ell in through_s:
+            Q, known, d = leash[ell]
+            ends.append((known - w2 * (S[i] - z(Q)) / mu, d))
+        assert abs(_meet(*ends[0], *ends[1]) - a.points["s"]) < 1e-9
+        Q3, known3, d3 = leash[third]
+        at_s = a.points["s"] - w2 * (z(Q3) - S[i]) / mu
+        assert abs(_meet(at_s, 1j * (z(Q3) - S[i]), known3, d3) - a.points[Q3.lower()]) < 1e-9
+        for ell in through_s:
+            Q, known, d = leash[ell]
+            at_q3 = a.points[Q3.lower()] - w2 * (z(Q) - z(Q3)) / mu
+            assert abs(_meet(at_q3, 1j * (z(Q) - z(Q3)), known, d) - a.points[Q.lower()]) < 1e-9
+        lines = [s for s in a.segments if s.kind == "construction" and np.isfinite(a.points[s.end])]
+        assert len(lines) == 8
+        for s in lines:                   # each drawn from one of those known points along one of those directions
+            start, q = a.points[s.start], a.points[s.end]
+            assert any(abs(start - p) < 1e-9 and abs(((q - start).conjugate() * d).imag) <= 1e-9 * abs(q - start) * abs(d)
+                       for p, d in [*ends, (at_s, 1j * (z(Q3) - S[i])), (known3, d3)]
+                       + [(a.points[Q3.lower()] - w2 * (z(leash[e][0]) - z(Q3)) / mu, 1j * (z(leash[e][0]) - z(Q3))) for e in through_s]
+                       + [(leash[e][1], leash[e][2]) for e in through_s]), s.name
+        assert [n for n in a.steps if n.startswith("point ")][:2] == ["point s", f"point {Q3.lower()}"]
 
 
 def test_triad_force_polygon_closed_along_the_axes_through_S(triad):

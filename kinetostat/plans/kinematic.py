@@ -193,7 +193,8 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     point, the relative velocities of each floating link's joints (a-b), the sliding velocities
     of blocks on moving guides (a1-a3), like points by similarity (s2 on ab), and a triad's
     special point s (v_S from the outer pins of the two leashes through S, e.g. a-s, e-s): all at
-    mu_v."""
+    mu_v; the construction of each dyad's point (`_constructions`) and of a triad's through s
+    (`_triad_lines`)."""
     mu = scales["mu_v"]
     pts = plan_point_names(mech, res)
     mo = _motion(res, pts)
@@ -262,7 +263,9 @@ def _constructions(mech, segs: list[Segment], pole: str, triads=()) -> tuple[lis
         out.extend(drawn)
         own: list[str] = []
         for (_, known), line in zip(lines, drawn):
-            own += [n for n in chain(known, fixed) if n not in own] + [line.name]
+            path = chain(known, fixed)
+            own += [n for n in path if n not in own] + [line.name]
+            fixed |= {x for v in vectors if v.name in path for x in (v.start, v.end)}
         fixed |= {q, *(known for _, known in lines)}
         return own + [drawn[-1].name]
 
@@ -411,8 +414,9 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     `-k` and relative `k-` parts of a block on a moving guide at the angles where the guide turns
     (where it stands still: the relative part alone, NaN, not drawn, elsewhere); pi-x for every
     point, the relative accelerations of each floating link's joints (a-b), like points by
-    similarity, and a triad's special point s with its construction from the outer pins of the
-    two leashes through S (e.g. a-s): all at mu_a."""
+    similarity, and a triad's special point s from the outer pins of the two leashes through S
+    (e.g. a-s): all at mu_a; the construction of each dyad's point (`_constructions`) and of a
+    triad's through s, with the base link's normal parts it needs (`_triad_normals`)."""
     mu = scales["mu_a"]
     pts = plan_point_names(mech, res)
     mo = _motion(res, pts)
@@ -459,16 +463,77 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         else:
             segs.append(_rel(s.start, s.end, np.abs(a_r), unit))
     segs += [_absolute(mech, pts, n, "pi", np.abs(m[2]), unit) for n, m in mo.items()]
-    for name, b, local, refs in _special(mech, res, pts):        # a_S = a_1 + a_S1 = a_2 + a_S2
+    special = _special(mech, res, pts)
+    for name, b, local, refs in special:        # a_S = a_1 + a_S1 = a_2 + a_S2
         aS = _point_motion(res.kin, b, local)[2]
         points[name] = aS / mu.value
         segs.append(Segment(f"pi-{name}", "pi", name, np.abs(aS), unit, role="result"))
         segs += [_rel(r, name, _where(on, np.abs(aS - mo[r][2])), unit) for r, on in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
-    lines, steps = _constructions(mech, segs, "pi")
+    notes = _collapsed(mech, pts, segs, len(res.phi_deg))
+    triads = _triad_normals(mech, res, mo, special, points, segs, mu.value)
+    _aliases(points, triads)
+    lines, steps = _constructions(mech, segs, "pi", triads)
     return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,
-                     points, tuple(segs + lines), notes=_collapsed(mech, pts, segs, len(res.phi_deg)), steps=steps)
+                     points, tuple(segs + lines), notes=notes, steps=steps)
+
+
+def _triad_normals(mech, res, mo: dict, special: list, points: dict, segs: list[Segment], mu: float) -> list:
+    """Per triad whose leashes each turn about two pins or slide in a guide of the frame, its
+    acceleration plan's construction in each order of its sides (as `_triad_lines`; Artobolevsky
+    1988, the class-III group): S, a point of the base link b on the axis of leash l (outer pin O,
+    inner Q), has a_S = a_O + a^n_QO + a^n_SQ + a^t, the tangential parts a^t_QO and a^t_SQ both
+    square to the axis (a slider's: a_S = a^n_SQ + a part along its guide); so s lies on the line
+    of that direction through the end of the normal parts drawn from the outer pin's point (a-n2,
+    then n2-n31: omega_b^2 QS, along S -> Q), for each of the two leashes through S. The third
+    leash's inner point Q3 on the line square to S Q3 through the end of its normal part relative
+    to s and on its leash's (through n5 square to F D; a slider's: through pi along the guide);
+    the other two inner points each on the line square to Q3 Q through the end of its normal part
+    relative to Q3 and on its leash's. The base link's normal parts n<b>1, n<b>2, ... (in the
+    order drawn) are added to `points` and `segs` at the angles of their order (NaN, not drawn,
+    at the others). A triad with a leash on an inner prismatic pair (a rocking block: its point
+    under the block is known only through the Coriolis part, drawn from the guide), or on a
+    prismatic pair to a moving link, is left out."""
+    from ..kinematics import special_index
+    triads = [g for g in mech.structure.groups if g.klass == 3]
+    out = []
+    for g, (s_name, base, local, _) in zip(triads, special):
+        if any(i.kind == "P" or (o.kind == "P" and 0 not in o.links) for _, o, i, _ in g.sides):
+            continue
+        w2 = res.kin.omega[:, base] ** 2
+        world = {s_name: _point_motion(res.kin, base, local)[0]}
+        leash = []
+        for ell, o, i, _ in g.sides:               # (inner point, the end of its leash's known parts)
+            q = _name_of(mech, i.point)
+            world[q] = mo[q][0]
+            leash.append((q, f"n{ell}" if o.kind == "R" else "pi"))
+        k = special_index(mech, res.kin, g)
+        orders = []
+        for x in sorted(set(k[_ok(res)].tolist())):
+            where = _ok(res) & (k == x)
+            made: list[str] = []
+
+            def normal(start: str, rel: str, to: str) -> str:
+                """The base link's normal part of `to` relative to `rel` drawn from `start`: its end."""
+                name = f"n{base}{len(made) + 1}"
+                made.append(name)
+                an = -w2 * (world[to] - world[rel])
+                points[name] = np.where(where, points[start] + an / mu, points.get(name, np.full(len(where), np.nan + 0j)))
+                segs.append(_rel(start, name, _where(where, np.abs(an)), "m/s^2"))
+                return name
+
+            (q1, k1), (q2, k2), (q3, k3) = (leash[(x + j) % 3] for j in (1, 2, 0))
+            m1, m2 = normal(k1, q1, s_name), normal(k2, q2, s_name)
+            m3 = normal(s_name, s_name, q3)
+            fixed = [(s_name, [(f"{m1}-{s_name}", m1), (f"{m2}-{s_name}", m2)]),
+                     (q3, [(f"{m3}-{q3}", m3), (f"{k3}-{q3}", k3)])]
+            for q, kq in ((q1, k1), (q2, k2)):
+                m = normal(q3, q3, q)
+                fixed.append((q, [(f"{m}-{q}", m), (f"{kq}-{q}", kq)]))
+            orders.append((where, str(x + 1), fixed))
+        out.append(orders)
+    return out
 
 
 # ----------------------------------------------------------------------------- plan of positions
