@@ -51,7 +51,6 @@ import re
 import warnings
 import zlib
 from collections.abc import Sequence
-from dataclasses import replace
 from html import escape
 from importlib import resources
 from pathlib import Path
@@ -572,15 +571,6 @@ def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
 
 # ============================================================================ the page
 
-def _one_order(cycle):
-    """The cycle without the constructions drawn in one order of a triad's sides (their points
-    `core.alias`es: a ':' in the name), and then without steps: the page of every angle has no
-    room for their lines within its 300 kB (triad_six_bar's would grow from 296 to 326 kB); the
-    sheets of one angle (`kinetostat plans --at`) draw them."""
-    kept = tuple(s for s in cycle.segments if not (s.kind in ("construction", "intersection") and ":" in s.end))
-    return cycle if len(kept) == len(cycle.segments) else replace(cycle, segments=kept, steps=())
-
-
 def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
          angles: Sequence[float] | None = None, fixed=None) -> str:
     """The interactive page of `mech` in `lang` (module docstring). `at`: the angle of the check
@@ -589,6 +579,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     analysis). ValueError where `at` is a singular position."""
     from . import build_cycle, cycle_scales
     from .draw import drawing
+    from .kinematic import without_triad_construction
     from .worksheet import analyses, worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
@@ -601,7 +592,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         warnings.simplefilter("ignore")
         res, other = analyses(mech, phi)           # the graphical method's; the other friction mode's rows
         fixed = fixed or cycle_scales(mech, res=res)
-        cycles = {kind: _one_order(c) for kind, c in build_cycle(mech, res, fixed).items()}
+        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed).items()}
         sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=other)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
