@@ -196,6 +196,7 @@ def test_triad_velocity_plan_through_assurs_point(triad):
             _lines_meet(v, ls, q)
         assert [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q1}", f"point {q2}"] \
             or [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q2}", f"point {q1}"]
+        assert set(v.steps) <= {s.name for s in v.segments if s.kind != "vector" or np.isfinite(v.points[s.end])}
     assert len(orders) == 2
 
 
@@ -250,6 +251,8 @@ def test_triad_acceleration_plan_through_assurs_point(triad):
                        + [(a.points[Q3.lower()] - w2 * (z(leash[e][0]) - z(Q3)) / mu, 1j * (z(leash[e][0]) - z(Q3))) for e in through_s]
                        + [(leash[e][1], leash[e][2]) for e in through_s]), s.name
         assert [n for n in a.steps if n.startswith("point ")][:2] == ["point s", f"point {Q3.lower()}"]
+        drawn = {s.name for s in a.segments if s.kind != "vector" or np.isfinite(a.points[s.end])}
+        assert set(a.steps) <= drawn                  # every step a segment drawn at this angle
 
 
 def test_triad_force_polygon_closed_along_the_axes_through_S(triad):

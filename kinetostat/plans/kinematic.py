@@ -247,26 +247,27 @@ def _constructions(mech, segs: list[Segment], pole: str, triads=()) -> tuple[lis
     out: list[Segment] = []
     steps: list[str] = []
 
-    def chain(x: str, fixed: set[str]) -> list[str]:
-        """The vectors from the pole or a point fixed already to x, in the order drawn (components
-        first: pi-a, a-n2)."""
-        into = [s for s in vectors if s.end == x and s.start != x]
+    def chain(x: str, fixed: set[str], pool: list[Segment]) -> list[str]:
+        """The vectors of `pool` from the pole or a point fixed already to x, in the order drawn
+        (components first: pi-a, a-n2)."""
+        into = [s for s in pool if s.end == x and s.start != x]
         if x in fixed or not into:
             return []
         s = next((s for s in into if _component(s.start)), into[0])
-        return [*chain(s.start, fixed), s.name]
+        return [*chain(s.start, fixed, pool), s.name]
 
-    def made(q: str, lines: list[tuple[str, str]], fixed: set[str], order: str = "") -> list[str]:
+    def made(q: str, lines: list[tuple[str, str]], fixed: set[str], order: str = "", pool=vectors) -> list[str]:
         """The construction of q (`core.construction`), through the known link first, added to
-        `out`; its steps; q and the known points added to `fixed`."""
-        lines = sorted(lines, key=lambda x: (-len(chain(x[1], fixed)), x[1] == pole))
+        `out`; its steps (the vectors of `pool`: those drawn in its order); q and the known
+        points added to `fixed`."""
+        lines = sorted(lines, key=lambda x: (-len(chain(x[1], fixed, pool)), x[1] == pole))
         drawn = construction(q, lines, order)
         out.extend(drawn)
         own: list[str] = []
         for (_, known), line in zip(lines, drawn):
-            path = chain(known, fixed)
+            path = chain(known, fixed, pool)
             own += [n for n in path if n not in own] + [line.name]
-            fixed |= {x for v in vectors if v.name in path for x in (v.start, v.end)}
+            fixed |= {x for v in pool if v.name in path for x in (v.start, v.end)}
         fixed |= {q, *(known for _, known in lines)}
         return own + [drawn[-1].name]
 
@@ -291,8 +292,9 @@ def _constructions(mech, segs: list[Segment], pole: str, triads=()) -> tuple[lis
         for where, order, points in orders:
             own: list[str] = []
             known = set(fixed)
+            pool = [v for v in vectors if np.isfinite(np.broadcast_to(np.asarray(v.value, float), where.shape)[where]).any()]
             for q, lines in points:
-                own += made(q, lines, known, order)
+                own += made(q, lines, known, order, pool)
             for i in np.flatnonzero(where):
                 at[i] += own
     return out, tuple(tuple(x) for x in at) if len({tuple(x) for x in at}) > 1 else tuple(at[0])
