@@ -6,7 +6,7 @@ every point, value and path an array over the angles, no loop over them. An elem
 where it exists at any of the angles; at an angle where it does not (a load of zero, an arm
 through its own pole), its points and value are NaN there (`PlanCycle.at` leaves it out). A
 triad whose leash closing it about S changes with the angle (`kinematics.special_index`) has
-each order's polygon and axes, each at the angles of that order.
+each order's polygon, axes and construction, each at the angles of that order.
 
 Lettering (the texts'): R<i><j> is the force of link i on link j (R12, R43, R32); a pin
 reaction split along and across the link is R<i><j>n, R<i><j>t (R^n_12, R^tau_12); G<k> a
