@@ -278,3 +278,16 @@ def test_triad_sheet_numbers_every_step(triad):
         if kind in ("velocity",) or kind.startswith("forces:"):
             plan = cycle.at(0)
             assert len(plan.steps) >= 4 and sorted(_numbers(svg(plan, lang="uk"))) == list(range(1, len(plan.steps) + 1)), kind
+
+
+def test_page_leaves_the_triad_construction_to_the_one_angle_sheets(triad):
+    """The page of every angle (300 kB) draws a triad's plans without their construction: no line,
+    no mark, no normal part of the base link n3<k> nor its point, no steps; all else kept."""
+    from kinetostat.plans.kinematic import without_triad_construction
+    mech, res, g, cycles, S = triad
+    for kind, c in cycles.items():
+        w = without_triad_construction(mech, c)
+        own = [s for s in c.segments if s.kind in ("construction", "intersection") or re.fullmatch(r"n3\d+", s.end)]
+        assert [s.name for s in w.segments] == [s.name for s in c.segments if not any(s is o for o in own)]
+        assert (w.steps == ()) == bool(own) or w is c
+        assert not any(re.fullmatch(r"n3\d+", p) or ":" in p and p.split(":")[1].isdigit() for p in w.points)
