@@ -106,3 +106,188 @@ def test_sheet_numbers_the_steps_as_the_page_does(ice, kind):
         assert np.hypot(float(x2) - float(x1), float(y2) - float(y1)) > 2 * PAST_MM
     page = [(s["segment"], s["n"]) for s in _steps(mech, res, plans, "uk") if s["plan"] == kind and "n" in s]
     assert page == [(name, k) for k, name in enumerate(plan.steps, 1)]
+
+
+# ----------------------------------------------------------------------------- triads
+
+TRIADS = ("triad_six_bar", "triad_rocking_block", "triad_slider")
+#: Angles at which S lies on each pair of leashes the models take (`kinematics.special_index`).
+TRIAD_ANGLES = [30.0, 90.0, 150.0, 330.0]
+
+
+def _axes(mech, res, g, i: int) -> dict[int, tuple[complex, complex]]:
+    """Per leash of triad g at angle index i: (a point of its axis, its direction), world, from the
+    positions alone: a two-pin leash outer pin -> inner pin, a slider the normal to its frame
+    guide through its pin, a rocking block the normal to the base's arm through its frame pin."""
+    z = lambda n: complex(*res.position(n)[i])
+    out = {}
+    for ell, o, inner, _ in g.sides:
+        if inner.kind == "P":                    # the arm of the base: its direction turned with the base
+            b = g.links[0]
+            local = [complex(*xy) for xy in mech.links[b].points.values()][:2]
+            world = [z(n) for n in list(mech.links[b].points)[:2]]
+            out[ell] = (z(o.point), 1j * complex(*inner.direction) * (world[1] - world[0]) / (local[1] - local[0]))
+        elif o.kind == "P":
+            out[ell] = (z(inner.point), 1j * complex(*o.direction))
+        else:
+            out[ell] = (z(inner.point), z(inner.point) - z(o.point))
+    return out
+
+
+def _world(mech, res, g, name: str, i: int, S: complex) -> complex:
+    """A velocity plan point's model point, world (s: Assur's point S; f3: the base's point under F)."""
+    return S if name.rstrip(":0123456789") == "s" else complex(*res.position(name.split(":")[0].rstrip("0123456789").upper())[i])
+
+
+@pytest.fixture(scope="module", params=TRIADS)
+def triad(request):
+    from kinetostat.kinematics import special_point_z
+    mech = kinetostat.load(request.param)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = kinetostat.analyze(mech, phi_deg=TRIAD_ANGLES)
+        fixed = P.cycle_scales(mech, step_deg=120.0)
+        cycles = P.build_cycle(mech, res, fixed, only=["velocity", "acceleration", "forces"])
+    g = next(g for g in mech.structure.groups if g.klass == 3)
+    return mech, res, g, cycles, special_point_z(mech, res.kin, g)
+
+
+def _lines_meet(plan, lines: list[tuple[str, complex]], point: str) -> None:
+    """Each line (name, the exact direction) runs from its known point parallel to it; the lines
+    of those directions through the known points meet at the plan's point to 1e-9 mm; its mark is there."""
+    got = {s.name: s for s in plan.segments if s.kind in ("construction", "intersection") and np.isfinite(plan.points[s.end])}
+    ends = []
+    for name, d in lines:
+        s = got[f"line {name}"]
+        drawn = plan.points[s.end] - plan.points[s.start]
+        assert abs((drawn.conjugate() * d).imag) <= 1e-9 * abs(drawn) * abs(d), name
+        ends.append((plan.points[s.start], d))
+    assert abs(_meet(*ends[0], *ends[1]) - plan.points[point]) < 1e-9
+    assert plan.points[got[f"point {point}"].start] == plan.points[point]
+
+
+def test_triad_velocity_plan_through_assurs_point(triad):
+    """Artobolevsky's construction: s where the lines square to the axes of the two leashes
+    through S (through their outer pins' points) meet; the third leash's inner point on the line
+    square to S-Q through s and its leash's line; the other two on the lines square to the base's
+    sides from it and their leashes' lines. Every direction from the positions alone; the
+    intersections at the solver's velocities to 1e-9 mm; at angles where S lies on each pair."""
+    mech, res, g, cycles, S = triad
+    outer = {ell: (o.point.lower() if o.kind == "R" and 0 not in o.links else "p") for ell, o, _, _ in g.sides}
+    inner = {ell: (i.point.lower() + (str(i.links[0]) if i.kind == "P" else "")) for ell, _, i, _ in g.sides}
+    orders = set()
+    for i in range(len(TRIAD_ANGLES)):
+        v = cycles["velocity"].at(i)
+        axes = _axes(mech, res, g, i)
+        lines = [s for s in v.segments if s.kind == "construction" and np.isfinite(v.points[s.end])]
+        through_s = [ell for ell, (X, u) in axes.items() if abs(((S[i] - X).conjugate() * u).imag) < 1e-9 * abs(u)]
+        assert len(through_s) == 2
+        third = next(ell for ell in axes if ell not in through_s)
+        orders.add(third)
+        q3 = inner[third]
+        q1, q2 = (inner[ell] for ell in through_s)
+        expected = {"s": [(f"{outer[ell]}-s", 1j * axes[ell][1]) for ell in through_s],
+                    q3: [(f"s-{q3}", 1j * (_world(mech, res, g, q3, i, S[i]) - S[i])), (f"{outer[third]}-{q3}", 1j * axes[third][1])]}
+        for ell, q in zip(through_s, (q1, q2)):
+            expected[q] = [(f"{q3}-{q}", 1j * (_world(mech, res, g, q, i, S[i]) - _world(mech, res, g, q3, i, S[i]))),
+                           (f"{outer[ell]}-{q}", 1j * axes[ell][1])]
+        assert sorted(s.name for s in lines) == sorted(f"line {n}" for ls in expected.values() for n, _ in ls)
+        for q, ls in expected.items():
+            _lines_meet(v, ls, q)
+        assert [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q1}", f"point {q2}"] \
+            or [n for n in v.steps if n.startswith("point ")] == ["point s", f"point {q3}", f"point {q2}", f"point {q1}"]
+        assert set(v.steps) <= {s.name for s in v.segments if s.kind != "vector" or np.isfinite(v.points[s.end])}
+    assert len(orders) == 2
+
+
+def test_triad_acceleration_plan_through_assurs_point(triad):
+    """Artobolevsky's a_S = a_O + a^n_QO + a^n_SQ + a^t (both tangential parts square to the
+    leash's axis through S; a slider's: a^n_SQ + a part along its guide): s where the lines of
+    those directions through the ends of the normal parts meet; Q3 from s (a^n_Q3S, square to
+    S Q3) and its leash (a^n_Q3O, square to its axis); the other two from Q3 likewise. Every
+    known point and direction from the positions, omega and the outer pins' accelerations alone;
+    the intersections at the solver's accelerations to 1e-9 mm. A rocking block (a leash on an
+    inner prismatic pair) has none."""
+    mech, res, g, cycles, S = triad
+    acc = cycles["acceleration"]
+    if any(i.kind == "P" for _, _, i, _ in g.sides):
+        assert not any(s.kind == "construction" for s in acc.segments) and acc.steps == ()
+        return
+    mu = acc.scale.value
+    base = g.links[0]
+    for i in range(len(TRIAD_ANGLES)):
+        a = acc.at(i)
+        z = lambda n: complex(*res.position(n)[i])
+        acc_of = lambda n: complex(*res.acceleration(n)[i]) / mu
+        w2 = res.omega(base)[i] ** 2
+        axes = _axes(mech, res, g, i)
+        leash = {}                 # leash -> (inner point, the end of its known parts (plan), the line's direction)
+        for ell, o, inner, _ in g.sides:
+            Q = z(inner.point)
+            if o.kind == "R":
+                leash[ell] = (inner.point, acc_of(o.point) - res.omega(ell)[i] ** 2 * (Q - z(o.point)) / mu, 1j * axes[ell][1])
+            else:
+                leash[ell] = (inner.point, 0j, complex(*o.direction))
+        through_s = [ell for ell, (X, u) in axes.items() if abs(((S[i] - X).conjugate() * u).imag) < 1e-9 * abs(u)]
+        third = next(ell for ell in axes if ell not in through_s)
+        ends = []
+        for ell in through_s:
+            Q, known, d = leash[ell]
+            ends.append((known - w2 * (S[i] - z(Q)) / mu, d))
+        assert abs(_meet(*ends[0], *ends[1]) - a.points["s"]) < 1e-9
+        Q3, known3, d3 = leash[third]
+        at_s = a.points["s"] - w2 * (z(Q3) - S[i]) / mu
+        assert abs(_meet(at_s, 1j * (z(Q3) - S[i]), known3, d3) - a.points[Q3.lower()]) < 1e-9
+        for ell in through_s:
+            Q, known, d = leash[ell]
+            at_q3 = a.points[Q3.lower()] - w2 * (z(Q) - z(Q3)) / mu
+            assert abs(_meet(at_q3, 1j * (z(Q) - z(Q3)), known, d) - a.points[Q.lower()]) < 1e-9
+        lines = [s for s in a.segments if s.kind == "construction" and np.isfinite(a.points[s.end])]
+        assert len(lines) == 8
+        for s in lines:                   # each drawn from one of those known points along one of those directions
+            start, q = a.points[s.start], a.points[s.end]
+            assert any(abs(start - p) < 1e-9 and abs(((q - start).conjugate() * d).imag) <= 1e-9 * abs(q - start) * abs(d)
+                       for p, d in [*ends, (at_s, 1j * (z(Q3) - S[i])), (known3, d3)]
+                       + [(a.points[Q3.lower()] - w2 * (z(leash[e][0]) - z(Q3)) / mu, 1j * (z(leash[e][0]) - z(Q3))) for e in through_s]
+                       + [(leash[e][1], leash[e][2]) for e in through_s]), s.name
+        assert [n for n in a.steps if n.startswith("point ")][:2] == ["point s", f"point {Q3.lower()}"]
+        drawn = {s.name for s in a.segments if s.kind != "vector" or np.isfinite(a.points[s.end])}
+        assert set(a.steps) <= drawn                  # every step a segment drawn at this angle
+
+
+def test_triad_force_polygon_closed_along_the_axes_through_S(triad):
+    """The polygon closed by R..n of the two leashes through S: their lines along those leashes'
+    axes (from the positions) through the polygon's start and the last known force's end, meeting
+    at the vertex the solver's reactions put there, to 1e-9 mm; the steps: the known sides, the
+    lines, the intersection, the two unknowns."""
+    mech, res, g, cycles, S = triad
+    cycle = next(c for k, c in cycles.items() if k.startswith("forces:"))
+    for i in range(len(TRIAD_ANGLES)):
+        f = cycle.at(i)
+        axes = _axes(mech, res, g, i)
+        last, before = f.equation[-1], f.equation[-2]
+        leash = lambda R: int(R[2])               # R<known><leash>n
+        _lines_meet(f, [(last, axes[leash(last)][1]), (before, axes[leash(before)][1])], f.segment(before).end)
+        assert f.steps == (*f.equation[:-2], f"line {last}", f"line {before}", f"point {f.segment(before).end}", before, last)
+
+
+def test_triad_sheet_numbers_every_step(triad):
+    """The one-angle sheets of a triad number each step (1)..(n) as `Plan.steps` lists them."""
+    mech, res, g, cycles, S = triad
+    for kind, cycle in cycles.items():
+        if kind in ("velocity",) or kind.startswith("forces:"):
+            plan = cycle.at(0)
+            assert len(plan.steps) >= 4 and sorted(_numbers(svg(plan, lang="uk"))) == list(range(1, len(plan.steps) + 1)), kind
+
+
+def test_page_leaves_the_triad_construction_to_the_one_angle_sheets(triad):
+    """The page of every angle (300 kB) draws a triad's plans without their construction: no line,
+    no mark, no normal part of the base link n3<k> nor its point, no steps; all else kept."""
+    from kinetostat.plans.kinematic import without_triad_construction
+    mech, res, g, cycles, S = triad
+    for kind, c in cycles.items():
+        w = without_triad_construction(mech, c)
+        own = [s for s in c.segments if s.kind in ("construction", "intersection") or re.fullmatch(r"n3\d+", s.end)]
+        assert [s.name for s in w.segments] == [s.name for s in c.segments if not any(s is o for o in own)]
+        assert (w.steps == ()) == bool(own) or w is c
+        assert not any(re.fullmatch(r"n3\d+", p) or ":" in p and p.split(":")[1].isdigit() for p in w.points)

@@ -20,7 +20,7 @@ from typing import Mapping
 import numpy as np
 
 __all__ = ["Scale", "Segment", "ROLES", "role_of", "Result", "Plan", "PlanCycle", "Element", "Drawing", "SEGMENT_COLUMNS",
-           "extent", "extent_cycle", "ELEMENTS", "fixed", "construction", "UNMEASURED"]
+           "extent", "extent_cycle", "ELEMENTS", "fixed", "construction", "alias", "UNMEASURED"]
 
 #: Columns of segments.csv, in order.
 SEGMENT_COLUMNS = ("plan", "segment", "from", "to", "x0_mm", "y0_mm", "x1_mm", "y1_mm", "length_mm",
@@ -95,13 +95,23 @@ def role_of(s: Segment) -> str:
 UNMEASURED = ("position", "line", "construction", "intersection")
 
 
-def construction(point: str, lines: list[tuple[str, str]]) -> list[Segment]:
+def construction(point: str, lines: list[tuple[str, str]], order: str = "") -> list[Segment]:
     """The construction that fixes `point` (seed 002 sec. 1.2: "through a draw a line
     perpendicular to AB, through p a vertical line; their intersection is b"): for each
     (name, known point) of `lines` the line of known direction "line <name>" from the known point
-    toward `point`, then the intersection's mark "point <point>"; nothing at a scale."""
-    return [*(Segment(f"line {name}", known, point, math.nan, "", "construction") for name, known in lines),
-            Segment(f"point {point}", point, point, math.nan, "", "intersection")]
+    toward `point`, then the intersection's mark "point <point>"; nothing at a scale. `order`: a
+    construction drawn at some angles only (a triad's, in one order of its sides): the lines run
+    to, and the mark is at, the unlettered point '<point>:<order>' (`alias`), which the plan
+    holds at those angles and NaN at the others."""
+    end = alias(point, order)
+    return [*(Segment(f"line {name}", known, end, math.nan, "", "construction") for name, known in lines),
+            Segment(f"point {point}", end, end, math.nan, "", "intersection")]
+
+
+def alias(point: str, order: str) -> str:
+    """The name of `point` in a construction drawn in `order` only ('c:1'; `point` where no order):
+    unlettered on a sheet (a ':' in its name)."""
+    return f"{point}:{order}" if order else point
 
 
 @dataclass(frozen=True)
@@ -215,7 +225,7 @@ class PlanCycle:
     `accuracy`: (digits left (N,), the count under which a sheet states it) or None.
     A segment with a unit whose value is NaN at an angle is not drawn there (`drawn`); `equation`
     the side names at every angle, or N such tuples where the order changes with the angle (a
-    triad's); a result's `how` one key, or N keys."""
+    triad's), and so `steps`; a result's `how` one key, or N keys."""
     kind: str
     titles: tuple[str, ...]                # (N,) the title at each angle
     scale: Scale
@@ -227,7 +237,8 @@ class PlanCycle:
     results: tuple[Result, ...] = ()
     equation: tuple[str, ...] = ()
     accuracy: tuple[np.ndarray, int] | None = None
-    steps: tuple[str, ...] = ()               # see Plan.steps: the same at every angle
+    steps: tuple = ()                         # see Plan.steps; N such tuples where they change with the
+                                              # angle (a triad's, its sides in another order)
 
     def __post_init__(self) -> None:
         phi = np.atleast_1d(np.asarray(self.phi_deg, dtype=float))
@@ -283,7 +294,11 @@ class PlanCycle:
                     tuple(Result(r.symbol, _one(r.value, i), r.unit, r.how if isinstance(r.how, str) else r.how[i])
                           for r in self.results),
                     self.equation if not self.equation or isinstance(self.equation[0], str) else self.equation[i], acc,
-                    self.steps)
+                    self.steps_at(i))
+
+    def steps_at(self, i: int) -> tuple[str, ...]:
+        """The construction's steps at angle i (`Plan.steps`)."""
+        return self.steps if not self.steps or isinstance(self.steps[0], str) else self.steps[i]
 
     def drawn(self, s: Segment) -> np.ndarray:
         """(N,) bool: the angles segment s is drawn at: all, but where a quantity's value (a

@@ -688,7 +688,10 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name)} if contract else {}
         attrs = {"stroke": colour, "stroke-width": f"{width}", **({"stroke-dasharray": dash} if dash else {}), **data}
         if s.kind in ("construction", "intersection"):
-            element, spots[s.name] = _construction(s.kind, a, b, ok, attrs, label, placer)
+            element, spot = _construction(s.kind, a, b, ok, attrs, label, placer)
+            if s.name in spots:               # the same step in another order of a triad's sides
+                spot = (np.where(np.isfinite(spot[0]), spot[0], spots[s.name][0]), None)
+            spots[s.name] = spot
             out.append(replace(element, length_mm=Lz if contract else None))
             none = ok & ~np.asarray(element.drawn()).reshape(-1)       # a line of no direction (v_B = 0): not drawn
             if contract and none.any():
@@ -730,9 +733,14 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         if lettered.any():
             names.append(_Name((segment_label(s, lang), segment_label(s, lang) + "*"), out_.astype(int),
                                _where(lettered, a), _where(drawn & named, b), _NAME_MM, "name"))
-    for k, name in enumerate(cycle.steps, 1):           # the construction's steps numbered: (1), (2), ...
+    steps = [cycle.steps_at(i) for i in range(n)]       # the construction's steps numbered: (1), (2), ...
+    for name in dict.fromkeys(name for at_i in steps for name in at_i):
         if name in spots:
-            names.append(_Name((f"({k})",), zero, *spots[name], _NUMBERED_MM, "step"))
+            numbers = [at_i.index(name) + 1 if name in at_i else 0 for at_i in steps]
+            texts, variant = _variants([f"({k})" if k else "" for k in numbers])
+            on = np.array(numbers) > 0
+            a, b = spots[name]
+            names.append(_Name(tuple(texts), variant, _where(on, a), None if b is None else _where(on, b), _NUMBERED_MM, "step"))
     return out
 
 

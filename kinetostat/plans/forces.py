@@ -6,7 +6,7 @@ every point, value and path an array over the angles, no loop over them. An elem
 where it exists at any of the angles; at an angle where it does not (a load of zero, an arm
 through its own pole), its points and value are NaN there (`PlanCycle.at` leaves it out). A
 triad whose leash closing it about S changes with the angle (`kinematics.special_index`) has
-each order's polygon and axes, each at the angles of that order.
+each order's polygon, axes and construction, each at the angles of that order.
 
 Lettering (the texts'): R<i><j> is the force of link i on link j (R12, R43, R32); a pin
 reaction split along and across the link is R<i><j>n, R<i><j>t (R^n_12, R^tau_12); G<k> a
@@ -47,7 +47,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..applied import applied_moment, point_forces
-from .core import PlanCycle, Result, Scale, Segment, construction
+from .core import PlanCycle, Result, Scale, Segment, alias, construction
 from ..model.lettering import lettering, link_number, reaction_name
 from .scales import round_scale
 from ..errors import ModelWarning, _angle_list
@@ -855,13 +855,23 @@ def _triad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Pla
     the whole reaction of each two-pin leash as a chord over its two parts, and each leash's
     inner reaction (of the base on it) from its own polygon: the chord from the end of its
     forces back to their start. Each order of the sides the angles hold (`_orders`) drawn at its
-    own angles: its equation and title there."""
+    own angles: its equation and title there, and its construction (as a dyad's, `_dyad_force_plan`):
+    the lines of the two unknowns R..n, along the axes of the leashes through S, through the
+    polygon's start and the last known force's end, and the intersection that fixes both
+    (`core.construction` in that order); its steps: the known forces, the lines, the
+    intersection, the unknowns (N tuples where the order changes with the angle)."""
     orders = _orders(mech, res, g)
-    parts, equations = [], []
+    parts, equations, steps = [], [], []
     for sides, where in orders:
         seq, spans, whole = _triad_polygon(mech, res, g, sides)
         pts, segs = _closed_polygon(seq, mu_F)
         m = len(seq)
+        equation = tuple(name for name, *_ in seq)
+        order = str(g.sides.index(sides[2]) + 1)          # the tag of the triad's order (kinematic's too)
+        lines = construction(_vertex(m - 1), [(equation[-1], _vertex(0)), (equation[-2], _vertex(m - 2))], order)
+        pts[alias(_vertex(m - 1), order)] = pts[_vertex(m - 1)]
+        segs += lines
+        steps.append(equation[:-2] + tuple(s.name for s in lines) + equation[-2:])
         for (ell, _, _, known), w in zip(sides, whole):
             if w is not None:
                 segs.append(Segment(reaction_name(mech, known, ell), _vertex(w[0] % m), _vertex(w[1] % m),
@@ -870,12 +880,13 @@ def _triad_force_plan(mech: "Mechanism", res: "Analysis", g, mu_F: Scale) -> Pla
             segs.append(Segment(reaction_name(mech, g.links[0], ell), _vertex(b % m), _vertex(a % m),
                                 _abs(_z(res.reaction(g.links[0], ell))), "N", role="result"))
         parts.append((where, pts, _masked(segs, where)))
-        equations.append(tuple(name for name, *_ in seq))
+        equations.append(equation)
     pts, segs = _merged(parts)
     which = np.argmax(np.stack([where for _, where in orders]), axis=0)      # each angle's order
     titles = [f"Force plan of group {g.label} (III3): " + " + ".join(equations[o]) + " = 0" for o in which.tolist()]
     equation = equations[0] if len(orders) == 1 else tuple(equations[o] for o in which.tolist())
-    return _cycle(f"forces:{_group_label(g)}", titles, mu_F, res, pts, segs, equation=equation)
+    steps_at = steps[0] if len(orders) == 1 else tuple(steps[o] for o in which.tolist())
+    return _cycle(f"forces:{_group_label(g)}", titles, mu_F, res, pts, segs, equation=equation, steps=steps_at)
 
 
 #: The longest force on the plan of the initial link when it takes a force scale of its own, mm.

@@ -26,6 +26,7 @@ side that collapses).
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -33,10 +34,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import PlanCycle, Scale, Segment, construction
+from .core import PlanCycle, Scale, Segment, alias, construction
 from .zero import by_pattern, translates, zero_of
 
-__all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
+__all__ = ["positions_plan", "without_triad_construction", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
 
 #: Positions of the plan of positions: every 30 deg.
@@ -193,7 +194,8 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     point, the relative velocities of each floating link's joints (a-b), the sliding velocities
     of blocks on moving guides (a1-a3), like points by similarity (s2 on ab), and a triad's
     special point s (v_S from the outer pins of the two leashes through S, e.g. a-s, e-s): all at
-    mu_v."""
+    mu_v; the construction of each dyad's point (`_constructions`) and of a triad's through s
+    (`_triad_lines`)."""
     mu = scales["mu_v"]
     pts = plan_point_names(mech, res)
     mo = _motion(res, pts)
@@ -203,12 +205,15 @@ def velocity_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         segs += [_rel(a, b, np.abs(mo[b][1] - mo[a][1]), "m/s") for i, a in enumerate(joints) for b in joints[i + 1:]]
     for s in _slidings(mech, "p"):
         segs.append(_rel(s.start, s.end, np.abs(res.kin.v_slide[:, s.pair.index]), "m/s"))
-    for name, b, local, refs in _special(mech, res, pts):        # v_S = v_1 + v_S1 = v_2 + v_S2
+    special = _special(mech, res, pts)
+    for name, b, local, refs in special:        # v_S = v_1 + v_S1 = v_2 + v_S2
         vS = _point_motion(res.kin, b, local)[1]
         points[name] = vS / mu.value
         segs += [Segment(f"{r or 'p'}-{name}", r or "p", name, _where(on, np.abs(vS - (mo[r][1] if r else 0j))), "m/s",
                          role="component" if r else "result") for r, on in refs]
-    lines, steps = _constructions(mech, segs, "p")
+    triads = _triad_lines(mech, res, "p", special)
+    _aliases(points, triads)
+    lines, steps = _constructions(mech, segs, "p", triads)
     return PlanCycle("velocity", _titles("Velocity plan at phi = {at:g} deg", res), mu, res.phi_deg, points,
                      tuple(segs + lines), notes=_collapsed(mech, pts, segs, len(res.phi_deg)), steps=steps)
 
@@ -225,7 +230,7 @@ def _component(name: str) -> bool:
     return name[:1] in "nk" and name[1:].isdigit() or name == "k"
 
 
-def _constructions(mech, segs: list[Segment], pole: str) -> tuple[list[Segment], tuple[str, ...]]:
+def _constructions(mech, segs: list[Segment], pole: str, triads=()) -> tuple[list[Segment], tuple]:
     """The construction of a velocity or an acceleration plan (seed 002 sec. 1.2.2) and its steps
     in the texts' order. Per dyad, the point q it fixes (`_found`) lies on two lines of known
     direction: those of the vectors drawn to q from known points (v_BA from a and v_B from p; a^t_BA
@@ -234,21 +239,39 @@ def _constructions(mech, segs: list[Segment], pole: str) -> tuple[list[Segment],
     point (`core.construction`), the one reached through more vectors first. The steps: per line
     the vectors that reach its known point from the pole or a point fixed already (components
     first: pi-a, a-n2), then the line; then the intersection.
-    A triad, or a dyad whose q is not fixed so, has no construction drawn."""
+    `triads`: per triad, its construction in each order of its sides (`_triad_lines`): (angles
+    (N,) bool, order, [(point, [(line, known point), (line, known point)]), ...]), each drawn at
+    its angles (`core.construction`'s order); the steps then change with the angle (N tuples).
+    A dyad whose q is not fixed so has no construction drawn."""
     vectors = [s for s in segs if s.kind == "vector"]
     out: list[Segment] = []
     steps: list[str] = []
-    fixed = {pole}
 
-    def chain(x: str) -> list[str]:
-        """The vectors from the pole or a point fixed already to x, in the order drawn (components
-        first: pi-a, a-n2)."""
-        into = [s for s in vectors if s.end == x and s.start != x]
+    def chain(x: str, fixed: set[str], pool: list[Segment]) -> list[str]:
+        """The vectors of `pool` from the pole or a point fixed already to x, in the order drawn
+        (components first: pi-a, a-n2)."""
+        into = [s for s in pool if s.end == x and s.start != x]
         if x in fixed or not into:
             return []
         s = next((s for s in into if _component(s.start)), into[0])
-        return [*chain(s.start), s.name]
+        return [*chain(s.start, fixed, pool), s.name]
 
+    def made(q: str, lines: list[tuple[str, str]], fixed: set[str], order: str = "", pool=vectors) -> list[str]:
+        """The construction of q (`core.construction`), through the known link first, added to
+        `out`; its steps (the vectors of `pool`: those drawn in its order); q and the known
+        points added to `fixed`."""
+        lines = sorted(lines, key=lambda x: (-len(chain(x[1], fixed, pool)), x[1] == pole))
+        drawn = construction(q, lines, order)
+        out.extend(drawn)
+        own: list[str] = []
+        for (_, known), line in zip(lines, drawn):
+            path = chain(known, fixed, pool)
+            own += [n for n in path if n not in own] + [line.name]
+            fixed |= {x for v in pool if v.name in path for x in (v.start, v.end)}
+        fixed |= {q, *(known for _, known in lines)}
+        return own + [drawn[-1].name]
+
+    fixed = {pole}
     for g in mech.structure.groups:
         if g.klass == 3:
             continue
@@ -260,14 +283,68 @@ def _constructions(mech, segs: list[Segment], pole: str) -> tuple[list[Segment],
             into = [s for s in into if s.start != pole]
         if len(into) != 2:
             continue
-        into.sort(key=lambda s: (-len(chain(s.start)), s.start == pole))     # through the known link first
-        made = construction(q, [(s.name, s.start) for s in into])
-        for s, line in zip(into, made):
-            steps += [n for n in chain(s.start) if n not in steps] + [line.name]
-        steps.append(made[-1].name)
-        out += made
-        fixed |= {q, *(s.start for s in into)}
-    return out, tuple(steps)
+        steps += [n for n in made(q, [(s.name, s.start) for s in into], fixed) if n not in steps]
+    if not triads:
+        return out, tuple(steps)
+    n = len(triads[0][0][0])
+    at = [list(steps) for _ in range(n)]
+    for orders in triads:
+        for where, order, points in orders:
+            own: list[str] = []
+            known = set(fixed)
+            pool = [v for v in vectors if np.isfinite(np.broadcast_to(np.asarray(v.value, float), where.shape)[where]).any()]
+            for q, lines in points:
+                own += made(q, lines, known, order, pool)
+            for i in np.flatnonzero(where):
+                at[i] += own
+    return out, tuple(tuple(x) for x in at) if len({tuple(x) for x in at}) > 1 else tuple(at[0])
+
+
+def _triad_lines(mech, res, pole: str, special: list) -> list:
+    """Per triad (Artobolevsky 1988, the class-III group: "the special point S of Assur, where the
+    axes of two leashes meet, taken as a point of the base link"), its velocity plan's
+    construction in each order of its sides over the angles of `res` (`kinematics.special_index`
+    k: S on the axes of sides k+1 and k+2): (angles (N,) bool, the order's tag, [(point fixed,
+    [(line, known point), (line, known point)]) in the order drawn]): s on the lines of v_S - v_O
+    through the outer pins o of the two leashes through S (square to a two-pin leash's axis, along
+    a slider's guide or a rocking block's arm: the vectors o-s); the third leash's inner point q3
+    on the line of v_Q3 - v_S through s (square to S Q3) and of the leash's own vector o-q3; the
+    other two inner points each on the line of its velocity relative to q3 (square to Q3 Q) and of
+    its leash's vector (a line through s would run parallel to it). A triad whose leash's outer
+    prismatic pair is on a moving link, or whose inner one has its guide on the leash, is left
+    out (the lines above are not then of known direction through a point on the plan)."""
+    from ..kinematics import special_index
+    triads = [g for g in mech.structure.groups if g.klass == 3]
+    out = []
+    for g, (s_name, _, _, _) in zip(triads, special):
+        ends = []
+        for ell, o, i, _ in g.sides:
+            if (o.kind == "P" and 0 not in o.links) or (i.kind == "P" and i.links[0] != g.links[0]):
+                break
+            outer = (_name_of(mech, o.point) if o.kind == "R" else "") or pole
+            inner = _name_of(mech, i.point) if i.kind == "R" else f"{i.point.lower()}{i.links[0]}"
+            ends.append((outer, inner))
+        else:
+            k = special_index(mech, res.kin, g)
+            orders = []
+            for x in sorted(set(k[_ok(res)].tolist())):
+                (o1, q1), (o2, q2), (o3, q3) = (ends[(x + j) % 3] for j in (1, 2, 0))
+                orders.append((_ok(res) & (k == x), str(x + 1), [
+                    (s_name, [(f"{o1}-{s_name}", o1), (f"{o2}-{s_name}", o2)]),
+                    (q3, [(f"{s_name}-{q3}", s_name), (f"{o3}-{q3}", o3)]),
+                    (q1, [(f"{q3}-{q1}", q3), (f"{o1}-{q1}", o1)]),
+                    (q2, [(f"{q3}-{q2}", q3), (f"{o2}-{q2}", o2)])]))
+            out.append(orders)
+    return out
+
+
+def _aliases(points: dict, triads: list) -> None:
+    """Each triad construction's points in its order (`core.alias`): the point at its angles, NaN
+    at the others."""
+    for orders in triads:
+        for where, order, fixed in orders:
+            for q, _ in fixed:
+                points[alias(q, order)] = np.where(where, points[q], np.nan)
 
 
 def _collapsed(mech, pts: dict[str, _Point], segs: list[Segment], n: int) -> tuple[tuple[str, ...], ...]:
@@ -340,8 +417,9 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     `-k` and relative `k-` parts of a block on a moving guide at the angles where the guide turns
     (where it stands still: the relative part alone, NaN, not drawn, elsewhere); pi-x for every
     point, the relative accelerations of each floating link's joints (a-b), like points by
-    similarity, and a triad's special point s with its construction from the outer pins of the
-    two leashes through S (e.g. a-s): all at mu_a."""
+    similarity, and a triad's special point s from the outer pins of the two leashes through S
+    (e.g. a-s): all at mu_a; the construction of each dyad's point (`_constructions`) and of a
+    triad's through s, with the base link's normal parts it needs (`_triad_normals`)."""
     mu = scales["mu_a"]
     pts = plan_point_names(mech, res)
     mo = _motion(res, pts)
@@ -388,16 +466,93 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         else:
             segs.append(_rel(s.start, s.end, np.abs(a_r), unit))
     segs += [_absolute(mech, pts, n, "pi", np.abs(m[2]), unit) for n, m in mo.items()]
-    for name, b, local, refs in _special(mech, res, pts):        # a_S = a_1 + a_S1 = a_2 + a_S2
+    special = _special(mech, res, pts)
+    for name, b, local, refs in special:        # a_S = a_1 + a_S1 = a_2 + a_S2
         aS = _point_motion(res.kin, b, local)[2]
         points[name] = aS / mu.value
         segs.append(Segment(f"pi-{name}", "pi", name, np.abs(aS), unit, role="result"))
         segs += [_rel(r, name, _where(on, np.abs(aS - mo[r][2])), unit) for r, on in refs if r]
     for _, joints in _floating_joints(mech, pts):
         segs += [_rel(a, b, np.abs(mo[b][2] - mo[a][2]), unit) for i, a in enumerate(joints) for b in joints[i + 1:]]
-    lines, steps = _constructions(mech, segs, "pi")
+    notes = _collapsed(mech, pts, segs, len(res.phi_deg))
+    triads = _triad_normals(mech, res, mo, special, points, segs, mu.value)
+    _aliases(points, triads)
+    lines, steps = _constructions(mech, segs, "pi", triads)
     return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,
-                     points, tuple(segs + lines), notes=_collapsed(mech, pts, segs, len(res.phi_deg)), steps=steps)
+                     points, tuple(segs + lines), notes=notes, steps=steps)
+
+
+def without_triad_construction(mech, cycle: PlanCycle) -> PlanCycle:
+    """`cycle` without what only a triad's construction draws (`_triad_lines`, `_triad_normals`,
+    `forces._triad_force_plan`): its lines and marks (at a point of one order of its sides,
+    `core.alias`) and the base link's normal parts n<b>1, n<b>2, ... they start from, with their
+    points; then with no steps. The interactive page of every angle has no room for them within its 300 kB
+    (triad_six_bar's would grow from 296 to 335 kB); the sheets of one angle draw them."""
+    own = [re.compile(f"n{g.links[0]}\\d+") for g in mech.structure.groups if g.klass == 3]
+    kept = tuple(s for s in cycle.segments if not ((s.kind in ("construction", "intersection") and ":" in s.end)
+                                                   or any(r.fullmatch(s.end) for r in own)))
+    if len(kept) == len(cycle.segments):
+        return cycle
+    used = {n for s in kept for n in (s.start, s.end)}
+    gone = {s.end for s in cycle.segments} - used          # their points (n31, c:2)
+    return replace(cycle, segments=kept, steps=(), points={k: v for k, v in cycle.points.items() if k not in gone})
+
+
+def _triad_normals(mech, res, mo: dict, special: list, points: dict, segs: list[Segment], mu: float) -> list:
+    """Per triad whose leashes each turn about two pins or slide in a guide of the frame, its
+    acceleration plan's construction in each order of its sides (as `_triad_lines`; Artobolevsky
+    1988, the class-III group): S, a point of the base link b on the axis of leash l (outer pin O,
+    inner Q), has a_S = a_O + a^n_QO + a^n_SQ + a^t, the tangential parts a^t_QO and a^t_SQ both
+    square to the axis (a slider's: a_S = a^n_SQ + a part along its guide); so s lies on the line
+    of that direction through the end of the normal parts drawn from the outer pin's point (a-n2,
+    then n2-n31: omega_b^2 QS, along S -> Q), for each of the two leashes through S. The third
+    leash's inner point Q3 on the line square to S Q3 through the end of its normal part relative
+    to s and on its leash's (through n5 square to F D; a slider's: through pi along the guide);
+    the other two inner points each on the line square to Q3 Q through the end of its normal part
+    relative to Q3 and on its leash's. The base link's normal parts n<b>1, n<b>2, ... (in the
+    order drawn) are added to `points` and `segs` at the angles of their order (NaN, not drawn,
+    at the others). A triad with a leash on an inner prismatic pair (a rocking block: its point
+    under the block is known only through the Coriolis part, drawn from the guide), or on a
+    prismatic pair to a moving link, is left out."""
+    from ..kinematics import special_index
+    triads = [g for g in mech.structure.groups if g.klass == 3]
+    out = []
+    for g, (s_name, base, local, _) in zip(triads, special):
+        if any(i.kind == "P" or (o.kind == "P" and 0 not in o.links) for _, o, i, _ in g.sides):
+            continue
+        w2 = res.kin.omega[:, base] ** 2
+        world = {s_name: _point_motion(res.kin, base, local)[0]}
+        leash = []
+        for ell, o, i, _ in g.sides:               # (inner point, the end of its leash's known parts)
+            q = _name_of(mech, i.point)
+            world[q] = mo[q][0]
+            leash.append((q, f"n{ell}" if o.kind == "R" else "pi"))
+        k = special_index(mech, res.kin, g)
+        orders = []
+        for x in sorted(set(k[_ok(res)].tolist())):
+            where = _ok(res) & (k == x)
+            made: list[str] = []
+
+            def normal(start: str, rel: str, to: str) -> str:
+                """The base link's normal part of `to` relative to `rel` drawn from `start`: its end."""
+                name = f"n{base}{len(made) + 1}"
+                made.append(name)
+                an = -w2 * (world[to] - world[rel])
+                points[name] = np.where(where, points[start] + an / mu, points.get(name, np.full(len(where), np.nan + 0j)))
+                segs.append(_rel(start, name, _where(where, np.abs(an)), "m/s^2"))
+                return name
+
+            (q1, k1), (q2, k2), (q3, k3) = (leash[(x + j) % 3] for j in (1, 2, 0))
+            m1, m2 = normal(k1, q1, s_name), normal(k2, q2, s_name)
+            m3 = normal(s_name, s_name, q3)
+            fixed = [(s_name, [(f"{m1}-{s_name}", m1), (f"{m2}-{s_name}", m2)]),
+                     (q3, [(f"{m3}-{q3}", m3), (f"{k3}-{q3}", k3)])]
+            for q, kq in ((q1, k1), (q2, k2)):
+                m = normal(q3, q3, q)
+                fixed.append((q, [(f"{m}-{q}", m), (f"{kq}-{q}", kq)]))
+            orders.append((where, str(x + 1), fixed))
+        out.append(orders)
+    return out
 
 
 # ----------------------------------------------------------------------------- plan of positions

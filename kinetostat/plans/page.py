@@ -504,7 +504,7 @@ def _construction_step(plan, name: str, n: int, lang: str) -> dict:
     if s.kind == "construction":
         eq = text("page.line", lang, plan=where, P=s.start, V=name[5:])
     elif s.kind == "intersection":
-        eq = text("page.point", lang, plan=where, P=s.start)
+        eq = text("page.point", lang, plan=where, P=name[len("point "):])        # its mark's point: a triad's 'c:2'
     else:
         eq = text("page.vector", lang, plan=where, V=name)
     return {"plan": plan.kind, "segment": name, "n": n, "eq": eq}
@@ -579,6 +579,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     analysis). ValueError where `at` is a singular position."""
     from . import build_cycle, cycle_scales
     from .draw import drawing
+    from .kinematic import without_triad_construction
     from .worksheet import analyses, worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
@@ -591,7 +592,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         warnings.simplefilter("ignore")
         res, other = analyses(mech, phi)           # the graphical method's; the other friction mode's rows
         fixed = fixed or cycle_scales(mech, res=res)
-        cycles = build_cycle(mech, res, fixed)
+        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed).items()}
         sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=other)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
