@@ -136,7 +136,7 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
     plans = a3.plans
     sc = plans.scales
     ws = worksheet_cycle(mech, res, sc["mu_l"].value, lang, other).at(0)
-    L = lettering(mech)
+    L = lettering(mech).in_lang(lang)
     spec, name = v.spec, v.title(lang)
     title = text("pack.task", lang, task=v.task, code=v.code or "—",
                  title=name[0].upper() + name[1:] if lang == "en" else name)

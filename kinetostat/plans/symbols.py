@@ -112,7 +112,8 @@ def plain(s: str) -> str:
     return "".join(t for t, _ in text_runs(s))
 
 
-def html(s: str) -> str:
-    """A text as HTML, escaped, its symbols' scripts in <sub> and <sup>."""
-    return "".join(escape(t) if not level else f"<{'sub' if level == SUB else 'sup'}>{escape(t)}</{'sub' if level == SUB else 'sup'}>"
+def html(s: str, escaped: bool = False) -> str:
+    """A text as HTML, escaped (`escaped`: `s` is HTML text already), its symbols' scripts in <sub> and <sup>."""
+    esc = str if escaped else escape
+    return "".join(esc(t) if not level else f"<{'sub' if level == SUB else 'sup'}>{esc(t)}</{'sub' if level == SUB else 'sup'}>"
                    for t, level in text_runs(s))
