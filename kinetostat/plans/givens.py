@@ -9,7 +9,7 @@ A diagram is laid out once (`layout`: lines, paths, dots and texts in mm from it
 drawn by both renderers: `draw_pdf` (a `pdf.Canvas`) and `svg` (the HTML sheet).
 
 May use: numpy, `kinetostat.applied` (where a load's diagram is read), `.i18n`, `.labels` (a
-text's width), `.scales`, `.symbols`. Never `kinetostat.variants`, matplotlib or the harness.
+text's width, its SVG markup, the least size), `.scales`, `.symbols`. Never `kinetostat.variants`, matplotlib or the harness.
 """
 from __future__ import annotations
 
