@@ -140,7 +140,7 @@ def test_the_worksheet_html_sets_symbols_with_true_scripts(ice_sheet):
     for lang in ("en", "uk", "ru"):
         page = replace(ice_sheet, lang=lang).html()
         assert "<td>R<sub>12</sub><sup>t</sup></td>" in page and "<td>a<sup>n</sup><sub>BA</sub></td>" in page
-        assert "m<sub>2</sub> g" in page and "μ<sub>l</sub> = " in page
+        assert "m<sub>2</sub> g" in page and "ω<sub>1</sub>² l<sub>OA</sub>" in page and "μ<sub>l</sub> = " in page
         seen = unescape(re.sub(r"<(su[bp])>.*?</\1>|<[^>]+>", " ", page.split("<body>")[1]))
         assert not re.search(r"R\d\d[nt]\b|[\^_]", seen), lang
 

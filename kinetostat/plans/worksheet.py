@@ -197,8 +197,8 @@ padding:.3em .6em;width:40%}
 """
 
 
-#: A name of letters and digits in a note's formula (m2, ω1, R12, ps2, R12t): a symbol, its digits a subscript.
-_NOTE_SYMBOL = re.compile(r"(?<![\w'])[^\W\d_]+\d+[nt]?(?![\w(])")
+#: A name of letters and digits in a note's formula (m2, ω1, R12, ps2, R12t; ω1² squared): a symbol, its digits a subscript.
+_NOTE_SYMBOL = re.compile(r"(?<![\w'])[^\W\d_]+\d+[nt]?(?=[²³]|[^\w(]|$)")
 
 
 def _html_cell(s: str, column: int) -> str:
