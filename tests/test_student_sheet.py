@@ -20,7 +20,7 @@ from kinetostat.plans.i18n import num, text
 from kinetostat.plans.worksheet import analyses, worksheet_cycle
 
 
-def sheet_pack(task: int, code: str, finer_rule: str | None = None) -> P.Pack:
+def sheet_pack(task: int, code: str, finer_rule: str | None = None, lang: str = "uk") -> P.Pack:
     """The pack of the variant with its plans at the texts' rule on a stand-in of the one A3
     sheet (`a3.one_sheet`, seconds a variant, is not under test here: the sheet's data and the
     key's values do not depend on the scales); with `finer_rule`, that scale's rule twice as
@@ -34,10 +34,10 @@ def sheet_pack(task: int, code: str, finer_rule: str | None = None) -> P.Pack:
     res, other = analyses(mech, [phi1])
     plans = build(mech, at=phi1)
     rule = {k: replace(s, value=s.value / 2) if k == finer_rule else s for k, s in plans.scales.items()}
-    a3 = OneSheet(plans, "uk", (), (), rule, references(mech, res))
+    a3 = OneSheet(plans, lang, (), (), rule, references(mech, res))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return P.pack(v, lang="uk", a3=a3, draws=20, analysis=(res, other))
+        return P.pack(v, lang=lang, a3=a3, draws=20, analysis=(res, other))
 
 
 def number(cell: str) -> float:
@@ -216,3 +216,13 @@ def test_the_pressure_diagram_is_lettered_at_the_sheets_least_size_and_nothing_c
     for t in texts[-len(d.marks):]:
         x0, y0, x1, y1 = G.text_box(*t)
         assert not ((x0 < drawn[:, 0]) & (drawn[:, 0] < x1) & (y0 < drawn[:, 1]) & (drawn[:, 1] < y1)).any(), t   # a leader ends at its corner
+
+
+def test_the_russian_sheet_and_key_letter_the_balancing_moment_m_ur():
+    """1/479 in Russian: the tables to fill in and the key's tables write M_ур, F'_ур, M'_ур (Russian
+    texts' уравновешивающий; the model's Ukrainian text letters M_зр), the statement M_ур; no зр left."""
+    p = sheet_pack(1, "479", lang="ru")
+    cells = {c for blocks in (p.sheet, p.key) for k, x in blocks if k == "table" for row in x.rows for c in row}
+    texts = " ".join(x for blocks in (p.sheet, p.key) for k, x in blocks if k in ("h1", "h2", "p"))
+    assert {"M_ур", "F'_ур", "M'_ур"} <= cells and "M_ур" in texts
+    assert not [c for c in cells if "зр" in c] and "зр" not in texts
