@@ -619,7 +619,7 @@ def index_markdown(keys: list[KeySummary], lang: str = "en") -> str:
     phi1, M_зр and the largest reaction at phi1, and the largest |M_зр| and |R| over the cycle;
     each code links to the worksheet in its folder `<name>/` (`KeySummary.name`)."""
     from .plans.i18n import num, text, unit
-    M = lettering_of(1).M_bal
+    M = lettering_of(1).in_lang(lang).M_bal
     Nm, N, deg = unit("N m", lang), unit("N", lang), unit("deg", lang)
     lines = [f"# {text('ix.title', lang)}", "", text("ix.intro", lang, M=M), ""]
     by_task: dict[str, list[KeySummary]] = {}
@@ -649,7 +649,7 @@ def summary(v: Variant, k: KeySummary, out: str | Path, lang: str = "en") -> lis
     """What `kinetostat variant TASK CODE` prints, in `lang`: the code's columns, the rows'
     values, M_зр and the largest reaction at phi1 and over the cycle, the files written."""
     from .plans.i18n import num, text, unit
-    spec, L = TASKS[v.task], lettering_of(v.task)
+    spec, L = TASKS[v.task], lettering_of(v.task).in_lang(lang)
     title = v.title(lang)
     Nm, N = unit("N m", lang), unit("N", lang)
     lines = [text("cli.variant", lang, task=v.task, title=title, code=v.code, table=spec.table)

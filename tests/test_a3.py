@@ -34,6 +34,11 @@ def _one(task: int, code: str, lang: str = "en") -> A3.OneSheet:
     return A3.one_sheet(v.mechanism(), float(v.values["phi1"]), lang)
 
 
+def _room(one: A3.OneSheet, plans, lang: str) -> float:
+    """The notes' room above the title block of `plans` on `one`'s sheet in `lang`, in the texts' order."""
+    return A3.notes_mm(len(A3.note_lines(A3._notes(plans.scales, one.rule, one.reference, True, lang))))
+
+
 def _check_sheet(one: A3.OneSheet) -> None:
     """One page; every plan's box (drawing with its heading) inside AREA, clear of the title block
     and of every other box."""
@@ -44,7 +49,7 @@ def _check_sheet(one: A3.OneSheet) -> None:
         x0, y0 = d.box[0] + p.dx, d.box[1] + p.dy - top
         x1, y1 = x0 + w, y0 + h
         assert A3.AREA[0] - 1e-9 <= x0 and x1 <= A3.AREA[2] + 1e-9 and A3.AREA[1] - 1e-9 <= y0 and y1 <= A3.AREA[3] + 1e-9, d.kind
-        assert x1 <= A3.TITLE_BLOCK[0] or y1 <= A3.TITLE_BLOCK[1] - A3.NOTES_MM, d.kind
+        assert x1 <= A3.TITLE_BLOCK[0] or y1 <= A3.TITLE_BLOCK[1] - A3.notes_room(one), d.kind
         for kind, b in boxes:
             assert x1 <= b[0] or b[2] <= x0 or y1 <= b[1] or b[3] <= y0, (d.kind, kind)
         boxes.append((d.kind, (x0, y0, x1, y1)))
@@ -109,7 +114,7 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
             floor[k] = next_coarser(floor[k])
     mech = one.plans.mech
     plans = kinetostat.plans.build(mech, at=one.plans.at, scales={"mu_l": 0.0015, **floor})
-    assert any(max(p.page for p in A3.layout([A3.drawing(plans[k], lang) for k in plans])) >= 1
+    assert any(max(p.page for p in A3.layout([A3.drawing(plans[k], lang) for k in plans], _room(one, plans, lang))) >= 1
                for lang in ("en", "uk", "ru"))
     for rule, chosen, _ in one.coarsened():
         if chosen.symbol in A3.FIRST:
@@ -117,7 +122,7 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
                         if v < chosen.value * (1 - 1e-9))
             given = {k: s.value for k, s in one.plans.scales.items()} | {chosen.symbol: finer}
             plans = kinetostat.plans.build(mech, at=one.plans.at, scales=given)
-            assert any(max(p.page for p in A3.layout([A3.drawing(plans[k], lang) for k in plans])) >= 1
+            assert any(max(p.page for p in A3.layout([A3.drawing(plans[k], lang) for k in plans], _room(one, plans, lang))) >= 1
                        for lang in ("en", "uk", "ru")), chosen
 
 
@@ -194,7 +199,7 @@ def test_the_packer_counts_its_work():
     try:
         for k in calls:
             setattr(A3, k, counted(k))
-        A3.layout(list(one.drawings))
+        A3.layout(list(one.drawings), A3.notes_room(one))
     finally:
         for k, f in saved.items():
             setattr(A3, k, f)
@@ -363,10 +368,11 @@ def test_a_sheet_packed_out_of_the_texts_order_says_so(monkeypatch):
     """Task 2 / 479's ten plans packed (as `layout` packs where no order of READING fits; the
     greedy found none for it before the depth-first search): one sheet, apart, and the notes
     above the title block say so."""
-    packed = A3.layout(list(_one(2, "479").drawings))
+    room = A3.notes_mm(len(A3.note_lines(A3.notes(_one(2, "479"), False, "en"))))
+    packed = A3.layout(list(_one(2, "479").drawings), room)
     monkeypatch.setattr(A3, "READING", ())
     from dataclasses import replace
-    one = replace(_one(2, "479"), places=tuple(A3.layout(list(_one(2, "479").drawings))))
+    one = replace(_one(2, "479"), places=tuple(A3.layout(list(_one(2, "479").drawings), room)))
     assert A3.placed_in_order(_one(2, "479").drawings, packed)
     b = _boxes(one)
     assert not A3.in_texts_order(list(b), list(b.values()))
@@ -405,9 +411,28 @@ def test_the_title_block_of_gost_2_104():
     assert _in_cell(page, (17, 0, 65, 20)) == [] and _in_cell(page, (17, 25, 65, 55)) == []      # for the hand
     tb = A3.TITLE_BLOCK
     notes = [(x, y, s, size) for x, y, s, size, _ in page.texts if x == tb[0] + 1.0 and y < tb[1]]
-    assert notes and all(tb[1] - A3.NOTES_MM < y < tb[1] and A3._width(s, size) <= tb[2] - tb[0] for x, y, s, size in notes)
+    assert notes and all(tb[1] - A3.notes_room(one) < y < tb[1] and A3._width(s, size) <= tb[2] - tb[0] for x, y, s, size in notes)
     for x0, y0, x1, y1 in _boxes(one).values():
-        assert x1 <= tb[0] or y1 <= tb[1] - A3.NOTES_MM
+        assert x1 <= tb[0] or y1 <= tb[1] - A3.notes_room(one)
+
+
+def test_the_notes_take_the_room_of_their_lines():
+    """The notes above the title block take the height of their lines (was: 20 mm whatever their
+    number): on 1/479's sheet five lines of 2.5 mm type 3.1 mm apart, the last 1.5 mm above the
+    block, 16.2 mm from the first line's ascent; the plans laid out clear of that room, and a
+    drawing across the sheet that fits above five lines' notes, not above 20 mm, is placed."""
+    one = _one(1, "479", "uk")
+    (page,) = A3.pages(one, "t")
+    tb = A3.TITLE_BLOCK
+    notes = [(y, size) for x, y, s, size, _ in page.texts if x == tb[0] + 1.0 and y < tb[1]]
+    top = min(y - A3.ASCENT * size for y, size in notes)
+    assert len(notes) == 5 and tb[1] - top == pytest.approx(A3.notes_room(one)) == pytest.approx(1.5 + 4 * 3.1 + 0.93 * 2.5)
+    assert A3.layout(list(one.drawings), A3.notes_room(one)) == list(one.places)
+    from dataclasses import replace
+    probe = A3.Drawing("positions", ("", ""), (), (), (), (), (), (0.0, 0.0, 380.0, 0.0))
+    wide = replace(probe, box=(0.0, 0.0, 380.0, 204.0 - A3._size(probe)[1]))    # 204 mm with its heading
+    small = replace(probe, kind="lever", box=(0.0, 0.0, 20.0, 20.0))
+    assert [max(p.page for p in A3.layout([wide, small], room)) for room in (A3.notes_room(one), 20.0)] == [0, 1]
 
 
 @pytest.mark.parametrize("mu_l, lang, ratio", [(0.0015, "uk", "1:1,5"), (0.0015, "en", "1:1.5"), (0.001, "en", "1:1"),

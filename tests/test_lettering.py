@@ -156,6 +156,32 @@ def test_en_sheets_have_no_cyrillic(ice30):
     assert "зр" in _words(svg(ice30["crank"], "uk"))
 
 
+def test_ru_sheets_letter_the_balancing_moment_as_russian_texts_do(ice30):
+    """Russian texts write the balancing moment and force M_ур, F_ур (уравновешивающий; seed 003:
+    "уравновешивающую силу"); the ICE's model letters its Ukrainian text's M_зр, F_зр: its ru
+    sheets, the worksheet and the page's steps write M_ур, F'_ур (was: M_зр), its uk ones M_зр and
+    its en ones M_bal; a model without lettering (the triad: M_bal) is lettered M_зр in uk."""
+    from kinetostat.plans.page import _steps
+    from kinetostat.plans.worksheet import worksheet
+    from kinetostat.model.lettering import in_lang
+    crank = {lang: _words(svg(ice30["crank"], lang)) for lang in ("uk", "ru", "en")}
+    lever = {lang: _words(svg(ice30["lever"], lang)) for lang in ("uk", "ru", "en")}
+    assert "Mур" in crank["ru"] and "F′ур" in lever["ru"] and "M′ур" in lever["ru"] and "зр" not in crank["ru"] + lever["ru"]
+    assert "Mзр" in crank["uk"] and "F′зр" in lever["uk"] and "ур" not in crank["uk"] + lever["uk"]
+    assert "Mbal" in crank["en"] and "F′bal" in lever["en"]
+    mech = kinetostat.load("ice_crank_slider")
+    ws = {lang: {r["key"]: r for r in worksheet(mech, 30.0, lang=lang).records()} for lang in ("uk", "ru")}
+    assert ws["ru"]["M_bal"]["symbol"] == "M_ур" and ws["ru"]["delta_pct"]["note"] == "(M'_ур - M_ур) / M'_ур 100 %"
+    assert ws["uk"]["M_bal"]["symbol"] == "M_зр"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = kinetostat.analyze(mech, phi_deg=[30.0])
+    eqs = " ".join(s["eq"] for s in _steps(mech, res, ice30, "ru"))
+    assert "M_ур" in eqs and "зр" not in eqs
+    assert (in_lang("M_bal", "uk"), in_lang("M_ур", "uk"), in_lang("F'_зр", "ru"), in_lang("F_КО", "en")) == \
+        ("M_зр", "M_зр", "F'_ур", "F_ur")
+
+
 def test_the_how_to_states_the_drawing_ratio_of_its_length_scale():
     """0.0015 m/mm draws 1 mm for 1.5 mm of the mechanism: 1:1.5 (the how-to said GOST's 1:15)."""
     doc = (ROOT / "docs" / "how-to" / "teachers-pack.md").read_text(encoding="utf-8")

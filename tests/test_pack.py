@@ -168,7 +168,7 @@ def test_all_writes_an_html_index_of_the_packs(cli, tmp_path, monkeypatch):
     assert page.startswith("<!DOCTYPE html>") and '<meta charset="utf-8">' in page
     assert 'href="task3_479/key.pdf"' in page and 'href="task3_479/sheet.pdf"' in page
     assert 'href="task3_479/worksheet.html"' in page
-    assert len(re.findall(r"<th[ >]", page)) == 7 and "<td>|М_зр| " not in page and "|M_зр| наибольшее за цикл" in page   # one table
+    assert len(re.findall(r"<th[ >]", page)) == 7 and "<td>|М_ур| " not in page and "|M_ур| наибольшее за цикл" in page   # one table
     assert (tmp_path / "task3_479" / "key.pdf").stat().st_size > 0
     assert re.search(r"Ключи ответов: 1 \(задания 3\) -> .*; оглавление -> .*index\.md; \d+,\d с", run.stdout)
 

@@ -20,7 +20,7 @@ from kinetostat.plans.i18n import num, text
 from kinetostat.plans.worksheet import analyses, worksheet_cycle
 
 
-def sheet_pack(task: int, code: str, finer_rule: str | None = None) -> P.Pack:
+def sheet_pack(task: int, code: str, finer_rule: str | None = None, lang: str = "uk") -> P.Pack:
     """The pack of the variant with its plans at the texts' rule on a stand-in of the one A3
     sheet (`a3.one_sheet`, seconds a variant, is not under test here: the sheet's data and the
     key's values do not depend on the scales); with `finer_rule`, that scale's rule twice as
@@ -34,10 +34,10 @@ def sheet_pack(task: int, code: str, finer_rule: str | None = None) -> P.Pack:
     res, other = analyses(mech, [phi1])
     plans = build(mech, at=phi1)
     rule = {k: replace(s, value=s.value / 2) if k == finer_rule else s for k, s in plans.scales.items()}
-    a3 = OneSheet(plans, "uk", (), (), rule, references(mech, res))
+    a3 = OneSheet(plans, lang, (), (), rule, references(mech, res))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return P.pack(v, lang="uk", a3=a3, draws=20, analysis=(res, other))
+        return P.pack(v, lang=lang, a3=a3, draws=20, analysis=(res, other))
 
 
 def number(cell: str) -> float:
@@ -187,3 +187,42 @@ def test_the_sheet_of_2_479_gives_the_scales_one_sheet_chose():
     assert {s.symbol for _, s, _ in p.a3.coarsened()} == {"mu_l", "mu_a", "mu_F"}
     sheet_scales = _plan_scales(after(p.sheet, "pack.use_scales", "uk"))
     assert sheet_scales == _plan_scales(p.key) and any("μ_F = 100 Н/мм" in r[1] for r in sheet_scales[0])
+
+
+@pytest.mark.parametrize("task, code", [(1, "479"), (2, "479"), (3, "123")])
+def test_the_pressure_diagram_is_lettered_at_the_sheets_least_size_and_nothing_collides(task, code):
+    """The diagram's texts (ticks, axes' names, scales, the mark's label) at the sheets' least font
+    size, capitals >= 2.5 mm (ГОСТ 2.304; were 1.8 mm), in the PDF and the HTML's SVG; no two texts'
+    boxes overlap, and no mark's label lies on a curve or on the mark's own lines."""
+    import numpy as np
+    from kinetostat.model.lettering import lettering
+    from kinetostat.plans import givens as G
+    from kinetostat.plans.labels import CAP, MIN_TEXT_MM
+    v = variants.variant(task, code)
+    mech = v.mechanism()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = kinetostat.analyze(mech, phi_deg=[float(v.values["phi1"])])
+    (d,) = {g.diagram for g in G.diagrams(mech, res, float(v.values["d"]), "uk", lettering(mech))}
+    lines, paths, dots, texts = G.layout(d)
+    assert CAP * G._SIZE >= 2.5 and G._SIZE == MIN_TEXT_MM
+    assert f'font-size="{MIN_TEXT_MM}"' in G.svg(d) and "F_p" not in G.svg(d)          # its symbols set with scripts
+    boxes = [G.text_box(*t) for t in texts]
+    for i, a in enumerate(boxes):
+        for b in boxes[:i]:
+            assert min(a[2], b[2]) <= max(a[0], b[0]) or min(a[3], b[3]) <= max(a[1], b[1]), (a, b)
+    drawn = np.concatenate([np.linspace(p, q, 50) for pts, _ in paths for p, q in zip(pts, pts[1:])]
+                           + [np.linspace((a, b), (c, e), 50) for a, b, c, e, *_ in lines])
+    for t in texts[-len(d.marks):]:
+        x0, y0, x1, y1 = G.text_box(*t)
+        assert not ((x0 < drawn[:, 0]) & (drawn[:, 0] < x1) & (y0 < drawn[:, 1]) & (drawn[:, 1] < y1)).any(), t   # a leader ends at its corner
+
+
+def test_the_russian_sheet_and_key_letter_the_balancing_moment_m_ur():
+    """1/479 in Russian: the tables to fill in and the key's tables write M_ур, F'_ур, M'_ур (Russian
+    texts' уравновешивающий; the model's Ukrainian text letters M_зр), the statement M_ур; no зр left."""
+    p = sheet_pack(1, "479", lang="ru")
+    cells = {c for blocks in (p.sheet, p.key) for k, x in blocks if k == "table" for row in x.rows for c in row}
+    texts = " ".join(x for blocks in (p.sheet, p.key) for k, x in blocks if k in ("h1", "h2", "p"))
+    assert {"M_ур", "F'_ур", "M'_ур"} <= cells and "M_ур" in texts
+    assert not [c for c in cells if "зр" in c] and "зр" not in texts

@@ -6,13 +6,15 @@ from __future__ import annotations
 import functools
 import json
 import math
+import re
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import kinetostat
 from conftest import EVERY_KIND, MODELS, sampled
-from kinetostat.plans.worksheet import analyses, worksheet, worksheet_cycle
+from kinetostat.plans.worksheet import _NOTE_SYMBOL, analyses, worksheet, worksheet_cycle
 
 # seed 002 sec. 1.2.2-1.2.3 at phi = 30 deg (drawn and measured: the text rounds)
 SEED_002 = {"V_B": 10.94, "V_BA": 14.92, "V_S2": 12.2, "omega_2": 135.6, "a_A": 7994.38, "a_B": 8311,
@@ -84,7 +86,7 @@ def test_outputs(ice_sheet, tmp_path):
     md = ice_sheet.markdown()
     assert "| V_BA | 14.8925 | m/s |" in md
     html = ice_sheet.html()
-    assert "<table>" in html and "<td>V_BA</td>" in html
+    assert "<table>" in html and "<td>V<sub>BA</sub></td>" in html
     df = ice_sheet.frame()
     assert list(df.columns) == ["section", "key", "symbol", "value", "unit", "direction", "note"]
     ice_sheet.to_csv(tmp_path / "w.csv")
@@ -110,17 +112,42 @@ def _markdown_it():
 
 
 def _commonmark(sheet) -> str:
-    """The page as markdown-it-py renders the sheet's Markdown (CommonMark with tables, no raw HTML)."""
+    """The page as markdown-it-py renders the sheet's Markdown (CommonMark with tables, no raw HTML),
+    its symbols' scripts inline (`symbols.plain`) as `_flat` reads the page: the rows' symbols and
+    notes, and the scale line, as the worksheet's records write them, set flat."""
+    from dataclasses import replace
     from kinetostat.plans.worksheet import html_document
     from kinetostat.plans.i18n import num, text
-    body = _markdown_it().render(sheet.markdown())
+    from kinetostat.plans.symbols import mark, plain
+    rows = tuple(replace(r, symbol=plain(mark(rec["symbol"])), note=plain(_NOTE_SYMBOL.sub(lambda m: mark(m.group()), rec["note"])))
+                 for r, rec in zip(sheet.rows, sheet.records()))
+    body = _markdown_it().render(replace(sheet, rows=rows).markdown())
+    body = re.sub(r"^(<p>[^<]*)μ_l", r"\1μl", body, count=1, flags=re.M)                # the scale line
     return html_document(text("ws.title", sheet.lang, name=sheet.mechanism, phi=num(sheet.phi_deg, sheet.lang, 6)),
                          body, sheet.lang)
 
 
+def _flat(page: str) -> str:
+    """The HTML page with its <sub> and <sup> tags taken out (their text left inline)."""
+    return re.sub(r"</?su[bp]>", "", page)
+
+
+def test_the_worksheet_html_sets_symbols_with_true_scripts(ice_sheet):
+    """worksheet.html sets each symbol by `symbols`' rule: R12t as R<sub>12</sub><sup>t</sup>,
+    a^n_BA as a<sup>n</sup><sub>BA</sub>, a note's m2 as m<sub>2</sub>; no "R12t", "^" or "_"
+    left in the text a reader sees."""
+    from html import unescape
+    for lang in ("en", "uk", "ru"):
+        page = replace(ice_sheet, lang=lang).html()
+        assert "<td>R<sub>12</sub><sup>t</sup></td>" in page and "<td>a<sup>n</sup><sub>BA</sub></td>" in page
+        assert "m<sub>2</sub> g" in page and "ω<sub>1</sub>² l<sub>OA</sub>" in page and "μ<sub>l</sub> = " in page
+        seen = unescape(re.sub(r"<(su[bp])>.*?</\1>|<[^>]+>", " ", page.split("<body>")[1]))
+        assert not re.search(r"R\d\d[nt]\b|[\^_]", seen), lang
+
+
 def test_the_html_is_the_markdown_as_commonmark_renders_it(ice_sheet):
     """worksheet.html is written without a Markdown renderer: it is markdown-it-py's page of
-    worksheet.md in every language, with the accuracy line, sections that come back (a triad's
+    worksheet.md (its symbols' scripts aside: `_flat`) in every language, with the accuracy line, sections that come back (a triad's
     a_S amid its velocities), and hostile names, symbols, units and notes (Markdown, HTML,
     controls, edge spaces)."""
     from dataclasses import replace
@@ -129,14 +156,14 @@ def test_the_html_is_the_markdown_as_commonmark_renders_it(ice_sheet):
                  for i, h in enumerate(HOSTILE))
     for lang in ("en", "uk", "ru"):
         sheet = replace(ice_sheet, lang=lang)
-        assert sheet.html() == _commonmark(sheet)
+        assert _flat(sheet.html()) == _commonmark(sheet)
         near = replace(sheet, digits=3.25)
-        assert near.html() == _commonmark(near) and "<strong>" in near.html()
+        assert _flat(near.html()) == _commonmark(near) and "<strong>" in near.html()
     hostile = replace(ice_sheet, rows=rows)
-    assert hostile.html() == _commonmark(hostile)
+    assert _flat(hostile.html()) == _commonmark(hostile)
     for h in HOSTILE:
         titled = replace(ice_sheet, mechanism=f"{h} mechanism {h}", rows=())
-        assert titled.html() == _commonmark(titled), h
+        assert _flat(titled.html()) == _commonmark(titled), h
 
 
 def test_bad_options():

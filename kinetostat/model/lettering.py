@@ -7,13 +7,15 @@ cycle.csv aliases) asks here, so that all of them say what the text says.
     >>> L = lettering(kinetostat.load("ice_crank_slider"))
     >>> L.frame, L.M_bal, L.F_bal, L.load("gas force"), L.language
     (4, 'M_зр', 'F_зр', 'F_p', 'uk')
+    >>> in_lang(L.M_bal, "ru"), in_lang(L.lever(L.F_bal), "en")
+    ('M_ур', "F'_bal")
 
 May use: the model (`kinetostat.model`), the standard library.
 """
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Iterable, Mapping
 
@@ -21,7 +23,7 @@ if TYPE_CHECKING:
     from .mechanism import Mechanism
 
 __all__ = ["Lettering", "lettering", "link_number", "reaction_name", "pair_name", "aliases", "with_alias_columns",
-           "with_aliases", "in_lang", "DEFAULT", "EN_SUBSCRIPTS"]
+           "with_aliases", "in_lang", "DEFAULT", "SUBSCRIPTS"]
 
 
 @dataclass(frozen=True)
@@ -50,21 +52,30 @@ class Lettering:
         """The mechanism's name in `lang` (its own name where the model gives none in `lang`)."""
         return self.names.get(lang, default)
 
+    def in_lang(self, lang: str) -> "Lettering":
+        """This lettering as `lang`'s texts write its balancing symbols and loads (`in_lang`):
+        for the texts of an output in `lang`; a plan's own names stay the model's."""
+        return replace(self, M_bal=in_lang(self.M_bal, lang), F_bal=in_lang(self.F_bal, lang),
+                       loads=MappingProxyType({k: in_lang(v, lang) for k, v in self.loads.items()}))
+
 
 DEFAULT = Lettering()
 
-#: The texts' Cyrillic subscripts as English writes them: зр (зрівноважувальний), ур
-#: (уравновешивающий): bal, balancing; КО (корисний опір): ur, useful resistance.
-EN_SUBSCRIPTS = MappingProxyType({"зр": "bal", "ур": "bal", "КО": "ur"})
-_CYRILLIC = re.compile(r"[\u0400-\u04ff]+")
+#: A subscript as each language's texts write it, language -> {as a model may letter it: as that
+#: language writes it}: the balancing quantity's зр (Ukrainian, зрівноважувальний), ур (Russian,
+#: уравновешивающий), bal (English, balancing); КО (корисний опір) in English ur, useful resistance.
+SUBSCRIPTS = MappingProxyType({"en": MappingProxyType({"зр": "bal", "ур": "bal", "КО": "ur"}),
+                               "uk": MappingProxyType({"bal": "зр", "ур": "зр"}),
+                               "ru": MappingProxyType({"bal": "ур", "зр": "ур"})})
+_SUBSCRIPT = re.compile(r"(?<=_)[^\W\d_]+")
 
 
 def in_lang(symbol: str, lang: str) -> str:
-    """A symbol as a text in `lang` writes it: in English the texts' Cyrillic subscripts in
-    EN_SUBSCRIPTS (M_зр -> M_bal, F_КО -> F_ur); in Ukrainian and Russian as the model letters it."""
-    if lang != "en":
-        return symbol
-    return _CYRILLIC.sub(lambda m: EN_SUBSCRIPTS.get(m.group(), m.group()), symbol)
+    """A symbol (or a text of symbols) as `lang`'s texts write it: each subscript after "_" that
+    SUBSCRIPTS[lang] names, in that language (M_зр -> M_bal in English, M_ур in Russian; M'_зр +
+    P_f/ω1 -> M'_ур + P_f/ω1); the model's other letters as it gives them."""
+    table = SUBSCRIPTS.get(lang, {})
+    return _SUBSCRIPT.sub(lambda m: table.get(m.group(), m.group()), symbol)
 
 
 def _published_frame(mech: "Mechanism") -> int:

@@ -35,10 +35,12 @@ import numpy as np
 from .core import Scale
 from .draw import SHEET_MM, language_part, scale_text, scales_of, sheet, title_of
 from .i18n import LANGS, num, text
+from .labels import ASCENT
 from .pdf import text_width
 from .scales import TARGET_MM
 
 __all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "placed_in_order", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
+           "notes", "note_lines", "notes_mm", "notes_room", "NOTE_SIZE",
            "MIN_HEADING_MM", "RULES", "ORDERS", "FIRST", "FLOOR_MM", "IN_ORDER_TRIES"]
 
 #: Where plans go on the A3 sheet (x0, y0, x1, y1), mm from the top left: inside the frame
@@ -47,9 +49,10 @@ AREA = (24.0, 13.0, 411.0, 288.0)
 #: The main title block of GOST 2.104 (form 1, 185 x 55 mm), bottom right, mm.
 TITLE_BLOCK = (230.0, 237.0, 415.0, 292.0)
 #: The notes above the title block (its width; GOST 2.316 puts a drawing's text there): the
-#: scales, their departures from the guide's, the order of the plans; their height, mm.
-NOTES_MM = 20.0
-_NOTE_STEP = 3.1                            # between the notes' lines (2.5 mm type), mm
+#: scales, their departures from the guide's, the order of the plans; their type and the step
+#: between their lines, mm; their height is their lines' (`notes_mm`).
+NOTE_SIZE, _NOTE_STEP = 2.5, 3.1
+_NOTE_BASE = 1.5                            # the last line's baseline above the title block, mm
 #: A plan's heading above its drawing (its title, 3.5 mm, then its scales, 3 mm) is broken into
 #: lines no wider than the drawing, or than this where the drawing is narrower, mm.
 MIN_HEADING_MM = 50.0
@@ -194,11 +197,11 @@ def _size(d: Drawing) -> tuple[float, float, float]:
     return max(d.box[2] - d.box[0], *(_width(t, size, wt) for t, size, wt in head)), d.box[3] - d.box[1] + top, top
 
 
-def _free(G: float) -> list[tuple[float, float, float, float]]:
+def _free(G: float, notes: float) -> list[tuple[float, float, float, float]]:
     """The free rectangles of an empty page for boxes grown by the gap G (right and bottom): AREA
-    above the notes over the title block, and AREA left of them (both maximal; they overlap)."""
+    above the notes (`notes` mm high) over the title block, and AREA left of them (both maximal; they overlap)."""
     x0, y0, x1, y1 = AREA
-    return [(x0, y0, x1 + G, TITLE_BLOCK[1] - NOTES_MM - 2 + G), (x0, y0, TITLE_BLOCK[0] - 2 + G, y1 + G)]
+    return [(x0, y0, x1 + G, TITLE_BLOCK[1] - notes - 2 + G), (x0, y0, TITLE_BLOCK[0] - 2 + G, y1 + G)]
 
 
 #: The rules of `_place`, each a key of a free rectangle's corner (x, y, x1, y1) for a box w x h
@@ -297,13 +300,14 @@ def _place_after(free: list, w: float, h: float, placed: list, rule) -> list[tup
 ORDERS = (lambda w, h: h, lambda w, h: w, lambda w, h: w * h, lambda w, h: max(w, h))
 
 
-def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule) -> dict[int, tuple[int, float, float]]:
-    """Each box (in `order`) at (page, x, y): the first page with room (`_place` by `rule`), a new one else."""
+def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule, notes: float) -> dict[int, tuple[int, float, float]]:
+    """Each box (in `order`) at (page, x, y): the first page with room (`_place` by `rule`; the
+    notes `notes` mm high), a new one else."""
     pages: list[list] = []
     out = {}
     for i in order:
         w, h = sizes[i][0] + _GAP, sizes[i][1] + _GAP
-        for k, free in enumerate(pages + [_free(_GAP)]):
+        for k, free in enumerate(pages + [_free(_GAP, notes)]):
             spot = _place(free, w, h, rule)
             if spot is not None:
                 if k == len(pages):
@@ -321,8 +325,9 @@ def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule) -> di
 IN_ORDER_TRIES = 2000
 
 
-def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule) -> dict[int, tuple[int, float, float]] | None:
-    """Each box (in `order`, the texts') at (0, x, y) on one page, each right of or below every
+def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule, notes: float
+              ) -> dict[int, tuple[int, float, float]] | None:
+    """Each box (in `order`, the texts') at (0, x, y) on one page (the notes `notes` mm high), each right of or below every
     box before it: at a corner of `_place_after` by `rule`, the next corner where the boxes after
     it find no room (depth first, IN_ORDER_TRIES corners at most); None where none is found."""
     left = IN_ORDER_TRIES
@@ -344,12 +349,12 @@ def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule) -
                 out[i] = (0, x, y)
                 return True
         return False
-    return out if fill(0, _free(_GAP), []) else None
+    return out if fill(0, _free(_GAP, notes), []) else None
 
 
-def layout(drawings: list[Drawing]) -> list[Placement]:
+def layout(drawings: list[Drawing], notes: float) -> list[Placement]:
     """The drawings (heading above each) on A3 pages inside AREA, clear of the title block and
-    the notes above it, _GAP apart, never turned. In the texts' order (`texts_rank`: each plan
+    the notes above it (`notes` mm high: `notes_mm`), _GAP apart, never turned. In the texts' order (`texts_rank`: each plan
     right of or below every plan before it; `_in_order` by rows, then by columns) where that fits
     one page; else packed (maximal rectangles, `_place`, by each of the RULES, the drawings taken
     in the texts' order, then in each of the ORDERS; the first packing on one page kept, else the
@@ -357,11 +362,11 @@ def layout(drawings: list[Drawing]) -> list[Placement]:
     goes onto a further page."""
     sizes = [_size(d) for d in drawings]
     texts = sorted(range(len(drawings)), key=lambda i: (texts_rank(drawings[i].kind), i))
-    best = next(((1, spots) for rule in READING if (spots := _in_order(sizes, texts, rule)) is not None), None)
+    best = next(((1, spots) for rule in READING if (spots := _in_order(sizes, texts, rule, notes)) is not None), None)
     orders = [texts] + [sorted(range(len(drawings)), key=lambda i: (-key(*sizes[i][:2]), i)) for key in ORDERS]
     for rule in RULES if best is None else ():
         for order in orders:
-            spots = _pack(sizes, order, rule)
+            spots = _pack(sizes, order, rule, notes)
             n = 1 + max((k for k, _, _ in spots.values()), default=0)
             if best is None or n < best[0]:
                 best = (n, spots)
@@ -469,6 +474,16 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
         return fixed[mu_l]
 
     tried: dict[tuple | None, tuple] = {}
+    ruled: dict[str, Scale] = {}                # the texts' rule, once its try is made
+
+    def placed(plans, ds: list[Drawing], lg: str) -> tuple[list[Placement], bool]:
+        """The drawings `ds` in `lg` laid out clear of the notes their scales take in `lg` (`notes_mm`:
+        the notes of the texts' order, else those of a packed sheet, a line more); in the texts' order?"""
+        for in_order in (True, False):
+            rows = _notes(plans.scales, ruled or plans.scales, reference, in_order, lg)
+            places = layout(ds, notes_mm(len(note_lines(rows))))
+            if placed_in_order(ds, places) or not in_order:
+                return places, in_order and placed_in_order(ds, places)
 
     def attempt(given: Mapping[str, float] | None):
         """(plans, their drawings in `lang`, placements, on one page in every language, and in the
@@ -481,18 +496,19 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
                 pos = positions(given["mu_l"])
                 plans = build(mech, at=at, scales=given, starting_deg=pos.start, positions=pos)
             ds = drawings(plans, lang)
-            places = layout(ds)
-            fit, ordered = all(p.page == 0 for p in places), placed_in_order(ds, places)
+            places, ordered = placed(plans, ds, lang)
+            fit = all(p.page == 0 for p in places)
             for lg in LANGS:
                 if lg != lang and fit:
                     other = drawings(plans, lg)
-                    there = layout(other)
+                    there, in_order = placed(plans, other, lg)
                     fit = all(p.page == 0 for p in there)
-                    ordered = ordered and fit and placed_in_order(other, there)
+                    ordered = ordered and fit and in_order
             tried[key] = plans, ds, places, fit, fit and ordered
         return tried[key]
 
-    rule = dict(attempt(None)[0].scales)
+    ruled.update(attempt(None)[0].scales)
+    rule = dict(ruled)
     coarsest = {}                                # each scale of FIRST as coarse as its floor allows
     for k in FIRST:
         coarsest[k] = rule[k].value
@@ -634,33 +650,56 @@ def _cell_lines(s: str, width: float, height: float, weight: str) -> tuple[float
 
 
 def notes(sheet: OneSheet, in_order: bool, lang: str) -> list[str]:
-    """The notes above the title block: every plan true to scale; the scales of the sheet (μ_l
-    also as GOST 2.302's ratio); each scale whose reference (`scales.REFERENCE_NAMES`) is drawn
-    outside the guide's recommended length (`scales.TARGET_MM`), with that length, and each scale
-    coarser than the texts' rule (`OneSheet.coarsened`); where the plans are packed, not in the
-    texts' order, that."""
+    """The notes above the title block of `sheet` (`_notes`)."""
+    return _notes(sheet.plans.scales, sheet.rule, sheet.reference, in_order, lang)
+
+
+def _notes(sc: Mapping[str, Scale], rule: Mapping[str, Scale], reference: Mapping[str, float], in_order: bool,
+           lang: str) -> list[str]:
+    """The notes above the title block of plans at the scales `sc`: every plan true to scale; the
+    scales (μ_l also as GOST 2.302's ratio); each scale whose reference (`scales.REFERENCE_NAMES`,
+    `reference` SI) is drawn outside the guide's recommended length (`scales.TARGET_MM`), with that
+    length, and each scale coarser than the texts' `rule`; where the plans are packed, not in
+    the texts' order, that."""
     from .scales import REFERENCE_NAMES, TARGET_MM
-    sc = sheet.plans.scales
     used = "; ".join(scale_text(s, lang) + (f" ({scale_ratio(s.value, lang)})" if k == "mu_l" else "")
                      for k, s in sc.items())
     out = [text("pack.a3_true", lang), f"{text('pack.scales', lang)}: {used}"]
     departs = []
     for k, s in sc.items():
         lo, hi = TARGET_MM[k]
-        mm = sheet.reference[k] / s.value
+        mm = reference[k] / s.value
         if not lo - 0.05 <= mm <= hi + 0.05:
             departs.append(text("a3.depart_one", lang, mm=num(mm, lang, decimals=1),
                                 ref=REFERENCE_NAMES.get(k) or text("pack.largest_force", lang),
                                 lo=num(lo, lang), hi=num(hi, lang)))
     if departs:
         out.append(text("a3.departs", lang, items="; ".join(departs)))
-    if sheet.coarsened():
+    coarser = [(rule[k], s) for k, s in sc.items() if s.value > rule[k].value * (1 + 1e-9)]
+    if coarser:
         out.append(text("pack.a3_coarser", lang, scales="; ".join(
-            text("pack.instead", lang, scale=scale_text(s, lang), rule=num(r.value, lang, 6))
-            for r, s, _ in sheet.coarsened())))
+            text("pack.instead", lang, scale=scale_text(s, lang), rule=num(r.value, lang, 6)) for r, s in coarser)))
     if not in_order:
         out.append(text("a3.packed", lang))
     return out
+
+
+def note_lines(rows: list[str]) -> list[str]:
+    """The notes' lines as set above the title block: each note broken to its width at NOTE_SIZE."""
+    return [ln for s in rows for ln in _lines(s, NOTE_SIZE, TITLE_BLOCK[2] - TITLE_BLOCK[0] - 2)]
+
+
+def notes_mm(lines: int) -> float:
+    """The height the notes' `lines` take above the title block, mm: the last baseline _NOTE_BASE
+    above it, the lines _NOTE_STEP apart, the first line's ascent above its baseline."""
+    return _NOTE_BASE + _NOTE_STEP * (lines - 1) + ASCENT * NOTE_SIZE if lines else 0.0
+
+
+def notes_room(sheet: OneSheet) -> float:
+    """The height of `sheet`'s notes above its title block as `pages` sets them, mm."""
+    n = max(p.page for p in sheet.places) + 1 if sheet.places else 1
+    rows = notes(sheet, placed_in_order(list(sheet.drawings), list(sheet.places)), sheet.lang)
+    return notes_mm(len(note_lines(rows + ([text("pack.a3_more", sheet.lang, n=n)] if n > 1 else []))))
 
 
 def pages(sheet: OneSheet, title: str) -> list[Page]:
@@ -682,11 +721,10 @@ def pages(sheet: OneSheet, title: str) -> list[Page]:
         x0, y0, x1, y1 = 20.0, 5.0, 415.0, 292.0
         polylines.append((((x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)), 0.7, "#000"))
         texts.append((24.0, 10.0, title, 4.0, "bold"))
-        rows = notes(sheet, ordered, lang) + ([text("pack.a3_more", lang, n=n)] if n > 1 else [])
-        rows = [ln for s in rows for ln in _lines(s, 2.5, tb[2] - tb[0] - 2)]
-        y = tb[1] - 1.5 - _NOTE_STEP * (len(rows) - 1)
+        rows = note_lines(notes(sheet, ordered, lang) + ([text("pack.a3_more", lang, n=n)] if n > 1 else []))
+        y = tb[1] - _NOTE_BASE - _NOTE_STEP * (len(rows) - 1)
         for s in rows:
-            texts.append((tb[0] + 1.0, y, s, 2.5, "normal"))
+            texts.append((tb[0] + 1.0, y, s, NOTE_SIZE, "normal"))
             y += _NOTE_STEP
         _title_block(lines, texts, {
             "designation": title, "name": f"{name}, φ = {num(sheet.plans.at, lang, 6)}°",

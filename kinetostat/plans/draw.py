@@ -645,7 +645,7 @@ def _paths(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
         if not (count >= 2).any():
             continue
         width, colour = _PATH_STYLE.get(name.split(" ")[0], _PATH_STYLE.get(name[:1], (0.25, "#1f5fa8")))
-        tip = text(name, lang) if name in MESSAGES else name if name[:1] in "ωεM" else ""   # no English tooltip
+        tip = text(name, lang) if name in MESSAGES else in_lang(name, lang) if name[:1] in "ωεM" else ""   # no English tooltip
         attrs = {"fill": "none", "stroke": colour, "stroke-width": f"{width}"}
         if contract:
             attrs.update({"data-plan": escape(cycle.kind), "data-path": escape(name)})
@@ -883,7 +883,7 @@ def language_part(plan: Plan, lang: str) -> tuple:
     _lang(lang)
     area = _room(PlanCycle.of(plan), lang, notes=False)[1]
     return (area, tuple(segment_label(s, lang) for s in plan.segments),
-            tuple(text(name, lang) for name in plan.paths if name in MESSAGES))
+            tuple(text(name, lang) if name in MESSAGES else in_lang(name, lang) for name in plan.paths))
 
 
 def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: bool, cycle_notes: bool = False) -> Drawing:

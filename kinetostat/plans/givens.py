@@ -9,30 +9,32 @@ A diagram is laid out once (`layout`: lines, paths, dots and texts in mm from it
 drawn by both renderers: `draw_pdf` (a `pdf.Canvas`) and `svg` (the HTML sheet).
 
 May use: numpy, `kinetostat.applied` (where a load's diagram is read), `.i18n`, `.labels` (a
-text's width), `.scales`, `.symbols`. Never `kinetostat.variants`, matplotlib or the harness.
+text's width, its SVG markup, the least size), `.scales`, `.symbols`. Never `kinetostat.variants`, matplotlib or the harness.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from html import escape
 
 import numpy as np
 
 from ..applied import forward_stroke, load_magnitude, travel
 from .i18n import num, text, unit
-from .labels import text_width
+from .labels import CAP, DESCENT, MIN_TEXT_MM, markup, text_width
 from .scales import coarser
-from .symbols import plain
+from .symbols import plain, text_runs
 
-__all__ = ["Diagram", "Given", "diagrams", "model_data", "layout", "draw_pdf", "svg", "PLOT_MM", "MPA"]
+__all__ = ["Diagram", "Given", "diagrams", "model_data", "layout", "text_box", "draw_pdf", "svg", "PLOT_MM", "MPA"]
 
 #: The largest plot of a diagram on the A4 sheet: width, height, mm.
 PLOT_MM = (150.0, 60.0)
 #: Pa per MPa: the diagrams are printed in MPa, as seed 002's tables give P_max.
 MPA = 1e6
-_LEFT, _TOP, _BOTTOM = 16.0, 6.0, 12.0        # room for the p ticks, the scales' line, the x ticks and name, mm
-_SIZE = 2.5                                   # lettering, mm (ГОСТ 2.304's smallest)
+_LEFT, _TOP, _BOTTOM, _RIGHT = 16.0, 7.0, 12.0, 16.0   # room for the p ticks, the scales' line, the x ticks, the x name, mm
+_SIZE = MIN_TEXT_MM                           # lettering: the sheets' smallest font size, capitals 2.55 mm (ГОСТ 2.304: 2.5)
+#: How far above or below its point a mark's label may be lifted clear of the curves and texts
+#: (a thin leader joins them), mm.
+_LIFTS = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 24.0)
 
 
 @dataclass(frozen=True)
@@ -54,7 +56,7 @@ class Diagram:
     @property
     def size(self) -> tuple[float, float]:
         """Width and height of the whole figure, mm."""
-        return (_LEFT + max(self.x_ticks) / self.mu_x + 12.0,
+        return (_LEFT + max(self.x_ticks) / self.mu_x + _RIGHT,
                 _TOP + (max(self.y_ticks) - min(self.y_ticks)) / self.mu_y + _BOTTOM)
 
 
@@ -184,20 +186,23 @@ def model_data(mech, rows_given: set[str], lang: str, g: float) -> tuple[tuple[t
 
 def layout(d: Diagram):
     """The diagram's primitives in mm from its top left: lines (x0, y0, x1, y1, width, dashed),
-    paths (points, width), dots (x, y, r) and texts (x, y baseline, text, right-aligned)."""
+    paths (points, width), dots (x, y, r) and texts (x, y baseline, text, right-aligned), the
+    texts at _SIZE; each mark's label where it covers no other text and the fewest curve points
+    (`_place`)."""
     y_lo, y_hi = min(d.y_ticks), max(d.y_ticks)                            # the ticks span the curves
     X = lambda x: _LEFT + x / d.mu_x                                        # noqa: E731
     Y = lambda y: _TOP + (y_hi - y) / d.mu_y                                # noqa: E731
     x_end = X(max(d.x_ticks))
     lines, paths, dots, texts = [], [], [], []
     lines += [(X(0), Y(0), x_end + 6, Y(0), 0.35, False), (X(0), Y(y_lo), X(0), Y(y_hi) - 5, 0.35, False)]
-    for x in d.x_ticks:
+    for x in d.x_ticks:                                                     # each number centred under its tick
         lines.append((X(x), Y(0), X(x), Y(0) + 1.2, 0.25, False))
-        texts.append((X(x) - 1.0, Y(y_lo) + 5.0, num(x, d.lang, 6), False))
+        label = num(x, d.lang, 6)
+        texts.append((X(x) - text_width(label, _SIZE) / 2, Y(y_lo) + 5.5, label, False))
     for y in d.y_ticks:
         lines.append((X(0) - 1.2, Y(y), X(0), Y(y), 0.25, False))
-        texts.append((X(0) - 2.0, Y(y) + _SIZE / 2 - 0.3, num(y, d.lang, 6), True))
-    texts += [(x_end + 5.0, Y(0) + 1.0, d.x_name, False), (X(0) + 2.0, Y(y_hi) - 2.5, d.y_name, False),
+        texts.append((X(0) - 2.0, Y(y) + CAP * _SIZE / 2, num(y, d.lang, 6), True))
+    texts += [(x_end + 7.0, Y(0) + CAP * _SIZE / 2, d.x_name, False), (X(0) + 2.0, Y(y_hi) - 2.5, d.y_name, False),
               (x_end + 6, _TOP - 3.0, d.scales, True)]
     for xs, ys in d.curves:
         paths.append(([(X(x), Y(y)) for x, y in zip(xs, ys)], 0.5))
@@ -206,27 +211,52 @@ def layout(d: Diagram):
         lines += [(X(x), Y(y), X(x), Y(0), 0.2, True), (X(x), Y(y), X(0), Y(y), 0.2, True)]
     segments = [pair for pts, _ in paths for pair in zip(pts, pts[1:])] + [((a, b), (c, e)) for a, b, c, e, *_ in lines]
     drawn = np.concatenate([np.linspace(a, b, 2 + int(math.dist(a, b) / 0.5)) for a, b in segments])    # every 0.5 mm
+    taken = [text_box(*t) for t in texts] + [(x - r, y - r, x + r, y + r) for x, y, r in dots]
     for x, y, label in d.marks:
-        texts.append(_place(X(x), Y(y), label, drawn, (X(0), _TOP, x_end, Y(y_lo))))
+        placed, leader = _place(X(x), Y(y), label, drawn, (X(0), 0.0, x_end + _RIGHT, Y(y_lo)), taken)
+        texts.append(placed)
+        taken.append(text_box(*placed))
+        lines += [leader] if leader else []
     return lines, paths, dots, texts
 
 
-def _place(x: float, y: float, label: str, drawn, bounds) -> tuple[float, float, str, bool]:
-    """The mark's label beside its point (x, y), mm: of the four corners around it, the one inside
-    `bounds` (x0, y0, x1, y1) whose box (the label's width as DejaVu Sans sets it) covers the fewest
-    of the curves' `drawn` points (K, 2)."""
-    width = text_width(plain(label), _SIZE)
-    px, py = drawn.T
+def text_box(x: float, y: float, s: str, right: bool) -> tuple[float, float, float, float]:
+    """The box (x0, y0, x1, y1), mm, of a text of the layout at _SIZE: its baseline y, from x (`right`: to x)."""
+    w = text_width(plain(s), _SIZE)
+    x0 = x - w if right else x
+    return x0, y - CAP * _SIZE, x0 + w, y + DESCENT * _SIZE
 
-    def cost(right: bool, above: bool) -> tuple[float, float]:
-        bx = x - 1.8 - width if right else x + 1.8
-        by = y - 1.5 - _SIZE if above else y + 1.5
-        inside = int(np.count_nonzero((bx <= px) & (px <= bx + width) & (by - 0.5 <= py) & (py <= by + _SIZE + 0.5)))
-        out = max(bounds[0] - bx, bx + width - bounds[2], 0.0) + max(bounds[1] - by, 0.0)
-        return out, inside
 
-    right, above = min(((r, a) for r in (False, True) for a in (True, False)), key=lambda c: cost(*c))
-    return x + (-1.8 if right else 1.8), y - 1.5 if above else y + 1.5 + _SIZE, label, right
+def _overlap(a: tuple, b: tuple) -> float:
+    """The area two boxes (x0, y0, x1, y1) share, mm²."""
+    return max(0.0, min(a[2], b[2]) - max(a[0], b[0])) * max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+
+
+def _place(x: float, y: float, label: str, drawn, bounds, taken: list) -> tuple[tuple, tuple | None]:
+    """The mark's label beside its point (x, y), mm: of the four corners around it, each lifted by
+    one of _LIFTS away from it, the one inside `bounds` (x0, y0, x1, y1), then covering the least
+    of the `taken` texts' boxes, then the fewest of the curves' `drawn` points (K, 2), then the
+    least lifted. Returns its text (x, baseline, label, right-aligned) and, where lifted, a thin
+    leader from the point to the label's near corner (a line of `layout`)."""
+    width, px, py = text_width(plain(label), _SIZE), *drawn.T
+
+    def spot(right: bool, above: bool, lift: float) -> tuple[float, float]:
+        return x + (-1.8 if right else 1.8), y - 1.5 - lift if above else y + 1.5 + CAP * _SIZE + lift
+
+    def cost(right: bool, above: bool, lift: float) -> tuple:
+        bx, by = spot(right, above, lift)
+        box = text_box(bx, by, label, right)
+        inside = int(np.count_nonzero((box[0] <= px) & (px <= box[2]) & (box[1] - 0.5 <= py) & (py <= box[3] + 0.5)))
+        out = max(bounds[0] - box[0], box[2] - bounds[2], 0.0) + max(bounds[1] - box[1], box[3] - bounds[3], 0.0)
+        return out, sum(_overlap(box, t) for t in taken), inside, lift
+
+    right, above, lift = min(((r, a, h) for h in _LIFTS for r in (False, True) for a in (True, False)), key=lambda c: cost(*c))
+    bx, by = spot(right, above, lift)
+    leader = None
+    if lift:
+        corner = (bx, by + DESCENT * _SIZE if above else by - CAP * _SIZE - 0.5)
+        leader = (x, y, *corner, 0.2, False)
+    return (bx, by, label, right), leader
 
 
 def draw_pdf(pdf, x0: float, y0: float, d: Diagram) -> None:
@@ -258,5 +288,5 @@ def svg(d: Diagram) -> str:
         out.append(f'<circle cx="{x:.2f}" cy="{y:.2f}" r="{r}"/>')
     for x, y, s, right in texts:
         anchor = ' text-anchor="end"' if right else ""
-        out.append(f'<text x="{x:.2f}" y="{y:.2f}"{anchor}>{escape(s)}</text>')
+        out.append(f'<text x="{x:.2f}" y="{y:.2f}"{anchor}>{markup(text_runs(s), _SIZE)}</text>')
     return "\n".join(out + ["</svg>"])

@@ -136,7 +136,7 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
     plans = a3.plans
     sc = plans.scales
     ws = worksheet_cycle(mech, res, sc["mu_l"].value, lang, other).at(0)
-    L = lettering(mech)
+    L = lettering(mech).in_lang(lang)
     spec, name = v.spec, v.title(lang)
     title = text("pack.task", lang, task=v.task, code=v.code or "—",
                  title=name[0].upper() + name[1:] if lang == "en" else name)
@@ -167,7 +167,7 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
         sheet.append(("h2", recs[idx[0]]["section"]))
         sheet.append(("table", Table((text("ws.head.symbol", lang), text("ws.head.value", lang),
                                       text("ws.head.unit", lang), text("ws.head.direction", lang)),
-                                     tuple((ws.rows[i].symbol, "", recs[i]["unit"], "") for i in idx),
+                                     tuple((recs[i]["symbol"], "", recs[i]["unit"], "") for i in idx),
                                      (0.2, 0.25, 0.2, 0.35), blank=frozenset({1, 3}), symbols=frozenset({0}))))
         krows = []
         for i in idx:
@@ -178,7 +178,7 @@ def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -
             if lo_hi and not lo_hi[0] <= r.value <= lo_hi[1]:
                 band += " *"
                 outside = True
-            krows.append((r.symbol, value, recs[i]["unit"], recs[i]["direction"], band))
+            krows.append((recs[i]["symbol"], value, recs[i]["unit"], recs[i]["direction"], band))
             answers.add(value)
             if lo_hi:
                 answers.update(num(x, lang, 3) for x in lo_hi)

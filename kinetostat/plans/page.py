@@ -433,7 +433,7 @@ def _steps(mech, res, plans, lang: str) -> list[dict]:
     terms written by the page's script from the sheet of the angle shown. `res`: the analysis at
     the angle of `plans` (one angle). A step of a plan's `steps` has "n", its number on the sheet."""
     from .forces import _carried, _group_label, _later, _moment_equations, link_couples, link_loads, reaction_name
-    from ..model.lettering import lettering
+    from ..model.lettering import in_lang, lettering
     L = lettering(mech)
     out = [_construction_step(plans[kind], name, k, lang) for kind in ("velocity", "acceleration") if kind in plans
            for k, name in enumerate(plans[kind].steps, 1)]
@@ -482,16 +482,17 @@ def _steps(mech, res, plans, lang: str) -> list[dict]:
     if crank is not None:
         vectors = [s.name for s in crank.segments if s.kind == "vector"]
         for name in vectors:
-            out.append({"plan": "crank", "segment": name, "eq": text("page.crank", lang, F=name)})
+            out.append({"plan": "crank", "segment": name, "eq": text("page.crank", lang, F=in_lang(name, lang))})
         where = {"path": L.M_bal} if L.M_bal in crank.paths else {"segment": "r_b"}     # an engine's couple; a gear's arm
-        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=L.M_bal, O=mech.drive.pivot),
-                    "moment": {**_moment(crank, mech.drive.pivot, vectors), "M": L.M_bal}})
+        M = in_lang(L.M_bal, lang)
+        out.append({"plan": "crank", **where, "eq": text("page.M_crank", lang, M=M, O=mech.drive.pivot),
+                    "moment": {**_moment(crank, mech.drive.pivot, vectors), "M": M}})
     lever = plans.get("lever")
     if lever is not None:
         vectors = [s.name for s in lever.segments if s.kind == "vector" and s.scale is not None and s.name != L.lever(L.F_bal)]
         for name in vectors:
-            out.append({"plan": "lever", "segment": name, "eq": text("page.lever", lang, F=name)})
-        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=L.M_bal, tol=num(TOLERANCE_PCT, lang)),
+            out.append({"plan": "lever", "segment": name, "eq": text("page.lever", lang, F=in_lang(name, lang))})
+        out.append({"plan": "lever", "segment": L.lever(L.F_bal), "eq": text("page.M_lever", lang, M=in_lang(L.M_bal, lang), tol=num(TOLERANCE_PCT, lang)),
                     "moment": _moment(lever, "p", vectors, unknown=L.lever(L.F_bal))})
     return out
 

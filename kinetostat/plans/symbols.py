@@ -3,7 +3,7 @@ one rule that every writer follows (the SVG sheets and the page: `labels.label_m
 of `draw`; the PDFs: `pdf.Canvas.text`; the HTML worksheet and pack: `html`).
 
     >>> runs("R12t"), runs("a^n_BA"), runs("μ_l"), runs("pi-a")
-    ((('R', 0), ('12', -1), ('t', 1)), (('a', 0), ('n', 1), ('BA', -1)), (('μ', 0), ('l', -1)), (('π', 0), ('a', 0)))
+    ((('R', 0), ('12', -1), ('t', 1)), (('a', 0), ('n', 1), ('BA', -1)), (('μ', 0), ('l', -1)), (('πa', 0),))
 
 A symbol as the project writes it: letters, then a subscript (digits, R12; or after "_", F_i2,
 μ_l), a superscript (after "^", a^n; a reaction's component letter after its digits, R12t), in
@@ -112,7 +112,8 @@ def plain(s: str) -> str:
     return "".join(t for t, _ in text_runs(s))
 
 
-def html(s: str) -> str:
-    """A text as HTML, escaped, its symbols' scripts in <sub> and <sup>."""
-    return "".join(escape(t) if not level else f"<{'sub' if level == SUB else 'sup'}>{escape(t)}</{'sub' if level == SUB else 'sup'}>"
+def html(s: str, escaped: bool = False) -> str:
+    """A text as HTML, escaped (`escaped`: `s` is HTML text already), its symbols' scripts in <sub> and <sup>."""
+    esc = str if escaped else escape
+    return "".join(esc(t) if not level else f"<{'sub' if level == SUB else 'sup'}>{esc(t)}</{'sub' if level == SUB else 'sup'}>"
                    for t, level in text_runs(s))

@@ -15,6 +15,7 @@ May use: the solver (`solve`, `analysis`, `applied`, `model`), `_io`, `_text` (s
 from __future__ import annotations
 
 import json
+import re
 import warnings
 import math
 from dataclasses import dataclass
@@ -33,8 +34,9 @@ from .._text import csv_cell, html_text, markdown_text
 from ..model import Mechanism
 from ..tables import by_unit, plain, rows_csv
 from .i18n import ZERO, accuracy, check_lang, num, phrase, text, unit
-from ..model.lettering import lettering
+from ..model.lettering import in_lang, lettering
 from .scales import choose_scales
+from .symbols import html, mark
 
 __all__ = ["Row", "Worksheet", "worksheet", "CycleRow", "WorksheetCycle", "worksheet_cycle", "analyses", "COLUMNS", "CSS", "html_document"]
 
@@ -85,11 +87,11 @@ class Worksheet:
     # -- outputs
     def records(self) -> list[dict]:
         """The rows in the worksheet's language: sections, units, senses and notes translated
-        (`i18n`); values stay numbers."""
+        (`i18n`), symbols as its texts write them (`lettering.in_lang`); values stay numbers."""
         lang = self.lang
-        return [{"section": text(f"ws.{r.section}", lang), "key": r.key, "symbol": r.symbol, "value": r.value,
+        return [{"section": text(f"ws.{r.section}", lang), "key": r.key, "symbol": in_lang(r.symbol, lang), "value": r.value,
                  "unit": unit(r.unit, lang), "direction": _direction(r.direction, lang),
-                 "note": phrase(r.note, lang)} for r in self.rows]
+                 "note": in_lang(phrase(r.note, lang), lang)} for r in self.rows]
 
     def frame(self):
         """The rows as a pandas DataFrame (columns COLUMNS)."""
@@ -126,11 +128,12 @@ class Worksheet:
 
     def html(self) -> str:
         """A standalone HTML page (`html_document`): the Markdown as a CommonMark renderer with
-        tables writes it (every text escaped, `_text.html_text`), written here directly."""
+        tables writes it (every text escaped, `_text.html_text`), written here directly, but for
+        the symbols of its cells: their scripts in <sub> and <sup> (`_html_cell`)."""
         lang = self.lang
         title = text("ws.title", lang, name=self.mechanism, phi=num(self.phi_deg, lang, 6))
         scale, head, tables = self._body()
-        out = [f"<h1>{html_text(title)}</h1>", f"<p>{html_text(scale)}</p>"]
+        out = [f"<h1>{html_text(title)}</h1>", f"<p>{html(html_text(scale), escaped=True)}</p>"]
         if self.digits < DIGITS_WARN:        # the Markdown's bold lead: "**Accuracy:** ..."
             lead, _, line = accuracy(self.digits, DIGITS_WARN, lang, markdown=False).partition(": ")
             out.append(f"<p><strong>{html_text(lead)}:</strong> {html_text(line)}</p>")
@@ -139,7 +142,8 @@ class Worksheet:
             out += [f"<h2>{html_text(section)}</h2>", "<table>", "<thead>", "<tr>",
                     *(f"<th{a}>{html_text(c)}</th>" for a, c in zip(align, head)), "</tr>", "</thead>", "<tbody>"]
             for cells in rows:
-                out += ["<tr>", *(f"<td{a}>{html_text(c)}</td>" for a, c in zip(align, cells)), "</tr>"]
+                out += ["<tr>", *(f"<td{a}>{_html_cell(c, k)}</td>" for k, (a, c) in enumerate(zip(align, cells))),
+                        "</tr>"]
             out += ["</tbody>", "</table>"]
         return html_document(title, "\n".join(out) + "\n", lang)
 
@@ -191,6 +195,21 @@ padding:.3em .6em;width:40%}
 .area{break-before:page;height:26cm}a{color:inherit;text-decoration:none}}
 @page{size:A4;margin:12mm 10mm 12mm 20mm}
 """
+
+
+#: A name of letters and digits in a note's formula (m2, ω1, R12, ps2, R12t; ω1² squared): a symbol, its digits a subscript.
+_NOTE_SYMBOL = re.compile(r"(?<![\w'])[^\W\d_]+\d+[nt]?(?=[²³]|[^\w(]|$)")
+
+
+def _html_cell(s: str, column: int) -> str:
+    """A table cell's text as HTML (`_text.html_text`), its symbols' scripts in <sub> and <sup>
+    by the one rule of `symbols` (`html`): the symbol column's (0) text one symbol (R12t as
+    R<sub>12</sub><sup>t</sup>), in a note (column 4) also its names of letters and digits (m2 g);
+    the value, unit and direction as they are."""
+    cell = html_text(s)
+    if column == 0:
+        return html(mark(cell), escaped=True)
+    return html(_NOTE_SYMBOL.sub(lambda m: mark(m.group()), cell), escaped=True) if column == 4 else cell
 
 
 def html_document(title: str, body: str, lang: str, css: str = CSS) -> str:
