@@ -163,18 +163,23 @@ class PinocchioScene:
         return self.data.oMi[self.jid[link]].actInv(pin.Force(f, np.array([0.0, 0.0, mz])))
 
     def applied_fext(self, n: int) -> pin.StdVec_Force:
+        """The scene's applied loads at angle n as Pinocchio's fext (needs data.oMi)."""
+        return self.fext(self.F_ext[n], self.M_ext[n]) if self.has_ext else self.fext()
+
+    def fext(self, F: np.ndarray | None = None, M: np.ndarray | None = None) -> pin.StdVec_Force:
+        """Loads F (L, 2), N, at the centres of mass and M (L,), N m, about them (world) as
+        Pinocchio's fext, one joint-local spatial force per joint (needs data.oMi); none: zeros."""
         fext = pin.StdVec_Force()
         for _ in range(self.model.njoints):
             fext.append(pin.Force.Zero())
-        if not self.has_ext:
+        if F is None:
             return fext
         for b in self.scene.bodies:
             k = b.link
-            F, M = self.F_ext[n, k], self.M_ext[n, k]
-            if F[0] == 0 and F[1] == 0 and M == 0:
+            if F[k, 0] == 0 and F[k, 1] == 0 and M[k] == 0:
                 continue
             S = self.data.oMi[self.jid[k]].act(self.com_local[k])
-            fext[self.jid[k]] += self._world_force(k, _v3(F), S, float(M))
+            fext[self.jid[k]] += self._world_force(k, _v3(F[k]), S, float(M[k]))
         return fext
 
     def _point_motion(self, link: int, X: np.ndarray):

@@ -1,0 +1,341 @@
+"""The machine's law of motion by forward dynamics: MuJoCo and Pinocchio integrate the machine
+with a free crank, and their omega(phi) is compared with kinetostat's (`kinetostat.law_of_motion`).
+
+The machine: the model's mechanism with the flywheel's J_flywheel added to the crank's moment of
+inertia about its axis (the same `Scene` for both engines), the drive's constant moment M_drive
+on the crank, and the model's applied loads evaluated by kinetostat's load model
+(`kinetostat.applied.applied_wrenches`) at the engine's own crank angle and speed at every stage
+of every step (they depend on the state, so this is a Python loop over the steps). Gravity is the
+engines' own. Friction is not modelled by the engines: a mechanism with [friction] is refused.
+
+Integration: the classical Runge-Kutta method (RK4, order 4) at a fixed step,
+dt = 2 pi / (omega_mean * steps_per_rev), from the exact state at phi_0 (kinetostat's positions,
+velocities at omega(phi_0)), over `cycles` revolutions; both engines give only the accelerations:
+- MuJoCo: `mj_forward` (its soft equality constraints as the harness builds them,
+  `engine_mujoco._compile`, made as stiff as it allows: impedance 0.9999, time constant
+  TIMECONST_STEPS steps); MuJoCo's own RK4 (`integrator="RK4"`) is not used because it holds
+  xfrc_applied over a step, which makes a state-dependent load first order.
+- Pinocchio: `pin.constraintDynamics` with its Baumgarte corrector where every loop-closing pair
+  is revolute, else the KKT system of `engine_pinocchio` with the same Baumgarte terms
+  (Pinocchio has no sliding rigid constraint), as `engine_pinocchio.forward_round_trip`.
+
+The engine's omega at kinetostat's angles of the last cycle is the cubic Hermite interpolation
+of its steps (phi(t) with omega, omega(t) with eps: O(dt^4), the integrator's order). The energy
+balance T + V - W = const (T kinetic energy, flywheel included, V gravity's potential, W the work
+of M_drive and the loads, integrated by the same RK4) is measured over the whole run.
+
+A load given by a table (np.interp: piecewise linear) has kinks: RK4's error in a step that
+contains one is O(dt^2), so the observed order of such a model is 2, not 4.
+
+May use: kinetostat (model, kinematics, applied), the scene, the MuJoCo and Pinocchio adapters
+(imported when used), numpy.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from typing import Protocol
+
+import numpy as np
+
+from kinetostat import Mechanism
+from kinetostat.applied import applied_wrenches, com_motion
+from kinetostat.kinematics import kinematics
+from kinetostat.planar import as_xy
+
+from .scene import Scene, build_scene, loads_at_centres
+
+__all__ = ["ENGINES", "Trajectory", "Forward", "Agreement", "integrate", "forward", "convergence",
+           "observed_order"]
+
+ENGINES = ("mujoco", "pinocchio")
+#: MuJoCo: the equality constraints' time constant in steps (critical damping): RK4 is stable
+#: for it (|lambda dt| = 1/2 against RK4's 2.78) and it is the harness's simulation route's.
+TIMECONST_STEPS = 4.0
+#: MuJoCo's largest constraint impedance (solimp): the softness 1 - 0.9999 left.
+IMPEDANCE = 0.9999
+#: Pinocchio: the Baumgarte corrector's natural frequency per crank speed (Kp = w^2, Kd = 2 w,
+#: w = BAUMGARTE * omega_mean): the loop-closure drift decays within a tenth of a revolution.
+BAUMGARTE = 20.0
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """One engine's run, sampled at every step (K samples)."""
+    engine: str
+    steps_per_rev: int
+    dt: float                  # s
+    t: np.ndarray              # (K,) s
+    phi: np.ndarray            # (K,) rad, crank angle in the drive's sense, unwrapped (phi_0 at t = 0)
+    omega: np.ndarray          # (K,) rad/s, in the drive's sense
+    eps: np.ndarray            # (K,) rad/s^2
+    energy: np.ndarray         # (K,) J: T + V - W, constant but for the integrator's error
+    work_swing: float          # J: max - min of W, the work of the drive and the loads, over the run
+    seconds: float             # wall time of the run
+    note: str
+
+    @property
+    def energy_error(self) -> float:
+        """max |T + V - W - its start value| over the work's swing, 1."""
+        return float(np.max(np.abs(self.energy - self.energy[0])) / (self.work_swing or 1.0))
+
+
+@dataclass(frozen=True)
+class Forward:
+    """An engine's omega(phi) over the last cycle at kinetostat's angles, beside kinetostat's."""
+    engine: str
+    steps_per_rev: int
+    phi_deg: np.ndarray        # (N,) deg, motion.phi_deg
+    omega: np.ndarray          # (N,) rad/s, the engine's
+    omega_law: np.ndarray      # (N,) rad/s, kinetostat's motion.omega
+    omega_mean: float          # rad/s
+    trajectory: Trajectory
+
+    @property
+    def error(self) -> float:
+        """max |omega_engine - omega_kinetostat| / omega_mean, 1."""
+        return float(np.max(np.abs(self.omega - self.omega_law)) / self.omega_mean)
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """One row of a convergence study."""
+    engine: str
+    steps_per_rev: int
+    error: float               # max |omega_engine - omega_kinetostat| / omega_mean, 1
+    order: float | None        # observed order against the previous row of the engine (None: first)
+    energy_error: float        # the run's energy balance, relative to the work's swing
+    seconds: float             # wall time of the run
+
+
+class _Engine(Protocol):
+    def start(self, qd_scale: float) -> tuple[np.ndarray, np.ndarray]: ...
+    def derivative(self, q: np.ndarray, v: np.ndarray, F: np.ndarray, M: np.ndarray,
+                   drive: float) -> tuple[np.ndarray, float, float]: ...
+
+
+# ----------------------------------------------------------------------------- loads
+
+def _loads(mech: Mechanism, scene: Scene, phi: float, omega: float) -> tuple[np.ndarray, np.ndarray]:
+    """kinetostat's applied loads (gravity out) at crank angle phi (rad) and speed omega (rad/s)
+    as the engines take them: force at each centre of mass (L, 2), N, moment about it (L,), N m."""
+    at = replace(mech, drive=replace(mech.drive, omega=omega, eps=0.0, law=None))
+    kin = kinematics(at, np.array([phi]))
+    F, M = applied_wrenches(at, kin, com_motion(at, kin)[0])
+    F, M = loads_at_centres(scene.bodies, scene.g, kin, as_xy(F), M)
+    return F[0], M[0]
+
+
+# ----------------------------------------------------------------------------- engines
+
+class _MuJoCo:
+    """MuJoCo's forward dynamics of the scene: accelerations by mj_forward."""
+
+    def __init__(self, scene: Scene, dt: float):
+        import mujoco
+        from .engine_mujoco import SIM_FLOOR, _compile, _regularisation_weights
+        self.scene = scene
+        tc = TIMECONST_STEPS * dt
+        self.mm = _compile(scene, SIM_FLOOR, exact_masses=False, timestep=dt, solref=(tc, 1.0),
+                           solimp=(IMPEDANCE, IMPEDANCE, 0.001, 0.5, 2.0))
+        _regularisation_weights(scene, self.mm)
+        self.mm.m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+        self.mm.m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_REFSAFE
+        self.crank = self.mm.crank_dof
+        self.note = (f"MuJoCo {mujoco.__version__}: mj_forward, soft equality constraints solref ({tc:.3g} s, 1), "
+                     f"impedance {IMPEDANCE}")
+
+    def start(self, qd_scale: float) -> tuple[np.ndarray, np.ndarray]:
+        from .engine_mujoco import _exact_state
+        qpos, qvel, _ = _exact_state(self.scene, self.mm)
+        return qpos[0], qvel[0] * qd_scale
+
+    def derivative(self, q, v, F, M, drive):
+        import mujoco
+        from .engine_mujoco import _applied
+        m, d = self.mm.m, self.mm.d
+        d.qpos[:], d.qvel[:] = q, v
+        mujoco.mj_kinematics(m, d)                  # xipos for the loads' generalised force
+        mujoco.mj_comPos(m, d)
+        Q = _applied(self.scene, self.mm, F, M)     # also sets xfrc_applied
+        d.qfrc_applied[:] = 0.0
+        d.qfrc_applied[self.crank] = drive
+        mujoco.mj_forward(m, d)
+        return d.qacc.copy(), float(Q @ v), float(d.energy.sum())
+
+
+class _Pinocchio:
+    """Pinocchio's constrained forward dynamics of the scene with Baumgarte stabilisation."""
+
+    def __init__(self, scene: Scene, omega_mean: float):
+        import pinocchio as pin
+        from .engine_pinocchio import PinocchioScene
+        self.pin = pin
+        self.ps = ps = PinocchioScene(scene)
+        self.crank = ps.crank_v
+        self.scene = scene
+        w = BAUMGARTE * omega_mean
+        self.kp, self.kd = w * w, 2.0 * w
+        self.zero = np.zeros(ps.nv)
+        self.method = "kkt" if ps.p_cuts else "constraintDynamics"
+        if self.method == "constraintDynamics":
+            for cm in ps.cmodels:
+                bp = cm.m_baumgarte_parameters
+                bp.Kp, bp.Kd = self.kp, self.kd
+                cm.m_baumgarte_parameters = bp
+            pin.initConstraintDynamics(ps.model, ps.data, ps.cmodels, ps.cdatas)
+            self.prox = pin.ProximalSettings(1e-14, 1e-10, 50)
+        self.note = (f"pin {pin.__version__}: {self.method}, Baumgarte Kp = {self.kp:.3g} 1/s^2, "
+                     f"Kd = {self.kd:.3g} 1/s")
+
+    def start(self, qd_scale: float) -> tuple[np.ndarray, np.ndarray]:
+        q, v, _ = self.ps.state(0)
+        return q, v * qd_scale
+
+    def derivative(self, q, v, F, M, drive):
+        pin, ps = self.pin, self.ps
+        model, data = ps.model, ps.data
+        pin.computeJointJacobians(model, data, q)                      # oMi for the loads
+        fext = ps.fext(F, M)
+        Q = pin.rnea(model, data, q, v, self.zero).copy() - pin.rnea(model, data, q, v, self.zero, fext)
+        tau = Q.copy()
+        tau[self.crank] += drive
+        if self.method == "constraintDynamics":
+            qdd = pin.constraintDynamics(model, data, q, v, tau, ps.cmodels, ps.cdatas, self.prox).copy()
+        else:
+            Jc, gamma, _ = ps.constraint_jacobian(q, with_drift=True, v=v)
+            gap = ps.constraint_gap(q)
+            b = pin.rnea(model, data, q, v, self.zero).copy()
+            Mq = pin.crba(model, data, q)
+            Mq = np.triu(Mq) + np.triu(Mq, 1).T
+            m = Jc.shape[0]
+            K = np.block([[Mq, -Jc.T], [Jc, np.zeros((m, m))]])
+            rhs = np.concatenate([tau - b, gamma - self.kd * (Jc @ v) - self.kp * gap])
+            qdd = np.linalg.solve(K, rhs)[:ps.nv]
+        energy = pin.computeKineticEnergy(model, data, q, v) + pin.computePotentialEnergy(model, data, q)
+        return qdd, float(Q @ v), float(energy)
+
+
+# ----------------------------------------------------------------------------- integration
+
+def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: float, omega0: float,
+              omega_mean: float, engine: str = "mujoco", steps_per_rev: int = 360,
+              cycles: float = 3) -> Trajectory:
+    """The machine integrated forward by `engine` (see the module docstring) from the crank angle
+    phi0_deg (deg) at speed omega0 (rad/s, drive's sense) until phi_0 + 360 cycles deg; flywheel
+    J_flywheel (kg m^2) on the crank, drive moment M_drive (N m, drive's sense) constant.
+    Raises ValueError for a mechanism with friction, an unknown engine, a bad step count, or a
+    crank that stops or turns back (no steady motion to follow)."""
+    if mech.friction is not None:
+        raise ValueError("integrate: the engines model no friction; give the mechanism without it "
+                         "(dataclasses.replace(mech, friction=None)) to kinetostat and the engines alike")
+    if engine not in ENGINES:
+        raise ValueError(f"engine: expected one of {ENGINES}, got {engine!r}")
+    if not (isinstance(steps_per_rev, (int, np.integer)) and steps_per_rev >= 4):
+        raise ValueError(f"steps_per_rev: expected an integer >= 4, got {steps_per_rev!r}")
+    if not (omega0 > 0 and omega_mean > 0 and J_flywheel >= 0 and cycles > 0):
+        raise ValueError(f"integrate: needs omega0 > 0, omega_mean > 0, J_flywheel >= 0 and cycles > 0, got "
+                         f"{omega0}, {omega_mean}, {J_flywheel}, {cycles}")
+    scene = _flywheel_scene(mech, phi0_deg, J_flywheel)
+    dt = 2 * math.pi / (omega_mean * steps_per_rev)
+    eng: _Engine = _MuJoCo(scene, dt) if engine == "mujoco" else _Pinocchio(scene, omega_mean)
+    sense, c = mech.drive.sense, eng.crank
+    q, v = eng.start(omega0 / mech.drive.omega)
+    qc0, phi0 = q[c], math.radians(phi0_deg)
+
+    def f(q, v):
+        phi, w = phi0 + sense * (q[c] - qc0), sense * v[c]
+        F, M = _loads(mech, scene, phi, w)
+        a, power, energy = eng.derivative(q, v, F, M, sense * M_drive)
+        return a, power + M_drive * w, energy, phi, w
+
+    t0 = time.perf_counter()
+    end, limit = phi0 + 2 * math.pi * cycles, int(3 * steps_per_rev * cycles) + 10
+    W, rows = 0.0, []
+    while True:
+        a1, p1, E, phi, w = f(q, v)
+        rows.append((len(rows) * dt, phi, w, sense * a1[c], E - W, W))
+        if phi >= end:
+            break
+        if w <= 0 or len(rows) > limit:
+            raise ValueError(f"integrate ({engine}): the crank stopped or turned back near phi = "
+                             f"{math.degrees(phi) % 360:.1f} deg (omega = {w:.4g} rad/s): no steady motion")
+        a2, p2, *_ = f(q + dt / 2 * v, v + dt / 2 * a1)
+        v2 = v + dt / 2 * a1
+        a3, p3, *_ = f(q + dt / 2 * v2, v + dt / 2 * a2)
+        v3 = v + dt / 2 * a2
+        a4, p4, *_ = f(q + dt * v3, v + dt * a3)
+        v4 = v + dt * a3
+        q = q + dt / 6 * (v + 2 * v2 + 2 * v3 + v4)
+        v = v + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+        W += dt / 6 * (p1 + 2 * p2 + 2 * p3 + p4)
+    seconds = time.perf_counter() - t0
+    t, phi, w, eps, energy, work = np.array(rows).T
+    return Trajectory(engine, int(steps_per_rev), dt, t, phi, w, eps, energy, float(np.ptp(work)), seconds,
+                      f"{eng.note}; RK4, {steps_per_rev} steps/rev (dt = {dt:.3g} s), {cycles} cycles")
+
+
+def _flywheel_scene(mech: Mechanism, phi0_deg: float, J_flywheel: float) -> Scene:
+    """The scene at phi_0 with J_flywheel added to the crank's moment of inertia (its centre
+    on the axis: about the centre of mass and about the axis alike)."""
+    scene = build_scene(mech, phi_deg=[phi0_deg])
+    crank = mech.drive.link
+    return replace(scene, bodies=tuple(replace(b, I_S=b.I_S + J_flywheel) if b.link == crank else b
+                                       for b in scene.bodies))
+
+
+def at_angles(tr: Trajectory, phi: np.ndarray) -> np.ndarray:
+    """The trajectory's omega at crank angles phi (rad, unwrapped, within the run): cubic
+    Hermite interpolation, phi(t) with omega and omega(t) with eps, the crossing by Newton."""
+    phi = np.asarray(phi, float)
+    k = np.clip(np.searchsorted(tr.phi, phi, side="right") - 1, 0, len(tr.phi) - 2)
+    h = tr.t[k + 1] - tr.t[k]
+    p0, p1, w0, w1, e0, e1 = tr.phi[k], tr.phi[k + 1], tr.omega[k], tr.omega[k + 1], tr.eps[k], tr.eps[k + 1]
+    s = (phi - p0) / (p1 - p0)                        # start: linear
+
+    def hermite(y0, y1, d0, d1, s):
+        return (y0 * (1 + 2 * s) * (1 - s) ** 2 + h * d0 * s * (1 - s) ** 2 + y1 * s * s * (3 - 2 * s)
+                - h * d1 * s * s * (1 - s))
+
+    for _ in range(8):
+        ds = h * (w0 * (1 - s) * (1 - 3 * s) + w1 * s * (3 * s - 2)) + 6 * (p1 - p0) * s * (1 - s)
+        s = s - (hermite(p0, p1, w0, w1, s) - phi) / ds
+    return hermite(w0, w1, e0, e1, s)
+
+
+def forward(mech: Mechanism, motion, engine: str = "mujoco", steps_per_rev: int = 360,
+            cycles: int = 3) -> Forward:
+    """The machine of `motion` (a `kinetostat.Motion` of `mech`, without friction) integrated by
+    `engine` from motion's omega(phi_0) at phi_0 over `cycles` revolutions, with motion's flywheel
+    and drive moment; its omega at motion.phi_deg in the last cycle beside motion.omega.
+    Raises ValueError where the drive's moment is not constant (a characteristic M(omega))."""
+    M = np.asarray(motion.M_drive, float)
+    if np.ptp(M) > 1e-12 * max(np.max(np.abs(M)), 1.0):
+        raise ValueError(f"forward: the engines take a constant drive moment; motion.M_drive varies "
+                         f"({M.min():.6g} .. {M.max():.6g} N m, drive {motion.drive!r})")
+    phi_deg = np.asarray(motion.phi_deg, float)
+    tr = integrate(mech, motion.J_flywheel, float(M[0]), float(phi_deg[0]), float(motion.omega[0]),
+                   motion.omega_mean, engine, steps_per_rev, cycles)
+    last = np.radians(phi_deg[0] + (phi_deg - phi_deg[0]) % 360.0 + 360.0 * (cycles - 1))
+    return Forward(engine, int(steps_per_rev), phi_deg, at_angles(tr, last), np.asarray(motion.omega, float),
+                   float(motion.omega_mean), tr)
+
+
+def observed_order(errors: list[float], steps: list[int]) -> list[float | None]:
+    """log(e_{i-1} / e_i) / log(n_i / n_{i-1}) for successive step counts n (None for the first)."""
+    return [None] + [math.log(errors[i - 1] / errors[i]) / math.log(steps[i] / steps[i - 1])
+                     if errors[i] > 0 and errors[i - 1] > 0 else None for i in range(1, len(errors))]
+
+
+def convergence(mech: Mechanism, motion, engines: tuple[str, ...] = ENGINES,
+                steps_per_rev: tuple[int, ...] = (90, 180, 360), cycles: int = 3) -> tuple[Agreement, ...]:
+    """Every engine at every step count: its error against kinetostat's omega(phi), the observed
+    order, the energy balance and the wall time (see `forward`)."""
+    rows = []
+    for engine in engines:
+        runs = [forward(mech, motion, engine, n, cycles) for n in steps_per_rev]
+        orders = observed_order([r.error for r in runs], list(steps_per_rev))
+        rows += [Agreement(engine, r.steps_per_rev, r.error, o, r.trajectory.energy_error, r.trajectory.seconds)
+                 for r, o in zip(runs, orders)]
+    return tuple(rows)
