@@ -22,9 +22,9 @@ from .limits import (FASTEST_PIN, LAW_VARIABLES, MAX_FILE_BYTES, MAX_KEY, MAX_KE
                      MAX_POINTS, MAX_PROBLEMS, MAX_PUBLISHED_ANGLES, MAX_SHOWN, MAX_TABLE_POINTS, MAX_VALUE, MIN_GEAR, MIN_LENGTH)
 from .lines import _Lines
 from .mechanism import Mechanism, _abbreviate
-from .parts import (PUBLISHED_UNITS, Body, Characteristic, Drive, Friction, Gear, Link, Load, Pair, Published, SpeedLaw,
+from .parts import (PUBLISHED_UNITS, Body, Characteristic, Drive, Flywheel, Friction, Gear, Link, Load, Pair, Published, SpeedLaw,
                     Spring, Study, Table, Vec, combine)
 from .source import _read_text, from_dict, load, loads, model_text
 
 __all__ = ["Link", "Body", "Pair", "Table", "Load", "Characteristic", "SpeedLaw", "combine", "Spring", "Gear", "Drive",
-           "Friction", "Published", "Study", "Mechanism", "PUBLISHED_UNITS", "load", "loads", "from_dict", "model_text"]
+           "Flywheel", "Friction", "Published", "Study", "Mechanism", "PUBLISHED_UNITS", "load", "loads", "from_dict", "model_text"]

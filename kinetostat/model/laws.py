@@ -84,6 +84,21 @@ def _spline_at(x: np.ndarray, y: np.ndarray, m: np.ndarray, phi: np.ndarray) -> 
     return value, slope
 
 
+def _hermite_at(x: np.ndarray, y: np.ndarray, dy: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Value and first derivative at `phi` (rad) of the periodic cubic Hermite through the values
+    `y` and slopes `dy` (per rad) at the increasing knots `x` (rad) of one period 2 pi."""
+    xe, ye, de = np.append(x, x[0] + 2 * np.pi), np.append(y, y[0]), np.append(dy, dy[0])
+    t = x[0] + np.mod(phi - x[0], 2 * np.pi)
+    i = np.clip(np.searchsorted(xe, t, side="right") - 1, 0, len(x) - 1)
+    h = xe[i + 1] - xe[i]
+    s = (t - xe[i]) / h
+    h00, h10, h01, h11 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2, s * s * (3 - 2 * s), s * s * (s - 1)
+    value = h00 * ye[i] + h10 * h * de[i] + h01 * ye[i + 1] + h11 * h * de[i + 1]
+    slope = (6 * s * (s - 1) * (ye[i] - ye[i + 1]) / h + (1 - s) * (1 - 3 * s) * de[i]
+             + s * (3 * s - 2) * de[i + 1])
+    return value, slope
+
+
 #: A law's value between two checked angles that exceeds this many times the largest value at
 #: those angles is a pole (`pole`).
 POLE_RISE = 1e3

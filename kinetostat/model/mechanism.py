@@ -13,7 +13,7 @@ import numpy as np
 
 from ..planar import diameter
 from ..structure import Structure, analyse_structure
-from .parts import Drive, Friction, Link, Load, Pair, Published, Spring, Study
+from .parts import Drive, Flywheel, Friction, Link, Load, Pair, Published, Spring, Study
 
 
 @dataclass(frozen=True)
@@ -37,6 +37,8 @@ class Mechanism:
     #: every field and parameter given as an expression: field path -> (expression, value)
     expressions: Mapping[str, tuple[str, float]] = field(default_factory=lambda: MappingProxyType({}))
     study: Study | None = None
+    #: `[flywheel]`: a flywheel on the crank shaft (J, or delta to size it for), None: none given
+    flywheel: Flywheel | None = None
     #: `[lettering]`: the names the model's source text uses (frame, M_bal, F_bal, loads, name,
     #: language), as given; read through `kinetostat.model.lettering.lettering`
     lettering: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))

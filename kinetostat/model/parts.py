@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..expressions import over_arrays
-from .laws import _expression, _periodic_spline, _spline_at
+from .laws import _expression, _hermite_at, _periodic_spline, _spline_at
 
 Vec = tuple[float, float]
 
@@ -170,11 +170,15 @@ class SpeedLaw:
     A table (`phi_deg`, `omega`) is interpolated by the periodic cubic spline through its points
     (C2: omega, d omega/d phi and eps = omega d omega/d phi are continuous, on any spacing of the
     angles); an expression is a function of `phi` (rad), differentiated exactly by the complex
-    step. omega in rad/s, >= 0, in the drive's sense."""
+    step. omega in rad/s, >= 0, in the drive's sense. With `slope` (a law found by
+    `kinetostat.law_of_motion`, never read from a file): the periodic cubic Hermite through the
+    table's values and these slopes (C1: omega and d omega/d phi exactly the given ones at the
+    table's angles)."""
     phi_deg: tuple[float, ...] = ()
     omega: tuple[float, ...] = ()
     expression: str | None = None
     parameters: tuple[tuple[str, float], ...] = ()   # the model's parameters the expression may read
+    slope: tuple[float, ...] = ()    # d omega / d phi at phi_deg, rad/s per rad (a one-revolution table, no repeated end)
 
     def __call__(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(omega, d omega / d phi) at crank angles `phi` (rad), rad/s and rad/s per rad."""
@@ -186,6 +190,8 @@ class SpeedLaw:
                 w = np.broadcast_to(over_arrays(expr, {**values, "phi": phi}), phi.shape).astype(float)
                 z = np.broadcast_to(over_arrays(expr, {**values, "phi": phi + 1j * h}), phi.shape)
             return w, np.where(np.isfinite(w), z.imag / h, np.nan)
+        if self.slope:
+            return _hermite_at(np.radians(self.phi_deg), np.asarray(self.omega), np.asarray(self.slope), phi)
         x, y, m = _periodic_spline(self.phi_deg, self.omega)
         return _spline_at(x, y, m, phi)
 
@@ -227,6 +233,15 @@ class Drive:
                               f"{eps[bad][0]:.6g} rad/s^2 at phi = {shown} deg: omega must be real, finite and "
                               f">= 0 (in the drive's sense), eps finite"], source=self.source)
         return w, eps
+
+
+@dataclass(frozen=True)
+class Flywheel:
+    """`[flywheel]`: a flywheel on the crank shaft, its centre on the crank's axis: its moment of
+    inertia `J` (kg m^2, >= 0), or the coefficient of fluctuation `delta` (1, 0 < delta < 2) to size
+    it for (`kinetostat.law_of_motion`); exactly one of the two."""
+    J: float | None = None
+    delta: float | None = None
 
 
 @dataclass(frozen=True)

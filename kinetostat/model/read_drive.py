@@ -1,5 +1,5 @@
-"""The reader's section for the drive: the crank, its speed or law of motion, the gear mesh of
-a working machine.
+"""The reader's sections for the drive: the crank, its speed or law of motion, the gear mesh of
+a working machine, the flywheel on its shaft.
 
 May use: the standard library, numpy, core, limits, laws, parts, mechanism, schema.
 """
@@ -13,8 +13,8 @@ from .core import ReaderCore
 from .laws import mentions_phi, pole
 from .limits import MAX_SHOWN, MAX_VALUE, MIN_GEAR
 from .mechanism import extent
-from .parts import Drive, Gear, Link, Pair, SpeedLaw
-from .schema import DRIVE, GEAR, MODEL, OMEGA_TABLE
+from .parts import Drive, Flywheel, Gear, Link, Pair, SpeedLaw
+from .schema import DRIVE, FLYWHEEL, GEAR, MODEL, OMEGA_TABLE
 
 
 class DriveReading(ReaderCore):
@@ -65,6 +65,17 @@ class DriveReading(ReaderCore):
             return None
         return Drive(1, pivot, point, ref, 1 if sense == "ccw" else -1, omega, eps, kind, gear, design, law,
                      self.source)
+
+    def flywheel(self) -> Flywheel | None:
+        """[flywheel]: J (kg m^2) or delta, exactly one (None: absent, or reported)."""
+        t = self.read(MODEL, self.data, "flywheel", "")
+        if t is None:
+            return None
+        self.unknown_keys(t, FLYWHEEL.keys(), "flywheel")
+        if not self.one_of(FLYWHEEL, t, "flywheel"):
+            return None
+        J, delta = self.read(FLYWHEEL, t, "J", "flywheel"), self.read(FLYWHEEL, t, "delta", "flywheel")
+        return None if J is None and delta is None else Flywheel(J, delta)
 
     def speed_table(self, t: dict | None, where: str) -> SpeedLaw | None:
         """[drive.omega_table] (None: reported): phi_deg and omega (rad/s) or rpm over one revolution."""

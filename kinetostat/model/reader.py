@@ -46,6 +46,7 @@ class _Reader(ParameterReading, LinkReading, DriveReading, LoadReading, RecordRe
         loads_ = self.loads(links, pairs)
         springs = self.springs(links)
         friction = self.friction()
+        flywheel = self.flywheel()
         published = self.published(links, pairs, drive)
         study = self.study(pairs)
         lettering = self.lettering(links, loads_)
@@ -61,7 +62,8 @@ class _Reader(ParameterReading, LinkReading, DriveReading, LoadReading, RecordRe
                              springs=tuple(springs), drive=drive, friction=friction,
                              published=tuple(published), path=self.source,
                              parameters=MappingProxyType({n: v for n, v in self.values.items() if n != "g"}),
-                             expressions=MappingProxyType(self.expressions), study=study, lettering=lettering)
+                             expressions=MappingProxyType(self.expressions), study=study, lettering=lettering,
+                             flywheel=flywheel)
         except StructureError as exc:
             raise StructureError(f"{self.source}: {exc}") from None
         for path, msg in doubts(mech, self.group_tables, self.slider_axes, self.text):

@@ -247,6 +247,12 @@ FRICTION = Section("friction", "Friction in the pairs (TMM course text on fricti
           "'reactions' (friction in the reactions, solved exactly)", default="first", choices=("first", "reactions")),
 ))
 
+FLYWHEEL = Section("flywheel", "A flywheel on the crank shaft, its centre on the crank's axis (kinetostat.law_of_motion).", (
+    _num("J", "its moment of inertia", "kg m^2", minimum=0.0),
+    _num("delta", "the coefficient of fluctuation (omega_max - omega_min) / omega_mean to size the smallest flywheel for",
+         positive=True, exclusive_maximum=2.0, rule="must be > 0 and < 2 (omega_min = omega_mean (1 - delta/2) > 0)"),
+), one_of=(OneOf(("J", "delta"), hint="a flywheel J in kg m^2, or delta to size it for"),))
+
 _AT_POINT, _OF_LINK = ("velocity", "acceleration"), ("omega", "eps", "inertia_force", "inertia_moment")
 PUBLISHED = Section("published", "A value the source prints for this model, checked by `kinetostat validate`.", (
     Field("symbol", "string", "as the source names it (unique in the file)", default=REQUIRED, one_line=True),
@@ -301,6 +307,7 @@ MODEL = Section("<top level>", "A kinetostat mechanism model: one planar linkage
     Field("load", "tables", LOAD.doc, section=LOAD),
     Field("spring", "tables", SPRING.doc, section=SPRING),
     Field("friction", "table", FRICTION.doc, section=FRICTION),
+    Field("flywheel", "table", FLYWHEEL.doc, section=FLYWHEEL),
     Field("published", "tables", PUBLISHED.doc, section=PUBLISHED),
     Field("study", "table", STUDY.doc, section=STUDY),
     Field("lettering", "table", LETTERING.doc, section=LETTERING),
