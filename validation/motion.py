@@ -27,11 +27,12 @@ of M_drive and the loads, integrated by the same RK4) is measured over the whole
 A load given by a table (np.interp: piecewise linear) has kinks: RK4's error in a step that
 contains one is O(dt^2), so the observed order of such a model is 2, not 4.
 
-May use: kinetostat (model, kinematics, applied), the scene, the MuJoCo and Pinocchio adapters
+May use: kinetostat (model, kinematics, applied, law_of_motion), the scene, the MuJoCo and Pinocchio adapters
 (imported when used), numpy.
 """
 from __future__ import annotations
 
+import importlib.util
 import math
 import time
 from dataclasses import dataclass, replace
@@ -39,25 +40,29 @@ from typing import Protocol
 
 import numpy as np
 
-from kinetostat import Mechanism
+from kinetostat import Mechanism, law_of_motion
 from kinetostat.applied import applied_wrenches, com_motion
 from kinetostat.kinematics import kinematics
 from kinetostat.planar import as_xy
 
 from .scene import Scene, build_scene, loads_at_centres
 
-__all__ = ["ENGINES", "Trajectory", "Forward", "Agreement", "integrate", "forward", "convergence",
-           "observed_order"]
+__all__ = ["ENGINES", "STEPS_PER_REV", "Trajectory", "Forward", "Agreement", "MotionCheck", "integrate", "forward",
+           "convergence", "observed_order", "check_law_of_motion", "with_flywheel", "at_angles"]
 
 ENGINES = ("mujoco", "pinocchio")
+#: The convergence study's steps per revolution (each twice the last).
+STEPS_PER_REV = (90, 180, 360)
 #: MuJoCo: the equality constraints' time constant in steps (critical damping): RK4 is stable
 #: for it (|lambda dt| = 1/2 against RK4's 2.78) and it is the harness's simulation route's.
 TIMECONST_STEPS = 4.0
 #: MuJoCo's largest constraint impedance (solimp): the softness 1 - 0.9999 left.
 IMPEDANCE = 0.9999
 #: Pinocchio: the Baumgarte corrector's natural frequency per crank speed (Kp = w^2, Kd = 2 w,
-#: w = BAUMGARTE * omega_mean): the loop-closure drift decays within a tenth of a revolution.
-BAUMGARTE = 20.0
+#: w = BAUMGARTE * omega_mean): the loop-closure drift decays within a tenth of a revolution, and the mode stays slow against RK4's step
+BAUMGARTE = 2.0
+#: A landing angle closer than this to the crank's (rad) counts as reached.
+LANDING = 1e-9
 
 
 @dataclass(frozen=True)
@@ -132,13 +137,19 @@ def _loads(mech: Mechanism, scene: Scene, phi: float, omega: float) -> tuple[np.
 class _MuJoCo:
     """MuJoCo's forward dynamics of the scene: accelerations by mj_forward."""
 
-    def __init__(self, scene: Scene, dt: float):
+    def __init__(self, scene: Scene, J_flywheel: float, dt: float):
         import mujoco
         from .engine_mujoco import SIM_FLOOR, _compile, _regularisation_weights
         self.scene = scene
         tc = TIMECONST_STEPS * dt
         self.mm = _compile(scene, SIM_FLOOR, exact_masses=False, timestep=dt, solref=(tc, 1.0),
                            solimp=(IMPEDANCE, IMPEDANCE, 0.001, 0.5, 2.0))
+        # the flywheel after compiling: in the MJCF it would set the scale of the placeholder
+        # floors (SIM_FLOOR of the largest inertia: 5e-5 kg m^2 on the shaper's slot helper, 1e-4
+        # of its rocker's I_S); mj_setConst then derives the constants from the new inertia
+        m, d = self.mm.m, self.mm.d
+        m.body_inertia[self.mm.body[scene.mech.drive.link]] += J_flywheel
+        mujoco.mj_setConst(m, d)
         _regularisation_weights(scene, self.mm)
         self.mm.m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
         self.mm.m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_REFSAFE
@@ -237,9 +248,10 @@ def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: floa
     if not (omega0 > 0 and omega_mean > 0 and J_flywheel >= 0 and cycles > 0):
         raise ValueError(f"integrate: needs omega0 > 0, omega_mean > 0, J_flywheel >= 0 and cycles > 0, got "
                          f"{omega0}, {omega_mean}, {J_flywheel}, {cycles}")
-    scene = _flywheel_scene(mech, phi0_deg, J_flywheel)
+    scene = build_scene(mech, phi_deg=[phi0_deg])
     dt = 2 * math.pi / (omega_mean * steps_per_rev)
-    eng: _Engine = _MuJoCo(scene, dt) if engine == "mujoco" else _Pinocchio(scene, omega_mean)
+    eng: _Engine = (_MuJoCo(scene, J_flywheel, dt) if engine == "mujoco"
+                    else _Pinocchio(with_flywheel(scene, J_flywheel), omega_mean))
     sense, c = mech.drive.sense, eng.crank
     q, v = eng.start(omega0 / mech.drive.omega)
     qc0, phi0 = q[c], math.radians(phi0_deg)
@@ -250,72 +262,101 @@ def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: floa
         a, power, energy = eng.derivative(q, v, F, M, sense * M_drive)
         return a, power + M_drive * w, energy, phi, w
 
+    def step(q, v, W, a1, p1, h):
+        """One RK4 step of length h (a1, p1: the derivatives at its start)."""
+        v2 = v + h / 2 * a1
+        a2, p2, *_ = f(q + h / 2 * v, v2)
+        v3 = v + h / 2 * a2
+        a3, p3, *_ = f(q + h / 2 * v2, v3)
+        v4 = v + h * a3
+        a4, p4, *_ = f(q + h * v3, v4)
+        return (q + h / 6 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4),
+                W + h / 6 * (p1 + 2 * p2 + 2 * p3 + p4))
+
     t0 = time.perf_counter()
     end, limit = phi0 + 2 * math.pi * cycles, int(3 * steps_per_rev * cycles) + 10
-    W, rows = 0.0, []
+    knots, k = _landings(mech, phi0, end), 0
+    W, t, rows = 0.0, 0.0, []
     while True:
         a1, p1, E, phi, w = f(q, v)
-        rows.append((len(rows) * dt, phi, w, sense * a1[c], E - W, W))
-        if phi >= end:
+        eps = sense * a1[c]
+        rows.append((t, phi, w, eps, E - W, W))
+        k += int(np.searchsorted(knots[k:], phi + LANDING))           # landings reached
+        if k == len(knots):
             break
         if w <= 0 or len(rows) > limit:
             raise ValueError(f"integrate ({engine}): the crank stopped or turned back near phi = "
                              f"{math.degrees(phi) % 360:.1f} deg (omega = {w:.4g} rad/s): no steady motion")
-        a2, p2, *_ = f(q + dt / 2 * v, v + dt / 2 * a1)
-        v2 = v + dt / 2 * a1
-        a3, p3, *_ = f(q + dt / 2 * v2, v + dt / 2 * a2)
-        v3 = v + dt / 2 * a2
-        a4, p4, *_ = f(q + dt * v3, v + dt * a3)
-        v4 = v + dt * a3
-        q = q + dt / 6 * (v + 2 * v2 + 2 * v3 + v4)
-        v = v + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
-        W += dt / 6 * (p1 + 2 * p2 + 2 * p3 + p4)
+        h, gap = dt, knots[k] - phi
+        if gap < w * dt + eps * dt * dt / 2 and w * w + 2 * eps * gap > 0:
+            # the next landing within this step: shortened to reach it by phi + w h + eps h^2 / 2 (it
+            # lands within O(h^3), so a kink there costs O(h^6)), and counted as reached
+            h = 2 * gap / (w + math.sqrt(w * w + 2 * eps * gap))
+            k += 1
+        q, v, W = step(q, v, W, a1, p1, h)
+        t += h
     seconds = time.perf_counter() - t0
     t, phi, w, eps, energy, work = np.array(rows).T
     return Trajectory(engine, int(steps_per_rev), dt, t, phi, w, eps, energy, float(np.ptp(work)), seconds,
-                      f"{eng.note}; RK4, {steps_per_rev} steps/rev (dt = {dt:.3g} s), {cycles} cycles")
+                      f"{eng.note}; RK4, {steps_per_rev} steps/rev (dt = {dt:.3g} s), {cycles} cycles, "
+                      f"{len(knots)} landings on load table knots and the run's end")
 
 
-def _flywheel_scene(mech: Mechanism, phi0_deg: float, J_flywheel: float) -> Scene:
-    """The scene at phi_0 with J_flywheel added to the crank's moment of inertia (its centre
-    on the axis: about the centre of mass and about the axis alike)."""
-    scene = build_scene(mech, phi_deg=[phi0_deg])
-    crank = mech.drive.link
+def _landings(mech: Mechanism, phi0: float, end: float) -> np.ndarray:
+    """The crank angles (rad, unwrapped, in (phi0, end], ascending) a step ends on: the knots of every
+    load's crank-angle table (np.interp: its slope jumps there, which would cost RK4 its order)
+    over the run, and the run's end."""
+    knots = np.radians([x for ld in mech.loads if ld.table is not None and ld.table.argument == "phi"
+                        for x in ld.table.x])
+    turns = np.arange(math.floor(phi0 / (2 * math.pi)), math.ceil(end / (2 * math.pi)) + 1)
+    every = (np.mod(knots, 2 * math.pi)[:, None] + 2 * math.pi * turns).ravel()
+    return np.unique(np.append(every[(every > phi0 + LANDING) & (every < end - LANDING)], end))
+
+
+def with_flywheel(scene: Scene, J_flywheel: float) -> Scene:
+    """The scene with J_flywheel (kg m^2) added to the crank's moment of inertia (the flywheel's
+    centre on the crank's axis: about the crank's centre of mass and its axis alike)."""
+    crank = scene.mech.drive.link
     return replace(scene, bodies=tuple(replace(b, I_S=b.I_S + J_flywheel) if b.link == crank else b
                                        for b in scene.bodies))
 
 
+def _hermite(y0, y1, d0, d1, h, s):
+    """The cubic Hermite interpolant over a step of length h (values y, derivatives d) at s in [0, 1]."""
+    return y0 * (1 + 2 * s) * (1 - s) ** 2 + h * d0 * s * (1 - s) ** 2 + y1 * s * s * (3 - 2 * s) - h * d1 * s * s * (1 - s)
+
+
+def _crossing(p0, p1, w0, w1, h, phi):
+    """s in [0, 1] where the Hermite phi(t) of a step (angles p, speeds w, length h) reaches phi:
+    Newton from the linear guess (phi(t) rises monotonically: omega > 0)."""
+    s = (phi - p0) / (p1 - p0)
+    for _ in range(8):
+        slope = h * (w0 * (1 - s) * (1 - 3 * s) + w1 * s * (3 * s - 2)) + 6 * (p1 - p0) * s * (1 - s)
+        s = s - (_hermite(p0, p1, w0, w1, h, s) - phi) / slope
+    return s
+
+
 def at_angles(tr: Trajectory, phi: np.ndarray) -> np.ndarray:
     """The trajectory's omega at crank angles phi (rad, unwrapped, within the run): cubic
-    Hermite interpolation, phi(t) with omega and omega(t) with eps, the crossing by Newton."""
+    Hermite interpolation of its steps, phi(t) with omega and omega(t) with eps (O(dt^4))."""
     phi = np.asarray(phi, float)
     k = np.clip(np.searchsorted(tr.phi, phi, side="right") - 1, 0, len(tr.phi) - 2)
     h = tr.t[k + 1] - tr.t[k]
-    p0, p1, w0, w1, e0, e1 = tr.phi[k], tr.phi[k + 1], tr.omega[k], tr.omega[k + 1], tr.eps[k], tr.eps[k + 1]
-    s = (phi - p0) / (p1 - p0)                        # start: linear
-
-    def hermite(y0, y1, d0, d1, s):
-        return (y0 * (1 + 2 * s) * (1 - s) ** 2 + h * d0 * s * (1 - s) ** 2 + y1 * s * s * (3 - 2 * s)
-                - h * d1 * s * s * (1 - s))
-
-    for _ in range(8):
-        ds = h * (w0 * (1 - s) * (1 - 3 * s) + w1 * s * (3 * s - 2)) + 6 * (p1 - p0) * s * (1 - s)
-        s = s - (hermite(p0, p1, w0, w1, s) - phi) / ds
-    return hermite(w0, w1, e0, e1, s)
+    w0, w1 = tr.omega[k], tr.omega[k + 1]
+    s = _crossing(tr.phi[k], tr.phi[k + 1], w0, w1, h, phi)
+    return _hermite(w0, w1, tr.eps[k], tr.eps[k + 1], h, s)
 
 
 def forward(mech: Mechanism, motion, engine: str = "mujoco", steps_per_rev: int = 360,
             cycles: int = 3) -> Forward:
     """The machine of `motion` (a `kinetostat.Motion` of `mech`, without friction) integrated by
     `engine` from motion's omega(phi_0) at phi_0 over `cycles` revolutions, with motion's flywheel
-    and drive moment; its omega at motion.phi_deg in the last cycle beside motion.omega.
-    Raises ValueError where the drive's moment is not constant (a characteristic M(omega))."""
-    M = np.asarray(motion.M_drive, float)
-    if np.ptp(M) > 1e-12 * max(np.max(np.abs(M)), 1.0):
-        raise ValueError(f"forward: the engines take a constant drive moment; motion.M_drive varies "
-                         f"({M.min():.6g} .. {M.max():.6g} N m, drive {motion.drive!r})")
+    and drive (a constant moment; a characteristic M(omega) is one of the model's loads, so the
+    load model gives it at the engine's speed); its omega at motion.phi_deg in the last cycle
+    beside motion.omega."""
+    drive = 0.0 if motion.drive == "characteristic" else float(motion.M_drive[0])
     phi_deg = np.asarray(motion.phi_deg, float)
-    tr = integrate(mech, motion.J_flywheel, float(M[0]), float(phi_deg[0]), float(motion.omega[0]),
+    tr = integrate(mech, motion.J_flywheel, drive, float(phi_deg[0]), float(motion.omega[0]),
                    motion.omega_mean, engine, steps_per_rev, cycles)
     last = np.radians(phi_deg[0] + (phi_deg - phi_deg[0]) % 360.0 + 360.0 * (cycles - 1))
     return Forward(engine, int(steps_per_rev), phi_deg, at_angles(tr, last), np.asarray(motion.omega, float),
@@ -329,7 +370,7 @@ def observed_order(errors: list[float], steps: list[int]) -> list[float | None]:
 
 
 def convergence(mech: Mechanism, motion, engines: tuple[str, ...] = ENGINES,
-                steps_per_rev: tuple[int, ...] = (90, 180, 360), cycles: int = 3) -> tuple[Agreement, ...]:
+                steps_per_rev: tuple[int, ...] = STEPS_PER_REV, cycles: int = 3) -> tuple[Agreement, ...]:
     """Every engine at every step count: its error against kinetostat's omega(phi), the observed
     order, the energy balance and the wall time (see `forward`)."""
     rows = []
@@ -339,3 +380,34 @@ def convergence(mech: Mechanism, motion, engines: tuple[str, ...] = ENGINES,
         rows += [Agreement(engine, r.steps_per_rev, r.error, o, r.trajectory.energy_error, r.trajectory.seconds)
                  for r, o in zip(runs, orders)]
     return tuple(rows)
+
+
+@dataclass(frozen=True)
+class MotionCheck:
+    """The "law of motion" check of one model: kinetostat's motion and the engines' agreement."""
+    model: str
+    omega_mean: float          # rad/s
+    delta: float               # 1
+    J_flywheel: float          # kg m^2
+    M_drive: float             # N m, the drive's constant moment (drive's sense)
+    energy_error: float        # kinetostat's side: max |T - T(phi_0) - A(phi)| over the swing of A, 1
+    rows: tuple[Agreement, ...]
+    skipped: tuple[str, ...]   # engines not installed (never counted as agreeing)
+    note: str
+
+
+def check_law_of_motion(mech: Mechanism, delta: float | None = None, flywheel: float | None = None,
+                        engines: tuple[str, ...] = ENGINES, steps_per_rev: tuple[int, ...] = STEPS_PER_REV,
+                        cycles: int = 3) -> MotionCheck:
+    """kinetostat's law of motion of `mech` without its friction (the engines model none), with
+    the flywheel `kinetostat.law_of_motion` sizes for `delta` or is given, checked by the engines
+    installed among `engines` at every step count (`convergence`)."""
+    plain = replace(mech, friction=None)
+    motion = law_of_motion(plain, delta=delta, flywheel=flywheel)
+    have = tuple(e for e in engines if importlib.util.find_spec(e))       # the engines' modules are named so
+    swing = float(np.ptp(motion.work)) or 1.0
+    energy = float(np.max(np.abs(motion.T - motion.T[0] - motion.work)) / swing)
+    note = "friction left out (the engines model none)" if mech.friction is not None else ""
+    return MotionCheck(mech.name, motion.omega_mean, motion.delta, motion.J_flywheel, float(motion.M_drive[0]),
+                       energy, convergence(plain, motion, have, steps_per_rev, cycles),
+                       tuple(e for e in engines if e not in have), note)
