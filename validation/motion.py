@@ -22,7 +22,9 @@ velocities at omega(phi_0)), over `cycles` revolutions; both engines give only t
 The engine's omega at kinetostat's angles of the last cycle is the cubic Hermite interpolation
 of its steps (phi(t) with omega, omega(t) with eps: O(dt^4), the integrator's order). The energy
 balance T + V - W = const (T kinetic energy, flywheel included, V gravity's potential, W the work
-of M_drive and the loads, integrated by the same RK4) is measured over the whole run.
+of M_drive and the loads, integrated by the same RK4, and in MuJoCo that of its soft constraints,
+efc_force . efc_vel: on the shaper 0.5 J a cycle, all of its T + V - W drift) is measured over
+the whole run.
 
 A load given by a table (np.interp: piecewise linear) has kinks: RK4's error in a step that
 contains one is O(dt^2), so the observed order of such a model is 2, not 4.
@@ -76,7 +78,8 @@ class Trajectory:
     omega: np.ndarray          # (K,) rad/s, in the drive's sense
     eps: np.ndarray            # (K,) rad/s^2
     energy: np.ndarray         # (K,) J: T + V - W, constant but for the integrator's error
-    work_swing: float          # J: max - min of W, the work of the drive and the loads, over the run
+    work_swing: float          # J: max - min over the run of W, the work of the drive, the loads (and
+                               #   MuJoCo's soft constraints)
     seconds: float             # wall time of the run
     note: str
 
@@ -173,7 +176,8 @@ class _MuJoCo:
         d.qfrc_applied[:] = 0.0
         d.qfrc_applied[self.crank] = drive
         mujoco.mj_forward(m, d)
-        return d.qacc.copy(), float(Q @ v), float(d.energy.sum())
+        soft = float(d.efc_force[:d.nefc] @ d.efc_vel[:d.nefc])    # the soft constraints' power
+        return d.qacc.copy(), float(Q @ v) + soft, float(d.energy.sum())
 
 
 class _Pinocchio:
