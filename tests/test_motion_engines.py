@@ -97,6 +97,9 @@ def test_observed_order():
 #: equality constraints, impedance 0.9999 and a time constant of 4 steps, dominate RK4's error).
 ORDER = {"pinocchio": (3.5, 4.5), "mujoco": (1.3, 2.2)}
 FINEST_ERROR = {"pinocchio": 1e-9, "mujoco": 2e-7}
+#: The energy balance shrinks with the step: Pinocchio 7.0e-6, 4.5e-7, 2.9e-8; MuJoCo 3.4e-5,
+#: 8.0e-6, 2.8e-6.
+FINEST_ENERGY = {"pinocchio": 1e-7, "mujoco": 1e-5}
 
 
 @pytest.mark.slow
@@ -110,7 +113,8 @@ def test_agreement_converges_at_the_integrators_order(ice):
         lo, hi = ORDER[engine]
         assert all(lo < r.order < hi for r in mine[1:]), [(r.steps_per_rev, r.error, r.order) for r in mine]
         assert mine[-1].error < FINEST_ERROR[engine]
-        assert all(r.energy_error < 3e-5 for r in mine), [r.energy_error for r in mine]
+        energy = [r.energy_error for r in mine]
+        assert energy == sorted(energy, reverse=True) and energy[-1] < FINEST_ENERGY[engine], energy
 
 
 #: The shaper (delta = 0.02, J_flywheel 451 kg m^2) at 180 steps per revolution, 3 cycles: measured
