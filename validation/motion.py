@@ -1,15 +1,18 @@
 """The machine's law of motion by forward dynamics: MuJoCo and Pinocchio integrate the machine
 with a free crank, and their omega(phi) is compared with kinetostat's (`kinetostat.law_of_motion`).
 
-The machine: the model's mechanism with the flywheel's J_flywheel added to the crank's moment of
-inertia about its axis (the same `Scene` for both engines), the drive's constant moment M_drive
-on the crank, and the model's applied loads evaluated by kinetostat's load model
+The machine: the model's mechanism (one `Scene` for both engines) with the flywheel's J_flywheel
+added to the crank's moment of inertia about its axis (Pinocchio: `with_flywheel`; MuJoCo: after
+compiling, so that its placeholder floors keep the linkage's scale), the drive's constant moment
+M_drive on the crank (a characteristic M(omega) is one of the model's loads), and its applied loads evaluated by kinetostat's load model
 (`kinetostat.applied.applied_wrenches`) at the engine's own crank angle and speed at every stage
 of every step (they depend on the state, so this is a Python loop over the steps). Gravity is the
 engines' own. Friction is not modelled by the engines: a mechanism with [friction] is refused.
 
-Integration: the classical Runge-Kutta method (RK4, order 4) at a fixed step,
-dt = 2 pi / (omega_mean * steps_per_rev), from the exact state at phi_0 (kinetostat's positions,
+Integration: the classical Runge-Kutta method (RK4, order 4) at the step
+dt = 2 pi / (omega_mean * steps_per_rev), shortened where a step would pass a knot of a load's
+crank-angle table (np.interp: its slope jumps there, an O(dt^2) error in the step that holds it)
+to end there (predicted by phi + omega h + eps h^2 / 2: within O(h^3)), from the exact state at phi_0 (kinetostat's positions,
 velocities at omega(phi_0)), over `cycles` revolutions; both engines give only the accelerations:
 - MuJoCo: `mj_forward` (its soft equality constraints as the harness builds them,
   `engine_mujoco._compile`, made as stiff as it allows: impedance 0.9999, time constant
@@ -26,11 +29,11 @@ of M_drive and the loads, integrated by the same RK4, and in MuJoCo that of its 
 efc_force . efc_vel: on the shaper 0.5 J a cycle, all of its T + V - W drift) is measured over
 the whole run.
 
-A load given by a table (np.interp: piecewise linear) has kinks: RK4's error in a step that
-contains one is O(dt^2), so the observed order of such a model is 2, not 4.
+A table in a point's travel (the shaper's cutting force) has its knots at crank angles no step
+lands on: such a model converges at order 2, not 4.
 
-May use: kinetostat (model, kinematics, applied, law_of_motion), the scene, the MuJoCo and Pinocchio adapters
-(imported when used), numpy.
+May use: kinetostat (model, kinematics, applied, planar, law_of_motion), the scene, the MuJoCo and
+Pinocchio adapters (imported when used), numpy.
 """
 from __future__ import annotations
 
@@ -55,13 +58,15 @@ __all__ = ["ENGINES", "STEPS_PER_REV", "Trajectory", "Forward", "Agreement", "Mo
 ENGINES = ("mujoco", "pinocchio")
 #: The convergence study's steps per revolution (each twice the last).
 STEPS_PER_REV = (90, 180, 360)
-#: MuJoCo: the equality constraints' time constant in steps (critical damping): RK4 is stable
-#: for it (|lambda dt| = 1/2 against RK4's 2.78) and it is the harness's simulation route's.
+#: MuJoCo: the equality constraints' time constant in steps (critical damping, |lambda dt| = 1/4
+#: against RK4's 2.78): of 1, 2, 4, 8 and 16 steps, 4 gave the ICE's smallest error (RK4's error
+#: on the stiff constraint mode grows below it, the constraints' softness above).
 TIMECONST_STEPS = 4.0
 #: MuJoCo's largest constraint impedance (solimp): the softness 1 - 0.9999 left.
 IMPEDANCE = 0.9999
 #: Pinocchio: the Baumgarte corrector's natural frequency per crank speed (Kp = w^2, Kd = 2 w,
-#: w = BAUMGARTE * omega_mean): the loop-closure drift decays within a tenth of a revolution, and the mode stays slow against RK4's step
+#: w = BAUMGARTE * omega_mean): the loop-closure drift decays by e in 1/(4 pi) of a revolution;
+#: 20 made the ICE's error at 90 steps/rev 30 times larger (the mode's |lambda dt| = 1.4).
 BAUMGARTE = 2.0
 #: A landing angle closer than this to the crank's (rad) counts as reached.
 LANDING = 1e-9
@@ -118,6 +123,10 @@ class Agreement:
 
 
 class _Engine(Protocol):
+    """An engine's forward dynamics of the scene, for `integrate`."""
+    crank: int                 # the crank's index in q and v
+    note: str                  # the engine's version and settings
+
     def start(self, qd_scale: float) -> tuple[np.ndarray, np.ndarray]: ...
     def derivative(self, q: np.ndarray, v: np.ndarray, F: np.ndarray, M: np.ndarray,
                    drive: float) -> tuple[np.ndarray, float, float]: ...
@@ -166,6 +175,8 @@ class _MuJoCo:
         return qpos[0], qvel[0] * qd_scale
 
     def derivative(self, q, v, F, M, drive):
+        """qacc at (q, v) under the loads F (L, 2), M (L,) and the crank moment `drive` (N m
+        about +z); the power of the loads and the soft constraints, W; T + V, J."""
         import mujoco
         from .engine_mujoco import _applied
         m, d = self.mm.m, self.mm.d
@@ -209,6 +220,8 @@ class _Pinocchio:
         return q, v * qd_scale
 
     def derivative(self, q, v, F, M, drive):
+        """qdd at (q, v) under the loads F (L, 2), M (L,) and the crank moment `drive` (N m about
+        +z); the loads' power, W; T + V, J."""
         pin, ps = self.pin, self.ps
         model, data = ps.model, ps.data
         pin.computeJointJacobians(model, data, q)                      # oMi for the loads
