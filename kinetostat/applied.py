@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from .model import Load, Mechanism
 
 __all__ = ["applied_wrenches", "com_motion", "inertia_loads", "load_magnitude", "point_forces", "PointForce", "applied_moment",
-           "travel", "forward_stroke"]
+           "travel", "travel_rates", "forward_stroke"]
 
 
 def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
@@ -182,17 +182,34 @@ def travel(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarray | Non
     """The travel of load `ld`'s point (a travel table's) from the table's origin at every angle,
     as a fraction of the stroke (0..1): where the diagram is read. X: the point's complex
     position, if the caller has it already. ModelError where the point does not move along the axis."""
+    if X is None:
+        X = kin.position_z(ld.link, mech.links[ld.link].points[ld.point])
+    lo, hi = _stroke_ends(mech, ld)
+    s = dot_z(X, _travel_axis(ld))
+    return (hi - s) / (hi - lo) if ld.table.origin == "max" else (s - lo) / (hi - lo)
+
+
+def travel_rates(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The travel of load `ld`'s point (`travel`, 0..1) and its first two derivatives by the crank
+    angle (per rad, per rad^2), from kinematics `kin` at unit crank speed (`unit_speed=True`)."""
+    X, V, A = kin.point_z(ld.link, mech.links[ld.link].points[ld.point])
+    lo, hi = _stroke_ends(mech, ld)
+    scale = (-1.0 if ld.table.origin == "max" else 1.0) / (hi - lo)
+    axis = _travel_axis(ld)
+    return travel(mech, kin, ld, X), scale * dot_z(V, axis), scale * dot_z(A, axis)
+
+
+def _stroke_ends(mech: "Mechanism", ld: "Load") -> tuple[float, float]:
+    """The extreme projections (m) of load `ld`'s point on its travel axis (memoised);
+    ModelError where the point does not move along the axis."""
     p = mech.links[ld.link].points[ld.point]
     axis = _travel_axis(ld)
-    if X is None:
-        X = kin.position_z(ld.link, p)
     lo, hi = mech.memo(("stroke", ld.link, tuple(p), axis), lambda: _stroke(mech, ld.link, p, axis))
     if not hi - lo > 1e-9 * mech.size:
         n = mech.loads.index(ld)
         raise ModelError([f"load[{n}].table: a travel diagram needs a moving point, but {ld.point!r} of link "
                           f"{ld.link} travels {hi - lo:.3g} m along the axis over the cycle"], source=mech.path or "model")
-    s = dot_z(X, axis)
-    return (hi - s) / (hi - lo) if ld.table.origin == "max" else (s - lo) / (hi - lo)
+    return lo, hi
 
 
 def forward_stroke(mech: "Mechanism", kin: "Kinematics", ld: "Load", V: np.ndarray | None = None) -> np.ndarray:

@@ -5,7 +5,8 @@ closed form: omega^2 = a - b sin(phi) and the flywheel for delta by hand); a cra
 and dJ_red against the kinetic energy by 9-point differences (conftest.kinetic_energy); the
 motion's eps against the derivative of its omega (periodic spectral differentiation); the
 balancing moment of the kinetostatics at the true motion against M_drive; the ICE and the
-shaper at delta = 0.02.
+shaper at delta = 0.02 (the shaper's at 360 steps against 1440); a motor's characteristic
+M(omega) against the machine integrated forward in time by scipy (DOP853) until periodic.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import pytest
 
 import kinetostat
 from kinetostat import ModelError
+from kinetostat.analysis import exact
 from conftest import ROOT, kinetic_energy
 from test_law_of_motion import CRANK_SLIDER, H_DEG, STENCIL
 
@@ -134,7 +136,6 @@ def ice():
     return mech, kinetostat.law_of_motion(mech, delta=0.02)
 
 
-@pytest.mark.slow      # ~9 s: the friction's fixed point refines its extremes by many small re-solves
 def test_ice_at_delta_002(ice):
     mech, mo = ice
     assert mo.delta == pytest.approx(0.02, rel=1e-10)
@@ -195,3 +196,101 @@ def test_analyze_refuses_another_mechanism_s_motion(crank):
     mo = kinetostat.law_of_motion(crank, delta=0.02, steps=12)
     with pytest.raises(ValueError, match="law: the Motion of another mechanism"):
         kinetostat.analyze(kinetostat.loads(CRANK_SLIDER), law=mo)
+
+
+def test_the_law_of_motion_costs_a_few_batched_solves(ice, monkeypatch):
+    """Every solve of a step (the grid with its Gauss nodes, or the candidates of all the
+    extremes sought at once) is one call: a pass of the friction's fixed point costs the grid's
+    solve and a few small ones, not one per extreme and refinement step."""
+    from kinetostat import motion
+    mech, ref = ice
+    calls = []
+    monkeypatch.setattr(motion, "exact", lambda m, phi_deg, *a: calls.append(len(phi_deg)) or exact(m, phi_deg, *a))
+    mo = kinetostat.law_of_motion(mech, delta=0.02)
+    assert mo.J_flywheel == pytest.approx(ref.J_flywheel, rel=1e-14)
+    assert calls.count(len(mo.phi_deg) * (1 + motion.GAUSS_NODES)) == mo.passes
+    assert len(calls) <= 5 * mo.passes + 5, calls
+
+
+def test_the_shaper_s_travel_table_knots_are_found_so_the_work_converges():
+    """The shaper's cutting force is a table against the ram's travel (kinks at its knots, a step
+    at the dead centres): the Gauss pieces are cut where the travel passes them, so J_flywheel at
+    360 steps is that at 1440 to rounding (7.4e-6 apart when the knots were not found)."""
+    mech = kinetostat.load(ROOT / "models" / "slotted_link_shaper.toml")
+    coarse, fine = (kinetostat.law_of_motion(mech, delta=0.02, steps=s) for s in (360, 1440))
+    assert coarse.J_flywheel == pytest.approx(fine.J_flywheel, rel=1e-11)
+    assert coarse.delta == pytest.approx(0.02, rel=1e-12)
+
+
+# ------------------------------------------------------------------ a motor's characteristic M(omega)
+
+#: The crank alone with a constant resisting moment C on it and a motor of the linear
+#: characteristic M = MS (1 - omega/W0) (its working branch), on a flywheel J_FLY.
+C, MS, W0, J_FLY = 3.0, 60.0, 12.0, 0.5
+RESISTANCE = f"""
+[[load]]
+name = "resistance"
+kind = "moment"
+link = 1
+value = {-C}
+"""
+MOTOR = """
+[[load]]
+name = "motor"
+kind = "moment"
+link = 1
+characteristic = {motor}
+"""
+
+
+def _motor(characteristic: str):
+    return kinetostat.loads(CRANK + RESISTANCE + MOTOR.format(motor=characteristic))
+
+
+def _forward_in_time(phi_deg: np.ndarray, cycles: int = 12, flywheel: float = J_FLY) -> np.ndarray:
+    """omega at `phi_deg` of the last of `cycles` cycles of the machine integrated forward from
+    omega = W0 at phi = 0 (scipy's DOP853; phi is the independent variable:
+    d omega/d phi = (M(omega) - C - M g R cos(phi)) / ((flywheel + J_O) omega)); the motor's
+    damping leaves the periodic motion (the transient decays ~e^-5 a cycle)."""
+    from scipy.integrate import solve_ivp
+
+    def rate(phi, w):
+        return (MS * (1 - w / W0) - C - M * G * R * np.cos(phi)) / ((flywheel + J_O) * w)
+    last = 2 * np.pi * (cycles - 1) + np.radians(phi_deg)
+    sol = solve_ivp(rate, (0.0, 2 * np.pi * cycles), [W0], method="DOP853", t_eval=last, rtol=1e-13, atol=1e-12)
+    assert sol.success
+    return sol.y[0]
+
+
+@pytest.mark.parametrize("characteristic", [f'"{MS} * (1 - omega / {W0})"',
+                                            "{ omega = [0.0, 9.0, 14.0], M = [30.0, 15.0, -10.0] }"],
+                         ids=["expression", "table"])
+def test_characteristic_drive_is_the_periodic_motion_of_forward_dynamics(characteristic):
+    """The table is the expression's line between 9 and 14 rad/s, where the motion runs."""
+    mech = _motor(characteristic)
+    mo = kinetostat.law_of_motion(mech, flywheel=J_FLY, steps=90)
+    w = _forward_in_time(mo.phi_deg)
+    assert mo.drive == "characteristic"
+    assert np.allclose(mo.omega, w, rtol=1e-8, atol=0)
+    assert np.allclose(mo.M_drive, MS * (1 - mo.omega / W0), rtol=0, atol=1e-12 * MS)
+    assert abs(np.mean(mo.M_red + mo.M_drive)) <= 1e-12 * MS      # the cycle's work closes
+    assert np.allclose(mo.M_red, -C - M * G * R * np.cos(np.radians(mo.phi_deg)), rtol=0, atol=1e-12)
+    assert 9.0 < w.min() and w.max() < 14.0 and mo.delta > 0.01
+
+
+@pytest.mark.parametrize("characteristic, flywheel, message", [
+    ('"2.0 * (1 - omega / 12.0)"', J_FLY, r"M\(0\) = 2 N m cannot drive the load \(its mean resisting moment 3 N m\)"),
+    (f'"{MS} * (1 - omega / {W0})"', 0.0, "no periodic motion with J_flywheel = 0 kg m.2: the crank stops"),
+], ids=["too weak to start", "stops in the cycle"])
+def test_a_characteristic_that_cannot_drive_the_load_is_refused_by_its_field(characteristic, flywheel, message):
+    with pytest.raises(ValueError, match=r"law_of_motion: load\[1\]\.characteristic \('motor'\): " + message):
+        kinetostat.law_of_motion(_motor(characteristic), flywheel=flywheel, steps=36)
+
+
+def test_a_characteristic_drive_sized_for_delta_holds_it():
+    mech = _motor(f'"{MS} * (1 - omega / {W0})"')
+    mo = kinetostat.law_of_motion(mech, delta=0.02, steps=36)
+    assert mo.delta == pytest.approx(0.02, rel=1e-11) and mo.delta_target == 0.02
+    again = kinetostat.law_of_motion(mech, flywheel=mo.J_flywheel, steps=36)
+    assert np.allclose(again.omega, mo.omega, rtol=1e-11)
+    assert np.allclose(_forward_in_time(mo.phi_deg, flywheel=mo.J_flywheel), mo.omega, rtol=1e-8)
