@@ -10,9 +10,10 @@ of every step (they depend on the state, so this is a Python loop over the steps
 engines' own. Friction is not modelled by the engines: a mechanism with [friction] is refused.
 
 Integration: the classical Runge-Kutta method (RK4, order 4) at the step
-dt = 2 pi / (omega_mean * steps_per_rev), shortened where a step would pass a knot of a load's
-crank-angle table (np.interp: its slope jumps there, an O(dt^2) error in the step that holds it)
-to end there (predicted by phi + omega h + eps h^2 / 2: within O(h^3)), from the exact state at phi_0 (kinetostat's positions,
+dt = 2 pi / (omega_mean * steps_per_rev), shortened where a step would pass a crank angle at
+which a load table's value has a kink (np.interp: its slope jumps there, an O(dt^2) error in the
+step that holds it; the angles law_of_motion cuts its work integral at) to end there (predicted
+by phi + omega h + eps h^2 / 2: within O(h^3)), from the exact state at phi_0 (kinetostat's positions,
 velocities at omega(phi_0)), over `cycles` revolutions; both engines give only the accelerations:
 - MuJoCo: `mj_forward` (its soft equality constraints as the harness builds them,
   `engine_mujoco._compile`, made as stiff as it allows: impedance 0.9999, time constant
@@ -29,10 +30,7 @@ of M_drive and the loads, integrated by the same RK4, and in MuJoCo that of its 
 efc_force . efc_vel: on the shaper 0.5 J a cycle, all of its T + V - W drift) is measured over
 the whole run.
 
-A table in a point's travel (the shaper's cutting force) has its knots at crank angles no step
-lands on: such a model converges at order 2, not 4.
-
-May use: kinetostat (model, kinematics, applied, planar, law_of_motion), the scene, the MuJoCo and
+May use: kinetostat (model, kinematics, applied, planar, motion: law_of_motion and its cuts), the scene, the MuJoCo and
 Pinocchio adapters (imported when used), numpy.
 """
 from __future__ import annotations
@@ -48,6 +46,7 @@ import numpy as np
 from kinetostat import Mechanism, law_of_motion
 from kinetostat.applied import applied_wrenches, com_motion
 from kinetostat.kinematics import kinematics
+from kinetostat.motion import _Cycle
 from kinetostat.planar import as_xy
 
 from .scene import Scene, build_scene, loads_at_centres
@@ -320,13 +319,13 @@ def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: floa
 
 
 def _landings(mech: Mechanism, phi0: float, end: float) -> np.ndarray:
-    """The crank angles (rad, unwrapped, in (phi0, end], ascending) a step ends on: the knots of every
-    load's crank-angle table (np.interp: its slope jumps there, which would cost RK4 its order)
-    over the run, and the run's end."""
-    knots = np.radians([x for ld in mech.loads if ld.table is not None and ld.table.argument == "phi"
-                        for x in ld.table.x])
+    """The crank angles (rad, unwrapped, in (phi0, end], ascending) a step ends on: over the run,
+    the angles where a load table's value has a kink, as law_of_motion cuts its work integral
+    there (its `_Cycle.knots`: a crank-angle table's knots, where a travel table's point passes its
+    knots or turns), and the run's end."""
+    knots = np.radians(_Cycle.of(mech, np.zeros(1)).knots)
     turns = np.arange(math.floor(phi0 / (2 * math.pi)), math.ceil(end / (2 * math.pi)) + 1)
-    every = (np.mod(knots, 2 * math.pi)[:, None] + 2 * math.pi * turns).ravel()
+    every = (knots[:, None] + 2 * math.pi * turns).ravel()
     return np.unique(np.append(every[(every > phi0 + LANDING) & (every < end - LANDING)], end))
 
 
