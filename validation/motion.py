@@ -405,7 +405,7 @@ class MotionCheck:
     omega_mean: float          # rad/s
     delta: float               # 1
     J_flywheel: float          # kg m^2
-    M_drive: float             # N m, the drive's constant moment (drive's sense)
+    M_drive: float             # N m, the drive's moment at phi_0 (drive's sense; constant but for a characteristic)
     energy_error: float        # kinetostat's side: max |T - T(phi_0) - A(phi)| over the swing of A, 1
     rows: tuple[Agreement, ...]
     skipped: tuple[str, ...]   # engines not installed (never counted as agreeing)
