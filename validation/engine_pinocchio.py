@@ -127,6 +127,9 @@ class PinocchioScene:
         # working machine: the drive is a gear force on the crank
         dr = scene.mech.drive
         self.gear = dr.gear if dr.kind == "machine" else None
+        # the P cuts' guide angle minus slider angle at the scene's first state: constraint_gap's zero
+        pin.forwardKinematics(model, self.data, self.state(0)[0])
+        self.p_angles = [self._angle(p.links[0]) - self._angle(p.links[1]) for p, _, _ in self.p_cuts]
 
     @staticmethod
     def _depth_first(scene: Scene) -> list[int]:
@@ -147,6 +150,11 @@ class PinocchioScene:
         return order
 
     # -- geometry helpers
+    def _angle(self, link: int) -> float:
+        """The world angle of `link`'s joint frame (needs data.oMi), rad."""
+        R = self.data.oMi[self.jid[link]].rotation
+        return math.atan2(R[1, 0], R[0, 0])
+
     def _local(self, link: int, name: str) -> np.ndarray:
         return np.asarray(self.scene.mech.links[link].points[name], float) - self.off[link]
 
@@ -163,18 +171,23 @@ class PinocchioScene:
         return self.data.oMi[self.jid[link]].actInv(pin.Force(f, np.array([0.0, 0.0, mz])))
 
     def applied_fext(self, n: int) -> pin.StdVec_Force:
+        """The scene's applied loads at angle n as Pinocchio's fext (needs data.oMi)."""
+        return self.fext(self.F_ext[n], self.M_ext[n]) if self.has_ext else self.fext()
+
+    def fext(self, F: np.ndarray | None = None, M: np.ndarray | None = None) -> pin.StdVec_Force:
+        """Loads F (L, 2), N, at the centres of mass and M (L,), N m, about them (world) as
+        Pinocchio's fext, one joint-local spatial force per joint (needs data.oMi); none: zeros."""
         fext = pin.StdVec_Force()
         for _ in range(self.model.njoints):
             fext.append(pin.Force.Zero())
-        if not self.has_ext:
+        if F is None:
             return fext
         for b in self.scene.bodies:
             k = b.link
-            F, M = self.F_ext[n, k], self.M_ext[n, k]
-            if F[0] == 0 and F[1] == 0 and M == 0:
+            if F[k, 0] == 0 and F[k, 1] == 0 and M[k] == 0:
                 continue
             S = self.data.oMi[self.jid[k]].act(self.com_local[k])
-            fext[self.jid[k]] += self._world_force(k, _v3(F), S, float(M))
+            fext[self.jid[k]] += self._world_force(k, _v3(F[k]), S, float(M[k]))
         return fext
 
     def _point_motion(self, link: int, X: np.ndarray):
@@ -254,6 +267,26 @@ class PinocchioScene:
                 drift += [n @ (as_ - ag) + 2 * wg[2] * (_rot90(n) @ (vs - vg)), 0.0]
             geo.append((X, n))
         return np.array(rows).reshape(-1, self.nv), np.array(drift), geo
+
+    def constraint_gap(self, q) -> np.ndarray:
+        """The loop closures' position errors at q, in the rows of `constraint_jacobian` (whose
+        rows times v are their rates): R cuts the pin on the first link minus on the second
+        (x, y, m); P cuts the guide line's offset from the slider point along the guide's normal
+        (m) and the guide's angle minus the slider's less their angle at the scene's first state
+        (rad). Sets data.oMi."""
+        model, data = self.model, self.data
+        pin.forwardKinematics(model, data, q)
+        gap = []
+        for cm, cd, pair in zip(self.cmodels, self.cdatas, self.r_cuts):
+            cm.calc(model, data, cd)
+            gap += list((cd.oMc1.translation - cd.oMc2.translation)[:2])
+        for (pair, x_slider, d_guide), a0 in zip(self.p_cuts, self.p_angles):
+            g, s = pair.links
+            X = data.oMi[self.jid[s]].act(x_slider)
+            G = data.oMi[self.jid[g]].act(_v3(self._local(g, pair.guide)))      # oMi[0]: the world itself
+            n = data.oMi[self.jid[g]].rotation @ _rot90(d_guide)
+            gap += [(G - X) @ n, (self._angle(g) - self._angle(s) - a0 + math.pi) % (2 * math.pi) - math.pi]
+        return np.array(gap)
 
     def constraint_jacobian(self, q, with_drift=False, v=None):
         """Stacked in-plane constraint rows (n_con, nv): R cuts (x, y world) then P cuts."""

@@ -21,7 +21,7 @@ crank (`mech.drive.kind == "machine"`) is driven by the pinion's force on its ge
 point, `kinetostat.kinetostatics.gear_force(mech.drive.gear, M)`: same driving moment M, but the
 frame's reaction on the crank carries that force too, so adapters must apply it to compare R(0,1).
 
-May use: kinetostat (model, analysis, planar), numpy.
+May use: kinetostat (model, analysis, kinematics, planar), numpy.
 """
 from __future__ import annotations
 
@@ -31,10 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinetostat import Analysis, Mechanism, analyze
+from kinetostat.kinematics import Kinematics
 from kinetostat.model import MAX_VALUE, Pair
 from kinetostat.planar import cross, rotate
 
-__all__ = ["Joint", "Body", "Scene", "EngineResult", "build_scene", "tracked_points"]
+__all__ = ["Joint", "Body", "Scene", "EngineResult", "build_scene", "loads_at_centres", "tracked_points"]
 
 
 @dataclass(frozen=True)
@@ -83,16 +84,7 @@ class Scene:
     def external(self) -> tuple[np.ndarray, np.ndarray]:
         """Applied loads other than gravity on each link: force at the centre of mass
         (N, L, 2) and moment about the centre of mass (N, L), world frame, N and N m."""
-        kin = self.res.kin
-        F, M = self.res.F_applied.copy(), self.res.M_applied.copy()
-        weight = np.array([0.0, -self.g])
-        for b in self.bodies:
-            O = kin.origin[:, b.link]
-            S = O + rotate(b.com, kin.theta[:, b.link])
-            F[:, b.link] -= b.mass * weight
-            M[:, b.link] -= cross(S - O, np.broadcast_to(b.mass * weight, S.shape))
-            M[:, b.link] += cross(O - S, F[:, b.link])
-        return F, M
+        return loads_at_centres(self.bodies, self.g, self.res.kin, self.res.F_applied, self.res.M_applied)
 
     def reaction(self, pair: Pair) -> np.ndarray:
         """The solver's reaction of pair.links[0] on pair.links[1], (N, 2), N."""
@@ -102,6 +94,22 @@ class Scene:
     def M_drive(self) -> np.ndarray:
         """The solver's driving moment on the crank about +z, (N,), N m."""
         return self.res.balancing_moment
+
+
+def loads_at_centres(bodies: tuple[Body, ...], g: float, kin: Kinematics, F_applied: np.ndarray,
+                     M_applied: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The applied loads F_applied (N, L, 2), N, and M_applied (N, L), N m about each link's local
+    origin, as the engines take them: gravity taken out (the engines have their own), the force at
+    the body's centre of mass and the moment about it."""
+    F, M = F_applied.copy(), M_applied.copy()
+    weight = np.array([0.0, -g])
+    for b in bodies:
+        O = kin.origin[:, b.link]
+        S = O + rotate(b.com, kin.theta[:, b.link])
+        F[:, b.link] -= b.mass * weight
+        M[:, b.link] -= cross(S - O, np.broadcast_to(b.mass * weight, S.shape))
+        M[:, b.link] += cross(O - S, F[:, b.link])
+    return F, M
 
 
 def tracked_points(mech: Mechanism) -> tuple[tuple[str, int], ...]:
