@@ -132,14 +132,14 @@ def test_analyze_delta_gives_the_laws_balancing_moment(cli, tmp_path, motion):
     assert abs(true - constant) > 1e-3 * abs(constant)          # the true motion's M_bal is another number
 
 
-def _section(name: str, **law) -> str:
+def _section(name: str, engines: tuple[str, ...] = (), **law) -> str:
     from kinetostat.report.document import Doc
     from kinetostat.report.runs import ModelRun
     from kinetostat.report.writer import _motion_section
     mech = kinetostat.load(name)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        run = ModelRun(mech, kinetostat.analyze(mech, steps=360))
+        run = ModelRun(mech, kinetostat.analyze(mech, steps=360), engines=engines)
         doc = Doc("t")
         _motion_section(doc, run, **law)
     return doc.markdown()
@@ -156,6 +156,20 @@ def test_report_section_law_of_motion(motion):
         constant = kinetostat.analyze(motion.mech, phi_deg=[30.0]).balancing_moment[0]
     assert f"| M_bal, N·m | {_fmt(constant)} | {_fmt(true)} |" in md          # the model's symbol (lettering)
     assert f"flywheel J = 0.5 kg·m² given (--flywheel)" in _section(MODEL, flywheel=0.5)
+
+
+@pytest.mark.engines
+def test_report_section_has_the_engines_forward_dynamics():
+    """With the engines among the run's routes the section gives each engine's omega(phi) against the
+    law of the frictionless machine: RK4 at 90 steps a revolution, MuJoCo's soft loops to ~1e-6,
+    Pinocchio to ~1e-7 (tests/test_motion_engines.py: they converge at the integrators' orders)."""
+    pytest.importorskip("mujoco")
+    pytest.importorskip("pinocchio")
+    md = _section(MODEL, engines=("lever", "pinocchio", "mujoco"))
+    rows = dict(re.findall(r"^\| (mujoco|pinocchio) \| (\S+) ", md, flags=re.M))
+    assert set(rows) == {"mujoco", "pinocchio"}
+    assert float(rows["mujoco"]) < 5e-6 and float(rows["pinocchio"]) < 5e-7
+    assert "mujoco" not in _section(MODEL)                      # not among the routes: not run
 
 
 def test_report_section_skips_a_model_with_no_drive_to_balance():

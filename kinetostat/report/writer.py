@@ -46,6 +46,9 @@ MOTION_HEADING = "Law of motion"
 DEFAULT_DELTA = 0.02
 #: The angle of the section's M_bal at constant omega and at the true omega(phi), deg.
 MOTION_AT_DEG = 30.0
+#: The engines' forward dynamics in the law-of-motion section: RK4 steps a revolution (one cycle; at
+#: 90 the error is about 1e-6 for MuJoCo's soft loops and 1e-7 for Pinocchio, about 1 s a model).
+MOTION_STEPS_PER_REV = 90
 
 #: The project's studies, linked from the index where their files are in its folder.
 STUDIES = (("stability.md", "Stability: the solver's accuracy near singular positions"),
@@ -491,10 +494,27 @@ def _law_choice(m: Mechanism, delta: float | None, flywheel: float | None) -> tu
     return {"delta": DEFAULT_DELTA}, f"the flywheel sized for δ = {DEFAULT_DELTA:g} by default (the model has no [flywheel])"
 
 
-def _forward_dynamics_rows(m: Mechanism, motion) -> list[list[str]]:
-    """The hook for the engines' check of the law (forward dynamics of the machine with its flywheel,
-    MuJoCo and Pinocchio): its rows for the section's table. None are run in the report today."""
-    return []
+def _forward_dynamics(doc: Doc, run: ModelRun, kwargs: dict) -> None:
+    """The engines' check of the law (`kinetostat_validation.motion.check_law_of_motion`): MuJoCo
+    and Pinocchio, those of them among the run's routes, integrate the machine forward with its
+    flywheel and drive moment (RK4, MOTION_STEPS_PER_REV steps a revolution, one cycle from
+    kinetostat's state at phi_0) on the mechanism without friction (the engines model none); their
+    omega(phi) against kinetostat's law of the same machine, and their energy balance."""
+    from kinetostat_validation.motion import ENGINES, check_law_of_motion
+    engines = tuple(e for e in ENGINES if e in run.engines)
+    if not engines:
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check = check_law_of_motion(run.mech, engines=engines, steps_per_rev=(MOTION_STEPS_PER_REV,), cycles=1, **kwargs)
+    doc.p(f"Forward dynamics of the same machine by the engines (RK4 at {MOTION_STEPS_PER_REV} steps a revolution, "
+          f"one cycle from kinetostat's state at φ₀{'; ' + esc(check.note) if check.note else ''}): ω(φ) against "
+          f"kinetostat's law of that machine (J_flywheel = {_fmt(check.J_flywheel)} kg·m², its energy balance "
+          f"{_rel(check.energy_error)} of the work's swing). The engines' error falls with the step at their "
+          "integrators' orders (tests/test_motion_engines.py).")
+    doc.table(["engine", "max |Δω| / ω_mean", "energy balance, of the work's swing"],
+              [[a.engine, _rel(a.error), _rel(a.energy_error)] for a in check.rows]
+              + [[e, "SKIPPED: not installed", "-"] for e in check.skipped], "lrr")
 
 
 def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywheel: float | None = None):
@@ -538,12 +558,16 @@ def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywhee
     doc.table(["quantity", "value", "from the exact"], rows, "lrr")
     s = m.drive.sense
     doc.table([f"at φ = {MOTION_AT_DEG:g}°", "constant ω", "true ω(φ)"],
-              [[f"{esc(quantity_name(m, 'M_bal'))}, N·m", _fmt(const.balancing_moment[0]), _fmt(true.balancing_moment[0])],
-               ["ω₁, rad/s", _fmt(s * const.omega(1)[0]), _fmt(s * true.omega(1)[0])],
-               ["ε₁, rad/s²", _fmt(s * const.eps(1)[0]), _fmt(s * true.eps(1)[0])]], "lrr")
-    fd = _forward_dynamics_rows(m, motion)
-    if fd:
-        doc.table(["engine", "max |Δω| / ω_mean", "energy balance"], fd, "lrr")
+              [[f"{esc(quantity_name(m, 'M_bal'))}, N·m", _fmt(const.balancing_moment[0]), _fmt(true.balancing_moment[0])]]
+              + ([[f"{esc(quantity_name(m, 'M_bal'))} with friction (first approximation), N·m",
+                   _fmt(const.balancing_moment_with_friction[0]), _fmt(true.balancing_moment_with_friction[0])]]
+                 if m.friction is not None else [])
+              + [["ω₁, rad/s", _fmt(s * const.omega(1)[0]), _fmt(s * true.omega(1)[0])],
+                 ["ε₁, rad/s²", _fmt(s * const.eps(1)[0]), _fmt(s * true.eps(1)[0])]], "lrr")
+    doc.p("At the true ω(φ) the crank carries the flywheel, so the balancing moment"
+          + (" with friction" if m.friction is not None else "") + " is the drive's moment at every angle "
+          "(the moment about +z).")
+    _forward_dynamics(doc, run, kwargs)
     return motion
 
 
