@@ -17,7 +17,8 @@ each sheet; an alternative (F_i2(h)) and a link drawn on to a force off it dashe
 vector shorter than 1 mm at its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a
 polygon whose sides must close, lettered at its point and noted as negligible; the lever's arms as
 dimension lines with their mm (`_dimensions`); every letter placed by `labels.Placer`
-(for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
+(for all angles at once) clear of every other letter, arrowhead and point, and off the links and
+vectors (heavy lines; a leader back to its point where it had to go far); coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
 
@@ -724,7 +725,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
                                    length_mm=Lz if contract else None))
         if s.kind in _ARROWS:
             out.append(Element("path", _where(drawn, head), {"class": "arrowhead", "fill": colour}))
-        placer.line(_where(drawn, _lines(a, b)))
+        placer.line(_where(drawn, _lines(a, b)), heavy=s.kind in _ARROWS or role_of(s) == "link")
         named = s.kind not in ("link", "extension") and (not labelled(s.end) or (sides is not None and s.kind == "vector")
                                                          or s.kind == "arm")
         lettered = neg | (drawn & named)
