@@ -87,20 +87,30 @@ def hidden_arc_heads(d, i: int) -> list[float]:
     return out
 
 
+def label_box(markup: str, size: float, x: float, y: float) -> np.ndarray:
+    """The box (x0, y0, x1, y1) of a label's markup at font size `size`, baseline start (x, y): each
+    tspan's advances at its font size (DejaVu Sans), from its ascent to its descent, shifted by its
+    dy (a sub- or superscript)."""
+    width, top, bottom, dy = 0.0, -ASCENT * size, DESCENT * size, 0.0
+    for attrs, t in re.findall(r"<tspan([^>]*)>([^<]*)</tspan>", markup):
+        fs = float(m[1]) if (m := re.search(r'font-size="([-\d.]+)"', attrs)) else size
+        dy += float(m[1]) if (m := re.search(r'dy="([-\d.]+)"', attrs)) else 0.0
+        width += text_width(t, fs)
+        top, bottom = min(top, dy - ASCENT * fs), max(bottom, dy + DESCENT * fs)
+    return np.array([x, y + top, x + width, y + bottom])
+
+
 def labels_over_heavy_lines(d, i: int) -> list[str]:
-    """The labels of angle i (points', vectors' names, steps) whose box (its tspans' advances at
-    their font sizes, ascent to descent, less 0.3 mm of rounding all round) a heavy line crosses."""
+    """The labels of angle i (points', vectors' names, steps) whose box (`label_box`, less 0.2 mm
+    all round: the page's rounding, the font's side bearings) a heavy line crosses."""
     out = []
     lines = _heavy(d, i)
     for e in d.elements:
         if e.tag != "text" or e.attrs.get("class") not in ("name", "point", "step") or not np.isfinite(_at(e, i)).all():
             continue
-        size = float(e.attrs["font-size"])
         markup = e.texts[int(e.variant[i if len(e.variant) > 1 else 0])]
-        runs = re.findall(r'<tspan(?: font-size="([\d.]+)")?[^>]*>([^<]*)</tspan>', markup)
-        width = sum(text_width(t, float(fs) if fs else size) for fs, t in runs)
         (x, y), = _at(e, i)
-        box = np.array([x + 0.3, y - ASCENT * size + 0.3, x + width - 0.3, y + DESCENT * size + 0.2])
+        box = label_box(markup, float(e.attrs["font-size"]), x, y) + np.array([0.2, 0.2, -0.2, -0.2])
         for a, b, _ in lines:
             p = a + np.linspace(0.0, 1.0, 201)[:, None] * (b - a)
             if ((p[:, 0] > box[0]) & (p[:, 0] < box[2]) & (p[:, 1] > box[1]) & (p[:, 1] < box[3])).any():
