@@ -262,8 +262,8 @@ class Placer:
         self.n = n
         self.bounds = bounds
         # ("hard", still) -> boxes grown by PAD (4, R, S); ("soft", still) -> lines and their bounding
-        # boxes (8, R, S), ("heavy", still) likewise for the heavy lines; float32, coordinate by
-        # coordinate; R = 1 where still (the same at every angle), else N
+        # costs a mm (LINE_COST, or HEAVY_COST: a heavy line) and bounding boxes (9, R, S); float32,
+        # coordinate by coordinate; R = 1 where still (the same at every angle), else N
         self._parts: dict[tuple[str, bool], list[np.ndarray]] = {}
         self._stacked: dict[tuple[str, bool], tuple[int, np.ndarray]] = {}     # parts stacked, their stack
 
@@ -276,7 +276,8 @@ class Placer:
         """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent.
         `heavy`: links, vectors, costed at HEAVY_COST a mm, not LINE_COST."""
         rows = self._rows(seg)
-        self._add("heavy" if heavy else "soft", np.concatenate([rows, _bounds(rows)], axis=-1))
+        cost = np.full(rows.shape[:-1] + (1,), HEAVY_COST if heavy else LINE_COST)
+        self._add("soft", np.concatenate([rows, cost, _bounds(rows)], axis=-1))
 
     def _rows(self, a) -> np.ndarray:
         """Obstacles as (R, S, 4): R = 1 where the same at every angle (given so, or found so)."""
@@ -288,15 +289,15 @@ class Placer:
         self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32).transpose(2, 0, 1))
 
     def _stack(self, key: str, still: bool) -> np.ndarray:
-        """The hard obstacles (grown by PAD) (4, R, H), or the lines (heavy or not) and their
-        bounding boxes (8, R, H), the same at every angle (still: R = 1) or not (R = N): those
+        """The hard obstacles (grown by PAD) (4, R, H), or the lines, their costs a mm and their
+        bounding boxes (9, R, H), the same at every angle (still: R = 1) or not (R = N): those
         added since the last call appended."""
         parts = self._parts.get((key, still), [])
         done, stacked = self._stacked.get((key, still), (0, None))
         if done < len(parts) or stacked is None:
             rows = 1 if still else self.n
             if stacked is None:
-                stacked = np.empty((4 if key == "hard" else 8, rows, 0), dtype=np.float32)
+                stacked = np.empty((4 if key == "hard" else 9, rows, 0), dtype=np.float32)
             stacked = np.concatenate([stacked, *(np.broadcast_to(p, p.shape[:1] + (rows,) + p.shape[2:])
                                                  for p in parts[done:])], axis=2)
             self._stacked[key, still] = (len(parts), stacked)
@@ -384,13 +385,12 @@ class Placer:
         return np.isfinite(cost[:, 0])
 
     def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: tuple[bool, ...],
-               kinds: tuple[str, ...] = ("hard", "heavy", "soft")) -> np.ndarray:
+               kinds: tuple[str, ...] = ("hard", "soft"), heavy: bool = False) -> np.ndarray:
         """Costs c (n', B) of the boxes centred at p (2, n', B), half size h (2, n'), at the angles
         `rows`: inf where a box meets a hard obstacle, plus LINE_COST per mm of the lines inside
-        it and HEAVY_COST per mm of the heavy lines inside it; of the obstacles the same at every
-        angle (`still` holds True) and of those that move (False); `kinds` ("hard",): whether
-        free only, the lines not costed; ("hard", "heavy"): the heavy lines costed, not the
-        others."""
+        it (HEAVY_COST per mm of a heavy one); of the obstacles the same at every angle (`still`
+        holds True) and of those that move (False); `kinds` ("hard",): whether free only, the
+        lines not costed; `heavy`: the heavy lines costed only."""
         stacks = [(key, fixed, items) for key in kinds for fixed in still
                   for items in (self._stack(key, fixed),) if items.shape[2]]
         free = np.isfinite(c)
@@ -406,7 +406,7 @@ class Placer:
             if not len(r):
                 continue
             at = j if fixed else rows[r] * items.shape[2] + j
-            items = np.take(items.reshape(len(items), -1), at, axis=1)   # (4 or 8, pairs)
+            items = np.take(items.reshape(len(items), -1), at, axis=1)   # (4 or 9, pairs)
             counts = np.bincount(r, minlength=len(c))                     # r ascending: each row's pairs together
             X, Y, w, v = (np.repeat(a, counts, axis=0) for a in (px, py, hx, hy))
             inside = X > (items[-4] - w)[:, None]                         # a box over it: its centre in it grown by h
@@ -417,14 +417,15 @@ class Placer:
                 blocked |= _any_by_row(inside, counts)
             else:
                 inside &= np.repeat(free & ~blocked, counts, axis=0)
+                if heavy:
+                    inside &= (items[4] == HEAVY_COST)[:, None]
                 f, q = _nonzero(inside)
-                pairs.append((key, r[f], q, np.take(items[:4], f, axis=1)))
+                pairs.append((r[f], q, np.take(items[:5], f, axis=1)))
         c = np.where(blocked, np.inf, c)
-        for key, r, q, ln in pairs:                                        # the lines each free box covers
+        for r, q, ln in pairs:                                             # the lines each free box covers
             x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
-            covered = _clipped(ln.T, np.stack([x - w, y - v, x + w, y + v], axis=-1))
-            cost = HEAVY_COST if key == "heavy" else LINE_COST
-            c = c + cost * np.bincount(r * c.shape[1] + q, covered, c.size).reshape(c.shape)
+            covered = _clipped(ln[:4].T, np.stack([x - w, y - v, x + w, y + v], axis=-1)) * ln[4]
+            c = c + np.bincount(r * c.shape[1] + q, covered, c.size).reshape(c.shape)
         return c
 
     def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool) -> np.ndarray:
@@ -449,7 +450,7 @@ class Placer:
         guess = np.column_stack([k[sample[at - 1]], k[sample[at]]])    # the searched angle before, then after
         xy, base = geometry(between, np.maximum(guess, 0))
         free = self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False),
-                           ("hard", "heavy")) <= base           # free, and over no heavy line
+                           heavy=True) <= base                  # free, and over no heavy line
         free &= np.isfinite(base)
         free &= guess >= 0
         first = np.argmax(free, axis=1)
