@@ -204,3 +204,19 @@ def test_clear_tells_a_box_that_meets_a_hard_obstacle_at_its_angle():
     assert pl.clear(np.array([over, over, [np.nan] * 4])).tolist() == [False, True, False]
     beside = np.array([12.2, 10.0, 20.0, 12.0])
     assert pl.clear(np.array([beside] * 3)).tolist() == [True, True, True]
+
+
+def test_a_label_keeps_off_heavy_lines_that_it_would_cover_were_they_thin():
+    """A point where twelve lines meet 30 deg apart (a force polygon's vertex, the links at a
+    pin): over thin lines its label stays next to it, over some of them (a line costs LINE_COST
+    a mm); over heavy ones (links, vectors) it goes out where none of them meets its box, with a
+    leader back to the point."""
+    t = np.radians(np.arange(0.0, 360.0, 30.0))
+    star = np.column_stack([np.full(12, 30.0), np.full(12, 30.0), 30.0 + 25.0 * np.cos(t), 30.0 + 25.0 * np.sin(t)])
+    for heavy in (False, True):
+        placer = Placer(1, (0.0, 0.0, 60.0, 60.0))
+        placer.line(star[None], heavy)
+        placed = placer.place(("B",), np.zeros(1, dtype=int), 3.5, np.array([[30.0, 30.0]]))
+        covered = sum(_clipped(s, placed.box[0]) for s in star)
+        assert (covered == 0 and np.allclose(placed.leader[0, :2], 30.0)) if heavy else \
+            (covered > 1.0 and np.isnan(placed.leader).all()), (heavy, placed)

@@ -17,11 +17,12 @@ each sheet; an alternative (F_i2(h)) and a link drawn on to a force off it dashe
 vector shorter than 1 mm at its scale is drawn out of scale at MIN_DRAWN_MM with a note, or, on a
 polygon whose sides must close, lettered at its point and noted as negligible; the lever's arms as
 dimension lines with their mm (`_dimensions`); every letter placed by `labels.Placer`
-(for all angles at once) clear of every other letter, arrowhead and point; coincident points lettered once ("B1 ≡ B11");
+(for all angles at once) clear of every other letter, arrowhead and point, and off the links and
+vectors (heavy lines; a leader back to its point where it had to go far); coincident points lettered once ("B1 ≡ B11");
 no text under 2.5 mm. Words, units and numbers from the catalogue (`i18n`: en, uk, ru). Every
 text that comes from a model (names, notes) is escaped.
 
-May use: the standard library, numpy, `.core`, `.i18n`, `.labels`, `.symbols`, `.forces` (an arm's
+May use: the standard library, numpy, `.arcs` (a short vector's drawn length), `.core`, `.i18n`, `.labels`, `.symbols`, `.forces` (an arm's
 name), `kinetostat._text` (XML-safe text), `kinetostat.model.lettering` (a symbol in the sheet's
 language); matplotlib only inside `figure`.
 """
@@ -35,6 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._text import xml_escape as escape     # also control characters, which XML cannot hold
+from .arcs import MIN_DRAWN_MM
 from .core import ELEMENTS, ROLES, Drawing, Element, Plan, PlanCycle, Segment, extent, extent_cycle, role_of
 from .forces import arm_name
 from .i18n import LANGS, MESSAGES, accuracy, check_lang, num, phrase, text, unit
@@ -54,8 +56,8 @@ _AREA = (25.0, 10.0, 410.0, 242.0)          # where the plan is centred (above t
 ARROW_MM = (3.5, 0.6)
 #: Arrowhead on an arc (the sense of ω, ε, a couple M), mm: drafting size whatever the arc's chord.
 ARC_HEAD_MM = 2.8
-#: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM.
-TINY_MM, MIN_DRAWN_MM = 1.0, 6.0
+#: A vector drawn shorter than this at its scale is drawn out of scale at MIN_DRAWN_MM (`arcs`).
+TINY_MM = 1.0
 #: A vector shorter than this (mm) is rounding noise of a zero (a load's arm at a dead centre): it
 #: has no direction to draw it out of scale in, and is noted as negligible.
 ZERO_MM = 1e-9
@@ -726,7 +728,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
                                    length_mm=Lz if contract else None))
         if s.kind in _ARROWS:
             out.append(Element("path", _where(drawn, head), {"class": "arrowhead", "fill": colour}))
-        placer.line(_where(drawn, _lines(a, b)))
+        placer.line(_where(drawn, _lines(a, b)), heavy=s.kind in _ARROWS or role_of(s) == "link")
         named = s.kind not in ("link", "extension") and (not labelled(s.end) or (sides is not None and s.kind == "vector")
                                                          or s.kind == "arm")
         lettered = neg | (drawn & named)

@@ -33,7 +33,8 @@ note; a prismatic pair's normal force whose offset x falls outside its slider li
 it acts, the link's line drawn on to it (kind "extension"), with a note and a ModelWarning.
 
 May use: numpy, the solver's public results (`Analysis`, `Mechanism`), `kinetostat.applied`
-(load magnitudes), `kinetostat.errors` (the warning), `core` and `zero`. Never matplotlib, never
+(load magnitudes), `kinetostat.errors` (the warning), `core`, `zero` and `arcs` (a couple's arc,
+turned so that its arrowhead falls clear of the plan's links and vectors). Never matplotlib, never
 the harness.
 """
 from __future__ import annotations
@@ -47,6 +48,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..applied import applied_moment, point_forces
+from .arcs import arc, heavy_lines
 from .core import PlanCycle, Result, Scale, Segment, alias, construction
 from ..model.lettering import lettering, link_number, reaction_name
 from .scales import round_scale
@@ -400,14 +402,6 @@ def _arm(mech: "Mechanism", segs: list, pts: dict, name: str, M: np.ndarray, M_n
     segs.append(Segment(name, M_name, f"{name}:foot", _abs(foot - M), "m", "arm"))
 
 
-def _couple_path(S: np.ndarray, moment: np.ndarray, radius_mm: float) -> np.ndarray:
-    """(N, 19): a 270-degree arc around S (mm) in the sense of the moment at each angle (ccw for
-    positive)."""
-    sense = np.where(np.asarray(moment) >= 0, 1.0, -1.0)
-    t = np.linspace(-0.75 * np.pi, 0.75 * np.pi, 19)
-    return np.asarray(S)[:, None] + radius_mm * np.exp(1j * sense[:, None] * t)
-
-
 def _link_drawing(mech: "Mechanism", res: "Analysis", k: int, pts: dict, segs: list, mu_l: Scale) -> None:
     """Link k at mu_l: its points, and a segment between every two of its joints."""
     joints = [p.point for p in mech.pairs if k in p.links and p.point in mech.links[k].points]
@@ -489,6 +483,7 @@ def _dyad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: S
         for x in links:
             for ld in loads[x]:
                 _arm(mech, segs, pts, arm_name(ld.name), M, M_name, ld.point, ld.force, mu_l)
+    _group_couples(mech, res, (j, k), pts, segs, paths, mu_l)
     notes = _friction_circles(mech, res, g.pairs, pts, segs, paths, mu_l)
     return _cycle(f"group:{_group_label(g)}", f"Group {_group_label(g)} ({g.kind}): loads and reactions"
                   + (" with friction" if res.friction is not None else "") + f"; forces drawn at {mu_g}",
@@ -497,9 +492,10 @@ def _dyad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: S
 
 def _links_and_loads(mech: "Mechanism", res: "Analysis", loads: dict[int, list[Load]], pts: dict, segs: list,
                      paths: dict, mu_l: Scale, mu_F: Scale) -> list[tuple[str, ...]]:
-    """The links of a group (the keys of `loads`) at mu_l, their loads at mu_F, the moments as
-    arcs and the single inertia resultants; an inertia force or a couple not drawn where it is
-    zero (`_zeros`). Returns each angle's notes: what is zero there, what F_i(h) replaces."""
+    """The links of a group (the keys of `loads`) at mu_l, their loads at mu_F and the single
+    inertia resultants; an inertia force not drawn where it is zero (`_zeros`). Returns each
+    angle's notes: what is zero there (a couple too: `_group_couples` draws them), what F_i(h)
+    replaces."""
     for x in loads:
         _link_drawing(mech, res, x, pts, segs, mu_l)
     zeros: dict[str, tuple[np.ndarray, str]] = {}
@@ -508,7 +504,6 @@ def _links_and_loads(mech: "Mechanism", res: "Analysis", loads: dict[int, list[L
         zeros.update(_zeros(mech, res, x))
         for ld in loads[x]:
             _load_arrow(segs, pts, ld, zeros, mu_l, mu_F)
-        _couples(mech, res, x, _couple_centre(mech, res, x), 8.0, zeros, paths, mu_l)
         replaces.append(_resultant(mech, res, x, pts, segs, mu_l, mu_F))
     notes = zero_notes(zeros, len(res.phi_deg))
     return [z + tuple(r[i] for r in replaces if r[i]) for i, z in enumerate(notes)]
@@ -545,13 +540,30 @@ def _couple_centre(mech: "Mechanism", res: "Analysis", k: int) -> np.ndarray:
 
 
 def _couples(mech: "Mechanism", res: "Analysis", k: int, at: np.ndarray, radius_mm: float,
-             zeros: dict[str, tuple[np.ndarray, str]], paths: dict, mu_l: Scale) -> None:
+             zeros: dict[str, tuple[np.ndarray, str]], paths: dict, mu_l: Scale, lines) -> None:
     """Link k's couples as arcs of `radius_mm` about `at` (world m), NaN where zero (`zeros`);
-    one zero at every angle not drawn at all."""
+    one zero at every angle not drawn at all. Each arc `_couple_arc`, clear of `lines`."""
     for c in link_couples(mech, res, k):
         zero = zeros[c.name][0]
         if not zero.all():
-            paths[c.name] = np.where(zero[:, None], np.nan, _couple_path(_over(at, mu_l.value), c.moment, radius_mm))
+            paths[c.name] = np.where(zero[:, None], np.nan, _couple_arc(_over(at, mu_l.value), c.moment, radius_mm, lines))
+
+
+def _couple_arc(S: np.ndarray, moment: np.ndarray, radius_mm: float, lines) -> np.ndarray:
+    """(N, 19): a 270-degree arc around S (mm) in the sense of the moment at each angle (ccw for
+    positive), its ends either side of S's right, turned so that its arrowhead falls clear of
+    the heavy `lines` (`arcs.arc`)."""
+    sense = np.where(np.asarray(moment) >= 0, 1.0, -1.0)
+    return arc(np.asarray(S), radius_mm, sense, -135.0 * sense, 270.0, lines)
+
+
+def _group_couples(mech: "Mechanism", res: "Analysis", links, pts: dict, segs: list, paths: dict,
+                   mu_l: Scale) -> None:
+    """The couples of a group's `links`, drawn last, about each link's centre of mass (8 mm arcs),
+    their arrowheads clear of every link and vector drawn on the plan."""
+    lines = heavy_lines(pts, segs)
+    for x in links:
+        _couples(mech, res, x, _couple_centre(mech, res, x), 8.0, _zeros(mech, res, x), paths, mu_l, lines)
 
 
 def _leash_parts(mech: "Mechanism", res: "Analysis", side) -> _Parts:
@@ -656,6 +668,7 @@ def _triad_group_plan(mech: "Mechanism", res: "Analysis", g, mu_l: Scale, mu_F: 
     for x in g.links:
         for ld in loads[x]:
             _arm(mech, segs, pts, f"{arm_name(ld.name)}({S_name})", S, S_name, ld.point, ld.force, mu_l)
+    _group_couples(mech, res, g.links, pts, segs, paths, mu_l)
     return _cycle(f"group:{_group_label(g)}", f"Group {g.label} (III3, Assur's point {S_name}): loads and reactions; "
                   f"forces drawn at {mu_F}", mu_l, res, pts, segs, paths, notes)
 
@@ -924,7 +937,6 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
         _load_arrow(segs, pts, ld, zeros, mu_l, mu_F)
     for ld in on_crank:
         _arm(mech, segs, pts, arm_name(ld.name), O, dr.pivot, ld.point, ld.force, mu_l)
-    _couples(mech, res, 1, O, 6.0, zeros, paths, mu_l)
     R01 = _reaction_load(mech, res, 0, 1)
     _arrow(segs, pts, R01.name, R01.point, R01.force, mu_l, mu_F, role="result")
     M_bal = np.asarray(res.balancing_moment, dtype=float)
@@ -951,9 +963,10 @@ def _crank_plan(mech: "Mechanism", res: "Analysis", mu_l: Scale, mu_F: Scale) ->
         results = (Result(L.F_bal, _abs(F_bal), "N"), Result("r_b", np.full(len(P), gear.r_b), "m"),
                    Result(L.M_bal, M_bal, "N m", "M = F r_b"))
     else:
-        paths[L.M_bal] = _couple_path(_over(O, mu_l.value), M_bal, 10.0)
+        paths[L.M_bal] = _couple_arc(_over(O, mu_l.value), M_bal, 10.0, heavy_lines(pts, segs))
         titles = [f"Initial link: balancing couple {L.M_bal} = {m:.6g} N m" for m in M_bal.tolist()]
         results = (Result(L.M_bal, M_bal, "N m", "M = sum"),)
+    _couples(mech, res, 1, O, 6.0, zeros, paths, mu_l, heavy_lines(pts, segs))
     notes = _friction_circles(mech, res, [p for p in mech.pairs if dr.link in p.links], pts, segs, paths, mu_l)
     return _cycle("crank", [f"{t}; forces drawn at {mu_F}" for t in titles], mu_l, res, pts, segs, paths,
                   notes=[tuple(notes) + z for z in zero_notes(zeros, len(res.phi_deg))], results=results)

@@ -10,13 +10,16 @@ anchors and segments are arrays with a leading angle axis N, NaN where absent at
 The placer takes labels in the order given (points first, then names of vectors) and, for all
 angles at once, each label's candidate places about its anchor (rings of 16 directions, or
 beside its segment): a candidate's cost is its distance from the anchor plus the length of drawn
-lines it covers (each line clipped to the box, exactly); a candidate over a hard obstacle
+lines it covers (each line clipped to the box, exactly), of a heavy line (a link, a vector:
+`Placer.line(..., heavy=True)`) HEAVY_COST a mm, so that a label goes round it, or away with a
+leader, rather than over it; a candidate over a hard obstacle
 (arrowhead, point, line end, a label placed before) or outside the bounds is not free. At every
 angle the least cost is found (candidates tested lazily, cheapest first, until none left can
 beat it); then the label keeps one place where it may: the candidate within `SLACK` of the best
 at the most angles is taken at all of them, and so on for the angles left. Over a page's many
 angles this search runs at every `STRIDE`-th angle; an angle between keeps a searched
-neighbour's place where that is free, and only the angles where neither is are searched.
+neighbour's place where that is free (and off every heavy line), and only the angles where
+neither is are searched.
 Obstacles and candidates the same at every angle are tested once for the cycle. A label that
 had to move far gets a thin leader line from its anchor.
 
@@ -176,6 +179,9 @@ _CAND_COST = _constant(np.r_[np.zeros(len(_ALONG_OFF)), _RING_COST])
 SLACK = 1.5
 #: The cost of covering a drawn line, per mm of it inside the label's box.
 LINE_COST = 0.6 / 0.7
+#: The cost of covering a heavy line (a link, a vector), per mm of it inside the label's box: as
+#: much as moving the label 25 mm further out.
+HEAVY_COST = 30.0
 #: Candidates tested at once (cheapest first): this many (a point label's three nearest rings),
 #: twice as many from the third batch on.
 _BATCH = 48
@@ -256,8 +262,8 @@ class Placer:
         self.n = n
         self.bounds = bounds
         # ("hard", still) -> boxes grown by PAD (4, R, S); ("soft", still) -> lines and their bounding
-        # boxes (8, R, S), float32, coordinate by coordinate; R = 1 where still (the same at every
-        # angle), else N
+        # costs a mm (LINE_COST, or HEAVY_COST: a heavy line) and bounding boxes (9, R, S); float32,
+        # coordinate by coordinate; R = 1 where still (the same at every angle), else N
         self._parts: dict[tuple[str, bool], list[np.ndarray]] = {}
         self._stacked: dict[tuple[str, bool], tuple[int, np.ndarray]] = {}     # parts stacked, their stack
 
@@ -266,10 +272,12 @@ class Placer:
         every angle); NaN where absent."""
         self._add("hard", self._rows(box) + np.array([-self.PAD, -self.PAD, self.PAD, self.PAD]))
 
-    def line(self, seg) -> None:
-        """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent."""
+    def line(self, seg, heavy: bool = False) -> None:
+        """Soft obstacles: drawn lines (x0, y0, x1, y1), shaped as `block`'s boxes; NaN where absent.
+        `heavy`: links, vectors, costed at HEAVY_COST a mm, not LINE_COST."""
         rows = self._rows(seg)
-        self._add("soft", np.concatenate([rows, _bounds(rows)], axis=-1))
+        cost = np.full(rows.shape[:-1] + (1,), HEAVY_COST if heavy else LINE_COST)
+        self._add("soft", np.concatenate([rows, cost, _bounds(rows)], axis=-1))
 
     def _rows(self, a) -> np.ndarray:
         """Obstacles as (R, S, 4): R = 1 where the same at every angle (given so, or found so)."""
@@ -281,15 +289,15 @@ class Placer:
         self._parts.setdefault((key, len(part) == 1), []).append(part.astype(np.float32).transpose(2, 0, 1))
 
     def _stack(self, key: str, still: bool) -> np.ndarray:
-        """The hard obstacles (grown by PAD) (4, R, H), or the lines and their bounding boxes
-        (8, R, H), the same at every angle (still: R = 1) or not (R = N): those added since the
-        last call appended."""
+        """The hard obstacles (grown by PAD) (4, R, H), or the lines, their costs a mm and their
+        bounding boxes (9, R, H), the same at every angle (still: R = 1) or not (R = N): those
+        added since the last call appended."""
         parts = self._parts.get((key, still), [])
         done, stacked = self._stacked.get((key, still), (0, None))
         if done < len(parts) or stacked is None:
             rows = 1 if still else self.n
             if stacked is None:
-                stacked = np.empty((4 if key == "hard" else 8, rows, 0), dtype=np.float32)
+                stacked = np.empty((4 if key == "hard" else 9, rows, 0), dtype=np.float32)
             stacked = np.concatenate([stacked, *(np.broadcast_to(p, p.shape[:1] + (rows,) + p.shape[2:])
                                                  for p in parts[done:])], axis=2)
             self._stacked[key, still] = (len(parts), stacked)
@@ -377,11 +385,12 @@ class Placer:
         return np.isfinite(cost[:, 0])
 
     def _costs(self, p: np.ndarray, h: np.ndarray, c: np.ndarray, rows: np.ndarray, still: tuple[bool, ...],
-               kinds: tuple[str, ...] = ("hard", "soft")) -> np.ndarray:
+               kinds: tuple[str, ...] = ("hard", "soft"), heavy: bool = False) -> np.ndarray:
         """Costs c (n', B) of the boxes centred at p (2, n', B), half size h (2, n'), at the angles
         `rows`: inf where a box meets a hard obstacle, plus LINE_COST per mm of the lines inside
-        it; of the obstacles the same at every angle (`still` holds True) and of those that move
-        (False); `kinds` ("hard",): whether free only, the lines not costed."""
+        it (HEAVY_COST per mm of a heavy one); of the obstacles the same at every angle (`still`
+        holds True) and of those that move (False); `kinds` ("hard",): whether free only, the
+        lines not costed; `heavy`: the heavy lines costed only."""
         stacks = [(key, fixed, items) for key in kinds for fixed in still
                   for items in (self._stack(key, fixed),) if items.shape[2]]
         free = np.isfinite(c)
@@ -397,7 +406,7 @@ class Placer:
             if not len(r):
                 continue
             at = j if fixed else rows[r] * items.shape[2] + j
-            items = np.take(items.reshape(len(items), -1), at, axis=1)   # (4 or 8, pairs)
+            items = np.take(items.reshape(len(items), -1), at, axis=1)   # (4 or 9, pairs)
             counts = np.bincount(r, minlength=len(c))                     # r ascending: each row's pairs together
             X, Y, w, v = (np.repeat(a, counts, axis=0) for a in (px, py, hx, hy))
             inside = X > (items[-4] - w)[:, None]                         # a box over it: its centre in it grown by h
@@ -408,13 +417,15 @@ class Placer:
                 blocked |= _any_by_row(inside, counts)
             else:
                 inside &= np.repeat(free & ~blocked, counts, axis=0)
+                if heavy:
+                    inside &= (items[4] == HEAVY_COST)[:, None]
                 f, q = _nonzero(inside)
-                pairs.append((r[f], q, np.take(items[:4], f, axis=1)))
+                pairs.append((r[f], q, np.take(items[:5], f, axis=1)))
         c = np.where(blocked, np.inf, c)
         for r, q, ln in pairs:                                             # the lines each free box covers
             x, y, w, v = px[r, q], py[r, q], hx[r], hy[r]
-            covered = _clipped(ln.T, np.stack([x - w, y - v, x + w, y + v], axis=-1))
-            c = c + LINE_COST * np.bincount(r * c.shape[1] + q, covered, c.size).reshape(c.shape)
+            covered = _clipped(ln[:4].T, np.stack([x - w, y - v, x + w, y + v], axis=-1)) * ln[4]
+            c = c + np.bincount(r * c.shape[1] + q, covered, c.size).reshape(c.shape)
         return c
 
     def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool) -> np.ndarray:
@@ -424,8 +435,8 @@ class Placer:
         candidates at every angle. Over many angles (N >= 2 STRIDE) a label keeps its place from
         angle to angle unless it must move: the places are searched (`_search`) at every STRIDE-th
         angle (and the last); an angle between keeps the place of the searched angle before it,
-        else of the one after it, where that place is free there (off every hard obstacle and in
-        the bounds); the angles where neither is are searched."""
+        else of the one after it, where that place is free there (off every hard obstacle and
+        every heavy line, and in the bounds); the angles where neither is are searched."""
         n = self.n
         if n < 2 * STRIDE:
             return self._search(geometry, K, half, still, np.arange(n))
@@ -438,8 +449,9 @@ class Placer:
         at = np.searchsorted(sample, between)
         guess = np.column_stack([k[sample[at - 1]], k[sample[at]]])    # the searched angle before, then after
         xy, base = geometry(between, np.maximum(guess, 0))
-        free = np.isfinite(self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False),
-                                       ("hard",)))
+        free = self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False),
+                           heavy=True) <= base                  # free, and over no heavy line
+        free &= np.isfinite(base)
         free &= guess >= 0
         first = np.argmax(free, axis=1)
         kept = free.any(axis=1)

@@ -1,14 +1,15 @@
 """The mechanism at its design position, drawn as seed 002 fig. 1.6 draws it: the links to scale
 (mu_l), the frame hatched under its pins and along its guides, the pairs drawn as pairs (a pin
 as a small circle, a slider as a block on its guide), the centres of mass, and the senses of
-every link's angular velocity ω and acceleration ε as arcs with an arrowhead, about the link; a
-zero ω or ε not drawn, and named in a note.
+every link's angular velocity ω and acceleration ε as arcs with an arrowhead, about the link,
+each turned so that its arrowhead falls clear of the links (`arcs`); a zero ω or ε not drawn,
+and named in a note.
 
 Built at every angle of an analysis at once (`PlanCycle`: points (N,), marks (N, K)).
 The drawing's marks are `PlanCycle.paths` (sheet mm) named by what they are: "pin A", "block B",
 "support O", "hatch ..", "com S2", and "ω2", "ε2" for the senses; `draw` draws each by its name.
 
-May use: numpy, `core`, `forces` (the links drawn at mu_l), `kinematic` (which angles draw), `zero`
+May use: numpy, `core`, `arcs` (the senses' arcs), `forces` (the links drawn at mu_l), `kinematic` (which angles draw), `zero`
 (which ω, ε are zero).
 Never matplotlib.
 """
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .arcs import arc, heavy_lines
 from .core import PlanCycle, Scale, Segment
 from .forces import _link_drawing, _world
 from .kinematic import _ok, _titles
@@ -42,13 +44,6 @@ def _hatch(a: np.ndarray, b: np.ndarray, side, name: str, paths: dict) -> None:
     for n, t in enumerate(np.arange(1.0, min(float(L[0]), 100.0), 2.0)):      # a frame's stretch: at most 50 strokes
         p = a + t * u
         paths[f"{name} {n}"] = np.stack([p, p + 2.0 * side - 1.5 * u], axis=1)
-
-
-def _arc(c: np.ndarray, r: float, sense: np.ndarray) -> np.ndarray:
-    """(N, 25): a 240-degree arc around each c, from the upper left, in the sense's direction
-    (ccw for +)."""
-    t = np.linspace(0.0, np.radians(240.0), 25)
-    return c[:, None] + r * np.exp(1j * (np.radians(150.0) + sense[:, None] * t))
 
 
 def _link_lines(mech, res, k: int, pts: dict, segs: list, mu: Scale) -> None:
@@ -135,6 +130,7 @@ def mechanism_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
                 a, b = S - 14.0 * d + s * (w / 2 + 0.5) * n, S + 14.0 * d + s * (w / 2 + 0.5) * n
                 _hatch(a, b, s * n, f"hatch {p.point}{'+' if s > 0 else '-'}", paths)
     zeros: dict[str, tuple[np.ndarray, str]] = {}
+    lines = heavy_lines(pts, segs)
     for k in range(1, mech.n_links):
         link = mech.links[k]
         if link.com and link.com in pts:
@@ -146,8 +142,8 @@ def mechanism_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
         c = _arc_centre(mech, k, pts)
         for name, (v, zero, r) in turns.items():
             zeros[name] = (zero & _ok(res), "")
-            if (~zero & _ok(res)).any():
-                paths[name] = np.where(zero[:, None], np.nan, _arc(c, r, np.sign(v)))
+            if (~zero & _ok(res)).any():       # 240 deg from the upper left, its arrowhead clear of the links
+                paths[name] = np.where(zero[:, None], np.nan, arc(c, r, np.sign(v), 150.0, 240.0, lines))
     return PlanCycle("mechanism", _titles("Mechanism at phi = {at:g} deg", res), mu, res.phi_deg, pts, tuple(segs), paths,
                      tuple(zero_notes(zeros, len(res.phi_deg))))
 
