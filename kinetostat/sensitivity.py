@@ -50,10 +50,11 @@ class Dual:
         self.der = np.asarray(der)
 
     # the partial derivative of each holomorphic (or real) ufunc by each argument, from the values
+    # (None: 1, the argument's derivative passes as it is)
     _PARTIALS = {
-        np.add: lambda a, b, r: (1.0, 1.0), np.subtract: lambda a, b, r: (1.0, -1.0),
+        np.add: lambda a, b, r: (None, None), np.subtract: lambda a, b, r: (None, -1.0),
         np.multiply: lambda a, b, r: (b, a), np.true_divide: lambda a, b, r: (1.0 / b, -r / b),
-        np.negative: lambda a, r: (-1.0,), np.positive: lambda a, r: (1.0,),
+        np.negative: lambda a, r: (-1.0,), np.positive: lambda a, r: (None,),
         np.sqrt: lambda a, r: (0.5 / r,), np.exp: lambda a, r: (r,), np.log: lambda a, r: (1.0 / a,),
         np.sin: lambda a, r: (np.cos(a),), np.cos: lambda a, r: (-np.sin(a),), np.tan: lambda a, r: (1.0 + r * r,),
         np.arcsin: lambda a, r: (1.0 / np.sqrt(1.0 - a * a),), np.arccos: lambda a, r: (-1.0 / np.sqrt(1.0 - a * a),),
@@ -62,7 +63,7 @@ class Dual:
         np.square: lambda a, r: (2.0 * a,), np.sign: lambda a, r: (0.0,),
         np.arctan2: lambda y, x, r: (x / (x * x + y * y), -y / (x * x + y * y)),
         np.maximum: lambda a, b, r: (a >= b, a < b), np.minimum: lambda a, b, r: (a <= b, a > b),
-        np.power: lambda a, b, r: (b * a ** (b - 1.0), r * np.log(np.where(a > 0, a, 1.0))),
+        np.power: lambda a, b, r: (b * a ** (b - 1.0), r * np.log(np.where(a > 0, a, 1.0))),   # (exponent's: a > 0)
     }
     _COMPARE = (np.less, np.less_equal, np.greater, np.greater_equal, np.equal, np.not_equal, np.isfinite,
                 np.isnan, np.isinf, np.signbit)
@@ -70,10 +71,10 @@ class Dual:
     def __array_ufunc__(self, ufunc, method, *inputs, **kwargs):
         if method != "__call__" or kwargs:
             return NotImplemented
-        vals = [x.val if isinstance(x, Dual) else np.asarray(x) for x in inputs]
+        vals = [x.val if isinstance(x, Dual) else x for x in inputs]
         if ufunc in self._COMPARE:
             return ufunc(*vals)
-        out = ufunc(*vals)
+        out = np.asarray(ufunc(*vals))
         ders = [x.der if isinstance(x, Dual) else None for x in inputs]
         if ufunc is np.conjugate:
             return Dual(out, np.conjugate(ders[0]))
@@ -84,14 +85,18 @@ class Dual:
             return Dual(out, np.sign(a)[..., None] * d)
         if ufunc not in self._PARTIALS:
             raise TypeError(f"Dual: no derivative rule for numpy.{ufunc.__name__}")
-        with np.errstate(all="ignore"):
+        if ufunc is np.power and ders[1] is None:          # a constant exponent: no logarithm
+            partials = (vals[1] * vals[0] ** (vals[1] - 1.0),)
+        else:
             partials = self._PARTIALS[ufunc](*vals, out)
         der = None
         for part, d in zip(partials, ders):
             if d is not None:
-                term = np.asarray(part)[..., None] * d
+                term = d if part is None else np.asarray(part)[..., None] * d
                 der = term if der is None else der + term
-        return Dual(out, np.broadcast_to(der, np.shape(out) + der.shape[-1:]))
+        if der.shape[:-1] != out.shape:
+            der = np.broadcast_to(der, out.shape + der.shape[-1:])
+        return Dual(out, der)
 
     def __add__(self, o): return np.add(self, o)
     def __radd__(self, o): return np.add(o, self)
