@@ -357,7 +357,7 @@ class Sensitivity:
     def _per_param(self, x: Any, vector: bool = False) -> Mapping[str, np.ndarray]:
         """parameter -> the derivative of x (N,), or of the plane vector x as (N, 2), read-only."""
         d = np.array(derivative(x, self.phi_deg.shape, len(self.params)), dtype=complex if vector else float)
-        d[self.result.singular] = np.nan
+        d[self.result.singular] = complex(np.nan, np.nan) if vector else np.nan
         out = {}
         for i, p in enumerate(self.params):
             a = as_xy(d[..., i]) if vector else d[..., i]
