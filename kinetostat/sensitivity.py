@@ -204,7 +204,8 @@ def _seeded(mech: "Mechanism", params: tuple[str, ...]) -> tuple[dict[str, Any],
     that no differentiated parameter reaches stays a float."""
     unit = np.eye(len(params))
     values: dict[str, Any] = {**mech.parameters, "g": float(mech.g)}
-    exprs = {path: parse(text) for path, (text, _) in mech.expressions.items()}
+    exprs = mech.memo("sensitivity: parsed expressions",
+                      lambda: {path: parse(text) for path, (text, _) in mech.expressions.items()})
     pending = [path.split(".", 1)[1] for path in exprs if path.startswith("parameters.")]
     for i, name in enumerate(params):
         if name not in pending:
@@ -271,7 +272,7 @@ def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any
                              f"values and table scales, springs, the gear's module, teeth and y); leave that "
                              f"parameter out of params")
     g = c["g"]
-    weighed = _weighed(mech) if isinstance(g, Dual) else set()
+    weighed = _weighed(mech) if isinstance(g, Dual) else frozenset()
     for k, link in enumerate(mech.links):
         for name, z in pts[k].items():
             c[f"x{k}_{name}"] = z
@@ -300,7 +301,7 @@ def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any
 
 
 def _bodies(link, pts: Mapping[str, Any], given: Mapping[int, Mapping[str, Any]], g: Any,
-            weighed: set[tuple[int, int | None]]) -> tuple[Any, Any, Any]:
+            weighed: frozenset[tuple[int, int | None]]) -> tuple[Any, Any, Any]:
     """Mass, centre of mass (complex) and I_S of a link given by bodies (`parts.combine` on duals)."""
     out = []
     for n, b in enumerate(link.bodies):
@@ -313,18 +314,20 @@ def _bodies(link, pts: Mapping[str, Any], given: Mapping[int, Mapping[str, Any]]
     return m, S[0] + 1j * S[1], I_S
 
 
-def _weighed(mech: "Mechanism") -> set[tuple[int, int | None]]:
+def _weighed(mech: "Mechanism") -> frozenset[tuple[int, int | None]]:
     """The links (id, None) and bodies (id, index) that the model file gives by their weight: their
     masses are weight / g, so they follow g (the Mechanism keeps the masses only). Empty where the
-    model has no file."""
-    import tomllib
-    text = model_text(mech)
-    out: set[tuple[int, int | None]] = set()
-    for t in tomllib.loads(text).get("link", []) if text else []:
-        if "weight" in t:
-            out.add((t.get("id"), None))
-        out.update((t.get("id"), n) for n, b in enumerate(t.get("body", [])) if "weight" in b)
-    return out
+    model has no file. Memoised per mechanism."""
+    def make() -> frozenset[tuple[int, int | None]]:
+        import tomllib
+        text = model_text(mech)
+        out: set[tuple[int, int | None]] = set()
+        for t in tomllib.loads(text).get("link", []) if text else []:
+            if "weight" in t:
+                out.add((t.get("id"), None))
+            out.update((t.get("id"), n) for n, b in enumerate(t.get("body", [])) if "weight" in b)
+        return frozenset(out)
+    return mech.memo("sensitivity: links given by weight", make)
 
 
 def _body_com(link, b: Body, pts: Mapping[str, Any], f: Mapping[str, Any]) -> Any:
@@ -488,7 +491,8 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
             W, M_W = groups.weight(r, env[f"mass{k}"], env["g"])
             env[f"F{k}"], env[f"M{k}"] = groups.wrench(W, M_W, F_i, M_i, r)
         _travel_ends(mech, view, c, pts)
-        for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, env["phi"], len(params))):
+        for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, env["phi"], len(params))) \
+                if mech.loads or mech.springs else ():
             if k:
                 env[f"F{k}"], env[f"M{k}"] = env[f"F{k}"] + f, env[f"M{k}"] + m
         run(statics_program(mech), env)
