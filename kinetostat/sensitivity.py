@@ -426,25 +426,23 @@ class Sensitivity:
         machine, error (phi) [1]."""
         xr = _xarray()
         m, base = self.mech, self.result.to_xarray()
-        try:
-            stated = {**parameter_units(m, model_text(m)), "g": "m/s^2"}
-        except (OSError, ValueError):
-            stated = {}
-        units = [stated.get(p, "") or "unit of p" for p in self.params]
-        stack = lambda acc: np.stack([np.stack([acc(x)[p] for x in keys], axis=1) for p in self.params])
-        pairs = [(pr.links[0], pr.links[1]) for pr in m.pairs]
+        stated = {**parameter_units(m, model_text(m)), "g": "m/s^2"}
+        units = [stated[p] for p in self.params]
         per = "per unit of the parameter (its unit: param_unit)"
+
+        def stack(acc, keys) -> np.ndarray:
+            return np.stack([np.stack([acc(x)[p] for x in keys], axis=1) for p in self.params])
         data = {
             "dM_bal": _labelled(("param", "phi"), np.stack([self.balancing_moment[p] for p in self.params]),
                                 "N m", "world", f"d M_bal / d p, {per}"),
-            "error": _labelled(("phi",), self.error, "1", "none", "estimated relative error of the derivatives")}
-        keys = pairs
-        data["dR"] = _labelled(("param", "phi", "pair", "xy"), stack(lambda ij: self.reaction(*ij)), "N", "world",
-                               f"d R_ij / d p, {per}")
-        keys = list(m.point_names)
+            "error": _labelled(("phi",), self.error, "1", "none", "estimated relative error of the derivatives"),
+            "dR": _labelled(("param", "phi", "pair", "xy"), stack(lambda ij: self.reaction(*ij),
+                                                                  [pr.links for pr in m.pairs]),
+                            "N", "world", f"d R_ij / d p, {per}")}
         for var, acc, unit in (("dposition", self.position, "m"), ("dvelocity", self.velocity, "m/s"),
                                ("dacceleration", self.acceleration, "m/s^2")):
-            data[var] = _labelled(("param", "phi", "point", "xy"), stack(acc), unit, "world", f"d {var[1:]} / d p, {per}")
+            data[var] = _labelled(("param", "phi", "point", "xy"), stack(acc, m.point_names), unit, "world",
+                                  f"d {var[1:]} / d p, {per}")
         if m.drive.kind == "machine":
             data["dF_bal"] = _labelled(("param", "phi", "xy"), np.stack([self.balancing_force[p] for p in self.params]),
                                        "N", "world", f"d F_bal / d p, {per}")
