@@ -11,13 +11,14 @@ import logging
 import math
 import time
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
-from ..model import Mechanism, model_text
+from ..model import Mechanism, Pair, model_text
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 
@@ -27,7 +28,7 @@ from .. import units as model_units
 from ..tables import csv_text, error, plain
 from .document import ROUNDING, ROUNDING_MARK, ROUNDING_NOTE, Doc, _err, _fmt, _is_rounding, _rel, esc, slug
 from .plots import (pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
-                    plot_mechanism, plot_moment, plot_reactions)
+                    plot_mechanism, plot_moment, plot_reactions, plot_tornado)
 from .published import PublishedCheck
 from .runs import ModelRun, trust
 from .sources import WORKS, Work, cited
@@ -161,6 +162,89 @@ def _study_section(doc: Doc, m: Mechanism) -> None:
               else [f"{esc(first)}, {units.get(first, 'not stated')}", f"max |R({i},{j})|, N"])
     doc.table(header, [[f"{x:g}"] + [f"{v:.1f}" if np.isfinite(v) else "\u2014" for v in row]
                        for x, row in zip(xs, table)], "r" * len(header))
+
+
+#: The report's sensitivity section: rows of its table and bars of its tornado chart.
+SENSITIVITY_ROWS, TORNADO_BARS = 5, 10
+SENSITIVITY_HEADING = "Sensitivity"
+
+
+@dataclass(frozen=True)
+class PeakElasticity:
+    """How one pair's peak |R| over the cycle moves with one parameter."""
+
+    pair: Pair
+    param: str
+    value: float          # the parameter's nominal value, its unit
+    peak: float           # max |R(i,j)| over the cycle, N
+    phi_deg: float        # the crank angle of the peak, deg
+    slope: float          # d peak / d param, N per unit of the parameter
+    elasticity: float     # (param / peak) d peak / d param, 1
+
+
+def peak_elasticities(sens) -> list[PeakElasticity]:
+    """Every (pair, parameter) of a `kinetostat.sensitivity` result, the largest |elasticity| first.
+    The derivative of a peak is that of |R| at the angle of the peak, (R . dR/dp) / |R| (the envelope
+    rule: it holds where the peak over the cycle's grid is reached at one angle). Pairs whose peak
+    is 0 (no load) have none."""
+    res = sens.result
+    out = []
+    for pair in res.mech.pairs:
+        i, j = pair.links
+        R = res.reaction(i, j)
+        mag = np.linalg.norm(R, axis=-1)
+        if not np.any(np.isfinite(mag)) or np.nanmax(mag) == 0:
+            continue
+        k = int(np.nanargmax(mag))
+        dR = sens.reaction(i, j)
+        for p in sens.params:
+            slope = float(R[k] @ dR[p][k]) / mag[k]
+            v = float(sens.values[p])
+            out.append(PeakElasticity(pair, p, v, float(mag[k]), float(res.phi_deg[k]), slope, v * slope / mag[k]))
+    return sorted(out, key=lambda e: -abs(e.elasticity))
+
+
+def _sensitivity_section(doc: Doc, run: ModelRun, d: Path) -> Path | None:
+    """The elasticities of the pairs' peak reactions to the model's parameters (`peak_elasticities`
+    of one `kinetostat.sensitivity` call at the report's angles): the SENSITIVITY_ROWS largest as a
+    table, the TORNADO_BARS largest as a tornado chart (returned); a model without [parameters] has
+    no section, one the sensitivities refuse a line saying why."""
+    from ..errors import AssemblyError, ModelError
+    from ..sensitivity import sensitivity
+    m = run.mech
+    if not m.parameters:
+        return None
+    doc.h(2, SENSITIVITY_HEADING)
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sens = sensitivity(m, phi_deg=run.res.phi_deg)
+        rows = peak_elasticities(sens)
+    except (ModelError, AssemblyError, ValueError, NotImplementedError) as exc:
+        doc.p(f"Skipped: {esc(str(exc).strip().splitlines()[0])}.")
+        return None
+    units = {**parameter_units(m), "g": "m/s²"}
+    per = {p: "N" if u == "1" else f"N per {u}" if u == model_units.NOT_STATED else f"N/{u}" for p, u in units.items()}
+    doc.p(f"Exact derivatives (`kinetostat.sensitivity`, forward mode) of every pair's peak |R| over the cycle "
+          f"({len(run.res.phi_deg)} positions) with respect to each of its {len(sens.params)} parameters "
+          f"({esc(', '.join(sens.params))}): "
+          "d peak / d p is that of |R| at the angle of the peak, (R · dR/dp) / |R| (the envelope rule: the peak "
+          "reached at one angle). Elasticity (p / peak) · d peak / d p: the peak's relative change for a relative "
+          "change of p (0.5: 1 % more p, 0.5 % more peak); a parameter that other parameters' expressions use moves "
+          f"them too. The {SENSITIVITY_ROWS} largest |elasticities| over the pairs and parameters:")
+    doc.table(["pair", "parameter", "value", "peak |R|, N", "at φ, deg", "d peak / d p", "elasticity, 1"],
+              [[esc(pair_name(m, e.pair)), esc(e.param), f"{e.value:.6g} {units[e.param]}".removesuffix(" 1"),
+                f"{e.peak:.6g}", f"{e.phi_deg:.4g}", f"{e.slope:.4g} {per[e.param]}", f"{e.elasticity:+.4f}"]
+               for e in rows[:SENSITIVITY_ROWS]], "llrrrrr")
+    bars = rows[:TORNADO_BARS]
+    with plain_text():
+        image = plot_tornado(m, [f"{pair_name(m, e.pair)}: {e.param}" for e in bars],
+                             [e.elasticity for e in bars], d / "sensitivity.svg")
+    doc.img(image, f"Elasticities of the peak reactions, the {len(bars)} largest: red, the peak grows with the "
+                   "parameter; blue, it falls")
+    log.info("%s: sensitivity (%.3f s)", run.stem, time.perf_counter() - t0)
+    return image
 
 
 def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
@@ -689,6 +773,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     _friction_section(doc, run)
     motion = _motion_section(doc, run, delta, flywheel)
     _study_section(doc, m)
+    sens_image = _sensitivity_section(doc, run, d)
     log.info("%s: cycle.csv.gz and the tables (%.1f s)", folder, time.perf_counter() - t0)
 
     doc.h(2, "Errors against the engines")
@@ -735,7 +820,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
         doc.h(2, "Sources")
         doc.ul([_work(w) for w in works])
     doc.h(2, "Files")
-    doc.ul([f"[{p.name}]({p.name})" for p in [*images.values(), *plan_files]]
+    doc.ul([f"[{p.name}]({p.name})" for p in [*images.values(), *([sens_image] if sens_image else []), *plan_files]]
            + [f"[{CYCLE_FILE}]({CYCLE_FILE}): `res.to_frame()` of the cycle as CSV, gzip-compressed",
                                                                   "[summary.json](summary.json)"])
 
