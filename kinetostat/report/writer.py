@@ -182,6 +182,13 @@ class PeakElasticity:
     elasticity: float     # (param / peak) d peak / d param, 1
 
 
+def free_parameters(m: Mechanism) -> tuple[str, ...]:
+    """The parameters the model file gives as numbers (not expressions of others), and g: those the
+    report differentiates, each then moving the parameters whose expressions use it (d l / d r
+    through l = sqrt(r**2 + c**2)), as a design sweep of it does."""
+    return (*(p for p in m.parameters if f"parameters.{p}" not in m.expressions), "g")
+
+
 def peak_elasticities(sens) -> list[PeakElasticity]:
     """Every (pair, parameter) of a `kinetostat.sensitivity` result, the largest |elasticity| first.
     The derivative of a peak is that of |R| at the angle of the peak, (R . dR/dp) / |R| (the envelope
@@ -205,7 +212,7 @@ def peak_elasticities(sens) -> list[PeakElasticity]:
 
 
 def _sensitivity_section(doc: Doc, run: ModelRun, d: Path) -> Path | None:
-    """The elasticities of the pairs' peak reactions to the model's parameters (`peak_elasticities`
+    """The elasticities of the pairs' peak reactions to the model's `free_parameters` (`peak_elasticities`
     of one `kinetostat.sensitivity` call at the report's angles): the SENSITIVITY_ROWS largest as a
     table, the TORNADO_BARS largest as a tornado chart (returned); a model without [parameters] has
     no section, one the sensitivities refuse a line saying why."""
@@ -219,7 +226,7 @@ def _sensitivity_section(doc: Doc, run: ModelRun, d: Path) -> Path | None:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            sens = sensitivity(m, phi_deg=run.res.phi_deg)
+            sens = sensitivity(m, params=free_parameters(m), phi_deg=run.res.phi_deg)
         rows = peak_elasticities(sens)
     except (ModelError, AssemblyError, ValueError, NotImplementedError) as exc:
         doc.p(f"Skipped: {esc(str(exc).strip().splitlines()[0])}.")
@@ -227,12 +234,12 @@ def _sensitivity_section(doc: Doc, run: ModelRun, d: Path) -> Path | None:
     units = {**parameter_units(m), "g": "m/s²"}
     per = {p: "N" if u == "1" else f"N per {u}" if u == model_units.NOT_STATED else f"N/{u}" for p, u in units.items()}
     doc.p(f"Exact derivatives (`kinetostat.sensitivity`, forward mode) of every pair's peak |R| over the cycle "
-          f"({len(run.res.phi_deg)} positions) with respect to each of its {len(sens.params)} parameters "
+          f"({len(run.res.phi_deg)} positions) with respect to each parameter the model gives as a number, and g "
           f"({esc(', '.join(sens.params))}): "
           "d peak / d p is that of |R| at the angle of the peak, (R · dR/dp) / |R| (the envelope rule: the peak "
           "reached at one angle). Elasticity (p / peak) · d peak / d p: the peak's relative change for a relative "
           "change of p (0.5: 1 % more p, 0.5 % more peak); a parameter that other parameters' expressions use moves "
-          f"them too. The {SENSITIVITY_ROWS} largest |elasticities| over the pairs and parameters:")
+          f"them too, as in a design sweep. The {SENSITIVITY_ROWS} largest |elasticities| over the pairs and parameters:")
     doc.table(["pair", "parameter", "value", "peak |R|, N", "at φ, deg", "d peak / d p", "elasticity, 1"],
               [[esc(pair_name(m, e.pair)), esc(e.param), f"{e.value:.6g} {units[e.param]}".removesuffix(" 1"),
                 f"{e.peak:.6g}", f"{e.phi_deg:.4g}", f"{e.slope:.4g} {per[e.param]}", f"{e.elasticity:+.4f}"]
