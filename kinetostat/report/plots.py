@@ -689,8 +689,10 @@ def plot_tornado(mech: Mechanism, labels: list[str], values: list[float], path: 
     ax = fig.subplots()
     y = np.arange(len(values))[::-1]
     ax.barh(y, values, height=0.6, color=["tab:red" if v > 0 else "tab:blue" for v in values])
+    from matplotlib.transforms import offset_copy
+    beside = offset_copy(ax.get_yaxis_transform(), fig, x=-_PAD_PT, units="points")
     for yy, label in zip(y, labels):
-        ax.text(0, yy, label + "  ", transform=ax.get_yaxis_transform(), ha="right", va="center", fontsize=9)
+        ax.text(0, yy, label, transform=beside, ha="right", va="center", fontsize=9)
     reach = max((abs(v) for v in values), default=1.0) or 1.0
     ax.set_xlim(-1.1 * reach, 1.1 * reach)
     ax.set_ylim(-0.6, len(values) - 0.4)

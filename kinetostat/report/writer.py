@@ -226,7 +226,7 @@ def _study_derivatives(doc: Doc, m: Mechanism, table: np.ndarray) -> None:
             else [f"{esc(first)}, {units.get(first, model_units.NOT_STATED)}", "value"])
     for n, (name, _) in enumerate(st.vary):
         doc.p(f"d max|R({i},{j})| / d {esc(name)}, {_per_unit(units.get(name, model_units.NOT_STATED))}:")
-        doc.table(head, [[f"{xv:g}", *(f"{v:.4g}" for v in row)] for xv, row in zip(xs, slopes[:, :, n])],
+        doc.table(head, [[f"{xv:g}", *(_fmt(v, 5) for v in row)] for xv, row in zip(xs, slopes[:, :, n])],
                   "r" * len(head))
     log.info("%s: the study by derivatives (%.3f s)", Path(m.path).stem, time.perf_counter() - t0)
 
@@ -347,7 +347,7 @@ def _sensitivity_section(doc: Doc, run: ModelRun, d: Path) -> Path | None:
           f"them too, as in a design sweep. The {SENSITIVITY_ROWS} largest |elasticities| over the pairs and parameters:")
     doc.table(["pair", "parameter", "value", "peak |R|, N", "at φ, deg", "d peak / d p", "elasticity, 1"],
               [[esc(pair_name(m, e.pair)), esc(e.param), f"{e.value:.6g} {units[e.param]}".removesuffix(" 1"),
-                f"{e.peak:.6g}", f"{e.phi_deg:.4g}", f"{e.slope:.4g} {_per_unit(units[e.param])}", f"{e.elasticity:+.4f}"]
+                f"{e.peak:.6g}", f"{e.phi_deg:.4g}", f"{_fmt(e.slope, 5)} {_per_unit(units[e.param])}", f"{e.elasticity:+.4f}"]
                for e in rows[:SENSITIVITY_ROWS]], "llrrrrr")
     bars = rows[:TORNADO_BARS]
     with plain_text():
