@@ -9,8 +9,8 @@ through the model's expressions (`Mechanism.expressions`, evaluated on duals by
 `expressions.over_arrays`) and through the fields they fill (points, masses, moments of inertia,
 bodies, g, the crank speed, load values and scales).
 
-May use: numpy, analysis, applied, expressions, groups, model (parts.combine, the file's text), planar,
-program, units; xarray (an optional extra) only inside `to_xarray`.
+May use: numpy, analysis, applied, expressions, groups, kinematics (its Kinematics), model
+(parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
 
@@ -23,10 +23,11 @@ import numpy as np
 
 from . import groups
 from .analysis import Analysis, _labelled, _xarray, crank_angles, exact
-from .applied import load_magnitude
+from .applied import load_wrenches, stroke
 from .expressions import ExpressionError, over_arrays, parse
+from .kinematics import Kinematics
 from .model.parts import Body, combine
-from .planar import as_xy
+from .planar import as_xy, dot_z
 from .program import constants, motion_program, run, statics_program
 from .model.source import model_text
 from .units import parameter_units
@@ -50,10 +51,11 @@ class Dual:
         self.der = np.asarray(der)
 
     # the partial derivative of each holomorphic (or real) ufunc by each argument, from the values
+    # (None: 1, the argument's derivative passes as it is)
     _PARTIALS = {
-        np.add: lambda a, b, r: (1.0, 1.0), np.subtract: lambda a, b, r: (1.0, -1.0),
+        np.add: lambda a, b, r: (None, None), np.subtract: lambda a, b, r: (None, -1.0),
         np.multiply: lambda a, b, r: (b, a), np.true_divide: lambda a, b, r: (1.0 / b, -r / b),
-        np.negative: lambda a, r: (-1.0,), np.positive: lambda a, r: (1.0,),
+        np.negative: lambda a, r: (-1.0,), np.positive: lambda a, r: (None,),
         np.sqrt: lambda a, r: (0.5 / r,), np.exp: lambda a, r: (r,), np.log: lambda a, r: (1.0 / a,),
         np.sin: lambda a, r: (np.cos(a),), np.cos: lambda a, r: (-np.sin(a),), np.tan: lambda a, r: (1.0 + r * r,),
         np.arcsin: lambda a, r: (1.0 / np.sqrt(1.0 - a * a),), np.arccos: lambda a, r: (-1.0 / np.sqrt(1.0 - a * a),),
@@ -62,7 +64,7 @@ class Dual:
         np.square: lambda a, r: (2.0 * a,), np.sign: lambda a, r: (0.0,),
         np.arctan2: lambda y, x, r: (x / (x * x + y * y), -y / (x * x + y * y)),
         np.maximum: lambda a, b, r: (a >= b, a < b), np.minimum: lambda a, b, r: (a <= b, a > b),
-        np.power: lambda a, b, r: (b * a ** (b - 1.0), r * np.log(np.where(a > 0, a, 1.0))),
+        np.power: lambda a, b, r: (b * a ** (b - 1.0), r * np.log(np.where(a > 0, a, 1.0))),   # (exponent's: a > 0)
     }
     _COMPARE = (np.less, np.less_equal, np.greater, np.greater_equal, np.equal, np.not_equal, np.isfinite,
                 np.isnan, np.isinf, np.signbit)
@@ -70,10 +72,10 @@ class Dual:
     def __array_ufunc__(self, ufunc, method, *inputs, **kwargs):
         if method != "__call__" or kwargs:
             return NotImplemented
-        vals = [x.val if isinstance(x, Dual) else np.asarray(x) for x in inputs]
+        vals = [x.val if isinstance(x, Dual) else x for x in inputs]
         if ufunc in self._COMPARE:
             return ufunc(*vals)
-        out = ufunc(*vals)
+        out = np.asarray(ufunc(*vals))
         ders = [x.der if isinstance(x, Dual) else None for x in inputs]
         if ufunc is np.conjugate:
             return Dual(out, np.conjugate(ders[0]))
@@ -84,14 +86,27 @@ class Dual:
             return Dual(out, np.sign(a)[..., None] * d)
         if ufunc not in self._PARTIALS:
             raise TypeError(f"Dual: no derivative rule for numpy.{ufunc.__name__}")
-        with np.errstate(all="ignore"):
+        if ufunc is np.power and ders[1] is None:          # a constant exponent: no logarithm
+            partials = (vals[1] * vals[0] ** (vals[1] - 1.0),)
+        else:
             partials = self._PARTIALS[ufunc](*vals, out)
         der = None
         for part, d in zip(partials, ders):
             if d is not None:
-                term = np.asarray(part)[..., None] * d
+                term = d if part is None else np.asarray(part)[..., None] * d
                 der = term if der is None else der + term
-        return Dual(out, np.broadcast_to(der, np.shape(out) + der.shape[-1:]))
+        if der.shape[:-1] != out.shape:
+            der = np.broadcast_to(der, out.shape + der.shape[-1:])
+        return Dual(out, der)
+
+    def __array_function__(self, func, types, args, kwargs):
+        if func is np.interp and not kwargs:
+            return _interp(*args)
+        if func is np.where and len(args) == 3 and not kwargs:
+            return _where(*args)
+        if func in (np.real, np.imag, np.shape) and not kwargs:
+            return getattr(args[0], func.__name__)
+        return NotImplemented
 
     def __add__(self, o): return np.add(self, o)
     def __radd__(self, o): return np.add(o, self)
@@ -106,6 +121,9 @@ class Dual:
     def __neg__(self): return np.negative(self)
     def __pos__(self): return self
     def __abs__(self): return np.absolute(self)
+    def __eq__(self, o): return np.equal(self, o)
+    def __ne__(self, o): return np.not_equal(self, o)
+    __hash__ = None
     def __lt__(self, o): return np.less(self, o)
     def __le__(self, o): return np.less_equal(self, o)
     def __gt__(self, o): return np.greater(self, o)
@@ -133,6 +151,32 @@ class Dual:
         return f"Dual(shape={self.val.shape}, parameters={self.der.shape[-1]})"
 
 
+def _interp(x: Any, xp: np.ndarray, fp: Any) -> Dual:
+    """np.interp on duals (x and the table's values fp may be): within a segment the slope of the
+    segment, so the derivative is exact there; at a knot, the slope of the segment above it (the
+    last knot: below); outside the table (held at its end values) 0."""
+    xv, fv, xp = value(x), np.asarray(value(fp)), np.asarray(xp, dtype=float)
+    out = np.interp(xv, xp, fv)
+    P = (x if isinstance(x, Dual) else fp).der.shape[-1]
+    der = np.zeros(np.shape(out) + (P,))
+    if isinstance(fp, Dual):
+        der = der + np.stack([np.interp(xv, xp, fp.der[..., j]) for j in range(P)], axis=-1)
+    if isinstance(x, Dual):
+        i = np.clip(np.searchsorted(xp, xv, side="right"), 1, len(xp) - 1)
+        dx = xp[i] - xp[i - 1]
+        slope = np.where((xv < xp[0]) | (xv > xp[-1]) | (dx == 0), 0.0, (fv[i] - fv[i - 1]) / np.where(dx == 0, 1.0, dx))
+        der = der + slope[..., None] * x.der
+    return Dual(out, der)
+
+
+def _where(cond: Any, a: Any, b: Any) -> Dual:
+    """np.where on duals: the value and the derivatives of the branch taken."""
+    cond = np.asarray(cond)
+    val = np.where(cond, value(a), value(b))
+    P = (a if isinstance(a, Dual) else b).der.shape[-1]
+    return Dual(val, np.where(cond[..., None], derivative(a, val.shape, P), derivative(b, val.shape, P)))
+
+
 def value(x: Any) -> Any:
     """The value of a Dual, or x itself."""
     return x.val if isinstance(x, Dual) else x
@@ -148,23 +192,28 @@ _POINT = re.compile(r"^(?:frame|link\[id=(\d+)\]\.points)\.(.+)\[([01])\]$")
 _LINK = re.compile(r"^link\[id=(\d+)\]\.(mass|weight|I_S)$")
 _BODY = re.compile(r"^link\[id=(\d+)\]\.body\[(\d+)\]\.(mass|weight|I_S|com\[([01])\])$")
 _LOAD = re.compile(r"^load\[(\d+)\]\.(value|table\.scale)$")
+_SPRING = re.compile(r"^spring\[(\d+)\]\.(stiffness|free_length)$")
+_GEAR = re.compile(r"^drive\.gear\.(module|z_pinion|z_wheel|y)$")
 
 
 def _seeded(mech: "Mechanism", params: tuple[str, ...]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The parameters (and g) as duals seeded by `params` (d p_i / d p_j = delta_ij; those given by
-    expressions of them follow), and every field written as an expression, on those duals:
-    (name -> value, field path -> value); a value that no differentiated parameter reaches stays a float."""
-    P = len(params)
+    """The parameters (and g) as duals, column i the derivative by params[i] as `load` with that
+    parameter overridden gives it: params[i] moves by 1, the parameters given by expressions follow
+    it (also one that is itself in `params`: its own column is 1 there), the others stay; and every
+    field written as an expression, on those duals: (name -> value, field path -> value); a value
+    that no differentiated parameter reaches stays a float."""
+    unit = np.eye(len(params))
     values: dict[str, Any] = {**mech.parameters, "g": float(mech.g)}
-    for i, name in enumerate(params):
-        values[name] = Dual(values[name], np.eye(P)[i])
     exprs = {path: parse(text) for path, (text, _) in mech.expressions.items()}
     pending = [path.split(".", 1)[1] for path in exprs if path.startswith("parameters.")]
-    pending = [n for n in pending if n not in params]
+    for i, name in enumerate(params):
+        if name not in pending:
+            values[name] = Dual(values[name], unit[i])
     while pending:                     # in the order of their dependencies
         ready = [n for n in pending if not (exprs[f"parameters.{n}"].names & set(pending))]
         for n in ready:
-            values[n] = _evaluate(exprs[f"parameters.{n}"], values, f"parameters.{n}")
+            v = _evaluate(exprs[f"parameters.{n}"], values, f"parameters.{n}")
+            values[n] = v if n not in params else Dual(value(v), derivative(v, (), len(params)) + unit[params.index(n)])
         pending = [n for n in pending if n not in ready]
     fields = {path: _evaluate(e, values, path) for path, e in exprs.items() if not path.startswith("parameters.")}
     if "g" in params:
@@ -182,17 +231,19 @@ def _evaluate(e, values: Mapping[str, Any], path: str) -> Any:
         raise ValueError(f"sensitivity: {path}: cannot differentiate its expression \"{e.text}\": {exc}") from None
 
 
-def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any], list[dict[str, Any]], dict[int, Any]]:
+def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any], list[dict[str, Any]], "Mechanism"]:
     """The constants of the programs (`program.constants`, plus the crank's w_in, e_in) with the
-    fields that the parameters reach as duals; the links' local points (dual where moved); the
-    loads' dual values and scales by load index. ValueError naming a field that a differentiated
-    parameter reaches but that this module does not carry."""
+    fields that the parameters reach as duals; the links' local points (dual where moved); and
+    `mech` with its loads' values and scales and its springs as duals (for `applied`). ValueError
+    naming a field that a differentiated parameter reaches but that this module does not carry."""
     c: dict[str, Any] = {**constants(mech), "w_in": float(mech.drive.omega or 0.0), "e_in": float(mech.drive.eps or 0.0)}
     pts: list[dict[str, Any]] = [dict(p) for p in mech.points_z]
     ids = {link.id: k for k, link in enumerate(mech.links)}
     masses: dict[int, dict[str, Any]] = {}
     bodies: dict[int, dict[int, dict[str, Any]]] = {}
-    loads: dict[int, Any] = {}
+    loads: dict[int, dict[str, Any]] = {}
+    springs: dict[int, dict[str, Any]] = {}
+    gear: dict[str, Any] = {}
     for path, v in fields.items():
         if m := _POINT.match(path):
             k = ids[int(m[1])] if m[1] else 0
@@ -203,7 +254,11 @@ def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any
         elif m := _BODY.match(path):
             bodies.setdefault(ids[int(m[1])], {}).setdefault(int(m[2]), {})[m[4] or m[3]] = v
         elif m := _LOAD.match(path):
-            loads[int(m[1])] = v
+            loads.setdefault(int(m[1]), {})[m[2]] = v
+        elif m := _SPRING.match(path):
+            springs.setdefault(int(m[1]), {})[m[2]] = v
+        elif m := _GEAR.match(path):
+            gear[m[1]] = v
         elif path == "mechanism.g":
             c["g"] = v
         elif path in ("drive.rpm", "drive.omega") and mech.drive.law is None:
@@ -213,7 +268,8 @@ def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any
         else:
             raise ValueError(f"sensitivity: a differentiated parameter enters {path}, whose derivative this version "
                              f"does not carry (points, masses, moments of inertia, bodies, g, the crank speed, load "
-                             f"values and table scales); leave that parameter out of params")
+                             f"values and table scales, springs, the gear's module, teeth and y); leave that "
+                             f"parameter out of params")
     g = c["g"]
     weighed = _weighed(mech) if isinstance(g, Dual) else set()
     for k, link in enumerate(mech.links):
@@ -234,7 +290,13 @@ def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any
                 c[f"I_S{k}"] = given["I_S"]
         if link.com:
             c[f"com{k}"] = pts[k][link.com]
-    return c, pts, loads
+    if gear:
+        c["gear_rb"] = replace(mech.drive.gear, **gear).r_b
+    view = replace(mech, _derived={}, springs=tuple(replace(sp, **springs.get(n, {})) for n, sp in enumerate(mech.springs)),
+                   loads=tuple(replace(ld, value=loads.get(n, {}).get("value", ld.value), table=ld.table if ld.table is None
+                                       else replace(ld.table, scale=loads.get(n, {}).get("table.scale", ld.table.scale)))
+                               for n, ld in enumerate(mech.loads)))
+    return c, pts, view
 
 
 def _bodies(link, pts: Mapping[str, Any], given: Mapping[int, Mapping[str, Any]], g: Any,
@@ -295,7 +357,7 @@ class Sensitivity:
     def _per_param(self, x: Any, vector: bool = False) -> Mapping[str, np.ndarray]:
         """parameter -> the derivative of x (N,), or of the plane vector x as (N, 2), read-only."""
         d = np.array(derivative(x, self.phi_deg.shape, len(self.params)), dtype=complex if vector else float)
-        d[self.result.singular] = np.nan
+        d[self.result.singular] = complex(np.nan, np.nan) if vector else np.nan
         out = {}
         for i, p in enumerate(self.params):
             a = as_xy(d[..., i]) if vector else d[..., i]
@@ -395,9 +457,10 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     """Exact derivatives of the kinematics, the reactions and the balancing load of `mech` by its
     parameters `params` (names of the model's [parameters], or "g"; None: every parameter) at
     `steps` equal crank angles over a turn, or at `phi_deg` (deg). Forward mode: the analysis'
-    own program run on `Dual` numbers (no finite differences). Parameters that are expressions of
-    the differentiated ones follow them (d l / d r through l = sqrt(r**2 + c**2)); a
-    differentiated parameter that is itself an expression is taken as independent.
+    own program run on `Dual` numbers (no finite differences). The derivative by p is that of the
+    model loaded with p overridden (`load(path, parameters={p: ...})`, as `sweep` sets it): the
+    parameters written as expressions of p follow it (d/d r moves l = sqrt(r**2 + c**2)), and
+    d/d l, for l itself written as an expression, moves l alone.
     The reactions are the frictionless ones (friction's first approximation). ValueError naming
     an unknown parameter, or a field that a parameter reaches and that is not carried."""
     valid = [*mech.parameters, "g"]
@@ -415,18 +478,19 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     phi_deg = crank_angles(phi_deg, steps)
     result = exact(mech, phi_deg, "first")
     values, fields = _seeded(mech, params)
-    env, pts, loads = _design(mech, fields)
+    _refuse_unsmooth(mech, values)
+    c, pts, view = _design(mech, fields)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        env["phi"] = np.radians(phi_deg)
-        if mech.drive.law is not None:
-            env["w_in"], env["e_in"] = mech.drive.speed(env["phi"])
-        run(motion_program(mech), env)
+        env = _motion(mech, c, np.radians(phi_deg))
         for k in range(1, mech.n_links):
             r, F_i, M_i = groups.inertia(env[f"A{k}"], env[f"w{k}"], env[f"e{k}"], env[f"rot{k}"], env[f"com{k}"],
                                          env[f"mass{k}"], env[f"I_S{k}"])
             W, M_W = groups.weight(r, env[f"mass{k}"], env["g"])
             env[f"F{k}"], env[f"M{k}"] = groups.wrench(W, M_W, F_i, M_i, r)
-        _add_loads(mech, env, pts, loads, result)
+        _travel_ends(mech, view, c, pts)
+        for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, env["phi"], len(params))):
+            if k:
+                env[f"F{k}"], env[f"M{k}"] = env[f"F{k}"] + f, env[f"M{k}"] + m
         run(statics_program(mech), env)
     keep = {n: env[n] for n in ("M_bal", "F_bal", *(f"R{p.index}" for p in mech.pairs),
                                 *(f"{s}{k}" for s in ("O", "V", "A", "w", "e", "rot") for k in range(1, mech.n_links)))}
@@ -434,32 +498,80 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
                        MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
 
 
-def _add_loads(mech: "Mechanism", env: dict[str, Any], pts: list[Mapping[str, Any]], loads: Mapping[int, Any],
-               result: Analysis) -> None:
-    """The applied loads besides gravity added to the links' wrenches F<k>, M<k> on duals: a force
-    or moment of constant magnitude or read from a phi diagram (its magnitude `applied.load_magnitude`
-    at unit value or scale, times the dual one). ValueError naming a load this version does not carry."""
-    kin = result.kin
-    for n, ld in enumerate(mech.loads):
-        kinematic = ld.characteristic is not None or ld.kind == "damper" or ld.direction in (
-            "against_velocity", "against_omega") or (ld.table is not None and ld.table.argument != "phi")
-        if kinematic:
-            raise ValueError(f"sensitivity: load {ld.name!r} (load[{n}]) depends on the motion (a damper, a travel "
-                             f"diagram, a characteristic M(omega) or a direction against the motion): this version "
-                             f"differentiates loads of constant magnitude and phi diagrams")
-        if ld.table is None:
-            mag = loads.get(n, ld.value)
-        else:
-            unit = replace(ld, table=replace(ld.table, scale=1.0))
-            mag = load_magnitude(mech, kin, unit) * loads.get(n, ld.table.scale)
+def _motion(mech: "Mechanism", env: dict[str, Any], phi: np.ndarray) -> dict[str, Any]:
+    """The motion program run on the (dual) constants `env` at the crank angles `phi` (rad)."""
+    env = dict(env, phi=phi)
+    if mech.drive.law is not None:
+        env["w_in"], env["e_in"] = mech.drive.speed(phi)
+    return run(motion_program(mech), env)
+
+
+@dataclass(frozen=True)
+class _DualMotion(Kinematics):
+    """Kinematics whose arrays are duals (N, L): what `applied` reads of a motion, with a link's
+    local point read as the dual the parameters move (found by its nominal coordinates)."""
+    local: tuple[Mapping[str, Any], ...] = ()
+
+    def _x(self, k: int, p) -> Any:
+        z = complex(p[0], p[1])
+        found = [x for x in self.local[k].values() if complex(value(x)) == z]
+        moves = [x.der.tolist() if isinstance(x, Dual) else None for x in found]
+        if any(d != moves[0] for d in moves):
+            raise ValueError(f"sensitivity: link {k} has two points at {z} that the parameters move apart: a load "
+                             f"at one of them is ambiguous; move one of them")
+        return found[0] if found else z
+
+    def position_z(self, k: int, p) -> Any:
+        return groups.place(self.origin_z[:, k], self.rot[:, k], self._x(k, p))
+
+    def velocity_z(self, k: int, p) -> Any:
+        return self.point_z(k, p)[1]
+
+    def point_z(self, k: int, p) -> tuple[Any, Any, Any]:
+        return groups.point_motion(self.origin_z[:, k], self.v_z[:, k], self.a_z[:, k], self.omega[:, k],
+                                   self.eps[:, k], self.rot[:, k], self._x(k, p))
+
+
+def _stacked(env: Mapping[str, Any], stem: str, count: int, rest: complex, N: int, P: int, start: int = 1) -> Dual:
+    """The per-link (or per-pair) duals stem<k> of `env` as one (N, count) dual (rest where absent)."""
+    cols = [env.get(f"{stem}{k}", rest) if k >= start else rest for k in range(count)]
+    return Dual(np.stack([np.broadcast_to(value(x), (N,)) for x in cols], axis=1),
+                np.stack([derivative(x, (N,), P) for x in cols], axis=1))
+
+
+def _dual_motion(mech: "Mechanism", env: Mapping[str, Any], pts, phi: np.ndarray, P: int) -> _DualMotion:
+    """The motion of the program's environment as `_DualMotion` (unguarded)."""
+    N, L, n = len(phi), mech.n_links, len(mech.pairs)
+    st = lambda stem, count, rest, start=1: _stacked(env, stem, count, rest, N, P, start)
+    return _DualMotion(phi, st("th", L, 0.0), st("rot", L, 1.0 + 0j), st("O", L, 0j), st("V", L, 0j), st("A", L, 0j),
+                       st("w", L, 0.0), st("e", L, 0.0), st("vs", n, 0.0, 0), st("as", n, 0.0, 0),
+                       np.zeros((N, 0)), np.zeros(N, bool), np.zeros(N), None, tuple(pts))
+
+
+def _travel_ends(mech: "Mechanism", view: "Mechanism", c: Mapping[str, Any], pts) -> None:
+    """Each travel diagram's stroke ends on duals, kept in `view` where `applied.travel` reads
+    them: the extreme projection at the dead centre phi* moves with the parameters as the point
+    at phi* does (ds/dphi = 0 there: the envelope rule)."""
+    for ld in view.loads:
+        if ld.table is None or ld.table.argument != "travel":
+            continue
+        lo, hi, phi_lo, phi_hi = stroke(mech, ld)
+        env = _motion(mech, dict(c), np.array([phi_lo, phi_hi]))
         k = ld.link
-        if not k:
-            continue
-        if ld.kind == "moment":
-            env[f"M{k}"] = env[f"M{k}"] + mag
-            continue
-        f = mag * complex(*ld.direction)
         X = groups.place(env[f"O{k}"], env[f"rot{k}"], pts[k][ld.point])
-        env[f"F{k}"], env[f"M{k}"] = env[f"F{k}"] + f, env[f"M{k}"] + groups.cross(X - env[f"O{k}"], f)
-    if mech.springs:
-        raise ValueError("sensitivity: springs: this version does not carry their derivatives")
+        s = dot_z(X, complex(*(ld.table.axis if ld.table.axis is not None else ld.direction)))
+        stroke(view, ld, make=lambda: (s[0], s[1], phi_lo, phi_hi))
+
+
+def _refuse_unsmooth(mech: "Mechanism", values: Mapping[str, Any]) -> None:
+    """ValueError where a differentiated parameter reaches what this version does not carry: a
+    law of motion or a characteristic M(omega) written as an expression of the parameters."""
+    moved = {n for n, v in values.items() if isinstance(v, Dual)}
+    law = mech.drive.law
+    if law is not None and law.expression is not None and parse(law.expression).names & moved:
+        raise ValueError(f"sensitivity: the law of motion omega(phi) reads {sorted(parse(law.expression).names & moved)}: "
+                         f"this version does not carry its derivative")
+    for n, ld in enumerate(mech.loads):
+        if ld.characteristic is not None and ld.characteristic.expression is not None:
+            raise ValueError(f"sensitivity: load {ld.name!r} (load[{n}]): a characteristic M(omega) written as an "
+                             f"expression: this version does not carry its derivative")
