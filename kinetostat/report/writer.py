@@ -171,8 +171,9 @@ def _signs(m: Mechanism, slopes: np.ndarray) -> list[str]:
 
 
 def _per_unit(unit: str) -> str:
-    """The unit of a force's derivative by a parameter of unit `unit`: N/m, N (a ratio), N per not stated."""
-    return "N" if unit == "1" else f"N per {unit}" if unit == model_units.NOT_STATED else f"N/{unit}"
+    """The unit of a force's derivative by a parameter of unit `unit`: N/m, N (a ratio), N per m/s², N per
+    kg m², N per not stated (a unit of more than one word or with a slash)."""
+    return "N" if unit == "1" else f"N per {unit}" if " " in unit or "/" in unit else f"N/{unit}"
 
 
 def _simpson(y: np.ndarray, x: Sequence[float]) -> np.ndarray | None:
