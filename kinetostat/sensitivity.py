@@ -204,7 +204,8 @@ def _seeded(mech: "Mechanism", params: tuple[str, ...]) -> tuple[dict[str, Any],
     that no differentiated parameter reaches stays a float."""
     unit = np.eye(len(params))
     values: dict[str, Any] = {**mech.parameters, "g": float(mech.g)}
-    exprs = {path: parse(text) for path, (text, _) in mech.expressions.items()}
+    exprs = mech.memo("sensitivity: parsed expressions",
+                      lambda: {path: parse(text) for path, (text, _) in mech.expressions.items()})
     pending = [path.split(".", 1)[1] for path in exprs if path.startswith("parameters.")]
     for i, name in enumerate(params):
         if name not in pending:
@@ -271,7 +272,7 @@ def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any
                              f"values and table scales, springs, the gear's module, teeth and y); leave that "
                              f"parameter out of params")
     g = c["g"]
-    weighed = _weighed(mech) if isinstance(g, Dual) else set()
+    weighed = _weighed(mech) if isinstance(g, Dual) else frozenset()
     for k, link in enumerate(mech.links):
         for name, z in pts[k].items():
             c[f"x{k}_{name}"] = z
@@ -300,7 +301,7 @@ def _design(mech: "Mechanism", fields: Mapping[str, Any]) -> tuple[dict[str, Any
 
 
 def _bodies(link, pts: Mapping[str, Any], given: Mapping[int, Mapping[str, Any]], g: Any,
-            weighed: set[tuple[int, int | None]]) -> tuple[Any, Any, Any]:
+            weighed: frozenset[tuple[int, int | None]]) -> tuple[Any, Any, Any]:
     """Mass, centre of mass (complex) and I_S of a link given by bodies (`parts.combine` on duals)."""
     out = []
     for n, b in enumerate(link.bodies):
@@ -313,18 +314,20 @@ def _bodies(link, pts: Mapping[str, Any], given: Mapping[int, Mapping[str, Any]]
     return m, S[0] + 1j * S[1], I_S
 
 
-def _weighed(mech: "Mechanism") -> set[tuple[int, int | None]]:
+def _weighed(mech: "Mechanism") -> frozenset[tuple[int, int | None]]:
     """The links (id, None) and bodies (id, index) that the model file gives by their weight: their
     masses are weight / g, so they follow g (the Mechanism keeps the masses only). Empty where the
-    model has no file."""
-    import tomllib
-    text = model_text(mech)
-    out: set[tuple[int, int | None]] = set()
-    for t in tomllib.loads(text).get("link", []) if text else []:
-        if "weight" in t:
-            out.add((t.get("id"), None))
-        out.update((t.get("id"), n) for n, b in enumerate(t.get("body", [])) if "weight" in b)
-    return out
+    model has no file. Memoised per mechanism."""
+    def make() -> frozenset[tuple[int, int | None]]:
+        import tomllib
+        text = model_text(mech)
+        out: set[tuple[int, int | None]] = set()
+        for t in tomllib.loads(text).get("link", []) if text else []:
+            if "weight" in t:
+                out.add((t.get("id"), None))
+            out.update((t.get("id"), n) for n, b in enumerate(t.get("body", [])) if "weight" in b)
+        return frozenset(out)
+    return mech.memo("sensitivity: links given by weight", make)
 
 
 def _body_com(link, b: Body, pts: Mapping[str, Any], f: Mapping[str, Any]) -> Any:
@@ -423,25 +426,23 @@ class Sensitivity:
         machine, error (phi) [1]."""
         xr = _xarray()
         m, base = self.mech, self.result.to_xarray()
-        try:
-            stated = {**parameter_units(m, model_text(m)), "g": "m/s^2"}
-        except (OSError, ValueError):
-            stated = {}
-        units = [stated.get(p, "") or "unit of p" for p in self.params]
-        stack = lambda acc: np.stack([np.stack([acc(x)[p] for x in keys], axis=1) for p in self.params])
-        pairs = [(pr.links[0], pr.links[1]) for pr in m.pairs]
+        stated = {**parameter_units(m, model_text(m)), "g": "m/s^2"}
+        units = [stated[p] for p in self.params]
         per = "per unit of the parameter (its unit: param_unit)"
+
+        def stack(acc, keys) -> np.ndarray:
+            return np.stack([np.stack([acc(x)[p] for x in keys], axis=1) for p in self.params])
         data = {
             "dM_bal": _labelled(("param", "phi"), np.stack([self.balancing_moment[p] for p in self.params]),
                                 "N m", "world", f"d M_bal / d p, {per}"),
-            "error": _labelled(("phi",), self.error, "1", "none", "estimated relative error of the derivatives")}
-        keys = pairs
-        data["dR"] = _labelled(("param", "phi", "pair", "xy"), stack(lambda ij: self.reaction(*ij)), "N", "world",
-                               f"d R_ij / d p, {per}")
-        keys = list(m.point_names)
+            "error": _labelled(("phi",), self.error, "1", "none", "estimated relative error of the derivatives"),
+            "dR": _labelled(("param", "phi", "pair", "xy"), stack(lambda ij: self.reaction(*ij),
+                                                                  [pr.links for pr in m.pairs]),
+                            "N", "world", f"d R_ij / d p, {per}")}
         for var, acc, unit in (("dposition", self.position, "m"), ("dvelocity", self.velocity, "m/s"),
                                ("dacceleration", self.acceleration, "m/s^2")):
-            data[var] = _labelled(("param", "phi", "point", "xy"), stack(acc), unit, "world", f"d {var[1:]} / d p, {per}")
+            data[var] = _labelled(("param", "phi", "point", "xy"), stack(acc, m.point_names), unit, "world",
+                                  f"d {var[1:]} / d p, {per}")
         if m.drive.kind == "machine":
             data["dF_bal"] = _labelled(("param", "phi", "xy"), np.stack([self.balancing_force[p] for p in self.params]),
                                        "N", "world", f"d F_bal / d p, {per}")
@@ -488,7 +489,8 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
             W, M_W = groups.weight(r, env[f"mass{k}"], env["g"])
             env[f"F{k}"], env[f"M{k}"] = groups.wrench(W, M_W, F_i, M_i, r)
         _travel_ends(mech, view, c, pts)
-        for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, env["phi"], len(params))):
+        for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, env["phi"], len(params))) \
+                if mech.loads or mech.springs else ():
             if k:
                 env[f"F{k}"], env[f"M{k}"] = env[f"F{k}"] + f, env[f"M{k}"] + m
         run(statics_program(mech), env)
