@@ -126,7 +126,7 @@ def sketch_plots(monkeypatch: pytest.MonkeyPatch) -> None:
             f.write('<svg xmlns="http://www.w3.org/2000/svg" width="1" height="1"/>\n')
         return Path(args[-1])
     for name in ("plot_mechanism", "plot_moment", "plot_balancing_force", "plot_reactions", "plot_errors",
-                 "plot_hodographs"):
+                 "plot_hodographs", "plot_tornado"):
         monkeypatch.setattr(writer, name, sketch)
 
 

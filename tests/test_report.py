@@ -23,6 +23,7 @@ from conftest import FOUR_BAR, MODELS, ROOT, sketch_plots
 from kinetostat import cli
 from kinetostat.report import published_rows, run_validation, write_index, write_report
 from kinetostat.report.document import ROUNDING_NOTE, Doc
+from kinetostat.report.plots import pair_name
 from kinetostat.tables import read_csv
 
 pytest.importorskip("matplotlib")
@@ -93,8 +94,9 @@ def test_reruns_are_byte_identical_and_jobs_do_not_matter(tmp_path):
     for f in files:
         assert (parallel / f).read_bytes() == (serial / f).read_bytes(), f
     plans = {m: len(kinetostat.plans.build(kinetostat.load(p))) for m, p in (("ice", ICE), ("shaper", SHAPER))}
-    # the index; ice: 5 figures, md, html, csv, json, an svg per plan, segments.csv, worksheet.csv; the shaper + 1 figure
-    assert len(files) == 2 + (9 + plans["ice"] + 2) + (10 + plans["shaper"] + 2)
+    # the index; ice: 5 figures and the sensitivity's, md, html, csv, json, an svg per plan, segments.csv,
+    # worksheet.csv; the shaper (no [parameters]: no sensitivity) the balancing force's figure in its place
+    assert len(files) == 2 + (10 + plans["ice"] + 2) + (10 + plans["shaper"] + 2)
     for fig in FIGURES:
         data = (serial / "ice_crank_slider" / fig).read_text(encoding="utf-8")
         assert "<svg" in data[:400] and len(data) > 10_000 and "<dc:date>" not in data, fig
@@ -209,6 +211,29 @@ def test_machine_report_shows_the_balancing_force(ice_report):
     assert b"<svg" in (d / "balancing_force.svg").read_bytes()[:400]
 
 
+def test_report_shows_the_peak_reactions_elasticities(ice_report):
+    """The sensitivity section (issue 39): the five largest elasticities of a pair's peak |R| over the
+    report's 36 positions, each the peak's own central difference over a reloaded model (h = 1e-6 p);
+    a model without [parameters] (the shaper) has no section."""
+    md = (ice_report / "ice_crank_slider" / "index.md").read_text()
+    section = md.split("## Sensitivity\n", 1)[1].split("\n## ", 1)[0]
+    rows = [r.split("|")[1:-1] for r in section.splitlines() if r.startswith("| R")]
+    assert len(rows) == 5 and "![Elasticities" in section and (ice_report / "ice_crank_slider" / "sensitivity.svg").is_file()
+    elasticities = [float(r[6]) for r in rows]
+    assert elasticities == sorted(elasticities, key=abs, reverse=True)
+    mech = kinetostat.load(ICE)
+    for pair_cell, param, *_, printed in rows:
+        pair = next(p for p in mech.pairs if pair_name(mech, p) == pair_cell.strip())
+        p, v = param.strip(), {**mech.parameters, "g": mech.g}[param.strip()]
+
+        def peak(x: float) -> float:
+            res = kinetostat.analyze(kinetostat.load(ICE, parameters={p: x}), steps=36)
+            return float(np.linalg.norm(res.reaction(*pair.links), axis=-1).max())
+        h = 1e-6 * v
+        assert float(printed) == pytest.approx(v / peak(v) * (peak(v + h) - peak(v - h)) / (2 * h), abs=1e-4)
+    assert "## Sensitivity" not in (ice_report / "slotted_link_shaper" / "index.md").read_text()
+
+
 def test_report_html_is_markdown_it_rendering(ice_report):
     from markdown_it import MarkdownIt
     d = ice_report / "ice_crank_slider"
@@ -223,7 +248,8 @@ def test_report_html_is_markdown_it_rendering(ice_report):
         assert f'<a href="{name}"><img src="{name}"' in html
         assert (d / name).read_text() == kinetostat.plans.svg(plan, mechanism=kinetostat.load(ICE).name)
     assert "data:" not in html and "<svg" not in html
-    assert html.count("<img ") == len(FIGURES) + len(plans) and len(html) < 100_000
+    assert html.count('src="sensitivity.svg"') == 1                  # the sensitivity section's tornado chart
+    assert html.count("<img ") == len(FIGURES) + 1 + len(plans) and len(html) < 100_000
     assert '<div class="scroll"><table>' in html and 'class="pass"' in html
     assert 'href="../index.html"' in html and 'href="cycle.csv.gz"' in html
     # the body is markdown-it's rendering of the Markdown file (tables as it renders them)

@@ -44,3 +44,24 @@ def test_crank_bearing_reaction_range(mech):
     # the most loaded pair of the mechanism
     others = [np.linalg.norm(res.reaction(i, j), axis=-1).max() for i, j in ((1, 2), (2, 3), (0, 3))]
     assert F.max() > max(others)
+
+
+def test_the_study_redone_with_derivatives(mech):
+    """Seed 004's study (crank radius r x crank speed n_k, the largest |R(0,1)| on the paper's 10-deg grid)
+    by exact derivatives at each of its cases: the trend the table shows, and its differences."""
+    from kinetostat.report.writer import study_slopes, study_table
+    table = study_table(mech)
+    slopes, angles = study_slopes(mech)
+    d_r, d_n = slopes[..., 0], slopes[..., 1]
+    assert np.all(d_r > 0)                                  # the peak grows with r at every speed ...
+    assert np.all(np.diff(d_r, axis=1) > 0)                 # ... the more, the faster the crank turns
+    assert np.all(np.abs(d_n[:, 0]) < 1e-12 * table[:, 0])  # flat in n_k at standstill (inertia ~ n_k^2)
+    assert np.all(d_n[:, 1:] > 0) and np.all(np.diff(d_n, axis=1) > 0)
+    r = np.array(mech.study.vary[0][1])
+    centred = (table[2:] - table[:-2]) / (r[2:] - r[:-2])[:, None]      # the table's own differences, 15 mm apart
+    same = (angles[2:] == angles[1:-1]) & (angles[:-2] == angles[1:-1])  # the three cases peak at one grid angle
+    assert same.sum() >= 10
+    np.testing.assert_allclose(centred[same], d_r[1:-1][same], rtol=5e-3)   # O(h^2) of the 15 mm steps
+    step = r[1] - r[0]
+    simpson = step / 3 * (d_r[0] + 4 * d_r[1] + 2 * d_r[2] + 4 * d_r[3] + d_r[4])
+    np.testing.assert_allclose(simpson, table[-1] - table[0], rtol=1e-2)    # r = 50 -> 110 mm

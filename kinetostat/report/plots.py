@@ -679,3 +679,25 @@ def plot_balancing_force(res: Analysis, path: Path) -> Path:
     ax.legend(fontsize=8, loc="best")
     _phi_axes(ax, step=30, ylabel="balancing force, N")
     return _save(fig, path)
+
+
+def plot_tornado(mech: Mechanism, labels: list[str], values: list[float], path: Path) -> Path:
+    """A tornado chart of the elasticities `values` (1, signed) named `labels`, the largest |value|
+    on top: bars to the right (red) where the quantity grows with the parameter, to the left (blue)
+    where it falls."""
+    fig = _figure(9.5, 0.9 + 0.34 * len(values), left=3.0, right=0.3, top=0.6, bottom=0.55)
+    ax = fig.subplots()
+    y = np.arange(len(values))[::-1]
+    ax.barh(y, values, height=0.6, color=["tab:red" if v > 0 else "tab:blue" for v in values])
+    from matplotlib.transforms import offset_copy
+    beside = offset_copy(ax.get_yaxis_transform(), fig, x=-_PAD_PT, units="points")
+    for yy, label in zip(y, labels):
+        ax.text(0, yy, label, transform=beside, ha="right", va="center", fontsize=9)
+    reach = max((abs(v) for v in values), default=1.0) or 1.0
+    ax.set_xlim(-1.1 * reach, 1.1 * reach)
+    ax.set_ylim(-0.6, len(values) - 0.4)
+    ax.axvline(0, color="0.3", lw=0.8)
+    ax.set_title(f"{mech.name}\nelasticity of the peak reaction: (p / peak) · d peak / d p", fontsize=10, y=1.0)
+    from matplotlib.ticker import FixedLocator
+    _axes(ax, _nice(6), FixedLocator([]), "elasticity, 1")
+    return _save(fig, path)

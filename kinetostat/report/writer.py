@@ -6,18 +6,20 @@ harness's tolerances.
 from __future__ import annotations
 
 import gzip
+import itertools
 import json
 import logging
 import math
 import time
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
 from .._io import atomic, inside, safe_name, write_text
-from ..model import Mechanism, model_text
+from ..model import Mechanism, Pair, model_text
 from ..virtual_work import virtual_work
 from ..structure import GROUP_KINDS
 
@@ -27,7 +29,7 @@ from .. import units as model_units
 from ..tables import csv_text, error, plain
 from .document import ROUNDING, ROUNDING_MARK, ROUNDING_NOTE, Doc, _err, _fmt, _is_rounding, _rel, esc, slug
 from .plots import (pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
-                    plot_mechanism, plot_moment, plot_reactions)
+                    plot_mechanism, plot_moment, plot_reactions, plot_tornado)
 from .published import PublishedCheck
 from .runs import ModelRun, trust
 from .sources import WORKS, Work, cited
@@ -133,6 +135,103 @@ def study_table(m: Mechanism) -> np.ndarray:
     return sw.peak(f"R_{p.links[0]}_{p.links[1]}").reshape(len(st.vary[0][1]), -1)
 
 
+def study_slopes(m: Mechanism) -> tuple[np.ndarray, np.ndarray]:
+    """The model's `[study]` redone with exact derivatives: at every case (the model file loaded with
+    its values, as `study_table`), d max |R(i,j)| / d p by each varied parameter p (`peak_slopes`
+    of a `kinetostat.sensitivity` at the study's angles), N per unit of p, shape (values of the
+    first, values of the second or 1, varied parameters); and the crank angle of each case's peak,
+    deg, shape (values of the first, of the second or 1)."""
+    from ..model import load
+    from ..sensitivity import sensitivity
+    st = m.study
+    names = [name for name, _ in st.vary]
+    pair = m.pair_between(*st.pair)
+    cases = list(itertools.product(*(xs for _, xs in st.vary)))
+    slopes, angles = np.empty((len(cases), len(names))), np.empty(len(cases))
+    for n, case in enumerate(cases):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sens = sensitivity(load(m.path, parameters=dict(zip(names, case))), params=names, steps=st.steps)
+        k, by = peak_slopes(sens, pair)
+        slopes[n], angles[n] = [by[p] for p in names], sens.phi_deg[k]
+    shape = (len(st.vary[0][1]), -1)
+    return slopes.reshape(*shape, len(names)), angles.reshape(shape)
+
+
+def _signs(m: Mechanism, slopes: np.ndarray) -> list[str]:
+    """Which way the study's peak moves with each varied parameter, from the signs of `study_slopes`."""
+    out = []
+    for n, (name, _) in enumerate(m.study.vary):
+        d = slopes[..., n]
+        zero = np.abs(d) <= 1e-12 * np.max(np.abs(d))
+        way = ("grows" if np.all(d[~zero] > 0) else "falls" if np.all(d[~zero] < 0) else None) if (~zero).any() else None
+        out.append(f"The peak {way} with {esc(name)} at every case{f' but {int(zero.sum())} where it is flat' if zero.any() else ''}."
+                   if way else f"The peak does not move one way with {esc(name)} over the study.")
+    return out
+
+
+def _per_unit(unit: str) -> str:
+    """The unit of a force's derivative by a parameter of unit `unit`: N/m, N (a ratio), N per m/s², N per
+    kg m², N per not stated (a unit of more than one word or with a slash)."""
+    return "N" if unit == "1" else f"N per {unit}" if " " in unit or "/" in unit else f"N/{unit}"
+
+
+def _simpson(y: np.ndarray, x: Sequence[float]) -> np.ndarray | None:
+    """The integral of y (first axis over the values x) by Simpson's rule; None unless the x are
+    equally spaced and odd in number (3 or more)."""
+    x = np.asarray(x, float)
+    if len(x) < 3 or len(x) % 2 == 0 or not np.allclose(np.diff(x), x[1] - x[0], rtol=1e-9, atol=0):
+        return None
+    w = np.ones(len(x))
+    w[1:-1:2], w[2:-1:2] = 4, 2
+    return (x[1] - x[0]) / 3 * np.tensordot(w, y, axes=1)
+
+
+def _study_derivatives(doc: Doc, m: Mechanism, table: np.ndarray) -> None:
+    """The study redone with derivatives (`study_slopes`): d peak / d p by each varied parameter at
+    every case, against the table's centred differences (over cases whose peaks lie at one angle
+    of the study's grid) and integrated by Simpson's rule against the table's change."""
+    t0 = time.perf_counter()
+    try:
+        slopes, angles = study_slopes(m)
+    except (ValueError, NotImplementedError) as exc:
+        doc.p(f"The study by exact derivatives: skipped: {esc(str(exc).strip().splitlines()[0])}.")
+        return
+    st = m.study
+    i, j = st.pair
+    units = parameter_units(m)
+    (first, xs) = st.vary[0]
+    ys = st.vary[1][1] if len(st.vary) > 1 else ()
+    x = np.asarray(xs, float)
+    centred = (table[2:] - table[:-2]) / (x[2:] - x[:-2])[:, None]
+    exact = slopes[1:-1, :, 0]
+    same = (angles[2:] == angles[1:-1]) & (angles[:-2] == angles[1:-1])
+    off = np.abs(centred - exact) / np.abs(exact)
+    words = [f"The study redone with exact derivatives (`kinetostat.sensitivity` at each case; the derivative of "
+             f"the peak by the envelope rule at its angle): d max|R({i},{j})| / d {esc(first)} at every case below"]
+    if same.any():
+        words.append(f"the table's centred differences over its steps of {esc(first)} agree with them within "
+                     f"{100 * off[same].max():.2g} % where the three cases peak at one angle of the study's grid")
+    if (~same).any():
+        words.append(f"{int((~same).sum())} case(s) whose peak moves to another angle of that grid differ by up to "
+                     f"{100 * off[~same].max():.2g} %")
+    integral = _simpson(slopes[:, :, 0], xs)
+    if integral is not None:
+        change = table[-1] - table[0]
+        words.append(f"Simpson's rule over these derivatives gives the table's change from {esc(first)} = {xs[0]:g} "
+                     f"to {xs[-1]:g} within {100 * np.max(np.abs(integral - change) / np.abs(change)):.2g} %")
+    doc.p("; ".join(words) + ". " + " ".join(_signs(m, slopes)))
+    second = st.vary[1][0] if ys else ""
+    head = ([f"{esc(first)}, {units.get(first, model_units.NOT_STATED)} \\ {esc(second)}, "
+             f"{units.get(second, model_units.NOT_STATED)}", *(f"{y:g}" for y in ys)] if ys
+            else [f"{esc(first)}, {units.get(first, model_units.NOT_STATED)}", "value"])
+    for n, (name, _) in enumerate(st.vary):
+        doc.p(f"d max|R({i},{j})| / d {esc(name)}, {_per_unit(units.get(name, model_units.NOT_STATED))}:")
+        doc.table(head, [[f"{xv:g}", *(_fmt(v, 5) for v in row)] for xv, row in zip(xs, slopes[:, :, n])],
+                  "r" * len(head))
+    log.info("%s: the study by derivatives (%.3f s)", Path(m.path).stem, time.perf_counter() - t0)
+
+
 def study_command(m: Mechanism) -> str:
     """The `kinetostat sweep` command line that computes the model's `[study]`."""
     params = " ".join(f"--param {name}={','.join(f'{x:.15g}' for x in xs)}" for name, xs in m.study.vary)
@@ -161,6 +260,104 @@ def _study_section(doc: Doc, m: Mechanism) -> None:
               else [f"{esc(first)}, {units.get(first, 'not stated')}", f"max |R({i},{j})|, N"])
     doc.table(header, [[f"{x:g}"] + [f"{v:.1f}" if np.isfinite(v) else "\u2014" for v in row]
                        for x, row in zip(xs, table)], "r" * len(header))
+    _study_derivatives(doc, m, table)
+
+
+#: The report's sensitivity section: rows of its table and bars of its tornado chart.
+SENSITIVITY_ROWS, TORNADO_BARS = 5, 10
+SENSITIVITY_HEADING = "Sensitivity"
+
+
+@dataclass(frozen=True)
+class PeakElasticity:
+    """How one pair's peak |R| over the cycle moves with one parameter."""
+
+    pair: Pair
+    param: str
+    value: float          # the parameter's nominal value, its unit
+    peak: float           # max |R(i,j)| over the cycle, N
+    phi_deg: float        # the crank angle of the peak, deg
+    slope: float          # d peak / d param, N per unit of the parameter
+    elasticity: float     # (param / peak) d peak / d param, 1
+
+
+def free_parameters(m: Mechanism) -> tuple[str, ...]:
+    """The parameters the model file gives as numbers (not expressions of others), and g: those the
+    report differentiates, each then moving the parameters whose expressions use it (d l / d r
+    through l = sqrt(r**2 + c**2)), as a design sweep of it does."""
+    return (*(p for p in m.parameters if f"parameters.{p}" not in m.expressions), "g")
+
+
+def peak_slopes(sens, pair: Pair) -> tuple[int, dict[str, float]] | None:
+    """The index of the crank angle where |R| of `pair` peaks over the cycle of a
+    `kinetostat.sensitivity` result, and d peak / d p there for each of its parameters, N per unit
+    of p: (R . dR/dp) / |R| at the peak (the envelope rule: it holds where the peak over the cycle's
+    grid is reached at one angle). None where the pair carries no load."""
+    R = sens.result.reaction(*pair.links)
+    mag = np.linalg.norm(R, axis=-1)
+    if not np.any(np.isfinite(mag)) or np.nanmax(mag) == 0:
+        return None
+    k = int(np.nanargmax(mag))
+    dR = sens.reaction(*pair.links)
+    return k, {p: float(R[k] @ dR[p][k]) / float(mag[k]) for p in sens.params}
+
+
+def peak_elasticities(sens) -> list[PeakElasticity]:
+    """Every (pair, parameter) of a `kinetostat.sensitivity` result (`peak_slopes`), the largest
+    |elasticity| first. Pairs that carry no load have none."""
+    res = sens.result
+    out = []
+    for pair in res.mech.pairs:
+        found = peak_slopes(sens, pair)
+        if found is None:
+            continue
+        k, slopes = found
+        peak = float(np.linalg.norm(res.reaction(*pair.links)[k]))
+        out += [PeakElasticity(pair, p, sens.values[p], peak, float(res.phi_deg[k]), slope,
+                               sens.values[p] * slope / peak) for p, slope in slopes.items()]
+    return sorted(out, key=lambda e: -abs(e.elasticity))
+
+
+def _sensitivity_section(doc: Doc, run: ModelRun, d: Path) -> Path | None:
+    """The elasticities of the pairs' peak reactions to the model's `free_parameters` (`peak_elasticities`
+    of one `kinetostat.sensitivity` call at the report's angles): the SENSITIVITY_ROWS largest as a
+    table, the TORNADO_BARS largest as a tornado chart (returned); a model without [parameters] has
+    no section, one the sensitivities refuse a line saying why."""
+    from ..errors import AssemblyError, ModelError
+    from ..sensitivity import sensitivity
+    m = run.mech
+    if not m.parameters:
+        return None
+    doc.h(2, SENSITIVITY_HEADING)
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sens = sensitivity(m, params=free_parameters(m), phi_deg=run.res.phi_deg)
+        rows = peak_elasticities(sens)
+    except (ModelError, AssemblyError, ValueError, NotImplementedError) as exc:
+        doc.p(f"Skipped: {esc(str(exc).strip().splitlines()[0])}.")
+        return None
+    units = {**parameter_units(m), "g": "m/s²"}
+    doc.p(f"Exact derivatives (`kinetostat.sensitivity`, forward mode) of every pair's peak |R| over the cycle "
+          f"({len(run.res.phi_deg)} positions) with respect to each parameter the model gives as a number, and g "
+          f"({esc(', '.join(sens.params))}): "
+          "d peak / d p is that of |R| at the angle of the peak, (R · dR/dp) / |R| (the envelope rule: the peak "
+          "reached at one angle). Elasticity (p / peak) · d peak / d p: the peak's relative change for a relative "
+          "change of p (0.5: 1 % more p, 0.5 % more peak); a parameter that other parameters' expressions use moves "
+          f"them too, as in a design sweep. The {SENSITIVITY_ROWS} largest |elasticities| over the pairs and parameters:")
+    doc.table(["pair", "parameter", "value", "peak |R|, N", "at φ, deg", "d peak / d p", "elasticity, 1"],
+              [[esc(pair_name(m, e.pair)), esc(e.param), f"{e.value:.6g} {units[e.param]}".removesuffix(" 1"),
+                f"{e.peak:.6g}", f"{e.phi_deg:.4g}", f"{_fmt(e.slope, 5)} {_per_unit(units[e.param])}", f"{e.elasticity:+.4f}"]
+               for e in rows[:SENSITIVITY_ROWS]], "llrrrrr")
+    bars = rows[:TORNADO_BARS]
+    with plain_text():
+        image = plot_tornado(m, [f"{pair_name(m, e.pair)}: {e.param}" for e in bars],
+                             [e.elasticity for e in bars], d / "sensitivity.svg")
+    doc.img(image, f"Elasticities of the peak reactions, the {len(bars)} largest: red, the peak grows with the "
+                   "parameter; blue, it falls")
+    log.info("%s: sensitivity (%.3f s)", run.stem, time.perf_counter() - t0)
+    return image
 
 
 def _mechanism_section(doc: Doc, m: Mechanism, path: Path | None) -> None:
@@ -689,6 +886,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     _friction_section(doc, run)
     motion = _motion_section(doc, run, delta, flywheel)
     _study_section(doc, m)
+    sens_image = _sensitivity_section(doc, run, d)
     log.info("%s: cycle.csv.gz and the tables (%.1f s)", folder, time.perf_counter() - t0)
 
     doc.h(2, "Errors against the engines")
@@ -735,7 +933,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
         doc.h(2, "Sources")
         doc.ul([_work(w) for w in works])
     doc.h(2, "Files")
-    doc.ul([f"[{p.name}]({p.name})" for p in [*images.values(), *plan_files]]
+    doc.ul([f"[{p.name}]({p.name})" for p in [*images.values(), *([sens_image] if sens_image else []), *plan_files]]
            + [f"[{CYCLE_FILE}]({CYCLE_FILE}): `res.to_frame()` of the cycle as CSV, gzip-compressed",
                                                                   "[summary.json](summary.json)"])
 
