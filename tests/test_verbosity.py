@@ -27,7 +27,8 @@ def test_quiet_and_verbose_before_or_after_every_command():
     parser = build_parser()
     commands = next(a for a in parser._actions if a.choices and "analyze" in a.choices).choices
     needs = {"analyze": ["m"], "structure": ["m"], "export": ["m", "--mjcf"], "plans": ["m", "--out", "d"],
-             "page": ["m", "--out", "p.html"], "sweep": ["m", "--param", "r=1", "--out", "s.csv"]}
+             "page": ["m", "--out", "p.html"], "sweep": ["m", "--param", "r=1", "--out", "s.csv"],
+             "motion": ["m", "--out", "d"]}
     for name in commands:
         rest = needs.get(name, [])
         assert parser.parse_args([name, *rest]).verbosity == 0
@@ -72,9 +73,11 @@ def test_report_says_what_it_will_do_first_then_each_part_of_a_model(tmp_path, m
     assert before_models == [f"report: 1 model(s) into {tmp_path}: routes lever, reference; no pages; 1 at a time\n"]
     err = capsys.readouterr().err.splitlines()
     parts = ["chain_unit_four_bar: route reference PASS (", "chain_unit_four_bar: figures mechanism, moment, ",
-             "chain_unit_four_bar: cycle.csv.gz and the tables (", "chain_unit_four_bar: plans, worksheet ("]
-    assert [next((i for i, s in enumerate(err) if s.startswith(p)), None) for p in parts] == list(range(4)), err
-    assert all(re.search(r"\(\d+\.\d s\)$", s) for s in err[:4]), err
+             "chain_unit_four_bar: law of motion (", "chain_unit_four_bar: the study by derivatives (",
+             "chain_unit_four_bar: sensitivity (", "chain_unit_four_bar: cycle.csv.gz and the tables (",
+             "chain_unit_four_bar: plans, worksheet ("]
+    assert [next((i for i, s in enumerate(err) if s.startswith(p)), None) for p in parts] == list(range(7)), err
+    assert all(re.search(r"\(\d+\.\d s\)$", s) for s in err[:7]), err
 
 
 def test_a_long_report_says_its_time_and_what_is_faster(cli, tmp_path, monkeypatch, clock):

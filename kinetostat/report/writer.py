@@ -229,7 +229,7 @@ def _study_derivatives(doc: Doc, m: Mechanism, table: np.ndarray) -> None:
         doc.p(f"d max|R({i},{j})| / d {esc(name)}, {_per_unit(units.get(name, model_units.NOT_STATED))}:")
         doc.table(head, [[f"{xv:g}", *(_fmt(v, 5) for v in row)] for xv, row in zip(xs, slopes[:, :, n])],
                   "r" * len(head))
-    log.info("%s: the study by derivatives (%.3f s)", Path(m.path).stem, time.perf_counter() - t0)
+    log.info("%s: the study by derivatives (%.1f s)", Path(m.path).stem, time.perf_counter() - t0)
 
 
 def study_command(m: Mechanism) -> str:
@@ -356,7 +356,7 @@ def _sensitivity_section(doc: Doc, run: ModelRun, d: Path) -> Path | None:
                              [e.elasticity for e in bars], d / "sensitivity.svg")
     doc.img(image, f"Elasticities of the peak reactions, the {len(bars)} largest: red, the peak grows with the "
                    "parameter; blue, it falls")
-    log.info("%s: sensitivity (%.3f s)", run.stem, time.perf_counter() - t0)
+    log.info("%s: sensitivity (%.1f s)", run.stem, time.perf_counter() - t0)
     return image
 
 
@@ -740,7 +740,7 @@ def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywhee
                 const = run.at([MOTION_AT_DEG])
     except (ModelError, AssemblyError, ValueError) as exc:
         why = str(exc).strip().splitlines()[0]
-    log.info("%s: law of motion (%.3f s)", run.stem, time.perf_counter() - t0)
+    log.info("%s: law of motion (%.1f s)", run.stem, time.perf_counter() - t0)
     if why:
         doc.p(f"Skipped: {esc(why)}.")
         return None
