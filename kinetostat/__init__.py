@@ -45,6 +45,7 @@ from .model import Flywheel, Mechanism, from_dict, load, loads
 from .motion import Motion, law_of_motion
 from .structure import AssurGroup, Structure
 from .sweep import Sweep, sweep
+from .tolerance import Tolerance, tolerance
 from .virtual_work import VirtualWork, virtual_work
 
 if _TYPE_CHECKING:
@@ -68,5 +69,5 @@ def __dir__() -> list[str]:
 __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
            "AssemblyError", "SingularPositionWarning", "SelfLockingWarning", "SingularFrictionWarning", "UndefinedFigureWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
-           "examples", "plans", "variants", "sweep", "Sweep", "law_of_motion", "Motion", "Flywheel"]
+           "examples", "plans", "variants", "sweep", "Sweep", "tolerance", "Tolerance", "law_of_motion", "Motion", "Flywheel"]
 __version__ = "0.2.0"

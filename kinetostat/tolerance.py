@@ -145,7 +145,7 @@ class Tolerance:
         cols.update({_level(q): mc.peak_quantiles[n] for n, q in enumerate(mc.quantiles)})
         cols.update({f"share_{p}": self.contributions.peak[n] for n, p in enumerate(self.params)})
         df = pd.DataFrame(cols)
-        value_unit = self.output_units[0] if len(set(self.output_units)) == 1 else "unit column"
+        value_unit = " or ".join(dict.fromkeys(self.output_units))      # each row's in its column `unit`
         df.attrs.update(mechanism=self.mechanism, units={
             "output": "text", "unit": "text", "peak_deg": "deg", "nominal": value_unit,
             **{c: value_unit for c in ("linear_worst", "linear_rss", "mc_mean", "mc_std")},

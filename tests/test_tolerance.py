@@ -141,3 +141,35 @@ def test_the_histogram_quantiles_lie_within_their_stated_error(small):
 def test_bad_input_is_named(limits, kwargs, message):
     with pytest.raises(ValueError, match=message):
         tolerance(CHAIN, limits, **{"samples": 20, "steps": 4, **kwargs})
+
+
+# ----------------------------------------------------------------------------- the command line
+
+def test_the_command_writes_a_table_an_xarray_file_and_a_tornado_chart(cli, tmp_path):
+    import xml.etree.ElementTree as ET
+    pytest.importorskip("xarray")
+    r = cli("tolerance", CHAIN, "--tol", "r=0.1mm", "--tol", "l=2e-4", "--samples", "20", "--steps", "8",
+            "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    head = (tmp_path / "tolerance.csv").read_text().splitlines()
+    assert head[0].startswith("output,unit,nominal [N or N m],peak_deg [deg],linear_worst [N or N m]")
+    assert head[0].endswith("share_r [1],share_l [1]") and len(head) == 6        # four pairs and M_bal
+    import xarray as xr
+    with xr.open_dataset(tmp_path / "tolerance.nc", engine="scipy") as ds:
+        assert ds["M_bal_mc_std"].attrs["units"] == "N m" and ds.sizes["phi"] == 8
+        assert ds.attrs["limits"] == "r: 0.0001 m, l: 0.0002 m"                 # 0.1 mm in the model's metres
+    svg = ET.parse(tmp_path / "tornado.svg").getroot()
+    assert sum(1 for e in svg.iter() if e.tag.endswith("rect")) == 2 * 5        # a bar per parameter and peak
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--tol", "m2=0.1mm"], "--tol m2=0.1mm: 'mm' is not a unit of m2 (kg); use kg, g, %"),
+    (["--tol", "r=abc"], "invalid --tol 'r=abc': expected NAME=VALUE[UNIT] with a positive VALUE"),
+    (["--tol", "rr=1mm"], "--tol rr: not a parameter of the model (did you mean 'r'?)"),
+    (["--tol", "r=1mm", "--tol", "r=2mm"], "--tol r: given more than once"),
+    (["--tol", "r=1mm", "--chunk", "30"], "--chunk expected a multiple of SEED_BLOCK (20) samples, got 30"),
+])
+def test_bad_options_are_one_line_naming_the_option(cli, tmp_path, args, message):
+    r = cli("tolerance", CHAIN, *args, "--samples", "20", "--steps", "4", "--out", tmp_path / "out")
+    assert r.returncode == 2 and message in r.stderr and "Traceback" not in r.stderr, r.stderr
+    assert not any((tmp_path / "out").glob("*"))                               # nothing written
