@@ -43,6 +43,7 @@ from .errors import (AssemblyError, ModelError, ModelFileNotFound, ModelWarning,
 from .kinematics import COND_CHECK, COND_MAX, DIGITS_MIN, DIGITS_WARN
 from .model import Flywheel, Mechanism, from_dict, load, loads
 from .motion import Motion, law_of_motion
+from .sensitivity import Sensitivity, sensitivity
 from .structure import AssurGroup, Structure
 from .sweep import Sweep, sweep
 from .tolerance import Tolerance, tolerance
@@ -69,5 +70,5 @@ def __dir__() -> list[str]:
 __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
            "AssemblyError", "SingularPositionWarning", "SelfLockingWarning", "SingularFrictionWarning", "UndefinedFigureWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
-           "examples", "plans", "variants", "sweep", "Sweep", "tolerance", "Tolerance", "law_of_motion", "Motion", "Flywheel"]
+           "examples", "plans", "variants", "sweep", "Sweep", "tolerance", "Tolerance", "law_of_motion", "Motion", "Flywheel", "sensitivity", "Sensitivity"]
 __version__ = "0.2.0"

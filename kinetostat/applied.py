@@ -8,7 +8,7 @@ May use: numpy, groups, model, kinematics (its results), planar, errors.
 from __future__ import annotations
 
 import warnings
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Callable, NamedTuple
 
 import numpy as np
 
@@ -20,13 +20,8 @@ if TYPE_CHECKING:
     from .kinematics import Kinematics
     from .model import Load, Mechanism
 
-__all__ = ["applied_wrenches", "com_motion", "inertia_loads", "load_magnitude", "point_forces", "PointForce", "applied_moment",
+__all__ = ["applied_wrenches", "load_wrenches", "stroke", "com_motion", "inertia_loads", "load_magnitude", "point_forces", "PointForce", "applied_moment",
            "travel", "travel_rates", "forward_stroke"]
-
-
-def _add_force(F, M, kin: "Kinematics", k: int, f: np.ndarray, X: np.ndarray) -> None:
-    F[:, k] += f
-    M[:, k] += cross_z(X - kin.origin_z[:, k], f)
 
 
 def com_motion(mech: "Mechanism", kin: "Kinematics") -> tuple[np.ndarray, np.ndarray]:
@@ -50,21 +45,32 @@ def applied_wrenches(mech: "Mechanism", kin: "Kinematics", r: np.ndarray) -> tup
     weight, M = groups.weight(r, mech.inertia_arrays[0], mech.g)
     F = np.empty(r.shape, complex)
     F[:] = weight
-    for ld in mech.loads:
-        if ld.kind == "moment":
-            M[:, ld.link] += applied_moment(mech, kin, ld)
-        elif ld.kind == "damper" and mech.pair_between(*ld.pair).kind == "R":
-            m = load_magnitude(mech, kin, ld)            # on link pair[1]; the opposite on pair[0]
-            M[:, ld.pair[1]] += m
-            if ld.pair[0]:
-                M[:, ld.pair[0]] -= m
-    for f in point_forces(mech, kin):
-        if f.link:
-            _add_force(F, M, kin, f.link, f.force, f.X)
-        unknown = np.isnan(f.force)
-        if unknown.any():                    # e.g. a spring of zero length: every force there is unknown
+    for k, f, m in load_wrenches(mech, kin):
+        if k:
+            F[:, k] += f
+            M[:, k] += m
+        unknown = np.isnan(f)
+        if np.any(unknown):                  # e.g. a spring of zero length: every force there is unknown
             F[unknown], M[unknown] = np.nan, np.nan
     return F, M
+
+
+def load_wrenches(mech: "Mechanism", kin: "Kinematics") -> list[tuple[int, object, object]]:
+    """Every applied load but gravity as (link k, force (N,) complex or 0, its moment about link
+    k's local origin (N,)), in the order `applied_wrenches` adds them (k = 0: on the frame, kept
+    for its NaN). Elementwise: it also runs on `sensitivity.Dual` motions and loads."""
+    out: list[tuple[int, object, object]] = []
+    for ld in mech.loads:
+        if ld.kind == "moment":
+            out.append((ld.link, 0.0, applied_moment(mech, kin, ld)))
+        elif ld.kind == "damper" and mech.pair_between(*ld.pair).kind == "R":
+            m = load_magnitude(mech, kin, ld)            # on link pair[1]; the opposite on pair[0]
+            out.append((ld.pair[1], 0.0, m))
+            if ld.pair[0]:
+                out.append((ld.pair[0], 0.0, -m))
+    for f in point_forces(mech, kin):
+        out.append((f.link, f.force, cross_z(f.X - kin.origin_z[:, f.link], f.force)))
+    return out
 
 
 def applied_moment(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> np.ndarray:
@@ -159,7 +165,7 @@ def load_magnitude(mech: "Mechanism", kin: "Kinematics", ld: "Load", X: np.ndarr
                              source=mech.path or mech.name)
         return s * M
     if ld.table is None:
-        return np.full(N, ld.value)
+        return ld.value + np.zeros(N)
     t = ld.table
     if t.argument == "phi":
         xp, vp = mech.memo(("periodic", id(t)), lambda: (   # the diagram (rad) over [-4 pi, 4 pi]: fmod lands inside
@@ -202,14 +208,21 @@ def travel_rates(mech: "Mechanism", kin: "Kinematics", ld: "Load") -> tuple[np.n
 def _stroke_ends(mech: "Mechanism", ld: "Load") -> tuple[float, float]:
     """The extreme projections (m) of load `ld`'s point on its travel axis (memoised);
     ModelError where the point does not move along the axis."""
-    p = mech.links[ld.link].points[ld.point]
-    axis = _travel_axis(ld)
-    lo, hi = mech.memo(("stroke", ld.link, tuple(p), axis), lambda: _stroke(mech, ld.link, p, axis))
+    lo, hi, _, _ = stroke(mech, ld)
     if not hi - lo > 1e-9 * mech.size:
         n = mech.loads.index(ld)
         raise ModelError([f"load[{n}].table: a travel diagram needs a moving point, but {ld.point!r} of link "
                           f"{ld.link} travels {hi - lo:.3g} m along the axis over the cycle"], source=mech.path or "model")
     return lo, hi
+
+
+def stroke(mech: "Mechanism", ld: "Load", make: Callable[[], tuple] | None = None) -> tuple:
+    """The extreme projections lo, hi (m) of load `ld`'s point on its travel axis over a cycle and
+    the crank angles (rad) where the point is there (memoised per mechanism). `make`: what to keep
+    instead, where none is kept yet (`sensitivity`: the ends on duals)."""
+    p = mech.links[ld.link].points[ld.point]
+    axis = _travel_axis(ld)
+    return mech.memo(("stroke", ld.link, tuple(p), axis), make or (lambda: _stroke(mech, ld.link, p, axis)))
 
 
 def forward_stroke(mech: "Mechanism", kin: "Kinematics", ld: "Load", V: np.ndarray | None = None) -> np.ndarray:
@@ -220,9 +233,10 @@ def forward_stroke(mech: "Mechanism", kin: "Kinematics", ld: "Load", V: np.ndarr
     return v <= 0 if ld.table.origin == "max" else v >= 0
 
 
-def _stroke(mech: "Mechanism", k: int, p, axis: complex) -> tuple[float, float]:
-    """Extreme projections of a point's path on `axis` over a full cycle, m: the dead centres,
-    where ds/dphi = 0, found by Newton's method from a coarse scan with the exact plans."""
+def _stroke(mech: "Mechanism", k: int, p, axis: complex) -> tuple[float, float, float, float]:
+    """Extreme projections of a point's path on `axis` over a full cycle, m, and their crank
+    angles, rad: the dead centres, where ds/dphi = 0, found by Newton's method from a coarse scan
+    with the exact plans."""
     from .kinematics import kinematics
 
     def state(phi):                               # s, ds/dphi, d2s/dphi2
@@ -239,5 +253,6 @@ def _stroke(mech: "Mechanism", k: int, p, axis: complex) -> tuple[float, float]:
             _, d1x, d2x = state(x)
             x = x - np.where(d2x != 0, d1x / d2x, 0.0)
         sx = state(x)[0] if len(x) else np.empty(0)
-    values = np.concatenate([s, sx])
-    return float(np.nanmin(values)), float(np.nanmax(values))
+    values, angles = np.concatenate([s, sx]), np.concatenate([phi, x])
+    lo, hi = np.nanargmin(values), np.nanargmax(values)
+    return float(values[lo]), float(values[hi]), float(angles[lo]), float(angles[hi])

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Literal, Mapping
+from typing import Callable, Literal, Mapping
 
 import numpy as np
 
@@ -45,14 +45,15 @@ class Link:
     bodies: tuple[Body, ...] = ()
 
 
-def combine(bodies: tuple[Body, ...]) -> tuple[float, Vec, float]:
+def combine(bodies: tuple[Body, ...], total: Callable = math.fsum) -> tuple[float, Vec, float]:
     """Total mass (kg), centre of mass (local, m) and I_S about it (kg m^2) of `bodies`:
-    m = sum m_b, S = sum m_b S_b / m, I_S = sum (I_b + m_b |S_b - S|^2)."""
-    m = math.fsum(b.mass for b in bodies)
+    m = sum m_b, S = sum m_b S_b / m, I_S = sum (I_b + m_b |S_b - S|^2). `total`: the sum taken
+    (`sum` where the numbers are `sensitivity.Dual`s)."""
+    m = total(b.mass for b in bodies)
     if m == 0:
         return 0.0, (0.0, 0.0), 0.0
-    S = (math.fsum(b.mass * b.com[0] for b in bodies) / m, math.fsum(b.mass * b.com[1] for b in bodies) / m)
-    I_S = math.fsum(b.I_S + b.mass * ((b.com[0] - S[0]) ** 2 + (b.com[1] - S[1]) ** 2) for b in bodies)
+    S = (total(b.mass * b.com[0] for b in bodies) / m, total(b.mass * b.com[1] for b in bodies) / m)
+    I_S = total(b.I_S + b.mass * ((b.com[0] - S[0]) ** 2 + (b.com[1] - S[1]) ** 2) for b in bodies)
     return m, S, I_S
 
 

@@ -1,0 +1,182 @@
+"""kinetostat.sensitivity: exact forward-mode derivatives of the kinematics, reactions and M_bal by a
+model's parameters, against an independent route: central differences of whole analyses of the model
+re-loaded with the parameter overridden (`kinetostat.load(path, parameters=...)`, as `sweep` sets
+parameters), Richardson-extrapolated in float64 (truncation O(h^4))."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kinetostat
+from kinetostat import SingularPositionWarning
+from kinetostat.analysis import exact
+
+from conftest import FOUR_BAR, ROOT
+
+CHAIN = ROOT / "models" / "chain_unit_four_bar.toml"
+ICE = ROOT / "models" / "ice_crank_slider.toml"
+COMPRESSOR = ROOT / "models" / "compressor.toml"
+YOKE = ROOT / "models" / "scotch_yoke.toml"
+PHI = np.arange(360.0)
+#: Agreement asked for: the largest difference over the angles, relative to the largest |derivative|.
+RTOL = 1e-8
+
+
+def outputs(mech, point: str) -> list:
+    """What is compared: (name, Analysis -> array, Sensitivity -> parameter -> array): M_bal (and
+    F_bal), every pair's reaction, the motion of `point`."""
+    out = [("M_bal", lambda r: r.balancing_moment, lambda s: s.balancing_moment)]
+    if mech.drive.kind == "machine":
+        out.append(("F_bal", lambda r: r.balancing_force, lambda s: s.balancing_force))
+    for p in mech.pairs:
+        out.append((f"R{p.links}", lambda r, ij=p.links: r.reaction(*ij), lambda s, ij=p.links: s.reaction(*ij)))
+    return out + [(f"{what}_{point}", lambda r, w=what: getattr(r, w)(point), lambda s, w=what: getattr(s, w)(point))
+                  for what in ("position", "velocity", "acceleration")]
+
+
+def richardson(path, name: str, x0: float, rel_step: float = 1e-3):
+    """output -> d output / d name at x0, by central differences of analyses of the model re-loaded
+    with name = x0 +- h, x0 +- h/2, Richardson-extrapolated."""
+    h = rel_step * abs(x0)
+    runs = {k: exact(kinetostat.load(path, parameters={name: x0 + k * h}), PHI, "first") for k in (-1, -0.5, 0.5, 1)}
+
+    def of(output) -> np.ndarray:
+        D = lambda k: (np.asarray(output(runs[k])) - np.asarray(output(runs[-k]))) / (2 * k * h)
+        return (4 * D(0.5) - D(1)) / 3
+    return of
+
+
+def worst(path, names, point: str = "B") -> dict[tuple[str, str], float]:
+    """(parameter, output) -> the largest difference of the exact derivative from Richardson's over
+    the angles, relative to the largest |derivative| (outputs that do not move: to 1 unit)."""
+    mech = kinetostat.load(path)
+    sens = kinetostat.sensitivity(mech, params=names, phi_deg=PHI)
+    out = {}
+    for name in names:
+        differences = richardson(path, name, sens.values[name])
+        for label, of_result, of_sens in outputs(mech, point):
+            ref = differences(of_result)
+            out[name, label] = float(np.abs(of_sens(sens)[name] - ref).max() / max(np.abs(ref).max(), 1.0))
+    return out
+
+
+def parametric_yoke(tmp_path) -> Path:
+    """The bundled Scotch yoke (an RPP group, a return spring, a resistance against the velocity)
+    with its crank, spring and resistance as [parameters]."""
+    text = YOKE.read_text(encoding="utf-8").replace(
+        "g = 9.81\n", "g = 9.81\n\n[parameters]\nr = 0.05\nk = 2000.0\nl0 = 0.10\nF = 150.0\n", 1)
+    for old, new in (("A = [0.05, 0.0]", 'A = ["r", 0.0]'), ("stiffness = 2000.0", 'stiffness = "k"'),
+                     ("free_length = 0.10", 'free_length = "l0"'), ("value = 150.0", 'value = "F"')):
+        assert old in text
+        text = text.replace(old, new, 1)
+    path = tmp_path / "yoke.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+#: the crank r and the coupler l = sqrt(r**2 + c**2) together (d/d r moves l with r, d/d l moves l alone: as
+#: the model loaded with one of them overridden), a frame point, a mass, an inertia, g
+CHAIN_SAMPLE = ["r", "l", "h", "m2", "J_C2", "g"]
+ICE_SAMPLE = ["l_OA", "n1", "p_max", "G2"]               # a length, the speed, the gas table's scale, a weight
+COMPRESSOR_SAMPLE = ["l_OA", "AB_OA", "module", "d"]     # the stroke (the travel diagram's ends), the gear
+CHAIN_ALL = [*kinetostat.load(CHAIN).parameters, "g"]
+ICE_ALL = [*kinetostat.load(ICE).parameters, "g"]
+COMPRESSOR_ALL = [n for n in [*kinetostat.load(COMPRESSOR).parameters, "g"] if n != "z_wheel"]   # an integer
+
+
+@pytest.mark.parametrize("path, names", [(CHAIN, CHAIN_SAMPLE), (ICE, ICE_SAMPLE), (COMPRESSOR, COMPRESSOR_SAMPLE)],
+                         ids=["chain_unit", "ice", "compressor"])
+def test_agrees_with_richardson_differences(path, names):
+    """Kinematics, reactions and M_bal at 360 angles, to 1e-8 of each output's scale: the chain-unit
+    four-bar (bodies, a dependent coupler length l = sqrt(r^2 + c^2)), the ICE crank-slider (a phi
+    diagram scaled by p_max, masses from weights), the compressor (a working machine's gear, a
+    travel diagram with a return stroke whose stroke the crank sets)."""
+    bad = {k: v for k, v in worst(path, names).items() if not v <= RTOL}
+    assert not bad, bad
+
+
+def test_spring_and_resistance_against_the_velocity_agree(tmp_path):
+    bad = {k: v for k, v in worst(parametric_yoke(tmp_path), ["r", "k", "l0", "F"], "S3").items() if not v <= RTOL}
+    assert not bad, bad
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path, names", [(CHAIN, CHAIN_ALL), (ICE, ICE_ALL), (COMPRESSOR, COMPRESSOR_ALL)],
+                         ids=["chain_unit", "ice", "compressor"])
+def test_every_parameter_agrees_with_richardson_differences(path, names):
+    bad = {k: v for k, v in worst(path, names).items() if not v <= RTOL}
+    assert not bad, bad
+
+
+def test_balancing_moment_is_affine_in_g():
+    """M_bal = M_0 + g M_g (masses given as masses): d M_bal / d g is exactly its gravity part over g."""
+    sens = kinetostat.sensitivity(kinetostat.load(CHAIN), params=["g", "r"], steps=90)
+    g = sens.values["g"]
+    weightless = exact(kinetostat.load(CHAIN, parameters={"g": 0.0}), sens.phi_deg, "first").balancing_moment
+    gravity_part = sens.result.balancing_moment - weightless
+    np.testing.assert_allclose(sens.balancing_moment["g"], gravity_part / g, rtol=0,
+                               atol=1e-12 * np.abs(gravity_part / g).max())
+
+
+def test_reactions_are_affine_in_the_gas_pressure():
+    """The gas force is the only load p_max scales: d R / d p_max = (R - R at p_max = 0) / p_max."""
+    sens = kinetostat.sensitivity(kinetostat.load(ICE), params=["p_max"], steps=72)
+    p = sens.values["p_max"]
+    idle = exact(kinetostat.load(ICE, parameters={"p_max": 0.0}), sens.phi_deg, "first")
+    for i, j in ((0, 1), (1, 2), (3, 2), (0, 3)):
+        part = (sens.result.reaction(i, j) - idle.reaction(i, j)) / p
+        np.testing.assert_allclose(sens.reaction(i, j)["p_max"], part, rtol=0, atol=1e-12 * np.abs(part).max())
+
+
+def test_result_is_the_analysis_and_arrays_are_read_only():
+    mech = kinetostat.load(CHAIN)
+    sens = kinetostat.sensitivity(mech, params=["r"], steps=36)
+    ref = kinetostat.analyze(mech, steps=36)
+    np.testing.assert_array_equal(sens.result.balancing_moment, ref.balancing_moment)
+    assert sens.params == ("r",) and sens.values == {"r": 0.08} and sens.phi_deg.shape == (36,)
+    d = sens.reaction(1, 2)["r"]
+    assert d.shape == (36, 2) and not d.flags.writeable
+    np.testing.assert_array_equal(sens.reaction(2, 1)["r"], -d)       # R_21 = -R_12
+    assert np.all(sens.error < 1e-10) and sens.error.shape == (36,)
+    with pytest.raises(AttributeError, match="engine"):
+        sens.balancing_force
+
+
+def test_every_parameter_by_default():
+    mech = kinetostat.load(ICE)
+    sens = kinetostat.sensitivity(mech, steps=8)
+    assert sens.params == tuple(mech.parameters)
+
+
+@pytest.mark.parametrize("params, match", [(["r", "nope"], "'nope' is not a parameter.*Parameters: r, n_k"),
+                                           (["r", "r"], "names a parameter twice"), ([], "params is empty")])
+def test_bad_params_are_named(params, match):
+    with pytest.raises(ValueError, match=match):
+        kinetostat.sensitivity(kinetostat.load(CHAIN), params=params, steps=4)
+
+
+def test_to_xarray_has_every_output_by_every_parameter_with_units():
+    pytest.importorskip("xarray")
+    ds = kinetostat.sensitivity(kinetostat.load(CHAIN), params=["r", "m2"], steps=12).to_xarray()
+    assert ds["dM_bal"].dims == ("param", "phi") and ds["dR"].dims == ("param", "phi", "pair", "xy")
+    assert list(ds["param"].values) == ["r", "m2"] and list(ds["param_unit"].values) == ["m", "kg"]
+    assert ds["dR"].attrs["units"] == "N" and "per unit of the parameter" in ds["dR"].attrs["long_name"]
+    assert ds["dposition"].sizes["point"] == len(kinetostat.load(CHAIN).point_names)
+
+
+def test_near_a_singular_position_the_guard_applies_to_the_derivatives():
+    """A four-bar through a toggle at 180 deg (test_kinetostatics' TOGGLE): at 179 deg the values keep
+    ~8 digits (warned) and the derivatives' estimate is that error times the plan's condition number;
+    at 179.99 deg the analysis is singular: every derivative NaN, error inf."""
+    toggle = (FOUR_BAR.replace("B = [0.35, 0.0], S2 = [0.15, 0.02]", "B = [0.2, 0.0], S2 = [0.1, 0.02]")
+              .replace("B = [0.3, 0.0], S3", "B = [0.2, 0.0], S3"))
+    with pytest.warns(SingularPositionWarning, match=r"values set to NaN at \[179\.99\] deg"):
+        sens = kinetostat.sensitivity(kinetostat.loads(toggle), params=["g"], phi_deg=[90.0, 179.0, 179.99])
+    res, cond = sens.result, sens.result.cond.max(axis=1)
+    assert list(res.singular) == [False, False, True]
+    np.testing.assert_allclose(sens.error[:2], res.error[:2] * cond[:2])
+    assert sens.error[0] < 1e-12 < 1e-8 < sens.error[1] and sens.error[2] == np.inf
+    for d in (sens.balancing_moment["g"], sens.reaction(1, 2)["g"], sens.position("B")["g"]):
+        assert np.isfinite(d[:2]).all() and np.isnan(d[2]).all()
