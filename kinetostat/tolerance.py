@@ -222,10 +222,12 @@ def tolerance(model: str | Path | Mechanism, limits: Mapping[str, float], *, sam
         raise ValueError(f"chunk: expected a multiple of SEED_BLOCK ({SEED_BLOCK}) samples, got {chunk}")
     phi_deg = crank_angles(phi_deg, steps)
     sigma = limit / math.sqrt(3) if dist == "uniform" else limit
-    lin, shares = _linear(base, names, phi_deg, limit if dist == "uniform" else 3 * limit, sigma)
+    nominal = np.array([float(base.parameters[n]) if n != "g" else base.g for n in names])
+    pinned = loads(text, source, parameters=dict(zip(names, map(float, nominal))))   # as every sample sets them
+    lin, shares = _linear(pinned, names, phi_deg, limit if dist == "uniform" else 3 * limit, sigma)
     from . import fast
-    spec = _Spec(names, np.array([float(base.parameters[n]) if n != "g" else base.g for n in names]), limit, dist,
-                 seed, phi_deg, fast.pays(base, samples * len(phi_deg), "full"), lin.nominal)
+    spec = _Spec(names, nominal, limit, dist, seed, phi_deg, fast.pays(base, samples * len(phi_deg), "full"),
+                 lin.nominal)
     pilot = _outputs(text, source, spec, range(min(PILOT, samples)))[0]
     spec = _with_range(spec, pilot)
     parts = [range(a, min(a + chunk, samples)) for a in range(0, samples, chunk)]
@@ -268,8 +270,10 @@ def _units(base: Mechanism, names: list[str]) -> list[str]:
 
 def _linear(base: Mechanism, names: list[str], phi_deg: np.ndarray, t: np.ndarray,
             sigma: np.ndarray) -> tuple[Linear, Contributions]:
-    """The first-order stacks from `kinetostat.sensitivity` at the nominal design (`t`: the
-    worst-case half widths, `sigma`: the standard deviations, each (P,))."""
+    """The first-order stacks from `kinetostat.sensitivity` at the nominal design `base`, loaded
+    with the toleranced parameters set, as each sample sets them (so that d/dr holds a toleranced
+    l = sqrt(r**2 + c**2) fixed, as the samples do; an untoleranced one follows r). `t`: the
+    worst-case half widths, `sigma`: the standard deviations, each (P,)."""
     from .sensitivity import sensitivity
     sens = sensitivity(base, params=names, steps=len(phi_deg), phi_deg=phi_deg)
     res = sens.result
