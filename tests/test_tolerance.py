@@ -28,19 +28,19 @@ def _same(a: tolmod.Tolerance, b: tolmod.Tolerance) -> None:
 
 @pytest.fixture(scope="module")
 def small():
-    """40 designs x 12 angles in one chunk, in this process: the reference split."""
-    return tolerance(CHAIN, LIMITS, samples=40, steps=12, seed=3, chunk=40)
+    """80 designs (four seed blocks) x 8 angles in one chunk, in this process: the reference split."""
+    return tolerance(CHAIN, LIMITS, samples=80, steps=8, seed=3, chunk=80)
 
 
-@pytest.mark.parametrize("chunk, scheduler", [(20, None), (20, "threads")])
+@pytest.mark.parametrize("chunk, scheduler", [(40, None), (20, "threads")])
 def test_samples_split_any_way_give_identical_results(small, chunk, scheduler):
-    other = tolerance(CHAIN, LIMITS, samples=40, steps=12, seed=3, chunk=chunk, scheduler=scheduler)
+    other = tolerance(CHAIN, LIMITS, samples=80, steps=8, seed=3, chunk=chunk, scheduler=scheduler)
     _same(small, other)
-    assert small.monte_carlo.failed == 0 and small.monte_carlo.count.min() == 40
+    assert small.monte_carlo.failed == 0 and small.monte_carlo.count.min() == 80
 
 
 def test_another_seed_draws_other_designs(small):
-    other = tolerance(CHAIN, LIMITS, samples=20, steps=12, seed=4)
+    other = tolerance(CHAIN, LIMITS, samples=20, steps=8, seed=4)
     assert not np.array_equal(small.monte_carlo.peaks[:20], other.monte_carlo.peaks)
 
 
