@@ -1,7 +1,7 @@
 """Tolerance studies: what the tolerances of a parametric model's parameters do to its forces.
 
     >>> import kinetostat
-    >>> tol = kinetostat.tolerance("chain_unit_four_bar", {"r": 1e-4, "l": 2e-4}, samples=1000, steps=36)
+    >>> tol = kinetostat.tolerance("chain_unit_four_bar", {"r": 1e-4, "l": 2e-4}, samples=100, steps=36)
     >>> tol.outputs[-1], tol.linear.rss.shape, tol.monte_carlo.peak_quantiles.shape
     ('M_bal', (36, 5), (7, 5))
 
