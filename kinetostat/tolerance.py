@@ -7,7 +7,8 @@
 
 The outputs (K of them, `Tolerance.outputs`): every pair's |R_i_j| (N), M_bal (N m, signed; its
 peak is max |M_bal|), a working machine's |F_bal| (N), at each of the N crank angles, and their
-peaks over the cycle (max |value|).
+peaks over the cycle (max |value|); the reactions frictionless (FRICTION: friction's first
+approximation, as `sensitivity` differentiates them).
 
 - `linear`: first order, from the exact derivatives (`kinetostat.sensitivity`): per output and
   angle the worst case sum_p |dy/dp| t_p and the RSS sqrt(sum_p (dy/dp sigma_p)^2), and of each
@@ -65,6 +66,8 @@ BINS = 256
 PILOT = 40
 #: The quantiles reported, of the peaks and at each angle.
 QUANTILES = (0.001, 0.01, 0.05, 0.5, 0.95, 0.99, 0.999)
+#: The reactions of every design: the frictionless ones (friction's first approximation), as the derivatives'.
+FRICTION = "first"
 #: The distributions of the parameters: "uniform" within +-limit, "normal" with sigma = limit.
 DISTRIBUTIONS = ("uniform", "normal")
 
@@ -376,11 +379,11 @@ def _outputs(text: str, source: str, spec: _Spec, part: range) -> tuple[np.ndarr
         for n, row in enumerate(values):
             try:
                 mech = loads(text, source, parameters=dict(zip(spec.names, map(float, row))))
-                if _kernel(mech, spec.compiled):
+                if _kernel(mech, spec.compiled, FRICTION):
                     buf = fast.buffer(mech, len(spec.phi_deg)) if buf is None else buf
                     res = fast.analyze_fast(mech, spec.phi_deg, out=buf)
                 else:
-                    res = analyze(mech, phi_deg=spec.phi_deg)
+                    res = analyze(mech, phi_deg=spec.phi_deg, friction=FRICTION)
                 y = _values(mech, res)
             except (ModelError, StructureError, AssemblyError) as exc:
                 failed += 1
