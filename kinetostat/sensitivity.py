@@ -106,7 +106,14 @@ class Dual:
             return _where(*args)
         if func in (np.real, np.imag, np.shape) and not kwargs:
             return getattr(args[0], func.__name__)
+        if func is np.broadcast_to and not kwargs:
+            x, shape = args
+            return Dual(np.broadcast_to(x.val, shape), np.broadcast_to(x.der, tuple(shape) + x.der.shape[-1:]))
         return NotImplemented
+
+    def astype(self, dtype) -> "Dual":
+        """The value as `dtype` (float: a real value's), its derivatives alike."""
+        return Dual(self.val.astype(dtype), self.der.astype(dtype))
 
     def __add__(self, o): return np.add(self, o)
     def __radd__(self, o): return np.add(o, self)
@@ -426,25 +433,23 @@ class Sensitivity:
         machine, error (phi) [1]."""
         xr = _xarray()
         m, base = self.mech, self.result.to_xarray()
-        try:
-            stated = {**parameter_units(m, model_text(m)), "g": "m/s^2"}
-        except (OSError, ValueError):
-            stated = {}
-        units = [stated.get(p, "") or "unit of p" for p in self.params]
-        stack = lambda acc: np.stack([np.stack([acc(x)[p] for x in keys], axis=1) for p in self.params])
-        pairs = [(pr.links[0], pr.links[1]) for pr in m.pairs]
+        stated = {**parameter_units(m, model_text(m)), "g": "m/s^2"}
+        units = [stated[p] for p in self.params]
         per = "per unit of the parameter (its unit: param_unit)"
+
+        def stack(acc, keys) -> np.ndarray:
+            return np.stack([np.stack([acc(x)[p] for x in keys], axis=1) for p in self.params])
         data = {
             "dM_bal": _labelled(("param", "phi"), np.stack([self.balancing_moment[p] for p in self.params]),
                                 "N m", "world", f"d M_bal / d p, {per}"),
-            "error": _labelled(("phi",), self.error, "1", "none", "estimated relative error of the derivatives")}
-        keys = pairs
-        data["dR"] = _labelled(("param", "phi", "pair", "xy"), stack(lambda ij: self.reaction(*ij)), "N", "world",
-                               f"d R_ij / d p, {per}")
-        keys = list(m.point_names)
+            "error": _labelled(("phi",), self.error, "1", "none", "estimated relative error of the derivatives"),
+            "dR": _labelled(("param", "phi", "pair", "xy"), stack(lambda ij: self.reaction(*ij),
+                                                                  [pr.links for pr in m.pairs]),
+                            "N", "world", f"d R_ij / d p, {per}")}
         for var, acc, unit in (("dposition", self.position, "m"), ("dvelocity", self.velocity, "m/s"),
                                ("dacceleration", self.acceleration, "m/s^2")):
-            data[var] = _labelled(("param", "phi", "point", "xy"), stack(acc), unit, "world", f"d {var[1:]} / d p, {per}")
+            data[var] = _labelled(("param", "phi", "point", "xy"), stack(acc, m.point_names), unit, "world",
+                                  f"d {var[1:]} / d p, {per}")
         if m.drive.kind == "machine":
             data["dF_bal"] = _labelled(("param", "phi", "xy"), np.stack([self.balancing_force[p] for p in self.params]),
                                        "N", "world", f"d F_bal / d p, {per}")
@@ -569,13 +574,15 @@ def _travel_ends(mech: "Mechanism", view: "Mechanism", c: Mapping[str, Any], pts
 
 def _refuse_unsmooth(mech: "Mechanism", values: Mapping[str, Any]) -> None:
     """ValueError where a differentiated parameter reaches what this version does not carry: a
-    law of motion or a characteristic M(omega) written as an expression of the parameters."""
+    law of motion omega(phi) or a characteristic M(omega) written as an expression that reads it
+    (they keep the parameters' values; M(omega) itself follows omega)."""
     moved = {n for n, v in values.items() if isinstance(v, Dual)}
-    law = mech.drive.law
-    if law is not None and law.expression is not None and parse(law.expression).names & moved:
-        raise ValueError(f"sensitivity: the law of motion omega(phi) reads {sorted(parse(law.expression).names & moved)}: "
-                         f"this version does not carry its derivative")
+    reads = lambda law: sorted(parse(law.expression).names & moved) if law is not None and law.expression else []
+    if reads(mech.drive.law):
+        raise ValueError(f"sensitivity: the law of motion omega(phi) reads {reads(mech.drive.law)}: this version "
+                         f"does not carry its derivative; leave them out of params")
     for n, ld in enumerate(mech.loads):
-        if ld.characteristic is not None and ld.characteristic.expression is not None:
-            raise ValueError(f"sensitivity: load {ld.name!r} (load[{n}]): a characteristic M(omega) written as an "
-                             f"expression: this version does not carry its derivative")
+        if reads(ld.characteristic):
+            raise ValueError(f"sensitivity: load {ld.name!r} (load[{n}]): its characteristic M(omega) reads "
+                             f"{reads(ld.characteristic)}: this version does not carry that derivative; leave them "
+                             f"out of params")

@@ -64,10 +64,12 @@ def worst(path, names, point: str = "B") -> dict[tuple[str, str], float]:
 
 def parametric_yoke(tmp_path) -> Path:
     """The bundled Scotch yoke (an RPP group, a return spring, a resistance against the velocity)
-    with its crank, spring and resistance as [parameters]."""
+    with its crank, spring and resistance as [parameters], and its block given by its weight (its
+    mass follows g)."""
     text = YOKE.read_text(encoding="utf-8").replace(
         "g = 9.81\n", "g = 9.81\n\n[parameters]\nr = 0.05\nk = 2000.0\nl0 = 0.10\nF = 150.0\n", 1)
-    for old, new in (("A = [0.05, 0.0]", 'A = ["r", 0.0]'), ("stiffness = 2000.0", 'stiffness = "k"'),
+    for old, new in (("A = [0.05, 0.0]", 'A = ["r", 0.0]'), ("mass = 0.3", "weight = 2.943"),
+                     ("stiffness = 2000.0", 'stiffness = "k"'),
                      ("free_length = 0.10", 'free_length = "l0"'), ("value = 150.0", 'value = "F"')):
         assert old in text
         text = text.replace(old, new, 1)
@@ -97,8 +99,9 @@ def test_agrees_with_richardson_differences(path, names):
     assert not bad, bad
 
 
-def test_spring_and_resistance_against_the_velocity_agree(tmp_path):
-    bad = {k: v for k, v in worst(parametric_yoke(tmp_path), ["r", "k", "l0", "F"], "S3").items() if not v <= RTOL}
+def test_spring_resistance_against_the_velocity_and_a_weight_agree(tmp_path):
+    bad = {k: v for k, v in worst(parametric_yoke(tmp_path), ["r", "k", "l0", "F", "g"], "S3").items()
+           if not v <= RTOL}
     assert not bad, bad
 
 
@@ -180,3 +183,57 @@ def test_near_a_singular_position_the_guard_applies_to_the_derivatives():
     assert sens.error[0] < 1e-12 < 1e-8 < sens.error[1] and sens.error[2] == np.inf
     for d in (sens.balancing_moment["g"], sens.reaction(1, 2)["g"], sens.position("B")["g"]):
         assert np.isfinite(d[:2]).all() and np.isnan(d[2]).all()
+
+
+#: A crank alone driven at n rpm with a motor's characteristic M(omega) on it ({char}).
+MOTOR_CRANK = """
+[mechanism]
+name = "crank alone with a motor"
+g = 9.81
+[parameters]
+n = 90.0
+R = 0.1
+MS = 60.0
+[drive]
+pivot = "O"
+point = "A"
+reference = [1.0, 0.0]
+sense = "ccw"
+rpm = "n"
+[frame]
+O = [0.0, 0.0]
+[[link]]
+id = 1
+points = {{ O = [0.0, 0.0], A = ["R", 0.0] }}
+mass = 2.0
+I_S = 0.01
+com = "A"
+[[pair]]
+kind = "R"
+links = [0, 1]
+point = "O"
+[[load]]
+name = "motor"
+kind = "moment"
+link = 1
+characteristic = {char}
+"""
+
+
+@pytest.mark.parametrize("char", ['"MS * (1 - omega / 12)"', "{ omega = [0.0, 9.0, 14.0], M = [30.0, 15.0, -10.0] }"],
+                         ids=["expression", "table"])
+def test_a_motor_characteristic_follows_the_speed(char):
+    """M_bal carries d M(omega) / d omega d omega / d n; the crank's length moves the weight's moment."""
+    text = MOTOR_CRANK.format(char=char)
+    sens = kinetostat.sensitivity(kinetostat.loads(text), params=["n", "R"], steps=36)
+    for name in ("n", "R"):
+        x0, h = sens.values[name], 1e-3 * sens.values[name]
+        f = lambda x: exact(kinetostat.loads(text, parameters={name: x}), sens.phi_deg, "first").balancing_moment
+        D = lambda h: (f(x0 + h) - f(x0 - h)) / (2 * h)
+        ref = (4 * D(h / 2) - D(h)) / 3
+        assert np.abs(sens.balancing_moment[name] - ref).max() <= RTOL * np.abs(ref).max()
+
+
+def test_a_characteristic_that_reads_the_parameter_is_refused_by_name():
+    with pytest.raises(ValueError, match=r"load 'motor' \(load\[0\]\): its characteristic M\(omega\) reads \['MS'\]"):
+        kinetostat.sensitivity(kinetostat.loads(MOTOR_CRANK.format(char='"MS * (1 - omega / 12)"')), params=["MS"])

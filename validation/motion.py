@@ -15,6 +15,7 @@ which a load table's value has a kink (np.interp: its slope jumps there, an O(dt
 step that holds it; the angles law_of_motion cuts its work integral at) to end there (predicted
 by phi + omega h + eps h^2 / 2: within O(h^3)), from the exact state at phi_0 (kinetostat's positions,
 velocities at omega(phi_0)), over `cycles` revolutions; both engines give only the accelerations:
+
 - MuJoCo: `mj_forward` (its soft equality constraints as the harness builds them,
   `engine_mujoco._compile`, made as stiff as it allows: impedance 0.9999, time constant
   TIMECONST_STEPS steps); MuJoCo's own RK4 (`integrator="RK4"`) is not used because it holds
