@@ -46,6 +46,7 @@ from .motion import Motion, law_of_motion
 from .sensitivity import Sensitivity, sensitivity
 from .structure import AssurGroup, Structure
 from .sweep import Sweep, sweep
+from .tolerance import Tolerance, tolerance
 from .virtual_work import VirtualWork, virtual_work
 
 if _TYPE_CHECKING:
@@ -69,5 +70,5 @@ def __dir__() -> list[str]:
 __all__ = ["load", "loads", "from_dict", "analyze", "virtual_work", "VirtualWork", "Mechanism", "Analysis", "InertiaLoad",
            "AssurGroup", "Structure", "ModelError", "ModelFileNotFound", "ModelWarning", "StructureError",
            "AssemblyError", "SingularPositionWarning", "SelfLockingWarning", "SingularFrictionWarning", "UndefinedFigureWarning", "COND_CHECK", "COND_MAX", "DIGITS_WARN", "DIGITS_MIN",
-           "examples", "plans", "variants", "sweep", "Sweep", "law_of_motion", "Motion", "Flywheel", "sensitivity", "Sensitivity"]
+           "examples", "plans", "variants", "sweep", "Sweep", "tolerance", "Tolerance", "law_of_motion", "Motion", "Flywheel", "sensitivity", "Sensitivity"]
 __version__ = "0.2.0"

@@ -27,6 +27,7 @@ Dask scheduler), tqdm (only for a progress bar) and xarray (only in `Sweep.to_xa
 """
 from __future__ import annotations
 
+import functools
 import itertools
 import logging
 import math
@@ -201,7 +202,8 @@ def sweep(model: str | Path | Mechanism, params: Mapping[str, Any], *, steps: in
     from . import fast
     n = len(designs) * len(phi_deg)                 # decided here once, so every chunk (any worker) agrees
     compiled = not full and fast.pays(base, n, "peaks")
-    results = _run(parts, text, source, phi_deg, full, scheduler, progress, friction, compiled)
+    results = _run(parts, functools.partial(_chunk, text, source, phi_deg=phi_deg, full=full, friction=friction,
+                                            compiled=compiled), scheduler, progress)
     table = _tidy(pd.concat([rows for rows, _ in results], ignore_index=True), names, base, friction)
     if "eta_cycle_reason" in table:
         _warn_undefined_eta(table["eta_cycle_reason"])
@@ -229,8 +231,7 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
         for design in designs:
             try:
                 mech = loads(text, source, parameters=design)
-                kernel = (compiled and fast.refusal(mech) is None            # a triad: the numpy path
-                          and friction_method(mech, friction) != "reactions")   # the kernel has no friction
+                kernel = _kernel(mech, compiled, friction)
                 res = None if kernel else analyze(mech, phi_deg=phi_deg, friction=friction)
             except (ModelError, StructureError, AssemblyError) as exc:
                 rows.append({**design, "error": _reason(exc)})
@@ -252,6 +253,13 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
     angles = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=list(designs[0]))
     angles.attrs["units"] = _units(frames, {})
     return pd.DataFrame(rows), angles
+
+
+def _kernel(mech: Mechanism, compiled: bool, friction: str | None = None) -> bool:
+    """Whether a design of a run that takes the compiled path (`compiled`) goes there: not a triad's
+    (the numpy path), nor with friction in the reactions (the kernel has no friction)."""
+    from . import fast
+    return compiled and fast.refusal(mech) is None and friction_method(mech, friction) != "reactions"
 
 
 def _peaks_into(rows: list[dict], built: list[tuple[int, Mechanism]], phi_deg: np.ndarray) -> None:
@@ -374,11 +382,11 @@ def _quiet() -> Iterator[None]:
 
 # ----------------------------------------------------------------------------- running the chunks
 
-def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: np.ndarray, full: bool,
-         scheduler: Any, progress: bool, friction: str | None = None,
-         compiled: bool = False) -> list[tuple[pd.DataFrame, pd.DataFrame | None]]:
-    """Every chunk's result, in the order of `parts`: in this process (each chunk logged, DEBUG;
-    the time of the rest logged after the first, INFO: `Forecast`), or over Dask."""
+def _run(parts: list, task: Callable[[Any], Any], scheduler: Any, progress: bool, name: str = "sweep") -> list:
+    """`task(part)` of every chunk in `parts` (a list of designs each, or what `task` takes; `task`
+    picklable: a module's function, or a partial of one), the results in the order of `parts`:
+    in this process (each chunk logged, DEBUG; the time of the rest logged after the first,
+    INFO: `Forecast`), or over Dask (tasks named kinetostat-<name>-chunk-<k>)."""
     bar = _bar(len(parts), progress)
     try:
         if scheduler is None:
@@ -386,15 +394,14 @@ def _run(parts: list[list[dict[str, float]]], text: str, source: str, phi_deg: n
             eta = Forecast(log, sum(map(len, parts)), "design(s)",
                            faster=["--scheduler processes (the API's scheduler='processes')"])
             for k, part in enumerate(parts):
-                out.append(_chunk(text, source, part, phi_deg, full, friction, compiled))
-                log.debug("sweep: chunk %d of %d done (%d design(s))", k + 1, len(parts), len(part))
+                out.append(task(part))
+                log.debug("%s: chunk %d of %d done (%d design(s))", name, k + 1, len(parts), len(part))
                 bar.update()
                 eta.done(len(part))
             return out
         import dask
-        keys = [f"kinetostat-sweep-chunk-{k}" for k in range(len(parts))]
-        tasks = [dask.delayed(_chunk, pure=True)(text, source, part, phi_deg, full, friction, compiled, dask_key_name=key)
-                 for part, key in zip(parts, keys)]
+        keys = [f"kinetostat-{name}-chunk-{k}" for k in range(len(parts))]
+        tasks = [dask.delayed(task, pure=True)(part, dask_key_name=key) for part, key in zip(parts, keys)]
         if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS:
             from dask.callbacks import Callback
             finished = set(keys)

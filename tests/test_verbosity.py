@@ -28,7 +28,8 @@ def test_quiet_and_verbose_before_or_after_every_command():
     commands = next(a for a in parser._actions if a.choices and "analyze" in a.choices).choices
     needs = {"analyze": ["m"], "structure": ["m"], "export": ["m", "--mjcf"], "plans": ["m", "--out", "d"],
              "page": ["m", "--out", "p.html"], "sweep": ["m", "--param", "r=1", "--out", "s.csv"],
-             "motion": ["m", "--out", "d"]}
+             "motion": ["m", "--out", "d"],
+             "tolerance": ["m", "--tol", "r=1", "--out", "d"]}
     for name in commands:
         rest = needs.get(name, [])
         assert parser.parse_args([name, *rest]).verbosity == 0

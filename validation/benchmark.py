@@ -4,6 +4,7 @@
     python -m kinetostat_validation.benchmark --out DIR    # ... into DIR instead
     python -m kinetostat_validation.benchmark --quick      # fewer repeats and settings, prints only
     python -m kinetostat_validation.benchmark --drawing-budgets   # only the drawing layer's budgets, printed
+    python -m kinetostat_validation.benchmark --tolerance 100000  # only a Monte Carlo tolerance study's rate, printed
 
 Every route runs over the same full cycle (360 angles) and is timed as the median of repeated
 runs in one process; its error is the worst peak-relative error over the driving moment and
@@ -855,12 +856,43 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
+def tolerance_rate(samples: int = 10**5, steps: int = 360) -> dict:
+    """A Monte Carlo tolerance study of the chain-unit four-bar (`samples` designs x `steps`
+    angles, r and l toleranced) beside a plain sweep of as many designs, in this process, one
+    after the other: positions (designs x angles) per second of CPU, i.e. per core, and the load."""
+    out = dict(samples=samples, steps=steps, load_before=os.getloadavg())
+    runs = (("tolerance", lambda: kinetostat.tolerance("chain_unit_four_bar", {"r": 1e-4, "l": 2e-4}, samples=samples,
+                                                          steps=steps, seed=1)),
+            ("sweep", lambda: kinetostat.sweep("chain_unit_four_bar", {"r": np.linspace(0.0799, 0.0801, samples)},
+                                               steps=steps)))
+    for name, run in runs:
+        cpu, wall = time.process_time(), time.perf_counter()
+        run()
+        cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+        out[name] = dict(cpu=cpu, wall=wall, per_core=samples * steps / cpu)
+    out["load_after"] = os.getloadavg()
+    return out
+
+
+def tolerance_lines(r: dict) -> list[str]:
+    return [f"{name}: {r['samples']:,} designs x {r['steps']} angles in {r[name]['wall']:.1f} s "
+            f"({r[name]['cpu']:.1f} s CPU) = {r[name]['per_core']:.3g} positions/s per core"
+            for name in ("tolerance", "sweep")] + [
+        f"load average (1, 5, 15 min) before {r['load_before']}, after {r['load_after']}"]
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = parser("benchmark", __doc__)
     ap.add_argument("--quick", action="store_true", help="fewer repeats and settings; print only")
     ap.add_argument("--drawing-budgets", action="store_true",
                     help="only the section 'Drawing budgets' (issue 34's budgets of the drawing layer); print only")
+    ap.add_argument("--tolerance", metavar="N", type=int,
+                    help="only a Monte Carlo tolerance study of N designs of the four-bar beside a sweep of as "
+                         "many (positions per second per core); print only")
     args = ap.parse_args(argv)
+    if args.tolerance:
+        print("\n".join(tolerance_lines(tolerance_rate(args.tolerance))))
+        return
     if args.drawing_budgets:
         print("\n".join(budget_lines(drawing_budgets())))
         return

@@ -13,6 +13,7 @@ from .motion import cmd_motion
 from .plans import _plan_names, _scale_item, cmd_page, cmd_plans, cmd_variant
 from .report import cmd_report
 from .sweep import _param, cmd_sweep
+from .tolerance import _tol, cmd_tolerance
 from .validate import cmd_validate
 
 
@@ -309,6 +310,37 @@ def build_parser() -> argparse.ArgumentParser:
                          "efficiency eta_cycle and n_self_locking, the count of self-locking angles")
     sw.add_argument("--no-progress", action="store_true", help="no progress bar")
     sw.set_defaults(func=cmd_sweep)
+
+    from ..tolerance import CHUNK as TOL_CHUNK, DISTRIBUTIONS, SEED_BLOCK
+    tl = sub.add_parser("tolerance", help="what the parameters' tolerances do to the forces: first order and Monte Carlo",
+                        description="Draw --samples designs of MODEL with each --tol parameter uniform within +-its "
+                                    "limit (or normal with that sigma), analyse each over the crank cycle and compare "
+                                    "with the first order from the exact derivatives. Writes into --out: "
+                                    "tolerance.csv (per output's peak: nominal, first-order worst case and RSS, the "
+                                    "Monte Carlo mean, std and quantiles, each parameter's share of the variance), "
+                                    "tolerance.nc (every output at every angle, xarray/NetCDF; needs xarray and "
+                                    "scipy) and tornado.svg. Exit codes: 0 written; 2 bad input; 130 interrupted.")
+    tl.add_argument("model", metavar="MODEL", help="model file (TOML) or a bundled model's name")
+    tl.add_argument("--tol", metavar="NAME=VALUE[UNIT]", type=_tol, action="append", required=True,
+                    help="a parameter of the model's [parameters] (or g) and its limit: in the model's unit of it "
+                         "(r=1e-4), in a unit of the same kind (r=0.1mm, m2=50g) or in %% of its nominal value "
+                         "(m2=2%%); repeat for each parameter")
+    tl.add_argument("--dist", choices=DISTRIBUTIONS, default="uniform",
+                    help="uniform within +-limit (default), or normal with sigma = limit")
+    tl.add_argument("--samples", metavar="N", type=_positive("number of designs", "--samples 10000"), default=10_000,
+                    help="Monte Carlo designs (default 10000)")
+    tl.add_argument("--seed", metavar="S", type=int, default=0, help="the draws' seed (default 0)")
+    tl.add_argument("--steps", metavar="N", type=_steps, default=360,
+                    help="N equal steps over a revolution for every design (default 360)")
+    tl.add_argument("--out", metavar="DIR", required=True, help="folder of the outputs (made if missing; each file "
+                                                                "written atomically)")
+    tl.add_argument("--scheduler", metavar="WHERE",
+                    help="run the chunks over Dask: 'threads' or 'processes' (this machine), or the address of a "
+                         "distributed scheduler (default: in this process, no Dask)")
+    tl.add_argument("--chunk", metavar="N", type=_positive("number of designs per task", "--chunk 2000"),
+                    default=TOL_CHUNK, help=f"designs per task, a multiple of {SEED_BLOCK} (default {TOL_CHUNK})")
+    tl.add_argument("--no-progress", action="store_true", help="no progress bar")
+    tl.set_defaults(func=cmd_tolerance)
     for command in sub.choices.values():     # -q/-v also after the command: kinetostat report -q ...
         _verbosity_options(command, argparse.SUPPRESS)
     return p
