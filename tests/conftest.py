@@ -32,6 +32,8 @@ def pytest_cmdline_main(config: pytest.Config) -> None:
 #: Bundled models that together hold every group kind (RRR, RRP, RPR, PRP, RPP), engines and
 #: machines: the default suite's sample where a test over every model is costly.
 EVERY_KIND = ("chain_unit_four_bar", "ice_crank_slider", "scotch_yoke", "slotted_link_shaper")
+#: EVERY_KIND and a triad (a class-III group): the sample where a triad's own rows matter too.
+EVERY_GROUP = (*EVERY_KIND, "triad_slider")
 
 
 def sampled(paths, keep=EVERY_KIND) -> list:
@@ -58,8 +60,9 @@ def chromium():
         yield browser
 
 
-@pytest.fixture(params=MODELS, ids=[p.stem for p in MODELS])
+@pytest.fixture(params=sampled(MODELS, EVERY_GROUP))
 def model_path(request) -> Path:
+    """Each bundled model: those of EVERY_GROUP by default, every one with -m slow."""
     return request.param
 
 

@@ -12,7 +12,7 @@ import pytest
 pin = pytest.importorskip("pinocchio")
 
 import kinetostat  # noqa: E402
-from conftest import four_bar  # noqa: E402
+from conftest import EVERY_GROUP, four_bar, sampled  # noqa: E402
 from kinetostat_validation.engine_pinocchio import PinocchioScene, forward_round_trip, solve  # noqa: E402
 from kinetostat_validation.scene import build_scene  # noqa: E402
 
@@ -94,7 +94,7 @@ def _forward(scene, method: str) -> float:
     return rel
 
 
-@pytest.fixture(scope="module", params=MODELS, ids=[p.stem for p in MODELS])
+@pytest.fixture(scope="module", params=sampled(MODELS, EVERY_GROUP))     # every model with -m slow
 def scene(request):
     try:
         mech = kinetostat.load(request.param)

@@ -79,7 +79,14 @@ def _with_parents(module: str, imports: dict[str, int]) -> dict[str, int]:
     return out
 
 
-GRAPH = {m: _with_parents(m, _imports(m)) for m in MODULES}
+#: Each module's imports (`_imports`, `_with_parents`), filled by `_graph` when this file's first
+#: test runs (not at collection, which every test worker does).
+GRAPH: dict[str, dict[str, int]] = {}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _graph() -> None:
+    GRAPH.update({m: _with_parents(m, _imports(m)) for m in MODULES})
 
 
 def _cycle() -> list[str] | None:

@@ -543,12 +543,12 @@ def test_shaper_check_and_values_in_ukrainian():
     assert _symbol("a^Cor(3,2)", "en") == "a^Cor(3,2)"
 
 
-def test_report_draws_its_page_every_time(tmp_path, monkeypatch, cli):
+def test_report_draws_its_page_every_time(tmp_path, monkeypatch, cli, sketched_plots):
     """`kinetostat report` writes and links each model's page by default, drawn anew every time:
     a page.html planted in the model's folder is replaced, even one sealed as the removed cache
     accepted a page (its own key kept, the SHA-256 of its bytes on its last line); --no-page
     removes the earlier page.
-    (A page of two angles at scales sampled every 90 deg: quick.)"""
+    (A page of two angles at scales sampled every 90 deg, the plots sketched: quick.)"""
     import kinetostat.plans.page as pg
     monkeypatch.setattr(pg, "PAGE_ANGLES", (0.0, 150.0))
     cycle = P.cycle_scales
