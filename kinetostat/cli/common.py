@@ -528,6 +528,20 @@ def _law(mech, path: Path, delta: float | None = None, flywheel: float | None = 
     return motion
 
 
+def _scheduler_installed(scheduler: str | None) -> None:
+    """CLIError where --scheduler names Dask (and, for an address, `distributed`) but it is not
+    installed; None (the designs run in this process) needs nothing."""
+    if scheduler is None:
+        return
+    import importlib.util
+    from ..sweep import LOCAL_SCHEDULERS
+    needs = ["dask"] + ([] if scheduler in LOCAL_SCHEDULERS else ["distributed"])
+    missing = [m for m in needs if importlib.util.find_spec(m) is None]
+    if missing:
+        raise CLIError(f"--scheduler {scheduler}: needs {' and '.join(missing)} (pip install "
+                       f"'kinetostat[sweep]'); without --scheduler the designs run in this process")
+
+
 def _coefficient(text: str) -> float:
     """An argparse type: --delta, a coefficient of fluctuation 0 < D < 2."""
     try:

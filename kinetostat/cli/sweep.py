@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from .common import CLIError, EXIT_OK, _done, _lines, _load, _parquet_engine, _quiet, _save, _writable_file
+from .common import CLIError, EXIT_OK, _done, _lines, _load, _parquet_engine, _quiet, _save, _scheduler_installed, _writable_file
 
 
 def _param(text: str) -> tuple[str, list[float]]:
@@ -71,14 +71,7 @@ def cmd_sweep(args) -> int:
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise CLIError(f"--param {twice[0]}: given more than once; give all its values in one --param")
-    if args.scheduler is not None:
-        import importlib.util
-        from ..sweep import LOCAL_SCHEDULERS
-        needs = ["dask"] + ([] if args.scheduler in LOCAL_SCHEDULERS else ["distributed"])
-        missing = [m for m in needs if importlib.util.find_spec(m) is None]
-        if missing:
-            raise CLIError(f"--scheduler {args.scheduler}: needs {' and '.join(missing)} (pip install "
-                           f"'kinetostat[sweep]'); without --scheduler the designs run in this process")
+    _scheduler_installed(args.scheduler)
     out = _writable_file(args.out, "--out")
     angles_out = out.with_name(f"{out.stem}.angles{out.suffix}") if args.full else None
     if angles_out is not None:

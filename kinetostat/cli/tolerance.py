@@ -17,7 +17,7 @@ import sys
 import time
 from pathlib import Path
 
-from .common import CLIError, EXIT_OK, _done, _lines, _load, _quiet, _save, _writable_dir
+from .common import CLIError, EXIT_OK, _done, _lines, _load, _quiet, _save, _scheduler_installed, _writable_dir
 
 #: The units a --tol may be given in, by the parameter's own unit: each with its size in that unit.
 SCALES = {"m": {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6}, "kg": {"kg": 1.0, "g": 1e-3},
@@ -64,14 +64,7 @@ def cmd_tolerance(args) -> int:
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise CLIError(f"--tol {twice[0]}: given more than once")
-    if args.scheduler is not None:
-        import importlib.util
-        from ..sweep import LOCAL_SCHEDULERS
-        needs = ["dask"] + ([] if args.scheduler in LOCAL_SCHEDULERS else ["distributed"])
-        missing = [m for m in needs if importlib.util.find_spec(m) is None]
-        if missing:
-            raise CLIError(f"--scheduler {args.scheduler}: needs {' and '.join(missing)} (pip install "
-                           f"'kinetostat[sweep]'); without --scheduler the designs run in this process")
+    _scheduler_installed(args.scheduler)
     out = _writable_dir(args.out, "--out")
     path = Path(args.model)
     mech = _load(path)

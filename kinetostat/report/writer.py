@@ -746,7 +746,7 @@ def _motion_section(doc: Doc, run: ModelRun, delta: float | None = None, flywhee
         return None
     doc.p(f"The steady periodic motion of the machine (the dynamic analysis before kinetostatics, "
           f"`kinetostat motion`), with {esc(said)}, over {len(motion.phi_deg)} positions; the drive: "
-          f"{esc(motion.drive)} (M_drive = {_fmt(float(np.mean(motion.M_drive)))} N·m on average).")
+          f"{esc(motion.drive)} (M_drive = {_fmt(float(np.mean(motion.M_drive)))} N·m on average, in the crank's sense of rotation).")
     J = motion.J_flywheel
     rows = [["ω_mean, rad/s", _fmt(motion.omega_mean), ""], ["δ, 1", _fmt(motion.delta), ""],
             ["J_flywheel, kg·m² (exact)", _fmt(J), ""]]
