@@ -797,3 +797,28 @@ def test_a_blob_holds_7_bits_a_character_and_no_lt_cr_or_nul(data):
     raw = pg._text7(data)                                     # the groups as they come, not deflated
     groups = "".join(format(b, "08b") for b in data)
     assert len(raw) <= -(-len(groups) // 7) and len(raw.encode()) <= len(data) * 8 / 7 + 2
+
+
+def test_triad_page_names_the_tiny_vectors_of_its_one_angle_sheets():
+    """The page's cycle of the triad (30 and 150 deg) finds the same tiny vectors, drawn the same
+    way, as each force plan's one-angle sheet (the page's kinematic plans leave the triad's
+    construction out: `without_triad_construction`): on the force polygon, whose sides a triad names anew at
+    each angle, R05n (0,75 mm) at 30 deg, not R12n (4,22 mm there; its side of the same name is
+    0,75 mm only at 150 deg). Before: found by the first segment of each name."""
+    from kinetostat.plans import draw
+    from kinetostat.plans.kinematic import without_triad_construction
+    from kinetostat.plans.worksheet import analyses
+    mech = kinetostat.load("triad_six_bar")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fixed = P.cycle_scales(mech)                    # the page's (`kinetostat plans --cycle-scales`)
+        res, _ = analyses(mech, [30.0, 150.0])
+        cycles = {k: without_triad_construction(mech, c) for k, c in P.build_cycle(mech, res, fixed).items()}
+    for i, at in enumerate((30.0, 150.0)):
+        for kind, plan in _build(mech, at, fixed).items():
+            if kind in ("mechanism", "positions", "velocity", "acceleration"):
+                continue
+            one = draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0)
+            assert draw._tiny_at(draw._tiny(cycles[kind]), i) == one, (at, kind)
+            if kind.startswith("forces:") and at == 30.0:
+                assert one == {"R05n": "negligible"}, one
