@@ -399,43 +399,52 @@ def _bare_text(s: str) -> str:
     return re.sub(r"\s+", "", html.unescape(re.sub(r"<[^>]+>", "", s)))
 
 
-def test_print_keeps_title_data_scales_and_notes(chromium, ice, tmp_path):
-    """Printed (A3 and A4), the key page's first page holds the title, the angle, the scales, every
-    data row and every value of the angle shown; each sheet's page holds the notes of the plan's
-    own SVG sheet (`kinetostat plans --at 30`) but the numbers the values table holds (results,
-    segments' lengths, a tiny vector's value and length: its name and how drawn); the student's
-    page prints its title, scales and data too. Before: print hid all of them."""
-    if shutil.which("pdftotext") is None:
-        pytest.skip("no pdftotext (apt-get install poppler-utils)")
-    from kinetostat.model.lettering import lettering
+def _sheet_notes(mech, fixed, at: float, name: str) -> dict[str, list[str]]:
+    """kind -> the notes of its own one-angle sheet at `at` (`kinetostat plans --at`: `_note_lines`
+    with their numbers), markup-free, each checked to be on that sheet as it draws them."""
     from kinetostat.plans import draw
     from kinetostat.plans.symbols import plain
-    mech, fixed, key, student = ice
-    name = lettering(mech).name("uk", mech.name)
-    want = {}                                           # kind -> the notes of its own sheet, markup-free
-    for kind, plan in _build(mech, 30.0, fixed).items():
+    want = {}
+    for kind, plan in _build(mech, at, fixed).items():
         svg = P.svg(plan, "uk", name)
         sheet = _bare_text(svg[svg.index('<g id="notes">'):])
         notes = [_bare_text(plain(n)) for n in draw._note_lines(plan, "uk", draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0))]
         assert all(n in sheet for n in notes), kind     # the notes as the sheet draws them, unwrapped
-        tiny = [re.match(r"(.*?)(\*?)=.*ммумасштабі", n) for n in notes]
-        want[kind] = [n for n, m in zip(notes, tiny) if not m and not n.startswith("Результати")] \
-            + [m[1] + m[2] + (":показанопозамасштабом" if m[2] else ":нехтовномала") for m in tiny if m]
-    assert any("G2*:" in x for v in want.values() for x in v)   # the ICE's G2*, G3*: out of scale
+        want[kind] = notes
+    return want
+
+
+def test_print_keeps_title_data_scales_and_notes(chromium, ice, tmp_path):
+    """Printed (A3 and A4 at 30 deg, A3 at 150 deg), the key page's first page holds the title, the
+    angle, the scales, every data row and every value of the angle shown; each sheet's page holds
+    the notes of the plan's own one-angle SVG sheet (`kinetostat plans --at`) with their numbers:
+    the results (M_зр, F'_зр, δ: 103,1 and 51,33 N·m) and each tiny vector's value and length at the
+    scale (G2* = 4,9 Н, 0,01 мм); the student's page prints its title, scales and data too. Before:
+    print hid all of them; then the notes came without their numbers."""
+    if shutil.which("pdftotext") is None:
+        pytest.skip("no pdftotext (apt-get install poppler-utils)")
+    from kinetostat.model.lettering import lettering
+    mech, fixed, key, student = ice
+    name = lettering(mech).name("uk", mech.name)
     data = [(r[0], r[1]) for r in make_page.__globals__["_data_rows"](mech, _one(mech, None), "uk")]
     pg = _open(chromium, key)
-    rows = pg.eval_on_selector_all("#value-table td.num", "es => es.map(e => [e.dataset.symbol, e.textContent])")
-    for paper in ("A3", "A4"):
-        pg.select_option("#paper", paper)
-        first, *sheets = _printed(pg, tmp_path / f"{paper}.pdf")
-        flat = _bare_text(first)
-        assert _bare_text(name) in flat and "Куткривошипаφ:30°" in flat and "μ_F=400Н/мм" in flat, first[:300]
-        for symbol, value in data + [(s, v) for s, v in rows]:
-            assert _bare_text(symbol + value) in flat, (paper, symbol, value)
-        assert len(sheets) == len(want)
-        for (kind, lines), page in zip(want.items(), sheets):
-            missing = [x for x in lines if x not in _bare_text(page)]
-            assert not missing, (paper, kind, missing)
+    for at, papers in ((30.0, ("A3", "A4")), (150.0, ("A3",))):
+        want = _sheet_notes(mech, fixed, at, name)
+        assert any("G2*=4,9Н:показанопозамасштабом(0,01ммумасштабі)" in x for x in want["lever"])
+        assert any(x.startswith("Результати:Mзр=" + ("103,1" if at == 30.0 else "51,33")) for x in want["crank"])
+        _slide(pg, at)
+        rows = pg.eval_on_selector_all("#value-table td.num", "es => es.map(e => [e.dataset.symbol, e.textContent])")
+        for paper in papers:
+            pg.select_option("#paper", paper)
+            first, *sheets = _printed(pg, tmp_path / f"{paper}.pdf")
+            flat = _bare_text(first)
+            assert _bare_text(name) in flat and f"Куткривошипаφ:{at:g}°" in flat and "μ_F=400Н/мм" in flat, first[:300]
+            for symbol, value in data + [(s, v) for s, v in rows]:
+                assert _bare_text(symbol + value) in flat, (paper, symbol, value)
+            assert len(sheets) == len(want)
+            for (kind, lines), page in zip(want.items(), sheets):
+                missing = [x for x in lines if x not in _bare_text(page)]
+                assert not missing, (at, paper, kind, missing)
     pg.close()
     pg = _open(chromium, student)
     first = _bare_text("".join(_printed(pg, tmp_path / "student.pdf")[:-1]))
@@ -788,3 +797,28 @@ def test_a_blob_holds_7_bits_a_character_and_no_lt_cr_or_nul(data):
     raw = pg._text7(data)                                     # the groups as they come, not deflated
     groups = "".join(format(b, "08b") for b in data)
     assert len(raw) <= -(-len(groups) // 7) and len(raw.encode()) <= len(data) * 8 / 7 + 2
+
+
+def test_triad_page_names_the_tiny_vectors_of_its_one_angle_sheets():
+    """The page's cycle of the triad (30 and 150 deg) finds the same tiny vectors, drawn the same
+    way, as each force plan's one-angle sheet (the page's kinematic plans leave the triad's
+    construction out: `without_triad_construction`): on the force polygon, whose sides a triad names anew at
+    each angle, R05n (0,75 mm) at 30 deg, not R12n (4,22 mm there; its side of the same name is
+    0,75 mm only at 150 deg). Before: found by the first segment of each name."""
+    from kinetostat.plans import draw
+    from kinetostat.plans.kinematic import without_triad_construction
+    from kinetostat.plans.worksheet import analyses
+    mech = kinetostat.load("triad_six_bar")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fixed = P.cycle_scales(mech)                    # the page's (`kinetostat plans --cycle-scales`)
+        res, _ = analyses(mech, [30.0, 150.0])
+        cycles = {k: without_triad_construction(mech, c) for k, c in P.build_cycle(mech, res, fixed).items()}
+    for i, at in enumerate((30.0, 150.0)):
+        for kind, plan in _build(mech, at, fixed).items():
+            if kind in ("mechanism", "positions", "velocity", "acceleration"):
+                continue
+            one = draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0)
+            assert draw._tiny_at(draw._tiny(cycles[kind]), i) == one, (at, kind)
+            if kind.startswith("forces:") and at == 30.0:
+                assert one == {"R05n": "negligible"}, one

@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -236,11 +237,12 @@ def _t(x: float, y: float, s: str, size: float, anchor: str = "start", weight: s
 
 def _wrap(s: str, size: float, width: float) -> list[str]:
     """`s` broken at spaces into lines no wider than `width` mm at `size` (a longer word alone);
-    a line's width the sum of its words' and spaces' (a symbol's mark never holds a space)."""
+    a line's width the sum of its words' and spaces' (a symbol's mark never holds a space; a page's
+    token as wide as _TOKEN_SAMPLE)."""
     out, line, used = [], "", 0.0
     space = text_width(" ", size)
     for word in s.split(" "):
-        w = text_width(plain(word), size)
+        w = text_width(TOKEN.sub(_TOKEN_SAMPLE, plain(word)), size)
         if line and used + space + w > width:
             out.append(line)
             line, used = word, w
@@ -259,18 +261,18 @@ _AS_IS, _OUT, _NEGLIGIBLE = 0, 1, 2
 
 
 def _tiny(cycle: PlanCycle) -> dict[str, np.ndarray]:
-    """Vectors under TINY_MM at their scale at some angle: name -> how drawn at each angle (N,)
+    """Vectors under TINY_MM at their scale at some angle where drawn: name -> how drawn at each angle (N,)
     (_OUT of scale at MIN_DRAWN_MM: a load at a scale of its own; _NEGLIGIBLE: a polygon's side
     or a plan's vector, not laid off; _AS_IS where not tiny or not drawn)."""
-    how = {}
+    how: dict[str, np.ndarray] = {}
     for s in cycle.segments:
         if s.kind not in _ARROWS:
             continue
-        L = cycle.length_mm(s.name)
-        tiny = L < TINY_MM
+        L = np.abs(cycle.points[s.end] - cycle.points[s.start])      # its own: a triad's force polygon
+        tiny = (L < TINY_MM) & cycle.drawn(s)                          # names its sides anew at each angle
         if tiny.any():
             out = (s.scale is not None) & (L > ZERO_MM)
-            how[s.name] = np.where(tiny, np.where(out, _OUT, _NEGLIGIBLE), _AS_IS)
+            how[s.name] = np.where(tiny, np.where(out, _OUT, _NEGLIGIBLE), how.get(s.name, _AS_IS))
     return how
 
 
@@ -297,24 +299,39 @@ def _collinear(cycle: PlanCycle, s: Segment, tiny: dict[str, np.ndarray]) -> np.
     return out
 
 
-def _result_line(plan: Plan, lang: str) -> list[str]:
+#: The page's stand-ins for a note's numbers (`_note_lines` with `page`; page.js `amounts` writes
+#: them at each angle), `_token`: a segment's value (its length times its scale, `num`), its length
+#: (mm, 2 decimals), a result (`num`): the mark, the segment's index in its cycle or the result's, END.
+VALUE, LENGTH, RESULT, END = "\ue000", "\ue002", "\ue003", "\ue001"
+TOKEN = re.compile(f"([{VALUE}{LENGTH}{RESULT}])(\\d+){END}")
+_TOKEN_SAMPLE = "-0000,00"                    # a token's width on the sheet: the widest number it may write
+
+
+def _token(mark: str, k: int) -> str:
+    """The token of `mark` (VALUE, LENGTH, RESULT) for the segment or result of index k."""
+    return f"{mark}{k}{END}"
+
+
+def _result_line(plan: Plan, lang: str, page: Mapping[str, int] | None = None) -> list[str]:
+    """The results line; where `page`, the values as the page's tokens (`RESULT`)."""
     if not plan.results:
         return []
     parts = []
-    for r in plan.results:
-        part = f"{_n(r.symbol, lang)} = {num(r.value, lang)}\u00a0{unit(r.unit, lang)}".rstrip()
+    for k, r in enumerate(plan.results):
+        value = num(r.value, lang) if page is None else _token(RESULT, k)
+        part = f"{_n(r.symbol, lang)} = {value}\u00a0{unit(r.unit, lang)}".rstrip()
         parts.append(part + (f" ({text(r.how, lang)})" if r.how else ""))
     return [f"{text('results', lang)}: " + "; ".join(parts)]
 
 
-def _note_lines(plan: Plan, lang: str, tiny: dict[str, str], amounts: bool = True) -> list[str]:
-    """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors;
-    where not `amounts`, without the results and the tiny vectors' values and lengths (the page's
-    notes: its values table holds them)."""
+def _note_lines(plan: Plan, lang: str, tiny: dict[str, str], page: Mapping[str, int] | None = None) -> list[str]:
+    """The sheet's notes in `lang`: legend, the plan's notes, results, equation, tiny vectors with
+    their values and lengths; where `page` (segment name -> its index in the cycle), those numbers
+    as the page's tokens (`VALUE`, `LENGTH`, `RESULT`: page.js writes them at each angle)."""
     base = plan.kind.partition(":")[0]
     lines = [text(f"legend.{base}", lang)] if f"legend.{base}" in MESSAGES else []
     lines += [_symbols(phrase(n, lang), lang) for n in plan.notes] + ([accuracy(*plan.accuracy, lang, False)] if plan.accuracy else [])
-    lines += _result_line(plan, lang) if amounts else []
+    lines += _result_line(plan, lang, page)
     if plan.equation:
         lines.append(f"{text('equation', lang)}: " + " + ".join(_n(e, lang) for e in plan.equation) + " = 0")
     for s in _drawable(plan):
@@ -322,11 +339,9 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str], amounts: bool = Tru
             L = abs(plan.points[s.end] - plan.points[s.start])
             key = "out of scale" if tiny[s.name] == "out" else "negligible"
             star = "*" if tiny[s.name] == "out" else ""
-            if not amounts:
-                lines.append(f"{_n(s.name, lang)}{star}: {text(key + ', page', lang)}")
-                continue
-            lines.append(f"{_n(s.name, lang)}{star} = {num(s.value, lang)}\u00a0{unit(s.unit, lang)}: "
-                         f"{text(key, lang, length=num(L, lang, decimals=2))}")
+            value, length = (num(s.value, lang), num(L, lang, decimals=2)) if page is None else \
+                (_token(VALUE, page[s.name]), _token(LENGTH, page[s.name]))
+            lines.append(f"{_n(s.name, lang)}{star} = {value}\u00a0{unit(s.unit, lang)}: {text(key, lang, length=length)}")
     if plan.kind == "lever":
         lines += [text("lever turned", lang), text("arms natural", lang)]
     return lines
@@ -445,34 +460,37 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float
 
 def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
                  where: tuple[float, float, float], bottom: float, placer: Placer) -> list[Element]:
-    """The notes of every angle (`_note_lines` without amounts: the results and the tiny vectors'
-    numbers change with every angle, the page's values table holds them) as lines of text at
-    `where` (x, first baseline, width; `_notes_block`), as many as fit above `bottom` (the legend's top):
-    line k shows the k-th line of each angle's notes where it has one (its texts once, an index
-    per angle) and where it is clear of the plan's arrowheads, points and letters (`placer`: the
-    plan of an angle may reach into the notes' room where the cycle's is larger than the room).
-    The angles grouped by what their notes are made of (the plan's notes, tiny vectors, accuracy,
-    equation) in one pass; each group's notes read and wrapped once, of the plan cut to its tiny
-    vectors."""
+    """The notes of every angle (`_note_lines`, their numbers as the page's tokens: page.js writes
+    each angle's from the lengths and values the page holds) as lines of text at `where` (x, first
+    baseline, width; `_notes_block`), as many as fit above `bottom` (the legend's top): line k
+    shows the k-th line of each angle's notes where it has one (its texts once, an index per
+    angle) and where it is clear of the plan's arrowheads, points and letters (`placer`: the plan
+    of an angle may reach into the notes' room where the cycle's is larger than the room; a token
+    as wide as _TOKEN_SAMPLE). The angles grouped by what their notes are made of (the plan's
+    notes, tiny vectors, accuracy, equation, how each result is found) in one pass; each group's
+    notes read and wrapped once, of the plan cut to its tiny vectors."""
     x, y, width = where
     room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
     segments = tuple(s for s in cycle.segments if s.name in tiny)       # all of its drawing the notes read
+    index = {s.name: k for k, s in enumerate(cycle.segments)}
     light = replace(cycle, points={k: cycle.points[k] for s in segments for k in (s.start, s.end)},
-                    segments=segments, paths={}, results=())
+                    segments=segments, paths={})
     drawn = np.array([light.drawn(s) for s in segments], dtype=bool).reshape(len(segments), cycle.n)
     acc = np.full(cycle.n, -1.0) if cycle.accuracy is None else \
         np.where(cycle.accuracy[0] < cycle.accuracy[1], cycle.accuracy[0], -1.0)     # stated where below the rule
     per_angle_equation = cycle.equation and not isinstance(cycle.equation[0], str)
     keys = np.column_stack([*tiny.values(), drawn.T, acc,                   # what an angle's notes are made of
                             _variants(list(cycle.notes) if cycle.notes else [()] * cycle.n)[1],
-                            _variants(list(cycle.equation) if per_angle_equation else [()] * cycle.n)[1]])
+                            _variants(list(cycle.equation) if per_angle_equation else [()] * cycle.n)[1],
+                            *(_variants([r.how] * cycle.n if isinstance(r.how, str) else list(r.how))[1]
+                              for r in cycle.results)])
     _, first, inverse = np.unique(keys.astype(float), axis=0, return_index=True, return_inverse=True)
     order = np.argsort(first)                          # the groups in the order of their first angle
     first, inverse = first[order], np.argsort(order)[inverse.reshape(-1)]
     wrapped: dict[str, list[str]] = {}
     groups = []                                        # each make-up's lines, read and wrapped once
     for j in first.tolist():
-        notes = _note_lines(light.at(j), lang, _tiny_at(tiny, j), amounts=False)
+        notes = _note_lines(light.at(j), lang, _tiny_at(tiny, j), page=index)
         for n in notes:
             if n not in wrapped:
                 wrapped[n] = _wrap(n, _NOTE_MM, width)
@@ -482,7 +500,7 @@ def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
         texts, variant = _variants([lines[k] if k < len(lines) else "" for lines in groups])
         variant = variant[inverse]
         base = y + k * _LINE_STEP
-        w = np.array([text_width(plain(t), _NOTE_MM) for t in texts])[variant]
+        w = np.array([text_width(TOKEN.sub(_TOKEN_SAMPLE, plain(t)), _NOTE_MM) for t in texts])[variant]
         box = np.column_stack([np.full(cycle.n, x), np.full(cycle.n, base - ASCENT * _NOTE_MM), x + w,
                                np.full(cycle.n, base + (SUB_DROP + DESCENT) * _NOTE_MM)])
         has = np.array([k < len(lines) for lines in groups])[inverse] & placer.clear(box)
@@ -940,8 +958,8 @@ def drawing(cycle: PlanCycle, lang: str = "en", mechanism: str = "", contract: b
     every angle centred in the room its notes leave at the angle with the most of them; moved at an
     angle only as far as keeps that angle's plan in the room, where the cycle's is larger), every
     element at every angle, labels placed for the cycle at once (`labels.Placer`); the notes left
-    out, their room kept, or where `notes` each angle's notes but its results and its segments'
-    lengths (`_cycle_notes`: the page's values table holds those). `contract`: every segment's element carries
+    out, their room kept, or where `notes` each angle's notes, their numbers as the page's tokens
+    (`_cycle_notes`: page.js writes them), but its segments' lengths (the page's values table). `contract`: every segment's element carries
     data-plan, data-segment and its drawn length (data-length-mm, as in segments.csv; a negligible
     vector, not drawn, an empty <g>): the interactive page's contract (`page`)."""
     return _sheet(cycle, lang, mechanism, contract, notes=False, cycle_notes=notes)

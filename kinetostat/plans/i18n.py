@@ -56,8 +56,6 @@ MESSAGES: dict[str, tuple[str, str, str]] = {
     "negligible": ("negligible: {length} mm at the scale, not laid off",
                    "нехтовно мала: {length} мм у масштабі, не відкладається",
                    "пренебрежимо мала: {length} мм в масштабе, не откладывается"),
-    "out of scale, page": ("drawn out of scale", "показано поза масштабом", "показано вне масштаба"),
-    "negligible, page": ("negligible, not laid off", "нехтовно мала, не відкладається", "пренебрежимо мала, не откладывается"),
     "arms natural": ("arms h measured on the drawing, mm", "плечі h виміряно на кресленні, мм",
                      "плечи h измерены на чертеже, мм"),
     "lever turned": ("the velocity plan is not turned: every force is turned by 90° clockwise and carried to the "

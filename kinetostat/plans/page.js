@@ -219,7 +219,7 @@
       if (el.len) lengths.push(el.len);
       return el;
     });
-    kinds.push({kind: K.kind, static: K.static, elements});
+    kinds.push({kind: K.kind, static: K.static, elements, amounts: K.amounts});
   }
   const at = (a, i) => a[a.length > 1 ? i : 0];
   function element(el, i) {                      // core.py Element.svg(i)
@@ -238,6 +238,18 @@
     return K.static.replace(D.elements, () => K.elements.map((el) => element(el, i)).join(""));
   }
   window.sheetSvg = (k, i) => sheet(kinds[k], i);   // for tests: the sheet of kind k at frame i
+  // The notes' tokens (draw.py TOKEN: VALUE, LENGTH, RESULT) with the numbers of frame i, as the one-angle sheet
+  // writes them (i18n.num): a segment's value (its length times its scale; of its element drawn at frame i),
+  // its length (2 decimals), a result (the values table's).
+  function amounts(K, i, svg) {
+    return svg.replace(/([\ue000\ue002\ue003])(\d+)\ue001/g, (_, mark, k) => {
+      if (mark === "\ue003") return local(values[i][K.amounts.res[k]], 4);
+      const [els, mu] = K.amounts.seg[k], all = els.map((e) => K.elements[e]);
+      const el = all.find((e) => e.drawn[e.rows > 1 ? i : 0]) || all[0], L = at(el.len, i) / 10 ** D.lengthd;
+      if (mark === "\ue000") return local(L * mu, 4);
+      return Math.abs(L) < 1e-9 ? "0" : L.toFixed(2).replace(".", D.decimal);
+    });
+  }
   const rows = meta.rows, ncol = rows.length, singular = new Set(D.singular);
   const vals = varints(await bytes("values")), values = frames.map(() => new Array(ncol));
   for (let c = 0, p = 0; c < ncol; c++) {          // column by column: page.py _columns
@@ -275,7 +287,7 @@
     frame = f;
     kinds.forEach((K, k) => {
       if (singular.has(f)) { boxes[k].textContent = D.ui.singular; return; }
-      boxes[k].innerHTML = sheet(K, f).replace(/^<\?xml[^>]*>\s*/, "").replace(/<\/svg>\s*$/, D.scalebar + "</svg>");
+      boxes[k].innerHTML = amounts(K, f, sheet(K, f)).replace(/^<\?xml[^>]*>\s*/, "").replace(/<\/svg>\s*$/, D.scalebar + "</svg>");
     });
     values[f].forEach((v, c) => {
       cells[c].dataset.value = isFinite(v) ? String(v) : "";

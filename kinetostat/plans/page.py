@@ -10,7 +10,8 @@ Key mode (default): one analysis at every whole degree, the design position and 
 angle; from it each plan of the cycle (`build_cycle`, every scale fixed for the whole cycle:
 `cycle_scales`; the plan of positions' 12 positions and paths made once: `fixed_positions`) and
 its sheet over all the angles as arrays (`draw.drawing`, with the page contract and each angle's
-notes but their numbers: the page's values table holds them); the worksheet's values of every angle
+notes, their numbers as tokens page.js writes from the lengths and values the page holds: `_amounts`);
+the worksheet's values of every angle
 (`worksheet_cycle`); "Next step". Student mode (`student=True`): no answer in the page: the data,
 the empty tables, an A3 sheet with a millimetre grid at true scale, and the check of typed lengths.
 A page is drawn anew every time: nothing is cached.
@@ -59,8 +60,8 @@ import numpy as np
 
 from .._io import write_text
 from .._text import script_json
-from .core import ELEMENTS, PAGE_DECIMALS, UNMEASURED, Drawing
-from .draw import TINY_MM, segment_label, title_of
+from .core import ELEMENTS, PAGE_DECIMALS, UNMEASURED, Drawing, PlanCycle
+from .draw import RESULT, TINY_MM, TOKEN, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 
 __all__ = ["page", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
@@ -317,6 +318,31 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     series = [np.array(a) if isinstance(a, tuple) else next(new) for a in series]
     return ({"kind": d.kind, "static": d.static, "elements": meta},
             _varints(np.concatenate(series)) if series else b"", lengths)
+
+
+def _amounts(d: Drawing, cycle: PlanCycle, symbols: Sequence[str], lang: str) -> dict:
+    """Where page.js `amounts` finds the numbers of the tokens in the notes of the sheet `d` of
+    `cycle` (draw.TOKEN): {"seg": {segment's index: [the sheet's elements of its name with a
+    length (their indices: page.js takes the one drawn at the angle, a
+    triad's force polygon names a side anew at each angle), its scale's value (SI per mm)]}, "res": {result's
+    index: its column in the values table: its symbol's, as `lang` letters both}}; `symbols`: the
+    values table's symbols in order; each only where the notes have such tokens. ValueError where a
+    result has no column."""
+    from ..model.lettering import in_lang
+    found = {(m[1], int(m[2])) for E in d.elements for t in E.texts for m in TOKEN.finditer(t)}
+    seg, res = {}, {}
+    for mark, k in sorted(found):
+        if mark == RESULT:
+            symbol = cycle.results[k].symbol
+            shown = [in_lang(x, lang) for x in symbols]
+            if in_lang(symbol, lang) not in shown:
+                raise ValueError(f"{cycle.kind}: result {symbol} has no row in the values table")
+            res[k] = shown.index(in_lang(symbol, lang))
+        else:
+            s = cycle.segments[k]
+            seg[k] = [[n for n, E in enumerate(d.elements) if E.length_mm is not None and E.attrs.get("data-segment") == s.name],
+                      (s.scale or cycle.scale).value]
+    return {k: v for k, v in (("seg", seg), ("res", res)) if v}
 
 
 def _shared_texts(kinds: Sequence[dict]) -> tuple[list[dict], list[list[str]]]:
@@ -614,9 +640,12 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     records = sheet.at(i_at).records()
     if not student:
         kinds, lengths = [], []
+        symbols = [r["symbol"] for r in records]
         for kind, cycle in cycles.items():
-            meta, numbers, more = encode_drawing(drawing(cycle, lang, name, contract=True, notes=True), lengths)
-            kinds.append(meta)
+            d = drawing(cycle, lang, name, contract=True, notes=True)
+            meta, numbers, more = encode_drawing(d, lengths)
+            amounts = _amounts(d, cycle, symbols, lang)
+            kinds.append(meta | ({"amounts": amounts} if amounts else {}))
             lengths += more
             blobs[f"k{len(kinds) - 1}"] = _packed(numbers)
         values = np.array(sheet.values, dtype=float)
