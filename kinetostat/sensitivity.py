@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from . import groups
+from . import fast, fast_sensitivity, groups
 from .analysis import Analysis, _labelled, _xarray, crank_angles, exact
 from .applied import load_wrenches, stroke
 from .expressions import ExpressionError, over_arrays, parse
@@ -461,7 +461,7 @@ class Sensitivity:
 
 # ----------------------------------------------------------------------------- the analysis on duals
 def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = None, steps: int = 360,
-                phi_deg=None) -> Sensitivity:
+                phi_deg=None, path: str = "auto") -> Sensitivity:
     """Exact derivatives of the kinematics, the reactions and the balancing load of `mech` by its
     parameters `params` (names of the model's [parameters], or "g"; None: every parameter) at
     `steps` equal crank angles over a turn, or at `phi_deg` (deg). Forward mode: the analysis'
@@ -470,7 +470,10 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     parameters written as expressions of p follow it (d/d r moves l = sqrt(r**2 + c**2)), and
     d/d l, for l itself written as an expression, moves l alone.
     The reactions are the frictionless ones (friction's first approximation). ValueError naming
-    an unknown parameter, or a field that a parameter reaches and that is not carried."""
+    an unknown parameter, or a field that a parameter reaches and that is not carried.
+    path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernel over
+    the same source; NotImplementedError naming why where it does not take the mechanism), or
+    "auto": the compiled one where `fast.pays` for the angles and `fast_sensitivity.refusal` is None."""
     valid = [*mech.parameters, "g"]
     params = tuple(valid[:-1] if params is None else ([params] if isinstance(params, str) else params))
     for p in params:
@@ -483,11 +486,21 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     if any(g.klass == 3 for g in mech.structure.groups):
         raise ValueError("sensitivity: a class-III group (triad): its positions are Newton's, not a closed form; "
                          "this version differentiates dyads only")
+    if path not in ("auto", "numpy", "compiled"):
+        raise ValueError(f"sensitivity: path {path!r}: one of 'auto', 'numpy', 'compiled'")
     phi_deg = crank_angles(phi_deg, steps)
+    if path == "auto":
+        path = "compiled" if fast.pays(mech, len(phi_deg)) and fast_sensitivity.refusal(mech) is None else "numpy"
+    if path == "compiled" and (why := fast_sensitivity.refusal(mech)):
+        raise NotImplementedError(f"sensitivity: path='compiled': {mech.name}: {why}")
     result = exact(mech, phi_deg, "first")
     values, fields = _seeded(mech, params)
     _refuse_unsmooth(mech, values)
     c, pts, view = _design(mech, fields)
+    if path == "compiled":
+        keep = fast_sensitivity.tangents(mech, c, np.radians(phi_deg), len(params))
+        return Sensitivity(mech, params, MappingProxyType({p: float(value(values[p])) for p in params}), phi_deg,
+                           result, MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         env = _motion(mech, c, np.radians(phi_deg))
         for k in range(1, mech.n_links):
