@@ -237,3 +237,60 @@ def test_a_motor_characteristic_follows_the_speed(char):
 def test_a_characteristic_that_reads_the_parameter_is_refused_by_name():
     with pytest.raises(ValueError, match=r"load 'motor' \(load\[0\]\): its characteristic M\(omega\) reads \['MS'\]"):
         kinetostat.sensitivity(kinetostat.loads(MOTOR_CRANK.format(char='"MS * (1 - omega / 12)"')), params=["MS"])
+
+
+# ----------------------------------------------------------------------------- the compiled path
+def _jvp_scope() -> dict:
+    """groups' functions and their generated `_jvp` versions in one pure-Python scope (numpy's
+    primitives), so the tangent transform is checked without a compile."""
+    import inspect
+    from kinetostat import fast_sensitivity, groups
+    scope = dict(vars(groups))
+    exec(compile(fast_sensitivity.jvp_source() + "\n" + "\n".join(
+        inspect.getsource(f) for f in fast_sensitivity.PRIMITIVE_JVPS), "<jvp>", "exec"), scope)
+    return scope
+
+
+def test_generated_tangents_match_duals_on_the_group_equations():
+    """Every group equation's generated `_jvp` gives the tangent the numpy path's Dual gives (one
+    direction), on random points (the RRR and RRP assemblies, polygons, inertia, gear force)."""
+    from kinetostat.sensitivity import Dual
+    scope, rng = _jvp_scope(), np.random.default_rng(3)
+    z = lambda: complex(*rng.normal(size=2))
+    cases = {"rrr_motion": [0.1 + 0j, z(), z(), 1.0 + 0.2j, z(), z(), 0.8, 0.7, 1.0, 1.0],
+             "rrp_motion": [0.1j, z(), z(), 0.5 + 0j, (0.6 + 0.8j), 0.1, 2.5, -1.0, z(), z(), z(), 0.4, 0.2, 1.0],
+             "rpr_motion": [1.0 + 0.5j, z(), z(), 0j, z(), z(), 0.1, 1.0, 1.0],
+             "rrr_polygon": [z(), z(), z(), 1.1, 0.9, z(), z(), 0.3, -0.2],
+             "inertia": [z(), 0.7, 0.2, np.exp(0.4j), z(), 2.0, 0.1],
+             "gear_force": [1.5, np.exp(0.3j), 0.35, 0.04]}
+    for fn, args in cases.items():
+        tans = [z() if isinstance(a, complex) else float(rng.normal()) for a in args]
+        duals = [Dual(np.asarray(a), np.asarray([t])) for a, t in zip(args, tans)]
+        want = scope[fn](*duals)
+        want = want if isinstance(want, tuple) else (want,)
+        got = scope[f"{fn}_jvp"](*[x for pair in zip(args, tans) for x in pair])
+        for k, w in enumerate(want):
+            w = w if isinstance(w, Dual) else Dual(w, np.zeros(1))
+            assert np.allclose(got[2 * k], w.val, rtol=1e-13, atol=1e-13), (fn, k)
+            assert np.allclose(got[2 * k + 1], w.der[..., 0], rtol=1e-11, atol=1e-12), (fn, k)
+
+
+def test_compiled_path_refuses_loads_by_name():
+    """The ICE's gas diagram: path='compiled' raises naming why; an unknown path is refused."""
+    ice = kinetostat.load(ICE)
+    with pytest.raises(NotImplementedError, match="loads besides gravity"):
+        kinetostat.sensitivity(ice, ["l_OA"], steps=8, path="compiled")
+    with pytest.raises(ValueError, match="path 'gpu'"):
+        kinetostat.sensitivity(ice, ["l_OA"], steps=8, path="gpu")
+
+
+@pytest.mark.slow   # compiles a kernel (minutes on a busy 2-core machine, once per machine)
+def test_compiled_and_numpy_paths_agree_on_the_chain_unit():
+    mech = kinetostat.load(CHAIN)
+    params = ["r", "l", "m2"]
+    a = kinetostat.sensitivity(mech, params, steps=360, path="numpy")
+    b = kinetostat.sensitivity(mech, params, steps=360, path="compiled")
+    for name, _, acc in outputs(mech, "C1"):
+        for p in params:
+            x, y = acc(a)[p], acc(b)[p]
+            assert np.nanmax(np.abs(x - y)) <= 1e-12 * np.nanmax(np.abs(x)), (name, p)
