@@ -14,8 +14,8 @@ Takes mechanisms without loads besides gravity and inertia (no load tables, spri
 characteristics: their derivatives are evaluated on duals by numpy, `sensitivity`'s path);
 `refusal` says why a mechanism is not taken.
 
-May use: numpy, ast, inspect, groups, program, fast (its kernel module, primitives, speeds,
-pool), kernel_cache, sensitivity (Dual).
+May use: numpy, groups, program, fast (its layout, kernel module, speeds, pool), kernel_cache, model
+(for type hints).
 """
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 
 from . import fast, groups, kernel_cache
-from .program import Identifiers, Program, statics_program
+from .program import Identifiers, statics_program
 
 if TYPE_CHECKING:
     from .model import Mechanism
@@ -331,23 +331,27 @@ def _kernel(mech: "Mechanism", p: int):
         return fast._KERNELS[src]
 
 
+def _tangent(x: Any, p: int) -> np.ndarray:
+    """The p tangents of a constant: a dual's `der` (any object with one), zeros for a number."""
+    return np.broadcast_to(np.asarray(x.der), (p,)) if hasattr(x, "der") else np.zeros(p)
+
+
 def tangents(mech: "Mechanism", c: Mapping[str, Any], phi: np.ndarray, p: int,
-             threads: int | None = None) -> dict[str, Any]:
-    """The outputs `Sensitivity` keeps, as duals (value (N,), tangents (N, p)), at the crank
-    angles `phi` (rad), from the design's constants `c` on duals (`sensitivity._design`), by the
-    compiled kernel. NotImplementedError with `refusal`'s reason where it does not take `mech`."""
-    from .sensitivity import Dual, derivative, value
+             threads: int | None = None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The outputs `Sensitivity` keeps, each as (value (N,), tangents (N, p)), at the crank angles
+    `phi` (rad), from the design's constants `c` (numbers, or duals with `val` and `der` (p,):
+    `sensitivity._design`'s), by the compiled kernel. NotImplementedError with `refusal`'s reason
+    where it does not take `mech`."""
     why = refusal(mech)
     if why:
         raise NotImplementedError(f"{mech.name}: {why}")
     lay = fast._layout(mech)
     base = fast._constants(mech)
     consts = [c.get(n, base[n]) for n in lay.consts]
-    C = np.array([complex(value(x)) for x in consts])
-    DC = np.array([derivative(x, (), p) for x in consts], dtype=complex).T.copy()
+    C = np.array([complex(getattr(x, "val", x)) for x in consts])
+    DC = np.array([_tangent(x, p) for x in consts], dtype=complex).T.copy()
     W, E = fast._speeds([mech], phi)
-    DW, DE = (np.asarray(derivative(c[n], (), p), float) if mech.drive.law is None else np.zeros(p)
-              for n in ("w_in", "e_in"))
+    DW, DE = (np.real(_tangent(c[n], p)) if mech.drive.law is None else np.zeros(p) for n in ("w_in", "e_in"))
     N = len(phi)
     rows = _rows(mech, p)
     S, FL = np.empty(rows[""] * N), np.zeros(N, bool)
@@ -367,5 +371,5 @@ def tangents(mech: "Mechanism", c: Mapping[str, Any], phi: np.ndarray, p: int,
             z = z[:, 0] + 1j * z[:, 1]
         else:
             z = S[r * N:(r + 1 + p) * N].reshape(1 + p, N)
-        out[name] = Dual(z[0], z[1:].T)
+        out[name] = (z[0], z[1:].T)
     return out

@@ -9,7 +9,9 @@ through the model's expressions (`Mechanism.expressions`, evaluated on duals by
 `expressions.over_arrays`) and through the fields they fill (points, masses, moments of inertia,
 bodies, g, the crank speed, load values and scales).
 
-May use: numpy, analysis, applied, expressions, groups, kinematics (its Kinematics), model
+The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source.
+
+May use: numpy, analysis, applied, expressions, fast (pays), fast_sensitivity, groups, kinematics (its Kinematics), model
 (parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
@@ -498,7 +500,7 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     _refuse_unsmooth(mech, values)
     c, pts, view = _design(mech, fields)
     if path == "compiled":
-        keep = fast_sensitivity.tangents(mech, c, np.radians(phi_deg), len(params))
+        keep = {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, np.radians(phi_deg), len(params)).items()}
         return Sensitivity(mech, params, MappingProxyType({p: float(value(values[p])) for p in params}), phi_deg,
                            result, MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
