@@ -32,7 +32,7 @@ from .program import Identifiers, statics_program
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["jvp_source", "refusal", "tangents", "PRIMITIVE_JVPS"]
+__all__ = ["jvp_source", "pays", "refusal", "tangents", "PRIMITIVE_JVPS"]
 
 
 # ----------------------------------------------------------------------------- the primitives' rules
@@ -99,7 +99,7 @@ class _Tangent:
             self.lines.append(f"D__{t} = {tan}")
         return t, (f"D__{t}" if tan is not None else None)
 
-    def call(self, name: str, args: list[ast.expr], outs: int) -> str:
+    def call(self, name: str, args: list[ast.expr]) -> str:
         """`name`_jvp on the arguments' (value, tangent) pairs: the flat tuple it returns."""
         pairs = [self.expr(a) for a in args]
         return f"{name}_jvp({', '.join(f'{v}, {d or 0.0}' for v, d in pairs)})"
@@ -142,7 +142,7 @@ class _Tangent:
             if self.counts.get(f.id, 1) != 1:
                 raise NotImplementedError(f"fast_sensitivity: {f.id} returns several values inside an expression")
             t = self.tmp()
-            self.lines.append(f"{t}, D__{t} = {self.call(f.id, e.args, 1)}")
+            self.lines.append(f"{t}, D__{t} = {self.call(f.id, e.args)}")
             return t, f"D__{t}"
         pairs = [self.expr(a) for a in e.args]
         (a, da) = pairs[0]
@@ -181,7 +181,7 @@ class _Tangent:
             if len(names) > 1:                    # a call of a function of several values
                 call = s.value
                 self.lines.append(f"{', '.join(f'{n}, D__{n}' for n in names)} = "
-                                  f"{self.call(call.func.id, call.args, len(names))}")
+                                  f"{self.call(call.func.id, call.args)}")
                 self.tan.update({n: f"D__{n}" for n in names})
                 return
             v, d = self.expr(s.value)
@@ -192,7 +192,7 @@ class _Tangent:
         if isinstance(s, ast.Return):
             r = s.value
             if isinstance(r, ast.Call) and isinstance(r.func, ast.Name) and self.counts.get(r.func.id, 1) > 1:
-                self.lines.append(f"return {self.call(r.func.id, r.args, self.counts[r.func.id])}")
+                self.lines.append(f"return {self.call(r.func.id, r.args)}")
                 return
             elts = r.elts if isinstance(r, ast.Tuple) else [r]
             pairs = [self.expr(x) for x in elts]
@@ -321,6 +321,18 @@ def _source(mech: "Mechanism", p: int) -> str:
     return "\n".join([jvps, "for _name in [n for n in list(globals()) if n.endswith('_jvp')]:",
                       "    globals()[_name] = numba.njit(inline='always', error_model='numpy')(globals()[_name])", ""]
                      + head + ["    " + ln for ln in pro + loop]) + "\n"
+
+
+def pays(mech: "Mechanism", n: int, p: int) -> bool:
+    """Whether `n` angles of `mech`'s sensitivities to p parameters go the compiled path: as
+    `fast.pays` (FAST_MIN where this process holds the kernel, FAST_COLD where it would load or
+    compile it) and `refusal` is None."""
+    if n < fast.FAST_MIN or not fast.available() or refusal(mech) is not None:
+        return False
+    src = mech.memo(("sensitivity kernel source", p), lambda: _source(mech, p))
+    with fast._LOCK:
+        held = src in fast._KERNELS
+    return n >= (fast.FAST_MIN if held else fast.FAST_COLD)
 
 
 def _kernel(mech: "Mechanism", p: int):

@@ -11,7 +11,7 @@ bodies, g, the crank speed, load values and scales).
 
 The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source.
 
-May use: numpy, analysis, applied, expressions, fast (pays), fast_sensitivity, groups, kinematics (its Kinematics), model
+May use: numpy, analysis, applied, expressions, fast_sensitivity, groups, kinematics (its Kinematics), model
 (parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from . import fast, fast_sensitivity, groups
+from . import fast_sensitivity, groups
 from .analysis import Analysis, _labelled, _xarray, crank_angles, exact
 from .applied import load_wrenches, stroke
 from .expressions import ExpressionError, over_arrays, parse
@@ -475,7 +475,8 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     an unknown parameter, or a field that a parameter reaches and that is not carried.
     path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernel over
     the same source; NotImplementedError naming why where it does not take the mechanism), or
-    "auto": the compiled one where `fast.pays` for the angles and `fast_sensitivity.refusal` is None."""
+    "auto": the compiled one where `fast_sensitivity.pays` (its kernel held from FAST_MIN angles, else
+    from FAST_COLD; a mechanism it takes)."""
     valid = [*mech.parameters, "g"]
     params = tuple(valid[:-1] if params is None else ([params] if isinstance(params, str) else params))
     for p in params:
@@ -492,7 +493,7 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
         raise ValueError(f"sensitivity: path {path!r}: one of 'auto', 'numpy', 'compiled'")
     phi_deg = crank_angles(phi_deg, steps)
     if path == "auto":
-        path = "compiled" if fast.pays(mech, len(phi_deg)) and fast_sensitivity.refusal(mech) is None else "numpy"
+        path = "compiled" if fast_sensitivity.pays(mech, len(phi_deg), len(params)) else "numpy"
     if path == "compiled" and (why := fast_sensitivity.refusal(mech)):
         raise NotImplementedError(f"sensitivity: path='compiled': {mech.name}: {why}")
     result = exact(mech, phi_deg, "first")
