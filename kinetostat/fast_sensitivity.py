@@ -10,9 +10,10 @@ calling the `_jvp` functions once per parameter; every call recomputes the value
 LLVM merges (the functions are inlined and pure). The constants' tangents are those
 `sensitivity` computes on duals (`sensitivity._seeded`, `_design`).
 
-Takes mechanisms without loads besides gravity and inertia (no load tables, springs or
-characteristics: their derivatives are evaluated on duals by numpy, `sensitivity`'s path);
-`refusal` says why a mechanism is not taken.
+Loads besides gravity and inertia (tables, diagrams, springs, characteristics) are evaluated
+between two passes, as `fast` does: the "motion" kernel writes the kinematics and their
+tangents, `sensitivity` evaluates the loads on those duals (numpy, `applied.load_wrenches`),
+the "full" kernel reads them (X) and their tangents (DX).
 
 May use: numpy, groups, program, fast (its layout, kernel module, speeds, pool), kernel_cache, model
 (for type hints).
@@ -221,33 +222,33 @@ def jvp_source() -> str:
 
 
 # ----------------------------------------------------------------------------- the kernel
-_COMPLEX = ("O", "V", "A", "rot", "R", "F_bal")
+_COMPLEX = ("O", "V", "A", "rot", "R", "F_bal")  # the others (th, w, e, vs, as, M_bal) are real
 
 
 def refusal(mech: "Mechanism") -> str | None:
-    """Why the compiled sensitivity does not take `mech` (None where it does): `fast.refusal`'s
-    reasons, or loads besides gravity and inertia."""
-    why = fast.refusal(mech)
-    if why is None and (mech.loads or mech.springs):
-        why = ("loads besides gravity and inertia (tables, springs, characteristics): the compiled "
-               "sensitivity does not carry their derivatives yet; the numpy path does")
-    return why
+    """Why the compiled sensitivity does not take `mech` (None where it does): `fast.refusal`'s."""
+    return fast.refusal(mech)
 
 
-def _outs(mech: "Mechanism") -> tuple[str, ...]:
-    """The outputs `Sensitivity` keeps (as `sensitivity` keeps them on the numpy path)."""
+def _outs(mech: "Mechanism", kind: str) -> tuple[str, ...]:
+    """The outputs of the `kind` kernel: "full", those `Sensitivity` keeps (as `sensitivity` keeps
+    them on the numpy path); "motion", the kinematics the loads read."""
+    links = range(1, mech.n_links)
+    if kind == "motion":
+        return (*(f"{s}{k}" for s in ("th", "O", "V", "A", "w", "e", "rot") for k in links),
+                *(f"{s}{i}" for s in ("vs", "as") for i in fast._layout(mech).slides))
     return ("M_bal", *(("F_bal",) if mech.drive.kind == "machine" else ()), *(f"R{p.index}" for p in mech.pairs),
-            *(f"{s}{k}" for s in ("O", "V", "A", "w", "e", "rot") for k in range(1, mech.n_links)))
+            *(f"{s}{k}" for s in ("O", "V", "A", "w", "e", "rot") for k in links))
 
 
 def _is_complex(name: str) -> bool:
     return name.rstrip("0123456789") in _COMPLEX
 
 
-def _rows(mech: "Mechanism", p: int) -> dict[str, int]:
+def _rows(mech: "Mechanism", p: int, kind: str) -> dict[str, int]:
     """Each output's first row in the buffer: its value, then its p tangents (a complex one two rows each)."""
     rows, r = {}, 0
-    for name in _outs(mech):
+    for name in _outs(mech, kind):
         rows[name] = r
         r += (1 + p) * (2 if _is_complex(name) else 1)
     rows[""] = r
@@ -269,21 +270,24 @@ def _step_lines(steps, v, p: int) -> list[str]:
     return lines
 
 
-def _source(mech: "Mechanism", p: int) -> str:
-    """The kernel: angles [a, b) of phi, constants C (K,) and their tangents DC (p, K), the crank's
-    speeds W, E ((1, N) or (1, 1)) and their tangents DW, DE (p,); writes every output's value and
-    tangents at rows of n angles of S (`_rows`)."""
+def _source(mech: "Mechanism", p: int, kind: str) -> str:
+    """The `kind` kernel ("motion" or "full"): angles [a, b) of phi, constants C (K,) and their
+    tangents DC (p, K), the crank's speeds W, E ((1, N) or (1, 1)) and their tangents DW, DE (p,),
+    the loads besides gravity X (3 (L - 1), N: F_x, F_y, M of each moving link; empty where there
+    are none) and their tangents DX (p, 3 (L - 1), N); writes every output's value and tangents
+    at rows of n angles of S (`_rows`)."""
     lay = fast._layout(mech)
     motion, statics = fast._motion(mech), statics_program(mech)
     v = Identifiers().__getitem__
-    rows = _rows(mech, p)
+    rows = _rows(mech, p, kind)
+    loads = mech.loads or mech.springs
     pro = []
     for j, (n, real) in enumerate(zip(lay.consts, lay.real)):
         pro.append(f"{v(n)} = C[{j}]" + (".real" if real else ""))
         pro += [f"{v(n)}_d{q} = DC[{q}, {j}]" + (".real" if real else "") for q in range(p)]
     fixed = set(lay.consts)
     hoisted, moving = [], []
-    for st in motion.steps + statics.steps:
+    for st in motion.steps + (() if kind == "motion" else statics.steps):
         if st.fn != "check" and all(not isinstance(a, str) or a in fixed for a in st.args):
             fixed.update(st.out)
             hoisted.append(st)
@@ -295,7 +299,7 @@ def _source(mech: "Mechanism", p: int) -> str:
             f"{v('e_in')} = E[0, i if E.shape[1] > 1 else U(0)]", "ok = True"]
     body += [f"{v(n)}_d{q} = {x}" for q in range(p) for n, x in (("phi", "0.0"), ("w_in", f"DW[{q}]"), ("e_in", f"DE[{q}]"))]
     body += _step_lines([st for st in moving if st in in_motion], v, p)
-    for k in range(1, lay.L):
+    for k in range(1, lay.L if kind == "full" else 1):
         for q in range(p):
             keep = lambda name: name if q == 0 else "_"
             a = lambda n: f"{v(n)}, {v(n)}_d{q}"
@@ -304,10 +308,16 @@ def _source(mech: "Mechanism", p: int) -> str:
                         f"{a(f'I_S{k}')})")
             body.append(f"{keep(f'Fa{k}')}, Fa{k}_d{q}, {keep(f'Ma{k}')}, Ma{k}_d{q} = weight_jvp(r{k}, r{k}_d{q}, "
                         f"{a(f'mass{k}')}, {a('g')})")
+            if loads:
+                if q == 0:
+                    body += [f"Fa{k} = Fa{k} + complex(X[{3 * k - 3}, i], X[{3 * k - 2}, i])", f"Ma{k} = Ma{k} + X[{3 * k - 1}, i]"]
+                body += [f"Fa{k}_d{q} = Fa{k}_d{q} + complex(DX[{q}, {3 * k - 3}, i], DX[{q}, {3 * k - 2}, i])",
+                         f"Ma{k}_d{q} = Ma{k}_d{q} + DX[{q}, {3 * k - 1}, i]"]
             body.append(f"{keep(v(f'F{k}'))}, {v(f'F{k}')}_d{q}, {keep(v(f'M{k}'))}, {v(f'M{k}')}_d{q} = wrench_jvp("
                         f"Fa{k}, Fa{k}_d{q}, Ma{k}, Ma{k}_d{q}, Fi{k}, Fi{k}_d{q}, Mi{k}, Mi{k}_d{q}, r{k}, r{k}_d{q})")
-    body += _step_lines([st for st in moving if st not in in_motion], v, p)
-    for name in _outs(mech):
+    if kind == "full":
+        body += _step_lines([st for st in moving if st not in in_motion], v, p)
+    for name in _outs(mech, kind):
         r = rows[name]
         for q, x in enumerate([v(name)] + [f"{v(name)}_d{q}" for q in range(p)]):
             if _is_complex(name):
@@ -315,7 +325,7 @@ def _source(mech: "Mechanism", p: int) -> str:
             else:
                 body.append(f"S[U({r + q}) * n + i] = {x}")
     body.append("FL[i] = not ok")
-    head = ["def kernel(phi, W, E, C, DC, DW, DE, a, b, n, S, FL):"]
+    head = ["def kernel(phi, W, E, C, DC, DW, DE, X, DX, a, b, n, S, FL):"]
     loop = ["for i in range(a, b):"] + ["    " + ln for ln in body]
     jvps = jvp_source() + "\n" + "\n\n".join(inspect.getsource(f) for f in PRIMITIVE_JVPS)
     return "\n".join([jvps, "for _name in [n for n in list(globals()) if n.endswith('_jvp')]:",
@@ -329,14 +339,16 @@ def pays(mech: "Mechanism", n: int, p: int) -> bool:
     compile it) and `refusal` is None."""
     if n < fast.FAST_MIN or not fast.available() or refusal(mech) is not None:
         return False
-    src = mech.memo(("sensitivity kernel source", p), lambda: _source(mech, p))
-    with fast._LOCK:
-        held = src in fast._KERNELS
+    held = True
+    for kind in ("motion", "full") if mech.loads or mech.springs else ("full",):
+        src = mech.memo(("sensitivity kernel source", p, kind), lambda: _source(mech, p, kind))
+        with fast._LOCK:
+            held &= src in fast._KERNELS
     return n >= (fast.FAST_MIN if held else fast.FAST_COLD)
 
 
-def _kernel(mech: "Mechanism", p: int):
-    src = mech.memo(("sensitivity kernel source", p), lambda: _source(mech, p))
+def _kernel(mech: "Mechanism", p: int, kind: str):
+    src = mech.memo(("sensitivity kernel source", p, kind), lambda: _source(mech, p, kind))
     with fast._LOCK:
         if src not in fast._KERNELS:
             fast._KERNELS[src] = kernel_cache.load(fast._module(src)).kernel
@@ -348,12 +360,14 @@ def _tangent(x: Any, p: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(x.der), (p,)) if hasattr(x, "der") else np.zeros(p)
 
 
-def tangents(mech: "Mechanism", c: Mapping[str, Any], phi: np.ndarray, p: int,
+def tangents(mech: "Mechanism", c: Mapping[str, Any], phi: np.ndarray, p: int, kind: str = "full",
+             X: np.ndarray | None = None, DX: np.ndarray | None = None,
              threads: int | None = None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """The outputs `Sensitivity` keeps, each as (value (N,), tangents (N, p)), at the crank angles
-    `phi` (rad), from the design's constants `c` (numbers, or duals with `val` and `der` (p,):
-    `sensitivity._design`'s), by the compiled kernel. NotImplementedError with `refusal`'s reason
-    where it does not take `mech`."""
+    """The outputs of the `kind` kernel (`_outs`: "full", those `Sensitivity` keeps; "motion", the
+    kinematics), each as (value (N,), tangents (N, p)), at the crank angles `phi` (rad), from the
+    design's constants `c` (numbers, or duals with `val` and `der` (p,): `sensitivity._design`'s)
+    and, for "full" where `mech` has loads besides gravity, those loads X and their tangents DX
+    (`_source`). NotImplementedError with `refusal`'s reason where it does not take `mech`."""
     why = refusal(mech)
     if why:
         raise NotImplementedError(f"{mech.name}: {why}")
@@ -365,18 +379,20 @@ def tangents(mech: "Mechanism", c: Mapping[str, Any], phi: np.ndarray, p: int,
     W, E = fast._speeds([mech], phi)
     DW, DE = (np.real(_tangent(c[n], p)) if mech.drive.law is None else np.zeros(p) for n in ("w_in", "e_in"))
     N = len(phi)
-    rows = _rows(mech, p)
+    rows = _rows(mech, p, kind)
     S, FL = np.empty(rows[""] * N), np.zeros(N, bool)
-    fn = _kernel(mech, p)
+    fn = _kernel(mech, p, kind)
+    X = np.zeros((0, 1)) if X is None else np.ascontiguousarray(X, float)
+    DX = np.zeros((p, 0, 1)) if DX is None else np.ascontiguousarray(DX, float)
     n = max(1, min(threads or fast.THREADS, N // fast.BLOCK or 1))
     spans = [(np.uint64(q * N // n), np.uint64((q + 1) * N // n)) for q in range(n)]
-    run = lambda s: fn(phi, W, E, C, DC, DW, DE, s[0], s[1], np.uint64(N), S, FL)
+    run = lambda s: fn(phi, W, E, C, DC, DW, DE, X, DX, s[0], s[1], np.uint64(N), S, FL)
     if n == 1:
         run(spans[0])
     else:
         list(fast._pool(n).map(run, spans))
     out = {}
-    for name in _outs(mech):
+    for name in _outs(mech, kind):
         r = rows[name]
         if _is_complex(name):
             z = S[r * N:(r + 2 * (1 + p)) * N].reshape(1 + p, 2, N)

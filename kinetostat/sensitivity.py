@@ -473,8 +473,8 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     d/d l, for l itself written as an expression, moves l alone.
     The reactions are the frictionless ones (friction's first approximation). ValueError naming
     an unknown parameter, or a field that a parameter reaches and that is not carried.
-    path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernel over
-    the same source; NotImplementedError naming why where it does not take the mechanism), or
+    path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernels over
+    the same source, the loads besides gravity evaluated on duals between their two passes), or
     "auto": the compiled one where `fast_sensitivity.pays` (its kernel held from FAST_MIN angles, else
     from FAST_COLD; a mechanism it takes)."""
     valid = [*mech.parameters, "g"]
@@ -494,14 +494,12 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     phi_deg = crank_angles(phi_deg, steps)
     if path == "auto":
         path = "compiled" if fast_sensitivity.pays(mech, len(phi_deg), len(params)) else "numpy"
-    if path == "compiled" and (why := fast_sensitivity.refusal(mech)):
-        raise NotImplementedError(f"sensitivity: path='compiled': {mech.name}: {why}")
     result = exact(mech, phi_deg, "first")
     values, fields = _seeded(mech, params)
     _refuse_unsmooth(mech, values)
     c, pts, view = _design(mech, fields)
     if path == "compiled":
-        keep = {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, np.radians(phi_deg), len(params)).items()}
+        keep = _compiled(mech, c, pts, view, np.radians(phi_deg), len(params))
         return Sensitivity(mech, params, MappingProxyType({p: float(value(values[p])) for p in params}), phi_deg,
                            result, MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -521,6 +519,25 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
                                 *(f"{s}{k}" for s in ("O", "V", "A", "w", "e", "rot") for k in range(1, mech.n_links)))}
     return Sensitivity(mech, params, MappingProxyType({p: float(value(values[p])) for p in params}), phi_deg, result,
                        MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
+
+
+def _compiled(mech: "Mechanism", c: Mapping[str, Any], pts, view: "Mechanism", phi: np.ndarray, P: int) -> dict[str, Dual]:
+    """The kept outputs by `fast_sensitivity`'s kernels: where `mech` has loads besides gravity,
+    its motion kernel first, the loads on that motion's duals (as the numpy path evaluates them),
+    then the full kernel with them (X, DX)."""
+    X = DX = None
+    if mech.loads or mech.springs:
+        env = {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, phi, P, "motion").items()}
+        _travel_ends(mech, view, c, pts)
+        L, N = mech.n_links, len(phi)
+        F = [[0.0, 0.0] for _ in range(L)]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, phi, P)):
+                F[k] = [F[k][0] + f, F[k][1] + m]
+        cols = [x for k in range(1, L) for x in (np.real(F[k][0]), np.imag(F[k][0]), F[k][1])]
+        X = np.stack([np.broadcast_to(value(x), (N,)) for x in cols])
+        DX = np.stack([derivative(x, (N,), P) for x in cols]).transpose(2, 0, 1)
+    return {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, phi, P, "full", X, DX).items()}
 
 
 def _motion(mech: "Mechanism", env: dict[str, Any], phi: np.ndarray) -> dict[str, Any]:
