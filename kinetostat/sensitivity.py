@@ -9,7 +9,9 @@ through the model's expressions (`Mechanism.expressions`, evaluated on duals by
 `expressions.over_arrays`) and through the fields they fill (points, masses, moments of inertia,
 bodies, g, the crank speed, load values and scales).
 
-May use: numpy, analysis, applied, expressions, groups, kinematics (its Kinematics), model
+The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source.
+
+May use: numpy, analysis, applied, expressions, fast_sensitivity, groups, kinematics (its Kinematics), model
 (parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
@@ -21,7 +23,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from . import groups
+from . import fast_sensitivity, groups
 from .analysis import Analysis, _labelled, _xarray, crank_angles, exact
 from .applied import load_wrenches, stroke
 from .expressions import ExpressionError, over_arrays, parse
@@ -461,7 +463,7 @@ class Sensitivity:
 
 # ----------------------------------------------------------------------------- the analysis on duals
 def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = None, steps: int = 360,
-                phi_deg=None) -> Sensitivity:
+                phi_deg=None, path: str = "auto") -> Sensitivity:
     """Exact derivatives of the kinematics, the reactions and the balancing load of `mech` by its
     parameters `params` (names of the model's [parameters], or "g"; None: every parameter) at
     `steps` equal crank angles over a turn, or at `phi_deg` (deg). Forward mode: the analysis'
@@ -470,7 +472,11 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     parameters written as expressions of p follow it (d/d r moves l = sqrt(r**2 + c**2)), and
     d/d l, for l itself written as an expression, moves l alone.
     The reactions are the frictionless ones (friction's first approximation). ValueError naming
-    an unknown parameter, or a field that a parameter reaches and that is not carried."""
+    an unknown parameter, or a field that a parameter reaches and that is not carried.
+    path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernels over
+    the same source, the loads besides gravity evaluated on duals between their two passes), or
+    "auto": the compiled one where `fast_sensitivity.pays` (its kernel held from FAST_MIN angles, else
+    from FAST_COLD; a mechanism it takes)."""
     valid = [*mech.parameters, "g"]
     params = tuple(valid[:-1] if params is None else ([params] if isinstance(params, str) else params))
     for p in params:
@@ -483,11 +489,19 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     if any(g.klass == 3 for g in mech.structure.groups):
         raise ValueError("sensitivity: a class-III group (triad): its positions are Newton's, not a closed form; "
                          "this version differentiates dyads only")
+    if path not in ("auto", "numpy", "compiled"):
+        raise ValueError(f"sensitivity: path {path!r}: one of 'auto', 'numpy', 'compiled'")
     phi_deg = crank_angles(phi_deg, steps)
+    if path == "auto":
+        path = "compiled" if fast_sensitivity.pays(mech, len(phi_deg), len(params)) else "numpy"
     result = exact(mech, phi_deg, "first")
     values, fields = _seeded(mech, params)
     _refuse_unsmooth(mech, values)
     c, pts, view = _design(mech, fields)
+    if path == "compiled":
+        keep = _compiled(mech, c, pts, view, np.radians(phi_deg), len(params))
+        return Sensitivity(mech, params, MappingProxyType({p: float(value(values[p])) for p in params}), phi_deg,
+                           result, MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         env = _motion(mech, c, np.radians(phi_deg))
         for k in range(1, mech.n_links):
@@ -505,6 +519,25 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
                                 *(f"{s}{k}" for s in ("O", "V", "A", "w", "e", "rot") for k in range(1, mech.n_links)))}
     return Sensitivity(mech, params, MappingProxyType({p: float(value(values[p])) for p in params}), phi_deg, result,
                        MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
+
+
+def _compiled(mech: "Mechanism", c: Mapping[str, Any], pts, view: "Mechanism", phi: np.ndarray, P: int) -> dict[str, Dual]:
+    """The kept outputs by `fast_sensitivity`'s kernels: where `mech` has loads besides gravity,
+    its motion kernel first, the loads on that motion's duals (as the numpy path evaluates them),
+    then the full kernel with them (X, DX)."""
+    X = DX = None
+    if mech.loads or mech.springs:
+        env = {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, phi, P, "motion").items()}
+        _travel_ends(mech, view, c, pts)
+        L, N = mech.n_links, len(phi)
+        F = [[0.0, 0.0] for _ in range(L)]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, phi, P)):
+                F[k] = [F[k][0] + f, F[k][1] + m]
+        cols = [x for k in range(1, L) for x in (np.real(F[k][0]), np.imag(F[k][0]), F[k][1])]
+        X = np.stack([np.broadcast_to(value(x), (N,)) for x in cols])
+        DX = np.stack([derivative(x, (N,), P) for x in cols]).transpose(2, 0, 1)
+    return {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, phi, P, "full", X, DX).items()}
 
 
 def _motion(mech: "Mechanism", env: dict[str, Any], phi: np.ndarray) -> dict[str, Any]:

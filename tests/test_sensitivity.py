@@ -237,3 +237,68 @@ def test_a_motor_characteristic_follows_the_speed(char):
 def test_a_characteristic_that_reads_the_parameter_is_refused_by_name():
     with pytest.raises(ValueError, match=r"load 'motor' \(load\[0\]\): its characteristic M\(omega\) reads \['MS'\]"):
         kinetostat.sensitivity(kinetostat.loads(MOTOR_CRANK.format(char='"MS * (1 - omega / 12)"')), params=["MS"])
+
+
+# ----------------------------------------------------------------------------- the compiled path
+def _jvp_scope() -> dict:
+    """groups' functions and their generated `_jvp` versions in one pure-Python scope (numpy's
+    primitives), so the tangent transform is checked without a compile."""
+    import inspect
+    from kinetostat import fast_sensitivity, groups
+    scope = dict(vars(groups))
+    exec(compile(fast_sensitivity.jvp_source() + "\n" + "\n".join(
+        inspect.getsource(f) for f in fast_sensitivity.PRIMITIVE_JVPS), "<jvp>", "exec"), scope)
+    return scope
+
+
+def test_generated_tangents_match_duals_on_the_group_equations():
+    """Every group equation's generated `_jvp` gives the tangent the numpy path's Dual gives (one
+    direction), on random points (the RRR and RRP assemblies, polygons, inertia, gear force)."""
+    from kinetostat.sensitivity import Dual
+    scope, rng = _jvp_scope(), np.random.default_rng(3)
+    z = lambda: complex(*rng.normal(size=2))
+    cases = {"rrr_motion": [0.1 + 0j, z(), z(), 1.0 + 0.2j, z(), z(), 0.8, 0.7, 1.0, 1.0],
+             "rrp_motion": [0.1j, z(), z(), 0.5 + 0j, (0.6 + 0.8j), 0.1, 2.5, -1.0, z(), z(), z(), 0.4, 0.2, 1.0],
+             "rpr_motion": [1.0 + 0.5j, z(), z(), 0j, z(), z(), 0.1, 1.0, 1.0],
+             "rrr_polygon": [z(), z(), z(), 1.1, 0.9, z(), z(), 0.3, -0.2],
+             "inertia": [z(), 0.7, 0.2, np.exp(0.4j), z(), 2.0, 0.1],
+             "gear_force": [1.5, np.exp(0.3j), 0.35, 0.04]}
+    for fn, args in cases.items():
+        tans = [z() if isinstance(a, complex) else float(rng.normal()) for a in args]
+        duals = [Dual(np.asarray(a), np.asarray([t])) for a, t in zip(args, tans)]
+        want = scope[fn](*duals)
+        want = want if isinstance(want, tuple) else (want,)
+        got = scope[f"{fn}_jvp"](*[x for pair in zip(args, tans) for x in pair])
+        for k, w in enumerate(want):
+            w = w if isinstance(w, Dual) else Dual(w, np.zeros(1))
+            assert np.allclose(got[2 * k], w.val, rtol=1e-13, atol=1e-13), (fn, k)
+            assert np.allclose(got[2 * k + 1], w.der[..., 0], rtol=1e-11, atol=1e-12), (fn, k)
+
+
+def test_unknown_path_is_refused_by_name():
+    with pytest.raises(ValueError, match="path 'gpu'"):
+        kinetostat.sensitivity(kinetostat.load(CHAIN), ["r"], steps=8, path="gpu")
+
+
+@pytest.mark.slow   # compiles its kernels (minutes on a busy 2-core machine, once per machine)
+@pytest.mark.parametrize("path, params", [(CHAIN, ["r", "l", "m2"]), (ICE, ["l_OA", "p_max", "G2"])],
+                         ids=["chain_unit_four_bar", "ice_crank_slider"])
+def test_compiled_and_numpy_paths_agree(path, params):
+    """path='compiled' (the ICE: its gas diagram on the motion kernel's duals between the two
+    passes) gives the numpy path's derivatives to 1e-12 of each output's largest."""
+    mech = kinetostat.load(path)
+    a = kinetostat.sensitivity(mech, params, steps=360, path="numpy")
+    b = kinetostat.sensitivity(mech, params, steps=360, path="compiled")
+    for name, _, acc in outputs(mech, mech.point_names[-1]):
+        for p in params:
+            x, y = acc(a)[p], acc(b)[p]
+            assert np.nanmax(np.abs(x - y)) <= 1e-12 * np.nanmax(np.abs(x)), (name, p)
+
+
+def test_auto_path_does_not_compile_for_few_angles():
+    """path='auto' at 360 angles (below fast.FAST_MIN) takes the numpy path: the same numbers as path='numpy'."""
+    from kinetostat import fast_sensitivity
+    mech = kinetostat.load(CHAIN)
+    assert not fast_sensitivity.pays(mech, 360, 2) and not fast_sensitivity.pays(mech, 20_000, 7)
+    a, b = (kinetostat.sensitivity(mech, ["r", "m2"], steps=360, path=p) for p in ("auto", "numpy"))
+    assert np.array_equal(a.balancing_moment["r"], b.balancing_moment["r"])
