@@ -316,6 +316,20 @@ def _scratch_rows(lay: _Layout) -> int:
     return 2 + 3 * lay.L + lay.n_rows + lay.P + 2
 
 
+def hoist(steps: tuple, consts) -> tuple[list, list]:
+    """(the steps that read constants only, directly or through other such steps: run once per
+    design before the loop over angles; the rest, in order). An assembly check is never hoisted."""
+    fixed = set(consts)
+    hoisted, moving = [], []
+    for st in steps:
+        if st.fn != "check" and all(not isinstance(a, str) or a in fixed for a in st.args):
+            fixed.update(st.out)
+            hoisted.append(st)
+        else:
+            moving.append(st)
+    return hoisted, moving
+
+
 def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     """The kernel's Python source (compiled by numba): the programs' steps inside a loop over
     blocks (design, first angle, count) and an unsigned loop over each block's angles that reads
@@ -347,14 +361,7 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
                 "    for j in range(m):", f"        T[{tr} + j] = {X}[{X.lower()}d, i0 + j]",
                 "else:", "    for j in range(m):", f"        T[{tr} + j] = {X}[{X.lower()}d, 0]"]
     pro = [f"{v(n)} = C[d, {j}]" + (".real" if real else "") for j, (n, real) in enumerate(zip(lay.consts, lay.real))]
-    fixed = set(lay.consts)               # hoisted: the steps that read constants only
-    hoisted, moving = [], []
-    for st in motion.steps + (() if kind == "motion" else statics.steps):
-        if st.fn != "check" and all(not isinstance(a, str) or a in fixed for a in st.args):
-            fixed.update(st.out)
-            hoisted.append(st)
-        else:
-            moving.append(st)
+    hoisted, moving = hoist(motion.steps + (() if kind == "motion" else statics.steps), lay.consts)
     pro += code(Program(tuple(hoisted), (), ()), v, lambda *a: "")
     check = lambda i, disc, scale: f"ok &= {disc} >= -1e-12 * {scale}"
     in_motion = set(motion.steps)

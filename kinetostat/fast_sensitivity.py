@@ -285,14 +285,7 @@ def _source(mech: "Mechanism", p: int, kind: str) -> str:
     for j, (n, real) in enumerate(zip(lay.consts, lay.real)):
         pro.append(f"{v(n)} = C[{j}]" + (".real" if real else ""))
         pro += [f"{v(n)}_d{q} = DC[{q}, {j}]" + (".real" if real else "") for q in range(p)]
-    fixed = set(lay.consts)
-    hoisted, moving = [], []
-    for st in motion.steps + (() if kind == "motion" else statics.steps):
-        if st.fn != "check" and all(not isinstance(a, str) or a in fixed for a in st.args):
-            fixed.update(st.out)
-            hoisted.append(st)
-        else:
-            moving.append(st)
+    hoisted, moving = fast.hoist(motion.steps + (() if kind == "motion" else statics.steps), lay.consts)
     pro += _step_lines(hoisted, v, p)
     in_motion = set(motion.steps)
     body = [f"{v('phi')} = phi[i]", f"{v('w_in')} = W[0, i if W.shape[1] > 1 else U(0)]",
