@@ -127,12 +127,13 @@ def tornado_svg(tol) -> str:
     P = len(tol.params)
     row, width, left, mid_w = 18, 760, 120, 420
     h_panel = (P + 2) * row
-    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{h_panel * len(tol.outputs) + 30}" '
+    head = 2 * row + 12                          # the title in two lines: the mechanism, then what is drawn
+    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{h_panel * len(tol.outputs) + head}" '
              f'font-family="DejaVu Sans, sans-serif" font-size="12">',
-             f'<text x="10" y="18" font-weight="bold">{html.escape(tol.mechanism)}: first-order swing of each peak '
-             f'(+- limit), share of its variance</text>']
+             f'<text x="10" y="18" font-weight="bold">{html.escape(tol.mechanism)}</text>',
+             f'<text x="10" y="{18 + row}">first-order swing of each peak (+- limit), share of its variance</text>']
     for k, (name, unit) in enumerate(zip(tol.outputs, tol.output_units)):
-        y0 = 30 + k * h_panel
+        y0 = head + k * h_panel
         swing = [abs(lin.peak_derivative[p, k]) * tol.limits[p] for p in range(P)]
         top = max(swing) or 1.0
         parts.append(f'<text x="10" y="{y0 + row - 4}" font-weight="bold">peak {name} = {lin.peak[k]:.6g} {unit} '
