@@ -237,3 +237,23 @@ def test_the_overlap_check_finds_a_planted_overlap(page, ice_plans):
     assert any("'QQ' over text" in b or "over text 'QQ'" in b for b in bad), bad
     assert any("'WW' over an arrowhead" in b for b in bad), bad
     assert any("'PP' over a point" in b for b in bad), bad
+
+
+_POINT = re.compile(r'<circle cx="([-\d.]+)" cy="([-\d.]+)"')
+
+
+@pytest.mark.parametrize("mu_l, fits", [(0.001, True), (0.0006, False)])
+def test_the_no_fit_note_only_where_the_plan_runs_off_its_room(mu_l, fits):
+    """The ICE's plan of positions at 30 deg (seed 002 fig 1.5 with the other assembly B'): at the
+    texts' mu_l = 0.001 m/mm it is 223 mm tall and every point lies inside the frame, above the
+    title block (247 mm) and the notes' first line: no note that it does not fit (before, the note:
+    the test asked 237 mm of the 232 mm above the title block). At 0.0006 m/mm (372 mm) points run
+    past the frame or into the notes: the note."""
+    mech = kinetostat.load("ice_crank_slider")
+    plan = P.build(mech, at=30.0, scales={"mu_l": mu_l}, only=["positions"])["positions"]
+    sheet = svg(plan, lang="uk")
+    drawn, notes = sheet.split('<g id="plan"')[1].split('<g id="title-block"')[0], sheet.split('<g id="notes">')[1]
+    first = float(re.search(r'<text x="[-\d.]+" y="([-\d.]+)"', notes)[1]) - 3.5           # the notes' top: a line's size above its baseline
+    ys = [float(y) for _, y in _POINT.findall(drawn)]
+    clear = 5.0 <= min(ys) and max(ys) <= min(247.0, first)
+    assert clear == fits and ("не вміщується" not in notes) == fits, (min(ys), max(ys), first)

@@ -72,6 +72,7 @@ SIDE_MM = 1.8
 _POINT_MM = _NAME_MM = _NUMBERED_MM = _NOTE_MM = MIN_TEXT_MM
 _LINE_STEP = 5.1                             # line spacing of the notes, mm (room for a sub- and superscript)
 _LEFT_NOTES_MM = 120.0                       # width of the notes beside a tall plan, mm
+_BELOW_NOTES_MM = _TITLE_BLOCK[0] - 3 - (_FRAME[0] + 3)   # width of the notes below a plan, beside the title block, mm
 
 #: Room a plan has on its sheet (width, height), mm: above notes of a few lines, or beside a
 #: column of notes at its left.
@@ -416,7 +417,7 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     (bottom left, from `bottom` up (the legend's top), beside the title block) or, for a tall
     plan, in a column at its left, and where the notes' lines go (x, first baseline, width; mm)."""
     x0 = _FRAME[0] + 3
-    width = _LEFT_NOTES_MM if left else _TITLE_BLOCK[0] - 3 - x0
+    width = _LEFT_NOTES_MM if left else _BELOW_NOTES_MM
     lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
     if nofit:
         lines.append(text("nofit", lang))
@@ -441,36 +442,41 @@ def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit:
     return out, (_AREA[0], _AREA[1], _AREA[2], min(_AREA[3], top - 3.0)), where
 
 
-def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float, float, float],
+def _placed_clear(box: tuple[float, float, float, float], spare: float, area: tuple[float, float, float, float],
+                  notes: tuple[float, float, float, float]) -> bool:
+    """Whether a drawing of extent `box` (plan mm), grown by `spare` mm on every side and centred
+    in `area` as `_sheet` places it, lies inside the frame and clear of the notes' block `notes`
+    (x0, y0, x1, y1; with the legend below it) and the title block (sheet mm)."""
+    w, h = box[2] - box[0] + 2 * spare, box[3] - box[1] + 2 * spare
+    cx, cy = (area[0] + area[2]) / 2, (area[1] + area[3]) / 2
+    x0, y0, x1, y1 = cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2
+    inside = _FRAME[0] <= x0 and _FRAME[1] <= y0 and x1 <= _FRAME[2] and y1 <= _FRAME[3]
+    return inside and not any(x0 < b[2] and b[0] < x1 and y0 < b[3] and b[1] < y1 for b in (notes, _TITLE_BLOCK))
+
+
+def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float, float, float], spare: float,
             draw: bool = True, bottom: float = _FRAME[3] - 1.5
             ) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
     """The notes of `plan` (SVG where `draw`, above `bottom`), the drawing area for a drawing of
     extent `box` and where the notes' lines go (`_notes_block`):
     notes below where it fits above them, else in a column at its left where it fits beside them,
-    else below with a note that it does not fit (fitting: with MIN_DRAWN_MM to spare on every
-    side, for a vector drawn out of scale)."""
-    x0, y0, x1, y1 = box
+    else below with a note that it does not fit. Fitting: as drawn, `spare` mm to spare on every
+    side (room for a vector drawn out of scale: `_room`), inside the frame and clear of the notes
+    (their block from their first line down to the frame, the legend's row with it) and the title
+    block (`_placed_clear`)."""
     for left in (False, True):
         notes, area, where = _notes_block(plan, lang, tiny, left, draw=draw, bottom=bottom)
-        if area is not None and x1 - x0 + 2 * MIN_DRAWN_MM <= area[2] - area[0] \
-                and y1 - y0 + 2 * MIN_DRAWN_MM <= area[3] - area[1]:      # room for a vector drawn out of scale
+        if area is not None and _placed_clear(box, spare, area, (where[0], where[1] - ASCENT * _NOTE_MM,
+                                                                  where[0] + where[2], _FRAME[3])):
             return notes, area, where
     return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw, bottom=bottom)
 
 
-def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
-                 where: tuple[float, float, float], bottom: float, placer: Placer) -> list[Element]:
-    """The notes of every angle (`_note_lines`, their numbers as the page's tokens: page.js writes
-    each angle's from the lengths and values the page holds) as lines of text at `where` (x, first
-    baseline, width; `_notes_block`), as many as fit above `bottom` (the legend's top): line k
-    shows the k-th line of each angle's notes where it has one (its texts once, an index per
-    angle) and where it is clear of the plan's arrowheads, points and letters (`placer`: the plan
-    of an angle may reach into the notes' room where the cycle's is larger than the room; a token
-    as wide as _TOKEN_SAMPLE). The angles grouped by what their notes are made of (the plan's
-    notes, tiny vectors, accuracy, equation, how each result is found) in one pass; each group's
-    notes read and wrapped once, of the plan cut to its tiny vectors."""
-    x, y, width = where
-    room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
+def _note_groups(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray]) -> tuple[list[list[str]], np.ndarray]:
+    """The notes of every angle (`_note_lines`, their numbers as the page's tokens), the angles
+    grouped by what their notes are made of (the plan's notes, tiny vectors, accuracy, equation,
+    how each result is found) in one pass: each group's lines (read once, of the plan cut to its
+    tiny vectors; in the order of their first angle) and each angle's group (N,)."""
     segments = tuple(s for s in cycle.segments if s.name in tiny)       # all of its drawing the notes read
     index = {s.name: k for k, s in enumerate(cycle.segments)}
     light = replace(cycle, points={k: cycle.points[k] for s in segments for k in (s.start, s.end)},
@@ -487,14 +493,32 @@ def _cycle_notes(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray],
     _, first, inverse = np.unique(keys.astype(float), axis=0, return_index=True, return_inverse=True)
     order = np.argsort(first)                          # the groups in the order of their first angle
     first, inverse = first[order], np.argsort(order)[inverse.reshape(-1)]
+    return [_note_lines(light.at(j), lang, _tiny_at(tiny, j), page=index) for j in first.tolist()], inverse
+
+
+def _wrapped(groups: list[list[str]], width: float) -> list[list[str]]:
+    """Each group's note lines wrapped to `width` mm (`_wrap`; each distinct line once)."""
     wrapped: dict[str, list[str]] = {}
-    groups = []                                        # each make-up's lines, read and wrapped once
-    for j in first.tolist():
-        notes = _note_lines(light.at(j), lang, _tiny_at(tiny, j), page=index)
+    for notes in groups:
         for n in notes:
             if n not in wrapped:
                 wrapped[n] = _wrap(n, _NOTE_MM, width)
-        groups.append([w for n in notes for w in wrapped[n]][:room])
+    return [[w for n in notes for w in wrapped[n]] for notes in groups]
+
+
+def _cycle_notes(cycle: PlanCycle, notes: tuple[list[list[str]], np.ndarray],
+                 where: tuple[float, float, float], bottom: float, placer: Placer) -> list[Element]:
+    """The notes of every angle (`notes`: `_note_groups`; page.js writes each angle's numbers from
+    the lengths and values the page holds) as lines of text at `where` (x, first baseline, width;
+    `_notes_block`), as many as fit above `bottom` (the legend's top): line k shows the k-th line
+    of each angle's notes where it has one (its texts once, an index per angle) and where it is
+    clear of the plan's arrowheads, points and letters (`placer`: the plan of an angle may reach
+    into the notes' room where the cycle's is larger than the room; a token as wide as
+    _TOKEN_SAMPLE)."""
+    x, y, width = where
+    room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
+    groups = [lines[:room] for lines in _wrapped(notes[0], width)]
+    inverse = notes[1]
     out = []
     for k in range(max(map(len, groups), default=0)):
         texts, variant = _variants([lines[k] if k < len(lines) else "" for lines in groups])
@@ -882,18 +906,21 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
 
 
 def _room(cycle: PlanCycle, lang: str, notes: bool):
-    """The notes block (SVG where `notes`, of the angle with the most lines of them), the drawing
-    area they leave and where the notes go, the legend of line weights (`_legend`: SVG, box), with
-    what they were found from: (block, area, where, legend, legend's box, tiny, extents, box)."""
+    """The notes block (SVG where `notes`, of the angle whose notes take the most lines below the
+    plan: the page's notes of every angle fit its room), the drawing area they leave and where the
+    notes go, the legend of line weights (`_legend`: SVG, box), with what they were found from:
+    (block, area, where, legend, legend's box, tiny, extents, box, the notes of every angle:
+    `_note_groups`)."""
     tiny = _tiny(cycle)
     ext = _extents(cycle)
     box = _union(ext)
-    lines = np.array([len(x) for x in cycle.notes] if cycle.notes else [0] * cycle.n) \
-        + sum((v != _AS_IS).astype(int) for v in tiny.values())
+    groups, inverse = _note_groups(cycle, lang, tiny)
+    lines = np.array([len(g) for g in _wrapped(groups, _BELOW_NOTES_MM)])[inverse]
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
     legend, key = _legend(cycle, lang)
-    block, area, where = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, draw=notes, bottom=key[1])
-    return block, area, where, legend, key, tiny, ext, box
+    spare = MIN_DRAWN_MM if any((v == _OUT).any() for v in tiny.values()) else 0.0   # a vector drawn out of scale
+    block, area, where = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, spare, draw=notes, bottom=key[1])
+    return block, area, where, legend, key, tiny, ext, box, (groups, inverse)
 
 
 def language_part(plan: Plan, lang: str) -> tuple:
@@ -910,7 +937,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where
     `notes`, the notes of every angle (`_cycle_notes`) where `cycle_notes`."""
     _lang(lang)
-    block, (ax0, ay0, ax1, ay1), where, legend, key, tiny, ext, box = _room(cycle, lang, notes)
+    block, (ax0, ay0, ax1, ay1), where, legend, key, tiny, ext, box, note_groups = _room(cycle, lang, notes)
     x0, y0, x1, y1 = box
     tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
@@ -929,7 +956,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     dots, points = _points(cycle, at, placer)
     elements += dots + _labels(placer, points + names)
     if cycle_notes:
-        elements += _cycle_notes(cycle, lang, tiny, where, key[1], placer)
+        elements += _cycle_notes(cycle, note_groups, where, key[1], placer)
     title = _title_block(cycle, lang, mechanism)
     W, H = SHEET_MM
     x0, y0, x1, y1 = _TITLE_BLOCK
