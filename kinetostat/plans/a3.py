@@ -446,7 +446,9 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     def drawings(plans, lg: str) -> list[Drawing]:
         """The plans' drawings in `lg`, each drawn once for all the languages its plan group is
         the same in (`draw.language_part`, found where a language drawn before may be one; its
-        heading in `lg`); in `lang` with the notes and the mechanism's name (`Plans.write`'s sheet)."""
+        heading in `lg`, its lines' tooltips the language's it was drawn in: `lang`'s drawings,
+        the ones kept, are always drawn in `lang`, first); in `lang` with the notes and the
+        mechanism's name (`Plans.write`'s sheet)."""
         out = []
         for k in plans:
             plan = plans[k]
