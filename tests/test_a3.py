@@ -459,3 +459,14 @@ def test_the_notes_state_the_scales_and_their_departures():
     oa = two.plans["mechanism"].length_mm("OA")
     (departs,) = [s for s in A3.notes(two, False, "en") if s.startswith("Outside")]
     assert f"OA {oa:.1f} mm (30–36)" in departs and round(oa) == 19
+
+
+def test_free_rectangles_split_around_a_box_stay_maximal():
+    """`_split` (maximal rectangles): a box inside a free rectangle leaves the four rectangles
+    beside it; a free rectangle inside another is dropped, and of two equal ones the later."""
+    free = [(0.0, 0.0, 10.0, 10.0)]
+    A3._split(free, (2.0, 2.0, 4.0, 4.0))
+    assert free == [(0.0, 0.0, 2.0, 10.0), (4.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 2.0), (0.0, 4.0, 10.0, 10.0)]
+    free = [(1.0, 1.0, 5.0, 5.0), (0.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]
+    A3._split(free, (40.0, 40.0, 41.0, 41.0))                      # meets none of them
+    assert free == [(0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]
