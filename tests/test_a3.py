@@ -132,7 +132,9 @@ def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
     each choice of scales once (was: 9 builds for 8 choices) and draws each plan once at its
     scales for all the languages that draw it alike (`draw.language_part`: was once a language:
     the velocity plan, lettered the same in all three, drawn three times; a group plan, whose
-    guide is lettered in each language, is drawn again in the others); every build after the
+    guide is lettered in each language, is drawn again in the others; the velocity plan in uk, whose
+    construction lines' tooltips differ from en's but whose letters and notes' room do not, is
+    en's drawing: was drawn again); every build after the
     rule's is given the plan of positions' 12 positions at its μ_l, made once per μ_l (was: made
     again in each build); the same sheet as `_one` (no state kept between calls)."""
     import kinetostat.plans as KP
@@ -151,7 +153,7 @@ def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
     assert len(built) == len(set(built)) >= 5
     assert len(drawn) == len(set(drawn)) and {lang for lang, _, _ in drawn} == {"en", "uk", "ru"}
     again = {kind for lang, kind, _ in drawn if lang != "en"}
-    assert "group:2,3" in again      # (the velocity plan at 0.4 and 0.5 carries a note in words: drawn in each)
+    assert "group:2,3" in again and not any(lang == "uk" and kind == "velocity" for lang, kind, _ in drawn)
     given = positions[1:]
     assert all(p is not None and p.mu.value == dict(b)["mu_l"] for p, b in zip(given, built[1:]))
     assert len({id(p) for p in given}) == len({p.mu.value for p in given}) < len(given)
@@ -457,3 +459,14 @@ def test_the_notes_state_the_scales_and_their_departures():
     oa = two.plans["mechanism"].length_mm("OA")
     (departs,) = [s for s in A3.notes(two, False, "en") if s.startswith("Outside")]
     assert f"OA {oa:.1f} mm (30–36)" in departs and round(oa) == 19
+
+
+def test_free_rectangles_split_around_a_box_stay_maximal():
+    """`_split` (maximal rectangles): a box inside a free rectangle leaves the four rectangles
+    beside it; a free rectangle inside another is dropped, and of two equal ones the later."""
+    free = [(0.0, 0.0, 10.0, 10.0)]
+    A3._split(free, (2.0, 2.0, 4.0, 4.0))
+    assert free == [(0.0, 0.0, 2.0, 10.0), (4.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 2.0), (0.0, 4.0, 10.0, 10.0)]
+    free = [(1.0, 1.0, 5.0, 5.0), (0.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]
+    A3._split(free, (40.0, 40.0, 41.0, 41.0))                      # meets none of them
+    assert free == [(0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]

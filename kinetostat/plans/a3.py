@@ -263,9 +263,15 @@ def _split(free: list, box: tuple) -> None:
             continue
         out += [c for c in ((fx0, fy0, bx0, fy1), (bx1, fy0, fx1, fy1), (fx0, fy0, fx1, by0), (fx0, by1, fx1, fy1))
                 if c[2] - c[0] > 1e-9 and c[3] - c[1] > 1e-9]
-    free[:] = [r for i, r in enumerate(out) if not any(
-        j != i and q[0] <= r[0] and q[1] <= r[1] and r[2] <= q[2] and r[3] <= q[3] and (q != r or j < i)
-        for j, q in enumerate(out))]
+    keep = []
+    for i, r in enumerate(out):
+        x0, y0, x1, y1 = r
+        for j, (qx0, qy0, qx1, qy1) in enumerate(out):
+            if qx0 <= x0 and qy0 <= y0 and x1 <= qx1 and y1 <= qy1 and (j < i or out[j] != r):
+                break                            # inside another (itself or an equal one after it: not)
+        else:
+            keep.append(r)
+    free[:] = keep
 
 
 def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float] | None:
@@ -446,7 +452,9 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     def drawings(plans, lg: str) -> list[Drawing]:
         """The plans' drawings in `lg`, each drawn once for all the languages its plan group is
         the same in (`draw.language_part`, found where a language drawn before may be one; its
-        heading in `lg`); in `lang` with the notes and the mechanism's name (`Plans.write`'s sheet)."""
+        heading in `lg`, its lines' tooltips the language's it was drawn in: `lang`'s drawings,
+        the ones kept, are always drawn in `lang`, first); in `lang` with the notes and the
+        mechanism's name (`Plans.write`'s sheet)."""
         out = []
         for k in plans:
             plan = plans[k]

@@ -925,11 +925,13 @@ def _room(cycle: PlanCycle, lang: str, notes: bool):
 
 def language_part(plan: Plan, lang: str) -> tuple:
     """All that the plan's drawing in `lang` (every element of its sheet's plan group and each
-    label's place: `sheet`) takes from the language: the drawing area its notes leave and the
-    letters of its segments and paths. Two languages with the same part draw the same plan group."""
+    label's place: `sheet`) takes from the language but its tooltips: the drawing area its notes
+    leave and the letters of its segments (a construction line or intersection is not lettered,
+    its name only its tooltip) and paths. Two languages with the same part draw the same plan
+    group, but for the tooltips."""
     _lang(lang)
     area = _room(PlanCycle.of(plan), lang, notes=False)[1]
-    return (area, tuple(segment_label(s, lang) for s in plan.segments),
+    return (area, tuple(segment_label(s, lang) for s in plan.segments if s.kind not in ("construction", "intersection")),
             tuple(text(name, lang) if name in MESSAGES else in_lang(name, lang) for name in plan.paths))
 
 
