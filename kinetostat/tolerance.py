@@ -371,34 +371,48 @@ def _draws(spec: _Spec, part: range) -> np.ndarray:
 
 def _outputs(model: ParsedModel, spec: _Spec, part: range) -> tuple[np.ndarray, int, str]:
     """The outputs (len(part), N, K) of the samples `part` of the parsed `model` (NaN for a design
-    that does not load, build or assemble), how many failed and the first one's reason (''). The
-    compiled kernel runs on one thread: the chunks are the parallel work, and sharing a design's
-    angles between threads cost more than it saved (four-bar, 360 angles, a loaded 2-core machine:
-    2.9 ms CPU a design against 0.46)."""
-    from . import fast
+    that does not load, build or assemble), how many failed and the first one's reason ('')."""
     from .sweep import _kernel, _quiet, _reason
     values = _draws(spec, part)
-    out, failed, first, buf = None, 0, "", None
+    y: dict[int, np.ndarray] = {}
+    errors: dict[int, Exception] = {}
+    built: dict[int, Mechanism] = {}
     with _quiet():
         for n, row in enumerate(values):
             try:
                 mech = build(model, parameters=dict(zip(spec.names, map(float, row))))
                 if _kernel(mech, spec.compiled, FRICTION):
-                    buf = fast.buffer(mech, len(spec.phi_deg)) if buf is None else buf
-                    res = fast.analyze_fast(mech, spec.phi_deg, threads=1, out=buf)
+                    built[n] = mech
                 else:
-                    res = analyze(mech, phi_deg=spec.phi_deg, friction=FRICTION)
-                y = _values(mech, res)
+                    y[n] = _values(mech, analyze(mech, phi_deg=spec.phi_deg, friction=FRICTION))
             except (ModelError, StructureError, AssemblyError) as exc:
-                failed += 1
-                first = first or f"sample {part.start + n}: {_reason(exc)}"
-                continue
-            if out is None:
-                out = np.full((len(values),) + y.shape, np.nan)
-            out[n] = y
-    if out is None:
-        out = np.full((len(values),) + spec.centre.shape, np.nan)
-    return out, failed, first
+                errors[n] = exc
+        compiled, failed = _compiled(built, spec.phi_deg)
+    y.update(compiled)
+    errors.update(failed)
+    out = np.full((len(values),) + spec.centre.shape, np.nan)
+    for n, v in y.items():
+        out[n] = v
+    first = f"sample {part.start + min(errors)}: {_reason(errors[min(errors)])}" if errors else ""
+    return out, len(errors), first
+
+
+def _compiled(built: Mapping[int, Mechanism], phi_deg: np.ndarray) -> tuple[dict[int, np.ndarray], dict[int, Exception]]:
+    """The outputs of the designs `built` (sample -> Mechanism) by the compiled kernel, together
+    (`fast.analyses`: a batch of designs per kernel call, on this thread: the chunks are the parallel
+    work); where one does not assemble, one by one: the outputs, and the failures (sample -> AssemblyError)."""
+    from . import fast
+    try:
+        return {n: _values(m, res) for (n, m), res in zip(built.items(), fast.analyses(list(built.values()), phi_deg))}, {}
+    except AssemblyError as exc:
+        if len(built) == 1:
+            return {}, {n: exc for n in built}
+    out, failed = {}, {}
+    for n, m in built.items():
+        y, f = _compiled({n: m}, phi_deg)
+        out.update(y)
+        failed.update(f)
+    return out, failed
 
 
 @dataclass(frozen=True)

@@ -1,18 +1,25 @@
-"""A model's text parsed once (`model.parse_text`) and each design built from it (`model.build`),
-as the sweep's and the tolerance study's chunks do: the very Mechanism, and the very analysis,
-that `loads` gives with the same parameters, design after design from one parsed text."""
+"""The many designs of a sweep or a Monte Carlo tolerance study: the model's text parsed once
+(`model.parse_text`) and each design built from it (`model.build`), the very Mechanism and analysis
+that `loads` gives with the same parameters; the designs analysed a batch per kernel call
+(`fast.analyses`), the very Analyses `analyze_fast` gives one by one; and a chunk whose designs
+partly fail keeps the others' outputs."""
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import warnings
 
 import numpy as np
 import pytest
 
 import kinetostat
+from kinetostat import fast
+from kinetostat.analysis import crank_angles
 from kinetostat.examples import resolve
 from kinetostat.model import ModelError, build, loads, parse_text
 from kinetostat.model.source import _read_text
+
+tolmod = importlib.import_module("kinetostat.tolerance")      # the module (kinetostat.tolerance is the function)
 
 #: Designs of models whose parameters are read by expressions (chain unit: l = sqrt(r**2 + c**2),
 #: O1C1 = m_A r / m1_mA; ICE: l_AS2 = AS2_AB l_AB), each built in turn from one parsed text.
@@ -61,3 +68,36 @@ def test_a_design_that_fails_names_its_field_and_line_as_loads_does():
         loads(text, source, parameters={"r": "sqrt(-1)"})
     assert built.value.located == read.value.located
     assert any("parameters.r" in m and "line" in m for m in built.value.located), built.value.located
+
+
+@pytest.mark.skipif(not fast.available(), reason="numba is not installed")
+@pytest.mark.parametrize("name", sorted(DESIGNS))
+def test_designs_analysed_a_batch_per_kernel_call_are_those_analysed_one_by_one(name):
+    text, source = _text(name)
+    model = parse_text(text, source)
+    phi = crank_angles(None, 36)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", kinetostat.ModelWarning)
+        mechs = [build(model, parameters=d) for d in DESIGNS[name]]
+    together = fast.analyses(mechs, phi)
+    for mech, a in zip(mechs, together):
+        b = fast.analyze_fast(mech, phi, threads=1)
+        for x, y in ((a.forces.R, b.forces.R), (a.balancing_moment, b.balancing_moment), (a.kin.a_z, b.kin.a_z),
+                     (a.kin.error, b.kin.error), (a.singular, b.singular)):
+            np.testing.assert_array_equal(x, y)
+
+
+@pytest.mark.skipif(not fast.available(), reason="numba is not installed")
+def test_a_chunk_whose_designs_partly_fail_keeps_the_others_outputs():
+    """The coupler l within +-0.3 m of its 0.546 m: some four-bars do not assemble (2 of these 40);
+    analysed together by the kernel, the same designs fail, for the same reason, as on the numpy
+    path, and the rest agree with it."""
+    text, source = _text("chain_unit_four_bar")
+    model = parse_text(text, source)
+    phi = crank_angles(None, 36)
+    spec = lambda compiled: tolmod._Spec(["l"], np.array([build(model).parameters["l"]]), np.array([0.3]), "uniform",
+                                         3, phi, compiled, np.zeros((36, 5)))
+    together, failed, first = tolmod._outputs(model, spec(True), range(40))
+    alone, failed_alone, first_alone = tolmod._outputs(model, spec(False), range(40))
+    assert 0 < failed < 40 and (failed, first) == (failed_alone, first_alone)
+    np.testing.assert_allclose(together, alone, rtol=1e-9, atol=1e-9)
