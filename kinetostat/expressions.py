@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import ast
 import difflib
+import functools
 import math
 import operator
 from collections.abc import Callable, Mapping
@@ -158,8 +159,10 @@ def over_arrays(expr: Expression, values: Mapping[str, Any]) -> Any:
         return ev(expr.tree.body)
 
 
+@functools.lru_cache(maxsize=1024)
 def parse(text: str) -> Expression:
-    """Check `text` and return it as an Expression; ExpressionError says what is not allowed."""
+    """Check `text` and return it as an Expression; ExpressionError says what is not allowed.
+    Cached (the designs of a sweep read the same expressions; an Expression is never changed)."""
     if len(text) > MAX_EXPRESSION:
         raise ExpressionError(f"{len(text)} characters, at most {MAX_EXPRESSION}")
     if not text.strip():

@@ -10,8 +10,10 @@ per angle, the kinematics, the loads, the reactions of every group and the balan
   each a view of one buffer reused from chunk to chunk (valid until the next is asked for).
 - `peaks(mechs, phi_deg)`: what a sweep keeps of each design: the largest |R| of every pair,
   |M_bal| and |F_bal| over the cycle, and the angles that need the exact guard.
+- `analyses(mechs, phi_deg)`: `analyze_fast` of many designs, those of one structure a batch at a
+  time in one kernel call (a Monte Carlo study's designs).
 - `refusal(mech)`: why a mechanism is not taken (a class-III group), None where it is; the
-  three above raise NotImplementedError with it, and `analyze` and the sweeps use the numpy path.
+  four above raise NotImplementedError with it, and `analyze` and the sweeps use the numpy path.
 
 The kernel: the five primitives of `groups` (|z|, complex / real, complex / complex, e^{i th},
 atan2) bound to branch-free versions (sincos and atan by polynomials, divisions part by part);
@@ -64,7 +66,7 @@ from .program import Identifiers, Program, code, constants, free_names, motion_p
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["analyze_fast", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "available",
+__all__ = ["analyze_fast", "analyses", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "available",
            "cache_dir", "kernel", "loaded", "threshold", "pays", "vector_report", "bytes_per_angle"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
@@ -83,6 +85,8 @@ FAST_COLD = 500_000
 CHUNK = 1 << 14
 #: Angles per block of the kernel's loop (not a multiple of 512: 4 KiB aliasing of the rows in L1).
 BLOCK = 264
+#: Designs per call of the full kernel in `analyses` (its guard flags take D^2 N bools).
+BATCH = 32
 #: Threads the kernel runs on (one per core by default).
 THREADS = os.cpu_count() or 1
 
@@ -509,16 +513,17 @@ def _blocks(D: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 
 def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, X: np.ndarray | None = None,
          S: np.ndarray | None = None, span: tuple[int, int] | None = None, FL: np.ndarray | None = None,
-         threads: int | None = None):
-    """The kernel over all designs and the angles span (default all) of `phi` (rad), S the flat
-    buffer of len(phi) angles, X the loads besides gravity ((3 (L - 1), len(phi)): F_x, F_y, M
-    of each moving link) or None, its blocks shared among `threads` threads (default THREADS),
-    one scratch each. Returns the flags (D, len(phi)), the peaks per block and the blocks' designs."""
+         threads: int | None = None, blocks: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None):
+    """The kernel over all designs and the angles span (default all) of `phi` (rad), or over
+    `blocks` (design, first angle, count: `_end_to_end`'s), S the flat buffer of len(phi) angles,
+    X the loads besides gravity ((3 (L - 1), len(phi)): F_x, F_y, M of each moving link) or None,
+    its blocks shared among `threads` threads (default THREADS), one scratch each. Returns the
+    flags (D, len(phi)), the peaks per block and the blocks' designs."""
     fn, lay = kernel(mechs[0], kind)
     D, N = len(mechs), len(phi)
     a, b = span or (0, N)
     W, E = _speeds(mechs, phi)
-    bd, b0, bn = _blocks(D, a, b)
+    bd, b0, bn = blocks or _blocks(D, a, b)
     FL = np.zeros((D, N), bool) if FL is None else FL
     S = np.zeros(1) if S is None else S
     PK = np.zeros((len(bd), lay.P + 2))
@@ -592,9 +597,15 @@ def _fill(mech: "Mechanism", phi: np.ndarray, buf: np.ndarray, threads: int | No
 
 def _analysis(mech: "Mechanism", phi_deg: np.ndarray, buf: np.ndarray, threads: int | None) -> "Analysis":
     """The Analysis of `mech` at `phi_deg` (deg) whose arrays are views of the flat buffer `buf`."""
+    r, FL = _fill(mech, np.radians(phi_deg), buf, threads)
+    return _result(mech, phi_deg, r, FL[0])
+
+
+def _result(mech: "Mechanism", phi_deg: np.ndarray, r: dict[str, np.ndarray], flags: np.ndarray) -> "Analysis":
+    """The Analysis of `mech` at `phi_deg` (deg) from the full kernel's arrays `r` (views, the
+    angle axis first) and its guard's flags (N,): those angles solved by the numpy path."""
     phi = np.radians(phi_deg)
     N = len(phi)
-    r, FL = _fill(mech, phi, buf, threads)
     xy = lambda z: z.T.view(np.float64).reshape(z.shape[1], N, 2).transpose(1, 0, 2)   # (N, w, 2), a view
     r["error"][:, 0] = a_priori_error(r["cond"])
     kin = _kinematics(mech, phi, r, r["error"][:, 0])
@@ -605,7 +616,7 @@ def _analysis(mech: "Mechanism", phi_deg: np.ndarray, buf: np.ndarray, threads: 
         F_all = r["F_app"] + r["F_i"]
         M_all = r["M_app"] + r["M_i"] + groups.cross(mech.inertia_arrays[2] * kin.rot, r["F_i"])
         res.lever_moment[:] = lever_moment(mech, kin, F_all, M_all)
-    flagged = np.flatnonzero(FL[0])
+    flagged = np.flatnonzero(flags)
     if len(flagged):          # the guard's angles: the numpy path, with its accuracy check and warnings
         _scatter(res, exact(mech, phi_deg[flagged]), flagged)
     if mech.friction is not None:
@@ -634,6 +645,45 @@ def analyze_fast(mech: "Mechanism", phi_deg: np.ndarray, threads: int | None = N
     N = len(phi_deg)
     buf = buffer(mech, N) if out is None else _check_buffer(mech, out, N)
     return _analysis(mech, phi_deg, buf, threads)
+
+
+def analyses(mechs: Sequence["Mechanism"], phi_deg: np.ndarray) -> list["Analysis"]:
+    """`analyze_fast(mech, phi_deg, threads=1)` of every design in `mechs` (the same Analyses):
+    the designs of one structure without loads besides gravity in one call of the full kernel per
+    BATCH of them, on this thread, their angles laid end to end in one buffer (each Analysis a
+    read-only view of its batch's buffer); the others one by one. For the many small designs of a
+    Monte Carlo study, where the per-call work (layout, kernel look-up) outweighs 360 angles'."""
+    phi_deg = np.asarray(phi_deg, float)
+    out: list[Analysis | None] = [None] * len(mechs)
+    kinds: dict[tuple, list[int]] = {}
+    for d, m in enumerate(mechs):
+        if _has_loads(m):
+            out[d] = analyze_fast(m, phi_deg, threads=1)
+        else:
+            kinds.setdefault((_motion(m).steps, statics_program(m).steps), []).append(d)
+    for same in kinds.values():
+        for k in range(0, len(same), BATCH):
+            batch = same[k:k + BATCH]
+            for d, res in zip(batch, _end_to_end([mechs[d] for d in batch], phi_deg)):
+                out[d] = res
+    return out
+
+
+def _end_to_end(mechs: Sequence["Mechanism"], phi_deg: np.ndarray) -> list["Analysis"]:
+    """The Analyses of `mechs` (one kernel, no loads besides gravity) at `phi_deg` (deg, N) from one
+    call of the full kernel over D N angles: design d's blocks cover angles [d N, (d + 1) N) of the
+    angles repeated D times, reading design d's constants and speeds (its flags: row d of (D, D N))."""
+    D, N = len(mechs), len(phi_deg)
+    phi = np.tile(np.radians(phi_deg), D)
+    lay = _layout(mechs[0])
+    buf = np.zeros(lay.n_rows * D * N)
+    r = _views(lay, buf, D * N)
+    r["rot"][:, 0] = 1.0
+    bd, b0, bn = _blocks(D, 0, N)
+    FL, _, _ = _run(mechs, phi, "full", S=buf, FL=np.zeros((D, D * N), bool), threads=1,
+                    blocks=(bd, b0 + bd * np.uint64(N), bn))
+    return [_result(m, phi_deg, {k: x[d * N:(d + 1) * N] for k, x in r.items()}, FL[d, d * N:(d + 1) * N])
+            for d, m in enumerate(mechs)]
 
 
 def chunks(mech: "Mechanism", phi_deg: np.ndarray, size: int = CHUNK, threads: int | None = None) -> Iterator["Analysis"]:

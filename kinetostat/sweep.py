@@ -8,8 +8,8 @@
 The designs are the Cartesian product of the values (first parameter the slowest), split into
 chunks; each chunk is one task, `_chunk`, run in this process or on Dask (local threads or
 processes, or a `distributed` scheduler). A task's arguments are plain and picklable: the model
-file's text and source name and the designs' parameter values; the worker rebuilds each
-Mechanism with `kinetostat.model.loads`.
+file's text and source name and the designs' parameter values; the worker parses the text once
+per chunk (`kinetostat.model.parse_text`) and builds each design's Mechanism from it (`build`).
 
 A design whose mechanism does not load, build or assemble keeps its row: NaN peaks and its
 reason in the `error` column (the sweep goes on). Warnings (singular positions, doubts about a
@@ -45,7 +45,7 @@ from .analysis import FRAME_NOTE, Analysis, _labelled, _xarray, crank_angles, fr
 from .solve import analyze
 from .errors import (AssemblyError, ModelError, ModelWarning, SelfLockingWarning, SingularPositionWarning, StructureError,
                      UndefinedFigureWarning)
-from .model import Mechanism, _read_text, _suggest, load, loads, model_text
+from .model import Mechanism, _read_text, _suggest, build, load, model_text, parse_text
 from .units import parameter_units
 
 if TYPE_CHECKING:
@@ -228,9 +228,10 @@ def _chunk(text: str, source: str, designs: list[dict[str, float]], phi_deg: np.
     from . import fast
     rows, frames, built = [], [], []
     with _quiet():
+        model = parse_text(text, source)            # once: each design is built from the parsed text
         for design in designs:
             try:
-                mech = loads(text, source, parameters=design)
+                mech = build(model, parameters=design)
                 kernel = _kernel(mech, compiled, friction)
                 res = None if kernel else analyze(mech, phi_deg=phi_deg, friction=friction)
             except (ModelError, StructureError, AssemblyError) as exc:

@@ -49,7 +49,7 @@ import numpy as np
 
 from .analysis import FRAME_NOTE, _labelled, _xarray, crank_angles
 from .errors import AssemblyError, ModelError, StructureError
-from .model import Mechanism, _suggest, loads, model_text
+from .model import Mechanism, ParsedModel, _suggest, build, model_text, parse_text
 from .solve import analyze
 from .units import parameter_units
 
@@ -226,12 +226,13 @@ def tolerance(model: str | Path | Mechanism, limits: Mapping[str, float], *, sam
     phi_deg = crank_angles(phi_deg, steps)
     sigma = limit / math.sqrt(3) if dist == "uniform" else limit
     nominal = np.array([float(base.parameters[n]) if n != "g" else base.g for n in names])
-    pinned = loads(text, source, parameters=dict(zip(names, map(float, nominal))))   # as every sample sets them
+    model = parse_text(text, source)
+    pinned = build(model, parameters=dict(zip(names, map(float, nominal))))   # as every sample sets them
     lin, shares = _linear(pinned, names, phi_deg, limit if dist == "uniform" else 3 * limit, sigma)
     from . import fast
     spec = _Spec(names, nominal, limit, dist, seed, phi_deg, fast.pays(base, samples * len(phi_deg), "full"),
                  lin.nominal)
-    pilot = _outputs(text, source, spec, range(min(PILOT, samples)))[0]
+    pilot = _outputs(model, spec, range(min(PILOT, samples)))[0]
     spec = _with_range(spec, pilot)
     parts = [range(a, min(a + chunk, samples)) for a in range(0, samples, chunk)]
     results = _run(parts, functools.partial(_chunk, text, source, spec), scheduler, progress, "tolerance")
@@ -368,33 +369,50 @@ def _draws(spec: _Spec, part: range) -> np.ndarray:
     return spec.nominal + z * spec.limit
 
 
-def _outputs(text: str, source: str, spec: _Spec, part: range) -> tuple[np.ndarray, int, str]:
-    """The outputs (len(part), N, K) of the samples `part` (NaN for a design that does not load,
-    build or assemble), how many failed and the first one's reason ('')."""
-    from . import fast
+def _outputs(model: ParsedModel, spec: _Spec, part: range) -> tuple[np.ndarray, int, str]:
+    """The outputs (len(part), N, K) of the samples `part` of the parsed `model` (NaN for a design
+    that does not load, build or assemble), how many failed and the first one's reason ('')."""
     from .sweep import _kernel, _quiet, _reason
     values = _draws(spec, part)
-    out, failed, first, buf = None, 0, "", None
+    y: dict[int, np.ndarray] = {}
+    errors: dict[int, Exception] = {}
+    built: dict[int, Mechanism] = {}
     with _quiet():
         for n, row in enumerate(values):
             try:
-                mech = loads(text, source, parameters=dict(zip(spec.names, map(float, row))))
+                mech = build(model, parameters=dict(zip(spec.names, map(float, row))))
                 if _kernel(mech, spec.compiled, FRICTION):
-                    buf = fast.buffer(mech, len(spec.phi_deg)) if buf is None else buf
-                    res = fast.analyze_fast(mech, spec.phi_deg, out=buf)
+                    built[n] = mech
                 else:
-                    res = analyze(mech, phi_deg=spec.phi_deg, friction=FRICTION)
-                y = _values(mech, res)
+                    y[n] = _values(mech, analyze(mech, phi_deg=spec.phi_deg, friction=FRICTION))
             except (ModelError, StructureError, AssemblyError) as exc:
-                failed += 1
-                first = first or f"sample {part.start + n}: {_reason(exc)}"
-                continue
-            if out is None:
-                out = np.full((len(values),) + y.shape, np.nan)
-            out[n] = y
-    if out is None:
-        out = np.full((len(values),) + spec.centre.shape, np.nan)
-    return out, failed, first
+                errors[n] = exc
+        compiled, failed = _compiled(built, spec.phi_deg)
+    y.update(compiled)
+    errors.update(failed)
+    out = np.full((len(values),) + spec.centre.shape, np.nan)
+    for n, v in y.items():
+        out[n] = v
+    first = f"sample {part.start + min(errors)}: {_reason(errors[min(errors)])}" if errors else ""
+    return out, len(errors), first
+
+
+def _compiled(built: Mapping[int, Mechanism], phi_deg: np.ndarray) -> tuple[dict[int, np.ndarray], dict[int, Exception]]:
+    """The outputs of the designs `built` (sample -> Mechanism) by the compiled kernel, together
+    (`fast.analyses`: a batch of designs per kernel call, on this thread: the chunks are the parallel
+    work); where one does not assemble, one by one: the outputs, and the failures (sample -> AssemblyError)."""
+    from . import fast
+    try:
+        return {n: _values(m, res) for (n, m), res in zip(built.items(), fast.analyses(list(built.values()), phi_deg))}, {}
+    except AssemblyError as exc:
+        if len(built) == 1:
+            return {}, {n: exc for n in built}
+    out, failed = {}, {}
+    for n, m in built.items():
+        y, f = _compiled({n: m}, phi_deg)
+        out.update(y)
+        failed.update(f)
+    return out, failed
 
 
 @dataclass(frozen=True)
@@ -412,14 +430,15 @@ class _Part:
 
 def _chunk(text: str, source: str, spec: _Spec, part: range) -> _Part:
     """The reduction of the samples `part` (whole seed blocks but the run's last), seed block by
-    seed block. A Dask task: plain, picklable arguments."""
+    seed block, the text parsed once. A Dask task: plain, picklable arguments."""
+    model = parse_text(text, source)
     N, K = spec.centre.shape
     peaks, leaves, failed, first = [], {}, 0, ""
     hist = np.zeros(N * K * (BINS + 2), np.int64)
     lo, hi = np.full((N, K), np.inf), np.full((N, K), -np.inf)
     cell = np.arange(N * K).reshape(N, K) * (BINS + 2)
     for a in range(part.start, part.stop, SEED_BLOCK):
-        y, f, why = _outputs(text, source, spec, range(a, min(a + SEED_BLOCK, part.stop)))
+        y, f, why = _outputs(model, spec, range(a, min(a + SEED_BLOCK, part.stop)))
         failed, first = failed + f, first or why
         ok = ~np.isnan(y)
         peaks.append(np.where(ok.any(axis=1), np.fmax.reduce(np.abs(y), axis=1), np.nan))

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import kinetostat
+from kinetostat.model import parse_text
 from kinetostat.sweep import _model_text
 from kinetostat.tolerance import first_order, tolerance
 
@@ -123,7 +124,7 @@ def test_the_histogram_quantiles_lie_within_their_stated_error(small):
     text, source, _ = _model_text(CHAIN)
     spec = tolmod._Spec(list(study.params), study.values, study.limits, study.dist, study.seed, study.phi_deg,
                         False, study.linear.nominal)
-    y = tolmod._outputs(text, source, spec, range(study.monte_carlo.samples))[0]
+    y = tolmod._outputs(parse_text(text, source), spec, range(study.monte_carlo.samples))[0]
     exact = np.quantile(y, tolmod.QUANTILES, axis=0, method="inverted_cdf")
     mc = study.monte_carlo
     assert (np.abs(mc.quantile - exact) <= mc.quantile_error).all()

@@ -24,7 +24,7 @@ from .lines import _Lines
 from .mechanism import Mechanism, _abbreviate
 from .parts import (PUBLISHED_UNITS, Body, Characteristic, Drive, Flywheel, Friction, Gear, Link, Load, Pair, Published, SpeedLaw,
                     Spring, Study, Table, Vec, combine)
-from .source import _read_text, from_dict, load, loads, model_text
+from .source import ParsedModel, _read_text, build, from_dict, load, loads, model_text, parse_text
 
 __all__ = ["Link", "Body", "Pair", "Table", "Load", "Characteristic", "SpeedLaw", "combine", "Spring", "Gear", "Drive",
            "Flywheel", "Friction", "Published", "Study", "Mechanism", "PUBLISHED_UNITS", "load", "loads", "from_dict", "model_text"]

@@ -80,14 +80,14 @@ class ReaderCore:
     schema (`schema.Section`) describes it. Each getter returns None after recording a problem."""
 
     def __init__(self, data: Mapping[str, Any], source: str, text: str | None = None,
-                 overrides: Mapping[str, Any] | None = None):
+                 overrides: Mapping[str, Any] | None = None, lines: _Lines | None = None):
         self.data, self.source, self.problems, self.lines = data, source, [], []
         self.overrides = dict(overrides or {})
         self.values: dict[str, float] = {}        # parameters and g, as expressions read them
         self.failed: set[str] = set()             # parameters (or g) whose value is in error
         self.expressions: dict[str, tuple[str, float]] = {}   # field path -> (expression, value)
         self.text = text or ""                    # the file's text (its comments state parameters' units)
-        self.where_lines = _Lines(text) if text is not None else None
+        self.where_lines = lines if lines is not None else _Lines(text) if text is not None else None   # text's
         self.link_table: dict[int, int] = {}      # link id -> index of its [[link]] table
         # causes already reported, whose consequences are not reported again:
         self.ids_unknown = False                  # some [[link]] has no valid id: "unknown link" follows

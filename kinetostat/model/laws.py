@@ -18,13 +18,9 @@ def mentions_phi(text: str) -> bool:
     """Whether a drive's `omega` string is a law of motion (an expression of `phi`) rather than
     a constant speed written over the model's parameters (`"n1 * pi / 30"`)."""
     try:
-        return "phi" in _expression(text).names
+        return "phi" in parse_expression(text).names
     except ExpressionError:
         return True                  # not a valid expression: the law's reader says why
-
-
-#: A checked expression, parsed once (laws of motion and characteristics are evaluated per call).
-_expression = functools.lru_cache(maxsize=256)(parse_expression)
 
 
 @functools.lru_cache(maxsize=64)

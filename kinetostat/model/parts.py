@@ -17,8 +17,8 @@ from typing import Callable, Literal, Mapping
 import numpy as np
 
 from ..errors import ModelError
-from ..expressions import over_arrays
-from .laws import _expression, _hermite_at, _periodic_spline, _spline_at
+from ..expressions import over_arrays, parse as parse_expression
+from .laws import _hermite_at, _periodic_spline, _spline_at
 
 Vec = tuple[float, float]
 
@@ -108,7 +108,7 @@ class Characteristic:
     def __call__(self, omega: np.ndarray) -> np.ndarray:
         """M (N m) at the angular velocities `omega` (rad/s), both in the drive's sense."""
         if self.expression is not None:
-            value = over_arrays(_expression(self.expression), {**dict(self.parameters), "omega": omega})
+            value = over_arrays(parse_expression(self.expression), {**dict(self.parameters), "omega": omega})
             return np.broadcast_to(value, np.shape(omega)).astype(float)
         return np.interp(omega, self.omega, self.M)
 
@@ -186,7 +186,7 @@ class SpeedLaw:
         phi = np.asarray(phi, dtype=float)
         if self.expression is not None:
             h = 1e-30                         # complex step: exact derivative, no cancellation
-            expr, values = _expression(self.expression), dict(self.parameters)
+            expr, values = parse_expression(self.expression), dict(self.parameters)
             with np.errstate(all="ignore"):   # outside its real domain (sqrt, log of x < 0) omega is NaN
                 w = np.broadcast_to(over_arrays(expr, {**values, "phi": phi}), phi.shape).astype(float)
                 z = np.broadcast_to(over_arrays(expr, {**values, "phi": phi + 1j * h}), phi.shape)

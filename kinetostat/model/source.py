@@ -1,11 +1,13 @@
 """From a file, a text or a dict to a Mechanism: the file read safely (a regular file, bounded
-size, UTF-8), the TOML parsed at a bounded cost, then read by the reader.
+size, UTF-8), the TOML parsed at a bounded cost (`parse_text`, once per text), then read by the
+reader (`build`, once per set of parameters: a sweep's designs share one parsed text).
 
-May use: the standard library, _io (`read_regular`), errors, expressions, examples, limits, mechanism, reader.
+May use: the standard library, _io (`read_regular`), errors, expressions, examples, limits, lines, mechanism, reader.
 """
 from __future__ import annotations
 
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -13,6 +15,7 @@ from .._io import FileTooLarge, NotRegularFile, read_regular
 from ..errors import ModelError, ModelFileNotFound
 from ..expressions import suggestion_budget
 from .limits import _KEY_BYTES, _LEVEL_BYTES, MAX_FILE_BYTES, MAX_KEY, MAX_KEY_MEMORY
+from .lines import _Lines
 from .mechanism import Mechanism
 from .reader import _Reader
 
@@ -58,8 +61,20 @@ def model_text(mech: Mechanism) -> str:
         return ""
 
 
-def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | None = None) -> Mechanism:
-    """Parse a model from TOML text (at most MAX_FILE_BYTES characters); `parameters` as for `load`."""
+@dataclass(frozen=True)
+class ParsedModel:
+    """A model's text parsed once: its TOML structure and where its keys sit (for the messages'
+    line numbers). `build` makes its Mechanism for any parameters without reading the text again;
+    nothing here changes `data` (a design sweep's designs share it)."""
+    text: str
+    source: str
+    data: Mapping[str, Any]
+    lines: _Lines
+
+
+def parse_text(text: str, source: str = "<string>") -> ParsedModel:
+    """Parse a model's TOML text (at most MAX_FILE_BYTES characters, keys of bounded cost) once;
+    ModelError for a text too large or not TOML."""
     if len(text) > MAX_FILE_BYTES:
         raise ModelError([f"a text of {len(text)} characters is too large for a model (at most {MAX_FILE_BYTES}, "
                           f"MAX_FILE_BYTES)"], source=source)
@@ -70,8 +85,19 @@ def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | N
         raise ModelError([f"TOML syntax error: {exc}"], source=source) from None
     except RecursionError:
         raise ModelError(["TOML nested too deeply (arrays or tables within each other)"], source=source) from None
+    return ParsedModel(text, source, data, _Lines(text))
+
+
+def build(model: ParsedModel, parameters: Mapping[str, Any] | None = None) -> Mechanism:
+    """The Mechanism of the parsed `model` with `parameters` (as for `load`): its expressions
+    evaluated again, every field read and checked as `loads` does (it is `loads` without the parsing)."""
     with suggestion_budget():       # "did you mean" work bounded per model
-        return _Reader(data, source, text, parameters).mechanism()
+        return _Reader(model.data, model.source, model.text, parameters, model.lines).mechanism()
+
+
+def loads(text: str, source: str = "<string>", parameters: Mapping[str, Any] | None = None) -> Mechanism:
+    """Parse a model from TOML text (at most MAX_FILE_BYTES characters); `parameters` as for `load`."""
+    return build(parse_text(text, source), parameters)
 
 
 def _check_key_cost(text: str, source: str) -> None:
