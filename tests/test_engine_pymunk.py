@@ -216,3 +216,17 @@ def test_angular_acceleration_of_the_crank_is_refused_as_nan():
 def test_too_few_steps_is_an_error():
     with pytest.raises(ValueError, match=r"steps_per_rev: expected an integer >= 36, got 10"):
         simulate(_scene("four-bar"), 10)
+
+
+def test_exact_poses_at_many_grid_indices_are_each_index_own():
+    """`_Prep.pose` at an index array (a machine's mesh arms over every step) gives, row by row,
+    the pose at each index alone: centre of mass (m) and angle (rad)."""
+    from kinetostat_validation.engine_pymunk import _Prep
+    prep = _Prep(_scene(str(MODELS[[p.stem for p in MODELS].index("compressor")])), 72)
+    idx = np.arange(0, 2 * prep.steps, 5)
+    for k in prep.links:
+        S, th = prep.pose(k, idx)
+        assert S.shape == (len(idx), 2) and th.shape == (len(idx),)
+        for n, i in enumerate(idx):
+            S1, th1 = prep.pose(k, int(i))
+            assert np.array_equal(S[n], S1) and th[n] == th1

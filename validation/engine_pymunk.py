@@ -88,7 +88,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinetostat import SingularPositionWarning, analyze
-from kinetostat.planar import rotate
+from kinetostat.planar import as_xy, rotate
 
 from .scene import EngineResult, Scene, build_scene, tracked_points
 
@@ -281,10 +281,11 @@ class _Prep:
             return np.zeros(2)
         return abs(M) / self.r_b * (self.line_pos if M >= 0 else self.line_neg)
 
-    def pose(self, k: int, i: int) -> tuple[np.ndarray, float]:
-        """Exact centre of mass and angle of link k at grid index i."""
-        th = float(self.kin.theta[i, k])
-        return self.kin.origin[i, k] + rotate(self.com[k], th), th
+    def pose(self, k: int, i) -> tuple[np.ndarray, np.ndarray]:
+        """Exact centre of mass (m) and angle (rad) of link k at grid index i: (2,) and a
+        scalar, or for an index array (n, 2) and (n,)."""
+        th = self.kin.theta[i, k]
+        return as_xy(self.kin.origin_z[i, k]) + rotate(self.com[k], th), th
 
 
 @dataclass
@@ -378,7 +379,7 @@ def _simulate(prep: _Prep, iterations: int, K: float, M_first: np.ndarray | None
         body = pymunk.Body(prep.mass[k], prep.moment[k])
         S, th = prep.pose(k, 0)
         body.position = (float(S[0]), float(S[1]))       # body origin = centre of mass
-        body.angle = th
+        body.angle = float(th)
         V = prep.V[k][1]                                  # exact velocity half a step ahead
         body.velocity = (float(V[0]) * v_u, float(V[1]) * v_u)
         body.angular_velocity = float(kin.omega[1, k]) * v_u
@@ -426,7 +427,7 @@ def _simulate(prep: _Prep, iterations: int, K: float, M_first: np.ndarray | None
             T = T + K
             if M_first is not None:
                 f = np.array([prep.mesh_force(float(M)) for M in M_first[:steps]])
-                r = prep.pitch - np.array([prep.pose(lk, j)[0] for j in jj])
+                r = prep.pitch - prep.pose(lk, jj)[0]
                 M_mesh[:] = r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0]
                 F = F + f
                 T = T + M_mesh

@@ -102,13 +102,13 @@ def loads_at_centres(bodies: tuple[Body, ...], g: float, kin: Kinematics, F_appl
     origin, as the engines take them: gravity taken out (the engines have their own), the force at
     the body's centre of mass and the moment about it."""
     F, M = F_applied.copy(), M_applied.copy()
-    weight = np.array([0.0, -g])
-    for b in bodies:
-        O = kin.origin[:, b.link]
-        S = O + rotate(b.com, kin.theta[:, b.link])
-        F[:, b.link] -= b.mass * weight
-        M[:, b.link] -= cross(S - O, np.broadcast_to(b.mass * weight, S.shape))
-        M[:, b.link] += cross(O - S, F[:, b.link])
+    links = np.array([b.link for b in bodies], dtype=int)          # each moving link once
+    weight = np.array([b.mass for b in bodies])[:, None] * np.array([0.0, -g])
+    O = kin.origin[:, links]
+    S = O + rotate(np.array([b.com for b in bodies]).reshape(-1, 2), kin.theta[:, links])
+    F[:, links] -= weight
+    M[:, links] -= cross(S - O, np.broadcast_to(weight, S.shape))
+    M[:, links] += cross(O - S, F[:, links])
     return F, M
 
 
