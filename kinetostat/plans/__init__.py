@@ -145,7 +145,7 @@ def cycle_scales(mech, step_deg: float = 5.0, res=None, solution: Solution | Non
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         if res is None:                             # where the linkage does not assemble: no plans
-            res = (solution or solve(mech)).among(cycle_angles(mech, step_deg))
+            res = (solution or solve(mech, other=False)).among(cycle_angles(mech, step_deg))
         keep = np.zeros(0, bool) if res is None else ~np.asarray(res.singular, bool) & (res.omega(1) != 0)
         if not keep.any():
             raise ValueError(f"{mech.name}: no crank angle where the plans can be drawn")
@@ -342,7 +342,7 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     chosen = _chosen(only)
     if friction not in ("first", "reactions"):
         raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
-    solution = solution or solve(mech, [float(at)], friction, law)    # default: the graphical method's frictionless reactions
+    solution = solution or solve(mech, [float(at)], friction, law, other=False)    # default: the graphical method's frictionless reactions
     res = solution.res
     if len(res.phi_deg) != 1 or res.phi_deg[0] != float(at):
         raise ValueError(f"solution: expected the analysis of {mech.name!r} at {float(at):g} deg, got {res}")

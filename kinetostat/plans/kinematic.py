@@ -605,7 +605,7 @@ def starting_position(mech, solution: Solution | None = None) -> float:
     when there is none."""
     steps = CYCLE_STEPS
     phi = grid(steps)
-    cyc = (solution or solve(mech)).on(phi)
+    cyc = (solution or solve(mech, other=False)).on(phi)
     for f in _dead_centre_functions(mech):
         val, ok = f(cyc)
         nxt = np.roll(val, -1)
@@ -765,7 +765,7 @@ def fixed_positions(mech, mu: Scale, starting_deg: float | None = None,
     default: solved here), at `mu`: made once for the plans of many angles (`positions_plan`'s `fixed`)."""
     if starting_deg is not None and not math.isfinite(float(starting_deg)):
         raise ValueError(f"starting position: expected a finite angle in degrees, got {starting_deg!r}")
-    solution = solution or solve(mech)
+    solution = solution or solve(mech, other=False)
     start = starting_position(mech, solution) if starting_deg is None else float(starting_deg)
     twelve = positions(mech, start + 30.0 * np.arange(N_POSITIONS))
     points: dict[str, complex] = {}

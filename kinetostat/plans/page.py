@@ -37,7 +37,7 @@ of that angle, or (student) the tables to fill in; then each sheet a page at tru
 A4 chosen) A4 around the plan with the title line and the notes on top (page.js `a4Title`).
 
 May use: the plans (`build_cycle`, `cycle_scales`, `core`, `draw`, `forces`, `worksheet`
-(`analyses`, `worksheet_cycle`), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
+(`worksheet_cycle`), `solution` (the page's one analysis), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
 `kinetostat._text` (`script_json`: the data block's JSON), numpy, the standard library. Never
 matplotlib, never the harness; the solver only through `worksheet.analyses` (the page's one
 analysis).
@@ -607,7 +607,8 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     from . import build_cycle, cycle_scales
     from .draw import drawing
     from .kinematic import without_triad_construction
-    from .worksheet import analyses, worksheet_cycle
+    from .solution import solve
+    from .worksheet import worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
     design = float(getattr(mech.drive, "design_deg", 30.0))
@@ -617,10 +618,11 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     i_at = phi.index(at)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res, other = analyses(mech, phi)           # the graphical method's; the other friction mode's rows
+        solution = solve(mech, phi)                # the graphical method's; the other friction mode's rows
+        res = solution.res
         fixed = fixed or cycle_scales(mech, res=res)
-        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed).items()}
-        sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=other)
+        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed, solution=solution).items()}
+        sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=solution.other)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
     name = lettering(mech).name(lang, mech.name)

@@ -186,7 +186,7 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
     given = check_given(given)
     if cycle is None:
         from .solution import grid, solve
-        cycle = solve(mech).on(grid(FIT_STEPS))
+        cycle = solve(mech, other=False).on(grid(FIT_STEPS))
     ok = ~np.asarray(res.singular, bool)
     if not ok.any():
         ok[:] = True

@@ -105,25 +105,27 @@ def _index(held: np.ndarray, phi_deg) -> np.ndarray:
     return np.where(match.any(axis=1), match.argmax(axis=1), -1)
 
 
-def solve(mech, at=(), friction: str = "first", law=None) -> Solution:
+def solve(mech, at=(), friction: str = "first", law=None, other: bool = True, also=()) -> Solution:
     """The one analysis of `mech` for drawings at the crank angles `at` (deg; module docstring):
-    frictionless over the cycle grid, the design position and `at` (one `analyze`, and one more
+    frictionless over the cycle grid, the design position, `at` and `also` (more angles of the
+    cycle: a table over it; one `analyze`, and one more
     without the angles an AssemblyError names); at `at` with `friction` ("first" or "reactions")
-    or `law` (`kinetostat.law_of_motion`) one more; a model with [friction]: the other mode at
-    `at`, one more (no SelfLockingWarning from it). ValueError (AssemblyError) where `mech` assembles at none of the grid, or not at `at`."""
+    or `law` (`kinetostat.law_of_motion`) one more; a model with [friction] and `other`: the other
+    mode at `at`, one more (no SelfLockingWarning from it). ValueError (AssemblyError) where `mech` assembles at none of the grid, or not at `at`."""
     from ..solve import analyze
     at = np.array(at, float, ndmin=1)
-    angles = np.unique(np.concatenate([grid(CYCLE_STEPS), [360.0, float(getattr(mech.drive, "design_deg", 30.0))], at]))
+    angles = np.unique(np.concatenate([grid(CYCLE_STEPS), [360.0, float(getattr(mech.drive, "design_deg", 30.0))], at,
+                                       np.asarray(also, float)]))
     cycle, where = assembled(lambda phi: analyze(mech, phi_deg=phi, friction="first"), angles)
     if cycle is None:
         analyze(mech, phi_deg=angles, friction="first")           # its error: where it does not assemble
     sol = Solution(mech, cycle, cycle, None)
     drawn = sol.on(at)
     res = drawn if friction == "first" and law is None else analyze(mech, phi_deg=at, friction=friction, law=law)
-    other = None
-    if mech.friction is not None:             # the worksheet's friction rows: they state eta, no self-locking warned of
+    rows = None
+    if other and mech.friction is not None:   # the worksheet's friction rows: they state eta, no self-locking warned of
         flip = "reactions" if friction == "first" else "first"
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SelfLockingWarning)
-            other = drawn if flip == "first" and law is None else analyze(mech, phi_deg=at, friction=flip, law=law)
-    return Solution(mech, cycle, res, other)
+            rows = drawn if flip == "first" and law is None else analyze(mech, phi_deg=at, friction=flip, law=law)
+    return Solution(mech, cycle, res, rows)
