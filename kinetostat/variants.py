@@ -593,7 +593,9 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     out = Path(out_dir)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
-    solution = solve(mech, [phi1], also=grid(steps))          # once: every file below from it
+    from .plans.page import page_angles
+    drawn = solve(mech, [phi1, *(page_angles(mech, at=phi1)[1] if page else [])], also=grid(steps))   # once: every file below
+    solution = drawn.sub([phi1])
     at, res = solution.res, solution.on(grid(steps))
     a3 = one_sheet(mech, phi1, lang, solution=solution) if teacher_pack else None      # the scales of every file below
     plans = a3.plans if a3 else build_plans(mech, at=phi1, solution=solution)
@@ -606,7 +608,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
             files.append(write_text(tmp / "cycle.csv", columns_csv(*with_alias_columns(*res.columns(), mech))))
         if page:
             from .plans.page import write_page
-            files.append(write_page(mech, tmp / "page.html", lang=lang, at=phi1))
+            files.append(write_page(mech, tmp / "page.html", lang=lang, at=phi1, solution=drawn))
     files = [out / f.relative_to(tmp) for f in files]
     label, R = _largest(at, mech)
     R_cycle = max(float(np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))) for p in mech.pairs)

@@ -35,10 +35,10 @@ from typing import NamedTuple
 import numpy as np
 
 from .core import PlanCycle, Scale, Segment, alias, construction
-from .solution import CYCLE_STEPS, Solution, assembled, grid, positions, solve
+from .solution import CYCLE_STEPS, Positions, Solution, grid, positions, solve
 from .zero import by_pattern, translates, zero_of
 
-__all__ = ["positions_plan", "without_triad_construction", "fixed_positions", "other_branches", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
+__all__ = ["positions_plan", "without_triad_construction", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
 
 #: Positions of the plan of positions: every 30 deg.
@@ -682,15 +682,32 @@ def _draw_position(mech, res, idx, label: int | None, mu: float, points: dict, s
                                     np.abs(zb - za) * mu, "m", "link" if label is None else "position"))
 
 
+def assembled(mech, phi_deg) -> tuple[Positions | None, np.ndarray]:
+    """(the positions of `mech` at the angles `phi_deg` where it assembles (`solution.positions`),
+    those angles (N,) bool): one solve, and one more without the angles an AssemblyError named;
+    (None, all False) where it does not assemble at the rest either (or the model is refused: a ValueError)."""
+    from ..errors import AssemblyError
+    phi = np.asarray(phi_deg, float)
+    where = np.ones(len(phi), bool)
+    for _ in range(2):
+        try:
+            return positions(mech, phi[where]), where
+        except AssemblyError as exc:
+            where = where & ~np.isin(np.round(phi, 9), exc.phi_deg)
+            if not where.any():
+                break
+        except (ValueError, KeyError):
+            break
+    return None, np.zeros(len(phi), bool)
+
+
 def other_branches(mech, res) -> dict:
     """Per group with two assembly branches (`mech.branches`): (the analysis of the mechanism with
     that group's other branch at the angles of `res` where it assembles, those angles (N,) bool),
-    positions only (`solution.positions`), one solve for all of them (`solution.assembled`); left
-    out where it assembles at none."""
+    positions only, one solve for all of them (`assembled`); left out where it assembles at none."""
     out = {}
     for key, b in mech.branches.items():
-        alt_mech = replace(mech, branches={**mech.branches, key: -b})
-        alt, where = assembled(lambda phi: positions(alt_mech, phi), res.phi_deg)
+        alt, where = assembled(replace(mech, branches={**mech.branches, key: -b}), res.phi_deg)
         if alt is not None:
             out[key] = (alt, where)
     return out

@@ -64,7 +64,7 @@ from .core import ELEMENTS, PAGE_DECIMALS, UNMEASURED, Drawing, PlanCycle
 from .draw import RESULT, TINY_MM, TOKEN, segment_label, title_of
 from .i18n import check_lang, num, text, unit
 
-__all__ = ["page", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
+__all__ = ["page", "page_angles", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
 
 #: The angles of the slider, deg (the design position is one more frame).
 PAGE_ANGLES = tuple(float(a) for a in range(360))
@@ -598,12 +598,23 @@ def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
 
 # ============================================================================ the page
 
+def page_angles(mech, student: bool = False, at: float | None = None,
+                angles: Sequence[float] | None = None) -> tuple[list[float], list[float]]:
+    """(the slider's frames, the angles the page is drawn from: the frames and `at`), deg, as `page`
+    takes them."""
+    design = float(getattr(mech.drive, "design_deg", 30.0))
+    at = design if at is None else float(at)
+    frames = [at] if student else [*map(float, PAGE_ANGLES if angles is None else angles), design]
+    return frames, (frames if at in frames else [*frames, at])
+
+
 def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
-         angles: Sequence[float] | None = None, fixed=None) -> str:
+         angles: Sequence[float] | None = None, fixed=None, solution=None) -> str:
     """The interactive page of `mech` in `lang` (module docstring). `at`: the angle of the check
     (and of a student's page; default the design position); `angles`: the slider's frames (deg;
     default PAGE_ANGLES); `fixed`: the plans' scales (default `cycle_scales` of the page's one
-    analysis). ValueError where `at` is a singular position."""
+    analysis); `solution`: that analysis (`solution.solve`, frictionless, its `res` at least at
+    `page_angles`; made here where not given). ValueError where `at` is a singular position."""
     from . import build_cycle, cycle_scales
     from .draw import drawing
     from .kinematic import without_triad_construction
@@ -613,13 +624,14 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     check_lang(lang)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
-    frames = [at] if student else [*map(float, PAGE_ANGLES if angles is None else angles), design]
-    phi = frames if at in frames else [*frames, at]
+    frames, phi = page_angles(mech, student, at, angles)
     i_at = phi.index(at)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        solution = solve(mech, phi)                # the graphical method's; the other friction mode's rows
+        solution = (solution or solve(mech, phi)).sub(phi)   # the graphical method's; the other friction mode's rows
         res = solution.res
+        if res.friction is not None:
+            raise ValueError(f"solution: expected the frictionless analysis of {mech.name!r} (friction='first'), got {res}")
         fixed = fixed or cycle_scales(mech, res=res)
         cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed, solution=solution).items()}
         sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=solution.other)
@@ -876,8 +888,10 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
 """
 
 
-def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None) -> Path:
-    """The page of `mech` (`page`), drawn anew, written to `out` atomically; returns its path."""
+def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None,
+               solution=None) -> Path:
+    """The page of `mech` (`page`, from `solution` where given), drawn anew, written to `out`
+    atomically; returns its path."""
     path = Path(out)
-    write_text(path, page(mech, lang=lang, student=student, at=at))
+    write_text(path, page(mech, lang=lang, student=student, at=at, solution=solution))
     return path

@@ -15,16 +15,14 @@ May use: numpy, `kinetostat.solve`, `kinetostat.analysis`, `kinetostat.kinematic
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
-from typing import Callable
-
+from dataclasses import dataclass, replace
 import numpy as np
 
 from ..analysis import Analysis
 from ..errors import AssemblyError, SelfLockingWarning
 from ..kinematics import Kinematics, kinematics
 
-__all__ = ["CYCLE_STEPS", "Solution", "Positions", "solve", "positions", "assembled", "grid"]
+__all__ = ["CYCLE_STEPS", "Solution", "Positions", "solve", "positions", "grid"]
 
 #: Steps of the cycle grid (0.5 deg): a multiple of the paths' PATH_STEPS, the scale rule's 72 and 5 deg.
 CYCLE_STEPS = 720
@@ -55,34 +53,26 @@ def positions(mech, phi_deg) -> Positions:
     return Positions(mech, phi, kinematics(mech, np.radians(phi)))
 
 
-def assembled(solve_at: Callable[[np.ndarray], object], phi_deg) -> tuple[object | None, np.ndarray]:
-    """(solve_at(the angles of `phi_deg` where the linkage assembles), those angles (N,) bool): one
-    solve, and one more without the angles an AssemblyError named; (None, all False) where it
-    does not assemble at the rest either (or the model is refused: a ValueError)."""
-    phi = np.asarray(phi_deg, float)
-    where = np.ones(len(phi), bool)
-    for _ in range(2):
-        try:
-            return solve_at(phi[where]), where
-        except AssemblyError as exc:
-            where = where & ~np.isin(np.round(phi, 9), exc.phi_deg)
-            if not where.any():
-                break
-        except (ValueError, KeyError):
-            break
-    return None, np.zeros(len(phi), bool)
-
-
 @dataclass(frozen=True)
 class Solution:
     """The analyses one drawing is built from (`solve`): `cycle`, frictionless at the model's drive
     over the cycle grid, the design position and the angles drawn (those where `mech` assembles);
     `res` at the angles drawn in the mode they are drawn in; `other` there in the other friction
-    mode (a model with [friction]), else None."""
+    mode (a model with [friction]), else None; `left_out`: the AssemblyError that left the angles
+    where `mech` does not assemble out of `cycle` (None: none left out)."""
     mech: object
     cycle: Analysis
     res: Analysis
     other: Analysis | None
+    left_out: AssemblyError | None = None
+
+    def sub(self, phi_deg) -> "Solution":
+        """The same with `res` and `other` at those of their angles `phi_deg` (deg), in that order
+        (the parts of one command drawn at some of its angles); ValueError naming an angle not analysed."""
+        idx = _index(self.res.phi_deg, phi_deg)
+        if (idx < 0).any():
+            raise ValueError(f"phi_deg: {np.asarray(phi_deg, float)[idx < 0][0]:g} deg is not an angle of {self.res}")
+        return replace(self, res=self.res.take(idx), other=None if self.other is None else self.other.take(idx))
 
     def among(self, phi_deg) -> Analysis | None:
         """`cycle` at those of the angles `phi_deg` (deg) it holds, in their order (None: at none)."""
@@ -91,11 +81,14 @@ class Solution:
         return self.cycle.take(idx) if len(idx) else None
 
     def on(self, phi_deg) -> Analysis:
-        """`cycle` at the angles `phi_deg` (deg); AssemblyError naming those where `mech` does not assemble."""
+        """`cycle` at the angles `phi_deg` (deg); `left_out` (an AssemblyError) at those where `mech`
+        does not assemble, ValueError at an angle not analysed."""
         idx = _index(self.cycle.phi_deg, phi_deg)
         if (idx < 0).any():
             missing = np.asarray(phi_deg, float)[idx < 0]
-            raise AssemblyError("of the linkage", missing, "no assembly on the cycle")
+            if self.left_out is not None and np.isin(np.round(missing, 9), self.left_out.phi_deg).all():
+                raise AssemblyError(self.left_out.group, missing, self.left_out.why)
+            raise ValueError(f"phi_deg: {missing[0]:g} deg is not an angle of {self.cycle}")
         return self.cycle.take(idx)
 
 
@@ -108,18 +101,22 @@ def _index(held: np.ndarray, phi_deg) -> np.ndarray:
 def solve(mech, at=(), friction: str = "first", law=None, other: bool = True, also=()) -> Solution:
     """The one analysis of `mech` for drawings at the crank angles `at` (deg; module docstring):
     frictionless over the cycle grid, the design position, `at` and `also` (more angles of the
-    cycle: a table over it; one `analyze`, and one more
-    without the angles an AssemblyError names); at `at` with `friction` ("first" or "reactions")
+    cycle: a table over it; one `analyze`, and one more without the angles an AssemblyError
+    names, `Solution.left_out`); at `at` with `friction` ("first" or "reactions")
     or `law` (`kinetostat.law_of_motion`) one more; a model with [friction] and `other`: the other
     mode at `at`, one more (no SelfLockingWarning from it). ValueError (AssemblyError) where `mech` assembles at none of the grid, or not at `at`."""
     from ..solve import analyze
     at = np.array(at, float, ndmin=1)
     angles = np.unique(np.concatenate([grid(CYCLE_STEPS), [360.0, float(getattr(mech.drive, "design_deg", 30.0))], at,
                                        np.asarray(also, float)]))
-    cycle, where = assembled(lambda phi: analyze(mech, phi_deg=phi, friction="first"), angles)
-    if cycle is None:
-        analyze(mech, phi_deg=angles, friction="first")           # its error: where it does not assemble
-    sol = Solution(mech, cycle, cycle, None)
+    try:
+        cycle, left_out = analyze(mech, phi_deg=angles, friction="first"), None
+    except AssemblyError as exc:              # where it does not assemble: no plans there
+        keep = ~np.isin(np.round(angles, 9), exc.phi_deg)
+        if not keep.any():
+            raise
+        cycle, left_out = analyze(mech, phi_deg=angles[keep], friction="first"), exc
+    sol = Solution(mech, cycle, cycle, None, left_out)
     drawn = sol.on(at)
     res = drawn if friction == "first" and law is None else analyze(mech, phi_deg=at, friction=friction, law=law)
     rows = None
@@ -128,4 +125,4 @@ def solve(mech, at=(), friction: str = "first", law=None, other: bool = True, al
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SelfLockingWarning)
             rows = drawn if flip == "first" and law is None else analyze(mech, phi_deg=at, friction=flip, law=law)
-    return Solution(mech, cycle, res, rows)
+    return Solution(mech, cycle, res, rows, left_out)
