@@ -38,6 +38,7 @@ from .i18n import LANGS, num, text
 from .labels import ASCENT
 from .pdf import text_width
 from .scales import TARGET_MM
+from .solution import Solution, solve
 
 __all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "placed_in_order", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
            "notes", "note_lines", "notes_mm", "notes_room", "NOTE_SIZE",
@@ -412,7 +413,7 @@ class OneSheet:
                 if s.value > self.rule[k].value * (1 + 1e-9)]
 
 
-def one_sheet(mech, at: float, lang: str, solution=None) -> OneSheet:
+def one_sheet(mech, at: float, lang: str, solution: Solution | None = None) -> OneSheet:
     """The plans of `mech` at crank angle `at` (deg), drawn in `lang`, at the texts' scales where
     they all fit one A3 sheet (`layout`) in every language of LANGS (so that a variant's scales do
     not depend on the language of its pack), else with scales chosen together for that sheet: the
@@ -429,7 +430,6 @@ def one_sheet(mech, at: float, lang: str, solution=None) -> OneSheet:
     from . import build
     from .kinematic import fixed_positions, starting_position
     from .scales import LENGTH_MANTISSAS, SCALE_UNITS, next_coarser, references
-    from .solution import solve
     solution = solution or solve(mech, [float(at)], other=False)
     reference = references(mech, solution.res)
     drawn: dict[tuple, Drawing] = {}            # (language, kind, its scales) -> its drawing

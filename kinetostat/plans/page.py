@@ -63,6 +63,7 @@ from .._text import script_json
 from .core import ELEMENTS, PAGE_DECIMALS, UNMEASURED, Drawing, PlanCycle
 from .draw import RESULT, TINY_MM, TOKEN, segment_label, title_of
 from .i18n import check_lang, num, text, unit
+from .solution import Solution, solve
 
 __all__ = ["page", "page_angles", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
 
@@ -609,7 +610,7 @@ def page_angles(mech, student: bool = False, at: float | None = None,
 
 
 def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
-         angles: Sequence[float] | None = None, fixed=None, solution=None) -> str:
+         angles: Sequence[float] | None = None, fixed=None, solution: Solution | None = None) -> str:
     """The interactive page of `mech` in `lang` (module docstring). `at`: the angle of the check
     (and of a student's page; default the design position); `angles`: the slider's frames (deg;
     default PAGE_ANGLES); `fixed`: the plans' scales (default `cycle_scales` of the page's one
@@ -618,7 +619,6 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     from . import build_cycle, cycle_scales
     from .draw import drawing
     from .kinematic import without_triad_construction
-    from .solution import solve
     from .worksheet import worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
@@ -889,7 +889,7 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
 
 
 def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None,
-               solution=None) -> Path:
+               solution: Solution | None = None) -> Path:
     """The page of `mech` (`page`, from `solution` where given), drawn anew, written to `out`
     atomically; returns its path."""
     path = Path(out)

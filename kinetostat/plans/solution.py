@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, replace
+
 import numpy as np
 
 from ..analysis import Analysis
