@@ -41,7 +41,7 @@ def test_only_the_solution_module_calls_the_solver():
     assert callers and [c for c in callers if not c.startswith("solution.py:")] == []
 
 
-@pytest.mark.parametrize("model, modes", [("triad_six_bar", {"first": 1}),
+@pytest.mark.parametrize("model, modes", [("slotted_link_shaper", {"first": 1}),
                                           ("ice_crank_slider", {"first": 1, "reactions": 1})])   # [friction]: its worksheet's rows
 def test_plans_at_an_angle_analyses_once_per_friction_mode(calls, tmp_path, model, modes):
     """`kinetostat plans MODEL --at 30` (the sheets and the worksheet): one analysis per friction mode
@@ -58,9 +58,8 @@ def test_plans_with_cycle_scales_and_friction_analyse_once_per_mode(calls, tmp_p
     assert dict(calls) == {"first": 1, "reactions": 1}
 
 
-def test_worksheet_page_and_variant_analyse_once(calls, tmp_path):
-    """The worksheet, a page (two frames) and a variant's key with its teacher's pack: one analysis
-    each (the ICE's worksheet: one per friction mode)."""
+def test_worksheet_and_page_analyse_once(calls):
+    """The worksheet and a page (one frame): one analysis each (the ICE's worksheet: one per friction mode)."""
     from kinetostat.plans.page import page
     from kinetostat.plans.worksheet import worksheet
     worksheet(kinetostat.load("ice_crank_slider"), 30.0)
@@ -68,11 +67,16 @@ def test_worksheet_page_and_variant_analyse_once(calls, tmp_path):
     calls.clear()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        page(kinetostat.load("triad_six_bar"), angles=[0.0, 90.0])
+        page(kinetostat.load("slotted_link_shaper"), angles=[0.0])
     assert dict(calls) == {"first": 1}
-    calls.clear()
-    variants.write_key(variants.variant(1, "479"), tmp_path / "key", lang="en", cycle_csv=False)
-    assert dict(calls) == {"first": 1}          # before: 48 (the A3 sheet's search analysed each try)
+
+
+@pytest.mark.parametrize("teacher_pack", [False, pytest.param(True, marks=pytest.mark.slow)])
+def test_a_variants_key_analyses_once(calls, tmp_path, teacher_pack):
+    """A variant's key (plans, worksheet, cycle.csv) and with it its teacher's pack (the A3 sheet's
+    search builds the plans at each try): one analysis (before: 48 with the pack)."""
+    variants.write_key(variants.variant(1, "479"), tmp_path / "key", lang="en", teacher_pack=teacher_pack)
+    assert dict(calls) == {"first": 1}
 
 
 def test_the_search_between_grid_angles_solves_positions_alone():
