@@ -64,7 +64,7 @@ class AssemblyError(ValueError):
     """The linkage cannot be assembled at some crank angles (`phi_deg` lists them)."""
 
     def __init__(self, group: str, phi_deg: np.ndarray, why: str):
-        self.group = group
+        self.group, self.why = group, why
         self.phi_deg = np.round(np.asarray(phi_deg, dtype=float), 9)   # undo rad->deg rounding
         super().__init__(f"group {group} cannot be assembled ({why}) at phi = {_angle_list(self.phi_deg)}")
 

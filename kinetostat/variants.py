@@ -57,7 +57,7 @@ all 1000 of each task are distinct models.
 9. Design position: phi1 of the table, from top dead centre (line 82; task 2: of cylinder 3) in
    the crank's sense; the key (worksheet, plans) is drawn there.
 
-May use: the solver (`model`, `solve`), `kinetostat.plans` (the key's plans and worksheet),
+May use: the solver (`model`), `kinetostat.plans` (the key's plans and worksheet, from its one analysis `plans.solve`),
 `examples` (the bundled models' assumptions), `_io`, `tables`; never the harness, the engines or `report`.
 """
 from __future__ import annotations
@@ -583,22 +583,24 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
     the cycle). cycle.csv is written without pandas (`Analysis.columns`, `tables.columns_csv`). The files
     are swapped in as a set (`kinetostat._io.unit`); `out_dir` must resolve inside `root`
     (default: itself), ValueError otherwise."""
-    from .solve import analyze
-    from .plans import build as build_plans
+    from .plans import build as build_plans, solve
     from .model.lettering import with_alias_columns
     from .plans.a3 import one_sheet
     from .plans.pack import pack
-    from .plans.worksheet import analyses, worksheet_cycle
+    from .plans.solution import grid
+    from .plans.worksheet import worksheet_cycle
     from .tables import columns_csv
     out = Path(out_dir)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
-    at, other = analyses(mech, [phi1])                                # phi1 once: every file below from it
-    res = analyze(mech, steps=steps)
-    a3 = one_sheet(mech, phi1, lang, res=at) if teacher_pack else None      # the scales of every file below
-    plans = a3.plans if a3 else build_plans(mech, at=phi1)
-    sheet = worksheet_cycle(mech, at, plans.scales["mu_l"].value, lang, other).at(0)
-    teacher = pack(v, lang, a3=a3, analysis=(at, other)) if teacher_pack else None
+    from .plans.page import page_angles
+    drawn = solve(mech, [phi1, *(page_angles(mech, at=phi1)[1] if page else [])], also=grid(steps))   # once: every file below
+    solution = drawn.sub([phi1])
+    at, res = solution.res, solution.on(grid(steps))
+    a3 = one_sheet(mech, phi1, lang, solution=solution) if teacher_pack else None      # the scales of every file below
+    plans = a3.plans if a3 else build_plans(mech, at=phi1, solution=solution)
+    sheet = worksheet_cycle(mech, at, plans.scales["mu_l"].value, lang, solution.other).at(0)
+    teacher = pack(v, lang, a3=a3, solution=solution) if teacher_pack else None
     with unit(out, root) as tmp:
         files = [write_text(tmp / f"{v.name}.toml", v.toml())]
         files += plans.write(tmp, lang=lang, sheets=a3.sheets if a3 else None) + sheet.write(tmp) + (teacher.write(tmp) if teacher else [])
@@ -606,7 +608,7 @@ def write_key(v: Variant, out_dir: str | Path, lang: str = "en", cycle_csv: bool
             files.append(write_text(tmp / "cycle.csv", columns_csv(*with_alias_columns(*res.columns(), mech))))
         if page:
             from .plans.page import write_page
-            files.append(write_page(mech, tmp / "page.html", lang=lang, at=phi1))
+            files.append(write_page(mech, tmp / "page.html", lang=lang, at=phi1, solution=drawn))
     files = [out / f.relative_to(tmp) for f in files]
     label, R = _largest(at, mech)
     R_cycle = max(float(np.nanmax(np.linalg.norm(res.forces.R[:, p.index], axis=-1))) for p in mech.pairs)

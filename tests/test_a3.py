@@ -300,7 +300,7 @@ def test_write_key_draws_every_file_at_the_one_sheets_scales(tmp_path, monkeypat
     class Fake:                                        # the pack itself: the tests above
         def write(self, out):
             return []
-    monkeypatch.setattr(P, "pack", lambda v, lang, a3=None, analysis=None: got.append(a3) or Fake())
+    monkeypatch.setattr(P, "pack", lambda v, lang, a3=None, solution=None: got.append(a3) or Fake())
     v = variants.variant(2, "479")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -15,7 +15,7 @@ from kinetostat.plans import build_cycle, cycle_scales
 from kinetostat.plans.arcs import CLEAR_MM, arc
 from kinetostat.plans.draw import drawing
 from kinetostat.plans.labels import ASCENT, DESCENT, text_width
-from kinetostat.plans.worksheet import analyses
+from kinetostat.plans.solution import solve
 
 from conftest import MODELS
 
@@ -34,7 +34,7 @@ def _drawings(stem: str, angles) -> dict:
     mech = load(next(p for p in MODELS if p.stem == stem))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res, _ = analyses(mech, list(angles))
+        res = solve(mech, list(angles)).res
         cycles = build_cycle(mech, res, cycle_scales(mech, res=res))
     return {kind: drawing(c, "uk", "", contract=True, notes=True) for kind, c in cycles.items()}
 

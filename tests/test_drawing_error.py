@@ -69,17 +69,15 @@ def test_reproducible_with_a_fixed_seed():
 
 
 def test_the_callers_analysis_is_drawn(monkeypatch):
-    """simulate(res=...) draws from the caller's analysis at its angle, the solver not called
-    again: the same samples as the study that analyses at its entry; an analysis at another
-    angle, of more than one angle or with friction in the reactions: ValueError naming res."""
-    import kinetostat.plans.drawing_error as D
-    import kinetostat.plans.worksheet as W
+    """simulate(res=..., scales=...) draws from the caller's analysis at its angle, the solver
+    not called again: the same samples as the study that analyses at its entry; an analysis at
+    another angle, of more than one angle or with friction in the reactions: ValueError naming res."""
+    import kinetostat.solve as S
     mech = kinetostat.load("ice_crank_slider")
     alone = simulate(mech, at=60.0, n=50, seed=4)
     res = kinetostat.analyze(mech, phi_deg=[60.0])
-    for module in (D, W):
-        monkeypatch.setattr(module, "analyze", lambda *a, **k: pytest.fail("analyze called"))
-    given = simulate(mech, n=50, seed=4, res=res)
+    monkeypatch.setattr(S, "analyze", lambda *a, **k: pytest.fail("analyze called"))
+    given = simulate(mech, n=50, seed=4, res=res, scales=alone.scales)
     assert given.phi_deg == 60.0 and given.scales == alone.scales and given.exact == alone.exact
     assert all(np.array_equal(given.samples[k], alone.samples[k]) for k in alone.samples)
     monkeypatch.undo()

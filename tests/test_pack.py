@@ -323,12 +323,10 @@ def test_the_figure_of_a_plan_holds_every_vector(pack_uk):
 def test_the_pack_is_built_from_the_callers_analysis(monkeypatch, pack_uk):
     """Given the analyses at phi1 and the A3 sheet (as `variants.write_key` gives them), the pack's
     worksheet, bands and key are built from them, the solver not called again; the same key."""
-    import kinetostat.plans.drawing_error as D
-    import kinetostat.plans.worksheet as W
-    from kinetostat.plans.worksheet import analyses
+    import kinetostat.solve as S
+    from kinetostat.plans.solution import solve
     v = variants.variant(1, "479")
-    pair = analyses(v.mechanism(), [float(v.values["phi1"])])
-    for module in (D, W):
-        monkeypatch.setattr(module, "analyze", lambda *a, **k: pytest.fail("analyze called"))
-    again = P.pack(v, lang="uk", a3=pack_uk.a3, analysis=pair)
+    solution = solve(v.mechanism(), [float(v.values["phi1"])])
+    monkeypatch.setattr(S, "analyze", lambda *a, **k: pytest.fail("analyze called"))
+    again = P.pack(v, lang="uk", a3=pack_uk.a3, solution=solution)
     assert again.key == pack_uk.key and again.bands == pack_uk.bands

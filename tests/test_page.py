@@ -807,12 +807,12 @@ def test_triad_page_names_the_tiny_vectors_of_its_one_angle_sheets():
     0,75 mm only at 150 deg). Before: found by the first segment of each name."""
     from kinetostat.plans import draw
     from kinetostat.plans.kinematic import without_triad_construction
-    from kinetostat.plans.worksheet import analyses
+    from kinetostat.plans.solution import solve
     mech = kinetostat.load("triad_six_bar")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fixed = P.cycle_scales(mech)                    # the page's (`kinetostat plans --cycle-scales`)
-        res, _ = analyses(mech, [30.0, 150.0])
+        res = solve(mech, [30.0, 150.0]).res
         cycles = {k: without_triad_construction(mech, c) for k, c in P.build_cycle(mech, res, fixed).items()}
     for i, at in enumerate((30.0, 150.0)):
         for kind, plan in _build(mech, at, fixed).items():

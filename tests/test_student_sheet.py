@@ -17,7 +17,8 @@ import kinetostat
 from kinetostat import variants
 from kinetostat.plans import pack as P
 from kinetostat.plans.i18n import num, text
-from kinetostat.plans.worksheet import analyses, worksheet_cycle
+from kinetostat.plans.solution import solve
+from kinetostat.plans.worksheet import worksheet_cycle
 
 
 def sheet_pack(task: int, code: str, finer_rule: str | None = None, lang: str = "uk") -> P.Pack:
@@ -31,13 +32,13 @@ def sheet_pack(task: int, code: str, finer_rule: str | None = None, lang: str = 
     v = variants.variant(task, code)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
-    res, other = analyses(mech, [phi1])
-    plans = build(mech, at=phi1)
+    solution = solve(mech, [phi1])
+    plans = build(mech, at=phi1, solution=solution)
     rule = {k: replace(s, value=s.value / 2) if k == finer_rule else s for k, s in plans.scales.items()}
-    a3 = OneSheet(plans, lang, (), (), rule, references(mech, res))
+    a3 = OneSheet(plans, lang, (), (), rule, references(mech, solution.res))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return P.pack(v, lang=lang, a3=a3, draws=20, analysis=(res, other))
+        return P.pack(v, lang=lang, a3=a3, draws=20, solution=solution)
 
 
 def number(cell: str) -> float:
@@ -136,8 +137,8 @@ def test_a_model_built_from_the_sheet_alone_gives_the_keys_values(task, code):
         given = read_sheet(p, task)
         mech = model_from_sheet(task, given)
         phi1 = given["values"]["phi1"]
-        res, other = analyses(mech, [phi1])
-        ws = worksheet_cycle(mech, res, p.plans.scales["mu_l"].value, "uk", other).at(0)
+        solution = solve(mech, [phi1])
+        ws = worksheet_cycle(mech, solution.res, p.plans.scales["mu_l"].value, "uk", solution.other).at(0)
     key = key_values(p)
     area = math.pi / 4 * given["values"]["d"] ** 2
     kind, _, marked = given["diagrams"][0]

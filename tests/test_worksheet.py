@@ -14,7 +14,8 @@ import pytest
 
 import kinetostat
 from conftest import EVERY_KIND, MODELS, sampled
-from kinetostat.plans.worksheet import _NOTE_SYMBOL, analyses, worksheet, worksheet_cycle
+from kinetostat.plans.solution import solve
+from kinetostat.plans.worksheet import _NOTE_SYMBOL, worksheet, worksheet_cycle
 
 # seed 002 sec. 1.2.2-1.2.3 at phi = 30 deg (drawn and measured: the text rounds)
 SEED_002 = {"V_B": 10.94, "V_BA": 14.92, "V_S2": 12.2, "omega_2": 135.6, "a_A": 7994.38, "a_B": 8311,
@@ -208,7 +209,8 @@ def test_the_cycle_is_the_one_angle_worksheet_at_every_angle(path, friction):
     if friction == "reactions" and mech.friction is None:
         pytest.skip("no [friction]")
     angles = np.arange(0.0, 360.0, 15.0)
-    res, other = analyses(mech, angles, friction)
+    sol = solve(mech, angles, friction)
+    res, other = sol.res, sol.other
     cyc = worksheet_cycle(mech, res, 0.002, "uk", other)
     assert cyc.values.shape == (24, len(cyc.rows)) and cyc.n == 24
     largest = {"%": 100.0}                # δ: the lever's and the groups' M_зр agree to rounding
@@ -235,10 +237,11 @@ def test_the_cycle_is_the_one_angle_worksheet_at_every_angle(path, friction):
 def test_the_cycle_analyses_nothing(monkeypatch):
     """worksheet_cycle builds from the analyses it is given (the friction rows included): the
     solver is not called again."""
-    import kinetostat.plans.worksheet as W
+    import kinetostat.solve as S
     mech = kinetostat.load("ice_crank_slider")                  # has [friction]
-    res, other = analyses(mech, [30.0, 60.0])
-    monkeypatch.setattr(W, "analyze", lambda *a, **k: pytest.fail("analyze called"))
+    sol = solve(mech, [30.0, 60.0])
+    res, other = sol.res, sol.other
+    monkeypatch.setattr(S, "analyze", lambda *a, **k: pytest.fail("analyze called"))
     cyc = worksheet_cycle(mech, res, 0.001, friction_res=other)
     assert cyc.at(1).value("M_bal_friction") == pytest.approx(float(other.balancing_moment[1]), rel=1e-12)
 
@@ -247,10 +250,11 @@ def test_the_friction_rows_come_from_the_other_mode():
     """A model with [friction]: its friction rows with the analysis in the other mode at the same
     angles, none without it; the wrong mode or other angles: ValueError naming friction_res."""
     mech = kinetostat.load("ice_crank_slider")
-    res, other = analyses(mech, [30.0])
+    sol = solve(mech, [30.0])
+    res, other = sol.res, sol.other
     assert worksheet_cycle(mech, res, 0.001, friction_res=other).at(0).section("friction")
     assert not worksheet_cycle(mech, res, 0.001).at(0).section("friction")
-    for bad in (res, analyses(mech, [31.0])[1]):               # the same mode, other angles
+    for bad in (res, solve(mech, [31.0]).other):               # the same mode, other angles
         with pytest.raises(ValueError, match="friction_res: .*friction='reactions'"):
             worksheet_cycle(mech, res, 0.001, friction_res=bad)
     with pytest.raises(ValueError, match="mu_l"):

@@ -52,8 +52,9 @@ def _plan_names(text: str) -> list[str]:
 
 def cmd_plans(args) -> int:
     import numpy as np
-    from ..errors import ModelWarning, SelfLockingWarning, SingularPositionWarning
-    from ..plans import build, cycle_scales
+    from ..errors import ModelWarning, SelfLockingWarning, SingularPositionWarning, singular_message
+    from ..kinematics import DIGITS_MIN
+    from ..plans import build, cycle_scales, solve
     from ..plans.worksheet import worksheet
     from ..model.lettering import lettering
     from ..plans.scales import ScaleError
@@ -68,11 +69,13 @@ def cmd_plans(args) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:     # the accuracy at this angle: said below
             warnings.simplefilter("always")
-            fixed = cycle_scales(mech) if args.cycle_scales else None          # the page's scales
-            plans = build(mech, at=args.at, scales=dict(args.scale or []), starting_deg=args.starting, only=only,
-                          fixed=fixed, friction=args.friction or "first", law=law)
+            at = mech.drive.design_deg if args.at is None else args.at
+            solution = solve(mech, [at], args.friction or "first", law)          # every sheet below from it
+            fixed = cycle_scales(mech, solution=solution) if args.cycle_scales else None          # the page's scales
+            plans = build(mech, at=at, scales=dict(args.scale or []), starting_deg=args.starting, only=only,
+                          fixed=fixed, friction=args.friction or "first", law=law, solution=solution)
             sheet = None if only else worksheet(mech, plans.at, mu_l=plans.scales["mu_l"].value, lang=args.lang,
-                                                friction=args.friction or "first", law=law)
+                                                friction=args.friction or "first", law=law, solution=solution)
     except ScaleError as exc:             # a plan beyond a sheet's size, before any of it is drawn
         raise CLIError(f"--scale {exc}") from None
     except ValueError as exc:
@@ -82,10 +85,16 @@ def cmd_plans(args) -> int:
             written = plans.write(tmp, lang=args.lang) + (sheet.write(tmp) if sheet is not None else [])
     except (OSError, ValueError) as exc:
         raise CLIError(f"cannot write --out {out}: {getattr(exc, 'strerror', None) or exc}") from None
-    at_plan = [w for w in caught if issubclass(w.category, SingularPositionWarning)
-               and np.isclose(w.message.phi_deg, plans.at).all()]          # not the plan of positions' angles
-    at_plan += [w for w in caught if issubclass(w.category, (SelfLockingWarning, ModelWarning))]   # the model's: any angle
-    for text in dict.fromkeys(str(w.message).splitlines()[0] for w in at_plan):
+    at_plan = []
+    for w in caught:                      # of the cycle's angles, the plans' alone; the model's: any angle
+        if issubclass(w.category, SingularPositionWarning):
+            here = np.isclose(w.message.phi_deg, plans.at)
+            if here.any():
+                m = w.message
+                at_plan.append(singular_message(m.group, m.phi_deg[here], m.cond[here], m.digits[here], DIGITS_MIN))
+        elif issubclass(w.category, (SelfLockingWarning, ModelWarning)):
+            at_plan.append(str(w.message))
+    for text in dict.fromkeys(t.splitlines()[0] for t in at_plan):
         _warn(f"{path.name}: {text}")
     _done(one_line(plans.summary(path.name, len(written), out, args.lang)))
     return EXIT_OK

@@ -12,9 +12,10 @@
 (every plan at the N angles of one analysis, `PlanCycle`s at the cycle's scales, `cycle_scales`);
 scales by the texts' rule or given
 (`scales`); the kinematic plans (`kinematic`); SVG sheets and Figures (`draw`, matplotlib only
-there and only when a figure is drawn).
+there and only when a figure is drawn). Every plan is drawn from one analysis (`solution.solve`),
+made at the entry (`build`, `cycle_scales`) where the caller does not pass it.
 
-May use: numpy, the solver (`kinetostat.solve`, `kinetostat.analysis`, `kinetostat.model`), `_io`, `_text`, `tables`;
+May use: numpy, the solver's results (`kinetostat.analysis`, `kinetostat.model`; analysed in `.solution`), `_io`, `_text`, `tables`;
 pandas only inside `Plans.segments_frame`; never the harness or
 `kinetostat.report`.
 """
@@ -36,13 +37,14 @@ from .draw import ROOM_MM, figure, sheet, svg
 from .forces import CRANK_FORCE_MM, crank_plan, force_plans, force_scale, group_plans
 from ..model.lettering import lettering
 from .mechanism import mechanism_plan
-from .kinematic import FixedPositions, acceleration_plan, assembled, fixed_positions, positions_plan, starting_position, velocity_plan
+from .kinematic import FixedPositions, acceleration_plan, fixed_positions, positions_plan, starting_position, velocity_plan
 from .lever import lever_plan
-from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser
+from .scales import MAX_EXTENT_MM, ScaleError, choose_scales, coarser, solution_scales
+from .solution import CYCLE_STEPS, Solution, solve
 
 __all__ = ["build", "build_cycle", "Plans", "BUILDERS", "Plan", "PlanCycle", "Scale", "Segment", "SEGMENT_COLUMNS", "svg",
            "figure", "choose_scales", "starting_position", "fixed_positions", "plan_file_name", "CycleScales",
-           "cycle_scales", "fits_cycle"]
+           "cycle_scales", "fits_cycle", "Solution", "solve"]
 
 
 #: The plans in the order the texts draw them: (name for --only, builder(mech, res, scales) ->
@@ -118,20 +120,22 @@ _FITTED = ("groups", "forces", "crank", "lever")
 
 
 def cycle_angles(mech, step_deg: float = 5.0):
-    """The angles `cycle_scales` samples, deg: 0, step_deg, ... below 360 and the design position."""
+    """The angles `cycle_scales` samples, deg: 0, step_deg, ... below 360 and the design position;
+    step_deg a multiple of the cycle grid's step (360 / CYCLE_STEPS deg: `solution`)."""
     import numpy as np
-    if not (isinstance(step_deg, (int, float)) and 0 < step_deg <= 360):
-        raise ValueError(f"step_deg: expected a step in (0, 360] deg, got {step_deg!r}")
+    if not (isinstance(step_deg, (int, float)) and 0 < step_deg <= 360 and (step_deg * CYCLE_STEPS / 360).is_integer()):
+        raise ValueError(f"step_deg: expected a step in (0, 360] deg, a multiple of {360 / CYCLE_STEPS:g} deg, "
+                         f"got {step_deg!r}")
     return np.array([*np.arange(0.0, 360.0, step_deg), float(getattr(mech.drive, "design_deg", 30.0))])
 
 
-def cycle_scales(mech, step_deg: float = 5.0, res=None) -> CycleScales:
+def cycle_scales(mech, step_deg: float = 5.0, res=None, solution: Solution | None = None) -> CycleScales:
     """The scales of `mech`'s plans fixed for the cycle: each the coarsest the texts' rule (and the
     fitting of each plan to its sheet) chooses at the angles 0, step_deg, ... and the design
     position (`cycle_angles`), or at the angles of `res` where given, so that every plan fits its
     sheet at every angle (a peak between two angles 5 deg apart exceeds the sampled one by under
-    0.4 % of a cosine; the round scales leave more room). One analysis (none where `res` is
-    given), one build of the plans at every angle at the base scales, each plan's scale then
+    0.4 % of a cosine; the round scales leave more room). Taken from `solution` (`solution.solve`;
+    made here where neither it nor `res` is given), one build of the plans at every angle at the base scales, each plan's scale then
     made coarser while it overflows its sheet at some angle. Singular positions and angles where
     the linkage does not assemble are left out."""
     import warnings
@@ -141,7 +145,7 @@ def cycle_scales(mech, step_deg: float = 5.0, res=None) -> CycleScales:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         if res is None:                             # where the linkage does not assemble: no plans
-            res = assembled(mech, cycle_angles(mech, step_deg), friction="first")[0]
+            res = (solution or solve(mech, other=False)).among(cycle_angles(mech, step_deg))
         keep = np.zeros(0, bool) if res is None else ~np.asarray(res.singular, bool) & (res.omega(1) != 0)
         if not keep.any():
             raise ValueError(f"{mech.name}: no crank angle where the plans can be drawn")
@@ -162,11 +166,13 @@ def cycle_scales(mech, step_deg: float = 5.0, res=None) -> CycleScales:
     return CycleScales(MappingProxyType(base), MappingProxyType(plan), MappingProxyType(forces_on))
 
 
-def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions | None) -> PlanCycle:
+def _positions(mech, res, sc, starting_deg: float | None, fixed: FixedPositions | None,
+               solution: Solution | None = None) -> PlanCycle:
     """The plan of positions at mu_l; at the angles where the other branch's dashed mark alone
     would run off the sheet (a slider's other branch below the crank), the mark left out and
-    noted (the scale rule keeps the crank at the length the text asks)."""
-    fixed = fixed or fixed_positions(mech, sc["mu_l"], starting_deg)
+    noted (the scale rule keeps the crank at the length the text asks). `fixed` made from
+    `solution` where not given."""
+    fixed = fixed or fixed_positions(mech, sc["mu_l"], starting_deg, solution)
     plan = positions_plan(mech, res, sc, starting_deg, fixed=fixed)
     fit = fits_cycle(plan) <= 1
     return plan if fit.all() else positions_plan(mech, res, sc, starting_deg, other_branch=fit, fixed=fixed)
@@ -215,14 +221,15 @@ def _chosen(only: Iterable[str] | None) -> list[str]:
 
 
 def build_cycle(mech, res, fixed: CycleScales, positions: FixedPositions | None = None,
-                only: Iterable[str] | None = None) -> dict[str, PlanCycle]:
+                only: Iterable[str] | None = None, solution: Solution | None = None) -> dict[str, PlanCycle]:
     """Every plan of `mech` (`only`: names of BUILDERS, default all) at every angle of `res` (an
     Analysis of `mech`, N angles) at the cycle's fixed scales `fixed` (`cycle_scales`), as
     PlanCycles: kind -> PlanCycle, kinds as in `build`. At a singular position of `res` every
     point and value is NaN (nothing drawn). `positions`: the plan of positions' 12 positions and
-    paths (`fixed_positions` of `mech` at fixed.base["mu_l"]; made here where not given)."""
+    paths (`fixed_positions` of `mech` at fixed.base["mu_l"]; made here from `solution` where not given)."""
     steps = dict(BUILDERS) | fixed.builders()
-    steps["positions"] = partial(_positions, starting_deg=None if positions is None else positions.start, fixed=positions)
+    steps["positions"] = partial(_positions, starting_deg=None if positions is None else positions.start, fixed=positions,
+                                 solution=solution)
     return {p.kind: p for p in _cycles(mech, res, dict(fixed.base), _chosen(only), steps)}
 
 
@@ -310,7 +317,7 @@ def plan_file_name(plan: Plan, suffix: str = ".svg") -> str:
 def build(mech, at: float | None = None, scales: Mapping[str, float] | None = None,
           starting_deg: float | None = None, only: Iterable[str] | None = None,
           fixed: CycleScales | None = None, friction: str = "first",
-          positions: FixedPositions | None = None, law=None) -> Plans:
+          positions: FixedPositions | None = None, law=None, solution: Solution | None = None) -> Plans:
     """The plans of `mech` at crank angle `at` (deg; default: the model's design position
     `drive.design_deg`). `scales`: any of mu_l [m/mm], mu_v [m/(s mm)], mu_a [m/(s^2 mm)],
     mu_F [N/mm] (the others chosen by the texts' rule, `choose_scales`); `starting_deg`: position
@@ -322,12 +329,12 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     the plan of positions' 12 positions and paths made once for many angles (`fixed_positions` of
     `mech` at the mu_l drawn at; from `starting_deg` where it is given, else ValueError). `law`: at
     that true law of motion (`kinetostat.law_of_motion`: omega and eps at `at`, the flywheel's
-    moment on the crank), not the model's drive. ValueError for
+    moment on the crank), not the model's drive. `solution`: the one analysis to draw from
+    (`solution.solve(mech, [at], friction, law)`; made here where not given). ValueError for
     a bad angle or name, or an angle with no equilibrium with friction; ScaleError (a ValueError)
     for a scale that would draw a plan beyond MAX_EXTENT_MM."""
     import math
 
-    from ..solve import analyze
     if at is None:
         at = getattr(mech.drive, "design_deg", 30.0)
     if isinstance(at, bool) or not isinstance(at, (int, float)) or not math.isfinite(at):
@@ -335,7 +342,10 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     chosen = _chosen(only)
     if friction not in ("first", "reactions"):
         raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
-    res = analyze(mech, phi_deg=[float(at)], friction=friction, law=law)    # default: the graphical method's frictionless reactions
+    solution = solution or solve(mech, [float(at)], friction, law, other=False)    # default: the graphical method's frictionless reactions
+    res = solution.res
+    if len(res.phi_deg) != 1 or res.phi_deg[0] != float(at):
+        raise ValueError(f"solution: expected the analysis of {mech.name!r} at {float(at):g} deg, got {res}")
     if res.friction is not None and not res.friction.solved[0]:
         raise ValueError(f"at {at:g} deg there is no equilibrium with friction in the reactions (self-locking): "
                          f"no plans of the forces to draw")
@@ -345,9 +355,9 @@ def build(mech, at: float | None = None, scales: Mapping[str, float] | None = No
     if res.omega(1)[0] == 0:
         raise ValueError("the crank stands still (omega_1 = 0): the velocity and acceleration plans have no "
                          "size to draw; the statics is in the tables (reactions, balancing moment)")
-    sc = dict(fixed.base) if fixed is not None else choose_scales(mech, res, scales)
+    sc = dict(fixed.base) if fixed is not None else solution_scales(mech, solution, scales)
     steps = dict(BUILDERS) | (fixed.builders() if fixed is not None else {})
-    steps["positions"] = partial(_positions, starting_deg=starting_deg, fixed=positions)
+    steps["positions"] = partial(_positions, starting_deg=starting_deg, fixed=positions, solution=solution)
     plans = [p.at(0) for p in _cycles(mech, res, sc, chosen, steps)]
     for p in plans:
         x0, y0, x1, y1 = extent(p)

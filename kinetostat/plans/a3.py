@@ -21,7 +21,7 @@ scale made coarser than the rule, and why. Where no choice fits them, further sh
 rest and the title block says so (no variant of the text's tasks: a test runs them all).
 
 May use: the standard library, numpy, `build` of this package, `.core`, `.draw`, `.i18n`, `.kinematic`,
-`.labels`, `.scales`, `.pdf`, `kinetostat.solve`. Never matplotlib.
+`.labels`, `.scales`, `.pdf`, `.solution` (the one analysis). Never matplotlib.
 """
 from __future__ import annotations
 
@@ -38,6 +38,7 @@ from .i18n import LANGS, num, text
 from .labels import ASCENT
 from .pdf import text_width
 from .scales import TARGET_MM
+from .solution import Solution, solve
 
 __all__ = ["Drawing", "Placement", "OneSheet", "Page", "drawing", "layout", "placed_in_order", "one_sheet", "pages", "draw_page", "AREA", "TITLE_BLOCK",
            "notes", "note_lines", "notes_mm", "notes_room", "NOTE_SIZE",
@@ -418,7 +419,7 @@ class OneSheet:
                 if s.value > self.rule[k].value * (1 + 1e-9)]
 
 
-def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
+def one_sheet(mech, at: float, lang: str, solution: Solution | None = None) -> OneSheet:
     """The plans of `mech` at crank angle `at` (deg), drawn in `lang`, at the texts' scales where
     they all fit one A3 sheet (`layout`) in every language of LANGS (so that a variant's scales do
     not depend on the language of its pack), else with scales chosen together for that sheet: the
@@ -430,15 +431,13 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     μ_l, `kinematic.fixed_positions`), the drawings of the plans whose scales changed (in each
     language; drawn once for the languages whose letters and notes' room are the same,
     `draw.language_part`) and their layouts. Where no scale within _TRIES steps fits them, the last
-    try is kept (more than one sheet). `res`: the caller's frictionless analysis of `mech` at
-    [at] for the references of the scales (default: made here, once)."""
+    try is kept (more than one sheet). `solution`: the caller's one analysis of `mech` at [at]
+    (`solution.solve`, frictionless), every build drawn from it (default: made here, once)."""
     from . import build
     from .kinematic import fixed_positions, starting_position
     from .scales import LENGTH_MANTISSAS, SCALE_UNITS, next_coarser, references
-    if res is None:
-        from ..solve import analyze
-        res = analyze(mech, phi_deg=[float(at)])
-    reference = references(mech, res)
+    solution = solution or solve(mech, [float(at)], other=False)
+    reference = references(mech, solution.res)
     drawn: dict[tuple, Drawing] = {}            # (language, kind, its scales) -> its drawing
     native: dict[tuple, list[str]] = {}         # (kind, its scales) -> the languages it was drawn in
     parts: dict[tuple, tuple] = {}              # (language, kind, its scales) -> `language_part`
@@ -477,8 +476,8 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
     def positions(mu_l: float):
         """The plan of positions' 12 positions and paths at μ_l (m/mm), made once per μ_l."""
         if mu_l not in fixed:
-            start = next(iter(fixed.values())).start if fixed else starting_position(mech)
-            fixed[mu_l] = fixed_positions(mech, Scale("mu_l", mu_l, SCALE_UNITS["mu_l"]), start)
+            start = next(iter(fixed.values())).start if fixed else starting_position(mech, solution)
+            fixed[mu_l] = fixed_positions(mech, Scale("mu_l", mu_l, SCALE_UNITS["mu_l"]), start, solution)
         return fixed[mu_l]
 
     tried: dict[tuple | None, tuple] = {}
@@ -499,10 +498,10 @@ def one_sheet(mech, at: float, lang: str, res=None) -> OneSheet:
         key = None if given is None else tuple(sorted(given.items()))
         if key not in tried:                     # the searches below come back to scales tried before
             if given is None:                    # the texts' rule: its μ_l is not known before
-                plans = build(mech, at=at)
+                plans = build(mech, at=at, solution=solution)
             else:
                 pos = positions(given["mu_l"])
-                plans = build(mech, at=at, scales=given, starting_deg=pos.start, positions=pos)
+                plans = build(mech, at=at, scales=given, starting_deg=pos.start, positions=pos, solution=solution)
             ds = drawings(plans, lang)
             places, ordered = placed(plans, ds, lang)
             fit = all(p.page == 0 for p in places)

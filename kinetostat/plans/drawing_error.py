@@ -24,7 +24,7 @@ are all RRR or RRP with its guide on the frame (Logvinenko and Nadtoka's ICE and
 the compressor, the chain-unit four-bar, the furnace loader); for the others `simulate` draws the
 kinematics and the inertia loads only.
 
-May use: the solver (`solve`, `analysis`, `applied`), `plans.worksheet`, numpy. Never matplotlib.
+May use: the solver's results (`analysis`, `applied`; analysed in `plans.solution`), `plans.worksheet`, numpy. Never matplotlib.
 """
 from __future__ import annotations
 
@@ -36,9 +36,9 @@ from typing import Mapping
 import numpy as np
 
 from ..analysis import Analysis
-from ..solve import analyze
 from ..model import Mechanism
-from .scales import choose_scales
+from .scales import solution_scales
+from .solution import Solution, solve
 
 __all__ = ["Scales", "DrawnSolution", "default_scales", "draws_forces", "simulate", "SUPPORTED"]
 
@@ -57,12 +57,12 @@ class Scales:
 
 def default_scales(mech: Mechanism, at: float | None = None) -> Scales:
     """The scales the plans are drawn at (`scales.choose_scales`: as Logvinenko, Nadtoka 2021 choose them)."""
-    return _scales(mech, analyze(mech, phi_deg=[mech.drive.design_deg if at is None else at], friction="first"))
+    return _scales(mech, solve(mech, [mech.drive.design_deg if at is None else at], other=False))
 
 
-def _scales(mech: Mechanism, res: Analysis) -> Scales:
-    """The texts' scales of the plans of `res` (one angle; drawn: frictionless)."""
-    sc = choose_scales(mech, res)
+def _scales(mech: Mechanism, solution: Solution) -> Scales:
+    """The texts' scales of the plans of `solution.res` (one angle; drawn: frictionless)."""
+    sc = solution_scales(mech, solution)
     return Scales(sc["mu_l"].value, sc["mu_v"].value, sc["mu_a"].value, sc["mu_F"].value)
 
 
@@ -474,20 +474,22 @@ def simulate(mech: Mechanism, at: float | None = None, *, n: int = 20000, length
     each act of drawing wrong by up to ±length_mm (lengths, arms, readings) and ±angle_deg
     (directions), at `scales` (default: the texts' choice). `res`: the caller's frictionless
     analysis of `mech` at the one angle `at` (`analyze(mech, phi_deg=[at])`; default: made here,
-    once). Reproducible for a given seed."""
+    once: `solution.solve`, and for the default scales of a given `res`). Reproducible for a given seed."""
     from .worksheet import worksheet_cycle
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise ValueError(f"n: expected a positive number of samples, got {n!r}")
     for name, v in (("length_mm", length_mm), ("angle_deg", angle_deg)):
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
             raise ValueError(f"{name}: expected a finite precision >= 0, got {v!r}")
+    solution = None
     if res is None:
-        res = analyze(mech, phi_deg=[mech.drive.design_deg if at is None else float(at)], friction="first")
+        solution = solve(mech, [mech.drive.design_deg if at is None else float(at)], other=False)
+        res = solution.res
     elif len(res.phi_deg) != 1 or res.friction is not None or (at is not None and float(at) != res.phi_deg[0]):
         raise ValueError(f"res: expected the frictionless analysis of {mech.name!r} at the one angle "
                          f"{'at' if at is None else f'{float(at):g} deg'} (analyze(mech, phi_deg=[at])), got {res}")
     at = float(res.phi_deg[0])
-    sc = scales or _scales(mech, res)
+    sc = scales or _scales(mech, solution or solve(mech, res.phi_deg, other=False))
     dr = _Drafter(int(n), float(length_mm), float(angle_deg), seed)
     pl = _Plans(res, sc, dr)
     pl.kinematics()

@@ -18,10 +18,10 @@ position number (`A3`, `S2_3` where the name ends in a digit) and the design pos
 Every plan is built for the N angles of one analysis at once (`core.PlanCycle`); an element that
 exists at some angles only is NaN (not drawn) at the others.
 
-May use: numpy, `kinetostat.solve` (the exact results: the plans' own analysis is never re-solved;
-solved here once each: the cycle of positions, the starting position, the other assembly branch
-at the angles drawn), `kinetostat.kinematics` (Assur's special point), `.core`, `.zero` (a plan's
-side that collapses).
+May use: numpy, `kinetostat.kinematics` (Assur's special point), `.solution` (the one analysis the
+plans are drawn from; positions alone where a search needs new angles: the starting position's
+refinement, its 12 positions, the other assembly branch at the angles drawn), `.core`, `.zero`
+(a plan's side that collapses).
 """
 from __future__ import annotations
 
@@ -35,6 +35,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .core import PlanCycle, Scale, Segment, alias, construction
+from .solution import CYCLE_STEPS, Positions, Solution, grid, positions, solve
 from .zero import by_pattern, translates, zero_of
 
 __all__ = ["positions_plan", "without_triad_construction", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
@@ -44,7 +45,7 @@ __all__ = ["positions_plan", "without_triad_construction", "fixed_positions", "o
 N_POSITIONS = 12
 #: Crank angles sampled for the path of a centre of mass.
 PATH_STEPS = 180
-#: Angles a round of the search for the starting position analyses at once.
+#: Angles a round of the search for the starting position solves at once.
 SECTIONS = 63
 
 
@@ -594,15 +595,17 @@ def _z(res, name: str) -> np.ndarray:
     return xy[:, 0] + 1j * xy[:, 1]
 
 
-def starting_position(mech, steps: int = 720) -> float:
+def starting_position(mech, solution: Solution | None = None) -> float:
     """The texts' starting position (seed 002: crank and rod stretched in one line), crank angle
     in deg in [0, 360): the first dead centre of the first group driven by a link turning about
     a frame pin that has one (module docstring of `_dead_centre_functions`), found by a scan of
-    `steps` angles, then its bracket cut in SECTIONS + 1 parts by one analysis a round, to the
-    resolution of a float (~1e-14 deg). 0 (the model's reference) when there is none."""
-    from ..solve import analyze
-    phi = np.arange(steps) * 360.0 / steps
-    cyc = analyze(mech, phi_deg=phi)
+    the CYCLE_STEPS angles of the cycle grid of `solution` (`solution.solve`; default: solved
+    here), then its bracket cut in SECTIONS + 1 parts by one solve of the positions a round
+    (`solution.positions`), to the resolution of a float (~1e-14 deg). 0 (the model's reference)
+    when there is none."""
+    steps = CYCLE_STEPS
+    phi = grid(steps)
+    cyc = (solution or solve(mech, other=False)).on(phi)
     for f in _dead_centre_functions(mech):
         val, ok = f(cyc)
         nxt = np.roll(val, -1)
@@ -618,7 +621,7 @@ def starting_position(mech, steps: int = 720) -> float:
             inner = inner[(inner > lo) & (inner < hi)]
             if not len(inner):
                 break
-            fm = f(analyze(mech, phi_deg=inner))[0]
+            fm = f(positions(mech, inner))[0]
             if np.any(fm == 0):
                 return float(inner[np.argmax(fm == 0)] % 360.0)
             changed = np.flatnonzero(np.sign(fm) != np.sign(flo))
@@ -679,18 +682,16 @@ def _draw_position(mech, res, idx, label: int | None, mu: float, points: dict, s
                                     np.abs(zb - za) * mu, "m", "link" if label is None else "position"))
 
 
-def assembled(mech, phi_deg, **options):
-    """(the analysis of `mech` at the angles `phi_deg` where it assembles, those angles (N,) bool):
-    one solve, and one more without the angles an AssemblyError named; (None, all False) where it
-    does not assemble at the rest either (or the model is refused: a ValueError). `options`: of
-    `analyze`."""
+def assembled(mech, phi_deg) -> tuple[Positions | None, np.ndarray]:
+    """(the positions of `mech` at the angles `phi_deg` where it assembles (`solution.positions`),
+    those angles (N,) bool): one solve, and one more without the angles an AssemblyError named;
+    (None, all False) where it does not assemble at the rest either (or the model is refused: a ValueError)."""
     from ..errors import AssemblyError
-    from ..solve import analyze
     phi = np.asarray(phi_deg, float)
     where = np.ones(len(phi), bool)
     for _ in range(2):
         try:
-            return analyze(mech, phi_deg=phi[where], **options), where
+            return positions(mech, phi[where]), where
         except AssemblyError as exc:
             where = where & ~np.isin(np.round(phi, 9), exc.phi_deg)
             if not where.any():
@@ -703,7 +704,7 @@ def assembled(mech, phi_deg, **options):
 def other_branches(mech, res) -> dict:
     """Per group with two assembly branches (`mech.branches`): (the analysis of the mechanism with
     that group's other branch at the angles of `res` where it assembles, those angles (N,) bool),
-    one solve for all of them (`assembled`); left out where it assembles at none."""
+    positions only, one solve for all of them (`assembled`); left out where it assembles at none."""
     out = {}
     for key, b in mech.branches.items():
         alt, where = assembled(replace(mech, branches={**mech.branches, key: -b}), res.phi_deg)
@@ -773,37 +774,41 @@ class FixedPositions:
     paths: Mapping[str, tuple[complex, ...]]
 
 
-def fixed_positions(mech, mu: Scale, starting_deg: float | None = None) -> FixedPositions:
+def fixed_positions(mech, mu: Scale, starting_deg: float | None = None,
+                    solution: Solution | None = None) -> FixedPositions:
     """The 12 positions every 30 deg in the drive's sense from the starting position (found by
-    `starting_position` unless given) and the paths of the centres of mass (PATH_STEPS angles), at
-    `mu`: made once for the plans of many angles (`positions_plan`'s `fixed`)."""
-    from ..solve import analyze
-    start = starting_position(mech) if starting_deg is None else float(starting_deg)
-    if not math.isfinite(start):
+    `starting_position` unless given; their positions alone, `solution.positions`) and the paths
+    of the centres of mass (PATH_STEPS angles of the cycle grid of `solution`, `solution.solve`;
+    default: solved here), at `mu`: made once for the plans of many angles (`positions_plan`'s `fixed`)."""
+    if starting_deg is not None and not math.isfinite(float(starting_deg)):
         raise ValueError(f"starting position: expected a finite angle in degrees, got {starting_deg!r}")
-    twelve = analyze(mech, phi_deg=start + 30.0 * np.arange(N_POSITIONS))
+    solution = solution or solve(mech, other=False)
+    start = starting_position(mech, solution) if starting_deg is None else float(starting_deg)
+    twelve = positions(mech, start + 30.0 * np.arange(N_POSITIONS))
     points: dict[str, complex] = {}
     segs: list[Segment] = []
     for i in range(N_POSITIONS):
         _draw_position(mech, twelve, i, i, mu.value, points, segs)
-    cycle = analyze(mech, phi_deg=np.arange(PATH_STEPS + 1) * 360.0 / PATH_STEPS)
+    cycle = solution.on(np.arange(PATH_STEPS + 1) * 360.0 / PATH_STEPS)
     paths = {link.com: tuple(_z(cycle, link.com) / mu.value) for link in mech.links[1:]
              if link.com and link.com not in mech.links[0].points}
     return FixedPositions(mech, mu, start, MappingProxyType(points), tuple(segs), MappingProxyType(paths))
 
 
 def positions_plan(mech, res, scales: dict[str, Scale], starting_deg: float | None = None,
-                   other_branch: bool | np.ndarray = True, fixed: FixedPositions | None = None) -> PlanCycle:
+                   other_branch: bool | np.ndarray = True, fixed: FixedPositions | None = None,
+                   solution: Solution | None = None) -> PlanCycle:
     """The plan of positions (seed 002 fig. 1.5) at every angle of `res`: 12 positions every 30 deg
     in the drive's sense from the starting position (found by `starting_position` unless given),
     the design position at each angle of `res` (plain names), the paths of every centre of mass
     and the assembly branch of each group (notes; the other branch dashed, except where
     `other_branch` (a bool, or (N,) bool per angle) is False): all at mu_l. Link segments' values
     are the exact distances between their points, m. `fixed`: the 12 positions and the paths made
-    already (`fixed_positions` of this `mech` at mu_l, from `starting_deg` where it is given)."""
+    already (`fixed_positions` of this `mech` at mu_l, from `starting_deg` where it is given; else
+    made from `solution`)."""
     mu = scales["mu_l"]
     if fixed is None:
-        fixed = fixed_positions(mech, mu, starting_deg)
+        fixed = fixed_positions(mech, mu, starting_deg, solution)
     elif fixed.mech is not mech or fixed.mu != mu:
         raise ValueError(f"fixed: the positions of {fixed.mech.name} at {fixed.mu}, not of {mech.name} at {mu}")
     elif starting_deg is not None and float(starting_deg) != fixed.start:

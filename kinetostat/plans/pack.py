@@ -51,7 +51,8 @@ from .pdf import ASCENT, Canvas
 from .scales import REFERENCE_NAMES as _REFERENCE
 from .symbols import html, mark
 from ..model.lettering import lettering
-from .worksheet import CSS, Worksheet, analyses, html_document, worksheet_cycle
+from .solution import Solution, solve
+from .worksheet import CSS, Worksheet, html_document, worksheet_cycle
 
 __all__ = ["Pack", "pack", "BAND", "BAND_DRAWS", "PACK_FILES"]
 
@@ -121,18 +122,19 @@ class Pack:
 
 # ============================================================================ content
 
-def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, analysis=None) -> Pack:
+def pack(v, lang: str = "en", a3=None, draws: int = BAND_DRAWS, solution: Solution | None = None) -> Pack:
     """The pack of variant `v` (`variants.Variant`) in `lang` at its design position, every part
     at the scales that put the plans on one A3 sheet (`a3`: `a3.one_sheet` in `lang`, when chosen
-    already); `draws`: Monte Carlo draws of the bands; `analysis`: the caller's analyses of the
-    variant at [phi1] (`worksheet.analyses`), from which every part is built (default: made here, once)."""
+    already); `draws`: Monte Carlo draws of the bands; `solution`: the caller's one analysis of the
+    variant at [phi1] (`solution.solve`), from which every part is built (default: made here, once)."""
     from .a3 import one_sheet
     from .drawing_error import Scales, simulate
     check_lang(lang)
     mech = v.mechanism()
     phi1 = float(v.values["phi1"])
-    res, other = analysis or analyses(mech, [phi1])
-    a3 = a3 or one_sheet(mech, phi1, lang, res=res)
+    solution = solution or solve(mech, [phi1])
+    res, other = solution.res, solution.other
+    a3 = a3 or one_sheet(mech, phi1, lang, solution=solution)
     plans = a3.plans
     sc = plans.scales
     ws = worksheet_cycle(mech, res, sc["mu_l"].value, lang, other).at(0)

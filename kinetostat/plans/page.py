@@ -37,7 +37,7 @@ of that angle, or (student) the tables to fill in; then each sheet a page at tru
 A4 chosen) A4 around the plan with the title line and the notes on top (page.js `a4Title`).
 
 May use: the plans (`build_cycle`, `cycle_scales`, `core`, `draw`, `forces`, `worksheet`
-(`analyses`, `worksheet_cycle`), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
+(`worksheet_cycle`), `solution` (the page's one analysis), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
 `kinetostat._text` (`script_json`: the data block's JSON), numpy, the standard library. Never
 matplotlib, never the harness; the solver only through `worksheet.analyses` (the page's one
 analysis).
@@ -63,8 +63,9 @@ from .._text import script_json
 from .core import ELEMENTS, PAGE_DECIMALS, UNMEASURED, Drawing, PlanCycle
 from .draw import RESULT, TINY_MM, TOKEN, segment_label, title_of
 from .i18n import check_lang, num, text, unit
+from .solution import Solution, solve
 
-__all__ = ["page", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
+__all__ = ["page", "page_angles", "write_page", "encode_drawing", "PAGE_ANGLES", "TOLERANCE_PCT", "COORD_DECIMALS", "LENGTH_DECIMALS"]
 
 #: The angles of the slider, deg (the design position is one more frame).
 PAGE_ANGLES = tuple(float(a) for a in range(360))
@@ -598,29 +599,42 @@ def _data_rows(mech, res, lang: str) -> list[tuple[str, str, str]]:
 
 # ============================================================================ the page
 
+def page_angles(mech, student: bool = False, at: float | None = None,
+                angles: Sequence[float] | None = None) -> tuple[list[float], list[float]]:
+    """(the slider's frames, the angles the page is drawn from: the frames and `at`), deg, as `page`
+    takes them."""
+    design = float(getattr(mech.drive, "design_deg", 30.0))
+    at = design if at is None else float(at)
+    frames = [at] if student else [*map(float, PAGE_ANGLES if angles is None else angles), design]
+    return frames, (frames if at in frames else [*frames, at])
+
+
 def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
-         angles: Sequence[float] | None = None, fixed=None) -> str:
+         angles: Sequence[float] | None = None, fixed=None, solution: Solution | None = None) -> str:
     """The interactive page of `mech` in `lang` (module docstring). `at`: the angle of the check
     (and of a student's page; default the design position); `angles`: the slider's frames (deg;
     default PAGE_ANGLES); `fixed`: the plans' scales (default `cycle_scales` of the page's one
-    analysis). ValueError where `at` is a singular position."""
+    analysis); `solution`: that analysis (`solution.solve`, frictionless, its `res` at least at
+    `page_angles`; made here where not given). ValueError where `at` is a singular position."""
     from . import build_cycle, cycle_scales
     from .draw import drawing
     from .kinematic import without_triad_construction
-    from .worksheet import analyses, worksheet_cycle
+    from .worksheet import worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
     design = float(getattr(mech.drive, "design_deg", 30.0))
     at = design if at is None else float(at)
-    frames = [at] if student else [*map(float, PAGE_ANGLES if angles is None else angles), design]
-    phi = frames if at in frames else [*frames, at]
+    frames, phi = page_angles(mech, student, at, angles)
     i_at = phi.index(at)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res, other = analyses(mech, phi)           # the graphical method's; the other friction mode's rows
+        solution = (solution or solve(mech, phi)).sub(phi)   # the graphical method's; the other friction mode's rows
+        res = solution.res
+        if res.friction is not None:
+            raise ValueError(f"solution: expected the frictionless analysis of {mech.name!r} (friction='first'), got {res}")
         fixed = fixed or cycle_scales(mech, res=res)
-        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed).items()}
-        sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=other)
+        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed, solution=solution).items()}
+        sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=solution.other)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
     name = lettering(mech).name(lang, mech.name)
@@ -874,8 +888,10 @@ table.fill td.blank{min-width:9em;height:1.6em}h3{font-size:1em;margin:.6em 0 .2
 """
 
 
-def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None) -> Path:
-    """The page of `mech` (`page`), drawn anew, written to `out` atomically; returns its path."""
+def write_page(mech, out: str | Path, lang: str = "en", student: bool = False, at: float | None = None,
+               solution: Solution | None = None) -> Path:
+    """The page of `mech` (`page`, from `solution` where given), drawn anew, written to `out`
+    atomically; returns its path."""
     path = Path(out)
-    write_text(path, page(mech, lang=lang, student=student, at=at))
+    write_text(path, page(mech, lang=lang, student=student, at=at, solution=solution))
     return path

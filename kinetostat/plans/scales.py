@@ -23,8 +23,8 @@ digits (l_OA = 0.036 m: 0.001 m/mm, OA = 36 mm, as the example).
           drawn 100..200 mm: the texts give the force plan a sheet of its own (seed 002 draws
           its 9651 N gas force 193 mm long at mu_F = 50 N/mm).
 
-May use: numpy, `kinetostat.solve` (the exact results; analysed here only where `choose_scales`
-is not given the cycle of positions), `.core`.
+May use: numpy, `.solution` (the one analysis; made here only where `choose_scales` is not given
+the cycle of positions), `.core`.
 """
 from __future__ import annotations
 
@@ -35,8 +35,8 @@ import numpy as np
 
 from .core import Scale
 
-__all__ = ["choose_scales", "references", "round_scale", "length_scale", "coarser", "next_coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
-           "LENGTH_MANTISSAS", "REFERENCE_NAMES", "FIT_MM", "MAX_EXTENT_MM", "PLAN_OF"]
+__all__ = ["choose_scales", "solution_scales", "references", "round_scale", "length_scale", "coarser", "next_coarser", "check_given", "ScaleError", "SCALE_UNITS", "ROUND_MANTISSAS",
+           "LENGTH_MANTISSAS", "REFERENCE_NAMES", "FIT_STEPS", "FIT_MM", "MAX_EXTENT_MM", "PLAN_OF"]
 
 #: Unit of each scale, per millimetre drawn.
 SCALE_UNITS = {"mu_l": "m/mm", "mu_v": "m/(s mm)", "mu_a": "m/(s^2 mm)", "mu_F": "N/mm"}
@@ -46,6 +46,8 @@ ROUND_MANTISSAS = (1.0, 2.0, 2.5, 4.0, 5.0)
 LENGTH_MANTISSAS = (1.0, 1.5, 2.0, 2.5, 4.0, 5.0, 7.5)
 #: Recommended drawn length of each scale's reference quantity, mm.
 TARGET_MM = {"mu_l": (30.0, 36.0), "mu_v": (70.0, 90.0), "mu_a": (70.0, 90.0), "mu_F": (100.0, 200.0)}
+#: Crank angles over the cycle whose positions the plan of positions must fit (every 5 deg).
+FIT_STEPS = 72
 #: Drawing area of an A3 landscape sheet a plan must fit (width, height), mm: inside the frame,
 #: above the title block.
 FIT_MM = (380.0, 220.0)
@@ -179,11 +181,12 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
     """Scales mu_l, mu_v, mu_a, mu_F for the plans of `res` (an Analysis at one crank angle or
     more): the given ones as given, the others by the texts' rule (module docstring), each the
     coarsest it chooses at the angles of `res` that are not singular. `cycle`: an Analysis over
-    the cycle whose positions the plan of positions must fit (default: 72 steps, analysed here)."""
+    the cycle whose positions the plan of positions must fit (default: the FIT_STEPS angles of
+    `solution.solve(mech)`, positions only)."""
     given = check_given(given)
     if cycle is None:
-        from ..solve import analyze
-        cycle = analyze(mech, steps=72, friction="first")      # positions only
+        from .solution import grid, solve
+        cycle = solve(mech, other=False).on(grid(FIT_STEPS))
     ok = ~np.asarray(res.singular, bool)
     if not ok.any():
         ok[:] = True
@@ -216,6 +219,13 @@ def choose_scales(mech, res, given: Mapping[str, float] | None = None,
                         for r, w, h in set(zip(reference, width, height)))
         out[key] = Scale(key, value, unit)
     return out
+
+
+def solution_scales(mech, solution, given: Mapping[str, float] | None = None) -> dict[str, Scale]:
+    """`choose_scales` of the plans of `solution.res` (`solution.solve`), the plan of positions
+    fitted over the FIT_STEPS angles of its cycle."""
+    from .solution import grid
+    return choose_scales(mech, solution.res, given, cycle=solution.on(grid(FIT_STEPS)))
 
 
 def _z(xy: np.ndarray) -> np.ndarray:

@@ -9,7 +9,7 @@ accelerations), the inertia loads and the applied loads, the reactions group by 
 last group attached back to the crank, the crank, Zhukovsky's lever and the difference of the two
 balancing moments. Outputs: Markdown, HTML, a pandas frame, CSV and JSON (written atomically).
 
-May use: the solver (`solve`, `analysis`, `applied`, `model`), `_io`, `_text` (safe cells), numpy; pandas inside
+May use: the solver's results (`analysis`, `applied`, `model`; analysed in `.solution`), `_io`, `_text` (safe cells), numpy; pandas inside
 `Worksheet.frame` only. Never matplotlib, never the harness.
 """
 from __future__ import annotations
@@ -25,7 +25,6 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis import Analysis
-from ..solve import analyze
 from ..applied import load_magnitude
 from ..errors import SelfLockingWarning
 from ..kinematics import DIGITS_WARN, leash_axes, special_point_z, special_index
@@ -35,10 +34,11 @@ from ..model import Mechanism
 from ..tables import by_unit, plain, rows_csv
 from .i18n import ZERO, accuracy, check_lang, num, phrase, text, unit
 from ..model.lettering import in_lang, lettering
-from .scales import choose_scales
+from .scales import solution_scales
+from .solution import Solution, solve
 from .symbols import html, mark
 
-__all__ = ["Row", "Worksheet", "worksheet", "CycleRow", "WorksheetCycle", "worksheet_cycle", "analyses", "COLUMNS", "CSS", "html_document"]
+__all__ = ["Row", "Worksheet", "worksheet", "CycleRow", "WorksheetCycle", "worksheet_cycle", "COLUMNS", "CSS", "html_document"]
 
 #: Columns of the worksheet's table (CSV, JSON, frame).
 COLUMNS = ("section", "key", "symbol", "value", "unit", "direction", "note")
@@ -649,27 +649,13 @@ def _point_of(res: Analysis, k: int, name: str) -> np.ndarray:
     return res.kin.v_origin[:, k] + res.omega(k)[:, None] * _across(r)
 
 
-def analyses(mech: Mechanism, phi_deg, friction: str = "first", law=None) -> tuple[Analysis, Analysis | None]:
-    """The analyses a worksheet of `mech` at the angles `phi_deg` (deg) is built from
-    (`worksheet_cycle`): in the mode `friction` ("first": the graphical method's frictionless
-    reactions, or "reactions"), and for a model with [friction] in the other mode too (its
-    friction rows), else None; at the true law of motion `law` (`kinetostat.law_of_motion`) where
-    given. Self-locking is not warned of: the sheet's rows state eta."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SelfLockingWarning)
-        res = analyze(mech, phi_deg=phi_deg, friction=friction, law=law)
-        other = None if mech.friction is None else \
-            analyze(mech, phi_deg=phi_deg, friction="reactions" if friction == "first" else "first", law=law)
-    return res, other
-
-
 def worksheet_cycle(mech: Mechanism, res: Analysis, mu_l: float, lang: str = "en",
                     friction_res: Analysis | None = None) -> WorksheetCycle:
     """The worksheet of `mech` at every crank angle of `res` (its analysis, `analyze`; the
     graphical method's is frictionless, friction="first"), arms and z in mm at `mu_l` (m/mm),
     in `lang`. The friction rows of a model with [friction] from `friction_res`: its analysis at
     the same angles in the other friction mode (friction="reactions" beside a frictionless `res`,
-    "first" beside one with friction in the reactions; `analyses` makes both); without it the
+    "first" beside one with friction in the reactions; `solution.solve` makes both); without it the
     sheet has no friction section. No Python loop over the angles."""
     check_lang(lang)
     if not (isinstance(mu_l, (int, float)) and not isinstance(mu_l, bool) and math.isfinite(mu_l) and mu_l > 0):
@@ -692,9 +678,11 @@ def worksheet_cycle(mech: Mechanism, res: Analysis, mu_l: float, lang: str = "en
 
 
 def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = None, lang: str = "en",
-              friction: str = "first", law=None) -> Worksheet:
+              friction: str = "first", law=None, solution: Solution | None = None) -> Worksheet:
     """The worksheet of `mech` at crank angle `at` (deg; default the model's design position):
-    `worksheet_cycle` at the one angle (at the true law of motion `law` where given: `analyses`).
+    `worksheet_cycle` at the one angle of `solution` (`solution.solve(mech, [at], friction, law)`:
+    at the true law of motion `law` where given; made here where not given). Self-locking is not
+    warned of here: the sheet's rows state eta.
 
     mu_l: the scale of the plan of positions, m/mm, for the arms and z in mm (default: the
     crank drawn 30-35 mm at a round scale, as seed 002 chooses it). lang: "en", "uk" or "ru"
@@ -710,7 +698,10 @@ def worksheet(mech: Mechanism, at: float | None = None, *, mu_l: float | None = 
         raise ValueError(f"mu_l: expected a positive scale in m/mm, got {mu_l!r}")
     if friction not in ("first", "reactions"):
         raise ValueError(f"friction: expected 'first' or 'reactions', got {friction!r}")
-    res, other = analyses(mech, [float(at)], friction, law)
+    if solution is None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SelfLockingWarning)
+            solution = solve(mech, [float(at)], friction, law)
     if mu_l is None:
-        mu_l = choose_scales(mech, res)["mu_l"].value
-    return worksheet_cycle(mech, res, float(mu_l), lang, other).at(0)
+        mu_l = solution_scales(mech, solution)["mu_l"].value
+    return worksheet_cycle(mech, solution.res, float(mu_l), lang, solution.other).at(0)

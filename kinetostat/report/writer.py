@@ -498,16 +498,20 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
     one picture each, with their segments.csv and the worksheet beside them, and with `page` the
     interactive page (`plans.page`, page.html, drawn anew) linked; `friction`: the method they are drawn with (`plans.build`);
     `law`: the plans and worksheet at that true law of motion (`law_said` says which); returns the files."""
-    from ..plans import build, plan_file_name, svg
+    from ..plans import build, plan_file_name, solve, svg
+    from ..plans.page import page_angles
     from ..plans.worksheet import worksheet
     at = m.drive.design_deg
+    shared = page and friction == "first" and law is None      # the page's analysis holds the plans' too
     doc.h(2, PLANS_HEADING)
     t0 = time.perf_counter()
     try:
         with warnings.catch_warnings():         # the cycle's warnings are reported below
             warnings.simplefilter("ignore")
-            plans = build(m, friction=friction, law=law)
-            sheet = worksheet(m, mu_l=plans.scales["mu_l"].value, friction=friction, law=law)
+            drawn = solve(m, page_angles(m)[1] if shared else [at], friction, law)   # once; the page's too where shared
+            solution = drawn.sub([at])
+            plans = build(m, friction=friction, law=law, solution=solution)
+            sheet = worksheet(m, mu_l=plans.scales["mu_l"].value, friction=friction, law=law, solution=solution)
     except ValueError as exc:
         doc.p(f"No plans at this position: {esc(str(exc))}")
         return []
@@ -525,7 +529,7 @@ def _plans_section(doc: Doc, m: Mechanism, d: Path, page: bool = False, friction
     files = []
     if page:
         from ..plans.page import write_page
-        files.append(write_page(m, d / "page.html"))
+        files.append(write_page(m, d / "page.html", solution=drawn if shared else None))
         doc.p("[The interactive page](page.html): every plan at every degree of the crank at scales fixed for "
               "the cycle, the values, the force plans step by step, a check of measured lengths (one offline file"
               + ("; the graphical method's first approximation: reactions without friction" if m.friction is not None else "")
