@@ -294,13 +294,17 @@ class _Earlier:
     def near(self, a: np.ndarray, care: np.ndarray) -> tuple[int, np.ndarray] | None:
         """(j, r) of the earlier series j that differs from `a` by a constant at the most of
         PROBES of the angles `care`: r is `a` less series j where `care`, held (`_held`) where
-        not; None where there is none."""
+        not; None where there is none, or where even it does so at fewer than half of them (not
+        worth `_serieses`' time)."""
         at = np.flatnonzero(care)
         if not self.index or len(a) != self.rows.shape[1] or len(at) < 2:
             return None
         rows = self.rows[:len(self.index)]
         probe = at[:: max(1, len(at) // PROBES)]
-        k = int(np.argmin((np.diff(rows[:, probe] - a[probe], axis=1) != 0).sum(axis=1)))
+        changes = (np.diff(rows[:, probe] - a[probe], axis=1) != 0).sum(axis=1)
+        k = int(np.argmin(changes))
+        if changes[k] > len(probe) // 2:
+            return None
         return self.index[k], _held((a - rows[k])[:, None], care)[:, 0]
 
 
