@@ -197,12 +197,14 @@
   for (let k = 0; k < meta.kinds.length; k++) {   // page.py encode_drawing, element by element
     const K = meta.kinds[k], nums = varints(await bytes("k" + k));
     let p = 0;
-    const made = [];                             // the sheet's series in order: one may repeat an earlier, or move it
+    const made = [];                             // the sheet's series in order: one may repeat an earlier, move it, or follow it
     const take = (n) => {
       let v;
+      const j = Math.floor((-1 - nums[p]) / 3), how = (-1 - nums[p]) % 3;
       if (nums[p] >= 0) { v = series(nums, p, n); p += n + 1; }
-      else if ((-1 - nums[p]) % 2 === 0) { v = made[(-1 - nums[p]) / 2]; p += 1; }
-      else { const c = nums[p + 1]; v = made[(-2 - nums[p]) / 2].map((x) => x + c); p += 2; }
+      else if (how === 0) { v = made[j]; p += 1; }
+      else if (how === 1) { const c = nums[p + 1]; v = made[j].map((x) => x + c); p += 2; }
+      else { const r = series(nums, p + 1, n); v = made[j].map((x, t) => x + r[t]); p += n + 2; }
       made.push(v);
       return v;
     };

@@ -24,7 +24,8 @@ is drawn, which text it shows, its coordinates and a segment's length as `Elemen
 suits it, as its jumps (`_jumps`: a label), as its least-squares prediction's misses (`_smooth`: a
 length), as an earlier series of the sheet (moved by a constant), or less a multiple of an earlier
 length (`_proportionals`: a velocity on its plan and on the lever; a value of the worksheet, its
-vector's length times the scale), zigzag varints, deflated and written as text, 7 bits a
+vector's length times the scale), or a coordinate less the earlier series it follows most
+closely (`_Earlier`: a label less its point), zigzag varints, deflated and written as text, 7 bits a
 character (`_text7`); the worksheet's rows and the check's items in the blobs too.
 The page's script (vanilla JavaScript, the browser's own DecompressionStream; without its comments,
 `_bare`; deflated in blob "js", `_UNPACK` runs it) decodes them once, writes the check's rows, and writes the sheet of the angle chosen as
@@ -256,6 +257,58 @@ def _shown(e) -> np.ndarray:
     return np.isfinite(L) & (drawn if len(L) == len(drawn) else True)
 
 
+#: A coordinate series is compared with the sheet's earlier ones at this many of its angles
+#: (`_Earlier.near`), and stored less the most alike where that is smaller.
+PROBES = 24
+
+
+class _Earlier:
+    """The series of one sheet so far that are as long as `n` (the frames), as rows of one array,
+    for `encode_drawing`'s search for an earlier series a new coordinate series follows."""
+
+    def __init__(self, n: int):
+        self.rows, self.index = np.empty((64, n), dtype=np.int64), []
+
+    def add(self, j: int, a: np.ndarray) -> None:
+        """Series j of the sheet, `a`, where as long as the frames."""
+        if len(a) != self.rows.shape[1]:
+            return
+        if len(self.index) == len(self.rows):
+            self.rows = np.concatenate([self.rows, np.empty_like(self.rows)])
+        self.rows[len(self.index)] = a
+        self.index.append(j)
+
+    def shifted(self, a: np.ndarray, care: np.ndarray) -> np.ndarray | None:
+        """An earlier series plus a constant that equals `a` wherever `care` (an element's
+        coordinate read only where it is drawn: a leader's end on its point), else None."""
+        at = np.flatnonzero(care)
+        if not self.index or len(a) != self.rows.shape[1] or not len(at):
+            return None
+        rows = self.rows[:len(self.index)]
+        c = rows[:, at[0]] - a[at[0]]
+        probe = at[:: max(1, len(at) // PROBES)]
+        for k in np.flatnonzero(((rows[:, probe] - a[probe]) == c[:, None]).all(axis=1)):
+            if ((rows[k, at] - a[at]) == c[k]).all():
+                return rows[k] - c[k]
+        return None
+
+    def near(self, a: np.ndarray, care: np.ndarray) -> tuple[int, np.ndarray] | None:
+        """(j, r) of the earlier series j that differs from `a` by a constant at the most of
+        PROBES of the angles `care`: r is `a` less series j where `care`, held (`_held`) where
+        not; None where there is none, or where even it does so at fewer than half of them (not
+        worth `_serieses`' time)."""
+        at = np.flatnonzero(care)
+        if not self.index or len(a) != self.rows.shape[1] or len(at) < 2:
+            return None
+        rows = self.rows[:len(self.index)]
+        probe = at[:: max(1, len(at) // PROBES)]
+        changes = (np.diff(rows[:, probe] - a[probe], axis=1) != 0).sum(axis=1)
+        k = int(np.argmin(changes))
+        if changes[k] > len(probe) // 2:
+            return None
+        return self.index[k], _held((a - rows[k])[:, None], care)[:, 0]
+
+
 def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict, bytes, list[np.ndarray]]:
     """A sheet's arrays as (meta, numbers, lengths): `meta` = {"kind", "static", "elements": [{"tag",
     "attrs" [[name, value]...], "title", "texts", "m" points, "rows" (1: the same at every angle),
@@ -267,8 +320,10 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not drawn
     or NaN; less `_scaled`(earlier[index], factor) where "from"); every series as differences of
     the order that suits it (`_serieses`), or, where an earlier series j of the sheet is the same (a
-    line's end and its point), -1 - 2j, or where it is j plus a constant c (a point's label),
-    -2 - 2j and c; as zigzag varints. `earlier`: the length
+    line's end and its point), -1 - 3j, or where it is j plus a constant c (a point's label),
+    -2 - 3j and c, or (a coordinate) where it costs less, -3 - 3j and its difference from j
+    (`_Earlier.near`; a coordinate where its element is not drawn holding what makes it j plus a
+    constant where there is such a j: `_Earlier.shifted`); as zigzag varints. `earlier`: the length
     series of the sheets before it on the page, in order; `lengths`: this sheet's, in order."""
     meta, series, seen, shapes = [], [], {}, {}
     lengths = [_ints(_held(np.asarray(e.length_mm, dtype=float).reshape(-1), _shown(e)), LENGTH_DECIMALS)
@@ -277,20 +332,28 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     sources = iter(_proportionals(lengths, pool, range(len(earlier), len(pool))))
     own = iter(lengths)
 
-    def put(a) -> None:
+    def put(a, care: np.ndarray | None = None) -> None:
         a = np.asarray(a, dtype=np.int64).ravel()
+        if care is not None and care.any() and not care.all():
+            same = bank.shifted(a, care)
+            a = a if same is None else same
         key, shape = a.tobytes(), (a - a[0]).tobytes()
         if key in seen:
-            series.append((-1 - 2 * seen[key],))
+            series.append((-1 - 3 * seen[key],))
         elif shape in shapes:
             j = shapes[shape]
-            series.append((-2 - 2 * j, int(a[0] - raw[j][0])))
+            series.append((-2 - 3 * j, int(a[0] - raw[j][0])))
         else:
-            series.append(a)
+            near = bank.near(a, care) if care is not None else None
+            if near is not None:                 # what it holds where not read: j plus the remainder held
+                a = raw[near[0]] + near[1]
+            series.append([(None, a), *([near] if near else [])])
+        bank.add(len(raw), a)
         raw.append(a)
         seen.setdefault(key, len(series) - 1)
         shapes.setdefault(shape, len(series) - 1)
     raw: list[np.ndarray] = []
+    bank = _Earlier(d.n)
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
         rows, m = xy.shape[0], xy.shape[1]
@@ -305,7 +368,7 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
                 put(finite[:, k])
         held = _held(np.where(finite[..., None], xy, np.nan), drawn) if m else xy
         for c in range(2 * m):
-            put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS))
+            put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS), drawn & finite[:, c // 2])
         source = None
         if e.length_mm is not None:
             q, source = next(own), next(sources)
@@ -315,8 +378,15 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
                      "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
                      "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))}
                     | ({"from": list(source)} if source else {}))
-    new = iter(_serieses([a for a in series if not isinstance(a, tuple)]))
-    series = [np.array(a) if isinstance(a, tuple) else next(new) for a in series]
+    coded = iter(_serieses([x for a in series if isinstance(a, list) for _, x in a]))
+    for k, a in enumerate(series):
+        if isinstance(a, list):              # the cheapest: alone, or less an earlier series j (-3 - 3j)
+            (j, best), *more = [(j, next(coded)) for j, _ in a]
+            for j2, c in more:
+                if _cost(c[1:]) < _cost(best[1:]):
+                    j, best = j2, c
+            a = best if j is None else np.concatenate([[-3 - 3 * j], best])
+        series[k] = np.asarray(a)
     return ({"kind": d.kind, "static": d.static, "elements": meta},
             _varints(np.concatenate(series)) if series else b"", lengths)
 
