@@ -401,14 +401,16 @@ def _bare_text(s: str) -> str:
 
 def _sheet_notes(mech, fixed, at: float, name: str) -> dict[str, list[str]]:
     """kind -> the notes of its own one-angle sheet at `at` (`kinetostat plans --at`: `_note_lines`
-    with their numbers), markup-free, each checked to be on that sheet as it draws them."""
+    and a row per segment, `_table_rows`, with their numbers), markup-free, each checked to be on
+    that sheet as it draws them."""
     from kinetostat.plans import draw
     from kinetostat.plans.symbols import plain
     want = {}
     for kind, plan in _build(mech, at, fixed).items():
         svg = P.svg(plan, "uk", name)
         sheet = _bare_text(svg[svg.index('<g id="notes">'):])
-        notes = [_bare_text(plain(n)) for n in draw._note_lines(plan, "uk", draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0))]
+        notes = [_bare_text(plain(n)) for n in draw._note_lines(plan, "uk", draw._tiny_at(draw._tiny(P.PlanCycle.of(plan)), 0))
+                 + draw._table_rows(plan, "uk")]
         assert all(n in sheet for n in notes), kind     # the notes as the sheet draws them, unwrapped
         want[kind] = notes
     return want
@@ -418,9 +420,10 @@ def test_print_keeps_title_data_scales_and_notes(chromium, ice, tmp_path):
     """Printed (A3 and A4 at 30 deg, A3 at 150 deg), the key page's first page holds the title, the
     angle, the scales, every data row and every value of the angle shown; each sheet's page holds
     the notes of the plan's own one-angle SVG sheet (`kinetostat plans --at`) with their numbers:
-    the results (M_зр, F'_зр, δ: 103,1 and 51,33 N·m) and each tiny vector's value and length at the
-    scale (G2* = 4,9 Н, 0,01 мм); the student's page prints its title, scales and data too. Before:
-    print hid all of them; then the notes came without their numbers."""
+    the results (M_зр, F'_зр, δ: 103,1 and 51,33 N·m), each tiny vector's value and length at the
+    scale (G2* = 4,9 Н, 0,01 мм) and each segment's row (pa: 84,82 мм → 16,96 м/с); the student's
+    page prints its title, scales and data too. Before: print hid all of them; then the notes came
+    without their numbers; then without the segments' rows."""
     if shutil.which("pdftotext") is None:
         pytest.skip("no pdftotext (apt-get install poppler-utils)")
     from kinetostat.model.lettering import lettering
@@ -432,6 +435,7 @@ def test_print_keeps_title_data_scales_and_notes(chromium, ice, tmp_path):
         want = _sheet_notes(mech, fixed, at, name)
         assert any("G2*=4,9Н:показанопозамасштабом(0,01ммумасштабі)" in x for x in want["lever"])
         assert any(x.startswith("Результати:Mзр=" + ("103,1" if at == 30.0 else "51,33")) for x in want["crank"])
+        assert at != 30.0 or "pa:84,82мм→16,96м/с" in want["velocity"]          # seed 002: pa = 84.8 mm at 0.2 m/(s·mm)
         _slide(pg, at)
         rows = pg.eval_on_selector_all("#value-table td.num", "es => es.map(e => [e.dataset.symbol, e.textContent])")
         for paper in papers:

@@ -348,23 +348,27 @@ def _note_lines(plan: Plan, lang: str, tiny: dict[str, str], page: Mapping[str, 
     return lines
 
 
+def _table_row(s: Segment, length: str, value: str, lang: str, sides: bool) -> str:
+    """The notes' row of a vector or arm drawn: its length `length` (mm) and, but for an arm kept
+    in mm, what it stands for (`value`, in its unit); a force plan's side by its ends."""
+    mm = unit("mm", lang)
+    if sides:
+        return f"{text('segment', lang)} {_n(s.start + '-' + s.end, lang)} = {length} {mm} → {_n(s.name, lang)} = {value}\u00a0{unit(s.unit, lang)}".rstrip()
+    if s.unit == "mm":                            # a length kept as drawn (the lever's arms): once
+        return f"{_n(s.name, lang)} = {length} {mm}"
+    return f"{_n(s.name, lang)}: {length} {mm} → {value}\u00a0{unit(s.unit, lang)}".rstrip()
+
+
+def _tabled(s: Segment) -> bool:
+    """Whether segment s has a row in the notes (`_table_row`): a vector or an arm."""
+    return s.kind in (*_ARROWS, "arm")
+
+
 def _table_rows(plan: Plan, lang: str) -> list[str]:
     """Every vector and arm drawn: its length and what it stands for."""
-    mm = unit("mm", lang)
-    sides = plan.kind.startswith("forces:")
-    out = []
-    for s in plan.segments:
-        if s.kind not in (*_ARROWS, "arm") or not math.isfinite(s.value):
-            continue
-        L = num(plan.length_mm(s.name), lang, decimals=2)
-        value = f"{num(s.value, lang)}\u00a0{unit(s.unit, lang)}".rstrip()
-        if sides:
-            out.append(f"{text('segment', lang)} {_n(s.start + '-' + s.end, lang)} = {L} {mm} → {_n(s.name, lang)} = {value}")
-        elif s.unit == "mm":                      # a length kept as drawn (the lever's arms): once
-            out.append(f"{_n(s.name, lang)} = {L} {mm}")
-        else:
-            out.append(f"{_n(s.name, lang)}: {L} {mm} → {value}")
-    return out
+    return [_table_row(s, num(plan.length_mm(s.name), lang, decimals=2), num(s.value, lang), lang,
+                       plan.kind.startswith("forces:"))
+            for s in plan.segments if _tabled(s) and math.isfinite(s.value)]
 
 
 #: The legend's sample stroke and the gaps after it and after its words, mm.
@@ -410,22 +414,30 @@ def _legend(cycle: PlanCycle, lang: str) -> tuple[list[str], tuple[float, float,
     return out, (x0, y0, right, _FRAME[3] - 1.5)
 
 
+def _row_columns(rows: list[str], width: float, left: bool) -> tuple[float, int]:
+    """The notes' rows of segments in columns across `width` mm (one in a column at the plan's
+    left): the columns' pitch (the widest row and 4 mm; a page's token as wide as _TOKEN_SAMPLE),
+    rows in a column."""
+    col_w = max((text_width(TOKEN.sub(_TOKEN_SAMPLE, plain(r)), _NOTE_MM) for r in rows), default=0.0) + 4.0
+    cols = 1 if left or not rows else max(1, int(width // col_w))
+    return col_w, -(-len(rows) // cols)
+
+
 def _notes_block(plan: Plan, lang: str, tiny: dict[str, str], left: bool, nofit: bool = False,
-                 draw: bool = True, bottom: float = _FRAME[3] - 1.5
+                 draw: bool = True, bottom: float = _FRAME[3] - 1.5, least: Mapping[bool, int] | None = None
                  ) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
     """SVG of the notes (none where not `draw`), the drawing area they leave: below the plan
     (bottom left, from `bottom` up (the legend's top), beside the title block) or, for a tall
-    plan, in a column at its left, and where the notes' lines go (x, first baseline, width; mm)."""
+    plan, in a column at its left, and where the notes' lines go (x, first baseline, width; mm);
+    room for at least `least[left]` lines (the page's notes of every angle: `_room`)."""
     x0 = _FRAME[0] + 3
     width = _LEFT_NOTES_MM if left else _BELOW_NOTES_MM
     lines = [w for n in _note_lines(plan, lang, tiny) for w in _wrap(n, _NOTE_MM, width)]
     if nofit:
         lines.append(text("nofit", lang))
     rows = [w for r in _table_rows(plan, lang) for w in (_wrap(r, _NOTE_MM, width) if left else [r])]
-    col_w = max((text_width(plain(r), _NOTE_MM) for r in rows), default=0.0) + 4.0
-    cols = 1 if left or not rows else max(1, int(width // col_w))
-    per_col = -(-len(rows) // cols) if rows else 0
-    height = _LINE_STEP * (len(lines) + per_col)
+    col_w, per_col = _row_columns(rows, width, left)
+    height = _LINE_STEP * max(len(lines) + per_col, (least or {}).get(left, 0))
     top = _AREA[1] if left else bottom - height
     out, where = [], (x0, top + ASCENT * _NOTE_MM, width)
     if draw:
@@ -455,7 +467,7 @@ def _placed_clear(box: tuple[float, float, float, float], spare: float, area: tu
 
 
 def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float, float, float], spare: float,
-            draw: bool = True, bottom: float = _FRAME[3] - 1.5
+            draw: bool = True, bottom: float = _FRAME[3] - 1.5, least: tuple[Mapping[bool, int] | None, ...] = (None,)
             ) -> tuple[list[str], tuple[float, float, float, float], tuple[float, float, float]]:
     """The notes of `plan` (SVG where `draw`, above `bottom`), the drawing area for a drawing of
     extent `box` and where the notes' lines go (`_notes_block`):
@@ -463,13 +475,15 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float
     else below with a note that it does not fit. Fitting: as drawn, `spare` mm to spare on every
     side (room for a vector drawn out of scale: `_room`), inside the frame and clear of the notes
     (their block from their first line down to the frame, the legend's row with it) and the title
-    block (`_placed_clear`)."""
-    for left in (False, True):
-        notes, area, where = _notes_block(plan, lang, tiny, left, draw=draw, bottom=bottom)
-        if area is not None and _placed_clear(box, spare, area, (where[0], where[1] - ASCENT * _NOTE_MM,
-                                                                  where[0] + where[2], _FRAME[3])):
-            return notes, area, where
-    return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw, bottom=bottom)
+    block (`_placed_clear`); room for at least the lines of the first of `least` with which it fits,
+    else of the last (`_notes_block`)."""
+    for lines in least:
+        for left in (False, True):
+            notes, area, where = _notes_block(plan, lang, tiny, left, draw=draw, bottom=bottom, least=lines)
+            if area is not None and _placed_clear(box, spare, area, (where[0], where[1] - ASCENT * _NOTE_MM,
+                                                                      where[0] + where[2], _FRAME[3])):
+                return notes, area, where
+    return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw, bottom=bottom, least=least[-1])
 
 
 def _note_groups(cycle: PlanCycle, lang: str, tiny: dict[str, np.ndarray]) -> tuple[list[list[str]], np.ndarray]:
@@ -508,7 +522,8 @@ def _wrapped(groups: list[list[str]], width: float) -> list[list[str]]:
 
 def _cycle_notes(cycle: PlanCycle, notes: tuple[list[list[str]], np.ndarray],
                  where: tuple[float, float, float], bottom: float, placer: Placer) -> list[Element]:
-    """The notes of every angle (`notes`: `_note_groups`; page.js writes each angle's numbers from
+    """The notes of every angle (`notes`: `_note_groups`, wrapped to the width of `where`:
+    `_wrapped`; page.js writes each angle's numbers from
     the lengths and values the page holds) as lines of text at `where` (x, first baseline, width;
     `_notes_block`), as many as fit above `bottom` (the legend's top): line k shows the k-th line
     of each angle's notes where it has one (its texts once, an index per angle) and where it is
@@ -517,7 +532,7 @@ def _cycle_notes(cycle: PlanCycle, notes: tuple[list[list[str]], np.ndarray],
     _TOKEN_SAMPLE)."""
     x, y, width = where
     room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9)     # whole lines (2 x 5.1 mm is 2)
-    groups = [lines[:room] for lines in _wrapped(notes[0], width)]
+    groups = [lines[:room] for lines in notes[0]]
     inverse = notes[1]
     out = []
     for k in range(max(map(len, groups), default=0)):
@@ -531,6 +546,44 @@ def _cycle_notes(cycle: PlanCycle, notes: tuple[list[list[str]], np.ndarray],
         e = _text_element(x, base, texts, variant, _NOTE_MM, cls="note")
         out.append(Element("text", np.where(has[:, None, None], e.xy, np.nan), e.attrs, texts=e.texts, variant=e.variant))
     return out
+
+
+def _page_rows(cycle: PlanCycle, lang: str) -> tuple[list[str], list[np.ndarray]]:
+    """The rows of the segments with a value at some angle (`_table_row`, their numbers as the
+    page's tokens), and at which angles each has one (N,)."""
+    sides = cycle.kind.startswith("forces:")
+    value = [(k, np.broadcast_to(np.isfinite(np.asarray(s.value, dtype=float)), (cycle.n,)))
+             for k, s in enumerate(cycle.segments) if _tabled(s)]
+    return ([_table_row(cycle.segments[k], _token(LENGTH, k), _token(VALUE, k), lang, sides) for k, v in value if v.any()],
+            [v for _, v in value if v.any()])
+
+
+def _cycle_rows(cycle: PlanCycle, lang: str, where: tuple[float, float, float], first: int, bottom: float,
+                placer: Placer) -> list[Element]:
+    """The rows of the segments (`_table_row`, their numbers as the page's tokens: page.js writes
+    each angle's from the lengths the page holds and the scale) below the notes' first `first`
+    lines at `where` (x, first baseline, width), in as many columns as the width holds (as
+    `_notes_block`), those that fit above `bottom`: one text of a line per row, at each angle the
+    rows of the segments with a value there whose line is clear of the plan (`placer`; a token as
+    wide as _TOKEN_SAMPLE)."""
+    x, y, width = where
+    rows, value = _page_rows(cycle, lang)
+    if not rows:
+        return []
+    col_w, per_col = _row_columns(rows, width, width == _LEFT_NOTES_MM)
+    room = int((bottom - (y - ASCENT * _NOTE_MM)) / _LINE_STEP + 1e-9) - first
+    lines, shown = [], []
+    for j, (r, v) in enumerate(zip(rows, value)):
+        if j % per_col >= room:
+            continue
+        w = text_width(TOKEN.sub(_TOKEN_SAMPLE, plain(r)), _NOTE_MM)
+        rx, base = x + col_w * (j // per_col), y + (first + j % per_col) * _LINE_STEP
+        box = np.tile([rx, base - ASCENT * _NOTE_MM, rx + w, base + (SUB_DROP + DESCENT) * _NOTE_MM], (cycle.n, 1))
+        lines.append(f'<tspan x="{rx:.1f}" y="{base:.1f}">{_rich(r, _NOTE_MM)}</tspan>')
+        shown.append(v & placer.clear(box))
+    texts, variant = _variants([tuple(np.flatnonzero(m)) for m in np.array(shown, dtype=bool).T])
+    e = _text_element(x, y, [""], [0], _NOTE_MM, cls="note")
+    return [Element("text", e.xy, e.attrs, texts=tuple("".join(lines[j] for j in t) for t in texts), variant=variant)]
 
 
 def _variants(strings: list) -> tuple[list, np.ndarray]:
@@ -905,12 +958,14 @@ def _points(cycle: PlanCycle, at, placer: Placer) -> tuple[list[Element], list[_
     return dots, labels
 
 
-def _room(cycle: PlanCycle, lang: str, notes: bool):
+def _room(cycle: PlanCycle, lang: str, notes: bool, page: bool = False):
     """The notes block (SVG where `notes`, of the angle whose notes take the most lines below the
     plan: the page's notes of every angle fit its room), the drawing area they leave and where the
     notes go, the legend of line weights (`_legend`: SVG, box), with what they were found from:
     (block, area, where, legend, legend's box, tiny, extents, box, the notes of every angle:
-    `_note_groups`)."""
+    `_note_groups`). `page`: room for the page's notes of every angle and its rows of segments
+    (`_cycle_notes`, `_cycle_rows`) beside or below the plan, else, where the plan would not fit
+    beside them, for its notes (the rows as many as fit)."""
     tiny = _tiny(cycle)
     ext = _extents(cycle)
     box = _union(ext)
@@ -919,7 +974,10 @@ def _room(cycle: PlanCycle, lang: str, notes: bool):
     i = int(np.argmax(lines))                                  # the notes' room: at the angle with the most lines
     legend, key = _legend(cycle, lang)
     spare = MIN_DRAWN_MM if any((v == _OUT).any() for v in tiny.values()) else 0.0   # a vector drawn out of scale
-    block, area, where = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, spare, draw=notes, bottom=key[1])
+    rows = _page_rows(cycle, lang)[0] if page else []
+    least = tuple({left: max(map(len, _wrapped(groups, w)), default=0) + _row_columns(r, w, left)[1]
+                   for left, w in ((False, _BELOW_NOTES_MM), (True, _LEFT_NOTES_MM))} for r in (rows, [])) if page else (None,)
+    block, area, where = _layout(cycle.at(i), lang, _tiny_at(tiny, i), box, spare, draw=notes, bottom=key[1], least=least)
     return block, area, where, legend, key, tiny, ext, box, (groups, inverse)
 
 
@@ -939,7 +997,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     """The sheet of the cycle at every angle (`drawing`); with the notes block (of angle 0) where
     `notes`, the notes of every angle (`_cycle_notes`) where `cycle_notes`."""
     _lang(lang)
-    block, (ax0, ay0, ax1, ay1), where, legend, key, tiny, ext, box, note_groups = _room(cycle, lang, notes)
+    block, (ax0, ay0, ax1, ay1), where, legend, key, tiny, ext, box, note_groups = _room(cycle, lang, notes, page=cycle_notes)
     x0, y0, x1, y1 = box
     tx, ty = _shifts(ext, (ax0, ay0, ax1, ay1), (ax0 + ax1) / 2 - (x0 + x1) / 2, (ay0 + ay1) / 2 + (y0 + y1) / 2)
 
@@ -958,7 +1016,9 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
     dots, points = _points(cycle, at, placer)
     elements += dots + _labels(placer, points + names)
     if cycle_notes:
-        elements += _cycle_notes(cycle, note_groups, where, key[1], placer)
+        wrapped = _wrapped(note_groups[0], where[2])
+        elements += _cycle_notes(cycle, (wrapped, note_groups[1]), where, key[1], placer)
+        elements += _cycle_rows(cycle, lang, where, max(map(len, wrapped), default=0), key[1], placer)
     title = _title_block(cycle, lang, mechanism)
     W, H = SHEET_MM
     x0, y0, x1, y1 = _TITLE_BLOCK
