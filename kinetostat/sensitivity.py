@@ -10,7 +10,7 @@ through the model's expressions (`Mechanism.expressions`, evaluated on duals by
 bodies, g, the crank speed, load values and scales).
 
 The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source, its nominal
-analysis `fast.analyze_fast`'s (as `analyze` takes it from FAST_MIN angles on).
+analysis `fast.analyze_fast`'s.
 
 May use: numpy, analysis, applied, expressions, fast (analyze_fast), fast_sensitivity, groups, kinematics (its Kinematics), model
 (parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
