@@ -15,7 +15,7 @@ between two passes, as `fast` does: the "motion" kernel writes the kinematics an
 tangents, `sensitivity` evaluates the loads on those duals (numpy, `applied.load_wrenches`),
 the "full" kernel reads them (X) and their tangents (DX).
 
-May use: numpy, groups, program, fast (its layout, kernel module, speeds, pool), kernel_cache, model
+May use: numpy, groups, program, fast (its layout, kernel module, speeds, pool, `loaded`), kernel_cache, model
 (for type hints).
 """
 from __future__ import annotations
@@ -33,7 +33,7 @@ from .program import Identifiers, statics_program
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["jvp_source", "pays", "refusal", "tangents", "PRIMITIVE_JVPS"]
+__all__ = ["jvp_source", "kernels", "pays", "refusal", "tangents", "PRIMITIVE_JVPS"]
 
 
 # ----------------------------------------------------------------------------- the primitives' rules
@@ -246,7 +246,8 @@ def _is_complex(name: str) -> bool:
 
 
 def _rows(mech: "Mechanism", p: int, kind: str) -> dict[str, int]:
-    """Each output's first row in the buffer: its value, then its p tangents (a complex one two rows each)."""
+    """Each output's first row (of n values) in the buffer: its value, then its p tangents (a complex
+    one two rows each, its real and imaginary parts interleaved: a view as complex, no copy)."""
     rows, r = {}, 0
     for name in _outs(mech, kind):
         rows[name] = r
@@ -314,7 +315,7 @@ def _source(mech: "Mechanism", p: int, kind: str) -> str:
         r = rows[name]
         for q, x in enumerate([v(name)] + [f"{v(name)}_d{q}" for q in range(p)]):
             if _is_complex(name):
-                body += [f"S[U({r + 2 * q}) * n + i] = {x}.real", f"S[U({r + 2 * q + 1}) * n + i] = {x}.imag"]
+                body += [f"S[U({r + 2 * q}) * n + i + i] = {x}.real", f"S[U({r + 2 * q}) * n + i + i + U(1)] = {x}.imag"]
             else:
                 body.append(f"S[U({r + q}) * n + i] = {x}")
     body.append("FL[i] = not ok")
@@ -328,16 +329,28 @@ def _source(mech: "Mechanism", p: int, kind: str) -> str:
 
 def pays(mech: "Mechanism", n: int, p: int) -> bool:
     """Whether `n` angles of `mech`'s sensitivities to p parameters go the compiled path: as
-    `fast.pays` (FAST_MIN where this process holds the kernel, FAST_COLD where it would load or
-    compile it) and `refusal` is None."""
+    `fast.pays` (FAST_MIN where this process holds the kernels, its own and the analysis' that
+    gives `sens.result`; FAST_COLD where it would load or compile one) and `refusal` is None."""
     if n < fast.FAST_MIN or not fast.available() or refusal(mech) is not None:
         return False
     held = True
-    for kind in ("motion", "full") if mech.loads or mech.springs else ("full",):
+    for kind in _kinds(mech):
         src = mech.memo(("sensitivity kernel source", p, kind), lambda: _source(mech, p, kind))
         with fast._LOCK:
             held &= src in fast._KERNELS
+        held &= fast.loaded(mech, kind)
     return n >= (fast.FAST_MIN if held else fast.FAST_COLD)
+
+
+def _kinds(mech: "Mechanism") -> tuple[str, ...]:
+    """The kernels `mech`'s sensitivities run: "motion" then "full" where it has loads besides gravity."""
+    return ("motion", "full") if mech.loads or mech.springs else ("full",)
+
+
+def kernels(mech: "Mechanism", p: int) -> list:
+    """The compiled kernels (numba dispatchers) of `mech`'s sensitivities to p parameters, loaded
+    or compiled as a call would (`_kinds`)."""
+    return [_kernel(mech, p, kind) for kind in _kinds(mech)]
 
 
 def _kernel(mech: "Mechanism", p: int, kind: str):
@@ -388,8 +401,7 @@ def tangents(mech: "Mechanism", c: Mapping[str, Any], phi: np.ndarray, p: int, k
     for name in _outs(mech, kind):
         r = rows[name]
         if _is_complex(name):
-            z = S[r * N:(r + 2 * (1 + p)) * N].reshape(1 + p, 2, N)
-            z = z[:, 0] + 1j * z[:, 1]
+            z = S[r * N:(r + 2 * (1 + p)) * N].view(complex).reshape(1 + p, N)
         else:
             z = S[r * N:(r + 1 + p) * N].reshape(1 + p, N)
         out[name] = (z[0], z[1:].T)

@@ -9,9 +9,10 @@ through the model's expressions (`Mechanism.expressions`, evaluated on duals by
 `expressions.over_arrays`) and through the fields they fill (points, masses, moments of inertia,
 bodies, g, the crank speed, load values and scales).
 
-The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source.
+The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source, its nominal
+analysis `fast.analyze_fast`'s.
 
-May use: numpy, analysis, applied, expressions, fast_sensitivity, groups, kinematics (its Kinematics), model
+May use: numpy, analysis, applied, expressions, fast (analyze_fast), fast_sensitivity, groups, kinematics (its Kinematics), model
 (parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
@@ -23,7 +24,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from . import fast_sensitivity, groups
+from . import fast, fast_sensitivity, groups
 from .analysis import Analysis, _labelled, _xarray, crank_angles, exact
 from .applied import load_wrenches, stroke
 from .expressions import ExpressionError, over_arrays, parse
@@ -474,7 +475,8 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     The reactions are the frictionless ones (friction's first approximation). ValueError naming
     an unknown parameter, or a field that a parameter reaches and that is not carried.
     path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernels over
-    the same source, the loads besides gravity evaluated on duals between their two passes), or
+    the same source, the loads besides gravity evaluated on duals between their two passes; the
+    nominal analysis `sens.result` by `fast.analyze_fast`, the same to rounding), or
     "auto": the compiled one where `fast_sensitivity.pays` (its kernel held from FAST_MIN angles, else
     from FAST_COLD; a mechanism it takes)."""
     valid = [*mech.parameters, "g"]
@@ -494,7 +496,7 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     phi_deg = crank_angles(phi_deg, steps)
     if path == "auto":
         path = "compiled" if fast_sensitivity.pays(mech, len(phi_deg), len(params)) else "numpy"
-    result = exact(mech, phi_deg, "first")
+    result = fast.analyze_fast(mech, phi_deg) if path == "compiled" else exact(mech, phi_deg, "first")
     values, fields = _seeded(mech, params)
     _refuse_unsmooth(mech, values)
     c, pts, view = _design(mech, fields)

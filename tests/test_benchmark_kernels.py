@@ -96,3 +96,14 @@ def test_cpu_info_names_the_cpu_and_its_vector_flags():
     assert ("avx2" in info["vector_flags"].split()) == ("avx2" in flags)
     assert ("avx512f" in info["vector_flags"].split()) == ("avx512f" in flags)
     assert info["model"] and info["llvm_target"] and len(info["load"].split()) == 3
+
+
+@pytest.mark.slow   # the sensitivity kernel of the four-bar (compiled once per machine: minutes on a busy 2-core one)
+def test_sensitivity_cost_times_the_plain_analysis_and_the_sensitivities():
+    """The benchmark's issue-39 budget: one row for the plain compiled analysis (ratio 1) and one
+    per count of parameters, the first p of the model's, with the budget (1 + 0.6 p) beside."""
+    from kinetostat_validation.benchmark import sensitivity_cost, sensitivity_lines
+    rows = sensitivity_cost(models=("chain_unit_four_bar",), angles=20_000, counts=(1,), rounds=1)
+    assert [(r["p"], r["params"], r["budget"]) for r in rows] == [(0, [], 1.0), (1, ["r"], 1.6)]
+    assert rows[0]["ratio"] == 1.0 and math.isfinite(rows[1]["ratio"]) and rows[1]["ratio"] > 0
+    assert "| chain_unit_four_bar | 1 (r) |" in "\n".join(sensitivity_lines(rows))

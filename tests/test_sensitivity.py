@@ -285,10 +285,13 @@ def test_unknown_path_is_refused_by_name():
                          ids=["chain_unit_four_bar", "ice_crank_slider"])
 def test_compiled_and_numpy_paths_agree(path, params):
     """path='compiled' (the ICE: its gas diagram on the motion kernel's duals between the two
-    passes) gives the numpy path's derivatives to 1e-12 of each output's largest."""
+    passes) gives the numpy path's derivatives to 1e-12 of each output's largest, and its nominal
+    analysis (the compiled one, `fast.analyze_fast`) the numpy path's."""
     mech = kinetostat.load(path)
     a = kinetostat.sensitivity(mech, params, steps=360, path="numpy")
     b = kinetostat.sensitivity(mech, params, steps=360, path="compiled")
+    for x, y in ((a.result.balancing_moment, b.result.balancing_moment), (a.result.forces.R, b.result.forces.R)):
+        assert np.max(np.abs(x - y)) <= 1e-12 * np.max(np.abs(x))
     for name, _, acc in outputs(mech, mech.point_names[-1]):
         for p in params:
             x, y = acc(a)[p], acc(b)[p]

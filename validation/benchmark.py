@@ -5,6 +5,7 @@
     python -m kinetostat_validation.benchmark --quick      # fewer repeats and settings, prints only
     python -m kinetostat_validation.benchmark --drawing-budgets   # only the drawing layer's budgets, printed
     python -m kinetostat_validation.benchmark --tolerance 100000  # only a Monte Carlo tolerance study's rate, printed
+    python -m kinetostat_validation.benchmark --sensitivity 100000  # only the compiled sensitivities' cost, printed
 
 Every route runs over the same full cycle (360 angles) and is timed as the median of repeated
 runs in one process; its error is the worst peak-relative error over the driving moment and
@@ -881,6 +882,48 @@ def tolerance_lines(r: dict) -> list[str]:
         f"load average (1, 5, 15 min) before {r['load_before']}, after {r['load_after']}"]
 
 
+def sensitivity_cost(models: tuple[str, ...] = ("chain_unit_four_bar", "ice_crank_slider"), angles: int = 10**5,
+                     counts: tuple[int, ...] = (1, 2, 5), rounds: int = 3) -> list[dict]:
+    """Issue 39's budget: the compiled sensitivities to p parameters (the first p of the model's
+    [parameters], in order) against the plain compiled analysis (`fast.analyze_fast`) of the same
+    `angles`, in one process: CPU time per angle, the minimum of `rounds` interleaved rounds,
+    after a first call of each that loads or compiles its kernels (its time stated apart, and
+    whether numba compiled them: its disk cache missed), against the budget (1 + 0.6 p)x."""
+    from kinetostat import fast_sensitivity
+    rows = []
+    for model in models:
+        mech = kinetostat.load(model)
+        phi = crank_angles(None, angles)
+        names = list(mech.parameters)
+        runs = {0: lambda: fast.analyze_fast(mech, phi)}
+        runs.update({p: (lambda p=p: kinetostat.sensitivity(mech, names[:p], phi_deg=phi, path="compiled"))
+                     for p in counts})
+        first = {p: _timed(run) for p, run in runs.items()}
+        compiled = {p: any(k.stats.cache_misses for k in fast_sensitivity.kernels(mech, p)) for p in counts}
+        load = os.getloadavg()
+        best = dict.fromkeys(runs, math.inf)
+        for _ in range(rounds):
+            for p, run in runs.items():
+                best[p] = min(best[p], _timed(run)[0])
+        rows += [dict(model=model, p=p, params=names[:p], angles=angles, ns_per_angle=best[p] / angles * 1e9,
+                      ratio=best[p] / best[0], budget=1 + 0.6 * p, first_cpu=first[p][0], first_wall=first[p][1],
+                      compiled=compiled.get(p), load=(load, os.getloadavg())) for p in runs]
+    return rows
+
+
+def sensitivity_lines(rows: list[dict]) -> list[str]:
+    out = ["| model | p (parameters) | CPU per angle, ns | x plain | budget | first call, s CPU / wall |",
+           "|---|---|---|---|---|---|"]
+    for r in rows:
+        what = "plain analysis" if not r["p"] else f"{r['p']} ({', '.join(r['params'])})"
+        first = f"{r['first_cpu']:.2f} / {r['first_wall']:.2f}" + (" (compiled)" if r["compiled"] else "")
+        budget = f"{r['budget']:.1f}" if r["p"] else ""
+        out.append(f"| {r['model']} | {what} | {r['ns_per_angle']:.0f} | {r['ratio']:.2f} | {budget} | {first} |")
+    return out + [f"{r['angles']:,} angles; CPU: this process, all its threads; the minimum of interleaved rounds. Load "
+                  f"average (1, 5, 15 min) {r['load'][0]} before the rounds, {r['load'][1]} after"
+                  for r in rows if r["p"] == 0]
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = parser("benchmark", __doc__)
     ap.add_argument("--quick", action="store_true", help="fewer repeats and settings; print only")
@@ -889,7 +932,13 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--tolerance", metavar="N", type=int,
                     help="only a Monte Carlo tolerance study of N designs of the four-bar beside a sweep of as "
                          "many (positions per second per core); print only")
+    ap.add_argument("--sensitivity", metavar="N", type=int,
+                    help="only the compiled sensitivities' cost (p = 1, 2, 5) against the plain compiled analysis of "
+                         "N angles of the four-bar and the ICE; print only")
     args = ap.parse_args(argv)
+    if args.sensitivity:
+        print("\n".join(sensitivity_lines(sensitivity_cost(angles=args.sensitivity))))
+        return
     if args.tolerance:
         print("\n".join(tolerance_lines(tolerance_rate(args.tolerance))))
         return
