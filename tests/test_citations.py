@@ -38,7 +38,7 @@ def test_bundled_files_cite_by_author_and_year(path):
         assert any(w.key in text for w in WORKS), path.name
 
 
-@pytest.mark.parametrize("lang", ["en", "uk", "ru"])
+@pytest.mark.parametrize("lang", [pytest.param("en", marks=pytest.mark.slow), "uk", pytest.param("ru", marks=pytest.mark.slow)])
 def test_a_variant_model_its_key_and_its_cli_lines_cite_by_author_and_year(lang, tmp_path):
     v = variants.variant(2, "479")
     with warnings.catch_warnings():

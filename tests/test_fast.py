@@ -330,12 +330,18 @@ def test_a_later_process_loads_the_kernel_from_the_cache(kernel_cache):
     assert (hits, misses, overloads) == ("1", "0", "1")
 
 
+@pytest.fixture(scope="module")
+def primitives():
+    """fast.cis and fast.phase compiled as the kernel compiles them, once for the module."""
+    import numba
+    return numba.njit(fast.cis), numba.njit(fast.phase)
+
+
 @pytest.mark.parametrize("scale", [1e-3, 1.0, 30.0, 1e5])
-def test_the_compiled_primitives_are_numpys_to_an_ulp(scale):
+def test_the_compiled_primitives_are_numpys_to_an_ulp(scale, primitives):
     """cis (polynomial sincos) and phase (polynomial atan2) against numpy's exp and arctan2,
     compiled as the kernel compiles them; NaN stays NaN; phase(0) = 0 as arctan2(0, 0)."""
-    import numba
-    cis, phase = numba.njit(fast.cis), numba.njit(fast.phase)
+    cis, phase = primitives
     rng = np.random.default_rng(int(scale * 7))
     th = scale * rng.standard_normal(2000)
     got = np.array([cis(t) for t in th])

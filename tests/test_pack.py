@@ -9,6 +9,7 @@ import re
 import shutil
 import subprocess
 import warnings
+from functools import lru_cache
 
 import numpy as np
 import pytest
@@ -47,9 +48,15 @@ def uk_479(tmp_path_factory):
     return out
 
 
+@lru_cache(maxsize=None)
+def built(task: int, code: str, lang: str, draws: int = P.BAND_DRAWS) -> P.Pack:
+    """`P.pack` of variant task/code, built once per module (a pack takes seconds: its A3 sheet's search)."""
+    return P.pack(variants.variant(task, code), lang=lang, draws=draws)
+
+
 @pytest.fixture(scope="module")
 def pack_uk():
-    return P.pack(variants.variant(1, "479"), lang="uk")
+    return built(1, "479", "uk")
 
 
 def test_the_command_writes_the_pack(uk_479):
@@ -125,7 +132,7 @@ def test_the_sheet_holds_no_answer(uk_479, pack_uk):
     ("ru", ("Ключ ответов", "Границы тщательного чертежа", "Частота вращения кривошипа")),
     pytest.param("en", ("Answer key", "Band of a careful drawing", "Crank speed"), marks=pytest.mark.slow)])
 def test_the_same_in_russian_and_english(lang, words, tmp_path):
-    p = P.pack(variants.variant(1, "479"), lang=lang)
+    p = built(1, "479", lang)
     for name, blocks in (("sheet", p.sheet), ("key", p.key)):                        # as Pack.write renders them
         (tmp_path / f"{name}.pdf").write_bytes(P._pdf(blocks, name))
     sheet, key = pdftext(tmp_path / "sheet.pdf"), pdftext(tmp_path / "key.pdf")
@@ -147,10 +154,11 @@ def test_html_pages_stand_alone(uk_479):
     assert 'src="velocity.svg"' in (tmp_path / "plans.html").read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize("lang", ["en", "ru"])
-def test_the_blocks_in_each_language(lang):
-    """The sheet and key, as their blocks (what both the PDF and the HTML print): every text in `lang`."""
-    p = P.pack(variants.variant(3, "479"), lang=lang, draws=50)
+@pytest.mark.parametrize("lang, draws", [("en", 20), ("ru", P.BAND_DRAWS)])
+def test_the_blocks_in_each_language(lang, draws):
+    """The sheet and key, as their blocks (what both the PDF and the HTML print): every text in `lang`
+    (the packs other tests here build)."""
+    p = built(1, "479", lang, draws)
     texts = [x for kind, x in p.sheet + p.key if kind in ("h1", "h2", "p")]
     texts += [c for kind, x in p.sheet + p.key if kind == "table" for row in (x.head,) + x.rows for c in row]
     assert (english(" ".join(texts)) == set()) is (lang != "en")
@@ -240,12 +248,11 @@ def test_the_a3_sheet_draws_every_plan_true_to_scale(pack_uk):
 
 
 @needs_poppler
-def test_the_a3_pdf_titles_each_plan_with_its_scales(uk_479):
+def test_the_a3_pdf_titles_each_plan_with_its_scales(uk_479, pack_uk):
     """Each panel heads its plan with every scale it is drawn at: the force scales of the group,
     crank and lever plans appear on the sheet (at the sheet's own scales, `one_sheet`)."""
     page = pdftext(uk_479 / "plans_a3.pdf")
-    from kinetostat.plans.a3 import one_sheet
-    plans = one_sheet(variants.variant(1, "479").mechanism(), 150.0, "uk").plans
+    plans = pack_uk.plans                                      # a3.one_sheet of variant 1 479 at phi1 = 150 deg, uk
     from kinetostat.plans.draw import scale_text, scales_of
     from kinetostat.plans.symbols import plain
     for kind in ("group:2,3", "crank", "lever"):
@@ -261,7 +268,7 @@ def test_the_key_states_each_plans_scales_and_its_arms_agree(task, code):
     crank's at 100 N/mm, besides the force plan's μ_F); the crank's arm h_R21 in the values table
     is its length in the segments table (task 3 123 printed 21.86 and 16.4 mm), both at the key's μ_l."""
     from kinetostat.plans.draw import scale_text, scales_of
-    p = P.pack(variants.variant(task, code), lang="en", draws=20)
+    p = built(task, code, "en", draws=20)
     tables = [x for kind, x in p.key if kind == "table"]
     flat = [c for t in tables for row in t.rows for c in row]
     mu_l = p.plans.scales["mu_l"]
