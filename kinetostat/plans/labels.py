@@ -98,12 +98,14 @@ def _label_runs(name: str) -> tuple[tuple[str, int], ...]:
     return tuple(rs)
 
 
+@lru_cache(maxsize=4096)
 def label_width(name: str, size: float) -> float:
     """Width of a lettered name (several names joined by ' ≡ ', a value after ' = ' allowed) as
     `label_markup` sets it, mm."""
     return sum(text_width(t, _run_size(level, size)) for t, level in _label_runs(name))
 
 
+@lru_cache(maxsize=4096)
 def label_height(name: str, size: float) -> tuple[float, float]:
     """(above, below) the baseline of a lettered name as `label_markup` sets it, mm."""
     levels = {level for _, level in _label_runs(name)}
@@ -358,7 +360,7 @@ class Placer:
             base[outside | ~fixed[rows][:, None]] = np.inf
             return xy, base
 
-        still = bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
+        still = n == 1 or bool(np.array_equal(A, np.broadcast_to(A[:1], A.shape), equal_nan=True)
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
         with np.errstate(invalid="ignore"):
