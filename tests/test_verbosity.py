@@ -9,7 +9,7 @@ import re
 
 import pytest
 
-from conftest import ROOT, sketch_plots
+from conftest import ROOT, sketch_report
 from kinetostat import _forecast
 from kinetostat.cli import build_parser
 
@@ -40,7 +40,7 @@ def test_quiet_and_verbose_before_or_after_every_command():
 
 
 def test_quiet_report_prints_nothing_and_verbose_shows_its_progress(cli, tmp_path, monkeypatch):
-    sketch_plots(monkeypatch)
+    sketch_report(monkeypatch)
     quick = ["--engines", "none", "--no-page", "--steps", "8", "--jobs", "1", "--out", tmp_path]
     r = cli("-q", "report", FOUR_BAR_MODEL, *quick)
     assert (r.returncode, r.stdout, r.stderr) == (0, "", "")
@@ -64,7 +64,7 @@ def test_report_says_what_it_will_do_first_then_each_part_of_a_model(tmp_path, m
     each with its time (-q: none of them, test_quiet_report_prints_nothing_...)."""
     from kinetostat import cli
     from kinetostat.cli import report
-    sketch_plots(monkeypatch)
+    sketch_report(monkeypatch)
     before_models = []
     reports = report._report_results
     monkeypatch.setattr(report, "_report_results",
