@@ -12,21 +12,18 @@ import numpy as np
 import pytest
 
 import kinetostat
-from conftest import MODELS, ROOT
+from conftest import EVERY_GROUP, MODELS, ROOT, sampled
 from kinetostat_validation.export import to_mjcf, to_urdf
 from kinetostat_validation.scene import build_scene
 
 ICE = ROOT / "models" / "ice_crank_slider.toml"
-ids = [p.stem for p in MODELS]
-
-
 def _com_positions(mech) -> dict[int, np.ndarray]:
     """kinetostat's centre of mass of every link with mass at phi = 0, world, m."""
     res = kinetostat.analyze(mech, phi_deg=[0.0])
     return {k.id: res.position(k.com)[0] for k in mech.links[1:] if k.com and k.mass > 0}
 
 
-@pytest.mark.parametrize("path", MODELS, ids=ids)
+@pytest.mark.parametrize("path", sampled(MODELS, EVERY_GROUP))
 def test_mjcf_loads_in_mujoco_and_its_keyframe_is_assembled(path):
     mujoco = pytest.importorskip("mujoco")
     mech = kinetostat.load(path)
@@ -63,7 +60,7 @@ def _pin_q(pin, model, values: dict[str, float]) -> np.ndarray:
     return q
 
 
-@pytest.mark.parametrize("path", MODELS, ids=ids)
+@pytest.mark.parametrize("path", sampled(MODELS, EVERY_GROUP))
 def test_urdf_parses_and_loads_in_pinocchio_with_the_moving_mass(path):
     mech = kinetostat.load(path)
     text = to_urdf(mech)
