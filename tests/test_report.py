@@ -156,12 +156,14 @@ def test_verdict_failed_checks_and_contents_on_top(ice_report):
 def test_failed_checks_are_listed(tmp_path, sketched_report):
     """A solver answer that is wrong on purpose: the report says FAIL and names the checks."""
     from dataclasses import replace
-    mech = kinetostat.load(ICE)
+    p = tmp_path / "four_bar.toml"
+    p.write_text(FOUR_BAR)
+    mech = kinetostat.load(p)
     res = kinetostat.analyze(mech, steps=24)
     wrong = replace(res, forces=replace(res.forces, M_bal=res.forces.M_bal * 1.01))
-    run = run_validation(mech, ["pinocchio"], steps=24, res=wrong, path=ICE)
-    summary = write_report(run, tmp_path)
-    md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
+    run = run_validation(mech, ["pinocchio"], steps=24, res=wrong, path=p)
+    summary = write_report(run, tmp_path / "out")
+    md = (tmp_path / "out" / "four_bar" / "index.md").read_text()
     assert not summary["passed"] and summary["failed"] == 2          # pinocchio, and the lever identity
     assert f"**FAIL**: 2 of {len(run.checks)} checks beyond tolerance" in md.split("## ")[0]
     assert re.search(r"^- lever M_drive: peak-relative error 9\.9\de-03 > tolerance 1e-11 ", md, re.M)
