@@ -233,3 +233,18 @@ def within(call, seconds: float = 10.0):
     t.join(seconds)
     assert out, f"{call} did not return within {seconds} s"
     return out[0]
+
+
+@pytest.fixture
+def sketched_report(monkeypatch):
+    """`sketch_report` for one test."""
+    sketch_report(monkeypatch)
+
+
+def sketch_report(monkeypatch: pytest.MonkeyPatch) -> None:
+    """`sketch_plots`, and each plan sheet of a report (`kinetostat.plans.svg`, most of a sketched
+    report's time) written as a 1-pixel SVG too: for tests of a report's text, tables, folders and
+    errors that look at no picture (the sheets themselves: tests/test_plans*.py)."""
+    import kinetostat.plans
+    sketch_plots(monkeypatch)
+    monkeypatch.setattr(kinetostat.plans, "svg", lambda plan, **_: '<svg xmlns="http://www.w3.org/2000/svg" width="1" height="1"/>\n')

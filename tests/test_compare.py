@@ -18,8 +18,10 @@ pytest.importorskip("pymunk")
 
 @pytest.mark.parametrize("path", sampled(MODELS))
 def test_every_route_passes_on_every_bundled_model(path):
+    """At 72 angles (every 5 deg): the simulations integrate at their own steps per revolution, so
+    each angle's comparison is the one a 360-angle run makes there, at a fifth of the exact routes' cost."""
     mech = kinetostat.load(path)
-    c = cmp.compare(mech, steps=360)
+    c = cmp.compare(mech, steps=72)
     assert not c.skipped
     assert set(c.results) == set(cmp.ROUTES)
     failed = [(r.route, r.quantity, r.peak_relative) for r in c.rows if not r.passed]
@@ -29,7 +31,7 @@ def test_every_route_passes_on_every_bundled_model(path):
         assert [r.quantity for r in c.rows if r.route == route] == cmp.quantity_names(mech, route)
     for r in c.rows:
         if r.route in ("pinocchio", "mujoco"):
-            assert r.n_compared == 360 and r.peak_relative < 1e-9
+            assert r.n_compared == 72 and r.peak_relative < 1e-9
 
 
 @pytest.fixture(scope="module")

@@ -6,29 +6,24 @@ from __future__ import annotations
 import math
 import os
 import re
-import subprocess
-import sys
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
 
 import kinetostat
-from conftest import MODELS, ROOT
+from conftest import EVERY_GROUP, MODELS, ROOT, sampled
 from kinetostat_validation.export import to_mjcf, to_urdf
 from kinetostat_validation.scene import build_scene
 
 ICE = ROOT / "models" / "ice_crank_slider.toml"
-ids = [p.stem for p in MODELS]
-
-
 def _com_positions(mech) -> dict[int, np.ndarray]:
     """kinetostat's centre of mass of every link with mass at phi = 0, world, m."""
     res = kinetostat.analyze(mech, phi_deg=[0.0])
     return {k.id: res.position(k.com)[0] for k in mech.links[1:] if k.com and k.mass > 0}
 
 
-@pytest.mark.parametrize("path", MODELS, ids=ids)
+@pytest.mark.parametrize("path", sampled(MODELS, EVERY_GROUP))
 def test_mjcf_loads_in_mujoco_and_its_keyframe_is_assembled(path):
     mujoco = pytest.importorskip("mujoco")
     mech = kinetostat.load(path)
@@ -65,7 +60,7 @@ def _pin_q(pin, model, values: dict[str, float]) -> np.ndarray:
     return q
 
 
-@pytest.mark.parametrize("path", MODELS, ids=ids)
+@pytest.mark.parametrize("path", sampled(MODELS, EVERY_GROUP))
 def test_urdf_parses_and_loads_in_pinocchio_with_the_moving_mass(path):
     mech = kinetostat.load(path)
     text = to_urdf(mech)
@@ -101,21 +96,16 @@ def test_urdf_parses_and_loads_in_pinocchio_with_the_moving_mass(path):
 
 # ----------------------------------------------------------------------------- command line
 
-def _run(*args, cwd) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "kinetostat", "export", *map(str, args)], capture_output=True,
-                          text=True, cwd=cwd, timeout=120)
-
-
-def test_cli_writes_both_formats(tmp_path):
+def test_cli_writes_both_formats(tmp_path, cli):
     mech = kinetostat.load(ICE)
-    r = _run(ICE, "--mjcf", "-o", tmp_path / "ice.xml", cwd=tmp_path)
+    r = cli("export", ICE, "--mjcf", "-o", tmp_path / "ice.xml", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "ice.xml").read_text(encoding="utf-8") == to_mjcf(mech)
-    r = _run(ICE, "--urdf", "-o", tmp_path / "ice.xml", cwd=tmp_path)        # replaces the file
+    r = cli("export", ICE, "--urdf", "-o", tmp_path / "ice.xml", cwd=tmp_path)        # replaces the file
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "ice.xml").read_text(encoding="utf-8") == to_urdf(mech)
     assert sorted(os.listdir(tmp_path)) == ["ice.xml"]                        # no temporary file left
-    r = _run(ICE, "--urdf", cwd=tmp_path)                                      # stdout
+    r = cli("export", ICE, "--urdf", cwd=tmp_path)                                      # stdout
     assert r.returncode == 0 and r.stdout == to_urdf(mech)
 
 
@@ -126,8 +116,8 @@ def test_cli_writes_both_formats(tmp_path):
     ((ICE, "--mjcf", "-o", "."), "it is a directory"),
     (("nope.toml", "--urdf"), "model file not found: nope.toml"),
 ])
-def test_cli_bad_input_is_one_line(tmp_path, args, message):
-    r = _run(*args, cwd=tmp_path)
+def test_cli_bad_input_is_one_line(tmp_path, cli, args, message):
+    r = cli("export", *args, cwd=tmp_path)
     assert r.returncode == 2
     assert message in r.stderr and len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
     assert os.listdir(tmp_path) == []

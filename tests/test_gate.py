@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import subprocess
 import sys
 from dataclasses import replace
 
@@ -28,19 +26,12 @@ SIX = ROOT / "models" / "furnace_loader_six_bar.toml"
 N_REFERENCE = sum(len(quantities(kinetostat.load(p), "reference")) for p in (ICE, CHAIN))
 ENGINES = ("pinocchio", "mujoco", "pymunk")
 
-#: Runs the CLI with every physics engine unimportable (as on a CI without them).
-HIDDEN = ("import sys\n"
-          f"for name in {ENGINES!r}:\n"
-          "    sys.modules[name] = None\n"
-          "from kinetostat.cli import main\n"
-          "sys.exit(main(sys.argv[1:]))\n")
-
-
-def cli(*args, hide: bool = False) -> subprocess.CompletedProcess:
-    env = {k: v for k, v in os.environ.items() if k != "KINETOSTAT_MODELS"}
-    head = ["-c", HIDDEN] if hide else ["-m", "kinetostat"]
-    return subprocess.run([sys.executable, *head, *map(str, args)], capture_output=True, text=True, env=env,
-                          cwd=ROOT, timeout=300)
+@pytest.fixture
+def hidden(monkeypatch) -> None:
+    """Every physics engine unimportable in this process for the test (as on a CI without them):
+    `import pinocchio` raises ImportError, as `kinetostat_validation.compare.available` reads it."""
+    for name in ENGINES:
+        monkeypatch.setitem(sys.modules, name, None)
 
 
 # ----------------------------------------------------------------------------- published values
@@ -240,8 +231,8 @@ def test_json_writes_nan_as_null():
 
 # ----------------------------------------------------------------------------- the CLI without engines
 
-def test_validate_with_the_engines_hidden():
-    r = cli("validate", ICE, CHAIN, "--steps", 72, "--no-progress", hide=True)
+def test_validate_with_the_engines_hidden(cli, hidden):
+    r = cli("validate", ICE, CHAIN, "--steps", 72, "--no-progress")
     assert r.returncode == 0, r.stdout + r.stderr
     assert "Traceback" not in r.stderr
     for engine in ENGINES:
@@ -255,8 +246,8 @@ def test_validate_with_the_engines_hidden():
     assert "4 route(s) skipped" in lines[-1] or "8 route(s) skipped" in lines[-1]
 
 
-def test_validate_json_with_the_engines_hidden():
-    r = cli("validate", ICE, CHAIN, "--steps", 72, "--json", "-", hide=True)
+def test_validate_json_with_the_engines_hidden(cli, hidden):
+    r = cli("validate", ICE, CHAIN, "--steps", 72, "--json", "-")
     assert r.returncode == 0, r.stderr
     doc = json.loads(r.stdout)
     assert doc["passed"] and doc["exit_code"] == 0
@@ -274,14 +265,14 @@ def test_validate_json_with_the_engines_hidden():
     assert "== ice_crank_slider:" in r.stderr           # the people's table went to stderr
 
 
-def test_engines_none_stands_alone():
+def test_engines_none_stands_alone(cli):
     r = cli("validate", ICE, "--engines", "none", "pinocchio")
     assert r.returncode == 2 and "stands alone" in r.stderr and "Traceback" not in r.stderr
 
 
-def test_report_without_engines(tmp_path):
+def test_report_without_engines(tmp_path, cli, hidden, sketched_report):
     pytest.importorskip("matplotlib")
-    r = cli("report", ICE, "--engines", "none", "--steps", 36, "--out", tmp_path, "--no-progress", "--no-page", hide=True)
+    r = cli("report", ICE, "--engines", "none", "--steps", 12, "--out", tmp_path, "--no-progress", "--no-page")
     assert r.returncode == 0, r.stdout + r.stderr
     md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
     assert not (tmp_path / "ice_crank_slider" / "page.html").exists() and "page.html" not in md     # --no-page

@@ -112,7 +112,7 @@ def test_doc_tables_keep_their_cells():
 
 # ============================================================================ paths
 
-def test_report_folders_stay_inside_out_and_never_overwrite_each_other(tmp_path, cli, sketched_plots):
+def test_report_folders_stay_inside_out_and_never_overwrite_each_other(tmp_path, cli, sketched_report):
     """A model file '...toml' (stem '..'), a stem of markup, a non-UTF-8 file name with a control
     character, and two files with the same stem: one folder each inside --out, nothing outside."""
     models = tmp_path / "models"
@@ -198,7 +198,7 @@ def test_a_full_disk_leaves_the_old_files(args, written, tmp_path, cli, request)
     """A rerun on a full disk: one error line naming the file, exit non-zero, every file of the
     first run as it was (no truncated table, no 0-byte image or index), no temporary file."""
     if args[0] == "report":
-        request.getfixturevalue("sketched_plots")
+        request.getfixturevalue("sketched_report")
     if args[-1] == "t.parquet":
         pytest.importorskip("pyarrow")
     first = cli(*args, cwd=tmp_path)

@@ -198,9 +198,9 @@ CHECKOUT = {"python3 -m venv .venv", "python -m pip install -e '.[all]'", "pytho
             "kinetostat report --out rerun --check reports"}
 #: Examples not run even with -m slow: (command, why).
 NOT_RUN = {"kinetostat variant 2 --all --out keys": "every code of task 2, about 1000 keys: hours"}
-#: Examples run by default (a second each); every other one is slow.
-QUICK = {"kinetostat analyze ice_crank_slider --at 30", "kinetostat structure slotted_link_shaper",
-         "kinetostat examples --copy my_models"}
+#: The example run by default (a process of its own, about a second); every other one is slow (the
+#: commands themselves run in-process in their own tests: test_cli, test_package).
+QUICK = {"kinetostat analyze ice_crank_slider --at 30"}
 #: The slow examples' own time limit: the suite's 300 s (pyproject's pytest timeout) is shorter
 #: than a report of every model with its pages, or the stability study, on 2 cores.
 SLOW_RUN = [pytest.mark.slow, pytest.mark.timeout(3600)]

@@ -9,6 +9,7 @@ import json
 import multiprocessing
 import os
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -19,7 +20,7 @@ import pytest
 import kinetostat
 import kinetostat.report
 import kinetostat.tables
-from conftest import FOUR_BAR, MODELS, ROOT, sketch_plots
+from conftest import FOUR_BAR, MODELS, ROOT, sketch_plots, sketch_report
 from kinetostat import cli
 from kinetostat.report import published_rows, run_validation, write_index, write_report
 from kinetostat.report.document import ROUNDING_NOTE, Doc
@@ -102,17 +103,15 @@ def test_reruns_are_byte_identical_and_jobs_do_not_matter(tmp_path):
         assert "<svg" in data[:400] and len(data) > 10_000 and "<dc:date>" not in data, fig
 
 
-def test_a_rerun_writes_the_same_text_files(tmp_path, sketched_plots):
+def test_a_rerun_writes_the_same_text_files(four_bar_runs):
     """The sample of the above: the text files of a four-bar's report (Markdown, HTML, tables,
-    summary), written twice, are the same bytes (the figures' own reruns: -m slow)."""
-    p = tmp_path / "four_bar.toml"
-    p.write_text(FOUR_BAR)
-    for out in ("a", "b"):
-        write_report(run_validation(kinetostat.load(p), [], steps=12, path=p), tmp_path / out)
-    files = sorted(f.relative_to(tmp_path / "a") for f in (tmp_path / "a").rglob("*") if f.is_file())
+    summary) and its index, written twice, are the same bytes (the figures' own reruns: -m slow)."""
+    a, b = four_bar_runs / "a", four_bar_runs / "b"
+    files = sorted(f.relative_to(a) for f in a.rglob("*") if f.is_file())
     assert {f.suffix for f in files} >= {".md", ".html", ".csv", ".json"}
+    assert files == sorted(f.relative_to(b) for f in b.rglob("*") if f.is_file())
     for f in files:
-        assert (tmp_path / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes(), f
+        assert (a / f).read_bytes() == (b / f).read_bytes(), f
 
 
 def test_report_files(ice_report):
@@ -154,15 +153,17 @@ def test_verdict_failed_checks_and_contents_on_top(ice_report):
     assert hrefs == [a for _, a in toc] == ids
 
 
-def test_failed_checks_are_listed(tmp_path, sketched_plots):
+def test_failed_checks_are_listed(tmp_path, sketched_report):
     """A solver answer that is wrong on purpose: the report says FAIL and names the checks."""
     from dataclasses import replace
-    mech = kinetostat.load(ICE)
+    p = tmp_path / "four_bar.toml"
+    p.write_text(FOUR_BAR)
+    mech = kinetostat.load(p)
     res = kinetostat.analyze(mech, steps=24)
     wrong = replace(res, forces=replace(res.forces, M_bal=res.forces.M_bal * 1.01))
-    run = run_validation(mech, ["pinocchio"], steps=24, res=wrong, path=ICE)
-    summary = write_report(run, tmp_path)
-    md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
+    run = run_validation(mech, ["pinocchio"], steps=24, res=wrong, path=p)
+    summary = write_report(run, tmp_path / "out")
+    md = (tmp_path / "out" / "four_bar" / "index.md").read_text()
     assert not summary["passed"] and summary["failed"] == 2          # pinocchio, and the lever identity
     assert f"**FAIL**: 2 of {len(run.checks)} checks beyond tolerance" in md.split("## ")[0]
     assert re.search(r"^- lever M_drive: peak-relative error 9\.9\de-03 > tolerance 1e-11 ", md, re.M)
@@ -347,7 +348,7 @@ def test_the_light_axes_label_ticks_that_read_back_as_the_ticks(lo, hi, log):
     assert all(lo <= v <= hi for v in values)
 
 
-def test_report_of_a_model_without_published_values(tmp_path, sketched_plots):
+def test_report_of_a_model_without_published_values(tmp_path, sketched_report):
     p = tmp_path / "four_bar.toml"
     p.write_text(FOUR_BAR)
     mech = kinetostat.load(p)
@@ -374,7 +375,7 @@ def test_published_values_agree(path):
     assert rows and all(r.passed for r in rows), [(r.entry.symbol, r.difference) for r in rows if not r.passed]
 
 
-def test_model_strings_cannot_inject_html_or_links(tmp_path, sketched_plots):
+def test_model_strings_cannot_inject_html_or_links(tmp_path, sketched_report):
     """A model's name is text: markdown-it (raw HTML off) escapes tags; no javascript: link."""
     p = tmp_path / "evil.toml"
     p.write_text(FOUR_BAR.replace('name = "test four-bar"',
@@ -455,12 +456,12 @@ def test_report_shows_friction_in_the_reactions_beside_the_first_approximation(i
 
 @pytest.fixture(scope="module")
 def four_bar_runs(tmp_path_factory) -> Path:
-    """The four-bar's report and index written twice (plots sketched), into a/ and b/."""
+    """The four-bar's report and index written twice (plots and plan sheets sketched), into a/ and b/."""
     folder = tmp_path_factory.mktemp("reruns")
     p = folder / "four_bar.toml"
     p.write_text(FOUR_BAR)
     with pytest.MonkeyPatch.context() as mp:
-        sketch_plots(mp)
+        sketch_report(mp)
         for name in ("a", "b"):
             summary = write_report(run_validation(kinetostat.load(p), [], steps=12, path=p), folder / name)
             write_index(folder / name, [summary])
@@ -469,7 +470,6 @@ def four_bar_runs(tmp_path_factory) -> Path:
 
 def _rerun(runs: Path, tmp_path: Path) -> tuple[Path, Path]:
     """A copy of the rerun b/ to change, and the earlier run a/."""
-    import shutil
     return Path(shutil.copytree(runs / "b", tmp_path / "b")), runs / "a"
 
 
@@ -511,7 +511,6 @@ def test_the_check_leaves_out_the_index_studies_and_still_reads_the_lines_after_
     """The committed folder holds a study (its index lists it under "Studies"), a rerun into an
     empty folder does not: no difference. A word changed after that section is still named, at
     the rerun's line."""
-    import shutil
     from kinetostat.report import compare_reports
     b, _ = _rerun(four_bar_runs, tmp_path)
     a = Path(shutil.copytree(four_bar_runs / "a", tmp_path / "a"))
@@ -570,7 +569,7 @@ def test_report_check_refuses_its_own_output_folder_and_a_missing_one(tmp_path, 
         assert code == 2 and "Traceback" not in err and f"--check {check}:" in err, err
 
 
-def test_report_check_says_a_rerun_reproduces_or_prints_each_difference(tmp_path, capsys, sketched_plots):
+def test_report_check_says_a_rerun_reproduces_or_prints_each_difference(tmp_path, capsys, sketched_report):
     """`kinetostat report --out B --check A`: a rerun that reproduces A exits 0 and says so; where
     it differs (A's count of checks edited), each difference is printed and the command fails."""
     p = tmp_path / "four_bar.toml"

@@ -9,7 +9,7 @@ import re
 
 import pytest
 
-from conftest import ROOT, sketch_plots
+from conftest import FOUR_BAR, ROOT, sketch_report
 from kinetostat import _forecast
 from kinetostat.cli import build_parser
 
@@ -40,16 +40,19 @@ def test_quiet_and_verbose_before_or_after_every_command():
 
 
 def test_quiet_report_prints_nothing_and_verbose_shows_its_progress(cli, tmp_path, monkeypatch):
-    sketch_plots(monkeypatch)
-    quick = ["--engines", "none", "--no-page", "--steps", "8", "--jobs", "1", "--out", tmp_path]
-    r = cli("-q", "report", FOUR_BAR_MODEL, *quick)
+    """On the small four-bar of conftest (no study to redo: a third of the chain unit's report)."""
+    sketch_report(monkeypatch)
+    model, out = tmp_path / "four_bar.toml", tmp_path / "out"
+    model.write_text(FOUR_BAR, encoding="utf-8")
+    quick = ["--engines", "none", "--no-page", "--steps", "8", "--jobs", "1", "--out", out]
+    r = cli("-q", "report", model, *quick)
     assert (r.returncode, r.stdout, r.stderr) == (0, "", "")
-    assert (tmp_path / "chain_unit_four_bar" / "index.html").is_file() and (tmp_path / "index.html").is_file()
-    r = cli("report", FOUR_BAR_MODEL, *quick, "-v")
-    assert r.returncode == 0 and "chain_unit_four_bar        PASS" in r.stdout and "report: 1 mechanism(s)" in r.stdout
-    for line in ("chain_unit_four_bar.toml: loaded and analysed over 8 positions in ",
-                 "chain_unit_four_bar: route reference PASS (", "chain_unit_four_bar: figures mechanism, moment, ",
-                 "chain_unit_four_bar: plans, worksheet ("):
+    assert (out / "four_bar" / "index.html").is_file() and (out / "index.html").is_file()
+    r = cli("report", model, *quick, "-v")
+    assert r.returncode == 0 and "four_bar                   PASS" in r.stdout and "report: 1 mechanism(s)" in r.stdout
+    for line in ("four_bar.toml: loaded and analysed over 8 positions in ",
+                 "four_bar: route reference PASS (", "four_bar: figures mechanism, moment, ",
+                 "four_bar: plans, worksheet ("):
         assert any(s.startswith(line) for s in r.stderr.splitlines()), (line, r.stderr)
     # the library's logger as it was after the command: its NullHandler alone, its level unset
     package = logging.getLogger("kinetostat")
@@ -64,7 +67,7 @@ def test_report_says_what_it_will_do_first_then_each_part_of_a_model(tmp_path, m
     each with its time (-q: none of them, test_quiet_report_prints_nothing_...)."""
     from kinetostat import cli
     from kinetostat.cli import report
-    sketch_plots(monkeypatch)
+    sketch_report(monkeypatch)
     before_models = []
     reports = report._report_results
     monkeypatch.setattr(report, "_report_results",

@@ -136,22 +136,23 @@ def study_table(m: Mechanism) -> np.ndarray:
 
 
 def study_slopes(m: Mechanism) -> tuple[np.ndarray, np.ndarray]:
-    """The model's `[study]` redone with exact derivatives: at every case (the model file loaded with
-    its values, as `study_table`), d max |R(i,j)| / d p by each varied parameter p (`peak_slopes`
+    """The model's `[study]` redone with exact derivatives: at every case (the model file, parsed once,
+    built with its values, as `study_table`), d max |R(i,j)| / d p by each varied parameter p (`peak_slopes`
     of a `kinetostat.sensitivity` at the study's angles), N per unit of p, shape (values of the
     first, values of the second or 1, varied parameters); and the crank angle of each case's peak,
     deg, shape (values of the first, of the second or 1)."""
-    from ..model import load
+    from ..model import _read_text, build, parse_text
     from ..sensitivity import sensitivity
     st = m.study
     names = [name for name, _ in st.vary]
     pair = m.pair_between(*st.pair)
     cases = list(itertools.product(*(xs for _, xs in st.vary)))
     slopes, angles = np.empty((len(cases), len(names))), np.empty(len(cases))
+    model = parse_text(_read_text(Path(m.path)), m.path)     # once: each case is built from the parsed text
     for n, case in enumerate(cases):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            sens = sensitivity(load(m.path, parameters=dict(zip(names, case))), params=names, steps=st.steps)
+            sens = sensitivity(build(model, parameters=dict(zip(names, case))), params=names, steps=st.steps)
         k, by = peak_slopes(sens, pair)
         slopes[n], angles[n] = [by[p] for p in names], sens.phi_deg[k]
     shape = (len(st.vary[0][1]), -1)
