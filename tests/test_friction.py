@@ -417,12 +417,11 @@ def test_a_sweep_of_a_model_with_friction_in_the_reactions_solves_it(tmp_path, m
     text = ICE.read_text().replace("radius = 0.012\n", 'radius = 0.012\nmethod = "reactions"\n', 1)
     mech = tmp_path / "ice.toml"
     mech.write_text(text)
-    phi = np.linspace(0.0, 360.0, 73)[:-1]
+    phi = np.linspace(0.0, 360.0, 5001)[:-1]
     from kinetostat import fast
     from kinetostat.sweep import sweep
-    monkeypatch.setattr(fast, "FAST_MIN", 0)           # any sweep large enough for the kernel, loaded or not
-    monkeypatch.setattr(fast, "FAST_COLD", 0)
-    assert fast.pays(kinetostat.load(mech), 2 * len(phi), "peaks")
+    monkeypatch.setattr(fast, "FAST_COLD", 0)          # the sweep large enough for the kernel, loaded or not
+    assert 2 * len(phi) >= fast.FAST_MIN
     table = sweep(mech, {"n1": [4500.0, 3000.0]}, phi_deg=phi).table
     for n1, row in zip([4500.0, 3000.0], table.itertuples()):
         res = reactions(kinetostat.load(mech, parameters={"n1": n1}), phi)
