@@ -22,6 +22,9 @@ it (`__pycache__/*.nbi`, `*.nbc`: pickles, unpickled when the kernel is first ca
   by an earlier version) are removed unread, so that numba compiles afresh. The pickles are read
   only from a trusted folder: where numba would keep them elsewhere (NUMBA_CACHE_DIR) and that
   folder is not trusted, the kernel compiles in memory, with one warning.
+- a kernel's first compile holds a lock (`k<hash>.lock` beside numba's pickles, `flock`): of
+  processes asking for the same kernel at once (test workers), one compiles it and the others,
+  waiting, load what it saved. No lock on Windows.
 
 What is trusted, then: the key file, and pickles it signed in a folder only this user can write.
 A kernel cache restored from elsewhere (a CI cache of an untrusted branch) is not: its pickles
@@ -46,6 +49,11 @@ import threading
 import types
 import warnings
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:                       # Windows: no lock of the first compile
+    fcntl = None
 
 from ._io import read_regular, write_bytes
 
@@ -261,11 +269,33 @@ def _sign_cache(cache, where: Path, stem: str) -> None:
     cache.load_overload, cache.save_overload = load_signed, save_signed
 
 
+def _compile_locked(kernel, lock: Path) -> None:
+    """numba's dispatcher `kernel` made to compile each new signature (or load it from its disk
+    cache) holding an exclusive `flock` of the file `lock`, so that a process waiting on another's
+    compile then loads its saved pickles. Unlocked where the file cannot be opened, or on Windows."""
+    compile_ = kernel.compile
+
+    def compile(sig):
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o600)
+        except OSError:
+            return compile_(sig)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            return compile_(sig)
+        finally:
+            os.close(fd)                  # releases the lock
+
+    if fcntl is not None:
+        kernel.compile = compile
+
+
 def load(text: str) -> types.ModuleType:
     """The generated module `text`, run from the file k<hash of text>.py of `folder()`, which is
     made to hold `text` first; its `kernel`'s disk cache is numba's, reading only pickles this
     user's key signed, where that folder is trusted (the pickles removed where the file was
-    rewritten), else none."""
+    rewritten) and compiling under a lock of other processes (`_compile_locked`), where that
+    folder is trusted, else none."""
     from numba.core.caching import NullCache
 
     name = "k" + hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -293,4 +323,5 @@ def load(text: str) -> types.ModuleType:
         if rewritten:
             _unsign(where, name)
         _sign_cache(kernel._cache, where, name)
+        _compile_locked(kernel, where / f"{name}.lock")
     return module

@@ -16,7 +16,7 @@ import pytest
 mujoco = pytest.importorskip("mujoco")
 
 import kinetostat  # noqa: E402
-from conftest import four_bar  # noqa: E402
+from conftest import EVERY_GROUP, four_bar  # noqa: E402
 from kinetostat_validation.engine_mujoco import mjcf, simulate, solve  # noqa: E402
 from kinetostat_validation.scene import build_scene  # noqa: E402
 
@@ -131,7 +131,10 @@ def errors(scene, result) -> dict[str, float]:
     return out
 
 
-ALL = [f.name for f in MODEL_FILES] + list(INLINE)
+#: Every bundled model and the scenes written here: those of EVERY_GROUP and the scenes by
+#: default, every bundled model with -m slow.
+ALL = [pytest.param(f.name, marks=() if f.stem in EVERY_GROUP else pytest.mark.slow)
+       for f in MODEL_FILES] + list(INLINE)
 SIMULATED = ALL          # ~0.15 s per model and cycle
 
 

@@ -20,7 +20,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import kinetostat
-from conftest import EVERY_KIND, sampled
+from conftest import EVERY_GROUP, EVERY_KIND, sampled
 from kinetostat.errors import ModelWarning, SelfLockingWarning
 from kinetostat.friction import MAX_PASSES, NEWTON_STEPS, RATE_TOL, relative_rate
 from test_properties import KINDS, _SETTINGS, dead_centres, valid
@@ -125,8 +125,9 @@ def test_zero_friction_gives_the_frictionless_result_bit_for_bit(ice):
     assert np.array_equal(b.efficiency[np.isfinite(b.efficiency)], np.ones(np.isfinite(b.efficiency).sum()))
 
 
-@pytest.mark.parametrize("path", sorted(MODELS.glob("*.toml")), ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", sampled(sorted(MODELS.glob("*.toml")), keep=EVERY_GROUP))
 def test_zero_friction_is_bit_for_bit_on_every_bundled_model(path):
+    """EVERY_GROUP's models by default, every one with -m slow."""
     mech = with_friction(path, f=0.0)
     phi = np.arange(0.0, 360.0, 45.0) + 0.5
     with warnings.catch_warnings():

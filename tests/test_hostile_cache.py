@@ -250,3 +250,28 @@ def test_a_link_owned_by_another_user_on_the_way_is_not_trusted(tmp_path):
     os.lchown(link, 65534, 65534)
     assert "through the link" in kernel_cache.untrusted(link)
     assert kernel_cache.untrusted(private) is None
+
+
+@POSIX
+def test_two_processes_asking_for_the_same_cold_kernel_compile_it_once(cache, tmp_path):
+    """Before: two test workers asking for the same kernel at once both compiled it (about 20 s of
+    CPU each for a four-bar's). The first compile holds a lock: the other process waits, then loads
+    the pickles the first saved. This process and another start their call together (when the
+    file `go` appears)."""
+    go = tmp_path / "go"
+    script = ("import os, time\nfrom kinetostat import kernel_cache\n"
+              f"m = kernel_cache.load({TEXT!r})\n"
+              "print('ready', flush=True)\n"
+              f"while not os.path.exists({str(go)!r}): time.sleep(0.002)\n"
+              "assert m.kernel(1) == 2\n"
+              "s = m.kernel.stats\nprint(sum(s.cache_misses.values()), sum(s.cache_hits.values()))\n")
+    other = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    here = kernel_cache.load(TEXT)          # the same folder and key: the cache fixture's, in the environment
+    assert other.stdout.readline() == "ready\n", other.communicate()[1]
+    go.write_text("")
+    assert here.kernel(1) == 2
+    out, err = other.communicate(timeout=120)
+    assert other.returncode == 0, err
+    stats = here.kernel.stats
+    results = [out.split(), [str(sum(stats.cache_misses.values())), str(sum(stats.cache_hits.values()))]]
+    assert sorted(results) == [["0", "1"], ["1", "0"]]        # one compiled (a miss), the other loaded (a hit)

@@ -8,6 +8,7 @@ that page (one source of truth), so the map stays true."""
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from pathlib import Path
 
@@ -34,6 +35,12 @@ def _modules() -> dict[str, tuple[Path, bool]]:
 MODULES = _modules()
 
 
+@functools.lru_cache(maxsize=None)
+def _tree(path: Path) -> ast.Module:
+    """The parsed source of `path`, parsed once for all the tests here."""
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
 def _target(name: str) -> str | None:
     """The module that an imported dotted name lives in (a name imported from a module: that module)."""
     while name and name not in MODULES:
@@ -46,7 +53,7 @@ def _imports(module: str) -> dict[str, int]:
     path, package = MODULES[module]
     here = module if package else module.rpartition(".")[0]
     out: dict[str, int] = {}
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(_tree(path)):
         if isinstance(node, ast.Import):
             names = [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom):
@@ -251,7 +258,7 @@ def test_no_module_defines_a_name_twice():
     twice = {}
     for name, (path, _) in _modules().items():
         seen: set[str] = set()
-        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        for node in _tree(path).body:
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
                 if node.name in seen:
                     twice.setdefault(name, []).append(node.name)

@@ -71,8 +71,11 @@ def test_a_design_that_fails_names_its_field_and_line_as_loads_does():
 
 
 @pytest.mark.skipif(not fast.available(), reason="numba is not installed")
-@pytest.mark.parametrize("name", sorted(DESIGNS))
+@pytest.mark.parametrize("name", [pytest.param(n, marks=() if n == "chain_unit_four_bar" else pytest.mark.slow)
+                                  for n in sorted(DESIGNS)])
 def test_designs_analysed_a_batch_per_kernel_call_are_those_analysed_one_by_one(name):
+    """The four-bar by default (its kernels are compiled for tests/test_fast.py anyway); the ICE
+    (its own two kernels to compile: about 40 s of CPU from a cold cache) with -m slow."""
     text, source = _text(name)
     model = parse_text(text, source)
     phi = crank_angles(None, 36)

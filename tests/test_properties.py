@@ -29,7 +29,6 @@ from __future__ import annotations
 import math
 import warnings
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -37,7 +36,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import kinetostat
-from conftest import four_bar, kinetic_energy
+from conftest import EVERY_GROUP, MODELS, four_bar, kinetic_energy, sampled
 from kinetostat import AssemblyError, SingularPositionWarning
 from kinetostat.model import FASTEST_PIN
 from kinetostat.planar import cross, rotate
@@ -717,10 +716,10 @@ def test_hard_cases_agree_with_mpmath_reference(case):
     assert eM <= MPMATH and eR <= MPMATH, (eM, eR)
 
 
-@pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parents[1] / "models").glob("*.toml")),
-                         ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", sampled(MODELS, EVERY_GROUP))
 def test_bundled_models_agree_with_mpmath_reference(path):
-    """Every bundled model (engines and machines, all five group kinds) at 12 angles."""
+    """The bundled models (engines and machines, all five group kinds and a triad by default;
+    every one with -m slow) at 12 angles."""
     from kinetostat_validation.reference import reference
     mech = kinetostat.load(path)
     phi = np.arange(0.0, 360.0, 30.0) + 7.0

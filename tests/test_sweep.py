@@ -146,10 +146,13 @@ def test_dask_local_schedulers_give_the_same_table(scheduler, bars):
 
 
 def test_a_local_cluster_of_two_workers_gives_the_same_table(bars):
+    """A distributed scheduler over TCP, by its Client and by its address; its two workers are
+    threads of this process (processes=False: the tasks still travel pickled over TCP), which
+    saves starting two interpreters (the processes scheduler above runs tasks in other processes)."""
     distributed = pytest.importorskip("distributed")
     here = kinetostat.sweep(CHAIN, STUDY, steps=360)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                 scheduler_kwargs={"dashboard_address": ":0"}) as lc, \
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, protocol="tcp://",
+                                 dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"}) as lc, \
             distributed.Client(lc) as client:
         by_client = kinetostat.sweep(CHAIN, STUDY, steps=360, scheduler=client, chunk=4, progress=True)
         by_address = kinetostat.sweep(CHAIN, STUDY, steps=360, scheduler=lc.scheduler_address, chunk=7)
