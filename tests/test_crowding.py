@@ -119,6 +119,43 @@ def labels_over_heavy_lines(d, i: int) -> list[str]:
     return out
 
 
+#: Labels crowd a point where their boxes' centres lie this near it, mm (the teacher's count
+#: about B on the ICE's group plan).
+CROWD_MM = 15.0
+
+
+def label_centres(d, i: int) -> np.ndarray:
+    """Angle i's placed labels (points', vectors' names, steps): the centres of their boxes
+    (`label_box`), (M, 2)."""
+    out = []
+    for e in d.elements:
+        if e.tag == "text" and e.attrs.get("class") in ("label", "name", "step") and np.isfinite(_at(e, i)).all():
+            (x, y), = _at(e, i)
+            box = label_box(e.texts[int(e.variant[i if len(e.variant) > 1 else 0])], float(e.attrs["font-size"]), x, y)
+            out.append((box[:2] + box[2:]) / 2)
+    return np.reshape(out, (-1, 2))
+
+
+def crowd(centres: np.ndarray, p: np.ndarray) -> int:
+    """How many labels (their centres (M, 2)) crowd the point p: lie within CROWD_MM of it."""
+    return int((np.hypot(*(centres - p).T) <= CROWD_MM).sum())
+
+
+def worst_crowd(d, i: int) -> int:
+    """The worst crowd of angle i: the most labels that crowd any label's centre (itself counted)."""
+    c = label_centres(d, i)
+    return max((crowd(c, p) for p in c), default=0)
+
+
+def point_on_sheet(d, cycle, name: str, i: int) -> np.ndarray:
+    """Where the lettered point `name` of `cycle` is drawn at angle i: its dot (the dots drawn in
+    the order of the cycle's lettered points, `draw._points`)."""
+    names = [k for k, z in cycle.points.items() if ":" not in k and np.isfinite(z).any()]
+    dots = [e for e in d.elements if e.tag == "circle" and e.attrs.get("fill") == "#000"]
+    assert len(dots) == len(names)
+    return _at(dots[names.index(name)], i)[0]
+
+
 def _crowding(stem: str, angles) -> tuple[dict, dict]:
     hidden, over = {}, {}
     for kind, d in _drawings(stem, angles).items():
