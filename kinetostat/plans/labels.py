@@ -12,7 +12,9 @@ angles at once, each label's candidate places about its anchor (rings of 16 dire
 beside its segment): a candidate's cost is its distance from the anchor plus the length of drawn
 lines it covers (each line clipped to the box, exactly), of a heavy line (a link, a vector:
 `Placer.line(..., heavy=True)`) HEAVY_COST a mm, so that a label goes round it, or away with a
-leader, rather than over it; a candidate over a hard obstacle
+leader, rather than over it; plus, where labels would crowd round a point (more than CROWD_FREE of
+that point's labels within CROWD_MM of it), CROWD_COST for each in that zone, so that a later one
+goes out on a leader to a clear place nearby, or along its line; a candidate over a hard obstacle
 (arrowhead, point, line end, a label placed before) or outside the bounds is not free. At every
 angle the least cost is found (candidates tested lazily, cheapest first, until none left can
 beat it); then the label keeps one place where it may: the candidate within `SLACK` of the best
@@ -21,7 +23,8 @@ angles this search runs at every `STRIDE`-th angle; an angle between keeps a sea
 neighbour's place where that is free (and off every heavy line), and only the angles where
 neither is are searched.
 Obstacles and candidates the same at every angle are tested once for the cycle. A label that
-had to move far gets a thin leader line from its anchor.
+had to move far from its anchor (not beside its own segment) gets a thin leader line from its
+point (a vector's: from its middle), which later labels keep off as a drawn line.
 
 May use: numpy, the standard library, `.dejavu`, `.symbols`, `kinetostat._text` (XML-safe text).
 """
