@@ -186,7 +186,7 @@ def test_at_most_five_labels_crowd_b_on_the_ices_group_plan():
         warnings.simplefilter("ignore")
         plan = build(ice, at=30.0)["group:2,3"]
         angles = list(np.arange(0.0, 360.0, 15.0))
-        res, _ = analyses(ice, angles)
+        res = solve(ice, angles).res
         cycle = build_cycle(ice, res, cycle_scales(ice, res=res))["group:2,3"]
     one = sheet(plan, lang="uk")
     assert crowd(label_centres(one, 0), point_on_sheet(one, PlanCycle.of(plan), "B", 0)) <= 5
