@@ -376,7 +376,8 @@ class Placer:
             xy, _ = geometry(np.arange(n), np.maximum(k, 0)[:, None])
         c = np.where((k >= 0)[:, None], xy[:, :, 0].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
-        far = _CAND_RING[np.maximum(k, 0)] & (np.hypot(*(c - C).T) - half @ _REACH > LEADER_MM)     # beside its segment: none
+        ring = _CAND_RING[np.maximum(k, 0)]                              # beside its own segment: no leader
+        far = ring & (np.hypot(*(c - C).T) - half @ _REACH > LEADER_MM)
         foot = np.clip(C, box[:, :2], box[:, 2:])
         leader = np.where(far[:, None], np.concatenate([C, foot], axis=1), np.nan)
         self.block(box)
@@ -464,8 +465,8 @@ class Placer:
         """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of the K candidates
         `geometry(rows, cols)` gives (their centres (2, r, m) and least costs (r, m) at the angles
         `rows` (r,), candidates `cols` (r, m) or (1, m)), half size `half` (2, N); `still`: the same
-        candidates at every angle; `zone`: the crowding round the label's point (`_crowding`; None:
-        none). Over many angles (N >= 2 STRIDE) a label keeps its place from
+        candidates at every angle; `zone`: the label's point (N, 2) and what a candidate in its zone
+        costs (N,) (`_crowded`; None: nothing). Over many angles (N >= 2 STRIDE) a label keeps its place from
         angle to angle unless it must move: the places are searched (`_search`) at every STRIDE-th
         angle (and the last); an angle between keeps the place of the searched angle before it,
         else of the one after it, where that place is free there (off every hard obstacle and
@@ -498,10 +499,11 @@ class Placer:
     def _search(self, geometry: Callable, K: int, half: np.ndarray, still: bool, at: np.ndarray,
                 zone: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
         """The candidate (len(at),) taken at each of the angles `at` (indices; -1: none), as
-        `_choose`'s arguments give them. Free candidates' costs (with their crowding, `_crowding`) found in batches, in the order of
-        their mean base where finite, at every angle until none left there can come within SLACK of
-        the best; then the candidate within SLACK of the best at the most angles is taken there,
-        and so on; where none is free, the cheapest (nowhere free: the test tells)."""
+        `_choose`'s arguments give them (`zone`: its crowding). Free candidates' costs, with their
+        crowding (`_crowding`), found in batches, in the order of their mean base where finite, at
+        every angle until none left there can come within SLACK of the best; then the candidate
+        within SLACK of the best at the most angles is taken there, and so on; where none is free,
+        the cheapest (nowhere free: the test tells)."""
         centres, base = geometry(at, np.arange(K)[None])
         centres = centres.astype(np.float32)
         n = len(at)
