@@ -6,6 +6,7 @@ placed over a hard obstacle or another label."""
 import numpy as np
 import pytest
 
+from kinetostat.plans import labels
 from kinetostat.plans.labels import LINE_COST, SLACK, STRIDE, Placer, _clipped
 
 
@@ -220,3 +221,33 @@ def test_a_label_keeps_off_heavy_lines_that_it_would_cover_were_they_thin():
         covered = sum(_clipped(s, placed.box[0]) for s in star)
         assert (covered == 0 and np.allclose(placed.leader[0, :2], 30.0)) if heavy else \
             (covered > 1.0 and np.isnan(placed.leader).all()), (heavy, placed)
+
+
+def _eight_round_one_point(n: int) -> tuple[np.ndarray, np.ndarray, list]:
+    """Eight labels of one point (a pin and the loads on it: B, F_i3, R_43, ...) on a clear sheet,
+    at n angles, the point moving: the point (n, 2) and each label's box centre (8, n, 2), and
+    the labels placed."""
+    anchor = np.column_stack([50.0 + 5.0 * np.sin(np.arange(n) / 7.0), np.full(n, 50.0)])
+    placer = Placer(n, (0.0, 0.0, 100.0, 100.0))
+    placer.block(np.concatenate([anchor - 0.6, anchor + 0.6], axis=1))        # the point's dot
+    placed = [placer.place((name,), np.zeros(n, dtype=int), 3.5, anchor)
+              for name in ("B", "F_i3", "R_43", "G_3", "x_43", "h_G2", "h_Fi2", "F_p")]
+    return anchor, np.stack([(p.box[:, :2] + p.box[:, 2:]) / 2 for p in placed]), placed
+
+
+@pytest.mark.parametrize("n", [1, 40], ids=["one angle", "a page's angles"])
+def test_labels_that_would_crowd_round_a_point_go_out_on_leaders(n, monkeypatch):
+    """Eight labels of one point on a clear sheet (one angle; 40, searched at every STRIDE-th):
+    without the crowding cost all eight lie within 15 mm of it (the teacher's crowd at B); with
+    it at most five do, at every angle, and each of the others is out on a leader that starts at
+    the point and ends on its box."""
+    anchor, centres, placed = _eight_round_one_point(n)
+    inside = np.hypot(*(centres - anchor).transpose(2, 0, 1)) <= 15.0                    # (8, n)
+    assert inside.sum(axis=0).max() <= 5
+    for p, near in zip(placed, inside):
+        lead = p.leader[~near]
+        assert np.isfinite(lead).all() and np.allclose(lead[:, :2], anchor[~near])
+        assert ((lead[:, 2:] >= p.box[~near, :2] - 1e-9) & (lead[:, 2:] <= p.box[~near, 2:] + 1e-9)).all()
+    monkeypatch.setattr(labels, "CROWD_COST", 0.0)
+    anchor, centres, _ = _eight_round_one_point(n)
+    assert (np.hypot(*(centres - anchor).transpose(2, 0, 1)) <= 15.0).all()

@@ -12,7 +12,9 @@ angles at once, each label's candidate places about its anchor (rings of 16 dire
 beside its segment): a candidate's cost is its distance from the anchor plus the length of drawn
 lines it covers (each line clipped to the box, exactly), of a heavy line (a link, a vector:
 `Placer.line(..., heavy=True)`) HEAVY_COST a mm, so that a label goes round it, or away with a
-leader, rather than over it; a candidate over a hard obstacle
+leader, rather than over it; plus, where labels would crowd round a point (more than CROWD_FREE of
+that point's labels within CROWD_MM of it), CROWD_COST for each in that zone, so that a later one
+goes out on a leader to a clear place nearby, or along its line; a candidate over a hard obstacle
 (arrowhead, point, line end, a label placed before) or outside the bounds is not free. At every
 angle the least cost is found (candidates tested lazily, cheapest first, until none left can
 beat it); then the label keeps one place where it may: the candidate within `SLACK` of the best
@@ -21,7 +23,8 @@ angles this search runs at every `STRIDE`-th angle; an angle between keeps a sea
 neighbour's place where that is free (and off every heavy line), and only the angles where
 neither is are searched.
 Obstacles and candidates the same at every angle are tested once for the cycle. A label that
-had to move far gets a thin leader line from its anchor.
+had to move far from its anchor (not beside its own segment) gets a thin leader line from its
+point (a vector's: from its middle), which later labels keep off as a drawn line.
 
 May use: numpy, the standard library, `.dejavu`, `.symbols`, `kinetostat._text` (XML-safe text).
 """
@@ -192,6 +195,11 @@ _BATCH = 48
 STRIDE = 8
 #: A label whose box is this far (mm) beyond its reach from the anchor gets a leader.
 LEADER_MM = 6.0
+#: Crowding round a point: the zone within CROWD_MM (mm) of a label's anchor holds CROWD_FREE labels
+#: of that point (anchored within ONE_POINT_MM of it: a pin and the loads on it, a pole and its
+#: vectors) free; a candidate whose centre lies in the zone costs CROWD_COST for each label of the
+#: point there already and itself beyond, so that a later one goes out of the crowd on a leader.
+ONE_POINT_MM, CROWD_MM, CROWD_FREE, CROWD_COST = 3.0, 15.0, 4, 15.0
 
 
 @dataclass(frozen=True)
@@ -268,6 +276,8 @@ class Placer:
         # coordinate by coordinate; R = 1 where still (the same at every angle), else N
         self._parts: dict[tuple[str, bool], list[np.ndarray]] = {}
         self._stacked: dict[tuple[str, bool], tuple[int, np.ndarray]] = {}     # parts stacked, their stack
+        self._anchors = np.empty((0, n, 2))                               # the labels placed: their anchors,
+        self._centres = np.empty((0, n, 2), dtype=np.float32)           # their boxes' centres
 
     def block(self, box) -> None:
         """Hard obstacles at every angle: boxes (4,), (R, 4) or (R, S, 4), R = N or 1 (the same at
@@ -364,14 +374,19 @@ class Placer:
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
         with np.errstate(invalid="ignore"):
-            k = self._choose(geometry, K, half.T.astype(np.float32), still)
+            k = self._choose(geometry, K, half.T.astype(np.float32), still, (A, self._crowded(A)))
             xy, _ = geometry(np.arange(n), np.maximum(k, 0)[:, None])
         c = np.where((k >= 0)[:, None], xy[:, :, 0].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
-        far = np.hypot(*(c - C).T) - half @ _REACH > LEADER_MM
+        ring = _CAND_RING[np.maximum(k, 0)]                              # beside its own segment: no leader
+        far = ring & (np.hypot(*(c - C).T) - half @ _REACH > LEADER_MM)
         foot = np.clip(C, box[:, :2], box[:, 2:])
         leader = np.where(far[:, None], np.concatenate([C, foot], axis=1), np.nan)
         self.block(box)
+        if far.any():
+            self.line(leader)
+        self._anchors = np.concatenate([self._anchors, A[None]])
+        self._centres = np.concatenate([self._centres, c[None].astype(np.float32)])
         return Placed(np.column_stack([box[:, 0], box[:, 1] + up]), box, leader)
 
     def clear(self, box: np.ndarray) -> np.ndarray:
@@ -430,23 +445,43 @@ class Placer:
             c = c + np.bincount(r * c.shape[1] + q, covered, c.size).reshape(c.shape)
         return c
 
-    def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool) -> np.ndarray:
+    def _crowded(self, anchor: np.ndarray) -> np.ndarray:
+        """What a candidate in the zone of the point `anchor` (N, 2) costs at each angle (N,): CROWD_COST
+        for each label of the point (anchored within ONE_POINT_MM of it) in the zone (its centre
+        within CROWD_MM of it), and the new one, beyond CROWD_FREE."""
+        with np.errstate(invalid="ignore"):
+            same = np.hypot(*(self._anchors - anchor).transpose(2, 0, 1)) <= ONE_POINT_MM       # (L, N)
+            near = np.hypot(*(self._centres - anchor).transpose(2, 0, 1)) <= CROWD_MM
+        return CROWD_COST * np.maximum((same & near).sum(axis=0) + 1 - CROWD_FREE, 0)
+
+    @staticmethod
+    def _crowding(p: np.ndarray, rows: np.ndarray, zone: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        """The crowding cost (n', B) of the boxes centred at p (2, n', B) at the angles `rows`: the
+        zone's (`_crowded`: its point (N, 2) and cost (N,)) where the centre lies in it."""
+        (x, y), cost = zone[0][rows].T, zone[1][rows]
+        inside = (p[0] - x[:, None]) ** 2 + (p[1] - y[:, None]) ** 2 <= CROWD_MM ** 2
+        return np.where(inside, cost[:, None], 0.0)
+
+    def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool,
+                zone: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of the K candidates
         `geometry(rows, cols)` gives (their centres (2, r, m) and least costs (r, m) at the angles
         `rows` (r,), candidates `cols` (r, m) or (1, m)), half size `half` (2, N); `still`: the same
-        candidates at every angle. Over many angles (N >= 2 STRIDE) a label keeps its place from
+        candidates at every angle; `zone`: the label's point (N, 2) and what a candidate in its zone
+        costs (N,) (`_crowded`; None: nothing). Over many angles (N >= 2 STRIDE) a label keeps its place from
         angle to angle unless it must move: the places are searched (`_search`) at every STRIDE-th
         angle (and the last); an angle between keeps the place of the searched angle before it,
         else of the one after it, where that place is free there (off every hard obstacle and
         every heavy line, and in the bounds); the angles where neither is are searched."""
         n = self.n
+        zone = (np.zeros((n, 2)), np.zeros(n)) if zone is None else zone
         if n < 2 * STRIDE:
-            return self._search(geometry, K, half, still, np.arange(n))
+            return self._search(geometry, K, half, still, np.arange(n), zone)
         k = np.full(n, -1)
         done = np.zeros(n, dtype=bool)                              # searched, or a neighbour's place kept
         done[::STRIDE] = done[-1] = True
         sample = np.flatnonzero(done)
-        k[sample] = self._search(geometry, K, half, still, sample)
+        k[sample] = self._search(geometry, K, half, still, sample, zone)
         between = np.flatnonzero(~done)
         at = np.searchsorted(sample, between)
         guess = np.column_stack([k[sample[at - 1]], k[sample[at]]])    # the searched angle before, then after
@@ -460,15 +495,17 @@ class Placer:
         k[between[kept]] = guess[kept, first[kept]]
         between = between[~kept]
         if len(between):
-            k[between] = self._search(geometry, K, half, still, between)
+            k[between] = self._search(geometry, K, half, still, between, zone)
         return k
 
-    def _search(self, geometry: Callable, K: int, half: np.ndarray, still: bool, at: np.ndarray) -> np.ndarray:
+    def _search(self, geometry: Callable, K: int, half: np.ndarray, still: bool, at: np.ndarray,
+                zone: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
         """The candidate (len(at),) taken at each of the angles `at` (indices; -1: none), as
-        `_choose`'s arguments give them. Free candidates' costs found in batches, in the order of
-        their mean base where finite, at every angle until none left there can come within SLACK of
-        the best; then the candidate within SLACK of the best at the most angles is taken there,
-        and so on; where none is free, the cheapest (nowhere free: the test tells)."""
+        `_choose`'s arguments give them (`zone`: its crowding). Free candidates' costs, with their
+        crowding (`_crowding`), found in batches, in the order of their mean base where finite, at
+        every angle until none left there can come within SLACK of the best; then the candidate
+        within SLACK of the best at the most angles is taken there, and so on; where none is free,
+        the cheapest (nowhere free: the test tells)."""
         centres, base = geometry(at, np.arange(K)[None])
         centres = centres.astype(np.float32)
         n = len(at)
@@ -492,11 +529,14 @@ class Placer:
             if still and len(rows) > 1:                                     # the still obstacles once
                 p, h = centres[:, :1, idx], half[:, rows[:1]]
                 c = self._costs(p, h, c[:1], rows[:1], (True,))
-                c = self._costs(np.broadcast_to(p, (2,) + (len(rows), len(idx))), np.broadcast_to(h, (2, len(rows))),
-                                np.broadcast_to(c, (len(rows), len(idx))), rows, (False,))
+                p = np.broadcast_to(p, (2,) + (len(rows), len(idx)))
+                c = self._costs(p, np.broadcast_to(h, (2, len(rows))), np.broadcast_to(c, (len(rows), len(idx))),
+                                rows, (False,))
             else:
                 p = np.take(centres.reshape(2, -1), local[:, None] * K + idx, axis=1)    # (2, rows, batch)
                 c = self._costs(p, half[:, rows], c, rows, (True, False))
+            if zone[1][rows].any():
+                c = c + self._crowding(p, rows, zone)
             cost = np.full((n, len(idx)), np.inf)
             cost[local] = c
             tested.append(cost)
