@@ -856,3 +856,33 @@ def test_triad_page_names_the_tiny_vectors_of_its_one_angle_sheets():
             assert draw._tiny_at(draw._tiny(cycles[kind]), i) == one, (at, kind)
             if kind.startswith("forces:") and at == 30.0:
                 assert one == {"R05n": "negligible"}, one
+
+
+def test_changes_of_a_sheets_coordinate_series_equal_a_plain_pairwise_count(monkeypatch):
+    """`_changes` (the encoder's all-at-once comparison of a sheet's coordinate series, in chunks, a
+    step at a time) gives for every pair the count a plain loop gives: at the PROBES of series i's
+    angles, how many of the steps of series j less series i are not 0 (j < i); a follower (a label
+    less its point) found with 0 changes; n where j >= i. Series read at all angles, at some, at one."""
+    import numpy as np
+
+    import kinetostat.plans.page as pg
+    rng = np.random.default_rng(36)
+    m, n = 40, 90
+    x = rng.integers(-50, 50, (m, n)).cumsum(axis=1)
+    x[7] = x[3] + 12                                          # a label that follows its point
+    x[9, ::2] = x[2, ::2] - 5                                 # one that follows at every other angle
+    care = np.ones((m, n), dtype=bool)
+    care[5:15] = rng.random((10, n)) < 0.4
+    care[20, 1:] = False
+    care[21] = False
+    changes, probes = pg._changes(x, care)
+    for i in range(m):
+        at = np.flatnonzero(care[i])
+        probe = at[:: max(1, len(at) // pg.PROBES)]
+        assert probes[i] == len(probe)
+        for j in range(m):
+            want = int((np.diff(x[j, probe] - x[i, probe]) != 0).sum()) if j < i and len(probe) else n
+            assert changes[i, j] == want, (i, j)
+    assert changes[7, 3] == 0 and pg._changes(x, care)[0][7].argmin() == 3
+    monkeypatch.setattr(pg, "CHUNK", 50)                     # chunks of one or two series
+    assert (pg._changes(x, care)[0] == changes).all()
