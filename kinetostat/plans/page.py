@@ -180,18 +180,23 @@ def _serieses(arrays: Sequence[np.ndarray]) -> list[np.ndarray]:
         d.append(d[0].copy())
         if large.any():
             d[-1][large] = _smooth(d[0][large])
-        diffs = np.stack(d)                                       # (order, series, angle)
-        costs = np.log2(1.0 + np.abs(diffs)).sum(axis=2)
+        costs = np.stack([_bits(x) for x in d])                   # (order, series)
         costs[-1, ~large] = np.inf
         order = np.argmin(costs, axis=0)
         for j, i in enumerate(idx):
-            out[i] = np.concatenate([[order[j]], diffs[order[j], j]])
+            out[i] = np.concatenate([[order[j]], d[order[j]][j]])
     return out
 
 
+def _bits(d: np.ndarray) -> np.ndarray:
+    """What series of integers cost as varints, roughly: the sum of their bits along the last
+    axis (in float32: half the memory of doubles, and as good a guess)."""
+    return np.log2(1 + np.abs(d).astype(np.float32)).sum(axis=-1)
+
+
 def _cost(d: np.ndarray) -> float:
-    """What a series of integers costs as varints, roughly: the sum of their bits."""
-    return float(np.log2(1.0 + np.abs(d)).sum())
+    """What a series of integers costs as varints, roughly: the sum of their bits (`_bits`)."""
+    return float(_bits(d))
 
 
 def _scaled(source: np.ndarray, f: float) -> np.ndarray:
@@ -258,55 +263,82 @@ def _shown(e) -> np.ndarray:
 
 
 #: A coordinate series is compared with the sheet's earlier ones at this many of its angles
-#: (`_Earlier.near`), and stored less the most alike where that is smaller.
+#: (`_changes`), and stored less the most alike where that is smaller.
 PROBES = 24
+#: The most pairs of series `_changes` compares in one array operation (its count: this many bytes).
+CHUNK = 1 << 22
+
+
+def _changes(x: np.ndarray, care: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For the coordinate series of one sheet, rows of `x` (int64 (m, n)) read where `care` (bool
+    (m, n)): (changes, probes): changes[i, j] (j < i) is in how many steps between the PROBES or so
+    angles of `care[i]` series j's difference from series i changes (0: j plus a constant there), n
+    where j >= i; probes[i] how many angles those are. All at once: the series with the same
+    angles as one 2-D comparison of their steps with every earlier series' steps there, a step at
+    a time."""
+    m, n = x.shape
+    changes = np.full((m, m), n, dtype=np.int16)
+    probes = np.zeros(m, dtype=np.int64)
+    groups: dict[bytes, tuple[np.ndarray, list[int]]] = {}
+    for i in range(m):
+        at = np.flatnonzero(care[i])
+        probe = at[:: max(1, len(at) // PROBES)]
+        probes[i] = len(probe)
+        if i and len(probe):
+            groups.setdefault(probe.tobytes(), (probe, []))[1].append(i)
+    for probe, rows in groups.values():
+        steps = np.ascontiguousarray(np.diff(x[:, probe], axis=1).T[:255], dtype=np.int32)   # a row a step (0.1 mm)
+        size = max(1, CHUNK // rows[-1])
+        for k in range(0, len(rows), size):
+            idx = np.asarray(rows[k:k + size])
+            top, count = int(idx[-1]), np.zeros((len(idx), int(idx[-1])), dtype=np.uint8)   # at most PROBES * 2 steps
+            for s in steps:
+                np.add(count, np.not_equal(s[idx, None], s[None, :top]), out=count)
+            changes[idx, :top] = np.where(np.arange(top) < idx[:, None], count, n)
+    return changes, probes
 
 
 class _Earlier:
-    """The series of one sheet so far that are as long as `n` (the frames), as rows of one array,
-    for `encode_drawing`'s search for an earlier series a new coordinate series follows."""
+    """The coordinate series of one sheet, for `encode_drawing`'s search for an earlier one that a
+    coordinate series follows: compared all at once first (`_changes`, as drawn: `x`, `care`), then
+    asked in their order, each as it is coded (`add`: the series as coded, which may hold other
+    values where its element is not drawn)."""
 
-    def __init__(self, n: int):
-        self.rows, self.index = np.empty((64, n), dtype=np.int64), []
+    def __init__(self, x: np.ndarray, care: np.ndarray):
+        self.changes, self.probes = _changes(x, care)
+        self.rows: list[np.ndarray] = []
+        self.index: list[int] = []
 
     def add(self, j: int, a: np.ndarray) -> None:
-        """Series j of the sheet, `a`, where as long as the frames."""
-        if len(a) != self.rows.shape[1]:
-            return
-        if len(self.index) == len(self.rows):
-            self.rows = np.concatenate([self.rows, np.empty_like(self.rows)])
-        self.rows[len(self.index)] = a
+        """The next coordinate series, `a`, coded as series j of the sheet."""
+        self.rows.append(a)
         self.index.append(j)
 
     def shifted(self, a: np.ndarray, care: np.ndarray) -> np.ndarray | None:
-        """An earlier series plus a constant that equals `a` wherever `care` (an element's
-        coordinate read only where it is drawn: a leader's end on its point), else None."""
-        at = np.flatnonzero(care)
-        if not self.index or len(a) != self.rows.shape[1] or not len(at):
+        """An earlier series plus a constant that equals `a` (the next coordinate series) wherever
+        `care` (an element's coordinate read only where it is drawn: a leader's end on its point),
+        else None."""
+        i, at = len(self.rows), np.flatnonzero(care)
+        if not len(at):
             return None
-        rows = self.rows[:len(self.index)]
-        c = rows[:, at[0]] - a[at[0]]
-        probe = at[:: max(1, len(at) // PROBES)]
-        for k in np.flatnonzero(((rows[:, probe] - a[probe]) == c[:, None]).all(axis=1)):
-            if ((rows[k, at] - a[at]) == c[k]).all():
-                return rows[k] - c[k]
+        for k in np.flatnonzero(self.changes[i, :i] == 0):
+            c = self.rows[k][at[0]] - a[at[0]]
+            if ((self.rows[k][at] - a[at]) == c).all():
+                return self.rows[k] - c
         return None
 
     def near(self, a: np.ndarray, care: np.ndarray) -> tuple[int, np.ndarray] | None:
-        """(j, r) of the earlier series j that differs from `a` by a constant at the most of
-        PROBES of the angles `care`: r is `a` less series j where `care`, held (`_held`) where
-        not; None where there is none, or where even it does so at fewer than half of them (not
-        worth `_serieses`' time)."""
-        at = np.flatnonzero(care)
-        if not self.index or len(a) != self.rows.shape[1] or len(at) < 2:
+        """(j, r) of the earlier series j that differs from `a` (the next coordinate series) by a
+        constant at the most of its probed angles (`_changes`): r is `a` less series j where
+        `care`, held (`_held`) where not; None where there is none, or where even it does so at
+        fewer than half of them (not worth `_serieses`' time)."""
+        i = len(self.rows)
+        if not i or self.probes[i] < 2:
             return None
-        rows = self.rows[:len(self.index)]
-        probe = at[:: max(1, len(at) // PROBES)]
-        changes = (np.diff(rows[:, probe] - a[probe], axis=1) != 0).sum(axis=1)
-        k = int(np.argmin(changes))
-        if changes[k] > len(probe) // 2:
+        k = int(np.argmin(self.changes[i, :i]))
+        if self.changes[i, k] > self.probes[i] // 2:
             return None
-        return self.index[k], _held((a - rows[k])[:, None], care)[:, 0]
+        return self.index[k], _held((a - self.rows[k])[:, None], care)[:, 0]
 
 
 def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict, bytes, list[np.ndarray]]:
@@ -348,17 +380,25 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
             if near is not None:                 # what it holds where not read: j plus the remainder held
                 a = raw[near[0]] + near[1]
             series.append([(None, a), *([near] if near else [])])
-        bank.add(len(raw), a)
+        if care is not None:
+            bank.add(len(raw), a)
         raw.append(a)
         seen.setdefault(key, len(series) - 1)
         shapes.setdefault(shape, len(series) - 1)
     raw: list[np.ndarray] = []
-    bank = _Earlier(d.n)
+    shown = []                                   # each element's drawn, finite, coordinates (as coded), where read
     for e in d.elements:
         xy = np.asarray(e.xy, dtype=float)
         rows, m = xy.shape[0], xy.shape[1]
         drawn = np.asarray(e.drawn()).reshape(rows)
         finite = np.isfinite(xy).all(axis=2)
+        held = (_held(np.where(finite[..., None], xy, np.nan), drawn) if m else xy).reshape(rows, -1)
+        shown.append((drawn, finite, [(_ints(held[:, c], COORD_DECIMALS), drawn & finite[:, c // 2]) for c in range(2 * m)]))
+    coords = [(a, care) for *_, xs in shown for a, care in xs if len(a) == d.n]
+    bank = _Earlier(np.array([a for a, _ in coords], dtype=np.int64).reshape(-1, d.n),
+                    np.array([care for _, care in coords], dtype=bool).reshape(-1, d.n))
+    for e, (drawn, finite, xs) in zip(d.elements, shown):
+        m = len(xs) // 2
         holes = e.tag == "polyline" and not finite[drawn].all()
         put(drawn)
         if len(e.texts) > 1:
@@ -366,25 +406,25 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
         if holes:
             for k in range(m):
                 put(finite[:, k])
-        held = _held(np.where(finite[..., None], xy, np.nan), drawn) if m else xy
-        for c in range(2 * m):
-            put(_ints(held.reshape(rows, -1)[:, c], COORD_DECIMALS), drawn & finite[:, c // 2])
+        for a, care in xs:
+            put(a, care if len(a) == d.n else None)
         source = None
         if e.length_mm is not None:
             q, source = next(own), next(sources)
             put(q if source is None else q - _scaled(pool[source[0]], source[1]))
         meta.append({"tag": e.tag, "attrs": [[k, v] for k, v in e.attrs.items()], "title": e.title,
-                     "texts": list(e.texts), "m": m, "rows": rows, "holes": holes,
+                     "texts": list(e.texts), "m": m, "rows": len(drawn), "holes": holes,
                      "len": 0 if e.length_mm is None else int(np.size(e.length_mm)),
                      "variants": 0 if len(e.texts) <= 1 else int(np.size(e.variant))}
                     | ({"from": list(source)} if source else {}))
     coded = iter(_serieses([x for a in series if isinstance(a, list) for _, x in a]))
+    series = [[(j, next(coded)) for j, _ in a] if isinstance(a, list) else a for a in series]
+    pairs = [a for a in series if isinstance(a, list) and len(a) == 2]     # alone, or less an earlier series j
+    bits = _bits(np.array([[c[1:] for _, c in a] for a in pairs])) if pairs else np.zeros((0, 2))
+    less = iter(bits[:, 1] < bits[:, 0])
     for k, a in enumerate(series):
         if isinstance(a, list):              # the cheapest: alone, or less an earlier series j (-3 - 3j)
-            (j, best), *more = [(j, next(coded)) for j, _ in a]
-            for j2, c in more:
-                if _cost(c[1:]) < _cost(best[1:]):
-                    j, best = j2, c
+            j, best = a[1] if len(a) == 2 and next(less) else a[0]
             a = best if j is None else np.concatenate([[-3 - 3 * j], best])
         series[k] = np.asarray(a)
     return ({"kind": d.kind, "static": d.static, "elements": meta},
