@@ -10,7 +10,9 @@ import shutil
 import subprocess
 import warnings
 import zlib
+from dataclasses import dataclass
 from functools import lru_cache
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -28,10 +30,46 @@ needs_poppler = pytest.mark.skipif(shutil.which("pdftotext") is None, reason="po
 PT = 72.0 / 25.4                                       # points per mm
 
 
-@lru_cache(maxsize=None)
 def _one(task: int, code: str, lang: str = "en") -> A3.OneSheet:
+    """`one_sheet` of variant task/code at phi1 in `lang`, made once per module (a sheet's search
+    takes seconds; `_sheet`, its arguments spelt one way for its cache); task 2 / 479 in English
+    is the one `_counted` made."""
+    return _counted().one if (task, code, lang) == (2, "479", "en") else _sheet(task, code, lang)
+
+
+@lru_cache(maxsize=None)
+def _sheet(task: int, code: str, lang: str) -> A3.OneSheet:
     v = variants.variant(task, code)
     return A3.one_sheet(v.mechanism(), float(v.values["phi1"]), lang)
+
+
+@dataclass(frozen=True)
+class Counted:
+    """A sheet and the work `one_sheet` did for it: the scales of each build of the plans (None:
+    the rule's), the positions given to each build, and each plan drawn (language, kind, scales)."""
+    one: A3.OneSheet
+    built: tuple
+    positions: tuple
+    drawn: tuple
+
+
+@lru_cache(maxsize=None)
+def _counted() -> Counted:
+    """Task 2 / 479 in English (its search comes back to scales tried before), its builds of the
+    plans and its drawings counted (`kinetostat.plans.build` and `a3.sheet` wrapped while it runs)."""
+    import kinetostat.plans as KP
+    built, drawn, positions = [], [], []
+    build, sheet = KP.build, A3.sheet
+
+    def counted(mech, at, scales=None, **kw):
+        built.append(None if scales is None else tuple(sorted(scales.items())))
+        positions.append(kw.get("positions"))
+        return build(mech, at=at, scales=scales, **kw)
+    v = variants.variant(2, "479")
+    with mock.patch.object(KP, "build", counted), mock.patch.object(A3, "sheet", lambda plan, lang, *a, **kw: drawn.append(
+            (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or sheet(plan, lang, *a, **kw)):
+        one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
+    return Counted(one, tuple(built), tuple(positions), tuple(drawn))
 
 
 def _room(one: A3.OneSheet, plans, lang: str) -> float:
@@ -75,17 +113,20 @@ def test_task_1_479_fits_one_sheet_in_the_texts_order():
     assert one.plans["mechanism"].length_mm("OA") == pytest.approx(32.0)
 
 
-def test_the_scales_do_not_depend_on_the_language():
+@pytest.mark.parametrize("task, code", [(1, "479"), pytest.param(3, "388", marks=pytest.mark.slow)])
+def test_the_scales_do_not_depend_on_the_language(task, code):
     """Task 3 / 388 fitted at μ_l = 0.0025 with English headings and labels, at 0.004 with Ukrainian
-    ones: the scales are chosen to fit in every language, so each pack of a variant states the same."""
-    en, uk = _one(3, "388", "en"), _one(3, "388", "uk")
+    ones; task 1 / 479 (the sheets other tests build) at μ_v = 0.25, μ_F = 50 in English, μ_v = 0.4,
+    μ_F = 40 in Ukrainian: the scales are chosen to fit in every language, so each pack of a variant
+    states the same."""
+    en, uk = _one(task, code, "en"), _one(task, code, "uk")
     assert dict(en.plans.scales) == dict(uk.plans.scales)
     _check_sheet(en)
     _check_sheet(uk)
 
 
-@pytest.mark.parametrize("task, code", [(1, "479"), (2, "479"), (3, "123"),    # 1 / 479: the sheet other tests build
-                                         pytest.param(1, "905", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("task, code", [(1, "479"), (2, "479"),    # the sheets other tests build
+                                         *(pytest.param(t, c, marks=pytest.mark.slow) for t, c in ((3, "123"), (1, "905")))])
 def test_a_sample_of_variants_fits_one_sheet(task, code):
     """Task 2 / 479 took 3 sheets (138,000 mm² of plans at the rule's scales), 3 / 123 two: each
     on one now; a coarsened scale is a round value of its series, one step or more above the
@@ -127,7 +168,7 @@ def test_mu_l_is_coarsened_only_where_the_others_cannot_make_room():
                        for lang in ("en", "uk", "ru")), chosen
 
 
-def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
+def test_each_scale_choice_is_built_and_drawn_once():
     """Task 2 / 479 (its search comes back to scales tried before): `one_sheet` builds the plans of
     each choice of scales once (was: 9 builds for 8 choices) and draws each plan once at its
     scales for all the languages that draw it alike (`draw.language_part`: was once a language:
@@ -136,28 +177,16 @@ def test_each_scale_choice_is_built_and_drawn_once(monkeypatch):
     construction lines' tooltips differ from en's but whose letters and notes' room do not, is
     en's drawing: was drawn again); every build after the
     rule's is given the plan of positions' 12 positions at its μ_l, made once per μ_l (was: made
-    again in each build); the same sheet as `_one` (no state kept between calls)."""
-    import kinetostat.plans as KP
-    built, drawn, positions = [], [], []
-    build, sheet = KP.build, A3.sheet
-
-    def counted(mech, at, scales=None, **kw):
-        built.append(None if scales is None else tuple(sorted(scales.items())))
-        positions.append(kw.get("positions"))
-        return build(mech, at=at, scales=scales, **kw)
-    monkeypatch.setattr(KP, "build", counted)
-    monkeypatch.setattr(A3, "sheet", lambda plan, lang, *a, **kw: drawn.append(
-        (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or sheet(plan, lang, *a, **kw))
-    v = variants.variant(2, "479")
-    one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
+    again in each build). (The same sheet as a call not counted: test_write_key_draws_every_file_at_the_one_sheets_scales.)"""
+    c = _counted()
+    built, drawn = c.built, c.drawn
     assert len(built) == len(set(built)) >= 5
     assert len(drawn) == len(set(drawn)) and {lang for lang, _, _ in drawn} == {"en", "uk", "ru"}
     again = {kind for lang, kind, _ in drawn if lang != "en"}
     assert "group:2,3" in again and not any(lang == "uk" and kind == "velocity" for lang, kind, _ in drawn)
-    given = positions[1:]
+    given = c.positions[1:]
     assert all(p is not None and p.mu.value == dict(b)["mu_l"] for p, b in zip(given, built[1:]))
     assert len({id(p) for p in given}) == len({p.mu.value for p in given}) < len(given)
-    assert one.places == _one(2, "479").places and one.drawings == _one(2, "479").drawings
 
 
 def test_a_plans_drawing_is_its_sheets_plan_group_as_written():
@@ -294,7 +323,8 @@ def test_the_bands_are_drawn_at_the_one_sheets_scales(task2_pack):
 def test_write_key_draws_every_file_at_the_one_sheets_scales(tmp_path, monkeypatch):
     """`write_key` chooses the scales once (`one_sheet`) and hands them to the SVG sheets, the
     worksheet and the pack: task 2 / 479's mechanism sheet and worksheet at μ_l = 0.002, not the
-    rule's 0.0012 (which the keys without a pack keep)."""
+    rule's 0.0012 (which the keys without a pack keep); its sheet is the one `_counted` made (no
+    state kept between calls of `one_sheet`)."""
     got = []
 
     class Fake:                                        # the pack itself: the tests above
@@ -308,6 +338,7 @@ def test_write_key_draws_every_file_at_the_one_sheets_scales(tmp_path, monkeypat
         variants.write_key(v, tmp_path / "rule", lang="en", cycle_csv=False, teacher_pack=False)
     (one,) = got
     assert scale_text(one.plans.scales["mu_l"], "en") == "μ_l = 0.002 m/mm" and one.lang == "en"
+    assert one.places == _one(2, "479").places and one.drawings == _one(2, "479").drawings    # no state kept between calls
     for folder, mu_l in (("pack", "μ_l = 0.002 m/mm"), ("rule", "μ_l = 0.0012 m/mm")):
         assert mu_l in (tmp_path / folder / "mechanism.svg").read_text(encoding="utf-8")
         assert f"scale {mu_l}" in (tmp_path / folder / "worksheet.md").read_text(encoding="utf-8")

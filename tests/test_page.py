@@ -561,23 +561,24 @@ def test_report_draws_its_page_every_time(tmp_path, monkeypatch, cli, sketched_p
     a page.html planted in the model's folder is replaced, even one sealed as the removed cache
     accepted a page (its own key kept, the SHA-256 of its bytes on its last line); --no-page
     removes the earlier page.
-    (A page of two angles at scales sampled every 90 deg, the plots sketched: quick.)"""
+    (The scotch yoke, without [friction] and [study] and their sections; a page of two angles at
+    scales sampled every 90 deg, the plots sketched: quick.)"""
     import kinetostat.plans.page as pg
     monkeypatch.setattr(pg, "PAGE_ANGLES", (0.0, 150.0))
     cycle = P.cycle_scales
     monkeypatch.setattr(P, "cycle_scales", lambda mech, res=None: cycle(mech, step_deg=90.0))
-    ice = next(p for p in MODELS if p.stem == "ice_crank_slider")
+    model = next(p for p in MODELS if p.stem == "scotch_yoke")
     out = tmp_path / "r"
-    html, md = out / "ice_crank_slider" / "page.html", out / "ice_crank_slider" / "index.md"
+    html, md = out / model.stem / "page.html", out / model.stem / "index.md"
 
     def report(*more) -> str:
-        r = cli("report", str(ice), "--engines", "none", "--steps", "8", "--jobs", "1", "--no-progress",
+        r = cli("report", str(model), "--engines", "none", "--steps", "8", "--jobs", "1", "--no-progress",
                 "--out", str(out), *more)
         assert r.returncode == 0, r.stderr
         return r.stdout
 
     assert ", page drawn  ->" in report() and "](page.html)" in md.read_text(encoding="utf-8")
-    assert "[page](ice_crank_slider/page.html)" in (out / "index.md").read_text(encoding="utf-8")
+    assert "[page](scotch_yoke/page.html)" in (out / "index.md").read_text(encoding="utf-8")
     first = html.read_bytes()
     body = re.sub(rb"<!-- kinetostat-page-sha256 \w+ -->\n$", b"", first).replace(b"</body>", b"<p>planted</p></body>")
     planted = body + b"<!-- kinetostat-page-sha256 " + hashlib.sha256(body).hexdigest().encode() + b" -->\n"

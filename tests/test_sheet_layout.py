@@ -23,7 +23,7 @@ from kinetostat.plans.draw import svg
 from kinetostat.model.lettering import lettering
 
 import sheet_browser
-from conftest import MODELS
+from conftest import EVERY_GROUP, MODELS, sampled
 
 
 @pytest.fixture(scope="session")
@@ -133,7 +133,7 @@ def _on(z: complex, a: complex, b: complex) -> bool:
     return -1e-9 <= t <= 1 + 1e-9 and abs(a + t * (b - a) - z) < 1e-6
 
 
-@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+@pytest.mark.parametrize("path", sampled(MODELS, EVERY_GROUP))
 def test_mechanism_sheet_draws_every_link(path):
     """Seed 002 fig. 1.6: every link drawn through all its points (a slotted link along its slot to
     every block in it, a ram through B, S5 and T), each guide lettered once."""
