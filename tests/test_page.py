@@ -337,15 +337,18 @@ def test_check_judges_variant_1_479_at_the_keys_scale(chromium, tmp_path):
 def _bars_mm(pdf) -> tuple[set[tuple[float, float]], list[dict[str, float]], int]:
     """(the pages' sizes in pt, on each page with the 100 mm bar its labels 0, 50, 100 -> their
     centres' y in mm, the number of pages) of a PDF (pdftotext -bbox); the bar's labels are the
-    words "0", "50", "100" left of 20 mm."""
+    words "0", "50", "100" left of 20 mm whose right ends (the labels are set flush right) lie within
+    1.5 mm of the leftmost right end (on A4 the notes, moved to the top, begin 12 mm in: a value
+    row's "0" ends further right)."""
     box = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
     sizes, bars = set(), []
     for page in box.split("</page>")[:-1]:
         size = re.search(r'<page width="([\d.]+)" height="([\d.]+)"', page)
         sizes.add((float(size[1]), float(size[2])))
         words = re.findall(r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="([\d.]+)">([^<]*)</word>', page)
-        y = {w[4]: (float(w[1]) + float(w[3])) / 2 * 25.4 / 72 for w in words
-             if float(w[0]) * 25.4 / 72 < 20.0 and w[4] in ("0", "50", "100")}
+        near = [w for w in words if float(w[0]) * 25.4 / 72 < 20.0 and w[4] in ("0", "50", "100")]
+        right = min((float(w[2]) for w in near), default=0.0)
+        y = {w[4]: (float(w[1]) + float(w[3])) / 2 * 25.4 / 72 for w in near if float(w[2]) < right + 1.5 * 72 / 25.4}
         if y:
             bars.append(y)
     return sizes, bars, box.count("<page ")
@@ -357,6 +360,30 @@ def _printed(pg, pdf) -> list[str]:
     pg.pdf(path=str(pdf), prefer_css_page_size=True, print_background=True)
     raw = subprocess.run(["pdftotext", "-raw", str(pdf), "-"], capture_output=True, text=True, check=True).stdout
     return raw.split("\f")[:-1]
+
+
+def test_a4_white_under_the_moved_notes_covers_their_text_only(chromium, ice):
+    """Printed on A4, the title line and the notes (the segments' value rows among them, a row a
+    line of one text) move to the top on white: the white under the notes is as wide as their
+    widest line, so the plan beside them stays drawn. Was: the width of the rows' text run laid
+    end to end (~500 mm) under the title's full height, the ICE's group plan blanked on A4."""
+    pg = _open(chromium, ice[2])
+    pg.select_option("#paper", "A4")
+    sheets = pg.evaluate("""() => [...document.querySelectorAll('svg')].filter((s) => s.querySelector('#a4-title')).map((svg) => {
+        const rects = [...svg.querySelectorAll('#a4-title rect')].map((r) => r.getBBox());
+        const notes = [...svg.querySelectorAll('text.note')].map((n) => n.getBoundingClientRect().width);
+        const m = svg.getScreenCTM().a;                 // px a mm
+        return {rects: rects.map((r) => [r.x, r.y, r.width, r.height]), widest: Math.max(0, ...notes) / m};
+    })""")
+    pg.close()
+    assert sheets
+    for s in sheets:
+        notes = s["rects"][1:]
+        assert len(notes) <= 1
+        for x, y, w, h in notes:
+            assert w <= s["widest"] + 2.5, (w, s["widest"])
+        if s["widest"]:
+            assert notes, s
 
 
 def test_print_scale_bar_measures_100_mm(chromium, ice, tmp_path):

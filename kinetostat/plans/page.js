@@ -338,21 +338,26 @@
       w.textContent = D.ui.a4_cut;
       t.appendChild(w);
     }
-    const r = document.createElementNS(NS, "rect");
-    r.setAttribute("x", x0 + 11); r.setAttribute("y", y0 + 2); r.setAttribute("fill", "#fff");
-    g.append(r, t);
+    const white = (x, y, w, h) => {             // a white ground under a block of text, its own width
+      const r = document.createElementNS(NS, "rect");
+      r.setAttribute("x", x); r.setAttribute("y", y); r.setAttribute("width", w); r.setAttribute("height", h);
+      r.setAttribute("fill", "#fff");
+      return r;
+    };
+    const top = y0 + (cut ? 11 : 7.5);
+    g.append(white(x0 + 11, y0 + 2, t.getComputedTextLength() + 2, top - y0 - 2), t);
     svg.appendChild(g);
-    let width = t.getComputedTextLength(), bottom = y0 + (cut ? 11 : 7.5);
     if (notes.length) {                          // the notes' block moved under the title line
       const x = +notes[0].getAttribute("x"), y = +notes[0].getAttribute("y");
+      let width = 0;
       notes.forEach((n) => {
-        n.setAttribute("transform", `translate(${x0 + 12 - x} ${bottom + 2 - y})`);
-        width = Math.max(width, n.getComputedTextLength());
-        svg.appendChild(n);                      // over the white
+        n.setAttribute("transform", `translate(${x0 + 12 - x} ${top + 2 - y})`);
+        width = Math.max(width, n.getBBox().width);   // a block of rows is one text: its box, not its run's length
       });
-      bottom = Math.max(...notes.map((n) => n.getBBox().y + n.getBBox().height)) + bottom + 2 - y;
+      const bottom = Math.max(...notes.map((n) => n.getBBox().y + n.getBBox().height)) + top + 2 - y;
+      g.appendChild(white(x0 + 11, top, width + 2, bottom - top));
+      notes.forEach((n) => svg.appendChild(n));  // over the white
     }
-    r.setAttribute("height", bottom - y0 - 2); r.setAttribute("width", width + 2);
     return g;
   }
   $("paper").addEventListener("change", paper);
