@@ -60,7 +60,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import write_text
-from .._text import script_json
+from .._text import script_json, xml_escape
 from .core import ELEMENTS, PAGE_DECIMALS, UNMEASURED, Drawing, PlanCycle
 from .draw import RESULT, TINY_MM, TOKEN, segment_label, title_of
 from .i18n import check_lang, num, text, unit
@@ -433,8 +433,8 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
 
 def _amounts(d: Drawing, cycle: PlanCycle, symbols: Sequence[str], lang: str) -> dict:
     """Where page.js `amounts` finds the numbers of the tokens in the notes of the sheet `d` of
-    `cycle` (draw.TOKEN): {"seg": {segment's index: [the sheet's elements of its name with a
-    length (their indices: page.js takes the one drawn at the angle, a
+    `cycle` (draw.TOKEN): {"seg": {segment's index: [the sheet's elements of its name (as the
+    sheet's attribute holds it, escaped) with a length (their indices: page.js takes the one drawn at the angle, a
     triad's force polygon names a side anew at each angle), its scale's value (SI per mm)]}, "res": {result's
     index: its column in the values table: its symbol's, as `lang` letters both}}; `symbols`: the
     values table's symbols in order; each only where the notes have such tokens. ValueError where a
@@ -451,7 +451,7 @@ def _amounts(d: Drawing, cycle: PlanCycle, symbols: Sequence[str], lang: str) ->
             res[k] = shown.index(in_lang(symbol, lang))
         else:
             s = cycle.segments[k]
-            seg[k] = [[n for n, E in enumerate(d.elements) if E.length_mm is not None and E.attrs.get("data-segment") == s.name],
+            seg[k] = [[n for n, E in enumerate(d.elements) if E.length_mm is not None and E.attrs.get("data-segment") == xml_escape(s.name)],
                       (s.scale or cycle.scale).value]
     return {k: v for k, v in (("seg", seg), ("res", res)) if v}
 
