@@ -40,7 +40,7 @@ A4 chosen) A4 around the plan with the title line and the notes on top (page.js 
 May use: the plans (`build_cycle`, `cycle_scales`, `core`, `draw`, `forces`, `worksheet`
 (`worksheet_cycle`), `solution` (the page's one analysis), `drawing_error`, `pack`, `labels`, `i18n`), `lettering`, `_io`,
 `kinetostat._text` (`script_json`: the data block's JSON), numpy, the standard library. Never
-matplotlib, never the harness; the solver only through `worksheet.analyses` (the page's one
+matplotlib, never the harness; the solver only through `solution.solve` (the page's one
 analysis).
 """
 from __future__ import annotations
