@@ -86,7 +86,8 @@ class Trajectory:
     energy: np.ndarray         # (K,) J: T + V - W, constant but for the integrator's error
     work_swing: float          # J: max - min over the run of W, the work of the drive, the loads (and
                                #   MuJoCo's soft constraints)
-    seconds: float             # wall time of the run
+    seconds: float             # wall time of the run: its own steps and its share of the load passes it
+                               #   shared with the runs integrated together (`_lockstep`)
     note: str
 
     @property
@@ -120,7 +121,8 @@ class Agreement:
     error: float               # max |omega_engine - omega_kinetostat| / omega_mean, 1
     order: float | None        # observed order against the previous row of the engine (None: first)
     energy_error: float        # the run's energy balance, relative to the work's swing
-    seconds: float             # wall time of the run
+    seconds: float             # wall time of the run: its own steps and its share of the load passes it
+                               #   shared with the runs integrated together (`_lockstep`)
 
 
 class _Engine(Protocol):
