@@ -135,3 +135,43 @@ def test_shaper_converges_to_the_law_of_motion(engine):
     lo, hi = SHAPER_ORDER[engine]
     assert lo < fine.order < hi and fine.error < SHAPER_ERROR[engine], (coarse, fine)
     assert fine.energy_error < coarse.energy_error and fine.energy_error < SHAPER_ENERGY[engine]
+
+
+def test_runs_step_together_with_one_load_pass_a_stage(ice, monkeypatch):
+    """`forwards` drives its runs in lockstep: each stage's loads of both engines come from one
+    `_loads` call of two angles, and each run's omega is what it gives alone."""
+    import kinetostat_validation.motion as motion_module
+    pytest.importorskip("mujoco")
+    pytest.importorskip("pinocchio")
+    mech, motion = ice
+    alone = [forward(mech, motion, e, 12, 1) for e in ENGINES]
+    sizes = []
+    loads = motion_module._loads
+    monkeypatch.setattr(motion_module, "_loads", lambda m, s, phi, w: (sizes.append(len(phi)), loads(m, s, phi, w))[1])
+    together = motion_module.forwards(mech, motion, tuple((e, 12) for e in ENGINES), 1)
+    assert sizes and set(sizes) <= {1, 2} and sizes.count(2) >= 4 * 12
+    assert len(sizes) < sum(4 * len(r.trajectory.t) for r in alone)
+    for a, b in zip(alone, together):
+        np.testing.assert_allclose(b.omega, a.omega, rtol=1e-12)
+
+
+def test_loads_at_unit_speed_scaled_are_the_loads_at_that_speed():
+    """`_loads` at several angles, each at its own speed, against the load model run on the
+    mechanism driven at that speed, one angle at a time."""
+    from kinetostat.applied import applied_wrenches, com_motion
+    from kinetostat.kinematics import kinematics
+    from kinetostat.planar import as_xy
+    from kinetostat_validation.motion import _loads
+    from kinetostat_validation.scene import build_scene, loads_at_centres
+    mech = replace(kinetostat.load(ROOT / "models" / "slotted_link_shaper.toml"), friction=None)
+    scene = build_scene(mech, phi_deg=[0.0])
+    phi, w = np.radians([10.0, 95.0, 250.0]), np.array([0.5, 3.0, 12.0]) * mech.drive.omega
+    F, M = _loads(mech, scene, phi, w)
+    for i in range(3):
+        at = replace(mech, drive=replace(mech.drive, omega=float(w[i]), eps=0.0, law=None))
+        kin = kinematics(at, phi[i:i + 1])
+        Fa, Ma = applied_wrenches(at, kin, com_motion(at, kin)[0])
+        Fi, Mi = loads_at_centres(scene.bodies, scene.g, kin, as_xy(Fa), Ma)
+        scale = np.abs(Fi).max()
+        np.testing.assert_allclose(F[i], Fi[0], rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(M[i], Mi[0], rtol=0, atol=1e-12 * np.abs(Mi).max())

@@ -6,7 +6,8 @@ added to the crank's moment of inertia about its axis (Pinocchio: `with_flywheel
 compiling, so that its placeholder floors keep the linkage's scale), the drive's constant moment
 M_drive on the crank (a characteristic M(omega) is one of the model's loads), and its applied loads evaluated by kinetostat's load model
 (`kinetostat.applied.applied_wrenches`) at the engine's own crank angle and speed at every stage
-of every step (they depend on the state, so this is a Python loop over the steps). Gravity is the
+of every step (they depend on the state, so this is a Python loop over the steps; the runs of one
+call, `forwards`, step together and have their loads evaluated in one pass a stage, `_lockstep`). Gravity is the
 engines' own. Friction is not modelled by the engines: a mechanism with [friction] is refused.
 
 Integration: the classical Runge-Kutta method (RK4, order 4) at the step
@@ -40,7 +41,7 @@ import importlib.util
 import math
 import time
 from dataclasses import dataclass, replace
-from typing import Protocol
+from typing import Generator, Protocol
 
 import numpy as np
 
@@ -52,7 +53,7 @@ from kinetostat.planar import as_xy
 
 from .scene import Scene, build_scene, loads_at_centres
 
-__all__ = ["ENGINES", "STEPS_PER_REV", "Trajectory", "Forward", "Agreement", "MotionCheck", "integrate", "forward",
+__all__ = ["ENGINES", "STEPS_PER_REV", "Trajectory", "Forward", "Agreement", "MotionCheck", "integrate", "forward", "forwards",
            "convergence", "observed_order", "check_law_of_motion", "with_flywheel", "at_angles"]
 
 ENGINES = ("mujoco", "pinocchio")
@@ -85,7 +86,8 @@ class Trajectory:
     energy: np.ndarray         # (K,) J: T + V - W, constant but for the integrator's error
     work_swing: float          # J: max - min over the run of W, the work of the drive, the loads (and
                                #   MuJoCo's soft constraints)
-    seconds: float             # wall time of the run
+    seconds: float             # wall time of the run: its own steps and its share of the load passes it
+                               #   shared with the runs integrated together (`_lockstep`)
     note: str
 
     @property
@@ -119,7 +121,8 @@ class Agreement:
     error: float               # max |omega_engine - omega_kinetostat| / omega_mean, 1
     order: float | None        # observed order against the previous row of the engine (None: first)
     energy_error: float        # the run's energy balance, relative to the work's swing
-    seconds: float             # wall time of the run
+    seconds: float             # wall time of the run: its own steps and its share of the load passes it
+                               #   shared with the runs integrated together (`_lockstep`)
 
 
 class _Engine(Protocol):
@@ -134,14 +137,17 @@ class _Engine(Protocol):
 
 # ----------------------------------------------------------------------------- loads
 
-def _loads(mech: Mechanism, scene: Scene, phi: float, omega: float) -> tuple[np.ndarray, np.ndarray]:
-    """kinetostat's applied loads (gravity out) at crank angle phi (rad) and speed omega (rad/s)
-    as the engines take them: force at each centre of mass (L, 2), N, moment about it (L,), N m."""
-    at = replace(mech, drive=replace(mech.drive, omega=omega, eps=0.0, law=None))
-    kin = kinematics(at, np.array([phi]))
-    F, M = applied_wrenches(at, kin, com_motion(at, kin)[0])
-    F, M = loads_at_centres(scene.bodies, scene.g, kin, as_xy(F), M)
-    return F[0], M[0]
+def _loads(mech: Mechanism, scene: Scene, phi: np.ndarray, omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """kinetostat's applied loads (gravity out) at the crank angles phi (rad, (n,)), each at its own
+    speed omega (rad/s, (n,)), as the engines take them: force at each centre of mass (n, L, 2), N,
+    moment about it (n, L), N m. One pass of the kinematics over all n angles at unit crank speed,
+    scaled to each angle's speed (velocities by omega, accelerations by omega^2: eps = 0)."""
+    unit = kinematics(mech, phi, unit_speed=True)
+    w = omega[:, None]
+    kin = replace(unit, v_z=unit.v_z * w, a_z=unit.a_z * w**2, omega=unit.omega * w, eps=unit.eps * w**2,
+                  v_slide=unit.v_slide * w, a_slide=unit.a_slide * w**2)
+    F, M = applied_wrenches(mech, kin, com_motion(mech, kin)[0])
+    return loads_at_centres(scene.bodies, scene.g, kin, as_xy(F), M)
 
 
 # ----------------------------------------------------------------------------- engines
@@ -247,6 +253,11 @@ class _Pinocchio:
 
 # ----------------------------------------------------------------------------- integration
 
+#: What a run yields: the crank angle (rad) and speed (rad/s) it needs the loads at; it is sent
+#: the loads there, force (L, 2), N, and moment (L,), N m, at each centre of mass (`_loads`).
+Run = Generator[tuple[float, float], tuple[np.ndarray, np.ndarray], Trajectory]
+
+
 def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: float, omega0: float,
               omega_mean: float, engine: str = "mujoco", steps_per_rev: int = 360,
               cycles: float = 3) -> Trajectory:
@@ -255,6 +266,15 @@ def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: floa
     J_flywheel (kg m^2) on the crank, drive moment M_drive (N m, drive's sense) constant.
     Raises ValueError for a mechanism with friction, an unknown engine, a bad step count, or a
     crank that stops or turns back (no steady motion to follow)."""
+    scene = build_scene(mech, phi_deg=[phi0_deg])
+    run = _run(mech, scene, J_flywheel, M_drive, phi0_deg, omega0, omega_mean, engine, steps_per_rev, cycles)
+    return _lockstep(mech, scene, [run])[0]
+
+
+def _run(mech: Mechanism, scene: Scene, J_flywheel: float, M_drive: float, phi0_deg: float, omega0: float,
+         omega_mean: float, engine: str, steps_per_rev: int, cycles: float) -> Run:
+    """`integrate`'s run (its arguments checked and its engine built now) as a generator that asks
+    for the loads at each stage of each step (`Run`); `_lockstep` drives it."""
     if mech.friction is not None:
         raise ValueError("integrate: the engines model no friction; give the mechanism without it "
                          "(dataclasses.replace(mech, friction=None)) to kinetostat and the engines alike")
@@ -265,37 +285,42 @@ def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: floa
     if not (omega0 > 0 and omega_mean > 0 and J_flywheel >= 0 and cycles > 0):
         raise ValueError(f"integrate: needs omega0 > 0, omega_mean > 0, J_flywheel >= 0 and cycles > 0, got "
                          f"{omega0}, {omega_mean}, {J_flywheel}, {cycles}")
-    scene = build_scene(mech, phi_deg=[phi0_deg])
     dt = 2 * math.pi / (omega_mean * steps_per_rev)
     eng: _Engine = (_MuJoCo(scene, J_flywheel, dt) if engine == "mujoco"
                     else _Pinocchio(with_flywheel(scene, J_flywheel), omega_mean))
+    return _steps(mech, engine, eng, M_drive, math.radians(phi0_deg), omega0, dt, steps_per_rev, cycles)
+
+
+def _steps(mech: Mechanism, engine: str, eng: _Engine, M_drive: float, phi0: float, omega0: float, dt: float,
+           steps_per_rev: int, cycles: float) -> Run:
+    """RK4 steps of `eng` from phi0 (rad) at omega0 (rad/s) to phi0 + 2 pi cycles, landing on the
+    load tables' kinks (`integrate`); the Trajectory is the generator's return value."""
     sense, c = mech.drive.sense, eng.crank
     q, v = eng.start(omega0 / mech.drive.omega)
-    qc0, phi0 = q[c], math.radians(phi0_deg)
+    qc0 = q[c]
 
     def f(q, v):
         phi, w = phi0 + sense * (q[c] - qc0), sense * v[c]
-        F, M = _loads(mech, scene, phi, w)
+        F, M = yield phi, w
         a, power, energy = eng.derivative(q, v, F, M, sense * M_drive)
         return a, power + M_drive * w, energy, phi, w
 
     def step(q, v, W, a1, p1, h):
         """One RK4 step of length h (a1, p1: the derivatives at its start)."""
         v2 = v + h / 2 * a1
-        a2, p2, *_ = f(q + h / 2 * v, v2)
+        a2, p2, *_ = yield from f(q + h / 2 * v, v2)
         v3 = v + h / 2 * a2
-        a3, p3, *_ = f(q + h / 2 * v2, v3)
+        a3, p3, *_ = yield from f(q + h / 2 * v2, v3)
         v4 = v + h * a3
-        a4, p4, *_ = f(q + h * v3, v4)
+        a4, p4, *_ = yield from f(q + h * v3, v4)
         return (q + h / 6 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4),
                 W + h / 6 * (p1 + 2 * p2 + 2 * p3 + p4))
 
-    t0 = time.perf_counter()
     end, limit = phi0 + 2 * math.pi * cycles, int(3 * steps_per_rev * cycles) + 10
     knots, k = _landings(mech, phi0, end), 0
     W, t, rows = 0.0, 0.0, []
     while True:
-        a1, p1, E, phi, w = f(q, v)
+        a1, p1, E, phi, w = yield from f(q, v)
         eps = sense * a1[c]
         rows.append((t, phi, w, eps, E - W, W))
         k += int(np.searchsorted(knots[k:], phi + LANDING))           # landings reached
@@ -310,13 +335,43 @@ def integrate(mech: Mechanism, J_flywheel: float, M_drive: float, phi0_deg: floa
             # lands within O(h^3), so a kink there costs O(h^6)), and counted as reached
             h = 2 * gap / (w + math.sqrt(w * w + 2 * eps * gap))
             k += 1
-        q, v, W = step(q, v, W, a1, p1, h)
+        q, v, W = yield from step(q, v, W, a1, p1, h)
         t += h
-    seconds = time.perf_counter() - t0
     t, phi, w, eps, energy, work = np.array(rows).T
-    return Trajectory(engine, int(steps_per_rev), dt, t, phi, w, eps, energy, float(np.ptp(work)), seconds,
+    return Trajectory(engine, int(steps_per_rev), dt, t, phi, w, eps, energy, float(np.ptp(work)), 0.0,
                       f"{eng.note}; RK4, {steps_per_rev} steps/rev (dt = {dt:.3g} s), {cycles} cycles, "
                       f"{len(knots)} landings on load table knots and the run's end")
+
+
+def _lockstep(mech: Mechanism, scene: Scene, runs: list[Run]) -> list[Trajectory]:
+    """The runs driven together: at each round the loads every unfinished run asks for are
+    evaluated in one `_loads` call (the kinematics of all their angles in one pass, the largest
+    cost of a run). Each Trajectory's `seconds`: its own steps' wall time and its share of the
+    rounds' loads."""
+    seconds = [0.0] * len(runs)
+    asked: dict[int, tuple[float, float]] = {}
+    done: dict[int, Trajectory] = {}
+
+    def advance(i: int, loads: tuple[np.ndarray, np.ndarray] | None) -> None:
+        t0 = time.perf_counter()
+        try:
+            asked[i] = next(runs[i]) if loads is None else runs[i].send(loads)
+        except StopIteration as stop:
+            asked.pop(i, None)
+            done[i] = stop.value
+        seconds[i] += time.perf_counter() - t0
+
+    for i in range(len(runs)):
+        advance(i, None)
+    while asked:
+        t0 = time.perf_counter()
+        order = list(asked)
+        F, M = _loads(mech, scene, np.array([asked[i][0] for i in order]), np.array([asked[i][1] for i in order]))
+        share = (time.perf_counter() - t0) / len(order)
+        for n, i in enumerate(order):
+            seconds[i] += share
+            advance(i, (F[n], M[n]))
+    return [replace(done[i], seconds=seconds[i]) for i in range(len(runs))]
 
 
 def _landings(mech: Mechanism, phi0: float, end: float) -> np.ndarray:
@@ -371,13 +426,19 @@ def forward(mech: Mechanism, motion, engine: str = "mujoco", steps_per_rev: int 
     and drive (a constant moment; a characteristic M(omega) is one of the model's loads, so the
     load model gives it at the engine's speed); its omega at motion.phi_deg in the last cycle
     beside motion.omega."""
+    return forwards(mech, motion, ((engine, steps_per_rev),), cycles)[0]
+
+
+def forwards(mech: Mechanism, motion, runs: tuple[tuple[str, int], ...], cycles: int = 3) -> list[Forward]:
+    """`forward` of every (engine, steps_per_rev) of `runs`, integrated together (`_lockstep`)."""
     drive = 0.0 if motion.drive == "characteristic" else float(motion.M_drive[0])
     phi_deg = np.asarray(motion.phi_deg, float)
-    tr = integrate(mech, motion.J_flywheel, drive, float(phi_deg[0]), float(motion.omega[0]),
-                   motion.omega_mean, engine, steps_per_rev, cycles)
+    scene = build_scene(mech, phi_deg=[float(phi_deg[0])])
+    trs = _lockstep(mech, scene, [_run(mech, scene, motion.J_flywheel, drive, float(phi_deg[0]), float(motion.omega[0]),
+                                       motion.omega_mean, engine, n, cycles) for engine, n in runs])
     last = np.radians(phi_deg[0] + (phi_deg - phi_deg[0]) % 360.0 + 360.0 * (cycles - 1))
-    return Forward(engine, int(steps_per_rev), phi_deg, at_angles(tr, last), np.asarray(motion.omega, float),
-                   float(motion.omega_mean), tr)
+    return [Forward(engine, int(n), phi_deg, at_angles(tr, last), np.asarray(motion.omega, float),
+                    float(motion.omega_mean), tr) for (engine, n), tr in zip(runs, trs)]
 
 
 def observed_order(errors: list[float], steps: list[int]) -> list[float | None]:
@@ -391,8 +452,9 @@ def convergence(mech: Mechanism, motion, engines: tuple[str, ...] = ENGINES,
     """Every engine at every step count: its error against kinetostat's omega(phi), the observed
     order, the energy balance and the wall time (see `forward`)."""
     rows = []
+    done = forwards(mech, motion, tuple((engine, n) for engine in engines for n in steps_per_rev), cycles)
     for engine in engines:
-        runs = [forward(mech, motion, engine, n, cycles) for n in steps_per_rev]
+        runs = [r for r in done if r.engine == engine]
         orders = observed_order([r.error for r in runs], list(steps_per_rev))
         rows += [Agreement(engine, r.steps_per_rev, r.error, o, r.trajectory.energy_error, r.trajectory.seconds)
                  for r, o in zip(runs, orders)]
