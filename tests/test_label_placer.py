@@ -99,7 +99,7 @@ def _reference_choice(centres, half, base, hard, lines, slack):
 @pytest.mark.parametrize("seed", range(4))
 def test_lazy_costs_choose_what_testing_every_candidate_chooses(seed, still):
     """Random anchors among random obstacles, candidates on rings about them (n = 7 angles,
-    160 candidates: more than the first batches; a few not free; still: the same candidates at
+    160 candidates: more than the first batch; a few not free; still: the same candidates at
     every angle): the placer's choice is the brute-force reference's."""
     n, K = 7, 160
     rng, placer, hard, lines = _scene(seed, n)
