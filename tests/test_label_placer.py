@@ -99,7 +99,7 @@ def _reference_choice(centres, half, base, hard, lines, slack):
 @pytest.mark.parametrize("seed", range(4))
 def test_lazy_costs_choose_what_testing_every_candidate_chooses(seed, still):
     """Random anchors among random obstacles, candidates on rings about them (n = 7 angles,
-    160 candidates: more than the first batches; a few not free; still: the same candidates at
+    160 candidates: more than the first batch; a few not free; still: the same candidates at
     every angle): the placer's choice is the brute-force reference's."""
     n, K = 7, 160
     rng, placer, hard, lines = _scene(seed, n)
@@ -168,6 +168,31 @@ def test_over_many_angles_a_label_keeps_a_searched_neighbours_place_where_it_is_
     assert np.array_equal(got, want), np.flatnonzero(got != want)
     assert free[np.arange(n), got].all()
     assert len(left) and (want[sample][1:] != want[sample][:-1]).any()      # the scene moves a label, and searches again
+
+
+@pytest.mark.parametrize("n", [10, 40])
+def test_angles_without_an_anchor_are_not_searched_and_change_no_choice(n):
+    """A label without an anchor at some angles (no candidate free there, as `place` gives it;
+    n = 10 angles, and 40: searched at every STRIDE-th): those angles are never searched or tested
+    (`geometry` never asked for them), -1 there, and every other angle's choice is the one made
+    with them searched."""
+    K = 96
+    placer, centres, half, base, _, _ = _scene_of_candidates(1, n, K)
+    anchored = np.ones(n, dtype=bool)
+    anchored[[1, 2, 3, n - 3]] = False
+    anchored[17:30] = n < 30
+    base[~anchored] = np.inf
+    want = placer._choose(_geometry(centres, base), K, half, False)
+    asked = []
+
+    def geometry(rows, cols):
+        asked.append(rows)
+        return _geometry(centres, base)(rows, cols)
+
+    got = placer._choose(geometry, K, half, False, anchored=anchored)
+    assert np.array_equal(got, want), np.flatnonzero(got != want)
+    assert (got[~anchored] == -1).all() and (got[anchored] >= 0).any()
+    assert not np.isin(np.flatnonzero(~anchored), np.concatenate(asked)).any()
 
 
 @pytest.mark.parametrize("seed", range(4))

@@ -33,6 +33,7 @@ import re
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -236,6 +237,13 @@ def _t(x: float, y: float, s: str, size: float, anchor: str = "start", weight: s
     return _text_element(x, y, [s], [0], size, anchor, weight, ident, cls).svg(0)
 
 
+@lru_cache(maxsize=8192)
+def _word_width(word: str, size: float) -> float:
+    """Width of a word of a note at `size`, mm, as `_wrap` measures it (a page's token as wide as
+    _TOKEN_SAMPLE): the notes of a page's angles repeat their words."""
+    return text_width(TOKEN.sub(_TOKEN_SAMPLE, plain(word)), size)
+
+
 def _wrap(s: str, size: float, width: float) -> list[str]:
     """`s` broken at spaces into lines no wider than `width` mm at `size` (a longer word alone);
     a line's width the sum of its words' and spaces' (a symbol's mark never holds a space; a page's
@@ -243,7 +251,7 @@ def _wrap(s: str, size: float, width: float) -> list[str]:
     out, line, used = [], "", 0.0
     space = text_width(" ", size)
     for word in s.split(" "):
-        w = text_width(TOKEN.sub(_TOKEN_SAMPLE, plain(word)), size)
+        w = _word_width(word, size)
         if line and used + space + w > width:
             out.append(line)
             line, used = word, w

@@ -187,9 +187,9 @@ LINE_COST = 0.6 / 0.7
 #: The cost of covering a heavy line (a link, a vector), per mm of it inside the label's box: as
 #: much as moving the label 25 mm further out.
 HEAVY_COST = 30.0
-#: Candidates tested at once (cheapest first): this many (a point label's three nearest rings),
-#: twice as many from the third batch on.
-_BATCH = 48
+#: Candidates tested at once (cheapest first): this many (a point label's six nearest rings),
+#: twice as many from the third batch on (fewer, larger batches: the same choice, less CPU).
+_BATCH = 96
 #: Over many angles a label's places are searched at every STRIDE-th angle; the angles between
 #: keep a neighbour's place where it is free (`Placer._choose`).
 STRIDE = 8
@@ -374,7 +374,7 @@ class Placer:
                      and np.array_equal(d, np.broadcast_to(d[:1], d.shape), equal_nan=True)
                      and np.array_equal(half, np.broadcast_to(half[:1], half.shape)))
         with np.errstate(invalid="ignore"):
-            k = self._choose(geometry, K, half.T.astype(np.float32), still, (A, self._crowded(A)))
+            k = self._choose(geometry, K, half.T.astype(np.float32), still, (A, self._crowded(A)), fixed)
             xy, _ = geometry(np.arange(n), np.maximum(k, 0)[:, None])
         c = np.where((k >= 0)[:, None], xy[:, :, 0].T, np.nan)
         box = np.concatenate([c - half, c + half], axis=1)
@@ -463,28 +463,35 @@ class Placer:
         return np.where(inside, cost[:, None], 0.0)
 
     def _choose(self, geometry: Callable, K: int, half: np.ndarray, still: bool,
-                zone: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                zone: tuple[np.ndarray, np.ndarray] | None = None, anchored: np.ndarray | None = None) -> np.ndarray:
         """The candidate (N,) taken at each angle (-1: none, the anchor NaN) of the K candidates
         `geometry(rows, cols)` gives (their centres (2, r, m) and least costs (r, m) at the angles
         `rows` (r,), candidates `cols` (r, m) or (1, m)), half size `half` (2, N); `still`: the same
         candidates at every angle; `zone`: the label's point (N, 2) and what a candidate in its zone
-        costs (N,) (`_crowded`; None: nothing). Over many angles (N >= 2 STRIDE) a label keeps its place from
-        angle to angle unless it must move: the places are searched (`_search`) at every STRIDE-th
-        angle (and the last); an angle between keeps the place of the searched angle before it,
-        else of the one after it, where that place is free there (off every hard obstacle and
-        every heavy line, and in the bounds); the angles where neither is are searched."""
+        costs (N,) (`_crowded`; None: nothing); `anchored` (N,): the angles where the label has an
+        anchor (None: every angle; elsewhere no candidate is free: -1 there, not searched). Over many
+        angles (N >= 2 STRIDE) a label keeps its place from angle to angle unless it must move: the
+        places are searched (`_search`) at every STRIDE-th angle (and the last); an angle between
+        keeps the place of the searched angle before it, else of the one after it, where that place
+        is free there (off every hard obstacle and every heavy line, and in the bounds); the angles
+        where neither is are searched. An angle's choice is the same with or without the angles
+        not anchored beside it in a search (no candidate of theirs counts)."""
         n = self.n
         zone = (np.zeros((n, 2)), np.zeros(n)) if zone is None else zone
-        if n < 2 * STRIDE:
-            return self._search(geometry, K, half, still, np.arange(n), zone)
+        anchored = np.ones(n, dtype=bool) if anchored is None else anchored
         k = np.full(n, -1)
+        if n < 2 * STRIDE:
+            at = np.flatnonzero(anchored)
+            k[at] = self._search(geometry, K, half, still, at, zone)
+            return k
         done = np.zeros(n, dtype=bool)                              # searched, or a neighbour's place kept
         done[::STRIDE] = done[-1] = True
         sample = np.flatnonzero(done)
-        k[sample] = self._search(geometry, K, half, still, sample, zone)
-        between = np.flatnonzero(~done)
-        at = np.searchsorted(sample, between)
-        guess = np.column_stack([k[sample[at - 1]], k[sample[at]]])    # the searched angle before, then after
+        at = sample[anchored[sample]]
+        k[at] = self._search(geometry, K, half, still, at, zone)
+        between = np.flatnonzero(~done & anchored)
+        near = np.searchsorted(sample, between)
+        guess = np.column_stack([k[sample[near - 1]], k[sample[near]]])    # the searched angle before, then after
         xy, base = geometry(between, np.maximum(guess, 0))
         free = self._costs(xy.astype(np.float32), half[:, between], base, between, (True, False),
                            heavy=True) <= base                  # free, and over no heavy line
@@ -493,9 +500,8 @@ class Placer:
         first = np.argmax(free, axis=1)
         kept = free.any(axis=1)
         k[between[kept]] = guess[kept, first[kept]]
-        between = between[~kept]
-        if len(between):
-            k[between] = self._search(geometry, K, half, still, between, zone)
+        at = between[~kept]
+        k[at] = self._search(geometry, K, half, still, at, zone)
         return k
 
     def _search(self, geometry: Callable, K: int, half: np.ndarray, still: bool, at: np.ndarray,
@@ -506,6 +512,8 @@ class Placer:
         every angle until none left there can come within SLACK of the best; then the candidate
         within SLACK of the best at the most angles is taken there, and so on; where none is free,
         the cheapest (nowhere free: the test tells)."""
+        if not len(at):
+            return np.full(0, -1)
         centres, base = geometry(at, np.arange(K)[None])
         centres = centres.astype(np.float32)
         n = len(at)
