@@ -495,10 +495,44 @@ def test_the_notes_state_the_scales_and_their_departures():
 
 def test_free_rectangles_split_around_a_box_stay_maximal():
     """`_split` (maximal rectangles): a box inside a free rectangle leaves the four rectangles
-    beside it; a free rectangle inside another is dropped, and of two equal ones the later."""
+    beside it; a piece inside another rectangle (another's piece, or one the box does not meet) is
+    dropped; the rectangles the box does not meet stay as they are."""
     free = [(0.0, 0.0, 10.0, 10.0)]
     A3._split(free, (2.0, 2.0, 4.0, 4.0))
     assert free == [(0.0, 0.0, 2.0, 10.0), (4.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 2.0), (0.0, 4.0, 10.0, 10.0)]
-    free = [(1.0, 1.0, 5.0, 5.0), (0.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]
+    free = [(0.0, 0.0, 10.0, 10.0), (0.0, 0.0, 20.0, 3.0), (0.0, 0.0, 2.0, 20.0)]
+    A3._split(free, (2.0, 2.0, 4.0, 6.0))
+    assert free == [(4.0, 0.0, 10.0, 10.0), (0.0, 6.0, 10.0, 10.0), (4.0, 0.0, 20.0, 3.0), (0.0, 0.0, 20.0, 2.0),
+                    (0.0, 0.0, 2.0, 20.0)]
     A3._split(free, (40.0, 40.0, 41.0, 41.0))                      # meets none of them
-    assert free == [(0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]
+    assert free == [(4.0, 0.0, 10.0, 10.0), (0.0, 6.0, 10.0, 10.0), (4.0, 0.0, 20.0, 3.0), (0.0, 0.0, 20.0, 2.0),
+                    (0.0, 0.0, 2.0, 20.0)]
+
+def _counting(monkeypatch, name: str) -> list:
+    """Calls of A3.`name` counted (one entry each) while the test runs."""
+    calls, saved = [], getattr(A3, name)
+    monkeypatch.setattr(A3, name, lambda *a: calls.append(1) or saved(*a))
+    return calls
+
+
+def test_the_texts_order_search_passes_over_a_corner_a_later_plan_cannot_follow(monkeypatch):
+    """Three small plans and one wider than the sheet: no corner of the first can be followed by
+    the wide one, so each is passed over at once (the corners of the second plan never searched);
+    none is found, and every corner was searched."""
+    calls = _counting(monkeypatch, "_place_after")
+    sizes = [(50.0, 40.0, 5.0), (50.0, 40.0, 5.0), (50.0, 40.0, 5.0), (500.0, 10.0, 5.0)]
+    assert A3._in_order(sizes, [0, 1, 2, 3], A3.READING[0], 10.0) == (None, True)
+    assert len(calls) == 1
+
+
+def test_a_texts_order_search_of_every_corner_is_not_repeated_by_the_next_rule(monkeypatch):
+    """Where the first rule of READING searched every corner and found none, the next finds none
+    either (the same corners in another order): it is not run. Where the first ran out of
+    tries, it is."""
+    calls = _counting(monkeypatch, "_in_order")
+    sizes = [(200.0, 150.0, 5.0), (200.0, 150.0, 5.0), (200.0, 150.0, 5.0)]   # no two fit side by side under the third
+    assert A3._texts_layout(sizes, [0, 1, 2], 10.0) is None
+    assert len(calls) == 1
+    monkeypatch.setattr(A3, "IN_ORDER_TRIES", 0)
+    assert A3._texts_layout(sizes, [0, 1, 2], 10.0) is None
+    assert len(calls) == 1 + len(A3.READING)
