@@ -253,12 +253,10 @@ def placed_in_order(drawings: list[Drawing], places: list[Placement]) -> bool:
     return all(p.page == 0 for p in places) and in_texts_order([d.kind for d in drawings], boxes)
 
 
-def _split(free: list, box: tuple) -> None:
-    """The free rectangles (maximal: none inside another) split around `box` (x0, y0, x1, y1), in
-    place: each one the box meets gives way to its pieces beside the box, and a piece inside another
-    rectangle is dropped (of equal pieces the first is kept). Only the pieces are tested: a
-    rectangle the box does not meet is inside no piece, as each piece is inside the rectangle it
-    came from."""
+def _cut(free: list, box: tuple) -> tuple[list, list[int]]:
+    """(the free rectangles with each one `box` (x0, y0, x1, y1) meets given way to its pieces
+    beside the box, the indices of the pieces). A box w x h fits one of them where it fits one
+    of `_split`'s, which drops only pieces inside another."""
     bx0, by0, bx1, by1 = box
     out, pieces = [], []
     for r in free:
@@ -268,15 +266,30 @@ def _split(free: list, box: tuple) -> None:
             continue
         for c in ((fx0, fy0, bx0, fy1), (bx1, fy0, fx1, fy1), (fx0, fy0, fx1, by0), (fx0, by1, fx1, fy1)):
             if c[2] - c[0] > 1e-9 and c[3] - c[1] > 1e-9:
-                pieces.append((len(out), c))
+                pieces.append(len(out))
                 out.append(c)
+    return out, pieces
+
+
+def _maximal(out: list, pieces: list[int]) -> list:
+    """`out` (`_cut`) without the pieces inside another rectangle (of equal pieces the first kept).
+    Only the pieces are tested: a rectangle the box does not meet is inside no piece, as each
+    piece is inside the rectangle it came from and those given are maximal."""
     drop = set()
-    for i, (x0, y0, x1, y1) in pieces:
+    for i in pieces:
+        x0, y0, x1, y1 = out[i]
         for j, (qx0, qy0, qx1, qy1) in enumerate(out):
             if j != i and qx0 <= x0 and qy0 <= y0 and x1 <= qx1 and y1 <= qy1 and (j < i or out[j] != out[i]):
                 drop.add(i)                      # inside another (an equal one after it: not)
                 break
-    free[:] = [r for i, r in enumerate(out) if i not in drop]
+    return [r for i, r in enumerate(out) if i not in drop]
+
+
+def _split(free: list, box: tuple) -> None:
+    """The free rectangles (maximal: none inside another) split around `box` (x0, y0, x1, y1), in
+    place: each one the box meets gives way to its pieces beside the box (`_cut`), and a piece
+    inside another rectangle is dropped (`_maximal`)."""
+    free[:] = _maximal(*_cut(free, box))
 
 
 def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float] | None:
@@ -298,10 +311,12 @@ def _place_after(free: list, w: float, h: float, placed: list, rule) -> list[tup
     boxes' right and bottom edges, least by `rule` (READING) first; none where none is free."""
     spots = set()
     for fx, fy, fx1, fy1 in free:
+        if fx + w > fx1 + 1e-9 or fy + h > fy1 + 1e-9:
+            continue                             # too small for the box at any corner
         for x in {fx, *(b[2] for b in placed if fx < b[2] <= fx1 - w + 1e-9)}:
             for y in {fy, *(b[3] for b in placed if fy < b[3] <= fy1 - h + 1e-9)}:
-                box = (x, y, x + w, y + h)
-                if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and all(_after(box, b) for b in placed):
+                if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and \
+                        all(x >= b[2] - 1e-9 or y >= b[3] - 1e-9 for b in placed):     # `_after` each
                     spots.add((rule(x, y), x, y))
     return [(x, y) for _, x, y in sorted(spots)]
 
@@ -362,10 +377,9 @@ def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule, n
             left -= 1
             if left < 0:
                 return False
-            rest = list(free)
-            _split(rest, (x, y, x + w, y + h))
-            if all(_fits_somewhere(rest, *later) for later in grown[k + 1:]) and \
-                    fill(k + 1, rest, [*placed, (x, y, x + w, y + h)]):
+            cut = _cut(free, (x, y, x + w, y + h))
+            if all(_fits_somewhere(cut[0], *later) for later in grown[k + 1:]) and \
+                    fill(k + 1, _maximal(*cut), [*placed, (x, y, x + w, y + h)]):
                 out[order[k]] = (0, x, y)
                 return True
         return False
