@@ -232,7 +232,8 @@ def texts_rank(kind: str) -> tuple:
 
 
 def _after(box: tuple, before: tuple) -> bool:
-    """Whether `box` (x0, y0, x1, y1) reads after `before`: right of it or below it."""
+    """Whether `box` (x0, y0, x1, y1, or its top left corner x0, y0) reads after `before` (x0, y0,
+    x1, y1): right of it or below it."""
     return box[0] >= before[2] - 1e-9 or box[1] >= before[3] - 1e-9
 
 
@@ -315,8 +316,7 @@ def _place_after(free: list, w: float, h: float, placed: list, rule) -> list[tup
             continue                             # too small for the box at any corner
         for x in {fx, *(b[2] for b in placed if fx < b[2] <= fx1 - w + 1e-9)}:
             for y in {fy, *(b[3] for b in placed if fy < b[3] <= fy1 - h + 1e-9)}:
-                if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and \
-                        all(x >= b[2] - 1e-9 or y >= b[3] - 1e-9 for b in placed):     # `_after` each
+                if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and all(_after((x, y), b) for b in placed):
                     spots.add((rule(x, y), x, y))
     return [(x, y) for _, x, y in sorted(spots)]
 
