@@ -32,9 +32,9 @@ PT = 72.0 / 25.4                                       # points per mm
 
 def _one(task: int, code: str, lang: str = "en") -> A3.OneSheet:
     """`one_sheet` of variant task/code at phi1 in `lang`, made once per module (a sheet's search
-    takes seconds; `_sheet`, its arguments spelt one way for its cache); task 2 / 479 in English
-    is the one `_counted` made."""
-    return _counted().one if (task, code, lang) == (2, "479", "en") else _sheet(task, code, lang)
+    takes seconds; `_sheet`, its arguments spelt one way for its cache); those of _COUNTED are the
+    ones `_counted` made."""
+    return _counted(task, code, lang).one if (task, code, lang) in _COUNTED else _sheet(task, code, lang)
 
 
 @lru_cache(maxsize=None)
@@ -53,10 +53,15 @@ class Counted:
     drawn: tuple
 
 
+#: The sheets `_counted` makes: task 2 / 479 in English (its search comes back to scales tried
+#: before), task 1 / 479 in Ukrainian (its search steps back to the rule's scales).
+_COUNTED = ((2, "479", "en"), (1, "479", "uk"))
+
+
 @lru_cache(maxsize=None)
-def _counted() -> Counted:
-    """Task 2 / 479 in English (its search comes back to scales tried before), its builds of the
-    plans and its drawings counted (`kinetostat.plans.build` and `a3.sheet` wrapped while it runs)."""
+def _counted(task: int = 2, code: str = "479", lang: str = "en") -> Counted:
+    """The sheet of variant task/code in `lang` (_COUNTED), its builds of the plans and its
+    drawings counted (`kinetostat.plans.build` and `a3.sheet` wrapped while it runs)."""
     import kinetostat.plans as KP
     built, drawn, positions = [], [], []
     build, sheet = KP.build, A3.sheet
@@ -65,10 +70,10 @@ def _counted() -> Counted:
         built.append(None if scales is None else tuple(sorted(scales.items())))
         positions.append(kw.get("positions"))
         return build(mech, at=at, scales=scales, **kw)
-    v = variants.variant(2, "479")
+    v = variants.variant(task, code)
     with mock.patch.object(KP, "build", counted), mock.patch.object(A3, "sheet", lambda plan, lang, *a, **kw: drawn.append(
             (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or sheet(plan, lang, *a, **kw)):
-        one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
+        one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), lang)
     return Counted(one, tuple(built), tuple(positions), tuple(drawn))
 
 
@@ -187,6 +192,15 @@ def test_each_scale_choice_is_built_and_drawn_once():
     given = c.positions[1:]
     assert all(p is not None and p.mu.value == dict(b)["mu_l"] for p, b in zip(given, built[1:]))
     assert len({id(p) for p in given}) == len({p.mu.value for p in given}) < len(given)
+
+
+def test_the_rules_scales_given_are_the_rules_try():
+    """Task 1 / 479 in Ukrainian: its search steps back to the rule's scales (μ_v 0.25 with μ_F
+    40); that try is the rule's own, its plans not built again (was: built and laid out again)."""
+    c = _counted(1, "479", "uk")
+    rule = tuple(sorted((k, s.value) for k, s in c.one.rule.items()))
+    assert c.built[0] is None and rule not in c.built
+    assert len(c.built) == len(set(c.built)) >= 4
 
 
 def test_a_plans_drawing_is_its_sheets_plan_group_as_written():
