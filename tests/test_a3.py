@@ -32,9 +32,9 @@ PT = 72.0 / 25.4                                       # points per mm
 
 def _one(task: int, code: str, lang: str = "en") -> A3.OneSheet:
     """`one_sheet` of variant task/code at phi1 in `lang`, made once per module (a sheet's search
-    takes seconds; `_sheet`, its arguments spelt one way for its cache); task 2 / 479 in English
-    is the one `_counted` made."""
-    return _counted().one if (task, code, lang) == (2, "479", "en") else _sheet(task, code, lang)
+    takes seconds; `_sheet`, its arguments spelt one way for its cache); those of _COUNTED are the
+    ones `_counted` made."""
+    return _counted(task, code, lang).one if (task, code, lang) in _COUNTED else _sheet(task, code, lang)
 
 
 @lru_cache(maxsize=None)
@@ -53,10 +53,15 @@ class Counted:
     drawn: tuple
 
 
+#: The sheets `_counted` makes: task 2 / 479 in English (its search comes back to scales tried
+#: before), task 1 / 479 in Ukrainian (its search steps back to the rule's scales).
+_COUNTED = ((2, "479", "en"), (1, "479", "uk"))
+
+
 @lru_cache(maxsize=None)
-def _counted() -> Counted:
-    """Task 2 / 479 in English (its search comes back to scales tried before), its builds of the
-    plans and its drawings counted (`kinetostat.plans.build` and `a3.sheet` wrapped while it runs)."""
+def _counted(task: int = 2, code: str = "479", lang: str = "en") -> Counted:
+    """The sheet of variant task/code in `lang` (_COUNTED), its builds of the plans and its
+    drawings counted (`kinetostat.plans.build` and `a3.sheet` wrapped while it runs)."""
     import kinetostat.plans as KP
     built, drawn, positions = [], [], []
     build, sheet = KP.build, A3.sheet
@@ -65,10 +70,10 @@ def _counted() -> Counted:
         built.append(None if scales is None else tuple(sorted(scales.items())))
         positions.append(kw.get("positions"))
         return build(mech, at=at, scales=scales, **kw)
-    v = variants.variant(2, "479")
+    v = variants.variant(task, code)
     with mock.patch.object(KP, "build", counted), mock.patch.object(A3, "sheet", lambda plan, lang, *a, **kw: drawn.append(
             (lang, plan.kind, tuple(s.value for s in A3.scales_of(plan)))) or sheet(plan, lang, *a, **kw)):
-        one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), "en")
+        one = A3.one_sheet(v.mechanism(), float(v.values["phi1"]), lang)
     return Counted(one, tuple(built), tuple(positions), tuple(drawn))
 
 
@@ -187,6 +192,15 @@ def test_each_scale_choice_is_built_and_drawn_once():
     given = c.positions[1:]
     assert all(p is not None and p.mu.value == dict(b)["mu_l"] for p, b in zip(given, built[1:]))
     assert len({id(p) for p in given}) == len({p.mu.value for p in given}) < len(given)
+
+
+def test_the_rules_scales_given_are_the_rules_try():
+    """Task 1 / 479 in Ukrainian: its search steps back to the rule's scales (μ_v 0.25 with μ_F
+    40); that try is the rule's own, its plans not built again (was: built and laid out again)."""
+    c = _counted(1, "479", "uk")
+    rule = tuple(sorted((k, s.value) for k, s in c.one.rule.items()))
+    assert c.built[0] is None and rule not in c.built
+    assert len(c.built) == len(set(c.built)) >= 4
 
 
 def test_a_plans_drawing_is_its_sheets_plan_group_as_written():
@@ -495,10 +509,44 @@ def test_the_notes_state_the_scales_and_their_departures():
 
 def test_free_rectangles_split_around_a_box_stay_maximal():
     """`_split` (maximal rectangles): a box inside a free rectangle leaves the four rectangles
-    beside it; a free rectangle inside another is dropped, and of two equal ones the later."""
+    beside it; a piece inside another rectangle (another's piece, or one the box does not meet) is
+    dropped; the rectangles the box does not meet stay as they are."""
     free = [(0.0, 0.0, 10.0, 10.0)]
     A3._split(free, (2.0, 2.0, 4.0, 4.0))
     assert free == [(0.0, 0.0, 2.0, 10.0), (4.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 2.0), (0.0, 4.0, 10.0, 10.0)]
-    free = [(1.0, 1.0, 5.0, 5.0), (0.0, 0.0, 10.0, 10.0), (0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]
+    free = [(0.0, 0.0, 10.0, 10.0), (0.0, 0.0, 20.0, 3.0), (0.0, 0.0, 2.0, 20.0)]
+    A3._split(free, (2.0, 2.0, 4.0, 6.0))
+    assert free == [(4.0, 0.0, 10.0, 10.0), (0.0, 6.0, 10.0, 10.0), (4.0, 0.0, 20.0, 3.0), (0.0, 0.0, 20.0, 2.0),
+                    (0.0, 0.0, 2.0, 20.0)]
     A3._split(free, (40.0, 40.0, 41.0, 41.0))                      # meets none of them
-    assert free == [(0.0, 0.0, 10.0, 10.0), (20.0, 0.0, 30.0, 5.0)]
+    assert free == [(4.0, 0.0, 10.0, 10.0), (0.0, 6.0, 10.0, 10.0), (4.0, 0.0, 20.0, 3.0), (0.0, 0.0, 20.0, 2.0),
+                    (0.0, 0.0, 2.0, 20.0)]
+
+def _counting(monkeypatch, name: str) -> list:
+    """Calls of A3.`name` counted (one entry each) while the test runs."""
+    calls, saved = [], getattr(A3, name)
+    monkeypatch.setattr(A3, name, lambda *a: calls.append(1) or saved(*a))
+    return calls
+
+
+def test_the_texts_order_search_passes_over_a_corner_a_later_plan_cannot_follow(monkeypatch):
+    """Three small plans and one wider than the sheet: no corner of the first can be followed by
+    the wide one, so each is passed over at once (the corners of the second plan never searched);
+    none is found, and every corner was searched."""
+    calls = _counting(monkeypatch, "_place_after")
+    sizes = [(50.0, 40.0, 5.0), (50.0, 40.0, 5.0), (50.0, 40.0, 5.0), (500.0, 10.0, 5.0)]
+    assert A3._in_order(sizes, [0, 1, 2, 3], A3.READING[0], 10.0) == (None, True)
+    assert len(calls) == 1
+
+
+def test_a_texts_order_search_of_every_corner_is_not_repeated_by_the_next_rule(monkeypatch):
+    """Where the first rule of READING searched every corner and found none, the next finds none
+    either (the same corners in another order): it is not run. Where the first ran out of
+    tries, it is."""
+    calls = _counting(monkeypatch, "_in_order")
+    sizes = [(200.0, 150.0, 5.0), (200.0, 150.0, 5.0), (200.0, 150.0, 5.0)]   # no two fit side by side under the third
+    assert A3._texts_layout(sizes, [0, 1, 2], 10.0) is None
+    assert len(calls) == 1
+    monkeypatch.setattr(A3, "IN_ORDER_TRIES", 0)
+    assert A3._texts_layout(sizes, [0, 1, 2], 10.0) is None
+    assert len(calls) == 1 + len(A3.READING)

@@ -232,7 +232,8 @@ def texts_rank(kind: str) -> tuple:
 
 
 def _after(box: tuple, before: tuple) -> bool:
-    """Whether `box` (x0, y0, x1, y1) reads after `before`: right of it or below it."""
+    """Whether `box` (x0, y0, x1, y1, or its top left corner x0, y0) reads after `before` (x0, y0,
+    x1, y1): right of it or below it."""
     return box[0] >= before[2] - 1e-9 or box[1] >= before[3] - 1e-9
 
 
@@ -253,26 +254,43 @@ def placed_in_order(drawings: list[Drawing], places: list[Placement]) -> bool:
     return all(p.page == 0 for p in places) and in_texts_order([d.kind for d in drawings], boxes)
 
 
-def _split(free: list, box: tuple) -> None:
-    """The free rectangles split around `box` (x0, y0, x1, y1), those inside another dropped (in place)."""
+def _cut(free: list, box: tuple) -> tuple[list, list[int]]:
+    """(the free rectangles with each one `box` (x0, y0, x1, y1) meets given way to its pieces
+    beside the box, the indices of the pieces). A box w x h fits one of them where it fits one
+    of `_split`'s, which drops only pieces inside another."""
     bx0, by0, bx1, by1 = box
-    out = []
+    out, pieces = [], []
     for r in free:
         fx0, fy0, fx1, fy1 = r
         if bx0 >= fx1 or bx1 <= fx0 or by0 >= fy1 or by1 <= fy0:
             out.append(r)
             continue
-        out += [c for c in ((fx0, fy0, bx0, fy1), (bx1, fy0, fx1, fy1), (fx0, fy0, fx1, by0), (fx0, by1, fx1, fy1))
-                if c[2] - c[0] > 1e-9 and c[3] - c[1] > 1e-9]
-    keep = []
-    for i, r in enumerate(out):
-        x0, y0, x1, y1 = r
+        for c in ((fx0, fy0, bx0, fy1), (bx1, fy0, fx1, fy1), (fx0, fy0, fx1, by0), (fx0, by1, fx1, fy1)):
+            if c[2] - c[0] > 1e-9 and c[3] - c[1] > 1e-9:
+                pieces.append(len(out))
+                out.append(c)
+    return out, pieces
+
+
+def _maximal(out: list, pieces: list[int]) -> list:
+    """`out` (`_cut`) without the pieces inside another rectangle (of equal pieces the first kept).
+    Only the pieces are tested: a rectangle the box does not meet is inside no piece, as each
+    piece is inside the rectangle it came from and those given are maximal."""
+    drop = set()
+    for i in pieces:
+        x0, y0, x1, y1 = out[i]
         for j, (qx0, qy0, qx1, qy1) in enumerate(out):
-            if qx0 <= x0 and qy0 <= y0 and x1 <= qx1 and y1 <= qy1 and (j < i or out[j] != r):
-                break                            # inside another (itself or an equal one after it: not)
-        else:
-            keep.append(r)
-    free[:] = keep
+            if j != i and qx0 <= x0 and qy0 <= y0 and x1 <= qx1 and y1 <= qy1 and (j < i or out[j] != out[i]):
+                drop.add(i)                      # inside another (an equal one after it: not)
+                break
+    return [r for i, r in enumerate(out) if i not in drop]
+
+
+def _split(free: list, box: tuple) -> None:
+    """The free rectangles (maximal: none inside another) split around `box` (x0, y0, x1, y1), in
+    place: each one the box meets gives way to its pieces beside the box (`_cut`), and a piece
+    inside another rectangle is dropped (`_maximal`)."""
+    free[:] = _maximal(*_cut(free, box))
 
 
 def _place(free: list, w: float, h: float, rule=RULES[0]) -> tuple[float, float] | None:
@@ -294,10 +312,11 @@ def _place_after(free: list, w: float, h: float, placed: list, rule) -> list[tup
     boxes' right and bottom edges, least by `rule` (READING) first; none where none is free."""
     spots = set()
     for fx, fy, fx1, fy1 in free:
+        if fx + w > fx1 + 1e-9 or fy + h > fy1 + 1e-9:
+            continue                             # too small for the box at any corner
         for x in {fx, *(b[2] for b in placed if fx < b[2] <= fx1 - w + 1e-9)}:
             for y in {fy, *(b[3] for b in placed if fy < b[3] <= fy1 - h + 1e-9)}:
-                box = (x, y, x + w, y + h)
-                if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and all(_after(box, b) for b in placed):
+                if x + w <= fx1 + 1e-9 and y + h <= fy1 + 1e-9 and all(_after((x, y), b) for b in placed):
                     spots.add((rule(x, y), x, y))
     return [(x, y) for _, x, y in sorted(spots)]
 
@@ -332,31 +351,52 @@ def _pack(sizes: list[tuple[float, float, float]], order: list[int], rule, notes
 IN_ORDER_TRIES = 2000
 
 
+def _fits_somewhere(free: list, w: float, h: float) -> bool:
+    """Whether a box w x h fits inside one of the free rectangles (at any place in it)."""
+    return any(w <= fx1 - fx + 1e-9 and h <= fy1 - fy + 1e-9 for fx, fy, fx1, fy1 in free)
+
+
 def _in_order(sizes: list[tuple[float, float, float]], order: list[int], rule, notes: float
-              ) -> dict[int, tuple[int, float, float]] | None:
-    """Each box (in `order`, the texts') at (0, x, y) on one page (the notes `notes` mm high), each right of or below every
+              ) -> tuple[dict[int, tuple[int, float, float]] | None, bool]:
+    """(each box (in `order`, the texts') at (0, x, y) on one page (the notes `notes` mm high), each right of or below every
     box before it: at a corner of `_place_after` by `rule`, the next corner where the boxes after
-    it find no room (depth first, IN_ORDER_TRIES corners at most); None where none is found."""
+    it find no room (depth first, IN_ORDER_TRIES corners at most); None where none is found;
+    whether every corner was searched). A corner after which a later box fits no free rectangle
+    at all is passed over at once (nothing below it can fit), so the corners searched, and
+    whether all were, are the same for every rule: only their order differs."""
     left = IN_ORDER_TRIES
     out: dict[int, tuple[int, float, float]] = {}
+    grown = [(sizes[i][0] + _GAP, sizes[i][1] + _GAP) for i in order]
 
     def fill(k: int, free: list, placed: list) -> bool:
         nonlocal left
         if k == len(order):
             return True
-        i = order[k]
-        w, h = sizes[i][0] + _GAP, sizes[i][1] + _GAP
+        w, h = grown[k]
         for x, y in _place_after(free, w, h, placed, rule):
             left -= 1
             if left < 0:
                 return False
-            rest = list(free)
-            _split(rest, (x, y, x + w, y + h))
-            if fill(k + 1, rest, [*placed, (x, y, x + w, y + h)]):
-                out[i] = (0, x, y)
+            cut = _cut(free, (x, y, x + w, y + h))
+            if all(_fits_somewhere(cut[0], *later) for later in grown[k + 1:]) and \
+                    fill(k + 1, _maximal(*cut), [*placed, (x, y, x + w, y + h)]):
+                out[order[k]] = (0, x, y)
                 return True
         return False
-    return out if fill(0, _free(_GAP, notes), []) else None
+    found = fill(0, _free(_GAP, notes), [])
+    return (out if found else None), left >= 0
+
+
+def _texts_layout(sizes: list[tuple[float, float, float]], order: list[int], notes: float
+                  ) -> dict[int, tuple[int, float, float]] | None:
+    """The boxes in the texts' `order` (`_in_order`) by the first rule of READING that places
+    them; the next rule only where the one before ran out of tries (a search of every corner that
+    found none finds none by any rule)."""
+    for rule in READING:
+        spots, searched_all = _in_order(sizes, order, rule, notes)
+        if spots is not None or searched_all:
+            return spots
+    return None
 
 
 def layout(drawings: list[Drawing], notes: float) -> list[Placement]:
@@ -369,7 +409,8 @@ def layout(drawings: list[Drawing], notes: float) -> list[Placement]:
     goes onto a further page."""
     sizes = [_size(d) for d in drawings]
     texts = sorted(range(len(drawings)), key=lambda i: (texts_rank(drawings[i].kind), i))
-    best = next(((1, spots) for rule in READING if (spots := _in_order(sizes, texts, rule, notes)) is not None), None)
+    spots = _texts_layout(sizes, texts, notes)
+    best = None if spots is None else (1, spots)
     orders = [texts] + [sorted(range(len(drawings)), key=lambda i: (-key(*sizes[i][:2]), i)) for key in ORDERS]
     for rule in RULES if best is None else ():
         for order in orders:
@@ -515,6 +556,7 @@ def one_sheet(mech, at: float, lang: str, solution: Solution | None = None) -> O
         return tried[key]
 
     ruled.update(attempt(None)[0].scales)
+    tried[tuple(sorted((k, s.value) for k, s in ruled.items()))] = tried[None]   # the rule's scales, given: that try
     rule = dict(ruled)
     coarsest = {}                                # each scale of FIRST as coarse as its floor allows
     for k in FIRST:
