@@ -154,7 +154,7 @@ def test_variant_all_refuses_a_planted_link_to_a_folder_elsewhere(tmp_path, cli,
     out.mkdir()
     elsewhere.mkdir()
     (out / "task1_000").symlink_to(elsewhere)
-    p = cli("variant", "1", "--all", "--out", out, "--no-progress")
+    p = cli("variant", "1", "--all", "--no-pack", "--out", out, "--no-progress")
     assert p.returncode == 2 and "Traceback" not in p.stderr
     assert "task 1 variant 000" in p.stderr and "outside" in p.stderr, p.stderr
     assert list(elsewhere.iterdir()) == []
