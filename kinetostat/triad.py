@@ -29,6 +29,7 @@ from __future__ import annotations
 import cmath
 import types
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import numpy as xp
@@ -327,9 +328,13 @@ class Track:
         seam = (w > span) & (self.full | (w - span <= ENDS) | (2 * np.pi - w <= ENDS))
         w = np.where(seam, np.where(w - span <= 2 * np.pi - w, span, 0.0), w)
         u = self.u[0] + w
-        th = np.unwrap(np.angle(self.rot))
         O = np.interp(u, self.u, self.O.real) + 1j * np.interp(u, self.u, self.O.imag)
-        return O, np.exp(1j * np.interp(u, self.u, th)), w <= span
+        return O, np.exp(1j * np.interp(u, self.u, self.theta)), w <= span
+
+    @cached_property
+    def theta(self) -> np.ndarray:
+        """(M,) rad: the base link's angle at the stations, unwrapped (once per track)."""
+        return np.unwrap(np.angle(self.rot))
 
 
 def _follow(solve, path: list, side: float, limit: float, sign: float, x: tuple, L: float, tol: float) -> int:
