@@ -40,7 +40,7 @@ from .groups import cis, cross, dot, magnitude, over, solve2
 __all__ = ["LEASH_KINDS", "leash_kinds", "leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
            "rr_tangential", "line_tangential", "iii3_polygon", "iii3_positions", "track", "Track", "pose_distance", "jacobian_det", "misses", "modes",
-           "MODE_SAMPLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "ENDS", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
+           "MODE_SAMPLES", "FEW_ANGLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "ENDS", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
 
 #: The continuation's longest step along the crank's path (rad).
 STATION = np.radians(3.0)
@@ -61,6 +61,9 @@ MOVE = 0.05
 MAX_ITER = 40
 #: The largest miss of a leash accepted as closed, in rounding units of the group's size.
 CLOSURE_TOL = 1e3
+#: Up to this many angles asked at once, `iii3_positions` closes them one by one on Python
+#: scalars (measured: at 1 to 4 angles 3 to 10 times cheaper than on arrays; at 16 dearer).
+FEW_ANGLES = 8
 #: Trial angles of the base per turn in the search for the modes.
 MODE_SAMPLES = 3600
 _EPS = np.finfo(float).eps
@@ -283,6 +286,15 @@ def _bind_scalars() -> types.SimpleNamespace:
     return types.SimpleNamespace(**{n: env[n] for n in ("newton_step", "misses", "largest", "jacobian_det", "pose_distance")})
 
 
+def _newton_each(kinds: str, O, rot, x: tuple, P: tuple, c: tuple, L: float):
+    """`_newton` angle by angle on Python scalars (`_newton_one`; O, rot, P, c arrays over the
+    angles): for a few angles, where numpy's cost per call outweighs the work."""
+    x, L = tuple(complex(v) for v in x), float(L)
+    rows = [_newton_one(kinds, complex(O[i]), complex(rot[i]), x, tuple(v[i].item() for v in P),
+                        tuple(v[i].item() for v in c), L)[:4] for i in np.ndindex(O.shape)]
+    return tuple(np.array(col, t).reshape(O.shape) for col, t in zip(zip(*rows), (complex, complex, int, float)))
+
+
 def _newton_one(kinds: str, O: complex, rot: complex, x: tuple, P: tuple, c: tuple, L: float):
     """`_newton` at one angle on Python scalars (the continuation solves one angle a step, where
     numpy's cost per call would be most of the work): the same `newton_step`s, bound to
@@ -397,7 +409,8 @@ def track(kinds: str, pins, phi0: float, O0: complex, rot0: complex, x: tuple, L
 
 def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L, track):
     """The program's step: the base link's pose O, e^{i theta} at the crank angles phi (rad),
-    closed by Newton on all the angles at once from the `track` (a Track) interpolated at each;
+    closed by Newton on all the angles at once from the `track` (a Track) interpolated at each
+    (up to FEW_ANGLES of them one by one on Python scalars, `_newton_each`);
     then per angle the closure (0, or -1 where a leash misses by more than CLOSURE_TOL rounding
     units of L, or the angle lies beyond the track's end: the mode drawn at the design position
     cannot be assembled there), the path (0, or -1 where the closed pose lies more than PREDICT
@@ -414,7 +427,7 @@ def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c
     O0, rot0, on = track.start(u)
     P = tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3))
     c = tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3))
-    O, rot, its, res = _newton(kinds, O0, rot0, x, P, c, L)
+    O, rot, its, res = (_newton_each if 0 < u.size <= FEW_ANGLES else _newton)(kinds, O0, rot0, x, P, c, L)
     tol = CLOSURE_TOL * _EPS * L
     closed = on & (res <= tol)
     flipped = np.sign(jacobian_det(misses(kinds, O, rot, x, P, c), O)) != track.sign

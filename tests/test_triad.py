@@ -152,6 +152,27 @@ def test_a_one_angle_solve_that_divides_by_zero_fails_as_on_arrays():
         assert solve[2] == triad.MAX_ITER and np.isnan(solve[3]) and np.isnan(solve[4]) and np.isnan(solve[0])
 
 
+def test_a_few_angles_closed_one_by_one_on_scalars_equal_the_arrays(mech):
+    """Up to FEW_ANGLES angles (the forward dynamics asks 1 to 4 a stage) `iii3_positions`
+    closes one by one on Python scalars (`triad._newton_each`): the same poses to rounding, the
+    same Newton steps and misses as on arrays, at 1, 4 and FEW_ANGLES angles over the cycle and
+    at an angle whose start is NaN (a failed solve on both)."""
+    from kinetostat import triad
+    kinds, pins, phi0, _, _, x, L = _track_inputs(mech)
+    tr = kinetostat.kinematics.tracks(mech)["track0"]
+    for phi in (np.radians([200.0]), np.radians([10.0, 97.3, 200.0, 333.3]), np.linspace(0.0, 6.2, triad.FEW_ANGLES)):
+        P, c = pins(phi)
+        O0, rot0, _ = tr.start(np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi)
+        O0[-1] = O0[-1] * np.nan if len(phi) == triad.FEW_ANGLES else O0[-1]
+        with np.errstate(all="ignore"):
+            (O, rot, its, res), (O_, rot_, its_, res_) = (f(kinds, O0, rot0, x, P, c, L) for f in (triad._newton_each, triad._newton))
+        assert np.array_equal(its, its_) and np.array_equal(np.isnan(res), np.isnan(res_))
+        ok = ~np.isnan(res_)
+        assert np.max(np.abs(O[ok] - O_[ok])) <= 1e-13 * L and np.max(np.abs(rot[ok] - rot_[ok])) <= 1e-13
+        assert max(np.max(res[ok]), np.max(res_[ok])) <= 8 * np.finfo(float).eps * L
+    assert not ok[-1] and its[-1] == triad.MAX_ITER
+
+
 @pytest.mark.parametrize("step", [5.0, 7.0, 13.0, 360.0])
 def test_the_result_does_not_depend_on_the_angles_asked(mech, step):
     """The continuation (with its stations every 3 deg) stays on the drawn mode whatever grid is
