@@ -20,9 +20,11 @@ primitives of `groups`, in the same elementwise style:
   angle per step with step control (`track`, once per mechanism: the mode's path, ending at a
   fold where the crank cannot pass), then at the angles asked all at once from the track
   (`iii3_positions`; numpy only: it reads the whole angle axis, so the compiled path and the
-  Array API path refuse triads by name), each checked to stay on the track's path.
+  Array API path refuse triads by name), each checked to stay on the track's path. The
+  continuation's one angle a step, and up to FEW_ANGLES angles asked, are solved on Python
+  scalars: the same `newton_step` bound to `_Scalars` (numpy's cost per call avoided).
 
-May use: numpy, groups.
+May use: the standard library, numpy, groups.
 """
 from __future__ import annotations
 
@@ -264,8 +266,7 @@ def _newton(kinds, O, rot, x, P, c, L):
 
 class _Scalars:
     """The names of `xp` that `newton_step`, `misses`, `largest`, `jacobian_det` and
-    `pose_distance` call, on
-    Python scalars (np.maximum's NaN included)."""
+    `pose_distance` call, on Python scalars (np.maximum's NaN included)."""
     where = staticmethod(lambda c, a, b: a if c else b)
     maximum = staticmethod(lambda a, b: a if a >= b or a != a else b)
     exp = staticmethod(cmath.exp)
@@ -276,14 +277,14 @@ class _Scalars:
 
 def _bind_scalars() -> types.SimpleNamespace:
     """`newton_step`, `misses`, `largest`, `jacobian_det` and `pose_distance` (and what they
-    call) rebuilt over
-    a copy of the globals of `groups` and this module in which `xp` is `_Scalars`, as
-    `program.bind` rebinds the equations to a namespace."""
+    call) rebuilt over a copy of the globals of `groups` and this module in which `xp` is
+    `_Scalars`, as `program.bind` rebinds the equations to a namespace."""
     env = {**vars(groups), **globals(), "xp": _Scalars}
     for name, f in list(env.items()):
         if isinstance(f, types.FunctionType) and f.__module__ in (__name__, groups.__name__):
             env[name] = types.FunctionType(f.__code__, env, name, f.__defaults__, f.__closure__)
-    return types.SimpleNamespace(**{n: env[n] for n in ("newton_step", "misses", "largest", "jacobian_det", "pose_distance")})
+    names = ("newton_step", "misses", "largest", "jacobian_det", "pose_distance")
+    return types.SimpleNamespace(**{n: env[n] for n in names})
 
 
 def _newton_each(kinds: str, O, rot, x: tuple, P: tuple, c: tuple, L: float):

@@ -165,7 +165,8 @@ def test_a_few_angles_closed_one_by_one_on_scalars_equal_the_arrays(mech):
         O0, rot0, _ = tr.start(np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi)
         O0[-1] = O0[-1] * np.nan if len(phi) == triad.FEW_ANGLES else O0[-1]
         with np.errstate(all="ignore"):
-            (O, rot, its, res), (O_, rot_, its_, res_) = (f(kinds, O0, rot0, x, P, c, L) for f in (triad._newton_each, triad._newton))
+            (O, rot, its, res), (O_, rot_, its_, res_) = (f(kinds, O0, rot0, x, P, c, L)
+                                                          for f in (triad._newton_each, triad._newton))
         assert np.array_equal(its, its_) and np.array_equal(np.isnan(res), np.isnan(res_))
         ok = ~np.isnan(res_)
         assert np.max(np.abs(O[ok] - O_[ok])) <= 1e-13 * L and np.max(np.abs(rot[ok] - rot_[ok])) <= 1e-13
