@@ -356,8 +356,9 @@ def tracks(mech: "Mechanism") -> dict[str, Any]:
 def _known_joints(mech: "Mechanism", n: int, env: Mapping[str, Any]) -> tuple[str, tuple, Any]:
     """Triad n's leash kinds, its x as `triad.misses` reads them (constants: from the program's
     steps that derive constants) and pins(phi): the known joints' (P, c) at the angles phi (rad,
-    (m,)) from the motion program's steps before the group's, run in `env` (None where an
-    earlier group does not close there)."""
+    (m,); or one angle, a float: scalars, the cheapest for `triad.track`'s one angle a step)
+    from the motion program's steps before the group's, run in `env` (None where an earlier
+    group does not close there)."""
     prog = motion_program(mech)
     at = next(i for i, st in enumerate(prog.steps) if st.fn == "iii3_positions" and f"it{n}" in st.out)
     args = prog.steps[at].args
@@ -372,7 +373,9 @@ def _known_joints(mech: "Mechanism", n: int, env: Mapping[str, Any]) -> tuple[st
             got = run(head, {**env, "phi": phi})
         except AssemblyError:
             return None
-        vals = [np.broadcast_to(got[f"pin{n}_{i}"], phi.shape) for i in range(3, 9)]
+        vals = [got[f"pin{n}_{i}"] for i in range(3, 9)]
+        if np.ndim(phi):
+            vals = [np.broadcast_to(v, np.shape(phi)) for v in vals]
         return tuple(vals[:3]), tuple(vals[3:])
     return leash_kinds(args[2:5]), x, pins
 

@@ -20,23 +20,29 @@ primitives of `groups`, in the same elementwise style:
   angle per step with step control (`track`, once per mechanism: the mode's path, ending at a
   fold where the crank cannot pass), then at the angles asked all at once from the track
   (`iii3_positions`; numpy only: it reads the whole angle axis, so the compiled path and the
-  Array API path refuse triads by name), each checked to stay on the track's path.
+  Array API path refuse triads by name), each checked to stay on the track's path. The
+  continuation's one angle a step, and up to FEW_ANGLES angles asked, are solved on Python
+  scalars: the same `newton_step` bound to `_Scalars` (numpy's cost per call avoided).
 
-May use: numpy, groups.
+May use: the standard library, numpy, groups.
 """
 from __future__ import annotations
 
+import cmath
+import types
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import numpy as xp
 
+from . import groups
 from .groups import cis, cross, dot, magnitude, over, solve2
 
 __all__ = ["LEASH_KINDS", "leash_kinds", "leash_rr", "leash_slider", "special_point", "special_solve", "third_arm", "iii3_newton", "iii3_velocity",
            "iii3_acceleration", "iii3_condition", "rr_leash_motion", "slider_leash_motion",
            "rr_tangential", "line_tangential", "iii3_polygon", "iii3_positions", "track", "Track", "pose_distance", "jacobian_det", "misses", "modes",
-           "MODE_SAMPLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "ENDS", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
+           "MODE_SAMPLES", "FEW_ANGLES", "MAX_ITER", "STATION", "STEP_MIN", "EASY", "PREDICT", "ENDS", "MOVE", "CLOSURE_TOL", "EQUATIONS"]
 
 #: The continuation's longest step along the crank's path (rad).
 STATION = np.radians(3.0)
@@ -57,6 +63,9 @@ MOVE = 0.05
 MAX_ITER = 40
 #: The largest miss of a leash accepted as closed, in rounding units of the group's size.
 CLOSURE_TOL = 1e3
+#: Up to this many angles asked at once, `iii3_positions` closes them one by one on Python
+#: scalars (measured: at 1 to 4 angles 3 to 10 times cheaper than on arrays; at 16 dearer).
+FEW_ANGLES = 8
 #: Trial angles of the base per turn in the search for the modes.
 MODE_SAMPLES = 3600
 _EPS = np.finfo(float).eps
@@ -85,8 +94,9 @@ def leash_slider(X, K, n):
 def _pick(k, a1, a2, a3):
     """Leash values in the order (first, second, third) for the special point S of the leashes
     other than k (0, 1, 2; cyclic: k = 2 takes 1, 2 then 3)."""
-    return (xp.where(k == 2.0, a1, xp.where(k == 0.0, a2, a3)), xp.where(k == 2.0, a2, xp.where(k == 0.0, a3, a1)),
-            xp.where(k == 2.0, a3, xp.where(k == 0.0, a1, a2)))
+    two, zero = k == 2.0, k == 0.0
+    return (xp.where(two, a1, xp.where(zero, a2, a3)), xp.where(two, a2, xp.where(zero, a3, a1)),
+            xp.where(two, a3, xp.where(zero, a1, a2)))
 
 
 def special_point(X1, u1, X2, u2, X3, u3):
@@ -197,8 +207,8 @@ def iii3_polygon(S, X1, X2, X3, u1, u2, u3, det, k, T1, T2, T3, P1, P2, P3, m1, 
 
 # -- the positions over the angles: Newton with continuation (numpy)
 def pose_distance(x: tuple, O1, rot1, O2, rot2):
-    """The largest distance between the inner pins of two poses of the base (m)."""
-    return np.max([np.abs(O1 - O2 + xi * (rot1 - rot2)) for xi in x], axis=0)
+    """The largest distance between the three inner pins of two poses of the base (m)."""
+    return largest(*(O1 - O2 + xi * (rot1 - rot2) for xi in x))
 
 
 def misses(kinds: str, O, rot, x: tuple, P: tuple, c: tuple):
@@ -224,21 +234,85 @@ def jacobian_det(leashes, O):
     return cross(u2, u3) * h[0] + cross(u3, u1) * h[1] + cross(u1, u2) * h[2]
 
 
+def largest(f1, f2, f3):
+    """The largest of three leashes' |miss| (NaN where any is NaN)."""
+    return xp.maximum(xp.maximum(abs(f1), abs(f2)), abs(f3))
+
+
+def newton_step(kinds: str, O, rot, x: tuple, P: tuple, c: tuple, L: float):
+    """One Newton step of the base's pose (`iii3_newton` at the `special_point` of the
+    `misses`): the pose moved (rot back on the unit circle), and whether the pose was closed
+    already (the step, or each leash's miss, below rounding)."""
+    (X1, u1, f1), (X2, u2, f2), (X3, u3, f3) = misses(kinds, O, rot, x, P, c)
+    S, det, k = special_point(X1, u1, X2, u2, X3, u3)
+    O_new, rot_new, step = iii3_newton(O, rot, S, det, k, X1, X2, X3, u1, u2, u3, f1, f2, f3)
+    return O_new, rot_new / abs(rot_new), (step <= 8 * _EPS * L) | (largest(f1, f2, f3) <= 2 * _EPS * L)
+
+
 def _newton(kinds, O, rot, x, P, c, L):
     """Newton on every angle at once until each step, or each leash's miss, is below rounding
     (MAX_ITER at most; near a singular position the steps stay at rounding times its condition);
     the pose, the steps taken and the largest miss left."""
     its = np.zeros(O.shape, int)
     for _ in range(MAX_ITER):
-        (X1, u1, f1), (X2, u2, f2), (X3, u3, f3) = misses(kinds, O, rot, x, P, c)
-        S, det, k = special_point(X1, u1, X2, u2, X3, u3)
-        O_new, rot_new, step = iii3_newton(O, rot, S, det, k, X1, X2, X3, u1, u2, u3, f1, f2, f3)
-        moving = ~(step <= 8 * _EPS * L) & ~(np.maximum(np.maximum(abs(f1), abs(f2)), abs(f3)) <= 2 * _EPS * L)
+        O_new, rot_new, done = newton_step(kinds, O, rot, x, P, c, L)
+        moving = ~done
         its += moving
-        O, rot = np.where(moving, O_new, O), np.where(moving, rot_new / np.abs(rot_new), rot)
+        O, rot = np.where(moving, O_new, O), np.where(moving, rot_new, rot)
         if not moving.any():
             break
-    return O, rot, its, np.max([np.abs(f) for _, _, f in misses(kinds, O, rot, x, P, c)], axis=0)
+    return O, rot, its, largest(*(f for _, _, f in misses(kinds, O, rot, x, P, c)))
+
+
+class _Scalars:
+    """The names of `xp` that `newton_step`, `misses`, `largest`, `jacobian_det` and
+    `pose_distance` call, on Python scalars (np.maximum's NaN included)."""
+    where = staticmethod(lambda c, a, b: a if c else b)
+    maximum = staticmethod(lambda a, b: a if a >= b or a != a else b)
+    exp = staticmethod(cmath.exp)
+    real = staticmethod(lambda z: z.real)
+    imag = staticmethod(lambda z: z.imag)
+    conj = staticmethod(lambda z: z.conjugate())
+
+
+def _bind_scalars() -> types.SimpleNamespace:
+    """`newton_step`, `misses`, `largest`, `jacobian_det` and `pose_distance` (and what they
+    call) rebuilt over a copy of the globals of `groups` and this module in which `xp` is
+    `_Scalars`, as `program.bind` rebinds the equations to a namespace."""
+    env = {**vars(groups), **globals(), "xp": _Scalars}
+    for name, f in list(env.items()):
+        if isinstance(f, types.FunctionType) and f.__module__ in (__name__, groups.__name__):
+            env[name] = types.FunctionType(f.__code__, env, name, f.__defaults__, f.__closure__)
+    names = ("newton_step", "misses", "largest", "jacobian_det", "pose_distance")
+    return types.SimpleNamespace(**{n: env[n] for n in names})
+
+
+def _newton_each(kinds: str, O, rot, x: tuple, P: tuple, c: tuple, L: float):
+    """`_newton` angle by angle on Python scalars (`_newton_one`; O, rot, P, c arrays over the
+    angles): for a few angles, where numpy's cost per call outweighs the work."""
+    x, L = tuple(complex(v) for v in x), float(L)
+    rows = [_newton_one(kinds, complex(O[i]), complex(rot[i]), x, tuple(v[i].item() for v in P),
+                        tuple(v[i].item() for v in c), L)[:4] for i in np.ndindex(O.shape)]
+    return tuple(np.array(col, t).reshape(O.shape) for col, t in zip(zip(*rows), (complex, complex, int, float)))
+
+
+def _newton_one(kinds: str, O: complex, rot: complex, x: tuple, P: tuple, c: tuple, L: float):
+    """`_newton` at one angle on Python scalars (the continuation solves one angle a step, where
+    numpy's cost per call would be most of the work): the same `newton_step`s, bound to
+    `_Scalars`. A step that divides by zero or leaves the floats fails the solve (NaN), as
+    numpy's inf and NaN do. The pose, the steps taken, the largest miss left and the sign of the
+    group's Jacobian there (`jacobian_det`)."""
+    its = 0
+    try:
+        for _ in range(MAX_ITER):
+            O_new, rot_new, done = _SCALAR.newton_step(kinds, O, rot, x, P, c, L)
+            if done:
+                break
+            its, O, rot = its + 1, O_new, rot_new
+        leashes = _SCALAR.misses(kinds, O, rot, x, P, c)
+        return O, rot, its, _SCALAR.largest(*(f for _, _, f in leashes)), float(np.sign(_SCALAR.jacobian_det(leashes, O)))
+    except (ArithmeticError, ValueError):
+        return complex(np.nan, np.nan), complex(np.nan, np.nan), MAX_ITER, np.nan, np.nan
 
 
 @dataclass(frozen=True)
@@ -267,9 +341,13 @@ class Track:
         seam = (w > span) & (self.full | (w - span <= ENDS) | (2 * np.pi - w <= ENDS))
         w = np.where(seam, np.where(w - span <= 2 * np.pi - w, span, 0.0), w)
         u = self.u[0] + w
-        th = np.unwrap(np.angle(self.rot))
         O = np.interp(u, self.u, self.O.real) + 1j * np.interp(u, self.u, self.O.imag)
-        return O, np.exp(1j * np.interp(u, self.u, th)), w <= span
+        return O, np.exp(1j * np.interp(u, self.u, self.theta)), w <= span
+
+    @cached_property
+    def theta(self) -> np.ndarray:
+        """(M,) rad: the base link's angle at the stations, unwrapped (once per track)."""
+        return np.unwrap(np.angle(self.rot))
 
 
 def _follow(solve, path: list, side: float, limit: float, sign: float, x: tuple, L: float, tol: float) -> int:
@@ -286,10 +364,10 @@ def _follow(solve, path: list, side: float, limit: float, sign: float, x: tuple,
         h = min(h, limit - u0)
         t = h / (u0 - path[-2][0]) if len(path) > 1 else 0.0
         Ob, rb = path[-2][1:] if len(path) > 1 else (Oa, ra)
-        Op, rp = Oa + t * (Oa - Ob), ra * np.exp(1j * t * np.angle(ra / rb))
+        Op, rp = Oa + t * (Oa - Ob), ra * cmath.exp(1j * t * cmath.phase(ra / rb))
         On, rn, its, res, sn = solve(side * (u0 + h), Op, rp)
         count += 1
-        miss, move = pose_distance(x, On, rn, Op, rp), pose_distance(x, On, rn, Oa, ra)
+        miss, move = _SCALAR.pose_distance(x, On, rn, Op, rp), _SCALAR.pose_distance(x, On, rn, Oa, ra)
         if sn == sign and res <= tol and its <= EASY and miss <= PREDICT * L and move <= MOVE * L and \
                 (len(path) == 1 or miss <= 0.3 * move + 1e-6 * L):
             path.append((u0 + h, On, rn))
@@ -303,17 +381,16 @@ def track(kinds: str, pins, phi0: float, O0: complex, rot0: complex, x: tuple, L
     """The base link's path by Newton with continuation along the crank's path from the design
     angle phi0 (rad), where the pose is near (O0, rot0), both ways round (`_follow`) to +-pi;
     where one way ends at a fold, the other goes on (up to a whole turn in all).
-    `pins(phi)`: the known joints' (P, c) at the angles phi (rad, (n,)) as `misses` reads them,
+    `pins(phi)`: the known joints' (P, c) at the angle phi (rad, a float) as `misses` reads them,
     or None where an earlier group does not close (the path ends there too)."""
     def solve(u, O, rot):
-        known = pins(np.array([phi0 + u]))
+        known = pins(phi0 + u)
         if known is None:
             return O, rot, MAX_ITER, np.inf, 0.0
-        P, c = known
-        O, rot, its, res = _newton(kinds, np.array([O]), np.array([rot]), x, P, c, L)
-        return O[0], rot[0], its[0], res[0], np.sign(jacobian_det(misses(kinds, O, rot, x, P, c), O))[0]
+        P, c = (tuple(np.asarray(v).item() for v in part) for part in known)
+        return _newton_one(kinds, complex(O), complex(rot), x, P, c, L)
 
-    tol = CLOSURE_TOL * _EPS * L
+    L, tol = float(L), CLOSURE_TOL * _EPS * L
     O, rot, _, res, sign = solve(0.0, O0, rot0)
     up, down = [(0.0, O, rot)], [(0.0, O, rot)]
     count = 1
@@ -333,7 +410,8 @@ def track(kinds: str, pins, phi0: float, O0: complex, rot0: complex, x: tuple, L
 
 def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c2, c3, L, track):
     """The program's step: the base link's pose O, e^{i theta} at the crank angles phi (rad),
-    closed by Newton on all the angles at once from the `track` (a Track) interpolated at each;
+    closed by Newton on all the angles at once from the `track` (a Track) interpolated at each
+    (up to FEW_ANGLES of them one by one on Python scalars, `_newton_each`);
     then per angle the closure (0, or -1 where a leash misses by more than CLOSURE_TOL rounding
     units of L, or the angle lies beyond the track's end: the mode drawn at the design position
     cannot be assembled there), the path (0, or -1 where the closed pose lies more than PREDICT
@@ -350,7 +428,7 @@ def iii3_positions(phi, phi0, kind1, kind2, kind3, x1, x2, x3, P1, P2, P3, c1, c
     O0, rot0, on = track.start(u)
     P = tuple(np.broadcast_to(p, u.shape) for p in (P1, P2, P3))
     c = tuple(np.broadcast_to(v, u.shape) for v in (c1, c2, c3))
-    O, rot, its, res = _newton(kinds, O0, rot0, x, P, c, L)
+    O, rot, its, res = (_newton_each if 0 < u.size <= FEW_ANGLES else _newton)(kinds, O0, rot0, x, P, c, L)
     tol = CLOSURE_TOL * _EPS * L
     closed = on & (res <= tol)
     flipped = np.sign(jacobian_det(misses(kinds, O, rot, x, P, c), O)) != track.sign
@@ -431,3 +509,6 @@ def modes(kinds: str, x: tuple, P: tuple, c: tuple, L: float) -> list[tuple[comp
             if all(abs(O_ - Ok) + L * abs(rot_ - rk) > 1e-9 * L for Ok, rk in found):
                 found.append((complex(O_), complex(rot_)))
     return found
+
+
+_SCALAR = _bind_scalars()

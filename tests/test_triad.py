@@ -97,6 +97,83 @@ def test_newton_converges_to_rounding_in_few_steps(mech):
     assert 1 <= np.max(out["it0"]) <= 6
 
 
+def _newton_on_arrays(kinds, O, rot, x, P, c, L):
+    """The continuation's one-angle solve on one-element numpy arrays (`triad._newton`, then the
+    sign of the group's Jacobian), as `triad.track` solved before it ran on Python scalars."""
+    from kinetostat import triad
+    P, c = tuple(np.array([v]) for v in P), tuple(np.array([v]) for v in c)
+    O, rot, its, res = triad._newton(kinds, np.array([O]), np.array([rot]), x, P, c, L)
+    return O[0], rot[0], its[0], res[0], np.sign(triad.jacobian_det(triad.misses(kinds, O, rot, x, P, c), O))[0]
+
+
+def _track_inputs(mech):
+    """Triad 0's (kinds, pins, phi0, O0, rot0, x, L) as `kinematics.tracks` passes them to `triad.track`."""
+    from kinetostat.kinematics import _known_joints, group_scales
+    kinds, x, pins = _known_joints(mech, 0, {**constants(mech), "w_in": 1.0, "e_in": 0.0})
+    return kinds, pins, np.radians(mech.drive.design_deg), 0j, 1 + 0j, x, group_scales(mech)[0]
+
+
+def test_the_track_solved_on_scalars_keeps_the_stations_and_the_branch_of_the_arrays(mech, monkeypatch):
+    """The continuation solves one angle a step on Python scalars (`triad._newton_one`: the same
+    `newton_step` bound to `_Scalars`, without numpy's cost per call): the same stations and
+    solves, hence the same path and branch, as on one-element arrays, the poses to rounding; the
+    poses closed from either track on a 0.5 deg grid agree to rounding, none off the path."""
+    from kinetostat import triad
+    args = _track_inputs(mech)
+    kinds, pins, phi0, _, _, x, L = args
+    scalar = triad.track(*args)
+    monkeypatch.setattr(triad, "_newton_one", _newton_on_arrays)
+    arrays = triad.track(*args)
+    assert scalar.full and np.array_equal(scalar.u, arrays.u) and scalar.steps == arrays.steps
+    assert scalar.sign == arrays.sign and np.max(np.abs(scalar.O - arrays.O)) <= 1e-13 * L
+    assert np.max(np.abs(scalar.rot - arrays.rot)) <= 1e-13
+    phi = np.radians(np.arange(0.0, 360.0, 0.5))
+    P, c = pins(phi)
+    codes = [float(triad.LEASH_KINDS.index(k)) for k in kinds]
+    (O, rot, closure, path, _, _), (O_, rot_, closure_, path_, _, _) = (
+        triad.iii3_positions(phi, phi0, *codes, *x, *P, *c, L, tr) for tr in (scalar, arrays))
+    assert not closure.any() and not path.any() and not closure_.any() and not path_.any()
+    assert np.max(np.abs(O - O_)) <= 1e-13 * L and np.max(np.abs(rot - rot_)) <= 1e-13
+
+
+def test_a_one_angle_solve_that_divides_by_zero_fails_as_on_arrays():
+    """A pose that puts a two-pin leash's inner pin on its outer pin (|AX| = 0, base turned to
+    rot = 0): on arrays numpy's NaN runs through every step; on scalars the ZeroDivisionError
+    ends the solve. Both are a failed solve (MAX_ITER steps, NaN miss and sign), which the
+    continuation rejects, instead of an exception out of the analysis."""
+    from kinetostat import triad
+    mech = kinetostat.load(ROOT / "models" / "triad_six_bar.toml")
+    kinds, pins, phi0, _, _, x, L = _track_inputs(mech)
+    P, c = (tuple(np.asarray(v).item() for v in part) for part in pins(phi0))
+    i = kinds.index("R")
+    with np.errstate(all="ignore"):
+        got, ref = triad._newton_one(kinds, P[i], 0j, x, P, c, L), _newton_on_arrays(kinds, P[i], 0j, x, P, c, L)
+    for solve in (got, ref):
+        assert solve[2] == triad.MAX_ITER and np.isnan(solve[3]) and np.isnan(solve[4]) and np.isnan(solve[0])
+
+
+def test_a_few_angles_closed_one_by_one_on_scalars_equal_the_arrays(mech):
+    """Up to FEW_ANGLES angles (the forward dynamics asks 1 to 4 a stage) `iii3_positions`
+    closes one by one on Python scalars (`triad._newton_each`): the same poses to rounding, the
+    same Newton steps and misses as on arrays, at 1, 4 and FEW_ANGLES angles over the cycle and
+    at an angle whose start is NaN (a failed solve on both)."""
+    from kinetostat import triad
+    kinds, pins, phi0, _, _, x, L = _track_inputs(mech)
+    tr = kinetostat.kinematics.tracks(mech)["track0"]
+    for phi in (np.radians([200.0]), np.radians([10.0, 97.3, 200.0, 333.3]), np.linspace(0.0, 6.2, triad.FEW_ANGLES)):
+        P, c = pins(phi)
+        O0, rot0, _ = tr.start(np.mod(phi - phi0 + np.pi, 2 * np.pi) - np.pi)
+        O0[-1] = O0[-1] * np.nan if len(phi) == triad.FEW_ANGLES else O0[-1]
+        with np.errstate(all="ignore"):
+            (O, rot, its, res), (O_, rot_, its_, res_) = (f(kinds, O0, rot0, x, P, c, L)
+                                                          for f in (triad._newton_each, triad._newton))
+        assert np.array_equal(its, its_) and np.array_equal(np.isnan(res), np.isnan(res_))
+        ok = ~np.isnan(res_)
+        assert np.max(np.abs(O[ok] - O_[ok])) <= 1e-13 * L and np.max(np.abs(rot[ok] - rot_[ok])) <= 1e-13
+        assert max(np.max(res[ok]), np.max(res_[ok])) <= 8 * np.finfo(float).eps * L
+    assert not ok[-1] and its[-1] == triad.MAX_ITER
+
+
 @pytest.mark.parametrize("step", [5.0, 7.0, 13.0, 360.0])
 def test_the_result_does_not_depend_on_the_angles_asked(mech, step):
     """The continuation (with its stations every 3 deg) stays on the drawn mode whatever grid is
