@@ -302,6 +302,6 @@ def test_auto_path_does_not_compile_for_few_angles():
     """path='auto' at 360 angles (below fast.FAST_MIN) takes the numpy path: the same numbers as path='numpy'."""
     from kinetostat import fast_sensitivity
     mech = kinetostat.load(CHAIN)
-    assert not fast_sensitivity.pays(mech, 360, 2) and not fast_sensitivity.pays(mech, 20_000, 7)
+    assert not fast_sensitivity.pays(mech, 360, {}, 2) and not fast_sensitivity.pays(mech, 20_000, {}, 7)
     a, b = (kinetostat.sensitivity(mech, ["r", "m2"], steps=360, path=p) for p in ("auto", "numpy"))
     assert np.array_equal(a.balancing_moment["r"], b.balancing_moment["r"])
