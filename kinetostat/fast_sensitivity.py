@@ -275,11 +275,13 @@ def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ..
                    for q in range(p) for s, n in enumerate(("w_in", "e_in")) if v(n) in on[q]])
 
     def jvp(fn: str, outs: list[str], args: list[str], q: int) -> list[str]:
-        """fn's tangent q where an argument carries one (its outputs then carry it too)."""
+        """fn's tangent q where an argument carries one (its outputs then carry it too; else not,
+        also where an output overwrites an argument that did)."""
         if not any(a in on[q] for a in args):
+            on[q].difference_update(outs)
             return []
-        on[q].update(outs)
         pairs = ", ".join(f"{a}, {f'{a}_d{q}' if a in on[q] else '0.0'}" for a in args)
+        on[q].update(outs)
         return [f"{', '.join(f'_, {o}_d{q}' for o in outs)} = {fn}_jvp({pairs})"]
 
     def steps(sts, v, check) -> list[str]:
@@ -289,9 +291,9 @@ def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ..
             if st.fn == "check":
                 lines.append(check(0, *map(arg, st.args)))
                 continue
-            outs, args = [v(o) for o in st.out], [arg(a) for a in st.args]
-            lines.append(f"{', '.join(outs)} = {st.fn}({', '.join(args)})")
-            lines += [ln for q in range(p) for ln in jvp(st.fn, outs, args, q)]
+            outs, args = [v(o) for o in st.out], [arg(a) for a in st.args]     # the tangents read the
+            lines += [ln for q in range(p) for ln in jvp(st.fn, outs, args, q)]  # arguments before a value
+            lines.append(f"{', '.join(outs)} = {st.fn}({', '.join(args)})")      # overwrites one
         return lines
 
     def link(k: int, v, row) -> tuple[list[str], list[str]]:
