@@ -14,6 +14,8 @@ per angle, the kinematics, the loads, the reactions of every group and the balan
   time in one kernel call (a Monte Carlo study's designs).
 - `refusal(mech)`: why a mechanism is not taken (a class-III group), None where it is; the
   four above raise NotImplementedError with it, and `analyze` and the sweeps use the numpy path.
+- `Splice`: what another kernel of the same layout adds to the analysis kernel's source
+  (`fast_sensitivity`'s tangents, written in the same pass).
 
 The kernel: the five primitives of `groups` (|z|, complex / real, complex / complex, e^{i th},
 atan2) bound to branch-free versions (sincos and atan by polynomials, divisions part by part);

@@ -4,19 +4,22 @@ same source as the numpy and compiled analyses.
 Every function of `groups` (but the five primitives) is turned, by a transformation of its
 syntax tree (`jvp_source`), into `<name>_jvp`: the same statements on (value, tangent) pairs,
 the chain rule applied to each operation (arithmetic, sqrt, maximum, conj, real, imag, sign,
-cos, sin, abs) and, for the primitives, `PRIMITIVE_JVPS`. The kernel runs the mechanism's
-motion and statics programs (`program.motion_program`, `statics_program`, as `fast` does)
-calling the `_jvp` functions once per parameter; every call recomputes the values, which
-LLVM merges (the functions are inlined and pure). The constants' tangents are those
-`sensitivity` computes on duals (`sensitivity._seeded`, `_design`).
+cos, sin, abs) and, for the primitives, `PRIMITIVE_JVPS`. The kernel is `fast`'s kernel of the
+analysis (its blocked loop, scratch rows and buffer layout) with the tangents spliced in
+(`fast.Splice`): after each step's value, a `_jvp` call per parameter whose seed reaches the
+step's arguments (the calls recompute the values, which LLVM merges: the functions are inlined
+and pure); a tangent no parameter reaches is known zero, neither computed nor written. One pass
+writes the analysis (`fast`'s rows) and the tangents (rows after them) into one buffer
+(`run`). The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
+`_design`); which of them are not zero picks the kernel (one per kind, p and reach).
 
 Loads besides gravity and inertia (tables, diagrams, springs, characteristics) are evaluated
 between two passes, as `fast` does: the "motion" kernel writes the kinematics and their
 tangents, `sensitivity` evaluates the loads on those duals (numpy, `applied.load_wrenches`),
-the "full" kernel reads them (X) and their tangents (DX).
+the "full" kernel reads them and their tangents (rows of X).
 
-May use: numpy, groups, program, fast (its layout, kernel module, speeds, pool, `loaded`), kernel_cache, model
-(for type hints).
+May use: numpy, groups, fast (its layout, kernel source and module, runner, result, `Splice`), kernel_cache,
+model (for type hints).
 """
 from __future__ import annotations
 
@@ -32,7 +35,7 @@ from . import fast, groups, kernel_cache
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["jvp_source", "kernels", "pays", "refusal", "tangents", "PRIMITIVE_JVPS"]
+__all__ = ["jvp_source", "kernels", "pays", "refusal", "run", "PRIMITIVE_JVPS"]
 
 
 # ----------------------------------------------------------------------------- the primitives' rules

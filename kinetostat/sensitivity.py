@@ -9,10 +9,10 @@ through the model's expressions (`Mechanism.expressions`, evaluated on duals by
 `expressions.over_arrays`) and through the fields they fill (points, masses, moments of inertia,
 bodies, g, the crank speed, load values and scales).
 
-The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source, its nominal
-analysis `fast.analyze_fast`'s.
+The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source, which writes
+the nominal analysis (`fast.analyze_fast`'s) and the derivatives in one pass.
 
-May use: numpy, analysis, applied, expressions, fast (analyze_fast), fast_sensitivity, groups, kinematics (its Kinematics), model
+May use: numpy, analysis, applied, expressions, fast_sensitivity, groups, kinematics (its Kinematics), model
 (parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from . import fast, fast_sensitivity, groups
+from . import fast_sensitivity, groups
 from .analysis import Analysis, _labelled, _xarray, crank_angles, exact
 from .applied import load_wrenches, stroke
 from .expressions import ExpressionError, over_arrays, parse
@@ -476,7 +476,7 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     an unknown parameter, or a field that a parameter reaches and that is not carried.
     path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernels over
     the same source, the loads besides gravity evaluated on duals between their two passes; the
-    nominal analysis `sens.result` by `fast.analyze_fast`, the same to rounding), or
+    nominal analysis `sens.result` written by the same pass, `fast.analyze_fast`'s to rounding), or
     "auto": the compiled one where `fast_sensitivity.pays` (its kernel held from FAST_MIN angles, else
     from FAST_COLD; a mechanism it takes)."""
     valid = [*mech.parameters, "g"]
