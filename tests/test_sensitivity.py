@@ -303,11 +303,13 @@ def _python_kernel(mech, p, kind, live):
     source checked at a few angles without a compile, and not kept among the compiled kernels."""
     import sys
     import types
+
+    import numba
     from kinetostat import fast, fast_sensitivity
     fake = types.ModuleType("numba")
     fake.njit = lambda *a, **k: (lambda f: f)
     scope: dict = {}
-    saved = sys.modules.get("numba")
+    saved = numba                     # restored after (also where nothing had imported it yet)
     sys.modules["numba"] = fake
     try:
         exec(compile(fast._module(fast_sensitivity._source(mech, p, kind, live)), "<kernel>", "exec"), scope)
