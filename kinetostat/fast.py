@@ -14,6 +14,8 @@ per angle, the kinematics, the loads, the reactions of every group and the balan
   time in one kernel call (a Monte Carlo study's designs).
 - `refusal(mech)`: why a mechanism is not taken (a class-III group), None where it is; the
   four above raise NotImplementedError with it, and `analyze` and the sweeps use the numpy path.
+- `Splice`: what another kernel of the same layout adds to the analysis kernel's source
+  (`fast_sensitivity`'s tangents, written in the same pass).
 
 The kernel: the five primitives of `groups` (|z|, complex / real, complex / complex, e^{i th},
 atan2) bound to branch-free versions (sincos and atan by polynomials, divisions part by part);
@@ -50,7 +52,7 @@ import re
 import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
 import numpy as np
 
@@ -334,7 +336,35 @@ def hoist(steps: tuple, consts) -> tuple[list, list]:
     return hoisted, moving
 
 
-def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
+@dataclass(frozen=True)
+class Splice:
+    """What another kernel of the same layout computes besides the analysis (`fast_sensitivity`'s
+    tangents), spliced into `_source`'s, each given `var` (a program's name -> the kernel's
+    identifier): `pro(var)`, lines after the constants are read; `steps(steps, var, check)`, the
+    lines of program steps (in place of `program.code`'s); `link(k, var, row)`, the lines (before
+    the loop, in it) after link k's wrench, `row()` giving the next scratch row; `stores(var)`,
+    called after those: (expression, complex?, first row of S) written per angle after the
+    analysis' arrays; `scratch`, the most scratch rows it takes besides `_scratch_rows`."""
+    pro: Callable[[Callable[[str], str]], list[str]]
+    steps: Callable[[Sequence, Callable[[str], str], Callable[[int, str, str], str]], list[str]]
+    link: Callable[[int, Callable[[str], str], Callable[[], str]], tuple[list[str], list[str]]]
+    stores: Callable[[Callable[[str], str]], Sequence[tuple[str, bool, int]]]
+    scratch: int
+
+
+def _store(t: Callable[[], str], val: str, is_complex: bool, first: int) -> tuple[list[str], list[str]]:
+    """The loop's line(s) keeping the value `val` in the next scratch row(s) and the lines after
+    the loop copying them to row `first` of S (a complex value interleaved in two rows)."""
+    if is_complex:
+        re_, im = t(), t()
+        return ([f"T[{re_} + j] = {val}.real", f"T[{im} + j] = {val}.imag"],
+                [f"c = U({first}) * n + i0 + i0", "for j in range(m):",
+                 f"    S[c + j + j] = T[{re_} + j]", f"    S[c + j + j + U(1)] = T[{im} + j]"])
+    tr = t()
+    return [f"T[{tr} + j] = {val}"], [f"c = U({first}) * n + i0", "for j in range(m):", f"    S[c + j] = T[{tr} + j]"]
+
+
+def _source(mech: "Mechanism", lay: _Layout, kind: str, splice: Splice | None = None) -> str:
     """The kernel's Python source (compiled by numba): the programs' steps inside a loop over
     blocks (design, first angle, count) and an unsigned loop over each block's angles that reads
     and writes the thread's scratch T only, at compile-time rows of BLOCK values (so LLVM sees
@@ -344,11 +374,11 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
     "peaks" keeps per block the largest |R| of each pair, |M_bal| and |F_bal| (PK) from the
     squares in T; "motion" runs the kinematics program only and copies its arrays (MOTION), the
     first pass of a mechanism whose loads depend on the motion. All flag in FL the angles the
-    exact guard must see."""
+    exact guard must see. `splice`: another kernel's additions (`Splice`)."""
     motion, statics = _motion(mech), statics_program(mech)
     v = Identifiers().__getitem__
     L, P = lay.L, lay.P
-    row = iter(range(_scratch_rows(lay)))
+    row = iter(range(_scratch_rows(lay) + (splice.scratch if splice else 0)))
     t = lambda: f"U({next(row) * BLOCK})"          # the next scratch row
     head = ["def kernel(phi, W, E, C, X, bd, b0, bn, n, FL, S, T, PK):",
             "    for b in range(bd.shape[0]):",
@@ -365,12 +395,14 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
                 "    for j in range(m):", f"        T[{tr} + j] = {X}[{X.lower()}d, i0 + j]",
                 "else:", "    for j in range(m):", f"        T[{tr} + j] = {X}[{X.lower()}d, 0]"]
     pro = [f"{v(n)} = C[d, {j}]" + (".real" if real else "") for j, (n, real) in enumerate(zip(lay.consts, lay.real))]
+    steps = (lambda sts, check: splice.steps(sts, v, check)) if splice else \
+        lambda sts, check: code(Program(tuple(sts), (), ()), v, check)
     hoisted, moving = hoist(motion.steps + (() if kind == "motion" else statics.steps), lay.consts)
-    pro += code(Program(tuple(hoisted), (), ()), v, lambda *a: "")
+    pro += (splice.pro(v) if splice else []) + steps(hoisted, lambda *a: "")
     check = lambda i, disc, scale: f"ok &= {disc} >= -1e-12 * {scale}"
     in_motion = set(motion.steps)
     body = [f"{v('phi')} = phi[i0 + j]", f"{v('w_in')} = {speeds[0]}", f"{v('e_in')} = {speeds[1]}", "ok = True"]
-    body += code(Program(tuple(st for st in moving if st in in_motion), (), motion.outputs), v, check)
+    body += steps([st for st in moving if st in in_motion], check)
     body += [f"ok &= {v(f'cond{n}')} <= {COND_CHECK!r}" for n in range(lay.G)]
     first = {name: r for name, r, _ in lay.rows}
     for k in range(1, L if kind != "motion" else 1):
@@ -384,11 +416,14 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
         body.append(f"Fa{k}, Ma{k} = weight(r{k}, {v(f'mass{k}')}, {v('g')})")
         body.append(f"Fa{k}, Ma{k} = Fa{k} + complex(T[{f} + j], T[{g} + j]), Ma{k} + T[{h} + j]")
         body.append(f"{v(f'F{k}')}, {v(f'M{k}')} = wrench(Fa{k}, Ma{k}, Fi{k}, Mi{k}, r{k})")
+        if splice:
+            more_pre, more = splice.link(k, v, t)
+            pre, body = pre + more_pre, body + more
     if kind == "full":       # Zhukovsky's lever, before the groups change the known wrenches
         pw = " + ".join(f"power({v(f'F{k}')}, {v(f'M{k}')}, {v(f'V{k}')}, {v(f'w{k}')})" for k in range(1, L))
         body.append(f"lever = -({pw}) / {v('w1')}")
     if kind != "motion":
-        body += code(Program(tuple(st for st in moving if st not in in_motion), (), statics.outputs), v, check)
+        body += steps([st for st in moving if st not in in_motion], check)
     if kind == "peaks":
         sq = [f"square({v(f'R{p}')}.real) + square({v(f'R{p}')}.imag)" for p in range(P)] + [f"square({v('M_bal')})"]
         sq += [f"square({v('F_bal')}.real) + square({v('F_bal')}.imag)"] if lay.machine else []
@@ -406,15 +441,11 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str) -> str:
         for (name, col), val in _value_map(lay, v).items():
             if kind == "motion" and name not in MOTION:
                 continue
-            if name in COMPLEX:
-                re_, im = t(), t()
-                body += [f"T[{re_} + j] = {val}.real", f"T[{im} + j] = {val}.imag"]
-                post += [f"c = U({first[name] + 2 * col}) * n + i0 + i0", "for j in range(m):",
-                         f"    S[c + j + j] = T[{re_} + j]", f"    S[c + j + j + U(1)] = T[{im} + j]"]
-            else:
-                tr = t()
-                body.append(f"T[{tr} + j] = {val}")
-                post += [f"c = U({first[name] + col}) * n + i0", "for j in range(m):", f"    S[c + j] = T[{tr} + j]"]
+            more, after = _store(t, val, name in COMPLEX, first[name] + (2 if name in COMPLEX else 1) * col)
+            body, post = body + more, post + after
+        for val, is_complex, at in splice.stores(v) if splice else ():
+            more, after = _store(t, val, is_complex, at)
+            body, post = body + more, post + after
     body.append("FL[fl + j] = not ok")
     loop = ["for j in range(m):"] + ["    " + ln for ln in body]
     return "\n".join(head + ["        " + ln for ln in pre + pro + loop + post]) + "\n"
@@ -513,13 +544,15 @@ def _blocks(D: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 
 def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, X: np.ndarray | None = None,
          S: np.ndarray | None = None, span: tuple[int, int] | None = None, FL: np.ndarray | None = None,
-         threads: int | None = None, blocks: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None):
+         threads: int | None = None, blocks: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+         other: tuple[Any, np.ndarray, int] | None = None):
     """The kernel over all designs and the angles span (default all) of `phi` (rad), or over
     `blocks` (design, first angle, count: `_end_to_end`'s), S the flat buffer of len(phi) angles,
     X the loads besides gravity ((3 (L - 1), len(phi)): F_x, F_y, M of each moving link) or None,
     its blocks shared among `threads` threads (default THREADS), one scratch each. Returns the
-    flags (D, len(phi)), the peaks per block and the blocks' designs."""
-    fn, lay = kernel(mechs[0], kind)
+    flags (D, len(phi)), the peaks per block and the blocks' designs. `other`: another kernel of
+    this layout (`Splice`'s), its constants table (D, >= K) and extra scratch rows."""
+    fn, lay = kernel(mechs[0], kind) if other is None else (other[0], _layout(mechs[0]))
     D, N = len(mechs), len(phi)
     a, b = span or (0, N)
     W, E = _speeds(mechs, phi)
@@ -527,12 +560,13 @@ def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, X: np.ndarray
     FL = np.zeros((D, N), bool) if FL is None else FL
     S = np.zeros(1) if S is None else S
     PK = np.zeros((len(bd), lay.P + 2))
-    C = _table(mechs, lay)
+    C = _table(mechs, lay) if other is None else other[1]
+    rows = _scratch_rows(lay) + (other[2] if other else 0)
     n = max(1, min(threads or THREADS, len(bd)))
     parts = [slice(q * len(bd) // n, (q + 1) * len(bd) // n) for q in range(n)]
 
     def part(s: slice) -> None:
-        T = np.empty(_scratch_rows(lay) * BLOCK)
+        T = np.empty(rows * BLOCK)
         fn(phi, W, E, C, _NO_LOADS if X is None else X, bd[s], b0[s], bn[s], np.uint64(N), FL.reshape(-1), S, T, PK[s])
 
     if n == 1:

@@ -4,36 +4,38 @@ same source as the numpy and compiled analyses.
 Every function of `groups` (but the five primitives) is turned, by a transformation of its
 syntax tree (`jvp_source`), into `<name>_jvp`: the same statements on (value, tangent) pairs,
 the chain rule applied to each operation (arithmetic, sqrt, maximum, conj, real, imag, sign,
-cos, sin, abs) and, for the primitives, `PRIMITIVE_JVPS`. The kernel runs the mechanism's
-motion and statics programs (`program.motion_program`, `statics_program`, as `fast` does)
-calling the `_jvp` functions once per parameter; every call recomputes the values, which
-LLVM merges (the functions are inlined and pure). The constants' tangents are those
-`sensitivity` computes on duals (`sensitivity._seeded`, `_design`).
+cos, sin, abs) and, for the primitives, `PRIMITIVE_JVPS`. The kernel is `fast`'s kernel of the
+analysis (its blocked loop, scratch rows and buffer layout) with the tangents spliced in
+(`fast.Splice`): after each step's value, a `_jvp` call per parameter whose seed reaches the
+step's arguments (the calls recompute the values, which LLVM merges: the functions are inlined
+and pure); a tangent no parameter reaches is known zero, neither computed nor written. One pass
+writes the analysis (`fast`'s rows) and the tangents (rows after them) into one buffer
+(`run`). The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
+`_design`); which of them are not zero picks the kernel (one per kind, p and reach).
 
 Loads besides gravity and inertia (tables, diagrams, springs, characteristics) are evaluated
 between two passes, as `fast` does: the "motion" kernel writes the kinematics and their
 tangents, `sensitivity` evaluates the loads on those duals (numpy, `applied.load_wrenches`),
-the "full" kernel reads them (X) and their tangents (DX).
+the "full" kernel reads them and their tangents (rows of X).
 
-May use: numpy, groups, program, fast (its layout, kernel module, speeds, pool, `loaded`), kernel_cache, model
-(for type hints).
+May use: numpy, groups, fast (its layout, kernel source and module, runner, result, `Splice`), kernel_cache,
+model (for type hints).
 """
 from __future__ import annotations
 
 import ast
 import inspect
 import textwrap
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
 from . import fast, groups, kernel_cache
-from .program import Identifiers, statics_program
 
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["jvp_source", "kernels", "pays", "refusal", "tangents", "PRIMITIVE_JVPS"]
+__all__ = ["jvp_source", "kernels", "pays", "refusal", "run", "PRIMITIVE_JVPS"]
 
 
 # ----------------------------------------------------------------------------- the primitives' rules
@@ -231,8 +233,8 @@ def refusal(mech: "Mechanism") -> str | None:
 
 
 def _outs(mech: "Mechanism", kind: str) -> tuple[str, ...]:
-    """The outputs of the `kind` kernel: "full", those `Sensitivity` keeps (as `sensitivity` keeps
-    them on the numpy path); "motion", the kinematics the loads read."""
+    """The outputs whose tangents the `kind` kernel writes: "full", those `Sensitivity` keeps (as
+    `sensitivity` keeps them on the numpy path); "motion", the kinematics the loads read."""
     links = range(1, mech.n_links)
     if kind == "motion":
         return (*(f"{s}{k}" for s in ("th", "O", "V", "A", "w", "e", "rot") for k in links),
@@ -245,120 +247,96 @@ def _is_complex(name: str) -> bool:
     return name.rstrip("0123456789") in _COMPLEX
 
 
-def _rows(mech: "Mechanism", p: int, kind: str) -> dict[str, int]:
-    """Each output's first row (of n values) in the buffer: its value, then its p tangents (a complex
-    one two rows each, its real and imaginary parts interleaved: a view as complex, no copy)."""
-    rows, r = {}, 0
-    for name in _outs(mech, kind):
+def _rows(mech: "Mechanism", p: int) -> dict[str, int]:
+    """Each output's first row (of n values) of tangents in the buffer, after the analysis' rows
+    (`fast._layout`): its p tangents (a complex one two rows each, its real and imaginary parts
+    interleaved: a view as complex, no copy); the motion kernel's and the full kernel's outputs."""
+    rows, r = {}, fast._layout(mech).n_rows
+    for name in dict.fromkeys(_outs(mech, "motion") + _outs(mech, "full")):
         rows[name] = r
-        r += (1 + p) * (2 if _is_complex(name) else 1)
+        r += p * (2 if _is_complex(name) else 1)
     rows[""] = r
     return rows
 
 
-def _step_lines(steps, v, p: int) -> list[str]:
-    """The steps as calls of the `_jvp` functions, once per tangent (the values from the first)."""
-    arg = lambda a, q: (f"{v(a)}_d{q}" if isinstance(a, str) else "0.0")
-    lines = []
-    for st in steps:
-        if st.fn == "check":
-            lines.append(f"ok &= {v(st.args[0])} >= -1e-12 * {v(st.args[1]) if isinstance(st.args[1], str) else repr(st.args[1])}")
-            continue
-        for q in range(p):
-            outs = ", ".join(f"{v(o) if q == 0 else '_'}, {v(o)}_d{q}" for o in st.out)
-            args = ", ".join(f"{v(a) if isinstance(a, str) else repr(a)}, {arg(a, q)}" for a in st.args)
-            lines.append(f"{outs} = {st.fn}_jvp({args})")
-    return lines
-
-
-def _source(mech: "Mechanism", p: int, kind: str) -> str:
-    """The `kind` kernel ("motion" or "full"): angles [a, b) of phi, constants C (K,) and their
-    tangents DC (p, K), the crank's speeds W, E ((1, N) or (1, 1)) and their tangents DW, DE (p,),
-    the loads besides gravity X (3 (L - 1), N: F_x, F_y, M of each moving link; empty where there
-    are none) and their tangents DX (p, 3 (L - 1), N); writes every output's value and tangents
-    at rows of n angles of S (`_rows`)."""
+def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> fast.Splice:
+    """The tangents spliced into `fast`'s `kind` kernel: tangent q of a value only where a seed of
+    `live[q]` (constants, "w_in", "e_in", "X": the loads besides gravity) reaches it, else known
+    zero and not computed, nor written (the buffer's rows stay zero). The constants' tangents are
+    read from columns K (1 + q) + j of C, those of the crank's speeds from K (1 + p) + q and
+    K (1 + p) + p + q; the loads' tangents from rows 3 (L - 1) (1 + q) + ... of X."""
     lay = fast._layout(mech)
-    motion, statics = fast._motion(mech), statics_program(mech)
-    v = Identifiers().__getitem__
-    rows = _rows(mech, p, kind)
-    loads = mech.loads or mech.springs
-    pro = []
-    for j, (n, real) in enumerate(zip(lay.consts, lay.real)):
-        pro.append(f"{v(n)} = C[{j}]" + (".real" if real else ""))
-        pro += [f"{v(n)}_d{q} = DC[{q}, {j}]" + (".real" if real else "") for q in range(p)]
-    hoisted, moving = fast.hoist(motion.steps + (() if kind == "motion" else statics.steps), lay.consts)
-    pro += _step_lines(hoisted, v, p)
-    in_motion = set(motion.steps)
-    body = [f"{v('phi')} = phi[i]", f"{v('w_in')} = W[0, i if W.shape[1] > 1 else U(0)]",
-            f"{v('e_in')} = E[0, i if E.shape[1] > 1 else U(0)]", "ok = True"]
-    body += [f"{v(n)}_d{q} = {x}" for q in range(p) for n, x in (("phi", "0.0"), ("w_in", f"DW[{q}]"), ("e_in", f"DE[{q}]"))]
-    body += _step_lines([st for st in moving if st in in_motion], v, p)
-    for k in range(1, lay.L if kind == "full" else 1):
+    K, L = len(lay.consts), lay.L
+    on: list[set[str]] = [set() for _ in live]          # the kernel's identifiers with a tangent q
+
+    def pro(v) -> list[str]:
+        for q, seeds in enumerate(live):
+            on[q].update(v(n) for n in seeds if n != "X")
+        return ([f"{v(n)}_d{q} = C[d, {K * (1 + q) + j}]" + (".real" if real else "")
+                 for q in range(p) for j, (n, real) in enumerate(zip(lay.consts, lay.real)) if v(n) in on[q]]
+                + [f"{v(n)}_d{q} = C[d, {K * (1 + p) + p * s + q}].real"
+                   for q in range(p) for s, n in enumerate(("w_in", "e_in")) if v(n) in on[q]])
+
+    def jvp(fn: str, outs: list[str], args: list[str], q: int) -> list[str]:
+        """fn's tangent q where an argument carries one (its outputs then carry it too; else not,
+        also where an output overwrites an argument that did)."""
+        if not any(a in on[q] for a in args):
+            on[q].difference_update(outs)
+            return []
+        pairs = ", ".join(f"{a}, {f'{a}_d{q}' if a in on[q] else '0.0'}" for a in args)
+        on[q].update(outs)
+        return [f"{', '.join(f'_, {o}_d{q}' for o in outs)} = {fn}_jvp({pairs})"]
+
+    def steps(sts, v, check) -> list[str]:
+        arg = lambda a: v(a) if isinstance(a, str) else repr(a)
+        lines = []
+        for st in sts:
+            if st.fn == "check":
+                lines.append(check(0, *map(arg, st.args)))
+                continue
+            outs, args = [v(o) for o in st.out], [arg(a) for a in st.args]     # the tangents read the
+            lines += [ln for q in range(p) for ln in jvp(st.fn, outs, args, q)]  # arguments before a value
+            lines.append(f"{', '.join(outs)} = {st.fn}({', '.join(args)})")      # overwrites one
+        return lines
+
+    def link(k: int, v, row) -> tuple[list[str], list[str]]:
+        pre, body = [], []
         for q in range(p):
-            keep = lambda name: name if q == 0 else "_"
-            a = lambda n: f"{v(n)}, {v(n)}_d{q}"
-            body.append(f"{keep(f'r{k}')}, r{k}_d{q}, {keep(f'Fi{k}')}, Fi{k}_d{q}, {keep(f'Mi{k}')}, Mi{k}_d{q} = inertia_jvp("
-                        f"{a(f'A{k}')}, {a(f'w{k}')}, {a(f'e{k}')}, {a(f'rot{k}')}, {a(f'com{k}')}, {a(f'mass{k}')}, "
-                        f"{a(f'I_S{k}')})")
-            body.append(f"{keep(f'Fa{k}')}, Fa{k}_d{q}, {keep(f'Ma{k}')}, Ma{k}_d{q} = weight_jvp(r{k}, r{k}_d{q}, "
-                        f"{a(f'mass{k}')}, {a('g')})")
-            if loads:
-                if q == 0:
-                    body += [f"Fa{k} = Fa{k} + complex(X[{3 * k - 3}, i], X[{3 * k - 2}, i])", f"Ma{k} = Ma{k} + X[{3 * k - 1}, i]"]
-                body += [f"Fa{k}_d{q} = Fa{k}_d{q} + complex(DX[{q}, {3 * k - 3}, i], DX[{q}, {3 * k - 2}, i])",
-                         f"Ma{k}_d{q} = Ma{k}_d{q} + DX[{q}, {3 * k - 1}, i]"]
-            body.append(f"{keep(v(f'F{k}'))}, {v(f'F{k}')}_d{q}, {keep(v(f'M{k}'))}, {v(f'M{k}')}_d{q} = wrench_jvp("
-                        f"Fa{k}, Fa{k}_d{q}, Ma{k}, Ma{k}_d{q}, Fi{k}, Fi{k}_d{q}, Mi{k}, Mi{k}_d{q}, r{k}, r{k}_d{q})")
-    if kind == "full":
-        body += _step_lines([st for st in moving if st not in in_motion], v, p)
-    for name in _outs(mech, kind):
-        r = rows[name]
-        for q, x in enumerate([v(name)] + [f"{v(name)}_d{q}" for q in range(p)]):
-            if _is_complex(name):
-                body += [f"S[U({r + 2 * q}) * n + i + i] = {x}.real", f"S[U({r + 2 * q}) * n + i + i + U(1)] = {x}.imag"]
-            else:
-                body.append(f"S[U({r + q}) * n + i] = {x}")
-    body.append("FL[i] = not ok")
-    head = ["def kernel(phi, W, E, C, DC, DW, DE, X, DX, a, b, n, S, FL):"]
-    loop = ["for i in range(a, b):"] + ["    " + ln for ln in body]
+            body += jvp("inertia", [f"r{k}", f"Fi{k}", f"Mi{k}"], [v(f"{s}{k}") for s in ("A", "w", "e", "rot", "com", "mass", "I_S")], q)
+            body += jvp("weight", [f"Fa{k}", f"Ma{k}"], [f"r{k}", v(f"mass{k}"), v("g")], q)
+            if "X" in live[q]:
+                f, g, h = row(), row(), row()
+                x = 3 * (L - 1) * (1 + q) + 3 * k
+                pre += ["for j in range(m):", f"    T[{f} + j] = X[{x - 3}, i0 + j]", f"    T[{g} + j] = X[{x - 2}, i0 + j]",
+                        f"    T[{h} + j] = X[{x - 1}, i0 + j]"]
+                had = f"Fa{k}" in on[q]
+                body += [f"Fa{k}_d{q} = " + (f"Fa{k}_d{q} + " if had else "") + f"complex(T[{f} + j], T[{g} + j])",
+                         f"Ma{k}_d{q} = " + (f"Ma{k}_d{q} + " if had else "") + f"T[{h} + j]"]
+                on[q].update((f"Fa{k}", f"Ma{k}"))
+            body += jvp("wrench", [v(f"F{k}"), v(f"M{k}")], [f"Fa{k}", f"Ma{k}", f"Fi{k}", f"Mi{k}", f"r{k}"], q)
+        return pre, body
+
+    rows = _rows(mech, p)
+
+    def stores(v) -> list[tuple[str, bool, int]]:
+        return [(f"{v(n)}_d{q}", _is_complex(n), rows[n] + (2 if _is_complex(n) else 1) * q)
+                for n in _outs(mech, kind) for q in range(p) if v(n) in on[q]]
+
+    return fast.Splice(pro, steps, link, stores, _scratch(mech, p))
+
+
+def _scratch(mech: "Mechanism", p: int) -> int:
+    """The most scratch rows `_splice`'s tangents take: the loads' and every output's."""
+    return 3 * (mech.n_links - 1) * p + 2 * (_rows(mech, p)[""] - fast._layout(mech).n_rows)
+
+
+def _source(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> str:
+    """The `kind` kernel ("motion" or "full") with p tangents: `fast`'s kernel of the analysis
+    (`fast._source`), `_splice`'s tangents spliced in, and the `_jvp` functions it calls."""
     jvps = jvp_source() + "\n" + "\n\n".join(inspect.getsource(f) for f in PRIMITIVE_JVPS)
     return "\n".join([jvps, "for _name in [n for n in list(globals()) if n.endswith('_jvp')]:",
-                      "    globals()[_name] = numba.njit(inline='always', error_model='numpy')(globals()[_name])", ""]
-                     + head + ["    " + ln for ln in pro + loop]) + "\n"
-
-
-def pays(mech: "Mechanism", n: int, p: int) -> bool:
-    """Whether `n` angles of `mech`'s sensitivities to p parameters go the compiled path: as
-    `fast.pays` (FAST_MIN where this process holds the kernels, its own and the analysis' that
-    gives `sens.result`; FAST_COLD where it would load or compile one) and `refusal` is None."""
-    if n < fast.FAST_MIN or not fast.available() or refusal(mech) is not None:
-        return False
-    held = True
-    for kind in _kinds(mech):
-        src = mech.memo(("sensitivity kernel source", p, kind), lambda: _source(mech, p, kind))
-        with fast._LOCK:
-            held &= src in fast._KERNELS
-        held &= fast.loaded(mech, kind)
-    return n >= (fast.FAST_MIN if held else fast.FAST_COLD)
-
-
-def _kinds(mech: "Mechanism") -> tuple[str, ...]:
-    """The kernels `mech`'s sensitivities run: "motion" then "full" where it has loads besides gravity."""
-    return ("motion", "full") if mech.loads or mech.springs else ("full",)
-
-
-def kernels(mech: "Mechanism", p: int) -> list:
-    """The compiled kernels (numba dispatchers) of `mech`'s sensitivities to p parameters, loaded
-    or compiled as a call would (`_kinds`)."""
-    return [_kernel(mech, p, kind) for kind in _kinds(mech)]
-
-
-def _kernel(mech: "Mechanism", p: int, kind: str):
-    src = mech.memo(("sensitivity kernel source", p, kind), lambda: _source(mech, p, kind))
-    with fast._LOCK:
-        if src not in fast._KERNELS:
-            fast._KERNELS[src] = kernel_cache.load(fast._module(src)).kernel
-        return fast._KERNELS[src]
+                      "    globals()[_name] = numba.njit(inline='always', error_model='numpy')(globals()[_name])", "",
+                      fast._source(mech, fast._layout(mech), kind, _splice(mech, p, kind, live))])
 
 
 def _tangent(x: Any, p: int) -> np.ndarray:
@@ -366,43 +344,102 @@ def _tangent(x: Any, p: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(x.der), (p,)) if hasattr(x, "der") else np.zeros(p)
 
 
-def tangents(mech: "Mechanism", c: Mapping[str, Any], phi: np.ndarray, p: int, kind: str = "full",
-             X: np.ndarray | None = None, DX: np.ndarray | None = None,
-             threads: int | None = None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """The outputs of the `kind` kernel (`_outs`: "full", those `Sensitivity` keeps; "motion", the
-    kinematics), each as (value (N,), tangents (N, p)), at the crank angles `phi` (rad), from the
-    design's constants `c` (numbers, or duals with `val` and `der` (p,): `sensitivity._design`'s)
-    and, for "full" where `mech` has loads besides gravity, those loads X and their tangents DX
-    (`_source`). NotImplementedError with `refusal`'s reason where it does not take `mech`."""
+def _table(mech: "Mechanism", c: Mapping[str, Any], p: int) -> tuple[np.ndarray, tuple[set[str], ...]]:
+    """The constants table of the kernels (1, K (1 + p) + 2 p: the constants, their p tangents,
+    those of the crank's omega and eps; `_splice`) from the design's constants `c` (numbers, or
+    duals with `val` and `der` (p,): `sensitivity._design`'s), and per tangent the names whose
+    tangent is not zero."""
+    lay = fast._layout(mech)
+    base = fast._constants(mech)
+    consts = [c.get(n, base[n]) for n in lay.consts]
+    DC = np.array([_tangent(x, p) for x in consts], dtype=complex).reshape(len(consts), p)
+    DW, DE = (np.real(_tangent(c[n], p)) if mech.drive.law is None and n in c else np.zeros(p) for n in ("w_in", "e_in"))
+    C = np.concatenate([[complex(getattr(x, "val", x)) for x in consts], DC.T.reshape(-1), DW, DE])[None, :]
+    live = tuple({n for n, d in zip(lay.consts, DC[:, q]) if d != 0} | {n for n, d in (("w_in", DW[q]), ("e_in", DE[q])) if d != 0}
+                 for q in range(p))
+    return C, live
+
+
+def _kernel(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]):
+    """The compiled `kind` kernel with p tangents reaching from `live` (loaded or compiled)."""
+    src = mech.memo(("sensitivity kernel source", p, kind, live), lambda: _source(mech, p, kind, live))
+    with fast._LOCK:
+        if src not in fast._KERNELS:
+            fast._KERNELS[src] = kernel_cache.load(fast._module(src)).kernel
+        held = mech.memo(("sensitivity kernels", p), dict)
+        held[src] = fast._KERNELS[src]
+        return fast._KERNELS[src]
+
+
+def _held(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> bool:
+    src = mech.memo(("sensitivity kernel source", p, kind, live), lambda: _source(mech, p, kind, live))
+    with fast._LOCK:
+        return src in fast._KERNELS
+
+
+def _kinds(mech: "Mechanism") -> tuple[str, ...]:
+    """The kernels `mech`'s sensitivities run: "motion" then "full" where it has loads besides gravity."""
+    return ("motion", "full") if fast._has_loads(mech) else ("full",)
+
+
+def pays(mech: "Mechanism", n: int, c: Mapping[str, Any], p: int) -> bool:
+    """Whether `n` angles of `mech`'s sensitivities to p parameters (the design's constants `c`, as
+    `run` takes them) go the compiled path: as `fast.pays` (FAST_MIN where this process holds
+    its kernels, FAST_COLD where it would load or compile one) and `refusal` is None."""
+    if n < fast.FAST_MIN or not fast.available() or refusal(mech) is not None:
+        return False
+    held = _held(mech, p, _kinds(mech)[0], tuple(frozenset(x) for x in _table(mech, c, p)[1]))
+    return n >= (fast.FAST_MIN if held else fast.FAST_COLD)
+
+
+def kernels(mech: "Mechanism", p: int) -> list:
+    """The compiled sensitivity kernels (numba dispatchers) with p tangents that this process has
+    run for `mech` (one per kind and set of parameters' reach)."""
+    return list(mech.memo(("sensitivity kernels", p), dict).values())
+
+
+def _pair(r: Mapping[str, np.ndarray], S: np.ndarray, rows: Mapping[str, int], name: str, N: int, p: int):
+    """The output `name`'s (value (N,), tangents (N, p)): views of the analysis' arrays `r`
+    (`fast._views`) and of the tangent rows of the buffer S."""
+    stem, k = name.rstrip("0123456789"), name[len(name.rstrip("0123456789")):]
+    value = r[stem][:, int(k) if k else 0]
+    at = rows[name]
+    if _is_complex(name):
+        return value, S[at * N:(at + 2 * p) * N].view(complex).reshape(p, N).T
+    return value, S[at * N:(at + p) * N].reshape(p, N).T
+
+
+def run(mech: "Mechanism", c: Mapping[str, Any], phi_deg: np.ndarray, p: int,
+        loads: Callable[[dict[str, tuple[np.ndarray, np.ndarray]]], tuple[np.ndarray, np.ndarray]] | None = None,
+        threads: int | None = None):
+    """The analysis of `mech` at `phi_deg` (deg) and the tangents of the outputs `Sensitivity`
+    keeps (`_outs`), in one pass of one kernel (two where `mech` has loads besides gravity), each
+    output as (value (N,), tangents (N, p)) views of one buffer: the Analysis `fast.analyze_fast`
+    gives (its guard's angles solved by the numpy path) and a dict of those pairs. `c`: the
+    design's constants (numbers, or duals with `val` and `der` (p,): `sensitivity._design`'s).
+    `loads(motion)`: where `mech` has loads besides gravity, those loads (3 (L - 1), N) (F_x, F_y,
+    M of each moving link, as `fast` reads them) and their tangents (p, 3 (L - 1), N) from the
+    motion kernel's outputs (pairs as above). NotImplementedError with `refusal`'s reason where
+    it does not take `mech`."""
     why = refusal(mech)
     if why:
         raise NotImplementedError(f"{mech.name}: {why}")
     lay = fast._layout(mech)
-    base = fast._constants(mech)
-    consts = [c.get(n, base[n]) for n in lay.consts]
-    C = np.array([complex(getattr(x, "val", x)) for x in consts])
-    DC = np.array([_tangent(x, p) for x in consts], dtype=complex).T.copy()
-    W, E = fast._speeds([mech], phi)
-    DW, DE = (np.real(_tangent(c[n], p)) if mech.drive.law is None else np.zeros(p) for n in ("w_in", "e_in"))
+    phi = np.radians(phi_deg)
     N = len(phi)
-    rows = _rows(mech, p, kind)
-    S, FL = np.empty(rows[""] * N), np.zeros(N, bool)
-    fn = _kernel(mech, p, kind)
-    X = np.zeros((0, 1)) if X is None else np.ascontiguousarray(X, float)
-    DX = np.zeros((p, 0, 1)) if DX is None else np.ascontiguousarray(DX, float)
-    n = max(1, min(threads or fast.THREADS, N // fast.BLOCK or 1))
-    spans = [(np.uint64(q * N // n), np.uint64((q + 1) * N // n)) for q in range(n)]
-    run = lambda s: fn(phi, W, E, C, DC, DW, DE, X, DX, s[0], s[1], np.uint64(N), S, FL)
-    if n == 1:
-        run(spans[0])
-    else:
-        list(fast._pool(n).map(run, spans))
-    out = {}
-    for name in _outs(mech, kind):
-        r = rows[name]
-        if _is_complex(name):
-            z = S[r * N:(r + 2 * (1 + p)) * N].view(complex).reshape(1 + p, N)
-        else:
-            z = S[r * N:(r + 1 + p) * N].reshape(1 + p, N)
-        out[name] = (z[0], z[1:].T)
-    return out
+    rows = _rows(mech, p)
+    S = np.zeros(rows[""] * N)
+    r = fast._views(lay, S, N)
+    r["rot"][:, 0] = 1.0              # the frame's e^{i theta}
+    C, seeds = _table(mech, c, p)
+    live = tuple(frozenset(x) for x in seeds)
+    other = lambda kind, live: (_kernel(mech, p, kind, live), C, _scratch(mech, p))
+    FL = np.zeros((1, N), bool)
+    X = None
+    if fast._has_loads(mech):
+        fast._run([mech], phi, "motion", S=S, FL=FL, threads=threads, other=other("motion", live))
+        x, dx = loads({n: _pair(r, S, rows, n, N, p) for n in _outs(mech, "motion")})
+        X = np.ascontiguousarray(np.concatenate([x, dx.reshape(-1, N)]), float)
+        live = tuple(ls | {"X"} if np.any(dx[q]) else ls for q, ls in enumerate(live))
+    fast._run([mech], phi, "full", X, S=S, FL=FL, threads=threads, other=other("full", live))
+    return fast._result(mech, phi_deg, r, FL[0]), {n: _pair(r, S, rows, n, N, p) for n in _outs(mech, "full")}

@@ -9,10 +9,10 @@ through the model's expressions (`Mechanism.expressions`, evaluated on duals by
 `expressions.over_arrays`) and through the fields they fill (points, masses, moments of inertia,
 bodies, g, the crank speed, load values and scales).
 
-The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source, its nominal
-analysis `fast.analyze_fast`'s.
+The compiled path (`path=`) is `fast_sensitivity`'s kernel over the same source, which writes
+the nominal analysis (`fast.analyze_fast`'s) and the derivatives in one pass.
 
-May use: numpy, analysis, applied, expressions, fast (analyze_fast), fast_sensitivity, groups, kinematics (its Kinematics), model
+May use: numpy, analysis, applied, expressions, fast_sensitivity, groups, kinematics (its Kinematics), model
 (parts.combine, the file's text), planar, program, units; xarray (an optional extra) only inside `to_xarray`.
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from . import fast, fast_sensitivity, groups
+from . import fast_sensitivity, groups
 from .analysis import Analysis, _labelled, _xarray, crank_angles, exact
 from .applied import load_wrenches, stroke
 from .expressions import ExpressionError, over_arrays, parse
@@ -476,7 +476,7 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     an unknown parameter, or a field that a parameter reaches and that is not carried.
     path: "numpy" (the program on `Dual` arrays), "compiled" (`fast_sensitivity`'s kernels over
     the same source, the loads besides gravity evaluated on duals between their two passes; the
-    nominal analysis `sens.result` by `fast.analyze_fast`, the same to rounding), or
+    nominal analysis `sens.result` written by the same pass, `fast.analyze_fast`'s to rounding), or
     "auto": the compiled one where `fast_sensitivity.pays` (its kernel held from FAST_MIN angles, else
     from FAST_COLD; a mechanism it takes)."""
     valid = [*mech.parameters, "g"]
@@ -494,16 +494,16 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
     if path not in ("auto", "numpy", "compiled"):
         raise ValueError(f"sensitivity: path {path!r}: one of 'auto', 'numpy', 'compiled'")
     phi_deg = crank_angles(phi_deg, steps)
-    if path == "auto":
-        path = "compiled" if fast_sensitivity.pays(mech, len(phi_deg), len(params)) else "numpy"
-    result = fast.analyze_fast(mech, phi_deg) if path == "compiled" else exact(mech, phi_deg, "first")
     values, fields = _seeded(mech, params)
     _refuse_unsmooth(mech, values)
     c, pts, view = _design(mech, fields)
+    if path == "auto":
+        path = "compiled" if fast_sensitivity.pays(mech, len(phi_deg), c, len(params)) else "numpy"
     if path == "compiled":
-        keep = _compiled(mech, c, pts, view, np.radians(phi_deg), len(params))
+        result, keep = _compiled(mech, c, pts, view, phi_deg, len(params))
         return Sensitivity(mech, params, MappingProxyType({p: float(value(values[p])) for p in params}), phi_deg,
                            result, MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
+    result = exact(mech, phi_deg, "first")
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         env = _motion(mech, c, np.radians(phi_deg))
         for k in range(1, mech.n_links):
@@ -523,23 +523,24 @@ def sensitivity(mech: "Mechanism", params: list[str] | tuple[str, ...] | None = 
                        MappingProxyType(keep), tuple(MappingProxyType(p) for p in pts))
 
 
-def _compiled(mech: "Mechanism", c: Mapping[str, Any], pts, view: "Mechanism", phi: np.ndarray, P: int) -> dict[str, Dual]:
-    """The kept outputs by `fast_sensitivity`'s kernels: where `mech` has loads besides gravity,
-    its motion kernel first, the loads on that motion's duals (as the numpy path evaluates them),
-    then the full kernel with them (X, DX)."""
-    X = DX = None
-    if mech.loads or mech.springs:
-        env = {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, phi, P, "motion").items()}
+def _compiled(mech: "Mechanism", c: Mapping[str, Any], pts, view: "Mechanism", phi_deg: np.ndarray,
+              P: int) -> tuple[Analysis, dict[str, Dual]]:
+    """The nominal analysis and the kept outputs by `fast_sensitivity.run`: where `mech` has loads
+    besides gravity, those evaluated on the motion kernel's duals (as the numpy path evaluates them)."""
+    def loads(motion: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+        env = {n: Dual(*vd) for n, vd in motion.items()}
         _travel_ends(mech, view, c, pts)
-        L, N = mech.n_links, len(phi)
+        L, N = mech.n_links, len(phi_deg)
         F = [[0.0, 0.0] for _ in range(L)]
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, phi, P)):
+            for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, np.radians(phi_deg), P)):
                 F[k] = [F[k][0] + f, F[k][1] + m]
         cols = [x for k in range(1, L) for x in (np.real(F[k][0]), np.imag(F[k][0]), F[k][1])]
-        X = np.stack([np.broadcast_to(value(x), (N,)) for x in cols])
-        DX = np.stack([derivative(x, (N,), P) for x in cols]).transpose(2, 0, 1)
-    return {n: Dual(*vd) for n, vd in fast_sensitivity.tangents(mech, c, phi, P, "full", X, DX).items()}
+        return (np.stack([np.broadcast_to(value(x), (N,)) for x in cols]),
+                np.stack([derivative(x, (N,), P) for x in cols]).transpose(2, 0, 1))
+
+    result, out = fast_sensitivity.run(mech, c, phi_deg, P, loads)
+    return result, {n: Dual(*vd) for n, vd in out.items()}
 
 
 def _motion(mech: "Mechanism", env: dict[str, Any], phi: np.ndarray) -> dict[str, Any]:

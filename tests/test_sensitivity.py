@@ -298,10 +298,51 @@ def test_compiled_and_numpy_paths_agree(path, params):
             assert np.nanmax(np.abs(x - y)) <= 1e-12 * np.nanmax(np.abs(x)), (name, p)
 
 
+def _python_kernel(mech, p, kind, live):
+    """`fast_sensitivity`'s kernel run as Python (numba's njit the identity): its generated
+    source checked at a few angles without a compile, and not kept among the compiled kernels."""
+    import sys
+    import types
+
+    import numba
+    from kinetostat import fast, fast_sensitivity
+    fake = types.ModuleType("numba")
+    fake.njit = lambda *a, **k: (lambda f: f)
+    scope: dict = {}
+    saved = numba                     # restored after (also where nothing had imported it yet)
+    sys.modules["numba"] = fake
+    try:
+        exec(compile(fast._module(fast_sensitivity._source(mech, p, kind, live)), "<kernel>", "exec"), scope)
+    finally:
+        sys.modules["numba"] = saved
+    return scope["kernel"]
+
+
+@pytest.mark.parametrize("path, params", [(CHAIN, ["r", "l", "m2"]), (ICE, ["l_OA", "p_max", "G2"])],
+                         ids=["chain_unit_four_bar", "ice_crank_slider"])
+def test_one_pass_kernel_source_gives_the_numpy_derivatives(path, params, monkeypatch):
+    """The compiled path's kernel source (the analysis and the tangents in one pass, each tangent
+    only where its parameter reaches: m2 reaches the statics only, p_max the gas load only), run
+    as Python at 6 angles, gives the numpy path's nominal analysis and derivatives to 1e-12: a
+    step whose value overwrites an argument (carry) has its tangents from the argument's old value."""
+    from kinetostat import fast_sensitivity
+    monkeypatch.setattr(fast_sensitivity, "_kernel", _python_kernel)
+    mech = kinetostat.load(path)
+    phi = np.array([5.0, 63.0, 131.0, 199.0, 262.0, 331.0])
+    a = kinetostat.sensitivity(mech, params, phi_deg=phi, path="numpy")
+    b = kinetostat.sensitivity(mech, params, phi_deg=phi, path="compiled")
+    for x, y in ((a.result.balancing_moment, b.result.balancing_moment), (a.result.forces.R, b.result.forces.R)):
+        assert np.max(np.abs(x - y)) <= 1e-12 * np.max(np.abs(x))
+    for name, _, acc in outputs(mech, mech.point_names[-1]):
+        for p in params:
+            x, y = acc(a)[p], acc(b)[p]
+            assert np.max(np.abs(x - y)) <= 1e-12 * np.max(np.abs(x)) + 1e-300, (name, p)
+
+
 def test_auto_path_does_not_compile_for_few_angles():
     """path='auto' at 360 angles (below fast.FAST_MIN) takes the numpy path: the same numbers as path='numpy'."""
     from kinetostat import fast_sensitivity
     mech = kinetostat.load(CHAIN)
-    assert not fast_sensitivity.pays(mech, 360, 2) and not fast_sensitivity.pays(mech, 20_000, 7)
+    assert not fast_sensitivity.pays(mech, 360, {}, 2) and not fast_sensitivity.pays(mech, 20_000, {}, 7)
     a, b = (kinetostat.sensitivity(mech, ["r", "m2"], steps=360, path=p) for p in ("auto", "numpy"))
     assert np.array_equal(a.balancing_moment["r"], b.balancing_moment["r"])
