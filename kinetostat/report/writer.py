@@ -26,7 +26,7 @@ from ..structure import GROUP_KINDS
 log = logging.getLogger(__name__)
 from ..sweep import sweep
 from .. import units as model_units
-from ..tables import csv_text, error, plain
+from ..tables import columns_csv, error, plain
 from .document import ROUNDING, ROUNDING_MARK, ROUNDING_NOTE, Doc, _err, _fmt, _is_rounding, _rel, esc, slug
 from .plots import (pair_name, plain_text, quantity_name, plot_balancing_force, plot_errors, plot_hodographs,
                     plot_mechanism, plot_moment, plot_reactions, plot_tornado)
@@ -34,8 +34,9 @@ from .published import PublishedCheck
 from .runs import ModelRun, trust
 from .sources import WORKS, Work, cited
 
-#: The table of the cycle in a report folder: `res.to_frame()` as `tables.csv_text` writes it,
-#: gzip-compressed (deterministic: no name, no time; 2.6x smaller, read by pandas, numpy, R as is).
+#: The table of the cycle in a report folder: `res.to_frame()` as `tables.csv_text` writes it (written from
+#: `res.columns()` by `tables.columns_csv`, the same text without pandas), gzip-compressed (deterministic: no
+#: name, no time; 2.6x smaller, read by pandas, numpy, R as is).
 CYCLE_FILE = "cycle.csv.gz"
 #: Fewer positions than this make the plots over the cycle meaningless.
 MIN_REPORT_STEPS = 8
@@ -839,7 +840,7 @@ def write_report(run: ModelRun, out: Path, folder: str | None = None, page: bool
     log.info("%s: figures %s (%.1f s)", folder, ", ".join(images), time.perf_counter() - t0)
     t0 = time.perf_counter()
     with atomic(d / CYCLE_FILE, binary=True) as f:
-        f.write(gzip.compress(csv_text(res.to_frame()).encode("utf-8"), compresslevel=9, mtime=0))
+        f.write(gzip.compress(columns_csv(*res.columns()).encode("utf-8"), compresslevel=9, mtime=0))
 
     N = len(res.phi_deg)
     routes = list(run.engines)
