@@ -364,15 +364,18 @@ def test_report_of_a_model_without_published_values(tmp_path, sketched_report):
 def test_a_report_is_written_without_pandas(tmp_path, sketched_report, monkeypatch):
     """A report of a model without [study] imports no pandas (its import was most of the cycle table's
     time): cycle.csv.gz is written from `Analysis.columns` (`tables.columns_csv`), the bytes
-    `csv_text` writes of `to_frame` (the bool column singular among the floats)."""
+    `csv_text` writes of `to_frame` (the bool column singular among the floats), gzip-compressed at
+    CYCLE_GZIP_LEVEL with no time in it."""
     p = tmp_path / "four_bar.toml"
     p.write_text(FOUR_BAR)
     run = run_validation(kinetostat.load(p), [], steps=12, path=p)
     with monkeypatch.context() as mp:
         mp.setitem(sys.modules, "pandas", None)          # `import pandas` raises ImportError
         write_report(run, tmp_path / "out")
-    text = gzip.decompress((tmp_path / "out" / "four_bar" / "cycle.csv.gz").read_bytes()).decode()
+    data = (tmp_path / "out" / "four_bar" / "cycle.csv.gz").read_bytes()
+    text = gzip.decompress(data).decode()
     assert text == kinetostat.tables.csv_text(run.res.to_frame()) and ",False\n" in text
+    assert data == gzip.compress(text.encode(), compresslevel=kinetostat.report.writer.CYCLE_GZIP_LEVEL, mtime=0)
 
 
 WITH_PUBLISHED = [p for p in MODELS if kinetostat.load(p).published]
