@@ -441,6 +441,19 @@ def test_doc_renders_markdown_and_html():
     assert 'href="javascript' not in html
 
 
+def test_doc_parses_plain_texts_at_once_into_markdown_its_own_tokens():
+    """`Doc.html`'s markdown-it skips the inline parse of a text without markup (`document._inline`):
+    the tokens are plain markdown-it's for every inline rule's markup, in paragraphs, headings and cells."""
+    from markdown_it import MarkdownIt
+    from kinetostat.report.document import _markdown_it
+    texts = ["plain 1.5e-05 N·m (at 30°): ~ $ # % + - = > @ ^ { } ≤ 3", "*em* and **strong**", "R_0_1 and _x_",
+             "a \\* b", "c \\# d", "`code`", "[link](x.md)", "![image](a.svg)", "<http://example.com>", "&amp; &lt;",
+             "line\nbreak", "hard  \nbreak", ""]
+    md = "\n\n".join([f"## {texts[1]}", *texts, "| a | b |\n|---|---:|\n" + "".join(f"| {t} | {t} |\n" for t in texts
+                                                                            if "\n" not in t)])
+    assert _markdown_it().parse(md) == MarkdownIt("commonmark", {"html": False}).enable("table").parse(md)
+
+
 def test_an_error_at_rounding_level_keeps_its_digits_and_is_marked():
     """The rule: below 1000 ulp of the peak (2.2e-13 of it) an error is at rounding level: its
     digits printed, the mark beside them; an exact 0 is 0."""
