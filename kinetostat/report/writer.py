@@ -5,6 +5,7 @@ harness's tolerances.
 """
 from __future__ import annotations
 
+import functools
 import gzip
 import itertools
 import json
@@ -78,7 +79,10 @@ def study_page(out: Path, name: str, title: str) -> str:
     return page
 
 
+@functools.cache
 def _versions() -> str:
+    """The versions of kinetostat and the libraries behind a report's numbers, once a process (each
+    metadata lookup reads the installed packages' folders)."""
     from importlib import metadata
 
     from .. import __version__
