@@ -1,6 +1,6 @@
-"""The tables a user gets (`analyze --out`, a report's cycle.csv, sweep tables; segments.csv,
-the worksheets and a variant's cycle.csv: rows rounded by `rounded_columns` and `by_unit`,
-written by `rows_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON
+"""The tables a user gets (`analyze --out`, sweep tables; segments.csv, the worksheets, a report's
+and a variant's cycle.csv: rows rounded by `rounded_columns` and `by_unit`, written by `rows_csv`
+and `columns_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON
 or Parquet of a pandas DataFrame whose `attrs["units"]` gives each column's unit, with the units
 in every format and the numbers of the text formats to the digits that mean something.
 
