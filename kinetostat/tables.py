@@ -1,6 +1,6 @@
-"""The tables a user gets (`analyze --out`, a report's cycle.csv, sweep tables; segments.csv,
-the worksheets and a variant's cycle.csv: rows rounded by `rounded_columns` and `by_unit`,
-written by `rows_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON
+"""The tables a user gets (`analyze --out`, sweep tables; segments.csv, the worksheets, a report's
+and a variant's cycle.csv: rows rounded by `rounded_columns` and `by_unit`, written by `rows_csv`
+and `columns_csv` without pandas, as `write_csv` writes a frame), written one way: CSV, JSON
 or Parquet of a pandas DataFrame whose `attrs["units"]` gives each column's unit, with the units
 in every format and the numbers of the text formats to the digits that mean something.
 
@@ -165,10 +165,16 @@ def cell_text(x: Any) -> str:
 def rows_csv(names: Iterable[str], rows: Iterable[Iterable[Any]]) -> str:
     """CSV text of the header `names` and `rows` (each a row's cells, `cell_text`), lines ending
     "\\n", quoted where the csv module must: the text `write_csv` writes of a frame, without pandas."""
+    return _csv(names, ([cell_text(x) for x in row] for row in rows))
+
+
+def _csv(names: Iterable[str], rows: Iterable[Iterable[str]]) -> str:
+    """CSV text of the header `names` and `rows` of cells already text, lines ending "\\n", quoted
+    where the csv module must."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(names)
-    w.writerows([cell_text(x) for x in row] for row in rows)
+    w.writerows(rows)
     return buf.getvalue()
 
 
@@ -177,8 +183,18 @@ def columns_csv(cols: dict[str, np.ndarray], units: dict[str, str]) -> str:
     `write_csv` writes of the frame of these columns with these `attrs["units"]` (float columns
     `rounded_columns`, cells `cell_text`)."""
     floats = rounded_columns({k: v for k, v in cols.items() if v.dtype.kind == "f"}, units)
-    table = [floats.get(k, v).tolist() for k, v in cols.items()]
-    return rows_csv(_named(cols, units), zip(*table))
+    return _csv(_named(cols, units), zip(*(_cells(floats.get(k, v)) for k, v in cols.items())))
+
+
+def _cells(col: np.ndarray) -> list[str]:
+    """A column's cells as `cell_text` writes them; a float column without a test per value (a
+    report's cycle.csv.gz has about 50 000)."""
+    if col.dtype.kind != "f":
+        return [cell_text(x) for x in col.tolist()]
+    cells = [FLOAT_FORMAT % x for x in col.tolist()]
+    for i in np.flatnonzero(np.isnan(col)).tolist():
+        cells[i] = ""
+    return cells
 
 
 def csv_text(df) -> str:

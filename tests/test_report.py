@@ -361,6 +361,23 @@ def test_report_of_a_model_without_published_values(tmp_path, sketched_report):
     assert "[four_bar](four_bar/index.md)" in (tmp_path / "out" / "index.md").read_text()
 
 
+def test_a_report_is_written_without_pandas(tmp_path, sketched_report, monkeypatch):
+    """A report of a model without [study] imports no pandas (its import was most of the cycle table's
+    time): cycle.csv.gz is written from `Analysis.columns` (`tables.columns_csv`), the bytes
+    `csv_text` writes of `to_frame` (the bool column singular among the floats), gzip-compressed at
+    CYCLE_GZIP_LEVEL with no time in it."""
+    p = tmp_path / "four_bar.toml"
+    p.write_text(FOUR_BAR)
+    run = run_validation(kinetostat.load(p), [], steps=12, path=p)
+    with monkeypatch.context() as mp:
+        mp.setitem(sys.modules, "pandas", None)          # `import pandas` raises ImportError
+        write_report(run, tmp_path / "out")
+    data = (tmp_path / "out" / "four_bar" / "cycle.csv.gz").read_bytes()
+    text = gzip.decompress(data).decode()
+    assert text == kinetostat.tables.csv_text(run.res.to_frame()) and ",False\n" in text
+    assert data == gzip.compress(text.encode(), compresslevel=kinetostat.report.writer.CYCLE_GZIP_LEVEL, mtime=0)
+
+
 WITH_PUBLISHED = [p for p in MODELS if kinetostat.load(p).published]
 
 
@@ -422,6 +439,19 @@ def test_doc_renders_markdown_and_html():
     assert '<a href="x/index.html#a">here</a>' in html and "<code>code</code>" in html
     assert '<a href="s.md">study</a>' in html         # only a report's index.md becomes its HTML page
     assert 'href="javascript' not in html
+
+
+def test_doc_parses_plain_texts_at_once_into_markdown_its_own_tokens():
+    """`Doc.html`'s markdown-it skips the inline parse of a text without markup (`document._inline`):
+    the tokens are plain markdown-it's for every inline rule's markup, in paragraphs, headings and cells."""
+    from markdown_it import MarkdownIt
+    from kinetostat.report.document import _markdown_it
+    texts = ["plain 1.5e-05 N·m (at 30°): ~ $ # % + - = > @ ^ { } ≤ 3", "*em* and **strong**", "R_0_1 and _x_",
+             "a \\* b", "c \\# d", "`code`", "[link](x.md)", "![image](a.svg)", "<http://example.com>", "&amp; &lt;",
+             "line\nbreak", "hard  \nbreak", ""]
+    md = "\n\n".join([f"## {texts[1]}", *texts, "| a | b |\n|---|---:|\n" + "".join(f"| {t} | {t} |\n" for t in texts
+                                                                            if "\n" not in t)])
+    assert _markdown_it().parse(md) == MarkdownIt("commonmark", {"html": False}).enable("table").parse(md)
 
 
 def test_an_error_at_rounding_level_keeps_its_digits_and_is_marked():

@@ -120,13 +120,18 @@ def test_write_csv_writes_what_pandas_to_csv_writes():
 def test_rows_csv_writes_what_pandas_to_csv_writes():
     """segments.csv and the worksheet's CSV are written without pandas (`rows_csv`): each cell as
     pandas' to_csv(float_format=FLOAT_FORMAT) writes it: floats with NaN and inf, None, text with
-    a comma, a quote and a newline, a formula led by a quote, integers, booleans."""
+    a comma, a quote and a newline, a formula led by a quote, integers, booleans; and `columns_csv`
+    (a report's cycle.csv.gz) of arrays what `csv_text` writes of their frame."""
     cols = {"x": [0.1, np.nan, np.inf, -1.5e-7, 30.0, 1 / 3],
             "why": ['a, "b"', None, "line\nbreak", "", "plain", "'=1"], "k": [1, 2, 3, 4, 5, -6],
             "ok": [True, False] * 3}
     want = pd.DataFrame(cols).to_csv(index=False, lineterminator="\n", float_format=tables.FLOAT_FORMAT)
     assert tables.rows_csv(cols, zip(*cols.values())) == want
     assert tables.rows_csv(cols, []) == "x,why,k,ok\n"
+    arrays = {"x": np.array(cols["x"]), "k": np.array(cols["k"]), "ok": np.array(cols["ok"])}   # columns_csv's own cells
+    frame = pd.DataFrame(arrays)
+    frame.attrs["units"] = {"x": "m"}
+    assert tables.columns_csv(arrays, {"x": "m"}) == tables.csv_text(frame)
 
 
 def test_a_variants_cycle_csv_is_the_frames_csv_without_pandas():
