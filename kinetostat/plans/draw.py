@@ -472,7 +472,9 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float
     """The notes of `plan` (SVG where `draw`, above `bottom`), the drawing area for a drawing of
     extent `box` and where the notes' lines go (`_notes_block`):
     notes below where it fits above them, else in a column at its left where it fits beside them,
-    else below with a note that it does not fit. Fitting: as drawn, `spare` mm to spare on every
+    else below with the drawing at their right, above the title block, where it fits there (a tall
+    narrow plan under many notes: the lever of a slotted link with a far point a'), else below
+    with a note that it does not fit. Fitting: as drawn, `spare` mm to spare on every
     side (room for a vector drawn out of scale: `_room`), inside the frame and clear of the notes
     (their block from their first line down to the frame, the legend's row with it) and the title
     block (`_placed_clear`); room for at least the lines of the first of `least` with which it fits,
@@ -483,6 +485,10 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float
             if area is not None and _placed_clear(box, spare, area, (where[0], where[1] - ASCENT * _NOTE_MM,
                                                                       where[0] + where[2], _FRAME[3])):
                 return notes, area, where
+    notes, _, where = _notes_block(plan, lang, tiny, False, draw=draw, bottom=bottom, least=least[-1])
+    beside = (where[0] + where[2] + 4.0, _AREA[1], _AREA[2], _TITLE_BLOCK[1] - 3.0)
+    if _placed_clear(box, spare, beside, (where[0], where[1] - ASCENT * _NOTE_MM, where[0] + where[2], _FRAME[3])):
+        return notes, beside, where
     return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw, bottom=bottom, least=least[-1])
 
 
