@@ -117,6 +117,13 @@ _DIMENSION_MARKER = (f'<defs><marker id="dimension" markerUnits="userSpaceOnUse"
                      f'fill="{_STYLE["dimension"][1]}"/></marker></defs>')
 
 
+#: The page's construction line past its two points: an SVG marker at both ends of the line from
+#: the known point to the point it fixes (`_construction`), PAST_MM long, the line's stroke.
+_PAST_MARKER = (f'<defs><marker id="past" markerUnits="userSpaceOnUse" orient="auto-start-reverse" overflow="visible" '
+                f'markerWidth="{PAST_MM:g}" markerHeight="1" refX="0" refY="0"><path d="M0,0 L{PAST_MM:g},0" '
+                f'stroke="{_STYLE["construction"][1]}" stroke-width="{WEIGHT_MM["construction"]}" stroke-linecap="round"/></marker></defs>')
+
+
 def style(s: Segment) -> tuple[float, str, str]:
     """How segment s is drawn: stroke width (mm, by its role: `WEIGHT_MM`), dash pattern, colour
     (by its kind: a kind not listed as a line)."""
@@ -791,7 +798,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name)} if contract else {}
         attrs = {"stroke": colour, "stroke-width": f"{width}", **({"stroke-dasharray": dash} if dash else {}), **data}
         if s.kind in ("construction", "intersection"):
-            element, spot = _construction(s.kind, a, b, ok, attrs, label, placer)
+            element, spot = _construction(s.kind, a, b, ok, attrs, label, placer, contract)
             if s.name in spots:               # the same step in another order of a triad's sides
                 spot = (np.where(np.isfinite(spot[0]), spot[0], spots[s.name][0]), None)
             spots[s.name] = spot
@@ -902,10 +909,12 @@ def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
 
 
 def _construction(kind: str, a: np.ndarray, b: np.ndarray, ok: np.ndarray, attrs: dict, title: str,
-                  placer: Placer) -> tuple[Element, tuple[np.ndarray, None]]:
+                  placer: Placer, contract: bool = False) -> tuple[Element, tuple[np.ndarray, None]]:
     """A construction line from its known point a through the point b it fixes (N, 2), drawn
-    PAST_MM past both, or an intersection's mark at a (a circle MARK_MM across); given to the
-    placer; with where its step's number goes (past the line's end, beside the mark)."""
+    PAST_MM past both (`contract`: the page's, its element from a to b, the two pieces past them
+    its markers: coordinates the page holds already), or an intersection's mark at a (a circle
+    MARK_MM across); given to the placer; with where its step's number goes (past the line's
+    end, beside the mark)."""
     if kind == "intersection":
         at = _where(ok, a)
         placer.block(np.concatenate([at - MARK_MM, at + MARK_MM], axis=1))
@@ -916,7 +925,12 @@ def _construction(kind: str, a: np.ndarray, b: np.ndarray, ok: np.ndarray, attrs
         u = np.where((L > ZERO_MM)[:, None], d / L[:, None], np.nan)
     ends = _where(ok, np.stack([a - PAST_MM * u, b + PAST_MM * u], axis=1))
     placer.line(_lines(ends[:, 0], ends[:, 1]))
-    return Element("line", ends, attrs, title=title), (ends[:, 1], None)
+    if contract:                          # from a to b, the rest drawn by its markers (`_PAST_MARKER`)
+        known = _where(ok & (L > ZERO_MM), np.stack([a, b], axis=1))
+        element = Element("line", known, {**attrs, "marker-start": "url(#past)", "marker-end": "url(#past)"}, title=title)
+    else:
+        element = Element("line", ends, attrs, title=title)
+    return element, (ends[:, 1], None)
 
 
 def _distinct_rows(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -1036,6 +1050,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
               f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
               f'fill="none" stroke="#000" stroke-width="0.7"/>',
               *([_DIMENSION_MARKER] if contract and any(_dimension(cycle, s) for s in cycle.segments) else []),
+              *([_PAST_MARKER] if contract and any(s.kind == "construction" for s in cycle.segments) else []),
               '<g id="plan" stroke-linecap="round">', ELEMENTS.rstrip("\n"), "</g>",
               f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
               f'stroke="#000" stroke-width="0.5"/>',
