@@ -945,3 +945,27 @@ def test_script_writes_every_sheet_of_the_triad_page_as_drawing_svg(chromium, tm
         got = page.evaluate(f"() => [...Array({n}).keys()].map((i) => window.sheetSvg({k}, i))")
         assert got == [d.svg(i, *PAGE_DECIMALS) for i in range(n)], d.kind
     page.close()
+
+
+def test_a_length_drawn_at_some_angles_is_stored_as_the_multiple_of_one_drawn_at_all():
+    """A segment drawn at some angles only (a triad's construction line in one order of its sides)
+    whose length is there twice another's drawn at every angle: the encoder stores it as that
+    multiple ("from": [0, 2.0]), the rest of it (where not drawn) taken as the multiple too, and
+    its lengths where drawn as drawn. Before: compared at every angle, the series held still where
+    not drawn, it matched no multiple and was stored alone."""
+    import numpy as np
+
+    import kinetostat.plans.page as pg
+    from kinetostat.plans.core import Drawing, Element
+    n = 60
+    L = 20.0 + 5.0 * np.sin(np.arange(n) / 7.0)
+    on = (np.arange(n) >= 20) & (np.arange(n) < 45)
+    full = np.stack([np.zeros((n, 2)), np.column_stack([L, np.zeros(n)])], axis=1)
+    part = np.where(on[:, None, None], np.stack([np.full((n, 2), 10.0), np.column_stack([10.0 + 2 * L, np.full(n, 10.0)])], axis=1), np.nan)
+    d = Drawing("velocity", np.arange(n, dtype=float), "", (
+        Element("line", full, {"data-segment": "a-b"}, length_mm=L),
+        Element("line", part, {"data-segment": "line a-b"}, length_mm=np.where(on, 2 * L, np.nan))))
+    meta, _, lengths = pg.encode_drawing(d)
+    assert meta["elements"][1].get("from") == [0, 2.0]
+    assert (lengths[1][on] == np.rint(2 * L[on] * 10.0 ** pg.LENGTH_DECIMALS)).all()
+    assert (lengths[1][~on] == pg._scaled(lengths[0], 2.0)[~on]).all()
