@@ -487,8 +487,9 @@ def without_triad_construction(mech, cycle: PlanCycle) -> PlanCycle:
     """`cycle` without what only a triad's construction draws (`_triad_lines`, `_triad_normals`,
     `forces._triad_force_plan`): its lines and marks (at a point of one order of its sides,
     `core.alias`) and the base link's normal parts n<b>1, n<b>2, ... they start from, with their
-    points; then with no steps. The interactive page of every angle has no room for them within its 300 kB
-    (triad_six_bar's would grow from 296 to 335 kB); the sheets of one angle draw them."""
+    points; then with no steps. The interactive page of every angle has no room for them within its
+    300 kB (triad_six_bar's, in Ukrainian, would grow from 283 to 337 kB); the sheets of one angle
+    draw them."""
     own = [re.compile(f"n{g.links[0]}\\d+") for g in mech.structure.groups if g.klass == 3]
     kept = tuple(s for s in cycle.segments if not ((s.kind in ("construction", "intersection") and ":" in s.end)
                                                    or any(r.fullmatch(s.end) for r in own)))
