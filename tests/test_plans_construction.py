@@ -108,6 +108,30 @@ def test_sheet_numbers_the_steps_as_the_page_does(ice, kind):
     assert page == [(name, k) for k, name in enumerate(plan.steps, 1)]
 
 
+
+@pytest.mark.parametrize("kind", ["velocity", "acceleration"])
+def test_page_draws_a_construction_line_to_its_points_and_past_them_by_markers(ice, kind):
+    """On the page (`contract`) a construction line's element runs from its known point to the point
+    it fixes, and the PAST_MM beyond each is drawn by the marker "past" at both ends (a stroke
+    PAST_MM long): the one-angle sheet's line less PAST_MM at each end, as the sheet places it.
+    Before: the page's element was the sheet's, its ends new coordinates at every angle."""
+    from kinetostat.plans.core import PlanCycle
+    from kinetostat.plans.draw import WEIGHT_MM, drawing
+    _, _, plans, _, _ = ice
+    cycle = PlanCycle.of(plans[kind])
+    page, sheet = drawing(cycle, contract=True), drawing(cycle)
+    lines = [e for e in page.elements if e.attrs.get("data-segment", "").startswith("line ")]
+    drawn = [e for e in sheet.elements if e.tag == "line" and e.title.startswith("line ")]
+    assert len(lines) == len(drawn) == 2
+    assert f'<marker id="past"' in page.static and f'd="M0,0 L{PAST_MM:g},0" stroke="#000" stroke-width="{WEIGHT_MM["construction"]}"' in page.static
+    assert '<marker id="past"' not in sheet.static
+    for e, f in zip(lines, drawn):
+        assert e.attrs["marker-start"] == e.attrs["marker-end"] == "url(#past)"
+        (a, b), (a0, b0) = e.xy[0], f.xy[0]
+        u = (b - a) / np.hypot(*(b - a))
+        assert np.allclose(a0, a - PAST_MM * u) and np.allclose(b0, b + PAST_MM * u)
+
+
 # ----------------------------------------------------------------------------- triads
 
 TRIADS = ("triad_six_bar", "triad_rocking_block", "triad_slider")
