@@ -812,11 +812,11 @@ def test_ice_page_has_no_overlap_at_24_angles(chromium, tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("path", MODELS, ids=lambda p: p.stem)
 def test_every_page_has_no_overlap_and_fits_300_kb(chromium, tmp_path, path):
-    """Every bundled model's whole page: at most 300 kB; at 24 angles no label over another
-    label, an arrowhead or a point."""
+    """Every bundled model's whole page in Ukrainian (its texts the most bytes; a triad's with its
+    construction): at most 300 kB; at 24 angles no label over another label, an arrowhead or a point."""
     mech = kinetostat.load(path)
     f = tmp_path / "page.html"
-    f.write_text(make_page(mech), encoding="utf-8")
+    f.write_text(make_page(mech, lang="uk"), encoding="utf-8")
     assert f.stat().st_size <= 300_000
     assert _page_overlaps(chromium, f, OVERLAP_ANGLES) == []
 
@@ -863,19 +863,17 @@ def test_a_blob_holds_7_bits_a_character_and_no_lt_cr_or_nul(data):
 
 def test_triad_page_names_the_tiny_vectors_of_its_one_angle_sheets():
     """The page's cycle of the triad (30 and 150 deg) finds the same tiny vectors, drawn the same
-    way, as each force plan's one-angle sheet (the page's kinematic plans leave the triad's
-    construction out: `without_triad_construction`): on the force polygon, whose sides a triad names anew at
+    way, as each force plan's one-angle sheet: on the force polygon, whose sides a triad names anew at
     each angle, R05n (0,75 mm) at 30 deg, not R12n (4,22 mm there; its side of the same name is
     0,75 mm only at 150 deg). Before: found by the first segment of each name."""
     from kinetostat.plans import draw
-    from kinetostat.plans.kinematic import without_triad_construction
     from kinetostat.plans.solution import solve
     mech = kinetostat.load("triad_six_bar")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fixed = P.cycle_scales(mech)                    # the page's (`kinetostat plans --cycle-scales`)
         res = solve(mech, [30.0, 150.0]).res
-        cycles = {k: without_triad_construction(mech, c) for k, c in P.build_cycle(mech, res, fixed).items()}
+        cycles = P.build_cycle(mech, res, fixed)
     for i, at in enumerate((30.0, 150.0)):
         for kind, plan in _build(mech, at, fixed).items():
             if kind in ("mechanism", "positions", "velocity", "acceleration"):

@@ -742,7 +742,6 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     `page_angles`; made here where not given). ValueError where `at` is a singular position."""
     from . import build_cycle, cycle_scales
     from .draw import drawing
-    from .kinematic import without_triad_construction
     from .worksheet import worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
@@ -757,7 +756,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         if res.friction is not None:
             raise ValueError(f"solution: expected the frictionless analysis of {mech.name!r} (friction='first'), got {res}")
         fixed = fixed or cycle_scales(mech, res=res)
-        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed, solution=solution).items()}
+        cycles = build_cycle(mech, res, fixed, solution=solution)
         sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=solution.other)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
