@@ -393,6 +393,7 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
             near = bank.near(a, care) if care is not None else None
             if near is not None:                 # what it holds where not read: j plus the remainder held
                 a = raw[near[0]] + near[1]
+                key, shape = a.tobytes(), (a - a[0]).tobytes()     # a later copy copies what page.js holds
             series.append([(None, a), *([near] if near else [])])
         if care is not None:
             bank.add(len(raw), a)
