@@ -812,11 +812,11 @@ def test_ice_page_has_no_overlap_at_24_angles(chromium, tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("path", MODELS, ids=lambda p: p.stem)
 def test_every_page_has_no_overlap_and_fits_300_kb(chromium, tmp_path, path):
-    """Every bundled model's whole page: at most 300 kB; at 24 angles no label over another
-    label, an arrowhead or a point."""
+    """Every bundled model's whole page in Ukrainian (its texts the most bytes; a triad's with its
+    construction): at most 300 kB; at 24 angles no label over another label, an arrowhead or a point."""
     mech = kinetostat.load(path)
     f = tmp_path / "page.html"
-    f.write_text(make_page(mech), encoding="utf-8")
+    f.write_text(make_page(mech, lang="uk"), encoding="utf-8")
     assert f.stat().st_size <= 300_000
     assert _page_overlaps(chromium, f, OVERLAP_ANGLES) == []
 
@@ -863,19 +863,17 @@ def test_a_blob_holds_7_bits_a_character_and_no_lt_cr_or_nul(data):
 
 def test_triad_page_names_the_tiny_vectors_of_its_one_angle_sheets():
     """The page's cycle of the triad (30 and 150 deg) finds the same tiny vectors, drawn the same
-    way, as each force plan's one-angle sheet (the page's kinematic plans leave the triad's
-    construction out: `without_triad_construction`): on the force polygon, whose sides a triad names anew at
+    way, as each force plan's one-angle sheet: on the force polygon, whose sides a triad names anew at
     each angle, R05n (0,75 mm) at 30 deg, not R12n (4,22 mm there; its side of the same name is
     0,75 mm only at 150 deg). Before: found by the first segment of each name."""
     from kinetostat.plans import draw
-    from kinetostat.plans.kinematic import without_triad_construction
     from kinetostat.plans.solution import solve
     mech = kinetostat.load("triad_six_bar")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fixed = P.cycle_scales(mech)                    # the page's (`kinetostat plans --cycle-scales`)
         res = solve(mech, [30.0, 150.0]).res
-        cycles = {k: without_triad_construction(mech, c) for k, c in P.build_cycle(mech, res, fixed).items()}
+        cycles = P.build_cycle(mech, res, fixed)
     for i, at in enumerate((30.0, 150.0)):
         for kind, plan in _build(mech, at, fixed).items():
             if kind in ("mechanism", "positions", "velocity", "acceleration"):
@@ -945,3 +943,27 @@ def test_script_writes_every_sheet_of_the_triad_page_as_drawing_svg(chromium, tm
         got = page.evaluate(f"() => [...Array({n}).keys()].map((i) => window.sheetSvg({k}, i))")
         assert got == [d.svg(i, *PAGE_DECIMALS) for i in range(n)], d.kind
     page.close()
+
+
+def test_a_length_drawn_at_some_angles_is_stored_as_the_multiple_of_one_drawn_at_all():
+    """A segment drawn at some angles only (a triad's construction line in one order of its sides)
+    whose length is there twice another's drawn at every angle: the encoder stores it as that
+    multiple ("from": [0, 2.0]), the rest of it (where not drawn) taken as the multiple too, and
+    its lengths where drawn as drawn. Before: compared at every angle, the series held still where
+    not drawn, it matched no multiple and was stored alone."""
+    import numpy as np
+
+    import kinetostat.plans.page as pg
+    from kinetostat.plans.core import Drawing, Element
+    n = 60
+    L = 20.0 + 5.0 * np.sin(np.arange(n) / 7.0)
+    on = (np.arange(n) >= 20) & (np.arange(n) < 45)
+    full = np.stack([np.zeros((n, 2)), np.column_stack([L, np.zeros(n)])], axis=1)
+    part = np.where(on[:, None, None], np.stack([np.full((n, 2), 10.0), np.column_stack([10.0 + 2 * L, np.full(n, 10.0)])], axis=1), np.nan)
+    d = Drawing("velocity", np.arange(n, dtype=float), "", (
+        Element("line", full, {"data-segment": "a-b"}, length_mm=L),
+        Element("line", part, {"data-segment": "line a-b"}, length_mm=np.where(on, 2 * L, np.nan))))
+    meta, _, lengths = pg.encode_drawing(d)
+    assert meta["elements"][1].get("from") == [0, 2.0]
+    assert (lengths[1][on] == np.rint(2 * L[on] * 10.0 ** pg.LENGTH_DECIMALS)).all()
+    assert (lengths[1][~on] == pg._scaled(lengths[0], 2.0)[~on]).all()

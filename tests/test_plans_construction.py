@@ -108,6 +108,30 @@ def test_sheet_numbers_the_steps_as_the_page_does(ice, kind):
     assert page == [(name, k) for k, name in enumerate(plan.steps, 1)]
 
 
+
+@pytest.mark.parametrize("kind", ["velocity", "acceleration"])
+def test_page_draws_a_construction_line_to_its_points_and_past_them_by_markers(ice, kind):
+    """On the page (`contract`) a construction line's element runs from its known point to the point
+    it fixes, and the PAST_MM beyond each is drawn by the marker "past" at both ends (a stroke
+    PAST_MM long): the one-angle sheet's line less PAST_MM at each end, as the sheet places it.
+    Before: the page's element was the sheet's, its ends new coordinates at every angle."""
+    from kinetostat.plans.core import PlanCycle
+    from kinetostat.plans.draw import WEIGHT_MM, drawing
+    _, _, plans, _, _ = ice
+    cycle = PlanCycle.of(plans[kind])
+    page, sheet = drawing(cycle, contract=True), drawing(cycle)
+    lines = [e for e in page.elements if e.attrs.get("data-segment", "").startswith("line ")]
+    drawn = [e for e in sheet.elements if e.tag == "line" and e.title.startswith("line ")]
+    assert len(lines) == len(drawn) == 2
+    assert f'<marker id="past"' in page.static and f'd="M0,0 L{PAST_MM:g},0" stroke="#000" stroke-width="{WEIGHT_MM["construction"]}"' in page.static
+    assert '<marker id="past"' not in sheet.static
+    for e, f in zip(lines, drawn):
+        assert e.attrs["marker-start"] == e.attrs["marker-end"] == "url(#past)"
+        (a, b), (a0, b0) = e.xy[0], f.xy[0]
+        u = (b - a) / np.hypot(*(b - a))
+        assert np.allclose(a0, a - PAST_MM * u) and np.allclose(b0, b + PAST_MM * u)
+
+
 # ----------------------------------------------------------------------------- triads
 
 TRIADS = ("triad_six_bar", "triad_rocking_block", "triad_slider")
@@ -280,14 +304,32 @@ def test_triad_sheet_numbers_every_step(triad):
             assert len(plan.steps) >= 4 and sorted(_numbers(svg(plan, lang="uk"))) == list(range(1, len(plan.steps) + 1)), kind
 
 
-def test_page_leaves_the_triad_construction_to_the_one_angle_sheets(triad):
-    """The page of every angle (300 kB) draws a triad's plans without their construction: no line,
-    no mark, no normal part of the base link n3<k> nor its point, no steps; all else kept."""
-    from kinetostat.plans.kinematic import without_triad_construction
-    mech, res, g, cycles, S = triad
-    for kind, c in cycles.items():
-        w = without_triad_construction(mech, c)
-        own = [s for s in c.segments if s.kind in ("construction", "intersection") or re.fullmatch(r"n3\d+", s.end)]
-        assert [s.name for s in w.segments] == [s.name for s in c.segments if not any(s is o for o in own)]
-        assert (w.steps == ()) == bool(own) or w is c
-        assert not any(re.fullmatch(r"n3\d+", p) or ":" in p and p.split(":")[1].isdigit() for p in w.points)
+def test_page_draws_the_triad_construction_of_each_one_angle_sheet(monkeypatch):
+    """The page of every angle (triad_six_bar at 30 and 150 deg) draws in its velocity and
+    acceleration plans each angle's construction lines and marks, and numbers them (1)..(n), as
+    the one-angle sheet of that angle does (`kinetostat plans --at A --cycle-scales`). Before: the
+    page left them out (`without_triad_construction`)."""
+    import kinetostat.plans.page as pg
+    mech = kinetostat.load("triad_six_bar")
+    sheets = {}
+    encode = pg.encode_drawing
+
+    def keep(d, earlier=()):
+        sheets[d.kind] = d
+        return encode(d, earlier)
+    monkeypatch.setattr(pg, "encode_drawing", keep)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        pg.page(mech, angles=[30.0, 150.0])
+        fixed = P.cycle_scales(mech)
+    for i, at in enumerate((30.0, 150.0)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            plans = P.build(mech, at=at, fixed=fixed)
+        for kind in ("velocity", "acceleration"):
+            page, one = sheets[kind].svg(i), plans[kind]
+            marks = sorted(set(re.findall(r'<line [^>]*data-segment="([^"]+)"[^>]*marker-start="url\(#past\)"', page)
+                               + re.findall(r'<circle [^>]*data-segment="([^"]+)"', page)))
+            want = sorted({s.name for s in one.segments if s.kind in ("construction", "intersection")})
+            assert want and marks == want, (at, kind, marks, want)
+            assert sorted(_numbers(page)) == list(range(1, len(one.steps) + 1)) == sorted(_numbers(svg(one, lang="en"))), (at, kind)

@@ -257,3 +257,22 @@ def test_the_no_fit_note_only_where_the_plan_runs_off_its_room(mu_l, fits):
     ys = [float(y) for _, y in _POINT.findall(drawn)]
     clear = 5.0 <= min(ys) and max(ys) <= min(247.0, first)
     assert clear == fits and ("не вміщується" not in notes) == fits, (min(ys), max(ys), first)
+
+
+def test_a_tall_plan_under_many_notes_goes_beside_them():
+    """The slotted link's lever at 30 deg (its far point a' of M_i2's pair of forces: 149 mm tall,
+    the room above its 24 lines of notes 135 mm): drawn at the notes' right, above the title
+    block, every point clear of the notes' block and no note that it does not fit. Before: centred
+    above the notes and run into them, the "Результати" line printed over a' and its arrowhead."""
+    mech = kinetostat.load("rotating_slotted_link")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plan = P.build(mech, at=30.0, only=["lever"])["lever"]
+    sheet = svg(plan, lang="uk")
+    drawn, notes = sheet.split('<g id="plan"')[1].split('<g id="title-block"')[0], sheet.split('<g id="notes">')[1]
+    lines = re.findall(r'<text x="([-\d.]+)" y="([-\d.]+)"', notes)
+    top = min(float(y) for _, y in lines) - 3.5
+    points = [(float(x), float(y)) for x, y in _POINT.findall(drawn)]
+    assert len(points) > 10 and "не вміщується" not in notes
+    assert all(y < top or x > 227.0 for x, y in points), [p for p in points if p[1] >= top]
+    assert all(5.0 <= y <= 247.0 and x <= 415.0 for x, y in points)

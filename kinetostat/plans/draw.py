@@ -118,6 +118,13 @@ _DIMENSION_MARKER = (f'<defs><marker id="dimension" markerUnits="userSpaceOnUse"
                      f'fill="{_STYLE["dimension"][1]}"/></marker></defs>')
 
 
+#: The page's construction line past its two points: an SVG marker at both ends of the line from
+#: the known point to the point it fixes (`_construction`), PAST_MM long, the line's stroke.
+_PAST_MARKER = (f'<defs><marker id="past" markerUnits="userSpaceOnUse" orient="auto-start-reverse" overflow="visible" '
+                f'markerWidth="{PAST_MM:g}" markerHeight="1" refX="0" refY="0"><path d="M0,0 L{PAST_MM:g},0" '
+                f'stroke="{_STYLE["construction"][1]}" stroke-width="{WEIGHT_MM["construction"]}" stroke-linecap="round"/></marker></defs>')
+
+
 def style(s: Segment) -> tuple[float, str, str]:
     """How segment s is drawn: stroke width (mm, by its role: `WEIGHT_MM`), dash pattern, colour
     (by its kind: a kind not listed as a line)."""
@@ -480,7 +487,9 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float
     """The notes of `plan` (SVG where `draw`, above `bottom`), the drawing area for a drawing of
     extent `box` and where the notes' lines go (`_notes_block`):
     notes below where it fits above them, else in a column at its left where it fits beside them,
-    else below with a note that it does not fit. Fitting: as drawn, `spare` mm to spare on every
+    else below with the drawing at their right, above the title block, where it fits there (a tall
+    narrow plan under many notes: the lever of a slotted link with a far point a'), else below
+    with a note that it does not fit. Fitting: as drawn, `spare` mm to spare on every
     side (room for a vector drawn out of scale: `_room`), inside the frame and clear of the notes
     (their block from their first line down to the frame, the legend's row with it) and the title
     block (`_placed_clear`); room for at least the lines of the first of `least` with which it fits,
@@ -491,6 +500,10 @@ def _layout(plan: Plan, lang: str, tiny: dict[str, str], box: tuple[float, float
             if area is not None and _placed_clear(box, spare, area, (where[0], where[1] - ASCENT * _NOTE_MM,
                                                                       where[0] + where[2], _FRAME[3])):
                 return notes, area, where
+    notes, _, where = _notes_block(plan, lang, tiny, False, draw=draw, bottom=bottom, least=least[-1])
+    beside = (where[0] + where[2] + 4.0, _AREA[1], _AREA[2], _TITLE_BLOCK[1] - 3.0)
+    if _placed_clear(box, spare, beside, (where[0], where[1] - ASCENT * _NOTE_MM, where[0] + where[2], _FRAME[3])):
+        return notes, beside, where
     return _notes_block(plan, lang, tiny, False, nofit=True, draw=draw, bottom=bottom, least=least[-1])
 
 
@@ -793,7 +806,7 @@ def _segments(cycle: PlanCycle, lang: str, contract: bool, at, tiny: dict[str, n
         data = {"data-plan": escape(cycle.kind), "data-segment": escape(s.name)} if contract else {}
         attrs = {"stroke": colour, "stroke-width": f"{width}", **({"stroke-dasharray": dash} if dash else {}), **data}
         if s.kind in ("construction", "intersection"):
-            element, spot = _construction(s.kind, a, b, ok, attrs, label, placer)
+            element, spot = _construction(s.kind, a, b, ok, attrs, label, placer, contract)
             if s.name in spots:               # the same step in another order of a triad's sides
                 spot = (np.where(np.isfinite(spot[0]), spot[0], spots[s.name][0]), None)
             spots[s.name] = spot
@@ -904,10 +917,12 @@ def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
 
 
 def _construction(kind: str, a: np.ndarray, b: np.ndarray, ok: np.ndarray, attrs: dict, title: str,
-                  placer: Placer) -> tuple[Element, tuple[np.ndarray, None]]:
+                  placer: Placer, contract: bool = False) -> tuple[Element, tuple[np.ndarray, None]]:
     """A construction line from its known point a through the point b it fixes (N, 2), drawn
-    PAST_MM past both, or an intersection's mark at a (a circle MARK_MM across); given to the
-    placer; with where its step's number goes (past the line's end, beside the mark)."""
+    PAST_MM past both (`contract`: the page's, its element from a to b, the two pieces past them
+    its markers: coordinates the page holds already), or an intersection's mark at a (a circle
+    MARK_MM across); given to the placer; with where its step's number goes (past the line's
+    end, beside the mark)."""
     if kind == "intersection":
         at = _where(ok, a)
         placer.block(np.concatenate([at - MARK_MM, at + MARK_MM], axis=1))
@@ -918,7 +933,12 @@ def _construction(kind: str, a: np.ndarray, b: np.ndarray, ok: np.ndarray, attrs
         u = np.where((L > ZERO_MM)[:, None], d / L[:, None], np.nan)
     ends = _where(ok, np.stack([a - PAST_MM * u, b + PAST_MM * u], axis=1))
     placer.line(_lines(ends[:, 0], ends[:, 1]))
-    return Element("line", ends, attrs, title=title), (ends[:, 1], None)
+    if contract:                          # from a to b, the rest drawn by its markers (`_PAST_MARKER`)
+        known = _where(ok & (L > ZERO_MM), np.stack([a, b], axis=1))
+        element = Element("line", known, {**attrs, "marker-start": "url(#past)", "marker-end": "url(#past)"}, title=title)
+    else:
+        element = Element("line", ends, attrs, title=title)
+    return element, (ends[:, 1], None)
 
 
 def _distinct_rows(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -1038,6 +1058,7 @@ def _sheet(cycle: PlanCycle, lang: str, mechanism: str, contract: bool, notes: b
               f'<rect x="{_FRAME[0]}" y="{_FRAME[1]}" width="{_FRAME[2] - _FRAME[0]:g}" height="{_FRAME[3] - _FRAME[1]:g}" '
               f'fill="none" stroke="#000" stroke-width="0.7"/>',
               *([_DIMENSION_MARKER] if contract and any(_dimension(cycle, s) for s in cycle.segments) else []),
+              *([_PAST_MARKER] if contract and any(s.kind == "construction" for s in cycle.segments) else []),
               '<g id="plan" stroke-linecap="round">', ELEMENTS.rstrip("\n"), "</g>",
               f'<g id="title-block"><rect x="{x0}" y="{y0}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="none" '
               f'stroke="#000" stroke-width="0.5"/>',

@@ -26,7 +26,6 @@ refinement, its 12 positions, the other assembly branch at the angles drawn), `.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -38,7 +37,7 @@ from .core import PlanCycle, Scale, Segment, alias, construction
 from .solution import CYCLE_STEPS, Positions, Solution, grid, positions, solve
 from .zero import by_pattern, translates, zero_of
 
-__all__ = ["positions_plan", "without_triad_construction", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
+__all__ = ["positions_plan", "fixed_positions", "other_branches", "assembled", "FixedPositions", "velocity_plan", "acceleration_plan", "starting_position", "plan_point_names",
            "N_POSITIONS", "PATH_STEPS"]
 
 #: Positions of the plan of positions: every 30 deg.
@@ -481,22 +480,6 @@ def acceleration_plan(mech, res, scales: dict[str, Scale]) -> PlanCycle:
     lines, steps = _constructions(mech, segs, "pi", triads)
     return PlanCycle("acceleration", _titles("Acceleration plan at phi = {at:g} deg", res), mu, res.phi_deg,
                      points, tuple(segs + lines), notes=notes, steps=steps)
-
-
-def without_triad_construction(mech, cycle: PlanCycle) -> PlanCycle:
-    """`cycle` without what only a triad's construction draws (`_triad_lines`, `_triad_normals`,
-    `forces._triad_force_plan`): its lines and marks (at a point of one order of its sides,
-    `core.alias`) and the base link's normal parts n<b>1, n<b>2, ... they start from, with their
-    points; then with no steps. The interactive page of every angle has no room for them within its 300 kB
-    (triad_six_bar's would grow from 296 to 335 kB); the sheets of one angle draw them."""
-    own = [re.compile(f"n{g.links[0]}\\d+") for g in mech.structure.groups if g.klass == 3]
-    kept = tuple(s for s in cycle.segments if not ((s.kind in ("construction", "intersection") and ":" in s.end)
-                                                   or any(r.fullmatch(s.end) for r in own)))
-    if len(kept) == len(cycle.segments):
-        return cycle
-    used = {n for s in kept for n in (s.start, s.end)}
-    gone = {s.end for s in cycle.segments} - used          # their points (n31, c:2)
-    return replace(cycle, segments=kept, steps=(), points={k: v for k, v in cycle.points.items() if k not in gone})
 
 
 def _triad_normals(mech, res, mo: dict, special: list, points: dict, segs: list[Segment], mu: float) -> list:

@@ -17,8 +17,9 @@ that point's labels within CROWD_MM of it), CROWD_COST for each in that zone, so
 goes out on a leader to a clear place nearby, or along its line; a candidate over a hard obstacle
 (arrowhead, point, line end, a label placed before) or outside the bounds is not free. At every
 angle the least cost is found (candidates tested lazily, cheapest first, until none left can
-beat it); then the label keeps one place where it may: the candidate within `SLACK` of the best
-at the most angles is taken at all of them, and so on for the angles left. Over a page's many
+beat it); then the label keeps its place from angle to angle unless it must move (hysteresis): of
+the candidates within `SLACK` of the best at each angle, the run over the angles of least total
+cost with MOVE_COST added for each move from one place to another (`_kept`). Over a page's many
 angles this search runs at every `STRIDE`-th angle; an angle between keeps a searched
 neighbour's place where that is free (and off every heavy line), and only the angles where
 neither is are searched.
@@ -180,8 +181,13 @@ _CAND_DIR_T = _constant(np.r_[np.zeros((len(_ALONG_OFF), 2)), _RING_DIRS].T.copy
 _CAND_ABS_DIR_T = _constant(np.abs(_CAND_DIR_T))
 _CAND_RAD = _constant(np.r_[np.zeros(len(_ALONG_OFF)), np.repeat(_RINGS, len(_DIRS))])
 _CAND_COST = _constant(np.r_[np.zeros(len(_ALONG_OFF)), _RING_COST])
-#: A label keeps one place over the angles where that place costs at most this more than the best.
-SLACK = 1.5
+#: A label keeps its place over the angles where that place costs at most this more than the best
+#: there (as much as 21 mm further out); over many angles, that lets a page's delta coder reuse
+#: its place (issue 34: triad_six_bar's page 336.9 -> 298.5 kB with its construction drawn).
+SLACK = 25.0
+#: What a label's move from its place at one angle to another at the next costs: more than any
+#: slack, so that a label moves only where its place is not free or beyond SLACK of the best.
+MOVE_COST = 4 * SLACK
 #: The cost of covering a drawn line, per mm of it inside the label's box.
 LINE_COST = 0.6 / 0.7
 #: The cost of covering a heavy line (a link, a vector), per mm of it inside the label's box: as
@@ -259,6 +265,25 @@ def _any_by_row(inside: np.ndarray, counts: np.ndarray) -> np.ndarray:
         out[some] = np.bitwise_or.reduceat(np.ascontiguousarray(inside).view(f"u{word}"), starts[some],
                                            axis=0).view(bool)
     return out
+
+
+def _kept(cost: np.ndarray, move: float) -> np.ndarray:
+    """The column taken at each row (angle) of `cost` (n, C) (inf: not to be taken; each row has a
+    finite one): the run of least total cost plus `move` for each row whose column differs from
+    the row's before (Viterbi; ties: the first column)."""
+    n, m = cost.shape
+    back = np.zeros((n, m), dtype=np.intp)
+    total = cost[0].copy()
+    for i in range(1, n):
+        j = int(np.argmin(total))
+        stay = total <= total[j] + move
+        back[i] = np.where(stay, np.arange(m), j)
+        total = np.where(stay, total, total[j] + move) + cost[i]
+    path = np.empty(n, dtype=np.intp)
+    path[-1] = int(np.argmin(total))
+    for i in range(n - 1, 0, -1):
+        path[i - 1] = back[i, path[i]]
+    return path
 
 
 class Placer:
@@ -509,9 +534,10 @@ class Placer:
         """The candidate (len(at),) taken at each of the angles `at` (indices; -1: none), as
         `_choose`'s arguments give them (`zone`: its crowding). Free candidates' costs, with their
         crowding (`_crowding`), found in batches, in the order of their mean base where finite, at
-        every angle until none left there can come within SLACK of the best; then the candidate
-        within SLACK of the best at the most angles is taken there, and so on; where none is free,
-        the cheapest (nowhere free: the test tells)."""
+        every angle until none left there can come within SLACK of the best; then of the
+        candidates within SLACK of the best, the run over the angles in order that `_kept` takes
+        (MOVE_COST a move; one angle: the cheapest); where none is free, the cheapest (nowhere
+        free: the test tells)."""
         if not len(at):
             return np.full(0, -1)
         centres, base = geometry(at, np.arange(K)[None])
@@ -553,15 +579,8 @@ class Placer:
         cost = np.concatenate(tested, axis=1) if tested else np.full((n, 0), np.inf)    # of order[:start]
         ok = (cost <= best[:, None] + slack) & np.isfinite(cost)
         cols = np.flatnonzero(ok.any(axis=0))                              # within SLACK somewhere
-        ok = ok[:, cols]
-        within = np.where(ok, cost[:, cols], 0.0)
         k = np.where(fin.any(axis=1), order[np.argmax(np.isfinite(ordered), axis=1)], -1)
         todo = np.isfinite(best)
-        while todo.any():
-            left = todo.astype(float)
-            count, total = left @ ok, left @ within                        # over the angles left
-            j = np.lexsort((np.arange(len(cols)), total, -count))[0]     # most angles, then least cost, then order
-            sel = ok[:, j] & todo
-            k[sel] = order[cols[j]]
-            todo &= ~sel
+        if todo.any():
+            k[todo] = order[cols[_kept(np.where(ok, cost, np.inf)[todo][:, cols], MOVE_COST)]]
         return k

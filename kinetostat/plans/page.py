@@ -206,13 +206,15 @@ def _scaled(source: np.ndarray, f: float) -> np.ndarray:
 
 
 def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
-                   limits: Sequence[int]) -> list[tuple[int, float] | None]:
+                   limits: Sequence[int], shown: Sequence[np.ndarray] | None = None) -> list[tuple[int, float] | None]:
     """For each series qs[i] (int64), the series of pool[:limits[i]] of which it is most nearly a
     multiple, (its index, the factor f), where q - `_scaled`(source, f) costs less than q
     (`_serieses`); None where none does (no source as long as q and, where q > 0, positive). A
     segment drawn on two plans at two scales (a velocity on its plan and on the lever), a value
     the length of its vector times the plan's scale: their remainders are a few units of the last
-    digit."""
+    digit. `shown` (each (N,) bool): compared only where qs[i] is read, the rest of it taken as
+    the multiple (`_filled`: a construction line of a triad drawn in one order of its sides,
+    whose length is its vector's)."""
     by_size: dict[int, list[int]] = {}
     for g, s in enumerate(pool):
         by_size.setdefault(len(s), []).append(g)
@@ -222,7 +224,7 @@ def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
         stacks[n] = (np.asarray(gs), stack, (stack.min(axis=1) >= 0), (stack <= 0).astype(np.float64))
     picks: list[tuple[int, int, float]] = []                     # (i, g, f)
     for i, q in enumerate(qs):
-        on = q > 0
+        on = q > 0 if shown is None else (q > 0) & shown[i]
         if len(q) < 2 or on.sum() < 2 or len(q) not in stacks:
             continue
         index, stack, nonneg, off = stacks[len(q)]
@@ -231,12 +233,19 @@ def _proportionals(qs: Sequence[np.ndarray], pool: Sequence[np.ndarray],
             ratio = q[on] / stack[usable][:, on]
             g = int(np.argmin((ratio.max(axis=1) - ratio.min(axis=1)) / ratio.mean(axis=1)))
             picks.append((i, int(index[usable[g]]), float(f"{np.median(ratio[g]):.10g}")))   # 10 digits: the page's JSON short
-    coded = _serieses([x for i, g, f in picks for x in (qs[i] - _scaled(pool[g], f), qs[i])])
+    coded = _serieses([x for i, g, f in picks
+                       for x in (_filled(qs[i], pool[g], f, None if shown is None else shown[i]) - _scaled(pool[g], f), qs[i])])
     out: list[tuple[int, float] | None] = [None] * len(qs)
     for n, (i, g, f) in enumerate(picks):
         if _cost(coded[2 * n][1:]) < _cost(coded[2 * n + 1][1:]):
             out[i] = (g, f)
     return out
+
+
+def _filled(q: np.ndarray, source: np.ndarray, f: float, shown: np.ndarray | None) -> np.ndarray:
+    """q where `shown`, elsewhere `_scaled`(source, f) (None: q everywhere): q with what is not read
+    the multiple."""
+    return q if shown is None else np.where(shown, q, _scaled(source, f))
 
 
 def _held(x: np.ndarray, drawn: np.ndarray) -> np.ndarray:
@@ -350,7 +359,8 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     angle (with more than one text), a polyline's finite points (with holes: m series of 0/1), its
     coordinates (m x 2 series over its rows, in 10^-COORD_DECIMALS mm, a row where not drawn
     holding the last drawn), its lengths (in 10^-LENGTH_DECIMALS mm, likewise held where not drawn
-    or NaN; less `_scaled`(earlier[index], factor) where "from"); every series as differences of
+    or NaN; where "from": less `_scaled`(earlier[index], factor), and that multiple where not
+    drawn, `_filled`); every series as differences of
     the order that suits it (`_serieses`), or, where an earlier series j of the sheet is the same (a
     line's end and its point), -1 - 3j, or where it is j plus a constant c (a point's label),
     -2 - 3j and c, or (a coordinate) where it costs less, -3 - 3j and its difference from j
@@ -358,11 +368,15 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
     constant where there is such a j: `_Earlier.shifted`); as zigzag varints. `earlier`: the length
     series of the sheets before it on the page, in order; `lengths`: this sheet's, in order."""
     meta, series, seen, shapes = [], [], {}, {}
-    lengths = [_ints(_held(np.asarray(e.length_mm, dtype=float).reshape(-1), _shown(e)), LENGTH_DECIMALS)
-               for e in d.elements if e.length_mm is not None]
+    shown = [_shown(e) for e in d.elements if e.length_mm is not None]
+    lengths = [_ints(_held(np.asarray(e.length_mm, dtype=float).reshape(-1), on), LENGTH_DECIMALS)
+               for e, on in zip((e for e in d.elements if e.length_mm is not None), shown)]
     pool = [*earlier, *lengths]
-    sources = iter(_proportionals(lengths, pool, range(len(earlier), len(pool))))
-    own = iter(lengths)
+    sources = _proportionals(lengths, pool, range(len(earlier), len(pool)), shown)
+    for i, source in enumerate(sources):      # where not read, each the multiple of its source (as page.js holds it)
+        if source is not None:
+            pool[len(earlier) + i] = lengths[i] = _filled(lengths[i], pool[source[0]], source[1], shown[i])
+    sources, own = iter(sources), iter(lengths)
 
     def put(a, care: np.ndarray | None = None) -> None:
         a = np.asarray(a, dtype=np.int64).ravel()
@@ -379,6 +393,7 @@ def encode_drawing(d: Drawing, earlier: Sequence[np.ndarray] = ()) -> tuple[dict
             near = bank.near(a, care) if care is not None else None
             if near is not None:                 # what it holds where not read: j plus the remainder held
                 a = raw[near[0]] + near[1]
+                key, shape = a.tobytes(), (a - a[0]).tobytes()     # a later copy copies what page.js holds
             series.append([(None, a), *([near] if near else [])])
         if care is not None:
             bank.add(len(raw), a)
@@ -728,7 +743,6 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
     `page_angles`; made here where not given). ValueError where `at` is a singular position."""
     from . import build_cycle, cycle_scales
     from .draw import drawing
-    from .kinematic import without_triad_construction
     from .worksheet import worksheet_cycle
     from ..model.lettering import lettering
     check_lang(lang)
@@ -743,7 +757,7 @@ def page(mech, lang: str = "en", student: bool = False, at: float | None = None,
         if res.friction is not None:
             raise ValueError(f"solution: expected the frictionless analysis of {mech.name!r} (friction='first'), got {res}")
         fixed = fixed or cycle_scales(mech, res=res)
-        cycles = {kind: without_triad_construction(mech, c) for kind, c in build_cycle(mech, res, fixed, solution=solution).items()}
+        cycles = build_cycle(mech, res, fixed, solution=solution)
         sheet = worksheet_cycle(mech, res, fixed.base["mu_l"].value, lang, friction_res=solution.other)
     if res.singular[i_at]:
         raise ValueError(f"at: {at:g} deg is a singular position: no plans to check there")
