@@ -590,9 +590,9 @@ class _Columns:
     start: int = 1
 
     def __getitem__(self, idx: tuple[slice, int]) -> Dual:
-        rows, k = idx
-        if rows != slice(None) or not isinstance(k, (int, np.integer)):
+        if not (isinstance(idx, tuple) and len(idx) == 2 and idx[0] == slice(None) and isinstance(idx[1], (int, np.integer))):
             raise TypeError(f"sensitivity: a motion's {self.stem} is read by column ([:, k]) only, not {idx!r}")
+        k = idx[1]
         x = self.env.get(f"{self.stem}{k}", self.rest) if k >= self.start else self.rest
         return Dual(np.broadcast_to(value(x), (self.N,)), derivative(x, (self.N,), self.P))
 
