@@ -19,7 +19,8 @@ per angle, the kinematics, the loads, the reactions of every group and the balan
 
 The kernel: the five primitives of `groups` (|z|, complex / real, complex / complex, e^{i th},
 atan2) bound to branch-free versions (sincos and atan by polynomials, divisions part by part);
-an outer loop over blocks of BLOCK angles (one design each), an inner loop with an unsigned
+an outer loop over blocks of BLOCK angles (one design each; fewer, `block`, where a `Splice`'s
+rows would take the scratch past SCRATCH doubles), an inner loop with an unsigned
 index from 0, the guard a boolean value, each per-angle output stored at a compile-time row of
 one flat buffer (row-major: rows of angles), peaks as per-block maxima of squares. LLVM
 vectorises that inner loop (`vector_report` counts the packed instructions). No fast-math:
@@ -68,7 +69,7 @@ from .program import Identifiers, Program, code, constants, free_names, motion_p
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["analyze_fast", "analyses", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "available",
+__all__ = ["analyze_fast", "analyses", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "SCRATCH", "block", "available",
            "cache_dir", "kernel", "loaded", "threshold", "pays", "vector_report", "bytes_per_angle"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
@@ -377,7 +378,7 @@ def _store(t: Callable[[], str], val: str, is_complex: bool, first: int) -> tupl
 def _source(mech: "Mechanism", lay: _Layout, kind: str, splice: Splice | None = None) -> str:
     """The kernel's Python source (compiled by numba): the programs' steps inside a loop over
     blocks (design, first angle, count) and an unsigned loop over each block's angles that reads
-    and writes the thread's scratch T only, at compile-time rows of BLOCK values (so LLVM sees
+    and writes the thread's scratch T only, at compile-time rows of `block` values (so LLVM sees
     no aliasing and vectorises it). Before it, the block's speeds and the loads besides gravity
     (X's rows, or zero where X is empty) are copied into T; after it, "full" copies every array
     of the result (a complex one interleaved) into the flat buffer S (rows of n angles);
