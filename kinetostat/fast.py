@@ -69,8 +69,8 @@ from .program import Identifiers, Program, code, constants, free_names, motion_p
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["analyze_fast", "analyses", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "SCRATCH", "block", "available",
-           "cache_dir", "kernel", "loaded", "threshold", "pays", "vector_report", "bytes_per_angle"]
+__all__ = ["analyze_fast", "analyses", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK",
+           "SCRATCH", "block", "available", "cache_dir", "kernel", "loaded", "threshold", "pays", "vector_report", "bytes_per_angle"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
 #: compiled path where this process holds the kernel already (`threshold`). Measured

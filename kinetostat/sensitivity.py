@@ -590,7 +590,8 @@ class _Columns:
     start: int = 1
 
     def __getitem__(self, idx: tuple[slice, int]) -> Dual:
-        if not (isinstance(idx, tuple) and len(idx) == 2 and idx[0] == slice(None) and isinstance(idx[1], (int, np.integer))):
+        column = isinstance(idx, tuple) and len(idx) == 2 and idx[0] == slice(None)
+        if not (column and isinstance(idx[1], (int, np.integer))):
             raise TypeError(f"sensitivity: a motion's {self.stem} is read by column ([:, k]) only, not {idx!r}")
         k = idx[1]
         x = self.env.get(f"{self.stem}{k}", self.rest) if k >= self.start else self.rest
