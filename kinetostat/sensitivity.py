@@ -536,8 +536,10 @@ def _compiled(mech: "Mechanism", c: Mapping[str, Any], pts, view: "Mechanism", p
             for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, np.radians(phi_deg), P)):
                 F[k] = [F[k][0] + f, F[k][1] + m]
         cols = [x for k in range(1, L) for x in (np.real(F[k][0]), np.imag(F[k][0]), F[k][1])]
-        return (np.stack([np.broadcast_to(value(x), (N,)) for x in cols]),
-                np.stack([derivative(x, (N,), P) for x in cols]).transpose(2, 0, 1))
+        x, dx = np.empty((len(cols), N)), np.empty((P, len(cols), N))     # dx contiguous: run reshapes it
+        for i, col in enumerate(cols):
+            x[i], dx[:, i] = value(col), derivative(col, (N,), P).T
+        return x, dx
 
     result, out = fast_sensitivity.run(mech, c, phi_deg, P, loads)
     return result, {n: Dual(*vd) for n, vd in out.items()}
