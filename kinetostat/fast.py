@@ -19,8 +19,7 @@ per angle, the kinematics, the loads, the reactions of every group and the balan
 
 The kernel: the five primitives of `groups` (|z|, complex / real, complex / complex, e^{i th},
 atan2) bound to branch-free versions (sincos and atan by polynomials, divisions part by part);
-an outer loop over blocks of BLOCK angles (one design each; fewer, `block`, where a `Splice`'s
-rows would take the scratch past SCRATCH doubles), an inner loop with an unsigned
+an outer loop over blocks of BLOCK angles (one design each), an inner loop with an unsigned
 index from 0, the guard a boolean value, each per-angle output stored at a compile-time row of
 one flat buffer (row-major: rows of angles), peaks as per-block maxima of squares. LLVM
 vectorises that inner loop (`vector_report` counts the packed instructions). No fast-math:
@@ -69,8 +68,8 @@ from .program import Identifiers, Program, code, constants, free_names, motion_p
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["analyze_fast", "analyses", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK",
-           "SCRATCH", "block", "available", "cache_dir", "kernel", "loaded", "threshold", "pays", "vector_report", "bytes_per_angle"]
+__all__ = ["analyze_fast", "analyses", "chunks", "buffer", "peaks", "Peaks", "FAST_MIN", "FAST_COLD", "CHUNK", "BLOCK", "available",
+           "cache_dir", "kernel", "loaded", "threshold", "pays", "vector_report", "bytes_per_angle"]
 
 #: From this many positions (designs x angles) on, `kinetostat.analyze` and sweeps take the
 #: compiled path where this process holds the kernel already (`threshold`). Measured
@@ -88,9 +87,6 @@ FAST_COLD = 500_000
 CHUNK = 1 << 14
 #: Angles per block of the kernel's loop (not a multiple of 512: 4 KiB aliasing of the rows in L1).
 BLOCK = 264
-#: The most doubles of a thread's scratch one block may take: BLOCK angles of 192 rows (396 KiB,
-#: within a core's L2 cache of 512 KiB; the analysis kernels take at most 187 rows, a six-link's).
-SCRATCH = 192 * BLOCK
 #: Designs per call of the full kernel in `analyses` (its guard flags take D^2 N bools).
 BATCH = 32
 #: Threads the kernel runs on (one per core by default).
@@ -326,13 +322,6 @@ def _scratch_rows(lay: _Layout) -> int:
     return 2 + 3 * lay.L + lay.n_rows + lay.P + 2
 
 
-def block(rows: int) -> int:
-    """Angles per block of a kernel of `rows` scratch rows: BLOCK, or the largest multiple of 8
-    whose rows fit in SCRATCH doubles (`Splice`'s kernels, whose tangents take many more rows:
-    a block of BLOCK angles would spill its rows out of L2)."""
-    return BLOCK if rows * BLOCK <= SCRATCH else max(8, SCRATCH // rows // 8 * 8)
-
-
 def hoist(steps: tuple, consts) -> tuple[list, list]:
     """(the steps that read constants only, directly or through other such steps: run once per
     design before the loop over angles; the rest, in order). An assembly check is never hoisted."""
@@ -378,7 +367,7 @@ def _store(t: Callable[[], str], val: str, is_complex: bool, first: int) -> tupl
 def _source(mech: "Mechanism", lay: _Layout, kind: str, splice: Splice | None = None) -> str:
     """The kernel's Python source (compiled by numba): the programs' steps inside a loop over
     blocks (design, first angle, count) and an unsigned loop over each block's angles that reads
-    and writes the thread's scratch T only, at compile-time rows of `block` values (so LLVM sees
+    and writes the thread's scratch T only, at compile-time rows of BLOCK values (so LLVM sees
     no aliasing and vectorises it). Before it, the block's speeds and the loads besides gravity
     (X's rows, or zero where X is empty) are copied into T; after it, "full" copies every array
     of the result (a complex one interleaved) into the flat buffer S (rows of n angles);
@@ -389,9 +378,8 @@ def _source(mech: "Mechanism", lay: _Layout, kind: str, splice: Splice | None = 
     motion, statics = _motion(mech), statics_program(mech)
     v = Identifiers().__getitem__
     L, P = lay.L, lay.P
-    rows = _scratch_rows(lay) + (splice.scratch if splice else 0)
-    row, size = iter(range(rows)), block(rows)
-    t = lambda: f"U({next(row) * size})"           # the next scratch row
+    row = iter(range(_scratch_rows(lay) + (splice.scratch if splice else 0)))
+    t = lambda: f"U({next(row) * BLOCK})"          # the next scratch row
     head = ["def kernel(phi, W, E, C, X, bd, b0, bn, n, FL, S, T, PK):",
             "    for b in range(bd.shape[0]):",
             "        d = bd[b]",
@@ -546,12 +534,12 @@ def _speeds(mechs: Sequence["Mechanism"], phi: np.ndarray) -> tuple[np.ndarray, 
     return W, E
 
 
-def _blocks(D: int, a: int, b: int, size: int = BLOCK) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Blocks of `size` angles of the kernel's loop over designs x angles [a, b): design, first angle, count."""
-    edges = np.arange(a, b, size, dtype=np.uint64)
+def _blocks(D: int, a: int, b: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Blocks of the kernel's loop over designs x angles [a, b): design, first angle, count."""
+    edges = np.arange(a, b, BLOCK, dtype=np.uint64)
     bd = np.repeat(np.arange(D, dtype=np.uint64), len(edges))
     b0 = np.tile(edges, D)
-    return bd, b0, np.minimum(b0 + np.uint64(size), np.uint64(b)) - b0
+    return bd, b0, np.minimum(b0 + np.uint64(BLOCK), np.uint64(b)) - b0
 
 
 def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, X: np.ndarray | None = None,
@@ -568,17 +556,17 @@ def _run(mechs: Sequence["Mechanism"], phi: np.ndarray, kind: str, X: np.ndarray
     D, N = len(mechs), len(phi)
     a, b = span or (0, N)
     W, E = _speeds(mechs, phi)
-    rows = _scratch_rows(lay) + (other[2] if other else 0)
-    bd, b0, bn = blocks or _blocks(D, a, b, block(rows))
+    bd, b0, bn = blocks or _blocks(D, a, b)
     FL = np.zeros((D, N), bool) if FL is None else FL
     S = np.zeros(1) if S is None else S
     PK = np.zeros((len(bd), lay.P + 2))
     C = _table(mechs, lay) if other is None else other[1]
+    rows = _scratch_rows(lay) + (other[2] if other else 0)
     n = max(1, min(threads or THREADS, len(bd)))
     parts = [slice(q * len(bd) // n, (q + 1) * len(bd) // n) for q in range(n)]
 
     def part(s: slice) -> None:
-        T = np.empty(rows * block(rows))
+        T = np.empty(rows * BLOCK)
         fn(phi, W, E, C, _NO_LOADS if X is None else X, bd[s], b0[s], bn[s], np.uint64(N), FL.reshape(-1), S, T, PK[s])
 
     if n == 1:

@@ -348,31 +348,6 @@ def test_auto_path_does_not_compile_for_few_angles():
     assert np.array_equal(a.balancing_moment["r"], b.balancing_moment["r"])
 
 
-def test_spliced_kernel_blocks_keep_its_scratch_within_scratch():
-    """fast.block: the compiled sensitivities' kernel of 5 tangents (chain unit: 587 scratch rows)
-    runs blocks of fewer angles, so that every scratch offset of its loop stays within fast.SCRATCH
-    doubles (a block of BLOCK angles spilled out of L2); every bundled model's analysis kernels
-    keep blocks of BLOCK angles (their sources, and their cache, unchanged)."""
-    import importlib
-    import re
-
-    from kinetostat import fast, fast_sensitivity
-    sens = importlib.import_module("kinetostat.sensitivity")
-    mech = kinetostat.load(CHAIN)
-    names = tuple(mech.parameters)[:5]         # r, n_k, c, h, l: as benchmark --sensitivity
-    c, _, _ = sens._design(mech, sens._seeded(mech, names)[1])
-    live = tuple(frozenset(x) for x in fast_sensitivity._table(mech, c, 5)[1])
-    rows = fast._scratch_rows(fast._layout(mech)) + fast_sensitivity._scratch(mech, 5)
-    size = fast.block(rows)
-    assert size % 8 == 0 and size < fast.BLOCK and rows * size <= fast.SCRATCH
-    loop = fast_sensitivity._source(mech, 5, "full", live).split("def kernel(")[1]
-    offsets = {int(x) for x in re.findall(r"\bU\((\d+)\) \+ j\]", loop)}
-    assert len(offsets) > 200 and all(x % size == 0 for x in offsets) and max(offsets) + size <= fast.SCRATCH
-    for path in sorted((ROOT / "models").glob("*.toml")):
-        m = kinetostat.load(path)
-        assert fast.refusal(m) is not None or fast.block(fast._scratch_rows(fast._layout(m))) == fast.BLOCK, path.name
-
-
 def test_dual_motion_builds_only_the_columns_read():
     """The loads' dual motion (`_dual_motion`) gives column k of a kinematic output as the
     environment's dual (the frame's rest value before `start`) and refuses any other read."""
