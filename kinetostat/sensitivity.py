@@ -536,8 +536,10 @@ def _compiled(mech: "Mechanism", c: Mapping[str, Any], pts, view: "Mechanism", p
             for k, f, m in load_wrenches(view, _dual_motion(mech, env, pts, np.radians(phi_deg), P)):
                 F[k] = [F[k][0] + f, F[k][1] + m]
         cols = [x for k in range(1, L) for x in (np.real(F[k][0]), np.imag(F[k][0]), F[k][1])]
-        return (np.stack([np.broadcast_to(value(x), (N,)) for x in cols]),
-                np.stack([derivative(x, (N,), P) for x in cols]).transpose(2, 0, 1))
+        x, dx = np.empty((len(cols), N)), np.empty((P, len(cols), N))     # dx contiguous: run reshapes it
+        for i, col in enumerate(cols):
+            x[i], dx[:, i] = value(col), derivative(col, (N,), P).T
+        return x, dx
 
     result, out = fast_sensitivity.run(mech, c, phi_deg, P, loads)
     return result, {n: Dual(*vd) for n, vd in out.items()}
@@ -553,7 +555,7 @@ def _motion(mech: "Mechanism", env: dict[str, Any], phi: np.ndarray) -> dict[str
 
 @dataclass(frozen=True)
 class _DualMotion(Kinematics):
-    """Kinematics whose arrays are duals (N, L): what `applied` reads of a motion, with a link's
+    """Kinematics whose arrays are duals (N, L) read by column (`_Columns`): what `applied` reads of a motion, with a link's
     local point read as the dual the parameters move (found by its nominal coordinates)."""
     local: tuple[Mapping[str, Any], ...] = ()
 
@@ -577,19 +579,33 @@ class _DualMotion(Kinematics):
                                    self.eps[:, k], self.rot[:, k], self._x(k, p))
 
 
-def _stacked(env: Mapping[str, Any], stem: str, count: int, rest: complex, N: int, P: int, start: int = 1) -> Dual:
-    """The per-link (or per-pair) duals stem<k> of `env` as one (N, count) dual (rest where absent)."""
-    cols = [env.get(f"{stem}{k}", rest) if k >= start else rest for k in range(count)]
-    return Dual(np.stack([np.broadcast_to(value(x), (N,)) for x in cols], axis=1),
-                np.stack([derivative(x, (N,), P) for x in cols], axis=1))
+@dataclass(frozen=True)
+class _Columns:
+    """The per-link (or per-pair) duals stem<k> of a program's environment read as an (N, count)
+    dual's columns (rest where absent, or k < start): `[:, k]`, the only way `applied` reads a
+    motion, gives column k's (N,) dual and builds nothing else (no (N, count, P) stack)."""
+    env: Mapping[str, Any]
+    stem: str
+    rest: complex
+    N: int
+    P: int
+    start: int = 1
+
+    def __getitem__(self, idx: tuple[slice, int]) -> Dual:
+        column = isinstance(idx, tuple) and len(idx) == 2 and idx[0] == slice(None)
+        if not (column and isinstance(idx[1], (int, np.integer))):
+            raise TypeError(f"sensitivity: a motion's {self.stem} is read by column ([:, k]) only, not {idx!r}")
+        k = idx[1]
+        x = self.env.get(f"{self.stem}{k}", self.rest) if k >= self.start else self.rest
+        return Dual(np.broadcast_to(value(x), (self.N,)), derivative(x, (self.N,), self.P))
 
 
 def _dual_motion(mech: "Mechanism", env: Mapping[str, Any], pts, phi: np.ndarray, P: int) -> _DualMotion:
-    """The motion of the program's environment as `_DualMotion` (unguarded)."""
-    N, L, n = len(phi), mech.n_links, len(mech.pairs)
-    st = lambda stem, count, rest, start=1: _stacked(env, stem, count, rest, N, P, start)
-    return _DualMotion(phi, st("th", L, 0.0), st("rot", L, 1.0 + 0j), st("O", L, 0j), st("V", L, 0j), st("A", L, 0j),
-                       st("w", L, 0.0), st("e", L, 0.0), st("vs", n, 0.0, 0), st("as", n, 0.0, 0),
+    """The motion of the program's environment as `_DualMotion` (unguarded), its arrays `_Columns`."""
+    N = len(phi)
+    st = lambda stem, rest, start=1: _Columns(env, stem, rest, N, P, start)
+    return _DualMotion(phi, st("th", 0.0), st("rot", 1.0 + 0j), st("O", 0j), st("V", 0j), st("A", 0j),
+                       st("w", 0.0), st("e", 0.0), st("vs", 0.0, 0), st("as", 0.0, 0),
                        np.zeros((N, 0)), np.zeros(N, bool), np.zeros(N), None, tuple(pts))
 
 

@@ -346,3 +346,18 @@ def test_auto_path_does_not_compile_for_few_angles():
     assert not fast_sensitivity.pays(mech, 360, {}, 2) and not fast_sensitivity.pays(mech, 20_000, {}, 7)
     a, b = (kinetostat.sensitivity(mech, ["r", "m2"], steps=360, path=p) for p in ("auto", "numpy"))
     assert np.array_equal(a.balancing_moment["r"], b.balancing_moment["r"])
+
+
+def test_dual_motion_builds_only_the_columns_read():
+    """The loads' dual motion (`_dual_motion`) gives column k of a kinematic output as the
+    environment's dual (the frame's rest value before `start`) and refuses any other read."""
+    from kinetostat.sensitivity import Dual, _dual_motion
+    mech = kinetostat.load(ICE)
+    N, P = 4, 2
+    O2 = Dual(np.arange(N) + 1j, np.ones((N, P)))
+    kin = _dual_motion(mech, {"O2": O2, "w1": 3.0}, [{}] * mech.n_links, np.zeros(N), P)
+    assert np.array_equal(kin.origin_z[:, 2].val, O2.val) and np.array_equal(kin.origin_z[:, 2].der, O2.der)
+    assert np.array_equal(kin.rot[:, 0].val, np.ones(N)) and not kin.rot[:, 0].der.any()
+    assert np.array_equal(kin.omega[:, 1].val, np.full(N, 3.0)) and kin.omega[:, 1].der.shape == (N, P)
+    with pytest.raises(TypeError, match=r"motion.s O is read by column"):
+        kin.origin_z[0]
