@@ -151,6 +151,19 @@ def test_bound_is_the_larger_of_ports_and_divider():
     assert (b.seconds, b.limit) == (pytest.approx(5e-8), "ports")
 
 
+def test_bound_lines_state_each_kernels_program_and_the_models_ratio_to_the_sum_of_bounds():
+    from kinetostat_validation.benchmark import bound_lines
+    rates = kernels.UnitRates(div=1e9, sqrt=1e9, fma=1e10, add_mul=1e10, note="given")
+    programs = {"motion": kernels.Program(add=100, div=5, width=4), "peaks": kernels.Program(mul=300, div=10, width=4)}
+    bounds = {k: kernels.bound(p, rates) for k, p in programs.items()}           # 10 ns (ports), 30 ns (ports)
+    row = dict(model="m", programs=programs, bounds=bounds, bound=4e-8, cpu=6e-8, ratio=1.5)
+    text = "\n".join(bound_lines(dict(rates=rates, rows=[row], angles=1000, rounds=3,
+                                      load=((1.0, 1.0, 1.0), (2.0, 2.0, 2.0)))))
+    assert "| m | motion | 100 | 0 | 0 | 5 | 0 | 0 | 0 | 105 | 4 | 10.0 | 5.0 | 10.0 (ports) |  | |" in text
+    assert "| m | peaks | 0 | 300 | 0 | 10 | 0 | 0 | 0 | 310 | 4 | 30.0 | 10.0 | 30.0 (ports) | 60.0 | 1.50 (bound 40.0) |" in text
+    assert "a division 1.0 ns" in text and "1.00 1.00 1.00 before" in text
+
+
 def test_cpu_info_names_the_cpu_and_its_vector_flags():
     info = kernels.cpu_info()
     flags = next((ln.split(":", 1)[1].split() for ln in open("/proc/cpuinfo") if ln.startswith("flags")), [])
