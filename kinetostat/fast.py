@@ -18,10 +18,11 @@ per angle, the kinematics, the loads, the reactions of every group and the balan
   (`fast_sensitivity`'s tangents, written in the same pass).
 
 The kernel: the five primitives of `groups` (|z|, complex / real, complex / complex, e^{i th},
-atan2) bound to branch-free versions (sincos and atan by polynomials, divisions part by part);
-an outer loop over blocks of BLOCK angles (one design each), an inner loop with an unsigned
-index from 0, the guard a boolean value, each per-angle output stored at a compile-time row of
-one flat buffer (row-major: rows of angles), peaks as per-block maxima of squares. LLVM
+atan2) bound to branch-free versions (sincos and atan by polynomials, a division as one
+reciprocal multiplied part by part, atan2 with one division); an outer loop over blocks of BLOCK
+angles (one design each), an inner loop with an unsigned index from 0, the guard a boolean value,
+each per-angle output stored at a compile-time row of one flat buffer (row-major: rows of
+angles), peaks as per-block maxima of squares. LLVM
 vectorises that inner loop (`vector_report` counts the packed instructions). No fast-math:
 every operation keeps IEEE semantics, so a NaN or inf that enters propagates (a non-finite peak
 flags the angle, below). The primitives agree with numpy's operators to rounding on finite values of
@@ -112,14 +113,16 @@ def magnitude(z):
 
 
 def over(z, r):
-    """z / r, part by part (numba promotes complex / real to complex / complex)."""
-    return complex(z.real / r, z.imag / r)
+    """z / r as z times one reciprocal of r, part by part (numba promotes complex / real to
+    complex / complex)."""
+    k = 1.0 / r
+    return complex(z.real * k, z.imag * k)
 
 
 def ratio(z, w):
-    """z / w as z conj(w) / |w|^2 (numba's complex division has branches)."""
-    n = w.real * w.real + w.imag * w.imag
-    return complex((z.real * w.real + z.imag * w.imag) / n, (z.imag * w.real - z.real * w.imag) / n)
+    """z / w as z conj(w) times one reciprocal of |w|^2 (numba's complex division has branches)."""
+    k = 1.0 / (w.real * w.real + w.imag * w.imag)
+    return complex((z.real * w.real + z.imag * w.imag) * k, (z.imag * w.real - z.real * w.imag) * k)
 
 
 def cis(th):
@@ -142,14 +145,15 @@ def cis(th):
 
 
 def phase(x):
-    """atan2(Im x, Re x): atan of min/max of |x|, |y| by fdlibm's polynomial on
-    [-tan(pi/8), tan(pi/8)] (atan a = pi/4 + atan((a - 1)/(a + 1)) above), octant by selects."""
+    """atan2(Im x, Re x): atan of a = min/max of |x|, |y| by fdlibm's polynomial on
+    [-tan(pi/8), tan(pi/8)] (atan a = pi/4 + atan((min - max)/(min + max)) above), octant by
+    selects; one division."""
     X, Y = x.real, x.imag
     ax, ay = abs(X), abs(Y)
     mx = ay if ay > ax else ax
-    a = (ax if ay > ax else ay) / (mx if mx > 0.0 else 1.0)
-    big = a > 0.41421356237309503
-    t = (a - 1.0) / (a + 1.0) if big else a
+    mn = ax if ay > ax else ay
+    big = mn > 0.41421356237309503 * mx
+    t = (mn - mx if big else mn) / (mn + mx if big else (mx if mx > 0.0 else 1.0))
     z = t * t
     p = t - t * z * (3.33333333333329318027e-01 + z * (-1.99999999998764832476e-01 + z * (
         1.42857142725034663711e-01 + z * (-1.11111104054623557880e-01 + z * (

@@ -65,9 +65,11 @@ def dot(a, b):
 
 def solve2(a, b, det, v):
     """(alpha, beta) closing the polygon v = alpha a + beta b (alpha, beta real), det = a x b:
-    a vector equation of the plans solved for its two unknown magnitudes. Where a and b are
-    parallel it divides by zero: the singular-position guard marks those positions."""
-    return cross(v, b) / det, cross(a, v) / det
+    a vector equation of the plans solved for its two unknown magnitudes, by one reciprocal of
+    det (compiled, the calls on one det share it). Where a and b are parallel it divides by
+    zero: the singular-position guard marks those positions."""
+    k = 1.0 / det
+    return cross(v, b) * k, cross(a, v) * k
 
 
 def condition(frob, det):
@@ -286,7 +288,7 @@ def rrr_polygon(P, B, Q, lj, lk, Fj, Fk, MjB, MkB):
     """RRR: tangential parts of the outer reactions from the moments of each link about B,
     normal parts from the closed force polygon of the group."""
     uj, uk = over(B - P, lj), over(B - Q, lk)
-    nj, nk = 1j * uj * (MjB / lj), 1j * uk * (MkB / lk)
+    nj, nk = over(1j * uj * MjB, lj), over(1j * uk * MkB, lk)       # one reciprocal of each length
     aj, ak = solve2(uj, uk, cross(uj, uk), -(Fj + Fk + nj + nk))
     R_aj = aj * uj + nj
     return R_aj, Fj + R_aj, ak * uk + nk
@@ -296,7 +298,7 @@ def rrp_polygon(P, B, lj, n, Fj, Fk, MjB, MkB):
     """RRP: the reaction at P from j's moment about B and the polygon; the guide's normal force
     N n on k, its moment about B balancing k's."""
     uj = over(B - P, lj)
-    nj = 1j * uj * (MjB / lj)
+    nj = over(1j * uj * MjB, lj)
     aj, N = solve2(uj, n, cross(uj, n), -(Fj + Fk + nj))
     R_aj = aj * uj + nj
     return R_aj, Fj + R_aj, N, -MkB

@@ -93,6 +93,77 @@ def test_count_flops_loop_counts_the_vector_body_per_iteration():
         kernels.count_flops_loop("entry:\n  %s = fadd double %p, %q\n  ret void\n")
 
 
+def divide_root(a, b, c, d, out):
+    """Per element a division, a square root, a multiply and an add (compiled by the test)."""
+    for i in range(out.size):
+        out[i] = a[i] / b[i] + math.sqrt(c[i]) * d[i]
+
+
+def real_times_complex(x, a, b, re, im):
+    """Per element a real times a complex: numba promotes x to x + 0j (compiled by the test)."""
+    for i in range(re.size):
+        w = x[i] * complex(a[i], b[i])
+        re[i] = w.real
+        im[i] = w.imag
+
+
+def _loop_ir(fn, *arrays) -> str:
+    import numba
+    compiled = numba.njit(error_model="numpy")(fn)
+    compiled(*arrays)
+    return "\n".join(compiled.inspect_llvm().values())
+
+
+def test_count_program_counts_a_known_loop_by_kind():
+    a = np.full(16, 4.0)
+    program = kernels.count_program(_loop_ir(divide_root, a, a, a, a, np.empty(16)))
+    assert (program.add, program.mul, program.div, program.sqrt, program.fma, program.by_zero, program.other) == (
+        1, 1, 1, 1, 0, 0, 0)
+    assert program.width in (2, 4, 8) and program.flops == 4
+
+
+def test_count_program_counts_a_real_promoted_to_complex_apart():
+    """x (a + bi) as numba computes it, (x + 0i)(a + bi): x a, x b, and 0 b, 0 a and the two
+    additions of those products by zero."""
+    a = np.full(16, 2.0)
+    program = kernels.count_program(_loop_ir(real_times_complex, a, a, a, np.empty(16), np.empty(16)))
+    assert (program.add, program.mul, program.by_zero) == (0, 2, 4)
+
+
+def test_count_program_reads_literal_zeros_and_fma():
+    """Per 4 angles: a multiply by -0.0 and an add of it, 0 - x, an FMA and a division (4 lanes)."""
+    ir = ("vector.body:\n  %a = fmul <4 x double> %x, splat (double -0.000000e+00)\n"
+          "  %b = fadd <4 x double> %y, %a\n  %c = fsub <4 x double> zeroinitializer, %b\n"
+          "  %d = call <4 x double> @llvm.fma.v4f64(<4 x double> %c, <4 x double> %y, <4 x double> %y)\n"
+          "  %e = fdiv <4 x double> %d, %y\n  %f = fadd <4 x double> %e, %y\n"
+          "  %index.next = add nuw i64 %index, 4\n  br label %vector.body\nend:\n")
+    assert kernels.count_program(ir) == kernels.Program(add=1, div=1, fma=1, by_zero=3, width=4)
+
+
+def test_bound_is_the_larger_of_ports_and_divider():
+    rates = kernels.UnitRates(div=1e9, sqrt=2e9, fma=1e10, add_mul=2e10, note="given")
+    program = kernels.Program(add=100, mul=60, by_zero=40, fma=50, div=20, sqrt=4)
+    b = kernels.bound(program, rates)
+    assert b.port == pytest.approx(200 / 2e10 + 50 / 1e10)         # 15 ns
+    assert b.divider == pytest.approx(20 / 1e9 + 4 / 2e9)          # 22 ns
+    assert (b.seconds, b.limit) == (b.divider, "divider")
+    b = kernels.bound(kernels.Program(add=1000, div=1), rates)
+    assert (b.seconds, b.limit) == (pytest.approx(5e-8), "ports")
+
+
+def test_bound_lines_state_each_kernels_program_and_the_models_ratio_to_the_sum_of_bounds():
+    from kinetostat_validation.benchmark import bound_lines
+    rates = kernels.UnitRates(div=1e9, sqrt=1e9, fma=1e10, add_mul=1e10, note="given")
+    programs = {"motion": kernels.Program(add=100, div=5, width=4), "peaks": kernels.Program(mul=300, div=10, width=4)}
+    bounds = {k: kernels.bound(p, rates) for k, p in programs.items()}           # 10 ns (ports), 30 ns (ports)
+    row = dict(model="m", programs=programs, bounds=bounds, bound=4e-8, cpu=6e-8, ratio=1.5)
+    text = "\n".join(bound_lines(dict(rates=rates, rows=[row], angles=1000, rounds=3,
+                                      load=((1.0, 1.0, 1.0), (2.0, 2.0, 2.0)))))
+    assert "| m | motion | 100 | 0 | 0 | 5 | 0 | 0 | 0 | 105 | 4 | 10.0 | 5.0 | 10.0 (ports) |  | |" in text
+    assert "| m | peaks | 0 | 300 | 0 | 10 | 0 | 0 | 0 | 310 | 4 | 30.0 | 10.0 | 30.0 (ports) | 60.0 | 1.50 (bound 40.0) |" in text
+    assert "a division 1.0 ns" in text and "1.00 1.00 1.00 before" in text
+
+
 def test_cpu_info_names_the_cpu_and_its_vector_flags():
     info = kernels.cpu_info()
     flags = next((ln.split(":", 1)[1].split() for ln in open("/proc/cpuinfo") if ln.startswith("flags")), [])

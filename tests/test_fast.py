@@ -350,3 +350,27 @@ def test_the_compiled_primitives_are_numpys_to_an_ulp(scale, primitives):
     z[:4] = [1.0, -1.0, 1j, -1j]
     assert np.max(np.abs(np.array([phase(w) for w in z]) - np.angle(z))) <= 4.5e-16
     assert phase(0j) == 0.0 and np.isnan(phase(complex(np.nan, 1.0))) and np.isnan(cis(np.nan).real)
+
+
+DIVIDING = '''
+def kernel(T, O, n):
+    for i in range(n):
+        u, w = complex(T[i], T[n + i]), complex(T[2 * n + i], T[3 * n + i])
+        v, x = complex(T[4 * n + i], T[5 * n + i]), complex(T[6 * n + i], T[7 * n + i])
+        det, r = T[8 * n + i], T[9 * n + i]
+        a, b = solve2(u, w, det, v)
+        c, d = solve2(u, w, det, x)
+        q, s = over(v, r), ratio(v, w)
+        O[i] = a + b + c + d + q.real + q.imag + s.real + s.imag + phase(x)
+'''
+
+
+def test_the_compiled_closed_forms_take_one_reciprocal_per_denominator():
+    """Two solve2 on one det, z / r, z / w and atan2 in a kernel's vectorised loop (the kernel's
+    own module, uncached): one division per denominator (det, r, |w|^2, the octant's), 4 an angle."""
+    from kinetostat_validation.kernels import count_program
+    ns: dict = {}
+    exec(fast._module(DIVIDING).replace("cache=True", "cache=False"), ns)
+    n = 64
+    ns["kernel"](np.ones(10 * n), np.empty(n), n)
+    assert count_program("\n".join(ns["kernel"].inspect_llvm().values())).div == 4

@@ -6,6 +6,7 @@
     python -m kinetostat_validation.benchmark --drawing-budgets   # only the drawing layer's budgets, printed
     python -m kinetostat_validation.benchmark --tolerance 100000  # only a Monte Carlo tolerance study's rate, printed
     python -m kinetostat_validation.benchmark --sensitivity 100000  # only the compiled sensitivities' cost, printed
+    python -m kinetostat_validation.benchmark --bound 100000  # only the four-bar's and the ICE's peaks against their bound, printed
 
 Every route runs over the same full cycle (360 angles) and is timed as the median of repeated
 runs in one process; its error is the worst peak-relative error over the driving moment and
@@ -19,7 +20,9 @@ times any `fast(mech, N)` the same way (the solver's rows come from it too). The
 compiled path" (`speed_study`) times `kinetostat.fast` (peaks on 1 and 2 threads, full results
 in reused chunks, into one reused buffer and into fresh memory) beside the scalar kernel of
 commit BEFORE, the numpy path and MuJoCo's kernels, in interleaved rounds, CPU and wall time,
-each against its own limit, with the CPU, its flags and its load recorded.
+each against its own limit, with the CPU, its flags and its load recorded. The section "The
+peaks kernels against their bound" (`bound_study`) counts each peaks kernel's program by kind and
+sets its time against the bound of this core's division, square-root and FMA rates.
 
 May use: kinetostat, the scene, compare, reference, the engine adapters, kernels, study_cli, matplotlib.
 """
@@ -43,6 +46,7 @@ from kinetostat.analysis import crank_angles, exact
 from kinetostat.kinematics import kinematics
 
 from .compare import errors
+from .kernels import Program
 from .scene import EngineResult, Scene, build_scene
 from .study_cli import parser, require_plots
 
@@ -430,6 +434,81 @@ def speed_study(repeat: int = 5, N: int = 10**6, N_numpy: int = 10**5, N_full: i
         print(f"speed {name}: {flops:.0f} flops/angle, {written} B/angle written, {models[name]}", flush=True)
     info["after"] = cpu_info()
     return dict(rates=rates, rows=rows, models=models, info=info, repeat=repeat)
+
+
+BOUND_MODELS = ("chain_unit_four_bar", "ice_crank_slider")
+
+
+def _kernel_programs(model: str) -> dict[str, Program]:
+    """The counted programs (`kernels.count_program`) of the kernels `fast.peaks` runs for
+    `model` (the peaks kernel; the motion kernel first where it has loads), compiled by a fresh
+    process into an empty cache folder (numba cannot inspect a kernel loaded from its cache)."""
+    import json
+    import subprocess
+    import sys
+    import tempfile
+    script = ("import dataclasses, json, sys, numpy as np, kinetostat; from kinetostat import fast; "
+              "from kinetostat_validation.kernels import count_program; m = kinetostat.load(sys.argv[1])\n"
+              "fast.peaks([m], np.arange(64.0), threads=1)\n"
+              "kinds = ('motion', 'peaks') if fast._has_loads(m) else ('peaks',)\n"
+              "print(json.dumps({k: dataclasses.asdict(count_program(chr(10).join("
+              "fast.kernel(m, k)[0].inspect_llvm().values()))) for k in kinds}))")
+    with tempfile.TemporaryDirectory(prefix="kinetostat-cache-") as folder:
+        out = subprocess.run([sys.executable, "-c", script, model], env=dict(os.environ, KINETOSTAT_CACHE=folder),
+                             check=True, capture_output=True, text=True).stdout.splitlines()[-1]
+    return {kind: Program(**counts) for kind, counts in json.loads(out).items()}
+
+
+def bound_study(models: tuple[str, ...] = BOUND_MODELS, angles: int = 10**5, rounds: int = 3) -> dict:
+    """Issue 40's honest bound: per model, the counted program of each kernel its peaks run
+    (`_kernel_programs`) and that kernel's bound at this core's unit rates (`kernels.unit_rates`,
+    measured in this run), and `fast.peaks` of `angles` angles on 1 thread, CPU time per angle
+    (the minimum of `rounds` after a warm-up), against the sum of its kernels' bounds (they run
+    one after the other; loads evaluated by numpy between them are not in any bound)."""
+    from .kernels import bound, unit_rates
+    load = os.getloadavg()
+    rates = unit_rates()
+    rows = []
+    for name in models:
+        mech = kinetostat.load(name)
+        programs = _kernel_programs(name)
+        phi = crank_angles(None, angles)
+        run = lambda m=mech: fast.peaks([m], phi, threads=1)
+        run()
+        cpu = min(_timed(run)[0] for _ in range(rounds)) / angles
+        bounds = {kind: bound(p, rates) for kind, p in programs.items()}
+        total = sum(b.seconds for b in bounds.values())
+        rows.append(dict(model=name, programs=programs, bounds=bounds, bound=total, cpu=cpu, ratio=cpu / total))
+    return dict(rates=rates, rows=rows, angles=angles, rounds=rounds, load=(load, os.getloadavg()))
+
+
+def bound_lines(study: dict) -> list[str]:
+    """The report's section on each model's peaks kernels against their bound (`bound_study`)."""
+    r, ns = study["rates"], lambda s: f"{s * 1e9:.1f}"
+    lines = ["## The peaks kernels against their bound", "",
+             f"This core, measured in this run ({r.note}): a division {ns(1 / r.div)} ns, a square root "
+             f"{ns(1 / r.sqrt)} ns, an FMA {1e12 / r.fma:.0f} ps, an unfused multiply or add {1e12 / r.add_mul:.0f} ps "
+             "per lane. A kernel's program is counted per angle in the LLVM IR of its vectorised loop over the "
+             "angles (`kernels.count_program`; 'by zero': additions and multiplications with a literal zero and "
+             "additions of such products, numba's promotion of a real operand to complex). Its bound is the larger "
+             "of its port time (adds, multiplies, by zero at the unfused rate; FMAs at the FMA rate) and its "
+             "divider time (divisions and square roots); a model's bound is the sum over the kernels its peaks "
+             f"run (loads besides gravity are evaluated by numpy between them: in no bound). CPU: `fast.peaks`, 1 "
+             f"thread, {study['angles']:,} angles, the minimum of {study['rounds']} rounds. Load average (1, 5, 15 "
+             f"min) {' '.join(f'{x:.2f}' for x in study['load'][0])} before, "
+             f"{' '.join(f'{x:.2f}' for x in study['load'][1])} after.", "",
+             "| model | kernel | adds | multiplies | by zero | divisions | square roots | FMAs | others | flops | "
+             "lanes | port ns | divider ns | bound ns | CPU ns/angle | CPU / bound |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for row in study["rows"]:
+        for kind, p in row["programs"].items():
+            b = row["bounds"][kind]
+            last = kind == "peaks"
+            lines.append(f"| {row['model']} | {kind} | {p.add:.0f} | {p.mul:.0f} | {p.by_zero:.0f} | {p.div:.0f} | "
+                         f"{p.sqrt:.0f} | {p.fma:.0f} | {p.other:.0f} | {p.flops:.0f} | {p.width} | {ns(b.port)} | "
+                         f"{ns(b.divider)} | {ns(b.seconds)} ({b.limit}) | " +
+                         (f"{ns(row['cpu'])} | {row['ratio']:.2f} (bound {ns(row['bound'])}) |" if last else " | |"))
+    return lines
 
 
 #: `kinetostat report --jobs 2` before, measured on this machine, each in fresh processes: the
@@ -853,7 +932,7 @@ def write_report(rows: list[dict], kin_rows: list[dict], thr: list[dict], kernel
     for r in thr:
         lines.append(f"| {r['angles']:,} | {r['first_seconds']:.3f} | {r['cpu_min']:.3f} / {r['cpu_median']:.3f} | "
                      f"{r['wall_min']:.3f} / {r['seconds']:.3f} | {r['per_second']:.3g} |")
-    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + crossover_lines(kernels["crossover"]) + [""] + main_job_lines(kernels["main_job"]) + [""] + budget_lines(kernels["budgets"])
+    lines += [""] + kernel_lines(kernels) + [""] + speed_lines(kernels["speed"]) + [""] + bound_lines(kernels["bound"]) + [""] + crossover_lines(kernels["crossover"]) + [""] + main_job_lines(kernels["main_job"]) + [""] + budget_lines(kernels["budgets"])
     (out / "benchmark.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -935,7 +1014,13 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--sensitivity", metavar="N", type=int,
                     help="only the compiled sensitivities' cost (p = 1, 2, 5) against the plain compiled analysis of "
                          "N angles of the four-bar and the ICE; print only")
+    ap.add_argument("--bound", metavar="N", type=int,
+                    help="only the peaks kernels' counted programs and bounds, and fast.peaks of N angles of the "
+                         "four-bar and the ICE against them; print only")
     args = ap.parse_args(argv)
+    if args.bound:
+        print("\n".join(bound_lines(bound_study(angles=args.bound))))
+        return
     if args.sensitivity:
         print("\n".join(sensitivity_lines(sensitivity_cost(angles=args.sensitivity))))
         return
@@ -966,6 +1051,9 @@ def main(argv: list[str] | None = None) -> None:
     kern["crossover"] = crossover(repeat=3 if args.quick else 5)
     print("\n".join(crossover_lines(kern["crossover"])))
     print("\n".join(speed_lines(kern["speed"])))
+    kern["bound"] = bound_study(models=tuple(n for n in kinetostat.examples.names()
+                                             if fast.refusal(kinetostat.load(n)) is None))
+    print("\n".join(bound_lines(kern["bound"])))
     rows = study(models, args.quick)
     if not args.quick:
         kern["main_job"] = main_job()

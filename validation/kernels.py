@@ -27,7 +27,14 @@ filling a 256 MiB buffer that is reused, so no page faults) and the double-preci
 of one core (a numba loop of independent multiply-adds, fused to FMAs by fastmath); a per-angle
 limit is max(flops / flop rate, bytes / bandwidth). `count_flops` counts the floating-point
 operations of a compiled per-angle numba function from its LLVM IR (a vector operation counts
-its lanes); `count_flops_loop` the flops per angle of a kernel's vectorised loop. `cpu_info`
+its lanes); `count_flops_loop` the flops per angle of a kernel's vectorised loop, `count_program`
+that loop's operations per angle by kind (adds, multiplies, divisions, square roots, FMAs, and
+operations with a literal zero: numba's promotion of a real operand to complex).
+
+A kernel's bound (`unit_rates`, `bound`): this core's vectorised throughput of division, square
+root, FMA and unfused multiply and add, measured by numba loops over arrays in the L1 cache; a
+program's bound is max(port time of its adds, multiplies and FMAs, divider time of its divisions
+and square roots). `cpu_info`
 names the CPU, its vector flags and the target numba compiles for, to record with every figure.
 
 May use: kinetostat, the scene, engine_mujoco and engine_pinocchio (their models and states),
@@ -52,7 +59,8 @@ import numpy as np
 from .scene import Scene
 
 __all__ = ["KernelTiming", "mujoco_kernel", "pinocchio_kernel", "MachineRates", "machine_rates",
-           "machine_limit", "count_flops", "count_flops_ir", "count_flops_loop", "bytes_per_angle", "cpu_info"]
+           "machine_limit", "count_flops", "count_flops_ir", "count_flops_loop", "bytes_per_angle", "cpu_info",
+           "Program", "count_program", "UnitRates", "unit_rates", "Bound", "bound"]
 
 
 @dataclass(frozen=True)
@@ -357,32 +365,93 @@ def count_flops(dispatcher, signature=None) -> int:
 
 _VECTOR_BODY = re.compile(r"^((?:[\w.$-]*\.)?vector\.body[\w.$-]*):")
 _STEP = re.compile(r"%index\.next[\w.]* = add (?:nuw )?(?:nsw )?i64 %index[\w.]*, (\d+)")
+_ZERO = r"(?:zeroinitializer|-?0\.0+e\+00|splat \((?:double|float) -?0\.0+e\+00\))"
+_BY_ZERO = re.compile(r"=\s*(?:fadd|fsub|fmul)\s+" + _TYPE + r"\s+(?:" + _ZERO + r",|[^,]+,\s*" + _ZERO + r"\s*(?:,|$))")
 
 
-def count_flops_loop(ir: str) -> float:
-    """Floating-point operations per iteration of the scalar loop that LLVM vectorised into the
-    largest `vector.body` block of the IR `ir` (a kernel's loop over the angles): the block's
-    flops (as `count_flops_ir` counts them, lanes included) over the iterations one pass of it
-    does (its index step). ValueError if no loop was vectorised."""
-    best, flops, step, current = (0.0, 0), 0, 0, None
+@dataclass(frozen=True)
+class Program:
+    """A kernel's counted program per angle, by kind (a vector operation counts its lanes):
+    additions and subtractions, multiplications, divisions, square roots, fused multiply-adds,
+    additions, subtractions and multiplications with a literal zero operand and additions and
+    subtractions of a product by one (numba's promotion of a real operand to complex: kept out of
+    `add` and `mul`), others (frem, libm calls); the widest
+    vector (lanes) of the loop."""
+    add: float = 0.0
+    mul: float = 0.0
+    div: float = 0.0
+    sqrt: float = 0.0
+    fma: float = 0.0
+    by_zero: float = 0.0
+    other: float = 0.0
+    width: int = 1
+
+    @property
+    def flops(self) -> float:
+        """Flops per angle: an FMA counts 2, every other operation 1."""
+        return self.add + self.mul + self.div + self.sqrt + 2 * self.fma + self.by_zero + self.other
+
+    def per(self, step: int) -> "Program":
+        """The counts over `step` angles (one pass of a vector loop) as counts per angle."""
+        return Program(*(getattr(self, k) / step for k in _KINDS), width=self.width)
+
+
+_KINDS = ("add", "mul", "div", "sqrt", "fma", "by_zero", "other")
+_VALUE = re.compile(r"%[\w.$-]+")
+
+
+def _count_line(line: str, counts: dict[str, float], zeros: set[str]) -> int:
+    """Add one IR line's floating-point operation to `counts` (lanes of it) by kind; its lanes
+    (0 where the line is no such operation). `zeros`: the values that are products by a literal
+    zero so far (a product by zero joins them; an addition of one counts as by zero)."""
+    if (m := _ARITH.search(line)) is not None:
+        lanes, (name, rest) = int(m.group(1) or 1), line.split("=", 1)
+        op = rest.split()[0]
+        by_zero = _BY_ZERO.search(line) is not None or (
+            op in ("fadd", "fsub") and any(v in zeros for v in _VALUE.findall(rest)))
+        if by_zero and op == "fmul":
+            zeros.add(name.strip())
+        kind = ("by_zero" if by_zero else "add" if op in ("fadd", "fsub") else "mul" if op == "fmul"
+                else "div" if op == "fdiv" else "other")
+    elif (m := _CALL.search(line)) is not None:
+        lanes, fn = int(m.group(1) or 1), m.group(2)
+        kind = "fma" if fn in ("fma", "fmuladd") else "sqrt" if fn == "sqrt" else "other"
+    else:
+        return 0
+    counts[kind] += lanes
+    return lanes
+
+
+def count_program(ir: str) -> Program:
+    """The counted program per iteration of the scalar loop that LLVM vectorised into the
+    `vector.body` block of the IR `ir` with the most flops (a kernel's loop over the angles): the
+    block's operations by kind (`Program`) over the iterations one pass of it does (its index
+    step). ValueError if no loop was vectorised."""
+    best: tuple[float, Program] = (0.0, Program())
+    counts, width, step, current, zeros = dict.fromkeys(_KINDS, 0.0), 1, 0, None, set()
     for line in ir.splitlines() + ["end:"]:
         if (m := _LABEL.match(line)) is not None:
             if current is not None and step:
-                best = max(best, (flops / step, flops), key=lambda fs: fs[1])
+                block = Program(**counts, width=width)
+                best = max(best, (block.flops, block.per(step)), key=lambda fp: fp[0])
             current = m.group(1) if _VECTOR_BODY.match(line) and not m.group(1).startswith("vec.epilog") else None
-            flops, step = 0, 0
+            counts, width, step = dict.fromkeys(_KINDS, 0.0), 1, 0
             continue
         if current is None:
             continue
         if (m := _STEP.search(line)) is not None:
             step = int(m.group(1))
-        if (m := _ARITH.search(line)) is not None:
-            flops += int(m.group(1) or 1)
-        elif (m := _CALL.search(line)) is not None:
-            flops += int(m.group(1) or 1) * (2 if m.group(2) in ("fma", "fmuladd") else 1)
-    if not best[1]:
+        width = max(width, _count_line(line, counts, zeros))
+    if not best[0]:
         raise ValueError("no vectorised loop (vector.body) in this IR")
-    return best[0]
+    return best[1]
+
+
+def count_flops_loop(ir: str) -> float:
+    """Floating-point operations per iteration of the scalar loop that LLVM vectorised into the
+    largest `vector.body` block of the IR `ir` (a kernel's loop over the angles): the flops of
+    `count_program`. ValueError if no loop was vectorised."""
+    return count_program(ir).flops
 
 
 def cpu_info() -> dict[str, str]:
@@ -468,6 +537,92 @@ def machine_limit(flops_per_angle: float, bytes_per_angle: float, cores: int = 1
     bytes / write bandwidth), the bandwidth shared by the cores."""
     rates = rates if rates is not None else machine_rates()
     return max(flops_per_angle / (rates.flops_per_second * cores), bytes_per_angle / rates.bytes_per_second)
+
+
+# ----------------------------------------------------------------------------- a kernel's bound
+
+def _divide(x: np.ndarray, rounds: int) -> None:
+    """`rounds` passes of x[i] = 1 / x[i]: one division per element, independent across elements."""
+    for _ in range(rounds):
+        for i in range(x.size):
+            x[i] = 1.0 / x[i]
+
+
+def _root(x: np.ndarray, rounds: int) -> None:
+    """`rounds` passes of x[i] = sqrt(x[i]): one square root per element."""
+    for _ in range(rounds):
+        for i in range(x.size):
+            x[i] = math.sqrt(x[i])
+
+
+def _multiply_add(x: np.ndarray, rounds: int) -> None:
+    """`rounds` passes over the columns of x (8, n): 8 independent chains a column, each 8 steps
+    of v * b + c (fused to FMAs where compiled with contraction)."""
+    b, c = 0.999999999, 1e-9
+    for _ in range(rounds):
+        for i in range(x.shape[1]):
+            p, q, r, s, t, u, v, w = x[0, i], x[1, i], x[2, i], x[3, i], x[4, i], x[5, i], x[6, i], x[7, i]
+            for _k in range(8):
+                p, q, r, s = p * b + c, q * b + c, r * b + c, s * b + c
+                t, u, v, w = t * b + c, u * b + c, v * b + c, w * b + c
+            x[0, i], x[1, i], x[2, i], x[3, i], x[4, i], x[5, i], x[6, i], x[7, i] = p, q, r, s, t, u, v, w
+
+
+@dataclass(frozen=True)
+class UnitRates:
+    """One core's vectorised double-precision throughput, operations (lanes) per second of this
+    thread's CPU time: divisions, square roots, fused multiply-adds, and multiplications and
+    additions unfused (as the kernels, compiled without fast-math, run them); how measured."""
+    div: float
+    sqrt: float
+    fma: float
+    add_mul: float
+    note: str
+
+
+@functools.cache
+def unit_rates(repeat: int = 3, size: int = 2048, rounds: int = 20_000) -> UnitRates:
+    """Measure the units once per process: numba loops over arrays of `size` doubles (in the L1
+    cache), `rounds` passes, each timed in this thread's CPU time, best of `repeat`."""
+    import numba
+    runs = {"div": (numba.njit(error_model="numpy")(_divide), (size,), 1),
+            "sqrt": (numba.njit(error_model="numpy")(_root), (size,), 1),
+            "fma": (numba.njit(error_model="numpy", fastmath={"contract"})(_multiply_add), (8, size // 8), 8),
+            "add_mul": (numba.njit(error_model="numpy")(_multiply_add), (8, size // 8), 16)}
+    rates = {}
+    for unit, (fn, shape, per_element) in runs.items():
+        x = np.full(shape, 1.5)
+        fn(x, 1)                                            # compiled, x in the cache
+        rates[unit] = per_element * size * rounds / min(_timed(lambda: fn(x, rounds)) for _ in range(repeat))
+    return UnitRates(**rates, note=f"numba {numba.__version__} loops over {size} doubles (L1): x = 1/x, x = sqrt(x), "
+                                   f"8 independent chains of v * b + c fused (FMA) and unfused (a multiply and an add); "
+                                   f"{rounds:,} passes, thread CPU time, best of {repeat}")
+
+
+@dataclass(frozen=True)
+class Bound:
+    """A kernel's least time per angle on this core, s: its adds, multiplies and FMAs at the
+    measured port rates (`port`), its divisions and square roots at the divider's (`divider`,
+    one unit for both); the bound is the larger."""
+    port: float
+    divider: float
+
+    @property
+    def seconds(self) -> float:
+        return max(self.port, self.divider)
+
+    @property
+    def limit(self) -> str:
+        """Which limit binds: "divider" or "ports"."""
+        return "divider" if self.divider > self.port else "ports"
+
+
+def bound(program: Program, rates: UnitRates) -> Bound:
+    """The bound of a counted program (per angle) at the units' rates: port time = (adds +
+    multiplies + operations by zero + others) / the unfused multiply-add rate + FMAs / the FMA
+    rate; divider time = divisions / the division rate + square roots / the square-root rate."""
+    port = (program.add + program.mul + program.by_zero + program.other) / rates.add_mul + program.fma / rates.fma
+    return Bound(port, program.div / rates.div + program.sqrt / rates.sqrt)
 
 
 def bytes_per_angle(arrays, n_angles: int) -> float:
