@@ -70,6 +70,7 @@ def phase_jvp(x, dx):
 
 PRIMITIVE_JVPS = (magnitude_jvp, over_jvp, ratio_jvp, cis_jvp, phase_jvp)
 _PRIMITIVES = tuple(f.__name__[:-4] for f in PRIMITIVE_JVPS)
+PASS = 3            # the most tangents one pass of a kernel carries (`_passes`)
 
 
 # ----------------------------------------------------------------------------- groups' source on tangents
@@ -259,14 +260,17 @@ def _rows(mech: "Mechanism", p: int) -> dict[str, int]:
     return rows
 
 
-def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> fast.Splice:
-    """The tangents spliced into `fast`'s `kind` kernel: tangent q of a value only where a seed of
+def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range) -> fast.Splice:
+    """The tangents qs (of p) spliced into `fast`'s `kind` kernel, the kernel's tangent q being
+    tangent qs[q]: tangent q of a value only where a seed of
     `live[q]` (constants, "w_in", "e_in", "X": the loads besides gravity) reaches it, else known
     zero and not computed, nor written (the buffer's rows stay zero). The constants' tangents are
     read from columns K (1 + q) + j of C, those of the crank's speeds from K (1 + p) + q and
-    K (1 + p) + p + q; the loads' tangents from rows 3 (L - 1) (1 + q) + ... of X."""
+    K (1 + p) + p + q (p here: len(qs), the pass' table, `_columns`); the loads' tangents from
+    rows 3 (L - 1) (1 + q) + ... of X; the tangents written at rows `_rows(mech, p)`."""
     lay = fast._layout(mech)
     K, L = len(lay.consts), lay.L
+    rows, p = _rows(mech, p), len(qs)
     on: list[set[str]] = [set() for _ in live]          # the kernel's identifiers with a tangent q
 
     def pro(v) -> list[str]:
@@ -316,13 +320,11 @@ def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ..
             body += jvp("wrench", [v(f"F{k}"), v(f"M{k}")], [f"Fa{k}", f"Ma{k}", f"Fi{k}", f"Mi{k}", f"r{k}"], q)
         return pre, body
 
-    rows = _rows(mech, p)
-
     def stores(v) -> list[tuple[str, bool, int]]:
-        return [(f"{v(n)}_d{q}", _is_complex(n), rows[n] + (2 if _is_complex(n) else 1) * q)
+        return [(f"{v(n)}_d{q}", _is_complex(n), rows[n] + (2 if _is_complex(n) else 1) * qs[q])
                 for n in _outs(mech, kind) for q in range(p) if v(n) in on[q]]
 
-    return fast.Splice(pro, steps, link, stores, _scratch(mech, p))
+    return fast.Splice(pro, steps, link, stores, _scratch(mech, len(qs)))
 
 
 def _scratch(mech: "Mechanism", p: int) -> int:
@@ -330,13 +332,19 @@ def _scratch(mech: "Mechanism", p: int) -> int:
     return 3 * (mech.n_links - 1) * p + 2 * (_rows(mech, p)[""] - fast._layout(mech).n_rows)
 
 
-def _source(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> str:
-    """The `kind` kernel ("motion" or "full") with p tangents: `fast`'s kernel of the analysis
-    (`fast._source`), `_splice`'s tangents spliced in, and the `_jvp` functions it calls."""
+def _passes(p: int) -> list[range]:
+    """The tangents each pass of a kernel carries: PASS at most (LLVM vectorised the chain unit's
+    kernels with 1 to 3 tangents, not the one with 5: no packed instruction in its object code)."""
+    return [range(q, min(p, q + PASS)) for q in range(0, p, PASS)]
+
+
+def _source(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range) -> str:
+    """The `kind` kernel ("motion" or "full") with the tangents qs of p: `fast`'s kernel of the
+    analysis (`fast._source`), `_splice`'s tangents spliced in, and the `_jvp` functions it calls."""
     jvps = jvp_source() + "\n" + "\n\n".join(inspect.getsource(f) for f in PRIMITIVE_JVPS)
     return "\n".join([jvps, "for _name in [n for n in list(globals()) if n.endswith('_jvp')]:",
                       "    globals()[_name] = numba.njit(inline='always', error_model='numpy')(globals()[_name])", "",
-                      fast._source(mech, fast._layout(mech), kind, _splice(mech, p, kind, live))])
+                      fast._source(mech, fast._layout(mech), kind, _splice(mech, p, kind, live, qs))])
 
 
 def _tangent(x: Any, p: int) -> np.ndarray:
@@ -360,9 +368,17 @@ def _table(mech: "Mechanism", c: Mapping[str, Any], p: int) -> tuple[np.ndarray,
     return C, live
 
 
-def _kernel(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]):
-    """The compiled `kind` kernel with p tangents reaching from `live` (loaded or compiled)."""
-    src = mech.memo(("sensitivity kernel source", p, kind, live), lambda: _source(mech, p, kind, live))
+def _columns(C: np.ndarray, K: int, p: int, qs: range) -> np.ndarray:
+    """The constants table (`_table`'s, of K constants and p tangents) of the pass carrying the
+    tangents qs: the constants, then those tangents' columns in the same order."""
+    cols = [*range(K), *(K * (1 + q) + j for q in qs for j in range(K)), *(K * (1 + p) + q for q in qs),
+            *(K * (1 + p) + p + q for q in qs)]
+    return np.ascontiguousarray(C[:, cols])
+
+
+def _kernel(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range):
+    """The compiled `kind` kernel with the tangents qs of p reaching from `live` (loaded or compiled)."""
+    src = mech.memo(("sensitivity kernel source", p, kind, live, qs), lambda: _source(mech, p, kind, live, qs))
     with fast._LOCK:
         if src not in fast._KERNELS:
             fast._KERNELS[src] = kernel_cache.load(fast._module(src)).kernel
@@ -371,8 +387,8 @@ def _kernel(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ..
         return fast._KERNELS[src]
 
 
-def _held(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> bool:
-    src = mech.memo(("sensitivity kernel source", p, kind, live), lambda: _source(mech, p, kind, live))
+def _held(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range) -> bool:
+    src = mech.memo(("sensitivity kernel source", p, kind, live, qs), lambda: _source(mech, p, kind, live, qs))
     with fast._LOCK:
         return src in fast._KERNELS
 
@@ -388,7 +404,8 @@ def pays(mech: "Mechanism", n: int, c: Mapping[str, Any], p: int) -> bool:
     its kernels, FAST_COLD where it would load or compile one) and `refusal` is None."""
     if n < fast.FAST_MIN or not fast.available() or refusal(mech) is not None:
         return False
-    held = _held(mech, p, _kinds(mech)[0], tuple(frozenset(x) for x in _table(mech, c, p)[1]))
+    live = tuple(frozenset(x) for x in _table(mech, c, p)[1])
+    held = all(_held(mech, p, _kinds(mech)[0], live[qs.start:qs.stop], qs) for qs in _passes(p))
     return n >= (fast.FAST_MIN if held else fast.FAST_COLD)
 
 
@@ -433,13 +450,19 @@ def run(mech: "Mechanism", c: Mapping[str, Any], phi_deg: np.ndarray, p: int,
     r["rot"][:, 0] = 1.0              # the frame's e^{i theta}
     C, seeds = _table(mech, c, p)
     live = tuple(frozenset(x) for x in seeds)
-    other = lambda kind, live: (_kernel(mech, p, kind, live), C, _scratch(mech, p))
     FL = np.zeros((1, N), bool)
+
+    def passes(kind: str, live: tuple[frozenset[str], ...], X: Callable[[range], np.ndarray] | None = None) -> None:
+        for qs in _passes(p):         # each writes the analysis (the same values) and its tangents
+            other = (_kernel(mech, p, kind, live[qs.start:qs.stop], qs), _columns(C, len(fast._layout(mech).consts), p, qs),
+                     _scratch(mech, len(qs)))
+            fast._run([mech], phi, kind, None if X is None else X(qs), S=S, FL=FL, threads=threads, other=other)
+
     X = None
     if fast._has_loads(mech):
-        fast._run([mech], phi, "motion", S=S, FL=FL, threads=threads, other=other("motion", live))
+        passes("motion", live)
         x, dx = loads({n: _pair(r, S, rows, n, N, p) for n in _outs(mech, "motion")})
-        X = np.ascontiguousarray(np.concatenate([x, dx.reshape(-1, N)]), float)
+        X = lambda qs: np.ascontiguousarray(np.concatenate([x, dx[qs.start:qs.stop].reshape(-1, N)]), float)
         live = tuple(ls | {"X"} if np.any(dx[q]) else ls for q, ls in enumerate(live))
-    fast._run([mech], phi, "full", X, S=S, FL=FL, threads=threads, other=other("full", live))
+    passes("full", live, X)
     return fast._result(mech, phi_deg, r, FL[0]), {n: _pair(r, S, rows, n, N, p) for n in _outs(mech, "full")}
