@@ -298,6 +298,29 @@ def test_compiled_and_numpy_paths_agree(path, params):
             assert np.nanmax(np.abs(x - y)) <= 1e-12 * np.nanmax(np.abs(x)), (name, p)
 
 
+@pytest.mark.slow   # compiles two kernels afresh (minutes on a busy 2-core machine)
+def test_five_parameters_run_in_two_vectorised_passes(tmp_path, monkeypatch):
+    """The chain unit's sensitivities to 5 parameters (the benchmark's) run in two passes of 3 and
+    2 tangents (`fast_sensitivity.PASS`) whose kernels LLVM vectorised (packed double arithmetic
+    in their assembly: one kernel of all 5 tangents had none), and agree with the numpy path."""
+    from kinetostat import fast, fast_sensitivity
+    monkeypatch.setenv(fast.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(fast, "_KERNELS", {})     # compiled here: a cached kernel keeps no assembly
+    mech = kinetostat.load(CHAIN)
+    params = CHAIN_ALL[:5]
+    a = kinetostat.sensitivity(mech, params, steps=360, path="numpy")
+    b = kinetostat.sensitivity(mech, params, steps=360, path="compiled")
+    kernels = fast_sensitivity.kernels(mech, 5)
+    assert len(kernels) == 2
+    for fn in kernels:
+        counts = fast.vector_report(fn)
+        assert counts["packed_ymm"] + counts["packed_zmm"] > 300, counts
+    for name, _, acc in outputs(mech, mech.point_names[-1]):
+        for p in params:
+            x, y = acc(a)[p], acc(b)[p]
+            assert np.nanmax(np.abs(x - y)) <= 1e-12 * np.nanmax(np.abs(x)), (name, p)
+
+
 def _python_kernel(mech, p, kind, live, qs):
     """`fast_sensitivity`'s kernel run as Python (numba's njit the identity): its generated
     source checked at a few angles without a compile, and not kept among the compiled kernels."""
