@@ -10,8 +10,10 @@ analysis (its blocked loop, scratch rows and buffer layout) with the tangents sp
 step's arguments (the calls recompute the values, which LLVM merges: the functions are inlined
 and pure); a tangent no parameter reaches is known zero, neither computed nor written. One pass
 writes the analysis (`fast`'s rows) and the tangents (rows after them) into one buffer
-(`run`). The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
-`_design`); which of them are not zero picks the kernel (one per kind, p and reach).
+(`run`); more than PASS tangents go in several passes, each writing the analysis again and its
+own tangents' rows (LLVM vectorised no kernel of 5 tangents: "too many memory checks needed").
+The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
+`_design`); which of them are not zero picks the kernel (one per kind, pass and reach).
 
 Loads besides gravity and inertia (tables, diagrams, springs, characteristics) are evaluated
 between two passes, as `fast` does: the "motion" kernel writes the kinematics and their
@@ -35,7 +37,7 @@ from . import fast, groups, kernel_cache
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["jvp_source", "kernels", "pays", "refusal", "run", "PRIMITIVE_JVPS"]
+__all__ = ["jvp_source", "kernels", "pays", "refusal", "run", "PASS", "PRIMITIVE_JVPS"]
 
 
 # ----------------------------------------------------------------------------- the primitives' rules
@@ -430,8 +432,9 @@ def run(mech: "Mechanism", c: Mapping[str, Any], phi_deg: np.ndarray, p: int,
         loads: Callable[[dict[str, tuple[np.ndarray, np.ndarray]]], tuple[np.ndarray, np.ndarray]] | None = None,
         threads: int | None = None):
     """The analysis of `mech` at `phi_deg` (deg) and the tangents of the outputs `Sensitivity`
-    keeps (`_outs`), in one pass of one kernel (two where `mech` has loads besides gravity), each
-    output as (value (N,), tangents (N, p)) views of one buffer: the Analysis `fast.analyze_fast`
+    keeps (`_outs`), in one pass of one kernel per PASS tangents (`_passes`; two kernels where
+    `mech` has loads besides gravity), each output as (value (N,), tangents (N, p)) views of one
+    buffer: the Analysis `fast.analyze_fast`
     gives (its guard's angles solved by the numpy path) and a dict of those pairs. `c`: the
     design's constants (numbers, or duals with `val` and `der` (p,): `sensitivity._design`'s).
     `loads(motion)`: where `mech` has loads besides gravity, those loads (3 (L - 1), N) (F_x, F_y,
@@ -454,7 +457,7 @@ def run(mech: "Mechanism", c: Mapping[str, Any], phi_deg: np.ndarray, p: int,
 
     def passes(kind: str, live: tuple[frozenset[str], ...], X: Callable[[range], np.ndarray] | None = None) -> None:
         for qs in _passes(p):         # each writes the analysis (the same values) and its tangents
-            other = (_kernel(mech, p, kind, live[qs.start:qs.stop], qs), _columns(C, len(fast._layout(mech).consts), p, qs),
+            other = (_kernel(mech, p, kind, live[qs.start:qs.stop], qs), _columns(C, len(lay.consts), p, qs),
                      _scratch(mech, len(qs)))
             fast._run([mech], phi, kind, None if X is None else X(qs), S=S, FL=FL, threads=threads, other=other)
 
