@@ -11,7 +11,7 @@ step's arguments (the calls recompute the values, which LLVM merges: the functio
 and pure); a tangent no parameter reaches is known zero, neither computed nor written. One pass
 writes the analysis (`fast`'s rows) and the tangents (rows after them) into one buffer
 (`run`); more than PASS tangents go in several passes, each writing the analysis again and its
-own tangents' rows (LLVM vectorised no kernel of 5 tangents: "too many memory checks needed").
+own tangents' rows (LLVM vectorised the kernels of 1 to 3 tangents, not the one of 5).
 The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
 `_design`); which of them are not zero picks the kernel (one per kind, pass and reach).
 
