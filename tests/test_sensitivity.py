@@ -342,14 +342,15 @@ def _python_kernel(mech, p, kind, live, qs):
 
 
 @pytest.mark.parametrize("path, params, passes", [(CHAIN, ["r", "l", "m2"], 3), (ICE, ["l_OA", "p_max", "G2"], 3),
-                                                  (CHAIN, ["r", "l", "m2"], 2), (ICE, ["l_OA", "p_max", "G2"], 2)],
+                                                  (CHAIN, ["r", "l", "m2"], 2), (ICE, ["G2", "l_OA", "p_max"], 2)],
                          ids=["chain_unit_four_bar", "ice_crank_slider", "chain_unit_two_passes", "ice_two_passes"])
 def test_one_pass_kernel_source_gives_the_numpy_derivatives(path, params, passes, monkeypatch):
     """The compiled path's kernel source (the analysis and the tangents in one pass, each tangent
     only where its parameter reaches: m2 reaches the statics only, p_max the gas load only), run
     as Python at 6 angles, gives the numpy path's nominal analysis and derivatives to 1e-12: a
     step whose value overwrites an argument (carry) has its tangents from the argument's old value.
-    With PASS 2 the three tangents go in two passes (2 + 1), each writing its own rows."""
+    With PASS 2 the three tangents go in two passes (2 + 1), each writing its own rows (the ICE's
+    second, p_max, reading its loads' tangents)."""
     from kinetostat import fast_sensitivity
     monkeypatch.setattr(fast_sensitivity, "_kernel", _python_kernel)
     monkeypatch.setattr(fast_sensitivity, "PASS", passes)
