@@ -11,7 +11,7 @@ step's arguments (the calls recompute the values, which LLVM merges: the functio
 and pure); a tangent no parameter reaches is known zero, neither computed nor written. One pass
 writes the analysis (`fast`'s rows) and the tangents (rows after them) into one buffer
 (`run`); more than PASS tangents go in several passes, each writing the analysis again and its
-own tangents' rows (LLVM vectorised the kernels of 1 to 3 tangents, not the one of 5).
+own tangents' rows (`_passes`).
 The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
 `_design`); which of them are not zero picks the kernel (one per kind, pass and reach).
 
@@ -335,8 +335,9 @@ def _scratch(mech: "Mechanism", p: int) -> int:
 
 
 def _passes(p: int) -> list[range]:
-    """The tangents each pass of a kernel carries: PASS at most (LLVM vectorised the chain unit's
-    kernels with 1 to 3 tangents, not the one with 5: no packed instruction in its object code)."""
+    """The tangents each pass of a kernel carries: PASS at most (LLVM left the chain unit's kernel
+    of 5 tangents unvectorised, 0 packed instructions; of its two passes, that of h and l is
+    vectorised, that of r, n_k and c is not)."""
     return [range(q, min(p, q + PASS)) for q in range(0, p, PASS)]
 
 
