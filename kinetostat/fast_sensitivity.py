@@ -10,8 +10,10 @@ analysis (its blocked loop, scratch rows and buffer layout) with the tangents sp
 step's arguments (the calls recompute the values, which LLVM merges: the functions are inlined
 and pure); a tangent no parameter reaches is known zero, neither computed nor written. One pass
 writes the analysis (`fast`'s rows) and the tangents (rows after them) into one buffer
-(`run`). The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
-`_design`); which of them are not zero picks the kernel (one per kind, p and reach).
+(`run`); more than PASS tangents go in several passes, each writing the analysis again and its
+own tangents' rows (`_passes`).
+The constants' tangents are those `sensitivity` computes on duals (`sensitivity._seeded`,
+`_design`); which of them are not zero picks the kernel (one per kind, pass and reach).
 
 Loads besides gravity and inertia (tables, diagrams, springs, characteristics) are evaluated
 between two passes, as `fast` does: the "motion" kernel writes the kinematics and their
@@ -35,7 +37,7 @@ from . import fast, groups, kernel_cache
 if TYPE_CHECKING:
     from .model import Mechanism
 
-__all__ = ["jvp_source", "kernels", "pays", "refusal", "run", "PRIMITIVE_JVPS"]
+__all__ = ["jvp_source", "kernels", "pays", "refusal", "run", "PASS", "PRIMITIVE_JVPS"]
 
 
 # ----------------------------------------------------------------------------- the primitives' rules
@@ -70,6 +72,7 @@ def phase_jvp(x, dx):
 
 PRIMITIVE_JVPS = (magnitude_jvp, over_jvp, ratio_jvp, cis_jvp, phase_jvp)
 _PRIMITIVES = tuple(f.__name__[:-4] for f in PRIMITIVE_JVPS)
+PASS = 3            # the most tangents one pass of a kernel carries (`_passes`)
 
 
 # ----------------------------------------------------------------------------- groups' source on tangents
@@ -259,14 +262,17 @@ def _rows(mech: "Mechanism", p: int) -> dict[str, int]:
     return rows
 
 
-def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> fast.Splice:
-    """The tangents spliced into `fast`'s `kind` kernel: tangent q of a value only where a seed of
+def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range) -> fast.Splice:
+    """The tangents qs (of p) spliced into `fast`'s `kind` kernel, the kernel's tangent q being
+    tangent qs[q]: tangent q of a value only where a seed of
     `live[q]` (constants, "w_in", "e_in", "X": the loads besides gravity) reaches it, else known
     zero and not computed, nor written (the buffer's rows stay zero). The constants' tangents are
     read from columns K (1 + q) + j of C, those of the crank's speeds from K (1 + p) + q and
-    K (1 + p) + p + q; the loads' tangents from rows 3 (L - 1) (1 + q) + ... of X."""
+    K (1 + p) + p + q (p here: len(qs), the pass' table, `_columns`); the loads' tangents from
+    rows 3 (L - 1) (1 + q) + ... of X; the tangents written at rows `_rows(mech, p)`."""
     lay = fast._layout(mech)
     K, L = len(lay.consts), lay.L
+    rows, p = _rows(mech, p), len(qs)
     on: list[set[str]] = [set() for _ in live]          # the kernel's identifiers with a tangent q
 
     def pro(v) -> list[str]:
@@ -316,13 +322,11 @@ def _splice(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ..
             body += jvp("wrench", [v(f"F{k}"), v(f"M{k}")], [f"Fa{k}", f"Ma{k}", f"Fi{k}", f"Mi{k}", f"r{k}"], q)
         return pre, body
 
-    rows = _rows(mech, p)
-
     def stores(v) -> list[tuple[str, bool, int]]:
-        return [(f"{v(n)}_d{q}", _is_complex(n), rows[n] + (2 if _is_complex(n) else 1) * q)
+        return [(f"{v(n)}_d{q}", _is_complex(n), rows[n] + (2 if _is_complex(n) else 1) * qs[q])
                 for n in _outs(mech, kind) for q in range(p) if v(n) in on[q]]
 
-    return fast.Splice(pro, steps, link, stores, _scratch(mech, p))
+    return fast.Splice(pro, steps, link, stores, _scratch(mech, len(qs)))
 
 
 def _scratch(mech: "Mechanism", p: int) -> int:
@@ -330,13 +334,20 @@ def _scratch(mech: "Mechanism", p: int) -> int:
     return 3 * (mech.n_links - 1) * p + 2 * (_rows(mech, p)[""] - fast._layout(mech).n_rows)
 
 
-def _source(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> str:
-    """The `kind` kernel ("motion" or "full") with p tangents: `fast`'s kernel of the analysis
-    (`fast._source`), `_splice`'s tangents spliced in, and the `_jvp` functions it calls."""
+def _passes(p: int) -> list[range]:
+    """The tangents each pass of a kernel carries: PASS at most (LLVM left the chain unit's kernel
+    of 5 tangents unvectorised, 0 packed instructions; of its two passes, that of h and l is
+    vectorised, that of r, n_k and c is not)."""
+    return [range(q, min(p, q + PASS)) for q in range(0, p, PASS)]
+
+
+def _source(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range) -> str:
+    """The `kind` kernel ("motion" or "full") with the tangents qs of p: `fast`'s kernel of the
+    analysis (`fast._source`), `_splice`'s tangents spliced in, and the `_jvp` functions it calls."""
     jvps = jvp_source() + "\n" + "\n\n".join(inspect.getsource(f) for f in PRIMITIVE_JVPS)
     return "\n".join([jvps, "for _name in [n for n in list(globals()) if n.endswith('_jvp')]:",
                       "    globals()[_name] = numba.njit(inline='always', error_model='numpy')(globals()[_name])", "",
-                      fast._source(mech, fast._layout(mech), kind, _splice(mech, p, kind, live))])
+                      fast._source(mech, fast._layout(mech), kind, _splice(mech, p, kind, live, qs))])
 
 
 def _tangent(x: Any, p: int) -> np.ndarray:
@@ -360,9 +371,17 @@ def _table(mech: "Mechanism", c: Mapping[str, Any], p: int) -> tuple[np.ndarray,
     return C, live
 
 
-def _kernel(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]):
-    """The compiled `kind` kernel with p tangents reaching from `live` (loaded or compiled)."""
-    src = mech.memo(("sensitivity kernel source", p, kind, live), lambda: _source(mech, p, kind, live))
+def _columns(C: np.ndarray, K: int, p: int, qs: range) -> np.ndarray:
+    """The constants table (`_table`'s, of K constants and p tangents) of the pass carrying the
+    tangents qs: the constants, then those tangents' columns in the same order."""
+    cols = [*range(K), *(K * (1 + q) + j for q in qs for j in range(K)), *(K * (1 + p) + q for q in qs),
+            *(K * (1 + p) + p + q for q in qs)]
+    return np.ascontiguousarray(C[:, cols])
+
+
+def _kernel(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range):
+    """The compiled `kind` kernel with the tangents qs of p reaching from `live` (loaded or compiled)."""
+    src = mech.memo(("sensitivity kernel source", p, kind, live, qs), lambda: _source(mech, p, kind, live, qs))
     with fast._LOCK:
         if src not in fast._KERNELS:
             fast._KERNELS[src] = kernel_cache.load(fast._module(src)).kernel
@@ -371,8 +390,8 @@ def _kernel(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ..
         return fast._KERNELS[src]
 
 
-def _held(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...]) -> bool:
-    src = mech.memo(("sensitivity kernel source", p, kind, live), lambda: _source(mech, p, kind, live))
+def _held(mech: "Mechanism", p: int, kind: str, live: tuple[frozenset[str], ...], qs: range) -> bool:
+    src = mech.memo(("sensitivity kernel source", p, kind, live, qs), lambda: _source(mech, p, kind, live, qs))
     with fast._LOCK:
         return src in fast._KERNELS
 
@@ -388,7 +407,8 @@ def pays(mech: "Mechanism", n: int, c: Mapping[str, Any], p: int) -> bool:
     its kernels, FAST_COLD where it would load or compile one) and `refusal` is None."""
     if n < fast.FAST_MIN or not fast.available() or refusal(mech) is not None:
         return False
-    held = _held(mech, p, _kinds(mech)[0], tuple(frozenset(x) for x in _table(mech, c, p)[1]))
+    live = tuple(frozenset(x) for x in _table(mech, c, p)[1])
+    held = all(_held(mech, p, _kinds(mech)[0], live[qs.start:qs.stop], qs) for qs in _passes(p))
     return n >= (fast.FAST_MIN if held else fast.FAST_COLD)
 
 
@@ -413,8 +433,9 @@ def run(mech: "Mechanism", c: Mapping[str, Any], phi_deg: np.ndarray, p: int,
         loads: Callable[[dict[str, tuple[np.ndarray, np.ndarray]]], tuple[np.ndarray, np.ndarray]] | None = None,
         threads: int | None = None):
     """The analysis of `mech` at `phi_deg` (deg) and the tangents of the outputs `Sensitivity`
-    keeps (`_outs`), in one pass of one kernel (two where `mech` has loads besides gravity), each
-    output as (value (N,), tangents (N, p)) views of one buffer: the Analysis `fast.analyze_fast`
+    keeps (`_outs`), in one pass of one kernel per PASS tangents (`_passes`; two kernels where
+    `mech` has loads besides gravity), each output as (value (N,), tangents (N, p)) views of one
+    buffer: the Analysis `fast.analyze_fast`
     gives (its guard's angles solved by the numpy path) and a dict of those pairs. `c`: the
     design's constants (numbers, or duals with `val` and `der` (p,): `sensitivity._design`'s).
     `loads(motion)`: where `mech` has loads besides gravity, those loads (3 (L - 1), N) (F_x, F_y,
@@ -433,13 +454,19 @@ def run(mech: "Mechanism", c: Mapping[str, Any], phi_deg: np.ndarray, p: int,
     r["rot"][:, 0] = 1.0              # the frame's e^{i theta}
     C, seeds = _table(mech, c, p)
     live = tuple(frozenset(x) for x in seeds)
-    other = lambda kind, live: (_kernel(mech, p, kind, live), C, _scratch(mech, p))
     FL = np.zeros((1, N), bool)
+
+    def passes(kind: str, live: tuple[frozenset[str], ...], X: Callable[[range], np.ndarray] | None = None) -> None:
+        for qs in _passes(p):         # each writes the analysis (the same values) and its tangents
+            other = (_kernel(mech, p, kind, live[qs.start:qs.stop], qs), _columns(C, len(lay.consts), p, qs),
+                     _scratch(mech, len(qs)))
+            fast._run([mech], phi, kind, None if X is None else X(qs), S=S, FL=FL, threads=threads, other=other)
+
     X = None
     if fast._has_loads(mech):
-        fast._run([mech], phi, "motion", S=S, FL=FL, threads=threads, other=other("motion", live))
+        passes("motion", live)
         x, dx = loads({n: _pair(r, S, rows, n, N, p) for n in _outs(mech, "motion")})
-        X = np.ascontiguousarray(np.concatenate([x, dx.reshape(-1, N)]), float)
+        X = lambda qs: np.ascontiguousarray(np.concatenate([x, dx[qs.start:qs.stop].reshape(-1, N)]), float)
         live = tuple(ls | {"X"} if np.any(dx[q]) else ls for q, ls in enumerate(live))
-    fast._run([mech], phi, "full", X, S=S, FL=FL, threads=threads, other=other("full", live))
+    passes("full", live, X)
     return fast._result(mech, phi_deg, r, FL[0]), {n: _pair(r, S, rows, n, N, p) for n in _outs(mech, "full")}

@@ -298,7 +298,23 @@ def test_compiled_and_numpy_paths_agree(path, params):
             assert np.nanmax(np.abs(x - y)) <= 1e-12 * np.nanmax(np.abs(x)), (name, p)
 
 
-def _python_kernel(mech, p, kind, live):
+@pytest.mark.slow   # compiles two kernels (minutes on a busy 2-core machine, once per machine)
+def test_five_parameters_run_in_two_passes_and_agree():
+    """The chain unit's sensitivities to 5 parameters (the benchmark's) run in two compiled passes
+    of 3 and 2 tangents (`fast_sensitivity.PASS`) and agree with the numpy path to 1e-12."""
+    from kinetostat import fast_sensitivity
+    mech = kinetostat.load(CHAIN)
+    params = CHAIN_ALL[:5]
+    a = kinetostat.sensitivity(mech, params, steps=360, path="numpy")
+    b = kinetostat.sensitivity(mech, params, steps=360, path="compiled")
+    assert len(fast_sensitivity.kernels(mech, 5)) == 2
+    for name, _, acc in outputs(mech, mech.point_names[-1]):
+        for p in params:
+            x, y = acc(a)[p], acc(b)[p]
+            assert np.nanmax(np.abs(x - y)) <= 1e-12 * np.nanmax(np.abs(x)), (name, p)
+
+
+def _python_kernel(mech, p, kind, live, qs):
     """`fast_sensitivity`'s kernel run as Python (numba's njit the identity): its generated
     source checked at a few angles without a compile, and not kept among the compiled kernels."""
     import sys
@@ -312,21 +328,25 @@ def _python_kernel(mech, p, kind, live):
     saved = numba                     # restored after (also where nothing had imported it yet)
     sys.modules["numba"] = fake
     try:
-        exec(compile(fast._module(fast_sensitivity._source(mech, p, kind, live)), "<kernel>", "exec"), scope)
+        exec(compile(fast._module(fast_sensitivity._source(mech, p, kind, live, qs)), "<kernel>", "exec"), scope)
     finally:
         sys.modules["numba"] = saved
     return scope["kernel"]
 
 
-@pytest.mark.parametrize("path, params", [(CHAIN, ["r", "l", "m2"]), (ICE, ["l_OA", "p_max", "G2"])],
-                         ids=["chain_unit_four_bar", "ice_crank_slider"])
-def test_one_pass_kernel_source_gives_the_numpy_derivatives(path, params, monkeypatch):
+@pytest.mark.parametrize("path, params, passes", [(CHAIN, ["r", "l", "m2"], 3), (ICE, ["l_OA", "p_max", "G2"], 3),
+                                                  (CHAIN, ["r", "l", "m2"], 2), (ICE, ["G2", "l_OA", "p_max"], 2)],
+                         ids=["chain_unit_four_bar", "ice_crank_slider", "chain_unit_two_passes", "ice_two_passes"])
+def test_one_pass_kernel_source_gives_the_numpy_derivatives(path, params, passes, monkeypatch):
     """The compiled path's kernel source (the analysis and the tangents in one pass, each tangent
     only where its parameter reaches: m2 reaches the statics only, p_max the gas load only), run
     as Python at 6 angles, gives the numpy path's nominal analysis and derivatives to 1e-12: a
-    step whose value overwrites an argument (carry) has its tangents from the argument's old value."""
+    step whose value overwrites an argument (carry) has its tangents from the argument's old value.
+    With PASS 2 the three tangents go in two passes (2 + 1), each writing its own rows (the ICE's
+    second, p_max, reading its loads' tangents)."""
     from kinetostat import fast_sensitivity
     monkeypatch.setattr(fast_sensitivity, "_kernel", _python_kernel)
+    monkeypatch.setattr(fast_sensitivity, "PASS", passes)
     mech = kinetostat.load(path)
     phi = np.array([5.0, 63.0, 131.0, 199.0, 262.0, 331.0])
     a = kinetostat.sensitivity(mech, params, phi_deg=phi, path="numpy")
