@@ -272,9 +272,11 @@ def test_engines_none_stands_alone(cli):
 
 def test_report_without_engines(tmp_path, cli, hidden, sketched_report):
     pytest.importorskip("matplotlib")
-    r = cli("report", ICE, "--engines", "none", "--steps", 12, "--out", tmp_path, "--no-progress", "--no-page")
+    r = cli("report", "ice_crank_slider", "--engines", "none", "--steps", 12, "--out", tmp_path, "--no-progress",
+            "--no-page")                                # a bundled model by its name
     assert r.returncode == 0, r.stdout + r.stderr
     md = (tmp_path / "ice_crank_slider" / "index.md").read_text()
+    assert "- **Model file**: ice_crank_slider.toml" in md   # the file's name, as a run from its path says
     assert not (tmp_path / "ice_crank_slider" / "page.html").exists() and "page.html" not in md     # --no-page
     assert "## Against the published values" in md and r"| M\_зр (lever) |" in md      # the text's lettering
     assert r"| reference | M\_зр |" in md and "| reference | mpmath |" not in md

@@ -35,6 +35,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
     `out/<folder>/` (`law`: --delta, --flywheel; with `page`, its page.html drawn; without, an
     earlier page.html removed). Returns {"summary", "warnings", "seconds", "page": "drawn" or
     None} or {"error"} (one line); raises only KeyboardInterrupt."""
+    from ..examples import resolve
     from ..report import run_validation, write_report
     t0 = time.perf_counter()
     try:
@@ -48,7 +49,7 @@ def _report_job(path: str, engines: list[str], steps: int, out: str, folder: str
                 t1 = time.perf_counter()
                 res = analyze(mech, steps=steps)
                 secs = time.perf_counter() - t1
-        run = run_validation(mech, engines, steps, res=res, path=path, level=logging.INFO)
+        run = run_validation(mech, engines, steps, res=res, path=resolve(path), level=logging.INFO)
         run.solver_seconds = secs
         earlier = Path(out) / folder / "page.html"
         with unit(out) as tmp:                # the model's files swapped in as a set at the end
