@@ -319,7 +319,7 @@ def count_flops_ir(ir: str) -> int:
     fmul, fdiv, frem count 1, fma and fmuladd 2, a call of sqrt or of a libm function (sin, cos,
     atan2, exp, ...) 1; a vector operation counts its lanes. ValueError if the body loops (its
     control-flow graph has a cycle): the count is then not per call."""
-    flops = 0
+    counts, zeros = dict.fromkeys(_KINDS, 0.0), set()
     blocks: dict[str, set[str]] = {}
     current = "entry"
     for line in ir.splitlines():
@@ -327,14 +327,11 @@ def count_flops_ir(ir: str) -> int:
             current = m.group(1)
         blocks.setdefault(current, set())
         blocks[current].update(_TARGET.findall(line))     # br, switch and its case lines
-        if (m := _ARITH.search(line)) is not None:
-            flops += int(m.group(1) or 1)
-        elif (m := _CALL.search(line)) is not None:
-            flops += int(m.group(1) or 1) * (2 if m.group(2) in ("fma", "fmuladd") else 1)
+        _count_line(line, counts, zeros)
     if _has_cycle(blocks):
         raise ValueError("the kernel loops: count_flops wants the per-angle body (a function of "
                          "scalars without loops), whose flops are then flops per angle")
-    return flops
+    return int(Program(**counts).flops)
 
 
 def _has_cycle(succ: dict[str, set[str]]) -> bool:

@@ -917,7 +917,7 @@ def _dimensions(cycle: PlanCycle, lang: str, contract: bool, at, placer: Placer,
 
 
 def _construction(kind: str, a: np.ndarray, b: np.ndarray, ok: np.ndarray, attrs: dict, title: str,
-                  placer: Placer, contract: bool = False) -> tuple[Element, tuple[np.ndarray, None]]:
+                  placer: Placer, contract: bool) -> tuple[Element, tuple[np.ndarray, None]]:
     """A construction line from its known point a through the point b it fixes (N, 2), drawn
     PAST_MM past both (`contract`: the page's, its element from a to b, the two pieces past them
     its markers: coordinates the page holds already), or an intersection's mark at a (a circle
